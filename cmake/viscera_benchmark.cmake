@@ -1,0 +1,2 @@
+# Google Benchmark -> benchmark::benchmark
+find_package(benchmark REQUIRED)

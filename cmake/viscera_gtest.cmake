@@ -1,0 +1,3 @@
+# GoogleTest -> GTest::gtest_main, GTest::gmock
+find_package(GTest REQUIRED)
+include(GoogleTest)

@@ -1,0 +1,2 @@
+# libzip -> libzip::zip
+find_package(libzip REQUIRED)

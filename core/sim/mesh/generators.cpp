@@ -1,0 +1,82 @@
+#include "sim/mesh/generators.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace viscera::sim {
+
+std::unique_ptr<TetMesh> makeBoxTetMesh(const BoxSpec& spec) {
+    const auto [nx, ny, nz] = spec.cells;
+    if (nx <= 0 || ny <= 0 || nz <= 0)
+        throw std::invalid_argument("sim::makeBoxTetMesh(): cell counts must be positive");
+    if (!(spec.size.array() > 0).all() || !spec.size.allFinite() || !spec.origin.allFinite())
+        throw std::invalid_argument("sim::makeBoxTetMesh(): size must be positive and finite");
+    auto id = [&](int i, int j, int k) { return static_cast<int32_t>((k * (ny + 1) + j) * (nx + 1) + i); };
+    std::vector<Vec3> pos;
+    pos.reserve(static_cast<size_t>((nx + 1) * (ny + 1) * (nz + 1)));
+    for (int k = 0; k <= nz; ++k)
+        for (int j = 0; j <= ny; ++j)
+            for (int i = 0; i <= nx; ++i)
+                pos.push_back(spec.origin + Vec3(spec.size.x() * i / nx, spec.size.y() * j / ny,
+                                                 spec.size.z() * k / nz));
+    // Kuhn subdivision: 6 tets per cube along monotone paths from corner (0,0,0) to (1,1,1).
+    static constexpr int kPerm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    std::vector<Tet> tets;
+    tets.reserve(static_cast<size_t>(6 * nx * ny * nz));
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i)
+                for (const auto& perm : kPerm) {
+                    int c[3] = {0, 0, 0};
+                    Tet t;
+                    t[0] = id(i, j, k);
+                    for (int s = 0; s < 3; ++s) {
+                        c[perm[s]] = 1;
+                        t[s + 1] = id(i + c[0], j + c[1], k + c[2]);
+                    }
+                    const Vec3 &a = pos[t[0]], &b = pos[t[1]], &cc = pos[t[2]], &d = pos[t[3]];
+                    if ((b - a).dot((cc - a).cross(d - a)) < 0) std::swap(t[2], t[3]);
+                    tets.push_back(t);
+                }
+    return TetMesh::fromArrays(std::move(pos), std::move(tets), "sim::makeBoxTetMesh()");
+}
+
+TriMesh makeEllipsoidSurface(const Vec3& center, const Vec3& radii, int slices, int stacks) {
+    if (slices < 3 || stacks < 2)
+        throw std::invalid_argument("sim::makeEllipsoidSurface(): needs slices >= 3 and stacks >= 2");
+    std::vector<Vec3> pos;
+    std::vector<Tri> tris;
+    pos.push_back(center + Vec3(0, 0, radii.z())); // north pole
+    for (int s = 1; s < stacks; ++s) {
+        const double th = std::numbers::pi * s / stacks;
+        for (int l = 0; l < slices; ++l) {
+            const double ph = 2.0 * std::numbers::pi * l / slices;
+            pos.push_back(center + Vec3(radii.x() * std::sin(th) * std::cos(ph),
+                                        radii.y() * std::sin(th) * std::sin(ph),
+                                        radii.z() * std::cos(th)));
+        }
+    }
+    pos.push_back(center - Vec3(0, 0, radii.z())); // south pole
+    const auto south = static_cast<int32_t>(pos.size() - 1);
+    auto ring = [&](int s, int l) { return static_cast<int32_t>(1 + (s - 1) * slices + (l % slices)); };
+    for (int l = 0; l < slices; ++l) tris.push_back({0, ring(1, l), ring(1, l + 1)});
+    for (int s = 1; s + 1 < stacks; ++s)
+        for (int l = 0; l < slices; ++l) {
+            tris.push_back({ring(s, l), ring(s + 1, l), ring(s + 1, l + 1)});
+            tris.push_back({ring(s, l), ring(s + 1, l + 1), ring(s, l + 1)});
+        }
+    for (int l = 0; l < slices; ++l) tris.push_back({south, ring(stacks - 1, l + 1), ring(stacks - 1, l)});
+    return TriMesh::fromArrays(std::move(pos), std::move(tris), "sim::makeEllipsoidSurface()");
+}
+
+TriMesh makeBoxSurface(const Vec3& lo, const Vec3& hi) {
+    std::vector<Vec3> pos;
+    for (int k = 0; k < 8; ++k)
+        pos.emplace_back(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z());
+    std::vector<Tri> tris = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                             {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+    return TriMesh::fromArrays(std::move(pos), std::move(tris), "sim::makeBoxSurface()");
+}
+
+} // namespace viscera::sim

@@ -1,0 +1,28 @@
+#pragma once
+/// Procedural meshes generated in code (sample projects and tests ship no binary assets).
+#include "sim/mesh/tet_mesh.hpp"
+#include "sim/mesh/tri_mesh.hpp"
+
+#include <array>
+#include <memory>
+
+namespace viscera::sim {
+
+struct BoxSpec {
+    Vec3 origin = Vec3::Zero();          ///< minimum corner, metres
+    Vec3 size = Vec3(0.1, 0.02, 0.04);   ///< edge lengths, metres
+    std::array<int, 3> cells = {10, 2, 4}; ///< hexahedral cells per axis (each split into 6 tets)
+};
+
+/// Structured tet block: every hex cell split into 6 positively oriented tets sharing its main
+/// diagonal (Kuhn subdivision; conforming across cells). Throws std::invalid_argument on
+/// non-positive sizes or cell counts.
+std::unique_ptr<TetMesh> makeBoxTetMesh(const BoxSpec& spec);
+
+/// Closed outward-oriented triangulated ellipsoid (UV sphere scaled by radii), for meshing tests.
+TriMesh makeEllipsoidSurface(const Vec3& center, const Vec3& radii, int slices, int stacks);
+
+/// Closed outward-oriented box surface (12 triangles).
+TriMesh makeBoxSurface(const Vec3& min, const Vec3& max);
+
+} // namespace viscera::sim

@@ -1,0 +1,148 @@
+#include "sim/mesh/tet_io.hpp"
+
+#include "sim/util/atomic_file.hpp"
+#include "sim/util/error.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace viscera::sim {
+namespace {
+
+/// Line-oriented tokenizer that skips blank lines and '#' comments and knows its line number.
+class LineReader {
+public:
+    LineReader(std::string_view text, const std::string& origin) : m_text(text), m_origin(origin) {}
+
+    /// Next significant line split into tokens; false at end of input.
+    bool next(std::vector<std::string_view>& tokens) {
+        while (m_pos < m_text.size()) {
+            size_t end = m_text.find('\n', m_pos);
+            if (end == std::string_view::npos) end = m_text.size();
+            std::string_view line = m_text.substr(m_pos, end - m_pos);
+            m_pos = end + 1;
+            ++m_line;
+            if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+            tokens.clear();
+            size_t i = 0;
+            while (i < line.size()) {
+                while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+                if (i >= line.size() || line[i] == '#') break;
+                size_t j = i;
+                while (j < line.size() && line[j] != ' ' && line[j] != '\t') ++j;
+                tokens.push_back(line.substr(i, j - i));
+                i = j;
+            }
+            if (!tokens.empty()) return true;
+        }
+        return false;
+    }
+
+    [[noreturn]] void fail(const std::string& rule) const {
+        throw InputError(m_origin + ": line " + std::to_string(m_line) + ": " + rule);
+    }
+    [[noreturn]] void failEof(const std::string& expected) const {
+        throw InputError(m_origin + ": unexpected end of file (expected " + expected + ")");
+    }
+
+    template <class T> T number(std::string_view tok, const char* what) const {
+        T value{};
+        auto res = std::from_chars(tok.data(), tok.data() + tok.size(), value);
+        if (res.ec != std::errc() || res.ptr != tok.data() + tok.size())
+            fail(std::string(what) + " '" + std::string(tok) + "' is not a valid number");
+        return value;
+    }
+
+private:
+    std::string_view m_text;
+    const std::string& m_origin;
+    size_t m_pos = 0;
+    size_t m_line = 0;
+};
+
+constexpr int64_t kMaxCount = int64_t{1} << 28;
+
+} // namespace
+
+std::unique_ptr<TetMesh> parseVtet(std::string_view text, const std::string& origin) {
+    LineReader in(text, origin);
+    std::vector<std::string_view> tok;
+    if (!in.next(tok)) in.failEof("header 'vtet 1'");
+    if (tok.size() != 2 || tok[0] != "vtet") in.fail("header must be 'vtet <version>'");
+    if (in.number<int>(tok[1], "version") != 1)
+        in.fail("unsupported vtet version " + std::string(tok[1]) + " (supported: 1)");
+
+    auto readCount = [&](const char* keyword) {
+        if (!in.next(tok)) in.failEof(std::string("'") + keyword + " <count>'");
+        if (tok.size() != 2 || tok[0] != keyword)
+            in.fail(std::string("expected '") + keyword + " <count>'");
+        auto n = in.number<int64_t>(tok[1], "count");
+        if (n < 0 || n > kMaxCount)
+            in.fail(std::string(keyword) + " count " + std::to_string(n) + " is out of range [0, 2^28]");
+        return n;
+    };
+
+    const int64_t nv = readCount("vertices");
+    std::vector<Vec3> pos;
+    pos.reserve(static_cast<size_t>(nv));
+    for (int64_t v = 0; v < nv; ++v) {
+        if (!in.next(tok)) in.failEof("vertex " + std::to_string(v));
+        if (tok.size() != 3) in.fail("vertex " + std::to_string(v) + " must have 3 coordinates");
+        Vec3 p(in.number<double>(tok[0], "coordinate"), in.number<double>(tok[1], "coordinate"),
+               in.number<double>(tok[2], "coordinate"));
+        if (!p.allFinite()) in.fail("vertex " + std::to_string(v) + " has a non-finite coordinate");
+        pos.push_back(p);
+    }
+    const int64_t nt = readCount("tets");
+    if (nt == 0) in.fail("mesh has no tets");
+    std::vector<Tet> tets;
+    tets.reserve(static_cast<size_t>(nt));
+    for (int64_t t = 0; t < nt; ++t) {
+        if (!in.next(tok)) in.failEof("tet " + std::to_string(t));
+        if (tok.size() != 4) in.fail("tet " + std::to_string(t) + " must have 4 vertex indices");
+        Tet e;
+        for (int k = 0; k < 4; ++k) {
+            auto idx = in.number<int64_t>(tok[k], "vertex index");
+            if (idx < 0 || idx >= nv)
+                in.fail("tet " + std::to_string(t) + " references vertex " + std::to_string(idx) +
+                        " (mesh has " + std::to_string(nv) + " vertices)");
+            e[k] = static_cast<int32_t>(idx);
+        }
+        tets.push_back(e);
+    }
+    if (in.next(tok)) in.fail("unexpected content after the last tet");
+    try {
+        return TetMesh::fromArrays(std::move(pos), std::move(tets), origin);
+    } catch (const std::invalid_argument& e) {
+        throw InputError(e.what());
+    }
+}
+
+std::string formatVtet(const TetMesh& mesh) {
+    std::string out;
+    out.reserve(mesh.vertexCount() * 64 + mesh.tetCount() * 32 + 64);
+    out += "vtet 1\nvertices " + std::to_string(mesh.vertexCount()) + "\n";
+    char buf[128];
+    for (const Vec3& p : mesh.positions()) {
+        int n = std::snprintf(buf, sizeof buf, "%.17g %.17g %.17g\n", p.x(), p.y(), p.z());
+        out.append(buf, static_cast<size_t>(n));
+    }
+    out += "tets " + std::to_string(mesh.tetCount()) + "\n";
+    for (const Tet& t : mesh.tets()) {
+        int n = std::snprintf(buf, sizeof buf, "%d %d %d %d\n", t[0], t[1], t[2], t[3]);
+        out.append(buf, static_cast<size_t>(n));
+    }
+    return out;
+}
+
+std::unique_ptr<TetMesh> readVtet(const std::filesystem::path& path) {
+    return parseVtet(readFile(path), path.filename().string());
+}
+
+void writeVtet(const std::filesystem::path& path, const TetMesh& mesh) {
+    writeFileAtomic(path, formatVtet(mesh));
+}
+
+} // namespace viscera::sim
