@@ -73,6 +73,7 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     s.gravity = doc.contains("gravity") ? r.vec3(doc["gravity"], "gravity") : Vec3::Zero();
     if (auto why = validate(s); !why.empty()) r.fail("solver", why);
 
+    if (doc.contains("instructions")) scene.instructions = r.string(doc["instructions"], "instructions");
     const json& bodies = r.require(doc, "bodies", "");
     if (!bodies.is_array() || bodies.empty()) r.fail("bodies", "must be a non-empty array");
     std::set<std::string> names;
@@ -115,6 +116,7 @@ std::string formatScene(const SceneDesc& scene) {
     doc["solver"] = {{"type", scene.solverType}, {"dt", s.dt},           {"substeps", s.substeps},
                      {"iterations", s.iterations}, {"damping", s.damping}, {"max_speed", s.maxSpeed}};
     doc["gravity"] = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
+    if (!scene.instructions.empty()) doc["instructions"] = scene.instructions;
     doc["bodies"] = json::array();
     for (const BodyDesc& b : scene.bodies) {
         doc["bodies"].push_back({{"name", b.name},

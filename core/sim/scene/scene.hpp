@@ -6,6 +6,7 @@
 ///   "solver": {"type": "xpbd", "dt": 0.0166667, "substeps": 10, "iterations": 1,
 ///              "damping": 1.0, "max_speed": 20.0},
 ///   "gravity": [0, 0, -9.81],
+///   "instructions": "Watch the slab settle under gravity.",
 ///   "bodies": [{"name": "slab", "mesh": "meshes/slab.vtet",
 ///               "material": {"model": "neo_hookean", "youngs_modulus": 3000,
 ///                            "poisson_ratio": 0.45, "density": 1050},
@@ -28,6 +29,7 @@ struct BodyDesc {
 };
 
 struct SceneDesc {
+    std::string instructions; ///< shown to the trainee; may be empty
     std::string solverType = "xpbd";
     XpbdSettings xpbd;
     std::vector<BodyDesc> bodies;

@@ -69,38 +69,43 @@ void XpbdSolver::solveTet(size_t t, double h2inv) {
     const double w[4] = {m_invMass[e[0]], m_invMass[e[1]], m_invMass[e[2]], m_invMass[e[3]]};
     const Eigen::Matrix3d& dmInv = m_dmInv[t];
     const double vol = m_restVolume[t];
-    // Two constraints in sequence: deviatoric then hydrostatic.
-    for (int c = 0; c < 2; ++c) {
-        Eigen::Matrix3d ds;
-        for (int k = 0; k < 3; ++k) ds.col(k) = m_x[e[k + 1]] - m_x[e[0]];
-        const Eigen::Matrix3d F = ds * dmInv;
-        double C;
-        Eigen::Matrix3d dCdF;
-        double alpha;
-        if (c == 0) {
-            C = std::sqrt(F.squaredNorm());
-            if (C < 1e-12) continue;
-            dCdF = F / C;
-            alpha = 1.0 / (m_mu * vol);
-        } else {
-            C = F.determinant() - m_gamma;
-            dCdF.col(0) = F.col(1).cross(F.col(2));
-            dCdF.col(1) = F.col(2).cross(F.col(0));
-            dCdF.col(2) = F.col(0).cross(F.col(1));
-            alpha = 1.0 / (m_lambda * vol);
-        }
-        // dC/dx_i for i = 1..3 are the columns of dCdF · Dm^-T; dC/dx_0 is minus their sum.
-        const Eigen::Matrix3d g = dCdF * dmInv.transpose();
-        const Vec3 g0 = -(g.col(0) + g.col(1) + g.col(2));
-        const double denom = w[0] * g0.squaredNorm() + w[1] * g.col(0).squaredNorm() +
-                             w[2] * g.col(1).squaredNorm() + w[3] * g.col(2).squaredNorm() + alpha * h2inv;
-        if (!(denom > 0)) continue;
-        double& lambda = m_multipliers[2 * t + c];
-        const double dl = (-C - alpha * h2inv * lambda) / denom;
-        lambda += dl;
-        m_x[e[0]] += w[0] * dl * g0;
-        for (int k = 0; k < 3; ++k) m_x[e[k + 1]] += w[k + 1] * dl * g.col(k);
+    Eigen::Matrix3d ds;
+    for (int k = 0; k < 3; ++k) ds.col(k) = m_x[e[k + 1]] - m_x[e[0]];
+    const Eigen::Matrix3d F = ds * dmInv;
+    // Deviatoric C_D = |F|_F and hydrostatic C_H = det F - gamma, solved together as one 2x2
+    // block: the rest state balances only when both multipliers are found at once.
+    const double cD = std::sqrt(F.squaredNorm());
+    if (cD < 1e-12) return;
+    const double cH = F.determinant() - m_gamma;
+    Eigen::Matrix3d dH;
+    dH.col(0) = F.col(1).cross(F.col(2));
+    dH.col(1) = F.col(2).cross(F.col(0));
+    dH.col(2) = F.col(0).cross(F.col(1));
+    // dC/dx_i for i = 1..3 are the columns of dC/dF * Dm^-T; dC/dx_0 is minus their sum.
+    const Eigen::Matrix3d gD = (F / cD) * dmInv.transpose();
+    const Eigen::Matrix3d gH = dH * dmInv.transpose();
+    const Vec3 gD0 = -gD.rowwise().sum();
+    const Vec3 gH0 = -gH.rowwise().sum();
+    double aDD = w[0] * gD0.squaredNorm(), aHH = w[0] * gH0.squaredNorm(), aDH = w[0] * gD0.dot(gH0);
+    for (int k = 0; k < 3; ++k) {
+        aDD += w[k + 1] * gD.col(k).squaredNorm();
+        aHH += w[k + 1] * gH.col(k).squaredNorm();
+        aDH += w[k + 1] * gD.col(k).dot(gH.col(k));
     }
+    const double tD = h2inv / (m_mu * vol), tH = h2inv / (m_lambda * vol); // compliance / h^2
+    double& lD = m_multipliers[2 * t];
+    double& lH = m_multipliers[2 * t + 1];
+    aDD += tD;
+    aHH += tH;
+    const double rD = -cD - tD * lD, rH = -cH - tH * lH;
+    const double det = aDD * aHH - aDH * aDH;
+    if (!(det > 0) || !std::isfinite(det)) return;
+    const double dD = (aHH * rD - aDH * rH) / det;
+    const double dHl = (aDD * rH - aDH * rD) / det;
+    lD += dD;
+    lH += dHl;
+    m_x[e[0]] += w[0] * (dD * gD0 + dHl * gH0);
+    for (int k = 0; k < 3; ++k) m_x[e[k + 1]] += w[k + 1] * (dD * gD.col(k) + dHl * gH.col(k));
 }
 
 StepStats XpbdSolver::step() {

@@ -6,6 +6,8 @@
 ///   Ψ = μ/2 (tr FᵀF − 3) + λ/2 (det F − γ)² − μ²/(2λ),   γ = 1 + μ/λ,
 /// split into a deviatoric constraint C_D = sqrt(tr FᵀF) with compliance 1/(μ V) and a hydrostatic
 /// constraint C_H = det F − γ with compliance 1/(λ V); both stay well defined under inversion.
+/// The two constraints of a tet are solved as one 2×2 block, which keeps the rest state a fixed
+/// point of the iteration.
 /// Gauss–Seidel order is the tet order, so results are bit-identical from run to run.
 #include "sim/material/material.hpp"
 #include "sim/mesh/tet_mesh.hpp"

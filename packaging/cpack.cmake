@@ -1,0 +1,10 @@
+# Debian packages for the studio and the player: `cpack -G DEB` in the build folder.
+set(CPACK_PACKAGE_NAME "viscera")
+set(CPACK_PACKAGE_VENDOR "Viscera")
+set(CPACK_PACKAGE_CONTACT "Viscera engineering")
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Surgical simulation: studio (authoring) and player (runtime)")
+set(CPACK_GENERATOR "DEB")
+set(CPACK_DEB_COMPONENT_INSTALL ON)
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+include(CPack)

@@ -1,0 +1,137 @@
+// viscera-player: verifies and runs packaged cases (see DESIGN.md, command-line contract).
+//
+//   viscera-player verify <case.vcase>
+//   viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]
+//                  [--report report.json] [--screenshot out.png]
+//
+// Exit codes: 0 success, 1 bad input (case, arguments), 2 usage, 3 the session broke an invariant.
+#include "case/case_package.hpp"
+#include "runtime/report.hpp"
+#include "runtime/session.hpp"
+#include "sim/util/atomic_file.hpp"
+#include "sim/util/error.hpp"
+#include "sim/util/log.hpp"
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace viscera;
+
+constexpr int kExitInput = 1, kExitUsage = 2, kExitInvariant = 3;
+
+void usage(std::FILE* out) {
+    std::fputs("usage: viscera-player verify <case.vcase>\n"
+               "       viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]\n"
+               "                      [--report report.json] [--screenshot out.png]\n"
+               "       viscera-player --version\n",
+               out);
+}
+
+int fail(int code, const std::string& message) {
+    std::fprintf(stderr, "viscera-player: %s\n", message.c_str());
+    return code;
+}
+
+int cmdVerify(const std::vector<std::string>& args) {
+    if (args.size() != 1) {
+        usage(stderr);
+        return kExitUsage;
+    }
+    vcase::Manifest m = vcase::verify(args[0]);
+    std::printf("%s: ok (case %s %s, %zu files, features:", args[0].c_str(), m.caseId.c_str(),
+                m.caseVersion.c_str(), m.files.size());
+    for (const auto& f : m.features) std::printf(" %s", f.c_str());
+    std::printf(")\n");
+    return 0;
+}
+
+int cmdRun(const std::vector<std::string>& args) {
+    std::optional<std::string> casePath, reportPath, screenshot, device;
+    bool headless = false;
+    int frames = 300;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        auto value = [&](const char* flag) -> std::string {
+            if (i + 1 >= args.size()) throw std::invalid_argument(std::string(flag) + " needs a value");
+            return args[++i];
+        };
+        if (a == "--headless") headless = true;
+        else if (a == "--frames") {
+            const std::string v = value("--frames");
+            char* end = nullptr;
+            long n = std::strtol(v.c_str(), &end, 10);
+            if (*end != '\0' || n < 1 || n > 10'000'000)
+                throw std::invalid_argument("--frames '" + v + "' must be an integer in [1, 10000000]");
+            frames = static_cast<int>(n);
+        } else if (a == "--report") reportPath = value("--report");
+        else if (a == "--screenshot") screenshot = value("--screenshot");
+        else if (a == "--device") device = value("--device");
+        else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option '" + a + "'");
+        else if (!casePath) casePath = a;
+        else throw std::invalid_argument("unexpected argument '" + a + "'");
+    }
+    if (!casePath) throw std::invalid_argument("run needs a case file");
+    // Capabilities that arrive with later subsystems are refused up front, before any work.
+    if (!headless)
+        return fail(kExitUsage, "window mode needs the renderer, which this build does not include; use --headless");
+    if (screenshot)
+        return fail(kExitUsage, "--screenshot needs the renderer, which this build does not include");
+    if (device)
+        return fail(kExitUsage, "--device " + *device + ": device backends (core/haptics) are not in this build");
+
+    player::LoadedCase loaded = player::loadCase(*casePath);
+    std::fprintf(stderr, "viscera-player: running %s for %d frames\n", casePath->c_str(), frames);
+    player::RunOptions opts;
+    opts.frames = frames;
+    const int every = std::max(1, frames / 10);
+    opts.progress = [every](int done, int total) {
+        if (done % every == 0 || done == total)
+            std::fprintf(stderr, "  frame %d/%d (%d%%)\n", done, total, 100 * done / total);
+    };
+    player::SessionResult result = player::runSession(loaded, opts);
+    if (reportPath) writeFileAtomic(*reportPath, player::reportJson(result).dump(2) + "\n");
+    std::fputs(player::summaryText(result).c_str(), stdout);
+    if (reportPath) std::printf("report        %s\n", std::filesystem::absolute(*reportPath).c_str());
+    return result.ok() ? 0 : kExitInvariant;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    log::setSink([](log::Level level, std::string_view msg) {
+        if (level >= log::Level::Warn) std::fprintf(stderr, "viscera-player: %.*s\n", int(msg.size()), msg.data());
+    });
+    std::vector<std::string> args(argv + 1, argv + argc);
+    if (args.empty()) {
+        usage(stderr);
+        return kExitUsage;
+    }
+    const std::string cmd = args[0];
+    args.erase(args.begin());
+    try {
+        if (cmd == "verify") return cmdVerify(args);
+        if (cmd == "run") return cmdRun(args);
+        if (cmd == "--version") {
+            std::printf("viscera-player %s\n", VISCERA_VERSION);
+            return 0;
+        }
+        if (cmd == "--help" || cmd == "-h") {
+            usage(stdout);
+            return 0;
+        }
+        usage(stderr);
+        return kExitUsage;
+    } catch (const InputError& e) {
+        return fail(kExitInput, e.what());
+    } catch (const std::invalid_argument& e) {
+        return fail(kExitUsage, e.what());
+    } catch (const std::exception& e) {
+        return fail(kExitInput, std::string("internal error: ") + e.what());
+    }
+}

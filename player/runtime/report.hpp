@@ -1,0 +1,20 @@
+#pragma once
+/// The session report (JSON) of the DESIGN.md command-line contract, and the one-screen summary.
+#include "runtime/session.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace viscera::player {
+
+nlohmann::json reportJson(const SessionResult& result);
+/// A short human-readable summary (at most ~15 lines).
+std::string summaryText(const SessionResult& result);
+
+struct StepTimeStats {
+    double mean = 0, p50 = 0, p99 = 0, max = 0; ///< ms
+};
+StepTimeStats stepTimeStats(const std::vector<sim::FrameRecord>& frames);
+
+} // namespace viscera::player

@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Main job on a built-in default case: install, build, export the sample project to a case
+# package, verify it and run it headless in the player; prints a summary and the report path.
+# Usage: scripts/demo.sh [project-name] [frames]     (default: tissue-slab 300)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+PROJECT=${1:-tissue-slab}
+FRAMES=${2:-300}
+BUILD_DIR=${VISCERA_BUILD_DIR:-build}
+bash scripts/configure.sh viscera-studio viscera-player
+mkdir -p out
+"$BUILD_DIR/studio/cli/viscera-studio" export "projects/$PROJECT" -o "out/$PROJECT.vcase"
+"$BUILD_DIR/player/viscera-player" verify "out/$PROJECT.vcase"
+"$BUILD_DIR/player/viscera-player" run "out/$PROJECT.vcase" --headless --frames "$FRAMES" \
+  --report "out/$PROJECT-report.json"

@@ -1,0 +1,155 @@
+// viscera-studio command line (headless; needs no display).
+//
+//   viscera-studio export <project-dir> -o <case.vcase>
+//   viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M] [--facet-size M]
+//                         [-o out.vtet]
+//
+// Exit codes: 0 success, 1 bad input (project, mesh), 2 usage.
+#include "bake/import.hpp"
+#include "bake/tetrahedralize.hpp"
+#include "project/project.hpp"
+#include "sim/mesh/tet_io.hpp"
+#include "sim/util/error.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace viscera;
+constexpr int kExitInput = 1, kExitUsage = 2;
+
+void usage(std::FILE* out) {
+    std::fputs("usage: viscera-studio export <project-dir> -o <case.vcase>\n"
+               "       viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M]\n"
+               "                             [--facet-size M] [-o out.vtet]\n"
+               "       viscera-studio --version\n",
+               out);
+}
+
+double parsePositive(const std::string& flag, const std::string& v) {
+    char* end = nullptr;
+    double d = std::strtod(v.c_str(), &end);
+    if (*end != '\0' || !(d > 0) || !std::isfinite(d))
+        throw std::invalid_argument(flag + " '" + v + "' must be a positive number");
+    return d;
+}
+
+void printQuality(const sim::QualityReport& q) {
+    std::printf("  quality: min dihedral %.2f deg, max dihedral %.2f deg, mean ratio min %.3f mean %.3f\n"
+                "           %zu inverted, %zu degenerate, %zu slivers; volume %.6g m^3\n",
+                q.minDihedralDeg, q.maxDihedralDeg, q.minMeanRatio, q.meanMeanRatio, q.inverted.size(),
+                q.degenerate.size(), q.slivers.size(), q.totalVolume);
+}
+
+int cmdExport(const std::vector<std::string>& args) {
+    std::optional<std::string> dir, out;
+    for (size_t i = 0; i < args.size(); ++i) {
+        if (args[i] == "-o" || args[i] == "--output") {
+            if (i + 1 >= args.size()) throw std::invalid_argument(args[i] + " needs a value");
+            out = args[++i];
+        } else if (!args[i].empty() && args[i][0] == '-') {
+            throw std::invalid_argument("unknown option '" + args[i] + "'");
+        } else if (!dir) {
+            dir = args[i];
+        } else {
+            throw std::invalid_argument("unexpected argument '" + args[i] + "'");
+        }
+    }
+    if (!dir || !out) throw std::invalid_argument("export needs <project-dir> and -o <case.vcase>");
+    const auto t0 = std::chrono::steady_clock::now();
+    studio::Project project = studio::loadProject(*dir);
+    studio::ExportResult r = studio::exportCase(project, *out, [](const std::string& stage) {
+        std::fprintf(stderr, "viscera-studio: %s\n", stage.c_str());
+    });
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("exported %s -> %s (%llu bytes, %.2f s)\n", project.caseId.c_str(), r.casePath.c_str(),
+                static_cast<unsigned long long>(r.bytes), secs);
+    std::printf("  features:");
+    for (const auto& f : r.features) std::printf(" %s", f.c_str());
+    std::printf("\n");
+    for (const auto& b : r.bodies) {
+        std::printf("  body %s: %zu nodes, %zu tets, %zu fixed\n", b.name.c_str(), b.nodes, b.tets, b.fixedNodes);
+        printQuality(b.quality);
+    }
+    return 0;
+}
+
+int cmdImport(const std::vector<std::string>& args) {
+    std::optional<std::string> in, out;
+    bool tetra = false;
+    bake::ImportOptions opt;
+    bake::MeshingParams meshing;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
+            return args[++i];
+        };
+        if (a == "--scale") opt.scale = parsePositive(a, value());
+        else if (a == "--tetrahedralize") tetra = true;
+        else if (a == "--cell-size") meshing.cellSize = parsePositive(a, value());
+        else if (a == "--facet-size") meshing.facetSize = parsePositive(a, value());
+        else if (a == "-o" || a == "--output") out = value();
+        else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option '" + a + "'");
+        else if (!in) in = a;
+        else throw std::invalid_argument("unexpected argument '" + a + "'");
+    }
+    if (!in) throw std::invalid_argument("import needs a mesh file");
+    if (out && !tetra) throw std::invalid_argument("-o writes a tet mesh; add --tetrahedralize");
+    sim::TriMesh surface = bake::importSurface(*in, opt);
+    auto [lo, hi] = surface.bounds();
+    std::printf("%s: %zu vertices, %zu triangles, closed: %s, bounds [%g %g %g] - [%g %g %g] m\n", in->c_str(),
+                surface.vertexCount(), surface.triangleCount(), surface.isClosedOriented() ? "yes" : "no", lo.x(),
+                lo.y(), lo.z(), hi.x(), hi.y(), hi.z());
+    if (!tetra) return 0;
+    const auto t0 = std::chrono::steady_clock::now();
+    bake::TetrahedralizeResult r = bake::tetrahedralize(surface, meshing);
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("tetrahedralized: %zu nodes, %zu tets in %.2f s\n", r.mesh->vertexCount(), r.mesh->tetCount(), secs);
+    printQuality(r.mesh->quality());
+    if (out) {
+        sim::writeVtet(*out, *r.mesh);
+        std::printf("wrote %s\n", out->c_str());
+    }
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    std::vector<std::string> args(argv + 1, argv + argc);
+    if (args.empty()) {
+        usage(stderr);
+        return kExitUsage;
+    }
+    const std::string cmd = args[0];
+    args.erase(args.begin());
+    try {
+        if (cmd == "export") return cmdExport(args);
+        if (cmd == "import") return cmdImport(args);
+        if (cmd == "--version") {
+            std::printf("viscera-studio %s\n", VISCERA_VERSION);
+            return 0;
+        }
+        if (cmd == "--help" || cmd == "-h") {
+            usage(stdout);
+            return 0;
+        }
+        usage(stderr);
+        return kExitUsage;
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "viscera-studio: %s\n", e.what());
+        return kExitInput;
+    } catch (const std::invalid_argument& e) {
+        std::fprintf(stderr, "viscera-studio: %s\n", e.what());
+        return kExitUsage;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "viscera-studio: internal error: %s\n", e.what());
+        return kExitInput;
+    }
+}

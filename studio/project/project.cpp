@@ -1,0 +1,295 @@
+#include "project/project.hpp"
+
+#include "bake/import.hpp"
+#include "case/case_writer.hpp"
+#include "sim/mesh/tet_io.hpp"
+#include "sim/scene/scene.hpp"
+#include "sim/util/atomic_file.hpp"
+#include "sim/util/error.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <set>
+
+namespace viscera::studio {
+namespace {
+
+using nlohmann::json;
+
+/// Strict field access with messages naming the file and the field path.
+class Fields {
+public:
+    explicit Fields(std::string origin) : m_origin(std::move(origin)) {}
+    [[noreturn]] void fail(const std::string& field, const std::string& rule) const {
+        throw InputError(m_origin + ": " + field + ": " + rule);
+    }
+    const json& req(const json& obj, const std::string& key, const std::string& path) const {
+        const std::string field = path.empty() ? key : path + "." + key;
+        if (!obj.is_object()) fail(path.empty() ? "(root)" : path, "must be an object");
+        auto it = obj.find(key);
+        if (it == obj.end()) fail(field, "required field is missing");
+        return *it;
+    }
+    const json* opt(const json& obj, const std::string& key) const {
+        auto it = obj.find(key);
+        return it == obj.end() ? nullptr : &*it;
+    }
+    double num(const json& v, const std::string& field) const {
+        if (!v.is_number() || !std::isfinite(v.get<double>())) fail(field, "must be a finite number");
+        return v.get<double>();
+    }
+    double positive(const json& v, const std::string& field) const {
+        double d = num(v, field);
+        if (!(d > 0)) fail(field, "must be positive");
+        return d;
+    }
+    int integer(const json& v, const std::string& field, int lo, int hi) const {
+        if (!v.is_number_integer()) fail(field, "must be an integer");
+        auto i = v.get<int64_t>();
+        if (i < lo || i > hi) fail(field, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        return static_cast<int>(i);
+    }
+    std::string str(const json& v, const std::string& field) const {
+        if (!v.is_string()) fail(field, "must be a string");
+        return v.get<std::string>();
+    }
+    sim::Vec3 vec3(const json& v, const std::string& field) const {
+        if (!v.is_array() || v.size() != 3) fail(field, "must be an array of 3 numbers");
+        return {num(v[0], field + "[0]"), num(v[1], field + "[1]"), num(v[2], field + "[2]")};
+    }
+    void only(const json& obj, std::initializer_list<const char*> keys, const std::string& path) const {
+        for (auto it = obj.begin(); it != obj.end(); ++it) {
+            bool known = false;
+            for (const char* k : keys) known |= it.key() == k;
+            if (!known) fail(path.empty() ? it.key() : path + "." + it.key(), "unknown field");
+        }
+    }
+
+private:
+    std::string m_origin;
+};
+
+bake::MeshingParams parseMeshing(const Fields& f, const json* m, const std::string& path) {
+    bake::MeshingParams p;
+    if (!m) return p;
+    if (!m->is_object()) f.fail(path, "must be an object");
+    f.only(*m, {"facet_angle", "facet_size", "facet_distance", "cell_radius_edge_ratio", "cell_size", "seed"}, path);
+    if (auto* v = f.opt(*m, "facet_angle")) p.facetAngleDeg = f.positive(*v, path + ".facet_angle");
+    if (auto* v = f.opt(*m, "facet_size")) p.facetSize = f.positive(*v, path + ".facet_size");
+    if (auto* v = f.opt(*m, "facet_distance")) p.facetDistance = f.positive(*v, path + ".facet_distance");
+    if (auto* v = f.opt(*m, "cell_radius_edge_ratio"))
+        p.cellRadiusEdgeRatio = f.positive(*v, path + ".cell_radius_edge_ratio");
+    if (auto* v = f.opt(*m, "cell_size")) p.cellSize = f.positive(*v, path + ".cell_size");
+    if (auto* v = f.opt(*m, "seed")) p.seed = static_cast<unsigned>(f.integer(*v, path + ".seed", 0, 1 << 30));
+    return p;
+}
+
+MeshSource parseMeshSource(const Fields& f, const json& m, const std::string& path,
+                           const std::filesystem::path& dir) {
+    MeshSource s;
+    if (!m.is_object()) f.fail(path, "must be an object");
+    if (auto* file = f.opt(m, "file")) {
+        f.only(m, {"file", "scale", "meshing"}, path);
+        s.kind = MeshSource::Kind::File;
+        const std::string rel = f.str(*file, path + ".file");
+        std::filesystem::path p(rel);
+        if (p.is_absolute() || rel.find("..") != std::string::npos)
+            f.fail(path + ".file", "must be a path inside the project folder");
+        s.file = dir / p;
+        if (auto* v = f.opt(m, "scale")) s.scale = f.positive(*v, path + ".scale");
+        s.meshing = parseMeshing(f, f.opt(m, "meshing"), path + ".meshing");
+        return s;
+    }
+    const std::string gen = f.str(f.req(m, "generator", path), path + ".generator");
+    if (gen == "box") {
+        f.only(m, {"generator", "origin", "size", "cells"}, path);
+        s.kind = MeshSource::Kind::Box;
+        if (auto* v = f.opt(m, "origin")) s.box.origin = f.vec3(*v, path + ".origin");
+        s.box.size = f.vec3(f.req(m, "size", path), path + ".size");
+        if (!(s.box.size.array() > 0).all()) f.fail(path + ".size", "every edge length must be positive");
+        const json& c = f.req(m, "cells", path);
+        if (!c.is_array() || c.size() != 3) f.fail(path + ".cells", "must be an array of 3 integers");
+        for (int k = 0; k < 3; ++k)
+            s.box.cells[k] = f.integer(c[k], path + ".cells[" + std::to_string(k) + "]", 1, 512);
+    } else if (gen == "ellipsoid") {
+        f.only(m, {"generator", "center", "radii", "slices", "stacks", "meshing"}, path);
+        s.kind = MeshSource::Kind::Ellipsoid;
+        if (auto* v = f.opt(m, "center")) s.center = f.vec3(*v, path + ".center");
+        s.radii = f.vec3(f.req(m, "radii", path), path + ".radii");
+        if (!(s.radii.array() > 0).all()) f.fail(path + ".radii", "every radius must be positive");
+        if (auto* v = f.opt(m, "slices")) s.slices = f.integer(*v, path + ".slices", 3, 1024);
+        if (auto* v = f.opt(m, "stacks")) s.stacks = f.integer(*v, path + ".stacks", 2, 1024);
+        s.meshing = parseMeshing(f, f.opt(m, "meshing"), path + ".meshing");
+    } else {
+        f.fail(path + ".generator", "'" + gen + "' is not a known generator (box, ellipsoid)");
+    }
+    return s;
+}
+
+} // namespace
+
+Project loadProject(const std::filesystem::path& dir) {
+    const std::filesystem::path file = dir / "project.json";
+    const std::string origin = file.string();
+    const std::string text = readFile(file);
+    json doc = json::parse(text, nullptr, false);
+    if (doc.is_discarded()) throw InputError(origin + ": not valid JSON");
+    Fields f(origin);
+    if (!doc.is_object()) f.fail("(root)", "must be an object");
+    f.only(doc, {"schemaVersion", "caseId", "caseVersion", "title", "instructions", "solver", "gravity", "bodies"}, "");
+    Project p;
+    p.dir = dir;
+    p.schemaVersion = f.integer(f.req(doc, "schemaVersion", ""), "schemaVersion", 1, 1);
+    p.caseId = f.str(f.req(doc, "caseId", ""), "caseId");
+    p.caseVersion = f.str(f.req(doc, "caseVersion", ""), "caseVersion");
+    if (auto* v = f.opt(doc, "title")) p.title = f.str(*v, "title");
+    if (auto* v = f.opt(doc, "instructions")) p.instructions = f.str(*v, "instructions");
+    const json& solver = f.req(doc, "solver", "");
+    f.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed"}, "solver");
+    const std::string type = f.str(f.req(solver, "type", "solver"), "solver.type");
+    if (type != "xpbd") f.fail("solver.type", "'" + type + "' is not supported (supported: xpbd)");
+    if (auto* v = f.opt(solver, "dt")) p.solver.dt = f.positive(*v, "solver.dt");
+    if (auto* v = f.opt(solver, "substeps")) p.solver.substeps = f.integer(*v, "solver.substeps", 1, 1000);
+    if (auto* v = f.opt(solver, "iterations")) p.solver.iterations = f.integer(*v, "solver.iterations", 1, 1000);
+    if (auto* v = f.opt(solver, "damping")) p.solver.damping = f.num(*v, "solver.damping");
+    if (auto* v = f.opt(solver, "max_speed")) p.solver.maxSpeed = f.positive(*v, "solver.max_speed");
+    p.solver.gravity = f.opt(doc, "gravity") ? f.vec3(doc["gravity"], "gravity") : sim::Vec3::Zero();
+    if (auto why = sim::validate(p.solver); !why.empty()) f.fail("solver", why);
+
+    const json& bodies = f.req(doc, "bodies", "");
+    if (!bodies.is_array() || bodies.empty()) f.fail("bodies", "must be a non-empty array");
+    std::set<std::string> names;
+    for (size_t i = 0; i < bodies.size(); ++i) {
+        const std::string path = "bodies[" + std::to_string(i) + "]";
+        const json& b = bodies[i];
+        if (!b.is_object()) f.fail(path, "must be an object");
+        f.only(b, {"name", "mesh", "material", "fixed"}, path);
+        BodyProject body;
+        body.name = f.str(f.req(b, "name", path), path + ".name");
+        bool okName = !body.name.empty() && body.name.size() <= 64;
+        for (char c : body.name) okName &= std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_';
+        if (!okName) f.fail(path + ".name", "must be 1-64 characters of [A-Za-z0-9_-]");
+        if (!names.insert(body.name).second) f.fail(path + ".name", "'" + body.name + "' is used twice");
+        body.mesh = parseMeshSource(f, f.req(b, "mesh", path), path + ".mesh", dir);
+        const json& m = f.req(b, "material", path);
+        const std::string mp = path + ".material";
+        f.only(m, {"model", "youngs_modulus", "poisson_ratio", "density"}, mp);
+        try {
+            body.material.model = sim::materialModelFromName(f.str(f.req(m, "model", mp), mp + ".model"));
+        } catch (const std::invalid_argument& e) {
+            f.fail(mp + ".model", e.what());
+        }
+        body.material.youngsModulus = f.num(f.req(m, "youngs_modulus", mp), mp + ".youngs_modulus");
+        body.material.poissonRatio = f.num(f.req(m, "poisson_ratio", mp), mp + ".poisson_ratio");
+        body.material.density = f.num(f.req(m, "density", mp), mp + ".density");
+        if (auto why = sim::validate(body.material); !why.empty()) f.fail(mp, why);
+        if (auto* fx = f.opt(b, "fixed")) {
+            f.only(*fx, {"min", "max"}, path + ".fixed");
+            sim::Vec3 lo = f.vec3(f.req(*fx, "min", path + ".fixed"), path + ".fixed.min");
+            sim::Vec3 hi = f.vec3(f.req(*fx, "max", path + ".fixed"), path + ".fixed.max");
+            if (!(lo.array() <= hi.array()).all()) f.fail(path + ".fixed", "min must not exceed max");
+            body.fixedBox = std::array<sim::Vec3, 2>{lo, hi};
+        }
+        p.bodies.push_back(std::move(body));
+    }
+    return p;
+}
+
+std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::string& origin) {
+    const MeshSource& s = body.mesh;
+    switch (s.kind) {
+    case MeshSource::Kind::Box: return sim::makeBoxTetMesh(s.box);
+    case MeshSource::Kind::Ellipsoid: {
+        bake::MeshingParams params = s.meshing;
+        params.label = origin + ": body '" + body.name + "' ellipsoid";
+        return bake::tetrahedralize(sim::makeEllipsoidSurface(s.center, s.radii, s.slices, s.stacks), params).mesh;
+    }
+    case MeshSource::Kind::File: {
+        bake::ImportOptions opt;
+        opt.scale = s.scale;
+        bake::MeshingParams params = s.meshing;
+        params.label = s.file.filename().string();
+        return bake::tetrahedralize(bake::importSurface(s.file, opt), params).mesh;
+    }
+    }
+    throw InputError(origin + ": unknown mesh source");
+}
+
+ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress) {
+    auto stage = [&](const std::string& s) {
+        if (progress) progress(s);
+    };
+    const std::string origin = (project.dir / "project.json").string();
+    sim::SceneDesc scene;
+    scene.solverType = "xpbd";
+    scene.xpbd = project.solver;
+    scene.instructions = project.instructions;
+    vcase::Manifest header;
+    header.caseId = project.caseId;
+    header.caseVersion = project.caseVersion;
+    header.minPlayerVersion = VISCERA_VERSION;
+    if (!project.title.empty()) header.title = project.title;
+    // Features: only what the scene needs.
+    header.features = {"xpbd"};
+    if (project.solver.gravity.squaredNorm() > 0) header.features.insert(header.features.begin(), "gravity");
+
+    ExportResult result;
+    std::vector<std::pair<std::string, std::string>> files;
+    for (size_t i = 0; i < project.bodies.size(); ++i) {
+        const BodyProject& b = project.bodies[i];
+        const std::string field = "bodies[" + std::to_string(i) + "] ('" + b.name + "')";
+        stage("meshing body '" + b.name + "'");
+        std::unique_ptr<sim::TetMesh> mesh;
+        try {
+            mesh = buildBodyMesh(b, origin);
+        } catch (const std::invalid_argument& e) {
+            throw InputError(origin + ": " + field + ".mesh: " + e.what());
+        }
+        BodyExport be;
+        be.name = b.name;
+        be.nodes = mesh->vertexCount();
+        be.tets = mesh->tetCount();
+        be.quality = mesh->quality();
+        if (!be.quality.inverted.empty())
+            throw InputError(origin + ": " + field + ".mesh: tet " + std::to_string(be.quality.inverted.front()) +
+                             " is inverted (" + std::to_string(be.quality.inverted.size()) + " inverted in all)");
+        if (!be.quality.degenerate.empty())
+            throw InputError(origin + ": " + field + ".mesh: tet " + std::to_string(be.quality.degenerate.front()) +
+                             " is degenerate (" + std::to_string(be.quality.degenerate.size()) + " in all)");
+        sim::BodyDesc desc;
+        desc.name = b.name;
+        desc.meshPath = "meshes/" + b.name + ".vtet";
+        desc.material = b.material;
+        if (b.fixedBox) {
+            const auto& [lo, hi] = *b.fixedBox;
+            const auto& pos = mesh->positions();
+            for (int32_t v = 0; v < static_cast<int32_t>(pos.size()); ++v)
+                if ((pos[v].array() >= lo.array()).all() && (pos[v].array() <= hi.array()).all())
+                    desc.fixedNodes.push_back(v);
+            if (desc.fixedNodes.empty())
+                throw InputError(origin + ": " + field + ".fixed: the box contains no mesh node");
+        }
+        be.fixedNodes = desc.fixedNodes.size();
+        // The player runs what it loads: refuse a body that cannot be simulated stably now.
+        try {
+            (void)sim::XpbdSolver::create(*mesh, b.material, desc.fixedNodes, project.solver);
+        } catch (const std::invalid_argument& e) {
+            throw InputError(origin + ": " + field + ": cannot be simulated stably: " + e.what());
+        }
+        files.emplace_back(desc.meshPath, sim::formatVtet(*mesh));
+        scene.bodies.push_back(std::move(desc));
+        result.bodies.push_back(std::move(be));
+    }
+    stage("packaging");
+    vcase::CaseWriter writer(header);
+    writer.addFile("scene.json", sim::formatScene(scene));
+    for (auto& [path, bytes] : files) writer.addFile(path, std::move(bytes));
+    vcase::Manifest written = writer.write(out);
+    result.casePath = out;
+    result.features = written.features;
+    result.bytes = std::filesystem::file_size(out);
+    return result;
+}
+
+} // namespace viscera::studio

@@ -1,0 +1,23 @@
+# Fails when the player binary links an authoring library (OpenVDB, OpenCV, assimp, GMP/MPFR from
+# CGAL, Qt Widgets) or when a core/ or player/ source includes a CGAL header.
+execute_process(COMMAND ldd ${PLAYER} OUTPUT_VARIABLE libs RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "ldd ${PLAYER} failed (${rc})")
+endif()
+foreach(pattern openvdb opencv assimp libgmp libmpfr Qt6Widgets libtbb)
+  string(TOLOWER "${libs}" lower)
+  string(TOLOWER "${pattern}" p)
+  if(lower MATCHES "${p}")
+    message(FATAL_ERROR "viscera-player links a forbidden library matching '${pattern}':\n${libs}")
+  endif()
+endforeach()
+file(GLOB_RECURSE sources ${SOURCE_DIR}/core/*.hpp ${SOURCE_DIR}/core/*.cpp ${SOURCE_DIR}/core/*.h
+     ${SOURCE_DIR}/player/*.hpp ${SOURCE_DIR}/player/*.cpp ${SOURCE_DIR}/player/*.h)
+foreach(f ${sources})
+  file(STRINGS ${f} hits REGEX "#[ \t]*include[ \t]*[<\"](CGAL|openvdb|opencv2|assimp|QtWidgets)/")
+  if(hits)
+    message(FATAL_ERROR "${f} includes an authoring header: ${hits}")
+  endif()
+endforeach()
+list(LENGTH sources n)
+message(STATUS "viscera-player: no authoring libraries linked; ${n} core/player sources free of authoring headers")

@@ -1,0 +1,240 @@
+// End-to-end: cases built in the test are verified and run by the viscera-player binary; sample
+// projects are exported by viscera-studio. Every rejection is checked for its exit code and its
+// one-line message naming the file and the rule.
+#include "case/case_writer.hpp"
+#include "case/zip_craft.hpp"
+#include "sim/mesh/generators.hpp"
+#include "sim/mesh/tet_io.hpp"
+#include "sim/scene/scene.hpp"
+#include "support/run_process.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <fstream>
+#include <set>
+
+using namespace viscera;
+using ::testing::HasSubstr;
+using vcase::test::RawEntry;
+using vcase::test::ScratchDir;
+
+namespace {
+
+test::ProcessResult player(const std::vector<std::string>& args) { return test::runProcess(VISCERA_PLAYER_EXE, args); }
+test::ProcessResult studio(const std::vector<std::string>& args) { return test::runProcess(VISCERA_STUDIO_EXE, args); }
+
+int lineCount(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+/// A small cantilever case: a box fixed at x = 0, with the given features.
+std::string writeSlabCase(const ScratchDir& dir, const std::string& name, std::vector<std::string> features,
+                          sim::Vec3 gravity = sim::Vec3(0, 0, -9.81)) {
+    auto mesh = sim::makeBoxTetMesh({sim::Vec3::Zero(), sim::Vec3(0.08, 0.02, 0.02), {8, 2, 2}});
+    sim::SceneDesc scene;
+    scene.xpbd.gravity = gravity;
+    scene.xpbd.substeps = 10;
+    sim::BodyDesc body;
+    body.name = "slab";
+    body.meshPath = "meshes/slab.vtet";
+    body.material.youngsModulus = 20000;
+    for (int32_t v = 0; v < static_cast<int32_t>(mesh->vertexCount()); ++v)
+        if (mesh->positions()[v].x() < 1e-9) body.fixedNodes.push_back(v);
+    scene.bodies.push_back(body);
+    vcase::Manifest header;
+    header.caseId = "slab-test";
+    header.caseVersion = "1.0.0";
+    header.minPlayerVersion = "0.1.0";
+    header.features = std::move(features);
+    vcase::CaseWriter w(header);
+    w.addFile("scene.json", sim::formatScene(scene));
+    w.addFile("meshes/slab.vtet", sim::formatVtet(*mesh));
+    const auto path = dir.path() / name;
+    w.write(path);
+    return path.string();
+}
+
+nlohmann::json readJson(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    return nlohmann::json::parse(in);
+}
+
+struct Rejection {
+    const char* label;
+    std::string bytes;
+    const char* rule;
+};
+
+} // namespace
+
+TEST(PlayerCli, VerifyRejectsEachBrokenPackageWithADistinctMessage) {
+    ScratchDir dir;
+    const std::vector<RawEntry> good = {{"meshes/a.vtet", vcase::test::unitTetVtet()}};
+    std::vector<Rejection> cases;
+    {
+        auto files = good;
+        vcase::Manifest m = vcase::test::manifestFor(files);
+        files[0].bytes[files[0].bytes.size() - 2] ^= 1; // same size, different hash
+        cases.push_back({"hash", vcase::test::craftPackage(m, files), "sha256 mismatch"});
+    }
+    {
+        auto files = good;
+        vcase::Manifest m = vcase::test::manifestFor(files);
+        files.push_back({"extra.txt", "surprise"});
+        cases.push_back({"unlisted", vcase::test::craftPackage(m, files), "not listed in manifest.json"});
+    }
+    {
+        auto files = good;
+        vcase::Manifest m = vcase::test::manifestFor(files);
+        files.push_back({"../x", "escape"});
+        cases.push_back({"dotdot", vcase::test::craftPackage(m, files), "'..'"});
+    }
+    {
+        auto files = good;
+        vcase::Manifest m = vcase::test::manifestFor(files);
+        files.push_back({"/etc/passwd", "root"});
+        cases.push_back({"absolute", vcase::test::craftPackage(m, files), "absolute entry path"});
+    }
+    {
+        vcase::Manifest m = vcase::test::manifestFor(good);
+        m.schemaVersion = 99;
+        cases.push_back({"schema", vcase::test::craftPackage(m, good), "schemaVersion 99 is newer"});
+    }
+    {
+        std::string whole = vcase::test::craftPackage(vcase::test::manifestFor(good), good);
+        cases.push_back({"truncated", whole.substr(0, whole.size() / 2), "not a valid zip archive"});
+    }
+    std::set<std::string> messages;
+    for (const auto& c : cases) {
+        const auto path = dir.write(std::string(c.label) + ".vcase", c.bytes);
+        test::ProcessResult r = player({"verify", path.string()});
+        EXPECT_EQ(r.exitCode, 1) << c.label << ": " << r.err;
+        EXPECT_THAT(r.err, HasSubstr(c.rule)) << c.label;
+        EXPECT_THAT(r.err, HasSubstr(path.string())) << c.label;
+        EXPECT_EQ(lineCount(r.err), 1) << c.label << ": " << r.err;
+        messages.insert(r.err.substr(r.err.find(path.filename().string()) + path.filename().string().size()));
+    }
+    EXPECT_EQ(messages.size(), cases.size()) << "every rule has its own message";
+}
+
+TEST(PlayerCli, VerifyAcceptsAGoodCase) {
+    ScratchDir dir;
+    const auto path = writeSlabCase(dir, "slab.vcase", {"gravity", "xpbd"});
+    test::ProcessResult r = player({"verify", path});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_THAT(r.out, HasSubstr("ok (case slab-test 1.0.0"));
+}
+
+TEST(PlayerCli, RunWritesTheSessionReport) {
+    ScratchDir dir;
+    const auto path = writeSlabCase(dir, "slab.vcase", {"gravity", "xpbd"});
+    const auto report = dir.path() / "report.json";
+    test::ProcessResult r = player({"run", path, "--headless", "--frames", "60", "--report", report.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
+    EXPECT_THAT(r.out, HasSubstr("subsystems    gravity, xpbd"));
+    EXPECT_THAT(r.out, HasSubstr(report.string()));
+    nlohmann::json j = readJson(report);
+    EXPECT_EQ(j["case"]["id"], "slab-test");
+    EXPECT_EQ(j["case"]["version"], "1.0.0");
+    EXPECT_EQ(j["active_subsystems"], nlohmann::json({"gravity", "xpbd"}));
+    ASSERT_EQ(j["frames"].size(), 60u);
+    for (const auto& f : j["frames"]) {
+        EXPECT_EQ(f["substeps"], 10);
+        EXPECT_EQ(f["iterations"], 1);
+        EXPECT_GE(f["step_ms"].get<double>(), 0.0);
+    }
+    EXPECT_TRUE(j["accuracy"].is_array());
+    EXPECT_TRUE(j["invariants"]["all_finite"].get<bool>());
+    EXPECT_GT(j["invariants"]["max_step_displacement_m"].get<double>(), 0.0);
+    EXPECT_EQ(j["invariants"]["max_force_n"].get<double>(), 0.0);
+    // The free end sags under gravity by a plausible amount (millimetres, not metres).
+    const double sag = j["metrics"]["max_node_displacement_m"].get<double>();
+    EXPECT_GT(sag, 1e-4);
+    EXPECT_LT(sag, 0.05);
+    EXPECT_TRUE(j["errors"].empty());
+}
+
+TEST(PlayerCli, OnlyDeclaredSubsystemsRun) {
+    ScratchDir dir;
+    // Without gravity the world creates no gravity subsystem and nothing moves.
+    const auto path = writeSlabCase(dir, "still.vcase", {"xpbd"}, sim::Vec3::Zero());
+    const auto report = dir.path() / "r.json";
+    test::ProcessResult r = player({"run", path, "--headless", "--frames", "10", "--report", report.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    nlohmann::json j = readJson(report);
+    EXPECT_EQ(j["active_subsystems"], nlohmann::json({"xpbd"}));
+    EXPECT_LT(j["metrics"]["max_node_displacement_m"].get<double>(), 1e-12);
+}
+
+TEST(PlayerCli, RunRejectsUnsupportedOrUndeclaredFeatures) {
+    ScratchDir dir;
+    auto a = player({"run", writeSlabCase(dir, "needle.vcase", {"gravity", "needle", "xpbd"}), "--headless"});
+    EXPECT_EQ(a.exitCode, 1);
+    EXPECT_THAT(a.err, HasSubstr("features: 'needle' is not supported by this player"));
+    auto b = player({"run", writeSlabCase(dir, "nograv.vcase", {"xpbd"}), "--headless"});
+    EXPECT_EQ(b.exitCode, 1);
+    EXPECT_THAT(b.err, HasSubstr("the scene sets gravity but the manifest does not declare 'gravity'"));
+}
+
+TEST(PlayerCli, UsageErrorsAreClear) {
+    EXPECT_EQ(player({}).exitCode, 2);
+    auto r = player({"run", "x.vcase", "--frames", "abc", "--headless"});
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_THAT(r.err, HasSubstr("--frames 'abc' must be an integer"));
+    auto m = player({"verify", "/nonexistent/case.vcase"});
+    EXPECT_EQ(m.exitCode, 1);
+    EXPECT_THAT(m.err, HasSubstr("/nonexistent/case.vcase"));
+}
+
+TEST(StudioCli, ExportsAndThePlayerRunsTheSampleProject) {
+    ScratchDir dir;
+    const auto out = dir.path() / "tissue-slab.vcase";
+    auto e = studio({"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab", "-o", out.string()});
+    ASSERT_EQ(e.exitCode, 0) << e.err;
+    EXPECT_THAT(e.out, HasSubstr("body slab:"));
+    EXPECT_THAT(e.out, HasSubstr("features: gravity xpbd"));
+    auto v = player({"verify", out.string()});
+    EXPECT_EQ(v.exitCode, 0) << v.err;
+    const auto report = dir.path() / "r.json";
+    auto r = player({"run", out.string(), "--headless", "--frames", "30", "--report", report.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(readJson(report)["invariants"]["all_finite"].get<bool>());
+    // Exports are deterministic.
+    const auto again = dir.path() / "again.vcase";
+    ASSERT_EQ(studio({"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab", "-o", again.string()}).exitCode, 0);
+    std::ifstream a(out, std::ios::binary), b(again, std::ios::binary);
+    std::string sa((std::istreambuf_iterator<char>(a)), {}), sb((std::istreambuf_iterator<char>(b)), {});
+    EXPECT_EQ(sa, sb);
+}
+
+TEST(StudioCli, ImportRejectsBadMeshesWithOneLineErrors) {
+    ScratchDir dir;
+    struct Bad {
+        const char* name;
+        std::string text;
+        const char* rule;
+    };
+    const std::vector<Bad> bad = {
+        {"nan.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n", "non-finite"},
+        {"nofaces.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n", "no faces"},
+        {"range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "out of range"},
+        {"mesh.xyz", "0 0 0\n1 0 0\n", "unsupported format"},
+    };
+    for (const auto& b : bad) {
+        const auto path = dir.write(b.name, b.text);
+        auto r = studio({"import", path.string()});
+        EXPECT_EQ(r.exitCode, 1) << b.name << ": " << r.err;
+        EXPECT_THAT(r.err, HasSubstr(b.name));
+        EXPECT_THAT(r.err, HasSubstr(b.rule)) << r.err;
+        EXPECT_EQ(lineCount(r.err), 1) << r.err;
+    }
+    auto bp = dir.write("project.json", R"({"schemaVersion": 1, "caseId": "x", "caseVersion": "1.0.0",
+        "solver": {"type": "xpbd"}, "bodies": [{"name": "b", "mesh": {"generator": "box", "size": [1, 1, -1],
+        "cells": [1, 1, 1]}, "material": {"model": "neo_hookean", "youngs_modulus": 1e4, "poisson_ratio": 0.4,
+        "density": 1000}}]})");
+    auto r = studio({"export", dir.path().string(), "-o", (dir.path() / "x.vcase").string()});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_THAT(r.err, HasSubstr("project.json: bodies[0].mesh.size: every edge length must be positive"));
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "x.vcase"));
+}

@@ -1,0 +1,99 @@
+#include "sim/mesh/generators.hpp"
+#include "sim/scene/scene.hpp"
+#include "sim/scene/world.hpp"
+#include "sim/util/error.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+using namespace viscera::sim;
+using ::testing::HasSubstr;
+
+namespace {
+SceneDesc slabScene() {
+    SceneDesc s;
+    s.instructions = "watch";
+    BodyDesc b;
+    b.name = "slab";
+    b.meshPath = "meshes/slab.vtet";
+    b.fixedNodes = {0, 1, 2};
+    s.bodies.push_back(b);
+    return s;
+}
+std::string parseError(const std::string& text) {
+    try {
+        parseScene(text, "scene.json");
+    } catch (const viscera::InputError& e) {
+        return e.what();
+    }
+    return "accepted";
+}
+std::vector<std::unique_ptr<TetMesh>> oneMesh() {
+    std::vector<std::unique_ptr<TetMesh>> v;
+    v.push_back(makeBoxTetMesh({}));
+    return v;
+}
+} // namespace
+
+TEST(Scene, RoundTrip) {
+    SceneDesc s = slabScene();
+    s.xpbd.substeps = 17;
+    SceneDesc back = parseScene(formatScene(s), "scene.json");
+    EXPECT_EQ(back.instructions, "watch");
+    EXPECT_EQ(back.xpbd.substeps, 17);
+    EXPECT_EQ(back.xpbd.gravity, s.xpbd.gravity);
+    ASSERT_EQ(back.bodies.size(), 1u);
+    EXPECT_EQ(back.bodies[0].fixedNodes, s.bodies[0].fixedNodes);
+    EXPECT_EQ(back.bodies[0].material.poissonRatio, s.bodies[0].material.poissonRatio);
+}
+
+TEST(Scene, ErrorsNameTheField) {
+    EXPECT_THAT(parseError("{"), HasSubstr("scene.json: not valid JSON"));
+    EXPECT_THAT(parseError("{}"), HasSubstr("scene.json: solver: required field is missing"));
+    EXPECT_THAT(parseError(R"({"solver": {"type": "fem"}, "bodies": []})"),
+                HasSubstr("solver.type: 'fem' is not supported"));
+    EXPECT_THAT(parseError(R"({"solver": {"type": "xpbd", "substeps": 0}, "bodies": []})"),
+                HasSubstr("solver: substeps must be in [1, 1000]"));
+    EXPECT_THAT(parseError(R"({"solver": {"type": "xpbd"}, "bodies": []})"), HasSubstr("bodies: must be a non-empty array"));
+    EXPECT_THAT(parseError(R"({"solver": {"type": "xpbd"}, "bodies": [{"name": "a", "mesh": "m.vtet",
+        "material": {"model": "neo_hookean", "youngs_modulus": 1000, "poisson_ratio": 0.7, "density": 1000}}]})"),
+                HasSubstr("bodies[0].material: poisson_ratio"));
+    EXPECT_THAT(parseError(R"({"solver": {"type": "xpbd"}, "bodies": [{"name": "a", "mesh": "m.vtet",
+        "material": {"model": "neo_hookean", "youngs_modulus": 1000, "poisson_ratio": 0.3, "density": 1000},
+        "fixed_nodes": [1, -2]}]})"),
+                HasSubstr("bodies[0].fixed_nodes[1]: must be non-negative"));
+}
+
+TEST(World, AssemblesOnlyDeclaredSubsystems) {
+    SceneDesc s = slabScene();
+    auto w = World::assemble(s, oneMesh(), {"gravity", "xpbd"}, "case");
+    EXPECT_EQ(w->activeSubsystems(), (std::vector<std::string>{"gravity", "xpbd"}));
+    FrameRecord r = w->step();
+    EXPECT_TRUE(r.finite);
+    EXPECT_EQ(r.substeps, s.xpbd.substeps);
+    EXPECT_GT(w->invariants().maxStepDisplacement, 0.0);
+
+    s.xpbd.gravity.setZero();
+    auto still = World::assemble(s, oneMesh(), {"xpbd"}, "case");
+    EXPECT_EQ(still->activeSubsystems(), std::vector<std::string>{"xpbd"});
+    still->step();
+    EXPECT_LT(still->invariants().maxStepDisplacement, 1e-12);
+}
+
+TEST(World, RefusesWhatItCannotRun) {
+    auto err = [](const SceneDesc& s, std::vector<std::string> f) {
+        try {
+            World::assemble(s, oneMesh(), f, "c.vcase: manifest.json");
+        } catch (const viscera::InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    SceneDesc s = slabScene();
+    EXPECT_THAT(err(s, {"xpbd", "gravity", "haptics"}),
+                HasSubstr("c.vcase: manifest.json: features: 'haptics' is not supported by this player"));
+    EXPECT_THAT(err(s, {"gravity"}), HasSubstr("the scene uses solver 'xpbd' but the manifest does not declare it"));
+    EXPECT_THAT(err(s, {"xpbd"}), HasSubstr("does not declare 'gravity'"));
+    s.bodies[0].fixedNodes = {100000};
+    EXPECT_THAT(err(s, {"xpbd", "gravity"}), HasSubstr("body 'slab': cannot be simulated stably: fixed node 100000"));
+}
