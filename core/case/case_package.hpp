@@ -1,0 +1,71 @@
+#pragma once
+/// Opening and verifying a .vcase case package (see packaging/vcase-spec.md).
+///
+/// CasePackage::open() checks, in this order, and throws viscera::InputError on the first rule
+/// broken, with a one-line message naming the package, the entry or field, and the rule:
+///   (a) the file exists, is readable, and is at most Limits::maxPackageBytes;
+///   (b) it is a zip archive ("not a valid zip archive (truncated or corrupt)") with at most
+///       Limits::maxEntries entries;
+///   (c) entry names follow entryNameProblem() (no '..', no absolute path, no backslash...);
+///       entries are regular files (no symbolic links or devices); no name repeats, even
+///       ignoring letter case; directory entries only as parents of packaged files;
+///   (d) entries are stored or deflated, not encrypted; the declared uncompressed sizes respect
+///       maxEntryBytes, maxTotalBytes and maxCompressionRatio;
+///   (e) manifest.json is present, at most maxManifestBytes, valid JSON, and schema-valid
+///       (Manifest::parse);
+///   (f) every listed file is present with the listed size and sha256; no file is unlisted;
+///   (g) the schemaVersion and minPlayerVersion suit this player (checkPlayerCompatibility);
+///   (h) every listed file ending in ".vtet" parses with sim::parseVtet (origin
+///       "<package>:<entry>").
+/// Example: "case.vcase: meshes/a.vtet: sha256 mismatch (manifest says 3a.., file has 9f..)".
+#include "case/limits.hpp"
+#include "case/manifest.hpp"
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+
+namespace viscera::vcase {
+
+/// A verified package, held in memory. Non-copyable; open() returns a unique_ptr.
+/// Memory: the uncompressed bytes of every listed file (at most Limits::maxTotalBytes); the
+/// archive itself is released once verified.
+class CasePackage {
+  public:
+    /// Reads and verifies the package at `path`. Cost: one read of the file, one decompression
+    /// and one SHA-256 pass over every entry, one parse of every .vtet. Throws viscera::InputError.
+    static std::unique_ptr<CasePackage> open(const std::filesystem::path& path,
+                                             const Limits& limits = {});
+    /// The same checks on a package already in memory (only (a)'s size rule applies); `name`
+    /// stands for the file in messages. `bytes` is not retained.
+    static std::unique_ptr<CasePackage> fromBytes(std::string_view bytes, std::string name,
+                                                  const Limits& limits = {});
+
+    CasePackage(const CasePackage&) = delete;
+    CasePackage& operator=(const CasePackage&) = delete;
+
+    /// The package as named in messages (the path given to open()).
+    const std::string& name() const { return m_name; }
+    const Manifest& manifest() const { return m_manifest; }
+    /// True when `path` is listed in the manifest.
+    bool contains(std::string_view path) const;
+    /// The verified bytes of listed file `path`; the view lives as long as the package. O(log n).
+    /// Throws viscera::InputError ("case.vcase: scene/x.json: not listed in manifest.json") for a
+    /// path that is not listed (manifest.json itself included: use manifest()).
+    std::string_view read(std::string_view path) const;
+
+  private:
+    CasePackage() = default;
+
+    std::string m_name;
+    Manifest m_manifest;
+    std::map<std::string, std::string, std::less<>> m_files;
+};
+
+/// Runs every check of CasePackage::open() and returns the manifest; for tools that only need a
+/// verdict. Same cost as open(); the file contents are released before returning.
+Manifest verify(const std::filesystem::path& path, const Limits& limits = {});
+
+} // namespace viscera::vcase

@@ -1,0 +1,78 @@
+#pragma once
+/// manifest.json of a .vcase package (schema version 1):
+///
+///   {
+///     "schemaVersion": 1,                       integer >= 1
+///     "caseId": "liver-resection-01",           [a-z0-9][a-z0-9._-]*, at most 64 characters
+///     "caseVersion": "1.2.0",                   semantic version
+///     "minPlayerVersion": "0.1.0",              semantic version: oldest player that runs it
+///     "title": "Liver resection",               optional string
+///     "features": ["xpbd", "gravity"],          unique [a-z0-9][a-z0-9_-]* subsystem names
+///     "units": {"length": "m", "mass": "kg", "time": "s"},
+///     "device": {},                             device requirements (any JSON object)
+///     "files": [{"path": "meshes/liver.vtet", "size": 1234, "sha256": "<64 lowercase hex>"}]
+///   }
+///
+/// Parsing is strict: a missing required field, a wrong JSON type, an unknown field, a duplicate
+/// object key or a value breaking its rule throws viscera::InputError naming the origin, the field
+/// and the rule, e.g. "case.vcase: manifest.json: files[2].sha256: must be 64 lowercase hex
+/// characters". units must give length, mass and time in SI ("m", "kg", "s"); further
+/// quantities are kept as given. files[].path follows entryNameProblem() and is unique.
+/// Compatibility with this player (schemaVersion, minPlayerVersion) is a separate check,
+/// checkPlayerCompatibility(), so that the package verification order stays explicit.
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace viscera::vcase {
+
+/// The manifest schema this player reads and writes.
+inline constexpr int kSchemaVersion = 1;
+/// The manifest's entry name at the package root.
+inline constexpr std::string_view kManifestName = "manifest.json";
+
+struct FileEntry {
+    std::string path;   ///< entry name inside the package
+    uint64_t size = 0;  ///< uncompressed size, bytes
+    std::string sha256; ///< of the uncompressed bytes, 64 lowercase hex characters
+
+    friend bool operator==(const FileEntry&, const FileEntry&) = default;
+};
+
+struct Manifest {
+    int schemaVersion = kSchemaVersion;
+    std::string caseId;
+    std::string caseVersion;      ///< semantic version of the case content
+    std::string minPlayerVersion; ///< semantic version
+    std::optional<std::string> title;
+    std::vector<std::string> features; ///< subsystems the case needs ("xpbd", "fem", "needle")
+    std::map<std::string, std::string> units = {{"length", "m"}, {"mass", "kg"}, {"time", "s"}};
+    nlohmann::json device = nlohmann::json::object(); ///< requirements; an object, may be empty
+    std::vector<FileEntry> files;                     ///< every packaged file but manifest.json
+
+    /// JSON form; object keys come out sorted, so the text form is deterministic.
+    nlohmann::json toJson() const;
+    /// toJson() dumped with a 2-space indent and a final newline (the bytes that get packaged).
+    std::string toJsonText() const;
+
+    /// Strict conversion from JSON; `origin` prefixes every message ("case.vcase: manifest.json").
+    static Manifest fromJson(const nlohmann::json& json, std::string_view origin);
+    /// Parses JSON text (duplicate object keys rejected), then fromJson(). O(text length).
+    static Manifest parse(std::string_view text, std::string_view origin);
+
+    /// The files[] entry for `path`, or nullptr. O(#files).
+    const FileEntry* findFile(std::string_view path) const;
+
+    friend bool operator==(const Manifest&, const Manifest&) = default;
+};
+
+/// Throws viscera::InputError ("<origin>: schemaVersion 99 is newer than this player supports
+/// (1)") unless 1 <= schemaVersion <= kSchemaVersion and minPlayerVersion <= playerVersion().
+void checkPlayerCompatibility(const Manifest& manifest, std::string_view origin);
+
+} // namespace viscera::vcase
