@@ -1,0 +1,75 @@
+#pragma once
+/// Import of authoring surfaces (anatomy meshes from modelling tools) into a sim::TriMesh.
+///
+/// Accepted formats form a whitelist checked twice: by the file extension and by the file's
+/// content (magic bytes or leading tokens must agree with the extension). Everything else is
+/// rejected with viscera::InputError before any third-party parser sees the bytes. Messages are
+/// one line: "<file>: <element or field>: <rule that failed>".
+///
+/// The importer merges every mesh instance of the scene graph (node transforms applied, winding
+/// reversed under mirroring transforms), triangulates polygons, drops points and lines, joins
+/// identical vertices (by position, across meshes), drops triangles that collapse when vertices
+/// are joined and applies the unit scale. It does not repair geometry (holes, self-intersections,
+/// orientation): that is the sanitize stage's job, and tetrahedralize() checks what it needs.
+/// Unit metadata stored in a file (FBX UnitScaleFactor) is not applied: ImportOptions::scale is
+/// the only unit conversion (glTF is in metres by specification; OBJ, STL and PLY carry no unit).
+/// Dropped triangles are counted in ImportReport and logged through viscera::log (warning).
+#include "sim/mesh/tri_mesh.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string_view>
+
+namespace viscera::bake {
+
+enum class SurfaceFormat { Obj, StlAscii, StlBinary, Ply, Gltf, Glb, Fbx };
+
+/// Short human-readable name: "OBJ", "ASCII STL", "binary STL", "PLY", "glTF", "GLB", "FBX".
+std::string_view formatName(SurfaceFormat format);
+
+/// The accepted extensions, lower case with the dot: .obj .stl .ply .gltf .glb .fbx
+/// (matched case-insensitively).
+std::span<const std::string_view> acceptedExtensions();
+
+struct ImportOptions {
+    /// Factor from file units to metres, applied after node transforms (0.001 for a file in
+    /// millimetres, 0.01 for centimetres). Finite and > 0.
+    double scale = 1.0;
+    /// Files larger than this are rejected before parsing (bytes).
+    std::uintmax_t maxFileBytes = std::uintmax_t{1} << 30;
+};
+
+struct ImportReport {
+    SurfaceFormat format = SurfaceFormat::Obj;
+    size_t meshInstances = 0;               ///< mesh instances merged from the scene graph
+    size_t sourceTriangles = 0;             ///< triangles after triangulation, before cleanup
+    size_t degenerateTrianglesDropped = 0;  ///< triangles that collapsed when vertices were joined
+    size_t unreferencedVerticesDropped = 0; ///< vertices used by no kept triangle
+};
+
+struct ImportResult {
+    sim::TriMesh mesh; ///< positions in metres, file's world frame; triangles as in the file
+    ImportReport report;
+};
+
+/// Checks the extension and the content of `file` and returns its format without parsing the
+/// whole scene. Throws InputError: file missing or unreadable, empty, unsupported extension,
+/// content that does not match the extension.
+SurfaceFormat detectSurfaceFormat(const std::filesystem::path& file);
+
+/// Imports the surface in `file` (see the file comment for what is merged and joined).
+/// Throws viscera::InputError, naming the file, the element and the rule, when: the format is not
+/// accepted or the content does not match the extension; the file is empty, truncated or
+/// malformed; the scene has no triangles; a coordinate is not finite (names the vertex); a face
+/// references a vertex that does not exist (names the face and the index).
+/// Throws std::invalid_argument when `options.scale` is not finite and > 0.
+/// Cost: linear in the file size; the whole file is read into memory once for the checks.
+sim::TriMesh importSurface(const std::filesystem::path& file, const ImportOptions& options = {});
+
+/// importSurface() with the figures of what was merged and cleaned up.
+ImportResult importSurfaceWithReport(const std::filesystem::path& file,
+                                     const ImportOptions& options = {});
+
+} // namespace viscera::bake
