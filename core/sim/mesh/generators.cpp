@@ -70,6 +70,55 @@ TriMesh makeEllipsoidSurface(const Vec3& center, const Vec3& radii, int slices, 
     return TriMesh::fromArrays(std::move(pos), std::move(tris), "sim::makeEllipsoidSurface()");
 }
 
+TriMesh makeLiverSurface(const Vec3& center, const Vec3& halfSize, double wedge, int slices, int stacks) {
+    if (!(halfSize.array() > 0).all() || !(wedge > 0 && wedge <= 1))
+        throw std::invalid_argument("sim::makeLiverSurface(): half sizes must be positive and wedge in (0, 1]");
+    TriMesh unit = makeEllipsoidSurface(Vec3::Zero(), Vec3::Ones(), slices, stacks);
+    std::vector<Vec3> pos = unit.positions();
+    for (Vec3& p : pos) {
+        const double u = 0.5 * (p.x() + 1.0);               // 0 at the thin end, 1 at the thick end
+        const double thickness = wedge + (1.0 - wedge) * u; // z scale
+        p = Vec3(halfSize.x() * p.x(), halfSize.y() * p.y() + 0.25 * halfSize.y() * p.x() * p.x(),
+                 halfSize.z() * thickness * p.z());
+        p += center;
+    }
+    return TriMesh::fromArrays(std::move(pos), unit.triangles(), "sim::makeLiverSurface()");
+}
+
+TriMesh makeTubeSurface(const Vec3& a, const Vec3& b, double radius, int slices, int rings) {
+    const Vec3 axis = b - a;
+    const double len = axis.norm();
+    if (!(len > 0) || !(radius > 0) || slices < 3 || rings < 1)
+        throw std::invalid_argument("sim::makeTubeSurface(): needs a != b, radius > 0, slices >= 3, rings >= 1");
+    const Vec3 d = axis / len;
+    const Vec3 helper = std::abs(d.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+    const Vec3 e1 = d.cross(helper).normalized();
+    const Vec3 e2 = d.cross(e1);
+    std::vector<Vec3> pos;
+    std::vector<Tri> tris;
+    for (int r = 0; r <= rings; ++r)
+        for (int s = 0; s < slices; ++s) {
+            const double ph = 2.0 * std::numbers::pi * s / slices;
+            pos.push_back(a + axis * (double(r) / rings) + radius * (std::cos(ph) * e1 + std::sin(ph) * e2));
+        }
+    auto id = [&](int r, int s) { return static_cast<int32_t>(r * slices + (s % slices)); };
+    // e1 x e2 = d, so increasing angle runs counter-clockwise seen from +d: this winding points out.
+    for (int r = 0; r < rings; ++r)
+        for (int s = 0; s < slices; ++s) {
+            tris.push_back({id(r, s), id(r, s + 1), id(r + 1, s + 1)});
+            tris.push_back({id(r, s), id(r + 1, s + 1), id(r + 1, s)});
+        }
+    const auto ca = static_cast<int32_t>(pos.size());
+    pos.push_back(a);
+    const auto cb = static_cast<int32_t>(pos.size());
+    pos.push_back(b);
+    for (int s = 0; s < slices; ++s) {
+        tris.push_back({ca, id(0, s + 1), id(0, s)});
+        tris.push_back({cb, id(rings, s), id(rings, s + 1)});
+    }
+    return TriMesh::fromArrays(std::move(pos), std::move(tris), "sim::makeTubeSurface()");
+}
+
 TriMesh makeBoxSurface(const Vec3& lo, const Vec3& hi) {
     std::vector<Vec3> pos;
     for (int k = 0; k < 8; ++k)

@@ -22,6 +22,14 @@ std::unique_ptr<TetMesh> makeBoxTetMesh(const BoxSpec& spec);
 /// Closed outward-oriented triangulated ellipsoid (UV sphere scaled by radii), for meshing tests.
 TriMesh makeEllipsoidSurface(const Vec3& center, const Vec3& radii, int slices, int stacks);
 
+/// Closed outward-oriented liver-like surface: an ellipsoid with half-lengths `halfSize` (x long
+/// axis), made wedge-shaped (thick at +x, thin at −x, thickness ratio `wedge` in (0, 1]) and bent
+/// along y. The map from the sphere is injective, so the surface stays closed and manifold.
+TriMesh makeLiverSurface(const Vec3& center, const Vec3& halfSize, double wedge, int slices, int stacks);
+
+/// Closed outward-oriented capped cylinder from `a` to `b` with the given radius.
+TriMesh makeTubeSurface(const Vec3& a, const Vec3& b, double radius, int slices, int rings);
+
 /// Closed outward-oriented box surface (12 triangles).
 TriMesh makeBoxSurface(const Vec3& min, const Vec3& max);
 

@@ -44,3 +44,15 @@ TEST(TriMesh, RejectsBadInput) {
     p[1].x() = std::numeric_limits<double>::infinity();
     EXPECT_THROW(TriMesh::fromArrays(p, {{0, 1, 2}}), std::invalid_argument);
 }
+
+TEST(TriMesh, LiverAndTubeSurfacesAreClosedAndOutward) {
+    TriMesh liver = makeLiverSurface(Vec3::Zero(), Vec3(0.1, 0.07, 0.04), 0.5, 48, 24);
+    EXPECT_TRUE(liver.isClosedOriented());
+    EXPECT_GT(liver.signedVolume(), 0.0);
+    // The wedge makes it smaller than the ellipsoid it starts from.
+    EXPECT_LT(liver.signedVolume(), 4.0 / 3.0 * std::numbers::pi * 0.1 * 0.07 * 0.04);
+    TriMesh tube = makeTubeSurface(Vec3(0, 0, 0), Vec3(0.1, 0.02, 0), 0.005, 32, 8);
+    EXPECT_TRUE(tube.isClosedOriented());
+    const double exact = std::numbers::pi * 0.005 * 0.005 * std::hypot(0.1, 0.02);
+    EXPECT_NEAR(tube.signedVolume(), exact, 0.01 * exact);
+}
