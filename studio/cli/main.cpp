@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -108,6 +109,7 @@ int cmdImport(const std::vector<std::string>& args) {
                 lo.y(), lo.z(), hi.x(), hi.y(), hi.z());
     if (!tetra) return 0;
     const auto t0 = std::chrono::steady_clock::now();
+    meshing.label = std::filesystem::path(*in).filename().string();
     bake::TetrahedralizeResult r = bake::tetrahedralize(surface, meshing);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("tetrahedralized: %zu nodes, %zu tets in %.2f s\n", r.mesh->vertexCount(), r.mesh->tetCount(), secs);

@@ -1,0 +1,258 @@
+#include "sim/material/curve.hpp"
+
+#include "sim/util/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace viscera::sim {
+
+namespace {
+
+std::string num(double v) {
+    if (std::isnan(v)) return "nan"; // not "-nan": messages are compared verbatim
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.12g", v);
+    return buf;
+}
+
+/// Derivative at nodes[i] of the polynomial interpolating (x_j, y_j), j in [lo, hi]:
+/// Σ_{j≠i} L′_j(x_i) (y_j − y_i) (Σ_j L′_j = 0, so the differences avoid cancellation).
+double lagrangeSlope(const std::vector<CurvePoint>& p, std::size_t lo, std::size_t hi,
+                     std::size_t i) {
+    const double xi = p[i].x;
+    double slope = 0;
+    for (std::size_t j = lo; j <= hi; ++j) {
+        if (j == i) continue;
+        double numer = 1, denom = 1;
+        for (std::size_t m = lo; m <= hi; ++m) {
+            if (m == j) continue;
+            denom *= p[j].x - p[m].x;
+            if (m != i) numer *= xi - p[m].x;
+        }
+        slope += numer / denom * (p[j].y - p[i].y);
+    }
+    return slope;
+}
+
+} // namespace
+
+MonotoneCurve::MonotoneCurve(std::string name, std::vector<CurvePoint> points, CurveShape shape,
+                             std::string context)
+    : m_name(std::move(name)), m_context(std::move(context)), m_shape(shape),
+      m_points(std::move(points)) {
+    check(m_points);
+    rebuild();
+}
+
+MonotoneCurve MonotoneCurve::fit(std::string name, const std::function<double(double)>& fn,
+                                 const CurveFitSpec& spec) {
+    const std::string where = "sim::MonotoneCurve::fit(): curve " + name + ": ";
+    if (!fn) throw std::invalid_argument(where + "no function given");
+    if (spec.count < 2)
+        throw std::invalid_argument(where + "count " + std::to_string(spec.count) +
+                                    " must be at least 2");
+    if (!std::isfinite(spec.xmin) || !std::isfinite(spec.xmax) || !(spec.xmin < spec.xmax))
+        throw std::invalid_argument(where + "range [" + num(spec.xmin) + ", " + num(spec.xmax) +
+                                    "] must be finite with xmin < xmax");
+    if (spec.spacing == CurveSpacing::Geometric && !(spec.xmin > 0))
+        throw std::invalid_argument(
+            where + "geometric spacing needs xmin > 0 (xmin=" + num(spec.xmin) + ")");
+    std::vector<CurvePoint> pts(static_cast<std::size_t>(spec.count));
+    const double last = spec.count - 1;
+    for (int k = 0; k < spec.count; ++k) {
+        double x;
+        if (k == 0)
+            x = spec.xmin;
+        else if (k == spec.count - 1)
+            x = spec.xmax;
+        else if (spec.spacing == CurveSpacing::Geometric)
+            x = spec.xmin * std::exp(std::log(spec.xmax / spec.xmin) * (k / last));
+        else
+            x = spec.xmin + (spec.xmax - spec.xmin) * (k / last);
+        pts[static_cast<std::size_t>(k)] = {x, fn(x)};
+    }
+    return MonotoneCurve(std::move(name), std::move(pts), spec.shape);
+}
+
+void MonotoneCurve::check(const std::vector<CurvePoint>& p) const {
+    const std::string where =
+        (m_context.empty() ? std::string() : m_context + ": ") + "curve " + m_name + ": ";
+    if (p.size() < 2)
+        throw InputError(where + "needs at least 2 control points (has " +
+                         std::to_string(p.size()) + ")");
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        const std::string point = "control point " + std::to_string(i) + " (x=" + num(p[i].x) +
+                                  ", y=" + num(p[i].y) + ")";
+        if (!std::isfinite(p[i].x) || !std::isfinite(p[i].y))
+            throw InputError(where + point + " is not finite");
+        if (i == 0) continue;
+        if (!(p[i].x > p[i - 1].x))
+            throw InputError(where + point + " does not lie right of point " +
+                             std::to_string(i - 1) + " (x=" + num(p[i - 1].x) + ")");
+        if (m_shape == CurveShape::StrictlyIncreasing && !(p[i].y > p[i - 1].y))
+            throw InputError(where + point + " does not increase over point " +
+                             std::to_string(i - 1) + " (y=" + num(p[i - 1].y) + ")");
+    }
+}
+
+void MonotoneCurve::validate() const {
+    check(m_points);
+}
+
+void MonotoneCurve::rebuild() {
+    const std::size_t n = m_points.size();
+    const auto& p = m_points;
+    const std::size_t k = std::min<std::size_t>(5, n);
+    m_slopes.assign(n, 0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t lo = std::min(i >= 2 ? i - 2 : 0, n - k);
+        m_slopes[i] = lagrangeSlope(p, lo, lo + k - 1, i);
+    }
+    std::vector<double> secant(n - 1);
+    for (std::size_t i = 0; i + 1 < n; ++i)
+        secant[i] = (p[i + 1].y - p[i].y) / (p[i + 1].x - p[i].x);
+    if (m_shape == CurveShape::StrictlyIncreasing) {
+        for (std::size_t i = 0; i < n; ++i) {
+            const double bound = 3.0 * (i == 0       ? secant[0]
+                                        : i + 1 == n ? secant[n - 2]
+                                                     : std::min(secant[i - 1], secant[i]));
+            m_slopes[i] = std::clamp(m_slopes[i], 0.0, bound);
+        }
+    }
+    m_c.assign(n - 1, 0.0);
+    m_d.assign(n - 1, 0.0);
+    m_cumulative.assign(n, 0.0);
+    for (std::size_t i = 0; i + 1 < n; ++i) {
+        const double h = p[i + 1].x - p[i].x;
+        const double m0 = m_slopes[i], m1 = m_slopes[i + 1];
+        m_c[i] = (3.0 * secant[i] - 2.0 * m0 - m1) / h;
+        m_d[i] = (m0 + m1 - 2.0 * secant[i]) / (h * h);
+        m_cumulative[i + 1] =
+            m_cumulative[i] + h * (p[i].y + h * (m0 / 2.0 + h * (m_c[i] / 3.0 + h * m_d[i] / 4.0)));
+    }
+}
+
+std::size_t MonotoneCurve::segment(double x) const {
+    // First point with x_k > x, minus one, clamped to a valid segment.
+    const auto it = std::upper_bound(m_points.begin(), m_points.end(), x,
+                                     [](double v, const CurvePoint& q) { return v < q.x; });
+    const std::size_t idx = static_cast<std::size_t>(it - m_points.begin());
+    return std::clamp<std::size_t>(idx == 0 ? 0 : idx - 1, 0, m_points.size() - 2);
+}
+
+double MonotoneCurve::value(double x) const {
+    if (x <= m_points.front().x)
+        return m_points.front().y + m_slopes.front() * (x - m_points.front().x);
+    if (x >= m_points.back().x)
+        return m_points.back().y + m_slopes.back() * (x - m_points.back().x);
+    const std::size_t k = segment(x);
+    const double s = x - m_points[k].x;
+    return m_points[k].y + s * (m_slopes[k] + s * (m_c[k] + s * m_d[k]));
+}
+
+double MonotoneCurve::derivative(double x) const {
+    if (x <= m_points.front().x) return m_slopes.front();
+    if (x >= m_points.back().x) return m_slopes.back();
+    const std::size_t k = segment(x);
+    const double s = x - m_points[k].x;
+    return m_slopes[k] + s * (2.0 * m_c[k] + 3.0 * s * m_d[k]);
+}
+
+double MonotoneCurve::antiderivative(double x) const {
+    if (x <= m_points.front().x) {
+        const double s = x - m_points.front().x;
+        return s * (m_points.front().y + 0.5 * m_slopes.front() * s);
+    }
+    if (x >= m_points.back().x) {
+        const double s = x - m_points.back().x;
+        return m_cumulative.back() + s * (m_points.back().y + 0.5 * m_slopes.back() * s);
+    }
+    const std::size_t k = segment(x);
+    const double s = x - m_points[k].x;
+    return m_cumulative[k] +
+           s * (m_points[k].y + s * (m_slopes[k] / 2.0 + s * (m_c[k] / 3.0 + s * m_d[k] / 4.0)));
+}
+
+double MonotoneCurve::segmentPrimitive(std::size_t k, double s) const {
+    return s * (m_points[k].y + s * (m_slopes[k] / 2.0 + s * (m_c[k] / 3.0 + s * m_d[k] / 4.0)));
+}
+
+double MonotoneCurve::integral(double a, double b) const {
+    if (b < a) return -integral(b, a);
+    // Split into the left extension, the spline and the right extension. Inside the spline,
+    // short spans sum their segments directly (no cancellation of the cumulative sums, which
+    // keeps energies near rest accurate); long spans use the cumulative table.
+    const double x0 = m_points.front().x, xn = m_points.back().x;
+    double sum = 0;
+    if (a < x0) {
+        const double y0 = m_points.front().y, m0 = m_slopes.front();
+        const auto prim = [&](double t) { return (t - x0) * (y0 + 0.5 * m0 * (t - x0)); };
+        sum += prim(std::min(b, x0)) - prim(a);
+    }
+    if (b > xn) {
+        const double yn = m_points.back().y, mn = m_slopes.back();
+        const auto prim = [&](double t) { return (t - xn) * (yn + 0.5 * mn * (t - xn)); };
+        sum += prim(b) - prim(std::max(a, xn));
+    }
+    const double u = std::max(a, x0), v = std::min(b, xn);
+    if (u < v) {
+        const std::size_t ku = segment(u), kv = segment(v);
+        const double su = u - m_points[ku].x, sv = v - m_points[kv].x;
+        if (ku == kv) {
+            sum += segmentPrimitive(ku, sv) - segmentPrimitive(ku, su);
+        } else if (kv - ku <= 16) {
+            const auto whole = [&](std::size_t k) {
+                return segmentPrimitive(k, m_points[k + 1].x - m_points[k].x);
+            };
+            sum += whole(ku) - segmentPrimitive(ku, su);
+            for (std::size_t k = ku + 1; k < kv; ++k)
+                sum += whole(k);
+            sum += segmentPrimitive(kv, sv);
+        } else {
+            sum += (m_cumulative[kv] - m_cumulative[ku]) + segmentPrimitive(kv, sv) -
+                   segmentPrimitive(ku, su);
+        }
+    }
+    return sum;
+}
+
+void MonotoneCurve::setControlPoint(std::size_t i, double x, double y) {
+    if (i >= m_points.size())
+        throw std::out_of_range("sim::MonotoneCurve::setControlPoint(): index " +
+                                std::to_string(i) + " out of range (curve " + m_name + " has " +
+                                std::to_string(m_points.size()) + " control points)");
+    auto edited = m_points;
+    edited[i] = {x, y};
+    check(edited);
+    m_points = std::move(edited);
+    rebuild();
+}
+
+std::size_t MonotoneCurve::insertControlPoint(double x, double y) {
+    auto edited = m_points;
+    const auto it = std::lower_bound(edited.begin(), edited.end(), x,
+                                     [](const CurvePoint& q, double v) { return q.x < v; });
+    const std::size_t idx = static_cast<std::size_t>(it - edited.begin());
+    edited.insert(it, CurvePoint{x, y});
+    check(edited);
+    m_points = std::move(edited);
+    rebuild();
+    return idx;
+}
+
+void MonotoneCurve::removeControlPoint(std::size_t i) {
+    if (i >= m_points.size())
+        throw std::out_of_range("sim::MonotoneCurve::removeControlPoint(): index " +
+                                std::to_string(i) + " out of range (curve " + m_name + " has " +
+                                std::to_string(m_points.size()) + " control points)");
+    auto edited = m_points;
+    edited.erase(edited.begin() + static_cast<std::ptrdiff_t>(i));
+    check(edited);
+    m_points = std::move(edited);
+    rebuild();
+}
+
+} // namespace viscera::sim
