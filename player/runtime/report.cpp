@@ -40,8 +40,14 @@ nlohmann::json reportJson(const SessionResult& r) {
                           {"energy_j", f.energy},
                           {"max_displacement_m", f.maxDisplacement}});
     doc["frames"] = std::move(frames);
-    // Accuracy against a converged reference arrives with the Newton reference solver.
-    doc["accuracy"] = json::array();
+    json accuracy = json::array();
+    for (const auto& a : r.accuracy)
+        accuracy.push_back({{"frame", a.frame},
+                            {"solver", a.solver},
+                            {"iterations", a.iterations},
+                            {"rel_error", a.relError},
+                            {"time_ms", a.timeMs}});
+    doc["accuracy"] = std::move(accuracy);
     doc["invariants"] = {{"all_finite", r.invariants.allFinite},
                          {"max_energy", r.invariants.maxEnergy},
                          {"max_step_displacement_m", r.invariants.maxStepDisplacement},
@@ -82,7 +88,23 @@ std::string summaryText(const SessionResult& r) {
                   r.invariants.maxStepDisplacement * 1e3, r.invariants.allFinite ? "yes" : "NO",
                   r.invariants.maxEnergy, r.invariants.maxForce,
                   r.ok() ? "ok" : ("FAILED: " + (r.errors.empty() ? std::string("invariants") : r.errors.front())).c_str());
-    return buf;
+    std::string out = buf;
+    // Error against run time on the last sampled frame [A eq. 4.45].
+    for (auto it = r.accuracy.rbegin(); it != r.accuracy.rend(); ++it) {
+        if (it->solver != "xpbd" || it->relError.size() < 2) continue;
+        size_t k = 1;
+        while (k < it->relError.size() && it->relError[k] > 1e-4) ++k;
+        char line[256];
+        if (k < it->relError.size())
+            std::snprintf(line, sizeof line, "accuracy      frame %d: XPBD rel. error %.2e after 1 iteration, <= 1e-4 after %d (%.3f ms)\n",
+                          it->frame, it->relError[1], it->iterations[k], it->timeMs[k]);
+        else
+            std::snprintf(line, sizeof line, "accuracy      frame %d: XPBD rel. error %.2e after 1 iteration, %.2e after %d (%.3f ms)\n",
+                          it->frame, it->relError[1], it->relError.back(), it->iterations.back(), it->timeMs.back());
+        out += line;
+        break;
+    }
+    return out;
 }
 
 } // namespace viscera::player

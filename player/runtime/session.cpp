@@ -22,7 +22,14 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
                              "', which is not in the package");
         meshes.push_back(sim::parseVtet(pkg.read(b.meshPath), pkg.name() + ":" + b.meshPath));
     }
-    out.world = sim::World::assemble(out.scene, std::move(meshes), pkg.manifest().features,
+    std::vector<sim::TriMesh> surfaces;
+    for (const sim::SurfaceDesc& sd : out.scene.surfaces) {
+        if (!pkg.contains(sd.meshPath))
+            throw InputError(pkg.name() + ": " + sceneName + ": surface '" + sd.name + "' uses mesh '" + sd.meshPath +
+                             "', which is not in the package");
+        surfaces.push_back(sim::parseVtri(pkg.read(sd.meshPath), pkg.name() + ":" + sd.meshPath));
+    }
+    out.world = sim::World::assemble(out.scene, std::move(meshes), std::move(surfaces), pkg.manifest().features,
                                      pkg.name() + ": manifest.json");
     return out;
 }
@@ -52,9 +59,10 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     r.wallTime = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     r.simTime = world.time();
     r.invariants = world.invariants();
+    r.accuracy = world.accuracy();
     for (size_t b = 0; b < world.bodyCount(); ++b) {
         const auto& rest = world.restMesh(b).positions();
-        const auto& x = world.body(b).positions();
+        const auto& x = world.positions(b);
         for (size_t v = 0; v < x.size(); ++v)
             r.maxNodeDisplacement = std::max(r.maxNodeDisplacement, (x[v] - rest[v]).norm());
     }

@@ -32,6 +32,7 @@ struct SessionResult {
     std::string caseId, caseVersion, title;
     std::vector<std::string> activeSubsystems;
     std::vector<sim::FrameRecord> frames;
+    std::vector<sim::AccuracyRecord> accuracy;
     sim::Invariants invariants;
     double simTime = 0;           ///< s
     double wallTime = 0;          ///< s

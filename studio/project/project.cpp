@@ -3,7 +3,9 @@
 #include "bake/import.hpp"
 #include "case/case_writer.hpp"
 #include "sim/mesh/tet_io.hpp"
+#include "sim/scene/material_json.hpp"
 #include "sim/scene/scene.hpp"
+#include "sim/scene/world.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
 
@@ -121,8 +123,29 @@ MeshSource parseMeshSource(const Fields& f, const json& m, const std::string& pa
         if (auto* v = f.opt(m, "slices")) s.slices = f.integer(*v, path + ".slices", 3, 1024);
         if (auto* v = f.opt(m, "stacks")) s.stacks = f.integer(*v, path + ".stacks", 2, 1024);
         s.meshing = parseMeshing(f, f.opt(m, "meshing"), path + ".meshing");
+    } else if (gen == "liver") {
+        f.only(m, {"generator", "center", "half_size", "wedge", "slices", "stacks", "meshing"}, path);
+        s.kind = MeshSource::Kind::Liver;
+        if (auto* v = f.opt(m, "center")) s.center = f.vec3(*v, path + ".center");
+        s.radii = f.vec3(f.req(m, "half_size", path), path + ".half_size");
+        if (!(s.radii.array() > 0).all()) f.fail(path + ".half_size", "every half size must be positive");
+        if (auto* v = f.opt(m, "wedge")) s.wedge = f.positive(*v, path + ".wedge");
+        if (s.wedge > 1) f.fail(path + ".wedge", "must be in (0, 1]");
+        if (auto* v = f.opt(m, "slices")) s.slices = f.integer(*v, path + ".slices", 3, 1024);
+        if (auto* v = f.opt(m, "stacks")) s.stacks = f.integer(*v, path + ".stacks", 2, 1024);
+        s.meshing = parseMeshing(f, f.opt(m, "meshing"), path + ".meshing");
+    } else if (gen == "tube") {
+        f.only(m, {"generator", "start", "end", "radius", "slices", "rings", "meshing"}, path);
+        s.kind = MeshSource::Kind::Tube;
+        s.center = f.vec3(f.req(m, "start", path), path + ".start");
+        s.end = f.vec3(f.req(m, "end", path), path + ".end");
+        s.radius = f.positive(f.req(m, "radius", path), path + ".radius");
+        if ((s.end - s.center).norm() <= 0) f.fail(path + ".end", "must differ from start");
+        if (auto* v = f.opt(m, "slices")) s.slices = f.integer(*v, path + ".slices", 3, 1024);
+        if (auto* v = f.opt(m, "rings")) s.stacks = f.integer(*v, path + ".rings", 1, 1024);
+        s.meshing = parseMeshing(f, f.opt(m, "meshing"), path + ".meshing");
     } else {
-        f.fail(path + ".generator", "'" + gen + "' is not a known generator (box, ellipsoid)");
+        f.fail(path + ".generator", "'" + gen + "' is not a known generator (box, ellipsoid, liver, tube)");
     }
     return s;
 }
@@ -137,7 +160,9 @@ Project loadProject(const std::filesystem::path& dir) {
     if (doc.is_discarded()) throw InputError(origin + ": not valid JSON");
     Fields f(origin);
     if (!doc.is_object()) f.fail("(root)", "must be an object");
-    f.only(doc, {"schemaVersion", "caseId", "caseVersion", "title", "instructions", "solver", "gravity", "bodies"}, "");
+    f.only(doc, {"schemaVersion", "caseId", "caseVersion", "title", "instructions", "solver", "gravity", "bodies",
+                 "surfaces", "accuracy"},
+           "");
     Project p;
     p.dir = dir;
     p.schemaVersion = f.integer(f.req(doc, "schemaVersion", ""), "schemaVersion", 1, 1);
@@ -146,7 +171,7 @@ Project loadProject(const std::filesystem::path& dir) {
     if (auto* v = f.opt(doc, "title")) p.title = f.str(*v, "title");
     if (auto* v = f.opt(doc, "instructions")) p.instructions = f.str(*v, "instructions");
     const json& solver = f.req(doc, "solver", "");
-    f.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed"}, "solver");
+    f.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads"}, "solver");
     const std::string type = f.str(f.req(solver, "type", "solver"), "solver.type");
     if (type != "xpbd") f.fail("solver.type", "'" + type + "' is not supported (supported: xpbd)");
     if (auto* v = f.opt(solver, "dt")) p.solver.dt = f.positive(*v, "solver.dt");
@@ -154,6 +179,14 @@ Project loadProject(const std::filesystem::path& dir) {
     if (auto* v = f.opt(solver, "iterations")) p.solver.iterations = f.integer(*v, "solver.iterations", 1, 1000);
     if (auto* v = f.opt(solver, "damping")) p.solver.damping = f.num(*v, "solver.damping");
     if (auto* v = f.opt(solver, "max_speed")) p.solver.maxSpeed = f.positive(*v, "solver.max_speed");
+    if (auto* v = f.opt(solver, "threads")) p.solver.threads = f.integer(*v, "solver.threads", 1, 64);
+    if (auto* a = f.opt(doc, "accuracy")) {
+        f.only(*a, {"every_frames", "max_iterations"}, "accuracy");
+        sim::AccuracySampling acc;
+        if (auto* v = f.opt(*a, "every_frames")) acc.everyFrames = f.integer(*v, "accuracy.every_frames", 1, 1 << 30);
+        if (auto* v = f.opt(*a, "max_iterations")) acc.maxIterations = f.integer(*v, "accuracy.max_iterations", 1, 10000);
+        p.accuracy = acc;
+    }
     p.solver.gravity = f.opt(doc, "gravity") ? f.vec3(doc["gravity"], "gravity") : sim::Vec3::Zero();
     if (auto why = sim::validate(p.solver); !why.empty()) f.fail("solver", why);
 
@@ -164,7 +197,7 @@ Project loadProject(const std::filesystem::path& dir) {
         const std::string path = "bodies[" + std::to_string(i) + "]";
         const json& b = bodies[i];
         if (!b.is_object()) f.fail(path, "must be an object");
-        f.only(b, {"name", "mesh", "material", "fixed"}, path);
+        f.only(b, {"name", "mesh", "material", "fixed", "stiffness_regions", "embedded_in", "embedding_compliance"}, path);
         BodyProject body;
         body.name = f.str(f.req(b, "name", path), path + ".name");
         bool okName = !body.name.empty() && body.name.size() <= 64;
@@ -172,18 +205,22 @@ Project loadProject(const std::filesystem::path& dir) {
         if (!okName) f.fail(path + ".name", "must be 1-64 characters of [A-Za-z0-9_-]");
         if (!names.insert(body.name).second) f.fail(path + ".name", "'" + body.name + "' is used twice");
         body.mesh = parseMeshSource(f, f.req(b, "mesh", path), path + ".mesh", dir);
-        const json& m = f.req(b, "material", path);
-        const std::string mp = path + ".material";
-        f.only(m, {"model", "youngs_modulus", "poisson_ratio", "density"}, mp);
-        try {
-            body.material.model = sim::materialModelFromName(f.str(f.req(m, "model", mp), mp + ".model"));
-        } catch (const std::invalid_argument& e) {
-            f.fail(mp + ".model", e.what());
+        body.material = sim::parseMaterial(f.req(b, "material", path), path + ".material", origin);
+        if (auto* regions = f.opt(b, "stiffness_regions")) {
+            if (!regions->is_array()) f.fail(path + ".stiffness_regions", "must be an array");
+            for (size_t k = 0; k < regions->size(); ++k) {
+                const std::string rp = path + ".stiffness_regions[" + std::to_string(k) + "]";
+                const json& rj = (*regions)[k];
+                f.only(rj, {"min", "max", "weight"}, rp);
+                StiffnessRegion reg;
+                reg.min = f.vec3(f.req(rj, "min", rp), rp + ".min");
+                reg.max = f.vec3(f.req(rj, "max", rp), rp + ".max");
+                reg.weight = f.positive(f.req(rj, "weight", rp), rp + ".weight");
+                body.stiffnessRegions.push_back(reg);
+            }
         }
-        body.material.youngsModulus = f.num(f.req(m, "youngs_modulus", mp), mp + ".youngs_modulus");
-        body.material.poissonRatio = f.num(f.req(m, "poisson_ratio", mp), mp + ".poisson_ratio");
-        body.material.density = f.num(f.req(m, "density", mp), mp + ".density");
-        if (auto why = sim::validate(body.material); !why.empty()) f.fail(mp, why);
+        if (auto* v = f.opt(b, "embedded_in")) body.embeddedIn = f.str(*v, path + ".embedded_in");
+        if (auto* v = f.opt(b, "embedding_compliance")) body.embeddingCompliance = f.num(*v, path + ".embedding_compliance");
         if (auto* fx = f.opt(b, "fixed")) {
             f.only(*fx, {"min", "max"}, path + ".fixed");
             sim::Vec3 lo = f.vec3(f.req(*fx, "min", path + ".fixed"), path + ".fixed.min");
@@ -193,28 +230,92 @@ Project loadProject(const std::filesystem::path& dir) {
         }
         p.bodies.push_back(std::move(body));
     }
+    for (size_t i = 0; i < p.bodies.size(); ++i) {
+        const std::string& cage = p.bodies[i].embeddedIn;
+        if (!cage.empty() && (!names.count(cage) || cage == p.bodies[i].name))
+            f.fail("bodies[" + std::to_string(i) + "].embedded_in", "'" + cage + "' is not another body of the project");
+    }
+    if (auto* surfaces = f.opt(doc, "surfaces")) {
+        if (!surfaces->is_array()) f.fail("surfaces", "must be an array");
+        for (size_t i = 0; i < surfaces->size(); ++i) {
+            const std::string path = "surfaces[" + std::to_string(i) + "]";
+            const json& sj = (*surfaces)[i];
+            f.only(sj, {"name", "from_boundary_of", "region", "areal_density", "stretch_stiffness", "attach_distance",
+                        "attach_compliance"},
+                   path);
+            SurfaceProject sp;
+            sp.name = f.str(f.req(sj, "name", path), path + ".name");
+            if (sp.name.empty() || !names.insert(sp.name).second) f.fail(path + ".name", "must be non-empty and unique");
+            sp.fromBoundaryOf = f.str(f.req(sj, "from_boundary_of", path), path + ".from_boundary_of");
+            if (!names.count(sp.fromBoundaryOf)) f.fail(path + ".from_boundary_of", "'" + sp.fromBoundaryOf + "' is not a body");
+            if (auto* r = f.opt(sj, "region")) {
+                f.only(*r, {"min", "max"}, path + ".region");
+                sp.region = std::array<sim::Vec3, 2>{f.vec3(f.req(*r, "min", path + ".region"), path + ".region.min"),
+                                                     f.vec3(f.req(*r, "max", path + ".region"), path + ".region.max")};
+            }
+            if (auto* v = f.opt(sj, "areal_density")) sp.arealDensity = f.positive(*v, path + ".areal_density");
+            if (auto* v = f.opt(sj, "stretch_stiffness")) sp.stretchStiffness = f.num(*v, path + ".stretch_stiffness");
+            if (auto* v = f.opt(sj, "attach_distance")) sp.attachDistance = f.positive(*v, path + ".attach_distance");
+            if (auto* v = f.opt(sj, "attach_compliance")) sp.attachCompliance = f.num(*v, path + ".attach_compliance");
+            p.surfaces.push_back(std::move(sp));
+        }
+    }
     return p;
 }
 
 std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::string& origin) {
     const MeshSource& s = body.mesh;
+    bake::MeshingParams params = s.meshing;
+    params.label = origin + ": body '" + body.name + "'";
     switch (s.kind) {
     case MeshSource::Kind::Box: return sim::makeBoxTetMesh(s.box);
-    case MeshSource::Kind::Ellipsoid: {
-        bake::MeshingParams params = s.meshing;
-        params.label = origin + ": body '" + body.name + "' ellipsoid";
+    case MeshSource::Kind::Ellipsoid:
         return bake::tetrahedralize(sim::makeEllipsoidSurface(s.center, s.radii, s.slices, s.stacks), params).mesh;
-    }
+    case MeshSource::Kind::Liver:
+        return bake::tetrahedralize(sim::makeLiverSurface(s.center, s.radii, s.wedge, s.slices, s.stacks), params).mesh;
+    case MeshSource::Kind::Tube:
+        return bake::tetrahedralize(sim::makeTubeSurface(s.center, s.end, s.radius, s.slices, s.stacks), params).mesh;
     case MeshSource::Kind::File: {
         bake::ImportOptions opt;
         opt.scale = s.scale;
-        bake::MeshingParams params = s.meshing;
         params.label = s.file.filename().string();
         return bake::tetrahedralize(bake::importSurface(s.file, opt), params).mesh;
     }
     }
     throw InputError(origin + ": unknown mesh source");
 }
+
+namespace {
+
+bool inBox(const sim::Vec3& p, const sim::Vec3& lo, const sim::Vec3& hi) {
+    return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all();
+}
+
+/// The boundary triangles of `mesh` whose centroid lies in `region` (all when absent), as a
+/// surface with its own compacted vertices.
+sim::TriMesh cutBoundary(sim::TetMesh& mesh, const std::optional<std::array<sim::Vec3, 2>>& region) {
+    mesh.requireLevel(3);
+    const sim::TriMesh& b = mesh.boundary();
+    std::vector<int32_t> remap(b.vertexCount(), sim::kNone);
+    std::vector<sim::Vec3> pos;
+    std::vector<sim::Tri> tris;
+    for (const sim::Tri& t : b.triangles()) {
+        const sim::Vec3 c = (b.positions()[t[0]] + b.positions()[t[1]] + b.positions()[t[2]]) / 3.0;
+        if (region && !inBox(c, (*region)[0], (*region)[1])) continue;
+        sim::Tri out;
+        for (int k = 0; k < 3; ++k) {
+            if (remap[t[k]] == sim::kNone) {
+                remap[t[k]] = static_cast<int32_t>(pos.size());
+                pos.push_back(b.positions()[t[k]]);
+            }
+            out[k] = remap[t[k]];
+        }
+        tris.push_back(out);
+    }
+    return sim::TriMesh::fromArrays(std::move(pos), std::move(tris), "fascia region");
+}
+
+} // namespace
 
 ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress) {
     auto stage = [&](const std::string& s) {
@@ -225,17 +326,11 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     scene.solverType = "xpbd";
     scene.xpbd = project.solver;
     scene.instructions = project.instructions;
-    vcase::Manifest header;
-    header.caseId = project.caseId;
-    header.caseVersion = project.caseVersion;
-    header.minPlayerVersion = VISCERA_VERSION;
-    if (!project.title.empty()) header.title = project.title;
-    // Features: only what the scene needs.
-    header.features = {"xpbd"};
-    if (project.solver.gravity.squaredNorm() > 0) header.features.insert(header.features.begin(), "gravity");
+    scene.accuracy = project.accuracy;
 
     ExportResult result;
     std::vector<std::pair<std::string, std::string>> files;
+    std::vector<std::unique_ptr<sim::TetMesh>> meshes;
     for (size_t i = 0; i < project.bodies.size(); ++i) {
         const BodyProject& b = project.bodies[i];
         const std::string field = "bodies[" + std::to_string(i) + "] ('" + b.name + "')";
@@ -261,27 +356,64 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
         desc.name = b.name;
         desc.meshPath = "meshes/" + b.name + ".vtet";
         desc.material = b.material;
+        desc.embeddedIn = b.embeddedIn;
+        desc.embeddingCompliance = b.embeddingCompliance;
+        const auto& pos = mesh->positions();
         if (b.fixedBox) {
-            const auto& [lo, hi] = *b.fixedBox;
-            const auto& pos = mesh->positions();
             for (int32_t v = 0; v < static_cast<int32_t>(pos.size()); ++v)
-                if ((pos[v].array() >= lo.array()).all() && (pos[v].array() <= hi.array()).all())
-                    desc.fixedNodes.push_back(v);
-            if (desc.fixedNodes.empty())
-                throw InputError(origin + ": " + field + ".fixed: the box contains no mesh node");
+                if (inBox(pos[v], (*b.fixedBox)[0], (*b.fixedBox)[1])) desc.fixedNodes.push_back(v);
+            if (desc.fixedNodes.empty()) throw InputError(origin + ": " + field + ".fixed: the box contains no mesh node");
+        }
+        if (!b.stiffnessRegions.empty()) {
+            desc.nodeWeights.assign(pos.size(), 1.0);
+            for (size_t v = 0; v < pos.size(); ++v)
+                for (const StiffnessRegion& r : b.stiffnessRegions)
+                    if (inBox(pos[v], r.min, r.max)) desc.nodeWeights[v] = r.weight;
         }
         be.fixedNodes = desc.fixedNodes.size();
-        // The player runs what it loads: refuse a body that cannot be simulated stably now.
-        try {
-            (void)sim::XpbdSolver::create(*mesh, b.material, desc.fixedNodes, project.solver);
-        } catch (const std::invalid_argument& e) {
-            throw InputError(origin + ": " + field + ": cannot be simulated stably: " + e.what());
-        }
         files.emplace_back(desc.meshPath, sim::formatVtet(*mesh));
         scene.bodies.push_back(std::move(desc));
         result.bodies.push_back(std::move(be));
+        meshes.push_back(std::move(mesh));
     }
+    std::vector<sim::TriMesh> surfaces;
+    for (size_t s = 0; s < project.surfaces.size(); ++s) {
+        const SurfaceProject& sp = project.surfaces[s];
+        stage("cutting surface '" + sp.name + "'");
+        size_t body = 0;
+        while (project.bodies[body].name != sp.fromBoundaryOf) ++body;
+        sim::TriMesh tri;
+        try {
+            tri = cutBoundary(*meshes[body], sp.region);
+        } catch (const std::invalid_argument&) {
+            throw InputError(origin + ": surfaces[" + std::to_string(s) + "].region: contains no boundary triangle of '" +
+                             sp.fromBoundaryOf + "'");
+        }
+        sim::SurfaceDesc sd;
+        sd.name = sp.name;
+        sd.meshPath = "meshes/" + sp.name + ".vtri";
+        sd.arealDensity = sp.arealDensity;
+        sd.stretchStiffness = sp.stretchStiffness;
+        sd.attachTo = sp.fromBoundaryOf;
+        sd.attachDistance = sp.attachDistance;
+        sd.attachCompliance = sp.attachCompliance;
+        files.emplace_back(sd.meshPath, sim::formatVtri(tri));
+        scene.surfaces.push_back(std::move(sd));
+        surfaces.push_back(std::move(tri));
+    }
+    // Features: only what the scene needs. The player runs what it loads, so assemble the world
+    // here exactly as the player will and refuse a case that cannot be simulated stably.
+    const std::vector<std::string> features = sim::requiredFeatures(scene);
+    stage("checking the scene");
+    sim::World::assemble(scene, std::move(meshes), std::move(surfaces), features, origin);
+
     stage("packaging");
+    vcase::Manifest header;
+    header.caseId = project.caseId;
+    header.caseVersion = project.caseVersion;
+    header.minPlayerVersion = VISCERA_VERSION;
+    if (!project.title.empty()) header.title = project.title;
+    header.features = features;
     vcase::CaseWriter writer(header);
     writer.addFile("scene.json", sim::formatScene(scene));
     for (auto& [path, bytes] : files) writer.addFile(path, std::move(bytes));

@@ -13,11 +13,17 @@
 ///     "mesh": {"generator": "box", "origin": [0,0,0], "size": [0.1,0.02,0.04], "cells": [20,4,8]}
 ///          | {"generator": "ellipsoid", "center": [..], "radii": [..], "slices": 48, "stacks": 24,
 ///             "meshing": {..}}
+///          | {"generator": "liver", "center": [..], "half_size": [..], "wedge": 0.5, "meshing": {..}}
+///          | {"generator": "tube", "start": [..], "end": [..], "radius": 0.004, "meshing": {..}}
 ///          | {"file": "liver.obj", "scale": 0.001, "meshing": {..}},
-///     "material": {"model": "neo_hookean", "youngs_modulus": 3000, "poisson_ratio": 0.45,
-///                  "density": 1050},
-///     "fixed": {"min": [..], "max": [..]}      nodes inside this box (metres) are fixed
-///   }]
+///     "material": {see core/sim/scene/material_json.hpp},
+///     "fixed": {"min": [..], "max": [..]},     nodes inside this box (metres) are fixed
+///     "stiffness_regions": [{"min": [..], "max": [..], "weight": 4}],
+///     "embedded_in": "organ", "embedding_compliance": 0
+///   }],
+///   "surfaces": [{"name": "fascia", "from_boundary_of": "organ", "region": {"min": .., "max": ..},
+///                 "areal_density": 0.1, "stretch_stiffness": 50, "attach_distance": 0.001}],
+///   "accuracy": {"every_frames": 60, "max_iterations": 100}
 /// }
 /// "meshing" (CGAL Mesh_3, metres and degrees): facet_angle, facet_size, facet_distance,
 /// cell_radius_edge_ratio, cell_size, seed.
@@ -25,6 +31,7 @@
 #include "sim/material/material.hpp"
 #include "sim/mesh/generators.hpp"
 #include "sim/mesh/tet_mesh.hpp"
+#include "sim/scene/scene.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
 
 #include <filesystem>
@@ -36,14 +43,23 @@
 namespace viscera::studio {
 
 struct MeshSource {
-    enum class Kind { Box, Ellipsoid, File };
+    enum class Kind { Box, Ellipsoid, Liver, Tube, File };
     Kind kind = Kind::Box;
     sim::BoxSpec box;
-    sim::Vec3 center = sim::Vec3::Zero(), radii = sim::Vec3::Constant(0.05);
+    sim::Vec3 center = sim::Vec3::Zero(), radii = sim::Vec3::Constant(0.05); ///< tube: center = start
+    sim::Vec3 end = sim::Vec3::Zero();  ///< tube end
+    double radius = 0.005;              ///< tube radius, m
+    double wedge = 0.5;                 ///< liver thickness ratio
     int slices = 48, stacks = 24;
     std::filesystem::path file; ///< absolute, resolved against the project folder
     double scale = 1.0;
     bake::MeshingParams meshing;
+};
+
+/// Nodes inside an axis-aligned box get a stiffness weight (the skeleton brush comes later).
+struct StiffnessRegion {
+    sim::Vec3 min, max; ///< metres
+    double weight = 1;  ///< > 0; multiplies the material's stiffness
 };
 
 struct BodyProject {
@@ -51,6 +67,18 @@ struct BodyProject {
     MeshSource mesh;
     sim::Material material;
     std::optional<std::array<sim::Vec3, 2>> fixedBox; ///< {min, max}, metres
+    std::vector<StiffnessRegion> stiffnessRegions;
+    std::string embeddedIn; ///< cage body name; empty = free-standing
+    double embeddingCompliance = 0;
+};
+
+/// A fascia layer cut from the boundary of a tet body: the boundary triangles whose centroid lies
+/// in `region` (all when absent), with their own particles, attached back to the body.
+struct SurfaceProject {
+    std::string name;
+    std::string fromBoundaryOf;
+    std::optional<std::array<sim::Vec3, 2>> region;
+    double arealDensity = 0.1, stretchStiffness = 50.0, attachDistance = 1e-3, attachCompliance = 0;
 };
 
 struct Project {
@@ -58,7 +86,9 @@ struct Project {
     int schemaVersion = 1;
     std::string caseId, caseVersion, title, instructions;
     sim::XpbdSettings solver;
+    std::optional<sim::AccuracySampling> accuracy;
     std::vector<BodyProject> bodies;
+    std::vector<SurfaceProject> surfaces;
 };
 
 /// Reads <dir>/project.json. Throws viscera::InputError.

@@ -231,7 +231,7 @@ TEST(StudioCli, ImportRejectsBadMeshesWithOneLineErrors) {
     }
     auto bp = dir.write("project.json", R"({"schemaVersion": 1, "caseId": "x", "caseVersion": "1.0.0",
         "solver": {"type": "xpbd"}, "bodies": [{"name": "b", "mesh": {"generator": "box", "size": [1, 1, -1],
-        "cells": [1, 1, 1]}, "material": {"model": "neo_hookean", "youngs_modulus": 1e4, "poisson_ratio": 0.4,
+        "cells": [1, 1, 1]}, "material": {"model": "stable_neo_hookean", "youngs_modulus": 1e4, "poisson_ratio": 0.4,
         "density": 1000}}]})");
     auto r = studio({"export", dir.path().string(), "-o", (dir.path() / "x.vcase").string()});
     EXPECT_EQ(r.exitCode, 1);

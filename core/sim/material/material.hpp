@@ -1,18 +1,41 @@
 #pragma once
-/// Isotropic material parameters (SI units) and their conversions.
+/// Material description (SI units) as authored in projects and carried by cases, and the factory
+/// that turns it into XPBD tet constraints.
+#include "sim/material/constraint_model.hpp"
+
+#include <array>
+#include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace viscera::sim {
 
 enum class MaterialModel {
-    NeoHookean, ///< stable Neo-Hookean (inversion-safe), XPBD constraints of Macklin & Müller 2021
+    StableNeoHookean,  ///< two constraints (deviatoric, hydrostatic), inversion-safe [Macklin & Müller 2021]
+    NeoHookean,        ///< compressible Neo-Hookean [A Table 4.1], as C = sqrt(2Ψ)
+    Linear,            ///< small-strain linear elasticity [A Table 4.1]
+    StVenantKirchhoff, ///< [A Table 4.1]
+    Corotated,         ///< corotated linear [A Table 4.1]
+    ValanisLandel,     ///< Ψ = Σf(λi) + Σg(λiλj) + h(J) with curve-edited f′, g′, h′ [A eq. 4.15]
+};
+
+/// One Valanis–Landel curve: control points (x, y) with y in Pa; `unconstrained` lifts the
+/// strictly-increasing rule (needed e.g. by the Neo-Hookean h′ beyond J ≈ e).
+struct CurveDesc {
+    std::vector<std::array<double, 2>> points;
+    bool unconstrained = false;
 };
 
 struct Material {
-    MaterialModel model = MaterialModel::NeoHookean;
+    MaterialModel model = MaterialModel::StableNeoHookean;
     double youngsModulus = 3000.0; ///< Pa
     double poissonRatio = 0.45;    ///< dimensionless, in [0, 0.5)
     double density = 1050.0;       ///< kg/m^3
+    /// Valanis–Landel only: either a preset generated from the Lamé parameters ("neo_hookean",
+    /// "st_venant_kirchhoff", "corotated") or explicit curves (absent curve = 0).
+    std::string curvePreset;
+    std::optional<CurveDesc> fPrime, gPrime, hPrime;
 
     double mu() const { return youngsModulus / (2.0 * (1.0 + poissonRatio)); }     ///< Pa
     double lambda() const {                                                          ///< Pa
@@ -20,11 +43,17 @@ struct Material {
     }
 };
 
-/// Checks the parameters; returns an empty string when valid, otherwise the rule that failed,
-/// e.g. "poisson_ratio 0.5 must be in [0, 0.5)".
+/// Checks the scalar parameters; returns an empty string when valid, otherwise the rule that
+/// failed, e.g. "poisson_ratio 0.5 must be in [0, 0.5)".
 std::string validate(const Material& m);
 
 MaterialModel materialModelFromName(const std::string& name); ///< throws std::invalid_argument
 std::string materialModelName(MaterialModel model);
+/// All model names, for messages and editors.
+const std::vector<std::string>& materialModelNames();
+
+/// Builds the constraint model of a material. Throws viscera::InputError naming `materialName`,
+/// the curve and the control point for invalid curves (not increasing, stress at rest not zero).
+std::shared_ptr<const TetConstraintModel> makeConstraintModel(const Material& m, const std::string& materialName);
 
 } // namespace viscera::sim

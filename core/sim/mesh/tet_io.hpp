@@ -28,4 +28,9 @@ std::unique_ptr<TetMesh> readVtet(const std::filesystem::path& path);
 /// Atomic write.
 void writeVtet(const std::filesystem::path& path, const TetMesh& mesh);
 
+/// The .vtri text format for triangle surfaces (fascia layers): as .vtet with a "vtri 1" header
+/// and "triangles <M>" followed by M lines of 3 indices (counter-clockwise seen from outside).
+TriMesh parseVtri(std::string_view text, const std::string& origin);
+std::string formatVtri(const TriMesh& mesh);
+
 } // namespace viscera::sim

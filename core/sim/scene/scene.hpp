@@ -1,20 +1,30 @@
 #pragma once
-/// Scene description carried by a case (scene.json): the solver settings and the bodies.
-/// Parsing is strict; every error names the origin, the field and the rule.
+/// Scene description carried by a case (scene.json): solver settings, tet bodies (fat, organs,
+/// embedded vessels), surface layers (fascia) and what couples them [A §4.2]. Parsing is strict;
+/// every error names the origin, the field and the rule.
 ///
 /// {
 ///   "solver": {"type": "xpbd", "dt": 0.0166667, "substeps": 10, "iterations": 1,
-///              "damping": 1.0, "max_speed": 20.0},
+///              "damping": 1.0, "max_speed": 20.0, "threads": 2},
 ///   "gravity": [0, 0, -9.81],
 ///   "instructions": "Watch the slab settle under gravity.",
-///   "bodies": [{"name": "slab", "mesh": "meshes/slab.vtet",
-///               "material": {"model": "neo_hookean", "youngs_modulus": 3000,
-///                            "poisson_ratio": 0.45, "density": 1050},
-///               "fixed_nodes": [0, 1, 2]}]
+///   "accuracy": {"every_frames": 60, "max_iterations": 100},          optional
+///   "bodies": [{"name": "organ", "mesh": "meshes/organ.vtet",
+///               "material": {...see material_json.hpp...},
+///               "fixed_nodes": [0, 1, 2],
+///               "node_weights": [1.0, ...],                            optional, one per node
+///               "strain_limits": {"axes": [[1,0,0],[0,1,0],[0,0,1]],   optional
+///                                 "limits": [{"i": 0, "j": 0, "upper": 0.2, "compliance": 0}]},
+///               "embedded_in": "fat", "embedding_compliance": 0}],   optional
+///   "surfaces": [{"name": "fascia", "mesh": "meshes/fascia.vtri", "areal_density": 0.1,
+///                 "stretch_stiffness": 50, "attach_to": "organ", "attach_distance": 0.001,
+///                 "attach_compliance": 0, "fixed_nodes": []}]
 /// }
 #include "sim/material/material.hpp"
-#include "sim/xpbd/xpbd_solver.hpp"
+#include "sim/xpbd/strain_limit.hpp"
+#include "sim/xpbd/xpbd_settings.hpp"
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -26,13 +36,35 @@ struct BodyDesc {
     std::string meshPath; ///< path of the .vtet inside the case
     Material material;
     std::vector<int32_t> fixedNodes;
+    std::vector<double> nodeWeights; ///< empty = all 1
+    std::optional<TetStrainLimits> strainLimits;
+    std::string embeddedIn; ///< name of the cage body; empty = free-standing
+    double embeddingCompliance = 0;
+};
+
+struct SurfaceDesc {
+    std::string name;
+    std::string meshPath; ///< path of the .vtri inside the case
+    double arealDensity = 0.1;      ///< kg/m^2
+    double stretchStiffness = 50.0; ///< N/m
+    std::string attachTo;           ///< tet body name; empty = free
+    double attachDistance = 1e-3;   ///< m
+    double attachCompliance = 0;    ///< m/N
+    std::vector<int32_t> fixedNodes;
+};
+
+struct AccuracySampling {
+    int everyFrames = 60;    ///< measure frames 0, every, 2·every, ...
+    int maxIterations = 100; ///< XPBD iterations recorded per sampled frame
 };
 
 struct SceneDesc {
     std::string instructions; ///< shown to the trainee; may be empty
     std::string solverType = "xpbd";
     XpbdSettings xpbd;
+    std::optional<AccuracySampling> accuracy;
     std::vector<BodyDesc> bodies;
+    std::vector<SurfaceDesc> surfaces;
 };
 
 /// Throws viscera::InputError ("scene.json: bodies[0].material.poisson_ratio: must be in [0, 0.5)").

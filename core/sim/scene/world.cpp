@@ -1,5 +1,6 @@
 #include "sim/scene/world.hpp"
 
+#include "sim/reference/accuracy.hpp"
 #include "sim/util/error.hpp"
 
 #include <algorithm>
@@ -10,76 +11,172 @@ namespace viscera::sim {
 namespace {
 const char* kXpbd = "xpbd";
 const char* kGravity = "gravity";
+const char* kFascia = "fascia";
+const char* kEmbedding = "embedding";
+const char* kStrainLimit = "strain_limit";
+const char* kAccuracy = "accuracy";
 
-bool has(const std::vector<std::string>& v, const std::string& x) {
-    return std::find(v.begin(), v.end(), x) != v.end();
+bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
+
+std::string stripPrefix(std::string why) {
+    for (const char* prefix : {"sim::XpbdSolver::create(): ", "sim::XpbdSystem::create(): "})
+        if (why.rfind(prefix, 0) == 0) return why.substr(std::char_traits<char>::length(prefix));
+    return why;
 }
 } // namespace
 
 const std::vector<std::string>& supportedFeatures() {
-    static const std::vector<std::string> f = {kGravity, kXpbd};
+    static const std::vector<std::string> f = {kAccuracy, kEmbedding, kFascia, kGravity, kStrainLimit, kXpbd};
     return f;
 }
 
+std::vector<std::string> requiredFeatures(const SceneDesc& scene) {
+    std::vector<std::string> f;
+    if (!scene.bodies.empty()) f.push_back(scene.solverType);
+    if (scene.xpbd.gravity.squaredNorm() > 0) f.push_back(kGravity);
+    if (!scene.surfaces.empty()) f.push_back(kFascia);
+    for (const auto& b : scene.bodies) {
+        if (!b.embeddedIn.empty() && !has(f, kEmbedding)) f.push_back(kEmbedding);
+        if (b.strainLimits && !has(f, kStrainLimit)) f.push_back(kStrainLimit);
+    }
+    if (scene.accuracy) f.push_back(kAccuracy);
+    std::sort(f.begin(), f.end());
+    return f;
+}
+
+World::~World() = default;
+
 std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::unique_ptr<TetMesh>> meshes,
-                                       const std::vector<std::string>& features, const std::string& origin) {
+                                       std::vector<TriMesh> surfaces, const std::vector<std::string>& features,
+                                       const std::string& origin) {
+    std::string list;
+    for (const auto& s : supportedFeatures()) list += (list.empty() ? "" : ", ") + s;
     for (const std::string& f : features)
-        if (!has(supportedFeatures(), f)) {
-            std::string list;
-            for (const auto& s : supportedFeatures()) list += (list.empty() ? "" : ", ") + s;
-            throw InputError(origin + ": features: '" + f + "' is not supported by this player (supported: " +
-                             list + ")");
+        if (!has(supportedFeatures(), f))
+            throw InputError(origin + ": features: '" + f + "' is not supported by this player (supported: " + list + ")");
+    if (meshes.size() != scene.bodies.size() || surfaces.size() != scene.surfaces.size())
+        throw std::invalid_argument("sim::World::assemble(): one mesh per body and per surface is required");
+    const std::vector<std::string> needed = requiredFeatures(scene);
+    for (const std::string& f : needed)
+        if (!has(features, f)) {
+            if (f == scene.solverType)
+                throw InputError(origin + ": features: the scene uses solver '" + f + "' but the manifest does not declare it");
+            if (f == kGravity)
+                throw InputError(origin + ": features: the scene sets gravity but the manifest does not declare 'gravity'");
+            throw InputError(origin + ": features: the scene uses '" + f + "' but the manifest does not declare it");
         }
-    if (meshes.size() != scene.bodies.size())
-        throw std::invalid_argument("sim::World::assemble(): one mesh per body is required");
-    if (!scene.bodies.empty() && !has(features, scene.solverType))
-        throw InputError(origin + ": features: the scene uses solver '" + scene.solverType +
-                         "' but the manifest does not declare it");
-    XpbdSettings settings = scene.xpbd;
-    if (settings.gravity.squaredNorm() > 0 && !has(features, kGravity))
-        throw InputError(origin + ": features: the scene sets gravity but the manifest does not declare 'gravity'");
-    if (!has(features, kGravity)) settings.gravity.setZero();
+    const bool layered = !scene.surfaces.empty() || scene.bodies.size() > 1;
+    if (scene.accuracy && layered)
+        throw InputError(origin + ": features: 'accuracy' sampling needs a scene with a single tet body and no layers");
 
     std::unique_ptr<World> w(new World());
-    w->m_dt = settings.dt;
+    w->m_scene = scene;
+    w->m_dt = scene.xpbd.dt;
+    XpbdSystemDesc desc;
     for (size_t i = 0; i < scene.bodies.size(); ++i) {
         const BodyDesc& b = scene.bodies[i];
-        try {
-            w->m_bodies.push_back(XpbdSolver::create(*meshes[i], b.material, b.fixedNodes, settings));
-        } catch (const std::invalid_argument& e) {
-            std::string why = e.what();
-            const std::string prefix = "sim::XpbdSolver::create(): ";
-            if (why.rfind(prefix, 0) == 0) why = why.substr(prefix.size());
-            throw InputError(origin + ": body '" + b.name + "': cannot be simulated stably: " + why);
-        }
+        TetBodyDesc tb;
+        tb.name = b.name;
+        tb.mesh = meshes[i].get();
+        tb.model = makeConstraintModel(b.material, b.name); // InputError names material and curve
+        tb.density = b.material.density;
+        tb.fixedNodes = b.fixedNodes;
+        tb.nodeWeights = b.nodeWeights;
+        tb.strainLimits = b.strainLimits;
+        desc.tetBodies.push_back(std::move(tb));
         w->m_names.push_back(b.name);
     }
+    auto bodyIndex = [&](const std::string& name) {
+        for (size_t i = 0; i < scene.bodies.size(); ++i)
+            if (scene.bodies[i].name == name) return i;
+        return size_t(0);
+    };
+    for (size_t i = 0; i < scene.bodies.size(); ++i)
+        if (!scene.bodies[i].embeddedIn.empty()) {
+            EmbeddingDesc e;
+            e.embedded = i;
+            e.cage = bodyIndex(scene.bodies[i].embeddedIn);
+            e.compliance = scene.bodies[i].embeddingCompliance;
+            desc.embeddings.push_back(e);
+        }
+    for (size_t s = 0; s < scene.surfaces.size(); ++s) {
+        const SurfaceDesc& sd = scene.surfaces[s];
+        SurfaceBodyDesc sb;
+        sb.name = sd.name;
+        sb.mesh = &surfaces[s];
+        sb.arealDensity = sd.arealDensity;
+        sb.stretchStiffness = sd.stretchStiffness;
+        sb.fixedNodes = sd.fixedNodes;
+        desc.surfaces.push_back(std::move(sb));
+        if (!sd.attachTo.empty()) {
+            SurfaceAttachmentDesc a;
+            a.surface = s;
+            a.tetBody = bodyIndex(sd.attachTo);
+            a.maxDistance = sd.attachDistance;
+            a.compliance = sd.attachCompliance;
+            desc.attachments.push_back(a);
+        }
+    }
+    try {
+        if (layered)
+            w->m_system = XpbdSystem::create(desc, scene.xpbd);
+        else
+            w->m_single = XpbdSolver::create(desc.tetBodies.front(), scene.xpbd);
+    } catch (const std::invalid_argument& e) {
+        throw InputError(origin + ": scene cannot be simulated stably: " + stripPrefix(e.what()));
+    }
     w->m_meshes = std::move(meshes);
-    if (!w->m_bodies.empty()) w->m_active.push_back(kXpbd);
-    if (settings.gravity.squaredNorm() > 0) w->m_active.push_back(kGravity);
-    std::sort(w->m_active.begin(), w->m_active.end());
+    w->m_surfaces = std::move(surfaces);
+    w->m_active = needed;
+    w->m_invariants.maxEnergy = w->totalEnergy();
     return w;
 }
 
+const std::vector<Vec3>& World::positions(size_t i) const {
+    return m_single ? m_single->positions() : m_system->tetPositions(i);
+}
+
+const std::vector<Vec3>& World::surfacePositions(size_t s) const { return m_system->surfacePositions(s); }
+
 double World::totalEnergy() const {
-    double e = 0;
-    for (const auto& b : m_bodies) e += b->elasticEnergy() + b->kineticEnergy() + b->potentialEnergy();
-    return e;
+    if (m_single) return m_single->elasticEnergy() + m_single->kineticEnergy() + m_single->potentialEnergy();
+    return m_system->elasticEnergy() + m_system->kineticEnergy() + m_system->potentialEnergy();
+}
+
+void World::measureAccuracy() {
+    // Never throws from the per-frame path: a failed measurement is recorded as empty traces.
+    auto keep = [&](AccuracyTrace t) {
+        AccuracyRecord r;
+        r.frame = m_frame;
+        r.solver = t.solver;
+        r.iterations = std::move(t.iterations);
+        r.relError = std::move(t.relError);
+        r.timeMs = std::move(t.timeMs);
+        m_accuracy.push_back(std::move(r));
+    };
+    try {
+        keep(measureXpbd(*m_single, m_scene.accuracy->maxIterations));
+        keep(measureNewton(*m_single));
+    } catch (const std::exception&) {
+        AccuracyRecord r;
+        r.frame = m_frame;
+        r.solver = "xpbd";
+        m_accuracy.push_back(std::move(r));
+    }
 }
 
 FrameRecord World::step() {
+    if (m_scene.accuracy && m_single && m_frame % m_scene.accuracy->everyFrames == 0) measureAccuracy();
     FrameRecord rec;
     rec.index = m_frame;
     const auto t0 = std::chrono::steady_clock::now();
-    for (auto& b : m_bodies) {
-        StepStats st = b->step();
-        rec.substeps = std::max(rec.substeps, st.substeps);
-        rec.iterations = std::max(rec.iterations, st.iterations);
-        rec.maxDisplacement = std::max(rec.maxDisplacement, st.maxDisplacement);
-        rec.finite = rec.finite && st.finite;
-        m_invariants.speedClamps += st.speedClamps;
-    }
+    const StepStats st = m_single ? m_single->step() : m_system->step();
     rec.stepMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    rec.substeps = st.substeps;
+    rec.iterations = st.iterations;
+    rec.maxDisplacement = st.maxDisplacement;
+    rec.finite = st.finite;
+    m_invariants.speedClamps += st.speedClamps;
     rec.energy = totalEnergy();
     m_invariants.record(rec.finite && std::isfinite(rec.energy), rec.energy, rec.maxDisplacement, 0.0);
     ++m_frame;

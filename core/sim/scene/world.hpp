@@ -1,9 +1,11 @@
 #pragma once
 /// The simulated world, assembled from a case's scene and feature list: only the subsystems the
-/// case declares are created (a case without "gravity" computes no gravity, and so on).
+/// case declares and uses are created (a case without "gravity" computes no gravity, one without
+/// surfaces builds no fascia layer, one without "accuracy" runs no reference solves).
 #include "sim/diagnostics/invariants.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
+#include "sim/xpbd/xpbd_system.hpp"
 
 #include <memory>
 #include <string>
@@ -13,6 +15,8 @@ namespace viscera::sim {
 
 /// Feature names of case manifests understood by this build, sorted.
 const std::vector<std::string>& supportedFeatures();
+/// The features a scene needs (what an exporter writes into the manifest), sorted.
+std::vector<std::string> requiredFeatures(const SceneDesc& scene);
 
 struct FrameRecord {
     int index = 0;
@@ -24,39 +28,59 @@ struct FrameRecord {
     bool finite = true;
 };
 
+/// One sampled frame of "error against run time" [A eq. 4.45].
+struct AccuracyRecord {
+    int frame = 0;
+    std::string solver;              ///< "xpbd" or "newton"
+    std::vector<int> iterations;
+    std::vector<double> relError;
+    std::vector<double> timeMs;
+};
+
 class World {
 public:
-    /// meshes[i] belongs to scene.bodies[i]. Throws viscera::InputError naming `origin`, the
-    /// field and the rule: unsupported feature, a feature the scene needs but the manifest does not
-    /// declare, a body that cannot be simulated stably (bad material, fixed node out of range,
-    /// inverted rest element, no free node).
-    static std::unique_ptr<World> assemble(const SceneDesc& scene,
-                                           std::vector<std::unique_ptr<TetMesh>> meshes,
-                                           const std::vector<std::string>& features,
+    /// meshes[i] belongs to scene.bodies[i], surfaces[s] to scene.surfaces[s]. Throws
+    /// viscera::InputError naming `origin`, the field and the rule: unsupported feature, a feature
+    /// the scene needs but the manifest does not declare, a body or layer that cannot be simulated
+    /// stably (bad material or curves, fixed node out of range, inverted rest element, embedded
+    /// node outside its cage, nothing free to move).
+    static std::unique_ptr<World> assemble(const SceneDesc& scene, std::vector<std::unique_ptr<TetMesh>> meshes,
+                                           std::vector<TriMesh> surfaces, const std::vector<std::string>& features,
                                            const std::string& origin);
     World(const World&) = delete;
     World& operator=(const World&) = delete;
+    ~World();
 
-    /// One frame of every body. Never throws.
+    /// One frame of every body; on sampled frames the accuracy of the frame's first substep is
+    /// measured first (on a copy; the simulation itself is unchanged). Never throws.
     FrameRecord step();
 
     const std::vector<std::string>& activeSubsystems() const { return m_active; }
     const Invariants& invariants() const { return m_invariants; }
+    const std::vector<AccuracyRecord>& accuracy() const { return m_accuracy; }
     double time() const { return m_time; }
     int frameCount() const { return m_frame; }
-    size_t bodyCount() const { return m_bodies.size(); }
+    size_t bodyCount() const { return m_meshes.size(); }
     const std::string& bodyName(size_t i) const { return m_names[i]; }
-    const XpbdSolver& body(size_t i) const { return *m_bodies[i]; }
     const TetMesh& restMesh(size_t i) const { return *m_meshes[i]; }
+    const std::vector<Vec3>& positions(size_t i) const;
+    size_t surfaceCount() const { return m_surfaces.size(); }
+    const std::vector<Vec3>& surfacePositions(size_t s) const;
     double totalEnergy() const;
 
 private:
     World() = default;
+    void measureAccuracy();
+
+    SceneDesc m_scene;
     std::vector<std::string> m_active;
     std::vector<std::string> m_names;
     std::vector<std::unique_ptr<TetMesh>> m_meshes;
-    std::vector<std::unique_ptr<XpbdSolver>> m_bodies;
+    std::vector<TriMesh> m_surfaces;
+    std::unique_ptr<XpbdSolver> m_single;  ///< one tet body, no layers (accuracy hooks available)
+    std::unique_ptr<XpbdSystem> m_system;  ///< several bodies and layers
     Invariants m_invariants;
+    std::vector<AccuracyRecord> m_accuracy;
     double m_time = 0;
     double m_dt = 0;
     int m_frame = 0;

@@ -1,80 +1,90 @@
 #pragma once
 /// XPBD soft-body solver for one tetrahedral body [A §4.4.2]: per-constraint compliance,
-/// substeps × iterations, Lagrange multipliers reset each substep, velocity damping.
+/// substeps × iterations, Lagrange multipliers accumulated over the iterations of a substep and
+/// reset each substep [A eq. 4.43–4.44], velocity damping, speed clamp, rollback of a non-finite
+/// frame.
 ///
-/// Elasticity: the stable Neo-Hookean energy
-///   Ψ = μ/2 (tr FᵀF − 3) + λ/2 (det F − γ)² − μ²/(2λ),   γ = 1 + μ/λ,
-/// split into a deviatoric constraint C_D = sqrt(tr FᵀF) with compliance 1/(μ V) and a hydrostatic
-/// constraint C_H = det F − γ with compliance 1/(λ V); both stay well defined under inversion.
-/// The two constraints of a tet are solved as one 2×2 block, which keeps the rest state a fixed
-/// point of the iteration.
-/// Gauss–Seidel order is the tet order, so results are bit-identical from run to run.
+/// Elasticity comes from any TetConstraintModel (1 or 2 constraints per tet; two are solved as
+/// one 2×2 block, which keeps the rest state a fixed point) with per-tet stiffness weights w
+/// (compliance α/w). The stable Neo-Hookean model runs a packed fast path (AVX2/FMA when the CPU
+/// has it, four tets per instruction); other models go through TetConstraintModel::evaluate.
+/// Optional anisotropic strain limits [A §4.3.4] are solved with the elastic constraints.
+///
+/// Constraints are greedy-coloured by shared nodes and each colour is split over
+/// settings.threads threads; the Gauss–Seidel order is colour by colour, so results are
+/// bit-identical from run to run and for every thread count. For several bodies and coupled
+/// layers see XpbdSystem, which this class wraps.
 #include "sim/material/material.hpp"
 #include "sim/mesh/tet_mesh.hpp"
+#include "sim/xpbd/step_problem.hpp"
+#include "sim/xpbd/xpbd_settings.hpp"
+#include "sim/xpbd/xpbd_system.hpp"
 
-#include <Eigen/Core>
-
+#include <functional>
 #include <memory>
 #include <vector>
 
 namespace viscera::sim {
 
-struct XpbdSettings {
-    double dt = 1.0 / 60.0;          ///< frame time step, s
-    int substeps = 10;               ///< substeps per frame
-    int iterations = 1;              ///< constraint sweeps per substep
-    double damping = 1.0;            ///< velocity damping rate, 1/s
-    Vec3 gravity = Vec3(0, 0, -9.81); ///< m/s^2, world frame
-    double maxSpeed = 20.0;          ///< m/s; faster nodes are clamped (counted in StepStats)
-};
-
-/// Checks settings; empty string when valid, otherwise the rule that failed.
-std::string validate(const XpbdSettings& s);
-
-struct StepStats {
-    bool finite = true;            ///< false: the step produced a non-finite value and was undone
-    int substeps = 0;
-    int iterations = 0;
-    double maxDisplacement = 0;    ///< m, largest node displacement over the frame
-    int speedClamps = 0;           ///< node-substeps whose speed was clamped to maxSpeed
-};
-
 class XpbdSolver {
 public:
-    /// Throws std::invalid_argument naming the rule: invalid material or settings, a fixed node out
-    /// of range, a tet with non-positive rest volume, or a body with no free node.
+    /// body.mesh is read during create only. Throws std::invalid_argument
+    /// ("sim::XpbdSolver::create(): fixed node 12 is out of range (mesh has 10 vertices)") on
+    /// invalid settings, a null mesh or model, a model with other than 1 or 2 constraints, bad
+    /// density, node weights or strain limits, a fixed node out of range, a tet with non-positive
+    /// rest volume, or a body with no free node.
+    static std::unique_ptr<XpbdSolver> create(const TetBodyDesc& body, const XpbdSettings& settings);
+    /// Convenience: a StableNeoHookeanModel from the material's Lamé parameters, its density, all
+    /// weights 1, no strain limits. Also throws on an invalid material.
     static std::unique_ptr<XpbdSolver> create(const TetMesh& rest, const Material& material,
                                               const std::vector<int32_t>& fixedNodes,
                                               const XpbdSettings& settings);
+    ~XpbdSolver();
     XpbdSolver(const XpbdSolver&) = delete;
     XpbdSolver& operator=(const XpbdSolver&) = delete;
 
     /// Advances one frame (settings().dt). Never throws; a non-finite result is rolled back.
     StepStats step();
 
-    const std::vector<Vec3>& positions() const { return m_x; }  ///< #V, metres
-    const std::vector<Vec3>& velocities() const { return m_v; } ///< #V, m/s
-    const XpbdSettings& settings() const { return m_settings; }
-    size_t tetCount() const { return m_tets.size(); }
+    const std::vector<Vec3>& positions() const;  ///< #V, metres
+    const std::vector<Vec3>& velocities() const; ///< #V, m/s
+    const XpbdSettings& settings() const;
+    size_t tetCount() const { return m_template.tets.size(); }
+    const TetConstraintModel& model() const { return *m_template.model; }
+    const std::vector<double>& tetWeights() const { return m_template.weight; } ///< #T
+    int colourCount() const;
+    bool usesSimd() const;
 
-    double elasticEnergy() const;   ///< J
+    /// Teleports the body (x, v: #V each, finite); fixed nodes are then held at the new x.
+    /// Between frames only. Throws std::invalid_argument on a size mismatch or non-finite value.
+    void setState(const std::vector<Vec3>& x, const std::vector<Vec3>& v);
+
+    double elasticEnergy() const;   ///< J, relative to the rest state (plus violated compliant strain limits)
     double kineticEnergy() const;   ///< J
     double potentialEnergy() const; ///< J, gravity relative to the rest configuration
     double totalMass() const;       ///< kg
 
-private:
-    XpbdSolver() = default;
-    void solveTet(size_t t, double h2inv);
+    // ---- measurement hooks for accuracy studies [A §4.4.3] --------------------------------------
 
-    XpbdSettings m_settings;
-    std::vector<Tet> m_tets;
-    std::vector<Eigen::Matrix3d> m_dmInv; // inverse rest shape matrices
-    std::vector<double> m_restVolume;
-    std::vector<double> m_invMass;        // 0 for fixed nodes
-    std::vector<double> m_mass;
-    std::vector<Vec3> m_rest, m_x, m_v, m_prev, m_frameStart;
-    std::vector<double> m_multipliers; // 2 per tet (deviatoric, hydrostatic), reset each substep
-    double m_mu = 0, m_lambda = 0, m_gamma = 1;
+    /// The implicit step that the next substep of step() iterates on, from the current state:
+    /// h = dt / substeps, x̃ = x + h (v + h g) for free nodes (the prediction of step(), bit for
+    /// bit), fixed nodes held at x; masses, tets, Dm⁻¹, volumes, weights and model of this body.
+    /// Strain limits are not part of the problem. O(#V + #T).
+    StepProblem nextSubstepProblem() const;
+
+    using IterateObserver = std::function<void(int k, const std::vector<Vec3>& xk, double seconds)>;
+    /// Runs `iterations` sweeps of the production XPBD iteration (the same blocks, colouring and
+    /// kernels as step()) on the elastic constraints of `problem`, from x_0 = x̃ with multipliers 0,
+    /// calling observe(k, x_k, seconds) after sweep k = 1..iterations; seconds is the cumulative
+    /// wall time of the sweeps alone. The solver's state is untouched; it shares the worker
+    /// threads, so it must not run concurrently with step(). Throws std::invalid_argument on an
+    /// inconsistent problem or iterations < 1.
+    void iterateOn(const StepProblem& problem, int iterations, const IterateObserver& observe) const;
+
+private:
+    XpbdSolver();
+    std::unique_ptr<XpbdSystem> m_sys;
+    StepProblem m_template; ///< h and xTilde empty; the rest as in nextSubstepProblem()
 };
 
 } // namespace viscera::sim

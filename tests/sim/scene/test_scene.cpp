@@ -66,7 +66,7 @@ TEST(Scene, ErrorsNameTheField) {
 
 TEST(World, AssemblesOnlyDeclaredSubsystems) {
     SceneDesc s = slabScene();
-    auto w = World::assemble(s, oneMesh(), {"gravity", "xpbd"}, "case");
+    auto w = World::assemble(s, oneMesh(), {}, {"gravity", "xpbd"}, "case");
     EXPECT_EQ(w->activeSubsystems(), (std::vector<std::string>{"gravity", "xpbd"}));
     FrameRecord r = w->step();
     EXPECT_TRUE(r.finite);
@@ -74,7 +74,7 @@ TEST(World, AssemblesOnlyDeclaredSubsystems) {
     EXPECT_GT(w->invariants().maxStepDisplacement, 0.0);
 
     s.xpbd.gravity.setZero();
-    auto still = World::assemble(s, oneMesh(), {"xpbd"}, "case");
+    auto still = World::assemble(s, oneMesh(), {}, {"xpbd"}, "case");
     EXPECT_EQ(still->activeSubsystems(), std::vector<std::string>{"xpbd"});
     still->step();
     EXPECT_LT(still->invariants().maxStepDisplacement, 1e-12);
@@ -83,7 +83,7 @@ TEST(World, AssemblesOnlyDeclaredSubsystems) {
 TEST(World, RefusesWhatItCannotRun) {
     auto err = [](const SceneDesc& s, std::vector<std::string> f) {
         try {
-            World::assemble(s, oneMesh(), f, "c.vcase: manifest.json");
+            World::assemble(s, oneMesh(), {}, f, "c.vcase: manifest.json");
         } catch (const viscera::InputError& e) {
             return std::string(e.what());
         }
@@ -95,5 +95,7 @@ TEST(World, RefusesWhatItCannotRun) {
     EXPECT_THAT(err(s, {"gravity"}), HasSubstr("the scene uses solver 'xpbd' but the manifest does not declare it"));
     EXPECT_THAT(err(s, {"xpbd"}), HasSubstr("does not declare 'gravity'"));
     s.bodies[0].fixedNodes = {100000};
-    EXPECT_THAT(err(s, {"xpbd", "gravity"}), HasSubstr("body 'slab': cannot be simulated stably: fixed node 100000"));
+    const std::string bad = err(s, {"xpbd", "gravity"});
+    EXPECT_THAT(bad, HasSubstr("cannot be simulated stably"));
+    EXPECT_THAT(bad, HasSubstr("fixed node 100000"));
 }

@@ -42,7 +42,7 @@ const char* kGood = R"({
   "gravity": [0, 0, -9.81],
   "bodies": [{"name": "slab",
               "mesh": {"generator": "box", "size": [0.04, 0.01, 0.01], "cells": [4, 1, 1]},
-              "material": {"model": "neo_hookean", "youngs_modulus": 20000, "poisson_ratio": 0.4, "density": 1000},
+              "material": {"model": "stable_neo_hookean", "youngs_modulus": 20000, "poisson_ratio": 0.4, "density": 1000},
               "fixed": {"min": [-1, -1, -1], "max": [0.0001, 1, 1]}}]
 })";
 

@@ -1,0 +1,308 @@
+// Error against run time [A §4.4.3, Fig. 4.12–4.13]: the relative error
+//     e_k = (f(x_k) − f(x*)) / (f(x_0) − f(x*))          [A eq. 4.45]
+// of XPBD and Newton iterates on one implicit step of an organ-like body (~5,000 tets, stable
+// Neo-Hookean, gravity, one end fixed, after a few frames of motion), against a converged Newton
+// reference x*.
+//
+// The body moves for five frames with the production setting (20 substeps × 1 iteration, as in
+// the organ-blob sample); that state is then given to one solver per substep count, and the
+// problem of its next substep (h = dt / s) is measured:
+//   - substeps 1: the frame is one implicit step (h = dt); one trace of N sweeps gives every
+//     setting 1×1 … 1×N, since XPBD restarts from x̃ with λ = 0 each substep;
+//   - substeps 5, 20, 100: the per-substep view; a frame costs s times the substep time.
+// Newton's own iterates are measured on the same problems (Fig. 4.12 "direct").
+//
+// Usage: bench_accuracy [output-dir]        (default ./accuracy_out)
+// Writes <dir>/xpbd_s<S>.csv and <dir>/newton_s<S>.csv (iteration,rel_error,time_ms),
+// <dir>/sweep.csv (s × k settings), <dir>/summary.csv, <dir>/accuracy.json (session-report
+// "accuracy" entries), <dir>/error_vs_time.png and <dir>/error_vs_iteration.png (log-scale error).
+#include "line_plot.hpp"
+
+#include "sim/mesh/generators.hpp"
+#include "sim/reference/accuracy.hpp"
+#include "sim/xpbd/xpbd_solver.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace viscera::sim;
+using viscera::bench::PlotSeries;
+using viscera::bench::PlotSpec;
+
+namespace {
+
+constexpr double kTarget = 1e-4; // the error XPBD reached with 100 iterations in [A §4.4.3]
+
+struct Organ {
+    std::unique_ptr<TetMesh> mesh;
+    std::vector<int32_t> fixed;
+};
+
+/// A liver-sized wedge-shaped ellipsoid (20 × 12 × 8 cm, thinner towards −x) carved from a
+/// structured block: whole hex cells (6 tets each) whose centre lies inside. The thin end
+/// (x within 10 % of the length from the minimum) is fixed.
+Organ makeOrgan() {
+    const Vec3 size(0.20, 0.12, 0.08);
+    const std::array<int, 3> cells = {21, 12, 8};
+    auto block = makeBoxTetMesh({Vec3::Zero(), size, cells});
+    const Vec3 cell(size.x() / cells[0], size.y() / cells[1], size.z() / cells[2]);
+    const Vec3 centre = 0.5 * size;
+    auto inside = [&](const Vec3& p) {
+        const Vec3 d = p - centre;
+        const double taper = 0.55 + 0.45 * p.x() / size.x(); // thickness grows along +x
+        const double a = d.x() / (0.5 * size.x()), b = d.y() / (0.5 * size.y()),
+                     c = d.z() / (0.5 * size.z() * taper);
+        return a * a + b * b + c * c <= 1.0;
+    };
+    const auto& x = block->positions();
+    std::vector<int32_t> remap(x.size(), -1);
+    std::vector<Vec3> positions;
+    std::vector<Tet> tets;
+    for (const Tet& t : block->tets()) {
+        const Vec3 centroid = 0.25 * (x[t[0]] + x[t[1]] + x[t[2]] + x[t[3]]);
+        const Vec3 cellCentre =
+            (centroid.cwiseQuotient(cell).array().floor() + 0.5).matrix().cwiseProduct(cell);
+        if (!inside(cellCentre)) continue;
+        Tet out;
+        for (int k = 0; k < 4; ++k) {
+            if (remap[t[k]] < 0) {
+                remap[t[k]] = static_cast<int32_t>(positions.size());
+                positions.push_back(x[t[k]]);
+            }
+            out[k] = remap[t[k]];
+        }
+        tets.push_back(out);
+    }
+    Organ organ;
+    organ.mesh = TetMesh::fromArrays(std::move(positions), std::move(tets), "bench_accuracy organ");
+    double xMin = 1e300, xMax = -1e300;
+    for (const Vec3& p : organ.mesh->positions()) {
+        xMin = std::min(xMin, p.x());
+        xMax = std::max(xMax, p.x());
+    }
+    for (size_t v = 0; v < organ.mesh->vertexCount(); ++v)
+        if (organ.mesh->positions()[v].x() <= xMin + 0.1 * (xMax - xMin))
+            organ.fixed.push_back(static_cast<int32_t>(v));
+    return organ;
+}
+
+Material organMaterial() { // the organ-blob sample's tissue
+    Material m;
+    m.youngsModulus = 8000;
+    m.poissonRatio = 0.45;
+    m.density = 1060;
+    return m;
+}
+
+struct Config {
+    int substeps;
+    int maxIterations; ///< XPBD sweeps measured on the substep problem
+};
+
+struct Measured {
+    Config config;
+    AccuracyTrace xpbd, newton;
+};
+
+void writeCsv(const std::filesystem::path& path, const AccuracyTrace& t) {
+    std::ofstream out(path);
+    out << "iteration,rel_error,time_ms\n";
+    char line[128];
+    for (size_t i = 0; i < t.iterations.size(); ++i) {
+        std::snprintf(line, sizeof line, "%d,%.9e,%.6f\n", t.iterations[i], t.relError[i],
+                      t.timeMs[i]);
+        out << line;
+    }
+    if (!out) throw std::runtime_error("cannot write " + path.string());
+}
+
+nlohmann::json toJson(const AccuracyTrace& t, int frame) {
+    return {{"frame", frame},
+            {"solver", t.solver},
+            {"h", t.h},
+            {"iterations", t.iterations},
+            {"rel_error", t.relError},
+            {"time_ms", t.timeMs},
+            {"f_star", t.fStar},
+            {"f0", t.f0},
+            {"rel_error_floor", t.relErrorFloor},
+            {"reference",
+             {{"status", t.referenceStatus},
+              {"iterations", t.referenceIterations},
+              {"gradient_inf_norm", t.referenceGradientNorm},
+              {"time_ms", t.referenceMs}}}};
+}
+
+PlotSeries series(const std::string& label, const AccuracyTrace& t, bool againstTime,
+                  double timeScale = 1) {
+    PlotSeries s;
+    s.label = label;
+    s.markers = t.solver == "newton";
+    for (size_t i = 0; i < t.iterations.size(); ++i) {
+        s.x.push_back(againstTime ? timeScale * t.timeMs[i] : t.iterations[i]);
+        s.y.push_back(t.relError[i]);
+    }
+    return s;
+}
+
+} // namespace
+
+int run(const std::filesystem::path& outDir) {
+    std::filesystem::create_directories(outDir);
+
+    const Organ organ = makeOrgan();
+    const Material material = organMaterial();
+    const int motionFrames = 5;
+    std::printf(
+        "organ: %zu tets, %zu nodes, %zu fixed; E = %.0f Pa, nu = %.2f, rho = %.0f kg/m^3\n",
+        organ.mesh->tetCount(), organ.mesh->vertexCount(), organ.fixed.size(),
+        material.youngsModulus, material.poissonRatio, material.density);
+
+    // Five frames of production motion; every configuration starts from that state.
+    XpbdSettings production;
+    production.substeps = 20;
+    production.iterations = 1;
+    production.damping = 2.0;
+    auto motion = XpbdSolver::create(*organ.mesh, material, organ.fixed, production);
+    for (int f = 0; f < motionFrames; ++f)
+        motion->step();
+    double minJ = 1e300, sag = 0;
+    {
+        const StepProblem p = motion->nextSubstepProblem();
+        for (size_t t = 0; t < p.tets.size(); ++t)
+            minJ = std::min(minJ, p.deformationGradient(motion->positions(), t).determinant());
+        for (size_t v = 0; v < organ.mesh->vertexCount(); ++v)
+            sag = std::max(sag, organ.mesh->positions()[v].z() - motion->positions()[v].z());
+    }
+    std::printf("after %d frames of %dx%d XPBD: max sag %.2f mm, min det F %.3f\n", motionFrames,
+                production.substeps, production.iterations, 1e3 * sag, minJ);
+
+    NewtonSettings reference; // default tolerances
+    const std::vector<Config> configs = {{1, 200}, {5, 100}, {20, 50}, {100, 50}};
+    std::vector<Measured> results;
+    for (const Config& c : configs) {
+        XpbdSettings s = production;
+        s.substeps = c.substeps;
+        auto solver = XpbdSolver::create(*organ.mesh, material, organ.fixed, s);
+        solver->setState(motion->positions(), motion->velocities());
+        results.push_back({c, measureXpbd(*solver, c.maxIterations, reference),
+                           measureNewton(*solver, reference)});
+    }
+
+    // Console report, CSV and JSON.
+    const int probes[] = {1, 2, 5, 10, 20, 50, 100, 200};
+    std::ofstream sweep(outDir / "sweep.csv"), summary(outDir / "summary.csv");
+    sweep << "substeps,iterations,h_s,rel_error,substep_time_ms,frame_time_ms\n";
+    summary << "substeps,h_s,newton_status,newton_iterations,newton_time_ms,newton_grad_inf,rel_"
+               "error_floor,"
+               "xpbd_iterations_to_1e-4,xpbd_substep_time_ms_to_1e-4,xpbd_frame_time_ms_to_1e-4,"
+               "xpbd_final_rel_error\n";
+    nlohmann::json accuracy = nlohmann::json::array();
+    for (const Measured& m : results) {
+        const int s = m.config.substeps;
+        const AccuracyTrace& x = m.xpbd;
+        std::printf("\n== substeps %d (h = %.3f ms), first substep of frame %d (0-based) ==\n", s,
+                    1e3 * x.h, motionFrames);
+        std::printf("Newton reference: %s, %d iterations, %.1f ms, |grad f|_inf %.2e kg m; "
+                    "rel error floor %.1e\n",
+                    x.referenceStatus.c_str(), x.referenceIterations, x.referenceMs,
+                    x.referenceGradientNorm, x.relErrorFloor);
+        std::printf("  %-6s %12s %14s %14s\n", "s x k", "rel error", "substep ms", "frame ms");
+        for (int k : probes) {
+            if (k >= static_cast<int>(x.iterations.size())) break;
+            std::printf("  %2dx%-3d %12.3e %14.3f %14.3f\n", s, k, x.relError[k], x.timeMs[k],
+                        s * x.timeMs[k]);
+            char line[160];
+            std::snprintf(line, sizeof line, "%d,%d,%.9g,%.9e,%.6f,%.6f\n", s, k, x.h,
+                          x.relError[k], x.timeMs[k], s * x.timeMs[k]);
+            sweep << line;
+        }
+        const int hit = firstBelow(x, kTarget);
+        if (hit >= 0)
+            std::printf("XPBD reaches rel error <= %.0e after %d iterations: %.2f ms per substep, "
+                        "%.2f ms per frame\n",
+                        kTarget, x.iterations[hit], x.timeMs[hit], s * x.timeMs[hit]);
+        else
+            std::printf("XPBD does not reach %.0e within %d iterations: it levels off at %.3e "
+                        "(lowest %.3e)\n",
+                        kTarget, x.iterations.back(), x.relError.back(),
+                        *std::min_element(x.relError.begin(), x.relError.end()));
+        std::printf("Newton's own iterates:");
+        for (size_t k = 0; k < m.newton.relError.size(); ++k)
+            std::printf(" [%zu] %.1e @ %.0f ms", k, m.newton.relError[k], m.newton.timeMs[k]);
+        std::printf("\n");
+        char line[320];
+        std::snprintf(line, sizeof line, "%d,%.9g,%s,%d,%.3f,%.3e,%.3e,%d,%.6f,%.6f,%.9e\n", s, x.h,
+                      x.referenceStatus.c_str(), x.referenceIterations, x.referenceMs,
+                      x.referenceGradientNorm, x.relErrorFloor, hit >= 0 ? x.iterations[hit] : -1,
+                      hit >= 0 ? x.timeMs[hit] : -1.0, hit >= 0 ? s * x.timeMs[hit] : -1.0,
+                      x.relError.back());
+        summary << line;
+        writeCsv(outDir / ("xpbd_s" + std::to_string(s) + ".csv"), x);
+        writeCsv(outDir / ("newton_s" + std::to_string(s) + ".csv"), m.newton);
+        accuracy.push_back(toJson(x, motionFrames));
+        accuracy.push_back(toJson(m.newton, motionFrames));
+    }
+    std::ofstream(outDir / "accuracy.json")
+        << nlohmann::json{{"accuracy", accuracy}}.dump() << "\n";
+
+    // Plots: error against per-frame wall time (a frame runs s substeps) and against iterations.
+    std::vector<PlotSeries> byTime, byIteration;
+    for (const Measured& m : results) {
+        const int s = m.config.substeps;
+        const std::string tag = std::to_string(s) + (s == 1 ? " substep" : " substeps");
+        byTime.push_back(series("XPBD, " + tag, m.xpbd, true, s));
+        byIteration.push_back(series("XPBD, " + tag, m.xpbd, false));
+    }
+    for (const Measured& m : results) {
+        const int s = m.config.substeps;
+        const std::string tag = std::to_string(s) + (s == 1 ? " substep" : " substeps");
+        byTime.push_back(series("Newton (CHOLMOD), " + tag, m.newton, true, s));
+        byIteration.push_back(series("Newton (CHOLMOD), " + tag, m.newton, false));
+    }
+    PlotSpec spec;
+    spec.yMarks = {kTarget};
+    spec.yMin = 1e-12;
+    spec.logX = true;
+    spec.title = "Relative error against frame wall time, " +
+                 std::to_string(organ.mesh->tetCount()) + " tets";
+    spec.xLabel = "wall time per frame (ms, log scale; s substeps cost s x one substep)";
+    spec.yLabel = "relative error (f(x_k) - f(x*)) / (f(x_0) - f(x*))";
+    std::string error =
+        viscera::bench::writeLinePlotPng((outDir / "error_vs_time.png").string(), spec, byTime);
+    spec.title =
+        "Relative error per iteration, " + std::to_string(organ.mesh->tetCount()) + " tets";
+    spec.xLabel = "iteration k (log scale)";
+    if (error.empty())
+        error = viscera::bench::writeLinePlotPng((outDir / "error_vs_iteration.png").string(), spec,
+                                                 byIteration);
+    if (!error.empty()) throw std::runtime_error(error);
+    if (!sweep || !summary)
+        throw std::runtime_error("cannot write sweep.csv or summary.csv in " + outDir.string());
+    std::printf("\nwrote %s/{xpbd_s*.csv,newton_s*.csv,sweep.csv,summary.csv,accuracy.json,"
+                "error_vs_time.png,error_vs_iteration.png}\n",
+                outDir.string().c_str());
+    return 0;
+}
+
+int main(int argc, char** argv) {
+    if (argc > 2 ||
+        (argc == 2 && (std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help"))) {
+        std::fprintf(stderr, "usage: bench_accuracy [output-dir]   (default ./accuracy_out)\n");
+        return argc == 2 ? 0 : 2;
+    }
+    try {
+        return run(argc == 2 ? argv[1] : "accuracy_out");
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_accuracy: %s\n", e.what());
+        return 1;
+    }
+}

@@ -1,0 +1,258 @@
+#include "sim/xpbd/detail/engine.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+
+namespace viscera::sim::detail {
+namespace {
+/// Chunks: at least kMinChunkPacks packs (~1–2 µs of work), at most kChunksPerThread per thread
+/// and colour (claiming a chunk costs two contended atomics).
+constexpr size_t kMinChunkPacks = 8;
+constexpr size_t kChunksPerThread = 4;
+constexpr size_t kChunkParticles = 1024;
+} // namespace
+
+void Block::arrange(const std::vector<int32_t>& colourOfUnit, int colours) {
+    std::vector<std::vector<int32_t>> byColour(colours);
+    for (size_t u = 0; u < colourOfUnit.size(); ++u) byColour[colourOfUnit[u]].push_back(static_cast<int32_t>(u));
+    std::vector<int32_t> slots;
+    m_colourStart.assign(colours + 1, 0);
+    for (int c = 0; c < colours; ++c) {
+        slots.insert(slots.end(), byColour[c].begin(), byColour[c].end());
+        while (slots.size() % 4) slots.push_back(-1);
+        m_colourStart[c + 1] = slots.size() / 4;
+    }
+    build(slots);
+}
+
+int32_t Engine::addParticles(const std::vector<Vec3>& x, const std::vector<double>& m,
+                             const std::vector<uint8_t>& fixed) {
+    const auto first = static_cast<int32_t>(particleCount());
+    for (size_t i = 0; i < x.size(); ++i) {
+        xw.insert(xw.end(), {x[i].x(), x[i].y(), x[i].z(), (fixed[i] || !(m[i] > 0)) ? 0.0 : 1.0 / m[i]});
+        v.push_back(Vec3::Zero());
+        mass.push_back(m[i]);
+    }
+    return first;
+}
+
+void Engine::colour() {
+    const size_t n = particleCount();
+    int words = 1;
+    std::vector<uint64_t> used(n * words, 0);
+    std::vector<std::vector<int32_t>> colourOf(blocks.size());
+    int32_t p[kMaxUnitParticles];
+    m_colours = 0;
+    for (size_t b = 0; b < blocks.size(); ++b) {
+        colourOf[b].resize(blocks[b]->unitCount());
+        for (size_t u = 0; u < colourOf[b].size(); ++u) {
+            const int np = blocks[b]->unitParticles(u, p);
+            int found = -1;
+            while (found < 0) {
+                for (int wd = 0; wd < words && found < 0; ++wd) {
+                    uint64_t taken = 0;
+                    for (int k = 0; k < np; ++k) taken |= used[static_cast<size_t>(p[k]) * words + wd];
+                    if (~taken) found = wd * 64 + __builtin_ctzll(~taken);
+                }
+                if (found < 0) { // every colour so far is taken around this unit: widen the sets
+                    std::vector<uint64_t> wider(n * (words + 1), 0);
+                    for (size_t i = 0; i < n; ++i)
+                        std::copy_n(used.begin() + i * words, words, wider.begin() + i * (words + 1));
+                    used.swap(wider);
+                    ++words;
+                }
+            }
+            for (int k = 0; k < np; ++k)
+                used[static_cast<size_t>(p[k]) * words + found / 64] |= uint64_t(1) << (found % 64);
+            colourOf[b][u] = found;
+            m_colours = std::max(m_colours, found + 1);
+        }
+    }
+    m_colourPacks.assign(m_colours, 0);
+    for (size_t b = 0; b < blocks.size(); ++b) {
+        blocks[b]->arrange(colourOf[b], m_colours);
+        for (int c = 0; c < m_colours; ++c) m_colourPacks[c] += blocks[b]->colourEnd(c) - blocks[b]->colourBegin(c);
+    }
+}
+
+namespace {
+
+inline void cpuRelax() {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+}
+
+/// Returns once a ≥ target: spins briefly, then sleeps on the futex.
+void waitAtLeast(const std::atomic<uint32_t>& a, uint32_t target) {
+    for (int i = 0; i < 2000; ++i) {
+        if (a.load(std::memory_order_acquire) >= target) return;
+        cpuRelax();
+    }
+    for (;;) {
+        const uint32_t seen = a.load(std::memory_order_acquire);
+        if (seen >= target) return;
+        a.wait(seen, std::memory_order_acquire);
+    }
+}
+
+} // namespace
+
+int Engine::usefulThreads(int threads) const {
+    if (threads <= 1) return 1;
+    size_t most = 1;
+    for (size_t packs : m_colourPacks) most = std::max(most, packs / kMinChunkPacks);
+    return static_cast<int>(std::min<size_t>(threads, most));
+}
+
+void Engine::solveColourChunk(int c, uint32_t chunk, uint32_t chunks, const SolveContext& ctx) {
+    const size_t total = m_colourPacks[c];
+    const size_t gb = total * chunk / chunks, ge = total * (chunk + 1) / chunks;
+    size_t offset = 0;
+    for (const auto& b : blocks) {
+        const size_t bb = b->colourBegin(c), count = b->colourEnd(c) - bb;
+        const size_t lo = std::max(gb, offset), hi = std::min(ge, offset + count);
+        if (lo < hi) b->solve(bb + (lo - offset), bb + (hi - offset), ctx);
+        offset += count;
+        if (offset >= ge) break;
+    }
+}
+
+void Engine::buildSchedule(const XpbdSettings* s, int threads) {
+    m_phases.clear();
+    const auto particleChunks = static_cast<uint32_t>((particleCount() + kChunkParticles - 1) / kChunkParticles);
+    auto colourPhases = [&](bool first) {
+        for (int c = 0; c < m_colours; ++c)
+            m_phases.push_back({c, first, false,
+                                static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1,
+                                                                         kChunksPerThread * threads))});
+    };
+    if (!s) {
+        colourPhases(false);
+    } else {
+        m_phases.push_back({kPredictOnly, false, true, particleChunks});
+        for (int sub = 0; sub < s->substeps; ++sub) {
+            for (int it = 0; it < s->iterations; ++it) colourPhases(it == 0);
+            m_phases.push_back({-1, false, sub + 1 < s->substeps, particleChunks});
+        }
+    }
+    m_phaseStart.assign(m_phases.size() + 1, 0);
+    for (size_t p = 0; p < m_phases.size(); ++p) m_phaseStart[p + 1] = m_phaseStart[p] + m_phases[p].chunks;
+}
+
+template <class RunChunk>
+void Engine::execute(int threads, WorkerPool* pool, const RunChunk& run) {
+    const uint32_t total = m_phaseStart.back();
+    if (threads <= 1) {
+        for (size_t p = 0; p < m_phases.size(); ++p)
+            for (uint32_t j = 0; j < m_phases[p].chunks; ++j) run(m_phases[p], j, 0);
+        return;
+    }
+    m_nextChunk.store(0, std::memory_order_relaxed);
+    m_doneChunks.store(0, std::memory_order_relaxed);
+    const std::function<void(int)> job = [&](int tid) {
+        size_t p = 0;
+        for (;;) {
+            const uint32_t k = m_nextChunk.fetch_add(1, std::memory_order_relaxed);
+            if (k >= total) return;
+            while (m_phaseStart[p + 1] <= k) ++p;
+            waitAtLeast(m_doneChunks, m_phaseStart[p]);
+            run(m_phases[p], k - m_phaseStart[p], tid);
+            m_doneChunks.fetch_add(1, std::memory_order_release);
+            m_doneChunks.notify_all();
+        }
+    };
+    pool->run(threads, job);
+}
+
+StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
+    StepStats st;
+    const int substeps = s.substeps;
+    const double h = s.dt / substeps;
+    const double h2inv = 1.0 / (h * h), invH = 1.0 / h;
+    const double decay = std::exp(-s.damping * h);
+    const double vmax = s.maxSpeed, vmax2 = vmax * vmax;
+    const Vec3 hg = h * s.gravity;
+    const size_t n = particleCount();
+    m_frameStart = xw;
+    m_v0 = v;
+    m_prev.resize(n);
+    const int threads = usefulThreads(pool ? std::min(s.threads, pool->size()) : 1);
+    m_clamps.assign(threads, 0);
+    buildSchedule(&s, threads);
+    double* const x = xw.data();
+    // Start of a substep for particle i: remember x, predict x̃ = x + h (v + h g).
+    auto predict = [&](size_t i, double* p, Vec3& vi) {
+        m_prev[i] = Vec3(p[0], p[1], p[2]);
+        if (p[3] == 0) return;
+        vi += hg;
+        p[0] += h * vi.x();
+        p[1] += h * vi.y();
+        p[2] += h * vi.z();
+    };
+    // End of a substep for particle i (velocity, speed clamp, damping).
+    auto finish = [&](size_t i, double* p, Vec3& vi, int tid) {
+        if (p[3] == 0) {
+            vi.setZero();
+            return;
+        }
+        Vec3 vel = (Vec3(p[0], p[1], p[2]) - m_prev[i]) * invH;
+        const double speed2 = vel.squaredNorm();
+        if (speed2 > vmax2) {
+            vel *= vmax / std::sqrt(speed2);
+            const Vec3 xi = m_prev[i] + h * vel;
+            p[0] = xi.x();
+            p[1] = xi.y();
+            p[2] = xi.z();
+            ++m_clamps[tid];
+        }
+        vi = decay * vel;
+    };
+    execute(threads, pool, [&](const Phase& ph, uint32_t chunk, int tid) {
+        if (ph.colour >= 0) {
+            solveColourChunk(ph.colour, chunk, ph.chunks, SolveContext{x, h2inv, ph.first});
+            return;
+        }
+        const size_t b = size_t(chunk) * kChunkParticles, e = std::min(n, b + kChunkParticles);
+        for (size_t i = b; i < e; ++i) {
+            double* p = x + 4 * i;
+            if (ph.colour != kPredictOnly) finish(i, p, v[i], tid);
+            if (ph.predictNext) predict(i, p, v[i]);
+        }
+    });
+
+    st.substeps = substeps;
+    st.iterations = s.iterations;
+    for (int c : m_clamps) st.speedClamps += c;
+    for (size_t i = 0; i < n; ++i) {
+        const double* p = x + 4 * i;
+        const Vec3 xi(p[0], p[1], p[2]);
+        if (!xi.allFinite() || !v[i].allFinite()) {
+            st.finite = false;
+            break;
+        }
+        const double* p0 = m_frameStart.data() + 4 * i;
+        st.maxDisplacement = std::max(st.maxDisplacement, (xi - Vec3(p0[0], p0[1], p0[2])).norm());
+    }
+    if (!st.finite) {
+        xw = m_frameStart;
+        v = m_v0;
+        st.maxDisplacement = 0;
+    }
+    return st;
+}
+
+double Engine::sweep(bool first, double h2inv, int threads, WorkerPool* pool) {
+    const int t = usefulThreads(pool ? std::min(threads, pool->size()) : 1);
+    buildSchedule(nullptr, t);
+    double* const x = xw.data();
+    const auto t0 = std::chrono::steady_clock::now();
+    execute(t, pool, [&](const Phase& ph, uint32_t chunk, int) {
+        solveColourChunk(ph.colour, chunk, ph.chunks, SolveContext{x, h2inv, first});
+    });
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+} // namespace viscera::sim::detail

@@ -1,0 +1,149 @@
+#pragma once
+/// The XPBD engine behind XpbdSolver and XpbdSystem (private to sim/xpbd).
+///
+/// Particles of every body live in one array, four doubles each (x, y, z in metres and the
+/// inverse mass in 1/kg, 0 for a fixed particle), 64-byte aligned, so that a SIMD kernel loads a
+/// particle with one instruction. Constraints live in blocks (one per kind and body); a block's
+/// unit is what one solve call updates at once (a tet with its constraints, a triangle, a tie).
+/// All units of all blocks are greedy-coloured by shared particles; a colour's units are
+/// independent, so a colour is split into chunks that run in parallel without locks, and the
+/// result does not depend on the number of threads. Inside each block the units of a colour are
+/// laid out in packs of four (padding slots marked), the granularity of chunks and SIMD lanes.
+#include "sim/xpbd/detail/thread_pool.hpp"
+#include "sim/xpbd/xpbd_settings.hpp"
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <new>
+#include <vector>
+
+namespace viscera::sim::detail {
+
+template <class T, std::size_t Align>
+struct AlignedAllocator {
+    using value_type = T;
+    AlignedAllocator() = default;
+    template <class U>
+    AlignedAllocator(const AlignedAllocator<U, Align>&) {}
+    template <class U>
+    struct rebind {
+        using other = AlignedAllocator<U, Align>;
+    };
+    T* allocate(std::size_t n) {
+        return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(Align)));
+    }
+    void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t(Align)); }
+    friend bool operator==(const AlignedAllocator&, const AlignedAllocator&) { return true; }
+};
+
+using ParticleArray = std::vector<double, AlignedAllocator<double, 64>>;
+
+inline Vec3 particlePosition(const double* xw, int32_t i) {
+    const double* p = xw + 4 * static_cast<size_t>(i);
+    return Vec3(p[0], p[1], p[2]);
+}
+inline double particleInvMass(const double* xw, int32_t i) { return xw[4 * static_cast<size_t>(i) + 3]; }
+inline void moveParticle(double* xw, int32_t i, const Vec3& d) {
+    double* p = xw + 4 * static_cast<size_t>(i);
+    p[0] += d.x();
+    p[1] += d.y();
+    p[2] += d.z();
+}
+
+struct SolveContext {
+    double* xw;    ///< particle array
+    double h2inv;  ///< 1/h², 1/s²
+    bool first;    ///< first iteration of a substep: multipliers start from 0 [A eq. 4.43]
+};
+
+inline constexpr int kMaxUnitParticles = 8;
+
+class Block {
+public:
+    virtual ~Block() = default;
+    virtual size_t unitCount() const = 0;
+    /// Particles of unit u into out (at most kMaxUnitParticles); returns their count.
+    virtual int unitParticles(size_t u, int32_t* out) const = 0;
+    /// Solves the units of packs [packBegin, packEnd) (all of one colour) once, in place.
+    virtual void solve(size_t packBegin, size_t packEnd, const SolveContext& ctx) = 0;
+    /// Stored energy (J) at the particle positions; hard constraints count 0.
+    virtual double energy(const double* xw) const = 0;
+
+    /// Lays the units out by colour (colourOfUnit: one entry per unit) in packs of four.
+    void arrange(const std::vector<int32_t>& colourOfUnit, int colours);
+    size_t packCount() const { return m_colourStart.empty() ? 0 : m_colourStart.back(); }
+    size_t colourBegin(int c) const { return m_colourStart[c]; }
+    size_t colourEnd(int c) const { return m_colourStart[c + 1]; }
+
+protected:
+    /// slots: four per pack, a unit index or −1 for padding, in colour order.
+    virtual void build(const std::vector<int32_t>& slots) = 0;
+
+private:
+    std::vector<size_t> m_colourStart;
+};
+
+class Engine {
+public:
+    ParticleArray xw;          ///< 4 per particle: x, y, z (m), inverse mass (1/kg, 0 = fixed)
+    std::vector<Vec3> v;       ///< velocities, m/s
+    std::vector<double> mass;  ///< kg (fixed particles keep theirs)
+    std::vector<std::unique_ptr<Block>> blocks;
+
+    size_t particleCount() const { return mass.size(); }
+    /// Appends particles (positions, masses, fixed flags; all the same size); returns the index
+    /// of the first. Inverse mass: 0 when fixed or massless, else 1/m.
+    int32_t addParticles(const std::vector<Vec3>& x, const std::vector<double>& m,
+                         const std::vector<uint8_t>& fixed);
+    /// Greedy colouring of all units of all blocks by shared particles, then arranges the
+    /// blocks. Call once, after the last block is added.
+    void colour();
+    int colourCount() const { return m_colours; }
+    /// Packs per colour, all blocks together.
+    const std::vector<size_t>& colourPacks() const { return m_colourPacks; }
+
+    /// One frame: substeps × (predict, iterations × colours, velocity update, speed clamp), with
+    /// rollback of a non-finite result. Never throws.
+    StepStats frame(const XpbdSettings& s, WorkerPool* pool);
+    /// One sweep over all colours; returns its wall time in seconds.
+    double sweep(bool first, double h2inv, int threads, WorkerPool* pool);
+    /// Threads worth using (≤ threads): 1 when no colour is large enough to split.
+    int usefulThreads(int threads) const;
+
+private:
+    /// A step of the schedule: a colour sweep (colour ≥ 0) or a particle pass (colour < 0: end of
+    /// a substep and, when predictNext, start of the next; or, with colour == kPredictOnly, only
+    /// the start of the first substep). Its work is cut into chunks (a colour: a few per thread;
+    /// particles: kChunkParticles each), which are independent of each other, so the results do
+    /// not depend on how the chunks are cut.
+    struct Phase {
+        int colour = 0;
+        bool first = false;       ///< colour sweep: first iteration of the substep
+        bool predictNext = false; ///< particle pass: also start the next substep
+        uint32_t chunks = 0;
+    };
+    static constexpr int kPredictOnly = -2;
+    void buildSchedule(const XpbdSettings* s, int threads);
+    /// Runs every chunk of m_phases in order: a phase starts when all chunks of the previous
+    /// ones are done. Parallel: threads claim chunks from one atomic counter and wait on a
+    /// second one that counts finished chunks, so a thread that the OS pauses only holds up the
+    /// others when it pauses inside a chunk. Serial: a plain loop over the same chunks.
+    template <class RunChunk>
+    void execute(int threads, WorkerPool* pool, const RunChunk& run);
+    void solveColourChunk(int c, uint32_t chunk, uint32_t chunks, const SolveContext& ctx);
+
+    std::vector<size_t> m_colourPacks;
+    int m_colours = 0;
+    std::vector<Phase> m_phases;
+    std::vector<uint32_t> m_phaseStart; ///< first global chunk of each phase, plus the total
+    alignas(64) std::atomic<uint32_t> m_nextChunk{0};
+    alignas(64) std::atomic<uint32_t> m_doneChunks{0};
+    std::vector<Vec3> m_prev;
+    ParticleArray m_frameStart;
+    std::vector<Vec3> m_v0;
+    std::vector<int> m_clamps; ///< per thread
+};
+
+} // namespace viscera::sim::detail

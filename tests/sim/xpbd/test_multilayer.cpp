@@ -1,0 +1,413 @@
+// Multi-layer tissue [A §4.2]: fascia membranes, couplings, embedded tissue, surface strain
+// limits in the UV frame, and the XpbdSystem that solves them together.
+#include "sim/material/stable_neo_hookean.hpp"
+#include "sim/xpbd/coupling.hpp"
+#include "sim/xpbd/membrane.hpp"
+#include "sim/xpbd/xpbd_system.hpp"
+#include "xpbd_test_support.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <limits>
+
+using namespace viscera::sim;
+using namespace viscera::sim::testing;
+using ::testing::HasSubstr;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// A (nu × nv)-cell triangulated sheet origin + s·du + t·dv, s, t ∈ [0, 1]; uv = (s |du|, t |dv|).
+TriMesh sheet(const Vec3& origin, const Vec3& du, const Vec3& dv, int nu, int nv, std::vector<Vec2>* uv = nullptr) {
+    std::vector<Vec3> x;
+    std::vector<Tri> tris;
+    for (int j = 0; j <= nv; ++j)
+        for (int i = 0; i <= nu; ++i) {
+            const double s = double(i) / nu, t = double(j) / nv;
+            x.push_back(origin + s * du + t * dv);
+            if (uv) uv->push_back(Vec2(s * du.norm(), t * dv.norm()));
+        }
+    auto id = [&](int i, int j) { return j * (nu + 1) + i; };
+    for (int j = 0; j < nv; ++j)
+        for (int i = 0; i < nu; ++i) {
+            tris.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+            tris.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+        }
+    return TriMesh::fromArrays(std::move(x), std::move(tris));
+}
+
+std::shared_ptr<const TetConstraintModel> snh(double E, double nu = 0.45) {
+    const Material m = tissue(E, nu);
+    return std::make_shared<StableNeoHookeanModel>(m.mu(), m.lambda());
+}
+
+/// Fat: a 6 × 2 × 2 cm cantilever fixed at x = 0; fascia on its top face (a finer, independent
+/// triangulation); a vessel: a 4 × 0.8 × 0.8 cm tet bar inside it.
+///
+/// Element sizes and stiffnesses keep h² (λ + 2μ)/(ρ L²) below 1 for the stable Neo-Hookean
+/// bodies (see xpbd_solver.hpp: its two-constraint split is only stable there).
+struct Layers {
+    std::unique_ptr<TetMesh> fat = makeBoxTetMesh({Vec3::Zero(), Vec3(0.06, 0.02, 0.02), {12, 4, 4}});
+    std::unique_ptr<TetMesh> vessel =
+        makeBoxTetMesh({Vec3(0.01, 0.006, 0.006), Vec3(0.04, 0.008, 0.008), {8, 1, 1}});
+    std::vector<Vec2> uv; // filled by the fascia initialiser below (declared first)
+    TriMesh fascia = sheet(Vec3(0, 0, 0.02), Vec3(0.06, 0, 0), Vec3(0, 0.02, 0), 15, 5, &uv);
+    std::vector<int32_t> fatFixed;
+
+    Layers() {
+        for (int32_t v = 0; v < static_cast<int32_t>(fat->vertexCount()); ++v)
+            if (fat->positions()[v].x() < 1e-9) fatFixed.push_back(v);
+    }
+
+    XpbdSystemDesc desc(double fatE = 3000, double vesselE = 10000, double fasciaK = 50) const {
+        XpbdSystemDesc d;
+        TetBodyDesc f;
+        f.name = "fat";
+        f.mesh = fat.get();
+        f.model = snh(fatE);
+        f.density = 950;
+        f.fixedNodes = fatFixed;
+        TetBodyDesc v;
+        v.name = "vessel";
+        v.mesh = vessel.get();
+        v.model = snh(vesselE);
+        v.density = 1050;
+        d.tetBodies = {f, v};
+        SurfaceBodyDesc s;
+        s.name = "fascia";
+        s.mesh = &fascia;
+        s.uv = uv;
+        s.stretchStiffness = fasciaK;
+        d.surfaces = {s};
+        d.attachments.push_back({0, 0, 1e-4, 0.0, true});
+        d.embeddings.push_back({1, 0, 0.0, 1e-9});
+        return d;
+    }
+};
+
+double maxSag(const std::vector<Vec3>& rest, const std::vector<Vec3>& x) {
+    double s = 0;
+    for (size_t i = 0; i < x.size(); ++i) s = std::max(s, rest[i].z() - x[i].z());
+    return s;
+}
+
+} // namespace
+
+TEST(Membrane, ConstraintGradientsMatchFiniteDifferences) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1, 1);
+    double worst = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        std::vector<Vec3> X = {Vec3::Zero(), Vec3(0.01, 0, 0), Vec3(0.002, 0.01, 0)};
+        for (Vec3& p : X) p += 0.002 * Vec3(u(rng), u(rng), u(rng));
+        Mat2 M;
+        ASSERT_TRUE(triangleRestDmInv({X[0], X[1], X[2]}, M));
+        // Rest: zero strain.
+        for (double c : membraneConstraints({X[0], X[1], X[2]}, M)) EXPECT_NEAR(c, 0.0, 1e-13);
+        const Mat3 F = randomF(rng, 0.4);
+        std::vector<Vec3> x(3);
+        for (int k = 0; k < 3; ++k) x[k] = F * X[k] + 1e-3 * Vec3(u(rng), u(rng), u(rng));
+        std::array<std::array<Vec3, 3>, 3> g;
+        membraneConstraints({x[0], x[1], x[2]}, M, &g);
+        for (int c = 0; c < 3; ++c) {
+            const auto f = [&](const std::vector<Vec3>& y) { return membraneConstraints({y[0], y[1], y[2]}, M)[c]; };
+            worst = std::max(worst, fdRelativeError(f, x, {g[c].begin(), g[c].end()}));
+        }
+    }
+    EXPECT_LT(worst, 1e-6);
+}
+
+TEST(Coupling, ResidualGradientMatchesFiniteDifferences) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1, 1);
+    double worst = 0;
+    for (int n : {3, 4})
+        for (int trial = 0; trial < 10; ++trial) {
+            std::vector<Vec3> x(n + 1);
+            for (Vec3& p : x) p = 0.01 * Vec3(u(rng), u(rng), u(rng));
+            double b[4];
+            double sum = 0;
+            for (int k = 0; k < n; ++k) sum += (b[k] = 0.1 + std::abs(u(rng)));
+            for (int k = 0; k < n; ++k) b[k] /= sum;
+            for (int c = 0; c < 3; ++c) {
+                // ∂C_c/∂x_p = e_c, ∂C_c/∂x_k = −b_k e_c.
+                std::vector<Vec3> g(n + 1, Vec3::Zero());
+                g[0][c] = 1;
+                for (int k = 0; k < n; ++k) g[k + 1][c] = -b[k];
+                const auto f = [&](const std::vector<Vec3>& y) { return couplingResidual(y[0], y.data() + 1, b, n)[c]; };
+                worst = std::max(worst, fdRelativeError(f, x, g));
+            }
+        }
+    EXPECT_LT(worst, 1e-6);
+}
+
+TEST(Coupling, ClosestPointOnTriangleMatchesDenseSampling) {
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> u(-1, 1);
+    const Vec3 a(0, 0, 0), b(1, 0.1, 0), c(0.2, 0.9, 0.1);
+    for (int trial = 0; trial < 200; ++trial) {
+        const Vec3 p = 1.5 * Vec3(u(rng), u(rng), u(rng));
+        Eigen::Vector3d bary;
+        const Vec3 q = closestPointOnTriangle(p, a, b, c, bary);
+        EXPECT_NEAR(bary.sum(), 1.0, 1e-12);
+        EXPECT_GE(bary.minCoeff(), -1e-12);
+        EXPECT_LT((bary[0] * a + bary[1] * b + bary[2] * c - q).norm(), 1e-12);
+        double best = kInf;
+        const int n = 200;
+        for (int i = 0; i <= n; ++i)
+            for (int j = 0; i + j <= n; ++j) {
+                const double s = double(i) / n, t = double(j) / n;
+                best = std::min(best, (a + s * (b - a) + t * (c - a) - p).norm());
+            }
+        EXPECT_LE((q - p).norm(), best + 1e-12);
+        EXPECT_GE((q - p).norm(), best - 0.01);
+    }
+}
+
+TEST(Coupling, BoundaryProjectionAndCageLocation) {
+    auto box = makeBoxTetMesh({Vec3::Zero(), Vec3(0.02, 0.02, 0.02), {3, 3, 3}});
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<double> u(0.001, 0.019);
+    std::vector<Vec3> above, inside;
+    for (int i = 0; i < 50; ++i) {
+        above.push_back(Vec3(u(rng), u(rng), 0.0205));
+        inside.push_back(Vec3(u(rng), u(rng), u(rng)));
+    }
+    inside.push_back(Vec3(0.01, 0.01, 0.01)); // centre (far from the boundary)
+    const auto proj = projectOntoBoundary(*box, above, 1e-3);
+    ASSERT_EQ(proj.size(), above.size());
+    for (const BoundaryProjection& p : proj) {
+        Vec3 q = Vec3::Zero();
+        for (int k = 0; k < 3; ++k) q += p.bary[k] * box->positions()[p.vertices[k]];
+        EXPECT_LT((q - Vec3(above[p.point].x(), above[p.point].y(), 0.02)).norm(), 1e-12);
+        EXPECT_NEAR(p.distance, 5e-4, 1e-12);
+    }
+    EXPECT_EQ(projectOntoBoundary(*box, {Vec3(0.01, 0.01, 0.01)}, 1e-3).size(), 0u);
+
+    const auto loc = locateInCage(*box, inside, 1e-9);
+    ASSERT_EQ(loc.size(), inside.size());
+    for (const CageLocation& c : loc) {
+        Vec3 q = Vec3::Zero();
+        for (int k = 0; k < 4; ++k) q += c.bary[k] * box->positions()[box->tets()[c.tet][k]];
+        EXPECT_LT((q - inside[c.point]).norm(), 1e-13);
+        EXPECT_GE(c.bary.minCoeff(), -1e-12);
+    }
+    try {
+        locateInCage(*box, {Vec3(0.01, 0.01, 0.01), Vec3(0.01, 0.01, 0.03)}, 1e-3);
+        ADD_FAILURE() << "a point outside the cage was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_THAT(e.what(), HasSubstr("sim::locateInCage(): point 1 lies more than 0.001"));
+    }
+}
+
+TEST(XpbdSystem, RestStateIsAFixedPoint) {
+    Layers L;
+    XpbdSettings s;
+    s.gravity.setZero();
+    auto sys = XpbdSystem::create(L.desc(), s);
+    EXPECT_EQ(sys->tetBodyCount(), 2u);
+    EXPECT_EQ(sys->surfaceCount(), 1u);
+    EXPECT_EQ(sys->tieCount(), L.fascia.vertexCount() + L.vessel->vertexCount());
+    EXPECT_LT(sys->maxTieGap(), 1e-15);
+    for (int f = 0; f < 10; ++f) EXPECT_LT(sys->step().maxDisplacement, 1e-15);
+    EXPECT_NEAR(sys->elasticEnergy(), 0.0, 1e-15);
+}
+
+TEST(XpbdSystem, FasciaAndVesselFollowTheFat) {
+    Layers L;
+    XpbdSettings s;
+    s.substeps = 20;
+    s.damping = 2.0;
+    auto sys = XpbdSystem::create(L.desc(), s);
+    double worstGap = 0;
+    for (int f = 0; f < 180; ++f) {
+        ASSERT_TRUE(sys->step().finite);
+        worstGap = std::max(worstGap, sys->maxTieGap());
+    }
+    // Hard ties, one iteration per substep: the layers stay together to a small fraction of a
+    // millimetre while the cantilever sags by centimetres.
+    const double fatSag = maxSag(L.fat->positions(), sys->tetPositions(0));
+    EXPECT_GT(fatSag, 0.01);
+    EXPECT_LT(worstGap, 2e-4);
+    EXPECT_LT(sys->maxTieGap(), 5e-5);
+    EXPECT_GT(maxSag(L.fascia.positions(), sys->surfacePositions(0)), 0.8 * fatSag);
+    EXPECT_GT(maxSag(L.vessel->positions(), sys->tetPositions(1)), 0.3 * fatSag);
+    EXPECT_LT(sys->kineticEnergy(), 1e-5);
+}
+
+TEST(XpbdSystem, CompliantTiesLetTheLayersSlideApartElastically) {
+    Layers L;
+    XpbdSettings s;
+    s.substeps = 20;
+    s.damping = 2.0;
+    XpbdSystemDesc d = L.desc();
+    d.attachments[0].compliance = 1e-2; // m/N: soft
+    d.embeddings[0].compliance = 1e-2;
+    auto soft = XpbdSystem::create(d, s);
+    auto hard = XpbdSystem::create(L.desc(), s);
+    for (int f = 0; f < 120; ++f) {
+        soft->step();
+        hard->step();
+    }
+    EXPECT_GT(soft->maxTieGap(), 5 * hard->maxTieGap());
+    EXPECT_LT(soft->maxTieGap(), 0.01);
+    EXPECT_GT(soft->elasticEnergy(), 0.0);
+}
+
+TEST(XpbdSystem, StiffnessRatioOfAMillionStaysFiniteAndBounded) {
+    Layers L;
+    XpbdSettings s;
+    s.substeps = 20;
+    s.damping = 2.0;
+    // Fat 1 kPa; vessel 1 GPa (10^6 times stiffer); fascia 10^6 times the fat's k = E L.
+    auto sys = XpbdSystem::create(L.desc(1e3, 1e9, 1e3 * 0.02 * 1e6), s);
+    const double e0 = sys->elasticEnergy() + sys->kineticEnergy() + sys->potentialEnergy();
+    double emax = e0, drop = 0;
+    for (int f = 0; f < 240; ++f) {
+        const StepStats st = sys->step();
+        ASSERT_TRUE(st.finite) << "frame " << f;
+        EXPECT_EQ(st.speedClamps, 0);
+        EXPECT_LT(st.maxDisplacement, 0.02);
+        const double e = sys->elasticEnergy() + sys->kineticEnergy() + sys->potentialEnergy();
+        ASSERT_TRUE(std::isfinite(e));
+        emax = std::max(emax, e);
+        drop = std::max(drop, -sys->potentialEnergy());
+    }
+    for (size_t b = 0; b < 2; ++b)
+        for (const Vec3& p : sys->tetPositions(b)) ASSERT_TRUE(p.allFinite());
+    // Damped, from rest: no energy beyond a few percent of the gravitational work.
+    EXPECT_LE(emax - e0, 0.05 * drop);
+    EXPECT_LT(sys->maxTieGap(), 5e-4);
+    // The stiff vessel stays straight: its length changes by well under a percent.
+    const auto& v = sys->tetPositions(1);
+    double lo = kInf, hi = -kInf;
+    for (const Vec3& p : v) {
+        lo = std::min(lo, p.x());
+        hi = std::max(hi, p.x());
+    }
+    EXPECT_GT(hi - lo, 0.98 * 0.04);
+    EXPECT_LT(hi - lo, 1.01 * 0.04);
+}
+
+TEST(XpbdSystem, SurfaceStrainLimitsInTheUvFrame) {
+    // A 4 × 4 cm sheet hanging from its top edge; u runs down the sheet, v across.
+    std::vector<Vec2> uv;
+    TriMesh mesh = sheet(Vec3(0, 0, 0.04), Vec3(0, 0, -0.04), Vec3(0.04, 0, 0), 8, 8, &uv);
+    SurfaceBodyDesc s;
+    s.name = "membrane";
+    s.mesh = &mesh;
+    s.uv = uv;
+    s.stretchStiffness = 0.5; // N/m: very soft, stretches a lot under its own weight
+    s.arealDensity = 0.2;
+    for (int32_t v = 0; v < static_cast<int32_t>(mesh.vertexCount()); ++v)
+        if (mesh.positions()[v].z() > 0.04 - 1e-9) s.fixedNodes.push_back(v);
+    XpbdSettings set;
+    set.substeps = 20;
+    set.iterations = 10;
+    set.damping = 5;
+    auto run = [&](std::optional<TriStrainLimits> limits) {
+        XpbdSystemDesc d;
+        SurfaceBodyDesc body = s;
+        body.strainLimits = std::move(limits);
+        d.surfaces = {body};
+        auto sys = XpbdSystem::create(d, set);
+        for (int f = 0; f < 120; ++f) EXPECT_TRUE(sys->step().finite);
+        return sys->surfacePositions(0);
+    };
+    auto range = [&](const std::vector<Vec3>& x, int i, int j) {
+        double lo = kInf, hi = -kInf;
+        for (const Tri& t : mesh.triangles()) {
+            Mat2 M;
+            triangleUvDmInv({mesh.positions()[t[0]], mesh.positions()[t[1]], mesh.positions()[t[2]]},
+                            {uv[t[0]], uv[t[1]], uv[t[2]]}, M);
+            const double e = triGreenStrain({x[t[0]], x[t[1]], x[t[2]]}, M, i, j);
+            lo = std::min(lo, e);
+            hi = std::max(hi, e);
+        }
+        return std::make_pair(lo, hi);
+    };
+    const auto free = run(std::nullopt);
+    EXPECT_GT(range(free, 0, 0).second, 0.1);
+    TriStrainLimits along;
+    along.limits.push_back({0, 0, -kInf, 0.02, 0.0});
+    const auto u = run(along);
+    EXPECT_LE(range(u, 0, 0).second, 0.02 + 2e-3);
+    TriStrainLimits both = along;
+    both.limits.push_back({1, 1, -0.01, 0.01, 0.0});
+    const auto uvLimited = run(both);
+    EXPECT_LE(range(uvLimited, 0, 0).second, 0.02 + 2e-3);
+    const auto across = range(uvLimited, 1, 1);
+    EXPECT_GE(across.first, -0.01 - 2e-3);
+    EXPECT_LE(across.second, 0.01 + 2e-3);
+}
+
+TEST(XpbdSystem, BitIdenticalAcrossThreadCounts) {
+    // Large enough that colours are split between threads.
+    auto fat = makeBoxTetMesh({Vec3::Zero(), Vec3(0.2, 0.1, 0.1), {20, 10, 10}});
+    auto vessel = makeBoxTetMesh({Vec3(0.02, 0.04, 0.04), Vec3(0.16, 0.02, 0.02), {16, 2, 2}});
+    TriMesh fascia = sheet(Vec3(0, 0, 0.1), Vec3(0.2, 0, 0), Vec3(0, 0.1, 0), 40, 20);
+    std::vector<int32_t> fixed;
+    for (int32_t v = 0; v < static_cast<int32_t>(fat->vertexCount()); ++v)
+        if (fat->positions()[v].x() < 1e-9) fixed.push_back(v);
+    XpbdSystemDesc d;
+    d.tetBodies.push_back({"fat", fat.get(), snh(3000), 950, fixed, {}, {}});
+    TetStrainLimits limits;
+    limits.limits.push_back({0, 0, -kInf, 0.05, 0.0});
+    d.tetBodies.push_back({"vessel", vessel.get(), snh(30000), 100, {}, {}, limits});
+    SurfaceBodyDesc s;
+    s.name = "fascia";
+    s.mesh = &fascia;
+    d.surfaces.push_back(s);
+    d.attachments.push_back({0, 0, 1e-4, 0.0, true});
+    d.embeddings.push_back({1, 0, 0.0, 1e-9});
+    std::vector<std::vector<Vec3>> results;
+    for (int threads : {1, 2, 3}) {
+        XpbdSettings set;
+        set.substeps = 5;
+        set.threads = threads;
+        auto sys = XpbdSystem::create(d, set);
+        for (int f = 0; f < 3; ++f) ASSERT_TRUE(sys->step().finite);
+        std::vector<Vec3> all = sys->tetPositions(0);
+        all.insert(all.end(), sys->tetPositions(1).begin(), sys->tetPositions(1).end());
+        all.insert(all.end(), sys->surfacePositions(0).begin(), sys->surfacePositions(0).end());
+        results.push_back(all);
+    }
+    EXPECT_EQ(results[1], results[0]);
+    EXPECT_EQ(results[2], results[0]);
+}
+
+TEST(XpbdSystem, RejectsInvalidCouplings) {
+    Layers L;
+    XpbdSettings s;
+    auto msg = [&](const XpbdSystemDesc& d) {
+        try {
+            XpbdSystem::create(d, s);
+        } catch (const std::invalid_argument& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    XpbdSystemDesc d = L.desc();
+    d.attachments[0].maxDistance = 0;
+    TriMesh far = sheet(Vec3(0, 0, 0.05), Vec3(0.06, 0, 0), Vec3(0, 0.02, 0), 3, 3);
+    d.surfaces[0].mesh = &far;
+    d.surfaces[0].uv.clear();
+    EXPECT_THAT(msg(d), HasSubstr("sim::XpbdSystem::create(): attachment 0: no vertex of surface 'fascia' lies within 0 m"));
+    d = L.desc();
+    auto outside = makeBoxTetMesh({Vec3(0.05, 0.0, 0.0), Vec3(0.04, 0.01, 0.01), {2, 1, 1}});
+    d.tetBodies[1].mesh = outside.get();
+    EXPECT_THAT(msg(d), HasSubstr("embedding 0: 'vessel' in 'fat': node"));
+    EXPECT_THAT(msg(d), HasSubstr("outside the cage"));
+    d = L.desc();
+    d.surfaces[0].uv.clear();
+    d.surfaces[0].strainLimits = TriStrainLimits{{{0, 0, -kInf, 0.1, 0.0}}, {}};
+    EXPECT_THAT(msg(d), HasSubstr("surface 0 ('fascia'): strain limits need per-vertex uv coordinates"));
+    d = L.desc();
+    d.embeddings[0].cage = 1;
+    EXPECT_THAT(msg(d), HasSubstr("cannot be embedded in itself"));
+    d = L.desc();
+    d.tetBodies[0].fixedNodes.push_back(100000);
+    EXPECT_THAT(msg(d), HasSubstr("tet body 0 ('fat'): fixed node 100000 is out of range"));
+}
