@@ -1,5 +1,6 @@
 #include "sim/scene/world.hpp"
 
+#include "sim/diagnostics/stability_check.hpp"
 #include "sim/reference/accuracy.hpp"
 #include "sim/util/error.hpp"
 
@@ -69,6 +70,8 @@ std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::
     if (scene.accuracy && layered)
         throw InputError(origin + ": features: 'accuracy' sampling needs a scene with a single tet body and no layers");
 
+    if (auto why = validate(scene.xpbd); !why.empty())
+        throw InputError(origin + ": scene cannot be simulated stably: solver: " + why);
     std::unique_ptr<World> w(new World());
     w->m_scene = scene;
     w->m_dt = scene.xpbd.dt;
@@ -83,6 +86,11 @@ std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::
         tb.fixedNodes = b.fixedNodes;
         tb.nodeWeights = b.nodeWeights;
         tb.strainLimits = b.strainLimits;
+        if (tb.nodeWeights.empty() || tb.nodeWeights.size() == meshes[i]->vertexCount()) {
+            const StabilityFigures fig = assessStability(*meshes[i], *tb.model, tb.density, tb.nodeWeights, scene.xpbd);
+            if (auto why = stabilityProblem(b.name, fig, scene.xpbd); !why.empty())
+                throw InputError(origin + ": scene cannot be simulated stably: " + why);
+        }
         desc.tetBodies.push_back(std::move(tb));
         w->m_names.push_back(b.name);
     }

@@ -88,15 +88,14 @@ TEST(StrainLimit, TriangleStrainGradientMatchesFiniteDifferences) {
 }
 
 TEST(StrainLimit, UvFrameFollowsTheTextureDirection) {
-    // A right triangle in the plane z = 0.01 whose u axis points along (1, 1, 0)/√2 and whose uv
-    // map is sheared (v is not perpendicular to u in space).
+    // A triangle in the plane z = 0.01 whose u axis points along t = (1, 1, 0)/√2 and whose uv
+    // map is sheared: u = d·t + 0.3 d·b, v = d·b, so ∂x/∂u = t but ∂x/∂v = b − 0.3 t.
     const Vec3 t = Vec3(1, 1, 0).normalized(), b = Vec3(-1, 1, 0).normalized();
     const std::array<Vec3, 3> X = {Vec3(0, 0, 0.01), Vec3(0, 0, 0.01) + 0.02 * t, Vec3(0, 0, 0.01) + 0.01 * b + 0.005 * t};
-    // uv: u = distance along t (per metre), v = distance along b, sheared by 0.3 u.
     std::array<Vec2, 3> uv;
     for (int k = 0; k < 3; ++k) {
         const Vec3 d = X[k] - X[0];
-        uv[k] = Vec2(d.dot(t), d.dot(b) + 0.3 * d.dot(t));
+        uv[k] = Vec2(d.dot(t) + 0.3 * d.dot(b), d.dot(b));
     }
     Mat2 M;
     ASSERT_TRUE(triangleUvDmInv(X, uv, M));

@@ -214,6 +214,7 @@ public:
           m_limits(std::move(limits)) {}
 
     size_t unitCount() const override { return m_elems.size(); }
+    int stage() const override { return 1; }
     int unitParticles(size_t u, int32_t* out) const override {
         std::copy_n(m_elems[u].begin(), N, out);
         return N;
@@ -338,6 +339,7 @@ public:
     explicit CouplingBlock(std::vector<Tie> ties) : m_ties(std::move(ties)) {}
 
     size_t unitCount() const override { return m_ties.size(); }
+    int stage() const override { return 2; }
     int unitParticles(size_t u, int32_t* out) const override {
         const Tie& t = m_ties[u];
         out[0] = t.p;

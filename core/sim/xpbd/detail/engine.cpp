@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <thread>
 
 namespace viscera::sim::detail {
 namespace {
@@ -40,35 +41,85 @@ int32_t Engine::addParticles(const std::vector<Vec3>& x, const std::vector<doubl
 
 void Engine::colour() {
     const size_t n = particleCount();
-    int words = 1;
-    std::vector<uint64_t> used(n * words, 0);
     std::vector<std::vector<int32_t>> colourOf(blocks.size());
     int32_t p[kMaxUnitParticles];
     m_colours = 0;
-    for (size_t b = 0; b < blocks.size(); ++b) {
-        colourOf[b].resize(blocks[b]->unitCount());
-        for (size_t u = 0; u < colourOf[b].size(); ++u) {
-            const int np = blocks[b]->unitParticles(u, p);
-            int found = -1;
-            while (found < 0) {
-                for (int wd = 0; wd < words && found < 0; ++wd) {
-                    uint64_t taken = 0;
-                    for (int k = 0; k < np; ++k) taken |= used[static_cast<size_t>(p[k]) * words + wd];
-                    if (~taken) found = wd * 64 + __builtin_ctzll(~taken);
+    int maxStage = 0;
+    for (const auto& b : blocks) maxStage = std::max(maxStage, b->stage());
+    for (int stage = 0; stage <= maxStage; ++stage) {
+        const int base = m_colours;
+        int words = 1;
+        std::vector<uint64_t> used(n * words, 0);
+        for (size_t b = 0; b < blocks.size(); ++b) {
+            if (blocks[b]->stage() != stage) continue;
+            colourOf[b].resize(blocks[b]->unitCount());
+            for (size_t u = 0; u < colourOf[b].size(); ++u) {
+                const int np = blocks[b]->unitParticles(u, p);
+                int found = -1;
+                while (found < 0) {
+                    for (int wd = 0; wd < words && found < 0; ++wd) {
+                        uint64_t taken = 0;
+                        for (int k = 0; k < np; ++k) taken |= used[static_cast<size_t>(p[k]) * words + wd];
+                        if (~taken) found = wd * 64 + __builtin_ctzll(~taken);
+                    }
+                    if (found < 0) { // every colour so far is taken around this unit: widen the sets
+                        std::vector<uint64_t> wider(n * (words + 1), 0);
+                        for (size_t i = 0; i < n; ++i)
+                            std::copy_n(used.begin() + i * words, words, wider.begin() + i * (words + 1));
+                        used.swap(wider);
+                        ++words;
+                    }
                 }
-                if (found < 0) { // every colour so far is taken around this unit: widen the sets
-                    std::vector<uint64_t> wider(n * (words + 1), 0);
-                    for (size_t i = 0; i < n; ++i)
-                        std::copy_n(used.begin() + i * words, words, wider.begin() + i * (words + 1));
-                    used.swap(wider);
-                    ++words;
+                for (int k = 0; k < np; ++k)
+                    used[static_cast<size_t>(p[k]) * words + found / 64] |= uint64_t(1) << (found % 64);
+                colourOf[b][u] = base + found;
+                m_colours = std::max(m_colours, base + found + 1);
+            }
+        }
+        // Greedy colours shrink towards the end; every colour costs a synchronisation per sweep.
+        // Move the units of the smallest colours into earlier ones where their particles are free,
+        // and drop the colours that empty.
+        const int count = m_colours - base;
+        std::vector<size_t> size(count, 0);
+        for (size_t b = 0; b < blocks.size(); ++b)
+            if (blocks[b]->stage() == stage)
+                for (int32_t c : colourOf[b]) ++size[c - base];
+        size_t mean = 0;
+        for (size_t z : size) mean += z;
+        mean /= std::max(count, 1);
+        std::vector<uint8_t> dropped(count, 0);
+        for (int c = count - 1; c > 0 && size[c] < mean / 4; --c) {
+            for (size_t b = 0; b < blocks.size(); ++b) {
+                if (blocks[b]->stage() != stage) continue;
+                for (size_t u = 0; u < colourOf[b].size(); ++u) {
+                    if (colourOf[b][u] != base + c) continue;
+                    const int np = blocks[b]->unitParticles(u, p);
+                    for (int to = 0; to < c; ++to) {
+                        if (dropped[to]) continue;
+                        bool free = true;
+                        for (int k = 0; k < np && free; ++k)
+                            free = !(used[static_cast<size_t>(p[k]) * words + to / 64] >> (to % 64) & 1);
+                        if (!free) continue;
+                        for (int k = 0; k < np; ++k) {
+                            used[static_cast<size_t>(p[k]) * words + c / 64] &= ~(uint64_t(1) << (c % 64));
+                            used[static_cast<size_t>(p[k]) * words + to / 64] |= uint64_t(1) << (to % 64);
+                        }
+                        colourOf[b][u] = base + to;
+                        --size[c];
+                        ++size[to];
+                        break;
+                    }
                 }
             }
-            for (int k = 0; k < np; ++k)
-                used[static_cast<size_t>(p[k]) * words + found / 64] |= uint64_t(1) << (found % 64);
-            colourOf[b][u] = found;
-            m_colours = std::max(m_colours, found + 1);
+            if (size[c] == 0) dropped[c] = 1;
         }
+        std::vector<int> renumber(count, 0);
+        int kept = 0;
+        for (int c = 0; c < count; ++c) renumber[c] = dropped[c] ? -1 : kept++;
+        for (size_t b = 0; b < blocks.size(); ++b)
+            if (blocks[b]->stage() == stage)
+                for (int32_t& c : colourOf[b]) c = base + renumber[c - base];
+        m_colours = base + kept;
     }
     m_colourPacks.assign(m_colours, 0);
     for (size_t b = 0; b < blocks.size(); ++b) {
@@ -85,11 +136,16 @@ inline void cpuRelax() {
 #endif
 }
 
-/// Returns once a ≥ target: spins briefly, then sleeps on the futex.
+/// Returns once a ≥ target: spins briefly, then yields the core (the thread we wait for may be
+/// queued behind us on a busy machine), then sleeps on the futex.
 void waitAtLeast(const std::atomic<uint32_t>& a, uint32_t target) {
-    for (int i = 0; i < 2000; ++i) {
+    for (int i = 0; i < 256; ++i) {
         if (a.load(std::memory_order_acquire) >= target) return;
         cpuRelax();
+    }
+    for (int i = 0; i < 64; ++i) {
+        if (a.load(std::memory_order_acquire) >= target) return;
+        std::this_thread::yield();
     }
     for (;;) {
         const uint32_t seen = a.load(std::memory_order_acquire);

@@ -70,6 +70,9 @@ public:
     virtual void solve(size_t packBegin, size_t packEnd, const SolveContext& ctx) = 0;
     /// Stored energy (J) at the particle positions; hard constraints count 0.
     virtual double energy(const double* xw) const = 0;
+    /// Sweep order: all colours of stage 0 (elasticity), then stage 1 (strain limits), then
+    /// stage 2 (couplings), so that limits and ties are the last word of every sweep.
+    virtual int stage() const { return 0; }
 
     /// Lays the units out by colour (colourOfUnit: one entry per unit) in packs of four.
     void arrange(const std::vector<int32_t>& colourOfUnit, int colours);
@@ -97,8 +100,9 @@ public:
     /// of the first. Inverse mass: 0 when fixed or massless, else 1/m.
     int32_t addParticles(const std::vector<Vec3>& x, const std::vector<double>& m,
                          const std::vector<uint8_t>& fixed);
-    /// Greedy colouring of all units of all blocks by shared particles, then arranges the
-    /// blocks. Call once, after the last block is added.
+    /// Greedy colouring of all units of all blocks by shared particles (stage by stage, each
+    /// stage with its own colours), then arranges the blocks. Call once, after the last block is
+    /// added.
     void colour();
     int colourCount() const { return m_colours; }
     /// Packs per colour, all blocks together.
