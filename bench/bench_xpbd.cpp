@@ -30,25 +30,26 @@ void runFrames(benchmark::State& state, const BoxSpec& box, int threads, bool si
         state.SkipWithError("no AVX2/FMA on this CPU");
         return;
     }
-    for (auto _ : state) benchmark::DoNotOptimize(solver->step().maxDisplacement);
+    for (auto _ : state)
+        benchmark::DoNotOptimize(solver->step().maxDisplacement);
     const double tetIters = double(mesh->tetCount()) * s.substeps * s.iterations;
     state.counters["tets"] = double(mesh->tetCount());
     state.counters["colours"] = solver->colourCount();
     // Seconds per tet-iteration (printed with an SI prefix, e.g. "14n" = 14 ns).
-    state.counters["time_per_tet_iteration"] =
-        benchmark::Counter(tetIters, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    state.counters["time_per_tet_iteration"] = benchmark::Counter(
+        tetIters, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
     state.SetItemsProcessed(state.iterations() * int64_t(tetIters));
 }
 
 void BM_XpbdFrame(benchmark::State& state) {
     const int n = static_cast<int>(state.range(0));
-    runFrames(state, {Vec3::Zero(), Vec3(0.2, 0.1, 0.05), {2 * n, n, n / 2}}, static_cast<int>(state.range(1)),
-              state.range(2) != 0);
+    runFrames(state, {Vec3::Zero(), Vec3(0.2, 0.1, 0.05), {2 * n, n, n / 2}},
+              static_cast<int>(state.range(1)), state.range(2) != 0);
 }
 
 void BM_XpbdFrame30k(benchmark::State& state) {
-    runFrames(state, {Vec3::Zero(), Vec3(0.25, 0.2, 0.1), {25, 20, 10}}, static_cast<int>(state.range(0)),
-              state.range(1) != 0);
+    runFrames(state, {Vec3::Zero(), Vec3(0.25, 0.2, 0.1), {25, 20, 10}},
+              static_cast<int>(state.range(0)), state.range(1) != 0);
 }
 
 } // namespace

@@ -34,7 +34,7 @@ std::string writeSlabCase(const ScratchDir& dir, const std::string& name, std::v
     auto mesh = sim::makeBoxTetMesh({sim::Vec3::Zero(), sim::Vec3(0.08, 0.02, 0.02), {8, 2, 2}});
     sim::SceneDesc scene;
     scene.xpbd.gravity = gravity;
-    scene.xpbd.substeps = 10;
+    scene.xpbd.substeps = 50; // what the load-time stability check asks for
     sim::BodyDesc body;
     body.name = "slab";
     body.meshPath = "meshes/slab.vtet";
@@ -140,7 +140,7 @@ TEST(PlayerCli, RunWritesTheSessionReport) {
     EXPECT_EQ(j["active_subsystems"], nlohmann::json({"gravity", "xpbd"}));
     ASSERT_EQ(j["frames"].size(), 60u);
     for (const auto& f : j["frames"]) {
-        EXPECT_EQ(f["substeps"], 10);
+        EXPECT_EQ(f["substeps"], 50);
         EXPECT_EQ(f["iterations"], 1);
         EXPECT_GE(f["step_ms"].get<double>(), 0.0);
     }

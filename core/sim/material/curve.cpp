@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 
 namespace viscera::sim {
@@ -122,17 +123,120 @@ void MonotoneCurve::rebuild() {
             m_slopes[i] = std::clamp(m_slopes[i], 0.0, bound);
         }
     }
-    m_c.assign(n - 1, 0.0);
-    m_d.assign(n - 1, 0.0);
+    m_segments.assign(n, Segment{});
     m_cumulative.assign(n, 0.0);
-    for (std::size_t i = 0; i + 1 < n; ++i) {
+    for (std::size_t i = 0; i < n; ++i) {
+        Segment& q = m_segments[i];
+        q.x = p[i].x;
+        q.y = p[i].y;
+        q.m = m_slopes[i];
+        if (i + 1 == n) break;
         const double h = p[i + 1].x - p[i].x;
         const double m0 = m_slopes[i], m1 = m_slopes[i + 1];
-        m_c[i] = (3.0 * secant[i] - 2.0 * m0 - m1) / h;
-        m_d[i] = (m0 + m1 - 2.0 * secant[i]) / (h * h);
-        m_cumulative[i + 1] =
-            m_cumulative[i] + h * (p[i].y + h * (m0 / 2.0 + h * (m_c[i] / 3.0 + h * m_d[i] / 4.0)));
+        q.c = (3.0 * secant[i] - 2.0 * m0 - m1) / h;
+        q.d = (m0 + m1 - 2.0 * secant[i]) / (h * h);
+        q.c3 = q.c / 3.0;
+        q.d4 = q.d / 4.0;
     }
+    const auto whole = [&](std::size_t i) { return segmentPrimitive(i, p[i + 1].x - p[i].x); };
+    for (std::size_t i = 0; i + 1 < n; ++i)
+        m_cumulative[i + 1] = m_cumulative[i] + whole(i);
+    // ∫₁^{x_k} y, summed outward from the segment that holds 1 (or from the end point next to 1
+    // when 1 lies on a linear extension), so that values near rest carry no cancellation.
+    constexpr double rest = 1.0;
+    std::size_t anchor;
+    if (rest <= p.front().x) {
+        const double s = rest - p.front().x;
+        anchor = 0;
+        m_segments[0].rest = -(s * (p.front().y + 0.5 * m_slopes.front() * s));
+    } else if (rest >= p.back().x) {
+        const double s = rest - p.back().x;
+        anchor = n - 1;
+        m_segments[n - 1].rest = -(s * (p.back().y + 0.5 * m_slopes.back() * s));
+    } else {
+        anchor = segment(rest);
+        m_segments[anchor].rest = -segmentPrimitive(anchor, rest - p[anchor].x);
+    }
+    for (std::size_t i = anchor + 1; i < n; ++i)
+        m_segments[i].rest = m_segments[i - 1].rest + whole(i - 1);
+    for (std::size_t i = anchor; i-- > 0;)
+        m_segments[i].rest = m_segments[i + 1].rest - whole(i);
+    // Collinear control points with equal slopes: the cubics are that line up to rounding.
+    constexpr double kLinearTolerance = 1e-13;
+    const double m0 = m_slopes.front();
+    m_linear = true;
+    for (std::size_t i = 0; i < n && m_linear; ++i) {
+        const double run = p[i].x - p[0].x;
+        const double line = p[0].y + m0 * run;
+        m_linear = std::abs(p[i].y - line) <= kLinearTolerance * (std::abs(p[i].y) + std::abs(m0 * run)) &&
+                   std::abs(m_slopes[i] - m0) <= kLinearTolerance * std::abs(m0);
+    }
+    m_line = m_segments.front();
+    m_line.c = m_line.d = m_line.c3 = m_line.d4 = 0.0;
+    {
+        // ∫₁^{x_0} of the line, with the expression sample() uses, so that x = 1 gives exactly 0.
+        const double s = rest - p.front().x;
+        m_line.rest = -(s * (m_line.y + 0.5 * m_line.m * s));
+    }
+    buildLookup();
+}
+
+void MonotoneCurve::buildLookup() {
+    // Bucket b of x is clamp(floor(map(x)), 0, B − 1) with map non-decreasing, so control points
+    // in buckets below b lie left of any x in bucket b: segment(x) ≥ first[b], where first[b] is
+    // the last segment start in a bucket below b. Likewise segment(x) ≤ first[b + 1]. The table
+    // is sized (per map, doubling B) until no bucket holds two segment starts; then one compare
+    // finishes a lookup.
+    const std::size_t n = m_points.size();
+    const std::size_t segments = n - 1;
+    const auto build = [&](BucketMap map, std::size_t buckets) {
+        m_bucketMap = map;
+        const double lo = map == BucketMap::Log2 ? log2Monotone(m_points.front().x)
+                                                 : m_points.front().x;
+        const double hi =
+            map == BucketMap::Log2 ? log2Monotone(m_points.back().x) : m_points.back().x;
+        m_bucketOrigin = lo;
+        m_bucketScale = static_cast<double>(buckets) / (hi - lo);
+        m_bucketMax = static_cast<double>(buckets - 1);
+        m_bucketFirst.assign(buckets + 1, 0);
+        // Segment starts k = 1..n−2 (k = 0 is every bucket's floor).
+        std::size_t k = 1;
+        for (std::size_t b = 1; b <= buckets; ++b) {
+            while (k < segments && static_cast<std::size_t>(bucketCoordinate(m_points[k].x)) < b)
+                ++k;
+            m_bucketFirst[b] = static_cast<std::uint32_t>(k - 1);
+        }
+        m_bucketFirst[buckets] = static_cast<std::uint32_t>(segments - 1);
+        bool single = true;
+        for (std::size_t b = 0; b < buckets && single; ++b)
+            single = m_bucketFirst[b + 1] - m_bucketFirst[b] <= 1;
+        return single;
+    };
+    const bool logOk = m_points.front().x >= std::numeric_limits<double>::min() &&
+                       std::isfinite(log2Monotone(m_points.back().x));
+    constexpr std::size_t kMaxBucketsPerSegment = 16;
+    for (std::size_t buckets = 2 * segments; buckets <= kMaxBucketsPerSegment * segments;
+         buckets *= 2) {
+        // Prefer the map that separates the points with fewer buckets (a smaller table).
+        if (build(BucketMap::Linear, buckets) || (logOk && build(BucketMap::Log2, buckets))) {
+            m_singleStep = true;
+            return;
+        }
+    }
+    m_singleStep = false;
+    build(logOk ? BucketMap::Log2 : BucketMap::Linear, kMaxBucketsPerSegment * segments);
+}
+
+std::size_t MonotoneCurve::searchBucket(std::size_t lo, std::size_t hi, double x) const {
+    // Last k in [lo, hi] with x_k ≤ x (x_lo ≤ x holds).
+    while (lo < hi) {
+        const std::size_t mid = (lo + hi + 1) / 2;
+        if (m_segments[mid].x <= x)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return lo;
 }
 
 std::size_t MonotoneCurve::segment(double x) const {
@@ -144,21 +248,15 @@ std::size_t MonotoneCurve::segment(double x) const {
 }
 
 double MonotoneCurve::value(double x) const {
-    if (x <= m_points.front().x)
-        return m_points.front().y + m_slopes.front() * (x - m_points.front().x);
-    if (x >= m_points.back().x)
-        return m_points.back().y + m_slopes.back() * (x - m_points.back().x);
-    const std::size_t k = segment(x);
-    const double s = x - m_points[k].x;
-    return m_points[k].y + s * (m_slopes[k] + s * (m_c[k] + s * m_d[k]));
+    return sample(x).value;
 }
 
 double MonotoneCurve::derivative(double x) const {
     if (x <= m_points.front().x) return m_slopes.front();
     if (x >= m_points.back().x) return m_slopes.back();
-    const std::size_t k = segment(x);
-    const double s = x - m_points[k].x;
-    return m_slopes[k] + s * (2.0 * m_c[k] + 3.0 * s * m_d[k]);
+    const Segment& q = m_segments[lookupInterior(x)];
+    const double s = x - q.x;
+    return q.m + s * (2.0 * q.c + 3.0 * s * q.d);
 }
 
 double MonotoneCurve::antiderivative(double x) const {
@@ -170,14 +268,12 @@ double MonotoneCurve::antiderivative(double x) const {
         const double s = x - m_points.back().x;
         return m_cumulative.back() + s * (m_points.back().y + 0.5 * m_slopes.back() * s);
     }
-    const std::size_t k = segment(x);
-    const double s = x - m_points[k].x;
-    return m_cumulative[k] +
-           s * (m_points[k].y + s * (m_slopes[k] / 2.0 + s * (m_c[k] / 3.0 + s * m_d[k] / 4.0)));
+    const std::size_t k = lookupInterior(x);
+    return m_cumulative[k] + segmentPrimitive(k, x - m_points[k].x);
 }
 
 double MonotoneCurve::segmentPrimitive(std::size_t k, double s) const {
-    return s * (m_points[k].y + s * (m_slopes[k] / 2.0 + s * (m_c[k] / 3.0 + s * m_d[k] / 4.0)));
+    return primitive(m_segments[k], s);
 }
 
 double MonotoneCurve::integral(double a, double b) const {

@@ -18,8 +18,20 @@
 /// Outside [x_0, x_{n−1}] the curve continues linearly with the end slopes (C1 at the ends), so
 /// value, derivative and integral are finite for every finite x.
 ///
-/// Cost: value/derivative/integral are O(log n) (a binary search for the segment); an edit
-/// rebuilds the O(n) segment table.
+/// A curve whose control points and slopes all lie on one line (within 1e-13 relative: the
+/// linear f′ of the Neo-Hookean and corotated presets, a constant g′) is evaluated by sample()
+/// and value() as that line, with no segment lookup.
+///
+/// Cost: value, derivative, sample, integralFromRest and antiderivative are O(1): the segment is
+/// found from a bucket table over x (uniform spacing) or over a monotone piecewise-linear log2 x
+/// (geometric spacing), built so that a bucket holds at most one control point, then one compare;
+/// control-point spacings that no table up to 16 buckets per segment separates fall back to a
+/// binary search inside the bucket. integral(a, b) is O(log n). The per-point data of the
+/// piecewise polynomial lie in one 64-byte record, so a lookup touches two cache lines. An edit
+/// rebuilds the O(n) tables.
+#include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -73,6 +85,20 @@ public:
     /// ∫_{x_0}^x y(t) dt (x_0 = first control point).
     double antiderivative(double x) const;
 
+    /// ∫₁ˣ y(t) dt: the primitive that vanishes at x = 1, the rest value of a stretch or a
+    /// stretch product (the rest-normalized Valanis–Landel terms f, g, h, [A eq. 4.18]). Equal to
+    /// integral(1, x) up to rounding and exactly 0 at x = 1. Near 1 the value is a difference
+    /// within one segment (no cancellation of large cumulative sums).
+    double integralFromRest(double x) const { return sample(x).integralFromRest; }
+
+    struct Sample {
+        double value = 0;            ///< y(x)
+        double integralFromRest = 0; ///< ∫₁ˣ y(t) dt
+    };
+    /// value(x) and integralFromRest(x) from one segment lookup: the per-tet hot path of
+    /// Valanis–Landel densities. O(1), no allocation.
+    Sample sample(double x) const;
+
     const std::vector<CurvePoint>& controlPoints() const { return m_points; }
     std::size_t size() const { return m_points.size(); }
     /// Slopes m_k used at the control points (after the monotonicity filter).
@@ -97,19 +123,87 @@ public:
     void validate() const;
 
 private:
+    /// Control point k and the cubic of segment k: y(x) = y + m s + c s² + d s³, s = x − x_k,
+    /// with its primitive s (y + s (m/2 + s (c/3 + s d/4))) (c3 = c/3, d4 = d/4). The last record
+    /// (k = n − 1) has c = d = 0 and serves the linear extension beyond x_{n−1}.
+    struct alignas(64) Segment {
+        double x = 0, y = 0, m = 0, c = 0, d = 0;
+        double rest = 0; ///< ∫₁^{x_k} y
+        double c3 = 0, d4 = 0;
+    };
+    /// How lookupInterior() maps x to a bucket: Linear: (x − origin) · scale; Log2:
+    /// (log2Monotone(x) − origin) · scale (geometric spacing, x_0 > 0).
+    enum class BucketMap : std::uint8_t { Linear, Log2 };
+
     void check(const std::vector<CurvePoint>& points) const;
     void rebuild();
+    void buildLookup();
     std::size_t segment(double x) const; ///< k with x_k ≤ x < x_{k+1}, clamped to [0, n−2]
+    /// segment(x) for x_0 ≤ x < x_{n−1}, O(1) (see buildLookup()).
+    std::size_t lookupInterior(double x) const;
+    std::size_t searchBucket(std::size_t lo, std::size_t hi, double x) const;
+    double bucketCoordinate(double x) const;
     double segmentPrimitive(std::size_t k, double s) const; ///< ∫ over [x_k, x_k + s]
+    /// Non-decreasing, piecewise-linear stand-in for 2^52 (log2 x + 1022) (x > 0): the bits of x
+    /// read as an integer (biased exponent, then mantissa). Exact monotonicity is all the bucket
+    /// table relies on.
+    static double log2Monotone(double x) {
+        return static_cast<double>(std::bit_cast<std::int64_t>(x));
+    }
+    /// Integrand primitive of a record at offset s: s (y + s (m/2 + s (c/3 + s d/4))), in
+    /// Estrin's order (shorter dependency chain than Horner's). The rest table is built with
+    /// the same expression, so that integralFromRest(1) is exactly 0.
+    static double primitive(const Segment& q, double s) {
+        const double s2 = s * s;
+        return s * ((q.y + 0.5 * q.m * s) + s2 * (q.c3 + q.d4 * s));
+    }
 
     std::string m_name;
     std::string m_context;
     CurveShape m_shape;
     std::vector<CurvePoint> m_points;
     std::vector<double> m_slopes;
-    /// Per segment k: y(x) = y_k + m_k s + c_k s² + d_k s³, s = x − x_k.
-    std::vector<double> m_c, m_d;
+    std::vector<Segment> m_segments;  ///< per control point (n records)
     std::vector<double> m_cumulative; ///< ∫_{x_0}^{x_k} y, per control point
+    /// Bucket table: segment(x) lies in [m_bucketFirst[b], m_bucketFirst[b + 1]] for x in bucket b
+    /// (B + 1 entries). With m_singleStep that range holds at most two segments.
+    std::vector<std::uint32_t> m_bucketFirst;
+    BucketMap m_bucketMap = BucketMap::Linear;
+    bool m_singleStep = false;
+    bool m_linear = false; ///< sample() evaluates m_line everywhere
+    Segment m_line;        ///< point 0 with rest = ∫₁^{x_0} of the line (when m_linear)
+    double m_bucketOrigin = 0, m_bucketScale = 0, m_bucketMax = 0; ///< m_bucketMax = B − 1
 };
+
+inline double MonotoneCurve::bucketCoordinate(double x) const {
+    const double t = ((m_bucketMap == BucketMap::Log2 ? log2Monotone(x) : x) - m_bucketOrigin) *
+                     m_bucketScale;
+    return std::max(0.0, std::min(t, m_bucketMax)); // NaN → 0 (min keeps t, max drops it)
+}
+
+inline std::size_t MonotoneCurve::lookupInterior(double x) const {
+    const auto b = static_cast<std::size_t>(static_cast<std::int64_t>(bucketCoordinate(x)));
+    const std::size_t k = m_bucketFirst[b];
+    if (m_singleStep) return k + (x >= m_segments[k + 1].x ? 1 : 0);
+    return searchBucket(k, m_bucketFirst[b + 1], x);
+}
+
+inline MonotoneCurve::Sample MonotoneCurve::sample(double x) const {
+    if (m_linear) {
+        const double s = x - m_line.x;
+        return {m_line.y + m_line.m * s, m_line.rest + s * (m_line.y + 0.5 * m_line.m * s)};
+    }
+    const Segment& first = m_segments.front();
+    const Segment& last = m_segments.back();
+    if (x > first.x && x < last.x) [[likely]] {
+        const Segment& q = m_segments[lookupInterior(x)];
+        const double s = x - q.x, s2 = s * s;
+        return {(q.y + q.m * s) + s2 * (q.c + q.d * s), q.rest + primitive(q, s)};
+    }
+    // Linear extensions (NaN takes the right one and stays NaN).
+    const Segment& e = x <= first.x ? first : last;
+    const double s = x - e.x;
+    return {e.y + e.m * s, e.rest + s * (e.y + 0.5 * e.m * s)};
+}
 
 } // namespace viscera::sim

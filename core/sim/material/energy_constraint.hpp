@@ -5,11 +5,26 @@
 /// restStiffness() (at and near rest, or a density that dips below zero) the constraint reports
 /// C = 0 and ∂C/∂F = 0: the gradient of sqrt(2Ψ) is undefined at rest and Ψ there is rounding
 /// noise (strains below ~1e-7).
+///
+/// Cost per evaluate(): one CombinedEnergyDensity::psiAndStress() when the density offers it (all
+/// densities of laws.hpp and valanis_landel.hpp do), else psi() and stress(); then a square root
+/// and one division.
 #include "sim/material/constraint_model.hpp"
 
 #include <memory>
 
 namespace viscera::sim {
+
+/// A density that evaluates Ψ and P from one decomposition of F (one signed SVD for the
+/// Valanis–Landel and corotated laws, one determinant and logarithm for Neo-Hookean).
+/// Implemented next to EnergyDensity by the densities of laws.hpp and valanis_landel.hpp;
+/// EnergyConstraintModel detects it once at construction and then makes one call per tet.
+class CombinedEnergyDensity {
+public:
+    virtual ~CombinedEnergyDensity() = default;
+    /// Returns Ψ(F) (J/m^3) and writes P(F) (Pa): bit-identical to psi(F) and stress(F).
+    virtual double psiAndStress(const Mat3& F, Mat3& P) const = 0;
+};
 
 class EnergyConstraintModel final : public TetConstraintModel {
 public:
@@ -30,6 +45,7 @@ public:
 
 private:
     std::shared_ptr<const EnergyDensity> m_density;
+    const CombinedEnergyDensity* m_combined = nullptr; ///< m_density's fused path, if it has one
     double m_restEnergy; ///< kRestEnergyTolerance · restStiffness()
 };
 

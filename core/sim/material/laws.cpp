@@ -56,6 +56,13 @@ Mat3 LinearElasticDensity::stress(const Mat3& F) const {
     return 2.0 * m_mu * eps + m_lambda * eps.trace() * Mat3::Identity();
 }
 
+double LinearElasticDensity::psiAndStress(const Mat3& F, Mat3& P) const {
+    const Mat3 eps = 0.5 * (F + F.transpose()) - Mat3::Identity();
+    const double tr = eps.trace();
+    P = 2.0 * m_mu * eps + m_lambda * tr * Mat3::Identity();
+    return m_mu * eps.squaredNorm() + 0.5 * m_lambda * tr * tr;
+}
+
 // --- St. Venant–Kirchhoff ---------------------------------------------------------------------
 
 StVenantKirchhoffDensity::StVenantKirchhoffDensity(double mu, double lambda)
@@ -72,6 +79,13 @@ double StVenantKirchhoffDensity::psi(const Mat3& F) const {
 Mat3 StVenantKirchhoffDensity::stress(const Mat3& F) const {
     const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
     return F * (2.0 * m_mu * E + m_lambda * E.trace() * Mat3::Identity());
+}
+
+double StVenantKirchhoffDensity::psiAndStress(const Mat3& F, Mat3& P) const {
+    const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
+    const double tr = E.trace();
+    P = F * (2.0 * m_mu * E + m_lambda * tr * Mat3::Identity());
+    return m_mu * E.squaredNorm() + 0.5 * m_lambda * tr * tr;
 }
 
 // --- corotated linear -------------------------------------------------------------------------
@@ -93,6 +107,15 @@ Mat3 CorotatedLinearDensity::stress(const Mat3& F) const {
     return 2.0 * m_mu * (F - R) + m_lambda * (svd.sigma.sum() - 3.0) * R;
 }
 
+double CorotatedLinearDensity::psiAndStress(const Mat3& F, Mat3& P) const {
+    const SignedSvd svd = signedSvd(F);
+    const Mat3 R = svd.U * svd.V.transpose();
+    P = 2.0 * m_mu * (F - R) + m_lambda * (svd.sigma.sum() - 3.0) * R;
+    const Eigen::Vector3d& s = svd.sigma;
+    const double tr = s.sum() - 3.0;
+    return m_mu * (s.array() - 1.0).square().sum() + 0.5 * m_lambda * tr * tr;
+}
+
 // --- Neo-Hookean ------------------------------------------------------------------------------
 
 NeoHookeanDensity::NeoHookeanDensity(double mu, double lambda, double jMin)
@@ -103,33 +126,39 @@ NeoHookeanDensity::NeoHookeanDensity(double mu, double lambda, double jMin)
                                     " must be in (0, 1)");
 }
 
-double NeoHookeanDensity::phi(double J) const {
+void NeoHookeanDensity::phi(double J, double& value, double& slope) const {
     if (J >= m_jMin) {
         const double l = std::log(J);
-        return -m_mu * l + 0.5 * m_lambda * l * l;
+        value = -m_mu * l + 0.5 * m_lambda * l * l;
+        slope = (m_lambda * l - m_mu) / J;
+        return;
     }
     const double l = std::log(m_jMin);
     const double p0 = -m_mu * l + 0.5 * m_lambda * l * l;
     const double p1 = (m_lambda * l - m_mu) / m_jMin;
     const double p2 = (m_mu + m_lambda * (1.0 - l)) / (m_jMin * m_jMin);
     const double d = J - m_jMin;
-    return p0 + d * (p1 + 0.5 * p2 * d);
-}
-
-double NeoHookeanDensity::dphi(double J) const {
-    if (J >= m_jMin) return (m_lambda * std::log(J) - m_mu) / J;
-    const double l = std::log(m_jMin);
-    const double p1 = (m_lambda * l - m_mu) / m_jMin;
-    const double p2 = (m_mu + m_lambda * (1.0 - l)) / (m_jMin * m_jMin);
-    return p1 + p2 * (J - m_jMin);
+    value = p0 + d * (p1 + 0.5 * p2 * d);
+    slope = p1 + p2 * d;
 }
 
 double NeoHookeanDensity::psi(const Mat3& F) const {
-    return 0.5 * m_mu * (F.squaredNorm() - 3.0) + phi(F.determinant());
+    double value, slope;
+    phi(F.determinant(), value, slope);
+    return 0.5 * m_mu * (F.squaredNorm() - 3.0) + value;
 }
 
 Mat3 NeoHookeanDensity::stress(const Mat3& F) const {
-    return m_mu * F + dphi(F.determinant()) * cofactor(F);
+    double value, slope;
+    phi(F.determinant(), value, slope);
+    return m_mu * F + slope * cofactor(F);
+}
+
+double NeoHookeanDensity::psiAndStress(const Mat3& F, Mat3& P) const {
+    double value, slope;
+    phi(F.determinant(), value, slope);
+    P = m_mu * F + slope * cofactor(F);
+    return 0.5 * m_mu * (F.squaredNorm() - 3.0) + value;
 }
 
 // --- factories --------------------------------------------------------------------------------

@@ -3,7 +3,9 @@
 /// their Valanis–Landel forms [A §4.3.2] where the law has one.
 ///
 /// All take Lamé parameters μ > 0, λ ≥ 0 (Pa) and throw std::invalid_argument otherwise; all
-/// have Ψ(I) = 0, P(I) = 0, restStiffness() = λ + 2μ, and are finite for every finite F.
+/// have Ψ(I) = 0, P(I) = 0, restStiffness() = λ + 2μ, and are finite for every finite F. Each
+/// also offers psiAndStress() (CombinedEnergyDensity), bit-identical to psi() and stress() and
+/// sharing their work (one signed SVD for corotated, one log J for Neo-Hookean).
 ///
 /// Corrections to the table as printed: the corotated energy is μ‖F − R‖² + λ/2 tr²(RᵀF − I)
 /// (the table's "2/λ" is a typo; its stress column matches λ/2), and the Neo-Hookean stress is
@@ -16,12 +18,13 @@ namespace viscera::sim {
 
 /// Linear (small-strain) elasticity: ε = ½(F + Fᵀ) − I, Ψ = μ ε:ε + λ/2 tr²ε,
 /// P = 2μ ε + λ tr(ε) I. Not rotation invariant (Ψ(RF) ≠ Ψ(F)); no Valanis–Landel form.
-class LinearElasticDensity final : public EnergyDensity {
+class LinearElasticDensity final : public EnergyDensity, public CombinedEnergyDensity {
 public:
     LinearElasticDensity(double mu, double lambda);
     std::string name() const override { return "linear"; }
     double psi(const Mat3& F) const override;
     Mat3 stress(const Mat3& F) const override;
+    double psiAndStress(const Mat3& F, Mat3& P) const override;
     double restStiffness() const override { return m_lambda + 2.0 * m_mu; }
 
 private:
@@ -31,12 +34,13 @@ private:
 /// St. Venant–Kirchhoff: E = ½(FᵀF − I), Ψ = μ E:E + λ/2 tr²E, P = F(2μE + λ tr(E) I).
 /// Rotation invariant but blind to inversion (Ψ depends on FᵀF only) and soft under strong
 /// compression.
-class StVenantKirchhoffDensity final : public EnergyDensity {
+class StVenantKirchhoffDensity final : public EnergyDensity, public CombinedEnergyDensity {
 public:
     StVenantKirchhoffDensity(double mu, double lambda);
     std::string name() const override { return "st_venant_kirchhoff"; }
     double psi(const Mat3& F) const override;
     Mat3 stress(const Mat3& F) const override;
+    double psiAndStress(const Mat3& F, Mat3& P) const override;
     double restStiffness() const override { return m_lambda + 2.0 * m_mu; }
 
 private:
@@ -46,12 +50,13 @@ private:
 /// Corotated linear: R = U Vᵀ from signedSvd() (a proper rotation, also for inverted F),
 /// Ψ = μ‖F − R‖² + λ/2 tr²(RᵀF − I) = μ Σ(σi − 1)² + λ/2 (Σσi − 3)²,
 /// P = 2μ(F − R) + λ tr(RᵀF − I) R.
-class CorotatedLinearDensity final : public EnergyDensity {
+class CorotatedLinearDensity final : public EnergyDensity, public CombinedEnergyDensity {
 public:
     CorotatedLinearDensity(double mu, double lambda);
     std::string name() const override { return "corotated"; }
     double psi(const Mat3& F) const override;
     Mat3 stress(const Mat3& F) const override;
+    double psiAndStress(const Mat3& F, Mat3& P) const override;
     double restStiffness() const override { return m_lambda + 2.0 * m_mu; }
 
 private:
@@ -63,7 +68,7 @@ private:
 /// log J extension: for J < jMin, φ is replaced by its second-order Taylor polynomial at jMin
 /// (C2 there, φ″(jMin) = (μ + λ(1 − log jMin))/jMin² > 0), so Ψ and P stay finite and smooth for
 /// J ≤ 0 and keep growing as the element inverts.
-class NeoHookeanDensity final : public EnergyDensity {
+class NeoHookeanDensity final : public EnergyDensity, public CombinedEnergyDensity {
 public:
     static constexpr double kDefaultJMin = 1e-2;
     /// jMin in (0, 1); throws std::invalid_argument otherwise.
@@ -71,12 +76,13 @@ public:
     std::string name() const override { return "neo_hookean"; }
     double psi(const Mat3& F) const override;
     Mat3 stress(const Mat3& F) const override;
+    double psiAndStress(const Mat3& F, Mat3& P) const override;
     double restStiffness() const override { return m_lambda + 2.0 * m_mu; }
     double jMin() const { return m_jMin; }
 
 private:
-    double phi(double J) const;
-    double dphi(double J) const;
+    /// φ(J) and φ′(J) (one logarithm).
+    void phi(double J, double& value, double& slope) const;
     double m_mu, m_lambda, m_jMin;
 };
 

@@ -2,11 +2,12 @@
 
 #include "sim/util/error.hpp"
 
-#include <Eigen/LU>
-#include <Eigen/SVD>
+#include <Eigen/Geometry>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
@@ -28,25 +29,206 @@ double curveValue(const std::optional<MonotoneCurve>& c, double x) {
 double curveSlope(const std::optional<MonotoneCurve>& c, double x) {
     return c ? c->derivative(x) : 0.0;
 }
-/// ∫₁ˣ c (the rest-normalized energy term).
-double curveEnergy(const std::optional<MonotoneCurve>& c, double x) {
-    return c ? c->integral(1.0, x) : 0.0;
+
+/// Largest root of β³ − 3β = 2r for r in [0, 1], β = 2 cos(acos(r)/3) in [√3, 2]: its degree-17
+/// Chebyshev interpolant in t = 2r − 1, in monomial form (coefficient sum 2, so no cancellation)
+/// evaluated in Estrin's order. The root is analytic on [0, 1] (its branch point is r = −1);
+/// error below 7e-16 (3 ulp) in double, so p β has the accuracy of the cubic's coefficients.
+double largestDepressedCubicRoot(double r) {
+    constexpr double c[18] = {
+        1.8793852415718166,     0.13164361454489953,    -0.012862827975309531,
+        0.002213309911670022,   -0.0004672905593236235, 0.00010982883739243108,
+        -2.7582551520811382e-05, 7.2465777463647e-06,   -1.967100732486947e-06,
+        5.473607998941967e-07,  -1.552200855299401e-07, 4.473191705071068e-08,
+        -1.3186905785460066e-08, 3.8929562920498784e-09, -1.032444158601723e-09,
+        3.08997060034581e-10,   -1.610559523763899e-10, 4.9182677563478205e-11};
+    const double t = 2.0 * r - 1.0;
+    const double t2 = t * t, t4 = t2 * t2, t8 = t4 * t4, t16 = t8 * t8;
+    const auto pair = [&](int i) { return c[i] + c[i + 1] * t; };
+    const double q0 = pair(0) + pair(2) * t2, q1 = pair(4) + pair(6) * t2;
+    const double q2 = pair(8) + pair(10) * t2, q3 = pair(12) + pair(14) * t2;
+    return ((q0 + q1 * t4) + (q2 + q3 * t4) * t8) + pair(16) * t16;
+}
+
+using Vec3 = Eigen::Vector3d;
+
+/// 2^-k with k = floor(log2(v) / 2) for a positive normal v, so that v 4^-k lies in [1, 4):
+/// exact rescaling by exponent arithmetic (no sqrt, no division).
+double inverseSqrtPowerOfTwo(double v) {
+    const std::int64_t e = static_cast<std::int64_t>(std::bit_cast<std::uint64_t>(v) >> 52) - 1023;
+    return std::bit_cast<double>(static_cast<std::uint64_t>(1023 - (e >> 1)) << 52);
+}
+
+/// signedSvd() for max|F_ij| in [2^-60, 2^60], so that A = FᵀF, the cubic's coefficients and
+/// the cross products below stay far from overflow and underflow.
+///
+/// Latency-minded (the XPBD loop waits on it): no loop, few divisions and square roots in
+/// sequence, and eigenvectors carried unnormalized (with their inverse lengths k_i) as long as
+/// possible, since U = F V diag(1/σ) does not depend on their lengths.
+SignedSvd signedSvdScaled(const Mat3& F) {
+    const double a00 = F.col(0).squaredNorm(), a11 = F.col(1).squaredNorm(),
+                 a22 = F.col(2).squaredNorm();
+    const double a01 = F.col(0).dot(F.col(1)), a02 = F.col(0).dot(F.col(2)),
+                 a12 = F.col(1).dot(F.col(2));
+    // B = A − qI: eigenvalues q + p β with p² = tr(B²)/6 (the spread) and β³ − 3β = 2r,
+    // r = det(B) / (2p³) in [−1, 1].
+    const double q = (a00 + a11 + a22) * (1.0 / 3.0);
+    const double b00 = a00 - q, b11 = a11 - q, b22 = a22 - q;
+    const double p2 = (b00 * b00 + b11 * b11 + b22 * b22) * (1.0 / 6.0) +
+                      (a01 * a01 + a02 * a02 + a12 * a12) * (1.0 / 3.0);
+    Vec3 c0 = Vec3::UnitX(), c1 = Vec3::UnitY(), c2 = Vec3::UnitZ(); // V up to lengths 1/k_i
+    double k0 = 1.0, k1 = 1.0, k2 = 1.0;
+    // Isotropic to far below rounding (spread < 1e-30 q): every basis diagonalizes A.
+    if (p2 > 1e-60 * q * q) {
+        const double p = std::sqrt(p2);
+        const double detB = b00 * (b11 * b22 - a12 * a12) - a01 * (a01 * b22 - a12 * a02) +
+                            a02 * (a01 * a12 - b11 * a02);
+        const double r = std::clamp(detB / (2.0 * p2 * p2) * p, -1.0, 1.0);
+        // The extreme root on the side of r (largest for r ≥ 0, smallest for r < 0) has
+        // |β| ≥ √3 while the other two lie in [−√3, 1] (resp. [−1, √3]): a simple eigenvalue,
+        // at least √3 p from the others, whatever their own gap.
+        const bool largest = r >= 0;
+        const double pb = p * largestDepressedCubicRoot(std::abs(r));
+        const double shift = largest ? pb : -pb;
+        // Its eigenvector x spans the null space of B − shift I (rank 2): the largest cross
+        // product of two rows (the largest column of the adjugate).
+        const Vec3 r0(b00 - shift, a01, a02), r1(a01, b11 - shift, a12), r2(a02, a12, b22 - shift);
+        const Vec3 x01 = r0.cross(r1), x02 = r0.cross(r2), x12 = r1.cross(r2);
+        const double n01 = x01.squaredNorm(), n02 = x02.squaredNorm(), n12 = x12.squaredNorm();
+        // (Branches, not selects: the chain is latency-bound and a predicted branch costs none.)
+        Vec3 x = x12;
+        double nmax = n12;
+        if (n01 >= n02 && n01 >= n12) {
+            x = x01;
+            nmax = n01;
+        } else if (n02 >= n12) {
+            x = x02;
+            nmax = n02;
+        }
+        x *= inverseSqrtPowerOfTwo(nmax); // exact; |x|² in [1, 4)
+        const double nx = x.squaredNorm(), len = std::sqrt(nx);
+        // Orthogonal complement, unnormalized: w1 = x × e_j with |x_j| smallest (|w1|² ≥ 2|x|²/3)
+        // and w2 = x × w1 (|w2|² = |x|² |w1|²); det[x, w1, w2] > 0.
+        const Vec3 ax = x.cwiseAbs();
+        Vec3 w1(x(1), -x(0), 0.0);
+        if (ax(0) <= ax(1) && ax(0) <= ax(2))
+            w1 = Vec3(0.0, x(2), -x(1));
+        else if (ax(1) <= ax(2))
+            w1 = Vec3(-x(2), 0.0, x(0));
+        const Vec3 w2 = x.cross(w1);
+        // The other two eigenvectors: the exact rotation diagonalizing the 2×2 block of B in the
+        // orthonormal basis (w1/|w1|, w2/|w2|) (robust for equal or nearly equal eigenvalues,
+        // where cross products are not). Its entries times |w2|² = |x|² |w1|² are
+        // (w1ᵀBw1 |x|², w1ᵀBw2 |x|, w2ᵀBw2): (h, m) below is (half-difference, off-diagonal)
+        // times |w2|², which leaves the rotation unchanged.
+        const Vec3 Bw1(b00 * w1(0) + a01 * w1(1) + a02 * w1(2),
+                       a01 * w1(0) + b11 * w1(1) + a12 * w1(2),
+                       a02 * w1(0) + a12 * w1(1) + b22 * w1(2));
+        const Vec3 Bw2(b00 * w2(0) + a01 * w2(1) + a02 * w2(2),
+                       a01 * w2(0) + b11 * w2(1) + a12 * w2(2),
+                       a02 * w2(0) + a12 * w2(1) + b22 * w2(2));
+        const double h = 0.5 * (w1.dot(Bw1) * nx - w2.dot(Bw2));
+        const double m = w1.dot(Bw2) * len;
+        const double rr = std::sqrt(h * h + m * m);
+        const double big = rr + std::abs(h);
+        double norm2 = 2.0 * rr * big; // |(ca, sa)|²
+        // (ca, sa) ∝ eigenvector of the larger eigenvalue: (big, m) for h ≥ 0, else (m, big).
+        double ca = h >= 0 ? big : m, sa = h >= 0 ? m : big; // compiled to compare masks
+        if (!(norm2 > 0)) { // equal eigenvalues: any rotation
+            ca = 1.0;
+            sa = 0.0;
+            norm2 = 1.0;
+        }
+        const Vec3 lw1 = len * w1;
+        const Vec3 e1 = ca * lw1 + sa * w2, e2 = ca * w2 - sa * lw1; // |e|² = norm2 |w2|²
+        const double kx = 1.0 / len, ke = 1.0 / std::sqrt(norm2 * nx * w1.squaredNorm());
+        // Decreasing eigenvalues, right-handed: det[x, e1, e2] = det[e1, e2, x] > 0.
+        k1 = ke;
+        if (largest) {
+            c0 = x;
+            c1 = e1;
+            c2 = e2;
+            k0 = kx;
+            k2 = ke;
+        } else {
+            c0 = e1;
+            c1 = e2;
+            c2 = x;
+            k0 = ke;
+            k2 = kx;
+        }
+    }
+    SignedSvd out;
+    out.V.col(0) = c0 * k0;
+    out.V.col(1) = c1 * k1;
+    out.V.col(2) = c2 * k2;
+    const Vec3 g0 = F * c0, g1 = F * c1, g2 = F * c2; // = U diag(σ) diag(1/k)
+    const double l0 = g0.norm(), l1 = g1.norm();
+    out.sigma(0) = l0 * k0; // ≥ max|F_ij| / √3 > 0 up to rounding
+    // F v1 ⊥ F v0 within ~1e-16 σ1²: u1 = F v1 / σ2 is orthogonal to u0 within ~1e-16 σ1/σ2.
+    // Below σ2 = 1e-3 σ1 orthogonalize explicitly (rank ≤ 1: any unit vector orthogonal to u0).
+    if (l1 * k1 > 1e-3 * out.sigma(0)) {
+        const double i0 = 1.0 / l0, i1 = 1.0 / l1;
+        out.U.col(0) = g0 * i0;
+        out.U.col(1) = g1 * i1;
+        out.U.col(2) = out.U.col(0).cross(out.U.col(1));
+        out.sigma(1) = l1 * k1;
+        // σ3 = u3 · F v3 = det[g0, g1, g2] k2 / (l0 l1): the triple product does not wait for U.
+        out.sigma(2) = g0.cross(g1).dot(g2) * (k2 * i0 * i1); // signed: det U = det V = +1
+    } else {
+        out.U.col(0) = g0 / l0;
+        const Vec3 b1 = g1 * k1 - out.U.col(0).dot(g1 * k1) * out.U.col(0);
+        const double n1 = b1.norm();
+        if (n1 > 1e-200) {
+            out.U.col(1) = b1 / n1;
+        } else {
+            const Vec3 u0 = out.U.col(0), a = u0.cwiseAbs();
+            const int axis = a(0) <= a(1) ? (a(0) <= a(2) ? 0 : 2) : (a(1) <= a(2) ? 1 : 2);
+            const Vec3 t = u0.cross(Vec3::Unit(axis));
+            out.U.col(1) = t / t.norm();
+        }
+        out.sigma(1) = n1;
+        out.U.col(2) = out.U.col(0).cross(out.U.col(1));
+        out.sigma(2) = out.U.col(2).dot(g2) * k2;
+    }
+    // Ties broken by rounding can leave the order one ulp off: restore σ1 ≥ σ2 ≥ |σ3|.
+    const auto swapColumns = [&](int i, int j) {
+        std::swap(out.sigma(i), out.sigma(j));
+        out.U.col(i).swap(out.U.col(j));
+        out.V.col(i).swap(out.V.col(j));
+        out.U.col(j) *= -1.0; // both determinants back to +1, U diag(σ) Vᵀ unchanged
+        out.V.col(j) *= -1.0;
+    };
+    if (out.sigma(1) > out.sigma(0)) swapColumns(0, 1);
+    if (std::abs(out.sigma(2)) > out.sigma(1)) {
+        swapColumns(1, 2);
+        if (out.sigma(1) > out.sigma(0)) swapColumns(0, 1);
+        for (int i = 0; i < 2; ++i)
+            if (out.sigma(i) < 0) { // move the sign to the smallest stretch
+                out.sigma(i) = -out.sigma(i);
+                out.U.col(i) *= -1.0;
+                out.sigma(2) = -out.sigma(2);
+                out.U.col(2) *= -1.0;
+            }
+    }
+    return out;
 }
 
 } // namespace
 
 SignedSvd signedSvd(const Mat3& F) {
-    Eigen::JacobiSVD<Mat3> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    SignedSvd out{svd.matrixU(), svd.singularValues(), svd.matrixV()};
-    // Singular values come sorted decreasingly; a reflection in U or V moves to σ3.
-    if (out.U.determinant() < 0) {
-        out.U.col(2) *= -1.0;
-        out.sigma(2) *= -1.0;
+    const double maxAbs = F.cwiseAbs().maxCoeff();
+    if (maxAbs >= 0x1p-60 && maxAbs <= 0x1p60) [[likely]]
+        return signedSvdScaled(F);
+    if (maxAbs == 0) return {Mat3::Identity(), Eigen::Vector3d::Zero(), Mat3::Identity()};
+    if (!std::isfinite(maxAbs)) {
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        return {Mat3::Constant(nan), Eigen::Vector3d::Constant(nan), Mat3::Constant(nan)};
     }
-    if (out.V.determinant() < 0) {
-        out.V.col(2) *= -1.0;
-        out.sigma(2) *= -1.0;
-    }
+    // Power-of-two scaling is exact: max|F_ij| moves into [1, 2).
+    const int e = std::ilogb(maxAbs);
+    SignedSvd out = signedSvdScaled(F * std::ldexp(1.0, -e));
+    out.sigma *= std::ldexp(1.0, e);
     return out;
 }
 
@@ -85,49 +267,65 @@ ValanisLandelDensity::ValanisLandelDensity(std::string materialName, ValanisLand
                          num(m_shearModulus) + " Pa is not positive (" + values + ")");
 }
 
-double ValanisLandelDensity::psiPrincipal(const Eigen::Vector3d& s) const {
+double ValanisLandelDensity::principal(const Eigen::Vector3d& s, const MonotoneCurve::Sample& hJ,
+                                       Eigen::Vector3d* d) const {
     const auto& c = m_curves;
     double e = 0;
-    if (c.fPrime)
-        e +=
-            curveEnergy(c.fPrime, s(0)) + curveEnergy(c.fPrime, s(1)) + curveEnergy(c.fPrime, s(2));
-    if (c.gPrime)
-        e += curveEnergy(c.gPrime, s(0) * s(1)) + curveEnergy(c.gPrime, s(1) * s(2)) +
-             curveEnergy(c.gPrime, s(0) * s(2));
-    if (c.hPrime) e += curveEnergy(c.hPrime, s(0) * s(1) * s(2));
+    Eigen::Vector3d dpsi = Eigen::Vector3d::Zero();
+    if (c.fPrime) {
+        const auto f0 = c.fPrime->sample(s(0)), f1 = c.fPrime->sample(s(1)),
+                   f2 = c.fPrime->sample(s(2));
+        e += f0.integralFromRest + f1.integralFromRest + f2.integralFromRest;
+        dpsi = Eigen::Vector3d(f0.value, f1.value, f2.value);
+    }
+    if (c.gPrime) {
+        const auto g01 = c.gPrime->sample(s(0) * s(1)), g12 = c.gPrime->sample(s(1) * s(2)),
+                   g02 = c.gPrime->sample(s(0) * s(2));
+        e += g01.integralFromRest + g12.integralFromRest + g02.integralFromRest;
+        dpsi(0) += s(1) * g01.value + s(2) * g02.value;
+        dpsi(1) += s(0) * g01.value + s(2) * g12.value;
+        dpsi(2) += s(0) * g02.value + s(1) * g12.value;
+    }
+    if (c.hPrime) {
+        e += hJ.integralFromRest;
+        dpsi(0) += s(1) * s(2) * hJ.value;
+        dpsi(1) += s(0) * s(2) * hJ.value;
+        dpsi(2) += s(0) * s(1) * hJ.value;
+    }
+    if (d) *d = dpsi;
     return e;
 }
 
+double ValanisLandelDensity::psiPrincipal(const Eigen::Vector3d& s) const {
+    return principal(s, volumeTerm(s.prod()), nullptr);
+}
+
 Eigen::Vector3d ValanisLandelDensity::stressPrincipal(const Eigen::Vector3d& s) const {
-    const auto& c = m_curves;
-    Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    if (c.fPrime)
-        for (int i = 0; i < 3; ++i)
-            d(i) += c.fPrime->value(s(i));
-    if (c.gPrime) {
-        const double g01 = c.gPrime->value(s(0) * s(1));
-        const double g12 = c.gPrime->value(s(1) * s(2));
-        const double g02 = c.gPrime->value(s(0) * s(2));
-        d(0) += s(1) * g01 + s(2) * g02;
-        d(1) += s(0) * g01 + s(2) * g12;
-        d(2) += s(0) * g02 + s(1) * g12;
-    }
-    if (c.hPrime) {
-        const double hJ = c.hPrime->value(s(0) * s(1) * s(2));
-        d(0) += s(1) * s(2) * hJ;
-        d(1) += s(0) * s(2) * hJ;
-        d(2) += s(0) * s(1) * hJ;
-    }
+    Eigen::Vector3d d;
+    principal(s, volumeTerm(s.prod()), &d);
     return d;
 }
 
 double ValanisLandelDensity::psi(const Mat3& F) const {
-    return psiPrincipal(signedSvd(F).sigma);
+    const auto hJ = volumeTerm(F.determinant());
+    return principal(signedSvd(F).sigma, hJ, nullptr);
 }
 
 Mat3 ValanisLandelDensity::stress(const Mat3& F) const {
+    Mat3 P;
+    psiAndStress(F, P);
+    return P;
+}
+
+double ValanisLandelDensity::psiAndStress(const Mat3& F, Mat3& P) const {
+    // J = det F = σ1 σ2 σ3 needs no SVD: the h′ lookup goes first, in program order, so that
+    // it runs while the SVD's dependency chain does.
+    const auto hJ = volumeTerm(F.determinant());
     const SignedSvd svd = signedSvd(F);
-    return svd.U * stressPrincipal(svd.sigma).asDiagonal() * svd.V.transpose();
+    Eigen::Vector3d d;
+    const double e = principal(svd.sigma, hJ, &d);
+    P.noalias() = (svd.U * d.asDiagonal()) * svd.V.transpose();
+    return e;
 }
 
 ValanisLandelCurves neoHookeanCurves(double mu, double lambda,

@@ -12,7 +12,7 @@ namespace {
 
 /// Uniform grid over element bounding boxes; query by box. Build O(#elements · cells per box).
 class BoxGrid {
-public:
+  public:
     BoxGrid(const std::vector<Eigen::AlignedBox3d>& boxes, double pad) {
         Eigen::AlignedBox3d all;
         double extent = 0;
@@ -25,14 +25,17 @@ public:
         m_origin = all.min();
         const double cell = std::max(extent / std::max<size_t>(boxes.size(), 1), 1e-9);
         const Vec3 size = all.max() - all.min();
-        for (int a = 0; a < 3; ++a) m_dims[a] = std::clamp(static_cast<int>(std::ceil(size[a] / cell)), 1, 256);
-        for (int a = 0; a < 3; ++a) m_cell[a] = std::max(size[a] / m_dims[a], 1e-12);
+        for (int a = 0; a < 3; ++a)
+            m_dims[a] = std::clamp(static_cast<int>(std::ceil(size[a] / cell)), 1, 256);
+        for (int a = 0; a < 3; ++a)
+            m_cell[a] = std::max(size[a] / m_dims[a], 1e-12);
         m_start.assign(static_cast<size_t>(m_dims[0]) * m_dims[1] * m_dims[2] + 1, 0);
         // Two passes: count, then fill (CSR).
         for (int pass = 0; pass < 2; ++pass) {
             std::vector<int32_t> fill;
             if (pass == 1) {
-                for (size_t c = 1; c < m_start.size(); ++c) m_start[c] += m_start[c - 1];
+                for (size_t c = 1; c < m_start.size(); ++c)
+                    m_start[c] += m_start[c - 1];
                 m_items.resize(m_start.back());
                 fill.assign(m_start.begin(), m_start.end() - 1);
             }
@@ -43,8 +46,10 @@ public:
                     for (int j = lo[1]; j <= hi[1]; ++j)
                         for (int k = lo[2]; k <= hi[2]; ++k) {
                             const size_t c = index(i, j, k);
-                            if (pass == 0) ++m_start[c + 1];
-                            else m_items[fill[c]++] = static_cast<int32_t>(e);
+                            if (pass == 0)
+                                ++m_start[c + 1];
+                            else
+                                m_items[fill[c]++] = static_cast<int32_t>(e);
                         }
             }
         }
@@ -70,11 +75,13 @@ public:
                 }
     }
 
-private:
+  private:
     void range(const Vec3& lo, const Vec3& hi, std::array<int, 3>& a, std::array<int, 3>& b) const {
         for (int d = 0; d < 3; ++d) {
-            a[d] = std::clamp(static_cast<int>(std::floor((lo[d] - m_origin[d]) / m_cell[d])), 0, m_dims[d] - 1);
-            b[d] = std::clamp(static_cast<int>(std::floor((hi[d] - m_origin[d]) / m_cell[d])), 0, m_dims[d] - 1);
+            a[d] = std::clamp(static_cast<int>(std::floor((lo[d] - m_origin[d]) / m_cell[d])), 0,
+                              m_dims[d] - 1);
+            b[d] = std::clamp(static_cast<int>(std::floor((hi[d] - m_origin[d]) / m_cell[d])), 0,
+                              m_dims[d] - 1);
         }
     }
     size_t index(int i, int j, int k) const {
@@ -93,11 +100,13 @@ private:
 
 Vec3 couplingResidual(const Vec3& xp, const Vec3* targets, const double* bary, int n) {
     Vec3 c = xp;
-    for (int k = 0; k < n; ++k) c -= bary[k] * targets[k];
+    for (int k = 0; k < n; ++k)
+        c -= bary[k] * targets[k];
     return c;
 }
 
-Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Eigen::Vector3d& bary) {
+Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
+                            Eigen::Vector3d& bary) {
     // Voronoi-region walk (Ericson, Real-Time Collision Detection §5.1.5).
     const Vec3 ab = b - a, ac = c - a, ap = p - a;
     const double d1 = ab.dot(ap), d2 = ac.dot(ap);
@@ -141,10 +150,11 @@ Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
     return a + ab * v + ac * w;
 }
 
-std::vector<BoundaryProjection> projectOntoBoundary(const TetMesh& cage, const std::vector<Vec3>& points,
-                                                    double maxDistance) {
+std::vector<BoundaryProjection>
+projectOntoBoundary(const TetMesh& cage, const std::vector<Vec3>& points, double maxDistance) {
     if (!(maxDistance >= 0) || !std::isfinite(maxDistance))
-        throw std::invalid_argument("sim::projectOntoBoundary(): maxDistance must be finite and >= 0");
+        throw std::invalid_argument(
+            "sim::projectOntoBoundary(): maxDistance must be finite and >= 0");
     const auto& x = cage.positions();
     std::vector<std::array<int32_t, 3>> tris;
     for (int32_t f = 0; f < static_cast<int32_t>(4 * cage.tetCount()); ++f)
@@ -168,7 +178,8 @@ std::vector<BoundaryProjection> projectOntoBoundary(const TetMesh& cage, const s
         best.distance = std::numeric_limits<double>::infinity();
         for (int32_t t : cand) {
             Eigen::Vector3d bary;
-            const Vec3 q = closestPointOnTriangle(points[i], x[tris[t][0]], x[tris[t][1]], x[tris[t][2]], bary);
+            const Vec3 q = closestPointOnTriangle(points[i], x[tris[t][0]], x[tris[t][1]],
+                                                  x[tris[t][2]], bary);
             const double d = (q - points[i]).norm();
             if (d < best.distance) {
                 best.distance = d;
@@ -184,7 +195,8 @@ std::vector<BoundaryProjection> projectOntoBoundary(const TetMesh& cage, const s
     return out;
 }
 
-std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Vec3>& points, double tolerance) {
+std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Vec3>& points,
+                                       double tolerance) {
     const std::string where = "sim::locateInCage(): ";
     if (!(tolerance >= 0) || !std::isfinite(tolerance))
         throw std::invalid_argument(where + "tolerance must be finite and >= 0");
@@ -194,7 +206,8 @@ std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Ve
     boxes.reserve(tets.size());
     for (const Tet& e : tets) {
         Eigen::AlignedBox3d b(x[e[0]]);
-        for (int k = 1; k < 4; ++k) b.extend(x[e[k]]);
+        for (int k = 1; k < 4; ++k)
+            b.extend(x[e[k]]);
         boxes.push_back(b);
     }
     BoxGrid grid(boxes, tolerance);
@@ -218,7 +231,8 @@ std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Ve
                 dist = std::numeric_limits<double>::infinity();
                 for (const auto& f : kFace) {
                     Eigen::Vector3d fb;
-                    const Vec3 q = closestPointOnTriangle(p, x[tets[t][f[0]]], x[tets[t][f[1]]], x[tets[t][f[2]]], fb);
+                    const Vec3 q = closestPointOnTriangle(p, x[tets[t][f[0]]], x[tets[t][f[1]]],
+                                                          x[tets[t][f[2]]], fb);
                     dist = std::min(dist, (q - p).norm());
                 }
             }
@@ -231,10 +245,11 @@ std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Ve
         }
         if (best.tet < 0 || bestDist > tolerance) {
             if (best.tet < 0)
-                throw std::invalid_argument(where + "point " + std::to_string(i) + " lies more than " +
-                                            std::to_string(tolerance) + " m outside the cage");
-            throw std::invalid_argument(where + "point " + std::to_string(i) + " lies " + std::to_string(bestDist) +
-                                        " m outside the cage");
+                throw std::invalid_argument(where + "point " + std::to_string(i) +
+                                            " lies more than " + std::to_string(tolerance) +
+                                            " m outside the cage");
+            throw std::invalid_argument(where + "point " + std::to_string(i) + " lies " +
+                                        std::to_string(bestDist) + " m outside the cage");
         }
         best.point = static_cast<int32_t>(i);
         out.push_back(best);

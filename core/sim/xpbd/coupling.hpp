@@ -22,30 +22,32 @@ namespace viscera::sim {
 Vec3 couplingResidual(const Vec3& xp, const Vec3* targets, const double* bary, int n);
 
 /// Closest point to p on triangle (a, b, c); its barycentric coordinates (≥ 0, sum 1) into bary.
-Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Eigen::Vector3d& bary);
+Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
+                            Eigen::Vector3d& bary);
 
 struct BoundaryProjection {
-    int32_t point = -1;                 ///< index into the query points
-    std::array<int32_t, 3> vertices{};  ///< cage mesh vertices of the boundary triangle
+    int32_t point = -1;                             ///< index into the query points
+    std::array<int32_t, 3> vertices{};              ///< cage mesh vertices of the boundary triangle
     Eigen::Vector3d bary = Eigen::Vector3d::Zero(); ///< closest point = Σ bary_k x_k
-    double distance = 0;                ///< m
+    double distance = 0;                            ///< m
 };
 
 /// For every point within maxDistance (m) of the boundary of `cage`, the closest boundary point;
 /// farther points are left out. Uses the mesh's level-1 adjacency only. Cost: a uniform grid,
 /// about O(#points + #boundary triangles).
-std::vector<BoundaryProjection> projectOntoBoundary(const TetMesh& cage, const std::vector<Vec3>& points,
-                                                    double maxDistance);
+std::vector<BoundaryProjection>
+projectOntoBoundary(const TetMesh& cage, const std::vector<Vec3>& points, double maxDistance);
 
 struct CageLocation {
-    int32_t point = -1;                 ///< index into the query points
-    int32_t tet = -1;                   ///< cage tet
+    int32_t point = -1;                             ///< index into the query points
+    int32_t tet = -1;                               ///< cage tet
     Eigen::Vector4d bary = Eigen::Vector4d::Zero(); ///< point = Σ bary_k x_k (exact at rest)
 };
 
 /// For every point, the cage tet containing it (or, for a point outside the cage by at most
 /// tolerance metres, the nearest tet). Throws std::invalid_argument
 /// ("sim::locateInCage(): point 12 lies 0.004 m outside the cage") for a point farther out.
-std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Vec3>& points, double tolerance);
+std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Vec3>& points,
+                                       double tolerance);
 
 } // namespace viscera::sim

@@ -27,7 +27,8 @@ std::array<double, 3> membraneConstraints(const std::array<Vec3, 3>& x, const Ma
     c[1] = triGreenStrain(x, M, 1, 1, grad ? &(*grad)[1] : nullptr);
     c[2] = kSqrt2 * triGreenStrain(x, M, 0, 1, grad ? &(*grad)[2] : nullptr);
     if (grad)
-        for (Vec3& g : (*grad)[2]) g *= kSqrt2;
+        for (Vec3& g : (*grad)[2])
+            g *= kSqrt2;
     return c;
 }
 

@@ -36,7 +36,7 @@ using Mat2 = Eigen::Matrix2d;
 struct StrainLimit {
     int i = 0, j = 0; ///< Green-strain entry in material axes: 0..2 for tets, 0..1 for triangles
     double lower = -std::numeric_limits<double>::infinity(); ///< ε_ij ≥ lower; −∞ = no lower limit
-    double upper = std::numeric_limits<double>::infinity();  ///< ε_ij ≤ upper; +∞ = no upper limit
+    double upper = std::numeric_limits<double>::infinity(); ///< ε_ij ≤ upper; +∞ = no upper limit
     /// 0 = hard. Tets: 1/Pa (per unit rest volume, energy V C²/(2α));
     /// triangles: m/N (per unit rest area, energy A C²/(2α)).
     double compliance = 0;
@@ -45,15 +45,15 @@ struct StrainLimit {
 /// Strain limits of a tet body. Lower and upper limits of one entry become two unilateral
 /// constraints; lower == upper one bilateral constraint.
 struct TetStrainLimits {
-    Mat3 axes = Mat3::Identity();     ///< orthonormal material axes (columns), rest frame
+    Mat3 axes = Mat3::Identity(); ///< orthonormal material axes (columns), rest frame
     std::vector<StrainLimit> limits;
-    std::vector<int32_t> tets;        ///< tets the limits apply to; empty = all
+    std::vector<int32_t> tets; ///< tets the limits apply to; empty = all
 };
 
 /// Strain limits of a triangle surface, in the UV frame of each triangle (needs per-vertex UVs).
 struct TriStrainLimits {
     std::vector<StrainLimit> limits;
-    std::vector<int32_t> triangles;   ///< triangles the limits apply to; empty = all
+    std::vector<int32_t> triangles; ///< triangles the limits apply to; empty = all
 };
 
 /// Empty when valid, otherwise the rule that failed. dim = 3 for tets, 2 for triangles.

@@ -10,12 +10,12 @@ namespace viscera::sim {
 int defaultXpbdThreads();
 
 struct XpbdSettings {
-    double dt = 1.0 / 60.0;          ///< frame time step, s
-    int substeps = 10;               ///< substeps per frame
-    int iterations = 1;              ///< constraint sweeps per substep
-    double damping = 1.0;            ///< velocity damping rate, 1/s
+    double dt = 1.0 / 60.0;           ///< frame time step, s
+    int substeps = 10;                ///< substeps per frame
+    int iterations = 1;               ///< constraint sweeps per substep
+    double damping = 1.0;             ///< velocity damping rate, 1/s
     Vec3 gravity = Vec3(0, 0, -9.81); ///< m/s^2, world frame
-    double maxSpeed = 20.0;          ///< m/s; faster nodes are clamped (counted in StepStats)
+    double maxSpeed = 20.0;           ///< m/s; faster nodes are clamped (counted in StepStats)
     /// Threads that share the constraint sweeps (1 = serial, on the calling thread). Constraints
     /// are graph-coloured, so results are bit-identical for every thread count.
     int threads = defaultXpbdThreads();
@@ -28,11 +28,11 @@ struct XpbdSettings {
 std::string validate(const XpbdSettings& s);
 
 struct StepStats {
-    bool finite = true;            ///< false: the step produced a non-finite value and was undone
+    bool finite = true; ///< false: the step produced a non-finite value and was undone
     int substeps = 0;
     int iterations = 0;
-    double maxDisplacement = 0;    ///< m, largest node displacement over the frame
-    int speedClamps = 0;           ///< node-substeps whose speed was clamped to maxSpeed
+    double maxDisplacement = 0; ///< m, largest node displacement over the frame
+    int speedClamps = 0;        ///< node-substeps whose speed was clamped to maxSpeed
 };
 
 } // namespace viscera::sim

@@ -14,7 +14,8 @@ namespace viscera::sim {
 XpbdSolver::XpbdSolver() = default;
 XpbdSolver::~XpbdSolver() = default;
 
-std::unique_ptr<XpbdSolver> XpbdSolver::create(const TetBodyDesc& body, const XpbdSettings& settings) {
+std::unique_ptr<XpbdSolver> XpbdSolver::create(const TetBodyDesc& body,
+                                               const XpbdSettings& settings) {
     const std::string where = "sim::XpbdSolver::create(): ";
     XpbdSystemDesc desc;
     desc.tetBodies.push_back(body);
@@ -29,19 +30,22 @@ std::unique_ptr<XpbdSolver> XpbdSolver::create(const TetBodyDesc& body, const Xp
     p.weight = s->m_sys->tetWeights(0);
     for (const Tet& e : p.tets) {
         Mat3 dm;
-        for (int k = 0; k < 3; ++k) dm.col(k) = x[e[k + 1]] - x[e[0]];
+        for (int k = 0; k < 3; ++k)
+            dm.col(k) = x[e[k + 1]] - x[e[0]];
         p.dmInv.push_back(dm.inverse());
         p.volume.push_back(dm.determinant() / 6.0);
     }
     const detail::Engine& eng = *s->m_sys->m_engine;
     p.mass = eng.mass;
     p.fixed.resize(eng.particleCount());
-    for (size_t i = 0; i < p.fixed.size(); ++i) p.fixed[i] = detail::particleInvMass(eng.xw.data(), i) == 0 ? 1 : 0;
+    for (size_t i = 0; i < p.fixed.size(); ++i)
+        p.fixed[i] = detail::particleInvMass(eng.xw.data(), i) == 0 ? 1 : 0;
     return s;
 }
 
 std::unique_ptr<XpbdSolver> XpbdSolver::create(const TetMesh& rest, const Material& material,
-                                               const std::vector<int32_t>& fixedNodes, const XpbdSettings& settings) {
+                                               const std::vector<int32_t>& fixedNodes,
+                                               const XpbdSettings& settings) {
     if (auto why = validate(material); !why.empty())
         throw std::invalid_argument("sim::XpbdSolver::create(): " + why);
     TetBodyDesc body;
@@ -52,16 +56,36 @@ std::unique_ptr<XpbdSolver> XpbdSolver::create(const TetMesh& rest, const Materi
     return create(body, settings);
 }
 
-StepStats XpbdSolver::step() { return m_sys->step(); }
-const std::vector<Vec3>& XpbdSolver::positions() const { return m_sys->tetPositions(0); }
-const std::vector<Vec3>& XpbdSolver::velocities() const { return m_sys->tetVelocities(0); }
-const XpbdSettings& XpbdSolver::settings() const { return m_sys->settings(); }
-int XpbdSolver::colourCount() const { return m_sys->colourCount(); }
-bool XpbdSolver::usesSimd() const { return m_sys->usesSimd(); }
-double XpbdSolver::elasticEnergy() const { return m_sys->elasticEnergy(); }
-double XpbdSolver::kineticEnergy() const { return m_sys->kineticEnergy(); }
-double XpbdSolver::potentialEnergy() const { return m_sys->potentialEnergy(); }
-double XpbdSolver::totalMass() const { return m_sys->totalMass(); }
+StepStats XpbdSolver::step() {
+    return m_sys->step();
+}
+const std::vector<Vec3>& XpbdSolver::positions() const {
+    return m_sys->tetPositions(0);
+}
+const std::vector<Vec3>& XpbdSolver::velocities() const {
+    return m_sys->tetVelocities(0);
+}
+const XpbdSettings& XpbdSolver::settings() const {
+    return m_sys->settings();
+}
+int XpbdSolver::colourCount() const {
+    return m_sys->colourCount();
+}
+bool XpbdSolver::usesSimd() const {
+    return m_sys->usesSimd();
+}
+double XpbdSolver::elasticEnergy() const {
+    return m_sys->elasticEnergy();
+}
+double XpbdSolver::kineticEnergy() const {
+    return m_sys->kineticEnergy();
+}
+double XpbdSolver::potentialEnergy() const {
+    return m_sys->potentialEnergy();
+}
+double XpbdSolver::totalMass() const {
+    return m_sys->totalMass();
+}
 
 void XpbdSolver::setState(const std::vector<Vec3>& x, const std::vector<Vec3>& v) {
     try {
@@ -93,10 +117,12 @@ StepProblem XpbdSolver::nextSubstepProblem() const {
     return p;
 }
 
-void XpbdSolver::iterateOn(const StepProblem& p, int iterations, const IterateObserver& observe) const {
+void XpbdSolver::iterateOn(const StepProblem& p, int iterations,
+                           const IterateObserver& observe) const {
     const std::string where = "sim::XpbdSolver::iterateOn(): ";
     if (iterations < 1) throw std::invalid_argument(where + "iterations must be >= 1");
-    if (!(p.h > 0) || !std::isfinite(p.h)) throw std::invalid_argument(where + "h must be positive and finite");
+    if (!(p.h > 0) || !std::isfinite(p.h))
+        throw std::invalid_argument(where + "h must be positive and finite");
     const size_t nv = p.xTilde.size(), nt = p.tets.size();
     if (p.mass.size() != nv || p.fixed.size() != nv)
         throw std::invalid_argument(where + "xTilde, mass and fixed must have one entry per node");
@@ -108,21 +134,25 @@ void XpbdSolver::iterateOn(const StepProblem& p, int iterations, const IterateOb
     for (size_t t = 0; t < nt; ++t) {
         for (int32_t v : p.tets[t])
             if (v < 0 || static_cast<size_t>(v) >= nv)
-                throw std::invalid_argument(where + "tet " + std::to_string(t) + " references node " +
-                                            std::to_string(v) + " (problem has " + std::to_string(nv) + " nodes)");
+                throw std::invalid_argument(where + "tet " + std::to_string(t) +
+                                            " references node " + std::to_string(v) +
+                                            " (problem has " + std::to_string(nv) + " nodes)");
         if (!(p.volume[t] > 0) || !(p.weight[t] > 0))
-            throw std::invalid_argument(where + "tet " + std::to_string(t) + " needs a positive volume and weight");
+            throw std::invalid_argument(where + "tet " + std::to_string(t) +
+                                        " needs a positive volume and weight");
     }
     detail::Engine eng;
     eng.addParticles(p.xTilde, p.mass, p.fixed);
-    eng.blocks.push_back(detail::makeElasticBlock({p.tets, p.dmInv, p.volume, p.weight, p.model}, settings().simd));
+    eng.blocks.push_back(
+        detail::makeElasticBlock({p.tets, p.dmInv, p.volume, p.weight, p.model}, settings().simd));
     eng.colour();
     const double h2inv = 1.0 / (p.h * p.h);
     double seconds = 0;
     std::vector<Vec3> xk(nv);
     for (int k = 1; k <= iterations; ++k) {
         seconds += eng.sweep(k == 1, h2inv, settings().threads, m_sys->m_pool.get());
-        for (size_t i = 0; i < nv; ++i) xk[i] = detail::particlePosition(eng.xw.data(), static_cast<int32_t>(i));
+        for (size_t i = 0; i < nv; ++i)
+            xk[i] = detail::particlePosition(eng.xw.data(), static_cast<int32_t>(i));
         if (observe) observe(k, xk, seconds);
     }
 }

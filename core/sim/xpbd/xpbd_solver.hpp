@@ -12,8 +12,21 @@
 ///
 /// Constraints are greedy-coloured by shared nodes and each colour is split over
 /// settings.threads threads; the Gauss–Seidel order is colour by colour, so results are
-/// bit-identical from run to run and for every thread count. For several bodies and coupled
-/// layers see XpbdSystem, which this class wraps.
+/// bit-identical from run to run and for every thread count (the AVX2 and the scalar kernel
+/// differ from each other in the last bits). For several bodies and coupled layers see
+/// XpbdSystem, which this class wraps.
+///
+/// Limits of the method (measured, see tests/sim/xpbd):
+///   - Stability: the stable Neo-Hookean split carries a rest pretension (C_D = √3 at F = I)
+///     whose geometric stiffness XPBD ignores; with multipliers restarted every substep it is
+///     stable only while the stiffness number h² (λ + 2μ) w / (ρ L²) stays below about 1
+///     (sim/diagnostics/stability_check.hpp refuses bodies above 0.25). More iterations do not
+///     help, more substeps do. Constraints that vanish at rest (a one-constraint
+///     EnergyConstraintModel, strain limits, membranes, ties) have no such limit: far beyond it
+///     they behave like PBD, as stiff as the iterations make them.
+///   - Equilibrium: XPBD drops the primal residual M(x − x̃) − ∇Cᵀλ, so its fixed point is off
+///     the static equilibrium by O(h² k/m) whatever the iteration count (a 3 cm block at
+///     20 kPa, 1 cm elements, 20 substeps of 1/60 s: 8e-5 m). It vanishes as h² / ρ.
 #include "sim/material/material.hpp"
 #include "sim/mesh/tet_mesh.hpp"
 #include "sim/xpbd/step_problem.hpp"
@@ -27,13 +40,14 @@
 namespace viscera::sim {
 
 class XpbdSolver {
-public:
+  public:
     /// body.mesh is read during create only. Throws std::invalid_argument
     /// ("sim::XpbdSolver::create(): fixed node 12 is out of range (mesh has 10 vertices)") on
     /// invalid settings, a null mesh or model, a model with other than 1 or 2 constraints, bad
     /// density, node weights or strain limits, a fixed node out of range, a tet with non-positive
     /// rest volume, or a body with no free node.
-    static std::unique_ptr<XpbdSolver> create(const TetBodyDesc& body, const XpbdSettings& settings);
+    static std::unique_ptr<XpbdSolver> create(const TetBodyDesc& body,
+                                              const XpbdSettings& settings);
     /// Convenience: a StableNeoHookeanModel from the material's Lamé parameters, its density, all
     /// weights 1, no strain limits. Also throws on an invalid material.
     static std::unique_ptr<XpbdSolver> create(const TetMesh& rest, const Material& material,
@@ -59,7 +73,8 @@ public:
     /// Between frames only. Throws std::invalid_argument on a size mismatch or non-finite value.
     void setState(const std::vector<Vec3>& x, const std::vector<Vec3>& v);
 
-    double elasticEnergy() const;   ///< J, relative to the rest state (plus violated compliant strain limits)
+    double elasticEnergy()
+        const; ///< J, relative to the rest state (plus violated compliant strain limits)
     double kineticEnergy() const;   ///< J
     double potentialEnergy() const; ///< J, gravity relative to the rest configuration
     double totalMass() const;       ///< kg
@@ -76,12 +91,18 @@ public:
     /// Runs `iterations` sweeps of the production XPBD iteration (the same blocks, colouring and
     /// kernels as step()) on the elastic constraints of `problem`, from x_0 = x̃ with multipliers 0,
     /// calling observe(k, x_k, seconds) after sweep k = 1..iterations; seconds is the cumulative
-    /// wall time of the sweeps alone. The solver's state is untouched; it shares the worker
-    /// threads, so it must not run concurrently with step(). Throws std::invalid_argument on an
-    /// inconsistent problem or iterations < 1.
-    void iterateOn(const StepProblem& problem, int iterations, const IterateObserver& observe) const;
+    /// wall time of the sweeps alone (each sweep is one job of the worker threads, so with
+    /// threads > 1 it includes waking them, a few µs; the packing and colouring of the problem
+    /// happen before the clock starts). On nextSubstepProblem() of a body without strain limits
+    /// the iterates are those of step() bit for bit (with substeps = iterations = 1 and no speed
+    /// clamp, x_1 is the position after the next step()). The
+    /// solver's state is untouched; it shares the worker threads, so it must not run
+    /// concurrently with step(). Throws std::invalid_argument on an inconsistent problem or
+    /// iterations < 1.
+    void iterateOn(const StepProblem& problem, int iterations,
+                   const IterateObserver& observe) const;
 
-private:
+  private:
     XpbdSolver();
     std::unique_ptr<XpbdSystem> m_sys;
     StepProblem m_template; ///< h and xTilde empty; the rest as in nextSubstepProblem()

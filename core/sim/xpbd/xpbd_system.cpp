@@ -29,29 +29,31 @@ struct Failer {
     }
 };
 
-void checkFixed(const std::vector<int32_t>& fixed, size_t nv, const std::string& label, const Failer& fail) {
+void checkFixed(const std::vector<int32_t>& fixed, size_t nv, const std::string& label,
+                const Failer& fail) {
     for (int32_t f : fixed)
         if (f < 0 || static_cast<size_t>(f) >= nv)
-            fail(label, "fixed node " + std::to_string(f) + " is out of range (mesh has " + std::to_string(nv) +
-                            " vertices)");
+            fail(label, "fixed node " + std::to_string(f) + " is out of range (mesh has " +
+                            std::to_string(nv) + " vertices)");
 }
 
-void checkLimits(const std::vector<StrainLimit>& limits, int dim, const std::vector<int32_t>& elems, size_t count,
-                 const char* elemName, const std::string& label, const Failer& fail) {
+void checkLimits(const std::vector<StrainLimit>& limits, int dim, const std::vector<int32_t>& elems,
+                 size_t count, const char* elemName, const std::string& label, const Failer& fail) {
     if (limits.empty()) fail(label, "strain limits: no limit given");
     for (size_t k = 0; k < limits.size(); ++k)
         if (auto why = validate(limits[k], dim); !why.empty())
             fail(label, "strain limit " + std::to_string(k) + ": " + why);
     for (int32_t e : elems)
         if (e < 0 || static_cast<size_t>(e) >= count)
-            fail(label, std::string("strain limits: ") + elemName + " " + std::to_string(e) + " is out of range (" +
-                            std::to_string(count) + " " + elemName + "s)");
+            fail(label, std::string("strain limits: ") + elemName + " " + std::to_string(e) +
+                            " is out of range (" + std::to_string(count) + " " + elemName + "s)");
 }
 
 std::vector<int32_t> allOr(const std::vector<int32_t>& subset, size_t count) {
     if (!subset.empty()) return subset;
     std::vector<int32_t> all(count);
-    for (size_t i = 0; i < count; ++i) all[i] = static_cast<int32_t>(i);
+    for (size_t i = 0; i < count; ++i)
+        all[i] = static_cast<int32_t>(i);
     return all;
 }
 
@@ -60,11 +62,13 @@ std::vector<int32_t> allOr(const std::vector<int32_t>& subset, size_t count) {
 XpbdSystem::XpbdSystem() : m_engine(std::make_unique<detail::Engine>()) {}
 XpbdSystem::~XpbdSystem() = default;
 
-std::unique_ptr<XpbdSystem> XpbdSystem::create(const XpbdSystemDesc& desc, const XpbdSettings& settings) {
+std::unique_ptr<XpbdSystem> XpbdSystem::create(const XpbdSystemDesc& desc,
+                                               const XpbdSettings& settings) {
     return build(desc, settings, "sim::XpbdSystem::create(): ", false);
 }
 
-std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const XpbdSettings& settings,
+std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
+                                              const XpbdSettings& settings,
                                               const std::string& where, bool singleBody) {
     const Failer fail{where};
     if (auto why = validate(settings); !why.empty()) fail("", why);
@@ -74,7 +78,9 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
     detail::Engine& eng = *sys->m_engine;
 
     auto tetLabel = [&](size_t b) {
-        return singleBody ? std::string() : "tet body " + std::to_string(b) + " ('" + desc.tetBodies[b].name + "'): ";
+        return singleBody
+                   ? std::string()
+                   : "tet body " + std::to_string(b) + " ('" + desc.tetBodies[b].name + "'): ";
     };
     auto surfLabel = [&](size_t s) {
         return "surface " + std::to_string(s) + " ('" + desc.surfaces[s].name + "'): ";
@@ -110,18 +116,19 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
         const auto alpha = d.model->compliance();
         for (int k = 0; k < count; ++k)
             if (!std::isfinite(alpha[k]) || alpha[k] < 0)
-                fail(label, "constraint model '" + d.model->name() + "' has compliance " + num(alpha[k]) +
-                                " (must be finite and >= 0)");
-        if (!std::isfinite(d.density) || d.density <= 0) fail(label, "density must be positive and finite");
+                fail(label, "constraint model '" + d.model->name() + "' has compliance " +
+                                num(alpha[k]) + " (must be finite and >= 0)");
+        if (!std::isfinite(d.density) || d.density <= 0)
+            fail(label, "density must be positive and finite");
         const size_t nv = mesh.vertexCount();
         if (!d.nodeWeights.empty()) {
             if (d.nodeWeights.size() != nv)
-                fail(label, "node weights: " + std::to_string(d.nodeWeights.size()) + " given for " +
-                                std::to_string(nv) + " vertices");
+                fail(label, "node weights: " + std::to_string(d.nodeWeights.size()) +
+                                " given for " + std::to_string(nv) + " vertices");
             for (size_t i = 0; i < nv; ++i)
                 if (!std::isfinite(d.nodeWeights[i]) || d.nodeWeights[i] <= 0)
-                    fail(label, "node weight " + std::to_string(i) + " is " + num(d.nodeWeights[i]) +
-                                    " (must be positive and finite)");
+                    fail(label, "node weight " + std::to_string(i) + " is " +
+                                    num(d.nodeWeights[i]) + " (must be positive and finite)");
         }
         const auto& x = mesh.positions();
         detail::ElasticTets et;
@@ -131,25 +138,31 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
         for (size_t t = 0; t < mesh.tetCount(); ++t) {
             const Tet& e = mesh.tets()[t];
             Mat3 dm;
-            for (int k = 0; k < 3; ++k) dm.col(k) = x[e[k + 1]] - x[e[0]];
+            for (int k = 0; k < 3; ++k)
+                dm.col(k) = x[e[k + 1]] - x[e[0]];
             const double vol = dm.determinant() / 6.0;
             if (!(vol > 0))
-                fail(label, "tet " + std::to_string(t) + " has non-positive rest volume " + num(vol) + " m^3");
+                fail(label, "tet " + std::to_string(t) + " has non-positive rest volume " +
+                                num(vol) + " m^3");
             et.tets.push_back({e[0] + off, e[1] + off, e[2] + off, e[3] + off});
             et.dmInv.push_back(dm.inverse());
             et.volume.push_back(vol);
             double w = 1.0;
             if (!d.nodeWeights.empty())
-                w = 0.25 * (d.nodeWeights[e[0]] + d.nodeWeights[e[1]] + d.nodeWeights[e[2]] + d.nodeWeights[e[3]]);
+                w = 0.25 * (d.nodeWeights[e[0]] + d.nodeWeights[e[1]] + d.nodeWeights[e[2]] +
+                            d.nodeWeights[e[3]]);
             et.weight.push_back(w);
-            for (int k = 0; k < 4; ++k) mass[e[k]] += d.density * vol / 4.0;
+            for (int k = 0; k < 4; ++k)
+                mass[e[k]] += d.density * vol / 4.0;
         }
         checkFixed(d.fixedNodes, nv, label, fail);
         std::vector<uint8_t> fixed(nv, 0);
-        for (int32_t f : d.fixedNodes) fixed[f] = 1;
+        for (int32_t f : d.fixedNodes)
+            fixed[f] = 1;
         if (d.strainLimits) {
             const TetStrainLimits& sl = *d.strainLimits;
-            if (auto why = validateAxes(sl.axes); !why.empty()) fail(label, "strain limits: " + why);
+            if (auto why = validateAxes(sl.axes); !why.empty())
+                fail(label, "strain limits: " + why);
             checkLimits(sl.limits, 3, sl.tets, mesh.tetCount(), "tet", label, fail);
             std::vector<Tet> tets;
             std::vector<Mat3> M;
@@ -161,7 +174,8 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
                 vol.push_back(et.volume[t]);
             }
             strainBlocks.push_back(
-                detail::makeTetStrainBlock(std::move(tets), std::move(M), std::move(vol), detail::expandStrainLimits(sl.limits)));
+                detail::makeTetStrainBlock(std::move(tets), std::move(M), std::move(vol),
+                                           detail::expandStrainLimits(sl.limits)));
         }
         Range r;
         r.name = d.name;
@@ -173,7 +187,8 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
         eng.blocks.push_back(detail::makeElasticBlock(std::move(et), settings.simd, &simd));
         sys->m_simd = sys->m_simd || simd;
     }
-    for (auto& b : strainBlocks) eng.blocks.push_back(std::move(b));
+    for (auto& b : strainBlocks)
+        eng.blocks.push_back(std::move(b));
 
     // ---- attachments (before the surfaces: snapping moves their rest vertices) ----
     std::vector<detail::Tie> ties;
@@ -184,13 +199,16 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
             fail(label, "surface " + std::to_string(at.surface) + " does not exist");
         if (at.tetBody >= desc.tetBodies.size())
             fail(label, "tet body " + std::to_string(at.tetBody) + " does not exist");
-        if (!std::isfinite(at.compliance) || at.compliance < 0) fail(label, "compliance must be finite and >= 0");
-        if (!std::isfinite(at.maxDistance) || at.maxDistance < 0) fail(label, "max distance must be finite and >= 0");
+        if (!std::isfinite(at.compliance) || at.compliance < 0)
+            fail(label, "compliance must be finite and >= 0");
+        if (!std::isfinite(at.maxDistance) || at.maxDistance < 0)
+            fail(label, "max distance must be finite and >= 0");
         const TetMesh& cage = *desc.tetBodies[at.tetBody].mesh;
         const auto proj = projectOntoBoundary(cage, surfX[at.surface], at.maxDistance);
         if (proj.empty())
-            fail(label, "no vertex of surface '" + desc.surfaces[at.surface].name + "' lies within " +
-                            num(at.maxDistance) + " m of the boundary of '" + desc.tetBodies[at.tetBody].name + "'");
+            fail(label, "no vertex of surface '" + desc.surfaces[at.surface].name +
+                            "' lies within " + num(at.maxDistance) + " m of the boundary of '" +
+                            desc.tetBodies[at.tetBody].name + "'");
         for (const BoundaryProjection& p : proj) {
             detail::Tie t;
             t.p = surfFirst[at.surface] + p.point;
@@ -203,7 +221,8 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
             ties.push_back(t);
             if (at.snap) {
                 Vec3 q = Vec3::Zero();
-                for (int k = 0; k < 3; ++k) q += p.bary[k] * cage.positions()[p.vertices[k]];
+                for (int k = 0; k < 3; ++k)
+                    q += p.bary[k] * cage.positions()[p.vertices[k]];
                 surfX[at.surface][p.point] = q;
             }
         }
@@ -216,11 +235,13 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
         const TriMesh& mesh = *d.mesh;
         const size_t nv = mesh.vertexCount();
         const auto& x = surfX[s];
-        if (!std::isfinite(d.arealDensity) || d.arealDensity <= 0) fail(label, "areal density must be positive and finite");
+        if (!std::isfinite(d.arealDensity) || d.arealDensity <= 0)
+            fail(label, "areal density must be positive and finite");
         if (!std::isfinite(d.stretchStiffness) || d.stretchStiffness < 0)
             fail(label, "stretch stiffness must be finite and >= 0");
         if (!d.uv.empty() && d.uv.size() != nv)
-            fail(label, "uv: " + std::to_string(d.uv.size()) + " given for " + std::to_string(nv) + " vertices");
+            fail(label, "uv: " + std::to_string(d.uv.size()) + " given for " + std::to_string(nv) +
+                            " vertices");
         for (size_t i = 0; i < d.uv.size(); ++i)
             if (!d.uv[i].allFinite()) fail(label, "uv " + std::to_string(i) + " is not finite");
         checkFixed(d.fixedNodes, nv, label, fail);
@@ -233,19 +254,24 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
             area[t] = 0.5 * (x[e[1]] - x[e[0]]).cross(x[e[2]] - x[e[0]]).norm();
             Mat2 M;
             if (!triangleRestDmInv({x[e[0]], x[e[1]], x[e[2]]}, M))
-                fail(label, "triangle " + std::to_string(t) + " is degenerate (area " + num(area[t]) + " m^2)");
+                fail(label, "triangle " + std::to_string(t) + " is degenerate (area " +
+                                num(area[t]) + " m^2)");
             tris.push_back({e[0] + off, e[1] + off, e[2] + off});
             restInv.push_back(M);
-            for (int k = 0; k < 3; ++k) mass[e[k]] += d.arealDensity * area[t] / 3.0;
+            for (int k = 0; k < 3; ++k)
+                mass[e[k]] += d.arealDensity * area[t] / 3.0;
         }
         std::vector<uint8_t> fixed(nv, 0);
-        for (int32_t f : d.fixedNodes) fixed[f] = 1;
+        for (int32_t f : d.fixedNodes)
+            fixed[f] = 1;
         Range r;
         r.name = d.name;
         r.first = off;
         sys->m_surf.push_back(std::move(r));
         eng.addParticles(x, mass, fixed);
-        if (d.stretchStiffness > 0) eng.blocks.push_back(detail::makeMembraneBlock(tris, restInv, area, d.stretchStiffness));
+        if (d.stretchStiffness > 0)
+            eng.blocks.push_back(
+                detail::makeMembraneBlock(tris, restInv, area, d.stretchStiffness));
         if (d.strainLimits) {
             const TriStrainLimits& sl = *d.strainLimits;
             if (d.uv.empty()) fail(label, "strain limits need per-vertex uv coordinates");
@@ -256,14 +282,15 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
             for (int32_t t : allOr(sl.triangles, mesh.triangleCount())) {
                 const Tri& e = mesh.triangles()[t];
                 Mat2 m;
-                if (!triangleUvDmInv({x[e[0]], x[e[1]], x[e[2]]}, {d.uv[e[0]], d.uv[e[1]], d.uv[e[2]]}, m))
+                if (!triangleUvDmInv({x[e[0]], x[e[1]], x[e[2]]},
+                                     {d.uv[e[0]], d.uv[e[1]], d.uv[e[2]]}, m))
                     fail(label, "triangle " + std::to_string(t) + " has a degenerate uv frame");
                 lt.push_back(tris[t]);
                 M.push_back(m);
                 la.push_back(area[t]);
             }
-            eng.blocks.push_back(
-                detail::makeTriStrainBlock(std::move(lt), std::move(M), std::move(la), detail::expandStrainLimits(sl.limits)));
+            eng.blocks.push_back(detail::makeTriStrainBlock(
+                std::move(lt), std::move(M), std::move(la), detail::expandStrainLimits(sl.limits)));
         }
     }
 
@@ -272,17 +299,21 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
         const EmbeddingDesc& em = desc.embeddings[k];
         const std::string label = "embedding " + std::to_string(k) + ": ";
         if (em.embedded >= desc.tetBodies.size() || em.cage >= desc.tetBodies.size())
-            fail(label, "tet body " + std::to_string(std::max(em.embedded, em.cage)) + " does not exist");
+            fail(label,
+                 "tet body " + std::to_string(std::max(em.embedded, em.cage)) + " does not exist");
         if (em.embedded == em.cage) fail(label, "a body cannot be embedded in itself");
-        if (!std::isfinite(em.compliance) || em.compliance < 0) fail(label, "compliance must be finite and >= 0");
+        if (!std::isfinite(em.compliance) || em.compliance < 0)
+            fail(label, "compliance must be finite and >= 0");
         std::vector<CageLocation> loc;
         try {
-            loc = locateInCage(*desc.tetBodies[em.cage].mesh, desc.tetBodies[em.embedded].mesh->positions(), em.tolerance);
+            loc = locateInCage(*desc.tetBodies[em.cage].mesh,
+                               desc.tetBodies[em.embedded].mesh->positions(), em.tolerance);
         } catch (const std::invalid_argument& e) {
             std::string why = e.what();
             const std::string prefix = "sim::locateInCage(): point";
             if (why.rfind(prefix, 0) == 0) why = "node" + why.substr(prefix.size());
-            fail(label, "'" + desc.tetBodies[em.embedded].name + "' in '" + desc.tetBodies[em.cage].name + "': " + why);
+            fail(label, "'" + desc.tetBodies[em.embedded].name + "' in '" +
+                            desc.tetBodies[em.cage].name + "': " + why);
         }
         for (const CageLocation& c : loc) {
             detail::Tie t;
@@ -297,17 +328,22 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
             ties.push_back(t);
         }
     }
-    for (const detail::Tie& t : ties) sys->m_ties.push_back({t.p, t.t, t.b, t.n});
+    for (const detail::Tie& t : ties)
+        sys->m_ties.push_back({t.p, t.t, t.b, t.n});
     if (!ties.empty()) eng.blocks.push_back(detail::makeCouplingBlock(std::move(ties)));
 
     bool anyFree = false;
-    for (size_t i = 0; i < eng.particleCount() && !anyFree; ++i) anyFree = detail::particleInvMass(eng.xw.data(), i) > 0;
-    if (!anyFree) fail("", singleBody ? "body has no free node" : "the system has no free particle");
+    for (size_t i = 0; i < eng.particleCount() && !anyFree; ++i)
+        anyFree = detail::particleInvMass(eng.xw.data(), i) > 0;
+    if (!anyFree)
+        fail("", singleBody ? "body has no free node" : "the system has no free particle");
 
     eng.colour();
-    if (eng.usefulThreads(settings.threads) > 1) sys->m_pool = std::make_unique<detail::WorkerPool>(settings.threads);
+    if (eng.usefulThreads(settings.threads) > 1)
+        sys->m_pool = std::make_unique<detail::WorkerPool>(settings.threads);
     sys->m_rest.reserve(eng.particleCount());
-    for (size_t i = 0; i < eng.particleCount(); ++i) sys->m_rest.push_back(detail::particlePosition(eng.xw.data(), i));
+    for (size_t i = 0; i < eng.particleCount(); ++i)
+        sys->m_rest.push_back(detail::particlePosition(eng.xw.data(), i));
     sys->refreshMirrors();
     return sys;
 }
@@ -324,8 +360,10 @@ void XpbdSystem::refreshMirrors() {
     };
     const size_t total = m_engine->particleCount();
     std::vector<Range*> all;
-    for (Range& r : m_tet) all.push_back(&r);
-    for (Range& r : m_surf) all.push_back(&r);
+    for (Range& r : m_tet)
+        all.push_back(&r);
+    for (Range& r : m_surf)
+        all.push_back(&r);
     for (size_t k = 0; k < all.size(); ++k) {
         const size_t end = k + 1 < all.size() ? static_cast<size_t>(all[k + 1]->first) : total;
         fill(*all[k], end - all[k]->first);
@@ -338,11 +376,13 @@ StepStats XpbdSystem::step() {
     return st;
 }
 
-void XpbdSystem::setState(Range& r, const std::vector<Vec3>& x, const std::vector<Vec3>& v, const char* what) {
+void XpbdSystem::setState(Range& r, const std::vector<Vec3>& x, const std::vector<Vec3>& v,
+                          const char* what) {
     const std::string where = std::string("sim::XpbdSystem::") + what + "(): ";
     if (x.size() != r.x.size() || v.size() != r.x.size())
-        throw std::invalid_argument(where + "expected " + std::to_string(r.x.size()) + " positions and velocities, got " +
-                                    std::to_string(x.size()) + " and " + std::to_string(v.size()));
+        throw std::invalid_argument(where + "expected " + std::to_string(r.x.size()) +
+                                    " positions and velocities, got " + std::to_string(x.size()) +
+                                    " and " + std::to_string(v.size()));
     for (size_t i = 0; i < x.size(); ++i)
         if (!x[i].allFinite() || !v[i].allFinite())
             throw std::invalid_argument(where + "node " + std::to_string(i) + " is not finite");
@@ -370,7 +410,8 @@ double XpbdSystem::maxTieGap() const {
     double gap = 0;
     for (const TieRecord& t : m_ties) {
         Vec3 c = detail::particlePosition(xw, t.p);
-        for (int k = 0; k < t.n; ++k) c -= t.b[k] * detail::particlePosition(xw, t.t[k]);
+        for (int k = 0; k < t.n; ++k)
+            c -= t.b[k] * detail::particlePosition(xw, t.t[k]);
         gap = std::max(gap, c.norm());
     }
     return gap;
@@ -378,13 +419,15 @@ double XpbdSystem::maxTieGap() const {
 
 double XpbdSystem::elasticEnergy() const {
     double e = 0;
-    for (const auto& b : m_engine->blocks) e += b->energy(m_engine->xw.data());
+    for (const auto& b : m_engine->blocks)
+        e += b->energy(m_engine->xw.data());
     return e;
 }
 
 double XpbdSystem::kineticEnergy() const {
     double e = 0;
-    for (size_t i = 0; i < m_engine->particleCount(); ++i) e += 0.5 * m_engine->mass[i] * m_engine->v[i].squaredNorm();
+    for (size_t i = 0; i < m_engine->particleCount(); ++i)
+        e += 0.5 * m_engine->mass[i] * m_engine->v[i].squaredNorm();
     return e;
 }
 
@@ -392,16 +435,20 @@ double XpbdSystem::potentialEnergy() const {
     double e = 0;
     const double* xw = m_engine->xw.data();
     for (size_t i = 0; i < m_engine->particleCount(); ++i)
-        e -= m_engine->mass[i] * m_settings.gravity.dot(detail::particlePosition(xw, i) - m_rest[i]);
+        e -=
+            m_engine->mass[i] * m_settings.gravity.dot(detail::particlePosition(xw, i) - m_rest[i]);
     return e;
 }
 
 double XpbdSystem::totalMass() const {
     double m = 0;
-    for (double x : m_engine->mass) m += x;
+    for (double x : m_engine->mass)
+        m += x;
     return m;
 }
 
-int XpbdSystem::colourCount() const { return m_engine->colourCount(); }
+int XpbdSystem::colourCount() const {
+    return m_engine->colourCount();
+}
 
 } // namespace viscera::sim

@@ -17,7 +17,11 @@
 /// Gauss–Seidel XPBD over all constraints [A eq. 4.43–4.44], multipliers restarted each substep,
 /// with velocity damping, a speed clamp and rollback of a non-finite frame (XpbdSettings). All
 /// constraints are greedy-coloured by shared particles and each colour is split over
-/// settings.threads threads; results are bit-identical for every thread count.
+/// settings.threads threads; results are bit-identical for every thread count. Sweep order:
+/// elasticity and membranes, then strain limits, then ties, each with colours of its own, so
+/// that limits and ties have the last word in every sweep (one iteration per substep leaves
+/// hard ties satisfied to ~1e-5 m in the tests). Stability and equilibrium limits of the
+/// method: see xpbd_solver.hpp.
 ///
 /// Masses: tet bodies density · V / 4 per tet node, surfaces arealDensity · A / 3 per triangle
 /// vertex. An embedded body's mass adds to its cage's (give it the density difference to the
@@ -41,8 +45,8 @@ class WorkerPool;
 } // namespace detail
 
 struct TetBodyDesc {
-    std::string name;                                ///< used in messages
-    const TetMesh* mesh = nullptr;                   ///< rest state; non-owning, read during create only
+    std::string name;              ///< used in messages
+    const TetMesh* mesh = nullptr; ///< rest state; non-owning, read during create only
     std::shared_ptr<const TetConstraintModel> model; ///< elasticity (count() 1 or 2)
     double density = 1050.0;                         ///< kg/m^3
     std::vector<int32_t> fixedNodes;                 ///< held where they are (see setTetState)
@@ -54,29 +58,30 @@ struct TetBodyDesc {
 
 struct SurfaceBodyDesc {
     std::string name;
-    const TriMesh* mesh = nullptr;   ///< rest state; non-owning, read during create only
-    std::vector<Vec2> uv;            ///< empty or one per vertex; needed by strainLimits
-    double arealDensity = 0.1;       ///< kg/m^2 (e.g. 1000 kg/m^3 × 0.1 mm)
-    double stretchStiffness = 50.0;  ///< membrane k, N/m (≈ Young's modulus × thickness); 0 = none
+    const TriMesh* mesh = nullptr;  ///< rest state; non-owning, read during create only
+    std::vector<Vec2> uv;           ///< empty or one per vertex; needed by strainLimits
+    double arealDensity = 0.1;      ///< kg/m^2 (e.g. 1000 kg/m^3 × 0.1 mm)
+    double stretchStiffness = 50.0; ///< membrane k, N/m (≈ Young's modulus × thickness); 0 = none
     std::vector<int32_t> fixedNodes;
     std::optional<TriStrainLimits> strainLimits;
 };
 
 struct SurfaceAttachmentDesc {
-    size_t surface = 0;          ///< index into XpbdSystemDesc::surfaces
-    size_t tetBody = 0;          ///< index into XpbdSystemDesc::tetBodies
-    double maxDistance = 1e-3;   ///< m; surface vertices farther from the boundary stay free
-    double compliance = 0;       ///< m/N; 0 = hard
+    size_t surface = 0;        ///< index into XpbdSystemDesc::surfaces
+    size_t tetBody = 0;        ///< index into XpbdSystemDesc::tetBodies
+    double maxDistance = 1e-3; ///< m; surface vertices farther from the boundary stay free
+    double compliance = 0;     ///< m/N; 0 = hard
     /// Move each tied surface vertex onto its boundary point before anything else is computed,
     /// so that the rest state is a fixed point of the ties.
     bool snap = true;
 };
 
 struct EmbeddingDesc {
-    size_t embedded = 0;         ///< tet body whose nodes are tied (index into tetBodies)
-    size_t cage = 0;             ///< tet body that contains them
-    double compliance = 0;       ///< m/N; 0 = hard
-    double tolerance = 1e-6;     ///< m; nodes outside the cage by at most this are tied to the nearest tet
+    size_t embedded = 0;   ///< tet body whose nodes are tied (index into tetBodies)
+    size_t cage = 0;       ///< tet body that contains them
+    double compliance = 0; ///< m/N; 0 = hard
+    double tolerance =
+        1e-6; ///< m; nodes outside the cage by at most this are tied to the nearest tet
 };
 
 struct XpbdSystemDesc {
@@ -87,13 +92,14 @@ struct XpbdSystemDesc {
 };
 
 class XpbdSystem {
-public:
+  public:
     /// Throws std::invalid_argument ("sim::XpbdSystem::create(): tet body 1 ('vessel'): tet 3
     /// has non-positive rest volume -1e-9 m^3") on invalid settings, a missing mesh or model, a
     /// model with other than 1 or 2 constraints, bad density, weights, fixed nodes or strain
     /// limits, a degenerate element, an attachment that ties nothing, an embedded node outside its
     /// cage, or a system without a free particle.
-    static std::unique_ptr<XpbdSystem> create(const XpbdSystemDesc& desc, const XpbdSettings& settings);
+    static std::unique_ptr<XpbdSystem> create(const XpbdSystemDesc& desc,
+                                              const XpbdSettings& settings);
     ~XpbdSystem();
     XpbdSystem(const XpbdSystem&) = delete;
     XpbdSystem& operator=(const XpbdSystem&) = delete;
@@ -105,8 +111,8 @@ public:
     size_t surfaceCount() const { return m_surf.size(); }
     const std::string& tetBodyName(size_t b) const { return m_tet[b].name; }
     const std::string& surfaceName(size_t s) const { return m_surf[s].name; }
-    const std::vector<Vec3>& tetPositions(size_t b) const { return m_tet[b].x; }   ///< #V, m
-    const std::vector<Vec3>& tetVelocities(size_t b) const { return m_tet[b].v; }  ///< #V, m/s
+    const std::vector<Vec3>& tetPositions(size_t b) const { return m_tet[b].x; }  ///< #V, m
+    const std::vector<Vec3>& tetVelocities(size_t b) const { return m_tet[b].v; } ///< #V, m/s
     const std::vector<Vec3>& surfacePositions(size_t s) const { return m_surf[s].x; }
     const std::vector<Vec3>& surfaceVelocities(size_t s) const { return m_surf[s].v; }
     /// Per-tet stiffness weights of tet body b (mean of the node weights).
@@ -122,7 +128,8 @@ public:
     /// Largest |x_p − Σ b_k x_k| over all ties, m (0 without ties).
     double maxTieGap() const;
 
-    double elasticEnergy() const;   ///< J: elasticity, membranes, compliant ties and strain limits, relative to rest
+    double elasticEnergy()
+        const; ///< J: elasticity, membranes, compliant ties and strain limits, relative to rest
     double kineticEnergy() const;   ///< J
     double potentialEnergy() const; ///< J, gravity relative to the rest configuration
     double totalMass() const;       ///< kg
@@ -132,12 +139,12 @@ public:
     /// True when the stable Neo-Hookean AVX2 kernel runs (settings().simd and CPU support).
     bool usesSimd() const { return m_simd; }
 
-private:
+  private:
     friend class XpbdSolver;
     struct Range {
         std::string name;
-        int32_t first = 0;            ///< first particle
-        std::vector<Vec3> x, v;       ///< mirrors of the particle state, refreshed after step()
+        int32_t first = 0;      ///< first particle
+        std::vector<Vec3> x, v; ///< mirrors of the particle state, refreshed after step()
         std::vector<double> tetWeight;
     };
     struct TieRecord {
@@ -147,10 +154,12 @@ private:
         int n;
     };
     XpbdSystem();
-    static std::unique_ptr<XpbdSystem> build(const XpbdSystemDesc& desc, const XpbdSettings& settings,
-                                             const std::string& where, bool singleBody);
+    static std::unique_ptr<XpbdSystem> build(const XpbdSystemDesc& desc,
+                                             const XpbdSettings& settings, const std::string& where,
+                                             bool singleBody);
     void refreshMirrors();
-    void setState(Range& r, const std::vector<Vec3>& x, const std::vector<Vec3>& v, const char* what);
+    void setState(Range& r, const std::vector<Vec3>& x, const std::vector<Vec3>& v,
+                  const char* what);
 
     XpbdSettings m_settings;
     std::unique_ptr<detail::Engine> m_engine;

@@ -21,7 +21,8 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// A (nu × nv)-cell triangulated sheet origin + s·du + t·dv, s, t ∈ [0, 1]; uv = (s |du|, t |dv|).
-TriMesh sheet(const Vec3& origin, const Vec3& du, const Vec3& dv, int nu, int nv, std::vector<Vec2>* uv = nullptr) {
+TriMesh sheet(const Vec3& origin, const Vec3& du, const Vec3& dv, int nu, int nv,
+              std::vector<Vec2>* uv = nullptr) {
     std::vector<Vec3> x;
     std::vector<Tri> tris;
     for (int j = 0; j <= nv; ++j)
@@ -50,7 +51,8 @@ std::shared_ptr<const TetConstraintModel> snh(double E, double nu = 0.45) {
 /// Element sizes and stiffnesses keep h² (λ + 2μ)/(ρ L²) below 1 for the stable Neo-Hookean
 /// bodies (see xpbd_solver.hpp: its two-constraint split is only stable there).
 struct Layers {
-    std::unique_ptr<TetMesh> fat = makeBoxTetMesh({Vec3::Zero(), Vec3(0.06, 0.02, 0.02), {12, 4, 4}});
+    std::unique_ptr<TetMesh> fat =
+        makeBoxTetMesh({Vec3::Zero(), Vec3(0.06, 0.02, 0.02), {12, 4, 4}});
     std::unique_ptr<TetMesh> vessel =
         makeBoxTetMesh({Vec3(0.01, 0.006, 0.006), Vec3(0.04, 0.008, 0.008), {8, 1, 1}});
     std::vector<Vec2> uv; // filled by the fascia initialiser below (declared first)
@@ -90,7 +92,8 @@ struct Layers {
 
 double maxSag(const std::vector<Vec3>& rest, const std::vector<Vec3>& x) {
     double s = 0;
-    for (size_t i = 0; i < x.size(); ++i) s = std::max(s, rest[i].z() - x[i].z());
+    for (size_t i = 0; i < x.size(); ++i)
+        s = std::max(s, rest[i].z() - x[i].z());
     return s;
 }
 
@@ -102,18 +105,23 @@ TEST(Membrane, ConstraintGradientsMatchFiniteDifferences) {
     double worst = 0;
     for (int trial = 0; trial < 40; ++trial) {
         std::vector<Vec3> X = {Vec3::Zero(), Vec3(0.01, 0, 0), Vec3(0.002, 0.01, 0)};
-        for (Vec3& p : X) p += 0.002 * Vec3(u(rng), u(rng), u(rng));
+        for (Vec3& p : X)
+            p += 0.002 * Vec3(u(rng), u(rng), u(rng));
         Mat2 M;
         ASSERT_TRUE(triangleRestDmInv({X[0], X[1], X[2]}, M));
         // Rest: zero strain.
-        for (double c : membraneConstraints({X[0], X[1], X[2]}, M)) EXPECT_NEAR(c, 0.0, 1e-13);
+        for (double c : membraneConstraints({X[0], X[1], X[2]}, M))
+            EXPECT_NEAR(c, 0.0, 1e-13);
         const Mat3 F = randomF(rng, 0.4);
         std::vector<Vec3> x(3);
-        for (int k = 0; k < 3; ++k) x[k] = F * X[k] + 1e-3 * Vec3(u(rng), u(rng), u(rng));
+        for (int k = 0; k < 3; ++k)
+            x[k] = F * X[k] + 1e-3 * Vec3(u(rng), u(rng), u(rng));
         std::array<std::array<Vec3, 3>, 3> g;
         membraneConstraints({x[0], x[1], x[2]}, M, &g);
         for (int c = 0; c < 3; ++c) {
-            const auto f = [&](const std::vector<Vec3>& y) { return membraneConstraints({y[0], y[1], y[2]}, M)[c]; };
+            const auto f = [&](const std::vector<Vec3>& y) {
+                return membraneConstraints({y[0], y[1], y[2]}, M)[c];
+            };
             worst = std::max(worst, fdRelativeError(f, x, {g[c].begin(), g[c].end()}));
         }
     }
@@ -127,17 +135,23 @@ TEST(Coupling, ResidualGradientMatchesFiniteDifferences) {
     for (int n : {3, 4})
         for (int trial = 0; trial < 10; ++trial) {
             std::vector<Vec3> x(n + 1);
-            for (Vec3& p : x) p = 0.01 * Vec3(u(rng), u(rng), u(rng));
+            for (Vec3& p : x)
+                p = 0.01 * Vec3(u(rng), u(rng), u(rng));
             double b[4];
             double sum = 0;
-            for (int k = 0; k < n; ++k) sum += (b[k] = 0.1 + std::abs(u(rng)));
-            for (int k = 0; k < n; ++k) b[k] /= sum;
+            for (int k = 0; k < n; ++k)
+                sum += (b[k] = 0.1 + std::abs(u(rng)));
+            for (int k = 0; k < n; ++k)
+                b[k] /= sum;
             for (int c = 0; c < 3; ++c) {
                 // ∂C_c/∂x_p = e_c, ∂C_c/∂x_k = −b_k e_c.
                 std::vector<Vec3> g(n + 1, Vec3::Zero());
                 g[0][c] = 1;
-                for (int k = 0; k < n; ++k) g[k + 1][c] = -b[k];
-                const auto f = [&](const std::vector<Vec3>& y) { return couplingResidual(y[0], y.data() + 1, b, n)[c]; };
+                for (int k = 0; k < n; ++k)
+                    g[k + 1][c] = -b[k];
+                const auto f = [&](const std::vector<Vec3>& y) {
+                    return couplingResidual(y[0], y.data() + 1, b, n)[c];
+                };
                 worst = std::max(worst, fdRelativeError(f, x, g));
             }
         }
@@ -181,7 +195,8 @@ TEST(Coupling, BoundaryProjectionAndCageLocation) {
     ASSERT_EQ(proj.size(), above.size());
     for (const BoundaryProjection& p : proj) {
         Vec3 q = Vec3::Zero();
-        for (int k = 0; k < 3; ++k) q += p.bary[k] * box->positions()[p.vertices[k]];
+        for (int k = 0; k < 3; ++k)
+            q += p.bary[k] * box->positions()[p.vertices[k]];
         EXPECT_LT((q - Vec3(above[p.point].x(), above[p.point].y(), 0.02)).norm(), 1e-12);
         EXPECT_NEAR(p.distance, 5e-4, 1e-12);
     }
@@ -191,7 +206,8 @@ TEST(Coupling, BoundaryProjectionAndCageLocation) {
     ASSERT_EQ(loc.size(), inside.size());
     for (const CageLocation& c : loc) {
         Vec3 q = Vec3::Zero();
-        for (int k = 0; k < 4; ++k) q += c.bary[k] * box->positions()[box->tets()[c.tet][k]];
+        for (int k = 0; k < 4; ++k)
+            q += c.bary[k] * box->positions()[box->tets()[c.tet][k]];
         EXPECT_LT((q - inside[c.point]).norm(), 1e-13);
         EXPECT_GE(c.bary.minCoeff(), -1e-12);
     }
@@ -212,7 +228,8 @@ TEST(XpbdSystem, RestStateIsAFixedPoint) {
     EXPECT_EQ(sys->surfaceCount(), 1u);
     EXPECT_EQ(sys->tieCount(), L.fascia.vertexCount() + L.vessel->vertexCount());
     EXPECT_LT(sys->maxTieGap(), 1e-15);
-    for (int f = 0; f < 10; ++f) EXPECT_LT(sys->step().maxDisplacement, 1e-15);
+    for (int f = 0; f < 10; ++f)
+        EXPECT_LT(sys->step().maxDisplacement, 1e-15);
     EXPECT_NEAR(sys->elasticEnergy(), 0.0, 1e-15);
 }
 
@@ -284,8 +301,8 @@ TEST(XpbdSystem, StiffnessRatioOfAMillionStaysFiniteAndBounded) {
     // Everything stays near the 6 cm cantilever it hangs from, and comes to rest.
     auto inBox = [](const std::vector<Vec3>& x) {
         for (const Vec3& p : x)
-            if (!p.allFinite() || p.x() < -0.05 || p.x() > 0.11 || std::abs(p.y() - 0.01) > 0.06 || p.z() < -0.1 ||
-                p.z() > 0.07)
+            if (!p.allFinite() || p.x() < -0.05 || p.x() > 0.11 || std::abs(p.y() - 0.01) > 0.06 ||
+                p.z() < -0.1 || p.z() > 0.07)
                 return false;
         return true;
     };
@@ -323,15 +340,17 @@ TEST(XpbdSystem, SurfaceStrainLimitsInTheUvFrame) {
         body.strainLimits = std::move(limits);
         d.surfaces = {body};
         auto sys = XpbdSystem::create(d, set);
-        for (int f = 0; f < 120; ++f) EXPECT_TRUE(sys->step().finite);
+        for (int f = 0; f < 120; ++f)
+            EXPECT_TRUE(sys->step().finite);
         return sys->surfacePositions(0);
     };
     auto range = [&](const std::vector<Vec3>& x, int i, int j) {
         double lo = kInf, hi = -kInf;
         for (const Tri& t : mesh.triangles()) {
             Mat2 M;
-            triangleUvDmInv({mesh.positions()[t[0]], mesh.positions()[t[1]], mesh.positions()[t[2]]},
-                            {uv[t[0]], uv[t[1]], uv[t[2]]}, M);
+            triangleUvDmInv(
+                {mesh.positions()[t[0]], mesh.positions()[t[1]], mesh.positions()[t[2]]},
+                {uv[t[0]], uv[t[1]], uv[t[2]]}, M);
             const double e = triGreenStrain({x[t[0]], x[t[1]], x[t[2]]}, M, i, j);
             lo = std::min(lo, e);
             hi = std::max(hi, e);
@@ -378,7 +397,8 @@ TEST(XpbdSystem, BitIdenticalAcrossThreadCounts) {
         set.substeps = 5;
         set.threads = threads;
         auto sys = XpbdSystem::create(d, set);
-        for (int f = 0; f < 3; ++f) ASSERT_TRUE(sys->step().finite);
+        for (int f = 0; f < 3; ++f)
+            ASSERT_TRUE(sys->step().finite);
         std::vector<Vec3> all = sys->tetPositions(0);
         all.insert(all.end(), sys->tetPositions(1).begin(), sys->tetPositions(1).end());
         all.insert(all.end(), sys->surfacePositions(0).begin(), sys->surfacePositions(0).end());
@@ -404,7 +424,8 @@ TEST(XpbdSystem, RejectsInvalidCouplings) {
     TriMesh far = sheet(Vec3(0, 0, 0.05), Vec3(0.06, 0, 0), Vec3(0, 0.02, 0), 3, 3);
     d.surfaces[0].mesh = &far;
     d.surfaces[0].uv.clear();
-    EXPECT_THAT(msg(d), HasSubstr("sim::XpbdSystem::create(): attachment 0: no vertex of surface 'fascia' lies within 0 m"));
+    EXPECT_THAT(msg(d), HasSubstr("sim::XpbdSystem::create(): attachment 0: no vertex of surface "
+                                  "'fascia' lies within 0 m"));
     d = L.desc();
     auto outside = makeBoxTetMesh({Vec3(0.05, 0.0, 0.0), Vec3(0.04, 0.01, 0.01), {2, 1, 1}});
     d.tetBodies[1].mesh = outside.get();
@@ -413,7 +434,8 @@ TEST(XpbdSystem, RejectsInvalidCouplings) {
     d = L.desc();
     d.surfaces[0].uv.clear();
     d.surfaces[0].strainLimits = TriStrainLimits{{{0, 0, -kInf, 0.1, 0.0}}, {}};
-    EXPECT_THAT(msg(d), HasSubstr("surface 0 ('fascia'): strain limits need per-vertex uv coordinates"));
+    EXPECT_THAT(msg(d),
+                HasSubstr("surface 0 ('fascia'): strain limits need per-vertex uv coordinates"));
     d = L.desc();
     d.embeddings[0].cage = 1;
     EXPECT_THAT(msg(d), HasSubstr("cannot be embedded in itself"));

@@ -18,11 +18,16 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-std::array<Vec3, 4> toArray4(const std::vector<Vec3>& x) { return {x[0], x[1], x[2], x[3]}; }
-std::array<Vec3, 3> toArray3(const std::vector<Vec3>& x) { return {x[0], x[1], x[2]}; }
+std::array<Vec3, 4> toArray4(const std::vector<Vec3>& x) {
+    return {x[0], x[1], x[2], x[3]};
+}
+std::array<Vec3, 3> toArray3(const std::vector<Vec3>& x) {
+    return {x[0], x[1], x[2]};
+}
 
 /// Largest and smallest ε_ij over the tets of a body, in material axes.
-std::pair<double, double> strainRange(const TetMesh& rest, const std::vector<Vec3>& x, const Mat3& axes, int i, int j) {
+std::pair<double, double> strainRange(const TetMesh& rest, const std::vector<Vec3>& x,
+                                      const Mat3& axes, int i, int j) {
     double lo = kInf, hi = -kInf;
     for (const Tet& e : rest.tets()) {
         const auto& X = rest.positions();
@@ -44,18 +49,24 @@ TEST(StrainLimit, TetStrainGradientMatchesFiniteDifferences) {
         // A random rest tet (positive volume) in random material axes, deformed by a random F
         // plus noise.
         std::vector<Vec3> X = {Vec3::Zero(), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0), Vec3(0, 0, 0.01)};
-        for (Vec3& p : X) p += 0.003 * Vec3(u(rng), u(rng), u(rng));
+        for (Vec3& p : X)
+            p += 0.003 * Vec3(u(rng), u(rng), u(rng));
         if ((X[1] - X[0]).cross(X[2] - X[0]).dot(X[3] - X[0]) <= 1e-8) continue;
-        const Mat3 axes = Eigen::Quaterniond(Eigen::Vector4d(u(rng), u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
+        const Mat3 axes =
+            Eigen::Quaterniond(Eigen::Vector4d(u(rng), u(rng), u(rng), u(rng)).normalized())
+                .toRotationMatrix();
         const Mat3 M = tetMaterialDmInv(toArray4(X), axes);
         const Mat3 F = randomF(rng, 0.4);
         std::vector<Vec3> x(4);
-        for (int k = 0; k < 4; ++k) x[k] = F * X[k] + 1e-3 * Vec3(u(rng), u(rng), u(rng));
+        for (int k = 0; k < 4; ++k)
+            x[k] = F * X[k] + 1e-3 * Vec3(u(rng), u(rng), u(rng));
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) {
                 std::array<Vec3, 4> g;
                 tetGreenStrain(toArray4(x), M, i, j, &g);
-                const auto f = [&](const std::vector<Vec3>& y) { return tetGreenStrain(toArray4(y), M, i, j); };
+                const auto f = [&](const std::vector<Vec3>& y) {
+                    return tetGreenStrain(toArray4(y), M, i, j);
+                };
                 worst = std::max(worst, fdRelativeError(f, x, {g.begin(), g.end()}));
             }
     }
@@ -68,19 +79,23 @@ TEST(StrainLimit, TriangleStrainGradientMatchesFiniteDifferences) {
     double worst = 0;
     for (int trial = 0; trial < 40; ++trial) {
         std::vector<Vec3> X = {Vec3::Zero(), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0)};
-        for (Vec3& p : X) p += 0.003 * Vec3(u(rng), u(rng), u(rng));
+        for (Vec3& p : X)
+            p += 0.003 * Vec3(u(rng), u(rng), u(rng));
         const std::array<Vec2, 3> uv = {Vec2(u(rng), u(rng)), Vec2(1 + u(rng) * 0.3, u(rng) * 0.3),
                                         Vec2(u(rng) * 0.3, 1 + u(rng) * 0.3)};
         Mat2 M;
         if (!triangleUvDmInv(toArray3(X), uv, M)) continue;
         const Mat3 F = randomF(rng, 0.4);
         std::vector<Vec3> x(3);
-        for (int k = 0; k < 3; ++k) x[k] = F * X[k] + 1e-3 * Vec3(u(rng), u(rng), u(rng));
+        for (int k = 0; k < 3; ++k)
+            x[k] = F * X[k] + 1e-3 * Vec3(u(rng), u(rng), u(rng));
         for (int i = 0; i < 2; ++i)
             for (int j = 0; j < 2; ++j) {
                 std::array<Vec3, 3> g;
                 triGreenStrain(toArray3(x), M, i, j, &g);
-                const auto f = [&](const std::vector<Vec3>& y) { return triGreenStrain(toArray3(y), M, i, j); };
+                const auto f = [&](const std::vector<Vec3>& y) {
+                    return triGreenStrain(toArray3(y), M, i, j);
+                };
                 worst = std::max(worst, fdRelativeError(f, x, {g.begin(), g.end()}));
             }
     }
@@ -91,7 +106,8 @@ TEST(StrainLimit, UvFrameFollowsTheTextureDirection) {
     // A triangle in the plane z = 0.01 whose u axis points along t = (1, 1, 0)/√2 and whose uv
     // map is sheared: u = d·t + 0.3 d·b, v = d·b, so ∂x/∂u = t but ∂x/∂v = b − 0.3 t.
     const Vec3 t = Vec3(1, 1, 0).normalized(), b = Vec3(-1, 1, 0).normalized();
-    const std::array<Vec3, 3> X = {Vec3(0, 0, 0.01), Vec3(0, 0, 0.01) + 0.02 * t, Vec3(0, 0, 0.01) + 0.01 * b + 0.005 * t};
+    const std::array<Vec3, 3> X = {Vec3(0, 0, 0.01), Vec3(0, 0, 0.01) + 0.02 * t,
+                                   Vec3(0, 0, 0.01) + 0.01 * b + 0.005 * t};
     std::array<Vec2, 3> uv;
     for (int k = 0; k < 3; ++k) {
         const Vec3 d = X[k] - X[0];
@@ -101,7 +117,8 @@ TEST(StrainLimit, UvFrameFollowsTheTextureDirection) {
     ASSERT_TRUE(triangleUvDmInv(X, uv, M));
     // Rest: zero strain.
     for (int i = 0; i < 2; ++i)
-        for (int j = 0; j < 2; ++j) EXPECT_NEAR(triGreenStrain(X, M, i, j), 0.0, 1e-14);
+        for (int j = 0; j < 2; ++j)
+            EXPECT_NEAR(triGreenStrain(X, M, i, j), 0.0, 1e-14);
     // Stretch by s along u: ε_00 = (s² − 1)/2, the rest zero.
     const double s = 1.2;
     std::array<Vec3, 3> x;
@@ -117,14 +134,16 @@ TEST(StrainLimit, UvFrameFollowsTheTextureDirection) {
 }
 
 TEST(StrainLimit, TetMaterialAxesRotateTheStrain) {
-    const std::array<Vec3, 4> X = {Vec3::Zero(), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0), Vec3(0, 0, 0.01)};
+    const std::array<Vec3, 4> X = {Vec3::Zero(), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0),
+                                   Vec3(0, 0, 0.01)};
     const Mat3 axes = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
     const Mat3 M = tetMaterialDmInv(X, axes);
     // Stretch s along material axis 1 (a column of axes).
     const double s = 1.3;
     const Vec3 a = axes.col(1);
     std::array<Vec3, 4> x;
-    for (int k = 0; k < 4; ++k) x[k] = X[k] + (s - 1) * X[k].dot(a) * a;
+    for (int k = 0; k < 4; ++k)
+        x[k] = X[k] + (s - 1) * X[k].dot(a) * a;
     EXPECT_NEAR(tetGreenStrain(x, M, 1, 1), 0.5 * (s * s - 1), 1e-12);
     EXPECT_NEAR(tetGreenStrain(x, M, 0, 0), 0.0, 1e-12);
     EXPECT_NEAR(tetGreenStrain(x, M, 2, 2), 0.0, 1e-12);
@@ -136,7 +155,8 @@ namespace {
 /// A 9 × 1 × 1 cm bar along x, fixed at x = 0 and pulled at x = L by moving its end nodes; the
 /// middle third is 100 times softer (node weights), so the strain gathers there.
 struct PulledBar {
-    std::unique_ptr<TetMesh> mesh = makeBoxTetMesh({Vec3::Zero(), Vec3(0.09, 0.01, 0.01), {9, 1, 1}});
+    std::unique_ptr<TetMesh> mesh =
+        makeBoxTetMesh({Vec3::Zero(), Vec3(0.09, 0.01, 0.01), {9, 1, 1}});
     std::vector<int32_t> fixed, pulled;
     std::vector<double> weights;
 
@@ -170,7 +190,8 @@ struct PulledBar {
         for (int f = 1; f <= 90; ++f) {
             std::vector<Vec3> x = solver->positions();
             const double stretch = 1.0 + 0.06 * std::min(f, 30) / 30.0;
-            for (int32_t v : pulled) x[v].x() = 0.09 * stretch;
+            for (int32_t v : pulled)
+                x[v].x() = 0.09 * stretch;
             solver->setState(x, solver->velocities());
             EXPECT_TRUE(solver->step().finite);
         }
@@ -198,7 +219,8 @@ TEST(StrainLimit, CompliantLimitYieldsPartially) {
     TetStrainLimits hard, soft;
     hard.limits.push_back({0, 0, -kInf, 0.1, 0.0});
     soft.limits.push_back({0, 0, -kInf, 0.1, 1.0 / 2e4}); // compliance 1/(20 kPa)
-    const double unlimited = strainRange(*bar.mesh, bar.run(std::nullopt), Mat3::Identity(), 0, 0).second;
+    const double unlimited =
+        strainRange(*bar.mesh, bar.run(std::nullopt), Mat3::Identity(), 0, 0).second;
     const double h = strainRange(*bar.mesh, bar.run(hard), Mat3::Identity(), 0, 0).second;
     const double s = strainRange(*bar.mesh, bar.run(soft), Mat3::Identity(), 0, 0).second;
     EXPECT_GT(s, h + 1e-3);
@@ -218,7 +240,8 @@ TEST(StrainLimit, RotatedMaterialAxesAndLowerAndBilateralLimits) {
     limits.limits.push_back({0, 0, -0.01, kInf, 0.0});
     limits.limits.push_back({0, 1, 0.0, 0.0, 0.0});
     const auto free = bar.run(std::nullopt);
-    EXPECT_LT(strainRange(*bar.mesh, free, axes, 0, 0).first, -0.02) << "without limits the bar narrows";
+    EXPECT_LT(strainRange(*bar.mesh, free, axes, 0, 0).first, -0.02)
+        << "without limits the bar narrows";
     const auto held = bar.run(limits, 20);
     EXPECT_LE(strainRange(*bar.mesh, held, axes, 2, 2).second, 0.1 + 2e-3);
     EXPECT_GE(strainRange(*bar.mesh, held, axes, 0, 0).first, -0.01 - 2e-3);

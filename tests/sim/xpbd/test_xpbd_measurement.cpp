@@ -14,7 +14,8 @@ namespace {
 
 std::unique_ptr<XpbdSolver> movingCantilever(const Cantilever& c, XpbdSettings s) {
     auto solver = XpbdSolver::create(*c.mesh, tissue(), c.fixed, s);
-    for (int f = 0; f < 5; ++f) solver->step(); // non-zero velocities
+    for (int f = 0; f < 5; ++f)
+        solver->step(); // non-zero velocities
     return solver;
 }
 
@@ -32,26 +33,32 @@ TEST(XpbdMeasurement, NextSubstepProblemIsThePrediction) {
     ASSERT_EQ(p.tets.size(), c.mesh->tetCount());
     EXPECT_EQ(p.model.get(), &solver->model());
     double mass = 0;
-    for (double m : p.mass) mass += m;
+    for (double m : p.mass)
+        mass += m;
     EXPECT_NEAR(mass, solver->totalMass(), 1e-15);
     std::vector<uint8_t> fixed(c.mesh->vertexCount(), 0);
-    for (int32_t f : c.fixed) fixed[f] = 1;
+    for (int32_t f : c.fixed)
+        fixed[f] = 1;
     EXPECT_EQ(p.fixed, fixed);
     for (size_t i = 0; i < p.xTilde.size(); ++i) {
-        const Vec3 expected = fixed[i] ? solver->positions()[i]
-                                       : Vec3(solver->positions()[i] + h * solver->velocities()[i] + h * h * s.gravity);
+        const Vec3 expected =
+            fixed[i]
+                ? solver->positions()[i]
+                : Vec3(solver->positions()[i] + h * solver->velocities()[i] + h * h * s.gravity);
         EXPECT_LT((p.xTilde[i] - expected).norm(), 1e-15) << i;
     }
     for (size_t t = 0; t < p.tets.size(); ++t) {
         EXPECT_EQ(p.weight[t], 1.0);
         EXPECT_GT(p.volume[t], 0.0);
-        EXPECT_LT((p.dmInv[t] * (Mat3() << c.mesh->positions()[p.tets[t][1]] - c.mesh->positions()[p.tets[t][0]],
-                                 c.mesh->positions()[p.tets[t][2]] - c.mesh->positions()[p.tets[t][0]],
-                                 c.mesh->positions()[p.tets[t][3]] - c.mesh->positions()[p.tets[t][0]])
-                                    .finished() -
-                   Mat3::Identity())
-                      .norm(),
-                  1e-12);
+        EXPECT_LT(
+            (p.dmInv[t] *
+                 (Mat3() << c.mesh->positions()[p.tets[t][1]] - c.mesh->positions()[p.tets[t][0]],
+                  c.mesh->positions()[p.tets[t][2]] - c.mesh->positions()[p.tets[t][0]],
+                  c.mesh->positions()[p.tets[t][3]] - c.mesh->positions()[p.tets[t][0]])
+                     .finished() -
+             Mat3::Identity())
+                .norm(),
+            1e-12);
     }
     // The objective and its gradient are those of the step (finite, decreasing from x̃ under
     // the iteration below).
@@ -59,10 +66,12 @@ TEST(XpbdMeasurement, NextSubstepProblemIsThePrediction) {
 }
 
 TEST(XpbdMeasurement, IterateOnFirstObservationIsOneProductionIterationAndChangesNothing) {
-    auto c = cantilever();
+    // 4,608 tets: large enough that the sweeps are shared between threads.
+    auto c = cantilever({16, 6, 8});
     XpbdSettings s;
     s.substeps = 1; // one substep, one iteration: a frame of step() is exactly one iteration
     s.iterations = 1;
+    s.dt = 1e-3;
     s.damping = 0;
     s.maxSpeed = 1e6;
     for (int threads : {1, 2}) {
@@ -80,7 +89,8 @@ TEST(XpbdMeasurement, IterateOnFirstObservationIsOneProductionIterationAndChange
         ASSERT_EQ(iterates.size(), 4u);
         EXPECT_EQ(solver->positions(), x0) << "iterateOn must not change the state";
         EXPECT_EQ(solver->velocities(), v0);
-        for (size_t k = 1; k < seconds.size(); ++k) EXPECT_GE(seconds[k], seconds[k - 1]);
+        for (size_t k = 1; k < seconds.size(); ++k)
+            EXPECT_GE(seconds[k], seconds[k - 1]);
         EXPECT_GE(seconds[0], 0.0);
         // The objective decreases over the iterations (XPBD is a descent method on this step).
         EXPECT_LT(p.objective(iterates[3]), p.objective(p.xTilde));
@@ -98,7 +108,8 @@ TEST(XpbdMeasurement, IterateOnUsesTheProblemItIsGiven) {
     const Material m = tissue();
     p.model = std::make_shared<GenericSnhModel>(m.mu(), m.lambda());
     std::vector<double> f;
-    solver->iterateOn(p, 30, [&](int, const std::vector<Vec3>& xk, double) { f.push_back(p.objective(xk)); });
+    solver->iterateOn(
+        p, 30, [&](int, const std::vector<Vec3>& xk, double) { f.push_back(p.objective(xk)); });
     ASSERT_EQ(f.size(), 30u);
     EXPECT_LT(f.back(), p.objective(p.xTilde));
     EXPECT_TRUE(std::isfinite(f.back()));
@@ -145,7 +156,8 @@ Patch patch() {
     for (int32_t i = 0; i < static_cast<int32_t>(p.x0.size()); ++i) {
         const Vec3& X = p.mesh->positions()[i];
         bool onBoundary = false;
-        for (int a = 0; a < 3; ++a) onBoundary |= X[a] < 1e-9 || X[a] > 0.03 - 1e-9;
+        for (int a = 0; a < 3; ++a)
+            onBoundary |= X[a] < 1e-9 || X[a] > 0.03 - 1e-9;
         if (onBoundary) {
             p.boundary.push_back(i);
             p.x0[i] = p.F * X;
@@ -158,7 +170,8 @@ Patch patch() {
 
 double patchError(const Patch& p, const std::vector<Vec3>& x) {
     double err = 0;
-    for (int32_t i : p.interior) err = std::max(err, (x[i] - p.F * p.mesh->positions()[i]).norm());
+    for (int32_t i : p.interior)
+        err = std::max(err, (x[i] - p.F * p.mesh->positions()[i]).norm());
     return err;
 }
 
@@ -186,14 +199,16 @@ TEST(XpbdPatchTest, UniformStretchIsAnEquilibriumOfTheDiscreteEnergy) {
     auto solver = patchSolver(p, 1050, 20);
     StepProblem prob = solver->nextSubstepProblem();
     std::vector<Vec3> exact = p.x0;
-    for (int32_t i : p.interior) exact[i] = p.F * p.mesh->positions()[i];
+    for (int32_t i : p.interior)
+        exact[i] = p.F * p.mesh->positions()[i];
     prob.xTilde = exact; // no inertia: the gradient is the elastic force
     std::vector<Vec3> g;
     prob.gradientInto(exact, g);
     // Scale: the elastic force one tet exerts on a node, h² V P / L.
     const double scale = prob.h * prob.h * 1e-6 * tissue().mu() * 0.1 / 0.01;
     double worst = 0;
-    for (int32_t i : p.interior) worst = std::max(worst, g[i].norm());
+    for (int32_t i : p.interior)
+        worst = std::max(worst, g[i].norm());
     EXPECT_LT(worst, 1e-10 * scale);
 }
 
@@ -201,16 +216,19 @@ TEST(XpbdPatchTest, InteriorReproducesTheUniformStretch) {
     Patch p = patch();
     // Quasi-static regime: h = 1/60/700 s, density 1e6 kg/m^3 (h² k/m ≈ 1e-9).
     auto solver = patchSolver(p, 1e6, 700);
-    for (int f = 0; f < 300; ++f) ASSERT_TRUE(solver->step().finite);
+    for (int f = 0; f < 300; ++f)
+        ASSERT_TRUE(solver->step().finite);
     EXPECT_LT(patchError(p, solver->positions()), 1e-10);
-    for (int32_t i : p.boundary) EXPECT_EQ(solver->positions()[i], p.x0[i]);
+    for (int32_t i : p.boundary)
+        EXPECT_EQ(solver->positions()[i], p.x0[i]);
 }
 
 TEST(XpbdPatchTest, EquilibriumBiasShrinksWithTheSquareOfTheSubstep) {
     Patch p = patch();
     auto settle = [&](int substeps) {
         auto solver = patchSolver(p, 1050, substeps);
-        for (int f = 0; f < 150; ++f) solver->step();
+        for (int f = 0; f < 150; ++f)
+            solver->step();
         return patchError(p, solver->positions());
     };
     const double e20 = settle(20), e40 = settle(40);

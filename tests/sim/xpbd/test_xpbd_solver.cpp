@@ -51,7 +51,8 @@ TEST(XpbdSolver, CantileverSagsFiniteBoundedAndDeterministic) {
     // iteration per substep (measured: about 2% of the gravitational work during the first fall).
     EXPECT_LE(maxEnergy, 0.05 * maxPotentialDrop);
     // Fixed nodes stay put; the free end sags by millimetres.
-    for (int32_t v : c.fixed) EXPECT_EQ(a->positions()[v], c.mesh->positions()[v]);
+    for (int32_t v : c.fixed)
+        EXPECT_EQ(a->positions()[v], c.mesh->positions()[v]);
     double tip = 0;
     for (size_t v = 0; v < a->positions().size(); ++v)
         tip = std::max(tip, c.mesh->positions()[v].z() - a->positions()[v].z());
@@ -92,7 +93,8 @@ TEST(XpbdSolver, RefusesAnInvertedRestState) {
     auto solver = XpbdSolver::create(*c.mesh, tissue(), c.fixed, s);
     // A mirrored copy has every element inverted; it cannot serve as a rest state.
     std::vector<Vec3> mirrored = c.mesh->positions();
-    for (Vec3& p : mirrored) p.z() = 0.02 - p.z();
+    for (Vec3& p : mirrored)
+        p.z() = 0.02 - p.z();
     auto inv = TetMesh::fromArrays(mirrored, c.mesh->tets());
     EXPECT_FALSE(inv->quality().inverted.empty());
     EXPECT_THROW(XpbdSolver::create(*inv, tissue(), c.fixed, s), std::invalid_argument)
@@ -120,7 +122,8 @@ TEST(XpbdSolver, RejectsUnstableParametersAtCreation) {
     EXPECT_THAT(msg(tissue(), bad, c.fixed), HasSubstr("substeps"));
     EXPECT_THAT(msg(tissue(), s, {999999}), HasSubstr("fixed node 999999 is out of range"));
     std::vector<int32_t> all(c.mesh->vertexCount());
-    for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int32_t>(i);
+    for (size_t i = 0; i < all.size(); ++i)
+        all[i] = static_cast<int32_t>(i);
     EXPECT_THAT(msg(tissue(), s, all), HasSubstr("no free node"));
 }
 
@@ -133,8 +136,10 @@ TEST(XpbdSolver, HugeTimeStepAndNearIncompressibleStayFinite) {
     for (int f = 0; f < 50; ++f) {
         StepStats st = solver->step();
         ASSERT_TRUE(st.finite);
-        for (const Vec3& p : solver->positions()) ASSERT_TRUE(p.allFinite());
-        for (const Vec3& v : solver->velocities()) ASSERT_LE(v.norm(), s.maxSpeed * (1 + 1e-12));
+        for (const Vec3& p : solver->positions())
+            ASSERT_TRUE(p.allFinite());
+        for (const Vec3& v : solver->velocities())
+            ASSERT_LE(v.norm(), s.maxSpeed * (1 + 1e-12));
     }
 }
 
@@ -161,7 +166,8 @@ TEST(XpbdSolver, GenericModelPathMatchesTheStableNeoHookeanFastPath) {
     for (size_t v = 0; v < fast->positions().size(); ++v)
         diff = std::max(diff, (fast->positions()[v] - generic->positions()[v]).norm());
     EXPECT_LT(diff, 1e-9);
-    EXPECT_NEAR(fast->elasticEnergy(), generic->elasticEnergy(), 1e-9 * std::abs(fast->elasticEnergy()));
+    EXPECT_NEAR(fast->elasticEnergy(), generic->elasticEnergy(),
+                1e-9 * std::abs(fast->elasticEnergy()));
 }
 
 TEST(XpbdSolver, OneConstraintModelRestsAndSags) {
@@ -176,11 +182,13 @@ TEST(XpbdSolver, OneConstraintModelRestsAndSags) {
     s.damping = 2.0;
     s.gravity.setZero();
     auto rest = XpbdSolver::create(body, s);
-    for (int f = 0; f < 10; ++f) EXPECT_EQ(rest->step().maxDisplacement, 0.0);
+    for (int f = 0; f < 10; ++f)
+        EXPECT_EQ(rest->step().maxDisplacement, 0.0);
     EXPECT_EQ(rest->elasticEnergy(), 0.0);
     s.gravity = Vec3(0, 0, -9.81);
     auto sag = XpbdSolver::create(body, s);
-    for (int f = 0; f < 240; ++f) ASSERT_TRUE(sag->step().finite);
+    for (int f = 0; f < 240; ++f)
+        ASSERT_TRUE(sag->step().finite);
     double tip = 0;
     for (size_t v = 0; v < sag->positions().size(); ++v)
         tip = std::max(tip, c.mesh->positions()[v].z() - sag->positions()[v].z());
@@ -200,7 +208,8 @@ TEST(XpbdSolver, NodeWeightsScaleTheStiffness) {
     s.substeps = 20;
     s.damping = 2.0;
     auto plain = XpbdSolver::create(body, s);
-    for (double w : plain->tetWeights()) EXPECT_EQ(w, 1.0);
+    for (double w : plain->tetWeights())
+        EXPECT_EQ(w, 1.0);
     body.nodeWeights.assign(c.mesh->vertexCount(), 1.0);
     body.nodeWeights[c.mesh->tets()[0][0]] = 5.0; // tet weight = mean of its nodes
     auto painted = XpbdSolver::create(body, s);
@@ -247,7 +256,8 @@ TEST(XpbdSolver, BitIdenticalAcrossRunsAndThreadCounts) {
             s.simd = simd;
             auto solver = XpbdSolver::create(*mesh, tissue(), fixed, s);
             EXPECT_GT(solver->colourCount(), 1);
-            for (int f = 0; f < 4; ++f) ASSERT_TRUE(solver->step().finite);
+            for (int f = 0; f < 4; ++f)
+                ASSERT_TRUE(solver->step().finite);
             results.push_back(solver->positions());
             energies.push_back(solver->elasticEnergy());
         }
@@ -281,7 +291,7 @@ namespace {
 /// A broken model whose constraint turns NaN once the tet is stretched: drives a frame
 /// non-finite.
 class PoisonModel final : public TetConstraintModel {
-public:
+  public:
     std::string name() const override { return "test_poison"; }
     int count() const override { return 1; }
     std::array<double, kMaxTetConstraints> compliance() const override { return {1e-3, 1e-3}; }
@@ -313,7 +323,8 @@ TEST(XpbdSolver, NonFiniteFrameIsRolledBack) {
             EXPECT_EQ(solver->velocities(), vBefore);
             EXPECT_EQ(st.maxDisplacement, 0.0);
         }
-        for (const Vec3& p : solver->positions()) ASSERT_TRUE(p.allFinite());
+        for (const Vec3& p : solver->positions())
+            ASSERT_TRUE(p.allFinite());
     }
     EXPECT_TRUE(rolledBack);
 }
@@ -324,7 +335,8 @@ TEST(XpbdSolver, SetStateTeleportsAndValidates) {
     s.gravity.setZero();
     auto solver = XpbdSolver::create(*c.mesh, tissue(), c.fixed, s);
     std::vector<Vec3> x = c.mesh->positions();
-    for (Vec3& p : x) p += Vec3(0.1, 0, 0); // a rigid translation stays at rest
+    for (Vec3& p : x)
+        p += Vec3(0.1, 0, 0); // a rigid translation stays at rest
     solver->setState(x, std::vector<Vec3>(x.size(), Vec3::Zero()));
     EXPECT_EQ(solver->positions(), x);
     EXPECT_LT(solver->step().maxDisplacement, 1e-12);
@@ -335,7 +347,8 @@ TEST(XpbdSolver, SetStateTeleportsAndValidates) {
         EXPECT_THAT(e.what(), HasSubstr("sim::XpbdSolver::setState(): expected"));
     }
     x[3].x() = std::numeric_limits<double>::quiet_NaN();
-    EXPECT_THROW(solver->setState(x, std::vector<Vec3>(x.size(), Vec3::Zero())), std::invalid_argument);
+    EXPECT_THROW(solver->setState(x, std::vector<Vec3>(x.size(), Vec3::Zero())),
+                 std::invalid_argument);
 }
 
 TEST(XpbdSolver, RejectsUnsupportedModelsAndSettings) {

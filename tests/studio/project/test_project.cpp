@@ -38,7 +38,7 @@ protected:
 
 const char* kGood = R"({
   "schemaVersion": 1, "caseId": "mini", "caseVersion": "1.0.0", "title": "Mini",
-  "solver": {"type": "xpbd", "substeps": 5},
+  "solver": {"type": "xpbd", "substeps": 100},
   "gravity": [0, 0, -9.81],
   "bodies": [{"name": "slab",
               "mesh": {"generator": "box", "size": [0.04, 0.01, 0.01], "cells": [4, 1, 1]},

@@ -1,6 +1,7 @@
 #include "sim/xpbd/detail/blocks.hpp"
 
 #include "sim/material/stable_neo_hookean.hpp"
+#include "sim/xpbd/coupling.hpp"
 #include "sim/xpbd/detail/snh_kernel.hpp"
 #include "sim/xpbd/membrane.hpp"
 
@@ -15,7 +16,7 @@ namespace {
 // ---- stable Neo-Hookean, packed ---------------------------------------------------------------
 
 class SnhBlock final : public Block {
-public:
+  public:
     SnhBlock(ElasticTets t, const StableNeoHookeanModel& m, bool avx2)
         : m_t(std::move(t)), m_mu(m.mu()), m_lambda(m.lambda()), m_gamma(m.gamma()), m_avx2(avx2) {}
 
@@ -26,8 +27,10 @@ public:
     }
     void solve(size_t pb, size_t pe, const SolveContext& ctx) override {
         const SnhParams p{ctx.xw, ctx.h2inv, m_gamma, ctx.first ? 1 : 0};
-        if (m_avx2) snhSolveAvx2(m_packs.data() + pb, pe - pb, p);
-        else snhSolveScalar(m_packs.data() + pb, pe - pb, p);
+        if (m_avx2)
+            snhSolveAvx2(m_packs.data() + pb, pe - pb, p);
+        else
+            snhSolveScalar(m_packs.data() + pb, pe - pb, p);
     }
     double energy(const double* xw) const override {
         // Ψ relative to rest: μ/2 (|F|² − 3) + λ/2 ((J − γ)² − (1 − γ)²).
@@ -35,17 +38,19 @@ public:
         for (size_t u = 0; u < m_t.tets.size(); ++u) {
             const Tet& e = m_t.tets[u];
             Mat3 ds;
-            for (int k = 0; k < 3; ++k) ds.col(k) = particlePosition(xw, e[k + 1]) - particlePosition(xw, e[0]);
+            for (int k = 0; k < 3; ++k)
+                ds.col(k) = particlePosition(xw, e[k + 1]) - particlePosition(xw, e[0]);
             const Mat3 F = ds * m_t.dmInv[u];
             const double J = F.determinant();
-            const double psi = 0.5 * m_mu * (F.squaredNorm() - 3.0) +
-                               0.5 * m_lambda * ((J - m_gamma) * (J - m_gamma) - (1 - m_gamma) * (1 - m_gamma));
+            const double psi =
+                0.5 * m_mu * (F.squaredNorm() - 3.0) +
+                0.5 * m_lambda * ((J - m_gamma) * (J - m_gamma) - (1 - m_gamma) * (1 - m_gamma));
             sum += m_t.volume[u] * m_t.weight[u] * psi;
         }
         return sum;
     }
 
-protected:
+  protected:
     void build(const std::vector<int32_t>& slots) override {
         m_packs.assign(slots.size() / 4, SnhPack{});
         for (size_t q = 0; q < m_packs.size(); ++q) {
@@ -54,9 +59,11 @@ protected:
             for (int l = 0; l < 4; ++l) {
                 const int32_t u = slots[4 * q + l] >= 0 ? slots[4 * q + l] : slots[4 * q];
                 if (slots[4 * q + l] >= 0) ++P.lanes;
-                for (int s = 0; s < 4; ++s) P.idx[s][l] = m_t.tets[u][s];
+                for (int s = 0; s < 4; ++s)
+                    P.idx[s][l] = m_t.tets[u][s];
                 for (int r = 0; r < 3; ++r)
-                    for (int c = 0; c < 3; ++c) P.m[3 * r + c][l] = m_t.dmInv[u](r, c);
+                    for (int c = 0; c < 3; ++c)
+                        P.m[3 * r + c][l] = m_t.dmInv[u](r, c);
                 const double vw = m_t.volume[u] * m_t.weight[u];
                 P.alphaD[l] = 1.0 / (m_mu * vw);
                 P.alphaH[l] = 1.0 / (m_lambda * vw);
@@ -65,7 +72,7 @@ protected:
         }
     }
 
-private:
+  private:
     ElasticTets m_t;
     double m_mu, m_lambda, m_gamma;
     bool m_avx2;
@@ -75,7 +82,7 @@ private:
 // ---- any TetConstraintModel ---------------------------------------------------------------------
 
 class ModelBlock final : public Block {
-public:
+  public:
     explicit ModelBlock(ElasticTets t) : m_t(std::move(t)) {
         m_count = m_t.model->count();
         m_alpha = m_t.model->compliance();
@@ -101,7 +108,8 @@ public:
                 w[k] = particleInvMass(ctx.xw, e[k]);
             }
             Mat3 ds;
-            for (int k = 0; k < 3; ++k) ds.col(k) = x[k + 1] - x[0];
+            for (int k = 0; k < 3; ++k)
+                ds.col(k) = x[k + 1] - x[0];
             const Mat3& M = m_t.dmInv[u.unit];
             m_t.model->evaluate(ds * M, cv);
             const int n = std::min(cv.count, m_count);
@@ -110,14 +118,17 @@ public:
             for (int c = 0; c < n; ++c) {
                 const Mat3 G = cv.dCdF[c] * M.transpose();
                 g[c][0] = -(G.col(0) + G.col(1) + G.col(2));
-                for (int k = 0; k < 3; ++k) g[c][k + 1] = G.col(k);
+                for (int k = 0; k < 3; ++k)
+                    g[c][k + 1] = G.col(k);
             }
             double A[2][2] = {{0, 0}, {0, 0}};
             for (int k = 0; k < 4; ++k)
                 for (int a = 0; a < n; ++a)
-                    for (int b = a; b < n; ++b) A[a][b] += w[k] * g[a][k].dot(g[b][k]);
+                    for (int b = a; b < n; ++b)
+                        A[a][b] += w[k] * g[a][k].dot(g[b][k]);
             double t[2];
-            for (int c = 0; c < n; ++c) t[c] = m_alpha[c] / u.vw * ctx.h2inv;
+            for (int c = 0; c < n; ++c)
+                t[c] = m_alpha[c] / u.vw * ctx.h2inv;
             double d[2] = {0, 0};
             if (n == 1) {
                 const double den = A[0][0] + t[0];
@@ -131,7 +142,8 @@ public:
                 d[0] = (a11 * r0 - a01 * r1) / det;
                 d[1] = (a00 * r1 - a01 * r0) / det;
             }
-            for (int c = 0; c < n; ++c) u.lam[c] += d[c];
+            for (int c = 0; c < n; ++c)
+                u.lam[c] += d[c];
             for (int k = 0; k < 4; ++k) {
                 Vec3 dx = d[0] * g[0][k];
                 if (n == 2) dx += d[1] * g[1][k];
@@ -144,13 +156,15 @@ public:
         for (size_t u = 0; u < m_t.tets.size(); ++u) {
             const Tet& e = m_t.tets[u];
             Mat3 ds;
-            for (int k = 0; k < 3; ++k) ds.col(k) = particlePosition(xw, e[k + 1]) - particlePosition(xw, e[0]);
-            sum += m_t.volume[u] * m_t.weight[u] * (m_t.model->energyDensity(ds * m_t.dmInv[u]) - m_restDensity);
+            for (int k = 0; k < 3; ++k)
+                ds.col(k) = particlePosition(xw, e[k + 1]) - particlePosition(xw, e[0]);
+            sum += m_t.volume[u] * m_t.weight[u] *
+                   (m_t.model->energyDensity(ds * m_t.dmInv[u]) - m_restDensity);
         }
         return sum;
     }
 
-protected:
+  protected:
     void build(const std::vector<int32_t>& slots) override {
         m_units.assign(slots.size(), Unit{});
         for (size_t s = 0; s < slots.size(); ++s) {
@@ -159,7 +173,7 @@ protected:
         }
     }
 
-private:
+  private:
     struct Unit {
         int32_t unit = -1;
         double vw = 1;
@@ -177,7 +191,8 @@ private:
 /// Applies one scalar strain-limit update; returns the new multiplier.
 template <int N>
 double strainLimitUpdate(const ScalarStrainLimit& lim, double eps, const std::array<Vec3, N>& g,
-                         const std::array<int32_t, N>& p, double measure, double lam, const SolveContext& ctx) {
+                         const std::array<int32_t, N>& p, double measure, double lam,
+                         const SolveContext& ctx) {
     double den = 0;
     double w[N];
     for (int k = 0; k < N; ++k) {
@@ -189,11 +204,14 @@ double strainLimitUpdate(const ScalarStrainLimit& lim, double eps, const std::ar
     if (!(den > 0) || !std::isfinite(den)) return lam;
     const double C = eps - lim.s;
     double next = lam + (-C - t * lam) / den;
-    if (lim.side > 0) next = std::min(next, 0.0);
-    else if (lim.side < 0) next = std::max(next, 0.0);
+    if (lim.side > 0)
+        next = std::min(next, 0.0);
+    else if (lim.side < 0)
+        next = std::max(next, 0.0);
     const double d = next - lam;
     if (d != 0)
-        for (int k = 0; k < N; ++k) moveParticle(ctx.xw, p[k], (w[k] * d) * g[k]);
+        for (int k = 0; k < N; ++k)
+            moveParticle(ctx.xw, p[k], (w[k] * d) * g[k]);
     return next;
 }
 
@@ -204,9 +222,8 @@ double strainLimitEnergy(const ScalarStrainLimit& lim, double eps, double measur
     return measure * C * C / (2 * lim.compliance);
 }
 
-template <int N, class MatM>
-class StrainBlock final : public Block {
-public:
+template <int N, class MatM> class StrainBlock final : public Block {
+  public:
     using Elem = std::array<int32_t, N>;
     StrainBlock(std::vector<Elem> elems, std::vector<MatM> dmInv, std::vector<double> measure,
                 std::vector<ScalarStrainLimit> limits)
@@ -229,7 +246,8 @@ public:
             const Elem& e = m_elems[u];
             for (size_t k = 0; k < nl; ++k) {
                 std::array<Vec3, N> x, g;
-                for (int i = 0; i < N; ++i) x[i] = particlePosition(ctx.xw, e[i]);
+                for (int i = 0; i < N; ++i)
+                    x[i] = particlePosition(ctx.xw, e[i]);
                 const double eps = strain(x, m_dmInv[u], m_limits[k].i, m_limits[k].j, &g);
                 lam[k] = strainLimitUpdate<N>(m_limits[k], eps, g, e, m_measure[u], lam[k], ctx);
             }
@@ -239,23 +257,28 @@ public:
         double sum = 0;
         for (size_t u = 0; u < m_elems.size(); ++u) {
             std::array<Vec3, N> x;
-            for (int i = 0; i < N; ++i) x[i] = particlePosition(xw, m_elems[u][i]);
+            for (int i = 0; i < N; ++i)
+                x[i] = particlePosition(xw, m_elems[u][i]);
             for (const auto& lim : m_limits)
-                sum += strainLimitEnergy(lim, strain(x, m_dmInv[u], lim.i, lim.j, nullptr), m_measure[u]);
+                sum += strainLimitEnergy(lim, strain(x, m_dmInv[u], lim.i, lim.j, nullptr),
+                                         m_measure[u]);
         }
         return sum;
     }
 
-protected:
+  protected:
     void build(const std::vector<int32_t>& slots) override {
         m_slots = slots;
         m_lam.assign(slots.size() * m_limits.size(), 0.0);
     }
 
-private:
-    static double strain(const std::array<Vec3, N>& x, const MatM& M, int i, int j, std::array<Vec3, N>* g) {
-        if constexpr (N == 4) return tetGreenStrain(x, M, i, j, g);
-        else return triGreenStrain(x, M, i, j, g);
+  private:
+    static double strain(const std::array<Vec3, N>& x, const MatM& M, int i, int j,
+                         std::array<Vec3, N>* g) {
+        if constexpr (N == 4)
+            return tetGreenStrain(x, M, i, j, g);
+        else
+            return triGreenStrain(x, M, i, j, g);
     }
     std::vector<Elem> m_elems;
     std::vector<MatM> m_dmInv;
@@ -268,8 +291,9 @@ private:
 // ---- membrane -----------------------------------------------------------------------------------
 
 class MembraneBlock final : public Block {
-public:
-    MembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area, double k)
+  public:
+    MembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area,
+                  double k)
         : m_tris(std::move(tris)), m_dmInv(std::move(dmInv)), m_area(std::move(area)), m_k(k) {}
 
     size_t unitCount() const override { return m_tris.size(); }
@@ -288,21 +312,26 @@ public:
             const Tri& e = m_tris[u];
             const double t = ctx.h2inv / (m_k * m_area[u]);
             double w[3];
-            for (int i = 0; i < 3; ++i) w[i] = particleInvMass(ctx.xw, e[i]);
+            for (int i = 0; i < 3; ++i)
+                w[i] = particleInvMass(ctx.xw, e[i]);
             for (int c = 0; c < 3; ++c) {
                 std::array<Vec3, 3> x, g;
-                for (int i = 0; i < 3; ++i) x[i] = particlePosition(ctx.xw, e[i]);
+                for (int i = 0; i < 3; ++i)
+                    x[i] = particlePosition(ctx.xw, e[i]);
                 double C = triGreenStrain(x, m_dmInv[u], kEntry[c][0], kEntry[c][1], &g);
                 if (c == 2) {
                     C *= kSqrt2;
-                    for (Vec3& gi : g) gi *= kSqrt2;
+                    for (Vec3& gi : g)
+                        gi *= kSqrt2;
                 }
                 double den = t;
-                for (int i = 0; i < 3; ++i) den += w[i] * g[i].squaredNorm();
+                for (int i = 0; i < 3; ++i)
+                    den += w[i] * g[i].squaredNorm();
                 if (!(den > 0) || !std::isfinite(den)) continue;
                 const double d = (-C - t * lam[c]) / den;
                 lam[c] += d;
-                for (int i = 0; i < 3; ++i) moveParticle(ctx.xw, e[i], (w[i] * d) * g[i]);
+                for (int i = 0; i < 3; ++i)
+                    moveParticle(ctx.xw, e[i], (w[i] * d) * g[i]);
             }
         }
     }
@@ -310,20 +339,21 @@ public:
         double sum = 0;
         for (size_t u = 0; u < m_tris.size(); ++u) {
             std::array<Vec3, 3> x;
-            for (int i = 0; i < 3; ++i) x[i] = particlePosition(xw, m_tris[u][i]);
+            for (int i = 0; i < 3; ++i)
+                x[i] = particlePosition(xw, m_tris[u][i]);
             const auto C = membraneConstraints(x, m_dmInv[u]);
             sum += 0.5 * m_k * m_area[u] * (C[0] * C[0] + C[1] * C[1] + C[2] * C[2]);
         }
         return sum;
     }
 
-protected:
+  protected:
     void build(const std::vector<int32_t>& slots) override {
         m_slots = slots;
         m_lam.assign(3 * slots.size(), 0.0);
     }
 
-private:
+  private:
     std::vector<Tri> m_tris;
     std::vector<Mat2> m_dmInv;
     std::vector<double> m_area;
@@ -335,7 +365,7 @@ private:
 // ---- coupling ties ------------------------------------------------------------------------------
 
 class CouplingBlock final : public Block {
-public:
+  public:
     explicit CouplingBlock(std::vector<Tie> ties) : m_ties(std::move(ties)) {}
 
     size_t unitCount() const override { return m_ties.size(); }
@@ -343,7 +373,8 @@ public:
     int unitParticles(size_t u, int32_t* out) const override {
         const Tie& t = m_ties[u];
         out[0] = t.p;
-        for (int k = 0; k < t.n; ++k) out[k + 1] = t.t[k];
+        for (int k = 0; k < t.n; ++k)
+            out[k + 1] = t.t[k];
         return t.n + 1;
     }
     void solve(size_t pb, size_t pe, const SolveContext& ctx) override {
@@ -354,41 +385,45 @@ public:
             if (ctx.first) lam.setZero();
             const Tie& t = m_ties[u];
             const double wp = particleInvMass(ctx.xw, t.p);
-            Vec3 C = particlePosition(ctx.xw, t.p);
-            double den = wp;
+            Vec3 target[4];
             double w[4];
+            double den = wp;
             for (int k = 0; k < t.n; ++k) {
+                target[k] = particlePosition(ctx.xw, t.t[k]);
                 w[k] = particleInvMass(ctx.xw, t.t[k]);
-                C -= t.b[k] * particlePosition(ctx.xw, t.t[k]);
                 den += w[k] * t.b[k] * t.b[k];
             }
+            const Vec3 C = couplingResidual(particlePosition(ctx.xw, t.p), target, t.b.data(), t.n);
             const double at = t.compliance * ctx.h2inv;
             den += at;
             if (!(den > 0) || !std::isfinite(den)) continue;
             const Vec3 d = (-C - at * lam) / den;
             lam += d;
             moveParticle(ctx.xw, t.p, wp * d);
-            for (int k = 0; k < t.n; ++k) moveParticle(ctx.xw, t.t[k], (-w[k] * t.b[k]) * d);
+            for (int k = 0; k < t.n; ++k)
+                moveParticle(ctx.xw, t.t[k], (-w[k] * t.b[k]) * d);
         }
     }
     double energy(const double* xw) const override {
         double sum = 0;
         for (const Tie& t : m_ties) {
             if (t.compliance == 0) continue;
-            Vec3 C = particlePosition(xw, t.p);
-            for (int k = 0; k < t.n; ++k) C -= t.b[k] * particlePosition(xw, t.t[k]);
+            Vec3 target[4];
+            for (int k = 0; k < t.n; ++k)
+                target[k] = particlePosition(xw, t.t[k]);
+            const Vec3 C = couplingResidual(particlePosition(xw, t.p), target, t.b.data(), t.n);
             sum += C.squaredNorm() / (2 * t.compliance);
         }
         return sum;
     }
 
-protected:
+  protected:
     void build(const std::vector<int32_t>& slots) override {
         m_slots = slots;
         m_lam.assign(slots.size(), Vec3::Zero());
     }
 
-private:
+  private:
     std::vector<Tie> m_ties;
     std::vector<int32_t> m_slots;
     std::vector<Vec3> m_lam;
@@ -419,21 +454,24 @@ std::vector<ScalarStrainLimit> expandStrainLimits(const std::vector<StrainLimit>
     return out;
 }
 
-std::unique_ptr<Block> makeTetStrainBlock(std::vector<Tet> tets, std::vector<Mat3> dmInv, std::vector<double> volume,
+std::unique_ptr<Block> makeTetStrainBlock(std::vector<Tet> tets, std::vector<Mat3> dmInv,
+                                          std::vector<double> volume,
                                           std::vector<ScalarStrainLimit> limits) {
-    return std::make_unique<StrainBlock<4, Mat3>>(std::move(tets), std::move(dmInv), std::move(volume),
-                                                  std::move(limits));
+    return std::make_unique<StrainBlock<4, Mat3>>(std::move(tets), std::move(dmInv),
+                                                  std::move(volume), std::move(limits));
 }
 
-std::unique_ptr<Block> makeTriStrainBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area,
+std::unique_ptr<Block> makeTriStrainBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv,
+                                          std::vector<double> area,
                                           std::vector<ScalarStrainLimit> limits) {
-    return std::make_unique<StrainBlock<3, Mat2>>(std::move(tris), std::move(dmInv), std::move(area),
-                                                  std::move(limits));
+    return std::make_unique<StrainBlock<3, Mat2>>(std::move(tris), std::move(dmInv),
+                                                  std::move(area), std::move(limits));
 }
 
-std::unique_ptr<Block> makeMembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area,
-                                         double stiffness) {
-    return std::make_unique<MembraneBlock>(std::move(tris), std::move(dmInv), std::move(area), stiffness);
+std::unique_ptr<Block> makeMembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv,
+                                         std::vector<double> area, double stiffness) {
+    return std::make_unique<MembraneBlock>(std::move(tris), std::move(dmInv), std::move(area),
+                                           stiffness);
 }
 
 std::unique_ptr<Block> makeCouplingBlock(std::vector<Tie> ties) {

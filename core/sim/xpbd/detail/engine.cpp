@@ -3,26 +3,27 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <functional>
 #include <thread>
 
 namespace viscera::sim::detail {
 namespace {
 /// Chunks: at least kMinChunkPacks packs (~1–2 µs of work), at most kChunksPerThread per thread
 /// and colour (claiming a chunk costs two contended atomics).
-constexpr size_t kMinChunkPacks = 8;
-constexpr size_t kChunksPerThread = 4;
+constexpr size_t kMinChunkPacks = 4;
+constexpr size_t kChunksPerThread = 16;
 constexpr size_t kChunkParticles = 1024;
 } // namespace
 
 void Block::arrange(const std::vector<int32_t>& colourOfUnit, int colours) {
     std::vector<std::vector<int32_t>> byColour(colours);
-    for (size_t u = 0; u < colourOfUnit.size(); ++u) byColour[colourOfUnit[u]].push_back(static_cast<int32_t>(u));
+    for (size_t u = 0; u < colourOfUnit.size(); ++u)
+        byColour[colourOfUnit[u]].push_back(static_cast<int32_t>(u));
     std::vector<int32_t> slots;
     m_colourStart.assign(colours + 1, 0);
     for (int c = 0; c < colours; ++c) {
         slots.insert(slots.end(), byColour[c].begin(), byColour[c].end());
-        while (slots.size() % 4) slots.push_back(-1);
+        while (slots.size() % 4)
+            slots.push_back(-1);
         m_colourStart[c + 1] = slots.size() / 4;
     }
     build(slots);
@@ -32,7 +33,8 @@ int32_t Engine::addParticles(const std::vector<Vec3>& x, const std::vector<doubl
                              const std::vector<uint8_t>& fixed) {
     const auto first = static_cast<int32_t>(particleCount());
     for (size_t i = 0; i < x.size(); ++i) {
-        xw.insert(xw.end(), {x[i].x(), x[i].y(), x[i].z(), (fixed[i] || !(m[i] > 0)) ? 0.0 : 1.0 / m[i]});
+        xw.insert(xw.end(),
+                  {x[i].x(), x[i].y(), x[i].z(), (fixed[i] || !(m[i] > 0)) ? 0.0 : 1.0 / m[i]});
         v.push_back(Vec3::Zero());
         mass.push_back(m[i]);
     }
@@ -45,7 +47,8 @@ void Engine::colour() {
     int32_t p[kMaxUnitParticles];
     m_colours = 0;
     int maxStage = 0;
-    for (const auto& b : blocks) maxStage = std::max(maxStage, b->stage());
+    for (const auto& b : blocks)
+        maxStage = std::max(maxStage, b->stage());
     for (int stage = 0; stage <= maxStage; ++stage) {
         const int base = m_colours;
         int words = 1;
@@ -59,72 +62,33 @@ void Engine::colour() {
                 while (found < 0) {
                     for (int wd = 0; wd < words && found < 0; ++wd) {
                         uint64_t taken = 0;
-                        for (int k = 0; k < np; ++k) taken |= used[static_cast<size_t>(p[k]) * words + wd];
+                        for (int k = 0; k < np; ++k)
+                            taken |= used[static_cast<size_t>(p[k]) * words + wd];
                         if (~taken) found = wd * 64 + __builtin_ctzll(~taken);
                     }
-                    if (found < 0) { // every colour so far is taken around this unit: widen the sets
+                    if (found <
+                        0) { // every colour so far is taken around this unit: widen the sets
                         std::vector<uint64_t> wider(n * (words + 1), 0);
                         for (size_t i = 0; i < n; ++i)
-                            std::copy_n(used.begin() + i * words, words, wider.begin() + i * (words + 1));
+                            std::copy_n(used.begin() + i * words, words,
+                                        wider.begin() + i * (words + 1));
                         used.swap(wider);
                         ++words;
                     }
                 }
                 for (int k = 0; k < np; ++k)
-                    used[static_cast<size_t>(p[k]) * words + found / 64] |= uint64_t(1) << (found % 64);
+                    used[static_cast<size_t>(p[k]) * words + found / 64] |= uint64_t(1)
+                                                                            << (found % 64);
                 colourOf[b][u] = base + found;
                 m_colours = std::max(m_colours, base + found + 1);
             }
         }
-        // Greedy colours shrink towards the end; every colour costs a synchronisation per sweep.
-        // Move the units of the smallest colours into earlier ones where their particles are free,
-        // and drop the colours that empty.
-        const int count = m_colours - base;
-        std::vector<size_t> size(count, 0);
-        for (size_t b = 0; b < blocks.size(); ++b)
-            if (blocks[b]->stage() == stage)
-                for (int32_t c : colourOf[b]) ++size[c - base];
-        size_t mean = 0;
-        for (size_t z : size) mean += z;
-        mean /= std::max(count, 1);
-        std::vector<uint8_t> dropped(count, 0);
-        for (int c = count - 1; c > 0 && size[c] < mean / 4; --c) {
-            for (size_t b = 0; b < blocks.size(); ++b) {
-                if (blocks[b]->stage() != stage) continue;
-                for (size_t u = 0; u < colourOf[b].size(); ++u) {
-                    if (colourOf[b][u] != base + c) continue;
-                    const int np = blocks[b]->unitParticles(u, p);
-                    for (int to = 0; to < c; ++to) {
-                        if (dropped[to]) continue;
-                        bool free = true;
-                        for (int k = 0; k < np && free; ++k)
-                            free = !(used[static_cast<size_t>(p[k]) * words + to / 64] >> (to % 64) & 1);
-                        if (!free) continue;
-                        for (int k = 0; k < np; ++k) {
-                            used[static_cast<size_t>(p[k]) * words + c / 64] &= ~(uint64_t(1) << (c % 64));
-                            used[static_cast<size_t>(p[k]) * words + to / 64] |= uint64_t(1) << (to % 64);
-                        }
-                        colourOf[b][u] = base + to;
-                        --size[c];
-                        ++size[to];
-                        break;
-                    }
-                }
-            }
-            if (size[c] == 0) dropped[c] = 1;
-        }
-        std::vector<int> renumber(count, 0);
-        int kept = 0;
-        for (int c = 0; c < count; ++c) renumber[c] = dropped[c] ? -1 : kept++;
-        for (size_t b = 0; b < blocks.size(); ++b)
-            if (blocks[b]->stage() == stage)
-                for (int32_t& c : colourOf[b]) c = base + renumber[c - base];
-        m_colours = base + kept;
     }
     m_colourPacks.assign(m_colours, 0);
     for (size_t b = 0; b < blocks.size(); ++b) {
         blocks[b]->arrange(colourOf[b], m_colours);
-        for (int c = 0; c < m_colours; ++c) m_colourPacks[c] += blocks[b]->colourEnd(c) - blocks[b]->colourBegin(c);
+        for (int c = 0; c < m_colours; ++c)
+            m_colourPacks[c] += blocks[b]->colourEnd(c) - blocks[b]->colourBegin(c);
     }
 }
 
@@ -159,7 +123,8 @@ void waitAtLeast(const std::atomic<uint32_t>& a, uint32_t target) {
 int Engine::usefulThreads(int threads) const {
     if (threads <= 1) return 1;
     size_t most = 1;
-    for (size_t packs : m_colourPacks) most = std::max(most, packs / kMinChunkPacks);
+    for (size_t packs : m_colourPacks)
+        most = std::max(most, packs / kMinChunkPacks);
     return static_cast<int>(std::min<size_t>(threads, most));
 }
 
@@ -178,46 +143,68 @@ void Engine::solveColourChunk(int c, uint32_t chunk, uint32_t chunks, const Solv
 
 void Engine::buildSchedule(const XpbdSettings* s, int threads) {
     m_phases.clear();
-    const auto particleChunks = static_cast<uint32_t>((particleCount() + kChunkParticles - 1) / kChunkParticles);
+    const auto particleChunks =
+        static_cast<uint32_t>((particleCount() + kChunkParticles - 1) / kChunkParticles);
     auto colourPhases = [&](bool first) {
         for (int c = 0; c < m_colours; ++c)
-            m_phases.push_back({c, first, false,
-                                static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1,
-                                                                         kChunksPerThread * threads))});
+            m_phases.push_back(
+                {c, first, false,
+                 static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1,
+                                                          kChunksPerThread * threads))});
     };
     if (!s) {
         colourPhases(false);
     } else {
         m_phases.push_back({kPredictOnly, false, true, particleChunks});
         for (int sub = 0; sub < s->substeps; ++sub) {
-            for (int it = 0; it < s->iterations; ++it) colourPhases(it == 0);
+            for (int it = 0; it < s->iterations; ++it)
+                colourPhases(it == 0);
             m_phases.push_back({-1, false, sub + 1 < s->substeps, particleChunks});
         }
     }
     m_phaseStart.assign(m_phases.size() + 1, 0);
-    for (size_t p = 0; p < m_phases.size(); ++p) m_phaseStart[p + 1] = m_phaseStart[p] + m_phases[p].chunks;
+    for (size_t p = 0; p < m_phases.size(); ++p)
+        m_phaseStart[p + 1] = m_phaseStart[p] + m_phases[p].chunks;
 }
 
-template <class RunChunk>
-void Engine::execute(int threads, WorkerPool* pool, const RunChunk& run) {
-    const uint32_t total = m_phaseStart.back();
+template <class RunChunk> void Engine::execute(int threads, WorkerPool* pool, const RunChunk& run) {
     if (threads <= 1) {
         for (size_t p = 0; p < m_phases.size(); ++p)
-            for (uint32_t j = 0; j < m_phases[p].chunks; ++j) run(m_phases[p], j, 0);
+            for (uint32_t j = 0; j < m_phases[p].chunks; ++j)
+                run(m_phases[p], j, 0);
         return;
     }
-    m_nextChunk.store(0, std::memory_order_relaxed);
+    const size_t cursors = m_phases.size() * threads;
+    if (m_cursorCount < cursors) {
+        m_cursors = std::make_unique<Cursor[]>(cursors);
+        m_cursorCount = cursors;
+    }
+    for (size_t i = 0; i < cursors; ++i)
+        m_cursors[i].claimed.store(0, std::memory_order_relaxed);
     m_doneChunks.store(0, std::memory_order_relaxed);
-    const std::function<void(int)> job = [&](int tid) {
-        size_t p = 0;
-        for (;;) {
-            const uint32_t k = m_nextChunk.fetch_add(1, std::memory_order_relaxed);
-            if (k >= total) return;
-            while (m_phaseStart[p + 1] <= k) ++p;
+    const auto job = [&](int tid) {
+        for (size_t p = 0; p < m_phases.size(); ++p) {
             waitAtLeast(m_doneChunks, m_phaseStart[p]);
-            run(m_phases[p], k - m_phaseStart[p], tid);
-            m_doneChunks.fetch_add(1, std::memory_order_release);
-            m_doneChunks.notify_all();
+            // Chunks of a phase are split into one group per thread (the same region of the
+            // mesh in every colour, so particles stay in that thread's cache); a thread takes
+            // its own group first, then helps with the others.
+            const uint32_t n = m_phases[p].chunks;
+            uint32_t done = 0;
+            for (int k = 0; k < threads; ++k) {
+                const int g = (tid + k) % threads;
+                const uint32_t gb = n * g / threads, size = n * (g + 1) / threads - gb;
+                std::atomic<uint32_t>& claimed = m_cursors[p * threads + g].claimed;
+                while (claimed.load(std::memory_order_relaxed) < size) {
+                    const uint32_t i = claimed.fetch_add(1, std::memory_order_relaxed);
+                    if (i >= size) break;
+                    run(m_phases[p], gb + i, tid);
+                    ++done;
+                }
+            }
+            if (done) {
+                m_doneChunks.fetch_add(done, std::memory_order_release);
+                m_doneChunks.notify_all();
+            }
         }
     };
     pool->run(threads, job);
@@ -281,7 +268,8 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
 
     st.substeps = substeps;
     st.iterations = s.iterations;
-    for (int c : m_clamps) st.speedClamps += c;
+    for (int c : m_clamps)
+        st.speedClamps += c;
     for (size_t i = 0; i < n; ++i) {
         const double* p = x + 4 * i;
         const Vec3 xi(p[0], p[1], p[2]);

@@ -21,16 +21,11 @@
 
 namespace viscera::sim::detail {
 
-template <class T, std::size_t Align>
-struct AlignedAllocator {
+template <class T, std::size_t Align> struct AlignedAllocator {
     using value_type = T;
     AlignedAllocator() = default;
-    template <class U>
-    AlignedAllocator(const AlignedAllocator<U, Align>&) {}
-    template <class U>
-    struct rebind {
-        using other = AlignedAllocator<U, Align>;
-    };
+    template <class U> AlignedAllocator(const AlignedAllocator<U, Align>&) {}
+    template <class U> struct rebind { using other = AlignedAllocator<U, Align>; };
     T* allocate(std::size_t n) {
         return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(Align)));
     }
@@ -44,7 +39,9 @@ inline Vec3 particlePosition(const double* xw, int32_t i) {
     const double* p = xw + 4 * static_cast<size_t>(i);
     return Vec3(p[0], p[1], p[2]);
 }
-inline double particleInvMass(const double* xw, int32_t i) { return xw[4 * static_cast<size_t>(i) + 3]; }
+inline double particleInvMass(const double* xw, int32_t i) {
+    return xw[4 * static_cast<size_t>(i) + 3];
+}
 inline void moveParticle(double* xw, int32_t i, const Vec3& d) {
     double* p = xw + 4 * static_cast<size_t>(i);
     p[0] += d.x();
@@ -53,15 +50,15 @@ inline void moveParticle(double* xw, int32_t i, const Vec3& d) {
 }
 
 struct SolveContext {
-    double* xw;    ///< particle array
-    double h2inv;  ///< 1/h², 1/s²
-    bool first;    ///< first iteration of a substep: multipliers start from 0 [A eq. 4.43]
+    double* xw;   ///< particle array
+    double h2inv; ///< 1/h², 1/s²
+    bool first;   ///< first iteration of a substep: multipliers start from 0 [A eq. 4.43]
 };
 
 inline constexpr int kMaxUnitParticles = 8;
 
 class Block {
-public:
+  public:
     virtual ~Block() = default;
     virtual size_t unitCount() const = 0;
     /// Particles of unit u into out (at most kMaxUnitParticles); returns their count.
@@ -80,19 +77,19 @@ public:
     size_t colourBegin(int c) const { return m_colourStart[c]; }
     size_t colourEnd(int c) const { return m_colourStart[c + 1]; }
 
-protected:
+  protected:
     /// slots: four per pack, a unit index or −1 for padding, in colour order.
     virtual void build(const std::vector<int32_t>& slots) = 0;
 
-private:
+  private:
     std::vector<size_t> m_colourStart;
 };
 
 class Engine {
-public:
-    ParticleArray xw;          ///< 4 per particle: x, y, z (m), inverse mass (1/kg, 0 = fixed)
-    std::vector<Vec3> v;       ///< velocities, m/s
-    std::vector<double> mass;  ///< kg (fixed particles keep theirs)
+  public:
+    ParticleArray xw;         ///< 4 per particle: x, y, z (m), inverse mass (1/kg, 0 = fixed)
+    std::vector<Vec3> v;      ///< velocities, m/s
+    std::vector<double> mass; ///< kg (fixed particles keep theirs)
     std::vector<std::unique_ptr<Block>> blocks;
 
     size_t particleCount() const { return mass.size(); }
@@ -116,7 +113,7 @@ public:
     /// Threads worth using (≤ threads): 1 when no colour is large enough to split.
     int usefulThreads(int threads) const;
 
-private:
+  private:
     /// A step of the schedule: a colour sweep (colour ≥ 0) or a particle pass (colour < 0: end of
     /// a substep and, when predictNext, start of the next; or, with colour == kPredictOnly, only
     /// the start of the first substep). Its work is cut into chunks (a colour: a few per thread;
@@ -131,18 +128,23 @@ private:
     static constexpr int kPredictOnly = -2;
     void buildSchedule(const XpbdSettings* s, int threads);
     /// Runs every chunk of m_phases in order: a phase starts when all chunks of the previous
-    /// ones are done. Parallel: threads claim chunks from one atomic counter and wait on a
-    /// second one that counts finished chunks, so a thread that the OS pauses only holds up the
-    /// others when it pauses inside a chunk. Serial: a plain loop over the same chunks.
-    template <class RunChunk>
-    void execute(int threads, WorkerPool* pool, const RunChunk& run);
+    /// ones are done. Parallel: the chunks of a phase form one group per thread; a thread claims
+    /// chunks of its own group, then of the others, from per-group atomic cursors, and adds its
+    /// count to an atomic of finished chunks that the next phase waits on. A thread that the OS
+    /// pauses therefore holds the others up only while it is inside a chunk. Serial: a plain
+    /// loop over the same chunks.
+    template <class RunChunk> void execute(int threads, WorkerPool* pool, const RunChunk& run);
     void solveColourChunk(int c, uint32_t chunk, uint32_t chunks, const SolveContext& ctx);
 
     std::vector<size_t> m_colourPacks;
     int m_colours = 0;
     std::vector<Phase> m_phases;
     std::vector<uint32_t> m_phaseStart; ///< first global chunk of each phase, plus the total
-    alignas(64) std::atomic<uint32_t> m_nextChunk{0};
+    struct alignas(64) Cursor {
+        std::atomic<uint32_t> claimed{0};
+    };
+    std::unique_ptr<Cursor[]> m_cursors; ///< per phase and thread group: chunks claimed
+    size_t m_cursorCount = 0;
     alignas(64) std::atomic<uint32_t> m_doneChunks{0};
     std::vector<Vec3> m_prev;
     ParticleArray m_frameStart;

@@ -12,12 +12,24 @@ namespace {
 
 using V = __m256d;
 
-inline V add(V a, V b) { return _mm256_add_pd(a, b); }
-inline V sub(V a, V b) { return _mm256_sub_pd(a, b); }
-inline V mul(V a, V b) { return _mm256_mul_pd(a, b); }
-inline V madd(V a, V b, V c) { return _mm256_fmadd_pd(a, b, c); }  // a·b + c
-inline V msub(V a, V b, V c) { return _mm256_fmsub_pd(a, b, c); }  // a·b − c
-inline V nmadd(V a, V b, V c) { return _mm256_fnmadd_pd(a, b, c); } // c − a·b
+inline V add(V a, V b) {
+    return _mm256_add_pd(a, b);
+}
+inline V sub(V a, V b) {
+    return _mm256_sub_pd(a, b);
+}
+inline V mul(V a, V b) {
+    return _mm256_mul_pd(a, b);
+}
+inline V madd(V a, V b, V c) {
+    return _mm256_fmadd_pd(a, b, c);
+} // a·b + c
+inline V msub(V a, V b, V c) {
+    return _mm256_fmsub_pd(a, b, c);
+} // a·b − c
+inline V nmadd(V a, V b, V c) {
+    return _mm256_fnmadd_pd(a, b, c);
+} // c − a·b
 
 /// Rows r0..r3 (x, y, z, w of four particles) to columns X, Y, Z, W (one lane per particle).
 inline void toColumns(V r0, V r1, V r2, V r3, V& X, V& Y, V& Z, V& W) {
@@ -43,13 +55,13 @@ inline void storeRows(double* xw, const int32_t* idx, V X, V Y, V Z, V W) {
 
 /// Solves K packs (4K tets of one colour, so no shared particle) with their instructions
 /// interleaved: the square root and divisions of one pack overlap the arithmetic of the other.
-template <int K>
-inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first) {
+template <int K> inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first) {
     const V one = _mm256_set1_pd(1.0), tiny = _mm256_set1_pd(1e-24);
     const V huge = _mm256_set1_pd(__builtin_huge_val());
     const V laneIndex = _mm256_set_pd(3, 2, 1, 0);
     const V signMask = _mm256_set1_pd(-0.0);
-    V X[K][4], Y[K][4], Z[K][4], W[K][4], gFx[K][4], gFy[K][4], gFz[K][4], gHx[K][4], gHy[K][4], gHz[K][4];
+    V X[K][4], Y[K][4], Z[K][4], W[K][4], gFx[K][4], gFy[K][4], gFz[K][4], gHx[K][4], gHy[K][4],
+        gHz[K][4];
     V sFF[K], sHH[K], sFH[K], cD2[K], J[K];
     for (int k = 0; k < K; ++k) {
         for (int s = 0; s < 4; ++s) {
@@ -57,13 +69,18 @@ inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first) {
             toColumns(_mm256_load_pd(xw + 4 * static_cast<size_t>(id[0])),
                       _mm256_load_pd(xw + 4 * static_cast<size_t>(id[1])),
                       _mm256_load_pd(xw + 4 * static_cast<size_t>(id[2])),
-                      _mm256_load_pd(xw + 4 * static_cast<size_t>(id[3])), X[k][s], Y[k][s], Z[k][s], W[k][s]);
+                      _mm256_load_pd(xw + 4 * static_cast<size_t>(id[3])), X[k][s], Y[k][s],
+                      Z[k][s], W[k][s]);
         }
-        const V d0x = sub(X[k][1], X[k][0]), d0y = sub(Y[k][1], Y[k][0]), d0z = sub(Z[k][1], Z[k][0]);
-        const V d1x = sub(X[k][2], X[k][0]), d1y = sub(Y[k][2], Y[k][0]), d1z = sub(Z[k][2], Z[k][0]);
-        const V d2x = sub(X[k][3], X[k][0]), d2y = sub(Y[k][3], Y[k][0]), d2z = sub(Z[k][3], Z[k][0]);
+        const V d0x = sub(X[k][1], X[k][0]), d0y = sub(Y[k][1], Y[k][0]),
+                d0z = sub(Z[k][1], Z[k][0]);
+        const V d1x = sub(X[k][2], X[k][0]), d1y = sub(Y[k][2], Y[k][0]),
+                d1z = sub(Z[k][2], Z[k][0]);
+        const V d2x = sub(X[k][3], X[k][0]), d2y = sub(Y[k][3], Y[k][0]),
+                d2z = sub(Z[k][3], Z[k][0]);
         V m[9];
-        for (int e = 0; e < 9; ++e) m[e] = _mm256_load_pd(P[k].m[e]);
+        for (int e = 0; e < 9; ++e)
+            m[e] = _mm256_load_pd(P[k].m[e]);
         // F = Ds Dm⁻¹, column c: Σ_j d_j m[3j + c].
         V Fx[3], Fy[3], Fz[3];
         for (int c = 0; c < 3; ++c) {
@@ -105,9 +122,18 @@ inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first) {
         gHz[k][0] = _mm256_xor_pd(add(add(gHz[k][1], gHz[k][2]), gHz[k][3]), signMask);
         V ff = _mm256_setzero_pd(), hh = ff, fh = ff;
         for (int s = 0; s < 4; ++s) {
-            ff = madd(W[k][s], madd(gFz[k][s], gFz[k][s], madd(gFy[k][s], gFy[k][s], mul(gFx[k][s], gFx[k][s]))), ff);
-            hh = madd(W[k][s], madd(gHz[k][s], gHz[k][s], madd(gHy[k][s], gHy[k][s], mul(gHx[k][s], gHx[k][s]))), hh);
-            fh = madd(W[k][s], madd(gFz[k][s], gHz[k][s], madd(gFy[k][s], gHy[k][s], mul(gFx[k][s], gHx[k][s]))), fh);
+            ff = madd(
+                W[k][s],
+                madd(gFz[k][s], gFz[k][s], madd(gFy[k][s], gFy[k][s], mul(gFx[k][s], gFx[k][s]))),
+                ff);
+            hh = madd(
+                W[k][s],
+                madd(gHz[k][s], gHz[k][s], madd(gHy[k][s], gHy[k][s], mul(gHx[k][s], gHx[k][s]))),
+                hh);
+            fh = madd(
+                W[k][s],
+                madd(gFz[k][s], gHz[k][s], madd(gFy[k][s], gHy[k][s], mul(gFx[k][s], gHx[k][s]))),
+                fh);
         }
         sFF[k] = ff;
         sHH[k] = hh;
@@ -125,7 +151,8 @@ inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first) {
         const V cD = _mm256_sqrt_pd(cD2[k]);
         const V lD = first ? _mm256_setzero_pd() : _mm256_load_pd(P[k].lamD);
         const V lH = first ? _mm256_setzero_pd() : _mm256_load_pd(P[k].lamH);
-        const V tD = mul(_mm256_load_pd(P[k].alphaD), h2inv), tH = mul(_mm256_load_pd(P[k].alphaH), h2inv);
+        const V tD = mul(_mm256_load_pd(P[k].alphaD), h2inv),
+                tH = mul(_mm256_load_pd(P[k].alphaH), h2inv);
         const V a00 = madd(tD, cD2[k], sFF[k]);
         const V a11 = add(sHH[k], tH);
         const V a01 = sFH[k];
@@ -147,7 +174,8 @@ inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first) {
             const V DX = mul(W[k][s], madd(dH[k], gHx[k][s], mul(cF[k], gFx[k][s])));
             const V DY = mul(W[k][s], madd(dH[k], gHy[k][s], mul(cF[k], gFy[k][s])));
             const V DZ = mul(W[k][s], madd(dH[k], gHz[k][s], mul(cF[k], gFz[k][s])));
-            storeRows(xw, P[k].idx[s], add(X[k][s], DX), add(Y[k][s], DY), add(Z[k][s], DZ), W[k][s]);
+            storeRows(xw, P[k].idx[s], add(X[k][s], DX), add(Y[k][s], DY), add(Z[k][s], DZ),
+                      W[k][s]);
         }
 }
 
@@ -162,7 +190,16 @@ void snhSolveAvx2(SnhPack* packs, size_t count, const SnhParams& prm) {
     const V h2inv = _mm256_set1_pd(prm.h2inv), gamma = _mm256_set1_pd(prm.gamma);
     const bool first = prm.first != 0;
     size_t q = 0;
-    for (; q + 2 <= count; q += 2) solvePacks<2>(packs + q, prm.xw, h2inv, gamma, first);
+    for (; q + 2 <= count; q += 2) {
+        // The particles of the next two packs: L2 → L1 while this pair computes.
+        for (size_t n = q + 2; n < q + 4 && n < count; ++n)
+            for (int s = 0; s < 4; ++s)
+                for (int l = 0; l < 4; ++l)
+                    _mm_prefetch(reinterpret_cast<const char*>(
+                                     prm.xw + 4 * static_cast<size_t>(packs[n].idx[s][l])),
+                                 _MM_HINT_T0);
+        solvePacks<2>(packs + q, prm.xw, h2inv, gamma, first);
+    }
     if (q < count) solvePacks<1>(packs + q, prm.xw, h2inv, gamma, first);
 }
 
@@ -172,8 +209,12 @@ void snhSolveAvx2(SnhPack* packs, size_t count, const SnhParams& prm) {
 
 namespace viscera::sim::detail {
 
-bool snhAvx2Available() { return false; }
-void snhSolveAvx2(SnhPack* packs, size_t count, const SnhParams& p) { snhSolveScalar(packs, count, p); }
+bool snhAvx2Available() {
+    return false;
+}
+void snhSolveAvx2(SnhPack* packs, size_t count, const SnhParams& p) {
+    snhSolveScalar(packs, count, p);
+}
 
 } // namespace viscera::sim::detail
 

@@ -14,20 +14,20 @@
 namespace viscera::sim::detail {
 
 struct alignas(64) SnhPack {
-    int32_t idx[4][4];  ///< [vertex slot][lane]: particle index
-    double m[9][4];     ///< Dm⁻¹ entry (3·row + col) per lane, 1/m
-    double alphaD[4];   ///< deviatoric compliance 1/(μ V w), 1/(Pa·m³)
-    double alphaH[4];   ///< hydrostatic compliance 1/(λ V w), 1/(Pa·m³)
-    double lamD[4];     ///< multipliers, accumulated over the iterations of one substep
+    int32_t idx[4][4]; ///< [vertex slot][lane]: particle index
+    double m[9][4];    ///< Dm⁻¹ entry (3·row + col) per lane, 1/m
+    double alphaD[4];  ///< deviatoric compliance 1/(μ V w), 1/(Pa·m³)
+    double alphaH[4];  ///< hydrostatic compliance 1/(λ V w), 1/(Pa·m³)
+    double lamD[4];    ///< multipliers, accumulated over the iterations of one substep
     double lamH[4];
-    int32_t lanes;      ///< valid lanes, 1..4
+    int32_t lanes; ///< valid lanes, 1..4
 };
 
 struct SnhParams {
-    double* xw;    ///< particles: x, y, z (m) and inverse mass (1/kg), 4 doubles each, 32-byte aligned
-    double h2inv;  ///< 1/h², 1/s²
-    double gamma;  ///< 1 + μ/λ
-    int first;     ///< 1: first iteration of a substep (multipliers start from 0)
+    double* xw; ///< particles: x, y, z (m) and inverse mass (1/kg), 4 doubles each, 32-byte aligned
+    double h2inv; ///< 1/h², 1/s²
+    double gamma; ///< 1 + μ/λ
+    int first;    ///< 1: first iteration of a substep (multipliers start from 0)
 };
 
 /// Portable scalar kernel.

@@ -17,10 +17,12 @@ void snhSolveScalar(SnhPack* packs, size_t count, const SnhParams& prm) {
             }
             double d[3][3]; // d[k][r]: edge k (vertex k+1 − vertex 0), component r
             for (int k = 0; k < 3; ++k)
-                for (int r = 0; r < 3; ++r) d[k][r] = v[k + 1][r] - v[0][r];
+                for (int r = 0; r < 3; ++r)
+                    d[k][r] = v[k + 1][r] - v[0][r];
             double M[3][3];
             for (int j = 0; j < 3; ++j)
-                for (int c = 0; c < 3; ++c) M[j][c] = P.m[3 * j + c][l];
+                for (int c = 0; c < 3; ++c)
+                    M[j][c] = P.m[3 * j + c][l];
             double F[3][3]; // F[c][r]: column c
             double cD2 = 0;
             for (int c = 0; c < 3; ++c)
@@ -74,7 +76,8 @@ void snhSolveScalar(SnhPack* packs, size_t count, const SnhParams& prm) {
             P.lamH[l] = lH + dH;
             const double cF = e;
             for (int s = 0; s < 4; ++s)
-                for (int r = 0; r < 3; ++r) v[s][r] += w[s] * (cF * gF[s][r] + dH * gH[s][r]);
+                for (int r = 0; r < 3; ++r)
+                    v[s][r] += w[s] * (cF * gF[s][r] + dH * gH[s][r]);
         }
     }
 }
