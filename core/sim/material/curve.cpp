@@ -171,13 +171,16 @@ void MonotoneCurve::rebuild() {
         m_linear = std::abs(p[i].y - line) <= kLinearTolerance * (std::abs(p[i].y) + std::abs(m0 * run)) &&
                    std::abs(m_slopes[i] - m0) <= kLinearTolerance * std::abs(m0);
     }
-    m_line = m_segments.front();
-    m_line.c = m_line.d = m_line.c3 = m_line.d4 = 0.0;
-    {
-        // ∫₁^{x_0} of the line, with the expression sample() uses, so that x = 1 gives exactly 0.
-        const double s = rest - p.front().x;
-        m_line.rest = -(s * (m_line.y + 0.5 * m_line.m * s));
-    }
+    // The line through the control point nearest to rest, so that f′(1) keeps the value of an
+    // authored point at 1 exactly.
+    std::size_t nearest = 0;
+    for (std::size_t i = 1; i < n; ++i)
+        if (std::abs(p[i].x - rest) < std::abs(p[nearest].x - rest)) nearest = i;
+    m_line = Segment{};
+    m_line.x = p[nearest].x;
+    m_line.y = p[nearest].y;
+    m_line.m = m_slopes[nearest];
+    m_line.rest = m_line.y + m_line.m * (rest - m_line.x); // y(1)
     buildLookup();
 }
 
@@ -248,7 +251,15 @@ std::size_t MonotoneCurve::segment(double x) const {
 }
 
 double MonotoneCurve::value(double x) const {
-    return sample(x).value;
+    const Segment& first = m_segments.front();
+    const Segment& last = m_segments.back();
+    if (x > first.x && x < last.x) {
+        const Segment& q = m_segments[lookupInterior(x)];
+        const double s = x - q.x;
+        return (q.y + q.m * s) + s * s * (q.c + q.d * s);
+    }
+    const Segment& e = x <= first.x ? first : last;
+    return e.y + e.m * (x - e.x);
 }
 
 double MonotoneCurve::derivative(double x) const {

@@ -20,7 +20,9 @@
 ///
 /// A curve whose control points and slopes all lie on one line (within 1e-13 relative: the
 /// linear f′ of the Neo-Hookean and corotated presets, a constant g′) is evaluated by sample()
-/// and value() as that line, with no segment lookup.
+/// as that line (through the control point nearest to x = 1), with no segment lookup; value(),
+/// derivative() and integral() keep evaluating the interpolant, which differs from the line by
+/// the rounding noise in its cubic coefficients (< 1e-13 relative).
 ///
 /// Cost: value, derivative, sample, integralFromRest and antiderivative are O(1): the segment is
 /// found from a bucket table over x (uniform spacing) or over a monotone piecewise-linear log2 x
@@ -88,7 +90,7 @@ public:
     /// ∫₁ˣ y(t) dt: the primitive that vanishes at x = 1, the rest value of a stretch or a
     /// stretch product (the rest-normalized Valanis–Landel terms f, g, h, [A eq. 4.18]). Equal to
     /// integral(1, x) up to rounding and exactly 0 at x = 1. Near 1 the value is a difference
-    /// within one segment (no cancellation of large cumulative sums).
+    /// within one segment (no cancellation of large cumulative sums). O(1).
     double integralFromRest(double x) const { return sample(x).integralFromRest; }
 
     struct Sample {
@@ -96,8 +98,15 @@ public:
         double integralFromRest = 0; ///< ∫₁ˣ y(t) dt
     };
     /// value(x) and integralFromRest(x) from one segment lookup: the per-tet hot path of
-    /// Valanis–Landel densities. O(1), no allocation.
+    /// Valanis–Landel densities. O(1), no allocation. Bit-identical to value(x) except on a
+    /// linear curve (see above).
     Sample sample(double x) const;
+    /// The lookup of sample() split in two, so that it can start from an early estimate of the
+    /// abscissa: sampleFrom(x, locate(y)) == sample(x) (bit-identical) for any x and y, and
+    /// costs only the polynomial when x lies in the segment of y. (Valanis–Landel: locate at
+    /// det F before the SVD, sample at J = σ1 σ2 σ3 after it.)
+    std::size_t locate(double y) const;
+    Sample sampleFrom(double x, std::size_t located) const;
 
     const std::vector<CurvePoint>& controlPoints() const { return m_points; }
     std::size_t size() const { return m_points.size(); }
@@ -170,8 +179,11 @@ private:
     std::vector<std::uint32_t> m_bucketFirst;
     BucketMap m_bucketMap = BucketMap::Linear;
     bool m_singleStep = false;
-    bool m_linear = false; ///< sample() evaluates m_line everywhere
-    Segment m_line;        ///< point 0 with rest = ∫₁^{x_0} of the line (when m_linear)
+    /// When m_linear, sample() evaluates the line through the control point nearest to x = 1:
+    /// y = m_line.y + m_line.m (x − m_line.x), ∫₁ˣ y = (x − 1) (m_line.rest + m_line.m (x − 1)/2)
+    /// with m_line.rest = y(1) (anchored at rest: exactly 0 there, no cancellation near it).
+    bool m_linear = false;
+    Segment m_line;
     double m_bucketOrigin = 0, m_bucketScale = 0, m_bucketMax = 0; ///< m_bucketMax = B − 1
 };
 
@@ -190,8 +202,8 @@ inline std::size_t MonotoneCurve::lookupInterior(double x) const {
 
 inline MonotoneCurve::Sample MonotoneCurve::sample(double x) const {
     if (m_linear) {
-        const double s = x - m_line.x;
-        return {m_line.y + m_line.m * s, m_line.rest + s * (m_line.y + 0.5 * m_line.m * s)};
+        const double t = x - 1.0;
+        return {m_line.y + m_line.m * (x - m_line.x), t * (m_line.rest + 0.5 * m_line.m * t)};
     }
     const Segment& first = m_segments.front();
     const Segment& last = m_segments.back();
@@ -204,6 +216,26 @@ inline MonotoneCurve::Sample MonotoneCurve::sample(double x) const {
     const Segment& e = x <= first.x ? first : last;
     const double s = x - e.x;
     return {e.y + e.m * s, e.rest + s * (e.y + 0.5 * e.m * s)};
+}
+
+inline std::size_t MonotoneCurve::locate(double y) const {
+    // n − 1 (no segment) for the linear paths of sample().
+    if (m_linear || !(y > m_segments.front().x && y < m_segments.back().x))
+        return m_segments.size() - 1;
+    return lookupInterior(y);
+}
+
+inline MonotoneCurve::Sample MonotoneCurve::sampleFrom(double x, std::size_t located) const {
+    if (located + 1 < m_segments.size()) {
+        // x in [x_k, x_{k+1}) ⊂ [x_0, x_{n−1}): segment k is what sample() finds (at x = x_0 its
+        // extension formula gives the same numbers, s = 0).
+        const Segment& q = m_segments[located];
+        if (x >= q.x && x < m_segments[located + 1].x) [[likely]] {
+            const double s = x - q.x, s2 = s * s;
+            return {(q.y + q.m * s) + s2 * (q.c + q.d * s), q.rest + primitive(q, s)};
+        }
+    }
+    return sample(x);
 }
 
 } // namespace viscera::sim

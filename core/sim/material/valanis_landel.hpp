@@ -65,8 +65,9 @@ public:
     std::string name() const override { return "valanis_landel"; }
     double psi(const Mat3& F) const override;  ///< J/m^3
     Mat3 stress(const Mat3& F) const override; ///< first Piola–Kirchhoff P (Pa)
-    /// Ψ and P from one signedSvd() and one lookup per curve term (the h′ lookup at J = det F
-    /// overlaps the SVD). psi(), stress() and psiAndStress() give bit-identical results.
+    /// Ψ and P from one signedSvd() and one lookup per curve term (the h′ segment lookup
+    /// starts from det F and overlaps the SVD). psi(), stress() and psiAndStress() give
+    /// bit-identical results.
     double psiAndStress(const Mat3& F, Mat3& P) const override;
     /// f″(1) + 2g″(1) + h″(1) = λ_eff + 2μ_eff (Pa).
     double restStiffness() const override { return m_restStiffness; }
@@ -83,15 +84,12 @@ public:
     const std::string& materialName() const { return m_materialName; }
 
 private:
-    /// h′ and h at the volume ratio J (zero when h′ is absent).
-    MonotoneCurve::Sample volumeTerm(double J) const {
-        return m_curves.hPrime ? m_curves.hPrime->sample(J) : MonotoneCurve::Sample{};
-    }
-    /// Ψ at signed stretches s, with the volume term hJ = volumeTerm(s1 s2 s3) (or of det F:
-    /// the same number up to rounding, known before the SVD); writes ∂Ψ/∂s_i into d when d is
-    /// not null.
+    /// Ψ at signed stretches s, with hJ = h′ and h at J = s1 s2 s3 (zero when h′ is absent);
+    /// writes ∂Ψ/∂s_i into d when d is not null.
     double principal(const Eigen::Vector3d& s, const MonotoneCurve::Sample& hJ,
                      Eigen::Vector3d* d) const;
+    /// Ψ(F), and P(F) into P when not null: the one path behind psi(), stress(), psiAndStress().
+    double evaluate(const Mat3& F, Mat3* P) const;
 
     std::string m_materialName;
     ValanisLandelCurves m_curves;

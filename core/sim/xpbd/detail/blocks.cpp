@@ -26,7 +26,7 @@ class SnhBlock final : public Block {
         return 4;
     }
     void solve(size_t pb, size_t pe, const SolveContext& ctx) override {
-        const SnhParams p{ctx.xw, ctx.h2inv, m_gamma, ctx.first ? 1 : 0};
+        const SnhParams p{ctx.xw, ctx.h2inv, m_gamma, ctx.first ? 1 : 0, ctx.last ? 0 : 1};
         if (m_avx2)
             snhSolveAvx2(m_packs.data() + pb, pe - pb, p);
         else

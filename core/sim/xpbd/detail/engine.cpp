@@ -7,8 +7,9 @@
 
 namespace viscera::sim::detail {
 namespace {
-/// Chunks: at least kMinChunkPacks packs (~1–2 µs of work), at most kChunksPerThread per thread
-/// and colour (claiming a chunk costs two contended atomics).
+/// Chunks: at least kMinChunkPacks packs (~1 µs of work), at most kChunksPerThread per thread and
+/// colour (claiming a chunk costs an atomic increment; smaller chunks balance the threads better
+/// at the end of each colour).
 constexpr size_t kMinChunkPacks = 4;
 constexpr size_t kChunksPerThread = 16;
 constexpr size_t kChunkParticles = 1024;
@@ -145,21 +146,21 @@ void Engine::buildSchedule(const XpbdSettings* s, int threads) {
     m_phases.clear();
     const auto particleChunks =
         static_cast<uint32_t>((particleCount() + kChunkParticles - 1) / kChunkParticles);
-    auto colourPhases = [&](bool first) {
+    auto colourPhases = [&](bool first, bool last) {
         for (int c = 0; c < m_colours; ++c)
             m_phases.push_back(
-                {c, first, false,
+                {c, first, last, false,
                  static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1,
                                                           kChunksPerThread * threads))});
     };
     if (!s) {
-        colourPhases(false);
+        colourPhases(false, false);
     } else {
-        m_phases.push_back({kPredictOnly, false, true, particleChunks});
+        m_phases.push_back({kPredictOnly, false, false, true, particleChunks});
         for (int sub = 0; sub < s->substeps; ++sub) {
             for (int it = 0; it < s->iterations; ++it)
-                colourPhases(it == 0);
-            m_phases.push_back({-1, false, sub + 1 < s->substeps, particleChunks});
+                colourPhases(it == 0, it + 1 == s->iterations);
+            m_phases.push_back({-1, false, false, sub + 1 < s->substeps, particleChunks});
         }
     }
     m_phaseStart.assign(m_phases.size() + 1, 0);
@@ -255,7 +256,8 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
     };
     execute(threads, pool, [&](const Phase& ph, uint32_t chunk, int tid) {
         if (ph.colour >= 0) {
-            solveColourChunk(ph.colour, chunk, ph.chunks, SolveContext{x, h2inv, ph.first});
+            solveColourChunk(ph.colour, chunk, ph.chunks,
+                             SolveContext{x, h2inv, ph.first, ph.last});
             return;
         }
         const size_t b = size_t(chunk) * kChunkParticles, e = std::min(n, b + kChunkParticles);
@@ -294,7 +296,7 @@ double Engine::sweep(bool first, double h2inv, int threads, WorkerPool* pool) {
     double* const x = xw.data();
     const auto t0 = std::chrono::steady_clock::now();
     execute(t, pool, [&](const Phase& ph, uint32_t chunk, int) {
-        solveColourChunk(ph.colour, chunk, ph.chunks, SolveContext{x, h2inv, first});
+        solveColourChunk(ph.colour, chunk, ph.chunks, SolveContext{x, h2inv, first, false});
     });
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

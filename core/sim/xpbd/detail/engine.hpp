@@ -53,6 +53,7 @@ struct SolveContext {
     double* xw;   ///< particle array
     double h2inv; ///< 1/h², 1/s²
     bool first;   ///< first iteration of a substep: multipliers start from 0 [A eq. 4.43]
+    bool last;    ///< last iteration of a substep: the multipliers need not be kept
 };
 
 inline constexpr int kMaxUnitParticles = 8;
@@ -122,6 +123,7 @@ class Engine {
     struct Phase {
         int colour = 0;
         bool first = false;       ///< colour sweep: first iteration of the substep
+        bool last = false;        ///< colour sweep: last iteration of the substep
         bool predictNext = false; ///< particle pass: also start the next substep
         uint32_t chunks = 0;
     };

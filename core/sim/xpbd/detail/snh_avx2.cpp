@@ -55,7 +55,8 @@ inline void storeRows(double* xw, const int32_t* idx, V X, V Y, V Z, V W) {
 
 /// Solves K packs (4K tets of one colour, so no shared particle) with their instructions
 /// interleaved: the square root and divisions of one pack overlap the arithmetic of the other.
-template <int K> inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first) {
+template <int K>
+inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first, bool keep) {
     const V one = _mm256_set1_pd(1.0), tiny = _mm256_set1_pd(1e-24);
     const V huge = _mm256_set1_pd(__builtin_huge_val());
     const V laneIndex = _mm256_set_pd(3, 2, 1, 0);
@@ -166,8 +167,10 @@ template <int K> inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma
         const V e = _mm256_and_pd(mul(msub(a11, r0, mul(a01, r1)), invDet), ok);
         dH[k] = _mm256_and_pd(mul(msub(a00, r1, mul(a01, r0)), invDet), ok);
         cF[k] = e;
-        _mm256_store_pd(P[k].lamD, madd(e, cD, lD));
-        _mm256_store_pd(P[k].lamH, add(lH, dH[k]));
+        if (keep) {
+            _mm256_store_pd(P[k].lamD, madd(e, cD, lD));
+            _mm256_store_pd(P[k].lamH, add(lH, dH[k]));
+        }
     }
     for (int k = 0; k < K; ++k)
         for (int s = 0; s < 4; ++s) {
@@ -188,7 +191,7 @@ bool snhAvx2Available() {
 
 void snhSolveAvx2(SnhPack* packs, size_t count, const SnhParams& prm) {
     const V h2inv = _mm256_set1_pd(prm.h2inv), gamma = _mm256_set1_pd(prm.gamma);
-    const bool first = prm.first != 0;
+    const bool first = prm.first != 0, keep = prm.keep != 0;
     size_t q = 0;
     for (; q + 2 <= count; q += 2) {
         // The particles of the next two packs: L2 → L1 while this pair computes.
@@ -198,9 +201,9 @@ void snhSolveAvx2(SnhPack* packs, size_t count, const SnhParams& prm) {
                     _mm_prefetch(reinterpret_cast<const char*>(
                                      prm.xw + 4 * static_cast<size_t>(packs[n].idx[s][l])),
                                  _MM_HINT_T0);
-        solvePacks<2>(packs + q, prm.xw, h2inv, gamma, first);
+        solvePacks<2>(packs + q, prm.xw, h2inv, gamma, first, keep);
     }
-    if (q < count) solvePacks<1>(packs + q, prm.xw, h2inv, gamma, first);
+    if (q < count) solvePacks<1>(packs + q, prm.xw, h2inv, gamma, first, keep);
 }
 
 } // namespace viscera::sim::detail

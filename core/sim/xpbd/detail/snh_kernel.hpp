@@ -28,6 +28,7 @@ struct SnhParams {
     double h2inv; ///< 1/h², 1/s²
     double gamma; ///< 1 + μ/λ
     int first;    ///< 1: first iteration of a substep (multipliers start from 0)
+    int keep;     ///< 1: store the multipliers (another iteration of the substep follows)
 };
 
 /// Portable scalar kernel.

@@ -32,8 +32,10 @@ void snhSolveScalar(SnhPack* packs, size_t count, const SnhParams& prm) {
                 }
             double lD = prm.first ? 0.0 : P.lamD[l];
             double lH = prm.first ? 0.0 : P.lamH[l];
-            P.lamD[l] = lD;
-            P.lamH[l] = lH;
+            if (prm.keep) {
+                P.lamD[l] = lD;
+                P.lamH[l] = lH;
+            }
             if (!(cD2 > 1e-24)) continue;
             const double cD = std::sqrt(cD2);
             double H[3][3]; // cofactor columns: H_0 = F_1 × F_2, H_1 = F_2 × F_0, H_2 = F_0 × F_1
@@ -72,8 +74,10 @@ void snhSolveScalar(SnhPack* packs, size_t count, const SnhParams& prm) {
             if (!(det > 0) || !std::isfinite(det)) continue;
             const double e = (a11 * r0 - a01 * r1) / det;
             const double dH = (a00 * r1 - a01 * r0) / det;
-            P.lamD[l] = lD + e * cD;
-            P.lamH[l] = lH + dH;
+            if (prm.keep) {
+                P.lamD[l] = lD + e * cD;
+                P.lamH[l] = lH + dH;
+            }
             const double cF = e;
             for (int s = 0; s < 4; ++s)
                 for (int r = 0; r < 3; ++r)
