@@ -15,7 +15,7 @@
 // Newton's own iterates are measured on the same problems (Fig. 4.12 "direct").
 //
 // Usage: bench_accuracy [output-dir]        (default ./accuracy_out)
-// Writes <dir>/xpbd_s<S>.csv and <dir>/newton_s<S>.csv (iteration,rel_error,time_ms),
+// Writes <dir>/xpbd_s<S>.csv, <dir>/xpbd-primal_s<S>.csv and <dir>/newton_s<S>.csv (iteration,rel_error,time_ms),
 // <dir>/sweep.csv (s × k settings), <dir>/summary.csv, <dir>/accuracy.json (session-report
 // "accuracy" entries), <dir>/error_vs_time.png and <dir>/error_vs_iteration.png (log-scale error).
 #include "line_plot.hpp"
@@ -112,8 +112,29 @@ struct Config {
 
 struct Measured {
     Config config;
-    AccuracyTrace xpbd, newton;
+    AccuracyTrace xpbd, primal, newton; ///< standard XPBD, primal-corrected XPBD, Newton
 };
+
+/// The fastest of kTimingRuns runs of every sweep, accumulated (the iterates are bit-identical
+/// every run, so a busy machine does not distort the curve).
+void keepFastestSweeps(const XpbdSolver& solver, XpbdIteration mode, AccuracyTrace& t) {
+    std::vector<double> sweepMs(t.timeMs.size(), 0.0);
+    for (size_t k = 1; k < sweepMs.size(); ++k)
+        sweepMs[k] = t.timeMs[k] - t.timeMs[k - 1];
+    const StepProblem problem = solver.nextSubstepProblem();
+    for (int repeat = 1; repeat < kTimingRuns; ++repeat) {
+        double previous = 0;
+        solver.iterateOn(
+            problem, static_cast<int>(sweepMs.size()) - 1,
+            [&](int k, const std::vector<Vec3>&, double seconds) {
+                sweepMs[k] = std::min(sweepMs[k], 1e3 * (seconds - previous));
+                previous = seconds;
+            },
+            mode);
+    }
+    for (size_t k = 1; k < sweepMs.size(); ++k)
+        t.timeMs[k] = t.timeMs[k - 1] + sweepMs[k];
+}
 
 void writeCsv(const std::filesystem::path& path, const AccuracyTrace& t) {
     std::ofstream out(path);
@@ -197,79 +218,72 @@ int run(const std::filesystem::path& outDir) {
         auto solver = XpbdSolver::create(*organ.mesh, material, organ.fixed, s);
         solver->setState(motion->positions(), motion->velocities());
         Measured m{c, measureXpbd(*solver, c.maxIterations, reference),
+                   measureXpbd(*solver, c.maxIterations, reference, XpbdIteration::PrimalCorrected),
                    measureNewton(*solver, reference)};
-        // XPBD sweeps take well under a millisecond: keep the fastest of a few runs for every
-        // sweep, so a busy machine does not distort the curve (the iterates are bit-identical
-        // every run), and accumulate.
-        std::vector<double> sweepMs(m.xpbd.timeMs.size(), 0.0);
-        for (size_t k = 1; k < sweepMs.size(); ++k)
-            sweepMs[k] = m.xpbd.timeMs[k] - m.xpbd.timeMs[k - 1];
-        const StepProblem problem = solver->nextSubstepProblem();
-        for (int repeat = 1; repeat < kTimingRuns; ++repeat) {
-            double previous = 0;
-            solver->iterateOn(problem, c.maxIterations,
-                              [&](int k, const std::vector<Vec3>&, double seconds) {
-                                  sweepMs[k] = std::min(sweepMs[k], 1e3 * (seconds - previous));
-                                  previous = seconds;
-                              });
-        }
-        for (size_t k = 1; k < sweepMs.size(); ++k)
-            m.xpbd.timeMs[k] = m.xpbd.timeMs[k - 1] + sweepMs[k];
+        keepFastestSweeps(*solver, XpbdIteration::Standard, m.xpbd);
+        keepFastestSweeps(*solver, XpbdIteration::PrimalCorrected, m.primal);
         results.push_back(std::move(m));
     }
 
     // Console report, CSV and JSON.
     const int probes[] = {1, 2, 5, 10, 20, 50, 100, 200};
     std::ofstream sweep(outDir / "sweep.csv"), summary(outDir / "summary.csv");
-    sweep << "substeps,iterations,h_s,rel_error,substep_time_ms,frame_time_ms\n";
-    summary << "substeps,h_s,newton_status,newton_iterations,newton_time_ms,newton_grad_inf,rel_"
-               "error_floor,"
-               "xpbd_iterations_to_1e-4,xpbd_substep_time_ms_to_1e-4,xpbd_frame_time_ms_to_1e-4,"
-               "xpbd_final_rel_error\n";
+    sweep << "solver,substeps,iterations,h_s,rel_error,substep_time_ms,frame_time_ms\n";
+    summary << "solver,substeps,h_s,newton_status,newton_iterations,newton_time_ms,"
+               "newton_grad_inf,rel_error_floor,iterations_to_1e-4,substep_time_ms_to_1e-4,"
+               "frame_time_ms_to_1e-4,final_rel_error\n";
     nlohmann::json accuracy = nlohmann::json::array();
     for (const Measured& m : results) {
         const int s = m.config.substeps;
-        const AccuracyTrace& x = m.xpbd;
         std::printf("\n== substeps %d (h = %.3f ms), first substep of frame %d (0-based) ==\n", s,
-                    1e3 * x.h, motionFrames);
+                    1e3 * m.xpbd.h, motionFrames);
         std::printf("Newton reference: %s, %d iterations, %.1f ms, |grad f|_inf %.2e kg m; "
                     "rel error floor %.1e\n",
-                    x.referenceStatus.c_str(), x.referenceIterations, x.referenceMs,
-                    x.referenceGradientNorm, x.relErrorFloor);
-        std::printf("  %-6s %12s %14s %14s\n", "s x k", "rel error", "substep ms", "frame ms");
+                    m.xpbd.referenceStatus.c_str(), m.xpbd.referenceIterations,
+                    m.xpbd.referenceMs, m.xpbd.referenceGradientNorm, m.xpbd.relErrorFloor);
+        std::printf("  %-6s %12s %14s %14s %12s %14s %14s\n", "s x k", "xpbd error",
+                    "substep ms", "frame ms", "primal err", "substep ms", "frame ms");
         for (int k : probes) {
-            if (k >= static_cast<int>(x.iterations.size())) break;
-            std::printf("  %2dx%-3d %12.3e %14.3f %14.3f\n", s, k, x.relError[k], x.timeMs[k],
-                        s * x.timeMs[k]);
-            char line[160];
-            std::snprintf(line, sizeof line, "%d,%d,%.9g,%.9e,%.6f,%.6f\n", s, k, x.h,
-                          x.relError[k], x.timeMs[k], s * x.timeMs[k]);
-            sweep << line;
+            if (k >= static_cast<int>(m.xpbd.iterations.size())) break;
+            std::printf("  %2dx%-3d %12.3e %14.3f %14.3f %12.3e %14.3f %14.3f\n", s, k,
+                        m.xpbd.relError[k], m.xpbd.timeMs[k], s * m.xpbd.timeMs[k],
+                        m.primal.relError[k], m.primal.timeMs[k], s * m.primal.timeMs[k]);
         }
-        const int hit = firstBelow(x, kTarget);
-        if (hit >= 0)
-            std::printf("XPBD reaches rel error <= %.0e after %d iterations: %.2f ms per substep, "
-                        "%.2f ms per frame\n",
-                        kTarget, x.iterations[hit], x.timeMs[hit], s * x.timeMs[hit]);
-        else
-            std::printf("XPBD does not reach %.0e within %d iterations: it levels off at %.3e "
-                        "(lowest %.3e)\n",
-                        kTarget, x.iterations.back(), x.relError.back(),
-                        *std::min_element(x.relError.begin(), x.relError.end()));
+        for (const AccuracyTrace* x : {&m.xpbd, &m.primal}) {
+            for (size_t k = 1; k < x->iterations.size(); ++k) {
+                char line[200];
+                std::snprintf(line, sizeof line, "%s,%d,%d,%.9g,%.9e,%.6f,%.6f\n",
+                              x->solver.c_str(), s, x->iterations[k], x->h, x->relError[k],
+                              x->timeMs[k], s * x->timeMs[k]);
+                sweep << line;
+            }
+            const int hit = firstBelow(*x, kTarget);
+            if (hit >= 0)
+                std::printf("%s reaches rel error <= %.0e after %d iterations: %.2f ms per "
+                            "substep, %.2f ms per frame\n",
+                            x->solver.c_str(), kTarget, x->iterations[hit], x->timeMs[hit],
+                            s * x->timeMs[hit]);
+            else
+                std::printf("%s does not reach %.0e within %d iterations: it ends at %.3e "
+                            "(lowest %.3e)\n",
+                            x->solver.c_str(), kTarget, x->iterations.back(), x->relError.back(),
+                            *std::min_element(x->relError.begin(), x->relError.end()));
+            char line[320];
+            std::snprintf(line, sizeof line, "%s,%d,%.9g,%s,%d,%.3f,%.3e,%.3e,%d,%.6f,%.6f,%.9e\n",
+                          x->solver.c_str(), s, x->h, x->referenceStatus.c_str(),
+                          x->referenceIterations, x->referenceMs, x->referenceGradientNorm,
+                          x->relErrorFloor, hit >= 0 ? x->iterations[hit] : -1,
+                          hit >= 0 ? x->timeMs[hit] : -1.0, hit >= 0 ? s * x->timeMs[hit] : -1.0,
+                          x->relError.back());
+            summary << line;
+            writeCsv(outDir / (x->solver + "_s" + std::to_string(s) + ".csv"), *x);
+            accuracy.push_back(toJson(*x, motionFrames));
+        }
         std::printf("Newton's own iterates:");
         for (size_t k = 0; k < m.newton.relError.size(); ++k)
             std::printf(" [%zu] %.1e @ %.0f ms", k, m.newton.relError[k], m.newton.timeMs[k]);
         std::printf("\n");
-        char line[320];
-        std::snprintf(line, sizeof line, "%d,%.9g,%s,%d,%.3f,%.3e,%.3e,%d,%.6f,%.6f,%.9e\n", s, x.h,
-                      x.referenceStatus.c_str(), x.referenceIterations, x.referenceMs,
-                      x.referenceGradientNorm, x.relErrorFloor, hit >= 0 ? x.iterations[hit] : -1,
-                      hit >= 0 ? x.timeMs[hit] : -1.0, hit >= 0 ? s * x.timeMs[hit] : -1.0,
-                      x.relError.back());
-        summary << line;
-        writeCsv(outDir / ("xpbd_s" + std::to_string(s) + ".csv"), x);
         writeCsv(outDir / ("newton_s" + std::to_string(s) + ".csv"), m.newton);
-        accuracy.push_back(toJson(x, motionFrames));
         accuracy.push_back(toJson(m.newton, motionFrames));
     }
     std::ofstream(outDir / "accuracy.json")
@@ -282,6 +296,8 @@ int run(const std::filesystem::path& outDir) {
         const std::string tag = std::to_string(s) + (s == 1 ? " substep" : " substeps");
         byTime.push_back(series("XPBD, " + tag, m.xpbd, true, s));
         byIteration.push_back(series("XPBD, " + tag, m.xpbd, false));
+        byTime.push_back(series("XPBD + primal correction, " + tag, m.primal, true, s));
+        byIteration.push_back(series("XPBD + primal correction, " + tag, m.primal, false));
     }
     for (const Measured& m : results) {
         const int s = m.config.substeps;
@@ -308,7 +324,7 @@ int run(const std::filesystem::path& outDir) {
     if (!error.empty()) throw std::runtime_error(error);
     if (!sweep || !summary)
         throw std::runtime_error("cannot write sweep.csv or summary.csv in " + outDir.string());
-    std::printf("\nwrote %s/{xpbd_s*.csv,newton_s*.csv,sweep.csv,summary.csv,accuracy.json,"
+    std::printf("\nwrote %s/{xpbd_s*.csv,xpbd-primal_s*.csv,newton_s*.csv,sweep.csv,summary.csv,accuracy.json,"
                 "error_vs_time.png,error_vs_iteration.png}\n",
                 outDir.string().c_str());
     return 0;

@@ -171,7 +171,8 @@ Project loadProject(const std::filesystem::path& dir) {
     if (auto* v = f.opt(doc, "title")) p.title = f.str(*v, "title");
     if (auto* v = f.opt(doc, "instructions")) p.instructions = f.str(*v, "instructions");
     const json& solver = f.req(doc, "solver", "");
-    f.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads"}, "solver");
+    f.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads", "primal_correction"},
+           "solver");
     const std::string type = f.str(f.req(solver, "type", "solver"), "solver.type");
     if (type != "xpbd") f.fail("solver.type", "'" + type + "' is not supported (supported: xpbd)");
     if (auto* v = f.opt(solver, "dt")) p.solver.dt = f.positive(*v, "solver.dt");
@@ -180,6 +181,10 @@ Project loadProject(const std::filesystem::path& dir) {
     if (auto* v = f.opt(solver, "damping")) p.solver.damping = f.num(*v, "solver.damping");
     if (auto* v = f.opt(solver, "max_speed")) p.solver.maxSpeed = f.positive(*v, "solver.max_speed");
     if (auto* v = f.opt(solver, "threads")) p.solver.threads = f.integer(*v, "solver.threads", 1, 64);
+    if (auto* v = f.opt(solver, "primal_correction")) {
+        if (!v->is_boolean()) f.fail("solver.primal_correction", "must be true or false");
+        p.solver.primalCorrection = v->get<bool>();
+    }
     if (auto* a = f.opt(doc, "accuracy")) {
         f.only(*a, {"every_frames", "max_iterations"}, "accuracy");
         sim::AccuracySampling acc;

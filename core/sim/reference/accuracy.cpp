@@ -66,17 +66,20 @@ void AccuracyRecorder::observe(int k, const std::vector<Vec3>& xk, double second
 }
 
 AccuracyTrace measureXpbd(const XpbdSolver& solver, int maxIterations,
-                          const NewtonSettings& settings) {
+                          const NewtonSettings& settings, XpbdIteration mode) {
     if (maxIterations < 1)
         throw std::invalid_argument("sim::measureXpbd(): max_iterations " +
                                     std::to_string(maxIterations) + " must be >= 1");
     const StepProblem problem = solver.nextSubstepProblem();
     const NewtonResult reference = solveNewton(problem, problem.xTilde, settings);
-    AccuracyRecorder recorder("xpbd", problem, reference, problem.xTilde);
-    solver.iterateOn(problem, maxIterations,
-                     [&](int k, const std::vector<Vec3>& xk, double seconds) {
-                         recorder.observe(k, xk, seconds);
-                     });
+    AccuracyRecorder recorder(mode == XpbdIteration::Standard ? "xpbd" : "xpbd-primal", problem,
+                              reference, problem.xTilde);
+    solver.iterateOn(
+        problem, maxIterations,
+        [&](int k, const std::vector<Vec3>& xk, double seconds) {
+            recorder.observe(k, xk, seconds);
+        },
+        mode);
     return recorder.take();
 }
 

@@ -71,7 +71,8 @@ private:
 /// solver's state is untouched. Throws std::invalid_argument when maxIterations < 1 or the
 /// settings are invalid. Cost: one Newton solve plus the sweeps plus one f evaluation per sweep.
 AccuracyTrace measureXpbd(const XpbdSolver& solver, int maxIterations,
-                          const NewtonSettings& settings = {});
+                          const NewtonSettings& settings = {},
+                          XpbdIteration mode = XpbdIteration::Standard);
 
 /// Newton's own iterates on `problem` from x_0 = x̃, measured against its final iterate
 /// (Fig. 4.12 "newton direct"); the last entry is 0 when the solve converged. Entries stop where

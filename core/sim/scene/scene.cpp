@@ -119,7 +119,8 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     r.only(doc, {"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces"}, "");
     SceneDesc scene;
     const json& solver = r.require(doc, "solver", "");
-    r.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads"}, "solver");
+    r.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads", "primal_correction"},
+           "solver");
     scene.solverType = r.string(r.require(solver, "type", "solver"), "solver.type");
     if (scene.solverType != "xpbd") r.fail("solver.type", "'" + scene.solverType + "' is not supported (supported: xpbd)");
     XpbdSettings& s = scene.xpbd;
@@ -129,6 +130,10 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     if (solver.contains("threads")) s.threads = r.integer(solver["threads"], "solver.threads");
     s.damping = r.optNumber(solver, "damping", "solver", s.damping);
     s.maxSpeed = r.optNumber(solver, "max_speed", "solver", s.maxSpeed);
+    if (solver.contains("primal_correction")) {
+        if (!solver["primal_correction"].is_boolean()) r.fail("solver.primal_correction", "must be true or false");
+        s.primalCorrection = solver["primal_correction"].get<bool>();
+    }
     s.gravity = doc.contains("gravity") ? r.vec3(doc["gravity"], "gravity") : Vec3::Zero();
     if (auto why = validate(s); !why.empty()) r.fail("solver", why);
     if (doc.contains("instructions")) scene.instructions = r.string(doc["instructions"], "instructions");
@@ -213,6 +218,7 @@ std::string formatScene(const SceneDesc& scene) {
     doc["solver"] = {{"type", scene.solverType}, {"dt", s.dt},           {"substeps", s.substeps},
                      {"iterations", s.iterations}, {"damping", s.damping}, {"max_speed", s.maxSpeed},
                      {"threads", s.threads}};
+    if (s.primalCorrection) doc["solver"]["primal_correction"] = true;
     doc["gravity"] = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
     if (!scene.instructions.empty()) doc["instructions"] = scene.instructions;
     if (scene.accuracy)

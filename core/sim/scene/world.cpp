@@ -163,7 +163,9 @@ void World::measureAccuracy() {
         m_accuracy.push_back(std::move(r));
     };
     try {
-        keep(measureXpbd(*m_single, m_scene.accuracy->maxIterations));
+        keep(measureXpbd(*m_single, m_scene.accuracy->maxIterations, {},
+                         m_scene.xpbd.primalCorrection ? XpbdIteration::PrimalCorrected
+                                                       : XpbdIteration::Standard));
         keep(measureNewton(*m_single));
     } catch (const std::exception&) {
         AccuracyRecord r;

@@ -117,8 +117,8 @@ StepProblem XpbdSolver::nextSubstepProblem() const {
     return p;
 }
 
-void XpbdSolver::iterateOn(const StepProblem& p, int iterations,
-                           const IterateObserver& observe) const {
+void XpbdSolver::iterateOn(const StepProblem& p, int iterations, const IterateObserver& observe,
+                           XpbdIteration mode) const {
     const std::string where = "sim::XpbdSolver::iterateOn(): ";
     if (iterations < 1) throw std::invalid_argument(where + "iterations must be >= 1");
     if (!(p.h > 0) || !std::isfinite(p.h))
@@ -151,6 +151,11 @@ void XpbdSolver::iterateOn(const StepProblem& p, int iterations,
     std::vector<Vec3> xk(nv);
     for (int k = 1; k <= iterations; ++k) {
         seconds += eng.sweep(k == 1, h2inv, settings().threads, m_sys->m_pool.get());
+        if (mode == XpbdIteration::PrimalCorrected) {
+            const double t = eng.primalCorrection(p.xTilde);
+            if (t < 0) throw std::logic_error(where + "a constraint block has no primal correction");
+            seconds += t;
+        }
         for (size_t i = 0; i < nv; ++i)
             xk[i] = detail::particlePosition(eng.xw.data(), static_cast<int32_t>(i));
         if (observe) observe(k, xk, seconds);

@@ -27,6 +27,10 @@
 ///   - Equilibrium: XPBD drops the primal residual M(x − x̃) − ∇Cᵀλ, so its fixed point is off
 ///     the static equilibrium by O(h² k/m) whatever the iteration count (a 3 cm block at
 ///     20 kPa, 1 cm elements, 20 substeps of 1/60 s: 8e-5 m). It vanishes as h² / ρ.
+///     XpbdSettings::primalCorrection removes it: each iteration is followed by
+///     x ← x̃ + M⁻¹∇C(x)ᵀλ, and the iterations of a substep converge to the implicit step's
+///     solution (bench/bench_accuracy: 1.4e-6 relative error after 5 iterations on a 4,944-tet
+///     organ at 20 substeps, where plain XPBD levels off at 1.4e-2).
 #include "sim/material/material.hpp"
 #include "sim/mesh/tet_mesh.hpp"
 #include "sim/xpbd/step_problem.hpp"
@@ -38,6 +42,18 @@
 #include <vector>
 
 namespace viscera::sim {
+
+/// How iterateOn() iterates.
+enum class XpbdIteration {
+    /// XPBD as step() runs it [A eq. 4.43–4.44]: the primal residual g(x, λ) of [A eq. 4.41] is
+    /// dropped, so the iterates level off at a fixed point off x* by O(h² k / m).
+    Standard,
+    /// Each sweep is followed by the primal correction x ← x̃ + M⁻¹ ∇C(x)ᵀ λ (g = 0 at the
+    /// current gradients), which the sweep's local updates keep only to first order. Its fixed
+    /// point satisfies both rows of [A eq. 4.41], so the iterates converge to x* itself. Costs
+    /// one gradient evaluation per tet per iteration (serial) on top of the sweep.
+    PrimalCorrected,
+};
 
 class XpbdSolver {
   public:
@@ -99,8 +115,8 @@ class XpbdSolver {
     /// solver's state is untouched; it shares the worker threads, so it must not run
     /// concurrently with step(). Throws std::invalid_argument on an inconsistent problem or
     /// iterations < 1.
-    void iterateOn(const StepProblem& problem, int iterations,
-                   const IterateObserver& observe) const;
+    void iterateOn(const StepProblem& problem, int iterations, const IterateObserver& observe,
+                   XpbdIteration mode = XpbdIteration::Standard) const;
 
   private:
     XpbdSolver();

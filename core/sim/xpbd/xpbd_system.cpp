@@ -338,6 +338,9 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
     if (!anyFree)
         fail("", singleBody ? "body has no free node" : "the system has no free particle");
 
+    if (settings.primalCorrection && !eng.supportsPrimalCorrection())
+        fail("", "primal_correction is available for elastic tets only (no strain limits, "
+                 "membranes or couplings)");
     eng.colour();
     if (eng.usefulThreads(settings.threads) > 1)
         sys->m_pool = std::make_unique<detail::WorkerPool>(settings.threads);

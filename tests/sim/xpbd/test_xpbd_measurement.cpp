@@ -175,7 +175,8 @@ double patchError(const Patch& p, const std::vector<Vec3>& x) {
     return err;
 }
 
-std::unique_ptr<XpbdSolver> patchSolver(const Patch& p, double density, int substeps) {
+std::unique_ptr<XpbdSolver> patchSolver(const Patch& p, double density, int substeps,
+                                        bool primalCorrection = false, int iterations = 1) {
     const Material m = tissue();
     TetBodyDesc body;
     body.mesh = p.mesh.get();
@@ -186,6 +187,8 @@ std::unique_ptr<XpbdSolver> patchSolver(const Patch& p, double density, int subs
     s.gravity.setZero();
     s.substeps = substeps;
     s.damping = 20;
+    s.primalCorrection = primalCorrection;
+    s.iterations = iterations;
     auto solver = XpbdSolver::create(body, s);
     solver->setState(p.x0, std::vector<Vec3>(p.x0.size(), Vec3::Zero()));
     return solver;
@@ -221,6 +224,47 @@ TEST(XpbdPatchTest, InteriorReproducesTheUniformStretch) {
     EXPECT_LT(patchError(p, solver->positions()), 1e-10);
     for (int32_t i : p.boundary)
         EXPECT_EQ(solver->positions()[i], p.x0[i]);
+}
+
+TEST(XpbdPatchTest, PrimalCorrectionReproducesTheStretchAtTheProductionSetting) {
+    // Tissue density, 20 substeps of 1/60 s: with the primal correction the iterations of a
+    // substep converge to the implicit step's solution (x*), and x* of a body at rest at x = F X
+    // is x = F X. Measured after 300 frames: 5.9e-5 m with 1 iteration per substep (the
+    // multipliers restart every substep, so an unconverged substep keeps a bias), 1.1e-6 m with
+    // 5, 7.4e-9 m with 10, below 1e-10 m with 20.
+    Patch p = patch();
+    auto solver = patchSolver(p, 1050, 20, true, 20);
+    double first = 0;
+    for (int f = 0; f < 300; ++f) {
+        ASSERT_TRUE(solver->step().finite) << "frame " << f;
+        if (f == 0) first = patchError(p, solver->positions());
+    }
+    EXPECT_GT(first, 1e-6); // it did move: the interior starts at X, not at F X
+    EXPECT_LT(patchError(p, solver->positions()), 1e-10);
+    for (int32_t i : p.boundary)
+        EXPECT_EQ(solver->positions()[i], p.x0[i]);
+    RecordProperty("patch_error_m", std::to_string(patchError(p, solver->positions())));
+}
+
+TEST(XpbdPatchTest, PrimalCorrectionIsRefusedWithLayersItCannotCorrect) {
+    Patch p = patch();
+    const Material m = tissue();
+    TetBodyDesc body;
+    body.mesh = p.mesh.get();
+    body.model = std::make_shared<StableNeoHookeanModel>(m.mu(), m.lambda());
+    body.density = 1050;
+    body.fixedNodes = p.boundary;
+    StrainLimit limit;
+    limit.upper = 0.2;
+    body.strainLimits = TetStrainLimits{Mat3::Identity(), {limit}, {}};
+    XpbdSettings s;
+    s.primalCorrection = true;
+    try {
+        XpbdSolver::create(body, s);
+        FAIL() << "expected a refusal";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_THAT(e.what(), HasSubstr("primal_correction is available for elastic tets only"));
+    }
 }
 
 TEST(XpbdPatchTest, EquilibriumBiasShrinksWithTheSquareOfTheSubstep) {

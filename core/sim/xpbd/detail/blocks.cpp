@@ -32,6 +32,35 @@ class SnhBlock final : public Block {
         else
             snhSolveScalar(m_packs.data() + pb, pe - pb, p);
     }
+    bool addMultiplierForces(const double* xw, double* f) const override {
+        for (const SnhPack& P : m_packs)
+            for (int l = 0; l < P.lanes; ++l) {
+                Mat3 ds, M;
+                int32_t id[4];
+                for (int s = 0; s < 4; ++s)
+                    id[s] = P.idx[s][l];
+                for (int k = 0; k < 3; ++k)
+                    ds.col(k) = particlePosition(xw, id[k + 1]) - particlePosition(xw, id[0]);
+                for (int r = 0; r < 3; ++r)
+                    for (int c = 0; c < 3; ++c)
+                        M(r, c) = P.m[3 * r + c][l];
+                const Mat3 F = ds * M;
+                const double cD = F.norm();
+                if (!(cD > 1e-12)) continue;
+                Mat3 H; // cofactor of F = ∂ det F / ∂F
+                H.col(0) = F.col(1).cross(F.col(2));
+                H.col(1) = F.col(2).cross(F.col(0));
+                H.col(2) = F.col(0).cross(F.col(1));
+                // ∂C/∂F: F/|F| for C_D, cof F for C_H; vertex k+1 gets column k of (∂C/∂F) Dm⁻ᵀ.
+                const Mat3 G = (P.lamD[l] / cD * F + P.lamH[l] * H) * M.transpose();
+                for (int k = 0; k < 3; ++k)
+                    for (int r = 0; r < 3; ++r) {
+                        f[3 * size_t(id[k + 1]) + r] += G(r, k);
+                        f[3 * size_t(id[0]) + r] -= G(r, k);
+                    }
+            }
+        return true;
+    }
     double energy(const double* xw) const override {
         // Ψ relative to rest: μ/2 (|F|² − 3) + λ/2 ((J − γ)² − (1 − γ)²).
         double sum = 0;
@@ -150,6 +179,29 @@ class ModelBlock final : public Block {
                 moveParticle(ctx.xw, e[k], w[k] * dx);
             }
         }
+    }
+    bool addMultiplierForces(const double* xw, double* f) const override {
+        TetConstraintValues cv;
+        for (const Unit& u : m_units) {
+            if (u.unit < 0) continue;
+            const Tet& e = m_t.tets[u.unit];
+            Mat3 ds;
+            for (int k = 0; k < 3; ++k)
+                ds.col(k) = particlePosition(xw, e[k + 1]) - particlePosition(xw, e[0]);
+            const Mat3& M = m_t.dmInv[u.unit];
+            m_t.model->evaluate(ds * M, cv);
+            const int n = std::min(cv.count, m_count);
+            Mat3 G = Mat3::Zero();
+            for (int c = 0; c < n; ++c)
+                G += u.lam[c] * cv.dCdF[c];
+            G = G * M.transpose();
+            for (int k = 0; k < 3; ++k)
+                for (int r = 0; r < 3; ++r) {
+                    f[3 * size_t(e[k + 1]) + r] += G(r, k);
+                    f[3 * size_t(e[0]) + r] -= G(r, k);
+                }
+        }
+        return true;
     }
     double energy(const double* xw) const override {
         double sum = 0;

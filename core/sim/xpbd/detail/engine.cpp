@@ -158,8 +158,11 @@ void Engine::buildSchedule(const XpbdSettings* s, int threads) {
     } else {
         m_phases.push_back({kPredictOnly, false, false, true, particleChunks});
         for (int sub = 0; sub < s->substeps; ++sub) {
-            for (int it = 0; it < s->iterations; ++it)
-                colourPhases(it == 0, it + 1 == s->iterations);
+            for (int it = 0; it < s->iterations; ++it) {
+                // The correction reads the multipliers, so they are kept after the last sweep too.
+                colourPhases(it == 0, it + 1 == s->iterations && !s->primalCorrection);
+                if (s->primalCorrection) m_phases.push_back({kCorrect, false, false, false, 1});
+            }
             m_phases.push_back({-1, false, false, sub + 1 < s->substeps, particleChunks});
         }
     }
@@ -223,6 +226,7 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
     m_frameStart = xw;
     m_v0 = v;
     m_prev.resize(n);
+    if (s.primalCorrection) m_xTilde.resize(n);
     const int threads = usefulThreads(pool ? std::min(s.threads, pool->size()) : 1);
     m_clamps.assign(threads, 0);
     buildSchedule(&s, threads);
@@ -235,6 +239,10 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
         p[0] += h * vi.x();
         p[1] += h * vi.y();
         p[2] += h * vi.z();
+    };
+    auto predictAndKeep = [&](size_t i, double* p, Vec3& vi) {
+        predict(i, p, vi);
+        if (s.primalCorrection) m_xTilde[i] = Vec3(p[0], p[1], p[2]);
     };
     // End of a substep for particle i (velocity, speed clamp, damping).
     auto finish = [&](size_t i, double* p, Vec3& vi, int tid) {
@@ -260,11 +268,15 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
                              SolveContext{x, h2inv, ph.first, ph.last});
             return;
         }
+        if (ph.colour == kCorrect) {
+            correct(m_xTilde);
+            return;
+        }
         const size_t b = size_t(chunk) * kChunkParticles, e = std::min(n, b + kChunkParticles);
         for (size_t i = b; i < e; ++i) {
             double* p = x + 4 * i;
             if (ph.colour != kPredictOnly) finish(i, p, v[i], tid);
-            if (ph.predictNext) predict(i, p, v[i]);
+            if (ph.predictNext) predictAndKeep(i, p, v[i]);
         }
     });
 
@@ -288,6 +300,34 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
         st.maxDisplacement = 0;
     }
     return st;
+}
+
+bool Engine::correct(const std::vector<Vec3>& xTilde) {
+    const size_t n = particleCount();
+    m_force.assign(3 * n, 0.0);
+    for (const auto& b : blocks)
+        if (!b->addMultiplierForces(xw.data(), m_force.data())) return false;
+    for (size_t i = 0; i < n; ++i) {
+        double* p = xw.data() + 4 * i;
+        const double w = p[3];
+        if (w == 0) continue;
+        for (int r = 0; r < 3; ++r)
+            p[r] = xTilde[i][r] + w * m_force[3 * i + r];
+    }
+    return true;
+}
+
+bool Engine::supportsPrimalCorrection() const {
+    std::vector<double> f(3 * particleCount(), 0.0);
+    for (const auto& b : blocks)
+        if (!b->addMultiplierForces(xw.data(), f.data())) return false;
+    return true;
+}
+
+double Engine::primalCorrection(const std::vector<Vec3>& xTilde) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (!correct(xTilde)) return -1;
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 double Engine::sweep(bool first, double h2inv, int threads, WorkerPool* pool) {

@@ -71,6 +71,11 @@ class Block {
     /// Sweep order: all colours of stage 0 (elasticity), then stage 1 (strain limits), then
     /// stage 2 (couplings), so that limits and ties are the last word of every sweep.
     virtual int stage() const { return 0; }
+    /// Adds Σ_j ∇C_j(x)ᵀ λ_j of the block's constraints, at the particle positions of xw and the
+    /// multipliers of the current substep, to f (3 per particle; kg·m, i.e. h² times a force).
+    /// Returns false when the block does not support it (then
+    /// the primal correction is not available for the engine). O(units).
+    virtual bool addMultiplierForces(const double* /*xw*/, double* /*f*/) const { return false; }
 
     /// Lays the units out by colour (colourOfUnit: one entry per unit) in packs of four.
     void arrange(const std::vector<int32_t>& colourOfUnit, int colours);
@@ -111,6 +116,14 @@ class Engine {
     StepStats frame(const XpbdSettings& s, WorkerPool* pool);
     /// One sweep over all colours; returns its wall time in seconds.
     double sweep(bool first, double h2inv, int threads, WorkerPool* pool);
+    /// Primal correction [A eq. 4.41, first row]: x ← x̃ + M⁻¹ Σ_j ∇C_j(x)ᵀ λ_j for every free
+    /// particle, so that the primal residual g(x, λ) that XPBD's update drops is zero at the
+    /// current gradients (fixed particles stay). xTilde: one per particle. Returns the wall time
+    /// in seconds, or a negative value when a block does not support it (nothing moved). Serial;
+    /// O(particles + units).
+    double primalCorrection(const std::vector<Vec3>& xTilde);
+    /// True when every block supports the primal correction.
+    bool supportsPrimalCorrection() const;
     /// Threads worth using (≤ threads): 1 when no colour is large enough to split.
     int usefulThreads(int threads) const;
 
@@ -128,6 +141,8 @@ class Engine {
         uint32_t chunks = 0;
     };
     static constexpr int kPredictOnly = -2;
+    static constexpr int kCorrect = -3; ///< one chunk: the primal correction (serial)
+    bool correct(const std::vector<Vec3>& xTilde);
     void buildSchedule(const XpbdSettings* s, int threads);
     /// Runs every chunk of m_phases in order: a phase starts when all chunks of the previous
     /// ones are done. Parallel: the chunks of a phase form one group per thread; a thread claims
@@ -152,6 +167,8 @@ class Engine {
     ParticleArray m_frameStart;
     std::vector<Vec3> m_v0;
     std::vector<int> m_clamps; ///< per thread
+    std::vector<double> m_force;  ///< primal correction: Σ ∇Cᵀλ, 3 per particle
+    std::vector<Vec3> m_xTilde;   ///< prediction of the current substep (primal correction)
 };
 
 } // namespace viscera::sim::detail
