@@ -4,6 +4,7 @@
 // substeps × 1 iteration per 1/60 s frame, stable Neo-Hookean, gravity on.
 // BM_XpbdFrame30k/<threads>/<simd>: the 30,000-tet block of the performance target
 // (25 × 20 × 10 cells, 25 × 20 × 10 cm).
+// BM_XpbdFramePrimal/<threads>: BM_XpbdFrame30k with the primal correction (AVX2 sweeps).
 #include "sim/mesh/generators.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
 
@@ -13,7 +14,8 @@ using namespace viscera::sim;
 
 namespace {
 
-void runFrames(benchmark::State& state, const BoxSpec& box, int threads, bool simd) {
+void runFrames(benchmark::State& state, const BoxSpec& box, int threads, bool simd,
+               bool primal = false) {
     auto mesh = makeBoxTetMesh(box);
     std::vector<int32_t> fixed;
     for (int32_t v = 0; v < static_cast<int32_t>(mesh->vertexCount()); ++v)
@@ -23,6 +25,7 @@ void runFrames(benchmark::State& state, const BoxSpec& box, int threads, bool si
     s.iterations = 1;
     s.threads = threads;
     s.simd = simd;
+    s.primalCorrection = primal;
     Material mat;
     mat.youngsModulus = 20000;
     auto solver = XpbdSolver::create(*mesh, mat, fixed, s);
@@ -52,8 +55,21 @@ void BM_XpbdFrame30k(benchmark::State& state) {
               static_cast<int>(state.range(0)), state.range(1) != 0);
 }
 
+/// The same frame with the primal correction after every iteration (XpbdSettings::
+/// primalCorrection): the cost of converging to the implicit step instead of levelling off.
+void BM_XpbdFramePrimal(benchmark::State& state) {
+    runFrames(state, {Vec3::Zero(), Vec3(0.25, 0.2, 0.1), {25, 20, 10}},
+              static_cast<int>(state.range(0)), true, true);
+}
+
 } // namespace
 
+BENCHMARK(BM_XpbdFramePrimal)
+    ->ArgNames({"threads"})
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_XpbdFrame)
     ->ArgNames({"cells", "threads", "simd"})
     ->Args({10, 1, 1})

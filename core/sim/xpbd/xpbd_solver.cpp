@@ -151,11 +151,8 @@ void XpbdSolver::iterateOn(const StepProblem& p, int iterations, const IterateOb
     std::vector<Vec3> xk(nv);
     for (int k = 1; k <= iterations; ++k) {
         seconds += eng.sweep(k == 1, h2inv, settings().threads, m_sys->m_pool.get());
-        if (mode == XpbdIteration::PrimalCorrected) {
-            const double t = eng.primalCorrection(p.xTilde);
-            if (t < 0) throw std::logic_error(where + "a constraint block has no primal correction");
-            seconds += t;
-        }
+        if (mode == XpbdIteration::PrimalCorrected)
+            seconds += eng.primalCorrection(p.xTilde, settings().threads, m_sys->m_pool.get());
         for (size_t i = 0; i < nv; ++i)
             xk[i] = detail::particlePosition(eng.xw.data(), static_cast<int32_t>(i));
         if (observe) observe(k, xk, seconds);

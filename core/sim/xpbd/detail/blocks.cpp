@@ -32,8 +32,9 @@ class SnhBlock final : public Block {
         else
             snhSolveScalar(m_packs.data() + pb, pe - pb, p);
     }
-    bool addMultiplierForces(const double* xw, double* f) const override {
-        for (const SnhPack& P : m_packs)
+    bool addMultiplierForces(size_t pb, size_t pe, const double* xw, double* f) const override {
+        for (size_t q = pb; q < pe; ++q) {
+            const SnhPack& P = m_packs[q];
             for (int l = 0; l < P.lanes; ++l) {
                 Mat3 ds, M;
                 int32_t id[4];
@@ -59,6 +60,7 @@ class SnhBlock final : public Block {
                         f[3 * size_t(id[0]) + r] -= G(r, k);
                     }
             }
+        }
         return true;
     }
     double energy(const double* xw) const override {
@@ -180,9 +182,10 @@ class ModelBlock final : public Block {
             }
         }
     }
-    bool addMultiplierForces(const double* xw, double* f) const override {
+    bool addMultiplierForces(size_t pb, size_t pe, const double* xw, double* f) const override {
         TetConstraintValues cv;
-        for (const Unit& u : m_units) {
+        for (size_t slot = 4 * pb; slot < 4 * pe; ++slot) {
+            const Unit& u = m_units[slot];
             if (u.unit < 0) continue;
             const Tet& e = m_t.tets[u.unit];
             Mat3 ds;

@@ -129,20 +129,58 @@ int Engine::usefulThreads(int threads) const {
     return static_cast<int>(std::min<size_t>(threads, most));
 }
 
-void Engine::solveColourChunk(int c, uint32_t chunk, uint32_t chunks, const SolveContext& ctx) {
+template <class Fn>
+void Engine::forColourChunk(int c, uint32_t chunk, uint32_t chunks, const Fn& fn) {
     const size_t total = m_colourPacks[c];
     const size_t gb = total * chunk / chunks, ge = total * (chunk + 1) / chunks;
     size_t offset = 0;
     for (const auto& b : blocks) {
         const size_t bb = b->colourBegin(c), count = b->colourEnd(c) - bb;
         const size_t lo = std::max(gb, offset), hi = std::min(ge, offset + count);
-        if (lo < hi) b->solve(bb + (lo - offset), bb + (hi - offset), ctx);
+        if (lo < hi) fn(*b, bb + (lo - offset), bb + (hi - offset));
         offset += count;
         if (offset >= ge) break;
     }
 }
 
-void Engine::buildSchedule(const XpbdSettings* s, int threads) {
+void Engine::solveColourChunk(int c, uint32_t chunk, uint32_t chunks, const SolveContext& ctx) {
+    forColourChunk(c, chunk, chunks,
+                   [&](Block& b, size_t pb, size_t pe) { b.solve(pb, pe, ctx); });
+}
+
+void Engine::forceColourChunk(int c, uint32_t chunk, uint32_t chunks) {
+    forColourChunk(c, chunk, chunks, [&](const Block& b, size_t pb, size_t pe) {
+        b.addMultiplierForces(pb, pe, xw.data(), m_force.data());
+    });
+}
+
+void Engine::correctParticles(uint32_t chunk) {
+    const size_t n = particleCount();
+    const size_t b = size_t(chunk) * kChunkParticles, e = std::min(n, b + kChunkParticles);
+    for (size_t i = b; i < e; ++i) {
+        double* p = xw.data() + 4 * i;
+        double* f = m_force.data() + 3 * i;
+        if (p[3] != 0)
+            for (int r = 0; r < 3; ++r)
+                p[r] = m_xTilde[i][r] + p[3] * f[r];
+        f[0] = f[1] = f[2] = 0;
+    }
+}
+
+void Engine::appendCorrectionPhases(int threads) {
+    for (int c = 0; c < m_colours; ++c) {
+        Phase ph{c, false, false, false,
+                 static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1,
+                                                          kChunksPerThread * threads))};
+        ph.forces = true;
+        m_phases.push_back(ph);
+    }
+    m_phases.push_back({kCorrect, false, false, false,
+                        static_cast<uint32_t>((particleCount() + kChunkParticles - 1) /
+                                              kChunkParticles)});
+}
+
+void Engine::buildSchedule(Schedule kind, const XpbdSettings* s, int threads) {
     m_phases.clear();
     const auto particleChunks =
         static_cast<uint32_t>((particleCount() + kChunkParticles - 1) / kChunkParticles);
@@ -153,15 +191,17 @@ void Engine::buildSchedule(const XpbdSettings* s, int threads) {
                  static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1,
                                                           kChunksPerThread * threads))});
     };
-    if (!s) {
+    if (kind == Schedule::Sweep) {
         colourPhases(false, false);
+    } else if (kind == Schedule::Correction) {
+        appendCorrectionPhases(threads);
     } else {
         m_phases.push_back({kPredictOnly, false, false, true, particleChunks});
         for (int sub = 0; sub < s->substeps; ++sub) {
             for (int it = 0; it < s->iterations; ++it) {
                 // The correction reads the multipliers, so they are kept after the last sweep too.
                 colourPhases(it == 0, it + 1 == s->iterations && !s->primalCorrection);
-                if (s->primalCorrection) m_phases.push_back({kCorrect, false, false, false, 1});
+                if (s->primalCorrection) appendCorrectionPhases(threads);
             }
             m_phases.push_back({-1, false, false, sub + 1 < s->substeps, particleChunks});
         }
@@ -226,10 +266,13 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
     m_frameStart = xw;
     m_v0 = v;
     m_prev.resize(n);
-    if (s.primalCorrection) m_xTilde.resize(n);
+    if (s.primalCorrection) {
+        m_xTilde.resize(n);
+        m_force.assign(3 * n, 0.0);
+    }
     const int threads = usefulThreads(pool ? std::min(s.threads, pool->size()) : 1);
     m_clamps.assign(threads, 0);
-    buildSchedule(&s, threads);
+    buildSchedule(Schedule::Frame, &s, threads);
     double* const x = xw.data();
     // Start of a substep for particle i: remember x, predict x̃ = x + h (v + h g).
     auto predict = [&](size_t i, double* p, Vec3& vi) {
@@ -264,12 +307,15 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
     };
     execute(threads, pool, [&](const Phase& ph, uint32_t chunk, int tid) {
         if (ph.colour >= 0) {
-            solveColourChunk(ph.colour, chunk, ph.chunks,
-                             SolveContext{x, h2inv, ph.first, ph.last});
+            if (ph.forces)
+                forceColourChunk(ph.colour, chunk, ph.chunks);
+            else
+                solveColourChunk(ph.colour, chunk, ph.chunks,
+                                 SolveContext{x, h2inv, ph.first, ph.last});
             return;
         }
         if (ph.colour == kCorrect) {
-            correct(m_xTilde);
+            correctParticles(chunk);
             return;
         }
         const size_t b = size_t(chunk) * kChunkParticles, e = std::min(n, b + kChunkParticles);
@@ -302,37 +348,30 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
     return st;
 }
 
-bool Engine::correct(const std::vector<Vec3>& xTilde) {
-    const size_t n = particleCount();
-    m_force.assign(3 * n, 0.0);
-    for (const auto& b : blocks)
-        if (!b->addMultiplierForces(xw.data(), m_force.data())) return false;
-    for (size_t i = 0; i < n; ++i) {
-        double* p = xw.data() + 4 * i;
-        const double w = p[3];
-        if (w == 0) continue;
-        for (int r = 0; r < 3; ++r)
-            p[r] = xTilde[i][r] + w * m_force[3 * i + r];
-    }
-    return true;
-}
-
 bool Engine::supportsPrimalCorrection() const {
-    std::vector<double> f(3 * particleCount(), 0.0);
     for (const auto& b : blocks)
-        if (!b->addMultiplierForces(xw.data(), f.data())) return false;
+        if (!b->addMultiplierForces(0, 0, xw.data(), nullptr)) return false;
     return true;
 }
 
-double Engine::primalCorrection(const std::vector<Vec3>& xTilde) {
+double Engine::primalCorrection(const std::vector<Vec3>& xTilde, int threads, WorkerPool* pool) {
+    const int t = usefulThreads(pool ? std::min(threads, pool->size()) : 1);
+    buildSchedule(Schedule::Correction, nullptr, t);
+    m_xTilde = xTilde;
+    m_force.assign(3 * particleCount(), 0.0);
     const auto t0 = std::chrono::steady_clock::now();
-    if (!correct(xTilde)) return -1;
+    execute(t, pool, [&](const Phase& ph, uint32_t chunk, int) {
+        if (ph.colour >= 0)
+            forceColourChunk(ph.colour, chunk, ph.chunks);
+        else
+            correctParticles(chunk);
+    });
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 double Engine::sweep(bool first, double h2inv, int threads, WorkerPool* pool) {
     const int t = usefulThreads(pool ? std::min(threads, pool->size()) : 1);
-    buildSchedule(nullptr, t);
+    buildSchedule(Schedule::Sweep, nullptr, t);
     double* const x = xw.data();
     const auto t0 = std::chrono::steady_clock::now();
     execute(t, pool, [&](const Phase& ph, uint32_t chunk, int) {

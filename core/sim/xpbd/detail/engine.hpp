@@ -71,11 +71,14 @@ class Block {
     /// Sweep order: all colours of stage 0 (elasticity), then stage 1 (strain limits), then
     /// stage 2 (couplings), so that limits and ties are the last word of every sweep.
     virtual int stage() const { return 0; }
-    /// Adds Σ_j ∇C_j(x)ᵀ λ_j of the block's constraints, at the particle positions of xw and the
-    /// multipliers of the current substep, to f (3 per particle; kg·m, i.e. h² times a force).
-    /// Returns false when the block does not support it (then
-    /// the primal correction is not available for the engine). O(units).
-    virtual bool addMultiplierForces(const double* /*xw*/, double* /*f*/) const { return false; }
+    /// Adds Σ_j ∇C_j(x)ᵀ λ_j of the units of packs [packBegin, packEnd) (all of one colour, so
+    /// no particle twice), at the particle positions of xw and the multipliers of the current
+    /// substep, to f (3 per particle; kg·m, i.e. h² times a force). Returns false when the block
+    /// does not support it (then the engine offers no primal correction). O(units).
+    virtual bool addMultiplierForces(size_t /*packBegin*/, size_t /*packEnd*/, const double* /*xw*/,
+                                     double* /*f*/) const {
+        return false;
+    }
 
     /// Lays the units out by colour (colourOfUnit: one entry per unit) in packs of four.
     void arrange(const std::vector<int32_t>& colourOfUnit, int colours);
@@ -119,9 +122,9 @@ class Engine {
     /// Primal correction [A eq. 4.41, first row]: x ← x̃ + M⁻¹ Σ_j ∇C_j(x)ᵀ λ_j for every free
     /// particle, so that the primal residual g(x, λ) that XPBD's update drops is zero at the
     /// current gradients (fixed particles stay). xTilde: one per particle. Returns the wall time
-    /// in seconds, or a negative value when a block does not support it (nothing moved). Serial;
-    /// O(particles + units).
-    double primalCorrection(const std::vector<Vec3>& xTilde);
+    /// in seconds. Parallel like a sweep (colour by colour, bit-identical for any thread count);
+    /// O(particles + units). Only when supportsPrimalCorrection().
+    double primalCorrection(const std::vector<Vec3>& xTilde, int threads, WorkerPool* pool);
     /// True when every block supports the primal correction.
     bool supportsPrimalCorrection() const;
     /// Threads worth using (≤ threads): 1 when no colour is large enough to split.
@@ -139,11 +142,18 @@ class Engine {
         bool last = false;        ///< colour sweep: last iteration of the substep
         bool predictNext = false; ///< particle pass: also start the next substep
         uint32_t chunks = 0;
+        bool forces = false; ///< colour pass of the primal correction: Σ ∇Cᵀλ into m_force
     };
     static constexpr int kPredictOnly = -2;
-    static constexpr int kCorrect = -3; ///< one chunk: the primal correction (serial)
-    bool correct(const std::vector<Vec3>& xTilde);
-    void buildSchedule(const XpbdSettings* s, int threads);
+    /// Particle pass of the primal correction: x = x̃ + w f, f = 0.
+    static constexpr int kCorrect = -3;
+    enum class Schedule { Frame, Sweep, Correction };
+    /// s: needed for Schedule::Frame only.
+    void buildSchedule(Schedule kind, const XpbdSettings* s, int threads);
+    void appendCorrectionPhases(int threads);
+    void forceColourChunk(int c, uint32_t chunk, uint32_t chunks);
+    void correctParticles(uint32_t chunk);
+    template <class Fn> void forColourChunk(int c, uint32_t chunk, uint32_t chunks, const Fn& fn);
     /// Runs every chunk of m_phases in order: a phase starts when all chunks of the previous
     /// ones are done. Parallel: the chunks of a phase form one group per thread; a thread claims
     /// chunks of its own group, then of the others, from per-group atomic cursors, and adds its
@@ -167,8 +177,8 @@ class Engine {
     ParticleArray m_frameStart;
     std::vector<Vec3> m_v0;
     std::vector<int> m_clamps; ///< per thread
-    std::vector<double> m_force;  ///< primal correction: Σ ∇Cᵀλ, 3 per particle
-    std::vector<Vec3> m_xTilde;   ///< prediction of the current substep (primal correction)
+    std::vector<double> m_force; ///< primal correction: Σ ∇Cᵀλ, 3 per particle (0 between uses)
+    std::vector<Vec3> m_xTilde;  ///< prediction of the current substep (primal correction)
 };
 
 } // namespace viscera::sim::detail
