@@ -2,12 +2,19 @@
 //
 //   viscera-player verify <case.vcase>
 //   viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]
-//                  [--report report.json] [--screenshot out.png]
+//                  [--report report.json] [--screenshot out.png] [--trace trace.csv] [--realtime]
+//
+// --device: replay:<file>, scripted:<name>, console:<host:port>, keyboard (window mode only).
+// Without --headless the trainee window opens (case title, instructions, timer, pedals and
+// clutch, force bars, a side view of the tissue); it runs until closed, or for --frames frames
+// and then writes --screenshot.
 //
 // Exit codes: 0 success, 1 bad input (case, arguments), 2 usage, 3 the session broke an invariant.
 #include "case/case_package.hpp"
+#include "haptics/device_spec.hpp"
 #include "runtime/report.hpp"
 #include "runtime/session.hpp"
+#include "window/window_mode.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
 #include "sim/util/log.hpp"
@@ -28,7 +35,9 @@ constexpr int kExitInput = 1, kExitUsage = 2, kExitInvariant = 3;
 void usage(std::FILE* out) {
     std::fputs("usage: viscera-player verify <case.vcase>\n"
                "       viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]\n"
-               "                      [--report report.json] [--screenshot out.png]\n"
+               "                      [--report report.json] [--screenshot out.png] [--trace trace.csv]\n"
+               "                      [--realtime]\n"
+               "       SPEC: replay:<file> | scripted:<name> | console:<host:port> | keyboard\n"
                "       viscera-player --version\n",
                out);
 }
@@ -52,8 +61,8 @@ int cmdVerify(const std::vector<std::string>& args) {
 }
 
 int cmdRun(const std::vector<std::string>& args) {
-    std::optional<std::string> casePath, reportPath, screenshot, device;
-    bool headless = false;
+    std::optional<std::string> casePath, reportPath, screenshot, device, tracePath;
+    bool headless = false, realtime = false, framesGiven = false;
     int frames = 300;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
@@ -69,7 +78,10 @@ int cmdRun(const std::vector<std::string>& args) {
             if (*end != '\0' || n < 1 || n > 10'000'000)
                 throw std::invalid_argument("--frames '" + v + "' must be an integer in [1, 10000000]");
             frames = static_cast<int>(n);
+            framesGiven = true;
         } else if (a == "--report") reportPath = value("--report");
+        else if (a == "--trace") tracePath = value("--trace");
+        else if (a == "--realtime") realtime = true;
         else if (a == "--screenshot") screenshot = value("--screenshot");
         else if (a == "--device") device = value("--device");
         else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option '" + a + "'");
@@ -77,27 +89,48 @@ int cmdRun(const std::vector<std::string>& args) {
         else throw std::invalid_argument("unexpected argument '" + a + "'");
     }
     if (!casePath) throw std::invalid_argument("run needs a case file");
-    // Capabilities that arrive with later subsystems are refused up front, before any work.
-    if (!headless)
-        return fail(kExitUsage, "window mode needs the renderer, which this build does not include; use --headless");
-    if (screenshot)
-        return fail(kExitUsage, "--screenshot needs the renderer, which this build does not include");
-    if (device)
-        return fail(kExitUsage, "--device " + *device + ": device backends (core/haptics) are not in this build");
+    // Refused up front, before any work.
+    if (headless && screenshot)
+        return fail(kExitUsage, "--screenshot captures the trainee window; drop --headless (QT_QPA_PLATFORM=offscreen works without a display)");
+    if (!headless) {
+        if (auto why = player::windowModeUnavailable(); !why.empty()) return fail(kExitUsage, why);
+    }
+    std::optional<haptics::DeviceSpec> spec;
+    if (device) {
+        spec = haptics::parseDeviceSpec(*device); // InputError names the spec and the rule
+        if (spec->kind == haptics::DeviceSpec::Kind::Keyboard && headless)
+            throw InputError("--device 'keyboard': the keyboard device needs the trainee window; drop --headless");
+    }
+    if (tracePath && !device) return fail(kExitUsage, "--trace records the device forces and poses; it needs --device");
 
     player::LoadedCase loaded = player::loadCase(*casePath);
-    std::fprintf(stderr, "viscera-player: running %s for %d frames\n", casePath->c_str(), frames);
+    std::unique_ptr<haptics::Device> dev;
+    if (spec) dev = haptics::openDevice(*spec);
     player::RunOptions opts;
     opts.frames = frames;
-    const int every = std::max(1, frames / 10);
-    opts.progress = [every](int done, int total) {
-        if (done % every == 0 || done == total)
-            std::fprintf(stderr, "  frame %d/%d (%d%%)\n", done, total, 100 * done / total);
-    };
-    player::SessionResult result = player::runSession(loaded, opts);
+    opts.device = dev.get();
+    opts.deviceSpec = device.value_or("");
+    opts.realtime = realtime || (dev && dev->capabilities().realtime) || !headless;
+    opts.keepTrace = tracePath.has_value();
+    player::SessionResult result;
+    if (headless) {
+        std::fprintf(stderr, "viscera-player: running %s for %d frames%s\n", casePath->c_str(), frames,
+                     dev ? (std::string(" with ") + *device + (opts.realtime ? " (real time)" : " (lockstep)")).c_str() : "");
+        const int every = std::max(1, frames / 10);
+        opts.progress = [every](int done, int total) {
+            if (done % every == 0 || done == total)
+                std::fprintf(stderr, "  frame %d/%d (%d%%)\n", done, total, 100 * done / total);
+        };
+        result = player::runSession(loaded, opts);
+    } else {
+        if (!framesGiven) opts.frames = 0; // until the trainee closes the window
+        result = player::runWindow(loaded, opts, screenshot.value_or(""));
+    }
     if (reportPath) writeFileAtomic(*reportPath, player::reportJson(result).dump(2) + "\n");
+    if (tracePath) writeFileAtomic(*tracePath, player::traceCsv(result));
     std::fputs(player::summaryText(result).c_str(), stdout);
     if (reportPath) std::printf("report        %s\n", std::filesystem::absolute(*reportPath).c_str());
+    if (tracePath) std::printf("trace         %s\n", std::filesystem::absolute(*tracePath).c_str());
     return result.ok() ? 0 : kExitInvariant;
 }
 

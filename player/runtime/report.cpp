@@ -26,6 +26,78 @@ StepTimeStats stepTimeStats(const std::vector<sim::FrameRecord>& frames) {
     return s;
 }
 
+namespace {
+
+nlohmann::json distribution(const haptics::Distribution& d) {
+    return {{"count", d.count}, {"mean", d.mean_us}, {"p50", d.p50_us}, {"p99", d.p99_us}, {"max", d.max_us}, {"min", d.min_us}};
+}
+
+nlohmann::json hapticsJson(const HapticsResult& h) {
+    using nlohmann::json;
+    json tools = json::array();
+    for (const auto& t : h.tools) tools.push_back({{"name", t.name}, {"hand", t.hand}, {"arm", t.arm}});
+    const haptics::ServoStats& s = h.servo;
+    json servo = {{"rate_hz", 1000.0}, {"ticks", s.ticks}, {"tick_cost_us", distribution(s.tickCost)}};
+    if (h.mode == "realtime") {
+        servo["overruns"] = s.overruns;
+        servo["realtime_priority"] = s.realtimePriority;
+        servo["period_us"] = distribution(s.period);
+        servo["jitter_us"] = distribution(s.jitter);
+        servo["wake_latency_us"] = distribution(s.wakeLatency);
+        servo["physics_realtime_priority"] = h.physicsRealtimePriority;
+    }
+    const auto& a = s.contactAge;
+    json contact = {{"physics_period_ms", h.physicsPeriod_s * 1e3},
+                    {"age_ms", {{"mean", a.mean_us * 1e-3}, {"p50", a.p50_us * 1e-3}, {"p99", a.p99_us * 1e-3}, {"max", a.max_us * 1e-3}}},
+                    {"max_age_over_period", h.maxContactAgeSteps},
+                    {"max_steps_behind", s.maxStepsBehind},
+                    {"models_used", s.contactModelsSeen}};
+    const haptics::SafetyCounts& c = s.safety;
+    json safety = {{"ticks", c.ticks},       {"non_finite", c.nonFinite}, {"disconnected", c.disconnected},
+                   {"sim_stale", c.simStale}, {"deadman", c.deadman},     {"clamped", c.clamped},
+                   {"rate_limited", c.rateLimited}};
+    const haptics::LinkStats& l = h.link;
+    json link = {{"received", l.received},
+                 {"rejected_malformed", l.rejectedMalformed},
+                 {"rejected_version", l.rejectedVersion},
+                 {"rejected_checksum", l.rejectedChecksum},
+                 {"rejected_order", l.rejectedOrder},
+                 {"dropped_flood", l.droppedFlood},
+                 {"sent", l.sent},
+                 {"send_errors", l.sendErrors},
+                 {"disconnects", l.disconnects},
+                 {"reconnects", l.reconnects}};
+    return {{"device", {{"spec", h.spec}, {"backend", h.backend}, {"name", h.name}, {"arms", h.arms}, {"pedals", h.pedals},
+                        {"max_force_n", h.deviceMaxForce_n}}},
+            {"case_max_force_n", h.caseMaxForce_n},
+            {"mode", h.mode},
+            {"tools", tools},
+            {"servo", servo},
+            {"contact_model", contact},
+            {"safety", safety},
+            {"link", link},
+            {"trace_samples", h.traceSamples},
+            {"trace_dropped", s.traceDropped}};
+}
+
+} // namespace
+
+std::string traceCsv(const SessionResult& r) {
+    std::string out = "t_s,arm,device_x,device_y,device_z,tool_x,tool_y,tool_z,force_x,force_y,force_z,force_n,desired_n,"
+                      "grip_rad,pedals,connected,safety_rules,contact_age_ms\n";
+    out.reserve(out.size() + r.trace.size() * 160);
+    const int64_t t0 = r.trace.empty() ? 0 : r.trace.front().t_ns;
+    char buf[512];
+    for (const TraceRow& s : r.trace) {
+        std::snprintf(buf, sizeof buf, "%.6f,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.5g,%.5g,%.5g,%.4g,%u,%d,%u,%.4f\n",
+                      1e-9 * double(s.t_ns - t0), int(s.arm), s.device.x(), s.device.y(), s.device.z(), s.tool.x(),
+                      s.tool.y(), s.tool.z(), s.force.x(), s.force.y(), s.force.z(), s.force.norm(), s.desired, s.grip,
+                      s.pedals, int(s.connected), s.rules, s.contactAge_s * 1e3);
+        out += buf;
+    }
+    return out;
+}
+
 nlohmann::json reportJson(const SessionResult& r) {
     using nlohmann::json;
     json doc;
@@ -64,6 +136,20 @@ nlohmann::json reportJson(const SessionResult& r) {
                       {"nodes", r.nodes},
                       {"tets", r.tets},
                       {"max_node_displacement_m", r.maxNodeDisplacement}};
+    // Task metrics [issue 7]: time, tool path, forces, tissue damage, punctures, clips.
+    const TaskMetrics& tm = r.metrics;
+    doc["metrics"]["time_s"] = tm.time_s;
+    doc["metrics"]["tool_path_length_m"] = tm.toolPathLength_m;
+    doc["metrics"]["tool_path_length_per_tool_m"] = tm.toolPathLengthPerTool_m;
+    doc["metrics"]["max_force_n"] = tm.maxForce_n;
+    doc["metrics"]["mean_force_n"] = tm.meanForce_n;
+    doc["metrics"]["mean_contact_force_n"] = tm.meanContactForce_n;
+    doc["metrics"]["max_contact_force_n"] = tm.maxContactForce_n;
+    doc["metrics"]["tissue_damage_ns"] = tm.tissueDamage_ns;
+    doc["metrics"]["damage_events"] = tm.damageEvents;
+    doc["metrics"]["punctures"] = tm.punctures;
+    doc["metrics"]["clips"] = tm.clips;
+    if (r.haptics) doc["haptics"] = hapticsJson(*r.haptics);
     doc["errors"] = r.errors;
     return doc;
 }
@@ -89,6 +175,31 @@ std::string summaryText(const SessionResult& r) {
                   r.invariants.maxEnergy, r.invariants.maxForce,
                   r.ok() ? "ok" : ("FAILED: " + (r.errors.empty() ? std::string("invariants") : r.errors.front())).c_str());
     std::string out = buf;
+    if (r.haptics) {
+        const HapticsResult& h = *r.haptics;
+        const auto& p = h.servo.period;
+        const auto& j = h.servo.jitter;
+        char line[512];
+        if (h.mode == "realtime")
+            std::snprintf(line, sizeof line, "haptics       %s (%s), %llu ticks, period mean %.1f us, jitter p99 %.1f us, max %.1f us\n",
+                          h.spec.c_str(), h.mode.c_str(), (unsigned long long)h.servo.ticks, p.mean_us, j.p99_us, j.max_us);
+        else
+            std::snprintf(line, sizeof line, "haptics       %s (%s), %llu ticks\n", h.spec.c_str(), h.mode.c_str(),
+                          (unsigned long long)h.servo.ticks);
+        out += line;
+        std::snprintf(line, sizeof line,
+                      "task          path %.1f mm, force max %.2f N mean %.2f N, contact model age max %.2f ms (%.2f periods)\n",
+                      r.metrics.toolPathLength_m * 1e3, r.metrics.maxForce_n, r.metrics.meanForce_n,
+                      h.servo.contactAge.max_us * 1e-3, h.maxContactAgeSteps);
+        out += line;
+        if (h.link.disconnects || h.link.rejectedMalformed || h.link.rejectedVersion || h.link.rejectedChecksum) {
+            std::snprintf(line, sizeof line, "link          %llu disconnects, %llu reconnects, %llu packets rejected\n",
+                          (unsigned long long)h.link.disconnects, (unsigned long long)h.link.reconnects,
+                          (unsigned long long)(h.link.rejectedMalformed + h.link.rejectedVersion + h.link.rejectedChecksum +
+                                               h.link.rejectedOrder));
+            out += line;
+        }
+    }
     // Error against run time on the last sampled frame [A eq. 4.45].
     for (auto it = r.accuracy.rbegin(); it != r.accuracy.rend(); ++it) {
         if (it->solver != "xpbd" || it->relError.size() < 2) continue;

@@ -47,18 +47,56 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         r.tets += world.restMesh(b).tetCount();
     }
     r.frames.reserve(static_cast<size_t>(std::max(options.frames, 0)));
+    std::unique_ptr<HapticRig> rig;
+    if (options.device) {
+        rig = std::make_unique<HapticRig>(*options.device, options.deviceSpec, world, options.realtime, options.keepTrace);
+        rig->configure(loaded.scene.xpbd.dt);
+        r.activeSubsystems.push_back("haptics");
+    }
+    if (options.live) {
+        std::lock_guard<std::mutex> lock(options.live->mutex);
+        for (size_t t = 0; t < world.toolCount(); ++t) options.live->toolRadius.push_back(world.toolDesc(t).radius);
+    }
     const auto t0 = std::chrono::steady_clock::now();
-    for (int f = 0; f < options.frames; ++f) {
+    if (rig) rig->start();
+    for (int f = 0; options.frames == 0 || f < options.frames; ++f) {
+        if (options.stop && options.stop->load()) break;
+        if (rig) rig->beforeStep();
         sim::FrameRecord rec = world.step();
+        if (rig) rig->afterStep();
+        if (options.live) {
+            std::lock_guard<std::mutex> lock(options.live->mutex);
+            LiveView& lv = *options.live;
+            if (rig) lv.state = rig->live();
+            lv.state.time_s = world.time();
+            lv.state.frame = world.frameCount();
+            lv.nodes.clear();
+            for (size_t b = 0; b < world.bodyCount(); ++b)
+                lv.nodes.insert(lv.nodes.end(), world.positions(b).begin(), world.positions(b).end());
+        }
         if (!rec.finite)
             r.errors.push_back("frame " + std::to_string(rec.index) +
                                ": the step produced a non-finite value and was rolled back");
         r.frames.push_back(rec);
         if (options.progress) options.progress(f + 1, options.frames);
     }
+    if (rig) {
+        rig->finish();
+        r.haptics = rig->result();
+        r.metrics = rig->metrics();
+        r.trace = std::move(rig->trace());
+        r.invariants.maxForce = r.metrics.maxForce_n;
+    }
+    r.metrics.time_s = world.time();
+    if (options.live) {
+        std::lock_guard<std::mutex> lock(options.live->mutex);
+        options.live->finished = true;
+    }
     r.wallTime = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     r.simTime = world.time();
+    const double deviceMax = r.invariants.maxForce;
     r.invariants = world.invariants();
+    r.invariants.maxForce = std::max(r.invariants.maxForce, deviceMax);
     r.accuracy = world.accuracy();
     for (size_t b = 0; b < world.bodyCount(); ++b) {
         const auto& rest = world.restMesh(b).positions();

@@ -1,12 +1,17 @@
 #pragma once
 /// Loading a verified case into a World and running a session on it.
 #include "case/case_package.hpp"
+#include "haptics/device.hpp"
+#include "runtime/haptic_rig.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/world.hpp"
 
+#include <atomic>
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,10 +27,25 @@ struct LoadedCase {
 /// manifest declares. Throws viscera::InputError naming the file, the field and the rule.
 LoadedCase loadCase(const std::filesystem::path& casePath);
 
+/// What the trainee window draws; the physics thread writes it after every frame.
+struct LiveView {
+    std::mutex mutex;
+    LiveState state;
+    std::vector<sim::Vec3> nodes; ///< nodes of every body, m, scene
+    std::vector<double> toolRadius;
+    bool finished = false;
+};
+
 struct RunOptions {
-    int frames = 300;
+    int frames = 300;             ///< 0: run until *stop is set
     /// Called after every frame with (frames done, frames total); may be empty.
     std::function<void(int, int)> progress;
+    haptics::Device* device = nullptr; ///< non-owning; null: no haptics subsystem
+    std::string deviceSpec;
+    bool realtime = false;        ///< servo thread + wall-clock pacing (console and keyboard need it)
+    bool keepTrace = false;       ///< keep every servo sample for the --trace CSV
+    const std::atomic<bool>* stop = nullptr; ///< set by the window when the trainee closes it
+    LiveView* live = nullptr;     ///< filled every frame when set
 };
 
 struct SessionResult {
@@ -39,6 +59,9 @@ struct SessionResult {
     double maxNodeDisplacement = 0; ///< m, from the rest configuration, at the end
     size_t nodes = 0, tets = 0;
     std::vector<std::string> errors;
+    std::optional<HapticsResult> haptics; ///< present when the session ran a device
+    TaskMetrics metrics;
+    std::vector<TraceRow> trace;          ///< when RunOptions::keepTrace
     bool ok() const { return errors.empty() && invariants.allFinite; }
 };
 

@@ -129,3 +129,47 @@ TriMesh makeBoxSurface(const Vec3& lo, const Vec3& hi) {
 }
 
 } // namespace viscera::sim
+
+namespace viscera::sim {
+
+std::unique_ptr<TetMesh> makeHollowTubeTetMesh(const HollowTubeSpec& s) {
+    const Vec3 axis = s.end - s.start;
+    if (!(axis.norm() > 0) || !(s.innerRadius > 0) || !(s.outerRadius > s.innerRadius) || s.slices < 3 ||
+        s.layers < 1 || s.rings < 1)
+        throw std::invalid_argument("sim::makeHollowTubeTetMesh(): needs start != end, 0 < inner < outer radius, "
+                                    "slices >= 3, layers >= 1, rings >= 1");
+    const Vec3 w = axis.normalized();
+    Vec3 a = std::abs(w.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+    const Vec3 u = (a - a.dot(w) * w).normalized(), v = w.cross(u);
+    const int ns = s.slices, nl = s.layers + 1, nr = s.rings + 1;
+    auto id = [&](int i, int j, int k) { return static_cast<int32_t>((k * nl + j) * ns + (i % ns)); };
+    std::vector<Vec3> pos;
+    pos.reserve(static_cast<size_t>(ns * nl * nr));
+    for (int k = 0; k < nr; ++k)
+        for (int j = 0; j < nl; ++j)
+            for (int i = 0; i < ns; ++i) {
+                const double th = 2.0 * std::numbers::pi * i / ns;
+                const double r = s.innerRadius + (s.outerRadius - s.innerRadius) * j / s.layers;
+                pos.push_back(s.start + axis * (double(k) / s.rings) + r * (std::cos(th) * u + std::sin(th) * v));
+            }
+    static constexpr int kPerm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    std::vector<Tet> tets;
+    for (int k = 0; k < s.rings; ++k)
+        for (int j = 0; j < s.layers; ++j)
+            for (int i = 0; i < ns; ++i)
+                for (const auto& perm : kPerm) {
+                    int c[3] = {0, 0, 0};
+                    Tet t;
+                    t[0] = id(i, j, k);
+                    for (int q = 0; q < 3; ++q) {
+                        c[perm[q]] = 1;
+                        t[q + 1] = id(i + c[0], j + c[1], k + c[2]);
+                    }
+                    const Vec3 &p0 = pos[t[0]], &p1 = pos[t[1]], &p2 = pos[t[2]], &p3 = pos[t[3]];
+                    if ((p1 - p0).dot((p2 - p0).cross(p3 - p0)) < 0) std::swap(t[2], t[3]);
+                    tets.push_back(t);
+                }
+    return TetMesh::fromArrays(std::move(pos), std::move(tets), "sim::makeHollowTubeTetMesh()");
+}
+
+} // namespace viscera::sim

@@ -34,3 +34,21 @@ TriMesh makeTubeSurface(const Vec3& a, const Vec3& b, double radius, int slices,
 TriMesh makeBoxSurface(const Vec3& min, const Vec3& max);
 
 } // namespace viscera::sim
+
+namespace viscera::sim {
+
+struct HollowTubeSpec {
+    Vec3 start = Vec3::Zero();           ///< axis start, metres
+    Vec3 end = Vec3(0, 0, 0.02);         ///< axis end, metres
+    double innerRadius = 0.003, outerRadius = 0.004; ///< metres, 0 < inner < outer
+    int slices = 32;                     ///< cells around (>= 3)
+    int layers = 2;                      ///< cells through the wall (>= 1)
+    int rings = 8;                       ///< cells along the axis (>= 1)
+};
+
+/// Structured hollow tube (a vessel): (slices × layers × rings) hexahedral cells in (θ, r, axis),
+/// each split into 6 positively oriented tets (Kuhn; conforming, also across θ = 2π). Node index
+/// ((ring · (layers + 1)) + layer) · slices + slice. Throws std::invalid_argument on bad sizes.
+std::unique_ptr<TetMesh> makeHollowTubeTetMesh(const HollowTubeSpec& spec);
+
+} // namespace viscera::sim

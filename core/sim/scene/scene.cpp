@@ -108,6 +108,39 @@ TetStrainLimits parseStrainLimits(const Reader& r, const json& j, const std::str
     return s;
 }
 
+std::vector<ToolDesc> parseTools(const Reader& r, const json& tools, std::set<std::string>& names) {
+    if (!tools.is_array()) r.fail("tools", "must be an array");
+    if (tools.size() > 2) r.fail("tools", "at most 2 tools (one per master)");
+    std::vector<ToolDesc> out;
+    for (size_t i = 0; i < tools.size(); ++i) {
+        const std::string p = "tools[" + std::to_string(i) + "]";
+        const json& t = tools[i];
+        r.only(t, {"name", "shape", "radius", "hand", "start", "motion_scale", "force_scale", "stiffness", "max_force_n",
+                   "damage_force_n"},
+               p);
+        ToolDesc d;
+        d.name = r.string(r.require(t, "name", p), p + ".name");
+        if (d.name.empty() || !names.insert(d.name).second) r.fail(p + ".name", "must be non-empty and unique");
+        if (t.contains("shape") && r.string(t["shape"], p + ".shape") != "sphere") r.fail(p + ".shape", "must be 'sphere'");
+        if (t.contains("hand")) d.hand = r.string(t["hand"], p + ".hand");
+        if (d.hand != "left" && d.hand != "right" && d.hand != "any") r.fail(p + ".hand", "must be 'left', 'right' or 'any'");
+        d.start = r.vec3(r.require(t, "start", p), p + ".start");
+        auto positive = [&](const char* key, double& v, double max) {
+            if (!t.contains(key)) return;
+            v = r.number(t[key], p + "." + key);
+            if (!(v > 0 && v <= max)) r.fail(p + "." + key, "must be in (0, " + json(max).dump() + "]");
+        };
+        positive("radius", d.radius, 0.1);
+        positive("motion_scale", d.motionScale, 10.0);
+        positive("force_scale", d.forceScale, 10.0);
+        positive("max_force_n", d.maxForceN, 50.0);
+        positive("damage_force_n", d.damageForceN, 1000.0);
+        if (t.contains("stiffness")) d.stiffness = r.nonNegative(t["stiffness"], p + ".stiffness");
+        out.push_back(d);
+    }
+    return out;
+}
+
 json limitNumber(double v) { return std::isfinite(v) ? json(v) : json(); }
 
 } // namespace
@@ -116,7 +149,7 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     Reader r(origin);
     json doc = json::parse(text, nullptr, false);
     if (doc.is_discarded()) throw InputError(origin + ": not valid JSON");
-    r.only(doc, {"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces"}, "");
+    r.only(doc, {"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces", "tools"}, "");
     SceneDesc scene;
     const json& solver = r.require(doc, "solver", "");
     r.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads", "primal_correction"},
@@ -209,6 +242,7 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
             scene.surfaces.push_back(std::move(sd));
         }
     }
+    if (doc.contains("tools")) scene.tools = parseTools(r, doc["tools"], names);
     return scene;
 }
 
@@ -260,6 +294,11 @@ std::string formatScene(const SceneDesc& scene) {
             doc["surfaces"].push_back(j);
         }
     }
+    for (const ToolDesc& t : scene.tools)
+        doc["tools"].push_back({{"name", t.name}, {"shape", "sphere"}, {"radius", t.radius}, {"hand", t.hand},
+                                {"start", {t.start.x(), t.start.y(), t.start.z()}}, {"motion_scale", t.motionScale},
+                                {"force_scale", t.forceScale}, {"stiffness", t.stiffness}, {"max_force_n", t.maxForceN},
+                                {"damage_force_n", t.damageForceN}});
     return doc.dump(2) + "\n";
 }
 

@@ -18,9 +18,11 @@
 ///               "embedded_in": "fat", "embedding_compliance": 0}],   optional
 ///   "surfaces": [{"name": "fascia", "mesh": "meshes/fascia.vtri", "areal_density": 0.1,
 ///                 "stretch_stiffness": 50, "attach_to": "organ", "attach_distance": 0.001,
-///                 "attach_compliance": 0, "fixed_nodes": []}]
+///                 "attach_compliance": 0, "fixed_nodes": []}],
+///   "tools": [{"name": "probe", "shape": "sphere", ...see tool_probe.hpp...}]   optional
 /// }
 #include "sim/material/material.hpp"
+#include "sim/scene/tool_probe.hpp"
 #include "sim/xpbd/strain_limit.hpp"
 #include "sim/xpbd/xpbd_settings.hpp"
 
@@ -65,6 +67,7 @@ struct SceneDesc {
     std::optional<AccuracySampling> accuracy;
     std::vector<BodyDesc> bodies;
     std::vector<SurfaceDesc> surfaces;
+    std::vector<ToolDesc> tools; ///< haptic probes (feature "probe")
 };
 
 /// Throws viscera::InputError ("scene.json: bodies[0].material.poisson_ratio: must be in [0, 0.5)").

@@ -16,6 +16,7 @@ const char* kFascia = "fascia";
 const char* kEmbedding = "embedding";
 const char* kStrainLimit = "strain_limit";
 const char* kAccuracy = "accuracy";
+const char* kProbe = "probe";
 
 bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
 
@@ -27,7 +28,7 @@ std::string stripPrefix(std::string why) {
 } // namespace
 
 const std::vector<std::string>& supportedFeatures() {
-    static const std::vector<std::string> f = {kAccuracy, kEmbedding, kFascia, kGravity, kStrainLimit, kXpbd};
+    static const std::vector<std::string> f = {kAccuracy, kEmbedding, kFascia, kGravity, kProbe, kStrainLimit, kXpbd};
     return f;
 }
 
@@ -41,6 +42,7 @@ std::vector<std::string> requiredFeatures(const SceneDesc& scene) {
         if (b.strainLimits && !has(f, kStrainLimit)) f.push_back(kStrainLimit);
     }
     if (scene.accuracy) f.push_back(kAccuracy);
+    if (!scene.tools.empty()) f.push_back(kProbe);
     std::sort(f.begin(), f.end());
     return f;
 }
@@ -135,6 +137,16 @@ std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::
     }
     w->m_meshes = std::move(meshes);
     w->m_surfaces = std::move(surfaces);
+    if (!scene.tools.empty()) {
+        std::vector<ToolProbes::Body> pb;
+        for (size_t i = 0; i < scene.bodies.size(); ++i) {
+            const Material& m = scene.bodies[i].material;
+            pb.push_back({lumpedMasses(*w->m_meshes[i], m.density, scene.bodies[i].fixedNodes),
+                          m.youngsModulus / (1 - m.poissonRatio * m.poissonRatio)});
+            if (!scene.bodies[i].embeddedIn.empty()) pb.back().mass.assign(pb.back().mass.size(), 0.0);
+        }
+        w->m_probes = std::make_unique<ToolProbes>(scene.tools, std::move(pb), scene.xpbd.dt);
+    }
     w->m_active = needed;
     w->m_invariants.maxEnergy = w->totalEnergy();
     return w;
@@ -180,7 +192,9 @@ FrameRecord World::step() {
     FrameRecord rec;
     rec.index = m_frame;
     const auto t0 = std::chrono::steady_clock::now();
+    if (m_probes) applyTools(false);
     const StepStats st = m_single ? m_single->step() : m_system->step();
+    if (m_probes) applyTools(true);
     rec.stepMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     rec.substeps = st.substeps;
     rec.iterations = st.iterations;
@@ -192,6 +206,20 @@ FrameRecord World::step() {
     ++m_frame;
     m_time += m_dt;
     return rec;
+}
+
+void World::applyTools(bool measure) {
+    std::vector<std::vector<Vec3>> x, v;
+    for (size_t b = 0; b < m_meshes.size(); ++b) {
+        x.push_back(positions(b));
+        v.push_back(m_single ? m_single->velocities() : m_system->tetVelocities(b));
+    }
+    const std::vector<char> changed = m_probes->apply(x, v, measure);
+    try {
+        for (size_t b = 0; b < changed.size(); ++b)
+            if (changed[b]) m_single ? m_single->setState(x[b], v[b]) : m_system->setTetState(b, x[b], v[b]);
+    } catch (const std::invalid_argument&) { // non-finite state: the step's rollback handles it
+    }
 }
 
 } // namespace viscera::sim

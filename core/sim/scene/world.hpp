@@ -4,6 +4,7 @@
 /// surfaces builds no fascia layer, one without "accuracy" runs no reference solves).
 #include "sim/diagnostics/invariants.hpp"
 #include "sim/scene/scene.hpp"
+#include "sim/scene/tool_probe.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
 #include "sim/xpbd/xpbd_system.hpp"
 
@@ -66,11 +67,24 @@ public:
     const std::vector<Vec3>& positions(size_t i) const;
     size_t surfaceCount() const { return m_surfaces.size(); }
     const std::vector<Vec3>& surfacePositions(size_t s) const;
+    /// Surface s as assembled (rest positions, triangles) and its scene name (renderer input).
+    const TriMesh& surfaceMesh(size_t s) const { return m_surfaces[s]; }
+    const std::string& surfaceName(size_t s) const { return m_scene.surfaces[s].name; }
     double totalEnergy() const;
+
+    // ---- haptic probes (feature "probe": only scenes with tools create them) --------------------
+    size_t toolCount() const { return m_probes ? m_probes->size() : 0; }
+    const ToolDesc& toolDesc(size_t t) const { return m_probes->desc(t); }
+    /// Where probe t is to be during the next step (m, scene). Between frames only; non-finite
+    /// positions are ignored.
+    void setToolPosition(size_t t, const Vec3& centre) { m_probes->setPosition(t, centre); }
+    /// Contact of probe t measured by the last step (tool_probe.hpp).
+    const ToolContact& toolContact(size_t t) const { return m_probes->contact(t); }
 
 private:
     World() = default;
     void measureAccuracy();
+    void applyTools(bool measure);
 
     SceneDesc m_scene;
     std::vector<std::string> m_active;
@@ -79,6 +93,7 @@ private:
     std::vector<TriMesh> m_surfaces;
     std::unique_ptr<XpbdSolver> m_single;  ///< one tet body, no layers (accuracy hooks available)
     std::unique_ptr<XpbdSystem> m_system;  ///< several bodies and layers
+    std::unique_ptr<ToolProbes> m_probes;  ///< null unless the scene has tools
     Invariants m_invariants;
     std::vector<AccuracyRecord> m_accuracy;
     double m_time = 0;

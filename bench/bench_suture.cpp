@@ -1,0 +1,55 @@
+// Physics time per step of the anastomosis run [B ch. 4], single thread: mean and p99 for the
+// running suture with 20 and with 50 punctures (5 and 13 stitches), needle driving and thread pull.
+// Run: OPENBLAS_NUM_THREADS=1 taskset -c 0 ./build/bench/bench_suture
+#include "sim/suture/anastomosis.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+using namespace viscera::sim;
+using namespace viscera::sim::suture;
+
+int main(int argc, char** argv) {
+    const int only = argc > 1 ? std::atoi(argv[1]) : 0;
+    std::printf("%-10s %-8s %-8s %-10s %-10s %-10s %-10s %-10s %-12s\n", "punctures", "stitches", "frames",
+                "mean_ms", "p50_ms", "p99_ms", "max_ms", "gap_mm", "penetr_mm");
+    for (int stitches : {5, 13}) {
+        if (only && only != stitches) continue;
+        AnastomosisSpec spec;
+        spec.stitches = stitches;
+        auto model = makeAnastomosisTubes(spec);
+        std::vector<int32_t> off;
+        auto merged = mergeMeshes({model.wide.get(), model.narrow.get()}, &off);
+        std::vector<int32_t> fixed = model.wideFixed;
+        for (int32_t v : model.narrowFixed) fixed.push_back(v + off[1]);
+        SutureSettings s;
+        s.needle.radius = spec.needleRadius;
+        s.needle.handle = anastomosisHandle(spec);
+        s.needle.punctureForce = 0.008;
+        s.fem.youngsModulus = 60e3;
+        const auto frames = makeAnastomosisTrajectory(spec);
+        auto sim = SutureSimulation::create(std::move(merged), fixed, s, frames.front().pose);
+        ClosureGauge gauge(sim->mesh(), off[1]);
+        std::vector<double> ms;
+        int punctures = 0;
+        for (const NeedleFrame& f : frames) {
+            const auto t0 = std::chrono::steady_clock::now();
+            const SutureStepStats st = sim->step(f);
+            ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            punctures = st.punctures;
+        }
+        const ClosureMetrics cm = gauge.measure(sim->positions());
+        std::vector<double> sorted = ms;
+        std::sort(sorted.begin(), sorted.end());
+        double sum = 0;
+        for (double x : ms) sum += x;
+        auto pct = [&](double p) { return sorted[std::min(sorted.size() - 1, static_cast<size_t>(p * sorted.size()))]; };
+        std::printf("%-10d %-8d %-8zu %-10.3f %-10.3f %-10.3f %-10.3f %-10.3f %-12.3f\n", punctures, stitches,
+                    frames.size(), sum / ms.size(), pct(0.5), pct(0.99), sorted.back(), cm.maxGap * 1e3,
+                    cm.maxPenetration * 1e3);
+    }
+    return 0;
+}

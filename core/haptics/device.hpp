@@ -1,0 +1,44 @@
+#pragma once
+/// The device interface every backend implements (replay, scripted, keyboard, network console).
+///
+/// Threading: poll() and send() are called from the servo thread only, once per tick; they must
+/// not block, allocate or take a lock. Everything else is called before the servo thread starts
+/// or after it stopped.
+#include "haptics/types.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+namespace viscera::haptics {
+
+/// Counters a backend keeps about its link (the network console fills most of them).
+struct LinkStats {
+    uint64_t received = 0;        ///< samples/packets accepted
+    uint64_t rejectedMalformed = 0; ///< wrong size, bad magic, bad field, non-finite value
+    uint64_t rejectedVersion = 0; ///< protocol version this build does not speak
+    uint64_t rejectedChecksum = 0;
+    uint64_t rejectedOrder = 0;   ///< duplicate or out-of-order sequence numbers
+    uint64_t droppedFlood = 0;    ///< valid packets superseded within one tick (only the newest is used)
+    uint64_t sent = 0;            ///< commands sent
+    uint64_t sendErrors = 0;
+    uint64_t disconnects = 0;     ///< connected → disconnected transitions
+    uint64_t reconnects = 0;      ///< disconnected → connected transitions (after a first connection)
+};
+
+class Device {
+public:
+    virtual ~Device() = default;
+    virtual const DeviceCapabilities& capabilities() const = 0;
+    /// Fills `out` with the newest state at time now_ns (servo clock). out.connected is false
+    /// when the device has not answered within its timeout; the rest of `out` then holds the
+    /// last good sample. Never blocks.
+    virtual void poll(int64_t now_ns, DeviceState& out) = 0;
+    /// Renders a command (already through the safety filter). Never blocks.
+    virtual void send(const DeviceCommand& command) = 0;
+    virtual LinkStats linkStats() const { return {}; }
+    /// Short backend name for reports: "replay", "scripted", "keyboard", "console".
+    virtual const char* backend() const = 0;
+};
+
+} // namespace viscera::haptics

@@ -1,0 +1,229 @@
+#include "haptics/servo_loop.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <pthread.h>
+#include <sched.h>
+#include <time.h>
+
+namespace viscera::haptics {
+namespace {
+
+inline void cpuRelax() {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+}
+
+void atomicMax(std::atomic<int64_t>& a, int64_t v) {
+    int64_t cur = a.load(std::memory_order_relaxed);
+    while (v > cur && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {}
+}
+void atomicMin(std::atomic<int64_t>& a, int64_t v) {
+    int64_t cur = a.load(std::memory_order_relaxed);
+    while (v < cur && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {}
+}
+
+void sleepUntil(int64_t t_ns) {
+    timespec ts{};
+    ts.tv_sec = t_ns / 1'000'000'000;
+    ts.tv_nsec = t_ns % 1'000'000'000;
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {}
+}
+
+} // namespace
+
+void ServoLoop::Histogram::add(int64_t ns) noexcept {
+    const int64_t us = std::max<int64_t>(0, (ns + 500) / 1000);
+    const size_t bin = std::min<size_t>(static_cast<size_t>(us), bins.size() - 1);
+    bins[bin].fetch_add(1, std::memory_order_relaxed);
+    count.fetch_add(1, std::memory_order_relaxed);
+    sum_ns.fetch_add(ns, std::memory_order_relaxed);
+    atomicMax(max_ns, ns);
+    atomicMin(min_ns, ns);
+}
+
+Distribution ServoLoop::Histogram::summary() const {
+    Distribution d;
+    d.count = count.load(std::memory_order_relaxed);
+    if (d.count == 0) return d;
+    d.mean_us = 1e-3 * double(sum_ns.load(std::memory_order_relaxed)) / double(d.count);
+    d.max_us = 1e-3 * double(max_ns.load(std::memory_order_relaxed));
+    d.min_us = 1e-3 * double(min_ns.load(std::memory_order_relaxed));
+    auto pct = [&](double p) {
+        const uint64_t want = static_cast<uint64_t>(std::ceil(p * double(d.count)));
+        uint64_t acc = 0;
+        for (size_t i = 0; i < bins.size(); ++i) {
+            acc += bins[i].load(std::memory_order_relaxed);
+            if (acc >= want) return i + 1 == bins.size() ? d.max_us : double(i);
+        }
+        return d.max_us;
+    };
+    d.p50_us = pct(0.5);
+    d.p99_us = std::min(pct(0.99), d.max_us);
+    return d;
+}
+
+ServoLoop::ServoLoop(Device& device, const Clock& clock, const ServoConfig& config)
+    : m_device(device), m_clock(clock), m_config(config), m_safety(device.capabilities(), config.safety),
+      m_trace(config.traceCapacity) {}
+
+ServoLoop::~ServoLoop() { stop(); }
+
+void ServoLoop::tick(int64_t now) {
+    const int64_t t0 = monotonicNs();
+    m_device.poll(now, m_state);
+    const int64_t started = m_stepsStarted.load(std::memory_order_acquire);
+    const LocalContactModel contact = m_contact.read();
+    double age_s = -1;
+    if (contact.frame >= 0) {
+        const int64_t age = now - contact.timestamp_ns;
+        age_s = 1e-9 * double(age);
+        m_age.add(age);
+        atomicMax(m_maxBehind, started - contact.frame);
+        if (contact.frame != m_lastFrame) {
+            m_lastFrame = contact.frame;
+            m_modelsSeen.fetch_add(1, std::memory_order_relaxed);
+        }
+    }
+    const bool clutch = (m_state.pedals & kPedalClutch) != 0;
+    const bool hold = clutch || !m_state.connected;
+    m_desired = DeviceCommand{};
+    m_desired.timestamp_ns = now;
+    m_desired.sequence = ++m_seq;
+    m_desired.flags = clutch ? uint32_t(kFlagClutch) : 0u;
+    ToolPoseState poses;
+    poses.timestamp_ns = now;
+    poses.tick = m_seq;
+    poses.connected = m_state.connected;
+    poses.pedals = m_state.pedals;
+    const int arms = std::clamp(m_device.capabilities().arms, 1, kMaxArms);
+    std::array<Vec3, kMaxArms> proxy{Vec3::Zero(), Vec3::Zero()};
+    for (int a = 0; a < arms; ++a) {
+        const ToolMapping& map = m_config.tools[a];
+        if (!map.enabled) continue;
+        const ArmState& arm = m_state.arms[a];
+        const Vec3 centre = m_device.capabilities().arm[a].workspaceCentre();
+        const Vec3 mapped = map.sceneStart + map.motionScale * (arm.measured_cp.position - centre);
+        if (!m_haveTarget[a]) {
+            m_target[a] = map.sceneStart;
+            m_offset[a] = m_target[a] - mapped;
+            m_haveTarget[a] = m_state.connected;
+        }
+        // Clutch or no device: the tool stays; the master is re-indexed on release/reconnection.
+        if (hold) m_offset[a] = m_target[a] - mapped;
+        else m_target[a] = mapped + m_offset[a];
+        const Vec3& x = m_target[a];
+        const ToolContactModel& tm = contact.tools[a];
+        Vec3 p = x;
+        double fn = 0;
+        if (tm.active && !hold) {
+            const double fTarget = tm.forceAt(x);
+            if (fTarget > 0) {
+                // Proxy in series with the local model: kc (s_p − s_t) = f0 − k (s_p + gap).
+                const double kc = map.couplingStiffness, k = tm.k;
+                const double st = (x - tm.p0).dot(tm.n);
+                const double sp = (tm.f0 - k * tm.gap + kc * st) / (kc + k);
+                fn = kc * (sp - st);
+                fn -= map.couplingDamping * map.motionScale * arm.measured_cv.linear.dot(tm.n);
+                fn = std::max(0.0, fn);
+                p = x + (sp - st) * tm.n;
+            }
+        }
+        proxy[a] = p;
+        m_desired.arms[a].servo_cf.force = map.forceScale * fn * tm.n;
+        poses.proxy[a] = p;
+        poses.target[a] = x;
+        poses.orientation[a] = arm.measured_cp.orientation;
+        poses.grip[a] = arm.jaw_measured_js;
+    }
+    SafetyInput in;
+    in.now_ns = now;
+    in.simTimestamp_ns = contact.frame >= 0 ? contact.timestamp_ns : INT64_MIN / 2;
+    in.deviceConnected = m_state.connected;
+    in.pedals = m_state.pedals;
+    const uint32_t rules = m_safety.apply(in, m_desired, m_out);
+    m_device.send(m_out);
+    poses.safetyRules = rules;
+    for (int a = 0; a < arms; ++a) poses.force[a] = m_out.arms[a].servo_cf.force.norm();
+    m_poses.write(poses);
+    for (int a = 0; a < arms; ++a) {
+        if (!m_config.tools[a].enabled) continue;
+        TraceSample s;
+        s.t_ns = now;
+        s.arm = static_cast<uint8_t>(a);
+        s.connected = m_state.connected;
+        s.pedals = m_state.pedals;
+        s.rules = rules;
+        s.device = m_state.arms[a].measured_cp.position;
+        s.tool = proxy[a];
+        s.force = m_out.arms[a].servo_cf.force;
+        s.desired = m_desired.arms[a].servo_cf.force.norm();
+        s.grip = m_state.arms[a].jaw_measured_js;
+        s.contactAge_s = age_s;
+        m_trace.push(s);
+    }
+    m_ticks.fetch_add(1, std::memory_order_relaxed);
+    m_cost.add(monotonicNs() - t0);
+}
+
+void ServoLoop::start() {
+    if (m_running.exchange(true)) return;
+    m_thread = std::thread([this] { run(); });
+}
+
+void ServoLoop::stop() {
+    if (!m_running.exchange(false)) return;
+    if (m_thread.joinable()) m_thread.join();
+}
+
+void ServoLoop::run() {
+    if (m_config.realtimePriority) {
+        sched_param sp{};
+        sp.sched_priority = std::min(80, sched_get_priority_max(SCHED_FIFO));
+        m_rt.store(pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0, std::memory_order_relaxed);
+    }
+    const int64_t period = static_cast<int64_t>(std::llround(1e9 / m_config.rateHz));
+    int64_t next = monotonicNs() + period;
+    int64_t prev = -1;
+    while (m_running.load(std::memory_order_acquire)) {
+        if (next - monotonicNs() > m_config.spin_ns) sleepUntil(next - m_config.spin_ns);
+        int64_t now = monotonicNs();
+        while (now < next) {
+            cpuRelax();
+            now = monotonicNs();
+        }
+        m_wake.add(now - next);
+        if (prev >= 0) {
+            m_period.add(now - prev);
+            m_jitter.add(std::llabs(now - prev - period));
+        }
+        prev = now;
+        tick(m_clock.now_ns());
+        next += period;
+        const int64_t after = monotonicNs();
+        if (after > next) { // overran a whole period: skip to the next deadline in the future
+            m_overruns.fetch_add(1, std::memory_order_relaxed);
+            next += ((after - next) / period + 1) * period;
+        }
+    }
+}
+
+ServoStats ServoLoop::stats() const {
+    ServoStats s;
+    s.ticks = m_ticks.load(std::memory_order_relaxed);
+    s.overruns = m_overruns.load(std::memory_order_relaxed);
+    s.realtimePriority = m_rt.load(std::memory_order_relaxed);
+    s.period = m_period.summary();
+    s.jitter = m_jitter.summary();
+    s.wakeLatency = m_wake.summary();
+    s.tickCost = m_cost.summary();
+    s.contactAge = m_age.summary();
+    s.contactModelsSeen = m_modelsSeen.load(std::memory_order_relaxed);
+    s.maxStepsBehind = m_maxBehind.load(std::memory_order_relaxed);
+    s.safety = m_safety.counts();
+    s.traceDropped = m_trace.dropped();
+    return s;
+}
+
+} // namespace viscera::haptics

@@ -1,0 +1,145 @@
+#pragma once
+/// The 1 kHz haptic servo loop. Each tick: poll the device, map each master to its tool
+/// (workspace scale and offset; the clutch pedal or a disconnection re-indexes instead of
+/// moving the tool), place the tool proxy against the local contact model through a virtual
+/// coupling, compute the force, pass it through the safety filter, send it, publish the tool
+/// poses for the physics thread and push a trace sample. A tick never allocates, locks or
+/// blocks: the contact model and the tool poses travel through SeqLocks, the trace through a
+/// bounded SPSC ring.
+///
+/// start() runs ticks on a thread of its own at `rateHz`, woken by clock_nanosleep(TIMER_ABSTIME)
+/// a little early and then spinning to the deadline; period, wake-up latency and contact-model
+/// age go into preallocated histograms (1 µs bins). Without start(), tick(now) can be driven by
+/// the caller on a ManualClock (lockstep, repeatable).
+#include "haptics/clock.hpp"
+#include "haptics/contact_model.hpp"
+#include "haptics/device.hpp"
+#include "haptics/lockfree.hpp"
+#include "haptics/safety_filter.hpp"
+
+#include <atomic>
+#include <memory>
+#include <thread>
+#include <vector>
+
+namespace viscera::haptics {
+
+/// How one device arm drives one simulated tool.
+struct ToolMapping {
+    bool enabled = false;
+    Vec3 sceneStart = Vec3::Zero(); ///< m, scene: tool centre when the master is at the workspace centre
+    double motionScale = 0.25;      ///< scene metres per device metre
+    double forceScale = 1.0;        ///< device newtons per scene newton
+    double couplingStiffness = 2000.0; ///< N/m, scene: virtual coupling proxy ↔ master
+    double couplingDamping = 2.0;   ///< N·s/m, scene: damps the normal approach while in contact
+};
+
+struct ServoConfig {
+    double rateHz = 1000.0;
+    int64_t spin_ns = 80'000;       ///< wake this early and spin to the deadline
+    bool realtimePriority = true;   ///< try SCHED_FIFO for the servo thread (ignored when refused)
+    SafetyLimits safety;
+    std::array<ToolMapping, kMaxArms> tools{};
+    size_t traceCapacity = 1 << 16; ///< samples (one per enabled arm per tick)
+};
+
+struct TraceSample {
+    int64_t t_ns = 0;
+    uint8_t arm = 0;
+    uint8_t connected = 0;
+    uint32_t pedals = 0;
+    uint32_t rules = 0;       ///< SafetyRule bits
+    Vec3 device = Vec3::Zero(); ///< m, device frame: master position
+    Vec3 tool = Vec3::Zero();   ///< m, scene: proxy (simulated tool) centre
+    Vec3 force = Vec3::Zero();  ///< N, device frame: after the safety filter
+    double desired = 0;       ///< N, magnitude before the safety filter
+    double grip = 0;          ///< rad
+    double contactAge_s = -1; ///< age of the contact model at this tick (-1: none yet)
+};
+
+/// Percentiles from a 1 µs histogram.
+struct Distribution {
+    uint64_t count = 0;
+    double mean_us = 0, p50_us = 0, p99_us = 0, max_us = 0, min_us = 0;
+};
+
+struct ServoStats {
+    uint64_t ticks = 0;
+    uint64_t overruns = 0;        ///< ticks that started more than one period late
+    bool realtimePriority = false; ///< SCHED_FIFO was granted
+    Distribution period;          ///< tick-to-tick interval
+    Distribution jitter;          ///< |period − nominal|
+    Distribution wakeLatency;     ///< tick start − deadline
+    Distribution tickCost;        ///< duration of tick()
+    Distribution contactAge;      ///< age of the contact model at each tick (after the first publish)
+    int64_t contactModelsSeen = 0; ///< distinct physics frames the ticks used
+    int64_t maxStepsBehind = 0;    ///< max over ticks of (physics steps started − model's frame)
+    SafetyCounts safety;
+    uint64_t traceDropped = 0;
+};
+
+class ServoLoop {
+public:
+    /// `device` and `clock` must outlive the loop. Allocates the trace ring and histograms.
+    ServoLoop(Device& device, const Clock& clock, const ServoConfig& config);
+    ~ServoLoop();
+    ServoLoop(const ServoLoop&) = delete;
+    ServoLoop& operator=(const ServoLoop&) = delete;
+
+    // ---- physics thread -----------------------------------------------------------------------
+    void publishContact(const LocalContactModel& model) { m_contact.write(model); }
+    /// Call when a physics step starts: ticks then count how many steps their model lags
+    /// (ServoStats::maxStepsBehind: 1 while the step after the model's is running).
+    void notifyStepStart() { m_stepsStarted.fetch_add(1, std::memory_order_release); }
+    ToolPoseState toolPoses() const { return m_poses.read(); }
+
+    // ---- servo ----------------------------------------------------------------------------------
+    /// One tick at time now_ns (the servo thread calls it; lockstep callers too).
+    void tick(int64_t now_ns);
+    /// Runs ticks on a thread at config.rateHz until stop().
+    void start();
+    void stop();
+    bool running() const { return m_running.load(std::memory_order_acquire); }
+
+    // ---- any thread ------------------------------------------------------------------------------
+    bool popTrace(TraceSample& out) { return m_trace.pop(out); }
+    /// Timing figures; exact after stop(), approximate while running.
+    ServoStats stats() const;
+    uint64_t ticks() const { return m_ticks.load(std::memory_order_relaxed); }
+    const SafetyFilter& safety() const { return m_safety; }
+    const ServoConfig& config() const { return m_config; }
+
+private:
+    struct Histogram {
+        std::vector<std::atomic<uint32_t>> bins; ///< 1 µs each; the last collects overflow
+        std::atomic<uint64_t> count{0};
+        std::atomic<int64_t> sum_ns{0}, max_ns{0}, min_ns{INT64_MAX};
+        explicit Histogram(size_t n) : bins(n) {}
+        void add(int64_t ns) noexcept;
+        Distribution summary() const;
+    };
+    void run();
+
+    Device& m_device;
+    const Clock& m_clock;
+    ServoConfig m_config;
+    SafetyFilter m_safety;
+    SeqLock<LocalContactModel> m_contact;
+    SeqLock<ToolPoseState> m_poses;
+    SpscRing<TraceSample> m_trace;
+    Histogram m_period{20001}, m_jitter{20001}, m_wake{20001}, m_cost{20001}, m_age{200001};
+    std::atomic<uint64_t> m_ticks{0}, m_overruns{0};
+    std::atomic<int64_t> m_modelsSeen{0}, m_stepsStarted{0}, m_maxBehind{0};
+    std::atomic<bool> m_running{false}, m_rt{false};
+    std::thread m_thread;
+    // tick state (servo thread only)
+    DeviceState m_state;
+    DeviceCommand m_desired, m_out;
+    std::array<Vec3, kMaxArms> m_offset{Vec3::Zero(), Vec3::Zero()};
+    std::array<Vec3, kMaxArms> m_target{Vec3::Zero(), Vec3::Zero()};
+    std::array<bool, kMaxArms> m_haveTarget{false, false};
+    int64_t m_lastFrame = -1;
+    uint64_t m_seq = 0;
+};
+
+} // namespace viscera::haptics

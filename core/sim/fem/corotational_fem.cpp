@@ -1,0 +1,713 @@
+#include "sim/fem/corotational_fem.hpp"
+
+#include "sim/fem/sparse_cholesky.hpp"
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+
+namespace viscera::sim::fem {
+namespace {
+
+constexpr const char* kWhere = "sim::fem::CorotationalFem::";
+
+std::string num(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    return buf;
+}
+
+/// A factorization of K_R with everything that depends on the rotations.
+struct Factor {
+    std::unique_ptr<SparseCholesky> chol;
+    std::vector<Mat3> rotations; ///< per tet
+    Eigen::VectorXd f;           ///< f_R, 3#V
+    Eigen::VectorXd u0;          ///< K_R⁻¹ f_R
+    std::vector<Vec3> xAt;       ///< positions the rotations were taken from
+};
+
+struct Group {
+    bool alive = false;
+    ConstraintDesc desc;
+    ConstraintState st;
+};
+
+/// A row of the current solve: free-node terms only, right-hand side in displacement form.
+struct SolveRow {
+    int group = 0, row = 0;
+    std::vector<std::pair<int, Vec3>> terms; // (cache slot, coefficient)
+    std::vector<std::pair<int32_t, Vec3>> nodeTerms; // (node, coefficient), free nodes
+    double bu = 0;
+};
+
+} // namespace
+
+std::string validate(const FemSettings& s) {
+    if (!(s.youngsModulus > 0) || !std::isfinite(s.youngsModulus))
+        return "youngs_modulus " + num(s.youngsModulus) + " must be positive";
+    if (!(s.poissonRatio >= 0 && s.poissonRatio < 0.5)) return "poisson_ratio " + num(s.poissonRatio) + " must be in [0, 0.5)";
+    if (!(s.refactorDisplacement > 0)) return "refactor_displacement " + num(s.refactorDisplacement) + " must be positive";
+    if (s.refactorLatencySteps < 1) return "refactor_latency_steps must be >= 1";
+    if (!(s.rankTolerance > 0 && s.rankTolerance < 1)) return "rank_tolerance " + num(s.rankTolerance) + " must be in (0, 1)";
+    if (!(s.releaseTolerance >= 0) || !(s.activationTolerance >= 0)) return "release/activation tolerances must be >= 0";
+    if (s.maxActiveSetIterations < 1) return "max_active_set_iterations must be >= 1";
+    if (s.cacheEvictSteps < 1) return "cache_evict_steps must be >= 1";
+    return {};
+}
+
+struct CorotationalFem::Impl {
+    FemSettings s;
+    double lambda = 0, mu = 0;
+    std::vector<Tet> tets;
+    std::vector<LinearTet> elems;
+    Eigen::VectorXd fext;
+    UpperPattern pattern;
+    std::vector<int> scatter; // 144 per tet, −1 = not stored
+    std::vector<int> fixedDiag;
+    const std::vector<Vec3>* x0 = nullptr;
+    const std::vector<uint8_t>* fixed = nullptr;
+
+    Factor cur;
+    // constrained-node cache: K_R⁻¹ blocks between cached nodes
+    std::vector<int> slotOf, nodeOf, lastUsed, freeSlots;
+    Eigen::MatrixXd kinv;
+    std::vector<double> rhsWork;
+
+    std::vector<Group> groups;
+    size_t liveGroups = 0;
+    int step = 0;
+
+    // background refactorization
+    struct Job {
+        std::vector<Vec3> x;
+        std::vector<int> nodes;
+        Factor result;
+        Eigen::MatrixXd kinv;
+        bool ok = false;
+        std::string error;
+    };
+    std::unique_ptr<Job> job;
+    std::thread worker;
+    int swapStep = 0;
+
+    // last solve, for tests
+    std::vector<SolveRow> lastRows;
+    Eigen::VectorXd lastLambda;
+
+    ~Impl() {
+        if (worker.joinable()) worker.join();
+    }
+
+    int n3() const { return 3 * static_cast<int>(x0->size()); }
+
+    void assemble(const std::vector<Mat3>& R, std::vector<double>& values, Eigen::VectorXd& f) const {
+        values.assign(pattern.rowIdx.size(), 0.0);
+        for (int d : fixedDiag) values[d] = 1.0;
+        f = fext;
+        const auto& X0 = *x0;
+        for (size_t t = 0; t < tets.size(); ++t) {
+            const Mat12& K = elems[t].stiffness;
+            const Mat3& r = R[t];
+            Mat12 KR;
+            for (int a = 0; a < 4; ++a)
+                for (int b = 0; b < 4; ++b) KR.block<3, 3>(3 * a, 3 * b) = r * K.block<3, 3>(3 * a, 3 * b) * r.transpose();
+            const int* map = &scatter[t * 144];
+            for (int i = 0; i < 144; ++i)
+                if (map[i] >= 0) values[map[i]] += KR(i / 12, i % 12);
+            if (r.isIdentity(0)) continue;
+            Vec12 d; // x0 − Rᵀ x0
+            for (int a = 0; a < 4; ++a) {
+                const Vec3& p = X0[tets[t][a]];
+                d.segment<3>(3 * a) = p - r.transpose() * p;
+            }
+            const Vec12 kd = K * d;
+            for (int a = 0; a < 4; ++a) f.segment<3>(3 * tets[t][a]) += r * kd.segment<3>(3 * a);
+        }
+        for (size_t v = 0; v < fixed->size(); ++v)
+            if ((*fixed)[v]) f.segment<3>(3 * v).setZero();
+    }
+
+    std::vector<Mat3> rotationsAt(const std::vector<Vec3>& x) const {
+        std::vector<Mat3> R(tets.size(), Mat3::Identity());
+        if (!s.corotational) return R;
+        for (size_t t = 0; t < tets.size(); ++t) {
+            const Tet& e = tets[t];
+            R[t] = polarRotation(deformationGradient(elems[t], {x[e[0]], x[e[1]], x[e[2]], x[e[3]]}));
+        }
+        return R;
+    }
+
+    bool buildFactor(const std::vector<Vec3>& x, Factor& out, std::string& error) const {
+        out.rotations = rotationsAt(x);
+        out.xAt = x;
+        std::vector<double> values;
+        assemble(out.rotations, values, out.f);
+        if (!out.chol) out.chol = std::make_unique<SparseCholesky>(pattern);
+        if (!out.chol->factorize(values, error)) return false;
+        out.u0 = out.f;
+        if (!out.chol->solveInPlace(out.u0.data(), 1, error)) return false;
+        return out.u0.allFinite();
+    }
+
+    /// K⁻¹ blocks between `nodes` (3|N| × 3|N|) with factor F.
+    static bool inverseBlocks(Factor& F, const std::vector<int>& nodes, int n3, Eigen::MatrixXd& out,
+                              std::string& error) {
+        const int k = static_cast<int>(nodes.size());
+        Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n3, 3 * k);
+        for (int i = 0; i < k; ++i)
+            for (int c = 0; c < 3; ++c) rhs(3 * nodes[i] + c, 3 * i + c) = 1.0;
+        if (!F.chol->solveInPlace(rhs.data(), 3 * k, error)) return false;
+        out.resize(3 * k, 3 * k);
+        for (int i = 0; i < k; ++i) out.middleRows(3 * i, 3) = rhs.middleRows(3 * nodes[i], 3);
+        return true;
+    }
+
+    int allocateSlot(int node) {
+        int slot;
+        if (!freeSlots.empty()) {
+            slot = freeSlots.back();
+            freeSlots.pop_back();
+            nodeOf[slot] = node;
+        } else {
+            slot = static_cast<int>(nodeOf.size());
+            nodeOf.push_back(node);
+            lastUsed.push_back(step);
+            if (3 * static_cast<int>(nodeOf.size()) > kinv.rows()) {
+                const int cap = std::max<int>(96, 2 * static_cast<int>(kinv.rows()));
+                Eigen::MatrixXd grown = Eigen::MatrixXd::Zero(cap, cap);
+                grown.topLeftCorner(kinv.rows(), kinv.cols()) = kinv;
+                kinv.swap(grown);
+            }
+        }
+        slotOf[node] = slot;
+        lastUsed[slot] = step;
+        return slot;
+    }
+
+    /// Caches the K⁻¹ columns of `nodes` (not yet cached) with the current factor.
+    bool cacheNodes(const std::vector<int>& nodes, std::string& error) {
+        if (nodes.empty()) return true;
+        const int k = static_cast<int>(nodes.size());
+        const int n = n3();
+        rhsWork.assign(static_cast<size_t>(n) * 3 * k, 0.0);
+        for (int i = 0; i < k; ++i)
+            for (int c = 0; c < 3; ++c) rhsWork[static_cast<size_t>(3 * i + c) * n + 3 * nodes[i] + c] = 1.0;
+        if (!cur.chol->solveInPlace(rhsWork.data(), 3 * k, error)) return false;
+        std::vector<int> slots(k);
+        for (int i = 0; i < k; ++i) slots[i] = allocateSlot(nodes[i]);
+        for (int i = 0; i < k; ++i) {
+            const int si = slots[i];
+            for (size_t s2 = 0; s2 < nodeOf.size(); ++s2) {
+                const int node = nodeOf[s2];
+                if (node < 0) continue;
+                for (int c = 0; c < 3; ++c)
+                    for (int r = 0; r < 3; ++r) {
+                        const double v = rhsWork[static_cast<size_t>(3 * i + c) * n + 3 * node + r];
+                        kinv(3 * s2 + r, 3 * si + c) = v;
+                        kinv(3 * si + c, 3 * s2 + r) = v;
+                    }
+            }
+        }
+        return true;
+    }
+
+    void resetCache() {
+        std::fill(slotOf.begin(), slotOf.end(), -1);
+        nodeOf.clear();
+        lastUsed.clear();
+        freeSlots.clear();
+    }
+
+    void evict() {
+        for (size_t s2 = 0; s2 < nodeOf.size(); ++s2)
+            if (nodeOf[s2] >= 0 && step - lastUsed[s2] > s.cacheEvictSteps) {
+                slotOf[nodeOf[s2]] = -1;
+                nodeOf[s2] = -1;
+                freeSlots.push_back(static_cast<int>(s2));
+            }
+    }
+
+    void takeJob(FemSolveStats& st) {
+        worker.join();
+        std::unique_ptr<Job> j = std::move(job);
+        if (!j->ok) {
+            st.error = "background refactorization failed (the previous factor stays in use): " + j->error;
+            cur.xAt = j->x; // do not retry at once
+            return;
+        }
+        cur = std::move(j->result);
+        resetCache();
+        const int k = static_cast<int>(j->nodes.size());
+        kinv = Eigen::MatrixXd::Zero(std::max(96, 3 * k), std::max(96, 3 * k));
+        kinv.topLeftCorner(3 * k, 3 * k) = j->kinv;
+        for (int i = 0; i < k; ++i) {
+            nodeOf.push_back(j->nodes[i]);
+            lastUsed.push_back(step);
+            slotOf[j->nodes[i]] = i;
+        }
+        st.refactored = true;
+    }
+
+    void startJob(const std::vector<Vec3>& x) {
+        job = std::make_unique<Job>();
+        job->x = x;
+        for (int node : nodeOf)
+            if (node >= 0) job->nodes.push_back(node);
+        swapStep = step + s.refactorLatencySteps;
+        Job* jp = job.get();
+        const int n = n3();
+        worker = std::thread([this, jp, n] {
+            try {
+                jp->ok = buildFactor(jp->x, jp->result, jp->error) &&
+                         inverseBlocks(jp->result, jp->nodes, n, jp->kinv, jp->error);
+            } catch (const std::exception& e) {
+                jp->ok = false;
+                jp->error = e.what();
+            }
+        });
+    }
+};
+
+CorotationalFem::~CorotationalFem() = default;
+
+std::unique_ptr<CorotationalFem> CorotationalFem::create(const TetMesh& mesh, const std::vector<int32_t>& fixedNodes,
+                                                         const FemSettings& settings, std::vector<Vec3> externalForces) {
+    auto fail = [](const std::string& why) { throw std::invalid_argument(std::string(kWhere) + "create(): " + why); };
+    if (auto why = validate(settings); !why.empty()) fail(why);
+    const size_t nv = mesh.vertexCount();
+    std::unique_ptr<CorotationalFem> w(new CorotationalFem());
+    w->m = std::make_unique<Impl>();
+    Impl& m = *w->m;
+    m.s = settings;
+    const double E = settings.youngsModulus, nu = settings.poissonRatio;
+    m.mu = E / (2 * (1 + nu));
+    m.lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+    w->m_x0 = mesh.positions();
+    w->m_x = w->m_x0;
+    w->m_fixed.assign(nv, 0);
+    m.x0 = &w->m_x0;
+    m.fixed = &w->m_fixed;
+    for (int32_t v : fixedNodes) {
+        if (v < 0 || static_cast<size_t>(v) >= nv)
+            fail("fixed node " + std::to_string(v) + " is out of range (mesh has " + std::to_string(nv) + " nodes)");
+        w->m_fixed[v] = 1;
+    }
+    if (!externalForces.empty() && externalForces.size() != nv)
+        fail("external forces have " + std::to_string(externalForces.size()) + " entries, the mesh " +
+             std::to_string(nv) + " nodes");
+    m.fext = Eigen::VectorXd::Zero(3 * nv);
+    for (size_t v = 0; v < externalForces.size(); ++v) {
+        if (!externalForces[v].allFinite()) fail("external force at node " + std::to_string(v) + " is not finite");
+        m.fext.segment<3>(3 * v) = externalForces[v];
+    }
+    m.tets = mesh.tets();
+    m.elems.reserve(m.tets.size());
+    double edgeSum = 0;
+    for (size_t t = 0; t < m.tets.size(); ++t) {
+        const Tet& e = m.tets[t];
+        const std::array<Vec3, 4> x = {w->m_x0[e[0]], w->m_x0[e[1]], w->m_x0[e[2]], w->m_x0[e[3]]};
+        try {
+            m.elems.push_back(makeLinearTet(x, m.lambda, m.mu));
+        } catch (const std::invalid_argument&) {
+            fail("tet " + std::to_string(t) + " has a non-positive rest volume");
+        }
+        edgeSum += (x[1] - x[0]).norm() + (x[2] - x[0]).norm() + (x[3] - x[0]).norm() + (x[2] - x[1]).norm() +
+                   (x[3] - x[1]).norm() + (x[3] - x[2]).norm();
+    }
+    w->m_meanEdge = edgeSum / (6.0 * static_cast<double>(std::max<size_t>(1, m.tets.size())));
+
+    // Pattern: upper triangle over free DOFs plus the diagonal of every DOF.
+    const int n = static_cast<int>(3 * nv);
+    std::vector<std::vector<int>> cols(n);
+    for (int d = 0; d < n; ++d) cols[d].push_back(d);
+    for (const Tet& e : m.tets)
+        for (int a = 0; a < 4; ++a)
+            for (int b = 0; b < 4; ++b) {
+                if (w->m_fixed[e[a]] || w->m_fixed[e[b]]) continue;
+                for (int i = 0; i < 3; ++i)
+                    for (int j = 0; j < 3; ++j) {
+                        const int r = 3 * e[a] + i, c = 3 * e[b] + j;
+                        if (r <= c) cols[c].push_back(r);
+                    }
+            }
+    m.pattern.colPtr.assign(n + 1, 0);
+    for (int c = 0; c < n; ++c) {
+        std::sort(cols[c].begin(), cols[c].end());
+        cols[c].erase(std::unique(cols[c].begin(), cols[c].end()), cols[c].end());
+        m.pattern.colPtr[c + 1] = m.pattern.colPtr[c] + static_cast<int>(cols[c].size());
+    }
+    for (auto& c : cols) m.pattern.rowIdx.insert(m.pattern.rowIdx.end(), c.begin(), c.end());
+    m.scatter.assign(m.tets.size() * 144, -1);
+    for (size_t t = 0; t < m.tets.size(); ++t) {
+        const Tet& e = m.tets[t];
+        for (int i = 0; i < 12; ++i)
+            for (int j = 0; j < 12; ++j) {
+                if (w->m_fixed[e[i / 3]] || w->m_fixed[e[j / 3]]) continue;
+                const int r = 3 * e[i / 3] + i % 3, c = 3 * e[j / 3] + j % 3;
+                if (r <= c) m.scatter[t * 144 + i * 12 + j] = m.pattern.find(r, c);
+            }
+    }
+    for (size_t v = 0; v < nv; ++v)
+        if (w->m_fixed[v])
+            for (int c = 0; c < 3; ++c) m.fixedDiag.push_back(m.pattern.find(3 * static_cast<int>(v) + c, 3 * static_cast<int>(v) + c));
+    m.slotOf.assign(nv, -1);
+    std::string error;
+    if (!m.buildFactor(w->m_x0, m.cur, error)) fail(error);
+    w->m_factorizations = 1;
+    for (size_t v = 0; v < nv; ++v) w->m_x[v] = w->m_x0[v] + m.cur.u0.segment<3>(3 * v);
+    return w;
+}
+
+int CorotationalFem::addConstraint(ConstraintDesc desc) {
+    const size_t nv = m_x0.size();
+    for (size_t r = 0; r < desc.rows.size(); ++r) {
+        for (const ConstraintTerm& t : desc.rows[r].terms)
+            if (t.node < 0 || static_cast<size_t>(t.node) >= nv || !t.a.allFinite())
+                throw std::invalid_argument(std::string(kWhere) + "addConstraint(): row " + std::to_string(r) +
+                                            " has a node out of range or a non-finite coefficient");
+        if (!std::isfinite(desc.rows[r].b))
+            throw std::invalid_argument(std::string(kWhere) + "addConstraint(): row " + std::to_string(r) +
+                                        " has a non-finite right-hand side");
+    }
+    if (desc.kind == ConstraintKind::Unilateral && desc.weights.empty()) desc.weights.assign(desc.rows.size(), 1.0);
+    Group g;
+    g.alive = true;
+    g.st.active = desc.kind == ConstraintKind::Equality || desc.startActive;
+    g.st.lambda.assign(desc.rows.size(), 0.0);
+    g.st.status.assign(desc.rows.size(), RowStatus::Inactive);
+    g.desc = std::move(desc);
+    for (size_t i = 0; i < m->groups.size(); ++i)
+        if (!m->groups[i].alive) {
+            m->groups[i] = std::move(g);
+            ++m->liveGroups;
+            return static_cast<int>(i);
+        }
+    m->groups.push_back(std::move(g));
+    ++m->liveGroups;
+    return static_cast<int>(m->groups.size() - 1);
+}
+
+void CorotationalFem::setRows(int id, std::vector<ConstraintRow> rows) {
+    Group& g = m->groups.at(id);
+    if (g.desc.kind == ConstraintKind::Unilateral && g.desc.weights.size() != rows.size())
+        g.desc.weights.assign(rows.size(), 1.0);
+    g.desc.rows = std::move(rows);
+    g.st.lambda.assign(g.desc.rows.size(), 0.0);
+    g.st.status.assign(g.desc.rows.size(), RowStatus::Inactive);
+}
+
+void CorotationalFem::setRhs(int id, int row, double b) { m->groups.at(id).desc.rows.at(row).b = b; }
+
+void CorotationalFem::removeConstraint(int id) {
+    if (!hasConstraint(id)) return;
+    m->groups[id] = Group{};
+    --m->liveGroups;
+}
+
+bool CorotationalFem::hasConstraint(int id) const {
+    return id >= 0 && static_cast<size_t>(id) < m->groups.size() && m->groups[id].alive;
+}
+const ConstraintState& CorotationalFem::state(int id) const { return m->groups.at(id).st; }
+const ConstraintDesc& CorotationalFem::constraint(int id) const { return m->groups.at(id).desc; }
+size_t CorotationalFem::constraintCount() const { return m->liveGroups; }
+
+int CorotationalFem::cachedNodes() const {
+    int c = 0;
+    for (int n : m->nodeOf) c += n >= 0;
+    return c;
+}
+
+bool CorotationalFem::refactorNow(std::string* error) {
+    if (m->worker.joinable()) m->worker.join();
+    m->job.reset();
+    Factor f;
+    std::string err;
+    if (!m->buildFactor(m_x, f, err)) {
+        if (error) *error = err;
+        return false;
+    }
+    m->cur = std::move(f);
+    m->resetCache();
+    ++m_factorizations;
+    return true;
+}
+
+FemSolveStats CorotationalFem::solve() {
+    Impl& I = *m;
+    FemSolveStats st;
+    ++I.step;
+    if (I.job && I.step >= I.swapStep) {
+        I.takeJob(st);
+        if (st.refactored) ++m_factorizations;
+    }
+    I.evict();
+    const int n = I.n3();
+    const auto& X0 = m_x0;
+
+    std::vector<int> order;
+    for (size_t g = 0; g < I.groups.size(); ++g)
+        if (I.groups[g].alive) order.push_back(static_cast<int>(g));
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return I.groups[a].desc.priority < I.groups[b].desc.priority; });
+    for (int g : order) {
+        auto& gs = I.groups[g].st;
+        std::fill(gs.lambda.begin(), gs.lambda.end(), 0.0);
+        std::fill(gs.status.begin(), gs.status.end(), RowStatus::Inactive);
+    }
+
+    std::vector<SolveRow> rows;
+    Eigen::VectorXd lam, u(n);
+    auto buildRows = [&]() -> bool {
+        rows.clear();
+        std::vector<int> missing;
+        for (int g : order) {
+            auto& status = I.groups[g].st.status;
+            std::fill(status.begin(), status.end(), RowStatus::Inactive);
+        }
+        for (int g : order) {
+            const Group& G = I.groups[g];
+            if (!G.st.active) continue;
+            for (size_t r = 0; r < G.desc.rows.size(); ++r) {
+                SolveRow sr;
+                sr.group = g;
+                sr.row = static_cast<int>(r);
+                sr.bu = G.desc.rows[r].b;
+                for (const ConstraintTerm& t : G.desc.rows[r].terms) {
+                    sr.bu -= t.a.dot(X0[t.node]);
+                    if (m_fixed[t.node] || t.a.squaredNorm() == 0) continue;
+                    sr.nodeTerms.emplace_back(t.node, t.a);
+                    if (I.slotOf[t.node] < 0 && std::find(missing.begin(), missing.end(), t.node) == missing.end())
+                        missing.push_back(t.node);
+                }
+                rows.push_back(std::move(sr));
+            }
+        }
+        if (!missing.empty()) {
+            if (!I.cacheNodes(missing, st.error)) return false;
+            st.newCachedNodes += static_cast<int>(missing.size());
+            st.substitutions += 3 * static_cast<int>(missing.size());
+        }
+        for (SolveRow& sr : rows)
+            for (auto& [node, a] : sr.nodeTerms) {
+                const int slot = I.slotOf[node];
+                I.lastUsed[slot] = I.step;
+                sr.terms.emplace_back(slot, a);
+            }
+        return true;
+    };
+
+    // Dense Schur system on the rows: returns false on failure. Fills lam (per row; 0 if rejected).
+    std::vector<uint8_t> rejected;
+    auto solveSchur = [&]() {
+        const int mrows = static_cast<int>(rows.size());
+        const int S = static_cast<int>(I.nodeOf.size());
+        Eigen::MatrixXd W(3 * S, mrows);
+        Eigen::MatrixXd M(mrows, mrows);
+        Eigen::VectorXd q(mrows);
+        for (int r = 0; r < mrows; ++r) {
+            auto w = W.col(r);
+            w.setZero();
+            for (const auto& [slot, a] : rows[r].terms) w.noalias() += I.kinv.block(0, 3 * slot, 3 * S, 3) * a;
+            double cu0 = 0;
+            for (const auto& [node, a] : rows[r].nodeTerms) cu0 += a.dot(I.cur.u0.segment<3>(3 * node));
+            q[r] = cu0 - rows[r].bu;
+        }
+        for (int r = 0; r < mrows; ++r)
+            for (int c = 0; c <= r; ++c) {
+                double v = 0;
+                for (const auto& [slot, a] : rows[c].terms) v += a.dot(W.col(r).segment<3>(3 * slot));
+                M(r, c) = M(c, r) = v;
+            }
+        // Pivoted incremental Cholesky in row order; a row whose pivot is too small is rejected.
+        Eigen::MatrixXd L = Eigen::MatrixXd::Zero(mrows, mrows);
+        std::vector<int> acc;
+        rejected.assign(mrows, 0);
+        Eigen::VectorXd l(mrows);
+        for (int r = 0; r < mrows; ++r) {
+            const int k = static_cast<int>(acc.size());
+            for (int i = 0; i < k; ++i) {
+                double v = M(acc[i], r);
+                for (int j = 0; j < i; ++j) v -= L(i, j) * l[j];
+                l[i] = v / L(i, i);
+            }
+            const double d = M(r, r) - l.head(k).squaredNorm();
+            if (!(M(r, r) > 0) || !(d > I.s.rankTolerance * M(r, r))) {
+                rejected[r] = 1;
+                continue;
+            }
+            L.row(k).head(k) = l.head(k).transpose();
+            L(k, k) = std::sqrt(d);
+            acc.push_back(r);
+        }
+        const int k = static_cast<int>(acc.size());
+        Eigen::VectorXd qa(k);
+        for (int i = 0; i < k; ++i) qa[i] = q[acc[i]];
+        const auto Lk = L.topLeftCorner(k, k).triangularView<Eigen::Lower>();
+        Eigen::VectorXd y = Lk.solve(qa);
+        Eigen::VectorXd la = Lk.transpose().solve(y);
+        lam = Eigen::VectorXd::Zero(mrows);
+        for (int i = 0; i < k; ++i) lam[acc[i]] = la[i];
+        // Classify rejected rows by the residual they would keep.
+        for (int r = 0; r < mrows; ++r) {
+            auto& status = I.groups[rows[r].group].st.status[rows[r].row];
+            if (!rejected[r]) {
+                status = RowStatus::Enforced;
+                continue;
+            }
+            double res = q[r];
+            for (int i = 0; i < k; ++i) res -= M(r, acc[i]) * la[i];
+            double cn = 0;
+            for (const auto& [node, a] : rows[r].nodeTerms) cn += a.squaredNorm();
+            const bool consistent = std::abs(res) <= I.s.activationTolerance * std::max(1.0, std::sqrt(cn));
+            status = consistent ? RowStatus::Redundant : RowStatus::Incompatible;
+        }
+    };
+
+    bool ok = true;
+    for (int outer = 0; outer < I.s.maxActiveSetIterations && ok; ++outer) {
+        bool changed = false;
+        for (int inner = 0; inner < I.s.maxActiveSetIterations; ++inner) {
+            ++st.activeSetIterations;
+            if (!buildRows()) {
+                ok = false;
+                break;
+            }
+            solveSchur();
+            // Release unilateral groups that pull.
+            bool released = false;
+            for (int g : order) {
+                Group& G = I.groups[g];
+                if (G.desc.kind != ConstraintKind::Unilateral || !G.st.active) continue;
+                double s = 0;
+                for (size_t r = 0; r < rows.size(); ++r)
+                    if (rows[r].group == g) s += G.desc.weights[rows[r].row] * lam[r];
+                if (s > I.s.releaseTolerance) {
+                    G.st.active = false;
+                    released = true;
+                }
+            }
+            if (!released) break;
+        }
+        if (!ok) break;
+        // One substitution u = K⁻¹ (f − Cᵀλ).
+        u = I.cur.f;
+        for (size_t r = 0; r < rows.size(); ++r)
+            if (lam[r] != 0)
+                for (const auto& [node, a] : rows[r].nodeTerms) u.segment<3>(3 * node) -= lam[r] * a;
+        if (!I.cur.chol->solveInPlace(u.data(), 1, st.error)) {
+            ok = false;
+            break;
+        }
+        ++st.substitutions;
+        // Activate violated unilateral groups.
+        for (int g : order) {
+            Group& G = I.groups[g];
+            if (G.desc.kind != ConstraintKind::Unilateral || G.st.active) continue;
+            double viol = 0;
+            for (size_t r = 0; r < G.desc.rows.size(); ++r) {
+                double v = -G.desc.rows[r].b;
+                for (const ConstraintTerm& t : G.desc.rows[r].terms)
+                    v += t.a.dot(X0[t.node] + (m_fixed[t.node] ? Vec3::Zero() : Vec3(u.segment<3>(3 * t.node))));
+                viol += G.desc.weights[r] * v;
+            }
+            if (viol < -I.s.activationTolerance && outer + 1 < I.s.maxActiveSetIterations) {
+                G.st.active = true;
+                changed = true;
+            }
+        }
+        if (!changed) break;
+    }
+    st.finite = ok && u.allFinite() && (lam.size() == 0 || lam.allFinite());
+    if (!st.finite) {
+        if (st.error.empty()) st.error = "the solve produced a non-finite value; the previous state is kept";
+        for (int g : order) {
+            auto& gs = I.groups[g].st;
+            std::fill(gs.lambda.begin(), gs.lambda.end(), 0.0);
+        }
+        return st;
+    }
+    for (size_t r = 0; r < rows.size(); ++r) {
+        I.groups[rows[r].group].st.lambda[rows[r].row] = lam[r];
+        if (rejected.size() > r && rejected[r]) {
+            const RowStatus s2 = I.groups[rows[r].group].st.status[rows[r].row];
+            st.redundant += s2 == RowStatus::Redundant;
+            st.incompatible += s2 == RowStatus::Incompatible;
+        } else {
+            ++st.rows;
+        }
+    }
+    I.lastRows = rows;
+    I.lastLambda = lam;
+    double maxMove = 0;
+    for (size_t v = 0; v < m_x.size(); ++v) {
+        m_x[v] = X0[v] + u.segment<3>(3 * v);
+        maxMove = std::max(maxMove, (m_x[v] - I.cur.xAt[v]).norm());
+    }
+    // Rotations are stale: refactor (now, or on the worker).
+    if (I.s.corotational && !I.job && maxMove > I.s.refactorDisplacement * m_meanEdge) {
+        if (I.s.refactorMode == RefactorMode::Synchronous) {
+            std::string err;
+            if (refactorNow(&err))
+                st.refactored = true;
+            else
+                st.error = err;
+        } else {
+            I.startJob(m_x);
+        }
+    }
+    return st;
+}
+
+double CorotationalFem::elasticEnergy() const {
+    double e = 0;
+    for (size_t t = 0; t < m->tets.size(); ++t) {
+        const Tet& T = m->tets[t];
+        const Mat3& R = m->cur.rotations[t];
+        Vec12 d;
+        for (int a = 0; a < 4; ++a) d.segment<3>(3 * a) = R.transpose() * m_x[T[a]] - m_x0[T[a]];
+        e += 0.5 * d.dot(m->elems[t].stiffness * d);
+    }
+    return e;
+}
+
+Eigen::SparseMatrix<double> CorotationalFem::stiffnessMatrix() const {
+    std::vector<double> values;
+    Eigen::VectorXd f;
+    m->assemble(m->cur.rotations, values, f);
+    const int n = m->n3();
+    std::vector<Eigen::Triplet<double>> trip;
+    for (int c = 0; c < n; ++c)
+        for (int k = m->pattern.colPtr[c]; k < m->pattern.colPtr[c + 1]; ++k) {
+            const int r = m->pattern.rowIdx[k];
+            trip.emplace_back(r, c, values[k]);
+            if (r != c) trip.emplace_back(c, r, values[k]);
+        }
+    Eigen::SparseMatrix<double> K(n, n);
+    K.setFromTriplets(trip.begin(), trip.end());
+    return K;
+}
+
+Eigen::VectorXd CorotationalFem::forceVector() const { return m->cur.f; }
+
+void CorotationalFem::lastSystem(Eigen::MatrixXd& C, Eigen::VectorXd& bu, Eigen::VectorXd& lambda) const {
+    const auto& rows = m->lastRows;
+    std::vector<int> keep;
+    for (size_t r = 0; r < rows.size(); ++r)
+        if (m->groups[rows[r].group].alive &&
+            m->groups[rows[r].group].st.status[rows[r].row] == RowStatus::Enforced)
+            keep.push_back(static_cast<int>(r));
+    C = Eigen::MatrixXd::Zero(keep.size(), m->n3());
+    bu.resize(keep.size());
+    lambda.resize(keep.size());
+    for (size_t i = 0; i < keep.size(); ++i) {
+        const SolveRow& sr = rows[keep[i]];
+        for (const auto& [node, a] : sr.nodeTerms) C.row(i).segment<3>(3 * node) += a.transpose();
+        bu[i] = sr.bu;
+        lambda[i] = m->lastLambda[keep[i]];
+    }
+}
+
+} // namespace viscera::sim::fem

@@ -1,0 +1,165 @@
+#pragma once
+/// Quasi-static corotational linear FEM on a TetMesh with algebraic constraints Cx = b solved
+/// through the Schur complement of the stiffness matrix [B §2.2.3–2.2.6].
+///
+/// Each solve finds the displacement u (#V × 3, metres, from the rest state) of
+///     minimize ½ uᵀK_R u − f_Rᵀu   subject to  C u = b_u,
+/// with K_R = Σ_e R_e K_e R_eᵀ (element rotations R_e frozen at the last factorization) and
+/// f_R = f_ext + Σ_e R_e K_e (x0_e − R_eᵀ x0_e). Fixed nodes are identity rows of K_R [B eq. 2.56–2.59];
+/// constraint terms on fixed nodes move to the right-hand side.
+///
+/// Cost model (what makes a step cheap):
+///  - K_R is factorized (CHOLMOD LLᵀ, pattern analysed once) only when the nodes have moved by more
+///    than `refactorDisplacement` mean edge lengths since the last factorization; in
+///    RefactorMode::Background that work runs on a worker thread and the new factor is swapped in
+///    exactly `refactorLatencySteps` solves later (deterministic; the solve waits only if the worker
+///    is late). u0 = K_R⁻¹ f_R is cached with the factor.
+///  - K_R⁻¹ restricted to the constrained nodes is cached (three substitutions per node, once, when
+///    a node first appears in a constraint). Every constraint row's column K_R⁻¹cᵀ at the
+///    constrained nodes is a combination of these blocks, so rows may be added, removed or change
+///    their coefficients without any substitution, and M = C K_R⁻¹ Cᵀ [B eq. 2.67] costs a small
+///    dense product.
+///  - a solve is: build M and q = C u0 − b, a pivoted dense Cholesky that rejects rows whose pivot
+///    falls below `rankTolerance` (redundant or incompatible rows, [B §2.2.6]) instead of producing a
+///    singular system, the multipliers λ, and one substitution u = K_R⁻¹(f_R − Cᵀλ).
+/// Unilateral groups (contact, thread pull) are released when their weighted multiplier shows that
+/// they pull (Σ w_r λ_r > releaseTolerance) and re-activated when violated; the active set is
+/// iterated at most `maxActiveSetIterations` times.
+/// Sign convention: K u + Cᵀλ = f, so the constraint force on the nodes is −Cᵀλ.
+/// Nothing here throws after create(); failures are reported in FemSolveStats.
+#include "sim/fem/element.hpp"
+#include "sim/mesh/tet_mesh.hpp"
+
+#include <Eigen/SparseCore>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace viscera::sim::fem {
+
+enum class RefactorMode { Synchronous, Background };
+
+struct FemSettings {
+    double youngsModulus = 50e3; ///< Pa
+    double poissonRatio = 0.45;  ///< in [0, 0.5)
+    bool corotational = true;    ///< false: linear FEM, one factorization for the whole run
+    /// Refactor when some node moved by more than this many mean edge lengths since the last
+    /// factorization (the rotations are then re-extracted from the current positions).
+    double refactorDisplacement = 0.25;
+    RefactorMode refactorMode = RefactorMode::Background;
+    int refactorLatencySteps = 3;  ///< Background: solves between the request and the swap, >= 1
+    double rankTolerance = 1e-9;   ///< relative pivot below which a row is rejected
+    double releaseTolerance = 0;   ///< N; unilateral group released when Σ w λ exceeds it
+    double activationTolerance = 1e-7; ///< m; inactive unilateral group activated when violated by more
+    int maxActiveSetIterations = 6;
+    int cacheEvictSteps = 400;     ///< constrained-node cache entries unused this long are freed
+};
+
+/// Empty when valid, else the rule that failed ("poisson_ratio 0.5 must be in [0, 0.5)").
+std::string validate(const FemSettings& s);
+
+enum class ConstraintKind { Equality, Unilateral };
+
+struct ConstraintTerm {
+    int32_t node = 0;
+    Vec3 a = Vec3::Zero(); ///< coefficient of the node's position
+};
+
+/// Σ_terms a · x_node = b, positions in metres (b in metres times the coefficient's unit).
+struct ConstraintRow {
+    std::vector<ConstraintTerm> terms;
+    double b = 0;
+};
+
+struct ConstraintDesc {
+    ConstraintKind kind = ConstraintKind::Equality;
+    std::vector<ConstraintRow> rows;
+    /// Unilateral only: per-row weights w of the release test Σ w_r λ_r > releaseTolerance and of
+    /// the violation measure Σ w_r (c_r x − b_r) < −activationTolerance; empty = all 1.
+    std::vector<double> weights;
+    int priority = 0;       ///< rows are kept in (priority, id) order when they conflict
+    bool startActive = true; ///< Unilateral: enforced from the first solve
+};
+
+enum class RowStatus { Inactive, Enforced, Redundant, Incompatible };
+
+struct ConstraintState {
+    bool active = false;              ///< Unilateral: currently enforced
+    std::vector<double> lambda;       ///< per row, N (per unit coefficient); 0 when not enforced
+    std::vector<RowStatus> status;    ///< per row
+};
+
+struct FemSolveStats {
+    int rows = 0;            ///< rows enforced
+    int redundant = 0;       ///< rows rejected: dependent and consistent
+    int incompatible = 0;    ///< rows rejected: dependent and inconsistent
+    int activeSetIterations = 0;
+    int substitutions = 0;   ///< forward/backward substitutions (columns) this solve
+    int newCachedNodes = 0;
+    bool refactored = false; ///< a new factor was taken into use
+    bool finite = true;      ///< false: the result was not finite and was discarded
+    std::string error;       ///< the last failure (empty when none)
+};
+
+class CorotationalFem {
+public:
+    /// Throws std::invalid_argument naming the rule: bad settings, fixed node out of range, an
+    /// element with non-positive rest volume, external forces of the wrong size, or a stiffness
+    /// matrix that is not positive definite (too few fixed nodes).
+    static std::unique_ptr<CorotationalFem> create(const TetMesh& mesh, const std::vector<int32_t>& fixedNodes,
+                                                   const FemSettings& settings,
+                                                   std::vector<Vec3> externalForces = {});
+    ~CorotationalFem();
+    CorotationalFem(const CorotationalFem&) = delete;
+    CorotationalFem& operator=(const CorotationalFem&) = delete;
+
+    // ---- constraints ------------------------------------------------------------------------
+    /// Returns the group id (>= 0). Throws std::invalid_argument on a node out of range or a
+    /// non-finite coefficient (this is set-up, not per-frame; per-frame users validate first).
+    int addConstraint(ConstraintDesc desc);
+    /// Replaces the rows (same count or not); keeps the id and the active flag.
+    void setRows(int id, std::vector<ConstraintRow> rows);
+    void setRhs(int id, int row, double b);
+    void removeConstraint(int id);
+    bool hasConstraint(int id) const;
+    const ConstraintState& state(int id) const;
+    const ConstraintDesc& constraint(int id) const;
+    size_t constraintCount() const;
+
+    // ---- solve ------------------------------------------------------------------------------
+    /// One quasi-static solve with the current constraints. Never throws.
+    FemSolveStats solve();
+    /// Re-extracts the rotations from the current positions and refactorizes now (synchronous).
+    bool refactorNow(std::string* error = nullptr);
+
+    const std::vector<Vec3>& positions() const { return m_x; }
+    const std::vector<Vec3>& restPositions() const { return m_x0; }
+    size_t nodeCount() const { return m_x0.size(); }
+    bool isFixed(int32_t node) const { return m_fixed[node] != 0; }
+    /// Elastic energy ½ uᵀ K_R u − (f_R − f_ext)ᵀu of the current state under the current rotations, J.
+    double elasticEnergy() const;
+    int factorizations() const { return m_factorizations; }
+    int cachedNodes() const;
+    double meanEdgeLength() const { return m_meanEdge; }
+
+    // ---- for tests and reports ----------------------------------------------------------------
+    /// The assembled K_R (3#V × 3#V, full symmetric, fixed rows identity) and f_R of the current factor.
+    Eigen::SparseMatrix<double> stiffnessMatrix() const;
+    Eigen::VectorXd forceVector() const;
+    /// The enforced rows of the last solve in displacement form (C u = b_u), in solve order, and
+    /// their multipliers.
+    void lastSystem(Eigen::MatrixXd& C, Eigen::VectorXd& bu, Eigen::VectorXd& lambda) const;
+
+private:
+    CorotationalFem() = default;
+    struct Impl;
+    std::unique_ptr<Impl> m;
+    std::vector<Vec3> m_x0, m_x;
+    std::vector<uint8_t> m_fixed;
+    double m_meanEdge = 0;
+    int m_factorizations = 0;
+};
+
+} // namespace viscera::sim::fem

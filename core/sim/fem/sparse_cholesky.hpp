@@ -1,0 +1,46 @@
+#pragma once
+/// Sparse Cholesky LLᵀ of a symmetric positive-definite matrix (CHOLMOD, supernodal) with a fixed
+/// pattern: the symbolic analysis (fill-reducing ordering) runs once, numeric factorizations reuse
+/// it, and solves are forward/backward substitutions [B eq. 2.61–2.66]. CHOLMOD types stay in the
+/// .cpp. One object is not thread-safe; two objects may be used from two threads.
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace viscera::sim::fem {
+
+/// Upper triangle (diagonal included) in compressed columns: colPtr (n + 1), sorted rowIdx.
+struct UpperPattern {
+    std::vector<int> colPtr;
+    std::vector<int> rowIdx;
+    int size() const { return colPtr.empty() ? 0 : static_cast<int>(colPtr.size()) - 1; }
+    int nonZeros() const { return static_cast<int>(rowIdx.size()); }
+    /// Index of entry (r, c), r <= c, in rowIdx / values; -1 when absent.
+    int find(int r, int c) const;
+};
+
+class SparseCholesky {
+public:
+    /// Analyses the pattern. Throws std::invalid_argument on an empty or malformed pattern and
+    /// std::runtime_error when CHOLMOD fails (out of memory).
+    explicit SparseCholesky(const UpperPattern& pattern);
+    ~SparseCholesky();
+    SparseCholesky(const SparseCholesky&) = delete;
+    SparseCholesky& operator=(const SparseCholesky&) = delete;
+
+    int size() const;
+    /// Numeric factorization of `values` (pattern order). False with a message when the matrix is
+    /// not positive definite or CHOLMOD fails; the previous factor is then invalid.
+    bool factorize(const std::vector<double>& values, std::string& error);
+    bool factorized() const;
+    /// Solves A X = B in place for `columns` right-hand sides stored column-major (size·columns).
+    bool solveInPlace(double* b, int columns, std::string& error);
+    /// Non-zeros of the factor L (for reports).
+    long factorNonZeros() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> m;
+};
+
+} // namespace viscera::sim::fem

@@ -1,0 +1,69 @@
+#pragma once
+/// The end-to-end anastomosis scenario of [B ch. 4]: two coaxial tubes of different diameters with
+/// fixed far ends and a gap between their facing ends, a semicircular needle driven around the
+/// circumference in a running suture (each stitch: in through the wider tube's wall, across the
+/// lumen, out through the narrower tube's wall, four punctures), then the thread pulled to close
+/// the gap. Meshes and trajectory are generated in code; the trajectory has a small text format.
+#include "sim/mesh/generators.hpp"
+#include "sim/suture/suture_sim.hpp"
+
+#include <string>
+#include <string_view>
+
+namespace viscera::sim::suture {
+
+struct AnastomosisSpec {
+    HollowTubeSpec wide{Vec3(0, 0, -0.013), Vec3(0, 0, -0.001), 0.0038, 0.0050, 33, 2, 8}; ///< lower tube
+    HollowTubeSpec narrow{Vec3(0, 0, 0.001), Vec3(0, 0, 0.013), 0.0034, 0.0045, 28, 2, 8}; ///< upper tube
+    double needleRadius = 0.0042;     ///< m
+    double needleCentre = 0.0062;     ///< radial distance of the needle's centre from the axis, m
+    int stitches = 5;                 ///< 4 punctures each
+    double degreesPerFrame = 3.0;     ///< needle rotation per frame while driving
+    int transferFrames = 10;          ///< per leg (out, around, in) between stitches
+    double transferDistance = 0.003;  ///< m, radial retreat between stitches
+    int pullFrames = 200;
+    double pullPerSegment = 0.0024;   ///< m of pull per outside thread segment
+    double slack = 0.002;             ///< m
+};
+
+struct AnastomosisModel {
+    std::unique_ptr<TetMesh> wide, narrow;
+    std::vector<int32_t> wideFixed, narrowFixed; ///< far-end rings, per body indices
+};
+
+/// The two tube meshes (about 1,650 nodes and 5,850 tets for the default spec) and their fixed rings.
+AnastomosisModel makeAnastomosisTubes(const AnastomosisSpec& spec);
+/// Needle frames: `stitches` full needle turns around the circumference, then the pull.
+std::vector<NeedleFrame> makeAnastomosisTrajectory(const AnastomosisSpec& spec);
+/// Needle pose grasp parameter that makes radial and circumferential moves pure sticking.
+double anastomosisHandle(const AnastomosisSpec& spec);
+
+/// Text format, one frame per line: px py pz qw qx qy qz pull (metres, unit quaternion); '#' comments.
+std::string formatTrajectory(const std::vector<NeedleFrame>& frames);
+/// Throws viscera::InputError "<origin>: line 12: <rule>".
+std::vector<NeedleFrame> parseTrajectory(std::string_view text, const std::string& origin);
+
+/// Merges several tet meshes into one (vertex and tet indices offset in order).
+std::unique_ptr<TetMesh> mergeMeshes(const std::vector<const TetMesh*>& meshes, std::vector<int32_t>* vertexOffsets);
+
+/// Closure figures between two bodies of a merged mesh: their facing boundary vertices (rest
+/// distance to the other body within 1.5× the smallest), the gap (largest separation of a facing
+/// vertex of one body beyond the facing surface of the other, along that surface's normal) and the
+/// interpenetration (largest depth below it).
+struct ClosureMetrics {
+    double maxGap = 0;            ///< m
+    double maxPenetration = 0;    ///< m
+    bool finite = true;
+};
+class ClosureGauge {
+public:
+    ClosureGauge(const TetMesh& merged, int32_t firstVertexOfB);
+    ClosureMetrics measure(const std::vector<Vec3>& x) const;
+    size_t facingVertices() const { return m_facingA.size() + m_facingB.size(); }
+
+private:
+    std::vector<int32_t> m_facingA, m_facingB;
+    std::vector<std::array<int32_t, 3>> m_trisA, m_trisB; // facing boundary triangles
+};
+
+} // namespace viscera::sim::suture

@@ -1,0 +1,302 @@
+// viscera-console-sim: a stand-in for the bimanual console (2 × 7-DOF masters with grip, five
+// pedals, [B §4]). It speaks the console protocol (packaging/console-protocol.md) over UDP:
+// replays a recorded trajectory (or a scripted motion) as state packets at 1 kHz to the player
+// that contacts it, and records every force command it receives.
+//
+//   viscera-console-sim --listen HOST:PORT (--trajectory FILE | --script NAME) [--duration S]
+//                       [--rate HZ] [--loop] [--record forces.csv] [--summary summary.json]
+//                       [--port-file FILE] [--pause-at S --pause-for S] [--wait-player S]
+//   viscera-console-sim --write-trajectory OUT.csv --script NAME --duration S [--rate HZ]
+//
+// --pause-at/--pause-for simulate a disconnection: no state is sent during the pause (commands
+// are still recorded). Exit codes: 0 done, 1 bad input, 2 usage, 3 no player contacted it.
+#include "haptics/clock.hpp"
+#include "haptics/console_protocol.hpp"
+#include "haptics/scripted_device.hpp"
+#include "haptics/trajectory.hpp"
+#include "haptics/udp_socket.hpp"
+#include "sim/util/atomic_file.hpp"
+#include "sim/util/error.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <optional>
+#include <string>
+#include <time.h>
+#include <vector>
+
+namespace {
+
+using namespace viscera;
+using namespace viscera::haptics;
+
+struct Options {
+    std::string listen = "127.0.0.1:7400";
+    std::optional<std::string> trajectory, script, record, summary, portFile, writeTrajectory;
+    double duration = -1, rate = 1000, pauseAt = -1, pauseFor = 0, waitPlayer = 30;
+    bool loop = false;
+};
+
+struct Received {
+    double t = 0;
+    bool paused = false;
+    protocol::CommandPacket cmd;
+};
+
+double number(const std::string& flag, const std::string& v, double lo, double hi) {
+    char* end = nullptr;
+    const double x = std::strtod(v.c_str(), &end);
+    if (v.empty() || *end != '\0' || !std::isfinite(x) || x < lo || x > hi)
+        throw std::invalid_argument(flag + " '" + v + "' must be a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return x;
+}
+
+Options parse(const std::vector<std::string>& args) {
+    Options o;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
+            return args[++i];
+        };
+        if (a == "--listen") o.listen = value();
+        else if (a == "--trajectory") o.trajectory = value();
+        else if (a == "--script") o.script = value();
+        else if (a == "--record") o.record = value();
+        else if (a == "--summary") o.summary = value();
+        else if (a == "--port-file") o.portFile = value();
+        else if (a == "--write-trajectory") o.writeTrajectory = value();
+        else if (a == "--duration") o.duration = number(a, value(), 0.001, 86400);
+        else if (a == "--rate") o.rate = number(a, value(), 1, 10000);
+        else if (a == "--pause-at") o.pauseAt = number(a, value(), 0, 86400);
+        else if (a == "--pause-for") o.pauseFor = number(a, value(), 0, 86400);
+        else if (a == "--wait-player") o.waitPlayer = number(a, value(), 0.1, 3600);
+        else if (a == "--loop") o.loop = true;
+        else throw std::invalid_argument("unknown option '" + a + "'");
+    }
+    if (o.trajectory.has_value() == o.script.has_value()) throw std::invalid_argument("give exactly one of --trajectory FILE or --script NAME");
+    if (o.writeTrajectory && (!o.script || o.duration <= 0))
+        throw std::invalid_argument("--write-trajectory needs --script NAME and --duration S");
+    return o;
+}
+
+void sleepUntil(int64_t t) {
+    timespec ts{};
+    ts.tv_sec = t / 1'000'000'000;
+    ts.tv_nsec = t % 1'000'000'000;
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {}
+}
+
+/// The motion source: a trajectory file or a scripted device, sampled at time t (s).
+class Source {
+public:
+    explicit Source(const Options& o) : m_loop(o.loop) {
+        if (o.trajectory) m_traj = Trajectory::load(*o.trajectory);
+        else m_script = std::make_unique<ScriptedDevice>(*o.script);
+    }
+    void sample(double t, DeviceState& s) {
+        if (m_traj) m_traj->sampleInto(t, m_loop, s);
+        else m_script->poll(int64_t(std::llround(t * 1e9)), s);
+    }
+    int arms() const { return m_traj ? std::max(1, m_traj->arms()) : m_script->capabilities().arms; }
+    double duration() const { return m_traj ? m_traj->duration() : 0; }
+
+private:
+    bool m_loop;
+    std::optional<Trajectory> m_traj;
+    std::unique_ptr<ScriptedDevice> m_script;
+};
+
+int writeTrajectory(const Options& o) {
+    Source src(o);
+    Trajectory out;
+    const int n = static_cast<int>(std::floor(o.duration * o.rate));
+    for (int k = 0; k <= n; ++k) {
+        DeviceState s;
+        src.sample(k / o.rate, s);
+        for (int a = 0; a < src.arms(); ++a) {
+            TrajectorySample ts;
+            ts.t = k / o.rate;
+            ts.pose = s.arms[a].measured_cp;
+            ts.grip = s.arms[a].jaw_measured_js;
+            ts.buttons = s.arms[a].buttons;
+            ts.pedals = s.pedals;
+            out.add(a, ts);
+        }
+    }
+    writeFileAtomic(*o.writeTrajectory, out.format());
+    std::printf("trajectory %s: %d samples per arm, %d arm(s), %.3f s\n", o.writeTrajectory->c_str(), n + 1, src.arms(), o.duration);
+    return 0;
+}
+
+int run(const Options& o) {
+    Source src(o);
+    const double duration = o.duration > 0 ? o.duration : src.duration();
+    if (!(duration > 0)) throw std::invalid_argument("--duration is needed with a script (or a trajectory shorter than 1 ms)");
+    UdpSocket sock(parseEndpoint(o.listen, "--listen", true), 1 << 20);
+    const Endpoint local = sock.local();
+    if (o.portFile) writeFileAtomic(*o.portFile, std::to_string(ntohs(local.addr.sin_port)) + "\n");
+    std::fprintf(stderr, "viscera-console-sim: listening on %s\n", local.text().c_str());
+
+    std::vector<Received> received;
+    received.reserve(static_cast<size_t>(duration * o.rate * 1.2) + 1024);
+    uint64_t rejected[16] = {};
+    uint8_t buf[protocol::kMaxPacketSize];
+    Endpoint player;
+    bool havePlayer = false;
+    const int64_t waitEnd = monotonicNs() + int64_t(o.waitPlayer * 1e9);
+    int64_t t0 = 0;
+    auto drain = [&](int64_t now) {
+        while (true) {
+            Endpoint from;
+            const long n = sock.receive(buf, sizeof buf, &from);
+            if (n < 0) break;
+            protocol::CommandPacket c;
+            const auto e = protocol::decode(buf, n > long(sizeof buf) ? sizeof buf + 1 : size_t(n), c);
+            if (e != protocol::DecodeError::None) {
+                ++rejected[static_cast<int>(e)];
+                continue;
+            }
+            if (!havePlayer) {
+                player = from;
+                havePlayer = true;
+                t0 = now;
+                std::fprintf(stderr, "viscera-console-sim: player at %s\n", player.text().c_str());
+            }
+            if (!(from == player)) continue;
+            const double t = 1e-9 * double(now - t0);
+            received.push_back({t, o.pauseAt >= 0 && t >= o.pauseAt && t < o.pauseAt + o.pauseFor, c});
+        }
+    };
+    while (!havePlayer) {
+        if (monotonicNs() > waitEnd) {
+            std::fprintf(stderr, "viscera-console-sim: no player contacted %s within %.1f s\n", local.text().c_str(), o.waitPlayer);
+            return 3;
+        }
+        sock.wait(50);
+        drain(monotonicNs());
+    }
+    const int64_t period = int64_t(std::llround(1e9 / o.rate));
+    uint32_t seq = 0;
+    uint64_t sent = 0, sendErrors = 0;
+    std::vector<std::pair<uint32_t, int64_t>> sentAt; // (sequence, time) for the echo latency
+    sentAt.reserve(static_cast<size_t>(duration * o.rate) + 16);
+    int64_t next = t0;
+    DeviceState s;
+    while (true) {
+        const int64_t now = monotonicNs();
+        const double t = 1e-9 * double(now - t0);
+        if (t > duration) break;
+        drain(now);
+        const bool paused = o.pauseAt >= 0 && t >= o.pauseAt && t < o.pauseAt + o.pauseFor;
+        if (!paused) {
+            src.sample(t, s);
+            protocol::StatePacket p;
+            p.sequence = ++seq;
+            p.timestamp_ns = now;
+            p.pedals = s.pedals;
+            p.arms = static_cast<uint8_t>(src.arms());
+            for (int a = 0; a < kMaxArms; ++a) p.arm[a] = s.arms[a];
+            const size_t n = protocol::encode(p, buf, sizeof buf);
+            if (sock.sendTo(buf, n, player)) ++sent, sentAt.emplace_back(p.sequence, now);
+            else ++sendErrors;
+        }
+        next += period;
+        sleepUntil(next);
+    }
+    const int64_t tail = monotonicNs() + 200'000'000;
+    while (monotonicNs() < tail) {
+        sock.wait(20);
+        drain(monotonicNs());
+    }
+
+    // Figures: forces, pauses, echo latency.
+    double maxForce = 0;
+    uint64_t nonZero = 0, pausedCmds = 0, pausedNonZeroLate = 0, nonFinite = 0;
+    std::vector<double> latency;
+    size_t j = 0;
+    for (const Received& r : received) {
+        double f = 0;
+        for (const auto& a : r.cmd.arm) {
+            if (!a.servo_cf.force.allFinite()) ++nonFinite;
+            f = std::max(f, a.servo_cf.force.norm());
+        }
+        maxForce = std::max(maxForce, f);
+        nonZero += f > 0;
+        if (r.paused) {
+            ++pausedCmds;
+            if (f > 0 && r.t > o.pauseAt + 0.25) ++pausedNonZeroLate; // beyond the player's device timeout
+        }
+        while (j < sentAt.size() && protocol::newer(r.cmd.echoSequence, sentAt[j].first)) ++j;
+        if (!r.paused && j < sentAt.size() && sentAt[j].first == r.cmd.echoSequence)
+            latency.push_back(1e-6 * double(int64_t(std::llround(r.t * 1e9)) + t0 - sentAt[j].second));
+    }
+    std::sort(latency.begin(), latency.end());
+    auto pct = [&](double p) { return latency.empty() ? 0.0 : latency[std::min(latency.size() - 1, size_t(p * double(latency.size())))]; };
+    uint64_t rejectedAll = 0;
+    for (uint64_t r : rejected) rejectedAll += r;
+    if (o.record) {
+        std::string csv = "t_s,seq,echo,flags,paused,f0x,f0y,f0z,f1x,f1y,f1z,grip0_n,grip1_n\n";
+        char line[320];
+        for (const Received& r : received) {
+            const auto& a = r.cmd.arm;
+            std::snprintf(line, sizeof line, "%.6f,%u,%u,%u,%d,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.4g,%.4g\n", r.t, r.cmd.sequence,
+                          r.cmd.echoSequence, r.cmd.flags, int(r.paused), a[0].servo_cf.force.x(), a[0].servo_cf.force.y(),
+                          a[0].servo_cf.force.z(), a[1].servo_cf.force.x(), a[1].servo_cf.force.y(), a[1].servo_cf.force.z(),
+                          a[0].jaw_servo_jf, a[1].jaw_servo_jf);
+            csv += line;
+        }
+        writeFileAtomic(*o.record, csv);
+    }
+    nlohmann::json sum = {{"duration_s", duration},
+                          {"states_sent", sent},
+                          {"send_errors", sendErrors},
+                          {"commands_received", received.size()},
+                          {"commands_rejected", rejectedAll},
+                          {"commands_nonzero", nonZero},
+                          {"commands_non_finite", nonFinite},
+                          {"max_force_n", maxForce},
+                          {"paused_commands", pausedCmds},
+                          {"paused_nonzero_after_timeout", pausedNonZeroLate},
+                          {"echo_latency_ms", {{"count", latency.size()}, {"p50", pct(0.5)}, {"p99", pct(0.99)}, {"max", latency.empty() ? 0.0 : latency.back()}}}};
+    if (o.summary) writeFileAtomic(*o.summary, sum.dump(2) + "\n");
+    std::printf("console-sim   %llu states sent, %zu commands received (%llu rejected), %llu non-zero, max force %.3f N\n",
+                (unsigned long long)sent, received.size(), (unsigned long long)rejectedAll, (unsigned long long)nonZero, maxForce);
+    std::printf("latency       state -> command echo p50 %.3f ms, p99 %.3f ms\n", pct(0.5), pct(0.99));
+    if (pausedCmds)
+        std::printf("pause         %llu commands during the pause, %llu non-zero after the device timeout\n",
+                    (unsigned long long)pausedCmds, (unsigned long long)pausedNonZeroLate);
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    std::vector<std::string> args(argv + 1, argv + argc);
+    if (args.empty() || args[0] == "--help" || args[0] == "-h") {
+        std::fputs("usage: viscera-console-sim --listen HOST:PORT (--trajectory FILE | --script NAME) [--duration S]\n"
+                   "           [--rate HZ] [--loop] [--record forces.csv] [--summary summary.json] [--port-file FILE]\n"
+                   "           [--pause-at S --pause-for S] [--wait-player S]\n"
+                   "       viscera-console-sim --write-trajectory OUT.csv --script NAME --duration S [--rate HZ]\n",
+                   args.empty() ? stderr : stdout);
+        return args.empty() ? 2 : 0;
+    }
+    try {
+        const Options o = parse(args);
+        return o.writeTrajectory ? writeTrajectory(o) : run(o);
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "viscera-console-sim: %s\n", e.what());
+        return 1;
+    } catch (const std::invalid_argument& e) {
+        std::fprintf(stderr, "viscera-console-sim: %s\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "viscera-console-sim: internal error: %s\n", e.what());
+        return 1;
+    }
+}

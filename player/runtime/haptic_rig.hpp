@@ -1,0 +1,123 @@
+#pragma once
+/// The haptic side of a session: the device, the servo loop and the hand-over with the physics
+/// thread (World). Created only when the player runs with --device.
+///
+/// Lockstep (replay, scripted; repeatable): before each physics frame the rig runs the servo
+/// ticks that fall in the frame on a ManualClock, then hands the tool poses to the World.
+/// Real time (console, keyboard, or --realtime): the servo loop runs on its own thread at 1 kHz;
+/// the physics thread steps at the scene's dt, paced to the wall clock, and publishes the local
+/// contact model after each step. A slow step delays only the next publish: the servo loop keeps
+/// its rate and the safety filter zeroes the force once the model is older than its limit.
+#include "haptics/device.hpp"
+#include "haptics/servo_loop.hpp"
+#include "sim/scene/world.hpp"
+
+#include <sched.h>
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace viscera::player {
+
+/// Task metrics of a session (report "metrics").
+struct TaskMetrics {
+    double time_s = 0;                 ///< simulated session time
+    double toolPathLength_m = 0;       ///< sum over tools, scene frame
+    std::vector<double> toolPathLengthPerTool_m;
+    double maxForce_n = 0;             ///< device force after the safety filter
+    double meanForce_n = 0;            ///< over all servo ticks of driven arms
+    double meanContactForce_n = 0;     ///< over ticks with a non-zero force
+    double tissueDamage_ns = 0;        ///< ∫ max(0, contact force − damage threshold) dt, N·s
+    int damageEvents = 0;              ///< times the contact force rose above the threshold
+    double maxContactForce_n = 0;      ///< N, tissue on tool, from the physics
+    int punctures = 0;                 ///< needle subsystem (not in this build's features): 0
+    int clips = 0;                     ///< clip applier subsystem (not in this build's features): 0
+};
+
+struct HapticsResult {
+    std::string spec, backend, name, mode; ///< mode: "lockstep" or "realtime"
+    int arms = 0, pedals = 0;
+    double deviceMaxForce_n = 0, caseMaxForce_n = 0;
+    struct Tool {
+        std::string name, hand;
+        int arm = -1; ///< -1: no arm of this device drives it
+    };
+    std::vector<Tool> tools;
+    haptics::ServoStats servo;
+    haptics::LinkStats link;
+    double physicsPeriod_s = 0;
+    double maxContactAgeSteps = 0; ///< max contact-model age / physics period
+    bool physicsRealtimePriority = false;
+    uint64_t traceSamples = 0;
+};
+
+/// One row of the force/pose trace (--trace CSV).
+using TraceRow = haptics::TraceSample;
+
+/// What the trainee window shows, written by the physics thread every frame.
+struct LiveState {
+    double time_s = 0;
+    int frame = 0;
+    bool connected = false;
+    uint32_t pedals = 0;
+    uint32_t safetyRules = 0;
+    std::array<double, haptics::kMaxArms> force{0, 0};
+    std::array<sim::Vec3, haptics::kMaxArms> tool{sim::Vec3::Zero(), sim::Vec3::Zero()};
+    std::array<bool, haptics::kMaxArms> toolActive{false, false};
+    double maxForce_n = 15;
+};
+
+class HapticRig {
+public:
+    /// `device` must outlive the rig. realtime: servo thread + wall-clock pacing.
+    HapticRig(haptics::Device& device, std::string spec, sim::World& world, bool realtime, bool keepTrace);
+    ~HapticRig();
+    /// dt: the scene's physics period (s). Creates the servo loop; call once before start().
+    void configure(double dt);
+    /// Starts the servo thread (real time) and publishes the initial contact model.
+    void start();
+    /// Before World::step(): lockstep ticks; tool poses → World.
+    void beforeStep();
+    /// After World::step(): publish the contact model, drain the trace, accumulate metrics, and
+    /// in real time sleep until the frame's deadline.
+    void afterStep();
+    /// Stops the servo thread and drains the rest of the trace.
+    void finish();
+    HapticsResult result() const;
+    const TaskMetrics& metrics() const { return m_metrics; }
+    std::vector<TraceRow>& trace() { return m_trace; }
+    LiveState live() const;
+    bool realtime() const { return m_realtime; }
+
+private:
+    void drain();
+    haptics::LocalContactModel contactModel(int64_t now) const;
+    haptics::Device& m_device;
+    std::string m_spec;
+    sim::World& m_world;
+    bool m_realtime, m_keepTrace;
+    std::unique_ptr<haptics::Clock> m_clock;
+    haptics::ManualClock* m_manual = nullptr;
+    haptics::ServoConfig m_servoConfig;
+    std::unique_ptr<haptics::ServoLoop> m_servo;
+    std::array<int, haptics::kMaxArms> m_toolOfArm{-1, -1};
+    std::vector<HapticsResult::Tool> m_tools;
+    double m_dt = 0, m_caseMaxForce = 15;
+    int64_t m_frame = 0, m_t0 = 0, m_tick = 0;
+    std::vector<TraceRow> m_trace;
+    uint64_t m_samples = 0;
+    TaskMetrics m_metrics;
+    std::array<bool, haptics::kMaxArms> m_haveLast{false, false};
+    std::array<sim::Vec3, haptics::kMaxArms> m_last{sim::Vec3::Zero(), sim::Vec3::Zero()};
+    std::vector<bool> m_aboveDamage;
+    double m_forceSum = 0, m_contactSum = 0;
+    uint64_t m_forceCount = 0, m_contactCount = 0;
+    double m_maxAgeSteps = 0;
+    bool m_physicsRt = false, m_hadPhysicsRt = false;
+    int m_oldPolicy = 0;
+    sched_param m_oldParam{};
+};
+
+} // namespace viscera::player

@@ -1,0 +1,22 @@
+#pragma once
+/// The trainee window: case title, instructions, timer, device/pedal/clutch state, force bars
+/// and a side view of the tissue and tools (QtGui raster window, no Qt Widgets, no editing UI).
+/// Built only when Qt6 Gui is found (window_mode_qt.cpp); otherwise window_mode_none.cpp
+/// refuses window mode with a message.
+#include "runtime/session.hpp"
+
+#include <string>
+
+namespace viscera::player {
+
+/// Empty when window mode can run here; otherwise the one-line reason (no Qt in this build, no
+/// display and no QT_QPA_PLATFORM).
+std::string windowModeUnavailable();
+
+/// Runs the session on a physics thread while the window shows it (the GUI thread owns the
+/// window). options.frames = 0 runs until the window closes; otherwise the window closes when
+/// the frames are done, after writing `screenshot` (PNG, atomically) when it is not empty.
+/// Keys and the mouse drive a KeyboardDevice when options.device is one.
+SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::string& screenshot);
+
+} // namespace viscera::player

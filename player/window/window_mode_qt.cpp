@@ -1,0 +1,240 @@
+// The trainee window on QtGui (QRasterWindow + QPainter): no Widgets, no OpenGL needed.
+#include "window/window_mode.hpp"
+
+#include "haptics/keyboard_device.hpp"
+#include "sim/util/atomic_file.hpp"
+#include "sim/util/log.hpp"
+
+#include <QBuffer>
+#include <QGuiApplication>
+#include <QImage>
+#include <QKeyEvent>
+#include <QMouseEvent>
+#include <QPainter>
+#include <QRasterWindow>
+#include <QTimer>
+#include <QWheelEvent>
+
+#include <atomic>
+#include <cstdlib>
+#include <thread>
+
+namespace viscera::player {
+namespace {
+
+using haptics::KeyboardDevice;
+
+class TraineeWindow final : public QRasterWindow {
+public:
+    TraineeWindow(LiveView& live, std::string title, std::string instructions, KeyboardDevice* keyboard,
+                  std::atomic<bool>& stop)
+        : m_live(live), m_title(std::move(title)), m_instructions(std::move(instructions)), m_keyboard(keyboard), m_stop(stop) {
+        setTitle(QString::fromStdString("Viscera — " + m_title));
+        resize(960, 600);
+    }
+
+    void paintHud(QPainter& p, const QSize& size) {
+        LiveState s;
+        std::vector<sim::Vec3> nodes;
+        std::vector<double> radius;
+        {
+            std::lock_guard<std::mutex> lock(m_live.mutex);
+            s = m_live.state;
+            nodes = m_live.nodes;
+            radius = m_live.toolRadius;
+        }
+        const int w = size.width(), h = size.height();
+        p.fillRect(0, 0, w, h, QColor(24, 26, 30));
+        p.setRenderHint(QPainter::Antialiasing, true);
+        // Header: title, timer, instructions.
+        QFont big = p.font();
+        big.setPointSizeF(16);
+        big.setBold(true);
+        p.setFont(big);
+        p.setPen(QColor(235, 235, 235));
+        p.drawText(QRect(16, 8, w - 200, 30), Qt::AlignLeft | Qt::AlignVCenter, QString::fromStdString(m_title));
+        const int minutes = static_cast<int>(s.time_s / 60);
+        p.drawText(QRect(w - 180, 8, 164, 30), Qt::AlignRight | Qt::AlignVCenter,
+                   QString::asprintf("%02d:%04.1f", minutes, s.time_s - 60 * minutes));
+        QFont small = p.font();
+        small.setPointSizeF(10);
+        small.setBold(false);
+        p.setFont(small);
+        p.setPen(QColor(190, 190, 190));
+        p.drawText(QRect(16, 40, w - 32, 40), Qt::AlignLeft | Qt::TextWordWrap, QString::fromStdString(m_instructions));
+        // Side view (x right, z up) of the tissue nodes and the tools.
+        const QRect view(16, 88, w - 280, h - 104);
+        p.setPen(QColor(60, 64, 70));
+        p.drawRect(view);
+        double x0 = 1e9, x1 = -1e9, z0 = 1e9, z1 = -1e9;
+        for (const auto& n : nodes) x0 = std::min(x0, n.x()), x1 = std::max(x1, n.x()), z0 = std::min(z0, n.z()), z1 = std::max(z1, n.z());
+        for (int a = 0; a < haptics::kMaxArms; ++a)
+            if (s.toolActive[a]) x0 = std::min(x0, s.tool[a].x()), x1 = std::max(x1, s.tool[a].x()), z0 = std::min(z0, s.tool[a].z()), z1 = std::max(z1, s.tool[a].z());
+        if (x1 > x0 && z1 >= z0) {
+            const double span = std::max(x1 - x0, z1 - z0) * 1.3 + 1e-3;
+            const double scale = std::min(view.width(), view.height()) / span;
+            const double cx = 0.5 * (x0 + x1), cz = 0.5 * (z0 + z1);
+            auto map = [&](const sim::Vec3& v) {
+                return QPointF(view.center().x() + (v.x() - cx) * scale, view.center().y() - (v.z() - cz) * scale);
+            };
+            p.setPen(Qt::NoPen);
+            p.setBrush(QColor(214, 120, 110));
+            for (const auto& n : nodes) p.drawEllipse(map(n), 1.6, 1.6);
+            size_t t = 0;
+            for (int a = 0; a < haptics::kMaxArms; ++a) {
+                if (!s.toolActive[a]) continue;
+                const double r = t < radius.size() ? radius[t] : 0.005;
+                ++t;
+                p.setBrush(QColor(170, 190, 210, 180));
+                p.setPen(QColor(220, 230, 240));
+                p.drawEllipse(map(s.tool[a]), r * scale, r * scale);
+            }
+        }
+        // Right panel: device, pedals, clutch, force bars, safety.
+        const int px = w - 248;
+        int y = 96;
+        p.setPen(QColor(235, 235, 235));
+        p.drawText(px, y, s.connected ? "Device: connected" : "Device: NOT CONNECTED");
+        y += 26;
+        const char* names[5] = {"Clutch", "Cam", "Dead", "Cut", "Coag"};
+        for (int k = 0; k < 5; ++k) {
+            const bool on = s.pedals & (1u << k);
+            p.setPen(QColor(120, 120, 120));
+            p.setBrush(on ? QColor(90, 200, 120) : QColor(50, 54, 60));
+            p.drawRect(px + k * 46, y, 42, 22);
+            p.setPen(on ? QColor(10, 10, 10) : QColor(200, 200, 200));
+            p.drawText(QRect(px + k * 46, y, 42, 22), Qt::AlignCenter, names[k]);
+        }
+        y += 40;
+        p.setPen(QColor(235, 235, 235));
+        p.drawText(px, y, (s.pedals & haptics::kPedalClutch) ? "Clutch: ENGAGED (tool holds)" : "Clutch: released");
+        y += 28;
+        for (int a = 0; a < haptics::kMaxArms; ++a) {
+            if (!s.toolActive[a]) continue;
+            const double frac = std::clamp(s.force[a] / std::max(1e-9, s.maxForce_n), 0.0, 1.0);
+            p.setPen(QColor(235, 235, 235));
+            p.drawText(px, y, QString::asprintf("%s force %.2f N", a == 0 ? "Left/1" : "Right/2", s.force[a]));
+            y += 8;
+            p.setPen(QColor(120, 120, 120));
+            p.setBrush(QColor(50, 54, 60));
+            p.drawRect(px, y, 230, 14);
+            p.setBrush(frac < 0.6 ? QColor(90, 200, 120) : frac < 0.85 ? QColor(230, 190, 70) : QColor(230, 80, 70));
+            p.drawRect(px, y, static_cast<int>(230 * frac), 14);
+            y += 34;
+        }
+        p.setPen(QColor(230, 120, 100));
+        if (s.safetyRules & haptics::kRuleSimStale) p.drawText(px, y, "Forces off: simulation stale"), y += 20;
+        if (s.safetyRules & haptics::kRuleDisconnected) p.drawText(px, y, "Forces off: device not answering"), y += 20;
+        if (s.safetyRules & haptics::kRuleDeadman) p.drawText(px, y, "Forces off: hold the deadman pedal"), y += 20;
+        p.setPen(QColor(140, 140, 140));
+        p.drawText(px, h - 16, QString::asprintf("frame %d", s.frame));
+    }
+
+    QImage render() {
+        QImage img(size().isEmpty() ? QSize(960, 600) : size(), QImage::Format_RGB32);
+        QPainter p(&img);
+        paintHud(p, img.size());
+        return img;
+    }
+
+protected:
+    void paintEvent(QPaintEvent*) override {
+        QPainter p(this);
+        paintHud(p, size());
+    }
+    void keyPressEvent(QKeyEvent* e) override { key(e, true); }
+    void keyReleaseEvent(QKeyEvent* e) override { key(e, false); }
+    void mouseMoveEvent(QMouseEvent* e) override {
+        const QPointF pos = e->position();
+        if (m_keyboard && (e->buttons() & Qt::LeftButton)) m_keyboard->addMouse(pos.x() - m_mouse.x(), pos.y() - m_mouse.y(), 0);
+        m_mouse = pos;
+    }
+    void mousePressEvent(QMouseEvent* e) override { m_mouse = e->position(); }
+    void wheelEvent(QWheelEvent* e) override {
+        if (m_keyboard) m_keyboard->addMouse(0, 0, e->angleDelta().y() / 120.0);
+    }
+    bool event(QEvent* e) override {
+        if (e->type() == QEvent::Close) m_stop = true;
+        return QRasterWindow::event(e);
+    }
+
+private:
+    void key(QKeyEvent* e, bool down) {
+        if (!m_keyboard || e->isAutoRepeat()) return;
+        switch (e->key()) {
+        case Qt::Key_Left: m_keyboard->setKey(KeyboardDevice::KeyLeft, down); break;
+        case Qt::Key_Right: m_keyboard->setKey(KeyboardDevice::KeyRight, down); break;
+        case Qt::Key_Up: m_keyboard->setKey(KeyboardDevice::KeyUp, down); break;
+        case Qt::Key_Down: m_keyboard->setKey(KeyboardDevice::KeyDown, down); break;
+        case Qt::Key_PageUp: m_keyboard->setKey(KeyboardDevice::KeyPageUp, down); break;
+        case Qt::Key_PageDown: m_keyboard->setKey(KeyboardDevice::KeyPageDown, down); break;
+        case Qt::Key_Space: m_keyboard->setKey(KeyboardDevice::KeyClutch, down); break;
+        default: break;
+        }
+    }
+    LiveView& m_live;
+    std::string m_title, m_instructions;
+    KeyboardDevice* m_keyboard;
+    std::atomic<bool>& m_stop;
+    QPointF m_mouse;
+};
+
+} // namespace
+
+std::string windowModeUnavailable() {
+    const char* platform = std::getenv("QT_QPA_PLATFORM");
+    const char* display = std::getenv("DISPLAY");
+    const char* wayland = std::getenv("WAYLAND_DISPLAY");
+    if ((platform && *platform) || (display && *display) || (wayland && *wayland)) return "";
+    return "window mode needs a display (DISPLAY or WAYLAND_DISPLAY), or QT_QPA_PLATFORM=offscreen; or use --headless";
+}
+
+SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::string& screenshot) {
+    static int argc = 1;
+    static char arg0[] = "viscera-player";
+    static char* argv[] = {arg0, nullptr};
+    QGuiApplication app(argc, argv);
+    LiveView live;
+    std::atomic<bool> stop{false};
+    options.live = &live;
+    options.stop = &stop;
+    const std::string title = loaded.package->manifest().title.value_or(loaded.package->manifest().caseId);
+    TraineeWindow window(live, title, loaded.scene.instructions, dynamic_cast<KeyboardDevice*>(options.device), stop);
+    window.show();
+    SessionResult result;
+    std::thread physics([&] { result = runSession(loaded, options); });
+    bool failed = false;
+    QTimer timer;
+    QObject::connect(&timer, &QTimer::timeout, [&] {
+        bool finished;
+        {
+            std::lock_guard<std::mutex> lock(live.mutex);
+            finished = live.finished;
+        }
+        window.requestUpdate();
+        window.update();
+        if (!finished) return;
+        timer.stop();
+        if (!screenshot.empty()) {
+            QByteArray bytes;
+            QBuffer buf(&bytes);
+            buf.open(QIODevice::WriteOnly);
+            window.render().save(&buf, "PNG");
+            try {
+                writeFileAtomic(screenshot, std::string_view(bytes.constData(), static_cast<size_t>(bytes.size())));
+            } catch (const std::exception& e) {
+                log::error(e.what());
+                failed = true;
+            }
+        }
+        app.quit();
+    });
+    timer.start(33);
+    app.exec();
+    stop = true;
+    physics.join();
+    if (failed) result.errors.push_back("screenshot " + screenshot + " could not be written");
+    return result;
+}
+
+} // namespace viscera::player

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Haptics loopback acceptance run: viscera-console-sim streams the bimanual script over UDP to
+# viscera-player (headless, real time, on the haptic sample case) and records the forces it gets
+# back. Prints the servo period/jitter, the contact-model age and the console-side figures.
+#
+#   scripts/haptics-loopback.sh [seconds=60] [build-dir=build] [out-dir=out/haptics-loopback]
+set -euo pipefail
+secs="${1:-60}"
+build="${2:-${VISCERA_BUILD_DIR:-build}}"
+out="${3:-out/haptics-loopback}"
+mkdir -p "$out"
+"$build/tests/player/make_haptic_case" "$out/haptic-slab.vcase" 2 >/dev/null
+rm -f "$out/port"
+"$build/player/viscera-console-sim" --listen 127.0.0.1:0 --port-file "$out/port" --script bimanual --loop \
+  --duration "$(( secs + 1 ))" --record "$out/console-forces.csv" --summary "$out/console-summary.json" \
+  > "$out/console-sim.log" 2>&1 &
+sim=$!
+for _ in $(seq 100); do [ -s "$out/port" ] && break; sleep 0.05; done
+port="$(cat "$out/port")"
+frames=$(( secs * 60 ))
+"$build/player/viscera-player" run "$out/haptic-slab.vcase" --headless --frames "$frames" \
+  --device "console:127.0.0.1:$port" --report "$out/report.json" --trace "$out/trace.csv" 2>/dev/null
+wait "$sim"
+cat "$out/console-sim.log" | grep -v '^viscera-console-sim:'
+python3 - "$out/report.json" <<'PY'
+import json, sys
+h = json.load(open(sys.argv[1]))["haptics"]
+s, c = h["servo"], h["contact_model"]
+print(f"servo         {s['ticks']} ticks, realtime priority {s['realtime_priority']}, overruns {s['overruns']}")
+print(f"period (us)   mean {s['period_us']['mean']:.2f}  p50 {s['period_us']['p50']:.0f}  p99 {s['period_us']['p99']:.0f}  max {s['period_us']['max']:.1f}")
+print(f"jitter (us)   mean {s['jitter_us']['mean']:.2f}  p99 {s['jitter_us']['p99']:.0f}  max {s['jitter_us']['max']:.1f}")
+print(f"wake (us)     p99 {s['wake_latency_us']['p99']:.0f}  max {s['wake_latency_us']['max']:.1f};  tick cost p99 {s['tick_cost_us']['p99']:.0f} us")
+print(f"contact model age (ms) mean {c['age_ms']['mean']:.2f}  p99 {c['age_ms']['p99']:.2f}  max {c['age_ms']['max']:.2f}"
+      f"  (physics period {c['physics_period_ms']:.2f} ms; max/period {c['max_age_over_period']:.2f}; steps behind <= {c['max_steps_behind']})")
+print(f"safety        {h['safety']}")
+print(f"link          {h['link']}")
+PY
+echo "files         $out/{report.json,trace.csv,console-forces.csv,console-summary.json}"

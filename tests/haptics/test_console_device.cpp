@@ -1,0 +1,214 @@
+// The network console backend over real loopback UDP sockets: good packets, malformed,
+// truncated, wrong-version, corrupted, foreign and out-of-order packets, a flood, and a
+// disconnect followed by a reconnection. Forces must never spike or become NaN.
+#include "haptics/console_device.hpp"
+#include "haptics/servo_loop.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+#include <vector>
+
+using namespace viscera::haptics;
+using namespace viscera::haptics::protocol;
+
+namespace {
+
+constexpr int64_t kMs = 1'000'000;
+
+Endpoint loopback(uint16_t port = 0) { return parseEndpoint("127.0.0.1:" + std::to_string(port), "test", true); }
+
+/// A fake console: a socket the device sends commands to and receives states from.
+struct FakeConsole {
+    UdpSocket socket{loopback()};
+    Endpoint address = socket.local();
+    Endpoint player;
+    bool knowsPlayer = false;
+    uint32_t seq = 0;
+
+    void learnPlayer(ConsoleDevice& dev) {
+        DeviceCommand c;
+        dev.send(c);
+        uint8_t buf[kMaxPacketSize];
+        ASSERT_TRUE(socket.wait(1000));
+        ASSERT_GT(socket.receive(buf, sizeof buf, &player), 0);
+        knowsPlayer = true;
+    }
+    void sendRaw(const std::vector<uint8_t>& b) { ASSERT_TRUE(socket.sendTo(b.data(), b.size(), player)); }
+    std::vector<uint8_t> state(const Vec3& p0, uint32_t pedals = kPedalDeadman, uint32_t sequence = 0) {
+        StatePacket s;
+        s.sequence = sequence ? sequence : ++seq;
+        s.pedals = pedals;
+        s.arm[0].measured_cp.position = p0;
+        std::vector<uint8_t> b(kMaxPacketSize);
+        b.resize(encode(s, b.data(), b.size()));
+        return b;
+    }
+    void send(const Vec3& p0, uint32_t pedals = kPedalDeadman) { sendRaw(state(p0, pedals)); }
+};
+
+void reseal(std::vector<uint8_t>& b) {
+    const uint32_t c = crc32(b.data(), b.size() - 4);
+    for (int k = 0; k < 4; ++k) b[b.size() - 4 + k] = uint8_t(c >> (8 * k));
+}
+
+} // namespace
+
+TEST(ConsoleDevice, ReceivesStatesAndSendsCommands) {
+    FakeConsole console;
+    ConsoleDevice dev(console.address);
+    EXPECT_EQ(dev.capabilities().arms, 2);
+    EXPECT_EQ(dev.capabilities().pedals, 5);
+    EXPECT_EQ(dev.capabilities().arm[0].hand, Hand::Left);
+    console.learnPlayer(dev);
+    DeviceState st;
+    dev.poll(1 * kMs, st);
+    EXPECT_FALSE(st.connected);
+    console.send(Vec3(0.01, 0.02, 0.03));
+    dev.poll(2 * kMs, st);
+    EXPECT_TRUE(st.connected);
+    EXPECT_TRUE(st.arms[0].measured_cp.position.isApprox(Vec3(0.01, 0.02, 0.03), 1e-6));
+    EXPECT_EQ(st.pedals, uint32_t(kPedalDeadman));
+    DeviceCommand c;
+    c.arms[1].servo_cf.force = Vec3(0, 0, 2);
+    dev.send(c);
+    uint8_t buf[kMaxPacketSize];
+    ASSERT_TRUE(console.socket.wait(1000));
+    const long n = console.socket.receive(buf, sizeof buf, nullptr);
+    CommandPacket got;
+    ASSERT_EQ(decode(buf, size_t(n), got), DecodeError::None);
+    EXPECT_TRUE(got.arm[1].servo_cf.force.isApprox(Vec3(0, 0, 2)));
+    EXPECT_EQ(got.echoSequence, console.seq);
+    EXPECT_EQ(dev.linkStats().received, 1u);
+}
+
+TEST(ConsoleDevice, MalformedTruncatedWrongVersionAndCorruptPacketsAreCountedAndIgnored) {
+    FakeConsole console;
+    ConsoleDevice dev(console.address);
+    console.learnPlayer(dev);
+    DeviceState st;
+    console.send(Vec3(0.01, 0, 0));
+    dev.poll(1 * kMs, st);
+    ASSERT_TRUE(st.connected);
+    const auto good = console.state(Vec3(0.2, 0.2, 0.2));
+    // Truncated at every length, an oversized datagram, garbage.
+    for (size_t n = 0; n < good.size(); n += 7) console.sendRaw(std::vector<uint8_t>(good.begin(), good.begin() + long(n)));
+    console.sendRaw(std::vector<uint8_t>(2000, 0xAB));
+    // Wrong version (valid CRC), corrupted payload.
+    auto v2 = good;
+    v2[4] = 2;
+    reseal(v2);
+    console.sendRaw(v2);
+    auto bad = good;
+    bad[50] ^= 1;
+    console.sendRaw(bad);
+    // A NaN position behind a valid CRC.
+    auto nan = good;
+    const float f = NAN;
+    std::memcpy(&nan[28], &f, 4);
+    reseal(nan);
+    console.sendRaw(nan);
+    for (int k = 0; k < 5; ++k) dev.poll((2 + k) * kMs, st);
+    EXPECT_TRUE(st.connected);
+    EXPECT_TRUE(st.arms[0].measured_cp.position.isApprox(Vec3(0.01, 0, 0), 1e-6)) << "no bad packet got through";
+    EXPECT_TRUE(st.arms[0].measured_cp.position.allFinite());
+    const LinkStats s = dev.linkStats();
+    EXPECT_EQ(s.rejectedVersion, 1u);
+    EXPECT_EQ(s.rejectedChecksum, 1u);
+    EXPECT_EQ(s.rejectedMalformed, good.size() / 7 + 1 + 1 + 1);
+    EXPECT_EQ(s.received, 1u);
+}
+
+TEST(ConsoleDevice, PacketsFromAnotherAddressAndOutOfOrderAreIgnored) {
+    FakeConsole console;
+    ConsoleDevice dev(console.address);
+    console.learnPlayer(dev);
+    FakeConsole intruder;
+    intruder.player = console.player;
+    intruder.send(Vec3(0.3, 0.3, 0.3));
+    DeviceState st;
+    dev.poll(1 * kMs, st);
+    EXPECT_FALSE(st.connected);
+    console.sendRaw(console.state(Vec3(0.01, 0, 0), kPedalDeadman, 100));
+    console.sendRaw(console.state(Vec3(0.02, 0, 0), kPedalDeadman, 99)); // older
+    console.sendRaw(console.state(Vec3(0.03, 0, 0), kPedalDeadman, 100)); // duplicate
+    dev.poll(2 * kMs, st);
+    EXPECT_TRUE(st.arms[0].measured_cp.position.isApprox(Vec3(0.01, 0, 0), 1e-6));
+    EXPECT_EQ(dev.linkStats().rejectedOrder, 2u);
+    EXPECT_EQ(dev.linkStats().rejectedMalformed, 1u);
+}
+
+TEST(ConsoleDevice, DisconnectAfterTheTimeoutAndReconnect) {
+    FakeConsole console;
+    ConsoleDeviceOptions opt;
+    opt.timeout_ns = 50 * kMs;
+    ConsoleDevice dev(console.address, opt);
+    console.learnPlayer(dev);
+    DeviceState st;
+    console.send(Vec3(0.01, 0, 0));
+    dev.poll(10 * kMs, st);
+    EXPECT_TRUE(st.connected);
+    dev.poll(60 * kMs, st);
+    EXPECT_TRUE(st.connected);
+    dev.poll(61 * kMs, st);
+    EXPECT_FALSE(st.connected);
+    EXPECT_EQ(dev.linkStats().disconnects, 1u);
+    // A console that restarted its sequence numbers is accepted after the disconnect.
+    console.seq = 0;
+    console.send(Vec3(0.02, 0, 0));
+    dev.poll(200 * kMs, st);
+    EXPECT_TRUE(st.connected);
+    EXPECT_EQ(dev.linkStats().reconnects, 1u);
+    EXPECT_TRUE(st.arms[0].measured_cp.position.isApprox(Vec3(0.02, 0, 0), 1e-6));
+}
+
+TEST(ConsoleDevice, AFloodOfPacketsCausesNoForceSpikeAndNoNaN) {
+    FakeConsole console;
+    ConsoleDevice dev(console.address);
+    console.learnPlayer(dev);
+    ManualClock clock(0);
+    ServoConfig cfg;
+    cfg.tools[0].enabled = true;
+    cfg.tools[0].motionScale = 1.0;
+    cfg.safety.maxForceRate = 1000.0;
+    ServoLoop servo(dev, clock, cfg);
+    // A stiff wall at z = 0 in the scene: the flood alternates between 20 cm inside and outside.
+    LocalContactModel m;
+    m.frame = 0;
+    m.tools[0].active = true;
+    m.tools[0].n = Vec3::UnitZ();
+    m.tools[0].gap = 0;
+    m.tools[0].k = 5000;
+    std::mt19937 rng(3);
+    double prev = 0, maxForce = 0;
+    int nonZero = 0;
+    console.send(Vec3::Zero());
+    for (int tick = 0; tick < 400; ++tick) {
+        const int burst = 1 + int(rng() % 200);
+        for (int k = 0; k < burst; ++k) {
+            if (k % 17 == 3) console.sendRaw(std::vector<uint8_t>(size_t(rng() % 300), uint8_t(rng())));
+            else console.send(Vec3(0, 0, (k % 2 ? -0.2 : 0.2) * double(rng() % 100) / 100.0));
+        }
+        clock.advance(kMs);
+        m.timestamp_ns = clock.now_ns();
+        servo.publishContact(m);
+        servo.tick(clock.now_ns());
+        TraceSample s;
+        while (servo.popTrace(s)) {
+            ASSERT_TRUE(s.force.allFinite());
+            const double f = s.force.norm();
+            ASSERT_LE(std::abs(f - prev), 1.0 + 1e-9) << "tick " << tick << ": dF > maxForceRate · 1 ms";
+            ASSERT_LE(f, 15.0 + 1e-9);
+            maxForce = std::max(maxForce, f);
+            nonZero += f > 0;
+            prev = f;
+        }
+    }
+    const LinkStats ls = dev.linkStats();
+    EXPECT_GT(ls.received, 400u);
+    EXPECT_GT(ls.droppedFlood, 0u);
+    EXPECT_GT(ls.rejectedMalformed, 0u);
+    EXPECT_GT(nonZero, 0) << "the flood still drives the tool";
+    EXPECT_LE(maxForce, 15.0);
+}

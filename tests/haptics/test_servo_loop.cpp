@@ -1,0 +1,228 @@
+// The servo loop driven tick by tick on a deterministic clock (lockstep), and once on its own
+// thread: virtual coupling against the local contact model, stale simulation, clutch,
+// disconnect and reconnection, contact-model age, and the trace.
+#include "haptics/scripted_device.hpp"
+#include "haptics/servo_loop.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+using namespace viscera::haptics;
+
+namespace {
+
+constexpr int64_t kMs = 1'000'000;
+
+/// A one-arm device whose state the test sets directly.
+class FakeDevice final : public Device {
+public:
+    FakeDevice() {
+        caps.arms = 1;
+        caps.pedals = 5;
+        caps.arm[0].maxForce = 15;
+    }
+    const DeviceCapabilities& capabilities() const override { return caps; }
+    void poll(int64_t now, DeviceState& out) override {
+        out = state;
+        out.timestamp_ns = now;
+    }
+    void send(const DeviceCommand& c) override {
+        last = c;
+        ++sent;
+    }
+    const char* backend() const override { return "fake"; }
+    DeviceCapabilities caps;
+    DeviceState state;
+    DeviceCommand last;
+    int sent = 0;
+};
+
+/// A flat tissue surface z = 0 under the tool (normal +z), stiffness k, no force at p0.
+LocalContactModel wall(int64_t t, int64_t frame, double k = 400) {
+    LocalContactModel m;
+    m.timestamp_ns = t;
+    m.frame = frame;
+    m.physicsPeriod_s = 1.0 / 60;
+    m.tools[0].active = true;
+    m.tools[0].p0 = Vec3::Zero();
+    m.tools[0].n = Vec3::UnitZ();
+    m.tools[0].f0 = 0;
+    m.tools[0].gap = 0;
+    m.tools[0].k = k;
+    return m;
+}
+
+struct Rig {
+    FakeDevice dev;
+    ManualClock clock{0};
+    ServoConfig cfg;
+    std::unique_ptr<ServoLoop> servo;
+    Rig(double kc = 2000) {
+        cfg.tools[0].enabled = true;
+        cfg.tools[0].motionScale = 1.0;
+        cfg.tools[0].couplingStiffness = kc;
+        cfg.tools[0].couplingDamping = 0;
+        cfg.safety.maxForceRate = 1e6; // the rate rule has its own tests
+        dev.state.connected = true;
+        dev.state.pedals = kPedalDeadman;
+        servo = std::make_unique<ServoLoop>(dev, clock, cfg);
+    }
+    void tick(double z, int ticks = 1) {
+        for (int k = 0; k < ticks; ++k) {
+            dev.state.arms[0].measured_cp.position = Vec3(0, 0, z);
+            clock.advance(kMs);
+            servo->tick(clock.now_ns());
+        }
+    }
+    double force() const { return dev.last.arms[0].servo_cf.force.z(); }
+};
+
+} // namespace
+
+TEST(ServoLoop, NoForceBeforeTheSimulationPublishes) {
+    Rig r;
+    r.tick(-0.01, 10);
+    EXPECT_EQ(r.dev.sent, 10);
+    EXPECT_EQ(r.force(), 0.0);
+    EXPECT_EQ(r.servo->stats().safety.simStale, 10u);
+}
+
+TEST(ServoLoop, VirtualCouplingInSeriesWithTheLocalModel) {
+    Rig r(2000);
+    r.tick(0.0);                       // connects: the tool starts at the scene start (origin)
+    r.servo->publishContact(wall(r.clock.now_ns(), 0, 400));
+    r.tick(0.01);                      // above the surface: no force
+    EXPECT_EQ(r.force(), 0.0);
+    r.servo->publishContact(wall(r.clock.now_ns(), 1, 400));
+    r.tick(-0.005);                    // 5 mm into the surface
+    // Series stiffness 400·2000/2400 N/m over 5 mm.
+    EXPECT_NEAR(r.force(), 400.0 * 2000 / 2400 * 0.005, 1e-9);
+    const ToolPoseState poses = r.servo->toolPoses();
+    EXPECT_NEAR(poses.target[0].z(), -0.005, 1e-12);
+    EXPECT_GT(poses.proxy[0].z(), -0.005) << "the proxy stays shallower than the master";
+    EXPECT_NEAR(poses.proxy[0].z(), -0.005 * 2000 / 2400, 1e-12);
+    EXPECT_NEAR(poses.force[0], r.force(), 1e-12);
+}
+
+TEST(ServoLoop, StaleSimulationZeroesAndFreshOutputResumes) {
+    Rig r;
+    r.tick(0.0);
+    r.servo->publishContact(wall(r.clock.now_ns(), 0));
+    r.tick(-0.004, 50);                // 50 ms: exactly the limit
+    EXPECT_GT(r.force(), 0.0);
+    r.tick(-0.004, 1);                 // 51 ms old
+    EXPECT_EQ(r.force(), 0.0);
+    EXPECT_TRUE(r.dev.last.flags & kFlagSimStale);
+    r.servo->publishContact(wall(r.clock.now_ns(), 1));
+    r.tick(-0.004);
+    EXPECT_GT(r.force(), 0.0);
+}
+
+TEST(ServoLoop, ClutchHoldsTheToolAndReindexesTheMaster) {
+    Rig r;
+    r.tick(0.0);
+    r.servo->publishContact(wall(r.clock.now_ns(), 0));
+    r.tick(0.02);
+    r.dev.state.pedals = kPedalDeadman | kPedalClutch;
+    r.tick(0.10, 5); // the master moves 8 cm while clutched
+    EXPECT_EQ(r.force(), 0.0);
+    EXPECT_NEAR(r.servo->toolPoses().target[0].z(), 0.02, 1e-12);
+    r.dev.state.pedals = kPedalDeadman;
+    r.tick(0.10);
+    EXPECT_NEAR(r.servo->toolPoses().target[0].z(), 0.02, 1e-12) << "no jump on release";
+    r.servo->publishContact(wall(r.clock.now_ns(), 1));
+    r.tick(0.075); // 2.5 cm down from the release point = 5 mm into the surface
+    EXPECT_NEAR(r.servo->toolPoses().target[0].z(), -0.005, 1e-12);
+    EXPECT_GT(r.force(), 0.0);
+}
+
+TEST(ServoLoop, DisconnectZeroesTheForceAndReconnectionResumesWithoutAJump) {
+    Rig r;
+    r.tick(0.0);
+    r.servo->publishContact(wall(r.clock.now_ns(), 0));
+    r.tick(-0.004);
+    EXPECT_GT(r.force(), 0.0);
+    r.dev.state.connected = false;
+    r.tick(0.3, 20); // garbage while disconnected
+    EXPECT_EQ(r.force(), 0.0);
+    EXPECT_TRUE(r.dev.last.flags & kFlagDisconnected);
+    EXPECT_NEAR(r.servo->toolPoses().target[0].z(), -0.004, 1e-12);
+    r.dev.state.connected = true;
+    r.servo->publishContact(wall(r.clock.now_ns(), 1));
+    r.tick(0.3); // reconnects at a new master position: the tool stays where it was
+    EXPECT_NEAR(r.servo->toolPoses().target[0].z(), -0.004, 1e-12);
+    r.tick(0.299); // and follows from there
+    EXPECT_NEAR(r.servo->toolPoses().target[0].z(), -0.005, 1e-9);
+    EXPECT_GT(r.force(), 0.0);
+}
+
+TEST(ServoLoop, ContactModelAgeNeverExceedsOnePhysicsStepInLockstep) {
+    // 1 kHz ticks, a physics step published every 1/60 s (16 or 17 ticks).
+    ScriptedDevice dev("press");
+    ManualClock clock(0);
+    ServoConfig cfg;
+    cfg.tools[0].enabled = true;
+    ServoLoop servo(dev, clock, cfg);
+    const double period = 1.0 / 60;
+    int64_t frame = 0;
+    double nextPublish = 0;
+    double maxAge = 0;
+    int samples = 0;
+    for (int tick = 0; tick < 3000; ++tick) {
+        const double t = tick * 1e-3;
+        clock.set(int64_t(std::llround(t * 1e9)));
+        if (t + 1e-12 >= nextPublish) {
+            servo.publishContact(wall(clock.now_ns(), frame++, 300));
+            nextPublish += period;
+        }
+        servo.tick(clock.now_ns());
+        TraceSample s;
+        while (servo.popTrace(s)) {
+            ASSERT_GE(s.contactAge_s, 0.0);
+            ASSERT_TRUE(s.force.allFinite());
+            maxAge = std::max(maxAge, s.contactAge_s);
+            ++samples;
+        }
+    }
+    EXPECT_EQ(samples, 3000);
+    EXPECT_LE(maxAge, period + 1e-9);
+    const ServoStats st = servo.stats();
+    EXPECT_EQ(st.contactModelsSeen, frame);
+    EXPECT_LE(st.contactAge.max_us, period * 1e6 + 1e-3);
+    EXPECT_EQ(st.traceDropped, 0u);
+}
+
+TEST(ServoLoop, RunsOnItsOwnThreadAgainstTheWallClock) {
+    ScriptedDevice dev("circle");
+    SteadyClock clock;
+    ServoConfig cfg;
+    cfg.tools[0].enabled = true;
+    cfg.realtimePriority = false;
+    ServoLoop servo(dev, clock, cfg);
+    servo.start();
+    EXPECT_TRUE(servo.running());
+    int64_t frame = 0;
+    size_t samples = 0;
+    for (int k = 0; k < 20; ++k) { // a "physics thread" publishing every ~16 ms
+        LocalContactModel m = wall(clock.now_ns(), frame++, 300);
+        m.tools[0].p0 = Vec3(0, 0, -0.0175);
+        servo.publishContact(m);
+        std::this_thread::sleep_for(std::chrono::milliseconds(16));
+        TraceSample s;
+        while (servo.popTrace(s)) {
+            ASSERT_TRUE(s.force.allFinite());
+            ASSERT_LE(s.force.norm(), 15.0);
+            ++samples;
+        }
+    }
+    servo.stop();
+    EXPECT_FALSE(servo.running());
+    const ServoStats st = servo.stats();
+    EXPECT_GT(st.ticks, 10u);
+    EXPECT_GT(samples, 0u);
+    EXPECT_GT(st.period.count, 0u);
+    EXPECT_GT(st.contactModelsSeen, 1);
+    EXPECT_GT(dev.linkStats().sent, 10u);
+}

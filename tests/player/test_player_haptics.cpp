@@ -1,0 +1,241 @@
+// End to end: the player with devices. Replay and scripted sessions (lockstep, repeatable), the
+// console loopback over UDP with viscera-console-sim including a disconnect mid-session, the
+// trainee window offscreen, and the one-line errors for bad device specs and trajectory files.
+#include "player/haptic_case.hpp"
+#include "support/run_process.hpp"
+
+#include "haptics/trajectory.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char** environ;
+
+using namespace viscera;
+using ::testing::HasSubstr;
+
+namespace {
+
+struct Scratch {
+    std::filesystem::path dir;
+    Scratch() {
+        dir = std::filesystem::temp_directory_path() /
+              ("viscera-haptics-" + std::to_string(::getpid()) + "-" + std::to_string(std::rand()));
+        std::filesystem::create_directories(dir);
+    }
+    ~Scratch() { std::filesystem::remove_all(dir); }
+    std::string operator/(const std::string& name) const { return (dir / name).string(); }
+};
+
+test::ProcessResult player(const std::vector<std::string>& args) { return test::runProcess(VISCERA_PLAYER_EXE, args); }
+
+nlohmann::json readJson(const std::string& p) {
+    std::ifstream in(p);
+    return nlohmann::json::parse(in);
+}
+
+std::string readText(const std::string& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+/// Starts a process in the background (stdout/stderr to files); waitFor() reaps it.
+struct Background {
+    pid_t pid = -1;
+    Background(const std::string& exe, const std::vector<std::string>& args, const std::string& logPrefix) {
+        std::vector<char*> argv;
+        argv.push_back(const_cast<char*>(exe.c_str()));
+        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        posix_spawn_file_actions_t fa;
+        posix_spawn_file_actions_init(&fa);
+        posix_spawn_file_actions_addopen(&fa, 1, (logPrefix + ".out").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        posix_spawn_file_actions_addopen(&fa, 2, (logPrefix + ".err").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (posix_spawn(&pid, exe.c_str(), &fa, nullptr, argv.data(), environ) != 0) pid = -1;
+        posix_spawn_file_actions_destroy(&fa);
+    }
+    int waitFor() {
+        int status = 0;
+        if (pid > 0 && ::waitpid(pid, &status, 0) == pid) {
+            pid = -1;
+            return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        }
+        return -1;
+    }
+    ~Background() {
+        if (pid > 0) {
+            ::kill(pid, SIGTERM);
+            ::waitpid(pid, nullptr, 0);
+        }
+    }
+};
+
+std::string waitForPort(const std::string& file) {
+    for (int k = 0; k < 200; ++k) {
+        std::ifstream in(file);
+        std::string port;
+        if (in >> port && !port.empty()) return port;
+        std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    }
+    return "";
+}
+
+} // namespace
+
+TEST(PlayerHaptics, ScriptedSessionIsRepeatableAndReportsTaskMetrics) {
+    Scratch s;
+    test::writeHapticCase(s / "slab.vcase");
+    auto run = [&](const std::string& tag) {
+        auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "200", "--device", "scripted:press", "--report",
+                         s / (tag + ".json"), "--trace", s / (tag + ".csv")});
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        return readJson(s / (tag + ".json"));
+    };
+    const nlohmann::json a = run("a"), b = run("b");
+    EXPECT_EQ(a["active_subsystems"], nlohmann::json({"gravity", "probe", "xpbd", "haptics"}));
+    const auto& m = a["metrics"];
+    for (const char* key : {"time_s", "tool_path_length_m", "max_force_n", "mean_force_n", "tissue_damage_ns", "punctures", "clips"})
+        EXPECT_TRUE(m.contains(key)) << key;
+    EXPECT_GT(m["tool_path_length_m"].get<double>(), 0.005);
+    EXPECT_GT(m["max_force_n"].get<double>(), 0.05) << "the probe pressed the tissue";
+    EXPECT_LE(m["max_force_n"].get<double>(), 15.0);
+    EXPECT_EQ(a["invariants"]["max_force_n"], m["max_force_n"]);
+    const auto& h = a["haptics"];
+    EXPECT_EQ(h["mode"], "lockstep");
+    EXPECT_EQ(h["servo"]["ticks"].get<int>(), 3334); // 1 kHz over 200 frames of 1/60 s (0.0166667 s)
+    EXPECT_LE(h["contact_model"]["max_age_over_period"].get<double>(), 1.0) << "never older than one physics step";
+    EXPECT_LE(h["contact_model"]["max_steps_behind"].get<int>(), 1);
+    EXPECT_EQ(h["safety"]["non_finite"], 0);
+    // Lockstep sessions are repeatable: same forces, same path.
+    EXPECT_EQ(a["metrics"]["max_force_n"], b["metrics"]["max_force_n"]);
+    EXPECT_EQ(a["metrics"]["tool_path_length_m"], b["metrics"]["tool_path_length_m"]);
+    EXPECT_EQ(readText(s / "a.csv"), readText(s / "b.csv"));
+    const std::string csv = readText(s / "a.csv");
+    EXPECT_EQ(csv.rfind("t_s,arm,device_x", 0), 0u);
+    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3335);
+    EXPECT_EQ(csv.find("nan"), std::string::npos);
+}
+
+TEST(PlayerHaptics, ReplaysARecordedTrajectory) {
+    Scratch s;
+    test::writeHapticCase(s / "slab.vcase");
+    auto w = test::runProcess(VISCERA_CONSOLE_SIM_EXE, {"--write-trajectory", s / "press.csv", "--script", "press", "--duration", "3"});
+    ASSERT_EQ(w.exitCode, 0) << w.err;
+    EXPECT_NO_THROW(haptics::Trajectory::load(s / "press.csv"));
+    auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "120", "--device", "replay:" + (s / "press.csv"),
+                     "--report", s / "r.json"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = readJson(s / "r.json");
+    EXPECT_EQ(j["haptics"]["device"]["backend"], "replay");
+    EXPECT_GT(j["metrics"]["max_force_n"].get<double>(), 0.05);
+}
+
+TEST(PlayerHaptics, BadDeviceSpecsAndTrajectoriesGiveOneLineErrors) {
+    Scratch s;
+    test::writeHapticCase(s / "slab.vcase");
+    std::ofstream(s / "bad.csv") << "# viscera-trajectory 1\nt,arm,x,y,z,qw,qx,qy,qz,grip,buttons,pedals\n0,0,0,0,0,1,0,0,0,0,0,99\n";
+    struct Bad {
+        std::string spec, rule;
+        int code;
+    };
+    const std::vector<Bad> bad = {{"joystick", "unknown device backend", 1},
+                                  {"console:localhost", "must be host:port", 1},
+                                  {"replay:" + (s / "missing.csv"), "missing.csv", 1},
+                                  {"replay:" + (s / "bad.csv"), "bad.csv: line 3: field 'pedals'", 1},
+                                  {"scripted:nope", "unknown script", 1},
+                                  {"keyboard", "needs the trainee window", 1}};
+    for (const Bad& b : bad) {
+        auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "5", "--device", b.spec});
+        EXPECT_EQ(r.exitCode, b.code) << b.spec << ": " << r.err;
+        EXPECT_THAT(r.err, HasSubstr(b.rule)) << b.spec;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    }
+    auto t = player({"run", s / "slab.vcase", "--headless", "--trace", s / "t.csv"});
+    EXPECT_EQ(t.exitCode, 2);
+    EXPECT_THAT(t.err, HasSubstr("--trace records the device forces"));
+}
+
+TEST(PlayerHaptics, ConsoleLoopbackWithADisconnectMidSession) {
+    Scratch s;
+    test::writeHapticCase(s / "slab.vcase", 2); // a probe for each hand
+    // The console streams 3.5 s of the bimanual script, silent from 1.0 s to 1.6 s.
+    Background sim(VISCERA_CONSOLE_SIM_EXE,
+                   {"--listen", "127.0.0.1:0", "--port-file", s / "port", "--script", "bimanual", "--duration", "3.5",
+                    "--pause-at", "1.0", "--pause-for", "0.6", "--record", s / "forces.csv", "--summary", s / "sum.json",
+                    "--wait-player", "20"},
+                   s / "sim");
+    const std::string port = waitForPort(s / "port");
+    ASSERT_FALSE(port.empty()) << readText(s / "sim.err");
+    auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "180", "--device", "console:127.0.0.1:" + port,
+                     "--report", s / "r.json", "--trace", s / "t.csv"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    ASSERT_EQ(sim.waitFor(), 0) << readText(s / "sim.err");
+    const auto j = readJson(s / "r.json");
+    const auto& h = j["haptics"];
+    EXPECT_EQ(h["mode"], "realtime");
+    EXPECT_EQ(h["device"]["arms"], 2);
+    EXPECT_EQ(h["tools"][0]["arm"], 0) << "the left-hand probe follows the left master";
+    EXPECT_EQ(h["tools"][1]["arm"], 1) << "the right-hand probe follows the right master";
+    EXPECT_GE(h["link"]["disconnects"].get<int>(), 1);
+    EXPECT_GE(h["link"]["reconnects"].get<int>(), 1);
+    EXPECT_GT(h["safety"]["disconnected"].get<int>(), 0);
+    EXPECT_GT(h["servo"]["ticks"].get<int>(), 1000);
+    EXPECT_LE(h["contact_model"]["max_steps_behind"].get<int>(), 1);
+    EXPECT_TRUE(j["invariants"]["all_finite"].get<bool>());
+    // The player kept running through the gap and forces came back to the console afterwards.
+    const auto sum = readJson(s / "sum.json");
+    EXPECT_GT(sum["commands_received"].get<int>(), 1000);
+    EXPECT_EQ(sum["commands_non_finite"], 0);
+    EXPECT_EQ(sum["paused_nonzero_after_timeout"], 0) << "force zeroed while the console was silent";
+    EXPECT_LE(sum["max_force_n"].get<double>(), 15.0);
+    const std::string forces = readText(s / "forces.csv");
+    EXPECT_EQ(forces.find("nan"), std::string::npos);
+    // Non-zero forces after the reconnection (t > 1.6 s): the left arm is still pressing.
+    bool after = false;
+    std::istringstream lines(forces);
+    std::string line;
+    std::getline(lines, line);
+    while (std::getline(lines, line)) {
+        double t, f[6];
+        unsigned seq, echo, flags;
+        int paused;
+        if (std::sscanf(line.c_str(), "%lf,%u,%u,%u,%d,%lf,%lf,%lf,%lf,%lf,%lf", &t, &seq, &echo, &flags, &paused, &f[0], &f[1],
+                        &f[2], &f[3], &f[4], &f[5]) == 11 &&
+            t > 1.7 && (std::abs(f[2]) > 0.01 || std::abs(f[5]) > 0.01))
+            after = true;
+    }
+    EXPECT_TRUE(after) << "forces resume after the reconnection";
+}
+
+TEST(PlayerHaptics, TraineeWindowRunsOffscreenAndWritesAScreenshot) {
+    Scratch s;
+    test::writeHapticCase(s / "slab.vcase");
+    ::setenv("QT_QPA_PLATFORM", "offscreen", 1);
+    auto r = player({"run", s / "slab.vcase", "--frames", "30", "--device", "scripted:press", "--screenshot", s / "shot.png",
+                     "--report", s / "r.json"});
+    ::unsetenv("QT_QPA_PLATFORM");
+    if (r.exitCode == 2 && r.err.find("Qt6 Gui") != std::string::npos) GTEST_SKIP() << "player built without Qt6 Gui";
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::string png = readText(s / "shot.png");
+    ASSERT_GT(png.size(), 1000u);
+    EXPECT_EQ(png.substr(1, 3), "PNG");
+    EXPECT_EQ(readJson(s / "r.json")["frames"].size(), 30u);
+    auto h = player({"run", s / "slab.vcase", "--headless", "--screenshot", s / "x.png"});
+    EXPECT_EQ(h.exitCode, 2);
+    EXPECT_THAT(h.err, HasSubstr("--screenshot captures the trainee window"));
+}

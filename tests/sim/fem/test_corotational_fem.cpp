@@ -1,0 +1,321 @@
+#include "sim/fem/corotational_fem.hpp"
+#include "sim/mesh/generators.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+
+#include <random>
+
+using namespace viscera::sim;
+using namespace viscera::sim::fem;
+
+namespace {
+
+struct Bar {
+    std::unique_ptr<TetMesh> mesh;
+    std::vector<int32_t> fixed;
+    std::vector<Vec3> gravity;
+};
+
+Bar makeBar(std::array<int, 3> cells = {6, 2, 2}) {
+    Bar b;
+    b.mesh = makeBoxTetMesh({Vec3::Zero(), Vec3(0.06, 0.02, 0.02), cells});
+    const auto& p = b.mesh->positions();
+    b.gravity.assign(p.size(), Vec3(0, 0, -1e-3)); // N per node
+    for (int32_t v = 0; v < static_cast<int32_t>(p.size()); ++v)
+        if (p[v].x() < 1e-9) b.fixed.push_back(v);
+    return b;
+}
+
+double maxAbs(const Eigen::VectorXd& v) { return v.size() ? v.cwiseAbs().maxCoeff() : 0.0; }
+
+Eigen::VectorXd displacement(const CorotationalFem& fem) {
+    Eigen::VectorXd u(3 * fem.nodeCount());
+    for (size_t v = 0; v < fem.nodeCount(); ++v) u.segment<3>(3 * v) = fem.positions()[v] - fem.restPositions()[v];
+    return u;
+}
+
+/// Point constraint: the material point with barycentric coordinates w in tet t goes to target.
+ConstraintDesc pointConstraint(const TetMesh& m, int t, const Eigen::Vector4d& w, const Vec3& target, int priority = 0) {
+    ConstraintDesc d;
+    d.priority = priority;
+    for (int k = 0; k < 3; ++k) {
+        ConstraintRow r;
+        for (int a = 0; a < 4; ++a) r.terms.push_back({m.tets()[t][a], w[a] * Vec3::Unit(k)});
+        r.b = target[k];
+        d.rows.push_back(r);
+    }
+    return d;
+}
+
+Vec3 materialPoint(const CorotationalFem& fem, const TetMesh& m, int t, const Eigen::Vector4d& w) {
+    Vec3 p = Vec3::Zero();
+    for (int a = 0; a < 4; ++a) p += w[a] * fem.positions()[m.tets()[t][a]];
+    return p;
+}
+
+/// Full KKT [K Cᵀ; C 0] solved with a sparse LU: the reference of the Schur-complement path.
+void fullKkt(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& f, const Eigen::MatrixXd& C,
+             const Eigen::VectorXd& b, Eigen::VectorXd& u, Eigen::VectorXd& lambda) {
+    const int n = static_cast<int>(K.rows()), m = static_cast<int>(C.rows());
+    std::vector<Eigen::Triplet<double>> t;
+    for (int k = 0; k < K.outerSize(); ++k)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(K, k); it; ++it) t.emplace_back(it.row(), it.col(), it.value());
+    for (int r = 0; r < m; ++r)
+        for (int c = 0; c < n; ++c)
+            if (C(r, c) != 0) {
+                t.emplace_back(n + r, c, C(r, c));
+                t.emplace_back(c, n + r, C(r, c));
+            }
+    Eigen::SparseMatrix<double> A(n + m, n + m);
+    A.setFromTriplets(t.begin(), t.end());
+    Eigen::VectorXd rhs(n + m);
+    rhs << f, b;
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+    lu.compute(A);
+    ASSERT_EQ(lu.info(), Eigen::Success);
+    const Eigen::VectorXd x = lu.solve(rhs);
+    u = x.head(n);
+    lambda = x.tail(m);
+}
+
+FemSettings linearSettings() {
+    FemSettings s;
+    s.corotational = false;
+    s.refactorMode = RefactorMode::Synchronous;
+    return s;
+}
+
+} // namespace
+
+TEST(CorotationalFem, UnconstrainedMatchesDirectSparseSolve) {
+    for (bool corot : {false, true}) {
+        Bar bar = makeBar({12, 4, 4});
+        FemSettings s = linearSettings();
+        s.corotational = corot;
+        s.refactorDisplacement = 1e9; // rotations only where the test asks for them
+        auto fem = CorotationalFem::create(*bar.mesh, bar.fixed, s, bar.gravity);
+        if (corot) {
+            // Bend the bar with a constraint, then take the rotations of the bent state.
+            const int id = fem->addConstraint(pointConstraint(*bar.mesh, static_cast<int>(bar.mesh->tetCount()) - 1,
+                                                              Eigen::Vector4d::Constant(0.25), Vec3(0.05, 0.03, 0.02)));
+            ASSERT_TRUE(fem->solve().finite);
+            ASSERT_TRUE(fem->refactorNow());
+            fem->removeConstraint(id);
+        }
+        const FemSolveStats st = fem->solve();
+        ASSERT_TRUE(st.finite) << st.error;
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(fem->stiffnessMatrix());
+        ASSERT_EQ(ldlt.info(), Eigen::Success);
+        const Eigen::VectorXd ref = ldlt.solve(fem->forceVector());
+        const double err = maxAbs(displacement(*fem) - ref) / maxAbs(ref);
+        RecordProperty(corot ? "corotational_rel_error" : "linear_rel_error", std::to_string(err));
+        EXPECT_LT(err, 1e-10) << (corot ? "corotational" : "linear");
+        EXPECT_GT(maxAbs(ref), 1e-6);
+    }
+}
+
+TEST(CorotationalFem, ConstraintsMatchFullKktSolve) {
+    Bar bar = makeBar({10, 3, 3});
+    const TetMesh& m = *bar.mesh;
+    for (bool corot : {false, true}) {
+        FemSettings s = linearSettings();
+        s.corotational = corot;
+        s.refactorDisplacement = 1e9;
+        auto fem = CorotationalFem::create(m, bar.fixed, s, bar.gravity);
+        std::mt19937 rng(5);
+        std::uniform_int_distribution<int> tet(0, static_cast<int>(m.tetCount()) - 1);
+        std::uniform_real_distribution<double> u(0.05, 1.0), d(-1, 1);
+        for (int k = 0; k < 6; ++k) {
+            Eigen::Vector4d w(u(rng), u(rng), u(rng), u(rng));
+            w /= w.sum();
+            const int t = tet(rng);
+            Vec3 rest = Vec3::Zero();
+            for (int a = 0; a < 4; ++a) rest += w[a] * m.positions()[m.tets()[t][a]];
+            fem->addConstraint(pointConstraint(m, t, w, rest + 2e-3 * Vec3(d(rng), d(rng), d(rng))));
+        }
+        for (int k = 0; k < 4; ++k) { // single rows along random directions (contact-like)
+            ConstraintDesc c;
+            ConstraintRow r;
+            const Tet& T = m.tets()[tet(rng)];
+            const Vec3 n = Vec3(d(rng), d(rng), d(rng)).normalized();
+            r.terms = {{T[0], 0.5 * n}, {T[1], 0.5 * n}, {T[3], -n}};
+            r.b = 0.5 * n.dot(m.positions()[T[0]] + m.positions()[T[1]]) - n.dot(m.positions()[T[3]]) + 1e-4;
+            c.rows.push_back(r);
+            fem->addConstraint(c);
+        }
+        FemSolveStats st = fem->solve();
+        if (corot) { // once more with the rotations of the deformed state
+            ASSERT_TRUE(fem->refactorNow());
+            st = fem->solve();
+        }
+        ASSERT_TRUE(st.finite) << st.error;
+        EXPECT_EQ(st.rows, 22);
+        EXPECT_EQ(st.redundant + st.incompatible, 0);
+        Eigen::MatrixXd C;
+        Eigen::VectorXd b, lambda;
+        fem->lastSystem(C, b, lambda);
+        const Eigen::VectorXd uu = displacement(*fem);
+        const double residual = maxAbs(C * uu - b);
+        Eigen::VectorXd uRef, lRef;
+        fullKkt(fem->stiffnessMatrix(), fem->forceVector(), C, b, uRef, lRef);
+        const double uErr = maxAbs(uu - uRef) / maxAbs(uRef);
+        const double lErr = maxAbs(lambda - lRef) / maxAbs(lRef);
+        RecordProperty(corot ? "corot_cu_b_residual_m" : "linear_cu_b_residual_m", std::to_string(residual));
+        RecordProperty(corot ? "corot_lambda_rel_error" : "linear_lambda_rel_error", std::to_string(lErr));
+        EXPECT_LT(residual, 1e-9);
+        EXPECT_LT(uErr, 1e-9);
+        EXPECT_LT(lErr, 1e-9);
+        // KKT stationarity: K u + Cᵀλ = f.
+        EXPECT_LT(maxAbs(fem->stiffnessMatrix() * uu + C.transpose() * lambda - fem->forceVector()),
+                  1e-9 * maxAbs(fem->forceVector().cwiseAbs() + (C.transpose() * lambda).cwiseAbs()));
+    }
+}
+
+TEST(CorotationalFem, RedundantAndIncompatibleRowsAreRejected) {
+    Bar bar = makeBar();
+    const TetMesh& m = *bar.mesh;
+    auto fem = CorotationalFem::create(m, bar.fixed, linearSettings(), bar.gravity);
+    const Eigen::Vector4d w = Eigen::Vector4d::Constant(0.25);
+    const int t = static_cast<int>(m.tetCount()) - 5;
+    Vec3 rest = Vec3::Zero();
+    for (int a = 0; a < 4; ++a) rest += 0.25 * m.positions()[m.tets()[t][a]];
+    const Vec3 target = rest + Vec3(0, 0, 1e-3);
+    const int a = fem->addConstraint(pointConstraint(m, t, w, target, 0));
+    ASSERT_TRUE(fem->solve().finite);
+    const std::vector<Vec3> alone = fem->positions();
+    // The same point constraint again: redundant; with another target: incompatible.
+    const int same = fem->addConstraint(pointConstraint(m, t, w, target, 1));
+    FemSolveStats st = fem->solve();
+    ASSERT_TRUE(st.finite);
+    EXPECT_EQ(st.redundant, 3);
+    EXPECT_EQ(st.incompatible, 0);
+    EXPECT_EQ(fem->state(same).status[0], RowStatus::Redundant);
+    const int clash = fem->addConstraint(pointConstraint(m, t, w, target + Vec3(1e-3, 0, 0), 2));
+    st = fem->solve();
+    ASSERT_TRUE(st.finite);
+    EXPECT_EQ(st.incompatible, 1); // only x disagrees
+    EXPECT_EQ(st.redundant, 5);
+    EXPECT_EQ(fem->state(clash).status[0], RowStatus::Incompatible);
+    for (size_t v = 0; v < alone.size(); ++v) EXPECT_LT((fem->positions()[v] - alone[v]).norm(), 1e-12);
+    // A row on fixed nodes only is a zero row: rejected, never singular.
+    ConstraintDesc z;
+    z.rows.push_back({{{bar.fixed[0], Vec3(1, 0, 0)}}, 5.0});
+    fem->addConstraint(z);
+    st = fem->solve();
+    EXPECT_TRUE(st.finite);
+    EXPECT_EQ(st.incompatible, 2);
+    EXPECT_NEAR((materialPoint(*fem, m, t, w) - target).norm(), 0, 1e-12);
+    (void)a;
+}
+
+TEST(CorotationalFem, ConstraintsChangeWithoutRefactorization) {
+    Bar bar = makeBar();
+    const TetMesh& m = *bar.mesh;
+    auto fem = CorotationalFem::create(m, bar.fixed, linearSettings(), bar.gravity);
+    EXPECT_EQ(fem->factorizations(), 1);
+    std::vector<int> ids;
+    for (int k = 0; k < 20; ++k) {
+        const int t = (k * 37) % static_cast<int>(m.tetCount());
+        Vec3 rest = Vec3::Zero();
+        for (int a = 0; a < 4; ++a) rest += 0.25 * m.positions()[m.tets()[t][a]];
+        ids.push_back(fem->addConstraint(pointConstraint(m, t, Eigen::Vector4d::Constant(0.25), rest + Vec3(0, 0, 1e-4 * k))));
+        const FemSolveStats st = fem->solve();
+        ASSERT_TRUE(st.finite);
+        if (k % 3 == 2) fem->removeConstraint(ids[k - 1]);
+        fem->setRhs(ids[0], 2, rest.z() + 1e-5 * k); // moving target
+    }
+    EXPECT_EQ(fem->factorizations(), 1);
+    const FemSolveStats st = fem->solve();
+    EXPECT_EQ(st.newCachedNodes, 0); // every node's K⁻¹ block is cached
+    EXPECT_EQ(st.substitutions, 1);  // one substitution per solve
+}
+
+TEST(CorotationalFem, UnilateralGroupsReleaseAndActivate) {
+    Bar bar = makeBar({8, 2, 2});
+    const TetMesh& m = *bar.mesh;
+    auto fem = CorotationalFem::create(m, bar.fixed, linearSettings(), bar.gravity);
+    ASSERT_TRUE(fem->solve().finite);
+    int tip = 0;
+    for (int v = 0; v < static_cast<int>(m.vertexCount()); ++v)
+        if (m.positions()[v].x() > m.positions()[tip].x() - 1e-12 && m.positions()[v].z() <= m.positions()[tip].z()) tip = v;
+    const double sag = m.positions()[tip].z() - fem->positions()[tip].z();
+    ASSERT_GT(sag, 1e-6);
+    // A floor half-way down the free sag: enforced, pushing (λ < 0 in K u + Cᵀλ = f).
+    ConstraintDesc floor;
+    floor.kind = ConstraintKind::Unilateral;
+    floor.startActive = false;
+    floor.rows.push_back({{{tip, Vec3(0, 0, 1)}}, m.positions()[tip].z() - 0.5 * sag});
+    const int id = fem->addConstraint(floor);
+    FemSolveStats st = fem->solve();
+    ASSERT_TRUE(st.finite);
+    EXPECT_TRUE(fem->state(id).active);
+    EXPECT_LT(fem->state(id).lambda[0], 0);
+    EXPECT_NEAR(fem->positions()[tip].z(), m.positions()[tip].z() - 0.5 * sag, 1e-12);
+    // The floor far below, started active: it would pull, so it is released.
+    fem->setRhs(id, 0, m.positions()[tip].z() - 1.0);
+    st = fem->solve();
+    EXPECT_FALSE(fem->state(id).active);
+    EXPECT_NEAR(m.positions()[tip].z() - fem->positions()[tip].z(), sag, 1e-12);
+}
+
+TEST(CorotationalFem, BackgroundRefactorIsDeterministicAndOffThePath) {
+    auto run = [](RefactorMode mode) {
+        Bar bar = makeBar({10, 2, 2});
+        FemSettings s;
+        s.refactorMode = mode;
+        s.refactorDisplacement = 0.05;
+        auto fem = CorotationalFem::create(*bar.mesh, bar.fixed, s, bar.gravity);
+        const int t = static_cast<int>(bar.mesh->tetCount()) - 1;
+        Vec3 rest = Vec3::Zero();
+        for (int a = 0; a < 4; ++a) rest += 0.25 * bar.mesh->positions()[bar.mesh->tets()[t][a]];
+        const int id = fem->addConstraint(pointConstraint(*bar.mesh, t, Eigen::Vector4d::Constant(0.25), rest));
+        std::vector<int> refactorSteps;
+        for (int k = 0; k < 40; ++k) {
+            for (int c = 0; c < 3; ++c) fem->setRhs(id, c, rest[c] + (c == 2 ? 1e-3 * k : 0.0));
+            const FemSolveStats st = fem->solve();
+            EXPECT_TRUE(st.finite);
+            EXPECT_TRUE(st.error.empty()) << st.error;
+            if (st.refactored) refactorSteps.push_back(k);
+        }
+        return std::make_pair(fem->positions(), refactorSteps);
+    };
+    const auto a = run(RefactorMode::Background), b = run(RefactorMode::Background);
+    EXPECT_EQ(a.first, b.first); // bit-identical
+    EXPECT_EQ(a.second, b.second);
+    EXPECT_GE(a.second.size(), 2u);
+    const auto c = run(RefactorMode::Synchronous);
+    EXPECT_GE(c.second.size(), 2u);
+}
+
+TEST(CorotationalFem, NonFiniteRightHandSideIsDiscarded) {
+    Bar bar = makeBar();
+    auto fem = CorotationalFem::create(*bar.mesh, bar.fixed, linearSettings(), bar.gravity);
+    ASSERT_TRUE(fem->solve().finite);
+    const std::vector<Vec3> before = fem->positions();
+    const int id = fem->addConstraint(pointConstraint(*bar.mesh, 3, Eigen::Vector4d::Constant(0.25), Vec3(0, 0, 0)));
+    fem->setRhs(id, 1, std::numeric_limits<double>::quiet_NaN());
+    const FemSolveStats st = fem->solve();
+    EXPECT_FALSE(st.finite);
+    EXPECT_FALSE(st.error.empty());
+    EXPECT_EQ(fem->positions(), before);
+}
+
+TEST(CorotationalFem, CreateRejectsBadInputWithMessages) {
+    Bar bar = makeBar();
+    auto expectMessage = [](auto&& f, const char* text) {
+        try {
+            f();
+            FAIL() << "expected invalid_argument";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+        }
+    };
+    FemSettings s;
+    s.poissonRatio = 0.5;
+    expectMessage([&] { CorotationalFem::create(*bar.mesh, bar.fixed, s); }, "poisson_ratio 0.5 must be in [0, 0.5)");
+    expectMessage([&] { CorotationalFem::create(*bar.mesh, {99999}, FemSettings{}); }, "fixed node 99999 is out of range");
+    expectMessage([&] { CorotationalFem::create(*bar.mesh, {}, FemSettings{}); }, "not positive definite");
+}
