@@ -15,7 +15,7 @@ PKGS=(
   libassimp-dev libopenvdb-dev libtbb-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
   # rendering, headless EGL on Mesa (llvmpipe)
-  libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri mesa-utils
+  libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri mesa-utils libpng-dev
   # Qt6 (studio widgets; the player uses QtGui at most)
   qt6-base-dev libqt6opengl6-dev
   # tests and benchmarks

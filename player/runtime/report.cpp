@@ -150,6 +150,15 @@ nlohmann::json reportJson(const SessionResult& r) {
     doc["metrics"]["punctures"] = tm.punctures;
     doc["metrics"]["clips"] = tm.clips;
     if (r.haptics) doc["haptics"] = hapticsJson(*r.haptics);
+    if (r.render) {
+        json passes = json::array();
+        for (const auto& p : r.render->passes)
+            passes.push_back({{"name", p.name}, {"eye", p.eye}, {"ms", p.ms}});
+        doc["render"] = {{"device", r.render->device},   {"image", r.render->image},
+                         {"width", r.render->width},     {"height", r.render->height},
+                         {"frame_ms", r.render->totalMs}, {"upload_ms", r.render->uploadMs},
+                         {"passes", passes}};
+    }
     doc["errors"] = r.errors;
     return doc;
 }
@@ -199,6 +208,18 @@ std::string summaryText(const SessionResult& r) {
                                                h.link.rejectedOrder));
             out += line;
         }
+    }
+    if (r.render) {
+        std::string passes;
+        for (const auto& p : r.render->passes) {
+            char item[96];
+            std::snprintf(item, sizeof item, "%s%s %.1f", passes.empty() ? "" : ", ", p.name.c_str(), p.ms);
+            passes += item;
+        }
+        char line[1024];
+        std::snprintf(line, sizeof line, "render        %dx%d frame %.1f ms (%s ms) -> %s\n", r.render->width,
+                      r.render->height, r.render->totalMs, passes.c_str(), r.render->image.c_str());
+        out += line;
     }
     // Error against run time on the last sampled frame [A eq. 4.45].
     for (auto it = r.accuracy.rbegin(); it != r.accuracy.rend(); ++it) {

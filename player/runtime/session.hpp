@@ -48,6 +48,20 @@ struct RunOptions {
     LiveView* live = nullptr;     ///< filled every frame when set
 };
 
+/// One rendered frame (--screenshot on the headless path): per-pass wall times.
+struct RenderFigures {
+    std::string device;   ///< e.g. "llvmpipe (LLVM 15.0.6, 256 bits) — EGL 1.5 (surfaceless), OpenGL 4.5 core"
+    std::string image;    ///< PNG path
+    int width = 0, height = 0;
+    double totalMs = 0, uploadMs = 0;
+    struct Pass {
+        std::string name;
+        int eye = 0;
+        double ms = 0;
+    };
+    std::vector<Pass> passes; ///< in execution order; a switched-off effect has no entry
+};
+
 struct SessionResult {
     std::string caseId, caseVersion, title;
     std::vector<std::string> activeSubsystems;
@@ -62,6 +76,7 @@ struct SessionResult {
     std::optional<HapticsResult> haptics; ///< present when the session ran a device
     TaskMetrics metrics;
     std::vector<TraceRow> trace;          ///< when RunOptions::keepTrace
+    std::optional<RenderFigures> render;  ///< when a frame was rendered (--screenshot)
     bool ok() const { return errors.empty() && invariants.allFinite; }
 };
 

@@ -30,6 +30,10 @@ TEST(SeqLock, ReadersNeverSeeATornValue) {
             ++reads;
         }
     });
+    // The reader is running before the writes start (else, on a busy machine, all the writes could
+    // be over before its first read).
+    while (reads.load() == 0)
+        std::this_thread::yield();
     for (int64_t k = 1; k <= 200000; ++k) {
         Payload p;
         p.v.fill(k);

@@ -1,0 +1,32 @@
+#pragma once
+/// 8-bit RGBA images (rows top to bottom) and the comparisons golden-image tests use.
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+namespace viscera::render {
+
+struct Image {
+    int width = 0, height = 0;
+    std::vector<uint8_t> rgba; ///< width·height·4 bytes, row-major, first row at the top
+    bool empty() const { return rgba.empty(); }
+    const uint8_t* pixel(int x, int y) const { return &rgba[(size_t(y) * width + x) * 4]; }
+};
+
+struct ImageDifference {
+    double rmse = 0;      ///< over RGB of the compared pixels, in 8-bit units
+    int maxChannel = 0;   ///< largest |a − b| of one RGB channel
+    size_t pixels = 0;    ///< pixels compared
+    size_t differing = 0; ///< pixels with any RGB channel different
+};
+
+/// Compares RGB of two images of the same size; `mask` (width·height, non-zero = compared) may be
+/// empty. Throws std::invalid_argument when sizes differ.
+ImageDifference compareImages(const Image& a, const Image& b, const std::vector<uint8_t>& mask = {});
+
+/// Writes an 8-bit RGBA PNG (libpng, zlib-compressed). Throws std::runtime_error naming the path.
+void writePng(const std::filesystem::path& path, const Image& image);
+/// Reads any PNG as 8-bit RGBA. Throws std::runtime_error naming the path.
+Image readPng(const std::filesystem::path& path);
+
+} // namespace viscera::render

@@ -1,0 +1,55 @@
+#include "render/backend.hpp"
+
+#include <Eigen/Geometry>
+
+namespace viscera::render {
+
+void MockBackend::resize(const FrameLayout& layout) {
+    if (layout == m_layout) return;
+    m_layout = layout;
+    ++m_stats.targetAllocations;
+}
+
+void MockBackend::createMesh(size_t index, const RenderMesh& mesh) {
+    if (m_meshes.size() <= index) m_meshes.resize(index + 1);
+    m_meshes[index] = {mesh.vertexCount(), mesh.triangleCount(), 0};
+    m_stats.bufferAllocations += 4; // positions (current, previous), normals, static attributes
+}
+
+void MockBackend::updateMesh(size_t index, const RenderMesh& mesh, bool staticChanged) {
+    MeshRecord& r = m_meshes.at(index);
+    if (r.vertices != mesh.vertexCount()) return; // the Renderer never lets this happen
+    ++r.updates;
+    m_stats.bufferUpdates += staticChanged ? 4 : 3;
+}
+
+void MockBackend::runPass(const PassDesc& pass, const PassContext& ctx) {
+    m_passes.push_back(pass);
+    ++m_stats.passesRun;
+    if (pass.kind == PassKind::GBuffer)
+        for (const RenderMesh& m : ctx.view.meshes()) m_stats.drawCalls += m.visible ? 1 : 0;
+    if (pass.kind == PassKind::Lighting) {
+        m_samples.assign(ctx.view.meshes().size(), {});
+        for (size_t i = 0; i < ctx.view.meshes().size(); ++i) {
+            const RenderMesh& m = ctx.view.meshes()[i];
+            for (size_t v = 0; v < m.vertexCount(); ++v) {
+                const float d = (Eigen::Map<const Eigen::Vector3f>(&m.positions[3 * v]) - ctx.light.center).norm();
+                m_samples[i].push_back(samplesFor(ctx.settings.sampling, d, int(m.sampleMap[v] + 0.5f)));
+            }
+        }
+    }
+}
+
+Image MockBackend::readPixels(ImageStage) {
+    Image img;
+    img.width = m_layout.outputWidth;
+    img.height = m_layout.outputHeight;
+    img.rgba.assign(size_t(img.width) * img.height * 4, 0);
+    return img;
+}
+
+std::vector<float> MockBackend::readDepth() {
+    return std::vector<float>(size_t(m_layout.eyeWidth) * m_layout.eyeHeight, 1.0f);
+}
+
+} // namespace viscera::render

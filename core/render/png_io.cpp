@@ -1,0 +1,47 @@
+// PNG through libpng's simplified API (zlib compression and CRCs are libpng's).
+#include "render/image.hpp"
+
+#include <png.h>
+
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+namespace viscera::render {
+
+void writePng(const std::filesystem::path& path, const Image& image) {
+    if (image.width <= 0 || image.height <= 0 || image.rgba.size() != size_t(image.width) * image.height * 4)
+        throw std::runtime_error(path.string() + ": render::writePng(): image is empty or its size is inconsistent");
+    png_image png;
+    std::memset(&png, 0, sizeof png);
+    png.version = PNG_IMAGE_VERSION;
+    png.width = png_uint_32(image.width);
+    png.height = png_uint_32(image.height);
+    png.format = PNG_FORMAT_RGBA;
+    if (!png_image_write_to_file(&png, path.string().c_str(), 0, image.rgba.data(), 0, nullptr)) {
+        const std::string why = png.message;
+        png_image_free(&png);
+        throw std::runtime_error(path.string() + ": cannot write PNG: " + why);
+    }
+}
+
+Image readPng(const std::filesystem::path& path) {
+    png_image png;
+    std::memset(&png, 0, sizeof png);
+    png.version = PNG_IMAGE_VERSION;
+    if (!png_image_begin_read_from_file(&png, path.string().c_str()))
+        throw std::runtime_error(path.string() + ": cannot read PNG: " + png.message);
+    png.format = PNG_FORMAT_RGBA;
+    Image image;
+    image.width = int(png.width);
+    image.height = int(png.height);
+    image.rgba.resize(PNG_IMAGE_SIZE(png));
+    if (!png_image_finish_read(&png, nullptr, image.rgba.data(), 0, nullptr)) {
+        const std::string why = png.message;
+        png_image_free(&png);
+        throw std::runtime_error(path.string() + ": cannot decode PNG: " + why);
+    }
+    return image;
+}
+
+} // namespace viscera::render

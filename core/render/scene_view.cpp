@@ -1,0 +1,211 @@
+#include "render/scene_view.hpp"
+
+#include "sim/mesh/tet_mesh.hpp"
+#include "sim/mesh/tri_mesh.hpp"
+#include "sim/scene/world.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+namespace viscera::render {
+
+namespace {
+
+using Tri3 = std::array<uint32_t, 3>;
+
+std::vector<Eigen::Vector3f> toFloat(const std::vector<sim::Vec3>& p) {
+    std::vector<Eigen::Vector3f> out(p.size());
+    for (size_t i = 0; i < p.size(); ++i) out[i] = p[i].cast<float>();
+    return out;
+}
+
+void computeNormals(const std::vector<float>& pos, const std::vector<uint32_t>& idx, std::vector<float>& nrm) {
+    std::fill(nrm.begin(), nrm.end(), 0.0f);
+    for (size_t t = 0; t + 2 < idx.size(); t += 3) {
+        const Eigen::Map<const Eigen::Vector3f> a(&pos[3 * idx[t]]), b(&pos[3 * idx[t + 1]]), c(&pos[3 * idx[t + 2]]);
+        const Eigen::Vector3f n = (b - a).cross(c - a); // area-weighted
+        for (int k = 0; k < 3; ++k) Eigen::Map<Eigen::Vector3f>(&nrm[3 * idx[t + k]]) += n;
+    }
+    for (size_t v = 0; v < nrm.size(); v += 3) {
+        Eigen::Map<Eigen::Vector3f> n(&nrm[v]);
+        const float len = n.norm();
+        if (len > 0) n /= len;
+        else n = Eigen::Vector3f::UnitZ();
+    }
+}
+
+std::vector<Eigen::Vector3f> asVectors(const std::vector<float>& flat) {
+    std::vector<Eigen::Vector3f> out(flat.size() / 3);
+    for (size_t i = 0; i < out.size(); ++i) out[i] = Eigen::Vector3f(flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]);
+    return out;
+}
+
+RenderMesh makeMesh(const std::string& name, const std::vector<Eigen::Vector3f>& pos, const std::vector<Tri3>& tris) {
+    RenderMesh m;
+    m.name = name;
+    m.indices.reserve(tris.size() * 3);
+    for (const Tri3& t : tris) m.indices.insert(m.indices.end(), t.begin(), t.end());
+    m.positions.resize(pos.size() * 3);
+    for (size_t i = 0; i < pos.size(); ++i)
+        for (int k = 0; k < 3; ++k) m.positions[3 * i + k] = pos[i][k];
+    m.rest = m.positions;
+    m.normals.resize(m.positions.size());
+    computeNormals(m.positions, m.indices, m.normals);
+    m.thickness.assign(pos.size(), 0.0f);
+    m.sampleMap.assign(pos.size(), 0.0f);
+    m.heat.assign(pos.size(), 0.0f);
+    return m;
+}
+
+std::vector<Tri3> trianglesOf(const sim::TriMesh& mesh) {
+    std::vector<Tri3> tris;
+    tris.reserve(mesh.triangleCount());
+    for (const sim::Tri& t : mesh.triangles()) tris.push_back({uint32_t(t[0]), uint32_t(t[1]), uint32_t(t[2])});
+    return tris;
+}
+
+} // namespace
+
+uint32_t SceneView::addMaterial(const TissueMaterial& material) {
+    m_materials.push_back(material);
+    return uint32_t(m_materials.size() - 1);
+}
+
+size_t SceneView::addMesh(const std::string& name, const sim::TriMesh& mesh, uint32_t material,
+                          const ThicknessBakeSettings& bake) {
+    if (material >= m_materials.size())
+        throw std::invalid_argument("render::SceneView::addMesh(): " + name + ": material " + std::to_string(material) +
+                                    " does not exist (" + std::to_string(m_materials.size()) + " materials)");
+    const auto pos = toFloat(mesh.positions());
+    const auto tris = trianglesOf(mesh);
+    RenderMesh m = makeMesh(name, pos, tris);
+    m.material = material;
+    m.doubleSided = !mesh.isClosedOriented();
+    const TriangleBvh bvh(pos, tris);
+    m.thickness = bakeThickness(pos, asVectors(m.normals), bvh, bake);
+    m_meshes.push_back(std::move(m));
+    return m_meshes.size() - 1;
+}
+
+SceneView SceneView::fromWorld(const sim::World& world, const ThicknessBakeSettings& bake) {
+    SceneView view;
+    std::vector<Eigen::Vector3f> allPos;
+    std::vector<Tri3> allTris;
+    for (size_t b = 0; b < world.bodyCount(); ++b) {
+        auto mesh = world.restMesh(b).clone();
+        mesh->requireLevel(3);
+        const sim::TriMesh& boundary = mesh->boundary();
+        const std::vector<int32_t>& map = mesh->boundaryVertexMap();
+        std::vector<Eigen::Vector3f> pos(map.size());
+        for (size_t i = 0; i < map.size(); ++i) pos[i] = mesh->positions()[map[i]].cast<float>();
+        const auto tris = trianglesOf(boundary);
+        RenderMesh m = makeMesh(world.bodyName(b), pos, tris);
+        m.material = view.addMaterial(defaultMaterialFor(world.bodyName(b)));
+        m.source = RenderMesh::Source::Body;
+        m.sourceIndex = b;
+        m.sourceVertex = map;
+        m.thickness = bakeThickness(pos, asVectors(m.normals), TriangleBvh(pos, tris), bake);
+        const uint32_t base = uint32_t(allPos.size());
+        allPos.insert(allPos.end(), pos.begin(), pos.end());
+        for (const Tri3& t : tris) allTris.push_back({t[0] + base, t[1] + base, t[2] + base});
+        view.m_meshes.push_back(std::move(m));
+    }
+    std::unique_ptr<TriangleBvh> bodies;
+    if (!allTris.empty()) bodies = std::make_unique<TriangleBvh>(allPos, allTris);
+    for (size_t s = 0; s < world.surfaceCount(); ++s) {
+        const auto& sp = world.surfacePositions(s);
+        std::vector<Tri3> tris;
+        // The world keeps the rest surfaces private; the current positions at assembly are the rest state.
+        // Topology comes from the surface mesh the world was assembled with.
+        tris = trianglesOf(world.surfaceMesh(s));
+        const auto pos = toFloat(sp);
+        const std::string name = world.surfaceName(s);
+        RenderMesh m = makeMesh(name, pos, tris);
+        m.material = view.addMaterial(defaultMaterialFor(name));
+        m.doubleSided = true;
+        m.drawOnTop = true;
+        m.source = RenderMesh::Source::Surface;
+        m.sourceIndex = s;
+        m.sourceVertex.resize(pos.size());
+        for (size_t i = 0; i < pos.size(); ++i) m.sourceVertex[i] = int32_t(i);
+        if (bodies) {
+            // The membrane sits on a body: its normal points away from the body, so −n enters it.
+            m.thickness = bakeThickness(pos, asVectors(m.normals), *bodies, bake);
+        }
+        view.m_meshes.push_back(std::move(m));
+    }
+    view.updateFromWorld(world); // baked in the rest state, shown in the current one
+    return view;
+}
+
+void SceneView::updateFromWorld(const sim::World& world) {
+    for (size_t i = 0; i < m_meshes.size(); ++i) {
+        RenderMesh& m = m_meshes[i];
+        const std::vector<sim::Vec3>* src = nullptr;
+        if (m.source == RenderMesh::Source::Body && m.sourceIndex < world.bodyCount())
+            src = &world.positions(m.sourceIndex);
+        else if (m.source == RenderMesh::Source::Surface && m.sourceIndex < world.surfaceCount())
+            src = &world.surfacePositions(m.sourceIndex);
+        if (!src) continue;
+        const size_t n = m.vertexCount();
+        for (size_t v = 0; v < n; ++v) {
+            const int32_t s = m.sourceVertex[v];
+            if (s < 0 || size_t(s) >= src->size()) continue;
+            const sim::Vec3& p = (*src)[s];
+            m.positions[3 * v] = float(p.x());
+            m.positions[3 * v + 1] = float(p.y());
+            m.positions[3 * v + 2] = float(p.z());
+        }
+        recomputeNormals(i);
+    }
+}
+
+void SceneView::recomputeNormals(size_t i) {
+    RenderMesh& m = m_meshes.at(i);
+    computeNormals(m.positions, m.indices, m.normals);
+    ++m.revision;
+}
+
+void SceneView::setHeat(size_t i, const std::vector<float>& heat) {
+    RenderMesh& m = m_meshes.at(i);
+    if (heat.size() != m.vertexCount())
+        throw std::invalid_argument("render::SceneView::setHeat(): mesh " + m.name + " has " +
+                                    std::to_string(m.vertexCount()) + " vertices, got " + std::to_string(heat.size()) +
+                                    " heat values");
+    for (size_t v = 0; v < heat.size(); ++v) m.heat[v] = std::clamp(heat[v], 0.0f, 1.0f);
+    ++m.revision;
+}
+
+void SceneView::paintSampleMap(const Eigen::Vector3f& centre, float radius, int samples) {
+    if (samples != 0 && samples != 1 && samples != 4 && samples != 8)
+        throw std::invalid_argument("render::SceneView::paintSampleMap(): samples must be 0, 1, 4 or 8, got " +
+                                    std::to_string(samples));
+    for (RenderMesh& m : m_meshes) {
+        bool changed = false;
+        for (size_t v = 0; v < m.vertexCount(); ++v)
+            if ((Eigen::Map<const Eigen::Vector3f>(&m.positions[3 * v]) - centre).norm() <= radius) {
+                m.sampleMap[v] = float(samples);
+                changed = true;
+            }
+        if (changed) ++m.staticRevision;
+    }
+}
+
+std::array<Eigen::Vector3f, 2> SceneView::bounds() const {
+    Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), hi = -lo;
+    bool any = false;
+    for (const RenderMesh& m : m_meshes) {
+        if (!m.visible) continue;
+        for (size_t v = 0; v < m.vertexCount(); ++v) {
+            const Eigen::Map<const Eigen::Vector3f> p(&m.positions[3 * v]);
+            lo = lo.cwiseMin(p);
+            hi = hi.cwiseMax(p);
+            any = true;
+        }
+    }
+    if (!any) return {Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero()};
+    return {lo, hi};
+}
+
+} // namespace viscera::render

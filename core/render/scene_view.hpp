@@ -1,0 +1,90 @@
+#pragma once
+/// What the renderer draws: triangle meshes (the boundary triangles of each simulated body and the
+/// fascia surfaces), their materials and per-vertex data. Topology and static attributes are fixed
+/// when a mesh is added; positions, normals and heat change every frame and are written into the
+/// same arrays (and, by the backends, into the same GPU buffers) without reallocation.
+#include "render/material.hpp"
+#include "render/thickness_bake.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace viscera::sim {
+class World;
+class TriMesh;
+} // namespace viscera::sim
+
+namespace viscera::render {
+
+struct RenderMesh {
+    std::string name;
+    uint32_t material = 0;     ///< index into SceneView::materials()
+    bool doubleSided = false;  ///< open surfaces (fascia): no culling, normal faces the viewer
+    bool drawOnTop = false;    ///< polygon offset towards the camera (a layer lying on a body)
+    bool visible = true;
+    // ---- fixed at creation ----------------------------------------------------------------
+    std::vector<uint32_t> indices;   ///< #F × 3, counter-clockwise from outside
+    std::vector<float> rest;         ///< #V × 3, m: rest positions (procedural pattern space)
+    std::vector<float> thickness;    ///< #V, m: baked thickness [A §6.3.1]
+    std::vector<float> sampleMap;    ///< #V: painted light samples (0 unpainted, else 1, 4 or 8)
+    // ---- per frame ------------------------------------------------------------------------
+    std::vector<float> positions;    ///< #V × 3, m, world frame
+    std::vector<float> normals;      ///< #V × 3, unit, area-weighted vertex normals
+    std::vector<float> heat;         ///< #V in [0, 1]: 0 fresh, ~0.5 coagulated, 1 charred
+    uint64_t revision = 0;           ///< bumped whenever per-frame data change
+    uint64_t staticRevision = 0;     ///< bumped when sampleMap or thickness change
+    // ---- where the per-frame positions come from -----------------------------------------
+    enum class Source : uint8_t { Static, Body, Surface } source = Source::Static;
+    size_t sourceIndex = 0;            ///< body or surface index in sim::World
+    std::vector<int32_t> sourceVertex; ///< #V: node of the source for each render vertex
+
+    size_t vertexCount() const { return positions.size() / 3; }
+    size_t triangleCount() const { return indices.size() / 3; }
+};
+
+class SceneView {
+public:
+    SceneView() = default;
+
+    /// The boundary of every body and every fascia surface of `world`, with a material from
+    /// defaultMaterialFor(name) and thickness baked in the rest configuration (bodies against their
+    /// own boundary, surfaces against all bodies). Cost: one BVH build and #V·rays ray casts.
+    static SceneView fromWorld(const sim::World& world, const ThicknessBakeSettings& bake = {});
+
+    /// Adds a static mesh (e.g. a generated organ surface), bakes its thickness against itself when
+    /// it is closed (against `bakeTarget` when given). Returns its index.
+    size_t addMesh(const std::string& name, const sim::TriMesh& mesh, uint32_t material,
+                   const ThicknessBakeSettings& bake = {});
+    uint32_t addMaterial(const TissueMaterial& material);
+
+    /// Copies the current positions of `world` into the meshes that came from it and recomputes
+    /// their normals. Allocation-free. Meshes whose source index is out of range are left as they are.
+    void updateFromWorld(const sim::World& world);
+
+    /// Sets the heat of every vertex of mesh `i` (values clamped to [0, 1]); `heat` has #V entries
+    /// (std::invalid_argument otherwise).
+    void setHeat(size_t i, const std::vector<float>& heat);
+    /// Paints `samples` (1, 4 or 8; 0 erases) into the sample map of every vertex of every mesh
+    /// within `radius` (m) of `centre` in the current positions.
+    void paintSampleMap(const Eigen::Vector3f& centre, float radius, int samples);
+
+    /// Recomputes the normals of mesh i from its positions (allocation-free); bumps its revision.
+    void recomputeNormals(size_t i);
+
+    std::vector<RenderMesh>& meshes() { return m_meshes; }
+    const std::vector<RenderMesh>& meshes() const { return m_meshes; }
+    std::vector<TissueMaterial>& materials() { return m_materials; }
+    const std::vector<TissueMaterial>& materials() const { return m_materials; }
+    /// Axis-aligned bounds of the current positions of all visible meshes, {min, max}.
+    std::array<Eigen::Vector3f, 2> bounds() const;
+
+private:
+    std::vector<RenderMesh> m_meshes;
+    std::vector<TissueMaterial> m_materials;
+};
+
+} // namespace viscera::render

@@ -1,0 +1,120 @@
+// Renderer data without GL: PNG round trip, image comparison, thickness bake by ray casting
+// [A §6.3.1], SceneView built from and updated by a simulated World.
+#include "render/image.hpp"
+#include "render/scene_view.hpp"
+#include "render/thickness_bake.hpp"
+#include "sim/mesh/generators.hpp"
+#include "sim/scene/world.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+using namespace viscera::render;
+namespace sim = viscera::sim;
+
+TEST(Png, RoundTripIsExact) {
+    Image img;
+    img.width = 37;
+    img.height = 11;
+    img.rgba.resize(size_t(img.width) * img.height * 4);
+    for (size_t i = 0; i < img.rgba.size(); ++i) img.rgba[i] = uint8_t((i * 7919u) >> 3);
+    const auto path = std::filesystem::path(VISCERA_BINARY_DIR) / "test_render_roundtrip.png";
+    writePng(path, img);
+    const Image back = readPng(path);
+    EXPECT_EQ(back.width, 37);
+    EXPECT_EQ(back.height, 11);
+    EXPECT_EQ(back.rgba, img.rgba);
+    std::filesystem::remove(path);
+    EXPECT_THROW(readPng(path), std::runtime_error);
+    EXPECT_THROW(writePng("/nonexistent-dir/x.png", img), std::runtime_error);
+}
+
+TEST(Image, CompareReportsRmseMaxAndMask) {
+    Image a, b;
+    a.width = b.width = 2;
+    a.height = b.height = 1;
+    a.rgba = {10, 10, 10, 255, 0, 0, 0, 255};
+    b.rgba = {10, 10, 10, 0, 6, 0, 0, 255}; // alpha ignored; one channel off by 6
+    const ImageDifference d = compareImages(a, b);
+    EXPECT_EQ(d.pixels, 2u);
+    EXPECT_EQ(d.differing, 1u);
+    EXPECT_EQ(d.maxChannel, 6);
+    EXPECT_NEAR(d.rmse, std::sqrt(36.0 / 6.0), 1e-12);
+    EXPECT_EQ(compareImages(a, b, {1, 0}).differing, 0u);
+    Image c = a;
+    c.width = 1;
+    EXPECT_THROW(compareImages(a, c), std::invalid_argument);
+}
+
+TEST(ThicknessBake, SphereAndEllipsoidByRayCasting) {
+    // Sphere of radius R: a chord at angle θ from the inward normal is 2R cos θ.
+    const double R = 0.02;
+    const sim::TriMesh sphere = sim::makeEllipsoidSurface(sim::Vec3::Zero(), sim::Vec3(R, R, R), 48, 24);
+    std::vector<Eigen::Vector3f> pos, nrm;
+    std::vector<std::array<uint32_t, 3>> tris;
+    for (const auto& p : sphere.positions()) {
+        pos.push_back(p.cast<float>());
+        nrm.push_back(p.normalized().cast<float>());
+    }
+    for (const auto& t : sphere.triangles()) tris.push_back({uint32_t(t[0]), uint32_t(t[1]), uint32_t(t[2])});
+    const TriangleBvh bvh(pos, tris);
+    EXPECT_NEAR(bvh.raycast(Eigen::Vector3f(0, 0, -1), Eigen::Vector3f(0, 0, 1), 0.0f, 10.0f), 1.0f - R, 2e-4f);
+    EXPECT_LT(bvh.raycast(Eigen::Vector3f(0, 0, -1), Eigen::Vector3f(0, 1, 0), 0.0f, 10.0f), 0.0f); // miss
+    const auto t = bakeThickness(pos, nrm, bvh);
+    double mean = 0;
+    for (float v : t) {
+        EXPECT_GT(v, 1.5f * R);
+        EXPECT_LT(v, 2.0f * R + 1e-4f);
+        mean += v / t.size();
+    }
+    // A sphere of half the radius through SceneView::addMesh: half the thickness.
+    SceneView view;
+    view.addMesh("small", sim::makeEllipsoidSurface(sim::Vec3::Zero(), sim::Vec3(R / 2, R / 2, R / 2), 48, 24),
+                 view.addMaterial(TissueMaterial{}));
+    double smallMean = 0;
+    for (float v : view.meshes()[0].thickness) smallMean += v / view.meshes()[0].thickness.size();
+    EXPECT_NEAR(smallMean / mean, 0.5, 0.02);
+    // Rays that leave an open surface count as the maximum thickness.
+    view.addMesh("sheet", sim::makeBoxSurface(sim::Vec3(0, 0, 0), sim::Vec3(0.01, 0.01, 0.01)), 0);
+    EXPECT_FALSE(view.meshes()[1].doubleSided);
+    EXPECT_THROW(TriangleBvh(pos, {{0, 1, 99999}}), std::invalid_argument);
+}
+
+TEST(SceneView, FollowsTheWorldWithoutReallocating) {
+    sim::SceneDesc scene;
+    scene.xpbd.substeps = 20;
+    sim::BodyDesc b;
+    b.name = "organ";
+    b.meshPath = "meshes/organ.vtet";
+    b.fixedNodes = {0, 1, 2};
+    scene.bodies.push_back(b);
+    std::vector<std::unique_ptr<sim::TetMesh>> meshes;
+    meshes.push_back(sim::makeBoxTetMesh({}));
+    auto world = sim::World::assemble(scene, std::move(meshes), {}, {"gravity", "xpbd"}, "test");
+    SceneView view = SceneView::fromWorld(*world);
+    ASSERT_EQ(view.meshes().size(), 1u);
+    const RenderMesh& m = view.meshes()[0];
+    EXPECT_EQ(m.name, "organ");
+    EXPECT_EQ(view.materials()[m.material].name, "organ");
+    auto rest = world->restMesh(0).clone();
+    rest->requireLevel(3);
+    EXPECT_EQ(m.vertexCount(), rest->boundary().vertexCount());
+    EXPECT_EQ(m.triangleCount(), rest->boundary().triangleCount());
+    for (float t : m.thickness) {
+        EXPECT_GT(t, 0.0f);
+        EXPECT_LE(t, 0.05f);
+    }
+    const float* before = m.positions.data();
+    const uint64_t revision = m.revision;
+    for (int f = 0; f < 3; ++f) world->step();
+    view.updateFromWorld(*world);
+    EXPECT_EQ(m.positions.data(), before); // same storage
+    EXPECT_GT(m.revision, revision);
+    for (size_t v = 0; v < m.vertexCount(); ++v) {
+        const sim::Vec3& p = world->positions(0)[m.sourceVertex[v]];
+        ASSERT_FLOAT_EQ(m.positions[3 * v + 2], float(p.z()));
+    }
+    EXPECT_THROW(view.setHeat(0, {1.0f}), std::invalid_argument);
+}
