@@ -73,6 +73,9 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
             lv.nodes.clear();
             for (size_t b = 0; b < world.bodyCount(); ++b)
                 lv.nodes.insert(lv.nodes.end(), world.positions(b).begin(), world.positions(b).end());
+            lv.surfaces.resize(world.surfaceCount());
+            for (size_t k = 0; k < world.surfaceCount(); ++k)
+                lv.surfaces[k].assign(world.surfacePositions(k).begin(), world.surfacePositions(k).end());
         }
         if (!rec.finite)
             r.errors.push_back("frame " + std::to_string(rec.index) +

@@ -32,6 +32,7 @@ struct LiveView {
     std::mutex mutex;
     LiveState state;
     std::vector<sim::Vec3> nodes; ///< nodes of every body, m, scene
+    std::vector<std::vector<sim::Vec3>> surfaces; ///< nodes of every fascia surface, m, scene
     std::vector<double> toolRadius;
     bool finished = false;
 };

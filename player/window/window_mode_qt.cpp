@@ -1,7 +1,11 @@
-// The trainee window on QtGui (QRasterWindow + QPainter): no Widgets, no OpenGL needed.
+// The trainee window on QtGui (QRasterWindow + QPainter), no Widgets. The 3D view is drawn by the
+// deferred renderer on a headless EGL context (the same path as --headless --screenshot) and
+// painted into the window; where no GL context can be made, a 2D side view of the nodes is drawn.
 #include "window/window_mode.hpp"
 
 #include "haptics/keyboard_device.hpp"
+#include "render/headless.hpp"
+#include "render/scene_view.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/log.hpp"
 
@@ -24,11 +28,75 @@ namespace {
 
 using haptics::KeyboardDevice;
 
+/// The rendered view of the tissue: a SceneView of the world (built before the physics thread
+/// starts), refreshed from the LiveView copies of the positions, rendered headless and kept as a
+/// QImage for the window's paint events. GUI thread only.
+class Viewport3D {
+public:
+    Viewport3D(const sim::World& world, LiveView& live, int width, int height) : m_live(live) {
+        m_view = render::SceneView::fromWorld(world);
+        for (size_t b = 0; b < world.bodyCount(); ++b) {
+            m_bodyOffset.push_back(m_offset);
+            m_offset += world.restMesh(b).vertexCount();
+        }
+        const render::RenderSettings settings = render::defaultSettingsFor(m_view, width, height);
+        m_renderer = render::HeadlessRenderer::create(settings, &m_whyNot);
+        if (m_renderer) refresh(); // the rest state, until the first frame arrives
+    }
+    bool available() const { return m_renderer != nullptr; }
+    const std::string& whyNot() const { return m_whyNot; }
+    const QImage& image() const { return m_image; }
+    double lastFrameMs() const { return m_frameMs; }
+
+    /// Copies the latest positions, renders one frame (the default passes) and keeps the image.
+    void refresh() {
+        if (!m_renderer) return;
+        {
+            std::lock_guard<std::mutex> lock(m_live.mutex);
+            if (m_live.nodes.size() == m_offset) {
+                for (size_t i = 0; i < m_view.meshes().size(); ++i) {
+                    render::RenderMesh& m = m_view.meshes()[i];
+                    const std::vector<sim::Vec3>* src = nullptr;
+                    size_t base = 0;
+                    if (m.source == render::RenderMesh::Source::Body && m.sourceIndex < m_bodyOffset.size()) {
+                        src = &m_live.nodes;
+                        base = m_bodyOffset[m.sourceIndex];
+                    } else if (m.source == render::RenderMesh::Source::Surface && m.sourceIndex < m_live.surfaces.size()) {
+                        src = &m_live.surfaces[m.sourceIndex];
+                    }
+                    if (!src) continue;
+                    for (size_t v = 0; v < m.sourceVertex.size(); ++v) {
+                        const size_t k = base + static_cast<size_t>(m.sourceVertex[v]);
+                        if (k >= src->size()) continue;
+                        for (int r = 0; r < 3; ++r) m.positions[3 * v + r] = static_cast<float>((*src)[k][r]);
+                    }
+                    m_view.recomputeNormals(i);
+                }
+            }
+        }
+        m_frameMs = m_renderer->renderFrame(m_view).totalMs;
+        const render::Image img = m_renderer->readPixels();
+        QImage q(img.rgba.data(), img.width, img.height, img.width * 4, QImage::Format_RGBA8888);
+        m_image = q.copy(); // own the pixels
+    }
+
+private:
+    LiveView& m_live;
+    render::SceneView m_view;
+    std::unique_ptr<render::HeadlessRenderer> m_renderer;
+    std::vector<size_t> m_bodyOffset;
+    size_t m_offset = 0;
+    std::string m_whyNot;
+    QImage m_image;
+    double m_frameMs = 0;
+};
+
 class TraineeWindow final : public QRasterWindow {
 public:
     TraineeWindow(LiveView& live, std::string title, std::string instructions, KeyboardDevice* keyboard,
-                  std::atomic<bool>& stop)
-        : m_live(live), m_title(std::move(title)), m_instructions(std::move(instructions)), m_keyboard(keyboard), m_stop(stop) {
+                  std::atomic<bool>& stop, const Viewport3D* viewport)
+        : m_live(live), m_title(std::move(title)), m_instructions(std::move(instructions)), m_keyboard(keyboard), m_stop(stop),
+          m_viewport(viewport) {
         setTitle(QString::fromStdString("Viscera — " + m_title));
         resize(960, 600);
     }
@@ -62,10 +130,22 @@ public:
         p.setFont(small);
         p.setPen(QColor(190, 190, 190));
         p.drawText(QRect(16, 40, w - 32, 40), Qt::AlignLeft | Qt::TextWordWrap, QString::fromStdString(m_instructions));
-        // Side view (x right, z up) of the tissue nodes and the tools.
+        // The rendered 3D view; without a GL context a side view (x right, z up) of the tissue
+        // nodes and the tools.
         const QRect view(16, 88, w - 280, h - 104);
         p.setPen(QColor(60, 64, 70));
         p.drawRect(view);
+        if (m_viewport && m_viewport->available() && !m_viewport->image().isNull()) {
+            const QImage& img = m_viewport->image();
+            const QSize fit = img.size().scaled(view.size(), Qt::KeepAspectRatio);
+            const QRect target(view.center().x() - fit.width() / 2, view.center().y() - fit.height() / 2, fit.width(),
+                               fit.height());
+            p.drawImage(target, img);
+            p.setPen(QColor(140, 140, 140));
+            p.drawText(view.adjusted(6, 0, 0, -4), Qt::AlignLeft | Qt::AlignBottom,
+                       QString::asprintf("render %.0f ms", m_viewport->lastFrameMs()));
+            nodes.clear(); // no side view
+        }
         double x0 = 1e9, x1 = -1e9, z0 = 1e9, z1 = -1e9;
         for (const auto& n : nodes) x0 = std::min(x0, n.x()), x1 = std::max(x1, n.x()), z0 = std::min(z0, n.z()), z1 = std::max(z1, n.z());
         for (int a = 0; a < haptics::kMaxArms; ++a)
@@ -176,6 +256,7 @@ private:
     std::string m_title, m_instructions;
     KeyboardDevice* m_keyboard;
     std::atomic<bool>& m_stop;
+    const Viewport3D* m_viewport;
     QPointF m_mouse;
 };
 
@@ -199,7 +280,10 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
     options.live = &live;
     options.stop = &stop;
     const std::string title = loaded.package->manifest().title.value_or(loaded.package->manifest().caseId);
-    TraineeWindow window(live, title, loaded.scene.instructions, dynamic_cast<KeyboardDevice*>(options.device), stop);
+    Viewport3D viewport(*loaded.world, live, 640, 480);
+    if (!viewport.available()) log::warn("3D view off (side view instead): " + viewport.whyNot());
+    TraineeWindow window(live, title, loaded.scene.instructions, dynamic_cast<KeyboardDevice*>(options.device), stop,
+                         &viewport);
     window.show();
     SessionResult result;
     std::thread physics([&] { result = runSession(loaded, options); });
@@ -211,6 +295,7 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
             std::lock_guard<std::mutex> lock(live.mutex);
             finished = live.finished;
         }
+        viewport.refresh();
         window.requestUpdate();
         window.update();
         if (!finished) return;

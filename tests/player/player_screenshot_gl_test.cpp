@@ -75,3 +75,32 @@ TEST(PlayerScreenshot, HeadlessRunWritesARenderedFrameAndPassTimes) {
     EXPECT_LE(sum, rj["frame_ms"].get<double>() * (1 + 1e-9));
     EXPECT_FALSE(rj["device"].get<std::string>().empty());
 }
+
+TEST(PlayerScreenshot, TraineeWindowShowsTheRenderedView) {
+    ::setenv("LIBGL_ALWAYS_SOFTWARE", "1", 0);
+    std::string why;
+    if (!render::headlessContextAvailable(&why)) GTEST_SKIP() << "no headless GL context: " << why;
+    Scratch s;
+    const auto vcase = s.dir / "tissue-slab.vcase";
+    auto e = test::runProcess(VISCERA_STUDIO_EXE, {"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab",
+                                                   "-o", vcase.string()});
+    ASSERT_EQ(e.exitCode, 0) << e.err;
+    const auto png = s.dir / "window.png";
+    ::setenv("QT_QPA_PLATFORM", "offscreen", 1);
+    auto r = test::runProcess(VISCERA_PLAYER_EXE, {"run", vcase.string(), "--frames", "20", "--screenshot", png.string()});
+    ::unsetenv("QT_QPA_PLATFORM");
+    if (r.exitCode == 2 && r.err.find("Qt6 Gui") != std::string::npos) GTEST_SKIP() << "player built without Qt6 Gui";
+    ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
+    EXPECT_THAT(r.err, ::testing::Not(HasSubstr("3D view off")));
+    const render::Image img = render::readPng(png);
+    ASSERT_GT(img.width, 400);
+    // The view pane (left of the HUD panel, below the header) holds the rendered tissue: many
+    // distinct shades, where the fallback side view has a handful of flat dot colours.
+    std::set<uint32_t> colours;
+    for (int y = 100; y < img.height - 20; ++y)
+        for (int x = 20; x < img.width - 290; ++x) {
+            const uint8_t* px = img.pixel(x, y);
+            colours.insert(uint32_t(px[0]) << 16 | uint32_t(px[1]) << 8 | px[2]);
+        }
+    EXPECT_GT(colours.size(), 1000u);
+}
