@@ -12,6 +12,7 @@
 // Exit codes: 0 success, 1 bad input (case, arguments), 2 usage, 3 the session broke an invariant.
 #include "case/case_package.hpp"
 #include "haptics/device_spec.hpp"
+#include "render/case_settings.hpp"
 #include "render/headless.hpp"
 #include "render/scene_view.hpp"
 #include "runtime/report.hpp"
@@ -130,7 +131,8 @@ int cmdRun(const std::vector<std::string>& args) {
         // The rendered view of the last frame (EGL; Mesa llvmpipe where there is no GPU).
         try {
             const render::SceneView view = render::SceneView::fromWorld(*loaded.world);
-            const render::RenderSettings rs = render::defaultSettingsFor(view);
+            render::RenderSettings rs = render::defaultSettingsFor(view);
+            render::applyCaseRender(rs, loaded.scene.render, *casePath);
             std::string why;
             auto renderer = render::HeadlessRenderer::create(rs, &why);
             if (!renderer) throw std::runtime_error("no OpenGL context: " + why);

@@ -1,5 +1,7 @@
 #include "runtime/session.hpp"
 
+#include "render/case_settings.hpp"
+
 #include "sim/mesh/tet_io.hpp"
 #include "sim/util/error.hpp"
 
@@ -15,6 +17,10 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
     if (!pkg.contains(sceneName))
         throw InputError(pkg.name() + ": " + sceneName + ": required file is missing from the package");
     out.scene = sim::parseScene(pkg.read(sceneName), pkg.name() + ":" + sceneName);
+    {
+        render::RenderSettings check; // the look the case asks for is checked at load, not at the first frame
+        render::applyCaseRender(check, out.scene.render, pkg.name() + ":" + sceneName);
+    }
     std::vector<std::unique_ptr<sim::TetMesh>> meshes;
     for (const sim::BodyDesc& b : out.scene.bodies) {
         if (!pkg.contains(b.meshPath))

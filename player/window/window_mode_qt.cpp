@@ -4,6 +4,7 @@
 #include "window/window_mode.hpp"
 
 #include "haptics/keyboard_device.hpp"
+#include "render/case_settings.hpp"
 #include "render/headless.hpp"
 #include "render/scene_view.hpp"
 #include "sim/util/atomic_file.hpp"
@@ -33,13 +34,15 @@ using haptics::KeyboardDevice;
 /// QImage for the window's paint events. GUI thread only.
 class Viewport3D {
 public:
-    Viewport3D(const sim::World& world, LiveView& live, int width, int height) : m_live(live) {
+    Viewport3D(const sim::World& world, const std::string& caseRender, LiveView& live, int width, int height)
+        : m_live(live) {
         m_view = render::SceneView::fromWorld(world);
         for (size_t b = 0; b < world.bodyCount(); ++b) {
             m_bodyOffset.push_back(m_offset);
             m_offset += world.restMesh(b).vertexCount();
         }
-        const render::RenderSettings settings = render::defaultSettingsFor(m_view, width, height);
+        render::RenderSettings settings = render::defaultSettingsFor(m_view, width, height);
+        render::applyCaseRender(settings, caseRender, "scene.json"); // checked at load already
         m_renderer = render::HeadlessRenderer::create(settings, &m_whyNot);
         if (m_renderer) refresh(); // the rest state, until the first frame arrives
     }
@@ -280,7 +283,7 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
     options.live = &live;
     options.stop = &stop;
     const std::string title = loaded.package->manifest().title.value_or(loaded.package->manifest().caseId);
-    Viewport3D viewport(*loaded.world, live, 640, 480);
+    Viewport3D viewport(*loaded.world, loaded.scene.render, live, 640, 480);
     if (!viewport.available()) log::warn("3D view off (side view instead): " + viewport.whyNot());
     TraineeWindow window(live, title, loaded.scene.instructions, dynamic_cast<KeyboardDevice*>(options.device), stop,
                          &viewport);

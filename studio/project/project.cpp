@@ -1,5 +1,7 @@
 #include "project/project.hpp"
 
+#include "render/case_settings.hpp"
+
 #include "bake/import.hpp"
 #include "case/case_writer.hpp"
 #include "sim/mesh/tet_io.hpp"
@@ -161,7 +163,7 @@ Project loadProject(const std::filesystem::path& dir) {
     Fields f(origin);
     if (!doc.is_object()) f.fail("(root)", "must be an object");
     f.only(doc, {"schemaVersion", "caseId", "caseVersion", "title", "instructions", "solver", "gravity", "bodies",
-                 "surfaces", "accuracy"},
+                 "surfaces", "accuracy", "render"},
            "");
     Project p;
     p.dir = dir;
@@ -170,6 +172,12 @@ Project loadProject(const std::filesystem::path& dir) {
     p.caseVersion = f.str(f.req(doc, "caseVersion", ""), "caseVersion");
     if (auto* v = f.opt(doc, "title")) p.title = f.str(*v, "title");
     if (auto* v = f.opt(doc, "instructions")) p.instructions = f.str(*v, "instructions");
+    if (auto* v = f.opt(doc, "render")) {
+        if (!v->is_object()) f.fail("render", "must be an object");
+        p.render = v->dump();
+        render::RenderSettings check;
+        render::applyCaseRender(check, p.render, origin); // names the field and the rule
+    }
     const json& solver = f.req(doc, "solver", "");
     f.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads", "primal_correction"},
            "solver");
@@ -331,6 +339,7 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     scene.solverType = "xpbd";
     scene.xpbd = project.solver;
     scene.instructions = project.instructions;
+    scene.render = project.render;
     scene.accuracy = project.accuracy;
 
     ExportResult result;

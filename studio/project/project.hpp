@@ -85,6 +85,7 @@ struct Project {
     std::filesystem::path dir;
     int schemaVersion = 1;
     std::string caseId, caseVersion, title, instructions;
+    std::string render; ///< the "render" object as JSON text (empty: renderer defaults), copied to the scene
     sim::XpbdSettings solver;
     std::optional<sim::AccuracySampling> accuracy;
     std::vector<BodyProject> bodies;

@@ -30,11 +30,12 @@ int lineCount(const std::string& s) { return static_cast<int>(std::count(s.begin
 
 /// A small cantilever case: a box fixed at x = 0, with the given features.
 std::string writeSlabCase(const ScratchDir& dir, const std::string& name, std::vector<std::string> features,
-                          sim::Vec3 gravity = sim::Vec3(0, 0, -9.81)) {
+                          sim::Vec3 gravity = sim::Vec3(0, 0, -9.81), const std::string& render = "") {
     auto mesh = sim::makeBoxTetMesh({sim::Vec3::Zero(), sim::Vec3(0.08, 0.02, 0.02), {8, 2, 2}});
     sim::SceneDesc scene;
     scene.xpbd.gravity = gravity;
     scene.xpbd.substeps = 50; // what the load-time stability check asks for
+    scene.render = render;
     sim::BodyDesc body;
     body.name = "slab";
     body.meshPath = "meshes/slab.vtet";
@@ -175,6 +176,19 @@ TEST(PlayerCli, RunRejectsUnsupportedOrUndeclaredFeatures) {
     auto b = player({"run", writeSlabCase(dir, "nograv.vcase", {"xpbd"}), "--headless"});
     EXPECT_EQ(b.exitCode, 1);
     EXPECT_THAT(b.err, HasSubstr("the scene sets gravity but the manifest does not declare 'gravity'"));
+}
+
+TEST(PlayerCli, RunRejectsAMalformedRenderBlockAtLoad) {
+    ScratchDir dir;
+    const auto bad = writeSlabCase(dir, "bad.vcase", {"gravity", "xpbd"}, sim::Vec3(0, 0, -9.81),
+                                   R"({"post": {"bloom": true}})");
+    auto r = player({"run", bad, "--headless", "--frames", "5"});
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_THAT(r.err, HasSubstr("bad.vcase:scene.json: render.post.bloom: unknown effect"));
+    EXPECT_EQ(lineCount(r.err), 1) << r.err;
+    const auto good = writeSlabCase(dir, "good.vcase", {"gravity", "xpbd"}, sim::Vec3(0, 0, -9.81),
+                                    R"({"sss": false, "post": {"tone_mapping": false}})");
+    EXPECT_EQ(player({"run", good, "--headless", "--frames", "5"}).exitCode, 0);
 }
 
 TEST(PlayerCli, UsageErrorsAreClear) {

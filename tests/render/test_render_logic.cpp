@@ -1,10 +1,12 @@
 // Renderer logic without GL: pass selection, mesh updates, sample counts [A eq. 6.15–6.16],
 // reflection cone [A eq. 6.21], stereo frustums [B ch. 4], settings validation.
 #include "render/area_light.hpp"
+#include "render/case_settings.hpp"
 #include "render/camera.hpp"
 #include "render/frame_plan.hpp"
 #include "render/renderer.hpp"
 #include "sim/mesh/generators.hpp"
+#include "sim/util/error.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -330,4 +332,47 @@ TEST(Settings, ValidationNamesTheField) {
     s.stereo.mode = StereoMode::SideBySide;
     EXPECT_THAT(message(s), HasSubstr("width: must be even"));
     EXPECT_THROW(Renderer(std::make_unique<MockBackend>(), s), std::invalid_argument);
+}
+
+TEST(CaseRender, TheCaseBlockSwitchesPassesOffAndOn) {
+    RenderSettings s;
+    applyCaseRender(s,
+                    R"({"sss": false, "sampling": "painted", "stereo": "anaglyph",
+                        "post": {"tone_mapping": false, "radial_mask": true, "sharpen": true}})",
+                    "case.vcase:scene.json");
+    EXPECT_FALSE(s.subsurface);
+    EXPECT_EQ(s.sampling.mode, SampleMode::Painted);
+    EXPECT_EQ(s.stereo.mode, StereoMode::Anaglyph);
+    EXPECT_FALSE(s.post.toneMapping.enabled);
+    EXPECT_TRUE(s.post.radialMask.enabled);
+    EXPECT_TRUE(s.post.sharpen.enabled);
+    // What the case leaves out runs no pass: only the two effects it named.
+    RenderSettings mono = s;
+    mono.stereo.mode = StereoMode::Off;
+    EXPECT_EQ(kinds(planFrame(mono)), (std::vector<PassKind>{PassKind::GBuffer, PassKind::Lighting, PassKind::Sharpen,
+                                                            PassKind::RadialMask, PassKind::Output}));
+    RenderSettings unchanged;
+    applyCaseRender(unchanged, "", "x");
+    EXPECT_EQ(unchanged.post.anyEnabled(), RenderSettings().post.anyEnabled());
+}
+
+TEST(CaseRender, MalformedBlocksNameTheFieldAndLeaveTheSettingsAlone) {
+    auto why = [](const char* json) {
+        RenderSettings s;
+        s.subsurface = true;
+        try {
+            applyCaseRender(s, json, "liver.vcase:scene.json");
+        } catch (const viscera::InputError& e) {
+            EXPECT_TRUE(s.subsurface) << "settings changed by a rejected block";
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    EXPECT_EQ(why(R"({"post": {"bloom": true}})").rfind("liver.vcase:scene.json: render.post.bloom: unknown effect", 0), 0u);
+    EXPECT_THAT(why(R"({"sss": false, "post": {"noise": 1}})"), HasSubstr("render.post.noise: must be true or false"));
+    EXPECT_THAT(why(R"({"sampling": "many"})"), HasSubstr("render.sampling: 'many' is not one of distance, painted, uniform"));
+    EXPECT_THAT(why(R"({"stereo": 3})"), HasSubstr("render.stereo: must be one of"));
+    EXPECT_THAT(why(R"({"shadows": true})"), HasSubstr("render.shadows: unknown field"));
+    EXPECT_THAT(why(R"([1, 2])"), HasSubstr("render: must be a JSON object"));
+    EXPECT_THAT(why(R"({"post": [true]})"), HasSubstr("render.post: must be an object"));
 }

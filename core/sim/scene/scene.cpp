@@ -149,7 +149,7 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     Reader r(origin);
     json doc = json::parse(text, nullptr, false);
     if (doc.is_discarded()) throw InputError(origin + ": not valid JSON");
-    r.only(doc, {"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces", "tools"}, "");
+    r.only(doc, {"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces", "tools", "render"}, "");
     SceneDesc scene;
     const json& solver = r.require(doc, "solver", "");
     r.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads", "primal_correction"},
@@ -170,6 +170,10 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     s.gravity = doc.contains("gravity") ? r.vec3(doc["gravity"], "gravity") : Vec3::Zero();
     if (auto why = validate(s); !why.empty()) r.fail("solver", why);
     if (doc.contains("instructions")) scene.instructions = r.string(doc["instructions"], "instructions");
+    if (doc.contains("render")) {
+        if (!doc["render"].is_object()) r.fail("render", "must be an object");
+        scene.render = doc["render"].dump();
+    }
     if (doc.contains("accuracy")) {
         const json& a = doc["accuracy"];
         r.only(a, {"every_frames", "max_iterations"}, "accuracy");
@@ -255,6 +259,7 @@ std::string formatScene(const SceneDesc& scene) {
     if (s.primalCorrection) doc["solver"]["primal_correction"] = true;
     doc["gravity"] = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
     if (!scene.instructions.empty()) doc["instructions"] = scene.instructions;
+    if (!scene.render.empty()) doc["render"] = json::parse(scene.render);
     if (scene.accuracy)
         doc["accuracy"] = {{"every_frames", scene.accuracy->everyFrames}, {"max_iterations", scene.accuracy->maxIterations}};
     doc["bodies"] = json::array();

@@ -20,6 +20,8 @@
 ///                 "stretch_stiffness": 50, "attach_to": "organ", "attach_distance": 0.001,
 ///                 "attach_compliance": 0, "fixed_nodes": []}],
 ///   "tools": [{"name": "probe", "shape": "sphere", ...see tool_probe.hpp...}]   optional
+///   "render": {"sss": true, "sampling": "distance", "stereo": "off",                optional
+///              "post": {"tone_mapping": true, ...}}   (checked by render/case_settings.hpp)
 /// }
 #include "sim/material/material.hpp"
 #include "sim/scene/tool_probe.hpp"
@@ -62,6 +64,9 @@ struct AccuracySampling {
 
 struct SceneDesc {
     std::string instructions; ///< shown to the trainee; may be empty
+    /// The "render" object as JSON text (empty: renderer defaults). The simulation does not read
+    /// it; the player checks it at load (render::applyCaseRender) and hands it to the renderer.
+    std::string render;
     std::string solverType = "xpbd";
     XpbdSettings xpbd;
     std::optional<AccuracySampling> accuracy;

@@ -48,6 +48,20 @@ TEST(Scene, RoundTrip) {
     EXPECT_EQ(back.bodies[0].material.poissonRatio, s.bodies[0].material.poissonRatio);
 }
 
+TEST(Scene, RenderBlockAndPrimalCorrectionRoundTrip) {
+    SceneDesc s = slabScene();
+    s.render = R"({"post":{"tone_mapping":false},"sss":false})";
+    s.xpbd.primalCorrection = true;
+    const SceneDesc back = parseScene(formatScene(s), "scene.json");
+    EXPECT_EQ(back.render, s.render);
+    EXPECT_TRUE(back.xpbd.primalCorrection);
+    EXPECT_FALSE(parseScene(formatScene(slabScene()), "scene.json").xpbd.primalCorrection);
+    EXPECT_THAT(parseError(R"({"solver": {"type": "xpbd"}, "render": [1], "bodies": []})"),
+                HasSubstr("scene.json: render: must be an object"));
+    EXPECT_THAT(parseError(R"({"solver": {"type": "xpbd", "primal_correction": 1}, "bodies": []})"),
+                HasSubstr("solver.primal_correction: must be true or false"));
+}
+
 TEST(Scene, ErrorsNameTheField) {
     EXPECT_THAT(parseError("{"), HasSubstr("scene.json: not valid JSON"));
     EXPECT_THAT(parseError("{}"), HasSubstr("scene.json: solver: required field is missing"));
