@@ -184,7 +184,15 @@ int main(int argc, char** argv) {
                                       v + 6, v + 7, v + 8) == 9;
         }
     }
-    if (!gbench) return runComparison(w, h, frames, out);
+    if (!gbench) {
+        try {
+            if (!out.empty()) std::filesystem::create_directories(out);
+            return runComparison(w, h, frames, out);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "bench_render: %s\n", e.what());
+            return 1;
+        }
+    }
     benchmark::Initialize(&argc, argv);
     benchmark::RunSpecifiedBenchmarks();
     benchmark::Shutdown();
