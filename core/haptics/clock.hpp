@@ -33,5 +33,7 @@ private:
 
 /// The monotonic clock as a free function (for code that has no Clock object at hand).
 int64_t monotonicNs();
+/// Sleeps until CLOCK_MONOTONIC reaches t_ns (absolute; resumes after signals).
+void sleepUntilNs(int64_t t_ns);
 
 } // namespace viscera::haptics

@@ -6,6 +6,7 @@
 /// or after it stopped.
 #include "haptics/types.hpp"
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -39,6 +40,31 @@ public:
     virtual LinkStats linkStats() const { return {}; }
     /// Short backend name for reports: "replay", "scripted", "keyboard", "console".
     virtual const char* backend() const = 0;
+};
+
+/// A device inside this process (replay, scripted, keyboard): keeps the last command and counts
+/// polls and commands for linkStats(). Subclasses call countPoll() at the end of poll().
+class LocalDevice : public Device {
+public:
+    void send(const DeviceCommand& command) override {
+        m_lastCommand = command;
+        m_sent.fetch_add(1, std::memory_order_relaxed);
+    }
+    LinkStats linkStats() const override {
+        LinkStats s;
+        s.received = m_polls.load(std::memory_order_relaxed);
+        s.sent = m_sent.load(std::memory_order_relaxed);
+        return s;
+    }
+    /// The last command sent (read after the servo thread stopped).
+    const DeviceCommand& lastCommand() const { return m_lastCommand; }
+
+protected:
+    void countPoll() { m_polls.fetch_add(1, std::memory_order_relaxed); }
+
+private:
+    DeviceCommand m_lastCommand;
+    std::atomic<uint64_t> m_polls{0}, m_sent{0};
 };
 
 } // namespace viscera::haptics

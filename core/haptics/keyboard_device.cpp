@@ -51,16 +51,9 @@ void KeyboardDevice::poll(int64_t now_ns, DeviceState& out) {
     out.arms[0].measured_cp.orientation = Quat::Identity();
     out.arms[0].measured_cv.linear = m_vel;
     out.arms[0].measured_cv.angular.setZero();
-    m_polls.fetch_add(1, std::memory_order_relaxed);
+    countPoll();
 }
 
-void KeyboardDevice::send(const DeviceCommand&) { m_sent.fetch_add(1, std::memory_order_relaxed); }
 
-LinkStats KeyboardDevice::linkStats() const {
-    LinkStats s;
-    s.received = m_polls.load(std::memory_order_relaxed);
-    s.sent = m_sent.load(std::memory_order_relaxed);
-    return s;
-}
 
 } // namespace viscera::haptics

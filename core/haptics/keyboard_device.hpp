@@ -11,14 +11,12 @@
 
 namespace viscera::haptics {
 
-class KeyboardDevice final : public Device {
+class KeyboardDevice final : public LocalDevice {
 public:
     enum Key : uint32_t { KeyLeft = 1, KeyRight = 2, KeyUp = 4, KeyDown = 8, KeyPageUp = 16, KeyPageDown = 32, KeyClutch = 64 };
     explicit KeyboardDevice(double speed = 0.05, double metresPerPixel = 2e-4);
     const DeviceCapabilities& capabilities() const override { return m_caps; }
     void poll(int64_t now_ns, DeviceState& out) override;
-    void send(const DeviceCommand& command) override;
-    LinkStats linkStats() const override;
     const char* backend() const override { return "keyboard"; }
 
     // GUI thread:
@@ -36,7 +34,6 @@ private:
     int64_t m_last_ns = 0;
     bool m_started = false;
     uint64_t m_seq = 0;
-    std::atomic<uint64_t> m_polls{0}, m_sent{0};
 };
 
 } // namespace viscera::haptics

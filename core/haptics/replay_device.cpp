@@ -22,19 +22,9 @@ void ReplayDevice::poll(int64_t now_ns, DeviceState& out) {
     out.timestamp_ns = now_ns;
     out.sequence = ++m_seq;
     out.connected = true;
-    m_polls.fetch_add(1, std::memory_order_relaxed);
+    countPoll();
 }
 
-void ReplayDevice::send(const DeviceCommand& command) {
-    m_lastCommand = command;
-    m_sent.fetch_add(1, std::memory_order_relaxed);
-}
 
-LinkStats ReplayDevice::linkStats() const {
-    LinkStats s;
-    s.received = m_polls.load(std::memory_order_relaxed);
-    s.sent = m_sent.load(std::memory_order_relaxed);
-    return s;
-}
 
 } // namespace viscera::haptics

@@ -15,17 +15,13 @@ struct ReplayOptions {
     std::string name = "replay";
 };
 
-class ReplayDevice final : public Device {
+class ReplayDevice final : public LocalDevice {
 public:
     ReplayDevice(Trajectory trajectory, const ReplayOptions& options = {});
     const DeviceCapabilities& capabilities() const override { return m_caps; }
     void poll(int64_t now_ns, DeviceState& out) override;
-    void send(const DeviceCommand& command) override;
-    LinkStats linkStats() const override;
     const char* backend() const override { return "replay"; }
     const Trajectory& trajectory() const { return m_traj; }
-    /// The last command sent (read after the servo thread stopped).
-    const DeviceCommand& lastCommand() const { return m_lastCommand; }
 
 private:
     Trajectory m_traj;
@@ -34,8 +30,6 @@ private:
     bool m_started = false;
     int64_t m_t0 = 0;
     uint64_t m_seq = 0;
-    DeviceCommand m_lastCommand;
-    std::atomic<uint64_t> m_polls{0}, m_sent{0};
 };
 
 } // namespace viscera::haptics

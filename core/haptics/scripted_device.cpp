@@ -79,19 +79,9 @@ void ScriptedDevice::poll(int64_t now_ns, DeviceState& out) {
         st.buttons = 0;
         if (a == 0 && m_script == Script::Clutch && rising) out.pedals |= kPedalClutch;
     }
-    m_polls.fetch_add(1, std::memory_order_relaxed);
+    countPoll();
 }
 
-void ScriptedDevice::send(const DeviceCommand& command) {
-    m_lastCommand = command;
-    m_sent.fetch_add(1, std::memory_order_relaxed);
-}
 
-LinkStats ScriptedDevice::linkStats() const {
-    LinkStats s;
-    s.received = m_polls.load(std::memory_order_relaxed);
-    s.sent = m_sent.load(std::memory_order_relaxed);
-    return s;
-}
 
 } // namespace viscera::haptics

@@ -15,17 +15,14 @@
 
 namespace viscera::haptics {
 
-class ScriptedDevice final : public Device {
+class ScriptedDevice final : public LocalDevice {
 public:
     /// Throws viscera::InputError "scripted:<name>: unknown script (known: idle, press, ...)".
     explicit ScriptedDevice(const std::string& script, double maxForce = 15.0);
     static const std::vector<std::string>& scripts();
     const DeviceCapabilities& capabilities() const override { return m_caps; }
     void poll(int64_t now_ns, DeviceState& out) override;
-    void send(const DeviceCommand& command) override;
-    LinkStats linkStats() const override;
     const char* backend() const override { return "scripted"; }
-    const DeviceCommand& lastCommand() const { return m_lastCommand; }
 
 private:
     enum class Script { Idle, Press, Circle, Bimanual, Clutch };
@@ -34,8 +31,6 @@ private:
     bool m_started = false;
     int64_t m_t0 = 0;
     uint64_t m_seq = 0;
-    DeviceCommand m_lastCommand;
-    std::atomic<uint64_t> m_polls{0}, m_sent{0};
 };
 
 } // namespace viscera::haptics

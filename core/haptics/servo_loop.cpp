@@ -24,12 +24,6 @@ void atomicMin(std::atomic<int64_t>& a, int64_t v) {
     while (v < cur && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {}
 }
 
-void sleepUntil(int64_t t_ns) {
-    timespec ts{};
-    ts.tv_sec = t_ns / 1'000'000'000;
-    ts.tv_nsec = t_ns % 1'000'000'000;
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {}
-}
 
 } // namespace
 
@@ -187,7 +181,7 @@ void ServoLoop::run() {
     int64_t next = monotonicNs() + period;
     int64_t prev = -1;
     while (m_running.load(std::memory_order_acquire)) {
-        if (next - monotonicNs() > m_config.spin_ns) sleepUntil(next - m_config.spin_ns);
+        if (next - monotonicNs() > m_config.spin_ns) sleepUntilNs(next - m_config.spin_ns);
         int64_t now = monotonicNs();
         while (now < next) {
             cpuRelax();

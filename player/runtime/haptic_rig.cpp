@@ -11,12 +11,6 @@ namespace {
 
 using haptics::kMaxArms;
 
-void sleepUntilNs(int64_t t) {
-    timespec ts{};
-    ts.tv_sec = t / 1'000'000'000;
-    ts.tv_nsec = t % 1'000'000'000;
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {}
-}
 
 } // namespace
 
@@ -142,7 +136,7 @@ void HapticRig::afterStep() {
     drain();
     if (m_realtime) {
         const int64_t deadline = m_t0 + int64_t(std::llround(double(m_frame) * m_dt * 1e9));
-        if (deadline > m_clock->now_ns()) sleepUntilNs(deadline);
+        if (deadline > m_clock->now_ns()) haptics::sleepUntilNs(deadline);
     }
 }
 

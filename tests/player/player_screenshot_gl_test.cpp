@@ -6,6 +6,7 @@
 #include "render/headless.hpp"
 #include "render/image.hpp"
 #include "support/run_process.hpp"
+#include "support/scratch_dir.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -21,16 +22,16 @@ using ::testing::HasSubstr;
 
 namespace {
 
-struct Scratch {
-    std::filesystem::path dir;
-    Scratch() {
-        dir = std::filesystem::temp_directory_path() /
-              ("viscera-shot-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" +
-               std::to_string(reinterpret_cast<uintptr_t>(this)));
-        std::filesystem::create_directories(dir);
-    }
-    ~Scratch() { std::filesystem::remove_all(dir); }
-};
+using test::Scratch;
+
+/// Exports the tissue-slab sample project into the scratch folder; returns the case path.
+std::string exportTissueSlab(const Scratch& s) {
+    const std::string vcase = s / "tissue-slab.vcase";
+    auto e = test::runProcess(VISCERA_STUDIO_EXE, {"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab",
+                                                   "-o", vcase});
+    EXPECT_EQ(e.exitCode, 0) << e.err;
+    return vcase;
+}
 
 } // namespace
 
@@ -38,13 +39,11 @@ TEST(PlayerScreenshot, HeadlessRunWritesARenderedFrameAndPassTimes) {
     ::setenv("LIBGL_ALWAYS_SOFTWARE", "1", 0); // llvmpipe, as the other GL tests (the child inherits it)
     std::string why;
     if (!render::headlessContextAvailable(&why)) GTEST_SKIP() << "no headless GL context: " << why;
-    Scratch s;
-    const auto vcase = s.dir / "tissue-slab.vcase";
-    auto e = test::runProcess(VISCERA_STUDIO_EXE, {"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab",
-                                                   "-o", vcase.string()});
-    ASSERT_EQ(e.exitCode, 0) << e.err;
+    Scratch s("viscera-shot");
+    const std::string vcase = exportTissueSlab(s);
+    ASSERT_FALSE(::testing::Test::HasFailure());
     const auto png = s.dir / "frame.png", report = s.dir / "report.json";
-    auto r = test::runProcess(VISCERA_PLAYER_EXE, {"run", vcase.string(), "--headless", "--frames", "20",
+    auto r = test::runProcess(VISCERA_PLAYER_EXE, {"run", vcase, "--headless", "--frames", "20",
                                                    "--screenshot", png.string(), "--report", report.string()});
     ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
     EXPECT_THAT(r.out, HasSubstr("render        640x480 frame"));
@@ -80,14 +79,12 @@ TEST(PlayerScreenshot, TraineeWindowShowsTheRenderedView) {
     ::setenv("LIBGL_ALWAYS_SOFTWARE", "1", 0);
     std::string why;
     if (!render::headlessContextAvailable(&why)) GTEST_SKIP() << "no headless GL context: " << why;
-    Scratch s;
-    const auto vcase = s.dir / "tissue-slab.vcase";
-    auto e = test::runProcess(VISCERA_STUDIO_EXE, {"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab",
-                                                   "-o", vcase.string()});
-    ASSERT_EQ(e.exitCode, 0) << e.err;
+    Scratch s("viscera-shot");
+    const std::string vcase = exportTissueSlab(s);
+    ASSERT_FALSE(::testing::Test::HasFailure());
     const auto png = s.dir / "window.png";
     ::setenv("QT_QPA_PLATFORM", "offscreen", 1);
-    auto r = test::runProcess(VISCERA_PLAYER_EXE, {"run", vcase.string(), "--frames", "20", "--screenshot", png.string()});
+    auto r = test::runProcess(VISCERA_PLAYER_EXE, {"run", vcase, "--frames", "20", "--screenshot", png.string()});
     ::unsetenv("QT_QPA_PLATFORM");
     if (r.exitCode == 2 && r.err.find("Qt6 Gui") != std::string::npos) GTEST_SKIP() << "player built without Qt6 Gui";
     ASSERT_EQ(r.exitCode, 0) << r.err << r.out;

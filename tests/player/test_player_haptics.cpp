@@ -3,6 +3,7 @@
 // trainee window offscreen, and the one-line errors for bad device specs and trajectory files.
 #include "player/haptic_case.hpp"
 #include "support/run_process.hpp"
+#include "support/scratch_dir.hpp"
 
 #include "haptics/trajectory.hpp"
 
@@ -29,16 +30,7 @@ using ::testing::HasSubstr;
 
 namespace {
 
-struct Scratch {
-    std::filesystem::path dir;
-    Scratch() {
-        dir = std::filesystem::temp_directory_path() /
-              ("viscera-haptics-" + std::to_string(::getpid()) + "-" + std::to_string(std::rand()));
-        std::filesystem::create_directories(dir);
-    }
-    ~Scratch() { std::filesystem::remove_all(dir); }
-    std::string operator/(const std::string& name) const { return (dir / name).string(); }
-};
+using test::Scratch;
 
 test::ProcessResult player(const std::vector<std::string>& args) { return test::runProcess(VISCERA_PLAYER_EXE, args); }
 
