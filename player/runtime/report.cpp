@@ -98,6 +98,39 @@ std::string traceCsv(const SessionResult& r) {
     return out;
 }
 
+/// Suturing figures [B ch. 4] of a "fem" case: per frame the enforced constraint rows, contacts,
+/// thread tension and needle force; the closure (gap, penetration) on sampled frames and at the end.
+static nlohmann::json sutureJson(const SessionResult& r) {
+    using nlohmann::json;
+    const sim::SutureSummary& s = *r.suture;
+    json frames = json::array();
+    for (const auto& f : r.sutureFrames) {
+        json j = {{"frame", f.frame},
+                  {"active_rows", f.activeRows},
+                  {"rejected_rows", f.rejectedRows},
+                  {"contacts", f.contacts},
+                  {"punctures", f.punctures},
+                  {"thread_tension_n", f.threadTension},
+                  {"needle_force_n", f.needleForce},
+                  {"thread_engaged", f.threadEngaged}};
+        if (f.maxGap >= 0) j["max_gap_m"] = f.maxGap;
+        if (f.maxPenetration >= 0) j["max_penetration_m"] = f.maxPenetration;
+        frames.push_back(std::move(j));
+    }
+    json doc = {{"punctures", s.punctures},
+                {"thread_tension_n", s.finalThreadTension},
+                {"max_thread_tension_n", s.maxThreadTension},
+                {"max_active_rows", s.maxActiveRows},
+                {"max_contacts", s.maxContacts},
+                {"frames", std::move(frames)}};
+    if (s.gauge) {
+        doc["initial_gap_m"] = s.initialGap;
+        doc["max_gap_m"] = s.finalGap;
+        doc["max_penetration_m"] = s.maxPenetration;
+    }
+    return doc;
+}
+
 nlohmann::json reportJson(const SessionResult& r) {
     using nlohmann::json;
     json doc;
@@ -150,6 +183,7 @@ nlohmann::json reportJson(const SessionResult& r) {
     doc["metrics"]["punctures"] = tm.punctures;
     doc["metrics"]["clips"] = tm.clips;
     if (r.haptics) doc["haptics"] = hapticsJson(*r.haptics);
+    if (r.suture) doc["suture"] = sutureJson(r);
     if (r.render) {
         json passes = json::array();
         for (const auto& p : r.render->passes)
@@ -220,6 +254,18 @@ std::string summaryText(const SessionResult& r) {
         std::snprintf(line, sizeof line, "render        %dx%d frame %.1f ms (%s ms) -> %s\n", r.render->width,
                       r.render->height, r.render->totalMs, passes.c_str(), r.render->image.c_str());
         out += line;
+    }
+    if (r.suture) {
+        char line[256];
+        std::snprintf(line, sizeof line, "suture        %d punctures, thread tension %.3f N (max %.3f N), max %d rows, %d contacts\n",
+                      r.suture->punctures, r.suture->finalThreadTension, r.suture->maxThreadTension,
+                      r.suture->maxActiveRows, r.suture->maxContacts);
+        out += line;
+        if (r.suture->gauge) {
+            std::snprintf(line, sizeof line, "closure       gap %.3f mm (from %.3f mm), max penetration %.3f mm\n",
+                          r.suture->finalGap * 1e3, r.suture->initialGap * 1e3, r.suture->maxPenetration * 1e3);
+            out += line;
+        }
     }
     // Error against run time on the last sampled frame [A eq. 4.45].
     for (auto it = r.accuracy.rbegin(); it != r.accuracy.rend(); ++it) {

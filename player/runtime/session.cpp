@@ -35,6 +35,12 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
                              "', which is not in the package");
         surfaces.push_back(sim::parseVtri(pkg.read(sd.meshPath), pkg.name() + ":" + sd.meshPath));
     }
+    if (out.scene.suture) { // the recorded needle trajectory travels with the case
+        const std::string& path = out.scene.suture->trajectoryPath;
+        if (!pkg.contains(path))
+            throw InputError(pkg.name() + ": " + sceneName + ": suture.trajectory: '" + path + "' is not in the package");
+        out.scene.suture->trajectoryText = pkg.read(path);
+    }
     out.world = sim::World::assemble(out.scene, std::move(meshes), std::move(surfaces), pkg.manifest().features,
                                      pkg.name() + ": manifest.json");
     return out;
@@ -107,6 +113,12 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     r.invariants = world.invariants();
     r.invariants.maxForce = std::max(r.invariants.maxForce, deviceMax);
     r.accuracy = world.accuracy();
+    if (world.hasSuture()) {
+        r.suture = world.sutureSummary();
+        r.sutureFrames = world.sutureFrames();
+        r.metrics.punctures = r.suture->punctures;
+        if (!r.suture->finite) r.errors.push_back("suture: the closure gauge or the thread tension was not finite");
+    }
     for (size_t b = 0; b < world.bodyCount(); ++b) {
         const auto& rest = world.restMesh(b).positions();
         const auto& x = world.positions(b);

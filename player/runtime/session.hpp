@@ -78,6 +78,8 @@ struct SessionResult {
     TaskMetrics metrics;
     std::vector<TraceRow> trace;          ///< when RunOptions::keepTrace
     std::optional<RenderFigures> render;  ///< when a frame was rendered (--screenshot)
+    std::optional<sim::SutureSummary> suture;           ///< solver "fem" cases (needle and thread)
+    std::vector<sim::SutureFrameRecord> sutureFrames;   ///< one per frame of a "fem" case
     bool ok() const { return errors.empty() && invariants.allFinite; }
 };
 

@@ -8,6 +8,7 @@
 #include "sim/scene/material_json.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/world.hpp"
+#include "sim/suture/anastomosis.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
 
@@ -146,10 +147,64 @@ MeshSource parseMeshSource(const Fields& f, const json& m, const std::string& pa
         if (auto* v = f.opt(m, "slices")) s.slices = f.integer(*v, path + ".slices", 3, 1024);
         if (auto* v = f.opt(m, "rings")) s.stacks = f.integer(*v, path + ".rings", 1, 1024);
         s.meshing = parseMeshing(f, f.opt(m, "meshing"), path + ".meshing");
+    } else if (gen == "hollow_tube") {
+        f.only(m, {"generator", "start", "end", "inner_radius", "outer_radius", "slices", "layers", "rings"}, path);
+        s.kind = MeshSource::Kind::HollowTube;
+        s.hollow.start = f.vec3(f.req(m, "start", path), path + ".start");
+        s.hollow.end = f.vec3(f.req(m, "end", path), path + ".end");
+        if ((s.hollow.end - s.hollow.start).norm() <= 0) f.fail(path + ".end", "must differ from start");
+        s.hollow.innerRadius = f.positive(f.req(m, "inner_radius", path), path + ".inner_radius");
+        s.hollow.outerRadius = f.positive(f.req(m, "outer_radius", path), path + ".outer_radius");
+        if (!(s.hollow.outerRadius > s.hollow.innerRadius)) f.fail(path + ".outer_radius", "must exceed inner_radius");
+        if (auto* v = f.opt(m, "slices")) s.hollow.slices = f.integer(*v, path + ".slices", 3, 1024);
+        if (auto* v = f.opt(m, "layers")) s.hollow.layers = f.integer(*v, path + ".layers", 1, 64);
+        if (auto* v = f.opt(m, "rings")) s.hollow.rings = f.integer(*v, path + ".rings", 1, 1024);
     } else {
-        f.fail(path + ".generator", "'" + gen + "' is not a known generator (box, ellipsoid, liver, tube)");
+        f.fail(path + ".generator", "'" + gen + "' is not a known generator (box, ellipsoid, liver, tube, hollow_tube)");
     }
     return s;
+}
+
+/// The suture section: the trajectory is generated (anastomosis) or read from a project file,
+/// checked, and referenced as tools/needle.traj in the exported scene.
+sim::suture::SutureSceneDesc parseSutureProject(const Fields& f, const json& su, const std::filesystem::path& dir,
+                                                const std::string& origin) {
+    if (!su.is_object()) f.fail("suture", "must be an object");
+    const json& t = f.req(su, "trajectory", "suture");
+    if (!t.is_object()) f.fail("suture.trajectory", "must be an object with 'generator' or 'file'");
+    std::string text;
+    if (auto* file = f.opt(t, "file")) {
+        f.only(t, {"file"}, "suture.trajectory");
+        const std::string rel = f.str(*file, "suture.trajectory.file");
+        if (std::filesystem::path(rel).is_absolute() || rel.find("..") != std::string::npos)
+            f.fail("suture.trajectory.file", "must be a path inside the project folder");
+        text = readFile(dir / rel);
+        sim::suture::parseTrajectory(text, (dir / rel).string()); // checked now, not in the player
+    } else {
+        const std::string p = "suture.trajectory";
+        const std::string gen = f.str(f.req(t, "generator", p), p + ".generator");
+        if (gen != "anastomosis") f.fail(p + ".generator", "'" + gen + "' is not a known generator (anastomosis)");
+        f.only(t, {"generator", "stitches", "needle_radius", "needle_centre", "degrees_per_frame", "transfer_frames",
+                   "transfer_distance", "pull_frames", "pull_per_segment", "slack"},
+               p);
+        sim::suture::AnastomosisSpec a;
+        if (auto* v = f.opt(t, "stitches")) a.stitches = f.integer(*v, p + ".stitches", 1, 64);
+        if (auto* v = f.opt(t, "needle_radius")) a.needleRadius = f.positive(*v, p + ".needle_radius");
+        if (auto* v = f.opt(t, "needle_centre")) a.needleCentre = f.positive(*v, p + ".needle_centre");
+        if (auto* v = f.opt(t, "degrees_per_frame")) a.degreesPerFrame = f.positive(*v, p + ".degrees_per_frame");
+        if (auto* v = f.opt(t, "transfer_frames")) a.transferFrames = f.integer(*v, p + ".transfer_frames", 1, 10000);
+        if (auto* v = f.opt(t, "transfer_distance")) a.transferDistance = f.positive(*v, p + ".transfer_distance");
+        if (auto* v = f.opt(t, "pull_frames")) a.pullFrames = f.integer(*v, p + ".pull_frames", 1, 100000);
+        if (auto* v = f.opt(t, "pull_per_segment")) a.pullPerSegment = f.positive(*v, p + ".pull_per_segment");
+        if (auto* v = f.opt(t, "slack")) a.slack = f.num(*v, p + ".slack");
+        if (a.degreesPerFrame > 90) f.fail(p + ".degrees_per_frame", "must be at most 90");
+        text = sim::suture::formatTrajectory(sim::suture::makeAnastomosisTrajectory(a));
+    }
+    json section = su;
+    section["trajectory"] = "tools/needle.traj";
+    sim::suture::SutureSceneDesc d = sim::suture::parseSutureSection(section.dump(), origin);
+    d.trajectoryText = std::move(text);
+    return d;
 }
 
 } // namespace
@@ -163,7 +218,7 @@ Project loadProject(const std::filesystem::path& dir) {
     Fields f(origin);
     if (!doc.is_object()) f.fail("(root)", "must be an object");
     f.only(doc, {"schemaVersion", "caseId", "caseVersion", "title", "instructions", "solver", "gravity", "bodies",
-                 "surfaces", "accuracy", "render"},
+                 "surfaces", "accuracy", "render", "suture"},
            "");
     Project p;
     p.dir = dir;
@@ -182,7 +237,12 @@ Project loadProject(const std::filesystem::path& dir) {
     f.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads", "primal_correction"},
            "solver");
     const std::string type = f.str(f.req(solver, "type", "solver"), "solver.type");
-    if (type != "xpbd") f.fail("solver.type", "'" + type + "' is not supported (supported: xpbd)");
+    if (type != "xpbd" && type != "fem") f.fail("solver.type", "'" + type + "' is not supported (supported: xpbd, fem)");
+    p.solverType = type;
+    if (type == "fem") f.only(solver, {"type", "dt"}, "solver");
+    if ((type == "fem") != (f.opt(doc, "suture") != nullptr))
+        f.fail("suture", type == "fem" ? "solver 'fem' needs a 'suture' section" : "needs solver.type 'fem'");
+    if (auto* su = f.opt(doc, "suture")) p.suture = parseSutureProject(f, *su, dir, origin);
     if (auto* v = f.opt(solver, "dt")) p.solver.dt = f.positive(*v, "solver.dt");
     if (auto* v = f.opt(solver, "substeps")) p.solver.substeps = f.integer(*v, "solver.substeps", 1, 1000);
     if (auto* v = f.opt(solver, "iterations")) p.solver.iterations = f.integer(*v, "solver.iterations", 1, 1000);
@@ -288,6 +348,7 @@ std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::
         return bake::tetrahedralize(sim::makeLiverSurface(s.center, s.radii, s.wedge, s.slices, s.stacks), params).mesh;
     case MeshSource::Kind::Tube:
         return bake::tetrahedralize(sim::makeTubeSurface(s.center, s.end, s.radius, s.slices, s.stacks), params).mesh;
+    case MeshSource::Kind::HollowTube: return sim::makeHollowTubeTetMesh(s.hollow);
     case MeshSource::Kind::File: {
         bake::ImportOptions opt;
         opt.scale = s.scale;
@@ -336,7 +397,8 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     };
     const std::string origin = (project.dir / "project.json").string();
     sim::SceneDesc scene;
-    scene.solverType = "xpbd";
+    scene.solverType = project.solverType;
+    scene.suture = project.suture;
     scene.xpbd = project.solver;
     scene.instructions = project.instructions;
     scene.render = project.render;
@@ -431,6 +493,7 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     vcase::CaseWriter writer(header);
     writer.addFile("scene.json", sim::formatScene(scene));
     for (auto& [path, bytes] : files) writer.addFile(path, std::move(bytes));
+    if (scene.suture) writer.addFile(scene.suture->trajectoryPath, scene.suture->trajectoryText);
     vcase::Manifest written = writer.write(out);
     result.casePath = out;
     result.features = written.features;

@@ -15,6 +15,8 @@
 ///             "meshing": {..}}
 ///          | {"generator": "liver", "center": [..], "half_size": [..], "wedge": 0.5, "meshing": {..}}
 ///          | {"generator": "tube", "start": [..], "end": [..], "radius": 0.004, "meshing": {..}}
+///          | {"generator": "hollow_tube", "start": [..], "end": [..], "inner_radius": 0.0038,
+///             "outer_radius": 0.005, "slices": 33, "layers": 2, "rings": 8}   (structured, no CGAL)
 ///          | {"file": "liver.obj", "scale": 0.001, "meshing": {..}},
 ///     "material": {see core/sim/scene/material_json.hpp},
 ///     "fixed": {"min": [..], "max": [..]},     nodes inside this box (metres) are fixed
@@ -23,8 +25,13 @@
 ///   }],
 ///   "surfaces": [{"name": "fascia", "from_boundary_of": "organ", "region": {"min": .., "max": ..},
 ///                 "areal_density": 0.1, "stretch_stiffness": 50, "attach_distance": 0.001}],
-///   "accuracy": {"every_frames": 60, "max_iterations": 100}
+///   "accuracy": {"every_frames": 60, "max_iterations": 100},
+///   "suture": {...the scene's suture section (core/sim/suture/suture_scene.hpp), with
+///              "trajectory": {"generator": "anastomosis", "stitches": 5, ...AnastomosisSpec fields}
+///                          | {"file": "needle.traj"}}     with "solver": {"type": "fem", "dt": ..}
 /// }
+/// The suture trajectory is generated (or read and checked) at load and exported as
+/// tools/needle.traj.
 /// "meshing" (CGAL Mesh_3, metres and degrees): facet_angle, facet_size, facet_distance,
 /// cell_radius_edge_ratio, cell_size, seed.
 #include "bake/tetrahedralize.hpp"
@@ -43,8 +50,9 @@
 namespace viscera::studio {
 
 struct MeshSource {
-    enum class Kind { Box, Ellipsoid, Liver, Tube, File };
+    enum class Kind { Box, Ellipsoid, Liver, Tube, HollowTube, File };
     Kind kind = Kind::Box;
+    sim::HollowTubeSpec hollow; ///< Kind::HollowTube
     sim::BoxSpec box;
     sim::Vec3 center = sim::Vec3::Zero(), radii = sim::Vec3::Constant(0.05); ///< tube: center = start
     sim::Vec3 end = sim::Vec3::Zero();  ///< tube end
@@ -90,6 +98,8 @@ struct Project {
     std::optional<sim::AccuracySampling> accuracy;
     std::vector<BodyProject> bodies;
     std::vector<SurfaceProject> surfaces;
+    std::string solverType = "xpbd"; ///< "xpbd" or "fem" (suturing; needs `suture`)
+    std::optional<sim::suture::SutureSceneDesc> suture; ///< with trajectoryText filled at load
 };
 
 /// Reads <dir>/project.json. Throws viscera::InputError.

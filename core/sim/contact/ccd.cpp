@@ -174,9 +174,24 @@ bool edgeEdgeCcd(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, d
     return false;
 }
 
-ContactDetector::ContactDetector(const TetMesh& mesh) {
+ContactDetector::ContactDetector(const TetMesh& mesh, bool selfContact) : m_selfContact(selfContact) {
     if (mesh.level() < 3)
         throw std::logic_error("sim::contact::ContactDetector(): requires adjacency level 3; call mesh.requireLevel(3) first");
+    // Bodies: connected components of the tets (union–find).
+    std::vector<int32_t> parent(mesh.vertexCount());
+    for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int32_t>(i);
+    auto root = [&](int32_t v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    for (const Tet& t : mesh.tets())
+        for (int k = 1; k < 4; ++k) parent[root(t[k])] = root(t[0]);
+    m_body.resize(parent.size());
+    std::map<int32_t, int> bodyIndex;
+    for (size_t i = 0; i < parent.size(); ++i) {
+        const int32_t r = root(static_cast<int32_t>(i));
+        m_body[i] = bodyIndex.emplace(r, static_cast<int>(bodyIndex.size())).first->second;
+    }
     const TriMesh& b = mesh.boundary();
     const auto& vmap = mesh.boundaryVertexMap();
     std::map<std::pair<int32_t, int32_t>, int> edges;
@@ -195,20 +210,28 @@ ContactDetector::ContactDetector(const TetMesh& mesh) {
         }
     }
     m_verts = vmap;
-    build(m_triTree, tc);
-    build(m_edgeTree, ec);
+    // One tree per body: between-body queries never descend into the querying body's own tree.
+    const int bodies = m_selfContact ? 1 : static_cast<int>(bodyIndex.size());
+    m_triTrees.assign(bodies, {});
+    m_edgeTrees.assign(bodies, {});
+    std::vector<std::vector<int>> triIds(bodies), edgeIds(bodies);
+    for (size_t i = 0; i < m_tris.size(); ++i) triIds[m_selfContact ? 0 : m_body[m_tris[i][0]]].push_back(static_cast<int>(i));
+    for (size_t i = 0; i < m_edges.size(); ++i) edgeIds[m_selfContact ? 0 : m_body[m_edges[i][0]]].push_back(static_cast<int>(i));
+    for (int b = 0; b < bodies; ++b) {
+        build(m_triTrees[b], tc, std::move(triIds[b]));
+        build(m_edgeTrees[b], ec, std::move(edgeIds[b]));
+    }
 }
 
-void ContactDetector::build(Tree& tree, const std::vector<Vec3>& c) {
-    tree.order.resize(c.size());
-    for (size_t i = 0; i < c.size(); ++i) tree.order[i] = static_cast<int>(i);
+void ContactDetector::build(Tree& tree, const std::vector<Vec3>& c, std::vector<int> ids) {
+    tree.order = std::move(ids);
     tree.nodes.clear();
-    if (c.empty()) return;
+    if (tree.order.empty()) return;
     struct Job {
         int node, first, count;
     };
     tree.nodes.push_back({});
-    std::vector<Job> stack = {{0, 0, static_cast<int>(c.size())}};
+    std::vector<Job> stack = {{0, 0, static_cast<int>(tree.order.size())}};
     while (!stack.empty()) {
         const Job j = stack.back();
         stack.pop_back();
@@ -264,8 +287,9 @@ void ContactDetector::detect(const std::vector<Vec3>& x0, const std::vector<Vec3
         b.max() += pad;
         return b;
     };
-    refit(m_triTree, [&](int i) { return swept({m_tris[i][0], m_tris[i][1], m_tris[i][2]}); });
-    refit(m_edgeTree, [&](int i) { return swept({m_edges[i][0], m_edges[i][1]}); });
+    for (Tree& t : m_triTrees) refit(t, [&](int i) { return swept({m_tris[i][0], m_tris[i][1], m_tris[i][2]}); });
+    for (Tree& t : m_edgeTrees) refit(t, [&](int i) { return swept({m_edges[i][0], m_edges[i][1]}); });
+    const int bodies = static_cast<int>(m_triTrees.size());
     std::vector<int> stack;
     auto query = [&](const Tree& tree, const Eigen::AlignedBox3d& q, auto&& visit) {
         if (tree.nodes.empty()) return;
@@ -285,9 +309,12 @@ void ContactDetector::detect(const std::vector<Vec3>& x0, const std::vector<Vec3
     // Vertex–face.
     for (int32_t v : m_verts) {
         const Eigen::AlignedBox3d q = swept({v});
-        query(m_triTree, q, [&](int ti) {
+        for (int tb = 0; tb < bodies; ++tb) {
+        if (!m_selfContact && tb == m_body[v]) continue;
+        query(m_triTrees[tb], q, [&](int ti) {
             const auto& f = m_tris[ti];
             if (f[0] == v || f[1] == v || f[2] == v) return;
+            if (!m_selfContact && m_body[f[0]] == m_body[v]) return;
             ++m_candidates;
             const std::array<Vec3, 4> a = {x0[v], x0[f[0]], x0[f[1]], x0[f[2]]};
             const std::array<Vec3, 4> b = {x1[v], x1[f[0]], x1[f[1]], x1[f[2]]};
@@ -305,15 +332,19 @@ void ContactDetector::detect(const std::vector<Vec3>& x0, const std::vector<Vec3
             c.normal = side >= 0 ? n : Vec3(-n);
             out.push_back(c);
         });
+        }
     }
     // Edge–edge (each unordered pair once).
     for (size_t ei = 0; ei < m_edges.size(); ++ei) {
         const auto& e = m_edges[ei];
         const Eigen::AlignedBox3d q = swept({e[0], e[1]});
-        query(m_edgeTree, q, [&](int ej) {
-            if (static_cast<size_t>(ej) <= ei) return;
+        for (int tb = 0; tb < bodies; ++tb) {
+        if (!m_selfContact && tb <= m_body[e[0]]) continue; // each pair of bodies once
+        query(m_edgeTrees[tb], q, [&](int ej) {
+            if (m_selfContact && static_cast<size_t>(ej) <= ei) return;
             const auto& g = m_edges[ej];
             if (g[0] == e[0] || g[0] == e[1] || g[1] == e[0] || g[1] == e[1]) return;
+            if (!m_selfContact && m_body[g[0]] == m_body[e[0]]) return;
             ++m_candidates;
             const std::array<Vec3, 4> a = {x0[e[0]], x0[e[1]], x0[g[0]], x0[g[1]]};
             const std::array<Vec3, 4> b = {x1[e[0]], x1[e[1]], x1[g[0]], x1[g[1]]};
@@ -333,6 +364,7 @@ void ContactDetector::detect(const std::vector<Vec3>& x0, const std::vector<Vec3
             c.normal = side >= 0 ? n : Vec3(-n);
             out.push_back(c);
         });
+        }
     }
     std::sort(out.begin() + static_cast<long>(first), out.end(),
               [](const Collision& a, const Collision& b) { return a.t < b.t; });

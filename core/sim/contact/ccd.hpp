@@ -28,8 +28,10 @@ struct Collision {
 
 class ContactDetector {
 public:
-    /// Throws std::logic_error when the mesh lacks adjacency level 3.
-    explicit ContactDetector(const TetMesh& mesh);
+    /// Throws std::logic_error when the mesh lacks adjacency level 3. Without `selfContact`, pairs
+    /// whose primitives belong to the same body (connected component of the tets) are skipped:
+    /// only contact between bodies is detected (the closing boundaries of a suture).
+    explicit ContactDetector(const TetMesh& mesh, bool selfContact = false);
 
     /// Appends the collisions between x0 and x1, sorted by time. `thickness` (m) is the proximity at
     /// which a coplanarity root counts as contact. Never throws.
@@ -51,13 +53,15 @@ private:
         std::vector<Node> nodes;
         std::vector<int> order; // primitive ids
     };
-    static void build(Tree& tree, const std::vector<Vec3>& centroids);
+    static void build(Tree& tree, const std::vector<Vec3>& centroids, std::vector<int> ids);
     template <class BoxOf> static void refit(Tree& tree, BoxOf&& boxOf);
 
     std::vector<std::array<int32_t, 3>> m_tris;  // mesh vertex ids
     std::vector<std::array<int32_t, 2>> m_edges; // mesh vertex ids
     std::vector<int32_t> m_verts;                // boundary vertices (mesh ids)
-    Tree m_triTree, m_edgeTree;
+    std::vector<int32_t> m_body;                 // body index (connected component) per mesh vertex
+    bool m_selfContact = false;
+    std::vector<Tree> m_triTrees, m_edgeTrees; // per body (one tree with selfContact)
     size_t m_candidates = 0;
 };
 

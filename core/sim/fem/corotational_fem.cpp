@@ -74,6 +74,9 @@ struct CorotationalFem::Impl {
     // constrained-node cache: K_R⁻¹ blocks between cached nodes
     std::vector<int> slotOf, nodeOf, lastUsed, freeSlots;
     Eigen::MatrixXd kinv;
+    // K_R⁻¹ columns of the cached nodes (3#V × 3 per slot): u = u0 − Σ cols·(Cᵀλ)_node replaces the
+    // substitution of a solve (a dense product over the constrained nodes only).
+    Eigen::MatrixXd cols;
     std::vector<double> rhsWork;
 
     std::vector<Group> groups;
@@ -85,13 +88,15 @@ struct CorotationalFem::Impl {
         std::vector<Vec3> x;
         std::vector<int> nodes;
         Factor result;
-        Eigen::MatrixXd kinv;
+        Eigen::MatrixXd kinv, cols;
         bool ok = false;
         std::string error;
     };
     std::unique_ptr<Job> job;
     std::thread worker;
     int swapStep = 0;
+
+    std::vector<std::array<int32_t, 2>> edges; // unique tet edges, for the refactor test
 
     // last solve, for tests
     std::vector<SolveRow> lastRows;
@@ -154,7 +159,7 @@ struct CorotationalFem::Impl {
 
     /// K⁻¹ blocks between `nodes` (3|N| × 3|N|) with factor F.
     static bool inverseBlocks(Factor& F, const std::vector<int>& nodes, int n3, Eigen::MatrixXd& out,
-                              std::string& error) {
+                              Eigen::MatrixXd& full, std::string& error) {
         const int k = static_cast<int>(nodes.size());
         Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n3, 3 * k);
         for (int i = 0; i < k; ++i)
@@ -162,6 +167,7 @@ struct CorotationalFem::Impl {
         if (!F.chol->solveInPlace(rhs.data(), 3 * k, error)) return false;
         out.resize(3 * k, 3 * k);
         for (int i = 0; i < k; ++i) out.middleRows(3 * i, 3) = rhs.middleRows(3 * nodes[i], 3);
+        full.swap(rhs);
         return true;
     }
 
@@ -180,6 +186,7 @@ struct CorotationalFem::Impl {
                 Eigen::MatrixXd grown = Eigen::MatrixXd::Zero(cap, cap);
                 grown.topLeftCorner(kinv.rows(), kinv.cols()) = kinv;
                 kinv.swap(grown);
+                cols.conservativeResize(n3(), cap);
             }
         }
         slotOf[node] = slot;
@@ -198,8 +205,11 @@ struct CorotationalFem::Impl {
         if (!cur.chol->solveInPlace(rhsWork.data(), 3 * k, error)) return false;
         std::vector<int> slots(k);
         for (int i = 0; i < k; ++i) slots[i] = allocateSlot(nodes[i]);
+        if (cols.rows() != n || cols.cols() < kinv.cols()) cols.conservativeResize(n, kinv.cols());
         for (int i = 0; i < k; ++i) {
             const int si = slots[i];
+            cols.middleCols(3 * si, 3) =
+                Eigen::Map<const Eigen::MatrixXd>(rhsWork.data() + static_cast<size_t>(3 * i) * n, n, 3);
             for (size_t s2 = 0; s2 < nodeOf.size(); ++s2) {
                 const int node = nodeOf[s2];
                 if (node < 0) continue;
@@ -243,6 +253,8 @@ struct CorotationalFem::Impl {
         const int k = static_cast<int>(j->nodes.size());
         kinv = Eigen::MatrixXd::Zero(std::max(96, 3 * k), std::max(96, 3 * k));
         kinv.topLeftCorner(3 * k, 3 * k) = j->kinv;
+        cols.resize(n3(), kinv.cols());
+        cols.leftCols(3 * k) = j->cols;
         for (int i = 0; i < k; ++i) {
             nodeOf.push_back(j->nodes[i]);
             lastUsed.push_back(step);
@@ -254,15 +266,16 @@ struct CorotationalFem::Impl {
     void startJob(const std::vector<Vec3>& x) {
         job = std::make_unique<Job>();
         job->x = x;
-        for (int node : nodeOf)
-            if (node >= 0) job->nodes.push_back(node);
+        // Only nodes in use now travel with the new factor; the rest are re-cached when needed.
+        for (size_t s2 = 0; s2 < nodeOf.size(); ++s2)
+            if (nodeOf[s2] >= 0 && step - lastUsed[s2] <= 1) job->nodes.push_back(nodeOf[s2]);
         swapStep = step + s.refactorLatencySteps;
         Job* jp = job.get();
         const int n = n3();
         worker = std::thread([this, jp, n] {
             try {
                 jp->ok = buildFactor(jp->x, jp->result, jp->error) &&
-                         inverseBlocks(jp->result, jp->nodes, n, jp->kinv, jp->error);
+                         inverseBlocks(jp->result, jp->nodes, n, jp->kinv, jp->cols, jp->error);
             } catch (const std::exception& e) {
                 jp->ok = false;
                 jp->error = e.what();
@@ -592,16 +605,20 @@ FemSolveStats CorotationalFem::solve() {
             if (!released) break;
         }
         if (!ok) break;
-        // One substitution u = K⁻¹ (f − Cᵀλ).
-        u = I.cur.f;
-        for (size_t r = 0; r < rows.size(); ++r)
-            if (lam[r] != 0)
-                for (const auto& [node, a] : rows[r].nodeTerms) u.segment<3>(3 * node) -= lam[r] * a;
-        if (!I.cur.chol->solveInPlace(u.data(), 1, st.error)) {
-            ok = false;
-            break;
+        // u = K⁻¹ (f − Cᵀλ) = u0 − Σ_nodes K⁻¹[:, node] (Cᵀλ)_node with the cached columns: no
+        // substitution, a dense product over the constrained nodes.
+        {
+            std::vector<std::pair<int, Vec3>> g; // (slot, (Cᵀλ)_node)
+            for (size_t r = 0; r < rows.size(); ++r)
+                if (lam[r] != 0)
+                    for (const auto& [slot, a] : rows[r].terms) {
+                        auto it = std::find_if(g.begin(), g.end(), [&](const auto& e) { return e.first == slot; });
+                        if (it == g.end()) g.emplace_back(slot, lam[r] * a);
+                        else it->second += lam[r] * a;
+                    }
+            u = I.cur.u0;
+            for (const auto& [slot, gv] : g) u.noalias() -= I.cols.middleCols(3 * slot, 3) * gv;
         }
-        ++st.substitutions;
         // Activate violated unilateral groups.
         for (int g : order) {
             Group& G = I.groups[g];
@@ -641,11 +658,29 @@ FemSolveStats CorotationalFem::solve() {
     }
     I.lastRows = rows;
     I.lastLambda = lam;
-    double maxMove = 0;
-    for (size_t v = 0; v < m_x.size(); ++v) {
-        m_x[v] = X0[v] + u.segment<3>(3 * v);
-        maxMove = std::max(maxMove, (m_x[v] - I.cur.xAt[v]).norm());
+    for (size_t v = 0; v < m_x.size(); ++v) m_x[v] = X0[v] + u.segment<3>(3 * v);
+    // Rotations go stale when edges turn, not with translation or stretch: the largest change of an
+    // edge vector normal to itself since the factorization.
+    if (I.edges.empty()) {
+        std::vector<std::array<int32_t, 2>> e;
+        for (const Tet& t : I.tets)
+            for (int a = 0; a < 4; ++a)
+                for (int b = a + 1; b < 4; ++b) e.push_back({std::min(t[a], t[b]), std::max(t[a], t[b])});
+        std::sort(e.begin(), e.end());
+        e.erase(std::unique(e.begin(), e.end()), e.end());
+        I.edges = std::move(e);
     }
+    double maxMove = 0;
+    if (I.s.corotational)
+        for (const auto& e : I.edges) {
+            // Turn of the edge (its change normal to the edge; a stretch along it does not count).
+            const Vec3 was = I.cur.xAt[e[1]] - I.cur.xAt[e[0]];
+            const Vec3 d = (m_x[e[1]] - m_x[e[0]]) - was;
+            const double w2 = was.squaredNorm();
+            const double along = w2 > 0 ? d.dot(was) / w2 : 0.0;
+            maxMove = std::max(maxMove, (d - along * was).squaredNorm());
+        }
+    maxMove = std::sqrt(maxMove);
     // Rotations are stale: refactor (now, or on the worker).
     if (I.s.corotational && !I.job && maxMove > I.s.refactorDisplacement * m_meanEdge) {
         if (I.s.refactorMode == RefactorMode::Synchronous) {

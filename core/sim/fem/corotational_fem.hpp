@@ -9,19 +9,21 @@
 /// constraint terms on fixed nodes move to the right-hand side.
 ///
 /// Cost model (what makes a step cheap):
-///  - K_R is factorized (CHOLMOD LLᵀ, pattern analysed once) only when the nodes have moved by more
-///    than `refactorDisplacement` mean edge lengths since the last factorization; in
+///  - K_R is factorized (CHOLMOD LLᵀ, pattern analysed once) only when some edge vector has turned
+///    by more than `refactorDisplacement` mean edge lengths (its change normal to itself) since the
+///    last factorization (translation and stretch do not count); in
 ///    RefactorMode::Background that work runs on a worker thread and the new factor is swapped in
 ///    exactly `refactorLatencySteps` solves later (deterministic; the solve waits only if the worker
 ///    is late). u0 = K_R⁻¹ f_R is cached with the factor.
 ///  - K_R⁻¹ restricted to the constrained nodes is cached (three substitutions per node, once, when
-///    a node first appears in a constraint). Every constraint row's column K_R⁻¹cᵀ at the
+///    a node first appears in a constraint; the full columns are kept too). Every constraint row's column K_R⁻¹cᵀ at the
 ///    constrained nodes is a combination of these blocks, so rows may be added, removed or change
 ///    their coefficients without any substitution, and M = C K_R⁻¹ Cᵀ [B eq. 2.67] costs a small
 ///    dense product.
 ///  - a solve is: build M and q = C u0 − b, a pivoted dense Cholesky that rejects rows whose pivot
 ///    falls below `rankTolerance` (redundant or incompatible rows, [B §2.2.6]) instead of producing a
-///    singular system, the multipliers λ, and one substitution u = K_R⁻¹(f_R − Cᵀλ).
+///    singular system, the multipliers λ, and u = u0 − Σ_nodes K_R⁻¹[:, node](Cᵀλ)_node from the
+///    cached columns (a dense product over the constrained nodes; no substitution).
 /// Unilateral groups (contact, thread pull) are released when their weighted multiplier shows that
 /// they pull (Σ w_r λ_r > releaseTolerance) and re-activated when violated; the active set is
 /// iterated at most `maxActiveSetIterations` times.
@@ -45,8 +47,8 @@ struct FemSettings {
     double youngsModulus = 50e3; ///< Pa
     double poissonRatio = 0.45;  ///< in [0, 0.5)
     bool corotational = true;    ///< false: linear FEM, one factorization for the whole run
-    /// Refactor when some node moved by more than this many mean edge lengths since the last
-    /// factorization (the rotations are then re-extracted from the current positions).
+    /// Refactor when some edge vector turned by more than this many mean edge lengths (change normal
+    /// to the edge) since the last factorization (the rotations are then re-extracted).
     double refactorDisplacement = 0.25;
     RefactorMode refactorMode = RefactorMode::Background;
     int refactorLatencySteps = 3;  ///< Background: solves between the request and the swap, >= 1

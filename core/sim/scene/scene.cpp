@@ -149,13 +149,21 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     Reader r(origin);
     json doc = json::parse(text, nullptr, false);
     if (doc.is_discarded()) throw InputError(origin + ": not valid JSON");
-    r.only(doc, {"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces", "tools", "render"}, "");
+    r.only(doc, {"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces", "tools", "render", "suture"}, "");
     SceneDesc scene;
     const json& solver = r.require(doc, "solver", "");
     r.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads", "primal_correction"},
            "solver");
     scene.solverType = r.string(r.require(solver, "type", "solver"), "solver.type");
-    if (scene.solverType != "xpbd") r.fail("solver.type", "'" + scene.solverType + "' is not supported (supported: xpbd)");
+    if (scene.solverType != "xpbd" && scene.solverType != "fem")
+        r.fail("solver.type", "'" + scene.solverType + "' is not supported (supported: xpbd, fem)");
+    if (scene.solverType == "fem") { // quasi-static suturing FEM [B §2.2]: needs the suture section
+        r.only(solver, {"type", "dt"}, "solver");
+        if (!doc.contains("suture")) r.fail("suture", "solver 'fem' needs a 'suture' section");
+    } else if (doc.contains("suture")) {
+        r.fail("suture", "needs solver.type 'fem'");
+    }
+    if (doc.contains("suture")) scene.suture = suture::parseSutureSection(doc["suture"].dump(), origin);
     XpbdSettings& s = scene.xpbd;
     s.dt = r.optNumber(solver, "dt", "solver", s.dt);
     if (solver.contains("substeps")) s.substeps = r.integer(solver["substeps"], "solver.substeps");
@@ -257,6 +265,8 @@ std::string formatScene(const SceneDesc& scene) {
                      {"iterations", s.iterations}, {"damping", s.damping}, {"max_speed", s.maxSpeed},
                      {"threads", s.threads}};
     if (s.primalCorrection) doc["solver"]["primal_correction"] = true;
+    if (scene.solverType == "fem") doc["solver"] = {{"type", "fem"}, {"dt", s.dt}};
+    if (scene.suture) doc["suture"] = json::parse(suture::formatSutureSection(*scene.suture));
     doc["gravity"] = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
     if (!scene.instructions.empty()) doc["instructions"] = scene.instructions;
     if (!scene.render.empty()) doc["render"] = json::parse(scene.render);

@@ -20,11 +20,14 @@
 ///                 "stretch_stiffness": 50, "attach_to": "organ", "attach_distance": 0.001,
 ///                 "attach_compliance": 0, "fixed_nodes": []}],
 ///   "tools": [{"name": "probe", "shape": "sphere", ...see tool_probe.hpp...}]   optional
+///   "suture": {...see suture/suture_scene.hpp...}   with "solver": {"type": "fem", "dt": ..}: the
+///              bodies are one quasi-static corotational FEM (E, ν of their material) with a needle
 ///   "render": {"sss": true, "sampling": "distance", "stereo": "off",                optional
 ///              "post": {"tone_mapping": true, ...}}   (checked by render/case_settings.hpp)
 /// }
 #include "sim/material/material.hpp"
 #include "sim/scene/tool_probe.hpp"
+#include "sim/suture/suture_scene.hpp"
 #include "sim/xpbd/strain_limit.hpp"
 #include "sim/xpbd/xpbd_settings.hpp"
 
@@ -73,6 +76,7 @@ struct SceneDesc {
     std::vector<BodyDesc> bodies;
     std::vector<SurfaceDesc> surfaces;
     std::vector<ToolDesc> tools; ///< haptic probes (feature "probe")
+    std::optional<suture::SutureSceneDesc> suture; ///< solver "fem" only (features fem, needle, thread, contact)
 };
 
 /// Throws viscera::InputError ("scene.json: bodies[0].material.poisson_ratio: must be in [0, 0.5)").

@@ -5,6 +5,7 @@
 #include "sim/diagnostics/invariants.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/tool_probe.hpp"
+#include "sim/suture/anastomosis.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
 #include "sim/xpbd/xpbd_system.hpp"
 
@@ -36,6 +37,31 @@ struct AccuracyRecord {
     std::vector<int> iterations;
     std::vector<double> relError;
     std::vector<double> timeMs;
+};
+
+/// One frame of the suturing FEM (solver "fem").
+struct SutureFrameRecord {
+    int frame = 0;
+    int activeRows = 0;       ///< constraint rows enforced
+    int rejectedRows = 0;     ///< redundant or incompatible rows rejected
+    int contacts = 0;         ///< contact constraints held
+    int punctures = 0;        ///< boundary punctures so far
+    double threadTension = 0; ///< N, from the pull multipliers
+    double needleForce = 0;   ///< N, resultant of the tissue on the needle
+    bool threadEngaged = false;
+    double maxGap = -1;       ///< m, closure gauge on sampled frames (every 10th), else −1
+    double maxPenetration = -1; ///< m, same sampling
+};
+
+struct SutureSummary {
+    int punctures = 0;
+    double finalThreadTension = 0, maxThreadTension = 0; ///< N
+    int maxActiveRows = 0, maxContacts = 0;
+    bool gauge = false;            ///< the scene names two bodies to gauge
+    double initialGap = 0;         ///< m
+    double finalGap = 0;           ///< m, measured on the current state
+    double maxPenetration = 0;     ///< m, over the sampled frames and the current state
+    bool finite = true;
 };
 
 class World {
@@ -81,10 +107,22 @@ public:
     /// Contact of probe t measured by the last step (tool_probe.hpp).
     const ToolContact& toolContact(size_t t) const { return m_probes->contact(t); }
 
+    // ---- suturing (solver "fem"; features fem, needle, thread, contact) ---------------------------
+    /// Only a "fem" scene creates the suturing simulation; the needle follows the case's recorded
+    /// trajectory, one frame per step (the last frame is held after the end).
+    bool hasSuture() const { return m_suture != nullptr; }
+    const std::vector<SutureFrameRecord>& sutureFrames() const { return m_sutureFrames; }
+    /// Figures so far; the closure gauge is evaluated on the current state (O(facing × tets)).
+    SutureSummary sutureSummary() const;
+
 private:
     World() = default;
     void measureAccuracy();
     void applyTools(bool measure);
+    static std::unique_ptr<World> assembleSuture(const SceneDesc& scene, std::vector<std::unique_ptr<TetMesh>> meshes,
+                                                 const std::vector<std::string>& active, const std::string& origin);
+    FrameRecord stepSuture();
+    std::vector<Vec3> gaugePositions() const;
 
     SceneDesc m_scene;
     std::vector<std::string> m_active;
@@ -94,6 +132,15 @@ private:
     std::unique_ptr<XpbdSolver> m_single;  ///< one tet body, no layers (accuracy hooks available)
     std::unique_ptr<XpbdSystem> m_system;  ///< several bodies and layers
     std::unique_ptr<ToolProbes> m_probes;  ///< null unless the scene has tools
+    std::unique_ptr<suture::SutureSimulation> m_suture; ///< null unless solver "fem"
+    std::vector<suture::NeedleFrame> m_trajectory;
+    std::vector<int32_t> m_offsets;                     ///< first merged node of each body
+    std::vector<std::vector<Vec3>> m_bodyX;             ///< per-body positions (fem)
+    std::unique_ptr<TetMesh> m_gaugeMesh;               ///< the two gauged bodies, merged
+    std::unique_ptr<suture::ClosureGauge> m_gauge;
+    std::array<size_t, 2> m_gaugeBodies{};
+    std::vector<SutureFrameRecord> m_sutureFrames;
+    double m_initialGap = 0, m_sampledPenetration = 0;
     Invariants m_invariants;
     std::vector<AccuracyRecord> m_accuracy;
     double m_time = 0;

@@ -32,19 +32,6 @@ Eigen::Isometry3d needlePose(double phi, double rhoC, double gamma) {
     return p;
 }
 
-Vec3 closestOnTri(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-    // Projection clamped to the triangle (adequate for the gauge).
-    const Vec3 n = (b - a).cross(c - a).normalized();
-    const Vec3 q = p - n.dot(p - a) * n;
-    const Vec3 v0 = b - a, v1 = c - a, v2 = q - a;
-    const double d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
-    const double den = d00 * d11 - d01 * d01;
-    double v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
-    v = std::clamp(v, 0.0, 1.0);
-    w = std::clamp(w, 0.0, 1.0 - v);
-    return a + v * v0 + w * v1;
-}
-
 } // namespace
 
 AnastomosisModel makeAnastomosisTubes(const AnastomosisSpec& s) {
@@ -150,6 +137,40 @@ std::unique_ptr<TetMesh> mergeMeshes(const std::vector<const TetMesh*>& meshes, 
     return TetMesh::fromArrays(std::move(pos), std::move(tets), "sim::suture::mergeMeshes()");
 }
 
+namespace {
+
+bool insideTet(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, double tol) {
+    Eigen::Matrix3d M;
+    M << b - a, c - a, d - a;
+    const double det = M.determinant();
+    if (!(std::abs(det) > 0)) return false;
+    const Vec3 l = M.inverse() * (p - a);
+    return l.minCoeff() > tol && l.sum() < 1 - tol;
+}
+
+Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+    // Ericson, region tests: exact closest point.
+    const Vec3 ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+    if (d1 <= 0 && d2 <= 0) return a;
+    const Vec3 bp = p - b;
+    const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+    if (d3 >= 0 && d4 <= d3) return b;
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
+    const Vec3 cp = p - c;
+    const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+    if (d6 >= 0 && d5 <= d6) return c;
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+    const double den = 1 / (va + vb + vc);
+    return a + ab * (vb * den) + ac * (vc * den);
+}
+
+} // namespace
+
 ClosureGauge::ClosureGauge(const TetMesh& m, int32_t firstB) {
     const auto& x = m.positions();
     const auto& vmap = m.boundaryVertexMap();
@@ -160,45 +181,86 @@ ClosureGauge::ClosureGauge(const TetMesh& m, int32_t firstB) {
         for (int32_t o : other) d = std::min(d, (x[v] - x[o]).norm());
         return d;
     };
-    std::vector<double> dA(bA.size()), dB(bB.size());
+    std::vector<double> dist(x.size(), std::numeric_limits<double>::infinity());
     double minD = std::numeric_limits<double>::infinity();
-    for (size_t i = 0; i < bA.size(); ++i) minD = std::min(minD, dA[i] = nearest(bA[i], bB));
-    for (size_t i = 0; i < bB.size(); ++i) dB[i] = nearest(bB[i], bA);
-    std::vector<uint8_t> facing(x.size(), 0);
-    for (size_t i = 0; i < bA.size(); ++i)
-        if (dA[i] <= 1.5 * minD) m_facingA.push_back(bA[i]), facing[bA[i]] = 1;
-    for (size_t i = 0; i < bB.size(); ++i)
-        if (dB[i] <= 1.5 * minD) m_facingB.push_back(bB[i]), facing[bB[i]] = 1;
+    for (int32_t v : bA) minD = std::min(minD, dist[v] = nearest(v, bB));
+    for (int32_t v : bB) dist[v] = nearest(v, bA);
+    std::vector<uint8_t> facing(x.size(), 0), near(x.size(), 0);
+    for (int32_t v : bA) {
+        if (dist[v] <= 1.5 * minD) m_facingA.push_back(v), facing[v] = 1;
+        if (dist[v] <= 3 * minD) near[v] = 1;
+    }
+    for (int32_t v : bB) {
+        if (dist[v] <= 1.5 * minD) m_facingB.push_back(v), facing[v] = 1;
+        if (dist[v] <= 3 * minD) near[v] = 1;
+    }
     const TriMesh& b = m.boundary();
     for (const Tri& t : b.triangles()) {
         const std::array<int32_t, 3> v = {vmap[t[0]], vmap[t[1]], vmap[t[2]]};
-        if (!(facing[v[0]] && facing[v[1]] && facing[v[2]])) continue;
-        (v[0] < firstB ? m_trisA : m_trisB).push_back(v);
+        const bool isA = v[0] < firstB;
+        if (facing[v[0]] && facing[v[1]] && facing[v[2]]) (isA ? m_trisA : m_trisB).push_back(v);
+        if (near[v[0]] || near[v[1]] || near[v[2]]) (isA ? m_surfA : m_surfB).push_back(v);
     }
+    for (const Tet& t : m.tets()) {
+        bool close = false;
+        for (int32_t v : t) close |= nearest(v, v < firstB ? bB : bA) <= 3 * minD;
+        if (close) (t[0] < firstB ? m_tetsA : m_tetsB).push_back(t);
+    }
+    // Vertices that face the other body's surface: their rest projection onto the nearest facing
+    // triangle of the other body is not on the triangle's border (an overhanging rim never closes).
+    auto opposing = [&](const std::vector<int32_t>& verts, const std::vector<std::array<int32_t, 3>>& tris,
+                        std::vector<int32_t>& out) {
+        for (int32_t v : verts) {
+            double best = std::numeric_limits<double>::infinity();
+            bool interior = false;
+            for (const auto& t : tris) {
+                const Vec3 q = closestPointOnTriangle(x[v], x[t[0]], x[t[1]], x[t[2]]);
+                const double d = (x[v] - q).norm();
+                if (d < best) {
+                    best = d;
+                    const Vec3 n = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).normalized();
+                    interior = std::abs(n.dot(x[v] - q)) > 0.999 * d;
+                }
+            }
+            if (interior) out.push_back(v);
+        }
+    };
+    opposing(m_facingA, m_trisB, m_opposingA);
+    opposing(m_facingB, m_trisA, m_opposingB);
 }
 
 ClosureMetrics ClosureGauge::measure(const std::vector<Vec3>& x) const {
     ClosureMetrics r;
-    auto side = [&](const std::vector<int32_t>& verts, const std::vector<std::array<int32_t, 3>>& tris) {
-        for (int32_t v : verts) {
-            double best = std::numeric_limits<double>::infinity(), signedDist = 0;
-            for (const auto& t : tris) {
-                const Vec3 q = closestOnTri(x[v], x[t[0]], x[t[1]], x[t[2]]);
-                const double d = (x[v] - q).norm();
-                if (d < best) {
-                    best = d;
-                    const Vec3 n = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).normalized(); // outward
-                    signedDist = n.dot(x[v] - q);
-                }
-            }
-            if (!std::isfinite(best)) continue;
-            r.maxGap = std::max(r.maxGap, signedDist);
-            r.maxPenetration = std::max(r.maxPenetration, -signedDist);
-        }
+    auto distanceTo = [&](const Vec3& p, const std::vector<std::array<int32_t, 3>>& tris) {
+        double best = std::numeric_limits<double>::infinity();
+        for (const auto& t : tris) best = std::min(best, (p - closestPointOnTriangle(p, x[t[0]], x[t[1]], x[t[2]])).norm());
+        return best;
     };
-    side(m_facingB, m_trisA);
-    side(m_facingA, m_trisB);
-    r.finite = std::isfinite(r.maxGap) && std::isfinite(r.maxPenetration);
+    auto inside = [&](const Vec3& p, const std::vector<Tet>& tets) {
+        for (const Tet& t : tets) {
+            const Vec3 lo = x[t[0]].cwiseMin(x[t[1]]).cwiseMin(x[t[2]]).cwiseMin(x[t[3]]);
+            const Vec3 hi = x[t[0]].cwiseMax(x[t[1]]).cwiseMax(x[t[2]]).cwiseMax(x[t[3]]);
+            if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
+            if (insideTet(p, x[t[0]], x[t[1]], x[t[2]], x[t[3]], 1e-12)) return true;
+        }
+        return false;
+    };
+    auto side = [&](const std::vector<int32_t>& facing, const std::vector<int32_t>& opposing,
+                    const std::vector<std::array<int32_t, 3>>& otherFacing,
+                    const std::vector<std::array<int32_t, 3>>& otherSurface, const std::vector<Tet>& otherTets) {
+        for (int32_t v : facing) {
+            if (!x[v].allFinite()) {
+                r.finite = false;
+                continue;
+            }
+            if (inside(x[v], otherTets)) r.maxPenetration = std::max(r.maxPenetration, distanceTo(x[v], otherSurface));
+        }
+        for (int32_t v : opposing)
+            if (!inside(x[v], otherTets)) r.maxGap = std::max(r.maxGap, distanceTo(x[v], otherFacing));
+    };
+    side(m_facingB, m_opposingB, m_trisA, m_surfA, m_tetsA);
+    side(m_facingA, m_opposingA, m_trisB, m_surfB, m_tetsB);
+    r.finite = r.finite && std::isfinite(r.maxGap) && std::isfinite(r.maxPenetration);
     return r;
 }
 

@@ -22,7 +22,7 @@ struct AnastomosisSpec {
     int transferFrames = 10;          ///< per leg (out, around, in) between stitches
     double transferDistance = 0.003;  ///< m, radial retreat between stitches
     int pullFrames = 200;
-    double pullPerSegment = 0.0024;   ///< m of pull per outside thread segment
+    double pullPerSegment = 0.0026;   ///< m of pull per outside thread segment (tuned: the gap stops closing beyond)
     double slack = 0.002;             ///< m
 };
 
@@ -46,13 +46,16 @@ std::vector<NeedleFrame> parseTrajectory(std::string_view text, const std::strin
 /// Merges several tet meshes into one (vertex and tet indices offset in order).
 std::unique_ptr<TetMesh> mergeMeshes(const std::vector<const TetMesh*>& meshes, std::vector<int32_t>* vertexOffsets);
 
-/// Closure figures between two bodies of a merged mesh: their facing boundary vertices (rest
-/// distance to the other body within 1.5× the smallest), the gap (largest separation of a facing
-/// vertex of one body beyond the facing surface of the other, along that surface's normal) and the
-/// interpenetration (largest depth below it).
+/// Closure figures between two bodies of a merged mesh. Facing boundary vertices: rest distance to
+/// the other body within 1.5× the smallest; opposing: facing vertices whose rest projection on the
+/// other body's facing surface falls inside a triangle (an overhanging rim, as where tubes of
+/// different diameters meet, is facing but not opposing). Gap: largest distance of an opposing
+/// vertex, outside the other body, to the other body's facing surface. Interpenetration: largest
+/// distance to the other body's surface of a facing vertex that lies inside one of its tets (the
+/// tets of its end region: within 3× the smallest distance). Cost: O(facing × (tets + triangles)).
 struct ClosureMetrics {
     double maxGap = 0;            ///< m
-    double maxPenetration = 0;    ///< m
+    double maxPenetration = 0;    ///< m, 0 when no vertex is inside the other body
     bool finite = true;
 };
 class ClosureGauge {
@@ -60,10 +63,13 @@ public:
     ClosureGauge(const TetMesh& merged, int32_t firstVertexOfB);
     ClosureMetrics measure(const std::vector<Vec3>& x) const;
     size_t facingVertices() const { return m_facingA.size() + m_facingB.size(); }
+    size_t opposingVertices() const { return m_opposingA.size() + m_opposingB.size(); }
 
 private:
-    std::vector<int32_t> m_facingA, m_facingB;
+    std::vector<int32_t> m_facingA, m_facingB, m_opposingA, m_opposingB;
     std::vector<std::array<int32_t, 3>> m_trisA, m_trisB; // facing boundary triangles
+    std::vector<std::array<int32_t, 3>> m_surfA, m_surfB; // boundary triangles of the end regions
+    std::vector<Tet> m_tetsA, m_tetsB;                    // tets of the end regions
 };
 
 } // namespace viscera::sim::suture

@@ -13,7 +13,8 @@ bool finitePose(const Eigen::Isometry3d& p) { return p.matrix().allFinite(); }
 
 /// Orthonormal pair spanning the plane normal to w [B eq. 3.30–3.31].
 void normalPlane(const Vec3& w, Vec3& u, Vec3& v) {
-    for (const Vec3& e : {Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()}) {
+    const Vec3 axes[3] = {Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
+    for (const Vec3& e : axes) {
         const Vec3 a = w.cross(e);
         if (a.norm() > 0.3) {
             u = a.cross(w).normalized();
@@ -27,6 +28,17 @@ void normalPlane(const Vec3& w, Vec3& u, Vec3& v) {
 
 } // namespace
 
+ThreadSegmentLinearization linearizeThreadSegment(const Vec3& ra, const Vec3& rb, double eps) {
+    ThreadSegmentLinearization l;
+    const Vec3 d = rb - ra;
+    const double n = d.norm();
+    if (!std::isfinite(n) || !(eps > 0)) return l;
+    l.length = n >= eps ? n : (n * n / (2 * eps) + eps / 2);
+    l.direction = d / std::max(n, eps);
+    l.offset = l.length - l.direction.dot(d);
+    return l;
+}
+
 double NeedleSpec::length_() const { return shape == Shape::Semicircle ? std::numbers::pi * radius : length; }
 
 std::string validate(const SutureSettings& s) {
@@ -37,8 +49,10 @@ std::string validate(const SutureSettings& s) {
     if (!(n.punctureForce > 0) || !std::isfinite(n.punctureForce)) return "needle puncture_force must be positive";
     if (!(s.thread.length > 0) || !(s.thread.slack >= 0) || !(s.thread.stabilization > 0))
         return "thread length and stabilization must be positive, slack >= 0";
-    if (!(s.contactThickness > 0) || s.contactRounds < 0 || s.contactsPerRound < 1)
-        return "contact thickness must be positive, rounds >= 0, per round >= 1";
+    if (!(s.thread.maxStrainPerStep > 0 && s.thread.maxStrainPerStep < 1))
+        return "thread max_strain_per_step must be in (0, 1)";
+    if (!(s.contactThickness > 0) || s.contactRounds < 0 || s.contactsPerRound < 1 || s.maxContacts < 1)
+        return "contact thickness must be positive, rounds >= 0, per round >= 1, max_contacts >= 1";
     return {};
 }
 
@@ -67,8 +81,7 @@ double slidingAmount(const NeedleSpec& spec, const Eigen::Isometry3d& from, cons
     if (!(q.norm() > 1e-12 * spec.radius)) return 0;
     q.normalize();
     const Vec3 ah = (h0 - a.p).normalized(), bh = q;
-    const double ang = std::acos(std::clamp(ah.dot(bh), -1.0, 1.0));
-    return (n.dot(ah.cross(bh)) >= 0 ? 1.0 : -1.0) * spec.radius * ang;
+    return spec.radius * std::atan2(n.dot(ah.cross(bh)), ah.dot(bh)); // signed angle, accurate near 0
 }
 
 SutureSimulation::~SutureSimulation() = default;
@@ -87,7 +100,7 @@ std::unique_ptr<SutureSimulation> SutureSimulation::create(std::unique_ptr<TetMe
     s->m_mesh = std::move(mesh);
     s->m_fem = fem::CorotationalFem::create(*s->m_mesh, fixed, settings.fem);
     s->m_tracker = std::make_unique<TipTracker>(*s->m_mesh);
-    if (settings.contact) s->m_detector = std::make_unique<contact::ContactDetector>(*s->m_mesh);
+    if (settings.contact) s->m_detector = std::make_unique<contact::ContactDetector>(*s->m_mesh, settings.selfContact);
     s->m_pose = initialPose;
     return s;
 }
@@ -209,44 +222,62 @@ void SutureSimulation::updateThreadConstraint(double pull, SutureStepStats& st) 
             lastExit = nullptr;
         }
     }
+    auto dropAll = [&] {
+        for (int id : m_pullIds) m_fem->removeConstraint(id);
+        m_pullIds.clear();
+    };
     if (!(pull > 0) || segs.empty()) {
-        if (m_pullId >= 0) m_fem->removeConstraint(m_pullId);
-        m_pullId = -1;
+        dropAll();
         return;
     }
+    // Smoothed lengths L_i and their gradients d̂_i (stabilized below ε) at the current positions.
     const double eps = m_s.thread.stabilization;
-    double lengthNow = 0, correction = 0;
-    fem::ConstraintRow row; // written as −Σ d̂·(r_b − r_a) ≥ −(ℓ − Σ(L − d̂·d)), unilateral
-    for (const auto& [a, b] : segs) {
-        const Vec3 d = materialPoint(b->face, b->xi) - materialPoint(a->face, a->xi);
-        const double n = d.norm();
-        const double L = n >= eps ? n : (n * n / (2 * eps) + eps / 2); // smoothed length
-        const Vec3 dh = d / std::max(n, eps);                           // its gradient [eq. 3.36, stabilized]
-        lengthNow += L;
-        correction += L - dh.dot(d);
-        const auto va = m_mesh->halfFacetVertices(a->face), vb = m_mesh->halfFacetVertices(b->face);
-        for (int k = 0; k < 3; ++k) {
-            if (b->xi[k] != 0) row.terms.push_back({vb[k], -b->xi[k] * dh});
-            if (a->xi[k] != 0) row.terms.push_back({va[k], a->xi[k] * dh});
-        }
+    std::vector<ThreadSegmentLinearization> lin(segs.size());
+    double lengthNow = 0;
+    for (size_t i = 0; i < segs.size(); ++i) {
+        const auto& [a, b] = segs[i];
+        lin[i] = linearizeThreadSegment(materialPoint(a->face, a->xi), materialPoint(b->face, b->xi), eps);
+        lengthNow += lin[i].length;
     }
-    if (!m_pullStarted) {
+    if (!m_pullStarted || segs.size() != m_pullSegments) {
+        // Engagement reference [eq. 3.33]: ℓ = outside length + slack when the pull starts; a new
+        // segment (another stitch) re-bases it on the pull applied so far.
         m_pullStarted = true;
-        m_outsideLength0 = lengthNow + m_s.thread.slack;
+        m_pullSegments = segs.size();
+        m_outsideLength0 = lengthNow + m_s.thread.slack + pull;
     }
     const double target = m_outsideLength0 - pull;
-    row.b = -(target - correction);
-    if (m_pullId < 0) {
-        fem::ConstraintDesc d;
-        d.kind = fem::ConstraintKind::Unilateral;
-        d.startActive = lengthNow > target;
-        d.priority = 2;
-        d.rows = {row};
-        m_pullId = m_fem->addConstraint(std::move(d));
-    } else {
-        m_fem->setRows(m_pullId, {row});
-    }
     st.threadEngaged = lengthNow >= target;
+    if (!st.threadEngaged) { // slack: pure sliding of the thread, zero multiplier
+        dropAll();
+        return;
+    }
+    // Every segment is brought together by the same factor κ [eq. 3.37], one-sided per segment (a
+    // thread does not push): d̂_i·(r_b − r_a) ≤ κ L_i − (L_i − d̂_i·d_i), written as ≥ with the signs flipped.
+    const double kappa = std::clamp(target / lengthNow, 1.0 - m_s.thread.maxStrainPerStep, 1.0);
+    if (m_pullIds.size() != segs.size()) {
+        dropAll();
+        for (size_t i = 0; i < segs.size(); ++i) {
+            fem::ConstraintDesc d;
+            d.kind = fem::ConstraintKind::Unilateral;
+            d.priority = 2;
+            d.rows = {fem::ConstraintRow{}};
+            m_pullIds.push_back(m_fem->addConstraint(std::move(d)));
+        }
+    }
+    for (size_t i = 0; i < segs.size(); ++i) {
+        const auto& [a, b] = segs[i];
+        const ThreadSegmentLinearization& l = lin[i];
+        fem::ConstraintRow row;
+        const auto va = m_mesh->halfFacetVertices(a->face), vb = m_mesh->halfFacetVertices(b->face);
+        for (int k = 0; k < 3; ++k) {
+            if (b->xi[k] != 0) row.terms.push_back({vb[k], -b->xi[k] * l.direction});
+            if (a->xi[k] != 0) row.terms.push_back({va[k], a->xi[k] * l.direction});
+        }
+        row.b = -(kappa * l.length - l.offset);
+        if (!n_finite(row)) row = fem::ConstraintRow{};
+        m_fem->setRows(m_pullIds[i], {row});
+    }
 }
 
 void SutureSimulation::updateContacts() {
@@ -307,15 +338,17 @@ void SutureSimulation::processContacts(const std::vector<Vec3>& before, SutureSt
     for (int round = 0; round < m_s.contactRounds; ++round) {
         hits.clear();
         m_detector->detect(before, m_fem->positions(), m_s.contactThickness, hits);
-        std::set<int32_t> used;
-        for (const Contact& c : m_contacts)
-            for (int32_t v : c.c.v) used.insert(v);
+        // A collision already held (same primitives) is skipped; others sharing a vertex are kept
+        // (redundant rows are rejected by the solve, [B §2.2.6]).
+        std::set<std::array<int32_t, 5>> held;
+        auto keyOf = [](const contact::Collision& c) {
+            return std::array<int32_t, 5>{static_cast<int32_t>(c.kind), c.v[0], c.v[1], c.v[2], c.v[3]};
+        };
+        for (const Contact& c : m_contacts) held.insert(keyOf(c.c));
         int added = 0;
         for (const contact::Collision& h : hits) { // time order [B §3.3.1]
-            if (added >= m_s.contactsPerRound) break;
-            bool shared = false;
-            for (int32_t v : h.v) shared |= used.count(v) > 0;
-            if (shared) continue;
+            if (added >= m_s.contactsPerRound || m_contacts.size() >= static_cast<size_t>(m_s.maxContacts)) break;
+            if (!held.insert(keyOf(h)).second) continue;
             fem::ConstraintDesc d;
             d.kind = fem::ConstraintKind::Unilateral;
             d.priority = 3;
@@ -332,7 +365,6 @@ void SutureSimulation::processContacts(const std::vector<Vec3>& before, SutureSt
             c.c = h;
             c.id = m_fem->addConstraint(std::move(d));
             m_contacts.push_back(c);
-            for (int32_t v : h.v) used.insert(v);
             ++added;
         }
         st.newContacts += added;
@@ -380,8 +412,11 @@ void SutureSimulation::readForces(SutureStepStats& st) {
         st.tipAxialForce = f.dot(curve().tangent(m_s.needle.length_()));
     }
     st.needleForce = total.norm();
-    if (m_pullId >= 0 && m_fem->hasConstraint(m_pullId) && m_fem->state(m_pullId).active)
-        st.threadTension = std::max(0.0, -m_fem->state(m_pullId).lambda[0]);
+    double tension = 0;
+    for (int id : m_pullIds)
+        if (m_fem->hasConstraint(id) && m_fem->state(id).active && !m_fem->state(id).lambda.empty())
+            tension = std::max(tension, -m_fem->state(id).lambda[0]);
+    st.threadTension = tension; // the largest segment tension (frictionless: all segments equal ideally)
 }
 
 SutureStepStats SutureSimulation::step(const NeedleFrame& frame) {

@@ -43,7 +43,18 @@ struct ThreadSpec {
     double length = 1.0;          ///< η: entries behind the needle end beyond −η are dropped, m
     double slack = 0.002;         ///< outside length above the taut length when the pull starts, m
     double stabilization = 2e-4;  ///< ε of the small-distance linearization, m
+    double maxStrainPerStep = 0.05; ///< largest relative shortening κ of a segment per step [eq. 3.37]
 };
+
+/// Linearization of one outside thread segment r_a → r_b [B eq. 3.34–3.36], stabilized below ε:
+/// length L = |d| for |d| >= ε, else |d|²/(2ε) + ε/2 (C¹ at ε, L(0) = ε/2 > 0); direction
+/// d̂ = ∂L/∂r_b = d / max(|d|, ε); offset = L − d̂·d, so L(d') ≈ d̂·d' + offset to first order.
+struct ThreadSegmentLinearization {
+    double length = 0;             ///< m
+    Vec3 direction = Vec3::Zero(); ///< dimensionless, |d̂| <= 1
+    double offset = 0;             ///< m, zero for |d| >= ε
+};
+ThreadSegmentLinearization linearizeThreadSegment(const Vec3& ra, const Vec3& rb, double eps);
 
 struct SutureSettings {
     fem::FemSettings fem;
@@ -52,7 +63,9 @@ struct SutureSettings {
     bool contact = true;
     double contactThickness = 1e-6; ///< m, proximity of a coplanarity root counted as contact
     int contactRounds = 3;          ///< detect → add (time order) → solve rounds per step
-    int contactsPerRound = 48;      ///< earliest collisions taken per round (disjoint vertices)
+    int contactsPerRound = 48;      ///< earliest collisions taken per round
+    int maxContacts = 256;          ///< contact constraints held at most (bounds the dense solve)
+    bool selfContact = false;       ///< also contact within one body (default: between bodies only)
 };
 
 /// Empty when valid, else the rule that failed.
@@ -172,7 +185,8 @@ private:
         std::vector<HistoryEntry> snapshot;
     } m_tip;
     // thread
-    int m_pullId = -1;
+    std::vector<int> m_pullIds; // one unilateral group per outside segment [eq. 3.37]
+    size_t m_pullSegments = 0;
     bool m_pullStarted = false;
     double m_outsideLength0 = 0;
     // contact

@@ -65,8 +65,8 @@ TEST(Scene, RenderBlockAndPrimalCorrectionRoundTrip) {
 TEST(Scene, ErrorsNameTheField) {
     EXPECT_THAT(parseError("{"), HasSubstr("scene.json: not valid JSON"));
     EXPECT_THAT(parseError("{}"), HasSubstr("scene.json: solver: required field is missing"));
-    EXPECT_THAT(parseError(R"({"solver": {"type": "fem"}, "bodies": []})"),
-                HasSubstr("solver.type: 'fem' is not supported"));
+    EXPECT_THAT(parseError(R"({"solver": {"type": "mpm"}, "bodies": []})"),
+                HasSubstr("solver.type: 'mpm' is not supported"));
     EXPECT_THAT(parseError(R"({"solver": {"type": "xpbd", "substeps": 0}, "bodies": []})"),
                 HasSubstr("solver: substeps must be in [1, 1000]"));
     EXPECT_THAT(parseError(R"({"solver": {"type": "xpbd"}, "bodies": []})"), HasSubstr("bodies: must be a non-empty array"));

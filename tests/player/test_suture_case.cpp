@@ -1,0 +1,102 @@
+// End-to-end suturing [B ch. 4]: viscera-studio exports projects/anastomosis (two hollow tubes, a
+// recorded needle trajectory with 52 punctures and the thread pull), viscera-player runs it headless
+// and reports per-frame step time, active constraint rows, thread tension, and the closure.
+#include "case/zip_craft.hpp"
+#include "support/run_process.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+using namespace viscera;
+using ::testing::HasSubstr;
+using vcase::test::ScratchDir;
+
+namespace {
+
+test::ProcessResult player(const std::vector<std::string>& args) { return test::runProcess(VISCERA_PLAYER_EXE, args); }
+test::ProcessResult studio(const std::vector<std::string>& args) { return test::runProcess(VISCERA_STUDIO_EXE, args); }
+
+nlohmann::json readJson(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    return nlohmann::json::parse(in);
+}
+
+bool has(const nlohmann::json& list, const std::string& s) {
+    return std::find(list.begin(), list.end(), s) != list.end();
+}
+
+} // namespace
+
+TEST(SutureCase, AnastomosisExportsRunsAndClosesTheGap) {
+    ScratchDir dir;
+    const auto out = dir.path() / "anastomosis.vcase";
+    auto e = studio({"export", std::string(VISCERA_SOURCE_DIR) + "/projects/anastomosis", "-o", out.string()});
+    ASSERT_EQ(e.exitCode, 0) << e.err;
+    EXPECT_THAT(e.out, HasSubstr("features: contact fem needle thread"));
+    auto v = player({"verify", out.string()});
+    ASSERT_EQ(v.exitCode, 0) << v.err;
+    const auto report = dir.path() / "r.json";
+    // 2130 frames: 13 stitches (52 punctures), the needle parked, then the pull.
+    auto r = player({"run", out.string(), "--headless", "--frames", "2130", "--report", report.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
+    EXPECT_THAT(r.out, HasSubstr("closure"));
+    const nlohmann::json doc = readJson(report);
+    const auto& active = doc["active_subsystems"];
+    for (const char* s : {"fem", "needle", "thread", "contact"}) EXPECT_TRUE(has(active, s)) << s;
+    EXPECT_FALSE(has(active, "xpbd"));
+    EXPECT_TRUE(doc["invariants"]["all_finite"].get<bool>());
+    ASSERT_EQ(doc["frames"].size(), 2130u);
+    for (const auto& f : doc["frames"]) ASSERT_TRUE(std::isfinite(f["step_ms"].get<double>()));
+    const nlohmann::json& s = doc["suture"];
+    EXPECT_GE(s["punctures"].get<int>(), 50);
+    EXPECT_EQ(doc["metrics"]["punctures"].get<int>(), s["punctures"].get<int>());
+    EXPECT_NEAR(s["initial_gap_m"].get<double>(), 0.002, 1e-6);
+    EXPECT_LT(s["max_gap_m"].get<double>(), 0.0002);         // 2 mm → closed (0.09 mm measured)
+    EXPECT_LE(s["max_penetration_m"].get<double>(), 1e-4);   // no interpenetration beyond 0.1 mm
+    EXPECT_GT(s["max_thread_tension_n"].get<double>(), 0.0);
+    ASSERT_EQ(s["frames"].size(), 2130u);
+    int withRows = 0;
+    for (const auto& f : s["frames"]) {
+        ASSERT_TRUE(std::isfinite(f["thread_tension_n"].get<double>()));
+        withRows += f["active_rows"].get<int>() > 0;
+    }
+    EXPECT_GT(withRows, 100);
+    EXPECT_TRUE(s["frames"][0].contains("max_gap_m")); // sampled every 10th frame
+}
+
+TEST(SutureCase, BrokenSutureSectionsAreRejectedAtExport) {
+    ScratchDir dir;
+    std::ifstream in(std::string(VISCERA_SOURCE_DIR) + "/projects/anastomosis/project.json");
+    nlohmann::json project = nlohmann::json::parse(in);
+    auto exportWith = [&](const nlohmann::json& p) {
+        const auto pdir = dir.path() / "p";
+        std::filesystem::create_directories(pdir);
+        std::ofstream(pdir / "project.json") << p.dump();
+        return studio({"export", pdir.string(), "-o", (dir.path() / "x.vcase").string()});
+    };
+    nlohmann::json p = project;
+    p["suture"]["needle"]["shape"] = "hook";
+    auto a = exportWith(p);
+    EXPECT_EQ(a.exitCode, 1);
+    EXPECT_THAT(a.err, HasSubstr("suture.needle.shape"));
+    p = project;
+    p["suture"]["trajectory"] = {{"file", "missing.traj"}};
+    auto b = exportWith(p);
+    EXPECT_EQ(b.exitCode, 1);
+    EXPECT_THAT(b.err, HasSubstr("missing.traj"));
+    p = project;
+    p["suture"]["gauge"] = {"wide", "nothere"};
+    auto c = exportWith(p);
+    EXPECT_EQ(c.exitCode, 1);
+    EXPECT_THAT(c.err, HasSubstr("suture.gauge"));
+    p = project;
+    p.erase("suture");
+    auto d = exportWith(p);
+    EXPECT_EQ(d.exitCode, 1);
+    EXPECT_THAT(d.err, HasSubstr("solver 'fem' needs a 'suture' section"));
+}

@@ -1,0 +1,130 @@
+// The "suture" section (solver "fem") of scene.json and the World it assembles: features, strict
+// parsing with messages naming the field, and only the declared subsystems created.
+#include "sim/mesh/generators.hpp"
+#include "sim/scene/scene.hpp"
+#include "sim/scene/world.hpp"
+#include "sim/suture/anastomosis.hpp"
+#include "sim/util/error.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+using namespace viscera::sim;
+using ::testing::HasSubstr;
+
+namespace {
+
+const char* kScene = R"({
+  "solver": {"type": "fem", "dt": 0.0333},
+  "bodies": [
+    {"name": "lower", "mesh": "meshes/lower.vtet", "fixed_nodes": [0, 1, 2, 3, 4, 5, 6, 7, 8],
+     "material": {"model": "linear", "youngs_modulus": 60000, "poisson_ratio": 0.45, "density": 1000}},
+    {"name": "upper", "mesh": "meshes/upper.vtet", "fixed_nodes": [0, 1, 2, 3, 4, 5, 6, 7, 8],
+     "material": {"model": "linear", "youngs_modulus": 60000, "poisson_ratio": 0.45, "density": 1000}}],
+  "suture": {"needle": {"shape": "straight", "length": 0.02, "puncture_force_n": 0.005},
+             "thread": {"slack": 0.001},
+             "trajectory": "tools/needle.traj", "gauge": ["lower", "upper"]}
+})";
+
+std::string parseError(const std::string& text) {
+    try {
+        parseScene(text, "scene.json");
+    } catch (const viscera::InputError& e) {
+        return e.what();
+    }
+    return "accepted";
+}
+
+std::string withChange(const std::function<void(nlohmann::json&)>& change) {
+    nlohmann::json j = nlohmann::json::parse(kScene);
+    change(j);
+    return j.dump();
+}
+
+/// A straight needle above the two stacked slabs, pushed down through both.
+std::string trajectory() {
+    std::vector<suture::NeedleFrame> frames;
+    for (int f = 0; f < 40; ++f) {
+        suture::NeedleFrame fr;
+        fr.pose.linear() = Eigen::AngleAxisd(0.5 * 3.141592653589793, Vec3::UnitY()).toRotationMatrix(); // +x → −z
+        fr.pose.translation() = Vec3(0.0051, 0.0049, 0.03 - 0.0007 * f);
+        frames.push_back(fr);
+    }
+    return suture::formatTrajectory(frames);
+}
+
+std::vector<std::unique_ptr<TetMesh>> slabs() {
+    std::vector<std::unique_ptr<TetMesh>> v;
+    v.push_back(makeBoxTetMesh({Vec3(0, 0, -0.003), Vec3(0.01, 0.01, 0.003), {4, 4, 2}}));
+    v.push_back(makeBoxTetMesh({Vec3(0, 0, 0.001), Vec3(0.01, 0.01, 0.003), {4, 4, 2}}));
+    return v;
+}
+
+} // namespace
+
+TEST(SutureScene, ParsesRoundTripsAndNamesItsFeatures) {
+    const SceneDesc s = parseScene(kScene, "scene.json");
+    ASSERT_TRUE(s.suture);
+    EXPECT_EQ(s.solverType, "fem");
+    EXPECT_EQ(s.suture->settings.needle.shape, suture::NeedleSpec::Shape::Straight);
+    EXPECT_TRUE(s.suture->thread);
+    EXPECT_FALSE(s.suture->contact);
+    EXPECT_EQ(s.suture->trajectoryPath, "tools/needle.traj");
+    EXPECT_EQ(requiredFeatures(s), (std::vector<std::string>{"fem", "needle", "thread"}));
+    const SceneDesc again = parseScene(formatScene(s), "again.json");
+    EXPECT_EQ(formatScene(again), formatScene(s));
+    EXPECT_DOUBLE_EQ(again.suture->settings.needle.punctureForce, 0.005);
+    EXPECT_DOUBLE_EQ(again.suture->settings.thread.slack, 0.001);
+}
+
+TEST(SutureScene, RejectsBadSectionsNamingTheField) {
+    EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"]["needle"]["shape"] = "hook"; })),
+                HasSubstr("scene.json: suture.needle.shape: 'hook' is not a needle shape"));
+    EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"]["needle"]["radius"] = -1; })),
+                HasSubstr("suture.needle.radius: must be a positive number"));
+    EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"].erase("trajectory"); })),
+                HasSubstr("suture.trajectory: required"));
+    EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"]["contact"] = {{"rounds", 99}}; })),
+                HasSubstr("suture.contact.rounds: must be an integer in [0, 16]"));
+    EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"]["knot"] = 1; })), HasSubstr("suture.knot: unknown field"));
+    EXPECT_THAT(parseError(withChange([](auto& j) { j.erase("suture"); })), HasSubstr("solver 'fem' needs a 'suture' section"));
+    EXPECT_THAT(parseError(withChange([](auto& j) { j["solver"]["type"] = "xpbd"; })), HasSubstr("suture: needs solver.type 'fem'"));
+    EXPECT_THAT(parseError(withChange([](auto& j) { j["solver"]["substeps"] = 3; })), HasSubstr("solver.substeps: unknown field"));
+}
+
+TEST(SutureScene, WorldCreatesOnlyTheDeclaredSubsystemsAndSteps) {
+    SceneDesc s = parseScene(kScene, "scene.json");
+    s.suture->trajectoryText = trajectory();
+    // Undeclared feature: refused.
+    EXPECT_THROW(World::assemble(s, slabs(), {}, {"fem", "needle"}, "case: manifest.json"), viscera::InputError);
+    auto w = World::assemble(s, slabs(), {}, {"fem", "needle", "thread"}, "case: manifest.json");
+    ASSERT_TRUE(w->hasSuture());
+    EXPECT_EQ(w->activeSubsystems(), (std::vector<std::string>{"fem", "needle", "thread"}));
+    EXPECT_EQ(w->bodyCount(), 2u);
+    for (int f = 0; f < 45; ++f) ASSERT_TRUE(w->step().finite) << f; // runs past the trajectory's end
+    ASSERT_EQ(w->sutureFrames().size(), 45u);
+    const SutureSummary sum = w->sutureSummary();
+    EXPECT_GE(sum.punctures, 2); // through the upper slab at least
+    EXPECT_TRUE(sum.gauge && sum.finite);
+    EXPECT_NEAR(sum.initialGap, 0.001, 1e-9);
+    EXPECT_TRUE(w->invariants().allFinite);
+    // A broken trajectory and mismatched materials are load errors naming the rule.
+    SceneDesc bad = s;
+    bad.suture->trajectoryText = "0 0 0 1 0 0 0\n";
+    try {
+        World::assemble(bad, slabs(), {}, {"fem", "needle", "thread"}, "case");
+        FAIL() << "accepted";
+    } catch (const viscera::InputError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("tools/needle.traj: line 1: expected 8 numbers"));
+    }
+    SceneDesc mixed = s;
+    mixed.bodies[1].material.youngsModulus = 1000;
+    try {
+        World::assemble(mixed, slabs(), {}, {"fem", "needle", "thread"}, "case");
+        FAIL() << "accepted";
+    } catch (const viscera::InputError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("all bodies need the same youngs_modulus and poisson_ratio"));
+    }
+}
