@@ -36,7 +36,7 @@ struct ToolMapping {
 
 struct ServoConfig {
     double rateHz = 1000.0;
-    int64_t spin_ns = 80'000;       ///< wake this early and spin to the deadline
+    int64_t spin_ns = 700'000;   ///< wake this early and spin to the deadline (see servo_loop.cpp)
     bool realtimePriority = true;   ///< try SCHED_FIFO for the servo thread (ignored when refused)
     SafetyLimits safety;
     std::array<ToolMapping, kMaxArms> tools{};

@@ -1,0 +1,344 @@
+#include "sim/collision/collision_solver.hpp"
+
+#include "sim/collision/distance.hpp"
+#include "sim/xpbd/xpbd_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace viscera::sim {
+
+const char* toString(CollisionMethod m) {
+    switch (m) {
+    case CollisionMethod::Circumsphere: return "circumsphere";
+    case CollisionMethod::BoundingSphere: return "bounding_sphere";
+    case CollisionMethod::Polygon: return "polygon";
+    }
+    return "unknown";
+}
+
+std::string validate(const CollisionSettings& s) {
+    if (std::string e = validate(s.circumsphere); !e.empty()) return e;
+    if (!(s.polygonMargin >= 0) || !std::isfinite(s.polygonMargin))
+        return "polygon margin must be finite and >= 0";
+    if (!(s.compliance >= 0) || !std::isfinite(s.compliance))
+        return "compliance must be finite and >= 0";
+    if (!(s.cellSize >= 0) || !std::isfinite(s.cellSize)) return "cell size must be finite and >= 0";
+    if (!(s.maxCorrectionPerStep > 0)) return "max correction per step must be > 0";
+    return {};
+}
+
+CollisionSurfaceDesc CollisionSurfaceDesc::fromTetMesh(const TetMesh& mesh,
+                                                       std::vector<double> inverseMass) {
+    CollisionSurfaceDesc d;
+    const TriMesh& b = mesh.boundary();
+    const std::vector<int32_t>& map = mesh.boundaryVertexMap();
+    d.triangles.reserve(b.triangleCount());
+    for (const Tri& t : b.triangles()) d.triangles.push_back({map[t[0]], map[t[1]], map[t[2]]});
+    d.restPositions = mesh.positions();
+    d.inverseMass = std::move(inverseMass);
+    return d;
+}
+
+double unifiedTriangleConstraint(const std::array<Vec3, 3>& x, const std::array<Vec3, 3>& target,
+                                 bool squared, std::array<Vec3, 3>* grad) {
+    double sum = 0;
+    for (int k = 0; k < 3; ++k) sum += (x[k] - target[k]).squaredNorm();
+    const double C = squared ? sum : std::sqrt(sum);
+    if (grad)
+        for (int k = 0; k < 3; ++k)
+            (*grad)[k] = squared ? Vec3(2 * (x[k] - target[k]))
+                                 : (C > 0 ? Vec3((x[k] - target[k]) / C) : Vec3::Zero());
+    return C;
+}
+
+double pointTriangleConstraint(const std::array<Vec3, 3>& x, const Vec3& bary, const Vec3& q,
+                               double reach, std::array<Vec3, 3>* grad) {
+    const Vec3 d = bary[0] * x[0] + bary[1] * x[1] + bary[2] * x[2] - q;
+    const double dist = d.norm();
+    if (grad) {
+        const Vec3 n = dist > 0 ? Vec3(d / dist) : Vec3::Zero();
+        for (int k = 0; k < 3; ++k) (*grad)[k] = bary[k] * n;
+    }
+    return dist - reach;
+}
+
+CollisionSolver::~CollisionSolver() = default;
+
+std::unique_ptr<CollisionSolver> CollisionSolver::create(CollisionSurfaceDesc desc,
+                                                         const CollisionSettings& settings) {
+    const std::string where = "sim::CollisionSolver::create(): ";
+    if (std::string e = validate(settings); !e.empty()) throw std::invalid_argument(where + e);
+    const size_t nv = desc.restPositions.size();
+    if (desc.triangles.empty()) throw std::invalid_argument(where + "the surface has no triangles");
+    if (desc.inverseMass.size() != nv)
+        throw std::invalid_argument(where + "inverse masses: " +
+                                    std::to_string(desc.inverseMass.size()) + " values for " +
+                                    std::to_string(nv) + " vertices");
+    for (size_t v = 0; v < nv; ++v) {
+        if (!desc.restPositions[v].allFinite())
+            throw std::invalid_argument(where + "vertex " + std::to_string(v) +
+                                        " has a non-finite rest position");
+        if (!(desc.inverseMass[v] >= 0) || !std::isfinite(desc.inverseMass[v]))
+            throw std::invalid_argument(where + "vertex " + std::to_string(v) +
+                                        " has an inverse mass that is negative or not finite");
+    }
+    for (size_t t = 0; t < desc.triangles.size(); ++t)
+        for (int32_t v : desc.triangles[t])
+            if (v < 0 || static_cast<size_t>(v) >= nv)
+                throw std::invalid_argument(where + "triangle " + std::to_string(t) +
+                                            " references vertex " + std::to_string(v) +
+                                            " (surface has " + std::to_string(nv) + " vertices)");
+    std::unique_ptr<CollisionSolver> s(new CollisionSolver());
+    s->m_settings = settings;
+    s->m_tris = std::move(desc.triangles);
+    s->m_rest = std::move(desc.restPositions);
+    s->m_w = std::move(desc.inverseMass);
+    s->m_curv = SurfaceCurvature(nv, s->m_tris);
+    s->m_h3Spline = curvatureHermite(settings.circumsphere.curvatureThreshold);
+    double cell = settings.cellSize;
+    if (cell <= 0) {
+        double sum = 0;
+        for (const Tri& t : s->m_tris)
+            for (int k = 0; k < 3; ++k) sum += (s->m_rest[t[k]] - s->m_rest[t[(k + 1) % 3]]).norm();
+        cell = 2 * sum / (3.0 * s->m_tris.size());
+        if (!(cell > 0)) cell = 1e-3;
+    }
+    s->m_hash = std::make_unique<SpatialHash>(cell);
+    const size_t nt = s->m_tris.size();
+    s->m_h3.assign(nt, 1.0);
+    s->m_energy.assign(nt, 0.0);
+    s->m_refArea.assign(nt, -1.0);
+    s->m_boxes.resize(nt);
+    s->m_touched.assign(nv, 0);
+    s->refreshAllFactors(s->m_rest);
+    return s;
+}
+
+void CollisionSolver::refreshFactors(int32_t t, const std::vector<Vec3>& x, double area) {
+    const Tri& f = m_tris[t];
+    m_h3[t] = m_h3Spline.value(m_curv.triangleCurvature(t, x));
+    m_energy[t] = triangleEnergyFactor({m_rest[f[0]], m_rest[f[1]], m_rest[f[2]]},
+                                       {x[f[0]], x[f[1]], x[f[2]]});
+    m_refArea[t] = area;
+}
+
+void CollisionSolver::refreshAllFactors(const std::vector<Vec3>& x) {
+    if (x.size() != m_rest.size()) return;
+    for (size_t t = 0; t < m_tris.size(); ++t) {
+        const Tri& f = m_tris[t];
+        const double area = 0.5 * (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]).norm();
+        refreshFactors(static_cast<int32_t>(t), x, area);
+    }
+}
+
+Sphere CollisionSolver::triangleSphere(int32_t t, const std::vector<Vec3>& x) const {
+    const Tri& f = m_tris[t];
+    if (m_settings.method != CollisionMethod::Circumsphere)
+        return boundingSphere(x[f[0]], x[f[1]], x[f[2]]);
+    const Circumcircle cc = circumcircle(x[f[0]], x[f[1]], x[f[2]]);
+    return circumsphere(cc, circumsphereOffset(cc.radius, m_h3[t], m_energy[t],
+                                               m_settings.circumsphere));
+}
+
+void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& tool, double h) {
+    m_stats = CollisionStats{};
+    m_candidates.clear();
+    std::fill(m_touched.begin(), m_touched.end(), 0);
+    m_contactDirty = true;
+    if (x.size() != m_rest.size() || !(h > 0)) return;
+    m_alphaTilde = m_settings.compliance / (h * h);
+    m_start = x;
+    const bool polygon = m_settings.method == CollisionMethod::Polygon;
+    for (size_t t = 0; t < m_tris.size(); ++t) {
+        const Tri& f = m_tris[t];
+        Aabb& b = m_boxes[t];
+        if (polygon) {
+            const Vec3 m = Vec3::Constant(m_settings.polygonMargin);
+            b.lo = x[f[0]].cwiseMin(x[f[1]]).cwiseMin(x[f[2]]) - m;
+            b.hi = x[f[0]].cwiseMax(x[f[1]]).cwiseMax(x[f[2]]) + m;
+        } else {
+            const Sphere s = triangleSphere(static_cast<int32_t>(t), x);
+            b.lo = s.centre - Vec3::Constant(s.radius);
+            b.hi = s.centre + Vec3::Constant(s.radius);
+        }
+    }
+    m_hash->build(m_boxes);
+    const auto tb = tool.bounds();
+    m_hash->queryInto(Aabb{tb[0], tb[1]}, m_candidates);
+    m_stats.candidates = static_cast<int>(m_candidates.size());
+    if (m_settings.method == CollisionMethod::Circumsphere) {
+        const double delta = m_settings.circumsphere.updateThreshold;
+        for (int32_t t : m_candidates) {
+            const Tri& f = m_tris[t];
+            const double area = 0.5 * (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]).norm();
+            const double ref = m_refArea[t];
+            const bool refresh = !(ref > 0) || std::abs(area / ref - 1.0) >= delta;
+            if (refresh) {
+                refreshFactors(t, x, area);
+                ++m_stats.factorUpdates;
+            }
+        }
+    }
+    m_lambda.assign(m_candidates.size() * tool.parts().size(), 0.0);
+}
+
+bool CollisionSolver::projectSphere(int32_t t, const Sphere& s, const Capsule& c, double& lambda,
+                                    std::vector<Vec3>& x) {
+    const AxisPoint ap = closestAxisPoint(c, s.centre);
+    const double pen = s.radius + c.radius - ap.distance;
+    if (!(pen > 0)) return false;
+    const Tri& f = m_tris[t];
+    Vec3 dir = ap.direction;
+    if (ap.distance <= 1e-12 * std::max(1.0, s.radius)) {
+        // Sphere centre on the axis: push the triangle into the tissue (against its normal).
+        const Vec3 n = (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]);
+        if (n.squaredNorm() > 0) dir = -n.normalized();
+    }
+    // Sphere translation (targets x'_i = x_i + move), at most one tool radius per projection:
+    // a sphere grows with its stretched triangle, and an uncapped push would feed that growth.
+    const Vec3 move = std::min(pen, c.radius) * dir;
+    const std::array<Vec3, 3> xs = {x[f[0]], x[f[1]], x[f[2]]};
+    const std::array<Vec3, 3> target = {xs[0] + move, xs[1] + move, xs[2] + move};
+    std::array<Vec3, 3> grad;
+    const double C = unifiedTriangleConstraint(xs, target, m_settings.squaredForm, &grad);
+    double denom = m_alphaTilde;
+    for (int k = 0; k < 3; ++k) denom += m_w[f[k]] * grad[k].squaredNorm();
+    if (!(denom > 0) || !(C > 0)) return true;
+    const double dl = (-C - m_alphaTilde * lambda) / denom;
+    lambda += dl;
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 dx = m_w[f[k]] * dl * grad[k];
+        x[f[k]] += dx;
+        capCorrection(f[k], x);
+        m_stats.maxCorrection = std::max(m_stats.maxCorrection, dx.norm());
+        m_touched[f[k]] = 1;
+    }
+    return true;
+}
+
+bool CollisionSolver::projectPolygon(int32_t t, const Capsule& c, double& lambda,
+                                     std::vector<Vec3>& x) {
+    const Tri& f = m_tris[t];
+    const SegmentTrianglePair st = closestPointsSegmentTriangle(c.a, c.b, x[f[0]], x[f[1]], x[f[2]]);
+    const double reach = c.radius + m_settings.polygonMargin;
+    if (!(st.distance < reach)) return false;
+    Vec3 n;
+    if (st.distance > 1e-12 * std::max(1.0, reach)) {
+        n = (st.onTriangle.point - st.onSegment) / st.distance;
+    } else {
+        const Vec3 nt = (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]);
+        if (!(nt.squaredNorm() > 0)) return false;
+        n = -nt.normalized();
+    }
+    const Vec3& b = st.onTriangle.bary;
+    // C = n·(Σ b_i x_i − q) − reach; with n the unit direction this is the distance form of
+    // pointTriangleConstraint, ∇_i C = b_i n.
+    const double C = st.distance - reach;
+    double denom = m_alphaTilde;
+    for (int k = 0; k < 3; ++k) denom += m_w[f[k]] * b[k] * b[k];
+    if (!(denom > 0)) return true;
+    const double dl = (-C - m_alphaTilde * lambda) / denom;
+    lambda += dl;
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 dx = m_w[f[k]] * b[k] * dl * n;
+        x[f[k]] += dx;
+        capCorrection(f[k], x);
+        m_stats.maxCorrection = std::max(m_stats.maxCorrection, dx.norm());
+        m_touched[f[k]] = 1;
+    }
+    return true;
+}
+
+void CollisionSolver::capCorrection(int32_t v, std::vector<Vec3>& x) const {
+    const Vec3 total = x[v] - m_start[v];
+    const double len = total.norm(), cap = m_settings.maxCorrectionPerStep;
+    if (len > cap) x[v] = m_start[v] + (cap / len) * total;
+}
+
+int CollisionSolver::iterate(std::vector<Vec3>& x, const ToolShape& tool) {
+    if (x.size() != m_rest.size()) return 0;
+    const auto& parts = tool.parts();
+    if (m_lambda.size() != m_candidates.size() * parts.size()) return 0;
+    int contacts = 0;
+    m_stats.maxCorrection = 0;
+    for (size_t i = 0; i < m_candidates.size(); ++i) {
+        const int32_t t = m_candidates[i];
+        if (m_settings.method == CollisionMethod::Polygon) {
+            for (size_t p = 0; p < parts.size(); ++p)
+                contacts += projectPolygon(t, parts[p], m_lambda[i * parts.size() + p], x);
+        } else {
+            for (size_t p = 0; p < parts.size(); ++p) {
+                const Sphere s = triangleSphere(t, x); // current vertices, cached factors
+                contacts += projectSphere(t, s, parts[p], m_lambda[i * parts.size() + p], x);
+            }
+        }
+    }
+    m_stats.contacts = contacts;
+    if (contacts) m_contactDirty = true;
+    return contacts;
+}
+
+const std::vector<int32_t>& CollisionSolver::contactVertices() const {
+    if (m_contactDirty) {
+        m_contactVerts.clear();
+        for (size_t v = 0; v < m_touched.size(); ++v)
+            if (m_touched[v]) m_contactVerts.push_back(static_cast<int32_t>(v));
+        m_contactDirty = false;
+    }
+    return m_contactVerts;
+}
+
+bool collisionVelocityUpdate(const std::vector<Vec3>& before, const std::vector<Vec3>& after,
+                             std::vector<Vec3>& v) {
+    bool finite = true;
+    for (size_t i = 0; i < after.size() && i < before.size() && i < v.size(); ++i) {
+        const Vec3 d = after[i] - before[i];
+        const double len = d.norm();
+        if (len > 0) {
+            const Vec3 n = d / len;
+            const double vn = v[i].dot(n);
+            if (vn < 0) v[i] -= vn * n;
+        }
+        finite = finite && after[i].allFinite() && v[i].allFinite();
+    }
+    return finite;
+}
+
+CollisionFrameResult stepWithCollision(XpbdSolver& solver, CollisionSolver& collision,
+                                       ToolShape& tool, const ToolShape::Pose& from,
+                                       const ToolShape::Pose& to, int substeps, int iterations) {
+    CollisionFrameResult r;
+    const double h = solver.settings().dt;
+    const std::vector<Vec3> start = solver.positions();
+    std::vector<Vec3> x, v;
+    substeps = std::max(1, substeps);
+    for (int s = 1; s <= substeps; ++s) {
+        tool.setPose(interpolatePose(from, to, static_cast<double>(s) / substeps));
+        const StepStats st = solver.step();
+        if (!st.finite) r.finite = false;
+        x = solver.positions();
+        collision.beginStep(x, tool, h);
+        for (int k = 0; k < iterations; ++k) collision.iterate(x, tool);
+        r.last = collision.stats();
+        if (collision.stats().candidates == 0) continue;
+        v = solver.velocities();
+        const bool finite = collisionVelocityUpdate(solver.positions(), x, v);
+        if (!finite) {
+            r.finite = false;
+            continue;
+        }
+        try {
+            solver.setState(x, v);
+        } catch (const std::exception&) {
+            r.finite = false;
+        }
+    }
+    const std::vector<Vec3>& end = solver.positions();
+    for (size_t i = 0; i < end.size() && i < start.size(); ++i)
+        r.maxDisplacement = std::max(r.maxDisplacement, (end[i] - start[i]).norm());
+    return r;
+}
+
+} // namespace viscera::sim

@@ -1,0 +1,173 @@
+#pragma once
+/// Tool–tissue collision detection and response for XPBD [A §5.2].
+///
+/// Pipeline per substep (beginStep): the surface triangles' boxes go into a spatial hash
+/// (spatial_hash.hpp) and the tool's box selects candidates; for the circumsphere method the
+/// candidates whose area changed by |S/S_ref − 1| >= δ since their last refresh get new curvature
+/// and energy factors [A §5.2.4]. Then every iterate() is one Gauss–Seidel sweep over the
+/// candidates × tool parts: narrow phase at the current positions, projection of each violated
+/// contact constraint with XPBD multipliers (accumulated over the sweeps of a step, reset by
+/// beginStep) and compliance α / h².
+///
+/// Narrow phases (CollisionMethod):
+///   - Circumsphere [A §5.2.1–5.2.3]: the triangle's adaptive circumsphere (circumsphere.hpp,
+///     centre recomputed every sweep from the current vertices with the cached factors) against
+///     the tool's capsules. A contact translates the sphere out along the line from the closest
+///     axis point to the sphere centre; the triangle's targets are x'_i = x_i + t, and the
+///     unified triangle constraint C = √(Σ |x_i − x'_i|²) (the root of [A eq. 5.8], same zero
+///     set and gradient direction, but one projection with α = 0 reaches the targets exactly;
+///     settings.squaredForm uses Σ |x_i − x'_i|² itself, whose Gauss–Newton step only halves the
+///     distance) moves the three vertices together.
+///   - BoundingSphere [MO06]: the same with the triangle's bounding sphere (centroid, largest
+///     vertex distance).
+///   - Polygon [Eri04]: the closest points of the capsule axis and the triangle (vertex, edge or
+///     face feature); a contact when closer than radius + margin, resolved by the point–triangle
+///     constraint C = n·(Σ b_i x_i − q) − (r + margin) >= 0 with the barycentric weights b_i
+///     (n from the axis point q to the triangle point; −N when the axis pierces the triangle).
+///
+/// Only the tissue moves (the tool is kinematic, infinite mass). Fixed nodes (inverse mass 0) are
+/// never moved. Results are deterministic (candidates in ascending order). Nothing here
+/// allocates after the first steps of a run, prints or throws once created.
+#include "sim/collision/circumsphere.hpp"
+#include "sim/collision/spatial_hash.hpp"
+#include "sim/collision/tool_shape.hpp"
+#include "sim/mesh/tet_mesh.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace viscera::sim {
+
+enum class CollisionMethod { Circumsphere, BoundingSphere, Polygon };
+const char* toString(CollisionMethod m);
+
+struct CollisionSettings {
+    CollisionMethod method = CollisionMethod::Circumsphere;
+    CircumsphereParams circumsphere;
+    double polygonMargin = 1e-3; ///< m, polygon method: contact distance beyond the tool surface
+    double compliance = 0;       ///< m/N per contact constraint (0 = hard), divided by h²
+    bool squaredForm = false;    ///< use [A eq. 5.8] literally (see above)
+    double cellSize = 0;         ///< m, spatial hash grid; 0 = twice the mean rest edge length
+    /// m: no vertex is moved farther than this by the sweeps of one step (a tool that starts
+    /// deep inside the tissue pushes it out over several substeps instead of in one jump).
+    double maxCorrectionPerStep = 0.002;
+};
+
+/// Empty when valid, otherwise the rule that failed.
+std::string validate(const CollisionSettings& s);
+
+struct CollisionSurfaceDesc {
+    std::vector<Tri> triangles;      ///< outward counter-clockwise, indices into the body's nodes
+    std::vector<Vec3> restPositions; ///< #V body nodes, m (rest shape for the energy factor)
+    std::vector<double> inverseMass; ///< #V, 1/kg; 0 = fixed (never moved)
+
+    /// The boundary of a tet mesh (level 3 must be built: mesh.requireLevel(3)), in the mesh's
+    /// vertex numbering, with the given inverse masses (#V).
+    static CollisionSurfaceDesc fromTetMesh(const TetMesh& mesh, std::vector<double> inverseMass);
+};
+
+struct CollisionStats {
+    int candidates = 0;    ///< broad-phase candidate triangles of the step
+    int contacts = 0;      ///< constraint projections in the last sweep
+    int factorUpdates = 0; ///< triangles whose curvature/energy factors were refreshed (δ test)
+    double maxCorrection = 0; ///< m, largest vertex move of the last sweep
+};
+
+/// The unified triangle constraint of [A eq. 5.8] for vertices x and targets x' (fixed):
+/// squared: C = Σ |x_i − x'_i|², ∇_i C = 2 (x_i − x'_i); otherwise its root
+/// C = √(Σ |x_i − x'_i|²), ∇_i C = (x_i − x'_i) / C (zero gradient at C = 0). grad may be null.
+double unifiedTriangleConstraint(const std::array<Vec3, 3>& x, const std::array<Vec3, 3>& target,
+                                 bool squared, std::array<Vec3, 3>* grad);
+/// The polygon method's point–triangle constraint for fixed barycentric weights b and axis point
+/// q: C = |Σ b_i x_i − q| − reach, ∇_i C = b_i n with n the unit direction from q (zero gradient
+/// when the point is on q). grad may be null.
+double pointTriangleConstraint(const std::array<Vec3, 3>& x, const Vec3& bary, const Vec3& q,
+                               double reach, std::array<Vec3, 3>* grad);
+
+class CollisionSolver {
+public:
+    /// Throws std::invalid_argument ("sim::CollisionSolver::create(): triangle 4 references
+    /// vertex 99 (surface has 50 vertices)") on invalid settings, sizes, indices, non-finite or
+    /// negative inverse masses.
+    static std::unique_ptr<CollisionSolver> create(CollisionSurfaceDesc desc,
+                                                   const CollisionSettings& settings);
+    CollisionSolver(const CollisionSolver&) = delete;
+    CollisionSolver& operator=(const CollisionSolver&) = delete;
+    ~CollisionSolver();
+
+    /// Starts a substep of length h (s, > 0) at positions x (#V): broad phase against the tool at
+    /// its current pose, δ update of the candidates' factors, multipliers reset.
+    void beginStep(const std::vector<Vec3>& x, const ToolShape& tool, double h);
+    /// One sweep over the candidates (positions in/out). Returns the number of projections.
+    int iterate(std::vector<Vec3>& x, const ToolShape& tool);
+
+    const CollisionStats& stats() const { return m_stats; }
+    /// Vertices of the triangles in contact during the current step (any sweep), ascending.
+    const std::vector<int32_t>& contactVertices() const;
+    const CollisionSettings& settings() const { return m_settings; }
+    size_t triangleCount() const { return m_tris.size(); }
+    const std::vector<Tri>& triangles() const { return m_tris; }
+
+    /// The sphere a sphere method uses for triangle t at positions x with the cached factors
+    /// (circumsphere or bounding sphere; for Polygon, the bounding sphere).
+    Sphere triangleSphere(int32_t t, const std::vector<Vec3>& x) const;
+    /// Cached curvature factor H3(K) and energy factor ε of triangle t (circumsphere method).
+    double curvatureFactor(int32_t t) const { return m_h3[t]; }
+    double energyFactor(int32_t t) const { return m_energy[t]; }
+    /// Refreshes H3(K), ε and the reference area of every triangle now (e.g. after teleporting).
+    void refreshAllFactors(const std::vector<Vec3>& x);
+
+private:
+    CollisionSolver() = default;
+    void refreshFactors(int32_t t, const std::vector<Vec3>& x, double area);
+    bool projectSphere(int32_t t, const Sphere& s, const Capsule& c, double& lambda,
+                       std::vector<Vec3>& x);
+    bool projectPolygon(int32_t t, const Capsule& c, double& lambda, std::vector<Vec3>& x);
+    void capCorrection(int32_t v, std::vector<Vec3>& x) const;
+
+    CollisionSettings m_settings;
+    std::vector<Tri> m_tris;
+    std::vector<Vec3> m_rest;
+    std::vector<double> m_w;
+    SurfaceCurvature m_curv;
+    CubicHermite m_h3Spline;
+    std::unique_ptr<SpatialHash> m_hash;
+    std::vector<double> m_h3, m_energy, m_refArea; ///< per triangle; m_refArea < 0: never set
+    std::vector<Aabb> m_boxes;
+    std::vector<int32_t> m_candidates;
+    std::vector<double> m_lambda; ///< #candidates × #parts
+    std::vector<char> m_touched;  ///< per vertex, this step
+    std::vector<Vec3> m_start;    ///< positions at beginStep
+    mutable std::vector<int32_t> m_contactVerts;
+    mutable bool m_contactDirty = false;
+    double m_alphaTilde = 0;
+    CollisionStats m_stats;
+};
+
+/// One frame of an XpbdSolver body with tool collision coupled per substep: the solver must run
+/// one substep per step() (settings().substeps == 1, settings().dt == frame dt / substeps). For
+/// each of `substeps` substeps the tool moves to the pose interpolated between `from` and `to`,
+/// the solver takes its step (its own iterations over the elastic constraints), then
+/// `iterations` collision sweeps project the contacts, and the moves they made are written back
+/// with v += Δx / h (XpbdSolver::setState). The collision constraints are therefore solved after
+/// the elastic ones in every substep, not interleaved with their sweeps (see the report in
+/// bench/bench_collision.cpp). Never throws; a non-finite collision result is dropped.
+/// Velocity update after a collision projection moved positions from `before` to `after`
+/// (#V each): the velocity component against each vertex's correction is removed (an inelastic
+/// contact; a separating push adds no velocity, so a tool that starts inside the tissue or a
+/// deep overlap cannot inject kinetic energy). Returns false when a value is not finite.
+bool collisionVelocityUpdate(const std::vector<Vec3>& before, const std::vector<Vec3>& after,
+                             std::vector<Vec3>& v);
+
+struct CollisionFrameResult {
+    bool finite = true;
+    double maxDisplacement = 0; ///< m, largest node move over the frame (XPBD's own stats)
+    CollisionStats last;        ///< stats of the last substep
+};
+class XpbdSolver;
+CollisionFrameResult stepWithCollision(XpbdSolver& solver, CollisionSolver& collision,
+                                       ToolShape& tool, const ToolShape::Pose& from,
+                                       const ToolShape::Pose& to, int substeps, int iterations);
+
+} // namespace viscera::sim

@@ -1,0 +1,239 @@
+#include "sim/collision/collision_solver.hpp"
+#include "sim/collision/distance.hpp"
+#include "sim/mesh/generators.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace viscera::sim;
+using ::testing::HasSubstr;
+
+namespace {
+
+/// A flat square of two triangles in z = 0 (normal +z), side L.
+CollisionSurfaceDesc square(double L = 0.01, std::vector<double> w = {1, 1, 1, 1}) {
+    CollisionSurfaceDesc d;
+    d.restPositions = {Vec3(0, 0, 0), Vec3(L, 0, 0), Vec3(L, L, 0), Vec3(0, L, 0)};
+    d.triangles = {{0, 1, 2}, {0, 2, 3}};
+    d.inverseMass = std::move(w);
+    return d;
+}
+
+ToolShape sphereAt(double r, const Vec3& c) {
+    ToolShape t = ToolShape::sphere(r);
+    ToolShape::Pose p = ToolShape::Pose::Identity();
+    p.translation() = c;
+    t.setPose(p);
+    return t;
+}
+
+} // namespace
+
+// Finite-difference check of the unified triangle constraint [A eq. 5.8] (both forms) and of the
+// polygon point–triangle constraint, over random configurations.
+TEST(CollisionConstraint, GradientsMatchFiniteDifferences) {
+    std::mt19937 rng(2);
+    std::uniform_real_distribution<double> u(-0.01, 0.01);
+    for (int trial = 0; trial < 50; ++trial) {
+        std::array<Vec3, 3> x, target;
+        for (int k = 0; k < 3; ++k) {
+            x[k] = Vec3(u(rng), u(rng), u(rng));
+            target[k] = x[k] + Vec3(u(rng), u(rng), u(rng));
+        }
+        const Vec3 bary = Vec3(std::abs(u(rng)), std::abs(u(rng)), std::abs(u(rng))).normalized();
+        const Vec3 b = bary / bary.sum(), q(u(rng), u(rng), 0.02 + u(rng));
+        for (int form = 0; form < 3; ++form) {
+            auto eval = [&](const std::array<Vec3, 3>& y, std::array<Vec3, 3>* g) {
+                if (form == 2) return pointTriangleConstraint(y, b, q, 0.005, g);
+                return unifiedTriangleConstraint(y, target, form == 1, g);
+            };
+            std::array<Vec3, 3> grad;
+            eval(x, &grad);
+            const double h = 1e-7;
+            for (int k = 0; k < 3; ++k)
+                for (int a = 0; a < 3; ++a) {
+                    auto xp = x, xm = x;
+                    xp[k][a] += h;
+                    xm[k][a] -= h;
+                    const double fd = (eval(xp, nullptr) - eval(xm, nullptr)) / (2 * h);
+                    EXPECT_NEAR(grad[k][a], fd, 1e-6 * std::max(1.0, std::abs(fd)))
+                        << "form " << form << " vertex " << k << " axis " << a;
+                }
+        }
+    }
+    // Zero at the targets.
+    std::array<Vec3, 3> x = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+    EXPECT_EQ(unifiedTriangleConstraint(x, x, false, nullptr), 0.0);
+    EXPECT_EQ(unifiedTriangleConstraint(x, x, true, nullptr), 0.0);
+}
+
+TEST(CollisionSolver, CircumsphereContactTranslatesTheTriangleAsOne) {
+    CollisionSettings s;
+    s.circumsphere.energyScale = 0;
+    s.maxCorrectionPerStep = 1.0; // geometry only: no per-step cap
+    auto col = CollisionSolver::create(square(), s);
+    // Sphere tool of radius 5 mm just above the first triangle, overlapping its circumsphere.
+    const Vec3 c0 = circumcircle(Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.01, 0.01, 0)).centre;
+    ToolShape tool = sphereAt(0.005, c0 + Vec3(0, 0, 0.005));
+    std::vector<Vec3> x = square().restPositions;
+    const std::vector<Vec3> x0 = x;
+    col->beginStep(x, tool, 1e-3);
+    EXPECT_EQ(col->stats().candidates, 2);
+    EXPECT_GT(col->iterate(x, tool), 0);
+    // Triangle 0 moved rigidly by one vector (its vertex 0 and 2 are shared with triangle 1,
+    // which also collides; check the sphere of each no longer overlaps after a few sweeps).
+    for (int k = 0; k < 10; ++k) col->iterate(x, tool);
+    for (int32_t t = 0; t < 2; ++t) {
+        const Sphere sp = col->triangleSphere(t, x);
+        EXPECT_GE((sp.centre - tool.parts()[0].a).norm(), sp.radius + 0.005 - 1e-9);
+    }
+    // Pushed down (into the tissue), not sideways much.
+    for (int v = 0; v < 4; ++v) EXPECT_LT(x[v].z(), x0[v].z());
+    EXPECT_EQ(col->contactVertices(), (std::vector<int32_t>{0, 1, 2, 3}));
+}
+
+TEST(CollisionSolver, UnifiedResponseMovesAllThreeVerticesEqually) {
+    CollisionSurfaceDesc d;
+    d.restPositions = {Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0)};
+    d.triangles = {{0, 1, 2}};
+    d.inverseMass = {2, 2, 2};
+    for (bool squared : {false, true}) {
+        CollisionSettings s;
+        s.squaredForm = squared;
+        auto col = CollisionSolver::create(d, s);
+        const Sphere sp = col->triangleSphere(0, d.restPositions);
+        ToolShape tool = sphereAt(0.003, sp.centre + Vec3(0, 0, sp.radius + 0.002));
+        std::vector<Vec3> x = d.restPositions;
+        col->beginStep(x, tool, 1e-3);
+        ASSERT_EQ(col->iterate(x, tool), 1);
+        const Vec3 m0 = x[0] - d.restPositions[0];
+        for (int v = 1; v < 3; ++v) EXPECT_LT((x[v] - d.restPositions[v] - m0).norm(), 1e-15);
+        // Root form resolves the 1 mm overlap in one projection; the squared form halves it.
+        EXPECT_NEAR(m0.z(), squared ? -0.0005 : -0.001, 1e-12);
+    }
+}
+
+TEST(CollisionSolver, PolygonContactKeepsTheMargin) {
+    CollisionSettings s;
+    s.method = CollisionMethod::Polygon;
+    s.polygonMargin = 0.001;
+    s.maxCorrectionPerStep = 1.0;
+    auto col = CollisionSolver::create(square(0.02), s);
+    ToolShape tool = sphereAt(0.004, Vec3(0.012, 0.006, 0.003)); // 1 mm into the face
+    std::vector<Vec3> x = square(0.02).restPositions;
+    col->beginStep(x, tool, 1e-3);
+    for (int k = 0; k < 20; ++k) col->iterate(x, tool);
+    const TrianglePoint tp = closestPointOnTriangle(tool.parts()[0].a, x[0], x[1], x[2]);
+    EXPECT_NEAR((tp.point - tool.parts()[0].a).norm(), 0.005, 1e-9);
+}
+
+TEST(CollisionSolver, CorrectionPerStepIsCapped) {
+    CollisionSettings s;
+    s.maxCorrectionPerStep = 0.001;
+    auto col = CollisionSolver::create(square(), s);
+    ToolShape tool = sphereAt(0.006, Vec3(0.005, 0.005, 0.0)); // deep inside
+    std::vector<Vec3> x = square().restPositions;
+    col->beginStep(x, tool, 1e-3);
+    for (int k = 0; k < 10; ++k) col->iterate(x, tool);
+    for (int v = 0; v < 4; ++v)
+        EXPECT_LE((x[v] - square().restPositions[v]).norm(), 0.001 + 1e-15);
+}
+
+TEST(CollisionSolver, FixedVerticesNeverMove) {
+    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
+                              CollisionMethod::Polygon}) {
+        CollisionSettings s;
+        s.method = m;
+        auto col = CollisionSolver::create(square(0.01, {0, 1, 1, 0}), s);
+        ToolShape tool = sphereAt(0.004, Vec3(0.005, 0.005, 0.001));
+        std::vector<Vec3> x = square().restPositions;
+        col->beginStep(x, tool, 1e-3);
+        for (int k = 0; k < 5; ++k) col->iterate(x, tool);
+        EXPECT_EQ(x[0], Vec3(0, 0, 0)) << toString(m);
+        EXPECT_EQ(x[3], Vec3(0, 0.01, 0)) << toString(m);
+        EXPECT_LT(x[1].z(), 0) << toString(m);
+    }
+}
+
+// [A §5.2.4]: factors are refreshed only when |S/S_ref − 1| >= δ.
+TEST(CollisionSolver, UpdateThresholdTriggers) {
+    CollisionSettings s;
+    s.circumsphere.updateThreshold = 0.2;
+    s.circumsphere.energyScale = 0.01;
+    auto col = CollisionSolver::create(square(), s);
+    ToolShape tool = sphereAt(0.001, Vec3(0.005, 0.005, 0.05)); // far above
+    ToolShape big = sphereAt(0.05, Vec3(0.005, 0.005, 0.04)); // its box covers the square
+    std::vector<Vec3> x = square().restPositions;
+    col->beginStep(x, big, 1e-3);
+    EXPECT_EQ(col->stats().candidates, 2);
+    EXPECT_EQ(col->stats().factorUpdates, 0);
+    // Stretch vertex 2 so that triangle areas grow by 10 %: below δ, factors kept.
+    std::vector<Vec3> y = x;
+    y[2] = Vec3(0.011, 0.011, 0);
+    col->beginStep(y, big, 1e-3);
+    EXPECT_EQ(col->stats().factorUpdates, 0);
+    EXPECT_EQ(col->energyFactor(0), 0.0);
+    // 30 %: refreshed; the energy factor now reflects the stretch.
+    y[2] = Vec3(0.013, 0.013, 0);
+    col->beginStep(y, big, 1e-3);
+    EXPECT_EQ(col->stats().factorUpdates, 2);
+    EXPECT_GT(col->energyFactor(0), 0.0);
+    // Same shape again: relative to the refreshed reference, no change.
+    col->beginStep(y, big, 1e-3);
+    EXPECT_EQ(col->stats().factorUpdates, 0);
+    // Outside the tool's box nothing is tested.
+    col->beginStep(x, tool, 1e-3);
+    EXPECT_EQ(col->stats().candidates, 0);
+    // δ = 0: every candidate refreshed every step.
+    s.circumsphere.updateThreshold = 0;
+    auto always = CollisionSolver::create(square(), s);
+    always->beginStep(x, big, 1e-3);
+    EXPECT_EQ(always->stats().factorUpdates, 2);
+    always->beginStep(x, big, 1e-3);
+    EXPECT_EQ(always->stats().factorUpdates, 2);
+}
+
+TEST(CollisionSolver, CurvatureFactorShrinksSpheresOnEdgesOfABox) {
+    auto mesh = makeBoxTetMesh({Vec3::Zero(), Vec3(0.04, 0.04, 0.02), {4, 4, 2}});
+    mesh->requireLevel(3);
+    auto col = CollisionSolver::create(
+        CollisionSurfaceDesc::fromTetMesh(*mesh, std::vector<double>(mesh->vertexCount(), 1.0)), {});
+    double flatMin = 1, edgeMax = 0;
+    const auto& x = mesh->positions();
+    for (int32_t t = 0; t < static_cast<int32_t>(col->triangleCount()); ++t) {
+        const Tri& f = col->triangles()[t];
+        bool onTopInterior = true;
+        for (int32_t v : f)
+            onTopInterior &= x[v].z() > 0.02 - 1e-9 && x[v].x() > 1e-9 && x[v].x() < 0.04 - 1e-9 &&
+                             x[v].y() > 1e-9 && x[v].y() < 0.04 - 1e-9;
+        bool touchesCorner = false;
+        for (int32_t v : f)
+            touchesCorner |= (x[v].x() < 1e-9 || x[v].x() > 0.04 - 1e-9) &&
+                             (x[v].y() < 1e-9 || x[v].y() > 0.04 - 1e-9) && x[v].z() > 0.02 - 1e-9;
+        if (onTopInterior) flatMin = std::min(flatMin, col->curvatureFactor(t));
+        if (touchesCorner) edgeMax = std::max(edgeMax, col->curvatureFactor(t));
+    }
+    EXPECT_EQ(flatMin, 1.0);
+    EXPECT_LT(edgeMax, 1.0);
+}
+
+TEST(CollisionSolver, CreateRejectsBadInputWithMessages) {
+    auto d = square();
+    d.triangles.push_back({0, 1, 9});
+    EXPECT_THAT([&] { CollisionSolver::create(d, {}); },
+                ::testing::ThrowsMessage<std::invalid_argument>(
+                    HasSubstr("triangle 2 references vertex 9 (surface has 4 vertices)")));
+    d = square();
+    d.inverseMass = {1, 1, -1, 1};
+    EXPECT_THAT([&] { CollisionSolver::create(d, {}); },
+                ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("vertex 2")));
+    d = square();
+    d.inverseMass = {1, 1};
+    EXPECT_THROW(CollisionSolver::create(d, {}), std::invalid_argument);
+    CollisionSettings s;
+    s.circumsphere.safeAngle = 2.0;
+    EXPECT_THAT([&] { CollisionSolver::create(square(), s); },
+                ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("safe angle")));
+}
