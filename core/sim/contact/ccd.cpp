@@ -1,5 +1,7 @@
 #include "sim/contact/ccd.hpp"
 
+#include "sim/collision/distance.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -107,35 +109,6 @@ Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& 
 }
 
 /// Closest points of segments (p0, p1) and (q0, q1): parameters (s, t) in [0, 1].
-void closestSegments(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double& s, double& t) {
-    const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
-    const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
-    if (a <= 1e-300 && e <= 1e-300) {
-        s = t = 0;
-        return;
-    }
-    if (a <= 1e-300) {
-        s = 0;
-        t = std::clamp(f / e, 0.0, 1.0);
-        return;
-    }
-    const double c = d1.dot(r);
-    if (e <= 1e-300) {
-        t = 0;
-        s = std::clamp(-c / a, 0.0, 1.0);
-        return;
-    }
-    const double b = d1.dot(d2), denom = a * e - b * b;
-    s = denom > 1e-300 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
-    t = (b * s + f) / e;
-    if (t < 0) {
-        t = 0;
-        s = std::clamp(-c / a, 0.0, 1.0);
-    } else if (t > 1) {
-        t = 1;
-        s = std::clamp((b - c) / a, 0.0, 1.0);
-    }
-}
 
 } // namespace
 
@@ -163,7 +136,9 @@ bool edgeEdgeCcd(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, d
     for (int i = 0; i < n; ++i) {
         const auto x = lerp(x0, x1, roots[i]);
         double s, u;
-        closestSegments(x[0], x[1], x[2], x[3], s, u);
+        const SegmentPair closest = closestPointsSegments(x[0], x[1], x[2], x[3]);
+        s = closest.s;
+        u = closest.t;
         const Vec3 p = x[0] + s * (x[1] - x[0]), q = x[2] + u * (x[3] - x[2]);
         if ((p - q).norm() <= thickness && s > 0 && s < 1 && u > 0 && u < 1) {
             t = roots[i];
