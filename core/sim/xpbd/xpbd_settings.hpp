@@ -24,7 +24,7 @@ struct XpbdSettings {
     bool simd = true;
     /// After every iteration, the primal correction x ← x̃ + M⁻¹ ∇C(x)ᵀ λ (XpbdIteration::
     /// PrimalCorrected): iterations then converge to the implicit step's solution instead of
-    /// levelling off O(h² k/m) away from it, at 3–4 times the cost of a plain iteration
+    /// levelling off O(h² k/m) away from it, at about 4 times the cost of a plain iteration
     /// (parallel like the sweeps, bit-identical for any thread count). Elastic tets only (no strain limits, membranes or ties); converges while the
     /// stiffness number h² k w/(ρ L²) is small, which the load-time stability check enforces.
     bool primalCorrection = false;
