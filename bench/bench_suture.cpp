@@ -22,22 +22,16 @@ int main(int argc, char** argv) {
         AnastomosisSpec spec;
         spec.stitches = stitches;
         if (stitches > 8) spec.pullPerSegment = 0.0021; // closer stitches: less pull closes the gap
-        auto model = makeAnastomosisTubes(spec);
-        std::vector<int32_t> off;
-        auto merged = mergeMeshes({model.wide.get(), model.narrow.get()}, &off);
-        std::vector<int32_t> fixed = model.wideFixed;
-        for (int32_t v : model.narrowFixed) fixed.push_back(v + off[1]);
         SutureSettings s;
-        s.needle.radius = spec.needleRadius;
-        s.needle.handle = anastomosisHandle(spec);
         s.needle.punctureForce = 0.008;
         s.fem.youngsModulus = 60e3;
         // One core: a background refactorization would share it, so it runs in the step (the same
         // settings as the SutureStability acceptance test).
         s.fem.refactorMode = fem::RefactorMode::Synchronous;
-        const auto frames = makeAnastomosisTrajectory(spec);
-        auto sim = SutureSimulation::create(std::move(merged), fixed, s, frames.front().pose);
-        ClosureGauge gauge(sim->mesh(), off[1]);
+        AnastomosisRun run = makeAnastomosisRun(spec, s);
+        SutureSimulation* sim = run.sim.get();
+        const std::vector<NeedleFrame>& frames = run.frames;
+        ClosureGauge gauge(sim->mesh(), run.narrowOffset);
         std::vector<double> ms;
         int punctures = 0;
         for (const NeedleFrame& f : frames) {

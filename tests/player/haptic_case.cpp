@@ -1,3 +1,5 @@
+// The haptic sample case (a slab with one or two sphere probes), written by code: shared by the
+// player e2e tests and the make_haptic_case tool. Not a test itself.
 #include "player/haptic_case.hpp"
 
 #include "case/case_writer.hpp"

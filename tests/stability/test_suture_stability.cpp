@@ -32,27 +32,13 @@ void runChecked(SutureSimulation& sim, const std::vector<NeedleFrame>& frames, i
     }
 }
 
-struct Anastomosis {
-    std::unique_ptr<SutureSimulation> sim;
-    std::vector<NeedleFrame> frames;
-};
-
-Anastomosis anastomosis(AnastomosisSpec spec) {
-    Anastomosis a;
-    auto model = makeAnastomosisTubes(spec);
-    std::vector<int32_t> off;
-    auto merged = mergeMeshes({model.wide.get(), model.narrow.get()}, &off);
-    std::vector<int32_t> fixed = model.wideFixed;
-    for (int32_t v : model.narrowFixed) fixed.push_back(v + off[1]);
+/// The anastomosis scenario with the settings of the acceptance checks.
+AnastomosisRun anastomosis(const AnastomosisSpec& spec) {
     SutureSettings s;
-    s.needle.radius = spec.needleRadius;
-    s.needle.handle = anastomosisHandle(spec);
     s.needle.punctureForce = 0.008;
     s.fem.youngsModulus = 60e3;
     s.fem.refactorMode = fem::RefactorMode::Synchronous; // deterministic and simple for the checks
-    a.frames = makeAnastomosisTrajectory(spec);
-    a.sim = SutureSimulation::create(std::move(merged), fixed, s, a.frames.front().pose);
-    return a;
+    return makeAnastomosisRun(spec, s);
 }
 
 /// Two slabs 20 × 20 × 3 mm stacked along z with `gap` between them, sides fixed.
@@ -99,7 +85,7 @@ TEST(SutureStability, NeedleTenTimesFasterThanTheTrajectory) {
     AnastomosisSpec spec;
     spec.stitches = 2;
     spec.pullFrames = 40;
-    Anastomosis a = anastomosis(spec);
+    AnastomosisRun a = anastomosis(spec);
     std::vector<NeedleFrame> fast;
     for (size_t f = 0; f < a.frames.size(); f += 10) fast.push_back(a.frames[f]); // 30° per frame
     fast.push_back(a.frames.back());
@@ -123,7 +109,7 @@ TEST(SutureStability, TwoPuncturesAtTheSamePoint) {
     AnastomosisSpec spec;
     spec.stitches = 1;
     spec.pullFrames = 20;
-    Anastomosis a = anastomosis(spec);
+    AnastomosisRun a = anastomosis(spec);
     // The same stitch twice: the second pass punctures exactly where the first did.
     std::vector<NeedleFrame> twice(a.frames.begin(), a.frames.begin() + 120);
     twice.insert(twice.end(), a.frames.begin(), a.frames.end());
@@ -151,9 +137,8 @@ TEST(SutureStability, AnastomosisRunningSutureClosesTheGap) {
     AnastomosisSpec spec;
     spec.stitches = 13;
     spec.pullPerSegment = 0.0021; // as bench_suture: the recorded pull ends when the gap has closed
-    Anastomosis a = anastomosis(spec);
-    std::vector<int32_t> off;
-    ClosureGauge gauge(a.sim->mesh(), static_cast<int32_t>(makeAnastomosisTubes(spec).wide->vertexCount()));
+    AnastomosisRun a = anastomosis(spec);
+    ClosureGauge gauge(a.sim->mesh(), a.narrowOffset);
     const ClosureMetrics before = gauge.measure(a.sim->positions());
     EXPECT_NEAR(before.maxGap, 0.002, 1e-6);
     int punctures = 0;

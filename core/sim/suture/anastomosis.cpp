@@ -264,4 +264,19 @@ ClosureMetrics ClosureGauge::measure(const std::vector<Vec3>& x) const {
     return r;
 }
 
+AnastomosisRun makeAnastomosisRun(const AnastomosisSpec& spec, SutureSettings settings) {
+    AnastomosisModel model = makeAnastomosisTubes(spec);
+    std::vector<int32_t> off;
+    auto merged = mergeMeshes({model.wide.get(), model.narrow.get()}, &off);
+    std::vector<int32_t> fixed = model.wideFixed;
+    for (int32_t v : model.narrowFixed) fixed.push_back(v + off[1]);
+    settings.needle.radius = spec.needleRadius;
+    settings.needle.handle = anastomosisHandle(spec);
+    AnastomosisRun run;
+    run.frames = makeAnastomosisTrajectory(spec);
+    run.narrowOffset = off[1];
+    run.sim = SutureSimulation::create(std::move(merged), fixed, settings, run.frames.front().pose);
+    return run;
+}
+
 } // namespace viscera::sim::suture

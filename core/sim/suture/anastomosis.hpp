@@ -35,6 +35,16 @@ struct AnastomosisModel {
 AnastomosisModel makeAnastomosisTubes(const AnastomosisSpec& spec);
 /// Needle frames: `stitches` full needle turns around the circumference, then the pull.
 std::vector<NeedleFrame> makeAnastomosisTrajectory(const AnastomosisSpec& spec);
+
+/// The scenario ready to run (bench_suture, tests): both tubes merged (wide first), their far ends
+/// fixed, the recorded trajectory, and a simulation whose needle radius and handle come from
+/// `spec` (everything else from `settings`).
+struct AnastomosisRun {
+    std::unique_ptr<SutureSimulation> sim;
+    std::vector<NeedleFrame> frames;
+    int32_t narrowOffset = 0; ///< first vertex of the narrow tube in the merged mesh
+};
+AnastomosisRun makeAnastomosisRun(const AnastomosisSpec& spec, SutureSettings settings);
 /// Needle pose grasp parameter that makes radial and circumferential moves pure sticking.
 double anastomosisHandle(const AnastomosisSpec& spec);
 

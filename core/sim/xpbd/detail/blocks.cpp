@@ -13,6 +13,24 @@
 namespace viscera::sim::detail {
 namespace {
 
+/// Edge matrix Ds = [x1 − x0, x2 − x0, x3 − x0] of tet e at the particle positions, m.
+Mat3 edgeMatrix(const double* xw, const Tet& e) {
+    Mat3 ds;
+    for (int k = 0; k < 3; ++k)
+        ds.col(k) = particlePosition(xw, e[k + 1]) - particlePosition(xw, e[0]);
+    return ds;
+}
+
+/// Adds column k of G (= ∂C/∂F Dm⁻ᵀ times λ) to particle e[k+1] of f and minus their sum to e[0]
+/// (f: 3 per particle).
+void scatterTetGradient(const Tet& e, const Mat3& G, double* f) {
+    for (int k = 0; k < 3; ++k)
+        for (int r = 0; r < 3; ++r) {
+            f[3 * size_t(e[k + 1]) + r] += G(r, k);
+            f[3 * size_t(e[0]) + r] -= G(r, k);
+        }
+}
+
 // ---- stable Neo-Hookean, packed ---------------------------------------------------------------
 
 class SnhBlock final : public Block {
@@ -36,12 +54,9 @@ class SnhBlock final : public Block {
         for (size_t q = pb; q < pe; ++q) {
             const SnhPack& P = m_packs[q];
             for (int l = 0; l < P.lanes; ++l) {
-                Mat3 ds, M;
-                int32_t id[4];
-                for (int s = 0; s < 4; ++s)
-                    id[s] = P.idx[s][l];
-                for (int k = 0; k < 3; ++k)
-                    ds.col(k) = particlePosition(xw, id[k + 1]) - particlePosition(xw, id[0]);
+                const Tet id{P.idx[0][l], P.idx[1][l], P.idx[2][l], P.idx[3][l]};
+                const Mat3 ds = edgeMatrix(xw, id);
+                Mat3 M;
                 for (int r = 0; r < 3; ++r)
                     for (int c = 0; c < 3; ++c)
                         M(r, c) = P.m[3 * r + c][l];
@@ -53,12 +68,7 @@ class SnhBlock final : public Block {
                 H.col(1) = F.col(2).cross(F.col(0));
                 H.col(2) = F.col(0).cross(F.col(1));
                 // ∂C/∂F: F/|F| for C_D, cof F for C_H; vertex k+1 gets column k of (∂C/∂F) Dm⁻ᵀ.
-                const Mat3 G = (P.lamD[l] / cD * F + P.lamH[l] * H) * M.transpose();
-                for (int k = 0; k < 3; ++k)
-                    for (int r = 0; r < 3; ++r) {
-                        f[3 * size_t(id[k + 1]) + r] += G(r, k);
-                        f[3 * size_t(id[0]) + r] -= G(r, k);
-                    }
+                scatterTetGradient(id, (P.lamD[l] / cD * F + P.lamH[l] * H) * M.transpose(), f);
             }
         }
         return true;
@@ -68,9 +78,7 @@ class SnhBlock final : public Block {
         double sum = 0;
         for (size_t u = 0; u < m_t.tets.size(); ++u) {
             const Tet& e = m_t.tets[u];
-            Mat3 ds;
-            for (int k = 0; k < 3; ++k)
-                ds.col(k) = particlePosition(xw, e[k + 1]) - particlePosition(xw, e[0]);
+            const Mat3 ds = edgeMatrix(xw, e);
             const Mat3 F = ds * m_t.dmInv[u];
             const double J = F.determinant();
             const double psi =
@@ -188,21 +196,14 @@ class ModelBlock final : public Block {
             const Unit& u = m_units[slot];
             if (u.unit < 0) continue;
             const Tet& e = m_t.tets[u.unit];
-            Mat3 ds;
-            for (int k = 0; k < 3; ++k)
-                ds.col(k) = particlePosition(xw, e[k + 1]) - particlePosition(xw, e[0]);
+            const Mat3 ds = edgeMatrix(xw, e);
             const Mat3& M = m_t.dmInv[u.unit];
             m_t.model->evaluate(ds * M, cv);
             const int n = std::min(cv.count, m_count);
             Mat3 G = Mat3::Zero();
             for (int c = 0; c < n; ++c)
                 G += u.lam[c] * cv.dCdF[c];
-            G = G * M.transpose();
-            for (int k = 0; k < 3; ++k)
-                for (int r = 0; r < 3; ++r) {
-                    f[3 * size_t(e[k + 1]) + r] += G(r, k);
-                    f[3 * size_t(e[0]) + r] -= G(r, k);
-                }
+            scatterTetGradient(e, G * M.transpose(), f);
         }
         return true;
     }
@@ -210,9 +211,7 @@ class ModelBlock final : public Block {
         double sum = 0;
         for (size_t u = 0; u < m_t.tets.size(); ++u) {
             const Tet& e = m_t.tets[u];
-            Mat3 ds;
-            for (int k = 0; k < 3; ++k)
-                ds.col(k) = particlePosition(xw, e[k + 1]) - particlePosition(xw, e[0]);
+            const Mat3 ds = edgeMatrix(xw, e);
             sum += m_t.volume[u] * m_t.weight[u] *
                    (m_t.model->energyDensity(ds * m_t.dmInv[u]) - m_restDensity);
         }
