@@ -28,6 +28,7 @@
 #include <optional>
 #include <string>
 #include <vector>
+#include <unistd.h>
 
 namespace {
 
@@ -39,7 +40,7 @@ void usage(std::FILE* out) {
     std::fputs("usage: viscera-player verify <case.vcase>\n"
                "       viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]\n"
                "                      [--report report.json] [--screenshot out.png] [--trace trace.csv]\n"
-               "                      [--realtime]\n"
+               "                      [--realtime] [--servo sleep|busy|busy:CPU]\n"
                "       SPEC: replay:<file> | scripted:<name> | console:<host:port> | keyboard\n"
                "       viscera-player --version\n",
                out);
@@ -66,6 +67,8 @@ int cmdVerify(const std::vector<std::string>& args) {
 int cmdRun(const std::vector<std::string>& args) {
     std::optional<std::string> casePath, reportPath, screenshot, device, tracePath;
     bool headless = false, realtime = false, framesGiven = false;
+    haptics::ServoWait servoWait = haptics::ServoWait::SleepSpin;
+    int servoCpu = -1;
     int frames = 300;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
@@ -87,6 +90,20 @@ int cmdRun(const std::vector<std::string>& args) {
         else if (a == "--realtime") realtime = true;
         else if (a == "--screenshot") screenshot = value("--screenshot");
         else if (a == "--device") device = value("--device");
+        else if (a == "--servo") {
+            const std::string v = value("--servo");
+            if (v == "sleep") servoWait = haptics::ServoWait::SleepSpin;
+            else if (v == "busy") servoWait = haptics::ServoWait::Busy;
+            else if (v.rfind("busy:", 0) == 0) {
+                char* end = nullptr;
+                const long c = std::strtol(v.c_str() + 5, &end, 10);
+                if (v.size() == 5 || *end != '\0' || c < 0 || c >= sysconf(_SC_NPROCESSORS_ONLN))
+                    throw std::invalid_argument("--servo '" + v + "': the CPU must be an integer in [0, " +
+                                                std::to_string(sysconf(_SC_NPROCESSORS_ONLN) - 1) + "]");
+                servoWait = haptics::ServoWait::Busy;
+                servoCpu = static_cast<int>(c);
+            } else throw std::invalid_argument("--servo '" + v + "': expected sleep, busy or busy:CPU");
+        }
         else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option '" + a + "'");
         else if (!casePath) casePath = a;
         else throw std::invalid_argument("unexpected argument '" + a + "'");
@@ -113,6 +130,8 @@ int cmdRun(const std::vector<std::string>& args) {
     opts.deviceSpec = device.value_or("");
     opts.realtime = realtime || (dev && dev->capabilities().realtime) || !headless;
     opts.keepTrace = tracePath.has_value();
+    opts.servoWait = servoWait;
+    opts.servoCpu = servoCpu;
     player::SessionResult result;
     if (headless) {
         std::fprintf(stderr, "viscera-player: running %s for %d frames%s\n", casePath->c_str(), frames,

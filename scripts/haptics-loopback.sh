@@ -3,11 +3,15 @@
 # viscera-player (headless, real time, on the haptic sample case) and records the forces it gets
 # back. Prints the servo period/jitter, the contact-model age and the console-side figures.
 #
-#   scripts/haptics-loopback.sh [seconds=60] [build-dir=build] [out-dir=out/haptics-loopback]
+#   scripts/haptics-loopback.sh [seconds=60] [build-dir=build] [out-dir=out/haptics-loopback] [servo=sleep]
+#
+# servo: "sleep" (sleep, then spin the last 0.7 ms: shares the CPU) or "busy[:CPU]" (spin the
+# whole period on a CPU of its own; for a console PC with a core set aside).
 set -euo pipefail
 secs="${1:-60}"
 build="${2:-${VISCERA_BUILD_DIR:-build}}"
 out="${3:-out/haptics-loopback}"
+servo="${4:-sleep}"
 mkdir -p "$out"
 "$build/tests/player/make_haptic_case" "$out/haptic-slab.vcase" 2 >/dev/null
 rm -f "$out/port"
@@ -19,14 +23,15 @@ for _ in $(seq 100); do [ -s "$out/port" ] && break; sleep 0.05; done
 port="$(cat "$out/port")"
 frames=$(( secs * 60 ))
 "$build/player/viscera-player" run "$out/haptic-slab.vcase" --headless --frames "$frames" \
-  --device "console:127.0.0.1:$port" --report "$out/report.json" --trace "$out/trace.csv" 2>/dev/null
+  --device "console:127.0.0.1:$port" --servo "$servo" --report "$out/report.json" --trace "$out/trace.csv" 2>/dev/null
 wait "$sim"
 cat "$out/console-sim.log" | grep -v '^viscera-console-sim:'
 python3 - "$out/report.json" <<'PY'
 import json, sys
 h = json.load(open(sys.argv[1]))["haptics"]
 s, c = h["servo"], h["contact_model"]
-print(f"servo         {s['ticks']} ticks, realtime priority {s['realtime_priority']}, overruns {s['overruns']}")
+print(f"servo         {s['ticks']} ticks, wait {s['wait']} (cpu {s['cpu']}), realtime priority {s['realtime_priority']}, overruns {s['overruns']}")
+if 'priority_note' in s: print(f"              {s['priority_note']}")
 print(f"period (us)   mean {s['period_us']['mean']:.2f}  p50 {s['period_us']['p50']:.0f}  p99 {s['period_us']['p99']:.0f}  max {s['period_us']['max']:.1f}")
 print(f"jitter (us)   mean {s['jitter_us']['mean']:.2f}  p99 {s['jitter_us']['p99']:.0f}  max {s['jitter_us']['max']:.1f}")
 print(f"wake (us)     p99 {s['wake_latency_us']['p99']:.0f}  max {s['wake_latency_us']['max']:.1f};  tick cost p99 {s['tick_cost_us']['p99']:.0f} us")

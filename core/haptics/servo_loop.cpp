@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 #include <pthread.h>
 #include <sched.h>
 #include <time.h>
@@ -24,6 +28,28 @@ void atomicMin(std::atomic<int64_t>& a, int64_t v) {
     while (v < cur && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {}
 }
 
+int onlineCpuCount() {
+    const long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n > 0 ? static_cast<int>(n) : 1;
+}
+
+bool pinCurrentThread(int cpu) {
+    if (cpu < 0 || cpu >= CPU_SETSIZE) return false;
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(cpu, &set);
+    return pthread_setaffinity_np(pthread_self(), sizeof(set), &set) == 0;
+}
+
+/// True when the kernel limits real-time tasks to a share of each period (the default 95 %).
+bool realtimeThrottled() {
+    std::FILE* f = std::fopen("/proc/sys/kernel/sched_rt_runtime_us", "r");
+    if (!f) return true;
+    long v = 0;
+    const bool read = std::fscanf(f, "%ld", &v) == 1;
+    std::fclose(f);
+    return !read || v >= 0;
+}
 
 } // namespace
 
@@ -172,20 +198,36 @@ void ServoLoop::stop() {
 }
 
 void ServoLoop::run() {
+    const bool busy = m_config.wait == ServoWait::Busy;
+    int cpu = m_config.cpu;
+    if (busy && cpu < 0) cpu = onlineCpuCount() - 1;
+    if (cpu >= 0 && pinCurrentThread(cpu)) m_cpu.store(cpu, std::memory_order_relaxed);
     if (m_config.realtimePriority) {
-        sched_param sp{};
-        sp.sched_priority = std::min(80, sched_get_priority_max(SCHED_FIFO));
-        m_rt.store(pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0, std::memory_order_relaxed);
+        if (busy && realtimeThrottled()) {
+            // Highest SCHED_OTHER weight instead (nice -20, where allowed), so that other processes
+            // landing on this CPU get short slices only.
+            const bool niced = setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), -20) == 0;
+            m_priorityNote = std::string("busy wait: kernel.sched_rt_runtime_us is not -1, a real-time spinner would be "
+                                         "throttled (50 ms stalls each second); running SCHED_OTHER") +
+                             (niced ? " at nice -20" : "") + " on its own CPU";
+        } else {
+            sched_param sp{};
+            sp.sched_priority = std::min(80, sched_get_priority_max(SCHED_FIFO));
+            const bool ok = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0;
+            m_rt.store(ok, std::memory_order_relaxed);
+            if (!ok) m_priorityNote = "SCHED_FIFO refused by the system (needs CAP_SYS_NICE or an rtprio limit)";
+        }
     }
     const int64_t period = static_cast<int64_t>(std::llround(1e9 / m_config.rateHz));
     int64_t next = monotonicNs() + period;
     int64_t prev = -1;
     while (m_running.load(std::memory_order_acquire)) {
-        // Sleep, then spin the last spin_ns to the deadline. The default spin (0.7 ms of each 1 ms
-        // period) covers the wake-up latency of an idle virtual CPU (p99 ~0.55 ms measured on the
-        // 2-core VM of the CI machine); spinning the whole period instead gets a SCHED_FIFO thread
-        // throttled by the kernel (50 ms stalls every second with the default sched_rt_runtime_us).
-        if (next - monotonicNs() > m_config.spin_ns) sleepUntilNs(next - m_config.spin_ns);
+        // SleepSpin: sleep, then spin the last spin_ns to the deadline. The default spin (0.7 ms
+        // of each 1 ms period) covers the wake-up latency of an idle virtual CPU (p99 ~0.55 ms
+        // measured on the 2-core VM of the CI machine); spinning the whole period at SCHED_FIFO
+        // gets the thread throttled by the kernel (50 ms stalls every second with the default
+        // sched_rt_runtime_us), hence Busy runs SCHED_OTHER there.
+        if (!busy && next - monotonicNs() > m_config.spin_ns) sleepUntilNs(next - m_config.spin_ns);
         int64_t now = monotonicNs();
         while (now < next) {
             cpuRelax();
@@ -212,6 +254,9 @@ ServoStats ServoLoop::stats() const {
     s.ticks = m_ticks.load(std::memory_order_relaxed);
     s.overruns = m_overruns.load(std::memory_order_relaxed);
     s.realtimePriority = m_rt.load(std::memory_order_relaxed);
+    s.wait = m_config.wait;
+    s.cpu = m_cpu.load(std::memory_order_relaxed);
+    if (!m_running.load(std::memory_order_acquire)) s.priorityNote = m_priorityNote;
     s.period = m_period.summary();
     s.jitter = m_jitter.summary();
     s.wakeLatency = m_wake.summary();

@@ -8,7 +8,8 @@
 /// bounded SPSC ring.
 ///
 /// start() runs ticks on a thread of its own at `rateHz`, woken by clock_nanosleep(TIMER_ABSTIME)
-/// a little early and then spinning to the deadline; period, wake-up latency and contact-model
+/// a little early and then spinning to the deadline, or (ServoWait::Busy) spinning the whole
+/// period on a pinned CPU; period, wake-up latency and contact-model
 /// age go into preallocated histograms (1 µs bins). Without start(), tick(now) can be driven by
 /// the caller on a ManualClock (lockstep, repeatable).
 #include "haptics/clock.hpp"
@@ -19,6 +20,7 @@
 
 #include <atomic>
 #include <memory>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -34,9 +36,22 @@ struct ToolMapping {
     double couplingDamping = 2.0;   ///< N·s/m, scene: damps the normal approach while in contact
 };
 
+/// How the servo thread waits for its deadline.
+enum class ServoWait {
+    /// clock_nanosleep to spin_ns before the deadline, then spin: shares the CPU, works anywhere.
+    SleepSpin,
+    /// Spin the whole period on a CPU of its own (`cpu`), for a console PC with a core set aside.
+    /// SCHED_FIFO only where the kernel does not throttle real-time tasks
+    /// (sched_rt_runtime_us = -1); otherwise the thread stays SCHED_OTHER, because a throttled
+    /// real-time spinner is stopped for 50 ms every second.
+    Busy,
+};
+
 struct ServoConfig {
     double rateHz = 1000.0;
-    int64_t spin_ns = 700'000;   ///< wake this early and spin to the deadline (see servo_loop.cpp)
+    ServoWait wait = ServoWait::SleepSpin;
+    int64_t spin_ns = 700'000;   ///< SleepSpin: wake this early and spin to the deadline (see servo_loop.cpp)
+    int cpu = -1;                ///< pin the servo thread to this CPU (-1: Busy → the last CPU, SleepSpin → none)
     bool realtimePriority = true;   ///< try SCHED_FIFO for the servo thread (ignored when refused)
     SafetyLimits safety;
     std::array<ToolMapping, kMaxArms> tools{};
@@ -67,6 +82,9 @@ struct ServoStats {
     uint64_t ticks = 0;
     uint64_t overruns = 0;        ///< ticks that started more than one period late
     bool realtimePriority = false; ///< SCHED_FIFO was granted
+    ServoWait wait = ServoWait::SleepSpin;
+    int cpu = -1;                  ///< CPU the thread was pinned to (-1: not pinned)
+    std::string priorityNote;      ///< why SCHED_FIFO was not used, when it was not
     Distribution period;          ///< tick-to-tick interval
     Distribution jitter;          ///< |period − nominal|
     Distribution wakeLatency;     ///< tick start − deadline
@@ -131,6 +149,8 @@ private:
     std::atomic<uint64_t> m_ticks{0}, m_overruns{0};
     std::atomic<int64_t> m_modelsSeen{0}, m_stepsStarted{0}, m_maxBehind{0};
     std::atomic<bool> m_running{false}, m_rt{false};
+    std::atomic<int> m_cpu{-1};
+    std::string m_priorityNote; ///< written by the servo thread before its first tick
     std::thread m_thread;
     // tick state (servo thread only)
     DeviceState m_state;

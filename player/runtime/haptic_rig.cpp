@@ -5,6 +5,7 @@
 #include <pthread.h>
 #include <sched.h>
 #include <time.h>
+#include <unistd.h>
 
 namespace viscera::player {
 namespace {
@@ -61,6 +62,11 @@ HapticRig::~HapticRig() {
     if (m_servo) m_servo->stop();
 }
 
+void HapticRig::setServoWait(haptics::ServoWait wait, int cpu) {
+    m_servoConfig.wait = wait;
+    m_servoConfig.cpu = cpu;
+}
+
 void HapticRig::configure(double dt) {
     m_dt = dt;
     // The simulation output may be three physics steps old (at least 50 ms) before the force goes.
@@ -99,6 +105,16 @@ void HapticRig::start() {
         m_physicsRt = pthread_getschedparam(pthread_self(), &m_oldPolicy, &m_oldParam) == 0 &&
                       pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0;
         m_servo->start();
+        if (m_servoConfig.wait == haptics::ServoWait::Busy) {
+            // Keep the physics thread off the servo's CPU (it spins there the whole period).
+            const long n = sysconf(_SC_NPROCESSORS_ONLN);
+            const int servoCpu = m_servoConfig.cpu >= 0 ? m_servoConfig.cpu : int(n) - 1;
+            cpu_set_t set;
+            CPU_ZERO(&set);
+            for (int c = 0; c < n && c < CPU_SETSIZE; ++c)
+                if (c != servoCpu) CPU_SET(c, &set);
+            if (CPU_COUNT(&set) > 0) pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
+        }
     }
 }
 

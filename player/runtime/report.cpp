@@ -41,6 +41,9 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
     if (h.mode == "realtime") {
         servo["overruns"] = s.overruns;
         servo["realtime_priority"] = s.realtimePriority;
+        servo["wait"] = s.wait == haptics::ServoWait::Busy ? "busy" : "sleep";
+        servo["cpu"] = s.cpu;
+        if (!s.priorityNote.empty()) servo["priority_note"] = s.priorityNote;
         servo["period_us"] = distribution(s.period);
         servo["jitter_us"] = distribution(s.jitter);
         servo["wake_latency_us"] = distribution(s.wakeLatency);

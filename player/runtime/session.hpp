@@ -45,6 +45,9 @@ struct RunOptions {
     std::string deviceSpec;
     bool realtime = false;        ///< servo thread + wall-clock pacing (console and keyboard need it)
     bool keepTrace = false;       ///< keep every servo sample for the --trace CSV
+    /// How the servo thread waits (--servo sleep|busy[:CPU]); cpu -1 = default.
+    haptics::ServoWait servoWait = haptics::ServoWait::SleepSpin;
+    int servoCpu = -1;
     const std::atomic<bool>* stop = nullptr; ///< set by the window when the trainee closes it
     LiveView* live = nullptr;     ///< filled every frame when set
 };

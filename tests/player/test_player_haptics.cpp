@@ -229,3 +229,33 @@ TEST(PlayerHaptics, TraineeWindowRunsOffscreenAndWritesAScreenshot) {
     EXPECT_EQ(readJson(s / "r.json")["frames"].size(), 30u);
     // With --headless, --screenshot renders the 3D view instead (tests/player/player_screenshot_gl_test.cpp).
 }
+
+TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
+    Scratch s;
+    test::writeHapticCase(s / "slab.vcase");
+    auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "60", "--device", "scripted:press", "--realtime",
+                     "--servo", "busy:0", "--report", s / "r.json"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto servo = readJson(s / "r.json")["haptics"]["servo"];
+    EXPECT_EQ(servo["wait"], "busy");
+    EXPECT_EQ(servo["cpu"], 0);
+    EXPECT_GT(servo["ticks"].get<int>(), 500);
+    // A real-time spinner is only used where the kernel does not throttle real-time tasks; the
+    // report says why when the servo thread did not get SCHED_FIFO.
+    if (!servo["realtime_priority"].get<bool>()) EXPECT_TRUE(servo.contains("priority_note"));
+    std::ifstream rt("/proc/sys/kernel/sched_rt_runtime_us");
+    long runtime = 0;
+    if (rt >> runtime && runtime >= 0) {
+        EXPECT_FALSE(servo["realtime_priority"].get<bool>()) << "busy + SCHED_FIFO would be throttled";
+        EXPECT_THAT(servo["priority_note"].get<std::string>(), HasSubstr("sched_rt_runtime_us"));
+    }
+    auto sleep = player({"run", s / "slab.vcase", "--headless", "--frames", "10", "--device", "scripted:press",
+                         "--realtime", "--report", s / "r2.json"});
+    ASSERT_EQ(sleep.exitCode, 0) << sleep.err;
+    EXPECT_EQ(readJson(s / "r2.json")["haptics"]["servo"]["wait"], "sleep");
+    for (const char* bad : {"busy:", "busy:x", "busy:-1", "busy:4096", "spin"}) {
+        auto b = player({"run", s / "slab.vcase", "--headless", "--frames", "1", "--servo", bad});
+        EXPECT_EQ(b.exitCode, 2) << bad;
+        EXPECT_THAT(b.err, HasSubstr("--servo")) << bad;
+    }
+}
