@@ -51,6 +51,10 @@ public:
     /// Writes the per-frame data (and static attributes when `staticChanged`) into the buffers
     /// created by createMesh, without reallocating them.
     virtual void updateMesh(size_t index, const RenderMesh& mesh, bool staticChanged) = 0;
+    /// Writes the indices of the faces `mesh.faceMask` keeps (all when empty), compacted, into the
+    /// index buffer created by createMesh and draws only those from then on [A §5.3.1]. No
+    /// reallocation.
+    virtual void updateFaceMask(size_t index, const RenderMesh& mesh) = 0;
     virtual void runPass(const PassDesc& pass, const PassContext& context) = 0;
     /// Blocks until submitted work is done (pass timing).
     virtual void finish() = 0;
@@ -70,11 +74,15 @@ public:
     struct MeshRecord {
         size_t vertices = 0, triangles = 0;
         uint64_t updates = 0;
+        size_t drawnTriangles = 0;   ///< faces the G-buffer pass would draw (face mask)
+        uint64_t maskUpdates = 0;    ///< updateFaceMask calls
+        std::vector<uint32_t> drawnIndices; ///< what the index buffer holds, compacted
     };
     const char* name() const override { return "mock"; }
     void resize(const FrameLayout& layout) override;
     void createMesh(size_t index, const RenderMesh& mesh) override;
     void updateMesh(size_t index, const RenderMesh& mesh, bool staticChanged) override;
+    void updateFaceMask(size_t index, const RenderMesh& mesh) override;
     void runPass(const PassDesc& pass, const PassContext& context) override;
     void finish() override {}
     Image readPixels(ImageStage stage) override;

@@ -12,7 +12,7 @@ void MockBackend::resize(const FrameLayout& layout) {
 
 void MockBackend::createMesh(size_t index, const RenderMesh& mesh) {
     if (m_meshes.size() <= index) m_meshes.resize(index + 1);
-    m_meshes[index] = {mesh.vertexCount(), mesh.triangleCount(), 0};
+    m_meshes[index] = {mesh.vertexCount(), mesh.triangleCount(), 0, mesh.triangleCount(), 0, mesh.indices};
     m_stats.bufferAllocations += 4; // positions (current, previous), normals, static attributes
 }
 
@@ -21,6 +21,15 @@ void MockBackend::updateMesh(size_t index, const RenderMesh& mesh, bool staticCh
     if (r.vertices != mesh.vertexCount()) return; // the Renderer never lets this happen
     ++r.updates;
     m_stats.bufferUpdates += staticChanged ? 4 : 3;
+}
+
+void MockBackend::updateFaceMask(size_t index, const RenderMesh& mesh) {
+    MeshRecord& r = m_meshes.at(index);
+    if (r.triangles != mesh.triangleCount()) return; // the Renderer never lets this happen
+    mesh.drawnIndicesInto(r.drawnIndices);
+    r.drawnTriangles = r.drawnIndices.size() / 3;
+    ++r.maskUpdates;
+    ++m_stats.bufferUpdates;
 }
 
 void MockBackend::runPass(const PassDesc& pass, const PassContext& ctx) {

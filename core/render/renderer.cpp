@@ -40,8 +40,10 @@ void Renderer::syncMeshes(const SceneView& view) {
             s.vertices = m.vertexCount();
             s.indices = m.indices.size();
             m_backend->updateMesh(i, m, true);
+            if (!m.faceMask.empty()) m_backend->updateFaceMask(i, m);
             s.revision = m.revision;
             s.staticRevision = m.staticRevision;
+            s.faceMaskRevision = m.faceMaskRevision;
             continue;
         }
         if (m.vertexCount() != s.vertices || m.indices.size() != s.indices) {
@@ -55,6 +57,10 @@ void Renderer::syncMeshes(const SceneView& view) {
             m_backend->updateMesh(i, m, staticChanged);
             s.revision = m.revision;
             s.staticRevision = m.staticRevision;
+        }
+        if (m.faceMaskRevision != s.faceMaskRevision) {
+            m_backend->updateFaceMask(i, m);
+            s.faceMaskRevision = m.faceMaskRevision;
         }
     }
 }

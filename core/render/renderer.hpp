@@ -60,6 +60,7 @@ private:
     struct MeshState {
         size_t vertices = 0, indices = 0;
         uint64_t revision = ~uint64_t(0), staticRevision = ~uint64_t(0);
+        uint64_t faceMaskRevision = 0;
         bool broken = false;
     };
     void syncMeshes(const SceneView& view);

@@ -177,6 +177,39 @@ void SceneView::setHeat(size_t i, const std::vector<float>& heat) {
     ++m.revision;
 }
 
+size_t RenderMesh::drawnTriangleCount() const {
+    if (faceMask.size() != triangleCount()) return triangleCount();
+    size_t n = 0;
+    for (uint8_t f : faceMask) n += f ? 1 : 0;
+    return n;
+}
+
+void RenderMesh::drawnIndicesInto(std::vector<uint32_t>& out) const {
+    if (faceMask.size() != triangleCount()) {
+        out.assign(indices.begin(), indices.end());
+        return;
+    }
+    out.resize(3 * drawnTriangleCount());
+    size_t k = 0;
+    for (size_t f = 0; f < faceMask.size(); ++f)
+        if (faceMask[f])
+            for (int c = 0; c < 3; ++c) out[k++] = indices[3 * f + c];
+}
+
+void SceneView::setFaceMask(size_t i, const std::vector<uint8_t>& mask) {
+    RenderMesh& m = m_meshes.at(i);
+    if (!mask.empty() && mask.size() != m.triangleCount())
+        throw std::invalid_argument("render::SceneView::setFaceMask(): mesh " + m.name + " has " +
+                                    std::to_string(m.triangleCount()) + " triangles, got " +
+                                    std::to_string(mask.size()) + " flags");
+    bool same = mask.size() == m.faceMask.size();
+    for (size_t f = 0; same && f < mask.size(); ++f) same = (mask[f] != 0) == (m.faceMask[f] != 0);
+    if (same) return;
+    m.faceMask.resize(mask.size());
+    for (size_t f = 0; f < mask.size(); ++f) m.faceMask[f] = mask[f] ? 1 : 0;
+    ++m.faceMaskRevision;
+}
+
 void SceneView::paintSampleMap(const Eigen::Vector3f& centre, float radius, int samples) {
     if (samples != 0 && samples != 1 && samples != 4 && samples != 8)
         throw std::invalid_argument("render::SceneView::paintSampleMap(): samples must be 0, 1, 4 or 8, got " +

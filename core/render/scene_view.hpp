@@ -35,6 +35,12 @@ struct RenderMesh {
     std::vector<float> positions;    ///< #V × 3, m, world frame
     std::vector<float> normals;      ///< #V × 3, unit, area-weighted vertex normals
     std::vector<float> heat;         ///< #V in [0, 1]: 0 fresh, ~0.5 coagulated, 1 charred
+    /// Dissection [A §5.3.1]: empty (every face drawn) or #F flags, 0 = face not drawn. Set it
+    /// with SceneView::setFaceMask (bumps faceMaskRevision); the backend then writes the visible
+    /// faces' indices, compacted, into the same index buffer and draws only those (no buffer is
+    /// created or resized).
+    std::vector<uint8_t> faceMask;
+    uint64_t faceMaskRevision = 0;
     uint64_t revision = 0;           ///< bumped whenever per-frame data change
     uint64_t staticRevision = 0;     ///< bumped when sampleMap or thickness change
     // ---- where the per-frame positions come from -----------------------------------------
@@ -44,6 +50,10 @@ struct RenderMesh {
 
     size_t vertexCount() const { return positions.size() / 3; }
     size_t triangleCount() const { return indices.size() / 3; }
+    /// Faces drawn: all without a mask, else the flagged ones. O(#F).
+    size_t drawnTriangleCount() const;
+    /// The indices of the drawn faces, in face order, into out (resized; #drawn × 3). O(#F).
+    void drawnIndicesInto(std::vector<uint32_t>& out) const;
 };
 
 class SceneView {
@@ -68,6 +78,10 @@ public:
     /// Sets the heat of every vertex of mesh `i` (values clamped to [0, 1]); `heat` has #V entries
     /// (std::invalid_argument otherwise).
     void setHeat(size_t i, const std::vector<float>& heat);
+    /// Sets the face mask of mesh `i` [A §5.3.1]: empty (draw every face) or one flag per
+    /// triangle (#F entries, std::invalid_argument otherwise), nonzero = drawn. Allocation-free
+    /// after the first call. Bumps the mesh's faceMaskRevision only when the mask changed.
+    void setFaceMask(size_t i, const std::vector<uint8_t>& mask);
     /// Paints `samples` (1, 4 or 8; 0 erases) into the sample map of every vertex of every mesh
     /// within `radius` (m) of `centre` in the current positions.
     void paintSampleMap(const Eigen::Vector3f& centre, float radius, int samples);

@@ -32,8 +32,9 @@ struct TaskMetrics {
     double tissueDamage_ns = 0;        ///< ∫ max(0, contact force − damage threshold) dt, N·s
     int damageEvents = 0;              ///< times the contact force rose above the threshold
     double maxContactForce_n = 0;      ///< N, tissue on tool, from the physics
-    int punctures = 0;                 ///< needle subsystem (not in this build's features): 0
-    int clips = 0;                     ///< clip applier subsystem (not in this build's features): 0
+    int punctures = 0;                 ///< needle punctures (suturing cases)
+    int clips = 0;                     ///< clips applied (cases with a clip applier)
+    int cutEdges = 0;                  ///< edges dissected by energy (cases with an energy hook)
 };
 
 struct HapticsResult {

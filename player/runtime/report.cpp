@@ -101,6 +101,36 @@ std::string traceCsv(const SessionResult& r) {
     return out;
 }
 
+/// Scripted instruments [A ch. 5]: where each ended, grasps, dissection counts, clips.
+static nlohmann::json interactionJson(const sim::InteractionSummary& s) {
+    using nlohmann::json;
+    auto vec = [](const sim::Vec3& v) { return json::array({v.x(), v.y(), v.z()}); };
+    json instruments = json::array();
+    for (const auto& i : s.instruments)
+        instruments.push_back({{"name", i.name}, {"kind", i.kind}, {"tip_m", vec(i.tip)}, {"jaw", i.jaw},
+                               {"act", i.act}, {"contacts", i.contacts}, {"grasped_vertices", i.grasped}});
+    json clips = json::array();
+    for (const auto& c : s.clips)
+        clips.push_back({{"instrument", c.instrument}, {"target", c.target}, {"fired_at_s", c.firedAt},
+                         {"centre_m", vec(c.centre)}, {"travel_m", c.travel}, {"rotation_deg", c.rotationDeg},
+                         {"max_contact_drift_m", c.maxContactDrift}, {"region_vertices", c.regionVertices},
+                         {"auxiliary_nodes", c.auxiliaryNodes}});
+    return {{"instruments", instruments},
+            {"max_contacts", s.maxContacts},
+            {"grasps", s.grasps},
+            {"dissection", {{"fascia_edges_cut", s.fasciaEdgesCut},
+                            {"fascia_triangles_cut", s.fasciaTrianglesCut},
+                            {"fat_edges_cut", s.fatEdgesCut},
+                            {"fat_tets_cut", s.fatTetsCut},
+                            {"fascia_vertices", s.fasciaVertices},
+                            {"fascia_vertices_at_start", s.fasciaVerticesAtStart},
+                            {"max_edge_heat_c", s.maxEdgeHeat},
+                            {"grid_max_c", s.gridMaxC},
+                            {"ms_total", s.dissectionMs}}},
+            {"clips", clips},
+            {"clip_ms_total", s.clipMs}};
+}
+
 /// Suturing figures [B ch. 4] of a "fem" case: per frame the enforced constraint rows, contacts,
 /// thread tension and needle force; the closure (gap, penetration) on sampled frames and at the end.
 static nlohmann::json sutureJson(const SessionResult& r) {
@@ -185,8 +215,10 @@ nlohmann::json reportJson(const SessionResult& r) {
     doc["metrics"]["damage_events"] = tm.damageEvents;
     doc["metrics"]["punctures"] = tm.punctures;
     doc["metrics"]["clips"] = tm.clips;
+    doc["metrics"]["cut_edges"] = tm.cutEdges;
     if (r.haptics) doc["haptics"] = hapticsJson(*r.haptics);
     if (r.suture) doc["suture"] = sutureJson(r);
+    if (r.interaction) doc["interaction"] = interactionJson(*r.interaction);
     if (r.render) {
         json passes = json::array();
         for (const auto& p : r.render->passes)
@@ -267,6 +299,21 @@ std::string summaryText(const SessionResult& r) {
         if (r.suture->gauge) {
             std::snprintf(line, sizeof line, "closure       gap %.3f mm (from %.3f mm), max penetration %.3f mm\n",
                           r.suture->finalGap * 1e3, r.suture->initialGap * 1e3, r.suture->maxPenetration * 1e3);
+            out += line;
+        }
+    }
+    if (r.interaction) {
+        const sim::InteractionSummary& in = *r.interaction;
+        char line[512];
+        std::snprintf(line, sizeof line,
+                      "instruments   %zu, max %d contacts, %d grasps; cut %d fascia edges (%d triangles), %d fat edges; "
+                      "fascia vertices %zu of %zu; %zu clips\n",
+                      in.instruments.size(), in.maxContacts, in.grasps, in.fasciaEdgesCut, in.fasciaTrianglesCut,
+                      in.fatEdgesCut, in.fasciaVertices, in.fasciaVerticesAtStart, in.clips.size());
+        out += line;
+        for (const auto& c : in.clips) {
+            std::snprintf(line, sizeof line, "clip          on %s at %.2f s: travel %.2f mm, rotation %.1f deg, max drift %.3f mm\n",
+                          c.target.c_str(), c.firedAt, c.travel * 1e3, c.rotationDeg, c.maxContactDrift * 1e3);
             out += line;
         }
     }

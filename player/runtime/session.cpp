@@ -1,5 +1,7 @@
 #include "runtime/session.hpp"
 
+#include "sim/skeleton/node_weights_io.hpp"
+
 #include "render/case_settings.hpp"
 
 #include "sim/mesh/tet_io.hpp"
@@ -28,6 +30,15 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
                              "', which is not in the package");
         meshes.push_back(sim::parseVtet(pkg.read(b.meshPath), pkg.name() + ":" + b.meshPath));
     }
+    for (sim::BodyDesc& b : out.scene.bodies) { // painted stiffness weights travel as files
+        if (b.nodeWeightsPath.empty()) continue;
+        if (!pkg.contains(b.nodeWeightsPath))
+            throw InputError(pkg.name() + ": " + sceneName + ": body '" + b.name + "' uses node weights '" +
+                             b.nodeWeightsPath + "', which are not in the package");
+        const size_t i = static_cast<size_t>(&b - out.scene.bodies.data());
+        b.nodeWeights = sim::parseNodeWeights(pkg.read(b.nodeWeightsPath), pkg.name() + ":" + b.nodeWeightsPath,
+                                              meshes[i]->vertexCount());
+    }
     std::vector<sim::TriMesh> surfaces;
     for (const sim::SurfaceDesc& sd : out.scene.surfaces) {
         if (!pkg.contains(sd.meshPath))
@@ -41,6 +52,14 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
             throw InputError(pkg.name() + ": " + sceneName + ": suture.trajectory: '" + path + "' is not in the package");
         out.scene.suture->trajectoryText = pkg.read(path);
     }
+    if (out.scene.interaction) // so do the instrument tracks
+        for (size_t i = 0; i < out.scene.interaction->instruments.size(); ++i) {
+            sim::InstrumentDesc& in = out.scene.interaction->instruments[i];
+            if (!pkg.contains(in.trackPath))
+                throw InputError(pkg.name() + ": " + sceneName + ": interaction.instruments[" + std::to_string(i) +
+                                 "].track: '" + in.trackPath + "' is not in the package");
+            in.trackText = pkg.read(in.trackPath);
+        }
     out.world = sim::World::assemble(out.scene, std::move(meshes), std::move(surfaces), pkg.manifest().features,
                                      pkg.name() + ": manifest.json");
     return out;
@@ -119,6 +138,11 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         r.sutureFrames = world.sutureFrames();
         r.metrics.punctures = r.suture->punctures;
         if (!r.suture->finite) r.errors.push_back("suture: the closure gauge or the thread tension was not finite");
+    }
+    if (const sim::InteractionRuntime* in = world.interaction()) {
+        r.interaction = in->summary();
+        r.metrics.clips = static_cast<int>(r.interaction->clips.size());
+        r.metrics.cutEdges = r.interaction->fasciaEdgesCut + r.interaction->fatEdgesCut;
     }
     for (size_t b = 0; b < world.bodyCount(); ++b) {
         const auto& rest = world.restMesh(b).positions();

@@ -83,6 +83,7 @@ struct SessionResult {
     std::optional<RenderFigures> render;  ///< when a frame was rendered (--screenshot)
     std::optional<sim::SutureSummary> suture;           ///< solver "fem" cases (needle and thread)
     std::vector<sim::SutureFrameRecord> sutureFrames;   ///< one per frame of a "fem" case
+    std::optional<sim::InteractionSummary> interaction; ///< cases with scripted instruments
     bool ok() const { return errors.empty() && invariants.allFinite; }
 };
 

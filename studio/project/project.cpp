@@ -8,10 +8,13 @@
 #include "sim/scene/material_json.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/world.hpp"
+#include "sim/skeleton/node_weights_io.hpp"
 #include "sim/suture/anastomosis.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -207,6 +210,68 @@ sim::suture::SutureSceneDesc parseSutureProject(const Fields& f, const json& su,
     return d;
 }
 
+StiffnessPaintProject parsePaint(const Fields& f, const json& j, const std::string& path, const std::string& origin) {
+    f.only(j, {"skeleton", "base_weight", "min_weight", "max_weight", "strokes"}, path);
+    StiffnessPaintProject p;
+    if (auto* sk = f.opt(j, "skeleton")) {
+        f.only(*sk, {"min_edge_length_rel", "medially_centered", "max_iterations"}, path + ".skeleton");
+        if (auto* v = f.opt(*sk, "min_edge_length_rel")) p.skeleton.minEdgeLengthRel = f.positive(*v, path + ".skeleton.min_edge_length_rel");
+        if (auto* v = f.opt(*sk, "medially_centered")) {
+            if (!v->is_boolean()) f.fail(path + ".skeleton.medially_centered", "must be true or false");
+            p.skeleton.mediallyCentered = v->get<bool>();
+        }
+        if (auto* v = f.opt(*sk, "max_iterations"))
+            p.skeleton.maxIterations = static_cast<size_t>(f.integer(*v, path + ".skeleton.max_iterations", 1, 10000));
+    }
+    if (auto* v = f.opt(j, "base_weight")) p.params.baseWeight = f.positive(*v, path + ".base_weight");
+    if (auto* v = f.opt(j, "min_weight")) p.params.minWeight = f.positive(*v, path + ".min_weight");
+    if (auto* v = f.opt(j, "max_weight")) p.params.maxWeight = f.positive(*v, path + ".max_weight");
+    p.params.origin = origin + ": " + path;
+    const json& strokes = f.req(j, "strokes", path);
+    if (!strokes.is_array() || strokes.empty()) f.fail(path + ".strokes", "must be a non-empty array");
+    for (size_t k = 0; k < strokes.size(); ++k) {
+        const std::string sp = path + ".strokes[" + std::to_string(k) + "]";
+        f.only(strokes[k], {"center", "radius", "amplitude", "scale"}, sp);
+        sim::BrushStroke s;
+        s.center = f.vec3(f.req(strokes[k], "center", sp), sp + ".center");
+        s.radius = f.positive(f.req(strokes[k], "radius", sp), sp + ".radius");
+        s.amplitude = f.num(f.req(strokes[k], "amplitude", sp), sp + ".amplitude");
+        if (auto* v = f.opt(strokes[k], "scale")) {
+            const std::string sc = f.str(*v, sp + ".scale");
+            if (sc == "peak") s.scale = sim::BrushScale::Peak;
+            else if (sc == "kernel") s.scale = sim::BrushScale::Kernel;
+            else f.fail(sp + ".scale", "'" + sc + "' is not a brush scale (peak, kernel)");
+        }
+        try {
+            sim::validateStroke(s, k, origin + ": " + sp);
+        } catch (const std::exception& e) {
+            throw InputError(e.what());
+        }
+        p.strokes.push_back(s);
+    }
+    return p;
+}
+
+/// The interaction section: every instrument's track is read from a project file, checked, and
+/// exported as tools/<instrument>.track.
+sim::InteractionDesc parseInteractionProject(const Fields& f, const json& section, const std::filesystem::path& dir,
+                                             const std::string& origin) {
+    if (!section.is_object()) f.fail("interaction", "must be an object");
+    sim::InteractionDesc d = sim::parseInteractionSection(section.dump(), origin);
+    for (size_t i = 0; i < d.instruments.size(); ++i) {
+        sim::InstrumentDesc& in = d.instruments[i];
+        const std::string field = "interaction.instruments[" + std::to_string(i) + "].track";
+        for (char c : in.name)
+            if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_')
+                f.fail("interaction.instruments[" + std::to_string(i) + "].name",
+                       "'" + in.name + "' may only use letters, digits, '-' and '_' (it names the track file)");
+        in.trackText = readFile(dir / in.trackPath);
+        sim::InstrumentTrack::parse(in.trackText, (dir / in.trackPath).string()); // checked now, not in the player
+        in.trackPath = "tools/" + in.name + ".track";
+    }
+    return d;
+}
+
 } // namespace
 
 Project loadProject(const std::filesystem::path& dir) {
@@ -218,7 +283,7 @@ Project loadProject(const std::filesystem::path& dir) {
     Fields f(origin);
     if (!doc.is_object()) f.fail("(root)", "must be an object");
     f.only(doc, {"schemaVersion", "caseId", "caseVersion", "title", "instructions", "solver", "gravity", "bodies",
-                 "surfaces", "accuracy", "render", "suture"},
+                 "surfaces", "accuracy", "render", "suture", "interaction"},
            "");
     Project p;
     p.dir = dir;
@@ -243,6 +308,10 @@ Project loadProject(const std::filesystem::path& dir) {
     if ((type == "fem") != (f.opt(doc, "suture") != nullptr))
         f.fail("suture", type == "fem" ? "solver 'fem' needs a 'suture' section" : "needs solver.type 'fem'");
     if (auto* su = f.opt(doc, "suture")) p.suture = parseSutureProject(f, *su, dir, origin);
+    if (auto* in = f.opt(doc, "interaction")) {
+        if (type != "xpbd") f.fail("interaction", "needs solver.type 'xpbd'");
+        p.interaction = parseInteractionProject(f, *in, dir, origin);
+    }
     if (auto* v = f.opt(solver, "dt")) p.solver.dt = f.positive(*v, "solver.dt");
     if (auto* v = f.opt(solver, "substeps")) p.solver.substeps = f.integer(*v, "solver.substeps", 1, 1000);
     if (auto* v = f.opt(solver, "iterations")) p.solver.iterations = f.integer(*v, "solver.iterations", 1, 1000);
@@ -270,7 +339,9 @@ Project loadProject(const std::filesystem::path& dir) {
         const std::string path = "bodies[" + std::to_string(i) + "]";
         const json& b = bodies[i];
         if (!b.is_object()) f.fail(path, "must be an object");
-        f.only(b, {"name", "mesh", "material", "fixed", "stiffness_regions", "embedded_in", "embedding_compliance"}, path);
+        f.only(b, {"name", "mesh", "material", "fixed", "stiffness_regions", "stiffness_paint", "embedded_in",
+                   "embedding_compliance"},
+               path);
         BodyProject body;
         body.name = f.str(f.req(b, "name", path), path + ".name");
         bool okName = !body.name.empty() && body.name.size() <= 64;
@@ -292,6 +363,7 @@ Project loadProject(const std::filesystem::path& dir) {
                 body.stiffnessRegions.push_back(reg);
             }
         }
+        if (auto* sp = f.opt(b, "stiffness_paint")) body.paint = parsePaint(f, *sp, path + ".stiffness_paint", origin);
         if (auto* v = f.opt(b, "embedded_in")) body.embeddedIn = f.str(*v, path + ".embedded_in");
         if (auto* v = f.opt(b, "embedding_compliance")) body.embeddingCompliance = f.num(*v, path + ".embedding_compliance");
         if (auto* fx = f.opt(b, "fixed")) {
@@ -332,6 +404,24 @@ Project loadProject(const std::filesystem::path& dir) {
             if (auto* v = f.opt(sj, "attach_compliance")) sp.attachCompliance = f.num(*v, path + ".attach_compliance");
             p.surfaces.push_back(std::move(sp));
         }
+    }
+    if (p.interaction) { // names are checked now, before any meshing
+        auto isBody = [&](const std::string& n) {
+            return std::any_of(p.bodies.begin(), p.bodies.end(), [&](const BodyProject& b) { return b.name == n; });
+        };
+        auto isSurface = [&](const std::string& n) {
+            return std::any_of(p.surfaces.begin(), p.surfaces.end(), [&](const SurfaceProject& sp) { return sp.name == n; });
+        };
+        for (size_t i = 0; i < p.interaction->instruments.size(); ++i) {
+            const sim::InstrumentDesc& in = p.interaction->instruments[i];
+            if (in.kind == sim::InstrumentDesc::Kind::ClipApplier && !isBody(in.target))
+                f.fail("interaction.instruments[" + std::to_string(i) + "].target",
+                       "'" + in.target + "' is not a body of the scene");
+        }
+        for (size_t i = 0; i < p.interaction->tissues.size(); ++i)
+            if (!isBody(p.interaction->tissues[i].layer) && !isSurface(p.interaction->tissues[i].layer))
+                f.fail("interaction.tissues[" + std::to_string(i) + "].layer",
+                       "'" + p.interaction->tissues[i].layer + "' is not a body or surface of the scene");
     }
     return p;
 }
@@ -399,6 +489,7 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     sim::SceneDesc scene;
     scene.solverType = project.solverType;
     scene.suture = project.suture;
+    scene.interaction = project.interaction;
     scene.xpbd = project.solver;
     scene.instructions = project.instructions;
     scene.render = project.render;
@@ -445,6 +536,23 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
             for (size_t v = 0; v < pos.size(); ++v)
                 for (const StiffnessRegion& r : b.stiffnessRegions)
                     if (inBox(pos[v], r.min, r.max)) desc.nodeWeights[v] = r.weight;
+        }
+        if (b.paint) {
+            stage("skeleton and stiffness paint of '" + b.name + "'");
+            sim::StiffnessPaintResult paint;
+            try {
+                bake::SkeletonParams skp = b.paint->skeleton;
+                skp.label = origin + ": " + field + ".stiffness_paint.skeleton";
+                const bake::SkeletonResult sk = bake::extractSkeleton(*mesh, skp);
+                paint = sim::bakeStiffnessPaint(*mesh, sk.skeleton, b.paint->strokes, b.paint->params);
+            } catch (const std::invalid_argument& e) {
+                throw InputError(origin + ": " + field + ".stiffness_paint: " + e.what());
+            }
+            if (desc.nodeWeights.empty()) desc.nodeWeights = paint.weights;
+            else
+                for (size_t v = 0; v < pos.size(); ++v) desc.nodeWeights[v] *= paint.weights[v];
+            desc.nodeWeightsPath = "meshes/" + b.name + ".vweights";
+            files.emplace_back(desc.nodeWeightsPath, sim::formatNodeWeights(desc.nodeWeights));
         }
         be.fixedNodes = desc.fixedNodes.size();
         files.emplace_back(desc.meshPath, sim::formatVtet(*mesh));
@@ -494,6 +602,8 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     writer.addFile("scene.json", sim::formatScene(scene));
     for (auto& [path, bytes] : files) writer.addFile(path, std::move(bytes));
     if (scene.suture) writer.addFile(scene.suture->trajectoryPath, scene.suture->trajectoryText);
+    if (scene.interaction)
+        for (const sim::InstrumentDesc& in : scene.interaction->instruments) writer.addFile(in.trackPath, in.trackText);
     vcase::Manifest written = writer.write(out);
     result.casePath = out;
     result.features = written.features;

@@ -21,6 +21,10 @@
 ///     "material": {see core/sim/scene/material_json.hpp},
 ///     "fixed": {"min": [..], "max": [..]},     nodes inside this box (metres) are fixed
 ///     "stiffness_regions": [{"min": [..], "max": [..], "weight": 4}],
+///     "stiffness_paint": {"skeleton": {"min_edge_length_rel": 0.002, "medially_centered": true},
+///                         "base_weight": 1, "min_weight": 0.001, "max_weight": 1e6,
+///                         "strokes": [{"center": [..], "radius": 0.02, "amplitude": 4,
+///                                      "scale": "peak" | "kernel"}]},   weights × region weights
 ///     "embedded_in": "organ", "embedding_compliance": 0
 ///   }],
 ///   "surfaces": [{"name": "fascia", "from_boundary_of": "organ", "region": {"min": .., "max": ..},
@@ -29,15 +33,20 @@
 ///   "suture": {...the scene's suture section (core/sim/suture/suture_scene.hpp), with
 ///              "trajectory": {"generator": "anastomosis", "stitches": 5, ...AnastomosisSpec fields}
 ///                          | {"file": "needle.traj"}}     with "solver": {"type": "fem", "dt": ..}
+///   "interaction": {...the scene's interaction section (core/sim/scene/interaction.hpp), with
+///                   every instrument's "track" a file of the project folder}
 /// }
 /// The suture trajectory is generated (or read and checked) at load and exported as
-/// tools/needle.traj.
+/// tools/needle.traj; instrument tracks are checked at load and exported as tools/<name>.track.
 /// "meshing" (CGAL Mesh_3, metres and degrees): facet_angle, facet_size, facet_distance,
 /// cell_radius_edge_ratio, cell_size, seed.
+#include "bake/skeleton.hpp"
 #include "bake/tetrahedralize.hpp"
 #include "sim/material/material.hpp"
 #include "sim/mesh/generators.hpp"
 #include "sim/mesh/tet_mesh.hpp"
+#include "sim/scene/interaction.hpp"
+#include "sim/skeleton/stiffness_paint.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
 
@@ -70,12 +79,21 @@ struct StiffnessRegion {
     double weight = 1;  ///< > 0; multiplies the material's stiffness
 };
 
+/// Skeleton stiffness painting [A §4.3.5]: the body's curve skeleton (mean curvature flow) maps
+/// every node to skeleton nodes; poly6 brush strokes on the skeleton set per-node weights.
+struct StiffnessPaintProject {
+    bake::SkeletonParams skeleton;
+    sim::PaintParams params;
+    std::vector<sim::BrushStroke> strokes;
+};
+
 struct BodyProject {
     std::string name;
     MeshSource mesh;
     sim::Material material;
     std::optional<std::array<sim::Vec3, 2>> fixedBox; ///< {min, max}, metres
     std::vector<StiffnessRegion> stiffnessRegions;
+    std::optional<StiffnessPaintProject> paint; ///< exported as meshes/<body>.vweights
     std::string embeddedIn; ///< cage body name; empty = free-standing
     double embeddingCompliance = 0;
 };
@@ -100,6 +118,7 @@ struct Project {
     std::vector<SurfaceProject> surfaces;
     std::string solverType = "xpbd"; ///< "xpbd" or "fem" (suturing; needs `suture`)
     std::optional<sim::suture::SutureSceneDesc> suture; ///< with trajectoryText filled at load
+    std::optional<sim::InteractionDesc> interaction;   ///< with every trackText filled at load
 };
 
 /// Reads <dir>/project.json. Throws viscera::InputError.

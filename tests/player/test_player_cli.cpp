@@ -170,10 +170,16 @@ TEST(PlayerCli, OnlyDeclaredSubsystemsRun) {
 
 TEST(PlayerCli, RunRejectsUnsupportedOrUndeclaredFeatures) {
     ScratchDir dir;
-    // ("needle" became a supported feature with the suturing engine; clip appliers are not yet.)
-    auto a = player({"run", writeSlabCase(dir, "clip.vcase", {"clip", "gravity", "xpbd"}), "--headless"});
+    // ("needle" and "clip" became supported features with the suturing and tool engines.)
+    auto a = player({"run", writeSlabCase(dir, "laser.vcase", {"gravity", "laser", "xpbd"}), "--headless"});
     EXPECT_EQ(a.exitCode, 1);
-    EXPECT_THAT(a.err, HasSubstr("features: 'clip' is not supported by this player"));
+    EXPECT_THAT(a.err, HasSubstr("features: 'laser' is not supported by this player"));
+    // A declared feature the scene does not use creates nothing.
+    const auto report = dir.path() / "clip.json";
+    auto c = player({"run", writeSlabCase(dir, "clip.vcase", {"clip", "gravity", "xpbd"}), "--headless", "--frames", "2",
+                     "--report", report.string()});
+    ASSERT_EQ(c.exitCode, 0) << c.err;
+    EXPECT_EQ(readJson(report)["active_subsystems"], nlohmann::json({"gravity", "xpbd"}));
     auto b = player({"run", writeSlabCase(dir, "nograv.vcase", {"xpbd"}), "--headless"});
     EXPECT_EQ(b.exitCode, 1);
     EXPECT_THAT(b.err, HasSubstr("the scene sets gravity but the manifest does not declare 'gravity'"));

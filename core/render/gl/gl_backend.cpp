@@ -119,6 +119,7 @@ struct GpuMesh {
     GLuint vao = 0;
     GLuint position = 0, previous = 0, normal = 0, heat = 0, attributes = 0, index = 0;
     size_t vertices = 0, indices = 0;
+    size_t drawIndices = 0; ///< leading indices drawn (face mask, [A §5.3.1])
 };
 
 class GlBackend final : public Backend {
@@ -131,6 +132,7 @@ public:
     void resize(const FrameLayout& layout) override;
     void createMesh(size_t index, const RenderMesh& mesh) override;
     void updateMesh(size_t index, const RenderMesh& mesh, bool staticChanged) override;
+    void updateFaceMask(size_t index, const RenderMesh& mesh) override;
     void runPass(const PassDesc& pass, const PassContext& ctx) override;
     void finish() override { m_gl.Finish(); }
     Image readPixels(ImageStage stage) override;
@@ -162,6 +164,7 @@ private:
     GLuint m_emptyVao = 0;
     RenderTarget m_gbufferTarget, m_lit, m_postA, m_postB, m_eyeLeft, m_eyeRight, m_final, m_scratch;
     std::vector<GpuMesh> m_meshes;
+    std::vector<uint32_t> m_maskScratch; ///< compacted indices of a face mask
     Target m_lastLitSource = Target::Lit;
 };
 
@@ -289,6 +292,7 @@ void GlBackend::createMesh(size_t index, const RenderMesh& mesh) {
     GpuMesh& g = m_meshes[index];
     g.vertices = mesh.vertexCount();
     g.indices = mesh.indices.size();
+    g.drawIndices = g.indices;
     m_gl.GenVertexArrays(1, &g.vao);
     m_gl.BindVertexArray(g.vao);
     auto buffer = [&](GLuint& b, size_t bytes, GLenum usage) {
@@ -312,12 +316,25 @@ void GlBackend::createMesh(size_t index, const RenderMesh& mesh) {
     for (GLuint a = 0; a < 6; ++a) m_gl.EnableVertexAttribArray(a);
     m_gl.GenBuffers(1, &g.index);
     m_gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.index);
-    m_gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(g.indices * 4), mesh.indices.data(), GL_STATIC_DRAW);
+    m_gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(g.indices * 4), mesh.indices.data(), GL_DYNAMIC_DRAW);
     ++m_stats.bufferAllocations;
     m_gl.BindVertexArray(0);
     // First frame: previous positions = current.
     m_gl.BindBuffer(GL_ARRAY_BUFFER, g.previous);
     m_gl.BufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(v * 12), mesh.positions.data());
+}
+
+void GlBackend::updateFaceMask(size_t index, const RenderMesh& mesh) {
+    GpuMesh& g = m_meshes.at(index);
+    if (mesh.indices.size() != g.indices || !g.vao) return; // the Renderer never lets this happen
+    mesh.drawnIndicesInto(m_maskScratch);
+    g.drawIndices = m_maskScratch.size();
+    m_gl.BindVertexArray(g.vao); // the element buffer binding belongs to the VAO
+    m_gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.index);
+    if (!m_maskScratch.empty())
+        m_gl.BufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, GLsizeiptr(m_maskScratch.size() * 4), m_maskScratch.data());
+    m_gl.BindVertexArray(0);
+    ++m_stats.bufferUpdates;
 }
 
 void GlBackend::updateMesh(size_t index, const RenderMesh& mesh, bool staticChanged) {
@@ -425,8 +442,9 @@ void GlBackend::gbufferPass(const PassDesc& pass, const PassContext& ctx) {
             m_gl.Enable(GL_POLYGON_OFFSET_FILL);
             m_gl.PolygonOffset(-2.0f, -4.0f);
         } else m_gl.Disable(GL_POLYGON_OFFSET_FILL);
+        if (g.drawIndices == 0) continue; // every face masked out
         m_gl.BindVertexArray(g.vao);
-        m_gl.DrawElements(GL_TRIANGLES, GLsizei(g.indices), GL_UNSIGNED_INT, nullptr);
+        m_gl.DrawElements(GL_TRIANGLES, GLsizei(g.drawIndices), GL_UNSIGNED_INT, nullptr);
         ++m_stats.drawCalls;
     }
     m_gl.BindVertexArray(0);
@@ -619,6 +637,7 @@ public:
     void resize(const FrameLayout& l) override { impl->resize(l); }
     void createMesh(size_t i, const RenderMesh& m) override { impl->createMesh(i, m); }
     void updateMesh(size_t i, const RenderMesh& m, bool s) override { impl->updateMesh(i, m, s); }
+    void updateFaceMask(size_t i, const RenderMesh& m) override { impl->updateFaceMask(i, m); }
     void runPass(const PassDesc& p, const PassContext& c) override { impl->runPass(p, c); }
     void finish() override { impl->finish(); }
     Image readPixels(ImageStage s) override { return impl->readPixels(s); }

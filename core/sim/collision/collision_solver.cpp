@@ -146,6 +146,7 @@ void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& too
     m_stats = CollisionStats{};
     m_candidates.clear();
     std::fill(m_touched.begin(), m_touched.end(), 0);
+    m_push.assign(m_rest.size(), Vec3::Zero());
     m_contactDirty = true;
     if (x.size() != m_rest.size() || !(h > 0)) return;
     m_alphaTilde = m_settings.compliance / (h * h);
@@ -209,9 +210,11 @@ bool CollisionSolver::projectSphere(int32_t t, const Sphere& s, const Capsule& c
     const double dl = (-C - m_alphaTilde * lambda) / denom;
     lambda += dl;
     for (int k = 0; k < 3; ++k) {
-        const Vec3 dx = m_w[f[k]] * dl * grad[k];
-        x[f[k]] += dx;
+        const Vec3 before = x[f[k]];
+        x[f[k]] += m_w[f[k]] * dl * grad[k];
         capCorrection(f[k], x);
+        const Vec3 dx = x[f[k]] - before;
+        m_push[f[k]] += dx;
         m_stats.maxCorrection = std::max(m_stats.maxCorrection, dx.norm());
         m_touched[f[k]] = 1;
     }
@@ -242,9 +245,11 @@ bool CollisionSolver::projectPolygon(int32_t t, const Capsule& c, double& lambda
     const double dl = (-C - m_alphaTilde * lambda) / denom;
     lambda += dl;
     for (int k = 0; k < 3; ++k) {
-        const Vec3 dx = m_w[f[k]] * b[k] * dl * n;
-        x[f[k]] += dx;
+        const Vec3 before = x[f[k]];
+        x[f[k]] += m_w[f[k]] * b[k] * dl * n;
         capCorrection(f[k], x);
+        const Vec3 dx = x[f[k]] - before;
+        m_push[f[k]] += dx;
         m_stats.maxCorrection = std::max(m_stats.maxCorrection, dx.norm());
         m_touched[f[k]] = 1;
     }
@@ -278,6 +283,73 @@ int CollisionSolver::iterate(std::vector<Vec3>& x, const ToolShape& tool) {
     m_stats.contacts = contacts;
     if (contacts) m_contactDirty = true;
     return contacts;
+}
+
+void CollisionSolver::beginStep(const XpbdParticles& particles, size_t offset,
+                                const ToolShape& tool, double h) {
+    const size_t nv = m_rest.size();
+    m_viewValid = offset <= particles.size() && nv <= particles.size() - offset;
+    m_candVerts.clear();
+    if (!m_viewValid) {
+        beginStep(std::vector<Vec3>{}, tool, h); // size mismatch: an empty step
+        return;
+    }
+    m_x.resize(nv);
+    for (size_t v = 0; v < nv; ++v) m_x[v] = particles.position(offset + v);
+    beginStep(m_x, tool, h);
+    m_mark.assign(nv, 0);
+    for (int32_t t : m_candidates)
+        for (int32_t v : m_tris[t])
+            if (!m_mark[v]) {
+                m_mark[v] = 1;
+                m_candVerts.push_back(v);
+            }
+    std::sort(m_candVerts.begin(), m_candVerts.end());
+}
+
+int CollisionSolver::iterate(XpbdParticles& particles, size_t offset, const ToolShape& tool) {
+    if (!m_viewValid || m_candidates.empty() || offset > particles.size() ||
+        m_rest.size() > particles.size() - offset)
+        return 0;
+    for (int32_t v : m_candVerts) m_x[v] = particles.position(offset + v);
+    const int contacts = iterate(m_x, tool);
+    if (contacts)
+        for (int32_t v : m_candVerts)
+            if (particles.inverseMass(offset + v) != 0) particles.setPosition(offset + v, m_x[v]);
+    return contacts;
+}
+
+int CollisionSolver::endStep(XpbdParticles& particles, size_t offset) {
+    if (!m_viewValid || !particles.hasVelocities() || offset > particles.size() ||
+        m_rest.size() > particles.size() - offset || m_push.size() != m_rest.size())
+        return 0;
+    int changed = 0;
+    for (int32_t v : m_candVerts) {
+        if (!m_touched[v] || particles.inverseMass(offset + v) == 0) continue;
+        const double len = m_push[v].norm();
+        if (!(len > 0)) continue;
+        const Vec3 n = m_push[v] / len;
+        Vec3 vel = particles.velocity(offset + v);
+        const double vn = vel.dot(n);
+        if (vn > 0) {
+            vel -= vn * n;
+            particles.setVelocity(offset + v, vel);
+            ++changed;
+        }
+    }
+    return changed;
+}
+
+XpbdIterationHook makeCollisionHook(CollisionSolver& collision, const ToolShape& tool,
+                                    size_t particleOffset) {
+    return [&collision, &tool, particleOffset](XpbdParticles& p, const XpbdIterationInfo& info) {
+        if (info.velocityPass) {
+            collision.endStep(p, particleOffset);
+            return;
+        }
+        if (info.iteration == 0) collision.beginStep(p, particleOffset, tool, info.h);
+        collision.iterate(p, particleOffset, tool);
+    };
 }
 
 const std::vector<int32_t>& CollisionSolver::contactVertices() const {

@@ -1,6 +1,10 @@
 #pragma once
 /// Tool–tissue collision detection and response for XPBD [A §5.2].
 ///
+/// Coupling to XPBD: makeCollisionHook (below) puts the contact constraints into the XPBD
+/// iterations (after every elastic sweep, multipliers per substep, inelastic velocity pass);
+/// stepWithCollision is the older after-the-substep coupling.
+///
 /// Pipeline per substep (beginStep): the surface triangles' boxes go into a spatial hash
 /// (spatial_hash.hpp) and the tool's box selects candidates; for the circumsphere method the
 /// candidates whose area changed by |S/S_ref − 1| >= δ since their last refresh get new curvature
@@ -32,6 +36,7 @@
 #include "sim/collision/spatial_hash.hpp"
 #include "sim/collision/tool_shape.hpp"
 #include "sim/mesh/tet_mesh.hpp"
+#include "sim/xpbd/xpbd_settings.hpp"
 
 #include <memory>
 #include <string>
@@ -102,6 +107,21 @@ public:
     /// One sweep over the candidates (positions in/out). Returns the number of projections.
     int iterate(std::vector<Vec3>& x, const ToolShape& tool);
 
+    /// The same inside an XPBD iteration (XpbdIterationHook): the surface's vertex v is particle
+    /// `offset + v` of `particles`. beginStep copies the #V positions once (broad phase, δ
+    /// update); iterate reads and writes only the vertices of the candidate triangles, and never
+    /// moves a particle whose inverse mass in `particles` is 0. A view too small for offset + #V
+    /// gives an empty step (nothing moves). Allocation-free after the first steps.
+    void beginStep(const XpbdParticles& particles, size_t offset, const ToolShape& tool, double h);
+    int iterate(XpbdParticles& particles, size_t offset, const ToolShape& tool);
+    /// Velocity pass of the step (XpbdIterationInfo::velocityPass): an inelastic contact with
+    /// the kinematic tool [A §5.2.5, "update the velocity ... linear impulse and momentum"]. For
+    /// every vertex the contacts moved in this step, the velocity component along its total
+    /// contact push is removed where it points along the push (the push itself then adds no
+    /// velocity; motion along the surface and towards the tool is kept). The tool counts as at
+    /// rest within a step (its pose is a device sample). Returns the vertices changed.
+    int endStep(XpbdParticles& particles, size_t offset);
+
     const CollisionStats& stats() const { return m_stats; }
     /// Vertices of the triangles in contact during the current step (any sweep), ascending.
     const std::vector<int32_t>& contactVertices() const;
@@ -139,11 +159,28 @@ private:
     std::vector<double> m_lambda; ///< #candidates × #parts
     std::vector<char> m_touched;  ///< per vertex, this step
     std::vector<Vec3> m_start;    ///< positions at beginStep
+    std::vector<Vec3> m_push;     ///< per vertex, sum of the contact moves of this step
+    std::vector<Vec3> m_x;        ///< particle-view steps: the surface's positions
+    std::vector<int32_t> m_candVerts; ///< particle-view steps: vertices of the candidates
+    std::vector<char> m_mark;         ///< per vertex, scratch
+    bool m_viewValid = false;         ///< particle-view step begun with a large enough view
     mutable std::vector<int32_t> m_contactVerts;
     mutable bool m_contactDirty = false;
     double m_alphaTilde = 0;
     CollisionStats m_stats;
 };
+
+/// The collision constraints as part of the XPBD iteration [A §5.2.5]: a hook for
+/// XpbdSolver::setIterationHook / XpbdSystem::setIterationHook that, at the first sweep of every
+/// substep, runs collision.beginStep at the tool's current pose (broad phase, δ update, contact
+/// multipliers reset) and after every sweep one collision.iterate, so the contact multipliers
+/// accumulate over the iterations of a substep like the elastic ones; in the substep's velocity
+/// pass collision.endStep makes the contacts inelastic (a push adds no velocity). The surface's vertex v is particle
+/// `particleOffset + v` (0 for an XpbdSolver; XpbdSystem::tetParticleOffset(b) for tet body b).
+/// collision and tool are held by reference and must outlive the hook; set the tool's pose
+/// between frames (device rate: the pose then holds for all substeps of the frame).
+XpbdIterationHook makeCollisionHook(CollisionSolver& collision, const ToolShape& tool,
+                                    size_t particleOffset = 0);
 
 /// One frame of an XpbdSolver body with tool collision coupled per substep: the solver must run
 /// one substep per step() (settings().substeps == 1, settings().dt == frame dt / substeps). For
@@ -151,8 +188,9 @@ private:
 /// the solver takes its step (its own iterations over the elastic constraints), then
 /// `iterations` collision sweeps project the contacts, and the moves they made are written back
 /// with v += Δx / h (XpbdSolver::setState). The collision constraints are therefore solved after
-/// the elastic ones in every substep, not interleaved with their sweeps (see the report in
-/// bench/bench_collision.cpp). Never throws; a non-finite collision result is dropped.
+/// the elastic ones in every substep, not interleaved with their sweeps; makeCollisionHook is
+/// the in-iteration coupling of [A §5.2.5] (bench/bench_collision.cpp compares both). Never
+/// throws; a non-finite collision result is dropped.
 /// Velocity update after a collision projection moved positions from `before` to `after`
 /// (#V each): the velocity component against each vertex's correction is removed (an inelastic
 /// contact; a separating push adds no velocity, so a tool that starts inside the tissue or a

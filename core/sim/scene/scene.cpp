@@ -149,7 +149,8 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     Reader r(origin);
     json doc = json::parse(text, nullptr, false);
     if (doc.is_discarded()) throw InputError(origin + ": not valid JSON");
-    r.only(doc, {"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces", "tools", "render", "suture"}, "");
+    r.only(doc, {"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces", "tools", "render", "suture",
+                 "interaction"}, "");
     SceneDesc scene;
     const json& solver = r.require(doc, "solver", "");
     r.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads", "primal_correction"},
@@ -199,8 +200,8 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     for (size_t i = 0; i < bodies.size(); ++i) {
         const std::string p = "bodies[" + std::to_string(i) + "]";
         const json& b = bodies[i];
-        r.only(b, {"name", "mesh", "material", "fixed_nodes", "node_weights", "strain_limits", "embedded_in",
-                   "embedding_compliance"},
+        r.only(b, {"name", "mesh", "material", "fixed_nodes", "node_weights", "node_weights_file", "strain_limits",
+                   "embedded_in", "embedding_compliance"},
                p);
         BodyDesc body;
         body.name = r.string(r.require(b, "name", p), p + ".name");
@@ -216,6 +217,13 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
                 if (!(x > 0)) r.fail(p + ".node_weights[" + std::to_string(k) + "]", "must be positive");
                 body.nodeWeights.push_back(x);
             }
+        }
+        if (b.contains("node_weights_file")) {
+            if (b.contains("node_weights")) r.fail(p + ".node_weights_file", "give node_weights or node_weights_file, not both");
+            body.nodeWeightsPath = r.string(b["node_weights_file"], p + ".node_weights_file");
+            if (body.nodeWeightsPath.empty() || body.nodeWeightsPath.front() == '/' ||
+                body.nodeWeightsPath.find("..") != std::string::npos)
+                r.fail(p + ".node_weights_file", "must be a relative path inside the case");
         }
         if (b.contains("strain_limits")) body.strainLimits = parseStrainLimits(r, b["strain_limits"], p + ".strain_limits");
         if (b.contains("embedded_in")) body.embeddedIn = r.string(b["embedded_in"], p + ".embedded_in");
@@ -255,6 +263,29 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
         }
     }
     if (doc.contains("tools")) scene.tools = parseTools(r, doc["tools"], names);
+    if (doc.contains("interaction")) {
+        if (scene.solverType != "xpbd") r.fail("interaction", "needs solver.type 'xpbd'");
+        InteractionDesc in = parseInteractionSection(doc["interaction"].dump(), origin);
+        auto isBody = [&](const std::string& n) {
+            for (const auto& b : scene.bodies)
+                if (b.name == n) return true;
+            return false;
+        };
+        auto isSurface = [&](const std::string& n) {
+            for (const auto& sd : scene.surfaces)
+                if (sd.name == n) return true;
+            return false;
+        };
+        for (size_t i = 0; i < in.instruments.size(); ++i)
+            if (in.instruments[i].kind == InstrumentDesc::Kind::ClipApplier && !isBody(in.instruments[i].target))
+                r.fail("interaction.instruments[" + std::to_string(i) + "].target",
+                       "'" + in.instruments[i].target + "' is not a body of the scene");
+        for (size_t i = 0; i < in.tissues.size(); ++i)
+            if (!isBody(in.tissues[i].layer) && !isSurface(in.tissues[i].layer))
+                r.fail("interaction.tissues[" + std::to_string(i) + "].layer",
+                       "'" + in.tissues[i].layer + "' is not a body or surface of the scene");
+        scene.interaction = std::move(in);
+    }
     return scene;
 }
 
@@ -267,6 +298,7 @@ std::string formatScene(const SceneDesc& scene) {
     if (s.primalCorrection) doc["solver"]["primal_correction"] = true;
     if (scene.solverType == "fem") doc["solver"] = {{"type", "fem"}, {"dt", s.dt}};
     if (scene.suture) doc["suture"] = json::parse(suture::formatSutureSection(*scene.suture));
+    if (scene.interaction) doc["interaction"] = json::parse(formatInteractionSection(*scene.interaction));
     doc["gravity"] = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
     if (!scene.instructions.empty()) doc["instructions"] = scene.instructions;
     if (!scene.render.empty()) doc["render"] = json::parse(scene.render);
@@ -275,7 +307,8 @@ std::string formatScene(const SceneDesc& scene) {
     doc["bodies"] = json::array();
     for (const BodyDesc& b : scene.bodies) {
         json j = {{"name", b.name}, {"mesh", b.meshPath}, {"material", materialToJson(b.material)}, {"fixed_nodes", b.fixedNodes}};
-        if (!b.nodeWeights.empty()) j["node_weights"] = b.nodeWeights;
+        if (!b.nodeWeightsPath.empty()) j["node_weights_file"] = b.nodeWeightsPath;
+        else if (!b.nodeWeights.empty()) j["node_weights"] = b.nodeWeights;
         if (b.strainLimits) {
             json lim = json::array();
             for (const StrainLimit& l : b.strainLimits->limits)

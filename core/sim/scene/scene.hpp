@@ -13,6 +13,7 @@
 ///               "material": {...see material_json.hpp...},
 ///               "fixed_nodes": [0, 1, 2],
 ///               "node_weights": [1.0, ...],                            optional, one per node
+///               "node_weights_file": "meshes/organ.vweights",         optional, instead
 ///               "strain_limits": {"axes": [[1,0,0],[0,1,0],[0,0,1]],   optional
 ///                                 "limits": [{"i": 0, "j": 0, "upper": 0.2, "compliance": 0}]},
 ///               "embedded_in": "fat", "embedding_compliance": 0}],   optional
@@ -20,12 +21,15 @@
 ///                 "stretch_stiffness": 50, "attach_to": "organ", "attach_distance": 0.001,
 ///                 "attach_compliance": 0, "fixed_nodes": []}],
 ///   "tools": [{"name": "probe", "shape": "sphere", ...see tool_probe.hpp...}]   optional
+///   "interaction": {...see scene/interaction.hpp...}   optional, xpbd: instruments on recorded
+///              tracks (grasper, energy hook, clip applier) and the tissues the hook can cut
 ///   "suture": {...see suture/suture_scene.hpp...}   with "solver": {"type": "fem", "dt": ..}: the
 ///              bodies are one quasi-static corotational FEM (E, ν of their material) with a needle
 ///   "render": {"sss": true, "sampling": "distance", "stereo": "off",                optional
 ///              "post": {"tone_mapping": true, ...}}   (checked by render/case_settings.hpp)
 /// }
 #include "sim/material/material.hpp"
+#include "sim/scene/interaction.hpp"
 #include "sim/scene/tool_probe.hpp"
 #include "sim/suture/suture_scene.hpp"
 #include "sim/xpbd/strain_limit.hpp"
@@ -44,6 +48,9 @@ struct BodyDesc {
     Material material;
     std::vector<int32_t> fixedNodes;
     std::vector<double> nodeWeights; ///< empty = all 1
+    /// "node_weights_file": a .vweights file inside the case (skeleton stiffness painting,
+    /// sim/skeleton/node_weights_io.hpp); whoever reads the case fills nodeWeights from it.
+    std::string nodeWeightsPath;
     std::optional<TetStrainLimits> strainLimits;
     std::string embeddedIn; ///< name of the cage body; empty = free-standing
     double embeddingCompliance = 0;
@@ -77,6 +84,8 @@ struct SceneDesc {
     std::vector<SurfaceDesc> surfaces;
     std::vector<ToolDesc> tools; ///< haptic probes (feature "probe")
     std::optional<suture::SutureSceneDesc> suture; ///< solver "fem" only (features fem, needle, thread, contact)
+    /// Scripted instruments (features collision, dissection, clip); XPBD scenes only.
+    std::optional<InteractionDesc> interaction;
 };
 
 /// Throws viscera::InputError ("scene.json: bodies[0].material.poisson_ratio: must be in [0, 0.5)").

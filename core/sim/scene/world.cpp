@@ -21,6 +21,9 @@ const char* kFem = "fem";
 const char* kNeedle = "needle";
 const char* kThread = "thread";
 const char* kContact = "contact";
+const char* kCollision = "collision";
+const char* kDissection = "dissection";
+const char* kClip = "clip";
 
 bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
 
@@ -32,8 +35,9 @@ std::string stripPrefix(std::string why) {
 } // namespace
 
 const std::vector<std::string>& supportedFeatures() {
-    static const std::vector<std::string> f = {kAccuracy, kContact, kEmbedding, kFascia, kFem,   kGravity,
-                                               kNeedle,   kProbe,   kStrainLimit, kThread, kXpbd};
+    static const std::vector<std::string> f = {kAccuracy, kClip,   kCollision,   kContact, kDissection, kEmbedding,
+                                               kFascia,   kFem,    kGravity,     kNeedle,  kProbe,      kStrainLimit,
+                                               kThread,   kXpbd};
     return f;
 }
 
@@ -48,6 +52,12 @@ std::vector<std::string> requiredFeatures(const SceneDesc& scene) {
     }
     if (scene.accuracy) f.push_back(kAccuracy);
     if (!scene.tools.empty()) f.push_back(kProbe);
+    if (scene.interaction) {
+        using K = InstrumentDesc::Kind;
+        if (scene.interaction->has(K::Grasper) || scene.interaction->has(K::EnergyHook)) f.push_back(kCollision);
+        if (scene.interaction->has(K::EnergyHook)) f.push_back(kDissection);
+        if (scene.interaction->has(K::ClipApplier)) f.push_back(kClip);
+    }
     if (scene.suture) {
         f.push_back(kNeedle);
         if (scene.suture->thread) f.push_back(kThread);
@@ -79,7 +89,7 @@ std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::
             throw InputError(origin + ": features: the scene uses '" + f + "' but the manifest does not declare it");
         }
     if (scene.solverType == kFem) return assembleSuture(scene, std::move(meshes), needed, origin);
-    const bool layered = !scene.surfaces.empty() || scene.bodies.size() > 1;
+    const bool layered = !scene.surfaces.empty() || scene.bodies.size() > 1 || scene.interaction.has_value();
     if (scene.accuracy && layered)
         throw InputError(origin + ": features: 'accuracy' sampling needs a scene with a single tet body and no layers");
 
@@ -158,6 +168,13 @@ std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::
         }
         w->m_probes = std::make_unique<ToolProbes>(scene.tools, std::move(pb), scene.xpbd.dt);
     }
+    if (scene.interaction) {
+        std::vector<const TetMesh*> bodies;
+        for (const auto& m : w->m_meshes) bodies.push_back(m.get());
+        std::vector<const TriMesh*> layers;
+        for (const TriMesh& m : w->m_surfaces) layers.push_back(&m);
+        w->m_interaction = InteractionRuntime::create(scene, *w->m_system, bodies, layers, origin);
+    }
     w->m_active = needed;
     w->m_invariants.maxEnergy = w->totalEnergy();
     return w;
@@ -207,7 +224,9 @@ FrameRecord World::step() {
     rec.index = m_frame;
     const auto t0 = std::chrono::steady_clock::now();
     if (m_probes) applyTools(false);
+    if (m_interaction) m_interaction->beforeStep(m_time + m_dt, m_dt);
     const StepStats st = m_single ? m_single->step() : m_system->step();
+    if (m_interaction) m_interaction->afterStep();
     if (m_probes) applyTools(true);
     rec.stepMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     rec.substeps = st.substeps;

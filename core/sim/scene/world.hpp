@@ -3,6 +3,7 @@
 /// case declares and uses are created (a case without "gravity" computes no gravity, one without
 /// surfaces builds no fascia layer, one without "accuracy" runs no reference solves).
 #include "sim/diagnostics/invariants.hpp"
+#include "sim/scene/interaction_runtime.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/tool_probe.hpp"
 #include "sim/suture/anastomosis.hpp"
@@ -107,6 +108,10 @@ public:
     /// Contact of probe t measured by the last step (tool_probe.hpp).
     const ToolContact& toolContact(size_t t) const { return m_probes->contact(t); }
 
+    // ---- scripted instruments (scene "interaction"; features collision, dissection, clip) --------
+    /// Null unless the scene has an interaction section.
+    const InteractionRuntime* interaction() const { return m_interaction.get(); }
+
     // ---- suturing (solver "fem"; features fem, needle, thread, contact) ---------------------------
     /// Only a "fem" scene creates the suturing simulation; the needle follows the case's recorded
     /// trajectory, one frame per step (the last frame is held after the end).
@@ -132,6 +137,7 @@ private:
     std::unique_ptr<XpbdSolver> m_single;  ///< one tet body, no layers (accuracy hooks available)
     std::unique_ptr<XpbdSystem> m_system;  ///< several bodies and layers
     std::unique_ptr<ToolProbes> m_probes;  ///< null unless the scene has tools
+    std::unique_ptr<InteractionRuntime> m_interaction; ///< null unless the scene has "interaction"
     std::unique_ptr<suture::SutureSimulation> m_suture; ///< null unless solver "fem"
     std::vector<suture::NeedleFrame> m_trajectory;
     std::vector<int32_t> m_offsets;                     ///< first merged node of each body

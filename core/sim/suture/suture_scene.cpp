@@ -1,6 +1,7 @@
 #include "sim/suture/suture_scene.hpp"
 
 #include "sim/util/error.hpp"
+#include "sim/util/json_section.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -11,19 +12,7 @@ namespace {
 
 using nlohmann::json;
 
-struct Reader {
-    const std::string& origin;
-    [[noreturn]] void fail(const std::string& field, const std::string& rule) const {
-        throw InputError(origin + ": suture." + field + ": " + rule);
-    }
-    void only(const json& obj, std::initializer_list<const char*> keys, const std::string& path) const {
-        if (!obj.is_object()) fail(path.empty() ? "(section)" : path, "must be an object");
-        for (auto it = obj.begin(); it != obj.end(); ++it) {
-            bool known = false;
-            for (const char* k : keys) known |= it.key() == k;
-            if (!known) fail(path.empty() ? it.key() : path + "." + it.key(), "unknown field");
-        }
-    }
+struct Reader : detail::SectionReader {
     double positive(const json& obj, const char* key, const std::string& path, double def) const {
         auto it = obj.find(key);
         if (it == obj.end()) return def;
@@ -43,7 +32,7 @@ struct Reader {
 } // namespace
 
 SutureSceneDesc parseSutureSection(std::string_view text, const std::string& origin) {
-    const Reader r{origin};
+    const Reader r{{origin, "suture"}};
     const json doc = json::parse(text, nullptr, false);
     if (doc.is_discarded()) throw InputError(origin + ": suture: not valid JSON");
     r.only(doc, {"needle", "thread", "contact", "trajectory", "gauge"}, "");

@@ -2,6 +2,8 @@
 /// Settings and per-frame statistics shared by the XPBD solvers [A §4.4.2].
 #include "sim/mesh/tri_mesh.hpp"
 
+#include <cstddef>
+#include <functional>
 #include <string>
 
 namespace viscera::sim {
@@ -40,5 +42,63 @@ struct StepStats {
     double maxDisplacement = 0; ///< m, largest node displacement over the frame
     int speedClamps = 0;        ///< node-substeps whose speed was clamped to maxSpeed
 };
+
+/// Non-owning view of a solver's particles while a frame runs (handed to an XpbdIterationHook):
+/// positions in metres (world frame), velocities in m/s and inverse masses in 1/kg (0 = fixed,
+/// never move those). Indices are particle indices of the whole system; a tet body's nodes start
+/// at its particle offset (XpbdSystem::tetParticleOffset; 0 for the single body of an
+/// XpbdSolver). Valid only during the hook call. O(1) per access, no bounds check.
+class XpbdParticles {
+  public:
+    /// xw: 4 doubles per particle (x, y, z, inverse mass); v: one per particle or null.
+    XpbdParticles(double* xw, Vec3* v, size_t count) : m_xw(xw), m_v(v), m_count(count) {}
+    size_t size() const { return m_count; }
+    Vec3 position(size_t i) const {
+        const double* p = m_xw + 4 * i;
+        return Vec3(p[0], p[1], p[2]);
+    }
+    void setPosition(size_t i, const Vec3& x) {
+        double* p = m_xw + 4 * i;
+        p[0] = x.x();
+        p[1] = x.y();
+        p[2] = x.z();
+    }
+    double inverseMass(size_t i) const { return m_xw[4 * i + 3]; }
+    bool hasVelocities() const { return m_v != nullptr; }
+    /// Meaningful in the velocity pass only (XpbdIterationInfo::velocityPass); zero without.
+    Vec3 velocity(size_t i) const { return m_v ? m_v[i] : Vec3::Zero(); }
+    void setVelocity(size_t i, const Vec3& v) {
+        if (m_v) m_v[i] = v;
+    }
+
+  private:
+    double* m_xw;
+    Vec3* m_v;
+    size_t m_count;
+};
+
+/// Where in a frame an XpbdIterationHook is called.
+struct XpbdIterationInfo {
+    int substep = 0;   ///< 0 .. substeps − 1
+    int iteration = 0; ///< 0 .. iterations − 1 (0: first sweep of the substep: reset multipliers)
+    int substeps = 1;
+    int iterations = 1;
+    double h = 0; ///< substep length, s
+    /// false: after sweep `iteration` (positions at the current iterate; velocities are those
+    /// of the substep start). true: once per substep after its velocity update (v = Δx / h,
+    /// damped, speed-clamped) and before the next prediction: positions final, velocities new;
+    /// iteration == iterations. A contact model removes here the velocity its pushes produced.
+    bool velocityPass = false;
+};
+
+/// Called after every constraint sweep of every substep (after elasticity, strain limits and
+/// ties: its projections have the last word of the sweep), with the particles at the current
+/// iterate, and once more per substep after the velocity update (info.velocityPass). Extra
+/// constraints projected here (tool contacts, [A §5.2.5]) are part of the Gauss–Seidel
+/// iteration like the built-in ones: the velocity update at the end of the substep sees their
+/// moves (the velocity pass may then correct the velocities). Runs on one thread (one of the
+/// solver's workers when threads > 1) while the others wait; it must not call back into the
+/// solver. An exception thrown by the hook marks the frame non-finite (it is rolled back).
+using XpbdIterationHook = std::function<void(XpbdParticles& particles, const XpbdIterationInfo& info)>;
 
 } // namespace viscera::sim

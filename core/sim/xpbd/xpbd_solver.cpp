@@ -59,6 +59,9 @@ std::unique_ptr<XpbdSolver> XpbdSolver::create(const TetMesh& rest, const Materi
 StepStats XpbdSolver::step() {
     return m_sys->step();
 }
+void XpbdSolver::setIterationHook(XpbdIterationHook hook) {
+    m_sys->setIterationHook(std::move(hook));
+}
 const std::vector<Vec3>& XpbdSolver::positions() const {
     return m_sys->tetPositions(0);
 }

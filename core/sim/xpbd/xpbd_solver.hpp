@@ -89,6 +89,12 @@ class XpbdSolver {
     /// Between frames only. Throws std::invalid_argument on a size mismatch or non-finite value.
     void setState(const std::vector<Vec3>& x, const std::vector<Vec3>& v);
 
+    /// Installs (empty function: removes) a hook called after every sweep of every substep of
+    /// step(), with the particles (this body's nodes, index = node) at the current iterate, and
+    /// once per substep after its velocity update; see XpbdIterationHook. Tool contacts: sim::makeCollisionHook (collision_solver.hpp). Between
+    /// frames only. Without a hook step() is bit-identical to a solver that never had one.
+    void setIterationHook(XpbdIterationHook hook);
+
     double elasticEnergy()
         const; ///< J, relative to the rest state (plus violated compliant strain limits)
     double kineticEnergy() const;   ///< J

@@ -104,6 +104,7 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
 
     // ---- tet bodies ----
     std::vector<std::unique_ptr<detail::Block>> strainBlocks;
+    std::vector<size_t> strainBlockBody; // dissection: tet body of each strain block
     for (size_t b = 0; b < desc.tetBodies.size(); ++b) {
         const TetBodyDesc& d = desc.tetBodies[b];
         const std::string label = tetLabel(b);
@@ -176,19 +177,33 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
             strainBlocks.push_back(
                 detail::makeTetStrainBlock(std::move(tets), std::move(M), std::move(vol),
                                            detail::expandStrainLimits(sl.limits)));
+            strainBlockBody.push_back(b);
         }
         Range r;
         r.name = d.name;
         r.first = off;
         r.tetWeight = et.weight;
+        for (const Tet& e : et.tets)
+            r.elems.push_back({e[0], e[1], e[2], e[3]});
+        r.active.assign(r.elems.size(), 1);
+        r.reshaped.assign(r.elems.size(), 0);
+        r.strainUnit.assign(r.elems.size(), -1);
+        r.elasticBlock = static_cast<int>(eng.blocks.size());
+        if (d.strainLimits) {
+            int32_t unit = 0;
+            for (int32_t t : allOr(d.strainLimits->tets, mesh.tetCount()))
+                r.strainUnit[t] = unit++;
+        }
         sys->m_tet.push_back(std::move(r));
         eng.addParticles(x, mass, fixed);
         bool simd = false;
         eng.blocks.push_back(detail::makeElasticBlock(std::move(et), settings.simd, &simd));
         sys->m_simd = sys->m_simd || simd;
     }
-    for (auto& b : strainBlocks)
-        eng.blocks.push_back(std::move(b));
+    for (size_t k = 0; k < strainBlocks.size(); ++k) {
+        sys->m_tet[strainBlockBody[k]].strainBlock = static_cast<int>(eng.blocks.size());
+        eng.blocks.push_back(std::move(strainBlocks[k]));
+    }
 
     // ---- attachments (before the surfaces: snapping moves their rest vertices) ----
     std::vector<detail::Tie> ties;
@@ -267,6 +282,18 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
         Range r;
         r.name = d.name;
         r.first = off;
+        for (const Tri& e : tris)
+            r.elems.push_back({e[0], e[1], e[2], -1});
+        r.active.assign(r.elems.size(), 1);
+        r.reshaped.assign(r.elems.size(), 0);
+        r.strainUnit.assign(r.elems.size(), -1);
+        if (d.stretchStiffness > 0) r.elasticBlock = static_cast<int>(eng.blocks.size());
+        if (d.strainLimits) {
+            r.strainBlock = static_cast<int>(eng.blocks.size()) + (d.stretchStiffness > 0 ? 1 : 0);
+            int32_t unit = 0;
+            for (int32_t t : allOr(d.strainLimits->triangles, mesh.triangleCount()))
+                r.strainUnit[t] = unit++;
+        }
         sys->m_surf.push_back(std::move(r));
         eng.addParticles(x, mass, fixed);
         if (d.stretchStiffness > 0)
@@ -373,6 +400,10 @@ void XpbdSystem::refreshMirrors() {
     }
 }
 
+void XpbdSystem::setIterationHook(XpbdIterationHook hook) {
+    m_engine->iterationHook = std::move(hook);
+}
+
 StepStats XpbdSystem::step() {
     const StepStats st = m_engine->frame(m_settings, m_pool.get());
     refreshMirrors();
@@ -406,6 +437,76 @@ void XpbdSystem::setTetState(size_t b, const std::vector<Vec3>& x, const std::ve
 
 void XpbdSystem::setSurfaceState(size_t s, const std::vector<Vec3>& x, const std::vector<Vec3>& v) {
     setState(m_surf.at(s), x, v, "setSurfaceState");
+}
+
+// ---- dissection ------------------------------------------------------------------------------
+
+void XpbdSystem::syncStrainUnit(Range& r, size_t t) {
+    if (r.strainBlock < 0 || r.strainUnit[t] < 0) return;
+    m_engine->blocks[r.strainBlock]->setUnitActive(static_cast<size_t>(r.strainUnit[t]),
+                                                   r.active[t] && !r.reshaped[t]);
+}
+
+void XpbdSystem::setTetActive(size_t b, size_t t, bool active) {
+    Range& r = m_tet.at(b);
+    r.active.at(t) = active ? 1 : 0;
+    m_engine->blocks[r.elasticBlock]->setUnitActive(t, active);
+    syncStrainUnit(r, t);
+}
+
+bool XpbdSystem::tetActive(size_t b, size_t t) const {
+    return m_tet.at(b).active.at(t) != 0;
+}
+
+void XpbdSystem::setTetRestShape(size_t b, size_t t, const Mat3& Fs) {
+    Range& r = m_tet.at(b);
+    const auto& e = r.elems.at(t);
+    const std::string where = "sim::XpbdSystem::setTetRestShape(): tet body " + std::to_string(b) +
+                              " ('" + r.name + "'), tet " + std::to_string(t) + ": ";
+    if (!Fs.allFinite()) throw std::invalid_argument(where + "Fs is not finite");
+    const double det = Fs.determinant();
+    if (!(det > 1e-12))
+        throw std::invalid_argument(where + "det Fs = " + num(det) + " (must be > 1e-12)");
+    Mat3 dm;
+    for (int k = 0; k < 3; ++k)
+        dm.col(k) = m_rest[e[k + 1]] - m_rest[e[0]];
+    const Mat3 inv = (Fs * dm).inverse();
+    if (!inv.allFinite()) throw std::invalid_argument(where + "the shrunk rest tet is singular");
+    double m[9];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            m[3 * i + j] = inv(i, j);
+    m_engine->blocks[r.elasticBlock]->setUnitRestInverse(t, m);
+    r.reshaped[t] = Fs.isIdentity(0) ? 0 : 1;
+    syncStrainUnit(r, t);
+}
+
+void XpbdSystem::setTriangleActive(size_t s, size_t t, bool active) {
+    Range& r = m_surf.at(s);
+    r.active.at(t) = active ? 1 : 0;
+    if (r.elasticBlock >= 0) m_engine->blocks[r.elasticBlock]->setUnitActive(t, active);
+    syncStrainUnit(r, t);
+}
+
+bool XpbdSystem::triangleActive(size_t s, size_t t) const {
+    return m_surf.at(s).active.at(t) != 0;
+}
+
+void XpbdSystem::setTriangleRestShape(size_t s, size_t t, const Mat3& Fs) {
+    Range& r = m_surf.at(s);
+    const auto& e = r.elems.at(t);
+    const std::string where = "sim::XpbdSystem::setTriangleRestShape(): surface " +
+                              std::to_string(s) + " ('" + r.name + "'), triangle " +
+                              std::to_string(t) + ": ";
+    if (!Fs.allFinite()) throw std::invalid_argument(where + "Fs is not finite");
+    const Vec3 x0 = m_rest[e[0]];
+    Mat2 M;
+    if (!triangleRestDmInv({x0, x0 + Fs * (m_rest[e[1]] - x0), x0 + Fs * (m_rest[e[2]] - x0)}, M))
+        throw std::invalid_argument(where + "the shrunk rest triangle is degenerate");
+    const double m[4] = {M(0, 0), M(0, 1), M(1, 0), M(1, 1)};
+    if (r.elasticBlock >= 0) m_engine->blocks[r.elasticBlock]->setUnitRestInverse(t, m);
+    r.reshaped[t] = Fs.isIdentity(0) ? 0 : 1;
+    syncStrainUnit(r, t);
 }
 
 double XpbdSystem::maxTieGap() const {

@@ -32,6 +32,7 @@
 #include "sim/xpbd/strain_limit.hpp"
 #include "sim/xpbd/xpbd_settings.hpp"
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -123,6 +124,29 @@ class XpbdSystem {
     void setTetState(size_t b, const std::vector<Vec3>& x, const std::vector<Vec3>& v);
     void setSurfaceState(size_t s, const std::vector<Vec3>& x, const std::vector<Vec3>& v);
 
+    // ---- dissection [A §5.3]: per-element switches, between frames, O(1) each ----------------
+    /// Element counts of tet body b and surface s.
+    size_t tetCount(size_t b) const { return m_tet.at(b).elems.size(); }
+    size_t triangleCount(size_t s) const { return m_surf.at(s).elems.size(); }
+    /// Switches the elasticity of tet t of body b on or off, together with its strain limits. An
+    /// inactive (cut) tet exerts no force and stores no energy; its nodes keep their mass, so a
+    /// node whose tets are all cut moves freely. Throws std::out_of_range on a bad b or t.
+    void setTetActive(size_t b, size_t t, bool active);
+    bool tetActive(size_t b, size_t t) const;
+    /// Shrinkage [A §5.3.3, eq. 5.12]: with F = Fe·Fs the elastic part is measured from the rest
+    /// edge matrix Fs·Dm₀ (Dm₀: the rest shape at create(); not cumulative, Fs = I restores it).
+    /// Fs is a 3 × 3 matrix in the world rest frame, finite with det Fs > 0. The energy stays
+    /// integrated over the creation rest volume (compliance unchanged). The tet's strain limits
+    /// are switched off while Fs ≠ I (burnt tissue). Throws std::invalid_argument on a bad Fs.
+    void setTetRestShape(size_t b, size_t t, const Mat3& Fs);
+    /// The same for triangle t of surface s (membrane constraints and strain limits).
+    void setTriangleActive(size_t s, size_t t, bool active);
+    bool triangleActive(size_t s, size_t t) const;
+    /// Shrinkage of triangle t of surface s: its rest triangle becomes x₀ + Fs (xₖ − x₀) (rest
+    /// positions, world frame; not cumulative); throws std::invalid_argument when that triangle is
+    /// degenerate or Fs is not finite.
+    void setTriangleRestShape(size_t s, size_t t, const Mat3& Fs);
+
     /// Number of coupling ties (attachments and embeddings).
     size_t tieCount() const { return m_ties.size(); }
     /// Largest |x_p − Σ b_k x_k| over all ties, m (0 without ties).
@@ -136,6 +160,16 @@ class XpbdSystem {
 
     const XpbdSettings& settings() const { return m_settings; }
     int colourCount() const;
+
+    /// Installs (or, with an empty function, removes) a hook called after every sweep of every
+    /// substep with the particles at the current iterate, and once per substep after its
+    /// velocity update (XpbdIterationHook; e.g. tool contacts
+    /// from sim/collision, makeCollisionHook). Between frames only. Without a hook step() runs
+    /// exactly as before (bit-identical, same schedule).
+    void setIterationHook(XpbdIterationHook hook);
+    /// First particle index of tet body b / surface s in the XpbdParticles of a hook.
+    int32_t tetParticleOffset(size_t b) const { return m_tet.at(b).first; }
+    int32_t surfaceParticleOffset(size_t s) const { return m_surf.at(s).first; }
     /// True when the stable Neo-Hookean AVX2 kernel runs (settings().simd and CPU support).
     bool usesSimd() const { return m_simd; }
 
@@ -146,7 +180,14 @@ class XpbdSystem {
         int32_t first = 0;      ///< first particle
         std::vector<Vec3> x, v; ///< mirrors of the particle state, refreshed after step()
         std::vector<double> tetWeight;
+        // Dissection: element vertices (global particles), blocks holding them (−1: none) and
+        // the element → unit map of the strain-limit block (−1: not limited).
+        std::vector<std::array<int32_t, 4>> elems;
+        int elasticBlock = -1, strainBlock = -1;
+        std::vector<int32_t> strainUnit;
+        std::vector<uint8_t> active, reshaped;
     };
+    void syncStrainUnit(Range& r, size_t t);
     struct TieRecord {
         int32_t p;
         std::array<int32_t, 4> t;

@@ -36,7 +36,8 @@ void scatterTetGradient(const Tet& e, const Mat3& G, double* f) {
 class SnhBlock final : public Block {
   public:
     SnhBlock(ElasticTets t, const StableNeoHookeanModel& m, bool avx2)
-        : m_t(std::move(t)), m_mu(m.mu()), m_lambda(m.lambda()), m_gamma(m.gamma()), m_avx2(avx2) {}
+        : m_t(std::move(t)), m_mu(m.mu()), m_lambda(m.lambda()), m_gamma(m.gamma()), m_avx2(avx2),
+          m_active(m_t.tets.size(), 1) {}
 
     size_t unitCount() const override { return m_t.tets.size(); }
     int unitParticles(size_t u, int32_t* out) const override {
@@ -77,6 +78,7 @@ class SnhBlock final : public Block {
         // Ψ relative to rest: μ/2 (|F|² − 3) + λ/2 ((J − γ)² − (1 − γ)²).
         double sum = 0;
         for (size_t u = 0; u < m_t.tets.size(); ++u) {
+            if (!m_active[u]) continue;
             const Tet& e = m_t.tets[u];
             const Mat3 ds = edgeMatrix(xw, e);
             const Mat3 F = ds * m_t.dmInv[u];
@@ -88,9 +90,25 @@ class SnhBlock final : public Block {
         }
         return sum;
     }
+    // An inactive tet keeps Dm⁻¹ = 0 in its lane: F = 0, which both kernels skip (|F| ≈ 0).
+    bool setUnitActive(size_t u, bool active) override {
+        m_active.at(u) = active ? 1 : 0;
+        writeLane(u);
+        return true;
+    }
+    bool setUnitRestInverse(size_t u, const double* m) override {
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c)
+                m_t.dmInv.at(u)(r, c) = m[3 * r + c];
+        writeLane(u);
+        return true;
+    }
 
   protected:
     void build(const std::vector<int32_t>& slots) override {
+        m_slotOf.assign(m_t.tets.size(), 0);
+        for (size_t s = 0; s < slots.size(); ++s)
+            if (slots[s] >= 0) m_slotOf[slots[s]] = static_cast<uint32_t>(s);
         m_packs.assign(slots.size() / 4, SnhPack{});
         for (size_t q = 0; q < m_packs.size(); ++q) {
             SnhPack& P = m_packs[q];
@@ -102,7 +120,7 @@ class SnhBlock final : public Block {
                     P.idx[s][l] = m_t.tets[u][s];
                 for (int r = 0; r < 3; ++r)
                     for (int c = 0; c < 3; ++c)
-                        P.m[3 * r + c][l] = m_t.dmInv[u](r, c);
+                        P.m[3 * r + c][l] = m_active[u] ? m_t.dmInv[u](r, c) : 0.0;
                 const double vw = m_t.volume[u] * m_t.weight[u];
                 P.alphaD[l] = 1.0 / (m_mu * vw);
                 P.alphaH[l] = 1.0 / (m_lambda * vw);
@@ -112,9 +130,24 @@ class SnhBlock final : public Block {
     }
 
   private:
+    /// Rewrites Dm⁻¹ of unit u in its pack lane (and in the padding lanes that repeat it).
+    void writeLane(size_t u) {
+        if (m_packs.empty()) return; // not arranged yet: build() reads m_t and m_active
+        const size_t slot = m_slotOf[u];
+        SnhPack& P = m_packs[slot / 4];
+        const int lane = static_cast<int>(slot % 4);
+        for (int l = 0; l < 4; ++l) {
+            if (l != lane && !(lane == 0 && l >= P.lanes)) continue;
+            for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 3; ++c)
+                    P.m[3 * r + c][l] = m_active[u] ? m_t.dmInv[u](r, c) : 0.0;
+        }
+    }
     ElasticTets m_t;
     double m_mu, m_lambda, m_gamma;
     bool m_avx2;
+    std::vector<uint8_t> m_active;  ///< per unit
+    std::vector<uint32_t> m_slotOf; ///< per unit: 4 · pack + lane
     std::vector<SnhPack> m_packs;
 };
 
@@ -126,6 +159,17 @@ class ModelBlock final : public Block {
         m_count = m_t.model->count();
         m_alpha = m_t.model->compliance();
         m_restDensity = m_t.model->energyDensity(Mat3::Identity());
+        m_active.assign(m_t.tets.size(), 1);
+    }
+    bool setUnitActive(size_t u, bool active) override {
+        m_active.at(u) = active ? 1 : 0;
+        return true;
+    }
+    bool setUnitRestInverse(size_t u, const double* m) override {
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c)
+                m_t.dmInv.at(u)(r, c) = m[3 * r + c];
+        return true;
     }
 
     size_t unitCount() const override { return m_t.tets.size(); }
@@ -137,7 +181,7 @@ class ModelBlock final : public Block {
         TetConstraintValues cv;
         for (size_t s = 4 * pb; s < 4 * pe; ++s) {
             Unit& u = m_units[s];
-            if (u.unit < 0) continue;
+            if (u.unit < 0 || !m_active[u.unit]) continue;
             if (ctx.first) u.lam = {0, 0};
             const Tet& e = m_t.tets[u.unit];
             Vec3 x[4];
@@ -194,7 +238,7 @@ class ModelBlock final : public Block {
         TetConstraintValues cv;
         for (size_t slot = 4 * pb; slot < 4 * pe; ++slot) {
             const Unit& u = m_units[slot];
-            if (u.unit < 0) continue;
+            if (u.unit < 0 || !m_active[u.unit]) continue;
             const Tet& e = m_t.tets[u.unit];
             const Mat3 ds = edgeMatrix(xw, e);
             const Mat3& M = m_t.dmInv[u.unit];
@@ -210,6 +254,7 @@ class ModelBlock final : public Block {
     double energy(const double* xw) const override {
         double sum = 0;
         for (size_t u = 0; u < m_t.tets.size(); ++u) {
+            if (!m_active[u]) continue;
             const Tet& e = m_t.tets[u];
             const Mat3 ds = edgeMatrix(xw, e);
             sum += m_t.volume[u] * m_t.weight[u] *
@@ -234,6 +279,7 @@ class ModelBlock final : public Block {
         std::array<double, 2> lam{};
     };
     ElasticTets m_t;
+    std::vector<uint8_t> m_active; ///< per unit
     int m_count = 1;
     std::array<double, kMaxTetConstraints> m_alpha{};
     double m_restDensity = 0;
@@ -282,7 +328,11 @@ template <int N, class MatM> class StrainBlock final : public Block {
     StrainBlock(std::vector<Elem> elems, std::vector<MatM> dmInv, std::vector<double> measure,
                 std::vector<ScalarStrainLimit> limits)
         : m_elems(std::move(elems)), m_dmInv(std::move(dmInv)), m_measure(std::move(measure)),
-          m_limits(std::move(limits)) {}
+          m_limits(std::move(limits)), m_active(m_elems.size(), 1) {}
+    bool setUnitActive(size_t u, bool active) override {
+        m_active.at(u) = active ? 1 : 0;
+        return true;
+    }
 
     size_t unitCount() const override { return m_elems.size(); }
     int stage() const override { return 1; }
@@ -294,7 +344,7 @@ template <int N, class MatM> class StrainBlock final : public Block {
         const size_t nl = m_limits.size();
         for (size_t s = 4 * pb; s < 4 * pe; ++s) {
             const int32_t u = m_slots[s];
-            if (u < 0) continue;
+            if (u < 0 || !m_active[u]) continue;
             double* lam = m_lam.data() + s * nl;
             if (ctx.first) std::fill_n(lam, nl, 0.0);
             const Elem& e = m_elems[u];
@@ -310,6 +360,7 @@ template <int N, class MatM> class StrainBlock final : public Block {
     double energy(const double* xw) const override {
         double sum = 0;
         for (size_t u = 0; u < m_elems.size(); ++u) {
+            if (!m_active[u]) continue;
             std::array<Vec3, N> x;
             for (int i = 0; i < N; ++i)
                 x[i] = particlePosition(xw, m_elems[u][i]);
@@ -338,6 +389,7 @@ template <int N, class MatM> class StrainBlock final : public Block {
     std::vector<MatM> m_dmInv;
     std::vector<double> m_measure;
     std::vector<ScalarStrainLimit> m_limits;
+    std::vector<uint8_t> m_active; ///< per unit
     std::vector<int32_t> m_slots;
     std::vector<double> m_lam;
 };
@@ -348,7 +400,16 @@ class MembraneBlock final : public Block {
   public:
     MembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area,
                   double k)
-        : m_tris(std::move(tris)), m_dmInv(std::move(dmInv)), m_area(std::move(area)), m_k(k) {}
+        : m_tris(std::move(tris)), m_dmInv(std::move(dmInv)), m_area(std::move(area)), m_k(k),
+          m_active(m_tris.size(), 1) {}
+    bool setUnitActive(size_t u, bool active) override {
+        m_active.at(u) = active ? 1 : 0;
+        return true;
+    }
+    bool setUnitRestInverse(size_t u, const double* m) override {
+        m_dmInv.at(u) << m[0], m[1], m[2], m[3];
+        return true;
+    }
 
     size_t unitCount() const override { return m_tris.size(); }
     int unitParticles(size_t u, int32_t* out) const override {
@@ -360,7 +421,7 @@ class MembraneBlock final : public Block {
         static const int kEntry[3][2] = {{0, 0}, {1, 1}, {0, 1}};
         for (size_t s = 4 * pb; s < 4 * pe; ++s) {
             const int32_t u = m_slots[s];
-            if (u < 0) continue;
+            if (u < 0 || !m_active[u]) continue;
             double* lam = m_lam.data() + 3 * s;
             if (ctx.first) std::fill_n(lam, 3, 0.0);
             const Tri& e = m_tris[u];
@@ -392,6 +453,7 @@ class MembraneBlock final : public Block {
     double energy(const double* xw) const override {
         double sum = 0;
         for (size_t u = 0; u < m_tris.size(); ++u) {
+            if (!m_active[u]) continue;
             std::array<Vec3, 3> x;
             for (int i = 0; i < 3; ++i)
                 x[i] = particlePosition(xw, m_tris[u][i]);
@@ -412,6 +474,7 @@ class MembraneBlock final : public Block {
     std::vector<Mat2> m_dmInv;
     std::vector<double> m_area;
     double m_k;
+    std::vector<uint8_t> m_active; ///< per unit
     std::vector<int32_t> m_slots;
     std::vector<double> m_lam;
 };

@@ -202,8 +202,25 @@ void Engine::buildSchedule(Schedule kind, const XpbdSettings* s, int threads) {
                 // The correction reads the multipliers, so they are kept after the last sweep too.
                 colourPhases(it == 0, it + 1 == s->iterations && !s->primalCorrection);
                 if (s->primalCorrection) appendCorrectionPhases(threads);
+                if (iterationHook) {
+                    Phase ph{kHook, false, false, false, 1};
+                    ph.substep = sub;
+                    ph.iteration = it;
+                    m_phases.push_back(ph);
+                }
             }
-            m_phases.push_back({-1, false, false, sub + 1 < s->substeps, particleChunks});
+            if (iterationHook) {
+                // End of substep split in two around the velocity pass of the hook.
+                m_phases.push_back({-1, false, false, false, particleChunks});
+                Phase ph{kHook, false, false, false, 1};
+                ph.substep = sub;
+                ph.iteration = s->iterations;
+                m_phases.push_back(ph);
+                if (sub + 1 < s->substeps)
+                    m_phases.push_back({kPredictOnly, false, false, true, particleChunks});
+            } else {
+                m_phases.push_back({-1, false, false, sub + 1 < s->substeps, particleChunks});
+            }
         }
     }
     m_phaseStart.assign(m_phases.size() + 1, 0);
@@ -272,6 +289,7 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
     }
     const int threads = usefulThreads(pool ? std::min(s.threads, pool->size()) : 1);
     m_clamps.assign(threads, 0);
+    m_hookFailed = false;
     buildSchedule(Schedule::Frame, &s, threads);
     double* const x = xw.data();
     // Start of a substep for particle i: remember x, predict x̃ = x + h (v + h g).
@@ -318,6 +336,17 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
             correctParticles(chunk);
             return;
         }
+        if (ph.colour == kHook) {
+            XpbdParticles view(x, v.data(), n);
+            const XpbdIterationInfo info{ph.substep, ph.iteration, substeps, s.iterations, h,
+                                         ph.iteration == s.iterations};
+            try {
+                iterationHook(view, info);
+            } catch (...) {
+                m_hookFailed = true;
+            }
+            return;
+        }
         const size_t b = size_t(chunk) * kChunkParticles, e = std::min(n, b + kChunkParticles);
         for (size_t i = b; i < e; ++i) {
             double* p = x + 4 * i;
@@ -330,7 +359,8 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
     st.iterations = s.iterations;
     for (int c : m_clamps)
         st.speedClamps += c;
-    for (size_t i = 0; i < n; ++i) {
+    if (m_hookFailed) st.finite = false;
+    for (size_t i = 0; i < n && st.finite; ++i) {
         const double* p = x + 4 * i;
         const Vec3 xi(p[0], p[1], p[2]);
         if (!xi.allFinite() || !v[i].allFinite()) {

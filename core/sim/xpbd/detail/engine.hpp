@@ -80,6 +80,15 @@ class Block {
         return false;
     }
 
+    /// Dissection [A §5.3]: switches unit u on or off between frames. An inactive unit moves
+    /// nothing, stores no energy and adds no multiplier force. Returns false (and changes
+    /// nothing) when the block kind does not support it. O(1).
+    virtual bool setUnitActive(size_t /*u*/, bool /*active*/) { return false; }
+    /// Dissection shrinkage [A eq. 5.12]: replaces the rest inverse edge matrix Dm⁻¹ of unit u
+    /// between frames (row-major; 9 doubles for a tet, 1/m, 4 for a triangle in its plane
+    /// frame). Returns false when the block kind does not support it. O(1).
+    virtual bool setUnitRestInverse(size_t /*u*/, const double* /*dmInv*/) { return false; }
+
     /// Lays the units out by colour (colourOfUnit: one entry per unit) in packs of four.
     void arrange(const std::vector<int32_t>& colourOfUnit, int colours);
     size_t packCount() const { return m_colourStart.empty() ? 0 : m_colourStart.back(); }
@@ -100,6 +109,9 @@ class Engine {
     std::vector<Vec3> v;      ///< velocities, m/s
     std::vector<double> mass; ///< kg (fixed particles keep theirs)
     std::vector<std::unique_ptr<Block>> blocks;
+    /// Optional: called by frame() after every sweep (see XpbdIterationHook). Empty: frame()
+    /// runs exactly the schedule it runs without hooks.
+    XpbdIterationHook iterationHook;
 
     size_t particleCount() const { return mass.size(); }
     /// Appends particles (positions, masses, fixed flags; all the same size); returns the index
@@ -143,10 +155,13 @@ class Engine {
         bool predictNext = false; ///< particle pass: also start the next substep
         uint32_t chunks = 0;
         bool forces = false; ///< colour pass of the primal correction: Σ ∇Cᵀλ into m_force
+        int substep = 0, iteration = 0; ///< kHook: where in the frame
     };
     static constexpr int kPredictOnly = -2;
     /// Particle pass of the primal correction: x = x̃ + w f, f = 0.
     static constexpr int kCorrect = -3;
+    /// One chunk: the iteration hook (after the sweep, and the correction, of an iteration).
+    static constexpr int kHook = -4;
     enum class Schedule { Frame, Sweep, Correction };
     /// s: needed for Schedule::Frame only.
     void buildSchedule(Schedule kind, const XpbdSettings* s, int threads);
@@ -179,6 +194,7 @@ class Engine {
     std::vector<int> m_clamps; ///< per thread
     std::vector<double> m_force; ///< primal correction: Σ ∇Cᵀλ, 3 per particle (0 between uses)
     std::vector<Vec3> m_xTilde;  ///< prediction of the current substep (primal correction)
+    bool m_hookFailed = false;   ///< the iteration hook threw during this frame
 };
 
 } // namespace viscera::sim::detail

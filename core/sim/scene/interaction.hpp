@@ -1,0 +1,71 @@
+#pragma once
+/// The "interaction" section of scene.json (XPBD scenes): scripted instruments on recorded tracks
+/// and what they do to the tissue [A ch. 5].
+///
+/// "interaction": {
+///   "collision": {"method": "circumsphere", "delta": 0.7},          optional (defaults shown)
+///   "instruments": [
+///     {"name": "grasper", "kind": "grasper", "track": "tools/grasper.track",
+///      "radius": 0.0025, "jaw_length": 0.012},                       → features collision, grasp
+///     {"name": "hook", "kind": "energy_hook", "track": "tools/hook.track",
+///      "radius": 0.0012, "temperature_c": 170},                      → features collision, dissection
+///     {"name": "clipper", "kind": "clip_applier", "track": "tools/clipper.track",
+///      "target": "vessel", "jaw_length": 0.008}                      → features collision, clip
+///   ],
+///   "tissues": [{"layer": "fascia", "ignition_c": 160, "conductivity": 0.4,
+///                "shrink": [0.1, 0.3, 1.0]}]                         what the energy hook can cut
+/// }
+/// Tracks are files inside the case (instrument_track.hpp). An instrument's tip is the track's
+/// position; its shaft points along the track's direction. Grasper: jaws (two capsules) that
+/// hold the surface vertices between them while closed (jaw < 0.5). Energy hook: a capsule whose
+/// tip sphere is the heat source while act = 1. Clip applier: fires a clip onto `target` at the
+/// first key with act = 1; the clip then follows the vessel [A §5.4].
+/// Units SI; temperatures °C. Parsing is strict; errors name the origin, the field and the rule.
+#include "sim/scene/instrument_track.hpp"
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace viscera::sim {
+
+struct InstrumentDesc {
+    enum class Kind { Grasper, EnergyHook, ClipApplier };
+    std::string name;
+    Kind kind = Kind::Grasper;
+    std::string trackPath;     ///< file inside the case
+    std::string trackText;     ///< its contents, filled by whoever reads the case (not serialized)
+    double radius = 0.0025;    ///< m: jaw / shaft radius
+    double jawLength = 0.012;  ///< m: grasper and clip jaws
+    double temperatureC = 170; ///< energy hook
+    std::string target;        ///< clip applier: the tet body (vessel) it clips
+};
+
+struct DissectionTissueDesc {
+    std::string layer;          ///< a surface (fascia) or tet body name
+    double ignitionC = 160;     ///< °C
+    double conductivity = 0.4;  ///< ξ of [A eq. 5.11]
+    Vec3 shrink = Vec3(0.1, 0.3, 1.0); ///< S_x, S_y, S_z of [A eq. 5.12], each in (0, 1]
+};
+
+struct InteractionDesc {
+    std::string collisionMethod = "circumsphere"; ///< circumsphere, bounding_sphere or polygon
+    double delta = 0.7;                           ///< area-change update threshold δ [A §5.2.4]
+    std::vector<InstrumentDesc> instruments;
+    std::vector<DissectionTissueDesc> tissues;
+
+    bool has(InstrumentDesc::Kind k) const {
+        for (const auto& i : instruments)
+            if (i.kind == k) return true;
+        return false;
+    }
+};
+
+/// `json` is the text of the section object. Throws viscera::InputError
+/// "<origin>: interaction.<field>: <rule>".
+InteractionDesc parseInteractionSection(std::string_view json, const std::string& origin);
+/// The section object as JSON text (parseInteractionSection reads it back).
+std::string formatInteractionSection(const InteractionDesc& desc);
+const char* kindName(InstrumentDesc::Kind k);
+
+} // namespace viscera::sim

@@ -1,0 +1,357 @@
+#include "sim/scene/interaction_runtime.hpp"
+
+#include "sim/util/error.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace viscera::sim {
+namespace {
+
+constexpr double kGraspClose = 0.5; ///< jaw below this holds, above releases
+constexpr double kMaxJawOpening = 0.6; ///< rad, grasper jaws fully open (jaw = 1)
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Rigid frame of an instrument: +x along the shaft towards the tip, origin at `origin`.
+ToolShape::Pose framePose(const Vec3& origin, const Vec3& direction) {
+    ToolShape::Pose p = ToolShape::Pose::Identity();
+    p.linear() = Eigen::Quaterniond::FromTwoVectors(Vec3::UnitX(), direction).toRotationMatrix();
+    p.translation() = origin;
+    return p;
+}
+
+/// Lumped inverse masses of a surface layer (areal density · area / 3 per vertex, fixed: 0).
+std::vector<double> surfaceInverseMass(const TriMesh& mesh, double arealDensity, const std::vector<int32_t>& fixed) {
+    std::vector<double> m(mesh.vertexCount(), 0.0);
+    const auto& x = mesh.positions();
+    for (const Tri& t : mesh.triangles()) {
+        const double a = 0.5 * (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).norm();
+        for (int k = 0; k < 3; ++k) m[t[k]] += arealDensity * a / 3;
+    }
+    std::vector<double> w(m.size(), 0.0);
+    for (size_t i = 0; i < m.size(); ++i) w[i] = m[i] > 0 ? 1.0 / m[i] : 0.0;
+    for (int32_t f : fixed) w[f] = 0;
+    return w;
+}
+
+} // namespace
+
+struct InteractionRuntime::Instrument {
+    InstrumentDesc desc;
+    InstrumentTrack track;
+    InstrumentKey key;
+    std::unique_ptr<ToolShape> shape;             ///< null: no collision (clip applier)
+    std::unique_ptr<CollisionSolver> collision;
+    XpbdIterationHook hook;
+    bool colliding = false;                       ///< this frame
+    // grasp
+    bool holding = false;
+    std::vector<int32_t> held;                    ///< collision-surface vertices
+    std::vector<Vec3> heldLocal;                  ///< in the instrument frame at the grasp
+    ToolShape::Pose pose = ToolShape::Pose::Identity();
+    // clip applier
+    bool fired = false;
+    int contacts = 0;
+};
+
+struct InteractionRuntime::Clip {
+    size_t body = 0;
+    std::unique_ptr<ClipAttachment> attachment;
+    std::vector<int32_t> contactVertices; ///< vessel vertices the contact points sat on
+    ClipState state;
+};
+
+InteractionRuntime::~InteractionRuntime() = default;
+
+std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& scene, XpbdSystem& system,
+                                                               const std::vector<const TetMesh*>& bodies,
+                                                               const std::vector<const TriMesh*>& surfaces,
+                                                               const std::string& origin) {
+    if (!scene.interaction) throw std::invalid_argument("sim::InteractionRuntime::create(): the scene has no interaction");
+    const InteractionDesc& desc = *scene.interaction;
+    auto fail = [&](const std::string& field, const std::string& rule) {
+        throw InputError(origin + ": interaction." + field + ": " + rule);
+    };
+    std::unique_ptr<InteractionRuntime> r(new InteractionRuntime());
+    r->m_sys = &system;
+    r->m_bodies = bodies;
+    for (const auto& b : scene.bodies) r->m_bodyNames.push_back(b.name);
+
+    // Collision surface: the first surface layer, else the boundary of the first tet body.
+    CollisionSurfaceDesc surface;
+    if (!surfaces.empty()) {
+        r->m_surfaceIsLayer = true;
+        r->m_surfaceIndex = 0;
+        r->m_particleOffset = static_cast<size_t>(system.surfaceParticleOffset(0));
+        surface.triangles = surfaces[0]->triangles();
+        surface.restPositions = surfaces[0]->positions();
+        surface.inverseMass =
+            surfaceInverseMass(*surfaces[0], scene.surfaces[0].arealDensity, scene.surfaces[0].fixedNodes);
+        r->m_surfaceVertices = surfaces[0]->vertexCount();
+    } else {
+        const TetMesh& m = *bodies.at(0);
+        std::vector<double> w(m.vertexCount(), 1.0);
+        for (int32_t f : scene.bodies[0].fixedNodes) w[f] = 0;
+        surface = CollisionSurfaceDesc::fromTetMesh(m, std::move(w));
+        r->m_particleOffset = static_cast<size_t>(system.tetParticleOffset(0));
+        r->m_surfaceVertices = m.vertexCount();
+    }
+    CollisionSettings cs;
+    if (desc.collisionMethod == "bounding_sphere") cs.method = CollisionMethod::BoundingSphere;
+    else if (desc.collisionMethod == "polygon") cs.method = CollisionMethod::Polygon;
+    cs.circumsphere.updateThreshold = desc.delta;
+    if (auto why = validate(cs); !why.empty()) fail("collision", why);
+
+    for (size_t i = 0; i < desc.instruments.size(); ++i) {
+        auto in = std::make_unique<Instrument>();
+        in->desc = desc.instruments[i];
+        in->track = InstrumentTrack::parse(in->desc.trackText, origin + ": " + in->desc.trackPath);
+        in->key = in->track.sample(0);
+        switch (in->desc.kind) {
+        case InstrumentDesc::Kind::Grasper:
+            in->shape = std::make_unique<ToolShape>(ToolShape::jaws(in->desc.jawLength, in->desc.radius, kMaxJawOpening));
+            break;
+        case InstrumentDesc::Kind::EnergyHook:
+            in->shape = std::make_unique<ToolShape>(ToolShape::capsule(0.5 * in->desc.jawLength, in->desc.radius));
+            break;
+        case InstrumentDesc::Kind::ClipApplier: {
+            size_t b = 0;
+            while (b < scene.bodies.size() && scene.bodies[b].name != in->desc.target) ++b;
+            if (b == scene.bodies.size())
+                fail("instruments[" + std::to_string(i) + "].target", "'" + in->desc.target + "' is not a body");
+            break;
+        }
+        }
+        if (in->shape) {
+            try {
+                in->collision = CollisionSolver::create(surface, cs);
+            } catch (const std::invalid_argument& e) {
+                fail("instruments[" + std::to_string(i) + "]", std::string("collision surface: ") + e.what());
+            }
+            in->hook = makeCollisionHook(*in->collision, *in->shape, r->m_particleOffset);
+        }
+        r->m_instruments.push_back(std::move(in));
+    }
+
+    if (desc.has(InstrumentDesc::Kind::EnergyHook)) {
+        DissectionDesc dd;
+        dd.system = &system;
+        for (const DissectionTissueDesc& t : desc.tissues) {
+            TissueDissectionParams p;
+            p.ignition = t.ignitionC;
+            p.conductivity = t.conductivity;
+            p.shrink = t.shrink;
+            bool found = false;
+            for (size_t s = 0; s < scene.surfaces.size() && !found; ++s)
+                if (scene.surfaces[s].name == t.layer) {
+                    if (dd.fascia) fail("tissues", "only one surface layer can be dissected");
+                    dd.fascia = surfaces[s];
+                    dd.surface = s;
+                    dd.fasciaTissue = p;
+                    r->m_dissectSurface = s;
+                    found = true;
+                }
+            for (size_t b = 0; b < scene.bodies.size() && !found; ++b)
+                if (scene.bodies[b].name == t.layer) {
+                    if (dd.fat) fail("tissues", "only one tet body can be dissected");
+                    dd.fat = bodies[b];
+                    dd.tetBody = b;
+                    dd.fatTissue = p;
+                    found = true;
+                }
+            if (!found) fail("tissues", "'" + t.layer + "' is not a body or surface of the scene");
+        }
+        try {
+            r->m_dissection = Dissection::create(dd);
+        } catch (const std::invalid_argument& e) {
+            fail("tissues", e.what());
+        }
+        if (dd.fascia) r->m_summary.fasciaVertices = r->m_summary.fasciaVerticesAtStart = dd.fascia->vertexCount();
+    }
+    InteractionRuntime* self = r.get();
+    system.setIterationHook([self](XpbdParticles& p, const XpbdIterationInfo& info) { self->runHook(p, info); });
+    return r;
+}
+
+void InteractionRuntime::beforeStep(double t, double dt) {
+    const std::vector<Vec3>& sx = m_surfaceIsLayer ? m_sys->surfacePositions(m_surfaceIndex) : m_sys->tetPositions(0);
+    auto t0 = std::chrono::steady_clock::now();
+    // The collision surface's box, grown by what it can move in a frame: a tool outside it runs no
+    // broad phase at all this frame (the hash rebuild per substep is the main collision cost).
+    Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+    for (const Vec3& p : sx) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    const double grow = 0.005;
+    lo.array() -= grow;
+    hi.array() += grow;
+    for (auto& inp : m_instruments) {
+        Instrument& in = *inp;
+        in.key = in.track.sample(t);
+        const Vec3 dir = in.key.direction;
+        if (in.shape) {
+            // Jaws and the hook's shaft end at the track's tip: the frame origin sits one jaw
+            // length (grasper) or half the shaft piece (hook capsule centre) behind it.
+            const double back = in.desc.kind == InstrumentDesc::Kind::Grasper ? in.desc.jawLength : 0.5 * in.desc.jawLength;
+            in.pose = framePose(in.key.position - back * dir, dir);
+            in.shape->setPose(in.pose);
+            in.shape->setOpening(kMaxJawOpening * in.key.jaw);
+            const auto box = in.shape->bounds();
+            const bool near = (box[0].array() <= hi.array()).all() && (box[1].array() >= lo.array()).all();
+            in.colliding = near && !(in.desc.kind == InstrumentDesc::Kind::EnergyHook && in.key.act);
+        }
+        if (in.desc.kind == InstrumentDesc::Kind::Grasper) {
+            if (!in.holding && in.key.jaw < kGraspClose) {
+                in.holding = true;
+                in.held.clear();
+                in.heldLocal.clear();
+                const double reach = in.desc.jawLength / 3;
+                for (size_t v = 0; v < sx.size(); ++v)
+                    if ((sx[v] - in.key.position).norm() <= reach) {
+                        in.held.push_back(static_cast<int32_t>(v));
+                        in.heldLocal.push_back(in.pose.inverse() * sx[v]);
+                    }
+                if (!in.held.empty()) ++m_summary.grasps;
+            } else if (in.holding && in.key.jaw > kGraspClose) {
+                in.holding = false;
+                in.held.clear();
+                in.heldLocal.clear();
+            }
+        }
+        if (in.desc.kind == InstrumentDesc::Kind::ClipApplier && !in.fired && in.key.act) {
+            in.fired = true;
+            auto c = std::make_unique<Clip>();
+            while (c->body < m_bodyNames.size() && m_bodyNames[c->body] != in.desc.target) ++c->body;
+            const std::vector<Vec3>& x = m_sys->tetPositions(c->body);
+            // Clip frame: the vessel's local axis (principal direction of its nodes near the
+            // tip), the jaw normal across it and the shaft, the closing direction between them.
+            const double r = in.desc.jawLength;
+            Vec3 mean = Vec3::Zero();
+            int n = 0;
+            for (const Vec3& p : x)
+                if ((p - in.key.position).norm() < r) mean += p, ++n;
+            if (n < 4) continue; // nothing to clip here: the applier fires into empty space
+            mean /= n;
+            Mat3 cov = Mat3::Zero();
+            for (const Vec3& p : x)
+                if ((p - in.key.position).norm() < r) cov += (p - mean) * (p - mean).transpose();
+            Eigen::SelfAdjointEigenSolver<Mat3> eig(cov);
+            const Vec3 axis = eig.eigenvectors().col(2).normalized();
+            Vec3 normal = axis.cross(dir);
+            if (normal.norm() < 1e-6) normal = axis.unitOrthogonal();
+            normal.normalize();
+            const Vec3 third = axis.cross(normal).normalized();
+            Mat3 axes;
+            axes.col(0) = axis;
+            axes.col(1) = normal;
+            axes.col(2) = third;
+            ClipDesc cd;
+            cd.bounds = ClipBounds::box(in.key.position, axes, Vec3(0.001, 0.5 * r, 0.5 * r));
+            cd.jawNormal = normal;
+            for (int side : {-1, 1}) // the two legs of the clip, as segments' end points
+                for (int end : {-1, 1})
+                    cd.vertices.push_back(in.key.position + side * 0.5 * r * normal + end * 0.5 * r * third);
+            for (size_t v = 0; v < x.size(); ++v)
+                if (cd.bounds.contains(x[v])) {
+                    cd.contactPoints.push_back(x[v]);
+                    c->contactVertices.push_back(static_cast<int32_t>(v));
+                }
+            try {
+                c->attachment = ClipAttachment::apply(*m_bodies[c->body], x, cd);
+            } catch (const std::invalid_argument&) {
+                continue; // a region the clip cannot hold (logged as no clip); the session goes on
+            }
+            c->state.instrument = in.desc.name;
+            c->state.target = in.desc.target;
+            c->state.firedAt = t;
+            c->state.centre = c->attachment->centre();
+            c->state.regionVertices = static_cast<int>(c->attachment->regionVertices().size());
+            c->state.auxiliaryNodes = static_cast<int>(c->attachment->auxiliaryNodes().size());
+            m_clips.push_back(std::move(c));
+        }
+    }
+    m_summary.clipMs += msSince(t0);
+    if (m_dissection) {
+        t0 = std::chrono::steady_clock::now();
+        for (auto& inp : m_instruments) {
+            if (inp->desc.kind != InstrumentDesc::Kind::EnergyHook) continue;
+            EnergyTool tool;
+            tool.centre = inp->key.position;
+            tool.radius = inp->desc.radius;
+            tool.temperature = inp->desc.temperatureC;
+            tool.energized = inp->key.act;
+            try {
+                const DissectionFrameStats st = m_dissection->update(tool, dt);
+                m_summary.fasciaEdgesCut = static_cast<int>(st.fascia.totalEdgesCut);
+                m_summary.fasciaTrianglesCut = static_cast<int>(st.fascia.totalPrimitivesCut);
+                m_summary.fatEdgesCut = static_cast<int>(st.fat.totalEdgesCut);
+                m_summary.fatTetsCut = static_cast<int>(st.fat.totalPrimitivesCut);
+                if (m_dissection->hasFascia()) m_summary.fasciaVertices = st.fascia.vertexCount;
+                m_summary.maxEdgeHeat = std::max({m_summary.maxEdgeHeat, st.fascia.maxEdgeHeat, st.fat.maxEdgeHeat});
+                m_summary.gridMaxC = std::max(m_summary.gridMaxC, st.gridMax);
+            } catch (const std::invalid_argument&) { // a non-finite tool pose: no heat this frame
+            }
+        }
+        m_summary.dissectionMs += msSince(t0);
+    }
+}
+
+void InteractionRuntime::runHook(XpbdParticles& particles, const XpbdIterationInfo& info) {
+    for (auto& inp : m_instruments) {
+        Instrument& in = *inp;
+        if (in.collision && in.colliding) in.hook(particles, info);
+        if (in.holding)
+            for (size_t k = 0; k < in.held.size(); ++k) {
+                const size_t p = m_particleOffset + static_cast<size_t>(in.held[k]);
+                if (p < particles.size() && particles.inverseMass(p) > 0)
+                    particles.setPosition(p, in.pose * in.heldLocal[k]);
+            }
+    }
+}
+
+void InteractionRuntime::afterStep() {
+    const auto t0 = std::chrono::steady_clock::now();
+    m_summary.instruments.clear();
+    int contacts = 0;
+    for (auto& inp : m_instruments) {
+        const Instrument& in = *inp;
+        InstrumentState s;
+        s.name = in.desc.name;
+        s.kind = kindName(in.desc.kind);
+        s.tip = in.key.position;
+        s.direction = in.key.direction;
+        s.jaw = in.key.jaw;
+        s.act = in.key.act;
+        s.contacts = in.collision && in.colliding ? in.collision->stats().contacts : 0;
+        s.grasped = static_cast<int>(in.held.size());
+        contacts += s.contacts;
+        m_summary.instruments.push_back(s);
+    }
+    m_summary.maxContacts = std::max(m_summary.maxContacts, contacts);
+    m_summary.clips.clear();
+    for (auto& c : m_clips) {
+        const std::vector<Vec3>& x = m_sys->tetPositions(c->body);
+        c->attachment->update(x); // keeps the previous pose on non-finite input
+        const Mat3 q = c->attachment->relativeRotation();
+        c->state.centre = c->attachment->centre();
+        c->state.rotationDeg = Eigen::AngleAxisd(q).angle() * 180.0 / M_PI;
+        c->state.travel = (c->attachment->centre() - c->attachment->applicationCentre()).norm();
+        const auto& cp = c->attachment->contactPoints();
+        for (size_t k = 0; k < cp.size() && k < c->contactVertices.size(); ++k)
+            c->state.maxContactDrift = std::max(c->state.maxContactDrift, (cp[k] - x[c->contactVertices[k]]).norm());
+        m_summary.clips.push_back(c->state);
+    }
+    m_summary.clipMs += msSince(t0);
+}
+
+void InteractionRuntime::surfaceFaceMaskInto(size_t s, std::vector<uint8_t>& out) const {
+    out.clear();
+    if (m_dissection && m_dissection->hasFascia() && s == m_dissectSurface) m_dissection->fasciaFaceMaskInto(out);
+}
+
+} // namespace viscera::sim

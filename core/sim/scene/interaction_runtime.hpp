@@ -1,0 +1,112 @@
+#pragma once
+/// The scene's "interaction" section at run time (interaction.hpp): scripted instruments on their
+/// recorded tracks acting on a layered XPBD system [A ch. 5].
+///
+/// Per frame (World::step): beforeStep(t, dt) samples every track at the frame's end time, poses
+/// the tools, starts or ends grasps, fires clips, runs the energized dissection (heat grid, edge
+/// temperatures, cuts, shrinkage) and arms the XPBD iteration hook; the solver then runs the tool
+/// contacts and the grasp holds inside its iterations; afterStep() moves the clips with their
+/// vessels and records the figures.
+///   - Collision [A §5.2]: every grasper and every energy hook while its energy is off collides
+///     with the collision surface (the first surface layer, else the boundary of the first tet
+///     body), each through its own CollisionSolver; a live energy hook cuts instead of pushing.
+///   - Grasp: when a grasper's jaw closes below 0.5 the collision-surface vertices within
+///     jaw_length / 3 of its tip are held rigidly in the instrument's frame (set inside every
+///     XPBD iteration) until the jaw opens above 0.5.
+///   - Dissection [A §5.3]: sim/dissection (feature "dissection").
+///   - Clip [A §5.4]: sim/clip, fired at a clip applier's first key with act = 1 (feature "clip").
+/// Deterministic: repeat runs are bit-identical.
+#include "sim/clip/clip_attachment.hpp"
+#include "sim/collision/collision_solver.hpp"
+#include "sim/dissection/dissection.hpp"
+#include "sim/scene/interaction.hpp"
+#include "sim/scene/scene.hpp"
+#include "sim/xpbd/xpbd_system.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace viscera::sim {
+
+struct InstrumentState {
+    std::string name;
+    const char* kind = "";
+    Vec3 tip = Vec3::Zero();
+    Vec3 direction = -Vec3::UnitZ();
+    double jaw = 1;
+    bool act = false;
+    int contacts = 0;    ///< collision projections in the last sweep of the frame
+    int grasped = 0;     ///< vertices held
+};
+
+struct ClipState {
+    std::string instrument, target;
+    double firedAt = 0;        ///< s
+    Vec3 centre = Vec3::Zero(); ///< m, current
+    double rotationDeg = 0;    ///< since application
+    double travel = 0;         ///< m, centre moved since application
+    /// m: largest distance between a contact point carried by the clip and the vessel vertex it
+    /// was on at application (how well the clip follows the vessel material).
+    double maxContactDrift = 0;
+    int regionVertices = 0, auxiliaryNodes = 0;
+};
+
+struct InteractionSummary {
+    std::vector<InstrumentState> instruments; ///< at the last frame
+    int maxContacts = 0;
+    int grasps = 0;
+    int fasciaEdgesCut = 0, fasciaTrianglesCut = 0, fatEdgesCut = 0, fatTetsCut = 0;
+    size_t fasciaVertices = 0, fasciaVerticesAtStart = 0;
+    double maxEdgeHeat = 0;    ///< °C
+    double gridMaxC = 0;       ///< °C, hottest heat-grid value seen
+    std::vector<ClipState> clips;
+    double dissectionMs = 0, clipMs = 0; ///< wall time summed over frames (collision runs inside the XPBD step)
+};
+
+class InteractionRuntime {
+public:
+    /// Throws viscera::InputError naming `origin` on a bad track, a tissue layer or clip target
+    /// the system does not have, or a collision surface that cannot be built.
+    /// bodies[i] / surfaces[s]: the rest meshes of scene.bodies[i] / scene.surfaces[s], as given
+    /// to the system (non-owning; must outlive the runtime).
+    static std::unique_ptr<InteractionRuntime> create(const SceneDesc& scene, XpbdSystem& system,
+                                                      const std::vector<const TetMesh*>& bodies,
+                                                      const std::vector<const TriMesh*>& surfaces,
+                                                      const std::string& origin);
+    ~InteractionRuntime();
+    InteractionRuntime(const InteractionRuntime&) = delete;
+    InteractionRuntime& operator=(const InteractionRuntime&) = delete;
+
+    /// Before XpbdSystem::step() of the frame that ends at time t (s). Never throws.
+    void beforeStep(double t, double dt);
+    /// After the step. Never throws.
+    void afterStep();
+
+    const InteractionSummary& summary() const { return m_summary; }
+    /// Render mask of surface s: 1 per intact triangle (empty: no dissection on that surface).
+    void surfaceFaceMaskInto(size_t s, std::vector<uint8_t>& out) const;
+    bool dissects() const { return m_dissection != nullptr; }
+
+private:
+    struct Instrument;
+    struct Clip;
+    InteractionRuntime() = default;
+    void runHook(XpbdParticles& particles, const XpbdIterationInfo& info);
+
+    XpbdSystem* m_sys = nullptr;
+    std::vector<const TetMesh*> m_bodies;
+    std::vector<std::string> m_bodyNames;
+    std::vector<std::unique_ptr<Instrument>> m_instruments;
+    std::vector<std::unique_ptr<Clip>> m_clips;
+    std::unique_ptr<Dissection> m_dissection;
+    size_t m_dissectSurface = SIZE_MAX;
+    // collision surface
+    bool m_surfaceIsLayer = false;
+    size_t m_surfaceIndex = 0;
+    size_t m_particleOffset = 0;
+    size_t m_surfaceVertices = 0;
+    InteractionSummary m_summary;
+};
+
+} // namespace viscera::sim

@@ -1,0 +1,127 @@
+#include "sim/skeleton/stiffness_paint.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace viscera::sim {
+
+double poly6Kernel(double v, double h) {
+    if (!(std::isfinite(h) && h > 0))
+        throw std::invalid_argument("sim::poly6Kernel(): h is " + std::to_string(h) + " (must be finite and > 0)");
+    if (!(std::isfinite(v) && v >= 0))
+        throw std::invalid_argument("sim::poly6Kernel(): v is " + std::to_string(v) + " (must be finite and >= 0)");
+    if (v >= h) return 0.0;
+    // h² − v² as (h − v)(h + v): h − v is exact near h (Sterbenz), so the value keeps full relative
+    // precision up to the edge of the support instead of cancelling.
+    const double d = (h - v) * (h + v);
+    const double h3 = h * h * h;
+    return 315.0 / (64.0 * std::numbers::pi * h3 * h3 * h3) * (d * d * d);
+}
+
+namespace {
+
+[[noreturn]] void failParam(const std::string& origin, const std::string& field, double value, const char* rule) {
+    throw std::invalid_argument(origin + ": PaintParams::" + field + " is " + std::to_string(value) + " (" + rule +
+                                ")");
+}
+
+void validateParams(const PaintParams& p) {
+    if (!(std::isfinite(p.minWeight) && p.minWeight > 0))
+        failParam(p.origin, "minWeight", p.minWeight, "must be finite and > 0: XPBD divides compliance by weights");
+    if (!(std::isfinite(p.maxWeight) && p.maxWeight >= p.minWeight))
+        failParam(p.origin, "maxWeight", p.maxWeight, "must be finite and >= minWeight");
+    if (!(std::isfinite(p.baseWeight) && p.baseWeight >= p.minWeight && p.baseWeight <= p.maxWeight))
+        failParam(p.origin, "baseWeight", p.baseWeight, "must be finite and in [minWeight, maxWeight]");
+}
+
+/// Added weight for a node at distance v from the centre.
+double strokeIncrement(const BrushStroke& s, double v) {
+    if (s.scale == BrushScale::Peak) return s.amplitude * (poly6Kernel(v, s.radius) / poly6Kernel(0.0, s.radius));
+    return s.amplitude * poly6Kernel(v, s.radius);
+}
+
+} // namespace
+
+void validateStroke(const BrushStroke& s, size_t index, const std::string& origin) {
+    const std::string p = origin + ": stroke " + std::to_string(index) + ": ";
+    if (!s.center.allFinite()) throw std::invalid_argument(p + "center has a non-finite coordinate");
+    if (!(s.radius >= kMinBrushRadius && s.radius <= kMaxBrushRadius))
+        throw std::invalid_argument(p + "radius is " + std::to_string(s.radius) + " m (must be in [1e-6, 1e3] m)");
+    if (!std::isfinite(s.amplitude))
+        throw std::invalid_argument(p + "amplitude is " + std::to_string(s.amplitude) + " (must be finite)");
+    if (s.scale != BrushScale::Peak && s.scale != BrushScale::Kernel)
+        throw std::invalid_argument(p + "scale is not a BrushScale value");
+    // The peak increment must be finite too (BrushScale::Kernel multiplies by up to 315/(64π h³)).
+    if (!std::isfinite(strokeIncrement(s, 0.0)))
+        throw std::invalid_argument(p + "amplitude × kernel at the centre is not finite");
+}
+
+void applyBrushStroke(const std::vector<Vec3>& positions, const Skeleton& skeleton, const SkeletonNodeMap& map,
+                      const BrushStroke& stroke, const PaintParams& params, std::vector<double>& weights,
+                      StiffnessPaintReport* report) {
+    validateParams(params);
+    const size_t index = report ? report->strokeSelected.size() : 0;
+    validateStroke(stroke, index, params.origin);
+    const size_t n = positions.size();
+    if (weights.size() != n || map.meshNodeCount != n || map.skeletonNodeCount() != skeleton.nodes.size())
+        throw std::invalid_argument(params.origin + ": stroke " + std::to_string(index) + ": " +
+                                    std::to_string(weights.size()) + " weights, " + std::to_string(n) +
+                                    " positions, a map of " + std::to_string(map.meshNodeCount) +
+                                    " nodes: sizes must agree (and the map must come from this skeleton)");
+
+    // Selection through the skeleton: skeleton nodes strictly inside the brush select their Π_j.
+    std::vector<int32_t> selected;
+    for (size_t j = 0; j < skeleton.nodes.size(); ++j)
+        if ((skeleton.nodes[j] - stroke.center).norm() < stroke.radius)
+            selected.insert(selected.end(), map.members.begin() + map.start[j], map.members.begin() + map.start[j + 1]);
+    std::sort(selected.begin(), selected.end());
+    selected.erase(std::unique(selected.begin(), selected.end()), selected.end());
+
+    // Compute first, commit only when every value is finite.
+    std::vector<double> next(selected.size());
+    size_t changed = 0, low = 0, high = 0;
+    for (size_t k = 0; k < selected.size(); ++k) {
+        const int32_t i = selected[k];
+        const double inc = strokeIncrement(stroke, (positions[i] - stroke.center).norm());
+        double w = weights[i] + inc;
+        if (!std::isfinite(w))
+            throw std::invalid_argument(params.origin + ": stroke " + std::to_string(index) + ": weight of node " +
+                                        std::to_string(i) + " is not finite");
+        if (inc != 0.0) ++changed;
+        if (w < params.minWeight) {
+            w = params.minWeight;
+            ++low;
+        } else if (w > params.maxWeight) {
+            w = params.maxWeight;
+            ++high;
+        }
+        next[k] = w;
+    }
+    for (size_t k = 0; k < selected.size(); ++k) weights[selected[k]] = next[k];
+    if (report) {
+        report->strokeSelected.push_back(selected.size());
+        report->strokeChanged.push_back(changed);
+        report->clampedLow += low;
+        report->clampedHigh += high;
+    }
+}
+
+StiffnessPaintResult bakeStiffnessPaint(const TetMesh& mesh, const Skeleton& skeleton,
+                                        const std::vector<BrushStroke>& strokes, const PaintParams& params) {
+    validateParams(params);
+    for (size_t k = 0; k < strokes.size(); ++k) validateStroke(strokes[k], k, params.origin);
+    StiffnessPaintResult r;
+    r.map = mapNodesToSkeleton(mesh.positions(), skeleton, params.origin);
+    r.weights.assign(mesh.vertexCount(), params.baseWeight);
+    for (const BrushStroke& s : strokes)
+        applyBrushStroke(mesh.positions(), skeleton, r.map, s, params, r.weights, &r.report);
+    r.report.fallbackNodes = r.map.fallbackNodes.size();
+    const auto [lo, hi] = std::minmax_element(r.weights.begin(), r.weights.end());
+    r.report.minWeight = *lo;
+    r.report.maxWeight = *hi;
+    return r;
+}
+
+} // namespace viscera::sim
