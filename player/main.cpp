@@ -40,7 +40,7 @@ void usage(std::FILE* out) {
     std::fputs("usage: viscera-player verify <case.vcase>\n"
                "       viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]\n"
                "                      [--report report.json] [--screenshot out.png] [--trace trace.csv]\n"
-               "                      [--realtime] [--servo sleep|busy|busy:CPU]\n"
+               "                      [--realtime] [--servo sleep|spin:US|busy|busy:CPU]\n"
                "       SPEC: replay:<file> | scripted:<name> | console:<host:port> | keyboard\n"
                "       viscera-player --version\n",
                out);
@@ -69,6 +69,7 @@ int cmdRun(const std::vector<std::string>& args) {
     bool headless = false, realtime = false, framesGiven = false;
     haptics::ServoWait servoWait = haptics::ServoWait::SleepSpin;
     int servoCpu = -1;
+    int64_t servoSpinNs = -1;
     int frames = 300;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
@@ -93,6 +94,14 @@ int cmdRun(const std::vector<std::string>& args) {
         else if (a == "--servo") {
             const std::string v = value("--servo");
             if (v == "sleep") servoWait = haptics::ServoWait::SleepSpin;
+            else if (v.rfind("spin:", 0) == 0) { // sleep, then spin the last US microseconds
+                char* end = nullptr;
+                const long us = std::strtol(v.c_str() + 5, &end, 10);
+                if (v.size() == 5 || *end != '\0' || us < 0 || us > 1000)
+                    throw std::invalid_argument("--servo '" + v + "': the spin must be an integer in [0, 1000] microseconds");
+                servoWait = haptics::ServoWait::SleepSpin;
+                servoSpinNs = int64_t(us) * 1000;
+            }
             else if (v == "busy") servoWait = haptics::ServoWait::Busy;
             else if (v.rfind("busy:", 0) == 0) {
                 char* end = nullptr;
@@ -102,7 +111,7 @@ int cmdRun(const std::vector<std::string>& args) {
                                                 std::to_string(sysconf(_SC_NPROCESSORS_ONLN) - 1) + "]");
                 servoWait = haptics::ServoWait::Busy;
                 servoCpu = static_cast<int>(c);
-            } else throw std::invalid_argument("--servo '" + v + "': expected sleep, busy or busy:CPU");
+            } else throw std::invalid_argument("--servo '" + v + "': expected sleep, spin:US, busy or busy:CPU");
         }
         else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option '" + a + "'");
         else if (!casePath) casePath = a;
@@ -132,6 +141,7 @@ int cmdRun(const std::vector<std::string>& args) {
     opts.keepTrace = tracePath.has_value();
     opts.servoWait = servoWait;
     opts.servoCpu = servoCpu;
+    opts.servoSpinNs = servoSpinNs;
     player::SessionResult result;
     if (headless) {
         std::fprintf(stderr, "viscera-player: running %s for %d frames%s\n", casePath->c_str(), frames,

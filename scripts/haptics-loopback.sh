@@ -5,8 +5,9 @@
 #
 #   scripts/haptics-loopback.sh [seconds=60] [build-dir=build] [out-dir=out/haptics-loopback] [servo=sleep]
 #
-# servo: "sleep" (sleep, then spin the last 0.7 ms: shares the CPU) or "busy[:CPU]" (spin the
-# whole period on a CPU of its own; for a console PC with a core set aside).
+# servo: "sleep" (sleep, then spin the last 0.94 ms), "spin:US" (the same with a
+# spin of US microseconds) or "busy[:CPU]" (spin the whole period on a CPU of its own; for a
+# console PC with a core set aside).
 set -euo pipefail
 secs="${1:-60}"
 build="${2:-${VISCERA_BUILD_DIR:-build}}"

@@ -50,7 +50,7 @@ enum class ServoWait {
 struct ServoConfig {
     double rateHz = 1000.0;
     ServoWait wait = ServoWait::SleepSpin;
-    int64_t spin_ns = 700'000;   ///< SleepSpin: wake this early and spin to the deadline (see servo_loop.cpp)
+    int64_t spin_ns = 940'000;   ///< SleepSpin: wake this early and spin to the deadline (see servo_loop.cpp)
     int cpu = -1;                ///< pin the servo thread to this CPU (-1: Busy → the last CPU, SleepSpin → none)
     bool realtimePriority = true;   ///< try SCHED_FIFO for the servo thread (ignored when refused)
     SafetyLimits safety;
@@ -84,6 +84,7 @@ struct ServoStats {
     bool realtimePriority = false; ///< SCHED_FIFO was granted
     ServoWait wait = ServoWait::SleepSpin;
     int cpu = -1;                  ///< CPU the thread was pinned to (-1: not pinned)
+    int64_t spinNs = 0;            ///< SleepSpin: spin before each deadline
     std::string priorityNote;      ///< why SCHED_FIFO was not used, when it was not
     Distribution period;          ///< tick-to-tick interval
     Distribution jitter;          ///< |period − nominal|

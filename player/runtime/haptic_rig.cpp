@@ -62,9 +62,10 @@ HapticRig::~HapticRig() {
     if (m_servo) m_servo->stop();
 }
 
-void HapticRig::setServoWait(haptics::ServoWait wait, int cpu) {
+void HapticRig::setServoWait(haptics::ServoWait wait, int cpu, int64_t spinNs) {
     m_servoConfig.wait = wait;
     m_servoConfig.cpu = cpu;
+    if (spinNs >= 0) m_servoConfig.spin_ns = spinNs;
 }
 
 void HapticRig::configure(double dt) {

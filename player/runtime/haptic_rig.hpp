@@ -76,8 +76,8 @@ public:
     HapticRig(haptics::Device& device, std::string spec, sim::World& world, bool realtime, bool keepTrace);
     ~HapticRig();
     /// Before configure(): how the servo thread waits. Busy pins the servo thread to `cpu` (-1:
-    /// the last CPU) and keeps the physics thread off that CPU.
-    void setServoWait(haptics::ServoWait wait, int cpu);
+    /// the last CPU) and keeps the physics thread off that CPU; spinNs >= 0 sets SleepSpin's spin.
+    void setServoWait(haptics::ServoWait wait, int cpu, int64_t spinNs = -1);
     /// dt: the scene's physics period (s). Creates the servo loop; call once before start().
     void configure(double dt);
     /// Starts the servo thread (real time) and publishes the initial contact model.

@@ -43,6 +43,7 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
         servo["realtime_priority"] = s.realtimePriority;
         servo["wait"] = s.wait == haptics::ServoWait::Busy ? "busy" : "sleep";
         servo["cpu"] = s.cpu;
+        if (s.wait == haptics::ServoWait::SleepSpin) servo["spin_us"] = s.spinNs / 1000;
         if (!s.priorityNote.empty()) servo["priority_note"] = s.priorityNote;
         servo["period_us"] = distribution(s.period);
         servo["jitter_us"] = distribution(s.jitter);

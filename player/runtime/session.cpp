@@ -81,7 +81,7 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     std::unique_ptr<HapticRig> rig;
     if (options.device) {
         rig = std::make_unique<HapticRig>(*options.device, options.deviceSpec, world, options.realtime, options.keepTrace);
-        rig->setServoWait(options.servoWait, options.servoCpu);
+        rig->setServoWait(options.servoWait, options.servoCpu, options.servoSpinNs);
         rig->configure(loaded.scene.xpbd.dt);
         r.activeSubsystems.push_back("haptics");
     }

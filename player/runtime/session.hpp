@@ -48,6 +48,7 @@ struct RunOptions {
     /// How the servo thread waits (--servo sleep|busy[:CPU]); cpu -1 = default.
     haptics::ServoWait servoWait = haptics::ServoWait::SleepSpin;
     int servoCpu = -1;
+    int64_t servoSpinNs = -1; ///< SleepSpin: spin this long before each deadline (-1: default 0.94 ms)
     const std::atomic<bool>* stop = nullptr; ///< set by the window when the trainee closes it
     LiveView* live = nullptr;     ///< filled every frame when set
 };

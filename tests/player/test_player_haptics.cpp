@@ -253,7 +253,11 @@ TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
                          "--realtime", "--report", s / "r2.json"});
     ASSERT_EQ(sleep.exitCode, 0) << sleep.err;
     EXPECT_EQ(readJson(s / "r2.json")["haptics"]["servo"]["wait"], "sleep");
-    for (const char* bad : {"busy:", "busy:x", "busy:-1", "busy:4096", "spin"}) {
+    auto spin = player({"run", s / "slab.vcase", "--headless", "--frames", "10", "--device", "scripted:press",
+                        "--realtime", "--servo", "spin:900", "--report", s / "r3.json"});
+    ASSERT_EQ(spin.exitCode, 0) << spin.err;
+    EXPECT_EQ(readJson(s / "r3.json")["haptics"]["servo"]["spin_us"], 900);
+    for (const char* bad : {"busy:", "busy:x", "busy:-1", "busy:4096", "spin", "spin:", "spin:2000", "spin:-5"}) {
         auto b = player({"run", s / "slab.vcase", "--headless", "--frames", "1", "--servo", bad});
         EXPECT_EQ(b.exitCode, 2) << bad;
         EXPECT_THAT(b.err, HasSubstr("--servo")) << bad;
