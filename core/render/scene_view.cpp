@@ -158,6 +158,11 @@ void SceneView::updateFromWorld(const sim::World& world) {
             m.positions[3 * v + 2] = float(p.z());
         }
         recomputeNormals(i);
+        // Energized dissection [A §5.3.1]: cut faces are dropped from the same buffers.
+        if (m.source == RenderMesh::Source::Surface && world.interaction() && world.interaction()->dissects()) {
+            world.interaction()->surfaceFaceMaskInto(m.sourceIndex, m_maskScratch);
+            if (m_maskScratch.size() == m.triangleCount()) setFaceMask(i, m_maskScratch);
+        }
     }
 }
 

@@ -72,7 +72,8 @@ public:
     uint32_t addMaterial(const TissueMaterial& material);
 
     /// Copies the current positions of `world` into the meshes that came from it and recomputes
-    /// their normals. Allocation-free. Meshes whose source index is out of range are left as they are.
+    /// their normals, and applies the dissection face masks of surfaces the world cuts. Meshes whose
+    /// source index is out of range are left as they are.
     void updateFromWorld(const sim::World& world);
 
     /// Sets the heat of every vertex of mesh `i` (values clamped to [0, 1]); `heat` has #V entries
@@ -99,6 +100,7 @@ public:
 private:
     std::vector<RenderMesh> m_meshes;
     std::vector<TissueMaterial> m_materials;
+    std::vector<uint8_t> m_maskScratch; ///< updateFromWorld: the dissection mask of a surface
 };
 
 } // namespace viscera::render

@@ -12,6 +12,7 @@
 #endif
 
 #include "bake/skeleton.hpp"
+#include "bake/surface_check.hpp"
 
 #include "sim/util/error.hpp"
 
@@ -173,14 +174,6 @@ namespace PMP = CGAL::Polygon_mesh_processing;
     throw InputError(label + ": " + message);
 }
 
-std::string edgeName(int32_t a, int32_t b) {
-    return "edge (" + std::to_string(a) + ", " + std::to_string(b) + ")";
-}
-
-uint64_t edgeKey(int32_t a, int32_t b) {
-    return (static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32) | static_cast<uint32_t>(b);
-}
-
 void requireParam(bool ok, const char* field, double value, const char* rule) {
     if (!ok)
         throw std::invalid_argument(std::string("bake::extractSkeleton(): SkeletonParams::") + field + " is " +
@@ -201,57 +194,6 @@ void validateParams(const SkeletonParams& p) {
                  "mediallyCenteredSpeedTradeoff", p.mediallyCenteredSpeedTradeoff, "must be finite and > 0");
 }
 
-/// Closed, consistently oriented, manifold: every edge in exactly two triangles traversing it in
-/// opposite directions, every vertex a single fan.
-void checkTopology(const std::string& label, const sim::TriMesh& surface) {
-    const auto& tris = surface.triangles();
-    const int32_t nt = static_cast<int32_t>(tris.size());
-    std::unordered_map<uint64_t, int32_t> undirected;
-    undirected.reserve(tris.size() * 2);
-    for (int32_t t = 0; t < nt; ++t)
-        for (int k = 0; k < 3; ++k) {
-            const int32_t a = tris[t][k], b = tris[t][(k + 1) % 3];
-            if (++undirected[edgeKey(std::min(a, b), std::max(a, b))] > 2)
-                fail(label, "surface is not manifold: " + edgeName(std::min(a, b), std::max(a, b)) +
-                                " is shared by more than two triangles (triangle " + std::to_string(t) +
-                                " is the third; a closed surface has 2)");
-        }
-    std::unordered_map<uint64_t, int32_t> directed;
-    directed.reserve(tris.size() * 3);
-    for (int32_t t = 0; t < nt; ++t)
-        for (int k = 0; k < 3; ++k) {
-            const int32_t a = tris[t][k], b = tris[t][(k + 1) % 3];
-            const auto [it, inserted] = directed.try_emplace(edgeKey(a, b), t);
-            if (!inserted)
-                fail(label, "surface is not consistently oriented: " + edgeName(a, b) +
-                                " is traversed in the same direction by triangles " + std::to_string(it->second) +
-                                " and " + std::to_string(t));
-        }
-    for (int32_t t = 0; t < nt; ++t)
-        for (int k = 0; k < 3; ++k) {
-            const int32_t a = tris[t][k], b = tris[t][(k + 1) % 3];
-            if (!directed.contains(edgeKey(b, a)))
-                fail(label, "surface is not closed: " + edgeName(a, b) + " belongs to only one triangle (" +
-                                std::to_string(t) + ")");
-        }
-    std::vector<char> visited(tris.size() * 3, 0);
-    std::vector<int32_t> fans(surface.vertexCount(), 0);
-    for (int32_t t = 0; t < nt; ++t)
-        for (int i = 0; i < 3; ++i) {
-            if (visited[3 * t + i]) continue;
-            const int32_t v = tris[t][i];
-            if (++fans[v] > 1)
-                fail(label, "surface is not manifold at vertex " + std::to_string(v) +
-                                ": its triangles form more than one fan (surfaces touch there)");
-            int32_t ct = t, ci = i;
-            while (!visited[3 * ct + ci]) {
-                visited[3 * ct + ci] = 1;
-                const int32_t prev = tris[ct][(ci + 2) % 3];
-                ct = directed.at(edgeKey(v, prev));
-                ci = tris[ct][0] == v ? 0 : tris[ct][1] == v ? 1 : 2;
-            }
-        }
-}
 
 double secondsSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -277,7 +219,7 @@ SkeletonResult extractSkeleton(const sim::TriMesh& surface, const SkeletonParams
             if (v < 0 || static_cast<size_t>(v) >= surface.vertexCount())
                 fail(label, "triangle " + std::to_string(t) + " references vertex " + std::to_string(v) +
                                 " (the surface has " + std::to_string(surface.vertexCount()) + " vertices)");
-    checkTopology(label, surface);
+    detail::checkClosedManifold(label, surface);
 
     // Normalized frame: bounding-box centre at the origin, unit diagonal.
     std::vector<char> used(surface.vertexCount(), 0);

@@ -9,6 +9,7 @@
 #endif
 
 #include "bake/tetrahedralize.hpp"
+#include "bake/surface_check.hpp"
 
 #include "sim/util/error.hpp"
 
@@ -53,14 +54,6 @@ constexpr double kRegularTetVolumePerR3 = 0.5132002392796673;
     throw InputError(label + ": " + message);
 }
 
-std::string edgeName(int32_t a, int32_t b) {
-    return "edge (" + std::to_string(a) + ", " + std::to_string(b) + ")";
-}
-
-uint64_t edgeKey(int32_t a, int32_t b) {
-    return (static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32) | static_cast<uint32_t>(b);
-}
-
 void requireParam(bool ok, const char* field, double value, const char* rule) {
     if (!ok)
         throw std::invalid_argument(std::string("bake::tetrahedralize(): MeshingParams::") + field +
@@ -86,69 +79,6 @@ void validateParams(const MeshingParams& p) {
                  static_cast<double>(p.maxEstimatedTets), "must be > 0");
 }
 
-/// Topological checks on the indexed triangles: every edge shared by exactly two triangles that
-/// traverse it in opposite directions, and every vertex a single fan of triangles.
-void checkTopology(const std::string& label, const sim::TriMesh& surface) {
-    const auto& tris = surface.triangles();
-    const int32_t nt = static_cast<int32_t>(tris.size());
-
-    std::unordered_map<uint64_t, std::array<int32_t, 3>> undirected; // count, first two tris
-    undirected.reserve(tris.size() * 2);
-    for (int32_t t = 0; t < nt; ++t)
-        for (int k = 0; k < 3; ++k) {
-            const int32_t a = tris[t][k], b = tris[t][(k + 1) % 3];
-            auto& u = undirected[edgeKey(std::min(a, b), std::max(a, b))];
-            if (u[0] < 2) u[1 + u[0]] = t;
-            ++u[0];
-        }
-    for (int32_t t = 0; t < nt; ++t)
-        for (int k = 0; k < 3; ++k) {
-            const int32_t a = std::min(tris[t][k], tris[t][(k + 1) % 3]);
-            const int32_t b = std::max(tris[t][k], tris[t][(k + 1) % 3]);
-            const auto& u = undirected.at(edgeKey(a, b));
-            if (u[0] > 2)
-                fail(label, "surface is not manifold: " + edgeName(a, b) + " is shared by " +
-                                std::to_string(u[0]) + " triangles (a closed surface has 2)");
-        }
-
-    std::unordered_map<uint64_t, int32_t> directed; // directed edge -> its triangle
-    directed.reserve(tris.size() * 3);
-    for (int32_t t = 0; t < nt; ++t)
-        for (int k = 0; k < 3; ++k) {
-            const int32_t a = tris[t][k], b = tris[t][(k + 1) % 3];
-            const auto [it, inserted] = directed.try_emplace(edgeKey(a, b), t);
-            if (!inserted)
-                fail(label, "surface is not consistently oriented: " + edgeName(a, b) +
-                                " is traversed in the same direction by triangles " +
-                                std::to_string(it->second) + " and " + std::to_string(t));
-        }
-    for (int32_t t = 0; t < nt; ++t)
-        for (int k = 0; k < 3; ++k) {
-            const int32_t a = tris[t][k], b = tris[t][(k + 1) % 3];
-            if (!directed.contains(edgeKey(b, a)))
-                fail(label, "surface is not closed: " + edgeName(a, b) +
-                                " belongs to only one triangle (" + std::to_string(t) + ")");
-        }
-
-    // Fans: rotate around each vertex through the triangle owning the reversed previous edge.
-    std::vector<char> visited(tris.size() * 3, 0);
-    std::vector<int32_t> fans(surface.vertexCount(), 0);
-    for (int32_t t = 0; t < nt; ++t)
-        for (int i = 0; i < 3; ++i) {
-            if (visited[3 * t + i]) continue;
-            const int32_t v = tris[t][i];
-            if (++fans[v] > 1)
-                fail(label, "surface is not manifold at vertex " + std::to_string(v) +
-                                ": its triangles form more than one fan (surfaces touch there)");
-            int32_t ct = t, ci = i;
-            while (!visited[3 * ct + ci]) {
-                visited[3 * ct + ci] = 1;
-                const int32_t prev = tris[ct][(ci + 2) % 3];
-                ct = directed.at(edgeKey(v, prev));
-                ci = tris[ct][0] == v ? 0 : tris[ct][1] == v ? 1 : 2;
-            }
-        }
-}
 
 /// Builds the CGAL surface from the referenced vertices; checks degenerate triangles and
 /// self-intersections (the indices in messages are those of the input TriMesh).
@@ -289,7 +219,7 @@ TetrahedralizeResult tetrahedralize(const sim::TriMesh& surface, const MeshingPa
                 fail(label, "triangle " + std::to_string(t) + " references vertex " +
                                 std::to_string(v) + " (the surface has " +
                                 std::to_string(surface.vertexCount()) + " vertices)");
-    checkTopology(label, surface);
+    detail::checkClosedManifold(label, surface);
     try {
         SurfaceMesh sm = buildSurfaceMesh(label, surface);
         report.surfaceVolume = std::abs(surface.signedVolume());

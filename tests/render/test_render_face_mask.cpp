@@ -2,6 +2,7 @@
 // into the existing index buffer; nothing is reallocated and the vertex count never changes.
 #include "render/renderer.hpp"
 #include "sim/mesh/generators.hpp"
+#include "sim/scene/interaction_rig.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -88,4 +89,25 @@ TEST(FaceMask, WrongSizeNamesTheMesh) {
             e.what(),
             HasSubstr("render::SceneView::setFaceMask(): mesh box has 12 triangles, got 5 flags"));
     }
+}
+
+// The World's dissection reaches the renderer: SceneView::updateFromWorld applies the cut faces of
+// the fascia as its face mask (same triangle order as the simulated surface).
+TEST(FaceMask, UpdateFromWorldDropsTheFasciaFacesTheHookCut) {
+    using namespace viscera::sim;
+    std::unique_ptr<World> w = test::assemble(test::makeRig());
+    SceneView view = SceneView::fromWorld(*w);
+    size_t fascia = view.meshes().size();
+    for (size_t i = 0; i < view.meshes().size(); ++i)
+        if (view.meshes()[i].name == "fascia") fascia = i;
+    ASSERT_LT(fascia, view.meshes().size());
+    const size_t all = view.meshes()[fascia].triangleCount();
+    EXPECT_EQ(view.meshes()[fascia].drawnTriangleCount(), all);
+    for (int f = 0; f < 20; ++f) w->step();
+    view.updateFromWorld(*w);
+    const int cut = w->interaction()->summary().fasciaTrianglesCut;
+    ASSERT_GT(cut, 0);
+    EXPECT_EQ(view.meshes()[fascia].drawnTriangleCount(), all - size_t(cut));
+    for (const RenderMesh& m : view.meshes())
+        if (m.name != "fascia") EXPECT_EQ(m.drawnTriangleCount(), m.triangleCount()) << m.name;
 }
