@@ -41,6 +41,19 @@ bool pinCurrentThread(int cpu) {
     return pthread_setaffinity_np(pthread_self(), sizeof(set), &set) == 0;
 }
 
+} // namespace
+
+bool pinCurrentThreadExcept(int cpu) {
+    const int n = onlineCpuCount();
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    for (int c = 0; c < n && c < CPU_SETSIZE; ++c)
+        if (c != cpu) CPU_SET(c, &set);
+    return CPU_COUNT(&set) > 0 && pthread_setaffinity_np(pthread_self(), sizeof(set), &set) == 0;
+}
+
+namespace {
+
 /// True when the kernel limits real-time tasks to a share of each period (the default 95 %).
 bool realtimeThrottled() {
     std::FILE* f = std::fopen("/proc/sys/kernel/sched_rt_runtime_us", "r");
@@ -86,7 +99,9 @@ Distribution ServoLoop::Histogram::summary() const {
 
 ServoLoop::ServoLoop(Device& device, const Clock& clock, const ServoConfig& config)
     : m_device(device), m_clock(clock), m_config(config), m_safety(device.capabilities(), config.safety),
-      m_trace(config.traceCapacity) {}
+      m_trace(config.traceCapacity) {
+    if (m_config.wait == ServoWait::Busy && m_config.cpu < 0) m_config.cpu = onlineCpuCount() - 1;
+}
 
 ServoLoop::~ServoLoop() { stop(); }
 
@@ -199,8 +214,7 @@ void ServoLoop::stop() {
 
 void ServoLoop::run() {
     const bool busy = m_config.wait == ServoWait::Busy;
-    int cpu = m_config.cpu;
-    if (busy && cpu < 0) cpu = onlineCpuCount() - 1;
+    const int cpu = m_config.cpu; // resolved at construction for Busy
     if (cpu >= 0 && pinCurrentThread(cpu)) m_cpu.store(cpu, std::memory_order_relaxed);
     if (m_config.realtimePriority) {
         if (busy && realtimeThrottled()) {

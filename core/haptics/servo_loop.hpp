@@ -51,7 +51,7 @@ struct ServoConfig {
     double rateHz = 1000.0;
     ServoWait wait = ServoWait::SleepSpin;
     int64_t spin_ns = 940'000;   ///< SleepSpin: wake this early and spin to the deadline (see servo_loop.cpp)
-    int cpu = -1;                ///< pin the servo thread to this CPU (-1: Busy → the last CPU, SleepSpin → none)
+    int cpu = -1;                ///< pin the servo thread to this CPU (-1: Busy → the last CPU, SleepSpin → none; ServoLoop::config() has it resolved)
     bool realtimePriority = true;   ///< try SCHED_FIFO for the servo thread (ignored when refused)
     SafetyLimits safety;
     std::array<ToolMapping, kMaxArms> tools{};
@@ -96,6 +96,10 @@ struct ServoStats {
     SafetyCounts safety;
     uint64_t traceDropped = 0;
 };
+
+/// Keeps the calling thread off `cpu` (e.g. the physics thread off a Busy servo's CPU). False when
+/// the system refuses or no other CPU is online.
+bool pinCurrentThreadExcept(int cpu);
 
 class ServoLoop {
 public:

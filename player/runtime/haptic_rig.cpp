@@ -5,7 +5,6 @@
 #include <pthread.h>
 #include <sched.h>
 #include <time.h>
-#include <unistd.h>
 
 namespace viscera::player {
 namespace {
@@ -108,13 +107,7 @@ void HapticRig::start() {
         m_servo->start();
         if (m_servoConfig.wait == haptics::ServoWait::Busy) {
             // Keep the physics thread off the servo's CPU (it spins there the whole period).
-            const long n = sysconf(_SC_NPROCESSORS_ONLN);
-            const int servoCpu = m_servoConfig.cpu >= 0 ? m_servoConfig.cpu : int(n) - 1;
-            cpu_set_t set;
-            CPU_ZERO(&set);
-            for (int c = 0; c < n && c < CPU_SETSIZE; ++c)
-                if (c != servoCpu) CPU_SET(c, &set);
-            if (CPU_COUNT(&set) > 0) pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
+            haptics::pinCurrentThreadExcept(m_servo->config().cpu);
         }
     }
 }

@@ -30,12 +30,12 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
                              "', which is not in the package");
         meshes.push_back(sim::parseVtet(pkg.read(b.meshPath), pkg.name() + ":" + b.meshPath));
     }
-    for (sim::BodyDesc& b : out.scene.bodies) { // painted stiffness weights travel as files
+    for (size_t i = 0; i < out.scene.bodies.size(); ++i) { // painted stiffness weights travel as files
+        sim::BodyDesc& b = out.scene.bodies[i];
         if (b.nodeWeightsPath.empty()) continue;
         if (!pkg.contains(b.nodeWeightsPath))
             throw InputError(pkg.name() + ": " + sceneName + ": body '" + b.name + "' uses node weights '" +
                              b.nodeWeightsPath + "', which are not in the package");
-        const size_t i = static_cast<size_t>(&b - out.scene.bodies.data());
         b.nodeWeights = sim::parseNodeWeights(pkg.read(b.nodeWeightsPath), pkg.name() + ":" + b.nodeWeightsPath,
                                               meshes[i]->vertexCount());
     }

@@ -406,22 +406,10 @@ Project loadProject(const std::filesystem::path& dir) {
         }
     }
     if (p.interaction) { // names are checked now, before any meshing
-        auto isBody = [&](const std::string& n) {
-            return std::any_of(p.bodies.begin(), p.bodies.end(), [&](const BodyProject& b) { return b.name == n; });
-        };
-        auto isSurface = [&](const std::string& n) {
-            return std::any_of(p.surfaces.begin(), p.surfaces.end(), [&](const SurfaceProject& sp) { return sp.name == n; });
-        };
-        for (size_t i = 0; i < p.interaction->instruments.size(); ++i) {
-            const sim::InstrumentDesc& in = p.interaction->instruments[i];
-            if (in.kind == sim::InstrumentDesc::Kind::ClipApplier && !isBody(in.target))
-                f.fail("interaction.instruments[" + std::to_string(i) + "].target",
-                       "'" + in.target + "' is not a body of the scene");
-        }
-        for (size_t i = 0; i < p.interaction->tissues.size(); ++i)
-            if (!isBody(p.interaction->tissues[i].layer) && !isSurface(p.interaction->tissues[i].layer))
-                f.fail("interaction.tissues[" + std::to_string(i) + "].layer",
-                       "'" + p.interaction->tissues[i].layer + "' is not a body or surface of the scene");
+        std::vector<std::string> bodies, surfaces;
+        for (const BodyProject& b : p.bodies) bodies.push_back(b.name);
+        for (const SurfaceProject& sp : p.surfaces) surfaces.push_back(sp.name);
+        sim::checkInteractionNames(*p.interaction, bodies, surfaces, origin);
     }
     return p;
 }

@@ -242,7 +242,9 @@ TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
     EXPECT_GT(servo["ticks"].get<int>(), 500);
     // A real-time spinner is only used where the kernel does not throttle real-time tasks; the
     // report says why when the servo thread did not get SCHED_FIFO.
-    if (!servo["realtime_priority"].get<bool>()) EXPECT_TRUE(servo.contains("priority_note"));
+    if (!servo["realtime_priority"].get<bool>()) {
+        EXPECT_TRUE(servo.contains("priority_note"));
+    }
     std::ifstream rt("/proc/sys/kernel/sched_rt_runtime_us");
     long runtime = 0;
     if (rt >> runtime && runtime >= 0) {

@@ -109,5 +109,7 @@ TEST(FaceMask, UpdateFromWorldDropsTheFasciaFacesTheHookCut) {
     ASSERT_GT(cut, 0);
     EXPECT_EQ(view.meshes()[fascia].drawnTriangleCount(), all - size_t(cut));
     for (const RenderMesh& m : view.meshes())
-        if (m.name != "fascia") EXPECT_EQ(m.drawnTriangleCount(), m.triangleCount()) << m.name;
+        if (m.name != "fascia") {
+            EXPECT_EQ(m.drawnTriangleCount(), m.triangleCount()) << m.name;
+        }
 }

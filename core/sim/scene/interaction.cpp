@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -111,6 +112,19 @@ InteractionDesc parseInteractionSection(std::string_view text, const std::string
     if (d.has(InstrumentDesc::Kind::EnergyHook) && d.tissues.empty())
         r.fail("tissues", "an energy_hook needs at least one tissue with an ignition temperature");
     return d;
+}
+
+void checkInteractionNames(const InteractionDesc& d, const std::vector<std::string>& bodies,
+                           const std::vector<std::string>& surfaces, const std::string& origin) {
+    const detail::SectionReader r{origin, "interaction"};
+    auto in = [](const std::vector<std::string>& v, const std::string& n) { return std::find(v.begin(), v.end(), n) != v.end(); };
+    for (size_t i = 0; i < d.instruments.size(); ++i)
+        if (d.instruments[i].kind == InstrumentDesc::Kind::ClipApplier && !in(bodies, d.instruments[i].target))
+            r.fail("instruments[" + std::to_string(i) + "].target", "'" + d.instruments[i].target + "' is not a body of the scene");
+    for (size_t i = 0; i < d.tissues.size(); ++i)
+        if (!in(bodies, d.tissues[i].layer) && !in(surfaces, d.tissues[i].layer))
+            r.fail("tissues[" + std::to_string(i) + "].layer",
+                   "'" + d.tissues[i].layer + "' is not a body or surface of the scene");
 }
 
 std::string formatInteractionSection(const InteractionDesc& d) {

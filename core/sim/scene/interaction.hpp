@@ -64,6 +64,10 @@ struct InteractionDesc {
 /// `json` is the text of the section object. Throws viscera::InputError
 /// "<origin>: interaction.<field>: <rule>".
 InteractionDesc parseInteractionSection(std::string_view json, const std::string& origin);
+/// Checks the names the section refers to: every clip target a tet body, every tissue layer a body
+/// or a surface. Throws viscera::InputError "<origin>: interaction.<field>: <rule>".
+void checkInteractionNames(const InteractionDesc& desc, const std::vector<std::string>& bodies,
+                           const std::vector<std::string>& surfaces, const std::string& origin);
 /// The section object as JSON text (parseInteractionSection reads it back).
 std::string formatInteractionSection(const InteractionDesc& desc);
 const char* kindName(InstrumentDesc::Kind k);

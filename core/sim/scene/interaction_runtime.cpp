@@ -57,6 +57,7 @@ struct InteractionRuntime::Instrument {
     std::vector<Vec3> heldLocal;                  ///< in the instrument frame at the grasp
     ToolShape::Pose pose = ToolShape::Pose::Identity();
     // clip applier
+    size_t target = 0; ///< tet body it clips
     bool fired = false;
     int contacts = 0;
 };
@@ -82,7 +83,6 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
     std::unique_ptr<InteractionRuntime> r(new InteractionRuntime());
     r->m_sys = &system;
     r->m_bodies = bodies;
-    for (const auto& b : scene.bodies) r->m_bodyNames.push_back(b.name);
 
     // Collision surface: the first surface layer, else the boundary of the first tet body.
     CollisionSurfaceDesc surface;
@@ -126,6 +126,7 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
             while (b < scene.bodies.size() && scene.bodies[b].name != in->desc.target) ++b;
             if (b == scene.bodies.size())
                 fail("instruments[" + std::to_string(i) + "].target", "'" + in->desc.target + "' is not a body");
+            in->target = b;
             break;
         }
         }
@@ -226,7 +227,7 @@ void InteractionRuntime::beforeStep(double t, double dt) {
         if (in.desc.kind == InstrumentDesc::Kind::ClipApplier && !in.fired && in.key.act) {
             in.fired = true;
             auto c = std::make_unique<Clip>();
-            while (c->body < m_bodyNames.size() && m_bodyNames[c->body] != in.desc.target) ++c->body;
+            c->body = in.target;
             const std::vector<Vec3>& x = m_sys->tetPositions(c->body);
             // Clip frame: the vessel's local axis (principal direction of its nodes near the
             // tip), the jaw normal across it and the shaft, the closing direction between them.

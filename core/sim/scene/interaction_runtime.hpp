@@ -96,7 +96,6 @@ private:
 
     XpbdSystem* m_sys = nullptr;
     std::vector<const TetMesh*> m_bodies;
-    std::vector<std::string> m_bodyNames;
     std::vector<std::unique_ptr<Instrument>> m_instruments;
     std::vector<std::unique_ptr<Clip>> m_clips;
     std::unique_ptr<Dissection> m_dissection;

@@ -266,24 +266,10 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     if (doc.contains("interaction")) {
         if (scene.solverType != "xpbd") r.fail("interaction", "needs solver.type 'xpbd'");
         InteractionDesc in = parseInteractionSection(doc["interaction"].dump(), origin);
-        auto isBody = [&](const std::string& n) {
-            for (const auto& b : scene.bodies)
-                if (b.name == n) return true;
-            return false;
-        };
-        auto isSurface = [&](const std::string& n) {
-            for (const auto& sd : scene.surfaces)
-                if (sd.name == n) return true;
-            return false;
-        };
-        for (size_t i = 0; i < in.instruments.size(); ++i)
-            if (in.instruments[i].kind == InstrumentDesc::Kind::ClipApplier && !isBody(in.instruments[i].target))
-                r.fail("interaction.instruments[" + std::to_string(i) + "].target",
-                       "'" + in.instruments[i].target + "' is not a body of the scene");
-        for (size_t i = 0; i < in.tissues.size(); ++i)
-            if (!isBody(in.tissues[i].layer) && !isSurface(in.tissues[i].layer))
-                r.fail("interaction.tissues[" + std::to_string(i) + "].layer",
-                       "'" + in.tissues[i].layer + "' is not a body or surface of the scene");
+        std::vector<std::string> bodies, surfaces;
+        for (const auto& bd : scene.bodies) bodies.push_back(bd.name);
+        for (const auto& sd : scene.surfaces) surfaces.push_back(sd.name);
+        checkInteractionNames(in, bodies, surfaces, origin);
         scene.interaction = std::move(in);
     }
     return scene;
