@@ -28,7 +28,8 @@ void ConsoleDevice::poll(int64_t now_ns, DeviceState& out) {
     protocol::StatePacket pkt;
     for (int k = 0; k < m_opt.maxPacketsPerPoll; ++k) {
         Endpoint from;
-        const long n = m_socket.receive(m_rx, sizeof m_rx, &from);
+        int64_t queued = 0;
+        const long n = m_socket.receive(m_rx, sizeof m_rx, &from, &queued);
         if (n < 0) break;
         if (!(from == m_console) || n > static_cast<long>(sizeof m_rx)) {
             m_count.malformed.fetch_add(1, std::memory_order_relaxed);
@@ -57,8 +58,10 @@ void ConsoleDevice::poll(int64_t now_ns, DeviceState& out) {
         m_haveState = true;
         m_seqValid = true;
         m_lastSeq = pkt.sequence;
-        m_lastArrival_ns = now_ns;
-        m_last.timestamp_ns = now_ns;
+        // Arrival on this poll's clock: a servo tick that ran late must not take a packet that
+        // waited in the queue for a fresh one (the device timeout counts from the arrival).
+        m_lastArrival_ns = now_ns - queued;
+        m_last.timestamp_ns = m_lastArrival_ns;
         m_last.sequence += 1;
         m_last.pedals = pkt.pedals;
         for (int a = 0; a < kMaxArms; ++a) m_last.arms[a] = pkt.arm[a];

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <poll.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
 
 namespace viscera::haptics {
@@ -41,6 +42,9 @@ UdpSocket::UdpSocket(const Endpoint& local, int receiveBufferBytes) {
     m_fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
     if (m_fd < 0) throw InputError("udp " + local.text() + ": socket(): " + std::strerror(errno));
     if (receiveBufferBytes > 0) ::setsockopt(m_fd, SOL_SOCKET, SO_RCVBUF, &receiveBufferBytes, sizeof receiveBufferBytes);
+    // Arrival stamps for the queue age receive() reports; without them the age reads 0.
+    const int on = 1;
+    ::setsockopt(m_fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
     if (::bind(m_fd, reinterpret_cast<const sockaddr*>(&local.addr), sizeof local.addr) != 0) {
         const int err = errno;
         ::close(m_fd);
@@ -53,12 +57,31 @@ UdpSocket::~UdpSocket() {
     if (m_fd >= 0) ::close(m_fd);
 }
 
-long UdpSocket::receive(uint8_t* buffer, size_t capacity, Endpoint* from) noexcept {
+long UdpSocket::receive(uint8_t* buffer, size_t capacity, Endpoint* from, int64_t* queued_ns) noexcept {
     sockaddr_in src{};
-    socklen_t len = sizeof src;
-    const ssize_t n = ::recvfrom(m_fd, buffer, capacity, MSG_DONTWAIT | MSG_TRUNC, reinterpret_cast<sockaddr*>(&src), &len);
+    iovec iov{buffer, capacity};
+    alignas(cmsghdr) uint8_t control[CMSG_SPACE(sizeof(timespec))];
+    msghdr msg{};
+    msg.msg_name = &src;
+    msg.msg_namelen = sizeof src;
+    msg.msg_iov = &iov;
+    msg.msg_iovlen = 1;
+    msg.msg_control = control;
+    msg.msg_controllen = sizeof control;
+    const ssize_t n = ::recvmsg(m_fd, &msg, MSG_DONTWAIT | MSG_TRUNC);
     if (n < 0) return -1;
     if (from) from->addr = src;
+    if (queued_ns) {
+        *queued_ns = 0;
+        for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c)) {
+            if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SCM_TIMESTAMPNS) continue;
+            timespec stamp{}, now{};
+            std::memcpy(&stamp, CMSG_DATA(c), sizeof stamp);
+            clock_gettime(CLOCK_REALTIME, &now); // the kernel stamps on the realtime clock
+            const int64_t age = (int64_t(now.tv_sec) - stamp.tv_sec) * 1'000'000'000 + (now.tv_nsec - stamp.tv_nsec);
+            *queued_ns = age > 0 ? age : 0; // a realtime step backwards reads as no wait
+        }
+    }
     return static_cast<long>(n);
 }
 

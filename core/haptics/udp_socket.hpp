@@ -32,8 +32,11 @@ public:
     UdpSocket& operator=(const UdpSocket&) = delete;
 
     /// Bytes received (truncated datagrams report their full length > capacity), or -1 when
-    /// nothing is waiting. `from` may be null.
-    long receive(uint8_t* buffer, size_t capacity, Endpoint* from) noexcept;
+    /// nothing is waiting. `from` may be null. `queued_ns` (may be null) gets how long the
+    /// datagram waited in the kernel queue (its arrival stamp, SO_TIMESTAMPNS, against now;
+    /// 0 when the kernel gave no stamp), so a reader that was descheduled can tell old packets
+    /// from fresh ones on its own clock.
+    long receive(uint8_t* buffer, size_t capacity, Endpoint* from, int64_t* queued_ns = nullptr) noexcept;
     bool sendTo(const uint8_t* data, size_t size, const Endpoint& to) noexcept;
     /// Waits up to timeout_ms for a datagram (not for the servo thread). True when one waits.
     bool wait(int timeout_ms) noexcept;

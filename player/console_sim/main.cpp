@@ -9,7 +9,8 @@
 //   viscera-console-sim --write-trajectory OUT.csv --script NAME --duration S [--rate HZ]
 //
 // --pause-at/--pause-for simulate a disconnection: no state is sent during the pause (commands
-// are still recorded). Exit codes: 0 done, 1 bad input, 2 usage, 3 no player contacted it.
+// are still recorded, dated by their arrival in the kernel queue; a command with force more than
+// 250 ms after the last state actually sent counts as paused_nonzero_after_timeout). Exit codes: 0 done, 1 bad input, 2 usage, 3 no player contacted it.
 #include "haptics/clock.hpp"
 #include "haptics/console_protocol.hpp"
 #include "haptics/scripted_device.hpp"
@@ -154,7 +155,8 @@ int run(const Options& o) {
     auto drain = [&](int64_t now) {
         while (true) {
             Endpoint from;
-            const long n = sock.receive(buf, sizeof buf, &from);
+            int64_t queued = 0;
+            const long n = sock.receive(buf, sizeof buf, &from, &queued);
             if (n < 0) break;
             protocol::CommandPacket c;
             const auto e = protocol::decode(buf, n > long(sizeof buf) ? sizeof buf + 1 : size_t(n), c);
@@ -162,14 +164,17 @@ int run(const Options& o) {
                 ++rejected[static_cast<int>(e)];
                 continue;
             }
+            const int64_t arrived = monotonicNs() - queued;
             if (!havePlayer) {
                 player = from;
                 havePlayer = true;
-                t0 = now;
+                t0 = arrived;
                 std::fprintf(stderr, "viscera-console-sim: player at %s\n", player.text().c_str());
             }
             if (!(from == player)) continue;
-            const double t = 1e-9 * double(now - t0);
+            // Time the command arrived, not when this loop got to it (the figures judge the
+            // player's forces by when it sent them, whatever the load on this process).
+            const double t = 1e-9 * double(arrived - t0);
             received.push_back({t, o.pauseAt >= 0 && t >= o.pauseAt && t < o.pauseAt + o.pauseFor, c});
         }
     };
@@ -188,6 +193,7 @@ int run(const Options& o) {
     sentAt.reserve(static_cast<size_t>(duration * o.rate) + 16);
     int64_t next = t0;
     DeviceState s;
+    double lastStateBeforeResume = 0; // s after t0
     while (true) {
         const int64_t now = monotonicNs();
         const double t = 1e-9 * double(now - t0);
@@ -203,8 +209,14 @@ int run(const Options& o) {
             p.arms = static_cast<uint8_t>(src.arms());
             for (int a = 0; a < kMaxArms; ++a) p.arm[a] = s.arms[a];
             const size_t n = protocol::encode(p, buf, sizeof buf);
-            if (sock.sendTo(buf, n, player)) ++sent, sentAt.emplace_back(p.sequence, now);
-            else ++sendErrors;
+            if (sock.sendTo(buf, n, player)) {
+                ++sent, sentAt.emplace_back(p.sequence, now);
+                // When the last state before the silence really left (this process may have
+                // been descheduled between reading the clock and sending).
+                const double left = 1e-9 * double(monotonicNs() - t0);
+                if (o.pauseAt >= 0 && left < o.pauseAt + o.pauseFor) lastStateBeforeResume = std::max(lastStateBeforeResume, left);
+            } else
+                ++sendErrors;
         }
         next += period;
         sleepUntil(next);
@@ -230,7 +242,9 @@ int run(const Options& o) {
         nonZero += f > 0;
         if (r.paused) {
             ++pausedCmds;
-            if (f > 0 && r.t > o.pauseAt + 0.25) ++pausedNonZeroLate; // beyond the player's device timeout
+            // Force still commanded 250 ms after the last state the player could have had: beyond
+            // its device timeout (100 ms) and the slack of a loaded machine.
+            if (f > 0 && r.t > lastStateBeforeResume + 0.25) ++pausedNonZeroLate;
         }
         while (j < sentAt.size() && protocol::newer(r.cmd.echoSequence, sentAt[j].first)) ++j;
         if (!r.paused && j < sentAt.size() && sentAt[j].first == r.cmd.echoSequence)
@@ -263,6 +277,7 @@ int run(const Options& o) {
                           {"max_force_n", maxForce},
                           {"paused_commands", pausedCmds},
                           {"paused_nonzero_after_timeout", pausedNonZeroLate},
+                          {"last_state_before_resume_s", lastStateBeforeResume},
                           {"echo_latency_ms", {{"count", latency.size()}, {"p50", pct(0.5)}, {"p99", pct(0.99)}, {"max", latency.empty() ? 0.0 : latency.back()}}}};
     if (o.summary) writeFileAtomic(*o.summary, sum.dump(2) + "\n");
     std::printf("console-sim   %llu states sent, %zu commands received (%llu rejected), %llu non-zero, max force %.3f N\n",

@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <chrono>
 #include <random>
+#include <thread>
 #include <vector>
 
 using namespace viscera::haptics;
@@ -149,7 +151,7 @@ TEST(ConsoleDevice, DisconnectAfterTheTimeoutAndReconnect) {
     console.send(Vec3(0.01, 0, 0));
     dev.poll(10 * kMs, st);
     EXPECT_TRUE(st.connected);
-    dev.poll(60 * kMs, st);
+    dev.poll(55 * kMs, st); // the packet's microseconds in the queue count against the timeout
     EXPECT_TRUE(st.connected);
     dev.poll(61 * kMs, st);
     EXPECT_FALSE(st.connected);
@@ -161,6 +163,44 @@ TEST(ConsoleDevice, DisconnectAfterTheTimeoutAndReconnect) {
     EXPECT_TRUE(st.connected);
     EXPECT_EQ(dev.linkStats().reconnects, 1u);
     EXPECT_TRUE(st.arms[0].measured_cp.position.isApprox(Vec3(0.02, 0, 0), 1e-6));
+}
+
+TEST(ConsoleDevice, APacketThatWaitedInTheQueuePastTheTimeoutIsNotFresh) {
+    // A servo tick that runs late (the thread was descheduled) reads packets that arrived long
+    // before: the device timeout counts from their arrival, not from the read.
+    FakeConsole console;
+    ConsoleDeviceOptions opt;
+    opt.timeout_ns = 20 * kMs;
+    ConsoleDevice dev(console.address, opt);
+    console.learnPlayer(dev);
+    console.send(Vec3(0.01, 0, 0));
+    std::this_thread::sleep_for(std::chrono::milliseconds(60));
+    DeviceState st;
+    dev.poll(1000 * kMs, st);
+    EXPECT_FALSE(st.connected) << "a packet 60 ms old is past the 20 ms timeout";
+    EXPECT_EQ(dev.linkStats().received, 1u) << "it was read and counted";
+    EXPECT_GE(1000 * kMs - st.timestamp_ns, 55 * kMs) << "its arrival is dated back by its time in the queue";
+    console.send(Vec3(0.02, 0, 0));
+    dev.poll(1001 * kMs, st);
+    EXPECT_TRUE(st.connected) << "a fresh packet connects";
+}
+
+TEST(UdpSocket, ReportsHowLongADatagramWaitedInTheQueue) {
+    UdpSocket a{loopback()}, b{loopback()};
+    const uint8_t msg[4] = {1, 2, 3, 4};
+    ASSERT_TRUE(a.sendTo(msg, sizeof msg, b.local()));
+    ASSERT_TRUE(b.wait(1000));
+    std::this_thread::sleep_for(std::chrono::milliseconds(40));
+    uint8_t buf[16];
+    int64_t queued = -1;
+    ASSERT_EQ(b.receive(buf, sizeof buf, nullptr, &queued), 4);
+    EXPECT_GE(queued, 39 * kMs);
+    EXPECT_LT(queued, 10'000 * kMs);
+    ASSERT_TRUE(a.sendTo(msg, sizeof msg, b.local()));
+    ASSERT_TRUE(b.wait(1000));
+    ASSERT_EQ(b.receive(buf, sizeof buf, nullptr, &queued), 4);
+    EXPECT_GE(queued, 0);
+    EXPECT_EQ(b.receive(buf, sizeof buf, nullptr, &queued), -1) << "nothing left";
 }
 
 TEST(ConsoleDevice, AFloodOfPacketsCausesNoForceSpikeAndNoNaN) {
