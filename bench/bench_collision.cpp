@@ -1,5 +1,6 @@
 // Tool–tissue collision comparison of [A §5.2.6]: a rigid capsule is pressed into a tissue slab,
-// held, slid over it and held again; the circumsphere, bounding-sphere and polygon (1 mm margin)
+// held, slid over it and held again; the circumsphere, bounding-sphere and polygon (1 mm margin;
+// [Eri04] per-feature constraints as in the thesis, and one closest-feature constraint per pair)
 // narrow phases are compared for accuracy (relative error of the mean distance of the collided
 // vertices to the tool axis against the radius, Fig. 5.10), stability (mean per-frame position
 // change of the collided vertices, Fig. 5.12: "hold" over frames 5–40 after the press, which
@@ -32,8 +33,10 @@
 // A frame with any such vertex is a tunnelled frame.
 //
 // Run: ./build/bench/bench_collision [output-dir] [--quick]   (default ./collision_out)
-//      ./build/bench/bench_collision --trace [tool 0|1] [method 0|1|2] [iterations] [delta]
-//                                    [speed] [energy scale ς]   (one run, per-frame figures)
+//      ./build/bench/bench_collision --trace [tool 0|1] [method 0..3] [iterations] [delta]
+//                                    [speed] [energy scale ς] [h 1/m] [θ deg]
+//        (one run, per-frame figures; methods 0 circumsphere, 1 bounding sphere, 2 polygon,
+//        3 polygon_features)
 #include "line_plot.hpp"
 
 #include "sim/collision/collision_solver.hpp"
@@ -128,6 +131,8 @@ struct RunSpec {
     double speed = 0.1; // m/s, slide
     Coupling coupling = Coupling::InIteration;
     double energyScale = CircumsphereParams{}.energyScale; // ς, m (--trace only)
+    double curvatureThreshold = CircumsphereParams{}.curvatureThreshold; // h, 1/m (--trace only)
+    double safeAngle = CircumsphereParams{}.safeAngle;                   // θ, rad (--trace only)
 };
 
 struct RunResult {
@@ -177,6 +182,8 @@ RunResult run(const Slab& slab, const RunSpec& spec) {
     cs.method = spec.method;
     cs.circumsphere.updateThreshold = spec.delta;
     cs.circumsphere.energyScale = spec.energyScale;
+    cs.circumsphere.curvatureThreshold = spec.curvatureThreshold;
+    cs.circumsphere.safeAngle = spec.safeAngle;
     cs.polygonMargin = 1e-3;
     auto col =
         CollisionSolver::create(CollisionSurfaceDesc::fromTetMesh(*slab.mesh, slab.invMass), cs);
@@ -201,7 +208,7 @@ RunResult run(const Slab& slab, const RunSpec& spec) {
     ToolShape::Pose prev = toolPose(kX0, zStart), next = prev;
     tool.setPose(prev);
     double ct = 0;      // collision seconds of the frame, accumulated by the hook
-    double updates = 0; // δ refreshes, all substeps
+    double updates = 0, tracedUpdates = 0; // δ refreshes, all substeps
     if (!post)
         solver->setIterationHook([&](XpbdParticles& p, const XpbdIterationInfo& info) {
             if (info.velocityPass) {
@@ -301,10 +308,11 @@ RunResult run(const Slab& slab, const RunSpec& spec) {
             }
             for (size_t v = 0; v < x.size(); ++v) maxMove = std::max(maxMove, (x[v] - last[v]).norm());
             std::printf("  frame %3zu: contacts %3zu  mean dist %.4f  mean move %.2e  max node "
-                        "move %.2e  candidates %d  contacts(last sweep) %d\n",
+                        "move %.2e  candidates %d  contacts(last sweep) %d  factor updates %.0f\n",
                         f, cv.size(), cv.empty() ? 0.0 : d / cv.size(),
                         cv.empty() ? 0.0 : move / cv.size(), maxMove, col->stats().candidates,
-                        col->stats().contacts);
+                        col->stats().contacts, updates - tracedUpdates);
+            tracedUpdates = updates;
         }
         last = x;
     }
@@ -386,7 +394,7 @@ int main(int argc, char** argv) {
         else if (a == "--trace") g_trace = true;
         else outDir = a;
     }
-    if (g_trace) { // --trace [tool 0|1] [method 0|1|2] [iterations] [delta] [speed] [ς m]
+    if (g_trace) { // --trace [tool 0|1] [method 0..3] [iterations] [delta] [speed] [ς m] [h 1/m] [θ deg]
         const Slab slab = makeSlab();
         RunSpec s;
         auto arg = [&](int i, double def) { return argc > i ? std::atof(argv[i]) : def; };
@@ -396,6 +404,8 @@ int main(int argc, char** argv) {
         s.delta = arg(5, 0.3);
         s.speed = arg(6, 0.1);
         s.energyScale = arg(7, CircumsphereParams{}.energyScale);
+        s.curvatureThreshold = arg(8, CircumsphereParams{}.curvatureThreshold);
+        s.safeAngle = arg(9, CircumsphereParams{}.safeAngle * 180 / M_PI) * M_PI / 180;
         printHeader();
         printRow(run(slab, s));
         return 0;
@@ -414,8 +424,8 @@ int main(int argc, char** argv) {
     const std::vector<double> deltas =
         quick ? std::vector<double>{0, 0.3}
               : std::vector<double>{0, 0.1, 0.3, 0.7, 0.9, std::numeric_limits<double>::infinity()};
-    const std::vector<CollisionMethod> methods = {
-        CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere, CollisionMethod::Polygon};
+    const std::vector<CollisionMethod> methods = {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
+                                                  CollisionMethod::PolygonFeatures, CollisionMethod::Polygon};
     const std::vector<Tool> tools = {kCylinder, kShaft};
 
     // 1. The comparison table: tool × method × iterations at 0.1 m/s, device-rate poses.

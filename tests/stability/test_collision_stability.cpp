@@ -15,6 +15,9 @@ using namespace viscera::sim;
 
 namespace {
 
+const CollisionMethod kAllMethods[] = {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
+                                       CollisionMethod::Polygon, CollisionMethod::PolygonFeatures};
+
 constexpr double kFrame = 1.0 / 60.0, kTop = 0.02, kR = 0.008;
 constexpr int kSubsteps = 20;
 
@@ -136,8 +139,7 @@ TEST(CollisionStability, CircumsphereAtHalfMetrePerSecondDoesNotTunnelAndRepeats
 }
 
 TEST(CollisionStability, AllMethodsStayFiniteAtTwoMetresPerSecond) {
-    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
-                              CollisionMethod::Polygon}) {
+    for (CollisionMethod m : kAllMethods) {
         SCOPED_TRACE(toString(m));
         const Outcome a = run(m, 2.0, kTop + kR + 0.002, 0.005);
         const Outcome b = run(m, 2.0, kTop + kR + 0.002, 0.005);
@@ -146,8 +148,7 @@ TEST(CollisionStability, AllMethodsStayFiniteAtTwoMetresPerSecond) {
 }
 
 TEST(CollisionStability, ToolStartingInsideTheTissue) {
-    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
-                              CollisionMethod::Polygon}) {
+    for (CollisionMethod m : kAllMethods) {
         SCOPED_TRACE(toString(m));
         // Axis 4 mm below the top surface from the first frame on.
         // 12 mm of a 20 mm slab displaced at once: bounded, not small.
@@ -161,8 +162,7 @@ TEST(CollisionStability, ToolStartingInsideTheTissue) {
 // finite, energy and displacement bounded (measured: up to 0.068 J with the bounding sphere in
 // the first slide frame), repeat runs bit-identical.
 TEST(CollisionStability, InIterationAllMethodsStayFiniteAtTwoMetresPerSecond) {
-    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
-                              CollisionMethod::Polygon}) {
+    for (CollisionMethod m : kAllMethods) {
         SCOPED_TRACE(toString(m));
         const Outcome a = run(m, 2.0, kTop + kR + 0.002, 0.005, 0.5, 0.04, true);
         const Outcome b = run(m, 2.0, kTop + kR + 0.002, 0.005, 0.5, 0.04, true);
@@ -171,8 +171,7 @@ TEST(CollisionStability, InIterationAllMethodsStayFiniteAtTwoMetresPerSecond) {
 }
 
 TEST(CollisionStability, InIterationToolStartingInsideTheTissue) {
-    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
-                              CollisionMethod::Polygon}) {
+    for (CollisionMethod m : kAllMethods) {
         SCOPED_TRACE(toString(m));
         run(m, 0.5, kTop - 0.004, 0.012, 0.5, 0.04, true);
     }
@@ -185,8 +184,7 @@ TEST(CollisionStability, DegenerateAndSliverTriangles) {
                        Vec3(0.005, 1e-9, 0)};                                    // sliver apex
     d.triangles = {{0, 1, 2}, {3, 4, 5}, {0, 1, 6}, {0, 1, 4}};
     d.inverseMass.assign(d.restPositions.size(), 10.0);
-    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
-                              CollisionMethod::Polygon}) {
+    for (CollisionMethod m : kAllMethods) {
         SCOPED_TRACE(toString(m));
         CollisionSettings s;
         s.method = m;

@@ -14,8 +14,19 @@ const char* toString(CollisionMethod m) {
     case CollisionMethod::Circumsphere: return "circumsphere";
     case CollisionMethod::BoundingSphere: return "bounding_sphere";
     case CollisionMethod::Polygon: return "polygon";
+    case CollisionMethod::PolygonFeatures: return "polygon_features";
     }
     return "unknown";
+}
+
+bool parseCollisionMethod(const std::string& name, CollisionMethod& out) {
+    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
+                              CollisionMethod::Polygon, CollisionMethod::PolygonFeatures})
+        if (name == toString(m)) {
+            out = m;
+            return true;
+        }
+    return false;
 }
 
 std::string validate(const CollisionSettings& s) {
@@ -151,7 +162,8 @@ void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& too
     if (x.size() != m_rest.size() || !(h > 0)) return;
     m_alphaTilde = m_settings.compliance / (h * h);
     m_start = x;
-    const bool polygon = m_settings.method == CollisionMethod::Polygon;
+    const bool polygon = m_settings.method == CollisionMethod::Polygon ||
+                         m_settings.method == CollisionMethod::PolygonFeatures;
     for (size_t t = 0; t < m_tris.size(); ++t) {
         const Tri& f = m_tris[t];
         Aabb& b = m_boxes[t];
@@ -165,6 +177,7 @@ void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& too
             b.hi = s.centre + Vec3::Constant(s.radius);
         }
     }
+
     m_hash->build(m_boxes);
     const auto tb = tool.bounds();
     m_hash->queryInto(Aabb{tb[0], tb[1]}, m_candidates);
@@ -182,7 +195,96 @@ void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& too
             }
         }
     }
-    m_lambda.assign(m_candidates.size() * tool.parts().size(), 0.0);
+
+    size_t constraints = m_candidates.size();
+    if (m_settings.method == CollisionMethod::PolygonFeatures) {
+        // Each shared vertex and edge once: sorted, unique.
+        m_candEdges.clear();
+        m_featVerts.clear();
+        for (int32_t t : m_candidates) {
+            const Tri& f = m_tris[t];
+            for (int k = 0; k < 3; ++k) {
+                m_featVerts.push_back(f[k]);
+                m_candEdges.push_back({std::min(f[k], f[(k + 1) % 3]), std::max(f[k], f[(k + 1) % 3])});
+            }
+        }
+        std::sort(m_featVerts.begin(), m_featVerts.end());
+        m_featVerts.erase(std::unique(m_featVerts.begin(), m_featVerts.end()), m_featVerts.end());
+        std::sort(m_candEdges.begin(), m_candEdges.end());
+        m_candEdges.erase(std::unique(m_candEdges.begin(), m_candEdges.end()), m_candEdges.end());
+        constraints += m_candEdges.size() + m_featVerts.size();
+    }
+    m_lambda.assign(constraints * tool.parts().size(), 0.0);
+}
+
+bool CollisionSolver::projectDistance(const int32_t* v, const double* b, int n, const Vec3& q,
+                                      double reach, const Vec3& fallback, double& lambda,
+                                      std::vector<Vec3>& x) {
+    Vec3 p = Vec3::Zero();
+    for (int k = 0; k < n; ++k) p += b[k] * x[v[k]];
+    const Vec3 d = p - q;
+    const double dist = d.norm();
+    if (!(dist < reach)) return false;
+    const Vec3 dir = dist > 1e-12 * std::max(1.0, reach) ? Vec3(d / dist) : fallback;
+    if (!(dir.squaredNorm() > 0)) return false;
+    double denom = m_alphaTilde;
+    for (int k = 0; k < n; ++k) denom += m_w[v[k]] * b[k] * b[k];
+    if (!(denom > 0)) return true;
+    const double dl = (-(dist - reach) - m_alphaTilde * lambda) / denom;
+    lambda += dl;
+    for (int k = 0; k < n; ++k) {
+        const Vec3 before = x[v[k]];
+        x[v[k]] += m_w[v[k]] * b[k] * dl * dir;
+        capCorrection(v[k], x);
+        const Vec3 dx = x[v[k]] - before;
+        m_push[v[k]] += dx;
+        m_stats.maxCorrection = std::max(m_stats.maxCorrection, dx.norm());
+        m_touched[v[k]] = 1;
+    }
+    return true;
+}
+
+int CollisionSolver::iterateFeatures(std::vector<Vec3>& x, const std::vector<Capsule>& parts) {
+    // [Eri04] primitive tests, one constraint type after the other: faces, edges, vertices.
+    const size_t np = parts.size(), nf = m_candidates.size(), ne = m_candEdges.size();
+    const double reachExtra = m_settings.polygonMargin;
+    constexpr double kInside = 1e-9; // a face contact only where the closest point is interior
+    int contacts = 0;
+    for (size_t i = 0; i < nf; ++i) {
+        const Tri& f = m_tris[m_candidates[i]];
+        const Vec3 nt = (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]);
+        if (!(nt.squaredNorm() > 0)) continue;
+        for (size_t p = 0; p < np; ++p) {
+            const Capsule& c = parts[p];
+            const SegmentTrianglePair st = closestPointsSegmentTriangle(c.a, c.b, x[f[0]], x[f[1]], x[f[2]]);
+            const Vec3& bary = st.onTriangle.bary;
+            if (!(bary.minCoeff() > kInside)) continue; // an edge or vertex feature: tested below
+            const double b[3] = {bary[0], bary[1], bary[2]};
+            contacts += projectDistance(f.data(), b, 3, st.onSegment, c.radius + reachExtra, -nt.normalized(),
+                                        m_lambda[i * np + p], x);
+        }
+    }
+    for (size_t e = 0; e < ne; ++e) {
+        const auto& ed = m_candEdges[e];
+        for (size_t p = 0; p < np; ++p) {
+            const Capsule& c = parts[p];
+            const SegmentPair sp = closestPointsSegments(x[ed[0]], x[ed[1]], c.a, c.b);
+            const double b[2] = {1 - sp.s, sp.s};
+            contacts += projectDistance(ed.data(), b, 2, sp.onQ, c.radius + reachExtra, Vec3::Zero(),
+                                        m_lambda[(nf + e) * np + p], x);
+        }
+    }
+    for (size_t k = 0; k < m_featVerts.size(); ++k) {
+        const int32_t v = m_featVerts[k];
+        for (size_t p = 0; p < np; ++p) {
+            const Capsule& c = parts[p];
+            const Vec3 q = c.a + closestParameterOnSegment(x[v], c.a, c.b) * (c.b - c.a);
+            const double b[1] = {1.0};
+            contacts += projectDistance(&v, b, 1, q, c.radius + reachExtra, Vec3::Zero(),
+                                        m_lambda[(nf + ne + k) * np + p], x);
+        }
+    }
+    return contacts;
 }
 
 bool CollisionSolver::projectSphere(int32_t t, const Sphere& s, const Capsule& c, double& lambda,
@@ -227,32 +329,13 @@ bool CollisionSolver::projectPolygon(int32_t t, const Capsule& c, double& lambda
     const SegmentTrianglePair st = closestPointsSegmentTriangle(c.a, c.b, x[f[0]], x[f[1]], x[f[2]]);
     const double reach = c.radius + m_settings.polygonMargin;
     if (!(st.distance < reach)) return false;
-    Vec3 n;
-    if (st.distance > 1e-12 * std::max(1.0, reach)) {
-        n = (st.onTriangle.point - st.onSegment) / st.distance;
-    } else {
-        const Vec3 nt = (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]);
-        if (!(nt.squaredNorm() > 0)) return false;
-        n = -nt.normalized();
-    }
-    const Vec3& b = st.onTriangle.bary;
-    // C = n·(Σ b_i x_i − q) − reach; with n the unit direction this is the distance form of
-    // pointTriangleConstraint, ∇_i C = b_i n.
-    const double C = st.distance - reach;
-    double denom = m_alphaTilde;
-    for (int k = 0; k < 3; ++k) denom += m_w[f[k]] * b[k] * b[k];
-    if (!(denom > 0)) return true;
-    const double dl = (-C - m_alphaTilde * lambda) / denom;
-    lambda += dl;
-    for (int k = 0; k < 3; ++k) {
-        const Vec3 before = x[f[k]];
-        x[f[k]] += m_w[f[k]] * b[k] * dl * n;
-        capCorrection(f[k], x);
-        const Vec3 dx = x[f[k]] - before;
-        m_push[f[k]] += dx;
-        m_stats.maxCorrection = std::max(m_stats.maxCorrection, dx.norm());
-        m_touched[f[k]] = 1;
-    }
+    // C = n·(Σ b_i x_i − q) − reach with n the unit direction from the axis point: the distance
+    // form of pointTriangleConstraint, ∇_i C = b_i n; −N when the axis pierces the triangle.
+    const Vec3 nt = (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]);
+    const Vec3 fallback = nt.squaredNorm() > 0 ? Vec3(-nt.normalized()) : Vec3::Zero();
+    const Vec3& bary = st.onTriangle.bary;
+    const double b[3] = {bary[0], bary[1], bary[2]};
+    projectDistance(f.data(), b, 3, st.onSegment, reach, fallback, lambda, x);
     return true;
 }
 
@@ -265,9 +348,18 @@ void CollisionSolver::capCorrection(int32_t v, std::vector<Vec3>& x) const {
 int CollisionSolver::iterate(std::vector<Vec3>& x, const ToolShape& tool) {
     if (x.size() != m_rest.size()) return 0;
     const auto& parts = tool.parts();
-    if (m_lambda.size() != m_candidates.size() * parts.size()) return 0;
+    const size_t features = m_settings.method == CollisionMethod::PolygonFeatures
+                                ? m_candEdges.size() + m_featVerts.size()
+                                : 0;
+    if (m_lambda.size() != (m_candidates.size() + features) * parts.size()) return 0;
     int contacts = 0;
     m_stats.maxCorrection = 0;
+    if (m_settings.method == CollisionMethod::PolygonFeatures) {
+        contacts = iterateFeatures(x, parts);
+        m_stats.contacts = contacts;
+        if (contacts) m_contactDirty = true;
+        return contacts;
+    }
     for (size_t i = 0; i < m_candidates.size(); ++i) {
         const int32_t t = m_candidates[i];
         if (m_settings.method == CollisionMethod::Polygon) {

@@ -28,6 +28,15 @@
 ///     face feature); a contact when closer than radius + margin, resolved by the point–triangle
 ///     constraint C = n·(Σ b_i x_i − q) − (r + margin) >= 0 with the barycentric weights b_i
 ///     (n from the axis point q to the triangle point; −N when the axis pierces the triangle).
+///     One smooth constraint per triangle–capsule pair, whichever feature is closest.
+///   - PolygonFeatures [Eri04] as [A §5.2.6] describes it: the vertex, edge and face primitives
+///     of the candidate triangles tested separately, each type with its own constraint: every
+///     candidate vertex against the capsule axis (C = |x_v − q| − reach, moves the vertex),
+///     every candidate edge against the axis (closest points of the two segments, weights 1 − s
+///     and s), and every candidate face whose closest point to the axis lies inside it
+///     (barycentric weights). Shared vertices and edges are tested once per sweep. This is the
+///     polygon baseline of the thesis' comparison; the switching between feature types is what
+///     [A §5.2.6] names as the polygon method's source of instability at few iterations.
 ///
 /// Only the tissue moves (the tool is kinematic, infinite mass). Fixed nodes (inverse mass 0) are
 /// never moved. Results are deterministic (candidates in ascending order). Nothing here
@@ -44,8 +53,11 @@
 
 namespace viscera::sim {
 
-enum class CollisionMethod { Circumsphere, BoundingSphere, Polygon };
+enum class CollisionMethod { Circumsphere, BoundingSphere, Polygon, PolygonFeatures };
 const char* toString(CollisionMethod m);
+/// The method named name (its toString); false for an unknown name.
+bool parseCollisionMethod(const std::string& name, CollisionMethod& out);
+constexpr const char* kCollisionMethodNames = "circumsphere, bounding_sphere, polygon, polygon_features";
 
 struct CollisionSettings {
     CollisionMethod method = CollisionMethod::Circumsphere;
@@ -144,6 +156,11 @@ private:
     bool projectSphere(int32_t t, const Sphere& s, const Capsule& c, double& lambda,
                        std::vector<Vec3>& x);
     bool projectPolygon(int32_t t, const Capsule& c, double& lambda, std::vector<Vec3>& x);
+    /// Distance constraint C = |Σ b_k x_{v_k} − q| − reach on n (1–3) vertices; false when not
+    /// violated. `fallback` is the push direction when the point lies on the axis.
+    bool projectDistance(const int32_t* v, const double* b, int n, const Vec3& q, double reach,
+                         const Vec3& fallback, double& lambda, std::vector<Vec3>& x);
+    int iterateFeatures(std::vector<Vec3>& x, const std::vector<Capsule>& parts);
     void capCorrection(int32_t v, std::vector<Vec3>& x) const;
 
     CollisionSettings m_settings;
@@ -156,7 +173,9 @@ private:
     std::vector<double> m_h3, m_energy, m_refArea; ///< per triangle; m_refArea < 0: never set
     std::vector<Aabb> m_boxes;
     std::vector<int32_t> m_candidates;
-    std::vector<double> m_lambda; ///< #candidates × #parts
+    std::vector<double> m_lambda; ///< #candidates × #parts (PolygonFeatures: faces, edges, vertices)
+    std::vector<std::array<int32_t, 2>> m_candEdges; ///< PolygonFeatures: edges of the candidates
+    std::vector<int32_t> m_featVerts;                 ///< PolygonFeatures: vertices of the candidates
     std::vector<char> m_touched;  ///< per vertex, this step
     std::vector<Vec3> m_start;    ///< positions at beginStep
     std::vector<Vec3> m_push;     ///< per vertex, sum of the contact moves of this step

@@ -1,5 +1,6 @@
 #include "sim/scene/interaction.hpp"
 
+#include "sim/collision/collision_solver.hpp"
 #include "sim/util/error.hpp"
 #include "sim/util/json_section.hpp"
 
@@ -52,8 +53,9 @@ InteractionDesc parseInteractionSection(std::string_view text, const std::string
         r.only(c, {"method", "delta"}, "collision");
         if (c.contains("method")) {
             d.collisionMethod = r.text(c, "method", "collision");
-            if (d.collisionMethod != "circumsphere" && d.collisionMethod != "bounding_sphere" && d.collisionMethod != "polygon")
-                r.fail("collision.method", "'" + d.collisionMethod + "' is not a method (circumsphere, bounding_sphere, polygon)");
+            CollisionMethod m;
+            if (!parseCollisionMethod(d.collisionMethod, m))
+                r.fail("collision.method", "'" + d.collisionMethod + "' is not a method (" + kCollisionMethodNames + ")");
         }
         d.delta = r.number(c, "delta", "collision", d.delta, 0.0, 10.0);
     }

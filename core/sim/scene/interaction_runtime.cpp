@@ -104,8 +104,7 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
         r->m_surfaceVertices = m.vertexCount();
     }
     CollisionSettings cs;
-    if (desc.collisionMethod == "bounding_sphere") cs.method = CollisionMethod::BoundingSphere;
-    else if (desc.collisionMethod == "polygon") cs.method = CollisionMethod::Polygon;
+    if (!parseCollisionMethod(desc.collisionMethod, cs.method)) fail("collision", "unknown method '" + desc.collisionMethod + "'");
     cs.circumsphere.updateThreshold = desc.delta;
     if (auto why = validate(cs); !why.empty()) fail("collision", why);
 

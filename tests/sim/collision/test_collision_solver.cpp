@@ -129,6 +129,60 @@ TEST(CollisionSolver, PolygonContactKeepsTheMargin) {
     EXPECT_NEAR((tp.point - tool.parts()[0].a).norm(), 0.005, 1e-9);
 }
 
+// The [Eri04] per-feature polygon method: a face, an edge and a vertex contact each end at the
+// margin, by the constraint of their own feature.
+TEST(CollisionSolver, PolygonFeaturesResolveFaceEdgeAndVertexContacts) {
+    CollisionSettings s;
+    s.method = CollisionMethod::PolygonFeatures;
+    s.polygonMargin = 0.001;
+    s.maxCorrectionPerStep = 1.0;
+    const double L = 0.02, reach = 0.005;
+    struct Case {
+        const char* feature;
+        Vec3 centre;
+    };
+    const Case cases[] = {{"face", Vec3(0.012, 0.006, 0.003)},     // 1 mm into the face
+                          {"edge", Vec3(0.010, -0.003, 0.0025)},   // beyond edge (0, 1)
+                          {"vertex", Vec3(L + 0.003, -0.003, 0.0015)}}; // beyond corner 1
+    for (const Case& c : cases) {
+        auto col = CollisionSolver::create(square(L), s);
+        ToolShape tool = sphereAt(0.004, c.centre);
+        std::vector<Vec3> x = square(L).restPositions;
+        const double before = std::min(closestPointsSegmentTriangle(c.centre, c.centre, x[0], x[1], x[2]).distance,
+                                       closestPointsSegmentTriangle(c.centre, c.centre, x[0], x[2], x[3]).distance);
+        ASSERT_LT(before, reach - 2e-4) << c.feature << ": the case starts in contact";
+        col->beginStep(x, tool, 1e-3);
+        int contacts = 0;
+        for (int k = 0; k < 40; ++k) contacts += col->iterate(x, tool);
+        EXPECT_GT(contacts, 0) << c.feature;
+        const double after = std::min(closestPointsSegmentTriangle(c.centre, c.centre, x[0], x[1], x[2]).distance,
+                                      closestPointsSegmentTriangle(c.centre, c.centre, x[0], x[2], x[3]).distance);
+        EXPECT_NEAR(after, reach, 1e-6) << c.feature;
+        for (const Vec3& p : x) EXPECT_TRUE(p.allFinite()) << c.feature;
+    }
+    // The vertex case moves vertex 1 to the reach along the line from the centre.
+    auto col = CollisionSolver::create(square(L), s);
+    ToolShape tool = sphereAt(0.004, cases[2].centre);
+    std::vector<Vec3> x = square(L).restPositions;
+    col->beginStep(x, tool, 1e-3);
+    for (int k = 0; k < 40; ++k) col->iterate(x, tool);
+    EXPECT_NEAR((x[1] - cases[2].centre).norm(), reach, 1e-6);
+    EXPECT_EQ(x[3], square(L).restPositions[3]) << "the far corner is not a candidate contact";
+}
+
+TEST(CollisionSolver, MethodNamesRoundTrip) {
+    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
+                              CollisionMethod::Polygon, CollisionMethod::PolygonFeatures}) {
+        CollisionMethod back = CollisionMethod::Circumsphere;
+        EXPECT_TRUE(parseCollisionMethod(toString(m), back)) << toString(m);
+        EXPECT_EQ(back, m);
+        EXPECT_THAT(kCollisionMethodNames, HasSubstr(toString(m)));
+    }
+    CollisionMethod m = CollisionMethod::Polygon;
+    EXPECT_FALSE(parseCollisionMethod("sdf", m));
+    EXPECT_EQ(m, CollisionMethod::Polygon) << "unchanged on an unknown name";
+}
+
 TEST(CollisionSolver, CorrectionPerStepIsCapped) {
     CollisionSettings s;
     s.maxCorrectionPerStep = 0.001;
@@ -143,7 +197,7 @@ TEST(CollisionSolver, CorrectionPerStepIsCapped) {
 
 TEST(CollisionSolver, FixedVerticesNeverMove) {
     for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
-                              CollisionMethod::Polygon}) {
+                              CollisionMethod::Polygon, CollisionMethod::PolygonFeatures}) {
         CollisionSettings s;
         s.method = m;
         auto col = CollisionSolver::create(square(0.01, {0, 1, 1, 0}), s);
