@@ -35,7 +35,8 @@ public:
     /// nothing is waiting. `from` may be null. `queued_ns` (may be null) gets how long the
     /// datagram waited in the kernel queue (its arrival stamp, SO_TIMESTAMPNS, against now;
     /// 0 when the kernel gave no stamp), so a reader that was descheduled can tell old packets
-    /// from fresh ones on its own clock.
+    /// from fresh ones on its own clock. Linux turns arrival stamping on shortly after the first
+    /// socket asks for it (a deferred switch): packets that arrive before then read age 0.
     long receive(uint8_t* buffer, size_t capacity, Endpoint* from, int64_t* queued_ns = nullptr) noexcept;
     bool sendTo(const uint8_t* data, size_t size, const Endpoint& to) noexcept;
     /// Waits up to timeout_ms for a datagram (not for the servo thread). True when one waits.

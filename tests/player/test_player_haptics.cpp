@@ -211,7 +211,9 @@ TEST(PlayerHaptics, ConsoleLoopbackWithADisconnectMidSession) {
             t > 1.7 && (std::abs(f[2]) > 0.01 || std::abs(f[5]) > 0.01))
             after = true;
     }
-    EXPECT_TRUE(after) << "forces resume after the reconnection";
+    EXPECT_TRUE(after) << "forces resume after the reconnection\nconsole: " << readText(s / "sum.json")
+                       << "player link: " << h["link"].dump() << "\nsafety: " << h["safety"].dump()
+                       << "\nmetrics: " << j["metrics"].dump();
 }
 
 TEST(PlayerHaptics, TraineeWindowRunsOffscreenAndWritesAScreenshot) {

@@ -232,15 +232,7 @@ bool CollisionSolver::projectDistance(const int32_t* v, const double* b, int n, 
     if (!(denom > 0)) return true;
     const double dl = (-(dist - reach) - m_alphaTilde * lambda) / denom;
     lambda += dl;
-    for (int k = 0; k < n; ++k) {
-        const Vec3 before = x[v[k]];
-        x[v[k]] += m_w[v[k]] * b[k] * dl * dir;
-        capCorrection(v[k], x);
-        const Vec3 dx = x[v[k]] - before;
-        m_push[v[k]] += dx;
-        m_stats.maxCorrection = std::max(m_stats.maxCorrection, dx.norm());
-        m_touched[v[k]] = 1;
-    }
+    for (int k = 0; k < n; ++k) applyCorrection(v[k], m_w[v[k]] * b[k] * dl * dir, x);
     return true;
 }
 
@@ -311,15 +303,7 @@ bool CollisionSolver::projectSphere(int32_t t, const Sphere& s, const Capsule& c
     if (!(denom > 0) || !(C > 0)) return true;
     const double dl = (-C - m_alphaTilde * lambda) / denom;
     lambda += dl;
-    for (int k = 0; k < 3; ++k) {
-        const Vec3 before = x[f[k]];
-        x[f[k]] += m_w[f[k]] * dl * grad[k];
-        capCorrection(f[k], x);
-        const Vec3 dx = x[f[k]] - before;
-        m_push[f[k]] += dx;
-        m_stats.maxCorrection = std::max(m_stats.maxCorrection, dx.norm());
-        m_touched[f[k]] = 1;
-    }
+    for (int k = 0; k < 3; ++k) applyCorrection(f[k], m_w[f[k]] * dl * grad[k], x);
     return true;
 }
 
@@ -337,6 +321,16 @@ bool CollisionSolver::projectPolygon(int32_t t, const Capsule& c, double& lambda
     const double b[3] = {bary[0], bary[1], bary[2]};
     projectDistance(f.data(), b, 3, st.onSegment, reach, fallback, lambda, x);
     return true;
+}
+
+void CollisionSolver::applyCorrection(int32_t v, const Vec3& delta, std::vector<Vec3>& x) {
+    const Vec3 before = x[v];
+    x[v] += delta;
+    capCorrection(v, x);
+    const Vec3 dx = x[v] - before;
+    m_push[v] += dx;
+    m_stats.maxCorrection = std::max(m_stats.maxCorrection, dx.norm());
+    m_touched[v] = 1;
 }
 
 void CollisionSolver::capCorrection(int32_t v, std::vector<Vec3>& x) const {

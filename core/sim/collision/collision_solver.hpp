@@ -162,6 +162,8 @@ private:
                          const Vec3& fallback, double& lambda, std::vector<Vec3>& x);
     int iterateFeatures(std::vector<Vec3>& x, const std::vector<Capsule>& parts);
     void capCorrection(int32_t v, std::vector<Vec3>& x) const;
+    /// x[v] += delta within the per-step cap; records the push, the largest move and the contact.
+    void applyCorrection(int32_t v, const Vec3& delta, std::vector<Vec3>& x);
 
     CollisionSettings m_settings;
     std::vector<Tri> m_tris;
