@@ -210,16 +210,7 @@ SkeletonResult extractSkeleton(const sim::TriMesh& surface, const SkeletonParams
     const detail::ScratchArena arena(reserveBytes);
 
     // ---- surface checks (indices of `surface` in every message) ------------------------------
-    if (surface.triangleCount() == 0) fail(label, "surface has no triangles");
-    for (size_t v = 0; v < surface.vertexCount(); ++v)
-        if (!surface.positions()[v].allFinite())
-            fail(label, "vertex " + std::to_string(v) + " has a non-finite coordinate");
-    for (size_t t = 0; t < surface.triangleCount(); ++t)
-        for (int32_t v : surface.triangles()[t])
-            if (v < 0 || static_cast<size_t>(v) >= surface.vertexCount())
-                fail(label, "triangle " + std::to_string(t) + " references vertex " + std::to_string(v) +
-                                " (the surface has " + std::to_string(surface.vertexCount()) + " vertices)");
-    detail::checkClosedManifold(label, surface);
+    detail::checkInputSurface(label, surface);
 
     // Normalized frame: bounding-box centre at the origin, unit diagonal.
     std::vector<char> used(surface.vertexCount(), 0);

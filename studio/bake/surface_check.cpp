@@ -26,9 +26,18 @@ uint64_t edgeKey(int32_t a, int32_t b) {
 
 } // namespace
 
-/// Topological checks on the indexed triangles: every edge shared by exactly two triangles that
-/// traverse it in opposite directions, and every vertex a single fan of triangles.
-void checkClosedManifold(const std::string& label, const sim::TriMesh& surface) {
+void checkInputSurface(const std::string& label, const sim::TriMesh& surface) {
+    if (surface.triangleCount() == 0) fail(label, "surface has no triangles");
+    for (size_t v = 0; v < surface.vertexCount(); ++v)
+        if (!surface.positions()[v].allFinite())
+            fail(label, "vertex " + std::to_string(v) + " has a non-finite coordinate");
+    for (size_t t = 0; t < surface.triangleCount(); ++t)
+        for (int32_t v : surface.triangles()[t])
+            if (v < 0 || static_cast<size_t>(v) >= surface.vertexCount())
+                fail(label, "triangle " + std::to_string(t) + " references vertex " + std::to_string(v) +
+                                " (the surface has " + std::to_string(surface.vertexCount()) + " vertices)");
+    // Topology: every edge shared by exactly two triangles that traverse it in opposite
+    // directions, and every vertex a single fan of triangles.
     const auto& tris = surface.triangles();
     const int32_t nt = static_cast<int32_t>(tris.size());
 

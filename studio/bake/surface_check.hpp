@@ -7,9 +7,10 @@
 
 namespace viscera::bake::detail {
 
-/// Closed, consistently oriented, manifold: every edge in exactly two triangles traversing it in
-/// opposite directions, every vertex a single fan. Throws viscera::InputError
+/// Non-empty, finite coordinates, triangle indices in range (indices of `surface` in every
+/// message), then closed, consistently oriented, manifold: every edge in exactly two triangles
+/// traversing it in opposite directions, every vertex a single fan. Throws viscera::InputError
 /// "<label>: surface is not closed: edge (a, b) belongs to only one triangle (t)" and the like.
-void checkClosedManifold(const std::string& label, const sim::TriMesh& surface);
+void checkInputSurface(const std::string& label, const sim::TriMesh& surface);
 
 } // namespace viscera::bake::detail

@@ -209,17 +209,7 @@ TetrahedralizeResult tetrahedralize(const sim::TriMesh& surface, const MeshingPa
 
     // ---- surface checks ----------------------------------------------------------------------
     progress.begin(MeshingStage::CheckSurface);
-    if (surface.triangleCount() == 0) fail(label, "surface has no triangles");
-    for (size_t v = 0; v < surface.vertexCount(); ++v)
-        if (!surface.positions()[v].allFinite())
-            fail(label, "vertex " + std::to_string(v) + " has a non-finite coordinate");
-    for (size_t t = 0; t < surface.triangleCount(); ++t)
-        for (int32_t v : surface.triangles()[t])
-            if (v < 0 || static_cast<size_t>(v) >= surface.vertexCount())
-                fail(label, "triangle " + std::to_string(t) + " references vertex " +
-                                std::to_string(v) + " (the surface has " +
-                                std::to_string(surface.vertexCount()) + " vertices)");
-    detail::checkClosedManifold(label, surface);
+    detail::checkInputSurface(label, surface);
     try {
         SurfaceMesh sm = buildSurfaceMesh(label, surface);
         report.surfaceVolume = std::abs(surface.signedVolume());
