@@ -34,9 +34,12 @@
 //
 // Run: ./build/bench/bench_collision [output-dir] [--quick]   (default ./collision_out)
 //      ./build/bench/bench_collision --trace [tool 0|1] [method 0..3] [iterations] [delta]
-//                                    [speed] [energy scale ς] [h 1/m] [θ deg]
+//                                    [speed] [energy scale ς] [h 1/m] [θ deg] [safe cone 1|0]
 //        (one run, per-frame figures; methods 0 circumsphere, 1 bounding sphere, 2 polygon,
 //        3 polygon_features)
+//
+// The comparison also runs the circumsphere with contacts through the whole sphere (safe cone
+// off, CollisionSettings::safeConeOnly = false) to show what that test is for.
 #include "line_plot.hpp"
 
 #include "sim/collision/collision_solver.hpp"
@@ -126,13 +129,14 @@ const char* couplingName(Coupling c) {
 struct RunSpec {
     Tool tool = kCylinder;
     CollisionMethod method = CollisionMethod::Circumsphere;
-    double delta = 0.3;
+    double delta = CircumsphereParams{}.updateThreshold;
     int iterations = 5;
     double speed = 0.1; // m/s, slide
     Coupling coupling = Coupling::InIteration;
     double energyScale = CircumsphereParams{}.energyScale; // ς, m (--trace only)
     double curvatureThreshold = CircumsphereParams{}.curvatureThreshold; // h, 1/m (--trace only)
     double safeAngle = CircumsphereParams{}.safeAngle;                   // θ, rad (--trace only)
+    bool safeCone = CollisionSettings{}.safeConeOnly; // contacts only through the safe cone
 };
 
 struct RunResult {
@@ -184,6 +188,7 @@ RunResult run(const Slab& slab, const RunSpec& spec) {
     cs.circumsphere.energyScale = spec.energyScale;
     cs.circumsphere.curvatureThreshold = spec.curvatureThreshold;
     cs.circumsphere.safeAngle = spec.safeAngle;
+    cs.safeConeOnly = spec.safeCone;
     cs.polygonMargin = 1e-3;
     auto col =
         CollisionSolver::create(CollisionSurfaceDesc::fromTetMesh(*slab.mesh, slab.invMass), cs);
@@ -338,7 +343,10 @@ std::string deltaName(double d) {
 
 std::string label(const RunSpec& s) {
     std::string l = std::string(s.tool.name) + " " + toString(s.method);
-    if (s.method == CollisionMethod::Circumsphere) l += " d=" + deltaName(s.delta);
+    if (s.method == CollisionMethod::Circumsphere) {
+        l += " d=" + deltaName(s.delta);
+        if (!s.safeCone) l += " no-cone";
+    }
     return l;
 }
 
@@ -368,14 +376,14 @@ void writeRow(std::ofstream& o, const RunResult& r) {
       << r.stabilitySteady << ',' << r.stabilitySlide << ',' << r.collisionMs << ',' << r.frameMs << ','
       << r.factorUpdatesPerFrame << ',' << r.contactVerticesMean << ',' << r.tunnelledFrames << ','
       << r.overFrames << ',' << r.insideFrames << ',' << r.tunnelledMax << ',' << r.deepestInside
-      << ',' << (r.finite ? 1 : 0) << '\n';
+      << ',' << (r.finite ? 1 : 0) << ',' << (r.spec.safeCone ? 1 : 0) << '\n';
 }
 
 const char* kHeader =
     "tool,method,coupling,delta,iterations,speed_m_s,rel_err_mean,rel_err_min,rel_err_max,"
     "stability_hold_m,stability_steady_m,stability_slide_m,collision_ms,frame_ms,factor_updates_per_frame,"
     "contact_vertices_mean,tunnelled_frames,over_frames,inside_frames,tunnelled_max,"
-    "deepest_inside_m,finite\n";
+    "deepest_inside_m,finite,safe_cone\n";
 
 } // namespace
 
@@ -394,18 +402,19 @@ int main(int argc, char** argv) {
         else if (a == "--trace") g_trace = true;
         else outDir = a;
     }
-    if (g_trace) { // --trace [tool 0|1] [method 0..3] [iterations] [delta] [speed] [ς m] [h 1/m] [θ deg]
+    if (g_trace) { // --trace [tool 0|1] [method 0..3] [iterations] [delta] [speed] [ς m] [h 1/m] [θ deg] [cone]
         const Slab slab = makeSlab();
         RunSpec s;
         auto arg = [&](int i, double def) { return argc > i ? std::atof(argv[i]) : def; };
         s.tool = arg(2, 0) == 0 ? kCylinder : kShaft;
         s.method = static_cast<CollisionMethod>(static_cast<int>(arg(3, 0)));
         s.iterations = static_cast<int>(arg(4, 5));
-        s.delta = arg(5, 0.3);
+        s.delta = arg(5, CircumsphereParams{}.updateThreshold);
         s.speed = arg(6, 0.1);
         s.energyScale = arg(7, CircumsphereParams{}.energyScale);
         s.curvatureThreshold = arg(8, CircumsphereParams{}.curvatureThreshold);
         s.safeAngle = arg(9, CircumsphereParams{}.safeAngle * 180 / M_PI) * M_PI / 180;
+        s.safeCone = arg(10, CollisionSettings{}.safeConeOnly ? 1 : 0) != 0;
         printHeader();
         printRow(run(slab, s));
         return 0;
@@ -446,6 +455,16 @@ int main(int argc, char** argv) {
                 printRow(main.back());
                 writeRow(sweep, main.back());
             }
+    for (const Tool& t : tools) // reference: the circumsphere without the safe-cone test
+        for (int k : iterations) {
+            RunSpec s;
+            s.tool = t;
+            s.iterations = k;
+            s.safeCone = false;
+            main.push_back(run(slab, s));
+            printRow(main.back());
+            writeRow(sweep, main.back());
+        }
     // 2. δ sweep (circumsphere, 10 mm cylinder) at 2 and 5 iterations.
     std::printf("\n== update threshold (circumsphere, %s) ==", kCylinder.name);
     printHeader();
@@ -507,12 +526,15 @@ int main(int argc, char** argv) {
     auto byIterations = [&](auto value) {
         std::vector<PlotSeries> out;
         for (const Tool& t : tools)
-            for (CollisionMethod m : methods) {
+            for (size_t mi = 0; mi <= methods.size(); ++mi) {
+                // The methods, then the circumsphere without the safe cone.
+                const bool cone = mi < methods.size();
+                const CollisionMethod m = cone ? methods[mi] : CollisionMethod::Circumsphere;
                 PlotSeries s;
-                s.label = std::string(t.name) + " " + toString(m);
+                s.label = std::string(t.name) + " " + toString(m) + (cone ? "" : " (no safe cone)");
                 s.markers = true;
                 for (const RunResult& r : main)
-                    if (r.spec.method == m && r.spec.tool.name == t.name) {
+                    if (r.spec.method == m && r.spec.tool.name == t.name && r.spec.safeCone == cone) {
                         s.x.push_back(r.spec.iterations);
                         s.y.push_back(value(r));
                     }

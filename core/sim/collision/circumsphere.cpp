@@ -72,7 +72,20 @@ double circumsphereOffset(double circumradius, double h3, double energy,
 }
 
 Sphere circumsphere(const Circumcircle& cc, double offset) {
-    return {cc.centre - offset * cc.normal, std::sqrt(cc.radius * cc.radius + offset * offset)};
+    Sphere s;
+    s.centre = cc.centre - offset * cc.normal;
+    s.radius = std::sqrt(cc.radius * cc.radius + offset * offset);
+    s.coneAxis = cc.normal;
+    // The circumcircle lies at height `offset` above the centre: cos(half-angle) = offset / r.
+    s.coneCos = s.radius > 0 ? offset / s.radius : 0.0;
+    return s;
+}
+
+bool Sphere::inSafeCone(const Vec3& p) const {
+    if (coneCos <= -1) return true;
+    const Vec3 d = p - centre;
+    const double len = d.norm();
+    return len > 0 && d.dot(coneAxis) >= coneCos * len;
 }
 
 Sphere boundingSphere(const Vec3& a, const Vec3& b, const Vec3& c) {

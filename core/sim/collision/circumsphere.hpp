@@ -37,7 +37,11 @@ struct CircumsphereParams {
     double scale = 1.0;                    ///< φ, >= 0
     double curvatureThreshold = 150.0;     ///< h, 1/m (> 0): sphere = circumcircle sphere above it
     double energyScale = 0.005;            ///< ς, m: largest extra inward offset (ε < 1), >= 0
-    double updateThreshold = 0.3;          ///< δ, >= 0: refresh H3(K) and ε when |S/S_ref − 1| >= δ
+    /// δ, >= 0: refresh H3(K) and ε when |S/S_ref − 1| >= δ. Default 0.7, the thesis' value for
+    /// scenes that need stability, efficiency and accuracy together [A §5.2.6] and the scene
+    /// default (interaction.hpp); small δ refreshes often, and every refresh reshapes the sphere
+    /// under a resting tool (bench_collision's δ sweep shows the jitter that adds).
+    double updateThreshold = 0.7;
 };
 
 /// Empty when valid, otherwise the rule that failed.
@@ -57,6 +61,14 @@ Circumcircle circumcircle(const Vec3& a, const Vec3& b, const Vec3& c);
 struct Sphere {
     Vec3 centre = Vec3::Zero(); ///< m
     double radius = 0;          ///< m
+    /// Safe cone [A §5.2.1]: the cone from the centre through the triangle's circumcircle, axis
+    /// coneAxis (the triangle's normal), half-angle acos(coneCos). Only its part of the sphere
+    /// (the converging surface) stands for the tissue surface; the rest lies inside the tissue.
+    /// coneCos = −1: the whole sphere counts (bounding sphere).
+    Vec3 coneAxis = Vec3::UnitZ();
+    double coneCos = -1;
+    /// Whether the direction from the centre to point p lies in the safe cone (p ≠ centre).
+    bool inSafeCone(const Vec3& p) const;
 };
 
 /// Inward offset s of [A eq. 5.7] for the given curvature factor H3(K) and energy factor ε.

@@ -284,6 +284,9 @@ bool CollisionSolver::projectSphere(int32_t t, const Sphere& s, const Capsule& c
     const AxisPoint ap = closestAxisPoint(c, s.centre);
     const double pen = s.radius + c.radius - ap.distance;
     if (!(pen > 0)) return false;
+    // A tool that meets the sphere outside its safe cone touches the part of the sphere that
+    // lies inside the tissue (under the neighbouring triangles), not this triangle's surface.
+    if (m_settings.safeConeOnly && !s.inSafeCone(ap.onAxis)) return false;
     const Tri& f = m_tris[t];
     Vec3 dir = ap.direction;
     if (ap.distance <= 1e-12 * std::max(1.0, s.radius)) {

@@ -115,6 +115,45 @@ TEST(CollisionSolver, UnifiedResponseMovesAllThreeVerticesEqually) {
     }
 }
 
+// The safe cone [A §5.2.1]: a tool meeting the circumsphere through the cap over the triangle
+// is a contact; one meeting its side (the part of the sphere inside the tissue) is not, unless
+// safeConeOnly is off.
+TEST(CollisionSolver, CircumsphereContactsOnlyThroughTheSafeCone) {
+    CollisionSurfaceDesc d;
+    d.restPositions = {Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0)};
+    d.triangles = {{0, 1, 2}};
+    d.inverseMass = {2, 2, 2};
+    for (bool coneOnly : {true, false}) {
+        CollisionSettings s;
+        s.circumsphere.energyScale = 0;
+        s.safeConeOnly = coneOnly;
+        auto col = CollisionSolver::create(d, s);
+        const Sphere sp = col->triangleSphere(0, d.restPositions);
+        // Flat, unstrained: H3 = 1, ε = 0, so the cone's half-angle is the safe angle θ.
+        EXPECT_NEAR(sp.coneCos, std::cos(s.circumsphere.safeAngle), 1e-12);
+        EXPECT_NEAR(sp.coneAxis.z(), 1.0, 1e-12);
+        const double toolR = 0.003;
+        for (double angleDeg : {0.0, 20.0, 45.0, 80.0}) {
+            SCOPED_TRACE("cone only " + std::to_string(coneOnly) + ", tool at " +
+                         std::to_string(angleDeg) + " deg from the normal");
+            const double a = angleDeg * M_PI / 180;
+            // 1 mm overlap with the sphere, in direction a from the normal.
+            const Vec3 dir(std::sin(a), 0, std::cos(a));
+            ToolShape tool = sphereAt(toolR, sp.centre + (sp.radius + toolR - 0.001) * dir);
+            EXPECT_EQ(sp.inSafeCone(tool.parts()[0].a), angleDeg < 30);
+            std::vector<Vec3> x = d.restPositions;
+            col->beginStep(x, tool, 1e-3);
+            const int contacts = col->iterate(x, tool);
+            const bool expected = !coneOnly || angleDeg < 30;
+            EXPECT_EQ(contacts, expected ? 1 : 0);
+            EXPECT_EQ(x == d.restPositions, !expected);
+        }
+    }
+    // The bounding sphere has no safe cone: every overlap is a contact.
+    EXPECT_TRUE(boundingSphere(d.restPositions[0], d.restPositions[1], d.restPositions[2])
+                    .inSafeCone(Vec3(0.003, 0.003, -0.1)));
+}
+
 TEST(CollisionSolver, PolygonContactKeepsTheMargin) {
     CollisionSettings s;
     s.method = CollisionMethod::Polygon;
