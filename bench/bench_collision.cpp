@@ -444,6 +444,12 @@ int main(int argc, char** argv) {
     std::ofstream sweep(outDir / "collision_sweep.csv");
     sweep << kHeader;
     std::vector<RunResult> main;
+    // Runs one case, prints its row, appends it to `into` and to the CSV.
+    auto record = [&](const RunSpec& s, std::vector<RunResult>& into, std::ofstream& csv) {
+        into.push_back(run(slab, s));
+        printRow(into.back());
+        writeRow(csv, into.back());
+    };
     for (const Tool& t : tools)
         for (CollisionMethod m : methods)
             for (int k : iterations) {
@@ -451,9 +457,7 @@ int main(int argc, char** argv) {
                 s.tool = t;
                 s.method = m;
                 s.iterations = k;
-                main.push_back(run(slab, s));
-                printRow(main.back());
-                writeRow(sweep, main.back());
+                record(s, main, sweep);
             }
     for (const Tool& t : tools) // reference: the circumsphere without the safe-cone test
         for (int k : iterations) {
@@ -461,9 +465,7 @@ int main(int argc, char** argv) {
             s.tool = t;
             s.iterations = k;
             s.safeCone = false;
-            main.push_back(run(slab, s));
-            printRow(main.back());
-            writeRow(sweep, main.back());
+            record(s, main, sweep);
         }
     // 2. δ sweep (circumsphere, 10 mm cylinder) at 2 and 5 iterations.
     std::printf("\n== update threshold (circumsphere, %s) ==", kCylinder.name);
@@ -474,9 +476,7 @@ int main(int argc, char** argv) {
             RunSpec s;
             s.delta = d;
             s.iterations = k;
-            deltaRuns.push_back(run(slab, s));
-            printRow(deltaRuns.back());
-            writeRow(sweep, deltaRuns.back());
+            record(s, deltaRuns, sweep);
         }
     // 3. Tunnelling: speeds 0.05–0.5 m/s, both tools, device-rate poses; at 0.5 m/s also the
     //    interpolated and the post-substep couplings for reference.
@@ -497,9 +497,7 @@ int main(int argc, char** argv) {
                     s.method = m;
                     s.iterations = k;
                     s.speed = v;
-                    tunRuns.push_back(run(slab, s));
-                    printRow(tunRuns.back());
-                    writeRow(tunnel, tunRuns.back());
+                    record(s, tunRuns, tunnel);
                 }
     for (Coupling c : {Coupling::InIterationInterp, Coupling::PostSubstepInterp})
         for (CollisionMethod m : methods)
@@ -510,9 +508,7 @@ int main(int argc, char** argv) {
                 s.iterations = k;
                 s.speed = 0.5;
                 s.coupling = c;
-                tunRuns.push_back(run(slab, s));
-                printRow(tunRuns.back());
-                writeRow(tunnel, tunRuns.back());
+                record(s, tunRuns, tunnel);
             }
     if (!sweep || !tunnel) {
         std::fprintf(stderr, "bench_collision: cannot write CSV files in %s\n",

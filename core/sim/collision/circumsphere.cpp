@@ -68,8 +68,10 @@ Circumcircle circumcircle(const Vec3& a, const Vec3& b, const Vec3& c) {
 
 double circumsphereOffset(double circumradius, double h3, double energy,
                           const CircumsphereParams& p) {
-    return p.scale * circumradius / std::tan(p.safeAngle) * h3 + p.energyScale * energy;
+    return circumsphereOffset(circumradius, h3, energy, offsetPerRadius(p), p.energyScale);
 }
+
+double offsetPerRadius(const CircumsphereParams& p) { return p.scale / std::tan(p.safeAngle); }
 
 Sphere circumsphere(const Circumcircle& cc, double offset) {
     Sphere s;

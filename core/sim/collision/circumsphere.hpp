@@ -74,6 +74,13 @@ struct Sphere {
 /// Inward offset s of [A eq. 5.7] for the given curvature factor H3(K) and energy factor ε.
 double circumsphereOffset(double circumradius, double h3, double energy,
                           const CircumsphereParams& p);
+/// φ cot θ of [A eq. 5.5]: the inward offset per metre of circumradius where H3 = 1.
+double offsetPerRadius(const CircumsphereParams& p);
+/// The same offset with φ cot θ already evaluated (offsetPerRadius), for the per-sweep loops.
+inline double circumsphereOffset(double circumradius, double h3, double energy, double perRadius,
+                                 double energyScale) {
+    return perRadius * circumradius * h3 + energyScale * energy;
+}
 /// The circumsphere: centre x_c − N_c s, radius √(R_b² + s²).
 Sphere circumsphere(const Circumcircle& cc, double offset);
 /// Bounding sphere of [MO06] used for comparison: centroid, largest vertex distance.

@@ -108,6 +108,7 @@ std::unique_ptr<CollisionSolver> CollisionSolver::create(CollisionSurfaceDesc de
     s->m_w = std::move(desc.inverseMass);
     s->m_curv = SurfaceCurvature(nv, s->m_tris);
     s->m_h3Spline = curvatureHermite(settings.circumsphere.curvatureThreshold);
+    s->m_offsetPerRadius = offsetPerRadius(settings.circumsphere);
     double cell = settings.cellSize;
     if (cell <= 0) {
         double sum = 0;
@@ -149,8 +150,8 @@ Sphere CollisionSolver::triangleSphere(int32_t t, const std::vector<Vec3>& x) co
     if (m_settings.method != CollisionMethod::Circumsphere)
         return boundingSphere(x[f[0]], x[f[1]], x[f[2]]);
     const Circumcircle cc = circumcircle(x[f[0]], x[f[1]], x[f[2]]);
-    return circumsphere(cc, circumsphereOffset(cc.radius, m_h3[t], m_energy[t],
-                                               m_settings.circumsphere));
+    return circumsphere(cc, circumsphereOffset(cc.radius, m_h3[t], m_energy[t], m_offsetPerRadius,
+                                               m_settings.circumsphere.energyScale));
 }
 
 void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& tool, double h) {
@@ -173,8 +174,20 @@ void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& too
             b.hi = x[f[0]].cwiseMax(x[f[1]]).cwiseMax(x[f[2]]) + m;
         } else {
             const Sphere s = triangleSphere(static_cast<int32_t>(t), x);
-            b.lo = s.centre - Vec3::Constant(s.radius);
-            b.hi = s.centre + Vec3::Constant(s.radius);
+            if (m_settings.safeConeOnly && s.coneCos > -1) {
+                // Only the safe cone inside the sphere can hold a contact: the cap lies within
+                // the circumcircle's radius of the circumcentre, and the cone narrows from
+                // there to the sphere centre. Box of that ball and the centre (exact for the
+                // contacts at x; about a sixth of the sphere's box for a flat surface).
+                const double c = std::clamp(s.coneCos, 0.0, 1.0);
+                const Vec3 rim = s.centre + s.radius * c * s.coneAxis; // circumcentre
+                const Vec3 R = Vec3::Constant(s.radius * std::sqrt(1 - c * c));
+                b.lo = (rim - R).cwiseMin(s.centre);
+                b.hi = (rim + R).cwiseMax(s.centre);
+            } else {
+                b.lo = s.centre - Vec3::Constant(s.radius);
+                b.hi = s.centre + Vec3::Constant(s.radius);
+            }
         }
     }
 

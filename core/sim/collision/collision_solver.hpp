@@ -5,8 +5,9 @@
 /// iterations (after every elastic sweep, multipliers per substep, inelastic velocity pass);
 /// stepWithCollision is the older after-the-substep coupling.
 ///
-/// Pipeline per substep (beginStep): the surface triangles' boxes go into a spatial hash
-/// (spatial_hash.hpp) and the tool's box selects candidates; for the circumsphere method the
+/// Pipeline per substep (beginStep): the surface triangles' boxes (sphere methods: the sphere's;
+/// circumsphere with the safe cone: the part of the sphere inside the cone) go into a spatial
+/// hash (spatial_hash.hpp) and the tool's box selects candidates; for the circumsphere method the
 /// candidates whose area changed by |S/S_ref − 1| >= δ since their last refresh get new curvature
 /// and energy factors [A §5.2.4]. Then every iterate() is one Gauss–Seidel sweep over the
 /// candidates × tool parts: narrow phase at the current positions, projection of each violated
@@ -179,6 +180,7 @@ private:
     std::vector<double> m_w;
     SurfaceCurvature m_curv;
     CubicHermite m_h3Spline;
+    double m_offsetPerRadius = 0; ///< φ cot θ
     std::unique_ptr<SpatialHash> m_hash;
     std::vector<double> m_h3, m_energy, m_refArea; ///< per triangle; m_refArea < 0: never set
     std::vector<Aabb> m_boxes;

@@ -21,6 +21,15 @@ CollisionSurfaceDesc square(double L = 0.01, std::vector<double> w = {1, 1, 1, 1
     return d;
 }
 
+/// One right triangle in z = 0 (normal +z), legs 1 cm, inverse mass 2 per vertex.
+CollisionSurfaceDesc oneTriangle() {
+    CollisionSurfaceDesc d;
+    d.restPositions = {Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0)};
+    d.triangles = {{0, 1, 2}};
+    d.inverseMass = {2, 2, 2};
+    return d;
+}
+
 ToolShape sphereAt(double r, const Vec3& c) {
     ToolShape t = ToolShape::sphere(r);
     ToolShape::Pose p = ToolShape::Pose::Identity();
@@ -95,10 +104,7 @@ TEST(CollisionSolver, CircumsphereContactTranslatesTheTriangleAsOne) {
 }
 
 TEST(CollisionSolver, UnifiedResponseMovesAllThreeVerticesEqually) {
-    CollisionSurfaceDesc d;
-    d.restPositions = {Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0)};
-    d.triangles = {{0, 1, 2}};
-    d.inverseMass = {2, 2, 2};
+    const CollisionSurfaceDesc d = oneTriangle();
     for (bool squared : {false, true}) {
         CollisionSettings s;
         s.squaredForm = squared;
@@ -119,10 +125,7 @@ TEST(CollisionSolver, UnifiedResponseMovesAllThreeVerticesEqually) {
 // is a contact; one meeting its side (the part of the sphere inside the tissue) is not, unless
 // safeConeOnly is off.
 TEST(CollisionSolver, CircumsphereContactsOnlyThroughTheSafeCone) {
-    CollisionSurfaceDesc d;
-    d.restPositions = {Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0)};
-    d.triangles = {{0, 1, 2}};
-    d.inverseMass = {2, 2, 2};
+    const CollisionSurfaceDesc d = oneTriangle();
     for (bool coneOnly : {true, false}) {
         CollisionSettings s;
         s.circumsphere.energyScale = 0;
