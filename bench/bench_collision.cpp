@@ -450,23 +450,24 @@ int main(int argc, char** argv) {
         printRow(into.back());
         writeRow(csv, into.back());
     };
+    // The methods, and for reference the circumsphere without the safe-cone test.
+    struct Variant {
+        CollisionMethod method;
+        bool safeCone;
+    };
+    std::vector<Variant> variants;
+    for (CollisionMethod m : methods) variants.push_back({m, true});
+    variants.push_back({CollisionMethod::Circumsphere, false});
     for (const Tool& t : tools)
-        for (CollisionMethod m : methods)
+        for (const Variant& v : variants)
             for (int k : iterations) {
                 RunSpec s;
                 s.tool = t;
-                s.method = m;
+                s.method = v.method;
+                s.safeCone = v.safeCone;
                 s.iterations = k;
                 record(s, main, sweep);
             }
-    for (const Tool& t : tools) // reference: the circumsphere without the safe-cone test
-        for (int k : iterations) {
-            RunSpec s;
-            s.tool = t;
-            s.iterations = k;
-            s.safeCone = false;
-            record(s, main, sweep);
-        }
     // 2. δ sweep (circumsphere, 10 mm cylinder) at 2 and 5 iterations.
     std::printf("\n== update threshold (circumsphere, %s) ==", kCylinder.name);
     printHeader();
@@ -522,15 +523,14 @@ int main(int argc, char** argv) {
     auto byIterations = [&](auto value) {
         std::vector<PlotSeries> out;
         for (const Tool& t : tools)
-            for (size_t mi = 0; mi <= methods.size(); ++mi) {
-                // The methods, then the circumsphere without the safe cone.
-                const bool cone = mi < methods.size();
-                const CollisionMethod m = cone ? methods[mi] : CollisionMethod::Circumsphere;
+            for (const Variant& v : variants) {
                 PlotSeries s;
-                s.label = std::string(t.name) + " " + toString(m) + (cone ? "" : " (no safe cone)");
+                s.label = std::string(t.name) + " " + toString(v.method) +
+                          (v.safeCone ? "" : " (no safe cone)");
                 s.markers = true;
                 for (const RunResult& r : main)
-                    if (r.spec.method == m && r.spec.tool.name == t.name && r.spec.safeCone == cone) {
+                    if (r.spec.method == v.method && r.spec.tool.name == t.name &&
+                        r.spec.safeCone == v.safeCone) {
                         s.x.push_back(r.spec.iterations);
                         s.y.push_back(value(r));
                     }
