@@ -152,7 +152,7 @@ int run(const Options& o) {
     bool havePlayer = false;
     const int64_t waitEnd = monotonicNs() + int64_t(o.waitPlayer * 1e9);
     int64_t t0 = 0;
-    auto drain = [&](int64_t now) {
+    auto drain = [&]() {
         while (true) {
             Endpoint from;
             int64_t queued = 0;
@@ -184,7 +184,7 @@ int run(const Options& o) {
             return 3;
         }
         sock.wait(50);
-        drain(monotonicNs());
+        drain();
     }
     const int64_t period = int64_t(std::llround(1e9 / o.rate));
     uint32_t seq = 0;
@@ -198,7 +198,7 @@ int run(const Options& o) {
         const int64_t now = monotonicNs();
         const double t = 1e-9 * double(now - t0);
         if (t > duration) break;
-        drain(now);
+        drain();
         const bool paused = o.pauseAt >= 0 && t >= o.pauseAt && t < o.pauseAt + o.pauseFor;
         if (!paused) {
             src.sample(t, s);
@@ -224,7 +224,7 @@ int run(const Options& o) {
     const int64_t tail = monotonicNs() + 200'000'000;
     while (monotonicNs() < tail) {
         sock.wait(20);
-        drain(monotonicNs());
+        drain();
     }
 
     // Figures: forces, pauses, echo latency.

@@ -50,6 +50,12 @@ struct FakeConsole {
     void send(const Vec3& p0, uint32_t pedals = kPedalDeadman) { sendRaw(state(p0, pedals)); }
 };
 
+ConsoleDeviceOptions withTimeout(int64_t ns) {
+    ConsoleDeviceOptions o;
+    o.timeout_ns = ns;
+    return o;
+}
+
 void reseal(std::vector<uint8_t>& b) {
     const uint32_t c = crc32(b.data(), b.size() - 4);
     for (int k = 0; k < 4; ++k) b[b.size() - 4 + k] = uint8_t(c >> (8 * k));
@@ -143,9 +149,7 @@ TEST(ConsoleDevice, PacketsFromAnotherAddressAndOutOfOrderAreIgnored) {
 
 TEST(ConsoleDevice, DisconnectAfterTheTimeoutAndReconnect) {
     FakeConsole console;
-    ConsoleDeviceOptions opt;
-    opt.timeout_ns = 50 * kMs;
-    ConsoleDevice dev(console.address, opt);
+    ConsoleDevice dev(console.address, withTimeout(50 * kMs));
     console.learnPlayer(dev);
     DeviceState st;
     console.send(Vec3(0.01, 0, 0));
@@ -169,9 +173,7 @@ TEST(ConsoleDevice, APacketThatWaitedInTheQueuePastTheTimeoutIsNotFresh) {
     // A servo tick that runs late (the thread was descheduled) reads packets that arrived long
     // before: the device timeout counts from their arrival, not from the read.
     FakeConsole console;
-    ConsoleDeviceOptions opt;
-    opt.timeout_ns = 100 * kMs;
-    ConsoleDevice dev(console.address, opt);
+    ConsoleDevice dev(console.address, withTimeout(100 * kMs));
     console.learnPlayer(dev);
     DeviceState st;
     // The kernel switches arrival stamping on shortly after a socket asks for it (a deferred

@@ -209,7 +209,6 @@ void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& too
         }
     }
 
-    size_t constraints = m_candidates.size();
     if (m_settings.method == CollisionMethod::PolygonFeatures) {
         // Each shared vertex and edge once: sorted, unique.
         m_candEdges.clear();
@@ -225,9 +224,14 @@ void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& too
         m_featVerts.erase(std::unique(m_featVerts.begin(), m_featVerts.end()), m_featVerts.end());
         std::sort(m_candEdges.begin(), m_candEdges.end());
         m_candEdges.erase(std::unique(m_candEdges.begin(), m_candEdges.end()), m_candEdges.end());
-        constraints += m_candEdges.size() + m_featVerts.size();
     }
-    m_lambda.assign(constraints * tool.parts().size(), 0.0);
+    m_lambda.assign(constraintsPerPart() * tool.parts().size(), 0.0);
+}
+
+size_t CollisionSolver::constraintsPerPart() const {
+    size_t n = m_candidates.size();
+    if (m_settings.method == CollisionMethod::PolygonFeatures) n += m_candEdges.size() + m_featVerts.size();
+    return n;
 }
 
 bool CollisionSolver::projectDistance(const int32_t* v, const double* b, int n, const Vec3& q,
@@ -358,10 +362,7 @@ void CollisionSolver::capCorrection(int32_t v, std::vector<Vec3>& x) const {
 int CollisionSolver::iterate(std::vector<Vec3>& x, const ToolShape& tool) {
     if (x.size() != m_rest.size()) return 0;
     const auto& parts = tool.parts();
-    const size_t features = m_settings.method == CollisionMethod::PolygonFeatures
-                                ? m_candEdges.size() + m_featVerts.size()
-                                : 0;
-    if (m_lambda.size() != (m_candidates.size() + features) * parts.size()) return 0;
+    if (m_lambda.size() != constraintsPerPart() * parts.size()) return 0;
     int contacts = 0;
     m_stats.maxCorrection = 0;
     if (m_settings.method == CollisionMethod::PolygonFeatures) {

@@ -170,6 +170,9 @@ private:
     bool projectDistance(const int32_t* v, const double* b, int n, const Vec3& q, double reach,
                          const Vec3& fallback, double& lambda, std::vector<Vec3>& x);
     int iterateFeatures(std::vector<Vec3>& x, const std::vector<Capsule>& parts);
+    /// Contact constraints of the step per tool part: the candidate triangles (PolygonFeatures:
+    /// and their unique edges and vertices). Sizes the multipliers.
+    size_t constraintsPerPart() const;
     void capCorrection(int32_t v, std::vector<Vec3>& x) const;
     /// x[v] += delta within the per-step cap; records the push, the largest move and the contact.
     void applyCorrection(int32_t v, const Vec3& delta, std::vector<Vec3>& x);

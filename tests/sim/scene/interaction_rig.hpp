@@ -43,12 +43,17 @@ inline Rig makeRig() {
     s.xpbd.substeps = 70;
     s.xpbd.damping = 2.0;
     s.xpbd.gravity = Vec3(0, 0, -9.81);
-    BodyDesc fat;
-    fat.name = "fat";
-    fat.meshPath = "meshes/fat.vtet";
-    fat.material.youngsModulus = 3000;
-    fat.material.poissonRatio = 0.45;
-    fat.material.density = 950;
+    // A tet body meshes/<name>.vtet with Young's modulus E (Pa), ν = 0.45 and density ρ.
+    auto body = [](const char* name, double E, double rho) {
+        BodyDesc b;
+        b.name = name;
+        b.meshPath = std::string("meshes/") + name + ".vtet";
+        b.material.youngsModulus = E;
+        b.material.poissonRatio = 0.45;
+        b.material.density = rho;
+        return b;
+    };
+    BodyDesc fat = body("fat", 3000, 950);
     BoxSpec box;
     box.size = Vec3(0.04, 0.03, kTop);
     box.cells = {16, 12, 3};
@@ -56,12 +61,7 @@ inline Rig makeRig() {
     for (int32_t v = 0; v < static_cast<int32_t>(r.meshes[0]->vertexCount()); ++v)
         if (r.meshes[0]->positions()[v].z() < 1e-9) fat.fixedNodes.push_back(v);
     s.bodies.push_back(fat);
-    BodyDesc vessel;
-    vessel.name = "vessel";
-    vessel.meshPath = "meshes/vessel.vtet";
-    vessel.material.youngsModulus = 1200;
-    vessel.material.poissonRatio = 0.45;
-    vessel.material.density = 1060;
+    BodyDesc vessel = body("vessel", 1200, 1060);
     vessel.embeddedIn = "fat";
     HollowTubeSpec tube;
     tube.start = Vec3(0.004, 0.02, 0.005);
@@ -83,35 +83,32 @@ inline Rig makeRig() {
     r.surfaces.push_back(fasciaSheet(32, 24, 0.04, 0.03));
 
     InteractionDesc in;
-    InstrumentDesc grasper;
-    grasper.name = "grasper";
-    grasper.kind = InstrumentDesc::Kind::Grasper;
-    grasper.trackPath = "tools/grasper.track";
+    // Tracks: t x y z  dx dy dz  jaw  act, one key per line.
+    auto instrument = [](const char* name, InstrumentDesc::Kind kind, const char* file, const char* keys) {
+        InstrumentDesc d;
+        d.name = name;
+        d.kind = kind;
+        d.trackPath = std::string("tools/") + file;
+        d.trackText = std::string(kHeader) + keys;
+        return d;
+    };
+    InstrumentDesc grasper = instrument("grasper", InstrumentDesc::Kind::Grasper, "grasper.track",
+                                        "0.00 0.010 0.008 0.030 0 0 -1 1 0\n"
+                                        "0.20 0.010 0.008 0.0105 0 0 -1 1 0\n"
+                                        "0.30 0.010 0.008 0.0100 0 0 -1 0 0\n"
+                                        "0.60 0.010 0.008 0.0180 0 0 -1 0 0\n");
     grasper.radius = 0.0015;
-    grasper.trackText = std::string(kHeader) +
-                        "0.00 0.010 0.008 0.030 0 0 -1 1 0\n"
-                        "0.20 0.010 0.008 0.0105 0 0 -1 1 0\n"
-                        "0.30 0.010 0.008 0.0100 0 0 -1 0 0\n"
-                        "0.60 0.010 0.008 0.0180 0 0 -1 0 0\n";
-    InstrumentDesc hook;
-    hook.name = "hook";
-    hook.kind = InstrumentDesc::Kind::EnergyHook;
-    hook.trackPath = "tools/hook.track";
+    InstrumentDesc hook = instrument("hook", InstrumentDesc::Kind::EnergyHook, "hook.track",
+                                     "0.00 0.008 0.020 0.0102 0 0 -1 1 1\n"
+                                     "0.50 0.032 0.020 0.0102 0 0 -1 1 1\n"
+                                     "0.55 0.032 0.020 0.0300 0 0 -1 1 0\n");
     hook.radius = 0.0012;
     hook.jawLength = 0.01;
-    hook.trackText = std::string(kHeader) +
-                     "0.00 0.008 0.020 0.0102 0 0 -1 1 1\n"
-                     "0.50 0.032 0.020 0.0102 0 0 -1 1 1\n"
-                     "0.55 0.032 0.020 0.0300 0 0 -1 1 0\n";
-    InstrumentDesc clip;
-    clip.name = "clipper";
-    clip.kind = InstrumentDesc::Kind::ClipApplier;
-    clip.trackPath = "tools/clipper.track";
+    InstrumentDesc clip = instrument("clipper", InstrumentDesc::Kind::ClipApplier, "clipper.track",
+                                     "0.00 0.020 0.020 0.005 0 0 -1 1 0\n"
+                                     "0.10 0.020 0.020 0.005 0 0 -1 0 1\n");
     clip.target = "vessel";
     clip.jawLength = 0.008;
-    clip.trackText = std::string(kHeader) +
-                     "0.00 0.020 0.020 0.005 0 0 -1 1 0\n"
-                     "0.10 0.020 0.020 0.005 0 0 -1 0 1\n";
     in.instruments = {grasper, hook, clip};
     in.tissues.push_back({"fascia", 160, 0.4, Vec3(0.1, 0.3, 1.0)});
     s.interaction = in;
