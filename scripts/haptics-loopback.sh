@@ -38,6 +38,12 @@ print(f"jitter (us)   mean {s['jitter_us']['mean']:.2f}  p99 {s['jitter_us']['p9
 print(f"wake (us)     p99 {s['wake_latency_us']['p99']:.0f}  max {s['wake_latency_us']['max']:.1f};  tick cost p99 {s['tick_cost_us']['p99']:.0f} us")
 print(f"contact model age (ms) mean {c['age_ms']['mean']:.2f}  p99 {c['age_ms']['p99']:.2f}  max {c['age_ms']['max']:.2f}"
       f"  (physics period {c['physics_period_ms']:.2f} ms; max/period {c['max_age_over_period']:.2f}; steps behind <= {c['max_steps_behind']})")
+o = c['handover']
+print(f"hand-over     {o['ticks_on_older_model']} of {o['ticks_checked']} ticks used an older model than the newest published;"
+      f" age <= {o['max_age_over_step']:.3f} of the physics step in progress")
+p = o['physics_step_ms']
+print(f"physics step  (publish to publish, ms) mean {p['mean']:.2f}  p99 {p['p99']:.2f}  max {p['max']:.2f};"
+      f" {o['steps_over_period']} of {o['models_published'] - 1} over the period")
 print(f"safety        {h['safety']}")
 print(f"link          {h['link']}")
 PY

@@ -196,6 +196,7 @@ void ServoLoop::tick(int64_t now) {
         s.desired = m_desired.arms[a].servo_cf.force.norm();
         s.grip = m_state.arms[a].jaw_measured_js;
         s.contactAge_s = age_s;
+        s.contactFrame = contact.frame;
         m_trace.push(s);
     }
     m_ticks.fetch_add(1, std::memory_order_relaxed);

@@ -70,6 +70,7 @@ struct TraceSample {
     double desired = 0;       ///< N, magnitude before the safety filter
     double grip = 0;          ///< rad
     double contactAge_s = -1; ///< age of the contact model at this tick (-1: none yet)
+    int64_t contactFrame = -1; ///< physics frame of that model (-1: none yet)
 };
 
 /// Percentiles from a 1 µs histogram.

@@ -1,6 +1,7 @@
 #include "runtime/haptic_rig.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <pthread.h>
 #include <sched.h>
@@ -72,6 +73,17 @@ void HapticRig::configure(double dt) {
     // The simulation output may be three physics steps old (at least 50 ms) before the force goes.
     m_servoConfig.safety.maxSimAge_ns = std::max<int64_t>(50'000'000, int64_t(3 * dt * 1e9));
     m_servo = std::make_unique<haptics::ServoLoop>(m_device, *m_clock, m_servoConfig);
+    m_audit = haptics::HandoverAudit(dt);
+    m_audit.reserve(1 << 14);
+}
+
+void HapticRig::publish() {
+    const int64_t stamp = m_clock->now_ns();
+    m_servo->publishContact(contactModel(stamp));
+    // Completion time read after the write is visible (the fence drains the store buffer): a tick
+    // that starts later must see this frame.
+    std::atomic_thread_fence(std::memory_order_seq_cst);
+    m_audit.published(m_frame, stamp, m_clock->now_ns());
 }
 
 haptics::LocalContactModel HapticRig::contactModel(int64_t now) const {
@@ -96,7 +108,7 @@ haptics::LocalContactModel HapticRig::contactModel(int64_t now) const {
 
 void HapticRig::start() {
     m_t0 = m_clock->now_ns();
-    m_servo->publishContact(contactModel(m_t0));
+    publish();
     if (m_realtime) {
         // The physics thread gets a real-time priority below the servo thread's, so other
         // processes do not delay its publishes (ignored when the system refuses).
@@ -131,8 +143,7 @@ void HapticRig::beforeStep() {
 
 void HapticRig::afterStep() {
     ++m_frame;
-    const int64_t now = m_clock->now_ns();
-    m_servo->publishContact(contactModel(now));
+    publish();
     for (size_t t = 0; t < m_world.toolCount(); ++t) {
         const double f = m_world.toolContact(t).force.norm();
         const double thr = m_world.toolDesc(t).damageForceN;
@@ -168,6 +179,10 @@ void HapticRig::drain() {
         m_last[a] = s.tool;
         m_haveLast[a] = true;
         if (s.contactAge_s >= 0 && m_dt > 0) m_maxAgeSteps = std::max(m_maxAgeSteps, s.contactAge_s / m_dt);
+        if (s.t_ns != m_lastAuditTick) { // one sample per driven arm and tick, one model per tick
+            m_audit.used(s.t_ns, s.contactFrame);
+            m_lastAuditTick = s.t_ns;
+        }
         if (m_keepTrace) m_trace.push_back(s);
     }
 }
@@ -199,6 +214,7 @@ HapticsResult HapticRig::result() const {
     r.link = m_device.linkStats();
     r.physicsPeriod_s = m_dt;
     r.maxContactAgeSteps = m_maxAgeSteps;
+    r.handover = m_audit.figures();
     r.physicsRealtimePriority = m_physicsRt || m_hadPhysicsRt;
     r.traceSamples = m_samples;
     return r;

@@ -9,6 +9,7 @@
 /// contact model after each step. A slow step delays only the next publish: the servo loop keeps
 /// its rate and the safety filter zeroes the force once the model is older than its limit.
 #include "haptics/device.hpp"
+#include "haptics/handover_audit.hpp"
 #include "haptics/servo_loop.hpp"
 #include "sim/scene/world.hpp"
 
@@ -49,7 +50,8 @@ struct HapticsResult {
     haptics::ServoStats servo;
     haptics::LinkStats link;
     double physicsPeriod_s = 0;
-    double maxContactAgeSteps = 0; ///< max contact-model age / physics period
+    double maxContactAgeSteps = 0; ///< max contact-model age / nominal physics period
+    haptics::HandoverFigures handover; ///< ticks against the physics thread's own publish log
     bool physicsRealtimePriority = false;
     uint64_t traceSamples = 0;
 };
@@ -98,6 +100,8 @@ public:
 private:
     void drain();
     haptics::LocalContactModel contactModel(int64_t now) const;
+    /// Publishes the contact model of m_frame and logs it for the hand-over audit.
+    void publish();
     haptics::Device& m_device;
     std::string m_spec;
     sim::World& m_world;
@@ -119,6 +123,8 @@ private:
     double m_forceSum = 0, m_contactSum = 0;
     uint64_t m_forceCount = 0, m_contactCount = 0;
     double m_maxAgeSteps = 0;
+    haptics::HandoverAudit m_audit;
+    int64_t m_lastAuditTick = INT64_MIN;
     bool m_physicsRt = false, m_hadPhysicsRt = false;
     int m_oldPolicy = 0;
     sched_param m_oldParam{};

@@ -56,6 +56,15 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
                     {"max_age_over_period", h.maxContactAgeSteps},
                     {"max_steps_behind", s.maxStepsBehind},
                     {"models_used", s.contactModelsSeen}};
+    // The hand-over checked against the physics thread's own publish log (haptics/handover_audit).
+    const haptics::HandoverFigures& ho = h.handover;
+    contact["handover"] = {{"ticks_checked", ho.ticksChecked},
+                           {"ticks_on_older_model", ho.ticksOnOlderModel},
+                           {"max_age_over_step", ho.maxAgeOverStep},
+                           {"models_published", ho.modelsPublished},
+                           {"physics_step_ms", {{"mean", ho.stepMean_ms}, {"p99", ho.stepP99_ms}, {"max", ho.stepMax_ms}}},
+                           {"steps_over_period", ho.stepsOverPeriod}};
+    if (ho.firstOlderTick_ns >= 0) contact["handover"]["first_older_tick_ns"] = ho.firstOlderTick_ns;
     const haptics::SafetyCounts& c = s.safety;
     json safety = {{"ticks", c.ticks},       {"non_finite", c.nonFinite}, {"disconnected", c.disconnected},
                    {"sim_stale", c.simStale}, {"deadman", c.deadman},     {"clamped", c.clamped},
@@ -88,15 +97,16 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
 
 std::string traceCsv(const SessionResult& r) {
     std::string out = "t_s,arm,device_x,device_y,device_z,tool_x,tool_y,tool_z,force_x,force_y,force_z,force_n,desired_n,"
-                      "grip_rad,pedals,connected,safety_rules,contact_age_ms\n";
+                      "grip_rad,pedals,connected,safety_rules,contact_age_ms,contact_frame\n";
     out.reserve(out.size() + r.trace.size() * 160);
     const int64_t t0 = r.trace.empty() ? 0 : r.trace.front().t_ns;
     char buf[512];
     for (const TraceRow& s : r.trace) {
-        std::snprintf(buf, sizeof buf, "%.6f,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.5g,%.5g,%.5g,%.4g,%u,%d,%u,%.4f\n",
+        std::snprintf(buf, sizeof buf, "%.6f,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.5g,%.5g,%.5g,%.4g,%u,%d,%u,%.4f,%lld\n",
                       1e-9 * double(s.t_ns - t0), int(s.arm), s.device.x(), s.device.y(), s.device.z(), s.tool.x(),
                       s.tool.y(), s.tool.z(), s.force.x(), s.force.y(), s.force.z(), s.force.norm(), s.desired, s.grip,
-                      s.pedals, int(s.connected), s.rules, s.contactAge_s * 1e3);
+                      s.pedals, int(s.connected), s.rules, s.contactAge_s * 1e3,
+                      static_cast<long long>(s.contactFrame));
         out += buf;
     }
     return out;
@@ -270,6 +280,13 @@ std::string summaryText(const SessionResult& r) {
                       "task          path %.1f mm, force max %.2f N mean %.2f N, contact model age max %.2f ms (%.2f periods)\n",
                       r.metrics.toolPathLength_m * 1e3, r.metrics.maxForce_n, r.metrics.meanForce_n,
                       h.servo.contactAge.max_us * 1e-3, h.maxContactAgeSteps);
+        out += line;
+        const haptics::HandoverFigures& ho = h.handover;
+        std::snprintf(line, sizeof line,
+                      "hand-over     %llu of %llu ticks on an older model than the newest published; age <= %.3f of the "
+                      "physics step in progress; steps mean %.2f ms, p99 %.2f, max %.2f (%lld over the period)\n",
+                      (unsigned long long)ho.ticksOnOlderModel, (unsigned long long)ho.ticksChecked, ho.maxAgeOverStep,
+                      ho.stepMean_ms, ho.stepP99_ms, ho.stepMax_ms, (long long)ho.stepsOverPeriod);
         out += line;
         if (h.link.disconnects || h.link.rejectedMalformed || h.link.rejectedVersion || h.link.rejectedChecksum) {
             std::snprintf(line, sizeof line, "link          %llu disconnects, %llu reconnects, %llu packets rejected\n",

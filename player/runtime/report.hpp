@@ -12,7 +12,8 @@ nlohmann::json reportJson(const SessionResult& result);
 /// The force and pose trace (--trace): one row per servo tick and driven arm.
 /// Columns: t_s, arm, device_x/y/z (m, device frame), tool_x/y/z (m, scene), force_x/y/z (N,
 /// device frame, after the safety filter), force_n, desired_n (before the filter), grip_rad,
-/// pedals, connected, safety_rules (SafetyRule bits), contact_age_ms.
+/// pedals, connected, safety_rules (SafetyRule bits), contact_age_ms, contact_frame (the physics
+/// frame of the contact model the tick used).
 std::string traceCsv(const SessionResult& result);
 /// A short human-readable summary (at most ~15 lines).
 std::string summaryText(const SessionResult& result);

@@ -121,6 +121,9 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         r.metrics = rig->metrics();
         r.trace = std::move(rig->trace());
         r.invariants.maxForce = r.metrics.maxForce_n;
+        if (const uint64_t n = r.haptics->handover.ticksOnOlderModel)
+            r.errors.push_back("haptics: " + std::to_string(n) +
+                               " servo ticks used an older contact model than the newest the physics had published");
     }
     r.metrics.time_s = world.time();
     if (options.live) {

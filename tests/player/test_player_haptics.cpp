@@ -112,6 +112,12 @@ TEST(PlayerHaptics, ScriptedSessionIsRepeatableAndReportsTaskMetrics) {
     EXPECT_EQ(h["servo"]["ticks"].get<int>(), 3334); // 1 kHz over 200 frames of 1/60 s (0.0166667 s)
     EXPECT_LE(h["contact_model"]["max_age_over_period"].get<double>(), 1.0) << "never older than one physics step";
     EXPECT_LE(h["contact_model"]["max_steps_behind"].get<int>(), 1);
+    const auto& ho = h["contact_model"]["handover"];
+    EXPECT_EQ(ho["ticks_checked"].get<int>(), 3334);
+    EXPECT_EQ(ho["ticks_on_older_model"].get<int>(), 0);
+    EXPECT_LT(ho["max_age_over_step"].get<double>(), 1.0);
+    EXPECT_EQ(ho["models_published"].get<int>(), 201); // the initial model and one per frame
+    EXPECT_NEAR(ho["physics_step_ms"]["mean"].get<double>(), 1000.0 / 60, 1e-6);
     EXPECT_EQ(h["safety"]["non_finite"], 0);
     // Lockstep sessions are repeatable: same forces, same path.
     EXPECT_EQ(a["metrics"]["max_force_n"], b["metrics"]["max_force_n"]);
@@ -188,6 +194,12 @@ TEST(PlayerHaptics, ConsoleLoopbackWithADisconnectMidSession) {
     EXPECT_GT(h["safety"]["disconnected"].get<int>(), 0);
     EXPECT_GT(h["servo"]["ticks"].get<int>(), 1000);
     EXPECT_LE(h["contact_model"]["max_steps_behind"].get<int>(), 1);
+    // Every tick used the newest model the physics thread had published (its own log says when).
+    const auto& ho = h["contact_model"]["handover"];
+    EXPECT_EQ(ho["ticks_checked"], h["servo"]["ticks"]);
+    EXPECT_EQ(ho["ticks_on_older_model"].get<int>(), 0);
+    EXPECT_LE(ho["max_age_over_step"].get<double>(), 1.0);
+    EXPECT_EQ(ho["models_published"].get<int>(), 181);
     EXPECT_TRUE(j["invariants"]["all_finite"].get<bool>());
     // The player kept running through the gap and forces came back to the console afterwards.
     const auto sum = readJson(s / "sum.json");
