@@ -40,7 +40,7 @@ void usage(std::FILE* out) {
     std::fputs("usage: viscera-player verify <case.vcase>\n"
                "       viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]\n"
                "                      [--report report.json] [--screenshot out.png] [--trace trace.csv]\n"
-               "                      [--realtime] [--servo sleep|spin:US|busy|busy:CPU]\n"
+               "                      [--realtime] [--servo sleep|sleep:CPU|spin:US|busy|busy:CPU]\n"
                "       SPEC: replay:<file> | scripted:<name> | console:<host:port> | keyboard\n"
                "       viscera-player --version\n",
                out);
@@ -93,7 +93,19 @@ int cmdRun(const std::vector<std::string>& args) {
         else if (a == "--device") device = value("--device");
         else if (a == "--servo") {
             const std::string v = value("--servo");
+            auto cpuOf = [&](size_t at) { // "…:CPU"
+                char* end = nullptr;
+                const long c = std::strtol(v.c_str() + at, &end, 10);
+                if (v.size() == at || *end != '\0' || c < 0 || c >= sysconf(_SC_NPROCESSORS_ONLN))
+                    throw std::invalid_argument("--servo '" + v + "': the CPU must be an integer in [0, " +
+                                                std::to_string(sysconf(_SC_NPROCESSORS_ONLN) - 1) + "]");
+                return static_cast<int>(c);
+            };
             if (v == "sleep") servoWait = haptics::ServoWait::SleepSpin;
+            else if (v.rfind("sleep:", 0) == 0) { // sleep + spin, pinned to a CPU the physics thread stays off
+                servoWait = haptics::ServoWait::SleepSpin;
+                servoCpu = cpuOf(6);
+            }
             else if (v.rfind("spin:", 0) == 0) { // sleep, then spin the last US microseconds
                 char* end = nullptr;
                 const long us = std::strtol(v.c_str() + 5, &end, 10);
@@ -104,14 +116,9 @@ int cmdRun(const std::vector<std::string>& args) {
             }
             else if (v == "busy") servoWait = haptics::ServoWait::Busy;
             else if (v.rfind("busy:", 0) == 0) {
-                char* end = nullptr;
-                const long c = std::strtol(v.c_str() + 5, &end, 10);
-                if (v.size() == 5 || *end != '\0' || c < 0 || c >= sysconf(_SC_NPROCESSORS_ONLN))
-                    throw std::invalid_argument("--servo '" + v + "': the CPU must be an integer in [0, " +
-                                                std::to_string(sysconf(_SC_NPROCESSORS_ONLN) - 1) + "]");
                 servoWait = haptics::ServoWait::Busy;
-                servoCpu = static_cast<int>(c);
-            } else throw std::invalid_argument("--servo '" + v + "': expected sleep, spin:US, busy or busy:CPU");
+                servoCpu = cpuOf(5);
+            } else throw std::invalid_argument("--servo '" + v + "': expected sleep, sleep:CPU, spin:US, busy or busy:CPU");
         }
         else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option '" + a + "'");
         else if (!casePath) casePath = a;
@@ -130,14 +137,23 @@ int cmdRun(const std::vector<std::string>& args) {
     }
     if (tracePath && !device) return fail(kExitUsage, "--trace records the device forces and poses; it needs --device");
 
-    player::LoadedCase loaded = player::loadCase(*casePath);
     std::unique_ptr<haptics::Device> dev;
     if (spec) dev = haptics::openDevice(*spec);
+    const bool rt = realtime || (dev && dev->capabilities().realtime) || !headless;
+    if (dev && rt) {
+        // The servo gets a CPU of its own (the last one, where there are two or more): this thread
+        // and every thread started from here on (physics, solver workers, window) stay off it, so
+        // nothing of ours waits behind the servo's spin and the kernel never has to preempt the
+        // servo to serve a starved task on its CPU.
+        if (servoCpu < 0) servoCpu = haptics::defaultServoCpu();
+        if (servoCpu >= 0) haptics::pinCurrentThreadExcept(servoCpu);
+    }
+    player::LoadedCase loaded = player::loadCase(*casePath);
     player::RunOptions opts;
     opts.frames = frames;
     opts.device = dev.get();
     opts.deviceSpec = device.value_or("");
-    opts.realtime = realtime || (dev && dev->capabilities().realtime) || !headless;
+    opts.realtime = rt;
     opts.keepTrace = tracePath.has_value();
     opts.servoWait = servoWait;
     opts.servoCpu = servoCpu;

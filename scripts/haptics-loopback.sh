@@ -5,7 +5,7 @@
 #
 #   scripts/haptics-loopback.sh [seconds=60] [build-dir=build] [out-dir=out/haptics-loopback] [servo=sleep]
 #
-# servo: "sleep" (sleep, then spin the last 0.94 ms), "spin:US" (the same with a
+# servo: "sleep" (sleep, then spin the last 0.94 ms; the last CPU), "sleep:CPU" (on that CPU), "spin:US" (the same with a
 # spin of US microseconds) or "busy[:CPU]" (spin the whole period on a CPU of its own; for a
 # console PC with a core set aside).
 set -euo pipefail
@@ -14,9 +14,20 @@ build="${2:-${VISCERA_BUILD_DIR:-build}}"
 out="${3:-out/haptics-loopback}"
 servo="${4:-sleep}"
 mkdir -p "$out"
+# The console is a machine of its own; here its simulator runs beside the player, so keep it off
+# the CPU the player's servo thread owns (the last one, or the one the servo mode names).
+ncpu="$(nproc)"
+case "$servo" in
+  sleep:*|busy:*) servo_cpu="${servo#*:}" ;;
+  *) servo_cpu=$(( ncpu >= 2 ? ncpu - 1 : -1 )) ;;
+esac
+sim_cpus=""
+if [ "$servo_cpu" -ge 0 ] && [ "$ncpu" -ge 2 ] && command -v taskset >/dev/null; then
+  sim_cpus="$(seq 0 $(( ncpu - 1 )) | grep -vx "$servo_cpu" | paste -sd, -)"
+fi
 "$build/tests/player/make_haptic_case" "$out/haptic-slab.vcase" 2 >/dev/null
 rm -f "$out/port"
-"$build/player/viscera-console-sim" --listen 127.0.0.1:0 --port-file "$out/port" --script bimanual --loop \
+${sim_cpus:+taskset -c "$sim_cpus"} "$build/player/viscera-console-sim" --listen 127.0.0.1:0 --port-file "$out/port" --script bimanual --loop \
   --duration "$(( secs + 1 ))" --record "$out/console-forces.csv" --summary "$out/console-summary.json" \
   > "$out/console-sim.log" 2>&1 &
 sim=$!

@@ -43,6 +43,11 @@ bool pinCurrentThread(int cpu) {
 
 } // namespace
 
+int defaultServoCpu() {
+    const int n = onlineCpuCount();
+    return n >= 2 ? n - 1 : -1;
+}
+
 bool pinCurrentThreadExcept(int cpu) {
     const int n = onlineCpuCount();
     cpu_set_t set;

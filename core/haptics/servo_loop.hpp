@@ -51,7 +51,7 @@ struct ServoConfig {
     double rateHz = 1000.0;
     ServoWait wait = ServoWait::SleepSpin;
     int64_t spin_ns = 940'000;   ///< SleepSpin: wake this early and spin to the deadline (see servo_loop.cpp)
-    int cpu = -1;                ///< pin the servo thread to this CPU (-1: Busy → the last CPU, SleepSpin → none; ServoLoop::config() has it resolved)
+    int cpu = -1;                ///< pin the servo thread to this CPU (-1: Busy → the last CPU, SleepSpin → none; ServoLoop::config() has it resolved; the player passes defaultServoCpu())
     bool realtimePriority = true;   ///< try SCHED_FIFO for the servo thread (ignored when refused)
     SafetyLimits safety;
     std::array<ToolMapping, kMaxArms> tools{};
@@ -97,6 +97,10 @@ struct ServoStats {
     SafetyCounts safety;
     uint64_t traceDropped = 0;
 };
+
+/// The CPU a real-time servo thread should own: the last online CPU where there are at least
+/// two, else -1 (share the only one).
+int defaultServoCpu();
 
 /// Keeps the calling thread off `cpu` (e.g. the physics thread off a Busy servo's CPU). False when
 /// the system refuses or no other CPU is online.

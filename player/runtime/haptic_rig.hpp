@@ -53,6 +53,7 @@ struct HapticsResult {
     double maxContactAgeSteps = 0; ///< max contact-model age / nominal physics period
     haptics::HandoverFigures handover; ///< ticks against the physics thread's own publish log
     bool physicsRealtimePriority = false;
+    std::vector<int> physicsCpus; ///< real time: the CPUs the physics thread may run on
     uint64_t traceSamples = 0;
 };
 
@@ -126,6 +127,7 @@ private:
     haptics::HandoverAudit m_audit;
     int64_t m_lastAuditTick = INT64_MIN;
     bool m_physicsRt = false, m_hadPhysicsRt = false;
+    std::vector<int> m_physicsCpus;
     int m_oldPolicy = 0;
     sched_param m_oldParam{};
 };

@@ -49,6 +49,7 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
         servo["jitter_us"] = distribution(s.jitter);
         servo["wake_latency_us"] = distribution(s.wakeLatency);
         servo["physics_realtime_priority"] = h.physicsRealtimePriority;
+        servo["physics_cpus"] = h.physicsCpus;
     }
     const auto& a = s.contactAge;
     json contact = {{"physics_period_ms", h.physicsPeriod_s * 1e3},

@@ -200,6 +200,14 @@ TEST(PlayerHaptics, ConsoleLoopbackWithADisconnectMidSession) {
     EXPECT_EQ(ho["ticks_on_older_model"].get<int>(), 0);
     EXPECT_LE(ho["max_age_over_step"].get<double>(), 1.0);
     EXPECT_EQ(ho["models_published"].get<int>(), 181);
+    // The servo owns the last CPU (where there are two or more); the physics thread stays off it.
+    const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    const auto& servo = h["servo"];
+    if (ncpu >= 2) {
+        EXPECT_EQ(servo["cpu"].get<long>(), ncpu - 1);
+        EXPECT_THAT(servo["physics_cpus"].get<std::vector<int>>(), ::testing::Not(::testing::Contains(int(ncpu - 1))));
+        EXPECT_FALSE(servo["physics_cpus"].empty());
+    }
     EXPECT_TRUE(j["invariants"]["all_finite"].get<bool>());
     // The player kept running through the gap and forces came back to the console afterwards.
     const auto sum = readJson(s / "sum.json");

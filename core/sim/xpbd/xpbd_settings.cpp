@@ -4,11 +4,17 @@
 #include <cmath>
 #include <thread>
 
+#include <sched.h>
+
 namespace viscera::sim {
 
 int defaultXpbdThreads() {
-    const unsigned hw = std::thread::hardware_concurrency();
-    return static_cast<int>(std::clamp(hw == 0 ? 2u : hw, 2u, 8u));
+    // The CPUs this thread may run on (the player keeps a real-time servo's CPU out of the set).
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    unsigned n = sched_getaffinity(0, sizeof(set), &set) == 0 ? static_cast<unsigned>(CPU_COUNT(&set)) : 0u;
+    if (n == 0) n = std::thread::hardware_concurrency();
+    return static_cast<int>(std::clamp(n == 0 ? 2u : n, 1u, 8u));
 }
 
 std::string validate(const XpbdSettings& s) {

@@ -8,7 +8,8 @@
 
 namespace viscera::sim {
 
-/// Default worker count: std::thread::hardware_concurrency() clamped to [2, 8] (2 when unknown).
+/// Default worker count: the CPUs the calling thread may run on (its affinity mask; else
+/// std::thread::hardware_concurrency()) clamped to [1, 8], 2 when unknown.
 int defaultXpbdThreads();
 
 struct XpbdSettings {
