@@ -51,7 +51,7 @@ print(f"contact model age (ms) mean {c['age_ms']['mean']:.2f}  p99 {c['age_ms'][
       f"  (physics period {c['physics_period_ms']:.2f} ms; max/period {c['max_age_over_period']:.2f}; steps behind <= {c['max_steps_behind']})")
 o = c['handover']
 print(f"hand-over     {o['ticks_on_older_model']} of {o['ticks_checked']} ticks used an older model than the newest published;"
-      f" age <= {o['max_age_over_step']:.3f} of the physics step in progress")
+      f" age <= {o['max_age_over_step']:.4f} of the physics step in progress")
 p = o['physics_step_ms']
 print(f"physics step  (publish to publish, ms) mean {p['mean']:.2f}  p99 {p['p99']:.2f}  max {p['max']:.2f};"
       f" {o['steps_over_period']} of {o['models_published'] - 1} over the period")

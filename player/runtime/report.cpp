@@ -284,7 +284,7 @@ std::string summaryText(const SessionResult& r) {
         out += line;
         const haptics::HandoverFigures& ho = h.handover;
         std::snprintf(line, sizeof line,
-                      "hand-over     %llu of %llu ticks on an older model than the newest published; age <= %.3f of the "
+                      "hand-over     %llu of %llu ticks on an older model than the newest published; age <= %.4f of the "
                       "physics step in progress; steps mean %.2f ms, p99 %.2f, max %.2f (%lld over the period)\n",
                       (unsigned long long)ho.ticksOnOlderModel, (unsigned long long)ho.ticksChecked, ho.maxAgeOverStep,
                       ho.stepMean_ms, ho.stepP99_ms, ho.stepMax_ms, (long long)ho.stepsOverPeriod);
