@@ -1,6 +1,7 @@
 // The servo loop driven tick by tick on a deterministic clock (lockstep), and once on its own
 // thread: virtual coupling against the local contact model, stale simulation, clutch,
-// disconnect and reconnection, contact-model age, and the trace.
+// disconnect and reconnection, contact-model age (checked by the hand-over audit too), and the trace.
+#include "haptics/handover_audit.hpp"
 #include "haptics/scripted_device.hpp"
 #include "haptics/servo_loop.hpp"
 
@@ -166,6 +167,7 @@ TEST(ServoLoop, ContactModelAgeNeverExceedsOnePhysicsStepInLockstep) {
     cfg.tools[0].enabled = true;
     ServoLoop servo(dev, clock, cfg);
     const double period = 1.0 / 60;
+    HandoverAudit audit(period);
     int64_t frame = 0;
     double nextPublish = 0;
     double maxAge = 0;
@@ -174,7 +176,8 @@ TEST(ServoLoop, ContactModelAgeNeverExceedsOnePhysicsStepInLockstep) {
         const double t = tick * 1e-3;
         clock.set(int64_t(std::llround(t * 1e9)));
         if (t + 1e-12 >= nextPublish) {
-            servo.publishContact(wall(clock.now_ns(), frame++, 300));
+            servo.publishContact(wall(clock.now_ns(), frame, 300));
+            audit.published(frame++, clock.now_ns(), clock.now_ns());
             nextPublish += period;
         }
         servo.tick(clock.now_ns());
@@ -182,12 +185,19 @@ TEST(ServoLoop, ContactModelAgeNeverExceedsOnePhysicsStepInLockstep) {
         while (servo.popTrace(s)) {
             ASSERT_GE(s.contactAge_s, 0.0);
             ASSERT_TRUE(s.force.allFinite());
+            ASSERT_EQ(s.contactFrame, frame - 1) << "the trace names the model the tick used";
+            audit.used(s.t_ns, s.contactFrame);
             maxAge = std::max(maxAge, s.contactAge_s);
             ++samples;
         }
     }
     EXPECT_EQ(samples, 3000);
     EXPECT_LE(maxAge, period + 1e-9);
+    const HandoverFigures ho = audit.figures();
+    EXPECT_EQ(ho.ticksChecked, 3000u);
+    EXPECT_EQ(ho.ticksOnOlderModel, 0u);
+    EXPECT_LT(ho.maxAgeOverStep, 1.0);
+    EXPECT_EQ(ho.stepsOverPeriod, 0) << "16 and 17 ms steps against 16.67 ms";
     const ServoStats st = servo.stats();
     EXPECT_EQ(st.contactModelsSeen, frame);
     EXPECT_LE(st.contactAge.max_us, period * 1e6 + 1e-3);
