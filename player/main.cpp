@@ -12,6 +12,7 @@
 // Exit codes: 0 success, 1 bad input (case, arguments), 2 usage, 3 the session broke an invariant.
 #include "case/case_package.hpp"
 #include "haptics/device_spec.hpp"
+#include "haptics/servo_loop.hpp"
 #include "render/case_settings.hpp"
 #include "render/headless.hpp"
 #include "render/scene_view.hpp"
@@ -22,6 +23,7 @@
 #include "sim/util/error.hpp"
 #include "sim/util/log.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -93,12 +95,15 @@ int cmdRun(const std::vector<std::string>& args) {
         else if (a == "--device") device = value("--device");
         else if (a == "--servo") {
             const std::string v = value("--servo");
-            auto cpuOf = [&](size_t at) { // "…:CPU"
+            auto cpuOf = [&](size_t at) { // "…:CPU", one this process may run on
+                const std::vector<int> allowed = haptics::allowedCpus();
                 char* end = nullptr;
                 const long c = std::strtol(v.c_str() + at, &end, 10);
-                if (v.size() == at || *end != '\0' || c < 0 || c >= sysconf(_SC_NPROCESSORS_ONLN))
-                    throw std::invalid_argument("--servo '" + v + "': the CPU must be an integer in [0, " +
-                                                std::to_string(sysconf(_SC_NPROCESSORS_ONLN) - 1) + "]");
+                if (v.size() == at || *end != '\0' || std::find(allowed.begin(), allowed.end(), c) == allowed.end()) {
+                    std::string list;
+                    for (int a : allowed) list += (list.empty() ? "" : ", ") + std::to_string(a);
+                    throw std::invalid_argument("--servo '" + v + "': the CPU must be one this process may run on (" + list + ")");
+                }
                 return static_cast<int>(c);
             };
             if (v == "sleep") servoWait = haptics::ServoWait::SleepSpin;

@@ -15,15 +15,17 @@ out="${3:-out/haptics-loopback}"
 servo="${4:-sleep}"
 mkdir -p "$out"
 # The console is a machine of its own; here its simulator runs beside the player, so keep it off
-# the CPU the player's servo thread owns (the last one, or the one the servo mode names).
-ncpu="$(nproc)"
+# the CPU the player's servo thread owns (the highest allowed one, or the one the servo mode names).
+# The CPUs this script may run on (taskset, cpusets), one per line; the player picks from the same.
+cpus="$(awk '/^Cpus_allowed_list/ {print $2}' /proc/self/status | tr ',' '\n' |
+        awk -F- '{ if (NF == 2) for (i = $1; i <= $2; i++) print i; else print $1 }')"
 case "$servo" in
   sleep:*|busy:*) servo_cpu="${servo#*:}" ;;
-  *) servo_cpu=$(( ncpu >= 2 ? ncpu - 1 : -1 )) ;;
+  *) if [ "$(echo "$cpus" | wc -l)" -ge 2 ]; then servo_cpu="$(echo "$cpus" | tail -n 1)"; else servo_cpu=-1; fi ;;
 esac
 sim_cpus=""
-if [ "$servo_cpu" -ge 0 ] && [ "$ncpu" -ge 2 ] && command -v taskset >/dev/null; then
-  sim_cpus="$(seq 0 $(( ncpu - 1 )) | grep -vx "$servo_cpu" | paste -sd, -)"
+if [ "$servo_cpu" -ge 0 ] && command -v taskset >/dev/null; then
+  sim_cpus="$(echo "$cpus" | grep -vx "$servo_cpu" | paste -sd, -)"
 fi
 "$build/tests/player/make_haptic_case" "$out/haptic-slab.vcase" 2 >/dev/null
 rm -f "$out/port"

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
-#include <string>
 
 namespace viscera::haptics {
 
@@ -14,11 +12,10 @@ void HandoverAudit::reserve(size_t frames) {
 }
 
 void HandoverAudit::published(int64_t frame, int64_t stamp_ns, int64_t done_ns) {
-    if (frame != static_cast<int64_t>(m_stamp.size()))
-        throw std::logic_error("HandoverAudit: frame " + std::to_string(frame) + " published, expected " +
-                               std::to_string(m_stamp.size()));
-    if (!m_done.empty() && done_ns < m_done.back())
-        throw std::logic_error("HandoverAudit: publish times must not decrease (frame " + std::to_string(frame) + ")");
+    if (frame != static_cast<int64_t>(m_stamp.size()) || (!m_done.empty() && done_ns < m_done.back())) {
+        ++m_logErrors;
+        return;
+    }
     m_stamp.push_back(stamp_ns);
     m_done.push_back(std::max(done_ns, stamp_ns));
     if (m_lastUse.size() < m_stamp.size()) m_lastUse.resize(m_stamp.size(), -1);
@@ -42,7 +39,8 @@ HandoverFigures HandoverAudit::figures() const {
     HandoverFigures f;
     f.ticksChecked = m_checked;
     f.ticksOnOlderModel = m_older;
-    f.firstOlderTick_ns = m_firstOlder;
+    if (m_firstOlder >= 0 && !m_stamp.empty()) f.firstOlderTick_s = 1e-9 * double(m_firstOlder - m_stamp.front());
+    f.logErrors = m_logErrors;
     f.modelsPublished = static_cast<int64_t>(m_stamp.size());
     const size_t n = m_stamp.size();
     std::vector<double> steps;

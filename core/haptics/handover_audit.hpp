@@ -12,6 +12,9 @@
 /// a tick was stale; ticks on the newest model, whose successor is not out yet, are checked once
 /// it is).
 ///
+/// Nothing here throws: a publish out of order is counted (logErrors) and left out, so the audit
+/// cannot take down the physics thread.
+///
 /// The publish-to-publish interval is the physics step as the servo sees it (step + pacing); its
 /// distribution says how far the physics kept to its nominal period. Not thread-safe: the physics
 /// thread calls everything (published() after each publish, used() while draining the trace).
@@ -24,7 +27,8 @@ namespace viscera::haptics {
 struct HandoverFigures {
     uint64_t ticksChecked = 0;     ///< ticks with a model
     uint64_t ticksOnOlderModel = 0; ///< ticks that used a model older than the newest published
-    int64_t firstOlderTick_ns = -1; ///< time of the first such tick (-1: none)
+    double firstOlderTick_s = -1;  ///< time of the first such tick after the first publish (-1: none)
+    uint64_t logErrors = 0;        ///< publishes out of order or back in time (an internal error; ignored)
     double maxAgeOverStep = 0;     ///< max over ticks of age / (physics step in progress)
     int64_t modelsPublished = 0;
     // publish-to-publish intervals (ms)
@@ -48,7 +52,7 @@ private:
     double m_period_s;
     std::vector<int64_t> m_stamp, m_done;  ///< per frame
     std::vector<int64_t> m_lastUse;        ///< per frame: latest tick start that used it (-1: none)
-    uint64_t m_checked = 0, m_older = 0;
+    uint64_t m_checked = 0, m_older = 0, m_logErrors = 0;
     int64_t m_firstOlder = -1;
 };
 

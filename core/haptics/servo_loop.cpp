@@ -28,11 +28,6 @@ void atomicMin(std::atomic<int64_t>& a, int64_t v) {
     while (v < cur && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {}
 }
 
-int onlineCpuCount() {
-    const long n = sysconf(_SC_NPROCESSORS_ONLN);
-    return n > 0 ? static_cast<int>(n) : 1;
-}
-
 bool pinCurrentThread(int cpu) {
     if (cpu < 0 || cpu >= CPU_SETSIZE) return false;
     cpu_set_t set;
@@ -43,17 +38,26 @@ bool pinCurrentThread(int cpu) {
 
 } // namespace
 
+std::vector<int> allowedCpus() {
+    std::vector<int> cpus;
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (pthread_getaffinity_np(pthread_self(), sizeof(set), &set) != 0) return cpus;
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+        if (CPU_ISSET(c, &set)) cpus.push_back(c);
+    return cpus;
+}
+
 int defaultServoCpu() {
-    const int n = onlineCpuCount();
-    return n >= 2 ? n - 1 : -1;
+    const std::vector<int> cpus = allowedCpus();
+    return cpus.size() >= 2 ? cpus.back() : -1;
 }
 
 bool pinCurrentThreadExcept(int cpu) {
-    const int n = onlineCpuCount();
     cpu_set_t set;
     CPU_ZERO(&set);
-    for (int c = 0; c < n && c < CPU_SETSIZE; ++c)
-        if (c != cpu) CPU_SET(c, &set);
+    if (pthread_getaffinity_np(pthread_self(), sizeof(set), &set) != 0) return false;
+    if (cpu >= 0 && cpu < CPU_SETSIZE) CPU_CLR(cpu, &set);
     return CPU_COUNT(&set) > 0 && pthread_setaffinity_np(pthread_self(), sizeof(set), &set) == 0;
 }
 
@@ -105,7 +109,10 @@ Distribution ServoLoop::Histogram::summary() const {
 ServoLoop::ServoLoop(Device& device, const Clock& clock, const ServoConfig& config)
     : m_device(device), m_clock(clock), m_config(config), m_safety(device.capabilities(), config.safety),
       m_trace(config.traceCapacity) {
-    if (m_config.wait == ServoWait::Busy && m_config.cpu < 0) m_config.cpu = onlineCpuCount() - 1;
+    if (m_config.wait == ServoWait::Busy && m_config.cpu < 0) {
+        const std::vector<int> cpus = allowedCpus();
+        m_config.cpu = cpus.empty() ? -1 : cpus.back();
+    }
 }
 
 ServoLoop::~ServoLoop() { stop(); }

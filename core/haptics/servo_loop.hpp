@@ -51,7 +51,7 @@ struct ServoConfig {
     double rateHz = 1000.0;
     ServoWait wait = ServoWait::SleepSpin;
     int64_t spin_ns = 940'000;   ///< SleepSpin: wake this early and spin to the deadline (see servo_loop.cpp)
-    int cpu = -1;                ///< pin the servo thread to this CPU (-1: Busy → the last CPU, SleepSpin → none; ServoLoop::config() has it resolved; the player passes defaultServoCpu())
+    int cpu = -1;                ///< pin the servo thread to this CPU (-1: Busy → the highest allowed CPU, SleepSpin → none; ServoLoop::config() has it resolved; the player passes defaultServoCpu())
     bool realtimePriority = true;   ///< try SCHED_FIFO for the servo thread (ignored when refused)
     SafetyLimits safety;
     std::array<ToolMapping, kMaxArms> tools{};
@@ -98,12 +98,15 @@ struct ServoStats {
     uint64_t traceDropped = 0;
 };
 
-/// The CPU a real-time servo thread should own: the last online CPU where there are at least
-/// two, else -1 (share the only one).
+/// The CPUs the calling thread may run on (its affinity mask: taskset, cpusets), ascending.
+std::vector<int> allowedCpus();
+
+/// The CPU a real-time servo thread should own: the highest CPU the calling thread may run on,
+/// where it may run on at least two; else -1 (share the only one).
 int defaultServoCpu();
 
-/// Keeps the calling thread off `cpu` (e.g. the physics thread off a Busy servo's CPU). False when
-/// the system refuses or no other CPU is online.
+/// Keeps the calling thread off `cpu`: its affinity mask loses that CPU (e.g. the physics thread
+/// off the servo's CPU). False when the system refuses or no other allowed CPU is left.
 bool pinCurrentThreadExcept(int cpu);
 
 class ServoLoop {

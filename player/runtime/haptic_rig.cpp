@@ -74,7 +74,7 @@ void HapticRig::configure(double dt) {
     m_servoConfig.safety.maxSimAge_ns = std::max<int64_t>(50'000'000, int64_t(3 * dt * 1e9));
     m_servo = std::make_unique<haptics::ServoLoop>(m_device, *m_clock, m_servoConfig);
     m_audit = haptics::HandoverAudit(dt);
-    m_audit.reserve(1 << 14);
+    m_audit.reserve(1 << 16); // 18 min at 60 Hz before the log grows on the physics thread
 }
 
 void HapticRig::publish() {

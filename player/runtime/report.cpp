@@ -65,7 +65,8 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
                            {"models_published", ho.modelsPublished},
                            {"physics_step_ms", {{"mean", ho.stepMean_ms}, {"p99", ho.stepP99_ms}, {"max", ho.stepMax_ms}}},
                            {"steps_over_period", ho.stepsOverPeriod}};
-    if (ho.firstOlderTick_ns >= 0) contact["handover"]["first_older_tick_ns"] = ho.firstOlderTick_ns;
+    if (ho.firstOlderTick_s >= 0) contact["handover"]["first_older_tick_s"] = ho.firstOlderTick_s;
+    if (ho.logErrors) contact["handover"]["log_errors"] = ho.logErrors;
     const haptics::SafetyCounts& c = s.safety;
     json safety = {{"ticks", c.ticks},       {"non_finite", c.nonFinite}, {"disconnected", c.disconnected},
                    {"sim_stale", c.simStale}, {"deadman", c.deadman},     {"clamped", c.clamped},

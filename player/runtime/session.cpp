@@ -121,9 +121,12 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         r.metrics = rig->metrics();
         r.trace = std::move(rig->trace());
         r.invariants.maxForce = r.metrics.maxForce_n;
-        if (const uint64_t n = r.haptics->handover.ticksOnOlderModel)
-            r.errors.push_back("haptics: " + std::to_string(n) +
+        const haptics::HandoverFigures& ho = r.haptics->handover;
+        if (ho.ticksOnOlderModel)
+            r.errors.push_back("haptics: " + std::to_string(ho.ticksOnOlderModel) +
                                " servo ticks used an older contact model than the newest the physics had published");
+        if (ho.logErrors)
+            r.errors.push_back("haptics: the hand-over log has " + std::to_string(ho.logErrors) + " publishes out of order");
     }
     r.metrics.time_s = world.time();
     if (options.live) {

@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -94,28 +95,28 @@ std::string waitForPort(const std::string& file) {
 /// and s/forces.csv (console side).
 void runLoopback(const Scratch& s, int frames, std::vector<std::string> simArgs) {
     test::writeHapticCase(s / "slab.vcase", 2);
-    // The console is a machine of its own: its simulator (started from here, it inherits this
-    // thread's CPUs) stays off the CPU the player's servo will own; restored on return.
-    cpu_set_t saved;
-    const bool haveSaved = sched_getaffinity(0, sizeof(saved), &saved) == 0;
-    if (haveSaved && haptics::defaultServoCpu() >= 0) haptics::pinCurrentThreadExcept(haptics::defaultServoCpu());
-    struct Restore {
-        const cpu_set_t* set;
-        ~Restore() {
-            if (set) sched_setaffinity(0, sizeof(*set), set);
-        }
-    } restore{haveSaved ? &saved : nullptr};
     const std::vector<std::string> common = {"--listen",  "127.0.0.1:0",     "--port-file", s / "port",
                                              "--script",  "bimanual",        "--record",    s / "forces.csv",
                                              "--summary", s / "sum.json",    "--wait-player", "20"};
     simArgs.insert(simArgs.end(), common.begin(), common.end());
-    Background sim(VISCERA_CONSOLE_SIM_EXE, simArgs, s / "sim");
+    // The console is a machine of its own: its simulator inherits this thread's CPUs at the spawn,
+    // so for that moment they leave out the CPU the player's servo will own; the player itself is
+    // spawned with this thread's mask restored.
+    std::optional<Background> sim;
+    {
+        cpu_set_t saved;
+        const bool haveSaved = sched_getaffinity(0, sizeof(saved), &saved) == 0;
+        const int servoCpu = haptics::defaultServoCpu();
+        const bool pinned = haveSaved && servoCpu >= 0 && haptics::pinCurrentThreadExcept(servoCpu);
+        sim.emplace(VISCERA_CONSOLE_SIM_EXE, simArgs, s / "sim");
+        if (pinned) sched_setaffinity(0, sizeof(saved), &saved);
+    }
     const std::string port = waitForPort(s / "port");
     ASSERT_FALSE(port.empty()) << readText(s / "sim.err");
     auto r = player({"run", s / "slab.vcase", "--headless", "--frames", std::to_string(frames), "--device",
                      "console:127.0.0.1:" + port, "--report", s / "r.json", "--trace", s / "t.csv"});
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    ASSERT_EQ(sim.waitFor(), 0) << readText(s / "sim.err");
+    ASSERT_EQ(sim->waitFor(), 0) << readText(s / "sim.err");
 }
 
 } // namespace
@@ -220,13 +221,15 @@ TEST(PlayerHaptics, ConsoleLoopbackWithADisconnectMidSession) {
     EXPECT_EQ(ho["ticks_on_older_model"].get<int>(), 0);
     EXPECT_LE(ho["max_age_over_step"].get<double>(), 1.0);
     EXPECT_EQ(ho["models_published"].get<int>(), 181);
-    // The servo owns the last CPU (where there are two or more); the physics thread stays off it.
-    const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    // The servo owns the highest CPU the player may run on (where there are two or more); the
+    // physics thread stays off it and keeps the others.
+    const std::vector<int> allowed = haptics::allowedCpus();
     const auto& servo = h["servo"];
-    if (ncpu >= 2) {
-        EXPECT_EQ(servo["cpu"].get<long>(), ncpu - 1);
-        EXPECT_THAT(servo["physics_cpus"].get<std::vector<int>>(), ::testing::Not(::testing::Contains(int(ncpu - 1))));
-        EXPECT_FALSE(servo["physics_cpus"].empty());
+    if (allowed.size() >= 2) {
+        EXPECT_EQ(servo["cpu"].get<int>(), allowed.back());
+        EXPECT_EQ(servo["physics_cpus"].get<std::vector<int>>(), std::vector<int>(allowed.begin(), allowed.end() - 1));
+    } else {
+        EXPECT_EQ(servo["cpu"].get<int>(), -1) << "one CPU: shared, not pinned";
     }
     EXPECT_TRUE(j["invariants"]["all_finite"].get<bool>());
     // The player kept running through the gap and forces came back to the console afterwards.
@@ -341,7 +344,27 @@ TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
                         "--realtime", "--servo", "spin:900", "--report", s / "r3.json"});
     ASSERT_EQ(spin.exitCode, 0) << spin.err;
     EXPECT_EQ(readJson(s / "r3.json")["haptics"]["servo"]["spin_us"], 900);
-    for (const char* bad : {"busy:", "busy:x", "busy:-1", "busy:4096", "spin", "spin:", "spin:2000", "spin:-5"}) {
+    // A mask set from outside (taskset, cpusets) is respected: started on one CPU, the player
+    // shares it with the servo instead of pinning anything elsewhere.
+    const std::vector<int> allowed = haptics::allowedCpus();
+    ASSERT_FALSE(allowed.empty());
+    cpu_set_t saved, one;
+    ASSERT_EQ(sched_getaffinity(0, sizeof(saved), &saved), 0);
+    CPU_ZERO(&one);
+    CPU_SET(allowed.front(), &one);
+    ASSERT_EQ(sched_setaffinity(0, sizeof(one), &one), 0);
+    auto masked = player({"run", s / "slab.vcase", "--headless", "--frames", "10", "--device", "scripted:press",
+                          "--realtime", "--report", s / "r4.json"});
+    auto outside = player({"run", s / "slab.vcase", "--headless", "--frames", "1", "--device", "scripted:press",
+                           "--realtime", "--servo", "sleep:" + std::to_string(allowed.back() + 1)});
+    sched_setaffinity(0, sizeof(saved), &saved);
+    ASSERT_EQ(masked.exitCode, 0) << masked.err;
+    const auto m = readJson(s / "r4.json")["haptics"]["servo"];
+    EXPECT_EQ(m["cpu"], -1);
+    EXPECT_EQ(m["physics_cpus"].get<std::vector<int>>(), std::vector<int>{allowed.front()});
+    EXPECT_EQ(outside.exitCode, 2);
+    EXPECT_THAT(outside.err, HasSubstr("the CPU must be one this process may run on (" + std::to_string(allowed.front()) + ")"));
+    for (const char* bad : {"busy:", "busy:x", "busy:-1", "busy:4096", "sleep:", "sleep:4096", "spin", "spin:", "spin:2000", "spin:-5"}) {
         auto b = player({"run", s / "slab.vcase", "--headless", "--frames", "1", "--servo", bad});
         EXPECT_EQ(b.exitCode, 2) << bad;
         EXPECT_THAT(b.err, HasSubstr("--servo")) << bad;
