@@ -146,7 +146,7 @@ int cmdRun(const std::vector<std::string>& args) {
     if (spec) dev = haptics::openDevice(*spec);
     const bool rt = realtime || (dev && dev->capabilities().realtime) || !headless;
     if (dev && rt) {
-        // The servo gets a CPU of its own (the last one, where there are two or more): this thread
+        // The servo gets a CPU of its own (the highest allowed, where two or more are): this thread
         // and every thread started from here on (physics, solver workers, window) stay off it, so
         // nothing of ours waits behind the servo's spin and the kernel never has to preempt the
         // servo to serve a starved task on its CPU.

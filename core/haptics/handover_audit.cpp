@@ -18,11 +18,15 @@ void HandoverAudit::published(int64_t frame, int64_t stamp_ns, int64_t done_ns) 
     }
     m_stamp.push_back(stamp_ns);
     m_done.push_back(std::max(done_ns, stamp_ns));
-    if (m_lastUse.size() < m_stamp.size()) m_lastUse.resize(m_stamp.size(), -1);
+    m_lastUse.push_back(-1);
 }
 
 void HandoverAudit::used(int64_t t_ns, int64_t frame) {
     if (frame < 0) return;
+    if (frame >= static_cast<int64_t>(m_stamp.size())) { // a model the log never saw published
+        ++m_logErrors;
+        return;
+    }
     ++m_checked;
     // The newest frame whose publish had completed when the tick started.
     const auto it = std::upper_bound(m_done.begin(), m_done.end(), t_ns);
@@ -31,8 +35,8 @@ void HandoverAudit::used(int64_t t_ns, int64_t frame) {
         ++m_older;
         if (m_firstOlder < 0) m_firstOlder = t_ns;
     }
-    if (static_cast<size_t>(frame) >= m_lastUse.size()) m_lastUse.resize(static_cast<size_t>(frame) + 1, -1);
-    m_lastUse[static_cast<size_t>(frame)] = std::max(m_lastUse[static_cast<size_t>(frame)], t_ns);
+    int64_t& last = m_lastUse[static_cast<size_t>(frame)];
+    last = std::max(last, t_ns);
 }
 
 HandoverFigures HandoverAudit::figures() const {
@@ -50,7 +54,7 @@ HandoverFigures HandoverAudit::figures() const {
         const int64_t step = m_done[k + 1] - m_done[k];
         steps.push_back(1e-6 * double(step));
         if (periodNs > 0 && step > periodNs + kOverPeriodSlack_ns) ++f.stepsOverPeriod;
-        if (k < m_lastUse.size() && m_lastUse[k] >= 0) {
+        if (m_lastUse[k] >= 0) {
             const double inProgress = double(m_done[k + 1] - m_stamp[k]);
             if (inProgress > 0) f.maxAgeOverStep = std::max(f.maxAgeOverStep, double(m_lastUse[k] - m_stamp[k]) / inProgress);
         }

@@ -12,8 +12,8 @@
 /// a tick was stale; ticks on the newest model, whose successor is not out yet, are checked once
 /// it is).
 ///
-/// Nothing here throws: a publish out of order is counted (logErrors) and left out, so the audit
-/// cannot take down the physics thread.
+/// Nothing here throws: a publish out of order, or a tick on a frame the log never saw, is
+/// counted (logErrors) and left out, so the audit cannot take down the physics thread.
 ///
 /// The publish-to-publish interval is the physics step as the servo sees it (step + pacing); its
 /// distribution says how far the physics kept to its nominal period. Not thread-safe: the physics
@@ -28,7 +28,7 @@ struct HandoverFigures {
     uint64_t ticksChecked = 0;     ///< ticks with a model
     uint64_t ticksOnOlderModel = 0; ///< ticks that used a model older than the newest published
     double firstOlderTick_s = -1;  ///< time of the first such tick after the first publish (-1: none)
-    uint64_t logErrors = 0;        ///< publishes out of order or back in time (an internal error; ignored)
+    uint64_t logErrors = 0;        ///< publishes out of order or back in time, ticks on a frame never logged (internal errors; ignored)
     double maxAgeOverStep = 0;     ///< max over ticks of age / (physics step in progress)
     int64_t modelsPublished = 0;
     // publish-to-publish intervals (ms)

@@ -117,15 +117,9 @@ void HapticRig::start() {
         m_physicsRt = pthread_getschedparam(pthread_self(), &m_oldPolicy, &m_oldParam) == 0 &&
                       pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0;
         m_servo->start();
-        if (m_servo->config().cpu >= 0) {
-            // Keep the physics thread off the servo's CPU (the servo spins there most of each period).
-            haptics::pinCurrentThreadExcept(m_servo->config().cpu);
-        }
-        cpu_set_t set;
-        CPU_ZERO(&set);
-        if (sched_getaffinity(0, sizeof(set), &set) == 0)
-            for (int c = 0; c < CPU_SETSIZE; ++c)
-                if (CPU_ISSET(c, &set)) m_physicsCpus.push_back(c);
+        // The caller has kept this thread off the servo's CPU before the world was built, so the
+        // solver's workers are off it too (player main); recorded for the report.
+        m_physicsCpus = haptics::allowedCpus();
     }
 }
 

@@ -78,8 +78,10 @@ public:
     /// `device` must outlive the rig. realtime: servo thread + wall-clock pacing.
     HapticRig(haptics::Device& device, std::string spec, sim::World& world, bool realtime, bool keepTrace);
     ~HapticRig();
-    /// Before configure(): how the servo thread waits. Busy pins the servo thread to `cpu` (-1:
-    /// the last CPU) and keeps the physics thread off that CPU; spinNs >= 0 sets SleepSpin's spin.
+    /// Before configure(): how the servo thread waits and the CPU it pins itself to (-1: Busy →
+    /// the highest allowed CPU, SleepSpin → none); spinNs >= 0 sets SleepSpin's spin. Keeping
+    /// the physics thread and its workers off that CPU is the caller's part, before the world is
+    /// built (player main: pinCurrentThreadExcept).
     void setServoWait(haptics::ServoWait wait, int cpu, int64_t spinNs = -1);
     /// dt: the scene's physics period (s). Creates the servo loop; call once before start().
     void configure(double dt);

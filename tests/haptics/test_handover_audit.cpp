@@ -85,8 +85,9 @@ TEST(HandoverAudit, CountsPublishesOutOfOrderWithoutThrowing) {
     audit.published(1, 0, 5);   // completes before frame 0 did
     audit.published(1, 20, 30);
     audit.used(100, -1); // no model yet: not counted
+    audit.used(200, 5);  // a frame the log never saw published
     const HandoverFigures f = audit.figures();
-    EXPECT_EQ(f.logErrors, 2u);
+    EXPECT_EQ(f.logErrors, 3u);
     EXPECT_EQ(f.modelsPublished, 2);
     EXPECT_EQ(f.ticksChecked, 0u);
 }

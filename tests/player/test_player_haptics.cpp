@@ -90,6 +90,29 @@ std::string waitForPort(const std::string& file) {
     return "";
 }
 
+/// Runs the calling thread (and what it spawns meanwhile) on `cpus`; the old mask comes back
+/// at the end of the scope. Nothing changes when `cpus` is empty or the system refuses.
+class OnCpus {
+public:
+    explicit OnCpus(const std::vector<int>& cpus) {
+        if (cpus.empty() || sched_getaffinity(0, sizeof(m_saved), &m_saved) != 0) return;
+        cpu_set_t set;
+        CPU_ZERO(&set);
+        for (int c : cpus) CPU_SET(c, &set);
+        m_active = sched_setaffinity(0, sizeof(set), &set) == 0;
+    }
+    ~OnCpus() {
+        if (m_active) sched_setaffinity(0, sizeof(m_saved), &m_saved);
+    }
+    OnCpus(const OnCpus&) = delete;
+    OnCpus& operator=(const OnCpus&) = delete;
+    bool active() const { return m_active; }
+
+private:
+    cpu_set_t m_saved{};
+    bool m_active = false;
+};
+
 /// console-sim streams the bimanual script to the player (headless, real time, a probe for each
 /// hand) and records the forces it gets back: s/r.json (report), s/t.csv (trace), s/sum.json
 /// and s/forces.csv (console side).
@@ -104,12 +127,10 @@ void runLoopback(const Scratch& s, int frames, std::vector<std::string> simArgs)
     // spawned with this thread's mask restored.
     std::optional<Background> sim;
     {
-        cpu_set_t saved;
-        const bool haveSaved = sched_getaffinity(0, sizeof(saved), &saved) == 0;
-        const int servoCpu = haptics::defaultServoCpu();
-        const bool pinned = haveSaved && servoCpu >= 0 && haptics::pinCurrentThreadExcept(servoCpu);
+        std::vector<int> simCpus = haptics::allowedCpus();
+        std::erase(simCpus, haptics::defaultServoCpu());
+        const OnCpus pin(simCpus);
         sim.emplace(VISCERA_CONSOLE_SIM_EXE, simArgs, s / "sim");
-        if (pinned) sched_setaffinity(0, sizeof(saved), &saved);
     }
     const std::string port = waitForPort(s / "port");
     ASSERT_FALSE(port.empty()) << readText(s / "sim.err");
@@ -348,16 +369,15 @@ TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
     // shares it with the servo instead of pinning anything elsewhere.
     const std::vector<int> allowed = haptics::allowedCpus();
     ASSERT_FALSE(allowed.empty());
-    cpu_set_t saved, one;
-    ASSERT_EQ(sched_getaffinity(0, sizeof(saved), &saved), 0);
-    CPU_ZERO(&one);
-    CPU_SET(allowed.front(), &one);
-    ASSERT_EQ(sched_setaffinity(0, sizeof(one), &one), 0);
-    auto masked = player({"run", s / "slab.vcase", "--headless", "--frames", "10", "--device", "scripted:press",
-                          "--realtime", "--report", s / "r4.json"});
-    auto outside = player({"run", s / "slab.vcase", "--headless", "--frames", "1", "--device", "scripted:press",
-                           "--realtime", "--servo", "sleep:" + std::to_string(allowed.back() + 1)});
-    sched_setaffinity(0, sizeof(saved), &saved);
+    test::ProcessResult masked, outside;
+    {
+        const OnCpus pin({allowed.front()});
+        ASSERT_TRUE(pin.active());
+        masked = player({"run", s / "slab.vcase", "--headless", "--frames", "10", "--device", "scripted:press",
+                         "--realtime", "--report", s / "r4.json"});
+        outside = player({"run", s / "slab.vcase", "--headless", "--frames", "1", "--device", "scripted:press",
+                          "--realtime", "--servo", "sleep:" + std::to_string(allowed.back() + 1)});
+    }
     ASSERT_EQ(masked.exitCode, 0) << masked.err;
     const auto m = readJson(s / "r4.json")["haptics"]["servo"];
     EXPECT_EQ(m["cpu"], -1);
