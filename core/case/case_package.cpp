@@ -1,7 +1,7 @@
 #include "case/case_package.hpp"
 
 #include "case/detail/zip_archive.hpp"
-#include "case/entry_name.hpp"
+#include "sim/util/entry_name.hpp"
 #include "case/sha256.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/util/atomic_file.hpp"
@@ -17,6 +17,9 @@
 #include <vector>
 
 namespace viscera::vcase {
+
+using sim::displayName;
+using sim::entryNameProblem;
 namespace {
 
 // Unix st_mode file types as stored in zip external attributes (host independent).

@@ -2,7 +2,7 @@
 
 #include "case/case_package.hpp"
 #include "case/detail/zip_archive.hpp"
-#include "case/entry_name.hpp"
+#include "sim/util/entry_name.hpp"
 #include "case/sha256.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
@@ -11,6 +11,9 @@
 #include <vector>
 
 namespace viscera::vcase {
+
+using sim::displayName;
+using sim::entryNameProblem;
 namespace {
 
 std::string lower(std::string_view s) {

@@ -1,15 +1,19 @@
 #include "case/manifest.hpp"
 
-#include "case/entry_name.hpp"
+#include "sim/util/entry_name.hpp"
 #include "case/semver.hpp"
 #include "case/sha256.hpp"
 #include "sim/util/error.hpp"
+#include "sim/util/json_reader.hpp"
 
 #include <algorithm>
 #include <initializer_list>
 #include <set>
 
 namespace viscera::vcase {
+
+using sim::displayName;
+using sim::entryNameProblem;
 namespace {
 
 using nlohmann::json;
@@ -32,82 +36,39 @@ bool isLowerId(std::string_view s, std::string_view extra) {
     });
 }
 
-/// Reads one JSON object field by field; every failure names origin and field path.
-class FieldReader {
-  public:
-    explicit FieldReader(std::string_view origin) : m_origin(origin) {}
-
-    [[noreturn]] void fail(std::string_view field, std::string_view rule) const {
-        throw InputError(m_origin + ": " + std::string(field) + ": " + std::string(rule));
-    }
-
-    const json& require(const json& object, const char* key, const std::string& field) const {
-        auto it = object.find(key);
-        if (it == object.end()) fail(field, "missing required field");
-        return *it;
-    }
-
-    void expectType(const json& value, json::value_t type, const char* typeName,
-                    const std::string& field) const {
-        if (value.type() != type)
-            fail(field, std::string("must be ") + typeName + " (found " + value.type_name() + ")");
-    }
-
-    std::string string(const json& value, const std::string& field) const {
-        expectType(value, json::value_t::string, "a string", field);
-        return value.get<std::string>();
-    }
-
-    void rejectUnknown(const json& object, std::initializer_list<std::string_view> known,
-                       const std::string& prefix) const {
-        for (auto it = object.begin(); it != object.end(); ++it)
-            if (std::find(known.begin(), known.end(), it.key()) == known.end())
-                fail(prefix + displayName(it.key()), "unknown field");
-    }
-
-  private:
-    std::string m_origin;
-};
-
-int readSchemaVersion(const FieldReader& r, const json& value) {
-    if (!value.is_number_integer()) // true for signed and unsigned integers, false for 1.0
-        r.fail("schemaVersion",
-               std::string("must be an integer (found ") + value.type_name() + ")");
-    bool inRange = value.is_number_unsigned()
-                       ? value.get<uint64_t>() <= uint64_t(INT32_MAX)
-                       : value.get<int64_t>() >= INT32_MIN && value.get<int64_t>() <= INT32_MAX;
-    if (!inRange) r.fail("schemaVersion", "integer out of range");
-    return static_cast<int>(value.get<int64_t>());
-}
-
-std::string readSemVer(const FieldReader& r, const json& value, const std::string& field) {
-    std::string text = r.string(value, field);
-    if (!SemVer::parse(text))
-        r.fail(field, "'" + displayName(text) +
-                          "' is not a semantic version (MAJOR.MINOR.PATCH[-PRERELEASE][+BUILD])");
-    return text;
-}
-
-FileEntry readFileEntry(const FieldReader& r, const json& value, const std::string& field) {
-    r.expectType(value, json::value_t::object, "an object", field);
+FileEntry readFileEntry(const sim::JsonField& f) {
+    f.object({"path", "size", "sha256"});
     FileEntry entry;
-    entry.path = r.string(r.require(value, "path", field + ".path"), field + ".path");
-    if (auto problem = entryNameProblem(entry.path)) r.fail(field + ".path", *problem);
-    if (entry.path == kManifestName) r.fail(field + ".path", "manifest.json must not list itself");
-    const json& size = r.require(value, "size", field + ".size");
-    if (!size.is_number_unsigned())
-        r.fail(field + ".size",
-               std::string("must be a non-negative integer (found ") +
-                   (size.is_number_integer() ? "a negative integer" : size.type_name()) + ")");
-    entry.size = size.get<uint64_t>();
-    entry.sha256 = r.string(r.require(value, "sha256", field + ".sha256"), field + ".sha256");
-    if (!isSha256Hex(entry.sha256))
-        r.fail(field + ".sha256", "must be 64 lowercase hex characters");
-    r.rejectUnknown(value, {"path", "size", "sha256"}, field + ".");
+    const sim::JsonField path = f["path"];
+    entry.path = path.string();
+    if (auto problem = entryNameProblem(entry.path)) path.fail(*problem);
+    if (entry.path == kManifestName) path.fail("manifest.json must not list itself");
+    const sim::JsonField size = f["size"];
+    if (!size.value().is_number_unsigned())
+        size.fail(std::string("must be a non-negative integer (found ") +
+                  (size.value().is_number_integer() ? "a negative integer" : size.value().type_name()) + ")");
+    entry.size = size.value().get<uint64_t>();
+    const sim::JsonField sha = f["sha256"];
+    entry.sha256 = sha.string();
+    if (!isSha256Hex(entry.sha256)) sha.fail("must be 64 lowercase hex characters");
     return entry;
 }
 
 } // namespace
+
+std::string readSemVer(const sim::JsonField& f) {
+    std::string text = f.string();
+    if (!SemVer::parse(text))
+        f.fail("'" + displayName(text) + "' is not a semantic version (MAJOR.MINOR.PATCH[-PRERELEASE][+BUILD])");
+    return text;
+}
+
+std::string readCaseId(const sim::JsonField& f) {
+    std::string id = f.string();
+    if (!isLowerId(id, "._-"))
+        f.fail("'" + displayName(id) + "' must match [a-z0-9][a-z0-9._-]* (at most 64 characters)");
+    return id;
+}
 
 nlohmann::json Manifest::toJson() const {
     json j = json::object();
@@ -131,103 +92,52 @@ std::string Manifest::toJsonText() const {
 }
 
 Manifest Manifest::fromJson(const nlohmann::json& j, std::string_view origin) {
-    FieldReader r(origin);
+    const std::string where(origin);
     if (!j.is_object())
-        throw InputError(std::string(origin) + ": must be a JSON object (found " + j.type_name() +
-                         ")");
+        throw InputError(where + ": must be a JSON object (found " + j.type_name() + ")");
+    const sim::JsonField root(j, "", where);
+    root.object({"schemaVersion", "caseId", "caseVersion", "minPlayerVersion", "title", "features", "units", "device",
+                 "files"});
     Manifest m;
-    m.schemaVersion = readSchemaVersion(r, r.require(j, "schemaVersion", "schemaVersion"));
+    m.schemaVersion = root["schemaVersion"].integer();
 
-    m.caseId = r.string(r.require(j, "caseId", "caseId"), "caseId");
-    if (!isLowerId(m.caseId, "._-"))
-        r.fail("caseId", "'" + displayName(m.caseId) +
-                             "' must match [a-z0-9][a-z0-9._-]* (at most 64 characters)");
+    m.caseId = readCaseId(root["caseId"]);
 
-    m.caseVersion = readSemVer(r, r.require(j, "caseVersion", "caseVersion"), "caseVersion");
-    m.minPlayerVersion =
-        readSemVer(r, r.require(j, "minPlayerVersion", "minPlayerVersion"), "minPlayerVersion");
+    m.caseVersion = readSemVer(root["caseVersion"]);
+    m.minPlayerVersion = readSemVer(root["minPlayerVersion"]);
+    if (auto t = root.find("title")) m.title = t->string();
 
-    if (auto it = j.find("title"); it != j.end()) m.title = r.string(*it, "title");
-
-    const json& features = r.require(j, "features", "features");
-    r.expectType(features, json::value_t::array, "an array", "features");
     std::set<std::string> seenFeatures;
-    for (size_t i = 0; i < features.size(); ++i) {
-        std::string field = "features[" + std::to_string(i) + "]";
-        std::string name = r.string(features[i], field);
-        if (!isLowerId(name, "_-"))
-            r.fail(field, "'" + displayName(name) + "' must match [a-z0-9][a-z0-9_-]*");
-        if (!seenFeatures.insert(name).second) r.fail(field, "duplicate feature '" + name + "'");
+    for (const sim::JsonField& f : root["features"].items()) {
+        std::string name = f.string();
+        if (!isLowerId(name, "_-")) f.fail("'" + displayName(name) + "' must match [a-z0-9][a-z0-9_-]*");
+        if (!seenFeatures.insert(name).second) f.fail("duplicate feature '" + name + "'");
         m.features.push_back(std::move(name));
     }
 
-    const json& units = r.require(j, "units", "units");
-    r.expectType(units, json::value_t::object, "an object", "units");
+    const sim::JsonField units = root["units"];
     m.units.clear();
-    for (auto it = units.begin(); it != units.end(); ++it)
-        m.units[it.key()] = r.string(it.value(), "units." + displayName(it.key()));
+    for (const auto& [quantity, value] : units.members()) m.units[quantity] = value.string();
     for (const auto& [quantity, si] : requiredUnits()) {
         auto it = m.units.find(quantity);
-        if (it == m.units.end()) r.fail("units." + quantity, "missing required field");
+        if (it == m.units.end()) units.failAt(quantity, "required field is missing");
         if (it->second != si)
-            r.fail("units." + quantity, "'" + displayName(it->second) +
-                                            "' is not supported (the player uses SI: '" + si +
-                                            "')");
+            units.failAt(quantity, "'" + displayName(it->second) + "' is not supported (the player uses SI: '" + si + "')");
     }
 
-    m.device = r.require(j, "device", "device");
-    r.expectType(m.device, json::value_t::object, "an object", "device");
+    m.device = root["device"].anyObject().value();
 
-    const json& files = r.require(j, "files", "files");
-    r.expectType(files, json::value_t::array, "an array", "files");
     std::set<std::string, std::less<>> seenPaths;
-    for (size_t i = 0; i < files.size(); ++i) {
-        std::string field = "files[" + std::to_string(i) + "]";
-        FileEntry entry = readFileEntry(r, files[i], field);
-        if (!seenPaths.insert(entry.path).second)
-            r.fail(field + ".path", "'" + entry.path + "' is listed more than once");
+    for (const sim::JsonField& f : root["files"].items()) {
+        FileEntry entry = readFileEntry(f);
+        if (!seenPaths.insert(entry.path).second) f.failAt("path", "'" + entry.path + "' is listed more than once");
         m.files.push_back(std::move(entry));
     }
-
-    r.rejectUnknown(j,
-                    {"schemaVersion", "caseId", "caseVersion", "minPlayerVersion", "title",
-                     "features", "units", "device", "files"},
-                    "");
     return m;
 }
 
 Manifest Manifest::parse(std::string_view text, std::string_view origin) {
-    // nlohmann::json keeps the last of repeated keys; a manifest must not be read differently by
-    // different parsers, so repeated keys are an error.
-    std::vector<std::set<std::string>> openObjects;
-    std::optional<std::string> duplicateKey;
-    json::parser_callback_t track = [&](int, json::parse_event_t event, json& parsed) {
-        switch (event) {
-        case json::parse_event_t::object_start:
-            openObjects.emplace_back();
-            break;
-        case json::parse_event_t::object_end:
-            openObjects.pop_back();
-            break;
-        case json::parse_event_t::key:
-            if (!openObjects.back().insert(parsed.get<std::string>()).second && !duplicateKey)
-                duplicateKey = parsed.get<std::string>();
-            break;
-        default:
-            break;
-        }
-        return true;
-    };
-    json j;
-    try {
-        j = json::parse(text.begin(), text.end(), track);
-    } catch (const json::parse_error& e) {
-        throw InputError(std::string(origin) + ": invalid JSON (" + e.what() + ")");
-    }
-    if (duplicateKey)
-        throw InputError(std::string(origin) + ": invalid JSON (duplicate object key \"" +
-                         displayName(*duplicateKey) + "\")");
-    return fromJson(j, origin);
+    return fromJson(sim::parseJsonText(text, std::string(origin)), origin);
 }
 
 const FileEntry* Manifest::findFile(std::string_view path) const {

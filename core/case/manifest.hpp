@@ -29,6 +29,10 @@
 #include <string_view>
 #include <vector>
 
+namespace viscera::sim {
+class JsonField;
+}
+
 namespace viscera::vcase {
 
 /// The manifest schema this player reads and writes.
@@ -74,5 +78,10 @@ struct Manifest {
 /// Throws viscera::InputError ("<origin>: schemaVersion 99 is newer than this player supports
 /// (1)") unless 1 <= schemaVersion <= kSchemaVersion and minPlayerVersion <= playerVersion().
 void checkPlayerCompatibility(const Manifest& manifest, std::string_view origin);
+
+/// The rules of "caseId" and of a semantic version ("caseVersion", "minPlayerVersion") for
+/// every file that carries them (manifest.json, the studio's project.json). Throw InputError.
+std::string readCaseId(const sim::JsonField& field);
+std::string readSemVer(const sim::JsonField& field);
 
 } // namespace viscera::vcase

@@ -1,68 +1,36 @@
 #include "render/case_settings.hpp"
 
 #include "sim/util/error.hpp"
-
-#include <nlohmann/json.hpp>
-
-#include <map>
+#include "sim/util/json_reader.hpp"
 
 namespace viscera::render {
 
 void applyCaseRender(RenderSettings& settings, std::string_view text, const std::string& origin) {
     if (text.empty()) return;
-    using nlohmann::json;
-    auto fail = [&](const std::string& field, const std::string& rule) {
-        throw InputError(origin + ": render" + (field.empty() ? "" : "." + field) + ": " + rule);
-    };
-    const json doc = json::parse(text, nullptr, false);
-    if (doc.is_discarded() || !doc.is_object()) fail("", "must be a JSON object");
+    const nlohmann::json doc = sim::parseJsonText(text, origin);
+    const sim::JsonField root(doc, "render", origin);
+    root.object({"sss", "sampling", "stereo", "post"});
     RenderSettings s = settings;
-    auto boolean = [&](const json& v, const std::string& field) {
-        if (!v.is_boolean()) fail(field, "must be true or false");
-        return v.get<bool>();
-    };
-    auto choice = [&](const json& v, const std::string& field, const std::map<std::string, int>& options) {
-        std::string list;
-        for (const auto& [name, _] : options) list += (list.empty() ? "" : ", ") + name;
-        if (!v.is_string()) fail(field, "must be one of " + list);
-        const auto it = options.find(v.get<std::string>());
-        if (it == options.end()) fail(field, "'" + v.get<std::string>() + "' is not one of " + list);
-        return it->second;
-    };
-    for (const auto& [key, v] : doc.items()) {
-        if (key == "sss") {
-            s.subsurface = boolean(v, key);
-        } else if (key == "sampling") {
-            s.sampling.mode = static_cast<SampleMode>(choice(
-                v, key,
-                {{"uniform", int(SampleMode::Uniform)}, {"distance", int(SampleMode::Distance)},
-                 {"painted", int(SampleMode::Painted)}}));
-        } else if (key == "stereo") {
-            s.stereo.mode = static_cast<StereoMode>(choice(
-                v, key,
-                {{"off", int(StereoMode::Off)}, {"side_by_side", int(StereoMode::SideBySide)},
-                 {"anaglyph", int(StereoMode::Anaglyph)}}));
-        } else if (key == "post") {
-            if (!v.is_object()) fail(key, "must be an object");
-            const std::map<std::string, bool*> effects = {
-                {"depth_of_field", &s.post.depthOfField.enabled},
-                {"chromatic_aberration", &s.post.chromaticAberration.enabled},
-                {"tone_mapping", &s.post.toneMapping.enabled},
-                {"colour_curve", &s.post.colourCurve.enabled},
-                {"sharpen", &s.post.sharpen.enabled},
-                {"noise", &s.post.noise.enabled},
-                {"radial_mask", &s.post.radialMask.enabled}};
-            for (const auto& [name, on] : v.items()) {
-                const auto it = effects.find(name);
-                if (it == effects.end())
-                    fail("post." + name,
-                         "unknown effect (known: chromatic_aberration, colour_curve, depth_of_field, "
-                         "noise, radial_mask, sharpen, tone_mapping)");
-                *it->second = boolean(on, "post." + name);
-            }
-        } else {
-            fail(key, "unknown field (known: post, sampling, sss, stereo)");
-        }
+    s.subsurface = root.boolean("sss", s.subsurface);
+    if (auto v = root.find("sampling")) {
+        const std::string m = v->choice({"uniform", "distance", "painted"}, "a sampling mode");
+        s.sampling.mode = m == "uniform" ? SampleMode::Uniform : m == "distance" ? SampleMode::Distance : SampleMode::Painted;
+    }
+    if (auto v = root.find("stereo")) {
+        const std::string m = v->choice({"off", "side_by_side", "anaglyph"}, "a stereo mode");
+        s.stereo.mode = m == "off" ? StereoMode::Off : m == "side_by_side" ? StereoMode::SideBySide : StereoMode::Anaglyph;
+    }
+    if (auto post = root.find("post")) {
+        post->object({"chromatic_aberration", "colour_curve", "depth_of_field", "noise", "radial_mask", "sharpen",
+                      "tone_mapping"});
+        const std::pair<const char*, bool*> effects[] = {{"depth_of_field", &s.post.depthOfField.enabled},
+                                                         {"chromatic_aberration", &s.post.chromaticAberration.enabled},
+                                                         {"tone_mapping", &s.post.toneMapping.enabled},
+                                                         {"colour_curve", &s.post.colourCurve.enabled},
+                                                         {"sharpen", &s.post.sharpen.enabled},
+                                                         {"noise", &s.post.noise.enabled},
+                                                         {"radial_mask", &s.post.radialMask.enabled}};
+        for (const auto& [name, on] : effects) *on = post->boolean(name, *on);
     }
     settings = std::move(s);
 }

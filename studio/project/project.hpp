@@ -87,38 +87,36 @@ struct StiffnessPaintProject {
     std::vector<sim::BrushStroke> strokes;
 };
 
+/// A tet body: its scene description (what the case's scene.json carries: name, material,
+/// strain limits, embedding; read by the same code as the player's scene) plus what only
+/// authoring needs. meshPath, fixedNodes and nodeWeights of `scene` are filled at export.
 struct BodyProject {
-    std::string name;
+    sim::BodyDesc scene;
     MeshSource mesh;
-    sim::Material material;
     std::optional<std::array<sim::Vec3, 2>> fixedBox; ///< {min, max}, metres
     std::vector<StiffnessRegion> stiffnessRegions;
     std::optional<StiffnessPaintProject> paint; ///< exported as meshes/<body>.vweights
-    std::string embeddedIn; ///< cage body name; empty = free-standing
-    double embeddingCompliance = 0;
 };
 
-/// A fascia layer cut from the boundary of a tet body: the boundary triangles whose centroid lies
-/// in `region` (all when absent), with their own particles, attached back to the body.
+/// A fascia layer cut from the boundary of a tet body (scene.attachTo, "from_boundary_of" in
+/// project.json): the boundary triangles whose centroid lies in `region` (all when absent), with
+/// their own particles, attached back to the body. meshPath of `scene` is filled at export.
 struct SurfaceProject {
-    std::string name;
-    std::string fromBoundaryOf;
+    sim::SurfaceDesc scene;
     std::optional<std::array<sim::Vec3, 2>> region;
-    double arealDensity = 0.1, stretchStiffness = 50.0, attachDistance = 1e-3, attachCompliance = 0;
 };
 
+/// The project model the studio edits and exports: the scene description the player reads
+/// (`scene`: solver, gravity, accuracy, render, suture with its trajectory text, interaction
+/// with its track texts; its bodies and surfaces live in `bodies` / `surfaces` with their
+/// authoring settings) plus the case header.
 struct Project {
     std::filesystem::path dir;
     int schemaVersion = 1;
-    std::string caseId, caseVersion, title, instructions;
-    std::string render; ///< the "render" object as JSON text (empty: renderer defaults), copied to the scene
-    sim::XpbdSettings solver;
-    std::optional<sim::AccuracySampling> accuracy;
+    std::string caseId, caseVersion, title;
+    sim::SceneDesc scene; ///< bodies and surfaces empty: see below
     std::vector<BodyProject> bodies;
     std::vector<SurfaceProject> surfaces;
-    std::string solverType = "xpbd"; ///< "xpbd" or "fem" (suturing; needs `suture`)
-    std::optional<sim::suture::SutureSceneDesc> suture; ///< with trajectoryText filled at load
-    std::optional<sim::InteractionDesc> interaction;   ///< with every trackText filled at load
 };
 
 /// Reads <dir>/project.json. Throws viscera::InputError.

@@ -219,7 +219,7 @@ TEST_F(VcasePackage, ManifestMissingRequiredFieldIsRejected) {
     j.erase("caseId");
     std::vector<RawEntry> entries{{"manifest.json", j.dump()}};
     EXPECT_EQ(rejection(craftZip(entries)),
-              pkg() + "manifest.json: caseId: missing required field");
+              pkg() + "manifest.json: caseId: required field is missing");
 }
 
 TEST_F(VcasePackage, ManifestSizeLimit) {

@@ -66,14 +66,14 @@ TEST(VcaseManifest, MissingRequiredFieldsAreNamed) {
                               "features", "units", "device", "files"}) {
         json j = sample().toJson();
         j.erase(field);
-        EXPECT_EQ(errorOf(j), std::string(kOrigin) + ": " + field + ": missing required field");
+        EXPECT_EQ(errorOf(j), std::string(kOrigin) + ": " + field + ": required field is missing");
     }
     json j = sample().toJson();
     j["files"][1].erase("sha256");
-    EXPECT_EQ(errorOf(j), std::string(kOrigin) + ": files[1].sha256: missing required field");
+    EXPECT_EQ(errorOf(j), std::string(kOrigin) + ": files[1].sha256: required field is missing");
     j = sample().toJson();
     j["units"].erase("mass");
-    EXPECT_EQ(errorOf(j), std::string(kOrigin) + ": units.mass: missing required field");
+    EXPECT_EQ(errorOf(j), std::string(kOrigin) + ": units.mass: required field is missing");
 }
 
 TEST(VcaseManifest, WrongTypesAreNamed) {

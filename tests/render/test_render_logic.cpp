@@ -368,11 +368,11 @@ TEST(CaseRender, MalformedBlocksNameTheFieldAndLeaveTheSettingsAlone) {
         }
         return std::string("accepted");
     };
-    EXPECT_EQ(why(R"({"post": {"bloom": true}})").rfind("liver.vcase:scene.json: render.post.bloom: unknown effect", 0), 0u);
+    EXPECT_EQ(why(R"({"post": {"bloom": true}})").rfind("liver.vcase:scene.json: render.post.bloom: unknown field", 0), 0u);
     EXPECT_THAT(why(R"({"sss": false, "post": {"noise": 1}})"), HasSubstr("render.post.noise: must be true or false"));
-    EXPECT_THAT(why(R"({"sampling": "many"})"), HasSubstr("render.sampling: 'many' is not one of distance, painted, uniform"));
-    EXPECT_THAT(why(R"({"stereo": 3})"), HasSubstr("render.stereo: must be one of"));
+    EXPECT_THAT(why(R"({"sampling": "many"})"), HasSubstr("render.sampling: 'many' is not a sampling mode (uniform, distance, painted)"));
+    EXPECT_THAT(why(R"({"stereo": 3})"), HasSubstr("render.stereo: must be a string (found number)"));
     EXPECT_THAT(why(R"({"shadows": true})"), HasSubstr("render.shadows: unknown field"));
-    EXPECT_THAT(why(R"([1, 2])"), HasSubstr("render: must be a JSON object"));
+    EXPECT_THAT(why(R"([1, 2])"), HasSubstr("render: must be an object (found array)"));
     EXPECT_THAT(why(R"({"post": [true]})"), HasSubstr("render.post: must be an object"));
 }

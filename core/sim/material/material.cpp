@@ -35,11 +35,11 @@ std::optional<MonotoneCurve> curveFrom(const std::optional<CurveDesc>& d, const 
 } // namespace
 
 std::string validate(const Material& m) {
-    if (!std::isfinite(m.youngsModulus) || m.youngsModulus <= 0 || m.youngsModulus > 1e12)
+    if (!std::isfinite(m.youngsModulus) || m.youngsModulus <= 0 || m.youngsModulus > MaterialLimits::maxYoungsModulus)
         return "youngs_modulus " + std::to_string(m.youngsModulus) + " must be in (0, 1e12] Pa";
-    if (!std::isfinite(m.poissonRatio) || m.poissonRatio < 0 || m.poissonRatio >= 0.5)
+    if (!std::isfinite(m.poissonRatio) || m.poissonRatio < 0 || m.poissonRatio >= MaterialLimits::maxPoissonRatio)
         return "poisson_ratio " + std::to_string(m.poissonRatio) + " must be in [0, 0.5)";
-    if (!std::isfinite(m.density) || m.density <= 0 || m.density > 1e5)
+    if (!std::isfinite(m.density) || m.density <= 0 || m.density > MaterialLimits::maxDensity)
         return "density " + std::to_string(m.density) + " must be in (0, 1e5] kg/m^3";
     if (m.model != MaterialModel::ValanisLandel && (m.fPrime || m.gPrime || m.hPrime || !m.curvePreset.empty()))
         return "curves are only allowed with model valanis_landel";

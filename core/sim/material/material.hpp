@@ -45,6 +45,12 @@ struct Material {
 
 /// Checks the scalar parameters; returns an empty string when valid, otherwise the rule that
 /// failed, e.g. "poisson_ratio 0.5 must be in [0, 0.5)".
+/// Admissible ranges of the material numbers: validate() and the scene reader use these.
+struct MaterialLimits {
+    static constexpr double maxYoungsModulus = 1e12; ///< Pa; youngs_modulus in (0, max]
+    static constexpr double maxPoissonRatio = 0.5;   ///< poisson_ratio in [0, max)
+    static constexpr double maxDensity = 1e5;        ///< kg/m^3; density in (0, max]
+};
 std::string validate(const Material& m);
 
 MaterialModel materialModelFromName(const std::string& name); ///< throws std::invalid_argument

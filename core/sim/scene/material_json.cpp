@@ -1,50 +1,31 @@
 #include "sim/scene/material_json.hpp"
 
+#include "sim/scene/scene_json.hpp"
 #include "sim/util/error.hpp"
 
 #include <nlohmann/json.hpp>
-
-#include <cmath>
 
 namespace viscera::sim {
 namespace {
 
 using nlohmann::json;
 
-[[noreturn]] void fail(const std::string& origin, const std::string& field, const std::string& rule) {
-    throw InputError(origin + ": " + field + ": " + rule);
-}
-
-double number(const json& obj, const char* key, const std::string& path, const std::string& origin) {
-    auto it = obj.find(key);
-    if (it == obj.end()) fail(origin, path + "." + key, "required field is missing");
-    if (!it->is_number() || !std::isfinite(it->get<double>())) fail(origin, path + "." + key, "must be a finite number");
-    return it->get<double>();
-}
-
-CurveDesc parseCurve(const json& c, const std::string& path, const std::string& origin) {
-    if (!c.is_object()) fail(origin, path, "must be an object with \"points\"");
-    for (auto it = c.begin(); it != c.end(); ++it)
-        if (it.key() != "points" && it.key() != "unconstrained") fail(origin, path + "." + it.key(), "unknown field");
+CurveDesc readCurve(const JsonField& c) {
+    c.object({"points", "unconstrained"});
     CurveDesc d;
-    auto pts = c.find("points");
-    if (pts == c.end() || !pts->is_array() || pts->size() < 2)
-        fail(origin, path + ".points", "must be an array of at least 2 [x, y] pairs");
-    for (size_t i = 0; i < pts->size(); ++i) {
-        const json& p = (*pts)[i];
-        const std::string pp = path + ".points[" + std::to_string(i) + "]";
-        if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number())
-            fail(origin, pp, "must be an [x, y] pair of numbers");
-        d.points.push_back({p[0].get<double>(), p[1].get<double>()});
+    const JsonField points = c["points"];
+    if (!points.value().is_array() || points.value().size() < 2)
+        points.fail("must be an array of at least 2 [x, y] pairs");
+    for (const JsonField& p : points.items()) {
+        if (!p.value().is_array() || p.value().size() != 2) p.fail("must be an [x, y] pair of numbers");
+        const std::vector<JsonField> xy = p.items();
+        d.points.push_back({xy[0].number(), xy[1].number()});
     }
-    if (auto u = c.find("unconstrained"); u != c.end()) {
-        if (!u->is_boolean()) fail(origin, path + ".unconstrained", "must be true or false");
-        d.unconstrained = u->get<bool>();
-    }
+    d.unconstrained = c.boolean("unconstrained", false);
     return d;
 }
 
-json curveToJson(const CurveDesc& d) {
+json curveJson(const CurveDesc& d) {
     json pts = json::array();
     for (const auto& p : d.points) pts.push_back({p[0], p[1]});
     json j = {{"points", pts}};
@@ -54,49 +35,31 @@ json curveToJson(const CurveDesc& d) {
 
 } // namespace
 
-Material parseMaterial(const json& j, const std::string& path, const std::string& origin) {
-    if (!j.is_object()) fail(origin, path, "must be an object");
-    for (auto it = j.begin(); it != j.end(); ++it) {
-        const std::string& k = it.key();
-        if (k != "model" && k != "youngs_modulus" && k != "poisson_ratio" && k != "density" && k != "curves")
-            fail(origin, path + "." + k, "unknown field");
-    }
+Material readMaterial(const JsonField& j) {
+    j.object({"model", "youngs_modulus", "poisson_ratio", "density", "curves"});
     Material m;
-    auto model = j.find("model");
-    if (model == j.end()) fail(origin, path + ".model", "required field is missing");
-    if (!model->is_string()) fail(origin, path + ".model", "must be a string");
+    const JsonField model = j["model"];
     try {
-        m.model = materialModelFromName(model->get<std::string>());
+        m.model = materialModelFromName(model.string());
     } catch (const std::invalid_argument& e) {
-        fail(origin, path + ".model", e.what());
+        model.fail(e.what());
     }
-    m.youngsModulus = number(j, "youngs_modulus", path, origin);
-    m.poissonRatio = number(j, "poisson_ratio", path, origin);
-    m.density = number(j, "density", path, origin);
-    if (auto c = j.find("curves"); c != j.end()) {
-        const std::string cp = path + ".curves";
-        if (!c->is_object()) fail(origin, cp, "must be an object");
-        for (auto it = c->begin(); it != c->end(); ++it) {
-            const std::string& k = it.key();
-            if (k == "preset") {
-                if (!it->is_string()) fail(origin, cp + ".preset", "must be a string");
-                m.curvePreset = it->get<std::string>();
-            } else if (k == "f_prime") {
-                m.fPrime = parseCurve(*it, cp + ".f_prime", origin);
-            } else if (k == "g_prime") {
-                m.gPrime = parseCurve(*it, cp + ".g_prime", origin);
-            } else if (k == "h_prime") {
-                m.hPrime = parseCurve(*it, cp + ".h_prime", origin);
-            } else {
-                fail(origin, cp + "." + k, "unknown field (preset, f_prime, g_prime, h_prime)");
-            }
-        }
+    using L = MaterialLimits;
+    m.youngsModulus = j["youngs_modulus"].number(NumberRule::aboveUpTo(0, L::maxYoungsModulus));
+    m.poissonRatio = j["poisson_ratio"].number(NumberRule::fromBelow(0, L::maxPoissonRatio));
+    m.density = j["density"].number(NumberRule::aboveUpTo(0, L::maxDensity));
+    if (auto c = j.find("curves")) {
+        c->object({"preset", "f_prime", "g_prime", "h_prime"});
+        if (auto p = c->find("preset")) m.curvePreset = p->string();
+        if (auto f = c->find("f_prime")) m.fPrime = readCurve(*f);
+        if (auto g = c->find("g_prime")) m.gPrime = readCurve(*g);
+        if (auto h = c->find("h_prime")) m.hPrime = readCurve(*h);
     }
-    if (auto why = validate(m); !why.empty()) fail(origin, path, why);
+    if (auto why = validate(m); !why.empty()) j.fail(why);
     return m;
 }
 
-json materialToJson(const Material& m) {
+json materialJson(const Material& m) {
     json j = {{"model", materialModelName(m.model)},
               {"youngs_modulus", m.youngsModulus},
               {"poisson_ratio", m.poissonRatio},
@@ -104,12 +67,19 @@ json materialToJson(const Material& m) {
     if (m.model == MaterialModel::ValanisLandel) {
         json c = json::object();
         if (!m.curvePreset.empty()) c["preset"] = m.curvePreset;
-        if (m.fPrime) c["f_prime"] = curveToJson(*m.fPrime);
-        if (m.gPrime) c["g_prime"] = curveToJson(*m.gPrime);
-        if (m.hPrime) c["h_prime"] = curveToJson(*m.hPrime);
+        if (m.fPrime) c["f_prime"] = curveJson(*m.fPrime);
+        if (m.gPrime) c["g_prime"] = curveJson(*m.gPrime);
+        if (m.hPrime) c["h_prime"] = curveJson(*m.hPrime);
         j["curves"] = c;
     }
     return j;
 }
+
+Material parseMaterial(std::string_view text, const std::string& origin) {
+    const json doc = parseJsonText(text, origin);
+    return readMaterial(JsonField(doc, "material", origin));
+}
+
+std::string formatMaterial(const Material& m) { return materialJson(m).dump(); }
 
 } // namespace viscera::sim

@@ -8,18 +8,19 @@
 ///           | {"f_prime": {"points": [[0.5, -900], [1, 0], [2, 2400]]},
 ///              "h_prime": {"points": [...], "unconstrained": true}}}
 ///
-/// Errors name the origin and the field path ("scene.json: bodies[0].material.poisson_ratio:
-/// ..."); curve rules are checked when the material is turned into constraints.
+/// Read by sim::readMaterial (scene_json.hpp) for both files. Errors name the origin and the
+/// JSON path ("scene.json: bodies[0].material.poisson_ratio: ..."); the material rules are
+/// sim::validate(Material); curve rules are checked when the material becomes constraints.
 #include "sim/material/material.hpp"
 
-#include <nlohmann/json_fwd.hpp>
-
 #include <string>
+#include <string_view>
 
 namespace viscera::sim {
 
-/// Throws viscera::InputError.
-Material parseMaterial(const nlohmann::json& j, const std::string& path, const std::string& origin);
-nlohmann::json materialToJson(const Material& m);
+/// One material object as JSON text (the studio's clipboard, tests). Throws viscera::InputError
+/// ("<origin>: material.density: ...").
+Material parseMaterial(std::string_view json, const std::string& origin);
+std::string formatMaterial(const Material& m);
 
 } // namespace viscera::sim

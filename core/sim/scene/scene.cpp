@@ -1,141 +1,58 @@
 #include "sim/scene/scene.hpp"
 
-#include "sim/scene/material_json.hpp"
+#include "sim/scene/scene_json.hpp"
 #include "sim/util/error.hpp"
 
-#include <nlohmann/json.hpp>
-
-#include <climits>
+#include <cctype>
 #include <cmath>
-#include <set>
 
 namespace viscera::sim {
 namespace {
 
 using nlohmann::json;
 
-class Reader {
-public:
-    explicit Reader(const std::string& origin) : m_origin(origin) {}
-    const std::string& origin() const { return m_origin; }
-    [[noreturn]] void fail(const std::string& field, const std::string& rule) const {
-        throw InputError(m_origin + ": " + field + ": " + rule);
-    }
-    const json& require(const json& obj, const std::string& key, const std::string& path) const {
-        if (!obj.is_object()) fail(path.empty() ? "(root)" : path, "must be an object");
-        auto it = obj.find(key);
-        if (it == obj.end()) fail(path.empty() ? key : path + "." + key, "required field is missing");
-        return *it;
-    }
-    void only(const json& obj, std::initializer_list<const char*> keys, const std::string& path) const {
-        if (!obj.is_object()) fail(path.empty() ? "(root)" : path, "must be an object");
-        for (auto it = obj.begin(); it != obj.end(); ++it) {
-            bool known = false;
-            for (const char* k : keys) known |= it.key() == k;
-            if (!known) fail(path.empty() ? it.key() : path + "." + it.key(), "unknown field");
-        }
-    }
-    double number(const json& v, const std::string& field) const {
-        if (!v.is_number()) fail(field, "must be a number");
-        double d = v.get<double>();
-        if (!std::isfinite(d)) fail(field, "must be finite");
-        return d;
-    }
-    double nonNegative(const json& v, const std::string& field) const {
-        double d = number(v, field);
-        if (d < 0) fail(field, "must not be negative");
-        return d;
-    }
-    int integer(const json& v, const std::string& field) const {
-        if (!v.is_number_integer()) fail(field, "must be an integer");
-        auto i = v.get<int64_t>();
-        if (i < INT32_MIN || i > INT32_MAX) fail(field, "is out of range");
-        return static_cast<int>(i);
-    }
-    std::string string(const json& v, const std::string& field) const {
-        if (!v.is_string()) fail(field, "must be a string");
-        return v.get<std::string>();
-    }
-    Vec3 vec3(const json& v, const std::string& field) const {
-        if (!v.is_array() || v.size() != 3) fail(field, "must be an array of 3 numbers");
-        return {number(v[0], field + "[0]"), number(v[1], field + "[1]"), number(v[2], field + "[2]")};
-    }
-    double optNumber(const json& obj, const char* key, const std::string& path, double def) const {
-        auto it = obj.find(key);
-        return it == obj.end() ? def : number(*it, path + "." + key);
-    }
-    std::vector<int32_t> indices(const json& obj, const char* key, const std::string& path) const {
-        std::vector<int32_t> out;
-        auto it = obj.find(key);
-        if (it == obj.end()) return out;
-        const std::string f = path + "." + key;
-        if (!it->is_array()) fail(f, "must be an array of vertex indices");
-        for (size_t k = 0; k < it->size(); ++k) {
-            int v = integer((*it)[k], f + "[" + std::to_string(k) + "]");
-            if (v < 0) fail(f + "[" + std::to_string(k) + "]", "must be non-negative");
-            out.push_back(v);
-        }
-        return out;
-    }
-
-private:
-    const std::string& m_origin;
-};
-
-TetStrainLimits parseStrainLimits(const Reader& r, const json& j, const std::string& path) {
-    r.only(j, {"axes", "limits"}, path);
+TetStrainLimits readStrainLimits(const JsonField& j) {
+    j.object({"axes", "limits"});
     TetStrainLimits s;
-    if (j.contains("axes")) {
-        const json& a = j["axes"];
-        if (!a.is_array() || a.size() != 3) r.fail(path + ".axes", "must be 3 axis vectors");
-        for (int c = 0; c < 3; ++c) s.axes.col(c) = r.vec3(a[c], path + ".axes[" + std::to_string(c) + "]");
-        if (!(s.axes.transpose() * s.axes).isIdentity(1e-9)) r.fail(path + ".axes", "must be orthonormal");
+    if (auto a = j.find("axes")) {
+        if (!a->value().is_array() || a->value().size() != 3) a->fail("must be 3 axis vectors");
+        const std::vector<JsonField> axes = a->items();
+        for (int c = 0; c < 3; ++c) s.axes.col(c) = axes[c].vec3();
+        if (!(s.axes.transpose() * s.axes).isIdentity(1e-9)) a->fail("must be orthonormal");
     }
-    const json& lim = r.require(j, "limits", path);
-    if (!lim.is_array() || lim.empty()) r.fail(path + ".limits", "must be a non-empty array");
-    for (size_t k = 0; k < lim.size(); ++k) {
-        const std::string lp = path + ".limits[" + std::to_string(k) + "]";
-        r.only(lim[k], {"i", "j", "lower", "upper", "compliance"}, lp);
-        StrainLimit l;
-        l.i = r.integer(r.require(lim[k], "i", lp), lp + ".i");
-        l.j = r.integer(r.require(lim[k], "j", lp), lp + ".j");
-        l.lower = r.optNumber(lim[k], "lower", lp, l.lower);
-        l.upper = r.optNumber(lim[k], "upper", lp, l.upper);
-        l.compliance = r.optNumber(lim[k], "compliance", lp, 0.0);
-        if (auto why = validate(l, 3); !why.empty()) r.fail(lp, why);
-        s.limits.push_back(l);
+    for (const JsonField& l : j["limits"].items(1)) {
+        l.object({"i", "j", "lower", "upper", "compliance"});
+        StrainLimit lim;
+        lim.i = l["i"].integer(0, 2);
+        lim.j = l["j"].integer(0, 2);
+        lim.lower = l.number("lower", lim.lower);
+        lim.upper = l.number("upper", lim.upper);
+        if (l.has("lower") && l.has("upper") && lim.lower > lim.upper) l.fail("lower must not exceed upper");
+        lim.compliance = l.number("compliance", 0.0, NumberRule::nonNegative());
+        if (auto why = validate(lim, 3); !why.empty()) l.fail(why); // a limit needs a finite bound
+        s.limits.push_back(lim);
     }
     return s;
 }
 
-std::vector<ToolDesc> parseTools(const Reader& r, const json& tools, std::set<std::string>& names) {
-    if (!tools.is_array()) r.fail("tools", "must be an array");
-    if (tools.size() > 2) r.fail("tools", "at most 2 tools (one per master)");
+std::vector<ToolDesc> readTools(const JsonField& tools, std::set<std::string>& names) {
     std::vector<ToolDesc> out;
-    for (size_t i = 0; i < tools.size(); ++i) {
-        const std::string p = "tools[" + std::to_string(i) + "]";
-        const json& t = tools[i];
-        r.only(t, {"name", "shape", "radius", "hand", "start", "motion_scale", "force_scale", "stiffness", "max_force_n",
-                   "damage_force_n"},
-               p);
+    const std::vector<JsonField> list = tools.items();
+    if (list.size() > 2) tools.fail("at most 2 tools (one per master)");
+    for (const JsonField& t : list) {
+        t.object({"name", "shape", "radius", "hand", "start", "motion_scale", "force_scale", "stiffness", "max_force_n",
+                  "damage_force_n"});
         ToolDesc d;
-        d.name = r.string(r.require(t, "name", p), p + ".name");
-        if (d.name.empty() || !names.insert(d.name).second) r.fail(p + ".name", "must be non-empty and unique");
-        if (t.contains("shape") && r.string(t["shape"], p + ".shape") != "sphere") r.fail(p + ".shape", "must be 'sphere'");
-        if (t.contains("hand")) d.hand = r.string(t["hand"], p + ".hand");
-        if (d.hand != "left" && d.hand != "right" && d.hand != "any") r.fail(p + ".hand", "must be 'left', 'right' or 'any'");
-        d.start = r.vec3(r.require(t, "start", p), p + ".start");
-        auto positive = [&](const char* key, double& v, double max) {
-            if (!t.contains(key)) return;
-            v = r.number(t[key], p + "." + key);
-            if (!(v > 0 && v <= max)) r.fail(p + "." + key, "must be in (0, " + json(max).dump() + "]");
-        };
-        positive("radius", d.radius, 0.1);
-        positive("motion_scale", d.motionScale, 10.0);
-        positive("force_scale", d.forceScale, 10.0);
-        positive("max_force_n", d.maxForceN, 50.0);
-        positive("damage_force_n", d.damageForceN, 1000.0);
-        if (t.contains("stiffness")) d.stiffness = r.nonNegative(t["stiffness"], p + ".stiffness");
+        d.name = readName(t["name"], names);
+        if (auto shape = t.find("shape")) shape->choice({"sphere"}, "a tool shape");
+        if (auto hand = t.find("hand")) d.hand = hand->choice({"left", "right", "any"}, "a hand");
+        d.start = t["start"].vec3();
+        d.radius = t.number("radius", d.radius, NumberRule::aboveUpTo(0, 0.1));
+        d.motionScale = t.number("motion_scale", d.motionScale, NumberRule::aboveUpTo(0, 10.0));
+        d.forceScale = t.number("force_scale", d.forceScale, NumberRule::aboveUpTo(0, 10.0));
+        d.maxForceN = t.number("max_force_n", d.maxForceN, NumberRule::aboveUpTo(0, 50.0));
+        d.damageForceN = t.number("damage_force_n", d.damageForceN, NumberRule::aboveUpTo(0, 1000.0));
+        d.stiffness = t.number("stiffness", d.stiffness, NumberRule::nonNegative());
         out.push_back(d);
     }
     return out;
@@ -145,137 +62,139 @@ json limitNumber(double v) { return std::isfinite(v) ? json(v) : json(); }
 
 } // namespace
 
-SceneDesc parseScene(std::string_view text, const std::string& origin) {
-    Reader r(origin);
-    json doc = json::parse(text, nullptr, false);
-    if (doc.is_discarded()) throw InputError(origin + ": not valid JSON");
-    r.only(doc, {"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces", "tools", "render", "suture",
-                 "interaction"}, "");
-    SceneDesc scene;
-    const json& solver = r.require(doc, "solver", "");
-    r.only(solver, {"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads", "primal_correction"},
-           "solver");
-    scene.solverType = r.string(r.require(solver, "type", "solver"), "solver.type");
-    if (scene.solverType != "xpbd" && scene.solverType != "fem")
-        r.fail("solver.type", "'" + scene.solverType + "' is not supported (supported: xpbd, fem)");
-    if (scene.solverType == "fem") { // quasi-static suturing FEM [B §2.2]: needs the suture section
-        r.only(solver, {"type", "dt"}, "solver");
-        if (!doc.contains("suture")) r.fail("suture", "solver 'fem' needs a 'suture' section");
-    } else if (doc.contains("suture")) {
-        r.fail("suture", "needs solver.type 'fem'");
-    }
-    if (doc.contains("suture")) scene.suture = suture::parseSutureSection(doc["suture"].dump(), origin);
+void readSolver(const JsonField& doc, SceneDesc& scene) {
+    using L = XpbdLimits;
+    const JsonField solver = doc["solver"];
+    solver.object({"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads", "primal_correction"});
+    scene.solverType = solver["type"].choice({"xpbd", "fem"}, "a supported solver");
     XpbdSettings& s = scene.xpbd;
-    s.dt = r.optNumber(solver, "dt", "solver", s.dt);
-    if (solver.contains("substeps")) s.substeps = r.integer(solver["substeps"], "solver.substeps");
-    if (solver.contains("iterations")) s.iterations = r.integer(solver["iterations"], "solver.iterations");
-    if (solver.contains("threads")) s.threads = r.integer(solver["threads"], "solver.threads");
-    s.damping = r.optNumber(solver, "damping", "solver", s.damping);
-    s.maxSpeed = r.optNumber(solver, "max_speed", "solver", s.maxSpeed);
-    if (solver.contains("primal_correction")) {
-        if (!solver["primal_correction"].is_boolean()) r.fail("solver.primal_correction", "must be true or false");
-        s.primalCorrection = solver["primal_correction"].get<bool>();
+    if (scene.solverType == "fem") solver.object({"type", "dt"}); // quasi-static suturing FEM [B §2.2]
+    if (scene.solverType == "fem" && !doc.has("suture")) doc.failAt("suture", "solver 'fem' needs a 'suture' section");
+    if (scene.solverType != "fem" && doc.has("suture")) doc.failAt("suture", "needs solver.type 'fem'");
+    if (scene.solverType != "xpbd" && doc.has("interaction")) doc.failAt("interaction", "needs solver.type 'xpbd'");
+    s.dt = solver.number("dt", s.dt, NumberRule::aboveUpTo(0, L::maxDt));
+    s.substeps = solver.integer("substeps", s.substeps, 1, L::maxSubsteps);
+    s.iterations = solver.integer("iterations", s.iterations, 1, L::maxIterations);
+    s.threads = solver.integer("threads", s.threads, 1, L::maxThreads);
+    s.damping = solver.number("damping", s.damping, NumberRule::closed(0, L::maxDamping));
+    s.maxSpeed = solver.number("max_speed", s.maxSpeed, NumberRule::positive());
+    s.primalCorrection = solver.boolean("primal_correction", s.primalCorrection);
+    s.gravity = Vec3::Zero();
+    if (auto g = doc.find("gravity")) {
+        s.gravity = g->vec3();
+        if (s.gravity.norm() > L::maxGravity) g->fail("must be at most 1000 m/s^2 in magnitude");
     }
-    s.gravity = doc.contains("gravity") ? r.vec3(doc["gravity"], "gravity") : Vec3::Zero();
-    if (auto why = validate(s); !why.empty()) r.fail("solver", why);
-    if (doc.contains("instructions")) scene.instructions = r.string(doc["instructions"], "instructions");
-    if (doc.contains("render")) {
-        if (!doc["render"].is_object()) r.fail("render", "must be an object");
-        scene.render = doc["render"].dump();
-    }
-    if (doc.contains("accuracy")) {
-        const json& a = doc["accuracy"];
-        r.only(a, {"every_frames", "max_iterations"}, "accuracy");
-        AccuracySampling acc;
-        if (a.contains("every_frames")) acc.everyFrames = r.integer(a["every_frames"], "accuracy.every_frames");
-        if (a.contains("max_iterations")) acc.maxIterations = r.integer(a["max_iterations"], "accuracy.max_iterations");
-        if (acc.everyFrames < 1) r.fail("accuracy.every_frames", "must be at least 1");
-        if (acc.maxIterations < 1 || acc.maxIterations > 10000) r.fail("accuracy.max_iterations", "must be in [1, 10000]");
-        scene.accuracy = acc;
-    }
+    if (auto why = validate(s); !why.empty()) solver.fail(why); // unreachable with the ranges above
+}
 
-    const json& bodies = r.require(doc, "bodies", "");
-    if (!bodies.is_array() || bodies.empty()) r.fail("bodies", "must be a non-empty array");
+std::optional<AccuracySampling> readAccuracy(const JsonField& doc) {
+    auto a = doc.find("accuracy");
+    if (!a) return std::nullopt;
+    a->object({"every_frames", "max_iterations"});
+    AccuracySampling acc;
+    acc.everyFrames = a->integer("every_frames", acc.everyFrames, 1, INT32_MAX);
+    acc.maxIterations = a->integer("max_iterations", acc.maxIterations, 1, 10000);
+    return acc;
+}
+
+std::string readName(const JsonField& field, std::set<std::string>& names) {
+    const std::string name = field.string();
+    bool ok = !name.empty() && name.size() <= 64;
+    for (char c : name) ok = ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_');
+    if (!ok) field.fail("must be 1-64 characters of [A-Za-z0-9_-]");
+    if (!names.insert(name).second) field.fail("'" + name + "' is used twice");
+    return name;
+}
+
+void readBodyCommon(const JsonField& b, BodyDesc& body, std::set<std::string>& names) {
+    body.name = readName(b["name"], names);
+    body.material = readMaterial(b["material"]);
+    if (auto sl = b.find("strain_limits")) body.strainLimits = readStrainLimits(*sl);
+    if (auto e = b.find("embedded_in")) body.embeddedIn = e->nonEmptyString();
+    body.embeddingCompliance = b.number("embedding_compliance", body.embeddingCompliance, NumberRule::nonNegative());
+}
+
+void readSurfaceCommon(const JsonField& sj, SurfaceDesc& sd, std::set<std::string>& names) {
+    sd.name = readName(sj["name"], names);
+    sd.arealDensity = sj.number("areal_density", sd.arealDensity, NumberRule::positive());
+    sd.stretchStiffness = sj.number("stretch_stiffness", sd.stretchStiffness, NumberRule::nonNegative());
+    sd.attachDistance = sj.number("attach_distance", sd.attachDistance, NumberRule::positive());
+    sd.attachCompliance = sj.number("attach_compliance", sd.attachCompliance, NumberRule::nonNegative());
+}
+
+void checkSceneReferences(const SceneDesc& scene, const std::string& origin) {
+    auto fail = [&](const std::string& field, const std::string& rule) {
+        throw InputError(origin + ": " + field + ": " + rule);
+    };
+    auto isBody = [&](const std::string& n) {
+        for (const BodyDesc& b : scene.bodies)
+            if (b.name == n) return true;
+        return false;
+    };
+    for (size_t i = 0; i < scene.bodies.size(); ++i) {
+        const BodyDesc& b = scene.bodies[i];
+        if (!b.embeddedIn.empty() && (!isBody(b.embeddedIn) || b.embeddedIn == b.name))
+            fail("bodies[" + std::to_string(i) + "].embedded_in", "'" + b.embeddedIn + "' is not another body of the scene");
+    }
+    if (scene.interaction) {
+        std::vector<std::string> bodies, surfaces;
+        for (const BodyDesc& b : scene.bodies) bodies.push_back(b.name);
+        for (const SurfaceDesc& s : scene.surfaces) surfaces.push_back(s.name);
+        checkInteractionNames(*scene.interaction, bodies, surfaces, origin);
+    }
+}
+
+SceneDesc parseScene(std::string_view text, const std::string& origin) {
+    const json doc = parseJsonText(text, origin);
+    const JsonField root(doc, "", origin);
+    root.object({"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces", "tools", "render", "suture",
+                 "interaction"});
+    SceneDesc scene;
+    readSolver(root, scene);
+    if (auto su = root.find("suture")) scene.suture = suture::readSutureSection(*su);
+    if (auto v = root.find("instructions")) scene.instructions = v->string();
+    if (auto v = root.find("render")) scene.render = v->anyObject().value().dump();
+    scene.accuracy = readAccuracy(root);
+
     std::set<std::string> names;
-    for (size_t i = 0; i < bodies.size(); ++i) {
-        const std::string p = "bodies[" + std::to_string(i) + "]";
-        const json& b = bodies[i];
-        r.only(b, {"name", "mesh", "material", "fixed_nodes", "node_weights", "node_weights_file", "strain_limits",
-                   "embedded_in", "embedding_compliance"},
-               p);
+    for (const JsonField& b : root["bodies"].items(1)) {
+        b.object({"name", "mesh", "material", "fixed_nodes", "node_weights", "node_weights_file", "strain_limits",
+                  "embedded_in", "embedding_compliance"});
         BodyDesc body;
-        body.name = r.string(r.require(b, "name", p), p + ".name");
-        if (body.name.empty() || !names.insert(body.name).second) r.fail(p + ".name", "must be non-empty and unique");
-        body.meshPath = r.string(r.require(b, "mesh", p), p + ".mesh");
-        body.material = parseMaterial(r.require(b, "material", p), p + ".material", origin);
-        body.fixedNodes = r.indices(b, "fixed_nodes", p);
-        if (b.contains("node_weights")) {
-            const json& w = b["node_weights"];
-            if (!w.is_array()) r.fail(p + ".node_weights", "must be an array of positive numbers");
-            for (size_t k = 0; k < w.size(); ++k) {
-                double x = r.number(w[k], p + ".node_weights[" + std::to_string(k) + "]");
-                if (!(x > 0)) r.fail(p + ".node_weights[" + std::to_string(k) + "]", "must be positive");
-                body.nodeWeights.push_back(x);
-            }
+        readBodyCommon(b, body, names);
+        body.meshPath = b["mesh"].entryPath();
+        if (auto f = b.find("fixed_nodes")) body.fixedNodes = f->indices();
+        if (auto w = b.find("node_weights"))
+            for (const JsonField& x : w->items()) body.nodeWeights.push_back(x.number(NumberRule::positive()));
+        if (auto f = b.find("node_weights_file")) {
+            if (b.has("node_weights")) f->fail("give node_weights or node_weights_file, not both");
+            body.nodeWeightsPath = f->entryPath();
         }
-        if (b.contains("node_weights_file")) {
-            if (b.contains("node_weights")) r.fail(p + ".node_weights_file", "give node_weights or node_weights_file, not both");
-            body.nodeWeightsPath = r.string(b["node_weights_file"], p + ".node_weights_file");
-            if (body.nodeWeightsPath.empty() || body.nodeWeightsPath.front() == '/' ||
-                body.nodeWeightsPath.find("..") != std::string::npos)
-                r.fail(p + ".node_weights_file", "must be a relative path inside the case");
-        }
-        if (b.contains("strain_limits")) body.strainLimits = parseStrainLimits(r, b["strain_limits"], p + ".strain_limits");
-        if (b.contains("embedded_in")) body.embeddedIn = r.string(b["embedded_in"], p + ".embedded_in");
-        if (b.contains("embedding_compliance"))
-            body.embeddingCompliance = r.nonNegative(b["embedding_compliance"], p + ".embedding_compliance");
         scene.bodies.push_back(std::move(body));
     }
-    for (size_t i = 0; i < scene.bodies.size(); ++i) {
-        const auto& b = scene.bodies[i];
-        if (!b.embeddedIn.empty() && (!names.count(b.embeddedIn) || b.embeddedIn == b.name))
-            r.fail("bodies[" + std::to_string(i) + "].embedded_in", "'" + b.embeddedIn + "' is not another body of the scene");
-    }
-    if (doc.contains("surfaces")) {
-        const json& surfaces = doc["surfaces"];
-        if (!surfaces.is_array()) r.fail("surfaces", "must be an array");
-        for (size_t i = 0; i < surfaces.size(); ++i) {
-            const std::string p = "surfaces[" + std::to_string(i) + "]";
-            const json& sj = surfaces[i];
-            r.only(sj, {"name", "mesh", "areal_density", "stretch_stiffness", "attach_to", "attach_distance",
-                        "attach_compliance", "fixed_nodes"},
-                   p);
+    if (auto surfaces = root.find("surfaces"))
+        for (const JsonField& sj : surfaces->items()) {
+            sj.object({"name", "mesh", "areal_density", "stretch_stiffness", "attach_to", "attach_distance",
+                       "attach_compliance", "fixed_nodes"});
             SurfaceDesc sd;
-            sd.name = r.string(r.require(sj, "name", p), p + ".name");
-            if (sd.name.empty() || !names.insert(sd.name).second) r.fail(p + ".name", "must be non-empty and unique");
-            sd.meshPath = r.string(r.require(sj, "mesh", p), p + ".mesh");
-            sd.arealDensity = r.optNumber(sj, "areal_density", p, sd.arealDensity);
-            if (!(sd.arealDensity > 0)) r.fail(p + ".areal_density", "must be positive");
-            if (sj.contains("stretch_stiffness")) sd.stretchStiffness = r.nonNegative(sj["stretch_stiffness"], p + ".stretch_stiffness");
-            if (sj.contains("attach_to")) sd.attachTo = r.string(sj["attach_to"], p + ".attach_to");
-            if (sj.contains("attach_distance")) sd.attachDistance = r.nonNegative(sj["attach_distance"], p + ".attach_distance");
-            if (sj.contains("attach_compliance")) sd.attachCompliance = r.nonNegative(sj["attach_compliance"], p + ".attach_compliance");
-            sd.fixedNodes = r.indices(sj, "fixed_nodes", p);
-            bool found = sd.attachTo.empty();
-            for (const auto& b : scene.bodies) found |= b.name == sd.attachTo;
-            if (!found) r.fail(p + ".attach_to", "'" + sd.attachTo + "' is not a body of the scene");
+            readSurfaceCommon(sj, sd, names);
+            sd.meshPath = sj["mesh"].entryPath();
+            if (auto a = sj.find("attach_to")) {
+                sd.attachTo = a->string();
+                bool found = false;
+                for (const auto& b : scene.bodies) found |= b.name == sd.attachTo;
+                if (!found) a->fail("'" + sd.attachTo + "' is not a body of the scene");
+            }
+            if (auto f = sj.find("fixed_nodes")) sd.fixedNodes = f->indices();
             scene.surfaces.push_back(std::move(sd));
         }
-    }
-    if (doc.contains("tools")) scene.tools = parseTools(r, doc["tools"], names);
-    if (doc.contains("interaction")) {
-        if (scene.solverType != "xpbd") r.fail("interaction", "needs solver.type 'xpbd'");
-        InteractionDesc in = parseInteractionSection(doc["interaction"].dump(), origin);
-        std::vector<std::string> bodies, surfaces;
-        for (const auto& bd : scene.bodies) bodies.push_back(bd.name);
-        for (const auto& sd : scene.surfaces) surfaces.push_back(sd.name);
-        checkInteractionNames(in, bodies, surfaces, origin);
-        scene.interaction = std::move(in);
-    }
+    if (auto t = root.find("tools")) scene.tools = readTools(*t, names);
+    if (auto in = root.find("interaction")) scene.interaction = readInteractionSection(*in);
+    checkSceneReferences(scene, origin);
     return scene;
 }
 
-std::string formatScene(const SceneDesc& scene) {
+json sceneJson(const SceneDesc& scene) {
     json doc;
     const XpbdSettings& s = scene.xpbd;
     doc["solver"] = {{"type", scene.solverType}, {"dt", s.dt},           {"substeps", s.substeps},
@@ -283,8 +202,8 @@ std::string formatScene(const SceneDesc& scene) {
                      {"threads", s.threads}};
     if (s.primalCorrection) doc["solver"]["primal_correction"] = true;
     if (scene.solverType == "fem") doc["solver"] = {{"type", "fem"}, {"dt", s.dt}};
-    if (scene.suture) doc["suture"] = json::parse(suture::formatSutureSection(*scene.suture));
-    if (scene.interaction) doc["interaction"] = json::parse(formatInteractionSection(*scene.interaction));
+    if (scene.suture) doc["suture"] = suture::sutureJson(*scene.suture);
+    if (scene.interaction) doc["interaction"] = interactionJson(*scene.interaction);
     doc["gravity"] = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
     if (!scene.instructions.empty()) doc["instructions"] = scene.instructions;
     if (!scene.render.empty()) doc["render"] = json::parse(scene.render);
@@ -292,7 +211,7 @@ std::string formatScene(const SceneDesc& scene) {
         doc["accuracy"] = {{"every_frames", scene.accuracy->everyFrames}, {"max_iterations", scene.accuracy->maxIterations}};
     doc["bodies"] = json::array();
     for (const BodyDesc& b : scene.bodies) {
-        json j = {{"name", b.name}, {"mesh", b.meshPath}, {"material", materialToJson(b.material)}, {"fixed_nodes", b.fixedNodes}};
+        json j = {{"name", b.name}, {"mesh", b.meshPath}, {"material", materialJson(b.material)}, {"fixed_nodes", b.fixedNodes}};
         if (!b.nodeWeightsPath.empty()) j["node_weights_file"] = b.nodeWeightsPath;
         else if (!b.nodeWeights.empty()) j["node_weights"] = b.nodeWeights;
         if (b.strainLimits) {
@@ -333,7 +252,9 @@ std::string formatScene(const SceneDesc& scene) {
                                 {"start", {t.start.x(), t.start.y(), t.start.z()}}, {"motion_scale", t.motionScale},
                                 {"force_scale", t.forceScale}, {"stiffness", t.stiffness}, {"max_force_n", t.maxForceN},
                                 {"damage_force_n", t.damageForceN}});
-    return doc.dump(2) + "\n";
+    return doc;
 }
+
+std::string formatScene(const SceneDesc& scene) { return sceneJson(scene).dump(2) + "\n"; }
 
 } // namespace viscera::sim

@@ -18,15 +18,16 @@ int defaultXpbdThreads() {
 }
 
 std::string validate(const XpbdSettings& s) {
-    if (!std::isfinite(s.dt) || s.dt <= 0 || s.dt > 0.1) return "dt must be in (0, 0.1] s";
-    if (s.substeps < 1 || s.substeps > 1000) return "substeps must be in [1, 1000]";
-    if (s.iterations < 1 || s.iterations > 1000) return "iterations must be in [1, 1000]";
-    if (!std::isfinite(s.damping) || s.damping < 0 || s.damping > 1000)
+    using L = XpbdLimits;
+    if (!std::isfinite(s.dt) || s.dt <= 0 || s.dt > L::maxDt) return "dt must be in (0, 0.1] s";
+    if (s.substeps < 1 || s.substeps > L::maxSubsteps) return "substeps must be in [1, 1000]";
+    if (s.iterations < 1 || s.iterations > L::maxIterations) return "iterations must be in [1, 1000]";
+    if (!std::isfinite(s.damping) || s.damping < 0 || s.damping > L::maxDamping)
         return "damping must be in [0, 1000] 1/s";
-    if (!s.gravity.allFinite() || s.gravity.norm() > 1000)
+    if (!s.gravity.allFinite() || s.gravity.norm() > L::maxGravity)
         return "gravity must be finite and at most 1000 m/s^2";
     if (!std::isfinite(s.maxSpeed) || s.maxSpeed <= 0) return "max_speed must be positive";
-    if (s.threads < 1 || s.threads > 64) return "threads must be in [1, 64]";
+    if (s.threads < 1 || s.threads > L::maxThreads) return "threads must be in [1, 64]";
     return {};
 }
 

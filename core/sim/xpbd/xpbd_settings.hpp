@@ -33,6 +33,17 @@ struct XpbdSettings {
     bool primalCorrection = false;
 };
 
+/// Admissible ranges of XpbdSettings: validate() and the scene readers (scene_json.hpp) use
+/// these, so scene.json and project.json get one rule.
+struct XpbdLimits {
+    static constexpr double maxDt = 0.1;          ///< s; dt in (0, maxDt]
+    static constexpr int maxSubsteps = 1000;      ///< substeps in [1, maxSubsteps]
+    static constexpr int maxIterations = 1000;    ///< iterations in [1, maxIterations]
+    static constexpr double maxDamping = 1000;    ///< 1/s; damping in [0, maxDamping]
+    static constexpr double maxGravity = 1000;    ///< m/s^2, |gravity|
+    static constexpr int maxThreads = 64;         ///< threads in [1, maxThreads]
+};
+
 /// Checks settings; empty string when valid, otherwise the rule that failed.
 std::string validate(const XpbdSettings& s);
 

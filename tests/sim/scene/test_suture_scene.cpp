@@ -83,7 +83,7 @@ TEST(SutureScene, RejectsBadSectionsNamingTheField) {
     EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"]["needle"]["shape"] = "hook"; })),
                 HasSubstr("scene.json: suture.needle.shape: 'hook' is not a needle shape"));
     EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"]["needle"]["radius"] = -1; })),
-                HasSubstr("suture.needle.radius: must be a positive number"));
+                HasSubstr("suture.needle.radius: must be positive"));
     EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"].erase("trajectory"); })),
                 HasSubstr("suture.trajectory: required"));
     EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"]["contact"] = {{"rounds", 99}}; })),

@@ -1,6 +1,6 @@
-#include "case/entry_name.hpp"
+#include "sim/util/entry_name.hpp"
 
-namespace viscera::vcase {
+namespace viscera::sim {
 namespace {
 
 bool isPortable(char c) {
@@ -55,4 +55,4 @@ std::string displayName(std::string_view name) {
     return out;
 }
 
-} // namespace viscera::vcase
+} // namespace viscera::sim

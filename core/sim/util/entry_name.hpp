@@ -1,5 +1,6 @@
 #pragma once
-/// Rules for the paths of files inside a .vcase package (zip entry names and manifest paths).
+/// Rules for the paths of files inside a .vcase package (zip entry names, manifest paths, the
+/// file references of a scene or project): one rule for every reader.
 ///
 /// A path is one or more components separated by '/', at most kMaxEntryNameBytes bytes, using
 /// only the portable characters A-Z a-z 0-9 '.' '_' '-'. It must not be absolute (leading '/',
@@ -9,7 +10,7 @@
 #include <string>
 #include <string_view>
 
-namespace viscera::vcase {
+namespace viscera::sim {
 
 inline constexpr size_t kMaxEntryNameBytes = 255;
 
@@ -21,4 +22,4 @@ std::optional<std::string> entryNameProblem(std::string_view path);
 /// result is cut after kMaxEntryNameBytes bytes. Names from a hostile archive go through this.
 std::string displayName(std::string_view name);
 
-} // namespace viscera::vcase
+} // namespace viscera::sim

@@ -1,8 +1,8 @@
-#include "case/entry_name.hpp"
+#include "sim/util/entry_name.hpp"
 
 #include <gtest/gtest.h>
 
-namespace viscera::vcase {
+namespace viscera::sim {
 namespace {
 
 std::string problem(std::string_view name) {
@@ -41,4 +41,4 @@ TEST(VcaseEntryName, DisplayNameKeepsMessagesOnOneLine) {
 }
 
 } // namespace
-} // namespace viscera::vcase
+} // namespace viscera::sim
