@@ -6,6 +6,7 @@
 #include "sim/scene/scene.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
+#include "support/scratch_dir.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -14,8 +15,6 @@
 #include <filesystem>
 #include <functional>
 #include <set>
-
-#include <unistd.h>
 
 using namespace viscera;
 using nlohmann::json;
@@ -109,14 +108,6 @@ int checkEveryNumber(const json& doc, const std::string& file, const std::functi
 
 class FieldRules : public ::testing::Test {
 protected:
-    void SetUp() override {
-        m_dir = std::filesystem::temp_directory_path() /
-                ("viscera_rules_" + std::to_string(::getpid()) + "_" +
-                 ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        std::filesystem::remove_all(m_dir);
-    }
-    void TearDown() override { std::filesystem::remove_all(m_dir); }
-
     /// Copies the sample to a fresh folder; returns its project.json document.
     json copySample(const std::string& name) {
         std::filesystem::remove_all(m_dir);
@@ -132,7 +123,8 @@ protected:
         }
         return "accepted";
     }
-    std::filesystem::path m_dir;
+    test::Scratch m_scratch{"viscera-rules"};
+    std::filesystem::path m_dir = m_scratch.dir / "project";
 };
 
 std::string sceneError(const std::string& text) {
