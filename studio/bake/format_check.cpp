@@ -1,6 +1,7 @@
 #include "bake/format_check.hpp"
 
 #include "sim/util/error.hpp"
+#include "sim/util/format.hpp"
 
 #include <algorithm>
 #include <array>
@@ -107,12 +108,6 @@ std::optional<int64_t> parseInt(std::string_view tok) {
     auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
     if (ec != std::errc() || ptr != tok.data() + tok.size()) return std::nullopt;
     return v;
-}
-
-std::string formatCoord(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
 }
 
 uint32_t readU32le(std::string_view b, size_t at) {
@@ -368,7 +363,7 @@ void checkStlBinary(const std::string& label, std::string_view b) {
                 const float v = readF32le(b, rec + 12 + 12 * corner + 4 * k);
                 if (!std::isfinite(v))
                     fail(label, "facet " + std::to_string(t) + " vertex " + std::to_string(corner) +
-                                    " has a non-finite coordinate (" + formatCoord(v) +
+                                    " has a non-finite coordinate (" + sim::formatNumber(v) +
                                     "); coordinates must be finite");
             }
         }
@@ -672,7 +667,7 @@ void checkPly(const std::string& label, std::string_view b) {
                     if (isVertex && (p.name == "x" || p.name == "y" || p.name == "z") &&
                         !std::isfinite(v))
                         fail(label, "vertex " + std::to_string(i) + " has a non-finite " + p.name +
-                                        " coordinate (" + formatCoord(v) +
+                                        " coordinate (" + sim::formatNumber(v) +
                                         "); coordinates must be finite");
                     continue;
                 }
@@ -685,8 +680,9 @@ void checkPly(const std::string& label, std::string_view b) {
                     get(p.type, v);
                     if (indices && (v < 0 || v >= static_cast<double>(vertexCount)))
                         fail(label, "face " + std::to_string(i) + ": index " + std::to_string(k) +
-                                        " references vertex " + formatCoord(v) + " (the file has " +
-                                        std::to_string(vertexCount) + " vertices)");
+                                        " references vertex " + sim::formatNumber(v) +
+                                        " (the file has " + std::to_string(vertexCount) +
+                                        " vertices)");
                 }
                 if (indices && n >= 3) ++polygons;
             }

@@ -2,6 +2,7 @@
 
 #include "bake/format_check.hpp"
 #include "sim/util/error.hpp"
+#include "sim/util/format.hpp"
 #include "sim/util/log.hpp"
 
 #include <assimp/Importer.hpp>
@@ -15,7 +16,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -41,9 +41,9 @@ std::string meshName(const aiMesh* mesh, unsigned index) {
 }
 
 std::string formatVec(double x, double y, double z) {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "(%g, %g, %g)", x, y, z);
-    return buf;
+    std::string s = "("; // appended, not "(" + string&&: GCC 12 warns (-Wrestrict) on that
+    s.append(sim::formatNumber(x)).append(", ").append(sim::formatNumber(y)).append(", ");
+    return s.append(sim::formatNumber(z)).append(")");
 }
 
 /// Checks of the scene exactly as the parser produced it, before any post-processing step can

@@ -1,5 +1,7 @@
 #include "sim/reference/newton.hpp"
 
+#include "sim/util/format.hpp"
+
 #include <Eigen/Eigenvalues>
 
 #include <cholmod.h>
@@ -8,7 +10,6 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <stdexcept>
 
@@ -20,12 +21,6 @@ using Mat12 = Eigen::Matrix<double, 12, 12>;
 using Clock = std::chrono::steady_clock;
 
 constexpr const char* kWhere = "sim::solveNewton(): ";
-
-std::string num(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.3g", v);
-    return buf;
-}
 
 double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
@@ -47,7 +42,8 @@ bool allFinite(const std::vector<Vec3>& v) {
 void checkProblem(const StepProblem& p, const std::vector<Vec3>& x0) {
     const size_t nv = p.xTilde.size();
     auto fail = [](const std::string& why) { throw std::invalid_argument(kWhere + why); };
-    if (!(p.h > 0) || !std::isfinite(p.h)) fail("step h " + num(p.h) + " must be positive");
+    if (!(p.h > 0) || !std::isfinite(p.h))
+        fail("step h " + formatNumber(p.h, 3) + " must be positive");
     if (!p.model) fail("problem has no constraint model");
     if (x0.size() != nv)
         fail("x0 has " + std::to_string(x0.size()) + " nodes, the problem has " +
@@ -61,7 +57,7 @@ void checkProblem(const StepProblem& p, const std::vector<Vec3>& x0) {
         fail("dmInv, volume and weight must have one entry per tet (" + std::to_string(nt) + ")");
     for (size_t i = 0; i < nv; ++i)
         if (!(p.mass[i] >= 0) || !std::isfinite(p.mass[i]))
-            fail("node " + std::to_string(i) + " has mass " + num(p.mass[i]) +
+            fail("node " + std::to_string(i) + " has mass " + formatNumber(p.mass[i], 3) +
                  " (must be finite and >= 0)");
     for (size_t t = 0; t < nt; ++t) {
         for (int32_t v : p.tets[t])
@@ -69,11 +65,11 @@ void checkProblem(const StepProblem& p, const std::vector<Vec3>& x0) {
                 fail("tet " + std::to_string(t) + " references node " + std::to_string(v) +
                      " (problem has " + std::to_string(nv) + " nodes)");
         if (!(p.volume[t] > 0) || !std::isfinite(p.volume[t]))
-            fail("tet " + std::to_string(t) + " has rest volume " + num(p.volume[t]) +
+            fail("tet " + std::to_string(t) + " has rest volume " + formatNumber(p.volume[t], 3) +
                  " m^3 (must be positive)");
         if (!(p.weight[t] >= 0) || !std::isfinite(p.weight[t]))
-            fail("tet " + std::to_string(t) + " has stiffness weight " + num(p.weight[t]) +
-                 " (must be finite and >= 0)");
+            fail("tet " + std::to_string(t) + " has stiffness weight " +
+                 formatNumber(p.weight[t], 3) + " (must be finite and >= 0)");
         if (!p.dmInv[t].allFinite()) fail("tet " + std::to_string(t) + " has a non-finite dmInv");
     }
 }
@@ -321,20 +317,21 @@ private:
 void validate(const NewtonSettings& s) {
     auto fail = [](const std::string& why) { throw std::invalid_argument(kWhere + why); };
     if (!(s.tolerance > 0) || !std::isfinite(s.tolerance))
-        fail("tolerance " + num(s.tolerance) + " must be positive");
+        fail("tolerance " + formatNumber(s.tolerance, 3) + " must be positive");
     if (!(s.relativeTolerance > 0 && s.relativeTolerance <= 1))
-        fail("relative_tolerance " + num(s.relativeTolerance) + " must be in (0, 1]");
+        fail("relative_tolerance " + formatNumber(s.relativeTolerance, 3) + " must be in (0, 1]");
     if (s.maxIterations < 1)
         fail("max_iterations " + std::to_string(s.maxIterations) + " must be >= 1");
-    if (!(s.armijo > 0 && s.armijo < 1)) fail("armijo " + num(s.armijo) + " must be in (0, 1)");
+    if (!(s.armijo > 0 && s.armijo < 1))
+        fail("armijo " + formatNumber(s.armijo, 3) + " must be in (0, 1)");
     if (!(s.backtrack > 0 && s.backtrack < 1))
-        fail("backtrack " + num(s.backtrack) + " must be in (0, 1)");
+        fail("backtrack " + formatNumber(s.backtrack, 3) + " must be in (0, 1)");
     if (s.maxBacktracks < 0)
         fail("max_backtracks " + std::to_string(s.maxBacktracks) + " must be >= 0");
     if (!(s.fdStep > 0 && s.fdStep < 0.1))
-        fail("fd_step " + num(s.fdStep) + " must be in (0, 0.1)");
+        fail("fd_step " + formatNumber(s.fdStep, 3) + " must be in (0, 0.1)");
     if (!(s.stepTolerance >= 0) || !std::isfinite(s.stepTolerance))
-        fail("step_tolerance " + num(s.stepTolerance) + " must be finite and >= 0");
+        fail("step_tolerance " + formatNumber(s.stepTolerance, 3) + " must be finite and >= 0");
 }
 
 const char* newtonStatusName(NewtonStatus status) {
@@ -466,7 +463,7 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
         }
         if (!accepted)
             return stall("line search found no decrease of f at iteration " + std::to_string(k) +
-                         " (|grad f| " + num(gNorm) + ")");
+                         " (|grad f| " + formatNumber(gNorm, 3) + ")");
         std::swap(r.x, xTry);
         r.f = fTry;
         p.gradientInto(r.x, g);
@@ -478,10 +475,10 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
         if (alpha * dNorm <= s.stepTolerance * std::max(infNorm(r.x), meanSize))
             return stall("step below floating-point resolution at iteration " + std::to_string(k));
     }
-    return finish(NewtonStatus::MaxIterations, "no convergence in " +
-                                                   std::to_string(s.maxIterations) +
-                                                   " iterations (|grad f| " + num(gNorm) +
-                                                   ", threshold " + num(threshold) + ")");
+    return finish(NewtonStatus::MaxIterations,
+                  "no convergence in " + std::to_string(s.maxIterations) +
+                      " iterations (|grad f| " + formatNumber(gNorm, 3) + ", threshold " +
+                      formatNumber(threshold, 3) + ")");
 }
 
 } // namespace viscera::sim
