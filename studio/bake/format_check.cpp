@@ -6,15 +6,11 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
-#include <memory>
 #include <optional>
-#include <system_error>
 #include <vector>
 
 namespace viscera::bake::detail {
@@ -720,26 +716,6 @@ std::string lowerExtension(const std::filesystem::path& file) {
     for (char& c : ext)
         c = lower(c);
     return ext;
-}
-
-std::string readFileBytes(const std::filesystem::path& file, const std::string& label,
-                          std::uintmax_t maxBytes) {
-    std::error_code ec;
-    const auto status = std::filesystem::status(file, ec);
-    if (ec || !std::filesystem::exists(status)) fail(label, "file not found");
-    if (std::filesystem::is_directory(status)) fail(label, "is a directory, not a file");
-    if (!std::filesystem::is_regular_file(status)) fail(label, "is not a regular file");
-    const std::uintmax_t size = std::filesystem::file_size(file, ec);
-    if (ec) fail(label, "cannot read the file size (" + ec.message() + ")");
-    if (size > maxBytes)
-        fail(label, "file is " + std::to_string(size) + " bytes, larger than the limit of " +
-                        std::to_string(maxBytes) + " bytes (ImportOptions::maxFileBytes)");
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(file.c_str(), "rb"), &std::fclose);
-    if (!f) fail(label, std::string("cannot open the file (") + std::strerror(errno) + ")");
-    std::string bytes(static_cast<size_t>(size), '\0');
-    const size_t got = bytes.empty() ? 0 : std::fread(bytes.data(), 1, bytes.size(), f.get());
-    if (got != bytes.size()) fail(label, "cannot read the whole file (read error)");
-    return bytes;
 }
 
 void checkExtension(const std::string& label, std::string_view extension) {
