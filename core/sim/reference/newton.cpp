@@ -1,16 +1,16 @@
 #include "sim/reference/newton.hpp"
 
+#include "sim/fem/sparse_cholesky.hpp"
 #include "sim/util/format.hpp"
 
 #include <Eigen/Eigenvalues>
-
-#include <cholmod.h>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 
 namespace viscera::sim {
@@ -74,105 +74,18 @@ void checkProblem(const StepProblem& p, const std::vector<Vec3>& x0) {
     }
 }
 
-/// Owns a CHOLMOD workspace, the upper triangle of the symmetric matrix (fixed pattern) and its
-/// symbolic + numeric factor. CHOLMOD types never leave this file.
-class CholmodLlt {
-public:
-    CholmodLlt() {
-        cholmod_start(&m_common);
-        m_common.print = 0;               // the library never prints
-        m_common.error_handler = nullptr; // errors come back through m_common.status
-        m_common.supernodal = CHOLMOD_SUPERNODAL;
-        m_common.final_ll = 1;
-    }
-    ~CholmodLlt() {
-        if (m_factor) cholmod_free_factor(&m_factor, &m_common);
-        if (m_matrix) cholmod_free_sparse(&m_matrix, &m_common);
-        cholmod_finish(&m_common);
-    }
-    CholmodLlt(const CholmodLlt&) = delete;
-    CholmodLlt& operator=(const CholmodLlt&) = delete;
-
-    /// Column pointers (n + 1) and sorted row indices of the upper triangle, diagonal included.
-    bool setPattern(const std::vector<int>& colPtr, const std::vector<int>& rowIdx,
-                    std::string& error) {
-        const size_t n = colPtr.size() - 1;
-        m_matrix = cholmod_allocate_sparse(n, n, rowIdx.size(), 1, 1, 1, CHOLMOD_REAL, &m_common);
-        if (!m_matrix) return fail("cholmod_allocate_sparse", error);
-        std::copy(colPtr.begin(), colPtr.end(), static_cast<int*>(m_matrix->p));
-        std::copy(rowIdx.begin(), rowIdx.end(), static_cast<int*>(m_matrix->i));
-        std::fill_n(values(), rowIdx.size(), 0.0);
-        return true;
-    }
-    double* values() { return static_cast<double*>(m_matrix->x); }
-
-    /// Symbolic analysis (fill-reducing ordering, supernodes) of the pattern, once.
-    bool analyze(std::string& error) {
-        m_factor = cholmod_analyze(m_matrix, &m_common);
-        if (!m_factor) return fail("cholmod_analyze", error);
-        return true;
-    }
-
-    /// Numeric LLᵀ factorization of the current values with the analysed pattern. False with a
-    /// message on failure; notPositiveDefinite tells that case apart.
-    bool factorize(std::string& error, bool* notPositiveDefinite = nullptr) {
-        if (notPositiveDefinite) *notPositiveDefinite = false;
-        const int ok = cholmod_factorize(m_matrix, m_factor, &m_common);
-        if (!ok || m_common.status < CHOLMOD_OK) return fail("cholmod_factorize", error);
-        if (m_common.status == CHOLMOD_NOT_POSDEF || m_factor->minor < m_factor->n) {
-            if (notPositiveDefinite) *notPositiveDefinite = true;
-            error = "CHOLMOD: the Hessian is not positive definite (failed at column " +
-                    std::to_string(m_factor->minor) + " of " + std::to_string(m_factor->n) + ")";
-            return false;
-        }
-        return true;
-    }
-
-    /// Solves A x = b in place.
-    bool solve(std::vector<double>& b, std::string& error) {
-        cholmod_dense* rhs = cholmod_allocate_dense(b.size(), 1, b.size(), CHOLMOD_REAL, &m_common);
-        if (!rhs) return fail("cholmod_allocate_dense", error);
-        std::copy(b.begin(), b.end(), static_cast<double*>(rhs->x));
-        cholmod_dense* sol = cholmod_solve(CHOLMOD_A, m_factor, rhs, &m_common);
-        cholmod_free_dense(&rhs, &m_common);
-        if (!sol) return fail("cholmod_solve", error);
-        const double* s = static_cast<const double*>(sol->x);
-        std::copy(s, s + b.size(), b.begin());
-        cholmod_free_dense(&sol, &m_common);
-        return true;
-    }
-
-private:
-    bool fail(const char* call, std::string& error) const {
-        const char* why = "error";
-        switch (m_common.status) {
-        case CHOLMOD_OUT_OF_MEMORY:
-            why = "out of memory";
-            break;
-        case CHOLMOD_TOO_LARGE:
-            why = "problem too large";
-            break;
-        case CHOLMOD_INVALID:
-            why = "invalid input";
-            break;
-        case CHOLMOD_NOT_INSTALLED:
-            why = "method not installed";
-            break;
-        case CHOLMOD_NOT_POSDEF:
-            why = "matrix not positive definite";
-            break;
-        default:
-            break;
-        }
-        error = std::string("CHOLMOD: ") + call + " failed: " + why + " (status " +
-                std::to_string(m_common.status) + ")";
-        return false;
-    }
-
-    cholmod_common m_common{};
-    cholmod_sparse* m_matrix = nullptr;
-    cholmod_factor* m_factor = nullptr;
-};
+/// Numeric factorization of `values` with the analysed pattern; the Newton wording of a Hessian
+/// that is not positive definite (notPositiveDefinite tells that case apart).
+bool factorizeHessian(fem::SparseCholesky& llt, const std::vector<double>& values,
+                      std::string& error, bool* notPositiveDefinite = nullptr) {
+    bool indefinite = false;
+    if (llt.factorize(values, error, &indefinite)) return true;
+    if (indefinite)
+        error = "CHOLMOD: the Hessian is not positive definite (failed at column " +
+                std::to_string(llt.failedColumn()) + " of " + std::to_string(llt.size()) + ")";
+    if (notPositiveDefinite) *notPositiveDefinite = indefinite;
+    return false;
+}
 
 /// Gradient (12) of the tet term h² V w Ψ(F) with respect to its four node positions.
 Vec12 elementGradient(const StepProblem& p, size_t t, const std::array<Vec3, 4>& xe, double scale) {
@@ -217,21 +130,19 @@ public:
                             if (r <= c) rows[c].push_back(r);
                         }
                 }
-        m_colPtr.assign(n + 1, 0);
+        std::vector<int>& colPtr = m_pattern.colPtr;
+        std::vector<int>& rowIdx = m_pattern.rowIdx;
+        colPtr.assign(n + 1, 0);
         for (size_t c = 0; c < n; ++c) {
             auto& col = rows[c];
             std::sort(col.begin(), col.end());
             col.erase(std::unique(col.begin(), col.end()), col.end());
-            m_colPtr[c + 1] = m_colPtr[c] + static_cast<int>(col.size());
+            colPtr[c + 1] = colPtr[c] + static_cast<int>(col.size());
         }
-        m_rowIdx.reserve(m_colPtr[n]);
+        rowIdx.reserve(colPtr[n]);
         for (const auto& col : rows)
-            m_rowIdx.insert(m_rowIdx.end(), col.begin(), col.end());
-        auto find = [&](int r, int c) {
-            const auto first = m_rowIdx.begin() + m_colPtr[c],
-                       last = m_rowIdx.begin() + m_colPtr[c + 1];
-            return static_cast<int>(std::lower_bound(first, last, r) - m_rowIdx.begin());
-        };
+            rowIdx.insert(rowIdx.end(), col.begin(), col.end());
+        auto find = [&](int r, int c) { return m_pattern.find(r, c); }; // every (r, c) is present
         m_diag.resize(n);
         for (size_t d = 0; d < n; ++d)
             m_diag[d] = find(static_cast<int>(d), static_cast<int>(d));
@@ -249,17 +160,16 @@ public:
         }
     }
 
-    const std::vector<int>& colPtr() const { return m_colPtr; }
-    const std::vector<int>& rowIdx() const { return m_rowIdx; }
+    const fem::UpperPattern& pattern() const { return m_pattern; }
     bool active(size_t node) const { return m_active[node] != 0; }
 
-    size_t nonZeros() const { return m_rowIdx.size(); }
+    size_t nonZeros() const { return m_pattern.rowIdx.size(); }
 
     /// Writes the values (pattern order) of M + Σ Π⁺(H_e) into `projected` and, when `exact` is
     /// not null, of M + Σ H_e into `exact`. False on a non-finite entry.
     bool assemble(const std::vector<Vec3>& x, double* projected, double* exact) const {
-        std::fill_n(projected, m_rowIdx.size(), 0.0);
-        if (exact) std::fill_n(exact, m_rowIdx.size(), 0.0);
+        std::fill_n(projected, nonZeros(), 0.0);
+        if (exact) std::fill_n(exact, nonZeros(), 0.0);
         for (size_t i = 0; i < m_active.size(); ++i)
             for (int d = 0; d < 3; ++d) {
                 const double diag = m_active[i] ? m_p.mass[i] : 1.0;
@@ -308,7 +218,8 @@ public:
 private:
     const StepProblem& m_p;
     std::vector<uint8_t> m_active;
-    std::vector<int> m_colPtr, m_rowIdx, m_diag, m_scatter;
+    fem::UpperPattern m_pattern;
+    std::vector<int> m_diag, m_scatter;
     std::vector<double> m_fdStep;
 };
 
@@ -394,10 +305,10 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
     if (gNorm <= threshold) return finish(NewtonStatus::Converged, {});
 
     HessianAssembler assembler(p, s);
-    CholmodLlt llt;
     std::string error;
-    if (!llt.setPattern(assembler.colPtr(), assembler.rowIdx(), error) || !llt.analyze(error))
-        return finish(NewtonStatus::FactorizationFailed, error);
+    const std::unique_ptr<fem::SparseCholesky> llt =
+        fem::SparseCholesky::tryCreate(assembler.pattern(), error);
+    if (!llt) return finish(NewtonStatus::FactorizationFailed, error);
 
     double meanSize = 0;
     for (double v : p.volume)
@@ -416,19 +327,19 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
         bool factored = false;
         if (tryExact) {
             bool indefinite = false;
-            std::copy(exact.begin(), exact.end(), llt.values());
-            factored = llt.factorize(error, &indefinite);
+            factored = factorizeHessian(*llt, exact, error, &indefinite);
             if (!factored && !indefinite) return finish(NewtonStatus::FactorizationFailed, error);
         }
         if (!factored) {
-            std::copy(projected.begin(), projected.end(), llt.values());
-            if (!llt.factorize(error)) return finish(NewtonStatus::FactorizationFailed, error);
+            if (!factorizeHessian(*llt, projected, error))
+                return finish(NewtonStatus::FactorizationFailed, error);
             ++r.projectedSteps;
         }
         for (size_t i = 0; i < nv; ++i)
             for (int c = 0; c < 3; ++c)
                 d[3 * i + c] = assembler.active(i) ? -g[i][c] : 0.0;
-        if (!llt.solve(d, error)) return finish(NewtonStatus::FactorizationFailed, error);
+        if (!llt->solveInPlace(d.data(), 1, error))
+            return finish(NewtonStatus::FactorizationFailed, error);
         double gd = 0, dNorm = 0;
         for (size_t i = 0; i < nv; ++i)
             for (int c = 0; c < 3; ++c) {
