@@ -47,6 +47,7 @@
 #include "sim/diagnostics/stability_check.hpp"
 #include "sim/mesh/generators.hpp"
 #include "sim/scene/tool_probe.hpp"
+#include "sim/util/format.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
 
 #include <algorithm>
@@ -336,9 +337,7 @@ RunResult run(const Slab& slab, const RunSpec& spec) {
 
 std::string deltaName(double d) {
     if (!std::isfinite(d)) return "inf";
-    char b[32];
-    std::snprintf(b, sizeof b, "%g", d);
-    return b;
+    return formatNumber(d);
 }
 
 std::string label(const RunSpec& s) {

@@ -20,6 +20,7 @@
 #include "runtime/session.hpp"
 #include "window/window_mode.hpp"
 #include "sim/util/atomic_file.hpp"
+#include "sim/util/cli_main.hpp"
 #include "sim/util/error.hpp"
 #include "sim/util/log.hpp"
 
@@ -35,8 +36,7 @@
 namespace {
 
 using namespace viscera;
-
-constexpr int kExitInput = 1, kExitUsage = 2, kExitInvariant = 3;
+using sim::kExitInput, sim::kExitUsage, sim::kExitInvariant;
 
 void usage(std::FILE* out) {
     std::fputs("usage: viscera-player verify <case.vcase>\n"
@@ -48,10 +48,7 @@ void usage(std::FILE* out) {
                out);
 }
 
-int fail(int code, const std::string& message) {
-    std::fprintf(stderr, "viscera-player: %s\n", message.c_str());
-    return code;
-}
+int fail(int code, const std::string& message) { return sim::cliFail("viscera-player", code, message); }
 
 int cmdVerify(const std::vector<std::string>& args) {
     if (args.size() != 1) {
@@ -216,31 +213,10 @@ int main(int argc, char** argv) {
     log::setSink([](log::Level level, std::string_view msg) {
         if (level >= log::Level::Warn) std::fprintf(stderr, "viscera-player: %.*s\n", int(msg.size()), msg.data());
     });
-    std::vector<std::string> args(argv + 1, argv + argc);
-    if (args.empty()) {
-        usage(stderr);
-        return kExitUsage;
-    }
-    const std::string cmd = args[0];
-    args.erase(args.begin());
-    try {
-        if (cmd == "verify") return cmdVerify(args);
-        if (cmd == "run") return cmdRun(args);
-        if (cmd == "--version") {
-            std::printf("viscera-player %s\n", VISCERA_VERSION);
-            return 0;
-        }
-        if (cmd == "--help" || cmd == "-h") {
-            usage(stdout);
-            return 0;
-        }
-        usage(stderr);
-        return kExitUsage;
-    } catch (const InputError& e) {
-        return fail(kExitInput, e.what());
-    } catch (const std::invalid_argument& e) {
-        return fail(kExitUsage, e.what());
-    } catch (const std::exception& e) {
-        return fail(kExitInput, std::string("internal error: ") + e.what());
-    }
+    sim::CliProgram program;
+    program.name = "viscera-player";
+    program.version = VISCERA_VERSION;
+    program.usage = usage;
+    program.subcommands = {{"verify", cmdVerify}, {"run", cmdRun}};
+    return sim::runCli(program, argc, argv);
 }

@@ -262,7 +262,7 @@ Verified verifyFile(const std::filesystem::path& path, const Limits& limits) {
     if (size > limits.maxPackageBytes)
         fail.package("package is " + bytesText(size) + ", larger than the limit of " +
                      bytesText(limits.maxPackageBytes));
-    std::string bytes = readFile(path); // InputError "<path>: cannot open for reading"
+    std::string bytes = readFile(path, limits.maxPackageBytes); // InputError "<path>: ..."
     return verifyBytes(bytes, name, limits);
 }
 

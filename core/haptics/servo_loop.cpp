@@ -1,5 +1,7 @@
 #include "haptics/servo_loop.hpp"
 
+#include "sim/util/cpu_relax.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -12,12 +14,6 @@
 
 namespace viscera::haptics {
 namespace {
-
-inline void cpuRelax() {
-#if defined(__x86_64__) || defined(__i386__)
-    __builtin_ia32_pause();
-#endif
-}
 
 void atomicMax(std::atomic<int64_t>& a, int64_t v) {
     int64_t cur = a.load(std::memory_order_relaxed);
@@ -259,7 +255,7 @@ void ServoLoop::run() {
         if (!busy && next - monotonicNs() > m_config.spin_ns) sleepUntilNs(next - m_config.spin_ns);
         int64_t now = monotonicNs();
         while (now < next) {
-            cpuRelax();
+            sim::cpuRelax();
             now = monotonicNs();
         }
         m_wake.add(now - next);

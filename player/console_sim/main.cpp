@@ -17,6 +17,7 @@
 #include "haptics/trajectory.hpp"
 #include "haptics/udp_socket.hpp"
 #include "sim/util/atomic_file.hpp"
+#include "sim/util/cli_main.hpp"
 #include "sim/util/error.hpp"
 
 #include <nlohmann/json.hpp>
@@ -289,29 +290,23 @@ int run(const Options& o) {
     return 0;
 }
 
+void usage(std::FILE* out) {
+    std::fputs("usage: viscera-console-sim --listen HOST:PORT (--trajectory FILE | --script NAME) [--duration S]\n"
+               "           [--rate HZ] [--loop] [--record forces.csv] [--summary summary.json] [--port-file FILE]\n"
+               "           [--pause-at S --pause-for S] [--wait-player S]\n"
+               "       viscera-console-sim --write-trajectory OUT.csv --script NAME --duration S [--rate HZ]\n",
+               out);
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
-    std::vector<std::string> args(argv + 1, argv + argc);
-    if (args.empty() || args[0] == "--help" || args[0] == "-h") {
-        std::fputs("usage: viscera-console-sim --listen HOST:PORT (--trajectory FILE | --script NAME) [--duration S]\n"
-                   "           [--rate HZ] [--loop] [--record forces.csv] [--summary summary.json] [--port-file FILE]\n"
-                   "           [--pause-at S --pause-for S] [--wait-player S]\n"
-                   "       viscera-console-sim --write-trajectory OUT.csv --script NAME --duration S [--rate HZ]\n",
-                   args.empty() ? stderr : stdout);
-        return args.empty() ? 2 : 0;
-    }
-    try {
+    sim::CliProgram program;
+    program.name = "viscera-console-sim";
+    program.usage = usage;
+    program.fallback = [](const sim::CliArgs& args) {
         const Options o = parse(args);
         return o.writeTrajectory ? writeTrajectory(o) : run(o);
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "viscera-console-sim: %s\n", e.what());
-        return 1;
-    } catch (const std::invalid_argument& e) {
-        std::fprintf(stderr, "viscera-console-sim: %s\n", e.what());
-        return 2;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "viscera-console-sim: internal error: %s\n", e.what());
-        return 1;
-    }
+    };
+    return sim::runCli(program, argc, argv);
 }

@@ -1,19 +1,16 @@
 #include "bake/format_check.hpp"
 
 #include "sim/util/error.hpp"
+#include "sim/util/format.hpp"
 
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
-#include <memory>
 #include <optional>
-#include <system_error>
 #include <vector>
 
 namespace viscera::bake::detail {
@@ -107,12 +104,6 @@ std::optional<int64_t> parseInt(std::string_view tok) {
     auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
     if (ec != std::errc() || ptr != tok.data() + tok.size()) return std::nullopt;
     return v;
-}
-
-std::string formatCoord(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
 }
 
 uint32_t readU32le(std::string_view b, size_t at) {
@@ -368,7 +359,7 @@ void checkStlBinary(const std::string& label, std::string_view b) {
                 const float v = readF32le(b, rec + 12 + 12 * corner + 4 * k);
                 if (!std::isfinite(v))
                     fail(label, "facet " + std::to_string(t) + " vertex " + std::to_string(corner) +
-                                    " has a non-finite coordinate (" + formatCoord(v) +
+                                    " has a non-finite coordinate (" + sim::formatNumber(v) +
                                     "); coordinates must be finite");
             }
         }
@@ -672,7 +663,7 @@ void checkPly(const std::string& label, std::string_view b) {
                     if (isVertex && (p.name == "x" || p.name == "y" || p.name == "z") &&
                         !std::isfinite(v))
                         fail(label, "vertex " + std::to_string(i) + " has a non-finite " + p.name +
-                                        " coordinate (" + formatCoord(v) +
+                                        " coordinate (" + sim::formatNumber(v) +
                                         "); coordinates must be finite");
                     continue;
                 }
@@ -685,8 +676,9 @@ void checkPly(const std::string& label, std::string_view b) {
                     get(p.type, v);
                     if (indices && (v < 0 || v >= static_cast<double>(vertexCount)))
                         fail(label, "face " + std::to_string(i) + ": index " + std::to_string(k) +
-                                        " references vertex " + formatCoord(v) + " (the file has " +
-                                        std::to_string(vertexCount) + " vertices)");
+                                        " references vertex " + sim::formatNumber(v) +
+                                        " (the file has " + std::to_string(vertexCount) +
+                                        " vertices)");
                 }
                 if (indices && n >= 3) ++polygons;
             }
@@ -724,26 +716,6 @@ std::string lowerExtension(const std::filesystem::path& file) {
     for (char& c : ext)
         c = lower(c);
     return ext;
-}
-
-std::string readFileBytes(const std::filesystem::path& file, const std::string& label,
-                          std::uintmax_t maxBytes) {
-    std::error_code ec;
-    const auto status = std::filesystem::status(file, ec);
-    if (ec || !std::filesystem::exists(status)) fail(label, "file not found");
-    if (std::filesystem::is_directory(status)) fail(label, "is a directory, not a file");
-    if (!std::filesystem::is_regular_file(status)) fail(label, "is not a regular file");
-    const std::uintmax_t size = std::filesystem::file_size(file, ec);
-    if (ec) fail(label, "cannot read the file size (" + ec.message() + ")");
-    if (size > maxBytes)
-        fail(label, "file is " + std::to_string(size) + " bytes, larger than the limit of " +
-                        std::to_string(maxBytes) + " bytes (ImportOptions::maxFileBytes)");
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(file.c_str(), "rb"), &std::fclose);
-    if (!f) fail(label, std::string("cannot open the file (") + std::strerror(errno) + ")");
-    std::string bytes(static_cast<size_t>(size), '\0');
-    const size_t got = bytes.empty() ? 0 : std::fread(bytes.data(), 1, bytes.size(), f.get());
-    if (got != bytes.size()) fail(label, "cannot read the whole file (read error)");
-    return bytes;
 }
 
 void checkExtension(const std::string& label, std::string_view extension) {

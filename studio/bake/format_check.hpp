@@ -15,11 +15,6 @@ namespace viscera::bake::detail {
 /// The file's extension, lower case with the dot ("" when it has none).
 std::string lowerExtension(const std::filesystem::path& file);
 
-/// Reads the whole file. Throws when it is missing, not a regular file, unreadable or larger
-/// than maxBytes. `label` names the file in messages.
-std::string readFileBytes(const std::filesystem::path& file, const std::string& label,
-                          std::uintmax_t maxBytes);
-
 /// Throws "unsupported format '.xyz' (accepted: ...)" when the extension is not in the whitelist.
 void checkExtension(const std::string& label, std::string_view extension);
 

@@ -1,7 +1,9 @@
 #include "bake/import.hpp"
 
 #include "bake/format_check.hpp"
+#include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
+#include "sim/util/format.hpp"
 #include "sim/util/log.hpp"
 
 #include <assimp/Importer.hpp>
@@ -15,7 +17,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -29,6 +30,7 @@ namespace {
 constexpr std::array<std::string_view, 6> kExtensions{".obj",  ".stl", ".ply",
                                                       ".gltf", ".glb", ".fbx"};
 constexpr int kMaxNodeDepth = 1024;
+constexpr std::string_view kMaxFileBytesName = "ImportOptions::maxFileBytes";
 
 [[noreturn]] void fail(const std::string& label, const std::string& message) {
     throw InputError(label + ": " + message);
@@ -41,9 +43,9 @@ std::string meshName(const aiMesh* mesh, unsigned index) {
 }
 
 std::string formatVec(double x, double y, double z) {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "(%g, %g, %g)", x, y, z);
-    return buf;
+    std::string s = "("; // appended, not "(" + string&&: GCC 12 warns (-Wrestrict) on that
+    s.append(sim::formatNumber(x)).append(", ").append(sim::formatNumber(y)).append(", ");
+    return s.append(sim::formatNumber(z)).append(")");
 }
 
 /// Checks of the scene exactly as the parser produced it, before any post-processing step can
@@ -212,7 +214,7 @@ std::span<const std::string_view> acceptedExtensions() {
 
 SurfaceFormat detectSurfaceFormat(const std::filesystem::path& file) {
     const std::string label = file.string();
-    const std::string bytes = detail::readFileBytes(file, label, ImportOptions{}.maxFileBytes);
+    const std::string bytes = readFile(file, ImportOptions{}.maxFileBytes, kMaxFileBytesName);
     return detail::sniffFormat(label, detail::lowerExtension(file), bytes);
 }
 
@@ -227,7 +229,7 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file,
         // The bytes are only needed for the checks; release them before assimp reads the file.
         const std::string ext = detail::lowerExtension(file);
         detail::checkExtension(label, ext); // before reading a file that is rejected anyway
-        const std::string bytes = detail::readFileBytes(file, label, options.maxFileBytes);
+        const std::string bytes = readFile(file, options.maxFileBytes, kMaxFileBytesName);
         report.format = detail::sniffFormat(label, ext, bytes);
         detail::checkStructure(label, report.format, bytes);
     }

@@ -9,6 +9,7 @@
 #include "bake/tetrahedralize.hpp"
 #include "project/project.hpp"
 #include "sim/mesh/tet_io.hpp"
+#include "sim/util/cli_main.hpp"
 #include "sim/util/error.hpp"
 
 #include <chrono>
@@ -22,7 +23,6 @@
 namespace {
 
 using namespace viscera;
-constexpr int kExitInput = 1, kExitUsage = 2;
 
 void usage(std::FILE* out) {
     std::fputs("usage: viscera-studio export <project-dir> -o <case.vcase>\n"
@@ -124,34 +124,10 @@ int cmdImport(const std::vector<std::string>& args) {
 } // namespace
 
 int main(int argc, char** argv) {
-    std::vector<std::string> args(argv + 1, argv + argc);
-    if (args.empty()) {
-        usage(stderr);
-        return kExitUsage;
-    }
-    const std::string cmd = args[0];
-    args.erase(args.begin());
-    try {
-        if (cmd == "export") return cmdExport(args);
-        if (cmd == "import") return cmdImport(args);
-        if (cmd == "--version") {
-            std::printf("viscera-studio %s\n", VISCERA_VERSION);
-            return 0;
-        }
-        if (cmd == "--help" || cmd == "-h") {
-            usage(stdout);
-            return 0;
-        }
-        usage(stderr);
-        return kExitUsage;
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "viscera-studio: %s\n", e.what());
-        return kExitInput;
-    } catch (const std::invalid_argument& e) {
-        std::fprintf(stderr, "viscera-studio: %s\n", e.what());
-        return kExitUsage;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "viscera-studio: internal error: %s\n", e.what());
-        return kExitInput;
-    }
+    sim::CliProgram program;
+    program.name = "viscera-studio";
+    program.version = VISCERA_VERSION;
+    program.usage = usage;
+    program.subcommands = {{"export", cmdExport}, {"import", cmdImport}};
+    return sim::runCli(program, argc, argv); // no arguments: usage (later: the authoring window)
 }

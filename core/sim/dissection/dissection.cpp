@@ -1,10 +1,10 @@
 #include "sim/dissection/dissection.hpp"
 
 #include "sim/collision/distance.hpp"
+#include "sim/util/format.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -12,20 +12,14 @@
 namespace viscera::sim {
 namespace {
 
-std::string num(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
-
 std::string checkTissue(const TissueDissectionParams& t) {
     if (!std::isfinite(t.ignition) || !(t.ignition > 0))
-        return "ignition is " + num(t.ignition) + " (must be finite and > 0)";
+        return "ignition is " + formatNumber(t.ignition) + " (must be finite and > 0)";
     if (!std::isfinite(t.conductivity) || !(t.conductivity > 0))
-        return "conductivity is " + num(t.conductivity) + " (must be finite and > 0)";
+        return "conductivity is " + formatNumber(t.conductivity) + " (must be finite and > 0)";
     for (int a = 0; a < 3; ++a)
         if (!(t.shrink[a] >= 0.01 && t.shrink[a] <= 10.0))
-            return "shrink[" + std::to_string(a) + "] is " + num(t.shrink[a]) +
+            return "shrink[" + std::to_string(a) + "] is " + formatNumber(t.shrink[a]) +
                    " (must be in [0.01, 10])";
     return {};
 }
@@ -80,7 +74,7 @@ std::unique_ptr<Dissection> Dissection::create(const DissectionDesc& d) {
     if (auto why = validate(d.grid); !why.empty())
         throw std::invalid_argument(where + "grid: " + why);
     if (!std::isfinite(d.referenceTime) || !(d.referenceTime > 0))
-        throw std::invalid_argument(where + "referenceTime is " + num(d.referenceTime) +
+        throw std::invalid_argument(where + "referenceTime is " + formatNumber(d.referenceTime) +
                                     " (must be > 0)");
     std::unique_ptr<Dissection> out(new Dissection(d.grid));
     out->m_sys = d.system;
@@ -151,13 +145,13 @@ DissectionFrameStats Dissection::update(const EnergyTool& tool, double dt) {
     if (!tool.centre.allFinite() || !std::isfinite(tool.radius) || !std::isfinite(tool.temperature))
         throw std::invalid_argument(where + "tool centre, radius or temperature is not finite");
     if (!(tool.radius > 0))
-        throw std::invalid_argument(where + "tool radius is " + num(tool.radius) +
+        throw std::invalid_argument(where + "tool radius is " + formatNumber(tool.radius) +
                                     " (must be > 0)");
     if (tool.temperature < -273.15)
-        throw std::invalid_argument(where + "tool temperature is " + num(tool.temperature) +
-                                    " (must be >= -273.15)");
+        throw std::invalid_argument(where + "tool temperature is " +
+                                    formatNumber(tool.temperature) + " (must be >= -273.15)");
     if (!std::isfinite(dt) || !(dt > 0))
-        throw std::invalid_argument(where + "dt is " + num(dt) + " (must be > 0)");
+        throw std::invalid_argument(where + "dt is " + formatNumber(dt) + " (must be > 0)");
 
     DissectionFrameStats st;
     st.heatSubsteps = tool.energized

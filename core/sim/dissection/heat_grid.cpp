@@ -1,19 +1,14 @@
 #include "sim/dissection/heat_grid.hpp"
 
+#include "sim/util/format.hpp"
+
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 
 namespace viscera::sim {
 namespace {
-
-std::string num(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
 
 constexpr double kAbsoluteZero = -273.15;
 
@@ -23,11 +18,12 @@ std::string validate(const HeatGridSettings& s) {
     if (s.nodes < 4 || s.nodes > 256)
         return "nodes is " + std::to_string(s.nodes) + " (must be 4..256)";
     if (!std::isfinite(s.spacing) || !(s.spacing > 0))
-        return "spacing is " + num(s.spacing) + " (must be > 0)";
+        return "spacing is " + formatNumber(s.spacing) + " (must be > 0)";
     if (!std::isfinite(s.diffusivity) || !(s.diffusivity > 0))
-        return "diffusivity is " + num(s.diffusivity) + " (must be > 0)";
+        return "diffusivity is " + formatNumber(s.diffusivity) + " (must be > 0)";
     if (!std::isfinite(s.bodyTemperature) || s.bodyTemperature < kAbsoluteZero)
-        return "bodyTemperature is " + num(s.bodyTemperature) + " (must be finite and >= -273.15)";
+        return "bodyTemperature is " + formatNumber(s.bodyTemperature) +
+               " (must be finite and >= -273.15)";
     return {};
 }
 
@@ -92,14 +88,14 @@ int HeatGrid::advance(const HeatSource& src, double dt) {
         !std::isfinite(dt))
         throw std::invalid_argument("sim::HeatGrid::advance(): source or dt is not finite");
     if (!(src.radius > 0))
-        throw std::invalid_argument("sim::HeatGrid::advance(): radius is " + num(src.radius) +
-                                    " (must be > 0)");
+        throw std::invalid_argument("sim::HeatGrid::advance(): radius is " +
+                                    formatNumber(src.radius) + " (must be > 0)");
     if (dt < 0)
-        throw std::invalid_argument("sim::HeatGrid::advance(): dt is " + num(dt) +
+        throw std::invalid_argument("sim::HeatGrid::advance(): dt is " + formatNumber(dt) +
                                     " (must be >= 0)");
     if (src.temperature < kAbsoluteZero)
         throw std::invalid_argument("sim::HeatGrid::advance(): temperature is " +
-                                    num(src.temperature) + " (must be >= -273.15)");
+                                    formatNumber(src.temperature) + " (must be >= -273.15)");
     place(src.centre);
     m_source = src;
     m_hasSource = true;

@@ -1,6 +1,7 @@
 #include "sim/fem/corotational_fem.hpp"
 
 #include "sim/fem/sparse_cholesky.hpp"
+#include "sim/util/format.hpp"
 
 #include <Eigen/Cholesky>
 
@@ -13,12 +14,6 @@ namespace viscera::sim::fem {
 namespace {
 
 constexpr const char* kWhere = "sim::fem::CorotationalFem::";
-
-std::string num(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.3g", v);
-    return buf;
-}
 
 /// A factorization of K_R with everything that depends on the rotations.
 struct Factor {
@@ -47,11 +42,11 @@ struct SolveRow {
 
 std::string validate(const FemSettings& s) {
     if (!(s.youngsModulus > 0) || !std::isfinite(s.youngsModulus))
-        return "youngs_modulus " + num(s.youngsModulus) + " must be positive";
-    if (!(s.poissonRatio >= 0 && s.poissonRatio < 0.5)) return "poisson_ratio " + num(s.poissonRatio) + " must be in [0, 0.5)";
-    if (!(s.refactorDisplacement > 0)) return "refactor_displacement " + num(s.refactorDisplacement) + " must be positive";
+        return "youngs_modulus " + formatNumber(s.youngsModulus, 3) + " must be positive";
+    if (!(s.poissonRatio >= 0 && s.poissonRatio < 0.5)) return "poisson_ratio " + formatNumber(s.poissonRatio, 3) + " must be in [0, 0.5)";
+    if (!(s.refactorDisplacement > 0)) return "refactor_displacement " + formatNumber(s.refactorDisplacement, 3) + " must be positive";
     if (s.refactorLatencySteps < 1) return "refactor_latency_steps must be >= 1";
-    if (!(s.rankTolerance > 0 && s.rankTolerance < 1)) return "rank_tolerance " + num(s.rankTolerance) + " must be in (0, 1)";
+    if (!(s.rankTolerance > 0 && s.rankTolerance < 1)) return "rank_tolerance " + formatNumber(s.rankTolerance, 3) + " must be in (0, 1)";
     if (!(s.releaseTolerance >= 0) || !(s.activationTolerance >= 0)) return "release/activation tolerances must be >= 0";
     if (s.maxActiveSetIterations < 1) return "max_active_set_iterations must be >= 1";
     if (s.cacheEvictSteps < 1) return "cache_evict_steps must be >= 1";

@@ -30,31 +30,55 @@ struct SparseCholesky::Impl {
         const char* w = "error";
         switch (common.status) {
         case CHOLMOD_OUT_OF_MEMORY: w = "out of memory"; break;
+        case CHOLMOD_TOO_LARGE: w = "problem too large"; break;
         case CHOLMOD_NOT_POSDEF: w = "matrix not positive definite"; break;
         case CHOLMOD_INVALID: w = "invalid input"; break;
+        case CHOLMOD_NOT_INSTALLED: w = "method not installed"; break;
         default: break;
         }
         return std::string("CHOLMOD: ") + call + " failed: " + w + " (status " + std::to_string(common.status) + ")";
     }
+
+    /// Copies the pattern and runs the symbolic analysis (fill-reducing ordering, supernodes).
+    bool analyze(const UpperPattern& p, std::string& error) {
+        const int size = p.size();
+        if (size <= 0 || static_cast<int>(p.rowIdx.size()) != p.colPtr[size])
+            throw std::invalid_argument("sim::fem::SparseCholesky(): empty or malformed pattern");
+        n = size;
+        matrix = cholmod_allocate_sparse(n, n, p.rowIdx.size(), 1, 1, 1, CHOLMOD_REAL, &common);
+        if (!matrix) {
+            error = why("cholmod_allocate_sparse");
+            return false;
+        }
+        std::copy(p.colPtr.begin(), p.colPtr.end(), static_cast<int*>(matrix->p));
+        std::copy(p.rowIdx.begin(), p.rowIdx.end(), static_cast<int*>(matrix->i));
+        std::fill_n(static_cast<double*>(matrix->x), p.rowIdx.size(), 0.0);
+        factor = cholmod_analyze(matrix, &common);
+        if (!factor) {
+            error = why("cholmod_analyze");
+            return false;
+        }
+        return true;
+    }
 };
 
-SparseCholesky::SparseCholesky(const UpperPattern& p) : m(std::make_unique<Impl>()) {
-    const int n = p.size();
-    if (n <= 0 || static_cast<int>(p.rowIdx.size()) != p.colPtr[n])
-        throw std::invalid_argument("sim::fem::SparseCholesky(): empty or malformed pattern");
+SparseCholesky::SparseCholesky(NoAnalysis) : m(std::make_unique<Impl>()) {
     cholmod_start(&m->common);
-    m->common.print = 0;
-    m->common.error_handler = nullptr;
+    m->common.print = 0;               // the library never prints
+    m->common.error_handler = nullptr; // errors come back through common.status
     m->common.supernodal = CHOLMOD_SUPERNODAL;
     m->common.final_ll = 1;
-    m->n = n;
-    m->matrix = cholmod_allocate_sparse(n, n, p.rowIdx.size(), 1, 1, 1, CHOLMOD_REAL, &m->common);
-    if (!m->matrix) throw std::runtime_error(m->why("cholmod_allocate_sparse"));
-    std::copy(p.colPtr.begin(), p.colPtr.end(), static_cast<int*>(m->matrix->p));
-    std::copy(p.rowIdx.begin(), p.rowIdx.end(), static_cast<int*>(m->matrix->i));
-    std::fill_n(static_cast<double*>(m->matrix->x), p.rowIdx.size(), 0.0);
-    m->factor = cholmod_analyze(m->matrix, &m->common);
-    if (!m->factor) throw std::runtime_error(m->why("cholmod_analyze"));
+}
+
+SparseCholesky::SparseCholesky(const UpperPattern& p) : SparseCholesky(NoAnalysis{}) {
+    std::string error;
+    if (!m->analyze(p, error)) throw std::runtime_error(error);
+}
+
+std::unique_ptr<SparseCholesky> SparseCholesky::tryCreate(const UpperPattern& p, std::string& error) {
+    std::unique_ptr<SparseCholesky> chol(new SparseCholesky(NoAnalysis{}));
+    if (!chol->m->analyze(p, error)) return nullptr;
+    return chol;
 }
 
 SparseCholesky::~SparseCholesky() {
@@ -83,8 +107,13 @@ long SparseCholesky::factorNonZeros() const {
     return static_cast<long>(m->factor->nzmax);
 }
 
-bool SparseCholesky::factorize(const std::vector<double>& values, std::string& error) {
+int SparseCholesky::failedColumn() const {
+    return m->factor ? static_cast<int>(m->factor->minor) : m->n;
+}
+
+bool SparseCholesky::factorize(const std::vector<double>& values, std::string& error, bool* notPositiveDefinite) {
     m->ok = false;
+    if (notPositiveDefinite) *notPositiveDefinite = false;
     if (values.size() != m->matrix->nzmax) {
         error = "sim::fem::SparseCholesky::factorize(): value count does not match the pattern";
         return false;
@@ -96,6 +125,7 @@ bool SparseCholesky::factorize(const std::vector<double>& values, std::string& e
         return false;
     }
     if (m->common.status == CHOLMOD_NOT_POSDEF || m->factor->minor < m->factor->n) {
+        if (notPositiveDefinite) *notPositiveDefinite = true;
         error = "CHOLMOD: the stiffness matrix is not positive definite (column " + std::to_string(m->factor->minor) +
                 " of " + std::to_string(m->factor->n) + "); fix enough nodes to remove rigid motions";
         return false;

@@ -2,7 +2,8 @@
 /// Sparse Cholesky LLᵀ of a symmetric positive-definite matrix (CHOLMOD, supernodal) with a fixed
 /// pattern: the symbolic analysis (fill-reducing ordering) runs once, numeric factorizations reuse
 /// it, and solves are forward/backward substitutions [B eq. 2.61–2.66]. CHOLMOD types stay in the
-/// .cpp. One object is not thread-safe; two objects may be used from two threads.
+/// .cpp. One object is not thread-safe; two objects may be used from two threads. The one CHOLMOD
+/// wrapper of the tree: the FEM solver and the Newton reference (sim/reference) both use it.
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,14 +25,21 @@ public:
     /// Analyses the pattern. Throws std::invalid_argument on an empty or malformed pattern and
     /// std::runtime_error when CHOLMOD fails (out of memory).
     explicit SparseCholesky(const UpperPattern& pattern);
+    /// As the constructor, but a CHOLMOD failure is returned: null with `error` set.
+    static std::unique_ptr<SparseCholesky> tryCreate(const UpperPattern& pattern,
+                                                     std::string& error);
     ~SparseCholesky();
     SparseCholesky(const SparseCholesky&) = delete;
     SparseCholesky& operator=(const SparseCholesky&) = delete;
 
     int size() const;
     /// Numeric factorization of `values` (pattern order). False with a message when the matrix is
-    /// not positive definite or CHOLMOD fails; the previous factor is then invalid.
-    bool factorize(const std::vector<double>& values, std::string& error);
+    /// not positive definite or CHOLMOD fails; the previous factor is then invalid. When not null,
+    /// `notPositiveDefinite` tells that case apart; failedColumn() then names the column.
+    bool factorize(const std::vector<double>& values, std::string& error,
+                   bool* notPositiveDefinite = nullptr);
+    /// Column at which the last factorize() found the matrix not positive definite; size() if none.
+    int failedColumn() const;
     bool factorized() const;
     /// Solves A X = B in place for `columns` right-hand sides stored column-major (size·columns).
     bool solveInPlace(double* b, int columns, std::string& error);
@@ -39,6 +47,8 @@ public:
     long factorNonZeros() const;
 
 private:
+    struct NoAnalysis {};
+    explicit SparseCholesky(NoAnalysis);
     struct Impl;
     std::unique_ptr<Impl> m;
 };

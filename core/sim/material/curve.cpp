@@ -1,23 +1,16 @@
 #include "sim/material/curve.hpp"
 
 #include "sim/util/error.hpp"
+#include "sim/util/format.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <stdexcept>
 
 namespace viscera::sim {
 
 namespace {
-
-std::string num(double v) {
-    if (std::isnan(v)) return "nan"; // not "-nan": messages are compared verbatim
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.12g", v);
-    return buf;
-}
 
 /// Derivative at nodes[i] of the polynomial interpolating (x_j, y_j), j in [lo, hi]:
 /// Σ_{j≠i} L′_j(x_i) (y_j − y_i) (Σ_j L′_j = 0, so the differences avoid cancellation).
@@ -56,11 +49,12 @@ MonotoneCurve MonotoneCurve::fit(std::string name, const std::function<double(do
         throw std::invalid_argument(where + "count " + std::to_string(spec.count) +
                                     " must be at least 2");
     if (!std::isfinite(spec.xmin) || !std::isfinite(spec.xmax) || !(spec.xmin < spec.xmax))
-        throw std::invalid_argument(where + "range [" + num(spec.xmin) + ", " + num(spec.xmax) +
+        throw std::invalid_argument(where + "range [" + formatNumber(spec.xmin, 12) + ", " +
+                                    formatNumber(spec.xmax, 12) +
                                     "] must be finite with xmin < xmax");
     if (spec.spacing == CurveSpacing::Geometric && !(spec.xmin > 0))
         throw std::invalid_argument(
-            where + "geometric spacing needs xmin > 0 (xmin=" + num(spec.xmin) + ")");
+            where + "geometric spacing needs xmin > 0 (xmin=" + formatNumber(spec.xmin, 12) + ")");
     std::vector<CurvePoint> pts(static_cast<std::size_t>(spec.count));
     const double last = spec.count - 1;
     for (int k = 0; k < spec.count; ++k) {
@@ -85,17 +79,18 @@ void MonotoneCurve::check(const std::vector<CurvePoint>& p) const {
         throw InputError(where + "needs at least 2 control points (has " +
                          std::to_string(p.size()) + ")");
     for (std::size_t i = 0; i < p.size(); ++i) {
-        const std::string point = "control point " + std::to_string(i) + " (x=" + num(p[i].x) +
-                                  ", y=" + num(p[i].y) + ")";
+        const std::string point = "control point " + std::to_string(i) +
+                                  " (x=" + formatNumber(p[i].x, 12) +
+                                  ", y=" + formatNumber(p[i].y, 12) + ")";
         if (!std::isfinite(p[i].x) || !std::isfinite(p[i].y))
             throw InputError(where + point + " is not finite");
         if (i == 0) continue;
         if (!(p[i].x > p[i - 1].x))
             throw InputError(where + point + " does not lie right of point " +
-                             std::to_string(i - 1) + " (x=" + num(p[i - 1].x) + ")");
+                             std::to_string(i - 1) + " (x=" + formatNumber(p[i - 1].x, 12) + ")");
         if (m_shape == CurveShape::StrictlyIncreasing && !(p[i].y > p[i - 1].y))
             throw InputError(where + point + " does not increase over point " +
-                             std::to_string(i - 1) + " (y=" + num(p[i - 1].y) + ")");
+                             std::to_string(i - 1) + " (y=" + formatNumber(p[i - 1].y, 12) + ")");
     }
 }
 

@@ -1,29 +1,23 @@
 #include "sim/material/laws.hpp"
 
 #include "sim/util/error.hpp"
+#include "sim/util/format.hpp"
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 
 namespace viscera::sim {
 
 namespace {
 
-std::string num(double v) {
-    if (std::isnan(v)) return "nan"; // not "-nan": messages are compared verbatim
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.12g", v);
-    return buf;
-}
-
 void checkLame(const char* where, double mu, double lambda) {
     if (!(mu > 0) || !std::isfinite(mu) || !(lambda >= 0) || !std::isfinite(lambda))
-        throw std::invalid_argument(std::string(where) + ": mu " + num(mu) + " and lambda " +
-                                    num(lambda) + " must be finite with mu > 0, lambda >= 0");
+        throw std::invalid_argument(std::string(where) + ": mu " + formatNumber(mu, 12) +
+                                    " and lambda " + formatNumber(lambda, 12) +
+                                    " must be finite with mu > 0, lambda >= 0");
 }
 
 /// ∂J/∂F = cof(F), columns as cross products of the other two columns of F.
@@ -122,7 +116,7 @@ NeoHookeanDensity::NeoHookeanDensity(double mu, double lambda, double jMin)
     : m_mu(mu), m_lambda(lambda), m_jMin(jMin) {
     checkLame("sim::NeoHookeanDensity()", mu, lambda);
     if (!(jMin > 0 && jMin < 1))
-        throw std::invalid_argument("sim::NeoHookeanDensity(): jMin " + num(jMin) +
+        throw std::invalid_argument("sim::NeoHookeanDensity(): jMin " + formatNumber(jMin, 12) +
                                     " must be in (0, 1)");
 }
 

@@ -1,6 +1,7 @@
 #include "sim/material/valanis_landel.hpp"
 
 #include "sim/util/error.hpp"
+#include "sim/util/format.hpp"
 
 #include <Eigen/Geometry>
 
@@ -8,20 +9,12 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <limits>
 #include <stdexcept>
 
 namespace viscera::sim {
 
 namespace {
-
-std::string num(double v) {
-    if (std::isnan(v)) return "nan"; // not "-nan": messages are compared verbatim
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.12g", v);
-    return buf;
-}
 
 double curveValue(const std::optional<MonotoneCurve>& c, double x) {
     return c ? c->value(x) : 0.0;
@@ -324,7 +317,7 @@ ValanisLandelDensity::ValanisLandelDensity(std::string materialName, ValanisLand
     m_shearModulus = 0.5 * (f2 + g2 - g1 - h1);
 
     const auto describe = [&](const char* label, const std::optional<MonotoneCurve>& c, double v) {
-        return std::string(label) + (c ? "(1)=" + num(v) : " absent");
+        return std::string(label) + (c ? "(1)=" + formatNumber(v, 12) : " absent");
     };
     const std::string values =
         describe("f'", f, f1) + ", " + describe("g'", g, g1) + ", " + describe("h'", h, h1);
@@ -332,14 +325,15 @@ ValanisLandelDensity::ValanisLandelDensity(std::string materialName, ValanisLand
     const double scale =
         std::max({std::abs(f1), std::abs(2.0 * g1), std::abs(h1), std::abs(m_restStiffness)});
     if (!(std::abs(rest) <= kRestStressTolerance * scale))
-        throw InputError(where + ": stress at rest f'(1) + 2 g'(1) + h'(1) = " + num(rest) +
-                         " Pa is not zero (" + values + ")");
+        throw InputError(where + ": stress at rest f'(1) + 2 g'(1) + h'(1) = " +
+                         formatNumber(rest, 12) + " Pa is not zero (" + values + ")");
     if (!(m_restStiffness > 0))
         throw InputError(where + ": stiffness at rest f''(1) + 2 g''(1) + h''(1) = " +
-                         num(m_restStiffness) + " Pa is not positive (" + values + ")");
+                         formatNumber(m_restStiffness, 12) + " Pa is not positive (" + values +
+                         ")");
     if (!(m_shearModulus > 0))
         throw InputError(where + ": shear modulus at rest (f''(1) + g''(1) - g'(1) - h'(1))/2 = " +
-                         num(m_shearModulus) + " Pa is not positive (" + values + ")");
+                         formatNumber(m_shearModulus, 12) + " Pa is not positive (" + values + ")");
 }
 
 inline double ValanisLandelDensity::principal(const Eigen::Vector3d& s,
@@ -416,8 +410,9 @@ double ValanisLandelDensity::psiAndStress(const Mat3& F, Mat3& P) const {
 ValanisLandelCurves neoHookeanCurves(double mu, double lambda,
                                      const NeoHookeanCurveOptions& options) {
     if (!(mu > 0) || !std::isfinite(mu) || !(lambda >= 0) || !std::isfinite(lambda))
-        throw std::invalid_argument("sim::neoHookeanCurves(): mu " + num(mu) + " and lambda " +
-                                    num(lambda) + " must be finite with mu > 0, lambda >= 0");
+        throw std::invalid_argument("sim::neoHookeanCurves(): mu " + formatNumber(mu, 12) +
+                                    " and lambda " + formatNumber(lambda, 12) +
+                                    " must be finite with mu > 0, lambda >= 0");
     ValanisLandelCurves curves;
     curves.fPrime = MonotoneCurve::fit("f'", [mu](double x) { return mu * x; },
                                        {.xmin = options.stretchMin,

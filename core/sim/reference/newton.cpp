@@ -1,15 +1,16 @@
 #include "sim/reference/newton.hpp"
 
-#include <Eigen/Eigenvalues>
+#include "sim/fem/sparse_cholesky.hpp"
+#include "sim/util/format.hpp"
 
-#include <cholmod.h>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 
 namespace viscera::sim {
@@ -20,12 +21,6 @@ using Mat12 = Eigen::Matrix<double, 12, 12>;
 using Clock = std::chrono::steady_clock;
 
 constexpr const char* kWhere = "sim::solveNewton(): ";
-
-std::string num(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.3g", v);
-    return buf;
-}
 
 double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
@@ -47,7 +42,8 @@ bool allFinite(const std::vector<Vec3>& v) {
 void checkProblem(const StepProblem& p, const std::vector<Vec3>& x0) {
     const size_t nv = p.xTilde.size();
     auto fail = [](const std::string& why) { throw std::invalid_argument(kWhere + why); };
-    if (!(p.h > 0) || !std::isfinite(p.h)) fail("step h " + num(p.h) + " must be positive");
+    if (!(p.h > 0) || !std::isfinite(p.h))
+        fail("step h " + formatNumber(p.h, 3) + " must be positive");
     if (!p.model) fail("problem has no constraint model");
     if (x0.size() != nv)
         fail("x0 has " + std::to_string(x0.size()) + " nodes, the problem has " +
@@ -61,7 +57,7 @@ void checkProblem(const StepProblem& p, const std::vector<Vec3>& x0) {
         fail("dmInv, volume and weight must have one entry per tet (" + std::to_string(nt) + ")");
     for (size_t i = 0; i < nv; ++i)
         if (!(p.mass[i] >= 0) || !std::isfinite(p.mass[i]))
-            fail("node " + std::to_string(i) + " has mass " + num(p.mass[i]) +
+            fail("node " + std::to_string(i) + " has mass " + formatNumber(p.mass[i], 3) +
                  " (must be finite and >= 0)");
     for (size_t t = 0; t < nt; ++t) {
         for (int32_t v : p.tets[t])
@@ -69,114 +65,27 @@ void checkProblem(const StepProblem& p, const std::vector<Vec3>& x0) {
                 fail("tet " + std::to_string(t) + " references node " + std::to_string(v) +
                      " (problem has " + std::to_string(nv) + " nodes)");
         if (!(p.volume[t] > 0) || !std::isfinite(p.volume[t]))
-            fail("tet " + std::to_string(t) + " has rest volume " + num(p.volume[t]) +
+            fail("tet " + std::to_string(t) + " has rest volume " + formatNumber(p.volume[t], 3) +
                  " m^3 (must be positive)");
         if (!(p.weight[t] >= 0) || !std::isfinite(p.weight[t]))
-            fail("tet " + std::to_string(t) + " has stiffness weight " + num(p.weight[t]) +
-                 " (must be finite and >= 0)");
+            fail("tet " + std::to_string(t) + " has stiffness weight " +
+                 formatNumber(p.weight[t], 3) + " (must be finite and >= 0)");
         if (!p.dmInv[t].allFinite()) fail("tet " + std::to_string(t) + " has a non-finite dmInv");
     }
 }
 
-/// Owns a CHOLMOD workspace, the upper triangle of the symmetric matrix (fixed pattern) and its
-/// symbolic + numeric factor. CHOLMOD types never leave this file.
-class CholmodLlt {
-public:
-    CholmodLlt() {
-        cholmod_start(&m_common);
-        m_common.print = 0;               // the library never prints
-        m_common.error_handler = nullptr; // errors come back through m_common.status
-        m_common.supernodal = CHOLMOD_SUPERNODAL;
-        m_common.final_ll = 1;
-    }
-    ~CholmodLlt() {
-        if (m_factor) cholmod_free_factor(&m_factor, &m_common);
-        if (m_matrix) cholmod_free_sparse(&m_matrix, &m_common);
-        cholmod_finish(&m_common);
-    }
-    CholmodLlt(const CholmodLlt&) = delete;
-    CholmodLlt& operator=(const CholmodLlt&) = delete;
-
-    /// Column pointers (n + 1) and sorted row indices of the upper triangle, diagonal included.
-    bool setPattern(const std::vector<int>& colPtr, const std::vector<int>& rowIdx,
-                    std::string& error) {
-        const size_t n = colPtr.size() - 1;
-        m_matrix = cholmod_allocate_sparse(n, n, rowIdx.size(), 1, 1, 1, CHOLMOD_REAL, &m_common);
-        if (!m_matrix) return fail("cholmod_allocate_sparse", error);
-        std::copy(colPtr.begin(), colPtr.end(), static_cast<int*>(m_matrix->p));
-        std::copy(rowIdx.begin(), rowIdx.end(), static_cast<int*>(m_matrix->i));
-        std::fill_n(values(), rowIdx.size(), 0.0);
-        return true;
-    }
-    double* values() { return static_cast<double*>(m_matrix->x); }
-
-    /// Symbolic analysis (fill-reducing ordering, supernodes) of the pattern, once.
-    bool analyze(std::string& error) {
-        m_factor = cholmod_analyze(m_matrix, &m_common);
-        if (!m_factor) return fail("cholmod_analyze", error);
-        return true;
-    }
-
-    /// Numeric LLᵀ factorization of the current values with the analysed pattern. False with a
-    /// message on failure; notPositiveDefinite tells that case apart.
-    bool factorize(std::string& error, bool* notPositiveDefinite = nullptr) {
-        if (notPositiveDefinite) *notPositiveDefinite = false;
-        const int ok = cholmod_factorize(m_matrix, m_factor, &m_common);
-        if (!ok || m_common.status < CHOLMOD_OK) return fail("cholmod_factorize", error);
-        if (m_common.status == CHOLMOD_NOT_POSDEF || m_factor->minor < m_factor->n) {
-            if (notPositiveDefinite) *notPositiveDefinite = true;
-            error = "CHOLMOD: the Hessian is not positive definite (failed at column " +
-                    std::to_string(m_factor->minor) + " of " + std::to_string(m_factor->n) + ")";
-            return false;
-        }
-        return true;
-    }
-
-    /// Solves A x = b in place.
-    bool solve(std::vector<double>& b, std::string& error) {
-        cholmod_dense* rhs = cholmod_allocate_dense(b.size(), 1, b.size(), CHOLMOD_REAL, &m_common);
-        if (!rhs) return fail("cholmod_allocate_dense", error);
-        std::copy(b.begin(), b.end(), static_cast<double*>(rhs->x));
-        cholmod_dense* sol = cholmod_solve(CHOLMOD_A, m_factor, rhs, &m_common);
-        cholmod_free_dense(&rhs, &m_common);
-        if (!sol) return fail("cholmod_solve", error);
-        const double* s = static_cast<const double*>(sol->x);
-        std::copy(s, s + b.size(), b.begin());
-        cholmod_free_dense(&sol, &m_common);
-        return true;
-    }
-
-private:
-    bool fail(const char* call, std::string& error) const {
-        const char* why = "error";
-        switch (m_common.status) {
-        case CHOLMOD_OUT_OF_MEMORY:
-            why = "out of memory";
-            break;
-        case CHOLMOD_TOO_LARGE:
-            why = "problem too large";
-            break;
-        case CHOLMOD_INVALID:
-            why = "invalid input";
-            break;
-        case CHOLMOD_NOT_INSTALLED:
-            why = "method not installed";
-            break;
-        case CHOLMOD_NOT_POSDEF:
-            why = "matrix not positive definite";
-            break;
-        default:
-            break;
-        }
-        error = std::string("CHOLMOD: ") + call + " failed: " + why + " (status " +
-                std::to_string(m_common.status) + ")";
-        return false;
-    }
-
-    cholmod_common m_common{};
-    cholmod_sparse* m_matrix = nullptr;
-    cholmod_factor* m_factor = nullptr;
-};
+/// Numeric factorization of `values` with the analysed pattern; the Newton wording of a Hessian
+/// that is not positive definite (notPositiveDefinite tells that case apart).
+bool factorizeHessian(fem::SparseCholesky& llt, const std::vector<double>& values,
+                      std::string& error, bool* notPositiveDefinite = nullptr) {
+    bool indefinite = false;
+    if (llt.factorize(values, error, &indefinite)) return true;
+    if (indefinite)
+        error = "CHOLMOD: the Hessian is not positive definite (failed at column " +
+                std::to_string(llt.failedColumn()) + " of " + std::to_string(llt.size()) + ")";
+    if (notPositiveDefinite) *notPositiveDefinite = indefinite;
+    return false;
+}
 
 /// Gradient (12) of the tet term h² V w Ψ(F) with respect to its four node positions.
 Vec12 elementGradient(const StepProblem& p, size_t t, const std::array<Vec3, 4>& xe, double scale) {
@@ -221,21 +130,19 @@ public:
                             if (r <= c) rows[c].push_back(r);
                         }
                 }
-        m_colPtr.assign(n + 1, 0);
+        std::vector<int>& colPtr = m_pattern.colPtr;
+        std::vector<int>& rowIdx = m_pattern.rowIdx;
+        colPtr.assign(n + 1, 0);
         for (size_t c = 0; c < n; ++c) {
             auto& col = rows[c];
             std::sort(col.begin(), col.end());
             col.erase(std::unique(col.begin(), col.end()), col.end());
-            m_colPtr[c + 1] = m_colPtr[c] + static_cast<int>(col.size());
+            colPtr[c + 1] = colPtr[c] + static_cast<int>(col.size());
         }
-        m_rowIdx.reserve(m_colPtr[n]);
+        rowIdx.reserve(colPtr[n]);
         for (const auto& col : rows)
-            m_rowIdx.insert(m_rowIdx.end(), col.begin(), col.end());
-        auto find = [&](int r, int c) {
-            const auto first = m_rowIdx.begin() + m_colPtr[c],
-                       last = m_rowIdx.begin() + m_colPtr[c + 1];
-            return static_cast<int>(std::lower_bound(first, last, r) - m_rowIdx.begin());
-        };
+            rowIdx.insert(rowIdx.end(), col.begin(), col.end());
+        auto find = [&](int r, int c) { return m_pattern.find(r, c); }; // every (r, c) is present
         m_diag.resize(n);
         for (size_t d = 0; d < n; ++d)
             m_diag[d] = find(static_cast<int>(d), static_cast<int>(d));
@@ -253,17 +160,16 @@ public:
         }
     }
 
-    const std::vector<int>& colPtr() const { return m_colPtr; }
-    const std::vector<int>& rowIdx() const { return m_rowIdx; }
+    const fem::UpperPattern& pattern() const { return m_pattern; }
     bool active(size_t node) const { return m_active[node] != 0; }
 
-    size_t nonZeros() const { return m_rowIdx.size(); }
+    size_t nonZeros() const { return m_pattern.rowIdx.size(); }
 
     /// Writes the values (pattern order) of M + Σ Π⁺(H_e) into `projected` and, when `exact` is
     /// not null, of M + Σ H_e into `exact`. False on a non-finite entry.
     bool assemble(const std::vector<Vec3>& x, double* projected, double* exact) const {
-        std::fill_n(projected, m_rowIdx.size(), 0.0);
-        if (exact) std::fill_n(exact, m_rowIdx.size(), 0.0);
+        std::fill_n(projected, nonZeros(), 0.0);
+        if (exact) std::fill_n(exact, nonZeros(), 0.0);
         for (size_t i = 0; i < m_active.size(); ++i)
             for (int d = 0; d < 3; ++d) {
                 const double diag = m_active[i] ? m_p.mass[i] : 1.0;
@@ -312,7 +218,8 @@ public:
 private:
     const StepProblem& m_p;
     std::vector<uint8_t> m_active;
-    std::vector<int> m_colPtr, m_rowIdx, m_diag, m_scatter;
+    fem::UpperPattern m_pattern;
+    std::vector<int> m_diag, m_scatter;
     std::vector<double> m_fdStep;
 };
 
@@ -321,20 +228,21 @@ private:
 void validate(const NewtonSettings& s) {
     auto fail = [](const std::string& why) { throw std::invalid_argument(kWhere + why); };
     if (!(s.tolerance > 0) || !std::isfinite(s.tolerance))
-        fail("tolerance " + num(s.tolerance) + " must be positive");
+        fail("tolerance " + formatNumber(s.tolerance, 3) + " must be positive");
     if (!(s.relativeTolerance > 0 && s.relativeTolerance <= 1))
-        fail("relative_tolerance " + num(s.relativeTolerance) + " must be in (0, 1]");
+        fail("relative_tolerance " + formatNumber(s.relativeTolerance, 3) + " must be in (0, 1]");
     if (s.maxIterations < 1)
         fail("max_iterations " + std::to_string(s.maxIterations) + " must be >= 1");
-    if (!(s.armijo > 0 && s.armijo < 1)) fail("armijo " + num(s.armijo) + " must be in (0, 1)");
+    if (!(s.armijo > 0 && s.armijo < 1))
+        fail("armijo " + formatNumber(s.armijo, 3) + " must be in (0, 1)");
     if (!(s.backtrack > 0 && s.backtrack < 1))
-        fail("backtrack " + num(s.backtrack) + " must be in (0, 1)");
+        fail("backtrack " + formatNumber(s.backtrack, 3) + " must be in (0, 1)");
     if (s.maxBacktracks < 0)
         fail("max_backtracks " + std::to_string(s.maxBacktracks) + " must be >= 0");
     if (!(s.fdStep > 0 && s.fdStep < 0.1))
-        fail("fd_step " + num(s.fdStep) + " must be in (0, 0.1)");
+        fail("fd_step " + formatNumber(s.fdStep, 3) + " must be in (0, 0.1)");
     if (!(s.stepTolerance >= 0) || !std::isfinite(s.stepTolerance))
-        fail("step_tolerance " + num(s.stepTolerance) + " must be finite and >= 0");
+        fail("step_tolerance " + formatNumber(s.stepTolerance, 3) + " must be finite and >= 0");
 }
 
 const char* newtonStatusName(NewtonStatus status) {
@@ -397,10 +305,10 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
     if (gNorm <= threshold) return finish(NewtonStatus::Converged, {});
 
     HessianAssembler assembler(p, s);
-    CholmodLlt llt;
     std::string error;
-    if (!llt.setPattern(assembler.colPtr(), assembler.rowIdx(), error) || !llt.analyze(error))
-        return finish(NewtonStatus::FactorizationFailed, error);
+    const std::unique_ptr<fem::SparseCholesky> llt =
+        fem::SparseCholesky::tryCreate(assembler.pattern(), error);
+    if (!llt) return finish(NewtonStatus::FactorizationFailed, error);
 
     double meanSize = 0;
     for (double v : p.volume)
@@ -419,19 +327,19 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
         bool factored = false;
         if (tryExact) {
             bool indefinite = false;
-            std::copy(exact.begin(), exact.end(), llt.values());
-            factored = llt.factorize(error, &indefinite);
+            factored = factorizeHessian(*llt, exact, error, &indefinite);
             if (!factored && !indefinite) return finish(NewtonStatus::FactorizationFailed, error);
         }
         if (!factored) {
-            std::copy(projected.begin(), projected.end(), llt.values());
-            if (!llt.factorize(error)) return finish(NewtonStatus::FactorizationFailed, error);
+            if (!factorizeHessian(*llt, projected, error))
+                return finish(NewtonStatus::FactorizationFailed, error);
             ++r.projectedSteps;
         }
         for (size_t i = 0; i < nv; ++i)
             for (int c = 0; c < 3; ++c)
                 d[3 * i + c] = assembler.active(i) ? -g[i][c] : 0.0;
-        if (!llt.solve(d, error)) return finish(NewtonStatus::FactorizationFailed, error);
+        if (!llt->solveInPlace(d.data(), 1, error))
+            return finish(NewtonStatus::FactorizationFailed, error);
         double gd = 0, dNorm = 0;
         for (size_t i = 0; i < nv; ++i)
             for (int c = 0; c < 3; ++c) {
@@ -466,7 +374,7 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
         }
         if (!accepted)
             return stall("line search found no decrease of f at iteration " + std::to_string(k) +
-                         " (|grad f| " + num(gNorm) + ")");
+                         " (|grad f| " + formatNumber(gNorm, 3) + ")");
         std::swap(r.x, xTry);
         r.f = fTry;
         p.gradientInto(r.x, g);
@@ -478,10 +386,10 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
         if (alpha * dNorm <= s.stepTolerance * std::max(infNorm(r.x), meanSize))
             return stall("step below floating-point resolution at iteration " + std::to_string(k));
     }
-    return finish(NewtonStatus::MaxIterations, "no convergence in " +
-                                                   std::to_string(s.maxIterations) +
-                                                   " iterations (|grad f| " + num(gNorm) +
-                                                   ", threshold " + num(threshold) + ")");
+    return finish(NewtonStatus::MaxIterations,
+                  "no convergence in " + std::to_string(s.maxIterations) +
+                      " iterations (|grad f| " + formatNumber(gNorm, 3) + ", threshold " +
+                      formatNumber(threshold, 3) + ")");
 }
 
 } // namespace viscera::sim

@@ -2,12 +2,12 @@
 
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
+#include "sim/util/format.hpp"
 #include "sim/util/line_reader.hpp"
 
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <stdexcept>
 
 namespace viscera::sim {
@@ -16,12 +16,6 @@ namespace {
 constexpr int64_t kMaxNodes = int64_t{1} << 28;
 
 using Lines = detail::LineReader;
-
-std::string shortest(double x) {
-    char buf[64];
-    const int n = std::snprintf(buf, sizeof buf, "%.17g", x);
-    return std::string(buf, static_cast<size_t>(n));
-}
 
 } // namespace
 
@@ -61,8 +55,8 @@ std::string formatNodeWeights(const std::vector<double>& weights) {
         const double x = weights[i];
         if (!(std::isfinite(x) && x > 0))
             throw std::invalid_argument("sim::formatNodeWeights(): weight of node " + std::to_string(i) + " is " +
-                                        shortest(x) + " (must be finite and > 0)");
-        out += shortest(x);
+                                        formatNumber(x, 17) + " (must be finite and > 0)");
+        out += formatNumber(x, 17);
         out += '\n';
     }
     return out;

@@ -3,11 +3,11 @@
 #include "sim/util/error.hpp"
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <fcntl.h>
+#include <memory>
 #include <sys/stat.h>
-#include <fstream>
-#include <sstream>
 #include <unistd.h>
 
 namespace viscera {
@@ -61,13 +61,38 @@ void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes) 
     }
 }
 
-std::string readFile(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path.string() + ": cannot open for reading");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (in.bad()) throw InputError(path.string() + ": read failed");
-    return ss.str();
+std::string readFile(const std::filesystem::path& path, std::uintmax_t maxBytes,
+                     std::string_view limitName) {
+    namespace fs = std::filesystem;
+    auto fail = [&](const std::string& rule) { throw InputError(path.string() + ": " + rule); };
+    auto tooLarge = [&](const std::string& size) { // size: "300000000 bytes, " or ""
+        fail("file is " + size + "larger than the limit of " + std::to_string(maxBytes) + " bytes" +
+             (limitName.empty() ? std::string() : " (" + std::string(limitName) + ")"));
+    };
+    std::error_code ec;
+    const fs::file_status status = fs::status(path, ec);
+    if (status.type() == fs::file_type::not_found) fail("cannot open for reading (file not found)");
+    if (ec) fail("cannot open for reading (" + ec.message() + ")");
+    if (fs::is_directory(status)) fail("cannot open for reading (is a directory, not a file)");
+    std::uintmax_t size = 0; // known for a regular file; a FIFO or device is read to its end
+    if (fs::is_regular_file(status)) {
+        size = fs::file_size(path, ec);
+        if (ec) fail("cannot read the file size (" + ec.message() + ")");
+        if (size > maxBytes) tooLarge(std::to_string(size) + " bytes, ");
+    }
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
+    if (!f) fail("cannot open for reading (" + errnoText() + ")");
+    std::string bytes;
+    bytes.reserve(static_cast<size_t>(size));
+    char chunk[1 << 16];
+    while (true) {
+        const size_t got = std::fread(chunk, 1, sizeof chunk, f.get());
+        if (bytes.size() + got > maxBytes) tooLarge("");
+        bytes.append(chunk, got);
+        if (got < sizeof chunk) break;
+    }
+    if (std::ferror(f.get())) fail("read failed (" + errnoText() + ")");
+    return bytes;
 }
 
 } // namespace viscera

@@ -1,15 +1,12 @@
 #pragma once
-/// Numbers in messages and reports.
-#include <cstdio>
+/// Number formatting for messages and reports.
 #include <string>
 
 namespace viscera::sim {
 
-/// v as printf "%.*g" with `significantDigits` digits ("0.1", "1e+06").
-inline std::string formatNumber(double v, int significantDigits = 6) {
-    char b[40];
-    std::snprintf(b, sizeof b, "%.*g", significantDigits, v);
-    return b;
-}
+/// `v` as printf "%.*g" with `significantDigits` significant digits ("0.001", "1e+06", "inf"),
+/// except that every NaN prints as "nan" (never "-nan"), so messages compare verbatim on every
+/// platform.
+std::string formatNumber(double v, int significantDigits = 6);
 
 } // namespace viscera::sim

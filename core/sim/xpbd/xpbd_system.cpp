@@ -1,5 +1,6 @@
 #include "sim/xpbd/xpbd_system.hpp"
 
+#include "sim/util/format.hpp"
 #include "sim/xpbd/coupling.hpp"
 #include "sim/xpbd/detail/blocks.hpp"
 #include "sim/xpbd/detail/engine.hpp"
@@ -10,17 +11,10 @@
 
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 
 namespace viscera::sim {
 namespace {
-
-std::string num(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
 
 struct Failer {
     const std::string& where;
@@ -118,7 +112,7 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
         for (int k = 0; k < count; ++k)
             if (!std::isfinite(alpha[k]) || alpha[k] < 0)
                 fail(label, "constraint model '" + d.model->name() + "' has compliance " +
-                                num(alpha[k]) + " (must be finite and >= 0)");
+                                formatNumber(alpha[k]) + " (must be finite and >= 0)");
         if (!std::isfinite(d.density) || d.density <= 0)
             fail(label, "density must be positive and finite");
         const size_t nv = mesh.vertexCount();
@@ -129,7 +123,8 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
             for (size_t i = 0; i < nv; ++i)
                 if (!std::isfinite(d.nodeWeights[i]) || d.nodeWeights[i] <= 0)
                     fail(label, "node weight " + std::to_string(i) + " is " +
-                                    num(d.nodeWeights[i]) + " (must be positive and finite)");
+                                    formatNumber(d.nodeWeights[i]) +
+                                    " (must be positive and finite)");
         }
         const auto& x = mesh.positions();
         detail::ElasticTets et;
@@ -144,7 +139,7 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
             const double vol = dm.determinant() / 6.0;
             if (!(vol > 0))
                 fail(label, "tet " + std::to_string(t) + " has non-positive rest volume " +
-                                num(vol) + " m^3");
+                                formatNumber(vol) + " m^3");
             et.tets.push_back({e[0] + off, e[1] + off, e[2] + off, e[3] + off});
             et.dmInv.push_back(dm.inverse());
             et.volume.push_back(vol);
@@ -222,8 +217,8 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
         const auto proj = projectOntoBoundary(cage, surfX[at.surface], at.maxDistance);
         if (proj.empty())
             fail(label, "no vertex of surface '" + desc.surfaces[at.surface].name +
-                            "' lies within " + num(at.maxDistance) + " m of the boundary of '" +
-                            desc.tetBodies[at.tetBody].name + "'");
+                            "' lies within " + formatNumber(at.maxDistance) +
+                            " m of the boundary of '" + desc.tetBodies[at.tetBody].name + "'");
         for (const BoundaryProjection& p : proj) {
             detail::Tie t;
             t.p = surfFirst[at.surface] + p.point;
@@ -270,7 +265,7 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
             Mat2 M;
             if (!triangleRestDmInv({x[e[0]], x[e[1]], x[e[2]]}, M))
                 fail(label, "triangle " + std::to_string(t) + " is degenerate (area " +
-                                num(area[t]) + " m^2)");
+                                formatNumber(area[t]) + " m^2)");
             tris.push_back({e[0] + off, e[1] + off, e[2] + off});
             restInv.push_back(M);
             for (int k = 0; k < 3; ++k)
@@ -466,7 +461,7 @@ void XpbdSystem::setTetRestShape(size_t b, size_t t, const Mat3& Fs) {
     if (!Fs.allFinite()) throw std::invalid_argument(where + "Fs is not finite");
     const double det = Fs.determinant();
     if (!(det > 1e-12))
-        throw std::invalid_argument(where + "det Fs = " + num(det) + " (must be > 1e-12)");
+        throw std::invalid_argument(where + "det Fs = " + formatNumber(det) + " (must be > 1e-12)");
     Mat3 dm;
     for (int k = 0; k < 3; ++k)
         dm.col(k) = m_rest[e[k + 1]] - m_rest[e[0]];

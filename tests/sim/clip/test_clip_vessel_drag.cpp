@@ -11,6 +11,7 @@
 #include "sim/collision/distance.hpp"
 #include "sim/diagnostics/stability_check.hpp"
 #include "sim/material/stable_neo_hookean.hpp"
+#include "sim/util/format.hpp"
 #include "sim/xpbd/xpbd_system.hpp"
 
 #include "clip_test_support.hpp"
@@ -18,7 +19,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 using namespace viscera::sim;
@@ -190,19 +190,13 @@ DragResult runDrag(const Vec3& drag, bool holdBottom, bool flatten) {
     return r;
 }
 
-std::string fmt(double v) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%.4g", v);
-    return b;
-}
-
 void check(const std::string& name, const Vec3& drag, bool holdBottom, double minRotation) {
     const DragResult a = runDrag(drag, holdBottom, true);
-    ::testing::Test::RecordProperty(name + "_max_mm", fmt(a.maxDistance * 1e3));
-    ::testing::Test::RecordProperty(name + "_mean_mm", fmt(a.meanDistance * 1e3));
+    ::testing::Test::RecordProperty(name + "_max_mm", formatNumber(a.maxDistance * 1e3, 4));
+    ::testing::Test::RecordProperty(name + "_mean_mm", formatNumber(a.meanDistance * 1e3, 4));
     ::testing::Test::RecordProperty(name + "_contacts", std::to_string(a.contacts));
-    ::testing::Test::RecordProperty(name + "_max_flatten_shift_mm", fmt(a.maxFlattenShift * 1e3));
-    ::testing::Test::RecordProperty(name + "_max_clip_rotation_deg", fmt(a.maxRotation * 180 / 3.141592653589793));
+    ::testing::Test::RecordProperty(name + "_max_flatten_shift_mm", formatNumber(a.maxFlattenShift * 1e3, 4));
+    ::testing::Test::RecordProperty(name + "_max_clip_rotation_deg", formatNumber(a.maxRotation * 180 / 3.141592653589793, 4));
     EXPECT_GE(a.maxRotation, minRotation);
     EXPECT_TRUE(a.finite);
     EXPECT_EQ(a.rejected, 0);
@@ -215,7 +209,7 @@ void check(const std::string& name, const Vec3& drag, bool holdBottom, double mi
     EXPECT_LE(a.maxFlattenShift, 0.8 * 0.003 + 1e-4); // κ × (a bit more than) the outer radius
     // The clip really travelled with the vessel (the check is not vacuous).
     EXPECT_GT(a.clipTravel, 0.015);
-    ::testing::Test::RecordProperty(name + "_clip_travel_mm", fmt(a.clipTravel * 1e3));
+    ::testing::Test::RecordProperty(name + "_clip_travel_mm", formatNumber(a.clipTravel * 1e3, 4));
     // Repeat run, without flattening: bit-identical figures (flattening never touches physics).
     const DragResult b = runDrag(drag, holdBottom, false);
     EXPECT_EQ(a.trace, b.trace);

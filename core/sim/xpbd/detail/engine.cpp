@@ -1,5 +1,7 @@
 #include "sim/xpbd/detail/engine.hpp"
 
+#include "sim/util/cpu_relax.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -94,12 +96,6 @@ void Engine::colour() {
 }
 
 namespace {
-
-inline void cpuRelax() {
-#if defined(__x86_64__) || defined(__i386__)
-    __builtin_ia32_pause();
-#endif
-}
 
 /// Returns once a ≥ target: spins briefly, then yields the core (the thread we wait for may be
 /// queued behind us on a busy machine), then sleeps on the futex.

@@ -1,15 +1,11 @@
 #include "sim/xpbd/detail/thread_pool.hpp"
 
+#include "sim/util/cpu_relax.hpp"
+
 #include <cassert>
 
 namespace viscera::sim::detail {
 namespace {
-
-inline void cpuRelax() {
-#if defined(__x86_64__) || defined(__i386__)
-    __builtin_ia32_pause();
-#endif
-}
 
 /// Spins up to `spins` rounds for `a` to differ from `old`, yields the core a few times (on a
 /// busy machine the thread we wait for may be queued behind us), then sleeps until it differs.
