@@ -191,7 +191,7 @@ TEST(PlayerCli, RunRejectsAMalformedRenderBlockAtLoad) {
                                    R"({"post": {"bloom": true}})");
     auto r = player({"run", bad, "--headless", "--frames", "5"});
     EXPECT_EQ(r.exitCode, 1);
-    EXPECT_THAT(r.err, HasSubstr("bad.vcase:scene.json: render.post.bloom: unknown effect"));
+    EXPECT_THAT(r.err, HasSubstr("bad.vcase:scene.json: render.post.bloom: unknown field"));
     EXPECT_EQ(lineCount(r.err), 1) << r.err;
     const auto good = writeSlabCase(dir, "good.vcase", {"gravity", "xpbd"}, sim::Vec3(0, 0, -9.81),
                                     R"({"sss": false, "post": {"tone_mapping": false}})");
