@@ -1,6 +1,7 @@
 #include "sim/xpbd/xpbd_solver.hpp"
 
 #include "sim/material/stable_neo_hookean.hpp"
+#include "sim/util/error.hpp"
 #include "sim/xpbd/detail/blocks.hpp"
 #include "sim/xpbd/detail/engine.hpp"
 
@@ -47,7 +48,7 @@ std::unique_ptr<XpbdSolver> XpbdSolver::create(const TetMesh& rest, const Materi
                                                const std::vector<int32_t>& fixedNodes,
                                                const XpbdSettings& settings) {
     if (auto why = validate(material); !why.empty())
-        throw std::invalid_argument("sim::XpbdSolver::create(): " + why);
+        throw PreconditionError("sim::XpbdSolver::create(): ", why);
     TetBodyDesc body;
     body.mesh = &rest;
     body.model = std::make_shared<StableNeoHookeanModel>(material.mu(), material.lambda());
@@ -93,11 +94,8 @@ double XpbdSolver::totalMass() const {
 void XpbdSolver::setState(const std::vector<Vec3>& x, const std::vector<Vec3>& v) {
     try {
         m_sys->setTetState(0, x, v);
-    } catch (const std::invalid_argument& e) {
-        std::string why = e.what();
-        const std::string prefix = "sim::XpbdSystem::setTetState(): ";
-        if (why.rfind(prefix, 0) == 0) why = why.substr(prefix.size());
-        throw std::invalid_argument("sim::XpbdSolver::setState(): " + why);
+    } catch (const PreconditionError& e) {
+        throw PreconditionError("sim::XpbdSolver::setState(): ", e.rule);
     }
 }
 

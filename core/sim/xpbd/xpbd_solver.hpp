@@ -57,7 +57,8 @@ enum class XpbdIteration {
 
 class XpbdSolver {
   public:
-    /// body.mesh is read during create only. Throws std::invalid_argument
+    /// body.mesh is read during create only. Throws viscera::PreconditionError (a
+    /// std::invalid_argument whose rule has no function prefix, sim/util/error.hpp)
     /// ("sim::XpbdSolver::create(): fixed node 12 is out of range (mesh has 10 vertices)") on
     /// invalid settings, a null mesh or model, a model with other than 1 or 2 constraints, bad
     /// density, node weights or strain limits, a fixed node out of range, a tet with non-positive
@@ -86,7 +87,8 @@ class XpbdSolver {
     bool usesSimd() const;
 
     /// Teleports the body (x, v: #V each, finite); fixed nodes are then held at the new x.
-    /// Between frames only. Throws std::invalid_argument on a size mismatch or non-finite value.
+    /// Between frames only. Throws viscera::PreconditionError (a std::invalid_argument,
+    /// sim/util/error.hpp) on a size mismatch or non-finite value.
     void setState(const std::vector<Vec3>& x, const std::vector<Vec3>& v);
 
     /// Installs (empty function: removes) a hook called after every sweep of every substep of
@@ -123,6 +125,12 @@ class XpbdSolver {
     /// iterations < 1.
     void iterateOn(const StepProblem& problem, int iterations, const IterateObserver& observe,
                    XpbdIteration mode = XpbdIteration::Standard) const;
+
+    /// The one-body system this solver wraps (its tet body 0 is this body): stepping or setting
+    /// state through it is stepping or setting state here (XpbdSystem::setTetState(0, ...) is
+    /// setState()). Non-owning; lives as long as this solver.
+    XpbdSystem& system() { return *m_sys; }
+    const XpbdSystem& system() const { return *m_sys; }
 
   private:
     XpbdSolver();

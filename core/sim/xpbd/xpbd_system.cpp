@@ -1,5 +1,6 @@
 #include "sim/xpbd/xpbd_system.hpp"
 
+#include "sim/util/error.hpp"
 #include "sim/util/format.hpp"
 #include "sim/xpbd/coupling.hpp"
 #include "sim/xpbd/detail/blocks.hpp"
@@ -19,7 +20,7 @@ namespace {
 struct Failer {
     const std::string& where;
     [[noreturn]] void operator()(const std::string& label, const std::string& why) const {
-        throw std::invalid_argument(where + label + why);
+        throw PreconditionError(where, label + why);
     }
 };
 
@@ -409,12 +410,13 @@ void XpbdSystem::setState(Range& r, const std::vector<Vec3>& x, const std::vecto
                           const char* what) {
     const std::string where = std::string("sim::XpbdSystem::") + what + "(): ";
     if (x.size() != r.x.size() || v.size() != r.x.size())
-        throw std::invalid_argument(where + "expected " + std::to_string(r.x.size()) +
-                                    " positions and velocities, got " + std::to_string(x.size()) +
-                                    " and " + std::to_string(v.size()));
+        throw PreconditionError(where, "expected " + std::to_string(r.x.size()) +
+                                           " positions and velocities, got " +
+                                           std::to_string(x.size()) + " and " +
+                                           std::to_string(v.size()));
     for (size_t i = 0; i < x.size(); ++i)
         if (!x[i].allFinite() || !v[i].allFinite())
-            throw std::invalid_argument(where + "node " + std::to_string(i) + " is not finite");
+            throw PreconditionError(where, "node " + std::to_string(i) + " is not finite");
     double* xw = m_engine->xw.data();
     for (size_t i = 0; i < x.size(); ++i) {
         double* p = xw + 4 * (r.first + i);

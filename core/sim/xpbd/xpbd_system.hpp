@@ -94,7 +94,8 @@ struct XpbdSystemDesc {
 
 class XpbdSystem {
   public:
-    /// Throws std::invalid_argument ("sim::XpbdSystem::create(): tet body 1 ('vessel'): tet 3
+    /// Throws viscera::PreconditionError, a std::invalid_argument whose rule has no function
+    /// prefix (sim/util/error.hpp) ("sim::XpbdSystem::create(): tet body 1 ('vessel'): tet 3
     /// has non-positive rest volume -1e-9 m^3") on invalid settings, a missing mesh or model, a
     /// model with other than 1 or 2 constraints, bad density, weights, fixed nodes or strain
     /// limits, a degenerate element, an attachment that ties nothing, an embedded node outside its
@@ -120,7 +121,8 @@ class XpbdSystem {
     const std::vector<double>& tetWeights(size_t b) const { return m_tet[b].tetWeight; }
 
     /// Teleports a body (x and v: #V each, finite); fixed nodes are then held at the new x.
-    /// Between frames only. Throws std::invalid_argument on a size mismatch or non-finite value.
+    /// Between frames only. Throws viscera::PreconditionError on a size mismatch or non-finite
+    /// value.
     void setTetState(size_t b, const std::vector<Vec3>& x, const std::vector<Vec3>& v);
     void setSurfaceState(size_t s, const std::vector<Vec3>& x, const std::vector<Vec3>& v);
 

@@ -6,6 +6,8 @@
 #include "sim/suture/anastomosis.hpp"
 #include "sim/util/error.hpp"
 
+#include "suture_fixture.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -15,18 +17,6 @@ using namespace viscera::sim;
 using ::testing::HasSubstr;
 
 namespace {
-
-const char* kScene = R"({
-  "solver": {"type": "fem", "dt": 0.0333},
-  "bodies": [
-    {"name": "lower", "mesh": "meshes/lower.vtet", "fixed_nodes": [0, 1, 2, 3, 4, 5, 6, 7, 8],
-     "material": {"model": "linear", "youngs_modulus": 60000, "poisson_ratio": 0.45, "density": 1000}},
-    {"name": "upper", "mesh": "meshes/upper.vtet", "fixed_nodes": [0, 1, 2, 3, 4, 5, 6, 7, 8],
-     "material": {"model": "linear", "youngs_modulus": 60000, "poisson_ratio": 0.45, "density": 1000}}],
-  "suture": {"needle": {"shape": "straight", "length": 0.02, "puncture_force_n": 0.005},
-             "thread": {"slack": 0.001},
-             "trajectory": "tools/needle.traj", "gauge": ["lower", "upper"]}
-})";
 
 std::string parseError(const std::string& text) {
     try {
@@ -38,34 +28,15 @@ std::string parseError(const std::string& text) {
 }
 
 std::string withChange(const std::function<void(nlohmann::json&)>& change) {
-    nlohmann::json j = nlohmann::json::parse(kScene);
+    nlohmann::json j = nlohmann::json::parse(suture_fixture::kScene);
     change(j);
     return j.dump();
-}
-
-/// A straight needle above the two stacked slabs, pushed down through both.
-std::string trajectory() {
-    std::vector<suture::NeedleFrame> frames;
-    for (int f = 0; f < 40; ++f) {
-        suture::NeedleFrame fr;
-        fr.pose.linear() = Eigen::AngleAxisd(0.5 * 3.141592653589793, Vec3::UnitY()).toRotationMatrix(); // +x → −z
-        fr.pose.translation() = Vec3(0.0051, 0.0049, 0.03 - 0.0007 * f);
-        frames.push_back(fr);
-    }
-    return suture::formatTrajectory(frames);
-}
-
-std::vector<std::unique_ptr<TetMesh>> slabs() {
-    std::vector<std::unique_ptr<TetMesh>> v;
-    v.push_back(makeBoxTetMesh({Vec3(0, 0, -0.003), Vec3(0.01, 0.01, 0.003), {4, 4, 2}}));
-    v.push_back(makeBoxTetMesh({Vec3(0, 0, 0.001), Vec3(0.01, 0.01, 0.003), {4, 4, 2}}));
-    return v;
 }
 
 } // namespace
 
 TEST(SutureScene, ParsesRoundTripsAndNamesItsFeatures) {
-    const SceneDesc s = parseScene(kScene, "scene.json");
+    const SceneDesc s = parseScene(suture_fixture::kScene, "scene.json");
     ASSERT_TRUE(s.suture);
     EXPECT_EQ(s.solverType, "fem");
     EXPECT_EQ(s.suture->settings.needle.shape, suture::NeedleSpec::Shape::Straight);
@@ -95,11 +66,11 @@ TEST(SutureScene, RejectsBadSectionsNamingTheField) {
 }
 
 TEST(SutureScene, WorldCreatesOnlyTheDeclaredSubsystemsAndSteps) {
-    SceneDesc s = parseScene(kScene, "scene.json");
-    s.suture->trajectoryText = trajectory();
+    SceneDesc s = parseScene(suture_fixture::kScene, "scene.json");
+    s.suture->trajectoryText = suture_fixture::trajectory(40, 0.0007);
     // Undeclared feature: refused.
-    EXPECT_THROW(World::assemble(s, slabs(), {}, {"fem", "needle"}, "case: manifest.json"), viscera::InputError);
-    auto w = World::assemble(s, slabs(), {}, {"fem", "needle", "thread"}, "case: manifest.json");
+    EXPECT_THROW(World::assemble(s, suture_fixture::slabs(), {}, {"fem", "needle"}, "case: manifest.json"), viscera::InputError);
+    auto w = World::assemble(s, suture_fixture::slabs(), {}, {"fem", "needle", "thread"}, "case: manifest.json");
     ASSERT_TRUE(w->hasSuture());
     EXPECT_EQ(w->activeSubsystems(), (std::vector<std::string>{"fem", "needle", "thread"}));
     EXPECT_EQ(w->bodyCount(), 2u);
@@ -114,7 +85,7 @@ TEST(SutureScene, WorldCreatesOnlyTheDeclaredSubsystemsAndSteps) {
     SceneDesc bad = s;
     bad.suture->trajectoryText = "0 0 0 1 0 0 0\n";
     try {
-        World::assemble(bad, slabs(), {}, {"fem", "needle", "thread"}, "case");
+        World::assemble(bad, suture_fixture::slabs(), {}, {"fem", "needle", "thread"}, "case");
         FAIL() << "accepted";
     } catch (const viscera::InputError& e) {
         EXPECT_THAT(e.what(), HasSubstr("tools/needle.traj: line 1: expected 8 numbers"));
@@ -122,7 +93,7 @@ TEST(SutureScene, WorldCreatesOnlyTheDeclaredSubsystemsAndSteps) {
     SceneDesc mixed = s;
     mixed.bodies[1].material.youngsModulus = 1000;
     try {
-        World::assemble(mixed, slabs(), {}, {"fem", "needle", "thread"}, "case");
+        World::assemble(mixed, suture_fixture::slabs(), {}, {"fem", "needle", "thread"}, "case");
         FAIL() << "accepted";
     } catch (const viscera::InputError& e) {
         EXPECT_THAT(e.what(), HasSubstr("all bodies need the same youngs_modulus and poisson_ratio"));

@@ -1,0 +1,56 @@
+#pragma once
+/// Solver "fem" behind the SceneSolver interface: the suturing simulation [B §2.2, §3] on the
+/// scene's bodies merged into one mesh, the needle following the case's recorded trajectory one
+/// frame per step (the last frame is held after the end), per-body position mirrors and, when
+/// the scene names two bodies, the closure gauge. Quasi-static: no velocities, no surfaces,
+/// probes, gravity or accuracy sampling (create() rejects scenes that use them).
+#include "sim/scene/scene_solver.hpp"
+#include "sim/suture/anastomosis.hpp"
+
+#include <array>
+#include <memory>
+
+namespace viscera::sim {
+
+class FemSceneSolver final : public SceneSolver, public SutureReport {
+public:
+    /// Throws viscera::InputError naming in.origin ("<origin>: scene: solver 'fem': <rule>", or
+    /// "... cannot be simulated stably: ..." for a mesh the FEM refuses).
+    static std::unique_ptr<FemSceneSolver> create(const SceneSolverInputs& in);
+    ~FemSceneSolver() override;
+
+    SolverStep step(const FrameClock& clock) override;
+    bool recordFrame(const FrameClock& clock) override;
+    void sampleAccuracy(const FrameClock&, std::vector<AccuracyRecord>&) override {} // rejected at create()
+    const std::vector<Vec3>& positions(size_t body) const override { return m_bodyX[body]; }
+    /// The FEM has no surfaces: throws std::out_of_range.
+    const std::vector<Vec3>& surfacePositions(size_t s) const override;
+    double totalEnergy() const override; ///< J, elastic energy of the FEM
+    /// Quasi-static: the velocities are zero (#V of the body).
+    const std::vector<Vec3>& velocities(size_t body) const override { return m_zeroV[body]; }
+    /// Not supported (probes are rejected at create()): throws std::invalid_argument.
+    void setState(size_t body, const std::vector<Vec3>& x, const std::vector<Vec3>& v) override;
+    const SutureReport* suture() const override { return this; }
+
+    const std::vector<SutureFrameRecord>& frames() const override { return m_frames; }
+    SutureSummary summary() const override;
+
+private:
+    FemSceneSolver();
+    std::vector<Vec3> gaugePositions() const;
+
+    std::unique_ptr<suture::SutureSimulation> m_suture;
+    std::vector<suture::NeedleFrame> m_trajectory;
+    bool m_thread = false;                  ///< pulls of the trajectory are applied
+    std::vector<int32_t> m_offsets;         ///< first merged node of each body
+    std::vector<std::vector<Vec3>> m_bodyX; ///< per-body positions
+    std::vector<std::vector<Vec3>> m_zeroV; ///< per-body zero velocities
+    std::unique_ptr<TetMesh> m_gaugeMesh;   ///< the two gauged bodies, merged
+    std::unique_ptr<suture::ClosureGauge> m_gauge;
+    std::array<size_t, 2> m_gaugeBodies{};
+    suture::SutureStepStats m_last;         ///< of the last step()
+    std::vector<SutureFrameRecord> m_frames;
+    double m_initialGap = 0, m_sampledPenetration = 0;
+};
+
+} // namespace viscera::sim
