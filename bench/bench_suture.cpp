@@ -11,7 +11,6 @@
 #include <vector>
 
 using namespace viscera::sim;
-using namespace viscera::sim::suture;
 
 int main(int argc, char** argv) {
     const int only = argc > 1 ? std::atoi(argv[1]) : 0;
@@ -27,7 +26,7 @@ int main(int argc, char** argv) {
         s.fem.youngsModulus = 60e3;
         // One core: a background refactorization would share it, so it runs in the step (the same
         // settings as the SutureStability acceptance test).
-        s.fem.refactorMode = fem::RefactorMode::Synchronous;
+        s.fem.refactorMode = RefactorMode::Synchronous;
         AnastomosisRun run = makeAnastomosisRun(spec, s);
         SutureSimulation* sim = run.sim.get();
         const std::vector<NeedleFrame>& frames = run.frames;

@@ -25,7 +25,7 @@ ConsoleDevice::ConsoleDevice(const Endpoint& console, const ConsoleDeviceOptions
 
 void ConsoleDevice::poll(int64_t now_ns, DeviceState& out) {
     bool fresh = false;
-    protocol::StatePacket pkt;
+    StatePacket pkt;
     for (int k = 0; k < m_opt.maxPacketsPerPoll; ++k) {
         Endpoint from;
         int64_t queued = 0;
@@ -35,21 +35,21 @@ void ConsoleDevice::poll(int64_t now_ns, DeviceState& out) {
             m_count.malformed.fetch_add(1, std::memory_order_relaxed);
             continue;
         }
-        const protocol::DecodeError e = protocol::decode(m_rx, static_cast<size_t>(n), pkt);
-        if (e == protocol::DecodeError::BadVersion) {
+        const DecodeError e = decode(m_rx, static_cast<size_t>(n), pkt);
+        if (e == DecodeError::BadVersion) {
             m_count.version.fetch_add(1, std::memory_order_relaxed);
             continue;
         }
-        if (e == protocol::DecodeError::BadChecksum) {
+        if (e == DecodeError::BadChecksum) {
             m_count.checksum.fetch_add(1, std::memory_order_relaxed);
             continue;
         }
-        if (e != protocol::DecodeError::None) {
+        if (e != DecodeError::None) {
             m_count.malformed.fetch_add(1, std::memory_order_relaxed);
             continue;
         }
         // After a disconnect the console may have restarted its sequence: accept any number then.
-        if (m_seqValid && !protocol::newer(pkt.sequence, m_lastSeq)) {
+        if (m_seqValid && !newer(pkt.sequence, m_lastSeq)) {
             m_count.order.fetch_add(1, std::memory_order_relaxed);
             continue;
         }
@@ -80,13 +80,13 @@ void ConsoleDevice::poll(int64_t now_ns, DeviceState& out) {
 }
 
 void ConsoleDevice::send(const DeviceCommand& command) {
-    protocol::CommandPacket p;
+    CommandPacket p;
     p.sequence = ++m_sendSeq;
     p.timestamp_ns = command.timestamp_ns;
     p.echoSequence = m_lastSeq;
     p.flags = command.flags;
     p.arm = command.arms;
-    const size_t n = protocol::encode(p, m_tx, sizeof m_tx);
+    const size_t n = encode(p, m_tx, sizeof m_tx);
     if (m_socket.sendTo(m_tx, n, m_console))
         m_count.sent.fetch_add(1, std::memory_order_relaxed);
     else

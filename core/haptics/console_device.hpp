@@ -52,8 +52,8 @@ private:
     bool m_everConnected = false;
     uint32_t m_lastSeq = 0;
     uint32_t m_sendSeq = 0;
-    alignas(8) uint8_t m_rx[protocol::kMaxPacketSize];
-    alignas(8) uint8_t m_tx[protocol::kMaxPacketSize];
+    alignas(8) uint8_t m_rx[kMaxPacketSize];
+    alignas(8) uint8_t m_tx[kMaxPacketSize];
 };
 
 } // namespace viscera::haptics

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstring>
 
-namespace viscera::haptics::protocol {
+namespace viscera::haptics {
 namespace {
 
 constexpr std::array<uint32_t, 256> makeCrcTable() {
@@ -204,4 +204,4 @@ DecodeError decode(const uint8_t* data, size_t size, CommandPacket& out) {
     return DecodeError::None;
 }
 
-} // namespace viscera::haptics::protocol
+} // namespace viscera::haptics

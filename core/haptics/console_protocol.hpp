@@ -11,7 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 
-namespace viscera::haptics::protocol {
+namespace viscera::haptics {
 
 constexpr uint32_t kMagic = 0x4E435356u; ///< bytes 'V' 'S' 'C' 'N'
 constexpr uint16_t kVersion = 1;
@@ -57,4 +57,4 @@ uint32_t crc32(const uint8_t* data, size_t size);
 /// True when `a` is newer than `b` in 32-bit serial-number arithmetic (RFC 1982).
 inline bool newer(uint32_t a, uint32_t b) { return a != b && uint32_t(a - b) < 0x80000000u; }
 
-} // namespace viscera::haptics::protocol
+} // namespace viscera::haptics

@@ -47,7 +47,7 @@ struct Options {
 struct Received {
     double t = 0;
     bool paused = false;
-    protocol::CommandPacket cmd;
+    CommandPacket cmd;
 };
 
 double number(const std::string& flag, const std::string& v, double lo, double hi) {
@@ -148,7 +148,7 @@ int run(const Options& o) {
     std::vector<Received> received;
     received.reserve(static_cast<size_t>(duration * o.rate * 1.2) + 1024);
     uint64_t rejected[16] = {};
-    uint8_t buf[protocol::kMaxPacketSize];
+    uint8_t buf[kMaxPacketSize];
     Endpoint player;
     bool havePlayer = false;
     const int64_t waitEnd = monotonicNs() + int64_t(o.waitPlayer * 1e9);
@@ -159,9 +159,9 @@ int run(const Options& o) {
             int64_t queued = 0;
             const long n = sock.receive(buf, sizeof buf, &from, &queued);
             if (n < 0) break;
-            protocol::CommandPacket c;
-            const auto e = protocol::decode(buf, n > long(sizeof buf) ? sizeof buf + 1 : size_t(n), c);
-            if (e != protocol::DecodeError::None) {
+            CommandPacket c;
+            const auto e = decode(buf, n > long(sizeof buf) ? sizeof buf + 1 : size_t(n), c);
+            if (e != DecodeError::None) {
                 ++rejected[static_cast<int>(e)];
                 continue;
             }
@@ -203,13 +203,13 @@ int run(const Options& o) {
         const bool paused = o.pauseAt >= 0 && t >= o.pauseAt && t < o.pauseAt + o.pauseFor;
         if (!paused) {
             src.sample(t, s);
-            protocol::StatePacket p;
+            StatePacket p;
             p.sequence = ++seq;
             p.timestamp_ns = now;
             p.pedals = s.pedals;
             p.arms = static_cast<uint8_t>(src.arms());
             for (int a = 0; a < kMaxArms; ++a) p.arm[a] = s.arms[a];
-            const size_t n = protocol::encode(p, buf, sizeof buf);
+            const size_t n = encode(p, buf, sizeof buf);
             if (sock.sendTo(buf, n, player)) {
                 ++sent, sentAt.emplace_back(p.sequence, now);
                 // When the last state before the silence really left (this process may have
@@ -247,7 +247,7 @@ int run(const Options& o) {
             // its device timeout (100 ms) and the slack of a loaded machine.
             if (f > 0 && r.t > lastStateBeforeResume + 0.25) ++pausedNonZeroLate;
         }
-        while (j < sentAt.size() && protocol::newer(r.cmd.echoSequence, sentAt[j].first)) ++j;
+        while (j < sentAt.size() && newer(r.cmd.echoSequence, sentAt[j].first)) ++j;
         if (!r.paused && j < sentAt.size() && sentAt[j].first == r.cmd.echoSequence)
             latency.push_back(1e-6 * double(int64_t(std::llround(r.t * 1e9)) + t0 - sentAt[j].second));
     }

@@ -120,23 +120,23 @@ MeshSource readMeshSource(const JsonField& m, const std::filesystem::path& dir) 
     return s;
 }
 
-/// The suture section: the scene's section (sim::suture::readSutureSection) whose trajectory is
+/// The suture section: the scene's section (sim::readSutureSection) whose trajectory is
 /// generated (anastomosis) or read from a project file, checked, and exported as
 /// tools/needle.traj.
-sim::suture::SutureSceneDesc readSutureProject(const JsonField& su, const std::filesystem::path& dir) {
-    sim::suture::SutureSceneDesc d = sim::suture::readSutureSection(su, /*readTrajectory=*/false);
+sim::SutureSceneDesc readSutureProject(const JsonField& su, const std::filesystem::path& dir) {
+    sim::SutureSceneDesc d = sim::readSutureSection(su, /*readTrajectory=*/false);
     const JsonField t = su["trajectory"];
     t.anyObject();
     if (auto file = t.find("file")) {
         t.object({"file"});
         const std::filesystem::path path = projectFile(*file, dir);
         d.trajectoryText = readFile(path);
-        sim::suture::parseTrajectory(d.trajectoryText, path.string()); // checked now, not in the player
+        sim::parseTrajectory(d.trajectoryText, path.string()); // checked now, not in the player
     } else {
         t["generator"].choice({"anastomosis"}, "a known generator");
         t.object({"generator", "stitches", "needle_radius", "needle_centre", "degrees_per_frame", "transfer_frames",
                   "transfer_distance", "pull_frames", "pull_per_segment", "slack"});
-        sim::suture::AnastomosisSpec a;
+        sim::AnastomosisSpec a;
         a.stitches = t.integer("stitches", a.stitches, 1, 64);
         a.needleRadius = t.number("needle_radius", a.needleRadius, NumberRule::positive());
         a.needleCentre = t.number("needle_centre", a.needleCentre, NumberRule::positive());
@@ -146,7 +146,7 @@ sim::suture::SutureSceneDesc readSutureProject(const JsonField& su, const std::f
         a.pullFrames = t.integer("pull_frames", a.pullFrames, 1, 100000);
         a.pullPerSegment = t.number("pull_per_segment", a.pullPerSegment, NumberRule::positive());
         a.slack = t.number("slack", a.slack);
-        d.trajectoryText = sim::suture::formatTrajectory(sim::suture::makeAnastomosisTrajectory(a));
+        d.trajectoryText = sim::formatTrajectory(sim::makeAnastomosisTrajectory(a));
     }
     d.trajectoryPath = "tools/needle.traj";
     return d;

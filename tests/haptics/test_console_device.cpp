@@ -13,7 +13,6 @@
 #include <vector>
 
 using namespace viscera::haptics;
-using namespace viscera::haptics::protocol;
 
 namespace {
 

@@ -9,7 +9,6 @@
 #include <vector>
 
 using namespace viscera::haptics;
-using namespace viscera::haptics::protocol;
 
 namespace {
 

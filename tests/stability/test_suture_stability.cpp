@@ -10,7 +10,6 @@
 #include <cmath>
 
 using namespace viscera::sim;
-using namespace viscera::sim::suture;
 
 namespace {
 
@@ -37,7 +36,7 @@ AnastomosisRun anastomosis(const AnastomosisSpec& spec) {
     SutureSettings s;
     s.needle.punctureForce = 0.008;
     s.fem.youngsModulus = 60e3;
-    s.fem.refactorMode = fem::RefactorMode::Synchronous; // deterministic and simple for the checks
+    s.fem.refactorMode = RefactorMode::Synchronous; // deterministic and simple for the checks
     return makeAnastomosisRun(spec, s);
 }
 
@@ -58,7 +57,7 @@ std::unique_ptr<SutureSimulation> slabs(double gap, const Eigen::Isometry3d& pos
     s.needle.length = 0.02;
     s.needle.handle = 0;
     s.needle.punctureForce = 0.005;
-    s.fem.refactorMode = fem::RefactorMode::Synchronous;
+    s.fem.refactorMode = RefactorMode::Synchronous;
     return SutureSimulation::create(std::move(merged), fixed, s, pose);
 }
 

@@ -7,7 +7,7 @@
 #include <map>
 #include <stdexcept>
 
-namespace viscera::sim::contact {
+namespace viscera::sim {
 namespace {
 
 /// Roots in [0, 1] of k0 + k1 t + k2 t² + k3 t³, ascending (bisection on monotone pieces).
@@ -151,7 +151,7 @@ bool edgeEdgeCcd(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, d
 
 ContactDetector::ContactDetector(const TetMesh& mesh, bool selfContact) : m_selfContact(selfContact) {
     if (mesh.level() < 3)
-        throw std::logic_error("sim::contact::ContactDetector(): requires adjacency level 3; call mesh.requireLevel(3) first");
+        throw std::logic_error("sim::ContactDetector(): requires adjacency level 3; call mesh.requireLevel(3) first");
     // Bodies: connected components of the tets (union–find).
     std::vector<int32_t> parent(mesh.vertexCount());
     for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int32_t>(i);
@@ -345,4 +345,4 @@ void ContactDetector::detect(const std::vector<Vec3>& x0, const std::vector<Vec3
               [](const Collision& a, const Collision& b) { return a.t < b.t; });
 }
 
-} // namespace viscera::sim::contact
+} // namespace viscera::sim

@@ -10,7 +10,7 @@
 
 #include <vector>
 
-namespace viscera::sim::contact {
+namespace viscera::sim {
 
 enum class CollisionKind { VertexFace, EdgeEdge };
 
@@ -71,4 +71,4 @@ bool vertexFaceCcd(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1,
 /// Same for the moving edges (a0, a1) and (b0, b1); w = (α, β, 0).
 bool edgeEdgeCcd(const std::array<Vec3, 4>& x0, const std::array<Vec3, 4>& x1, double thickness, double& t, Vec3& w);
 
-} // namespace viscera::sim::contact
+} // namespace viscera::sim

@@ -10,10 +10,10 @@
 #include <stdexcept>
 #include <thread>
 
-namespace viscera::sim::fem {
+namespace viscera::sim {
 namespace {
 
-constexpr const char* kWhere = "sim::fem::CorotationalFem::";
+constexpr const char* kWhere = "sim::CorotationalFem::";
 
 /// A factorization of K_R with everything that depends on the rotations.
 struct Factor {
@@ -135,7 +135,7 @@ struct CorotationalFem::Impl {
         if (!s.corotational) return R;
         for (size_t t = 0; t < tets.size(); ++t) {
             const Tet& e = tets[t];
-            R[t] = polarRotation(deformationGradient(elems[t], {x[e[0]], x[e[1]], x[e[2]], x[e[3]]}));
+            R[t] = elementRotation(deformationGradient(elems[t], {x[e[0]], x[e[1]], x[e[2]], x[e[3]]}));
         }
         return R;
     }
@@ -740,4 +740,4 @@ void CorotationalFem::lastSystem(Eigen::MatrixXd& C, Eigen::VectorXd& bu, Eigen:
     }
 }
 
-} // namespace viscera::sim::fem
+} // namespace viscera::sim

@@ -39,7 +39,7 @@
 #include <string>
 #include <vector>
 
-namespace viscera::sim::fem {
+namespace viscera::sim {
 
 enum class RefactorMode { Synchronous, Background };
 
@@ -164,4 +164,4 @@ private:
     int m_factorizations = 0;
 };
 
-} // namespace viscera::sim::fem
+} // namespace viscera::sim

@@ -1,12 +1,14 @@
 #include "sim/fem/element.hpp"
 
+#include "sim/clip/exp_map_rotation.hpp"
+
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
 #include <stdexcept>
 #include <string>
 
-namespace viscera::sim::fem {
+namespace viscera::sim {
 
 LinearTet makeLinearTet(const std::array<Vec3, 4>& x, double lambda, double mu) {
     LinearTet e;
@@ -14,7 +16,7 @@ LinearTet makeLinearTet(const std::array<Vec3, 4>& x, double lambda, double mu) 
     for (int k = 0; k < 3; ++k) dm.col(k) = x[k + 1] - x[0];
     e.volume = dm.determinant() / 6.0;
     if (!(e.volume > 0) || !std::isfinite(e.volume))
-        throw std::invalid_argument("sim::fem::makeLinearTet(): rest volume " + std::to_string(e.volume) +
+        throw std::invalid_argument("sim::makeLinearTet(): rest volume " + std::to_string(e.volume) +
                                     " m^3 must be positive");
     e.dmInv = dm.inverse();
     for (int a = 1; a < 4; ++a) e.grad.row(a) = e.dmInv.row(a - 1);
@@ -45,13 +47,6 @@ Mat3 deformationGradient(const LinearTet& e, const std::array<Vec3, 4>& x) {
     return ds * e.dmInv;
 }
 
-Mat3 polarRotation(const Mat3& F) {
-    if (!F.allFinite()) return Mat3::Identity();
-    Eigen::JacobiSVD<Mat3> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Mat3 U = svd.matrixU();
-    const Mat3 V = svd.matrixV();
-    if ((U * V.transpose()).determinant() < 0) U.col(2) = -U.col(2); // smallest singular value
-    return U * V.transpose();
-}
+Mat3 elementRotation(const Mat3& F) { return F.allFinite() ? polarRotation(F) : Mat3::Identity(); }
 
-} // namespace viscera::sim::fem
+} // namespace viscera::sim

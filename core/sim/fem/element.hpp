@@ -7,7 +7,7 @@
 
 #include <array>
 
-namespace viscera::sim::fem {
+namespace viscera::sim {
 
 using Mat3 = Eigen::Matrix3d;
 using Vec12 = Eigen::Matrix<double, 12, 1>;
@@ -32,8 +32,9 @@ double linearTetEnergy(const LinearTet& e, const Vec12& u, double lambda, double
 /// Deformation gradient F = Ds Dm⁻¹ of the element at positions x (4 nodes).
 Mat3 deformationGradient(const LinearTet& e, const std::array<Vec3, 4>& x);
 
-/// Rotation of the polar decomposition F = R S (SVD, det R = +1; an inverted element gets the
-/// rotation nearest to F's orthogonal factor). Identity for a non-finite F.
-Mat3 polarRotation(const Mat3& F);
+/// The element rotation of the corotational FEM: the polar rotation of F (sim::polarRotation,
+/// clip/exp_map_rotation.hpp: det R = +1, an inverted element gets the rotation nearest to F's
+/// orthogonal factor), the identity for a non-finite F.
+Mat3 elementRotation(const Mat3& F);
 
-} // namespace viscera::sim::fem
+} // namespace viscera::sim

@@ -6,7 +6,7 @@
 #include <cstring>
 #include <stdexcept>
 
-namespace viscera::sim::fem {
+namespace viscera::sim {
 
 int UpperPattern::find(int r, int c) const {
     if (c < 0 || c >= size()) return -1;
@@ -43,7 +43,7 @@ struct SparseCholesky::Impl {
     bool analyze(const UpperPattern& p, std::string& error) {
         const int size = p.size();
         if (size <= 0 || static_cast<int>(p.rowIdx.size()) != p.colPtr[size])
-            throw std::invalid_argument("sim::fem::SparseCholesky(): empty or malformed pattern");
+            throw std::invalid_argument("sim::SparseCholesky(): empty or malformed pattern");
         n = size;
         matrix = cholmod_allocate_sparse(n, n, p.rowIdx.size(), 1, 1, 1, CHOLMOD_REAL, &common);
         if (!matrix) {
@@ -115,7 +115,7 @@ bool SparseCholesky::factorize(const std::vector<double>& values, std::string& e
     m->ok = false;
     if (notPositiveDefinite) *notPositiveDefinite = false;
     if (values.size() != m->matrix->nzmax) {
-        error = "sim::fem::SparseCholesky::factorize(): value count does not match the pattern";
+        error = "sim::SparseCholesky::factorize(): value count does not match the pattern";
         return false;
     }
     std::copy(values.begin(), values.end(), static_cast<double*>(m->matrix->x));
@@ -136,7 +136,7 @@ bool SparseCholesky::factorize(const std::vector<double>& values, std::string& e
 
 bool SparseCholesky::solveInPlace(double* b, int columns, std::string& error) {
     if (!m->ok) {
-        error = "sim::fem::SparseCholesky::solveInPlace(): no valid factorization";
+        error = "sim::SparseCholesky::solveInPlace(): no valid factorization";
         return false;
     }
     if (columns <= 0) return true;
@@ -158,4 +158,4 @@ bool SparseCholesky::solveInPlace(double* b, int columns, std::string& error) {
     return true;
 }
 
-} // namespace viscera::sim::fem
+} // namespace viscera::sim

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace viscera::sim::fem {
+namespace viscera::sim {
 
 /// Upper triangle (diagonal included) in compressed columns: colPtr (n + 1), sorted rowIdx.
 struct UpperPattern {
@@ -53,4 +53,4 @@ private:
     std::unique_ptr<Impl> m;
 };
 
-} // namespace viscera::sim::fem
+} // namespace viscera::sim

@@ -76,7 +76,7 @@ void checkProblem(const StepProblem& p, const std::vector<Vec3>& x0) {
 
 /// Numeric factorization of `values` with the analysed pattern; the Newton wording of a Hessian
 /// that is not positive definite (notPositiveDefinite tells that case apart).
-bool factorizeHessian(fem::SparseCholesky& llt, const std::vector<double>& values,
+bool factorizeHessian(SparseCholesky& llt, const std::vector<double>& values,
                       std::string& error, bool* notPositiveDefinite = nullptr) {
     bool indefinite = false;
     if (llt.factorize(values, error, &indefinite)) return true;
@@ -160,7 +160,7 @@ public:
         }
     }
 
-    const fem::UpperPattern& pattern() const { return m_pattern; }
+    const UpperPattern& pattern() const { return m_pattern; }
     bool active(size_t node) const { return m_active[node] != 0; }
 
     size_t nonZeros() const { return m_pattern.rowIdx.size(); }
@@ -218,7 +218,7 @@ public:
 private:
     const StepProblem& m_p;
     std::vector<uint8_t> m_active;
-    fem::UpperPattern m_pattern;
+    UpperPattern m_pattern;
     std::vector<int> m_diag, m_scatter;
     std::vector<double> m_fdStep;
 };
@@ -306,8 +306,8 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
 
     HessianAssembler assembler(p, s);
     std::string error;
-    const std::unique_ptr<fem::SparseCholesky> llt =
-        fem::SparseCholesky::tryCreate(assembler.pattern(), error);
+    const std::unique_ptr<SparseCholesky> llt =
+        SparseCholesky::tryCreate(assembler.pattern(), error);
     if (!llt) return finish(NewtonStatus::FactorizationFailed, error);
 
     double meanSize = 0;

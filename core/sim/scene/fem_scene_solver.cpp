@@ -15,7 +15,7 @@ std::unique_ptr<FemSceneSolver> FemSceneSolver::create(const SceneSolverInputs& 
     const SceneDesc& scene = in.scene;
     const auto& meshes = in.meshes;
     const std::string& origin = in.origin;
-    const suture::SutureSceneDesc& sd = *scene.suture;
+    const SutureSceneDesc& sd = *scene.suture;
     auto fail = [&](const std::string& rule) -> void { throw InputError(origin + ": scene: solver 'fem': " + rule); };
     if (!scene.surfaces.empty()) fail("surfaces (fascia) are not supported");
     if (!scene.tools.empty()) fail("haptic probes are not supported");
@@ -42,15 +42,15 @@ std::unique_ptr<FemSceneSolver> FemSceneSolver::create(const SceneSolverInputs& 
         parts.push_back(meshes[i].get());
         offset += static_cast<int32_t>(meshes[i]->vertexCount());
     }
-    std::vector<suture::NeedleFrame> trajectory = suture::parseTrajectory(sd.trajectoryText, origin + ": " + sd.trajectoryPath);
-    suture::SutureSettings settings = sd.settings;
+    std::vector<NeedleFrame> trajectory = parseTrajectory(sd.trajectoryText, origin + ": " + sd.trajectoryPath);
+    SutureSettings settings = sd.settings;
     settings.fem.youngsModulus = scene.bodies[0].material.youngsModulus;
     settings.fem.poissonRatio = scene.bodies[0].material.poissonRatio;
     // One core: a background refactorization would share it; results are then also repeatable.
-    settings.fem.refactorMode = fem::RefactorMode::Synchronous;
+    settings.fem.refactorMode = RefactorMode::Synchronous;
     std::unique_ptr<FemSceneSolver> f(new FemSceneSolver());
     try {
-        f->m_suture = suture::SutureSimulation::create(suture::mergeMeshes(parts, nullptr), fixed, settings,
+        f->m_suture = SutureSimulation::create(mergeMeshes(parts, nullptr), fixed, settings,
                                                        trajectory.front().pose);
     } catch (const std::invalid_argument& e) {
         throw InputError(origin + ": scene cannot be simulated stably: " + e.what());
@@ -62,9 +62,9 @@ std::unique_ptr<FemSceneSolver> FemSceneSolver::create(const SceneSolverInputs& 
             if (i == scene.bodies.size()) fail("suture.gauge: '" + sd.gauge[k] + "' is not a body of the scene");
             f->m_gaugeBodies[k] = i;
         }
-        f->m_gaugeMesh = suture::mergeMeshes({parts[f->m_gaugeBodies[0]], parts[f->m_gaugeBodies[1]]}, nullptr);
+        f->m_gaugeMesh = mergeMeshes({parts[f->m_gaugeBodies[0]], parts[f->m_gaugeBodies[1]]}, nullptr);
         f->m_gaugeMesh->requireLevel(3);
-        f->m_gauge = std::make_unique<suture::ClosureGauge>(
+        f->m_gauge = std::make_unique<ClosureGauge>(
             *f->m_gaugeMesh, static_cast<int32_t>(parts[f->m_gaugeBodies[0]]->vertexCount()));
     }
     f->m_trajectory = std::move(trajectory);
@@ -85,7 +85,7 @@ std::vector<Vec3> FemSceneSolver::gaugePositions() const {
 }
 
 SolverStep FemSceneSolver::step(const FrameClock& clock) {
-    suture::NeedleFrame frame = m_trajectory[std::min<size_t>(static_cast<size_t>(clock.frame), m_trajectory.size() - 1)];
+    NeedleFrame frame = m_trajectory[std::min<size_t>(static_cast<size_t>(clock.frame), m_trajectory.size() - 1)];
     if (!m_thread) frame.pull = 0;
     m_last = m_suture->step(frame);
     SolverStep rec;
@@ -107,7 +107,7 @@ SolverStep FemSceneSolver::step(const FrameClock& clock) {
 }
 
 bool FemSceneSolver::recordFrame(const FrameClock& clock) {
-    const suture::SutureStepStats& st = m_last;
+    const SutureStepStats& st = m_last;
     SutureFrameRecord sr;
     sr.frame = clock.frame;
     sr.activeRows = st.activeRows;
@@ -119,7 +119,7 @@ bool FemSceneSolver::recordFrame(const FrameClock& clock) {
     sr.threadEngaged = st.threadEngaged;
     bool finite = std::isfinite(st.threadTension);
     if (m_gauge && clock.frame % 10 == 0) { // sampled, outside the timed step
-        const suture::ClosureMetrics cm = m_gauge->measure(gaugePositions());
+        const ClosureMetrics cm = m_gauge->measure(gaugePositions());
         sr.maxGap = cm.maxGap;
         sr.maxPenetration = cm.maxPenetration;
         m_sampledPenetration = std::max(m_sampledPenetration, cm.maxPenetration);
@@ -149,7 +149,7 @@ SutureSummary FemSceneSolver::summary() const {
     }
     if (!m_frames.empty()) s.finalThreadTension = m_frames.back().threadTension;
     if (m_gauge) {
-        const suture::ClosureMetrics cm = m_gauge->measure(gaugePositions());
+        const ClosureMetrics cm = m_gauge->measure(gaugePositions());
         s.gauge = true;
         s.initialGap = m_initialGap;
         s.finalGap = cm.maxGap;

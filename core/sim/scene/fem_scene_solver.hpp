@@ -39,16 +39,16 @@ private:
     FemSceneSolver();
     std::vector<Vec3> gaugePositions() const;
 
-    std::unique_ptr<suture::SutureSimulation> m_suture;
-    std::vector<suture::NeedleFrame> m_trajectory;
+    std::unique_ptr<SutureSimulation> m_suture;
+    std::vector<NeedleFrame> m_trajectory;
     bool m_thread = false;                  ///< pulls of the trajectory are applied
     std::vector<int32_t> m_offsets;         ///< first merged node of each body
     std::vector<std::vector<Vec3>> m_bodyX; ///< per-body positions
     std::vector<std::vector<Vec3>> m_zeroV; ///< per-body zero velocities
     std::unique_ptr<TetMesh> m_gaugeMesh;   ///< the two gauged bodies, merged
-    std::unique_ptr<suture::ClosureGauge> m_gauge;
+    std::unique_ptr<ClosureGauge> m_gauge;
     std::array<size_t, 2> m_gaugeBodies{};
-    suture::SutureStepStats m_last;         ///< of the last step()
+    SutureStepStats m_last;         ///< of the last step()
     std::vector<SutureFrameRecord> m_frames;
     double m_initialGap = 0, m_sampledPenetration = 0;
 };

@@ -151,7 +151,7 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
                  "interaction"});
     SceneDesc scene;
     readSolver(root, scene);
-    if (auto su = root.find("suture")) scene.suture = suture::readSutureSection(*su);
+    if (auto su = root.find("suture")) scene.suture = readSutureSection(*su);
     if (auto v = root.find("instructions")) scene.instructions = v->string();
     if (auto v = root.find("render")) scene.render = v->anyObject().value().dump();
     scene.accuracy = readAccuracy(root);
@@ -202,7 +202,7 @@ json sceneJson(const SceneDesc& scene) {
                      {"threads", s.threads}};
     if (s.primalCorrection) doc["solver"]["primal_correction"] = true;
     if (scene.solverType == "fem") doc["solver"] = {{"type", "fem"}, {"dt", s.dt}};
-    if (scene.suture) doc["suture"] = suture::sutureJson(*scene.suture);
+    if (scene.suture) doc["suture"] = sutureJson(*scene.suture);
     if (scene.interaction) doc["interaction"] = interactionJson(*scene.interaction);
     doc["gravity"] = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
     if (!scene.instructions.empty()) doc["instructions"] = scene.instructions;

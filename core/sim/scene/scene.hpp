@@ -83,7 +83,7 @@ struct SceneDesc {
     std::vector<BodyDesc> bodies;
     std::vector<SurfaceDesc> surfaces;
     std::vector<ToolDesc> tools; ///< haptic probes (feature "probe")
-    std::optional<suture::SutureSceneDesc> suture; ///< solver "fem" only (features fem, needle, thread, contact)
+    std::optional<SutureSceneDesc> suture; ///< solver "fem" only (features fem, needle, thread, contact)
     /// Scripted instruments (features collision, dissection, clip); XPBD scenes only.
     std::optional<InteractionDesc> interaction;
 };

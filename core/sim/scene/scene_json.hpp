@@ -40,12 +40,10 @@ nlohmann::json interactionJson(const InteractionDesc& desc);
 
 nlohmann::json sceneJson(const SceneDesc& scene);
 
-namespace suture {
 /// The suture section (sim/suture/suture_scene.cpp); `readTrajectory` false leaves
 /// "trajectory" to the caller (a project's trajectory is an object, a scene's a path inside
 /// the case).
 SutureSceneDesc readSutureSection(const JsonField& section, bool readTrajectory = true);
 nlohmann::json sutureJson(const SutureSceneDesc& desc);
-} // namespace suture
 
 } // namespace viscera::sim

@@ -10,7 +10,7 @@
 #include <numbers>
 #include <sstream>
 
-namespace viscera::sim::suture {
+namespace viscera::sim {
 namespace {
 
 std::vector<int32_t> ringAt(const TetMesh& m, const Vec3& point, const Vec3& axis) {
@@ -134,7 +134,7 @@ std::unique_ptr<TetMesh> mergeMeshes(const std::vector<const TetMesh*>& meshes, 
             tets.push_back(t);
         }
     }
-    return TetMesh::fromArrays(std::move(pos), std::move(tets), "sim::suture::mergeMeshes()");
+    return TetMesh::fromArrays(std::move(pos), std::move(tets), "sim::mergeMeshes()");
 }
 
 namespace {
@@ -279,4 +279,4 @@ AnastomosisRun makeAnastomosisRun(const AnastomosisSpec& spec, SutureSettings se
     return run;
 }
 
-} // namespace viscera::sim::suture
+} // namespace viscera::sim

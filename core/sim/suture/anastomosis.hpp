@@ -10,7 +10,7 @@
 #include <string>
 #include <string_view>
 
-namespace viscera::sim::suture {
+namespace viscera::sim {
 
 struct AnastomosisSpec {
     HollowTubeSpec wide{Vec3(0, 0, -0.013), Vec3(0, 0, -0.001), 0.0038, 0.0050, 33, 2, 8}; ///< lower tube
@@ -82,4 +82,4 @@ private:
     std::vector<Tet> m_tetsA, m_tetsB;                    // tets of the end regions
 };
 
-} // namespace viscera::sim::suture
+} // namespace viscera::sim

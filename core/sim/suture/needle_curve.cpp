@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-namespace viscera::sim::suture {
+namespace viscera::sim {
 
 NeedleCurve NeedleCurve::straight(const Vec3& p, const Vec3& w) {
     NeedleCurve c;
@@ -80,4 +80,4 @@ double NeedleCurve::closestParameter(const Vec3& q, double a, double b) const {
     return s;
 }
 
-} // namespace viscera::sim::suture
+} // namespace viscera::sim

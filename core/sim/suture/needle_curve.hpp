@@ -7,7 +7,7 @@
 
 #include <Eigen/Core>
 
-namespace viscera::sim::suture {
+namespace viscera::sim {
 
 struct NeedleCurve {
     enum class Kind { Straight, Arc };
@@ -32,4 +32,4 @@ struct NeedleCurve {
     double closestParameter(const Vec3& q, double a, double b) const;
 };
 
-} // namespace viscera::sim::suture
+} // namespace viscera::sim

@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace viscera::sim::suture {
+namespace viscera::sim {
 
 using nlohmann::json;
 
@@ -81,4 +81,4 @@ SutureSceneDesc parseSutureSection(std::string_view text, const std::string& ori
 
 std::string formatSutureSection(const SutureSceneDesc& d) { return sutureJson(d).dump(); }
 
-} // namespace viscera::sim::suture
+} // namespace viscera::sim

@@ -18,7 +18,7 @@
 #include <string>
 #include <string_view>
 
-namespace viscera::sim::suture {
+namespace viscera::sim {
 
 struct SutureSceneDesc {
     SutureSettings settings;      ///< fem.youngsModulus / poissonRatio come from the bodies' material
@@ -34,4 +34,4 @@ SutureSceneDesc parseSutureSection(std::string_view json, const std::string& ori
 /// The section object as JSON text (parseSutureSection reads it back).
 std::string formatSutureSection(const SutureSceneDesc& desc);
 
-} // namespace viscera::sim::suture
+} // namespace viscera::sim

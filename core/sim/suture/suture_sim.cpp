@@ -6,7 +6,7 @@
 #include <set>
 #include <stdexcept>
 
-namespace viscera::sim::suture {
+namespace viscera::sim {
 namespace {
 
 bool finitePose(const Eigen::Isometry3d& p) { return p.matrix().allFinite(); }
@@ -42,7 +42,7 @@ ThreadSegmentLinearization linearizeThreadSegment(const Vec3& ra, const Vec3& rb
 double NeedleSpec::length_() const { return shape == Shape::Semicircle ? std::numbers::pi * radius : length; }
 
 std::string validate(const SutureSettings& s) {
-    if (auto why = fem::validate(s.fem); !why.empty()) return why;
+    if (auto why = validate(s.fem); !why.empty()) return why;
     const NeedleSpec& n = s.needle;
     if (!(n.radius > 0) || !(n.length > 0)) return "needle radius and length must be positive";
     if (!(n.handle >= 0 && n.handle <= n.length_())) return "needle handle must lie on the needle (0 <= handle <= length)";
@@ -90,17 +90,17 @@ std::unique_ptr<SutureSimulation> SutureSimulation::create(std::unique_ptr<TetMe
                                                            const SutureSettings& settings,
                                                            const Eigen::Isometry3d& initialPose) {
     if (auto why = validate(settings); !why.empty())
-        throw std::invalid_argument("sim::suture::SutureSimulation::create(): " + why);
-    if (!mesh) throw std::invalid_argument("sim::suture::SutureSimulation::create(): no mesh");
+        throw std::invalid_argument("sim::SutureSimulation::create(): " + why);
+    if (!mesh) throw std::invalid_argument("sim::SutureSimulation::create(): no mesh");
     if (!finitePose(initialPose))
-        throw std::invalid_argument("sim::suture::SutureSimulation::create(): initial needle pose is not finite");
+        throw std::invalid_argument("sim::SutureSimulation::create(): initial needle pose is not finite");
     std::unique_ptr<SutureSimulation> s(new SutureSimulation());
     s->m_s = settings;
     mesh->requireLevel(3);
     s->m_mesh = std::move(mesh);
-    s->m_fem = fem::CorotationalFem::create(*s->m_mesh, fixed, settings.fem);
+    s->m_fem = CorotationalFem::create(*s->m_mesh, fixed, settings.fem);
     s->m_tracker = std::make_unique<TipTracker>(*s->m_mesh);
-    if (settings.contact) s->m_detector = std::make_unique<contact::ContactDetector>(*s->m_mesh, settings.selfContact);
+    if (settings.contact) s->m_detector = std::make_unique<ContactDetector>(*s->m_mesh, settings.selfContact);
     s->m_pose = initialPose;
     return s;
 }
@@ -111,8 +111,8 @@ Vec3 SutureSimulation::materialPoint(int32_t face, const Vec3& xi) const {
     return xi[0] * x[v[0]] + xi[1] * x[v[1]] + xi[2] * x[v[2]];
 }
 
-fem::ConstraintRow SutureSimulation::pointRow(int32_t face, const Vec3& xi, const Vec3& dir, double b) const {
-    fem::ConstraintRow r;
+ConstraintRow SutureSimulation::pointRow(int32_t face, const Vec3& xi, const Vec3& dir, double b) const {
+    ConstraintRow r;
     const auto v = m_mesh->halfFacetVertices(face);
     for (int k = 0; k < 3; ++k)
         if (xi[k] != 0) r.terms.push_back({v[k], xi[k] * dir});
@@ -196,7 +196,7 @@ void SutureSimulation::addNeedleConstraints(bool slip) {
         const HistoryEntry& e = m_history[i];
         if (e.alpha < 0 || e.alpha > l || e.face == kNone) continue;
         const Vec3 target = c.point(e.alpha);
-        fem::ConstraintDesc d;
+        ConstraintDesc d;
         d.priority = 1;
         if (slip) { // eq. 3.29: free along the needle axis
             Vec3 u, v;
@@ -258,24 +258,24 @@ void SutureSimulation::updateThreadConstraint(double pull, SutureStepStats& st) 
     if (m_pullIds.size() != segs.size()) {
         dropAll();
         for (size_t i = 0; i < segs.size(); ++i) {
-            fem::ConstraintDesc d;
-            d.kind = fem::ConstraintKind::Unilateral;
+            ConstraintDesc d;
+            d.kind = ConstraintKind::Unilateral;
             d.priority = 2;
-            d.rows = {fem::ConstraintRow{}};
+            d.rows = {ConstraintRow{}};
             m_pullIds.push_back(m_fem->addConstraint(std::move(d)));
         }
     }
     for (size_t i = 0; i < segs.size(); ++i) {
         const auto& [a, b] = segs[i];
         const ThreadSegmentLinearization& l = lin[i];
-        fem::ConstraintRow row;
+        ConstraintRow row;
         const auto va = m_mesh->halfFacetVertices(a->face), vb = m_mesh->halfFacetVertices(b->face);
         for (int k = 0; k < 3; ++k) {
             if (b->xi[k] != 0) row.terms.push_back({vb[k], -b->xi[k] * l.direction});
             if (a->xi[k] != 0) row.terms.push_back({va[k], a->xi[k] * l.direction});
         }
         row.b = -(kappa * l.length - l.offset);
-        if (!n_finite(row)) row = fem::ConstraintRow{};
+        if (!n_finite(row)) row = ConstraintRow{};
         m_fem->setRows(m_pullIds[i], {row});
     }
 }
@@ -288,8 +288,8 @@ void SutureSimulation::updateContacts() {
         Contact& c = *it;
         bool drop = false;
         const auto& v = c.c.v;
-        fem::ConstraintRow r;
-        if (c.c.kind == contact::CollisionKind::VertexFace) {
+        ConstraintRow r;
+        if (c.c.kind == CollisionKind::VertexFace) {
             Vec3 n = (x[v[2]] - x[v[1]]).cross(x[v[3]] - x[v[1]]);
             drop = !(n.norm() > 0);
             n = n.normalized();
@@ -334,27 +334,27 @@ void SutureSimulation::updateContacts() {
 
 void SutureSimulation::processContacts(const std::vector<Vec3>& before, SutureStepStats& st) {
     if (!m_detector) return;
-    std::vector<contact::Collision> hits;
+    std::vector<Collision> hits;
     for (int round = 0; round < m_s.contactRounds; ++round) {
         hits.clear();
         m_detector->detect(before, m_fem->positions(), m_s.contactThickness, hits);
         // A collision already held (same primitives) is skipped; others sharing a vertex are kept
         // (redundant rows are rejected by the solve, [B §2.2.6]).
         std::set<std::array<int32_t, 5>> held;
-        auto keyOf = [](const contact::Collision& c) {
+        auto keyOf = [](const Collision& c) {
             return std::array<int32_t, 5>{static_cast<int32_t>(c.kind), c.v[0], c.v[1], c.v[2], c.v[3]};
         };
         for (const Contact& c : m_contacts) held.insert(keyOf(c.c));
         int added = 0;
-        for (const contact::Collision& h : hits) { // time order [B §3.3.1]
+        for (const Collision& h : hits) { // time order [B §3.3.1]
             if (added >= m_s.contactsPerRound || m_contacts.size() >= static_cast<size_t>(m_s.maxContacts)) break;
             if (!held.insert(keyOf(h)).second) continue;
-            fem::ConstraintDesc d;
-            d.kind = fem::ConstraintKind::Unilateral;
+            ConstraintDesc d;
+            d.kind = ConstraintKind::Unilateral;
             d.priority = 3;
             const Vec3& n = h.normal;
-            fem::ConstraintRow r;
-            if (h.kind == contact::CollisionKind::VertexFace)
+            ConstraintRow r;
+            if (h.kind == CollisionKind::VertexFace)
                 r.terms = {{h.v[0], n}, {h.v[1], -h.w[0] * n}, {h.v[2], -h.w[1] * n}, {h.v[3], -h.w[2] * n}};
             else
                 r.terms = {{h.v[0], (1 - h.w[0]) * n}, {h.v[1], h.w[0] * n}, {h.v[2], -(1 - h.w[1]) * n}, {h.v[3], -h.w[1] * n}};
@@ -373,14 +373,14 @@ void SutureSimulation::processContacts(const std::vector<Vec3>& before, SutureSt
     }
 }
 
-bool SutureSimulation::n_finite(const fem::ConstraintRow& r) {
+bool SutureSimulation::n_finite(const ConstraintRow& r) {
     for (const auto& t : r.terms)
         if (!t.a.allFinite()) return false;
     return std::isfinite(r.b);
 }
 
 bool SutureSimulation::solve(SutureStepStats& st) {
-    const fem::FemSolveStats fs = m_fem->solve();
+    const FemSolveStats fs = m_fem->solve();
     ++st.solves;
     st.activeRows = fs.rows;
     st.rejectedRows = fs.redundant + fs.incompatible;
@@ -457,7 +457,7 @@ SutureStepStats SutureSimulation::step(const NeedleFrame& frame) {
     updateThreadConstraint(pull, st);
     if (m_tip.active) {
         const Vec3 tip = curve().point(l);
-        fem::ConstraintDesc d;
+        ConstraintDesc d;
         d.priority = 0;
         for (int k = 0; k < 3; ++k) d.rows.push_back(pointRow(m_tip.face, m_tip.xi, Vec3::Unit(k), tip[k]));
         if (m_fem->hasConstraint(m_tip.id)) m_fem->removeConstraint(m_tip.id);
@@ -504,4 +504,4 @@ SutureStepStats SutureSimulation::step(const NeedleFrame& frame) {
     return st;
 }
 
-} // namespace viscera::sim::suture
+} // namespace viscera::sim

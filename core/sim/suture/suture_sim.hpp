@@ -27,7 +27,7 @@
 #include <memory>
 #include <vector>
 
-namespace viscera::sim::suture {
+namespace viscera::sim {
 
 struct NeedleSpec {
     enum class Shape { Straight, Semicircle };
@@ -57,7 +57,7 @@ struct ThreadSegmentLinearization {
 ThreadSegmentLinearization linearizeThreadSegment(const Vec3& ra, const Vec3& rb, double eps);
 
 struct SutureSettings {
-    fem::FemSettings fem;
+    FemSettings fem;
     NeedleSpec needle;
     ThreadSpec thread;
     bool contact = true;
@@ -132,7 +132,7 @@ public:
 
     const TetMesh& mesh() const { return *m_mesh; }
     const std::vector<Vec3>& positions() const { return m_fem->positions(); }
-    const fem::CorotationalFem& fem() const { return *m_fem; }
+    const CorotationalFem& fem() const { return *m_fem; }
     const std::vector<HistoryEntry>& history() const { return m_history; }
     const Eigen::Isometry3d& needlePose() const { return m_pose; }
     NeedleCurve curve() const { return needleCurve(m_s.needle, m_pose); }
@@ -145,7 +145,7 @@ private:
     SutureSimulation() = default;
     struct Contact {
         int id = -1;
-        contact::Collision c;
+        Collision c;
         int inactiveSteps = 0;
     };
     int32_t topCell() const;
@@ -161,14 +161,14 @@ private:
     void processContacts(const std::vector<Vec3>& before, SutureStepStats& st);
     bool solve(SutureStepStats& st);
     void readForces(SutureStepStats& st);
-    fem::ConstraintRow pointRow(int32_t face, const Vec3& xi, const Vec3& dir, double b) const;
-    static bool n_finite(const fem::ConstraintRow& r);
+    ConstraintRow pointRow(int32_t face, const Vec3& xi, const Vec3& dir, double b) const;
+    static bool n_finite(const ConstraintRow& r);
 
     SutureSettings m_s;
     std::unique_ptr<TetMesh> m_mesh;
-    std::unique_ptr<fem::CorotationalFem> m_fem;
+    std::unique_ptr<CorotationalFem> m_fem;
     std::unique_ptr<TipTracker> m_tracker;
-    std::unique_ptr<contact::ContactDetector> m_detector;
+    std::unique_ptr<ContactDetector> m_detector;
     Eigen::Isometry3d m_pose = Eigen::Isometry3d::Identity();
     std::vector<HistoryEntry> m_history;
     std::vector<int> m_needleIds;
@@ -193,4 +193,4 @@ private:
     std::vector<Contact> m_contacts;
 };
 
-} // namespace viscera::sim::suture
+} // namespace viscera::sim

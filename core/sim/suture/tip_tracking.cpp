@@ -5,7 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
-namespace viscera::sim::suture {
+namespace viscera::sim {
 namespace {
 
 Vec3 faceNormal(const std::vector<Vec3>& x, const std::array<int32_t, 3>& v) {
@@ -16,7 +16,7 @@ Vec3 faceNormal(const std::vector<Vec3>& x, const std::array<int32_t, 3>& v) {
 
 TipTracker::TipTracker(const TetMesh& mesh) : m_mesh(mesh) {
     if (mesh.level() < 3)
-        throw std::logic_error("sim::suture::TipTracker(): requires adjacency level 3; call mesh.requireLevel(3) first");
+        throw std::logic_error("sim::TipTracker(): requires adjacency level 3; call mesh.requireLevel(3) first");
     double sum = 0;
     size_t k = 0;
     const auto& x = mesh.positions();
@@ -233,4 +233,4 @@ int32_t TipTracker::track(const std::vector<Vec3>& x, const NeedleCurve& c, doub
     return t;
 }
 
-} // namespace viscera::sim::suture
+} // namespace viscera::sim

@@ -14,7 +14,7 @@
 
 #include <vector>
 
-namespace viscera::sim::suture {
+namespace viscera::sim {
 
 enum class CrossingKind { Face, Edge, Vertex };
 
@@ -71,4 +71,4 @@ private:
     double m_epsB = 1e-9; // barycentric tolerance
 };
 
-} // namespace viscera::sim::suture
+} // namespace viscera::sim

@@ -244,12 +244,9 @@ std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Ve
             }
         }
         if (best.tet < 0 || bestDist > tolerance) {
-            if (best.tet < 0)
-                throw std::invalid_argument(where + "point " + std::to_string(i) +
-                                            " lies more than " + std::to_string(tolerance) +
-                                            " m outside the cage");
-            throw std::invalid_argument(where + "point " + std::to_string(i) + " lies " +
-                                        std::to_string(bestDist) + " m outside the cage");
+            const std::string howFar = best.tet < 0 ? "lies more than " + std::to_string(tolerance) + " m outside the cage"
+                                                    : "lies " + std::to_string(bestDist) + " m outside the cage";
+            throw OutsideCageError(where, static_cast<int32_t>(i), howFar);
         }
         best.point = static_cast<int32_t>(i);
         out.push_back(best);

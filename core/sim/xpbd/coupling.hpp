@@ -8,6 +8,7 @@
 ///     its barycentric coordinates, [A eq. 4.1]);
 ///   - embedded tissue in fat: each embedded node → the fat tet that contains it (a cage, as in
 ///     free-form deformation), with its four barycentric coordinates.
+#include "sim/util/error.hpp"
 #include "sim/mesh/tet_mesh.hpp"
 
 #include <Eigen/Core>
@@ -47,6 +48,14 @@ struct CageLocation {
 /// For every point, the cage tet containing it (or, for a point outside the cage by at most
 /// tolerance metres, the nearest tet). Throws std::invalid_argument
 /// ("sim::locateInCage(): point 12 lies 0.004 m outside the cage") for a point farther out.
+/// What locateInCage throws for a point outside the cage: what() is the full message, `point` and
+/// `howFar` ("lies 0.004 m outside the cage") let a caller word it for its own elements.
+struct OutsideCageError : PreconditionError {
+    OutsideCageError(const std::string& where, int32_t point, const std::string& howFar)
+        : PreconditionError(where, "point " + std::to_string(point) + " " + howFar), point(point), howFar(howFar) {}
+    int32_t point;
+    std::string howFar;
+};
 std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Vec3>& points,
                                        double tolerance);
 

@@ -331,12 +331,11 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
         try {
             loc = locateInCage(*desc.tetBodies[em.cage].mesh,
                                desc.tetBodies[em.embedded].mesh->positions(), em.tolerance);
-        } catch (const std::invalid_argument& e) {
-            std::string why = e.what();
-            const std::string prefix = "sim::locateInCage(): point";
-            if (why.rfind(prefix, 0) == 0) why = "node" + why.substr(prefix.size());
-            fail(label, "'" + desc.tetBodies[em.embedded].name + "' in '" +
-                            desc.tetBodies[em.cage].name + "': " + why);
+        } catch (const OutsideCageError& e) {
+            fail(label, "'" + desc.tetBodies[em.embedded].name + "' in '" + desc.tetBodies[em.cage].name + "': node " +
+                            std::to_string(e.point) + " " + e.howFar);
+        } catch (const std::invalid_argument& e) { // a bad tolerance: a programming error, named as is
+            fail(label, e.what());
         }
         for (const CageLocation& c : loc) {
             detail::Tie t;

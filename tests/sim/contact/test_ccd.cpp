@@ -11,7 +11,6 @@
 #include <set>
 
 using namespace viscera::sim;
-using namespace viscera::sim::contact;
 
 TEST(Ccd, VertexFaceTimeMatchesAnalyticCrossing) {
     // Static triangle in z = 0; the point falls from z0 to z1: contact at t = z0 / (z0 − z1).
@@ -86,7 +85,7 @@ TEST(Ccd, DetectorEqualsBruteForceBetweenBodies) {
     auto lower = makeBoxTetMesh({Vec3(0, 0, -0.004), Vec3(0.01, 0.01, 0.004), {4, 4, 2}});
     auto upper = makeBoxTetMesh({Vec3(0, 0, 0.001), Vec3(0.01, 0.01, 0.004), {4, 4, 2}});
     std::vector<int32_t> off;
-    auto mesh = suture::mergeMeshes({lower.get(), upper.get()}, &off);
+    auto mesh = mergeMeshes({lower.get(), upper.get()}, &off);
     mesh->requireLevel(3);
     ContactDetector det(*mesh);
     const auto& x0 = mesh->positions();

@@ -9,7 +9,6 @@
 #include <random>
 
 using namespace viscera::sim;
-using namespace viscera::sim::fem;
 
 namespace {
 

@@ -24,14 +24,14 @@ inline constexpr const char* kScene = R"({
 
 /// A straight needle above the two stacked slabs, pushed down `stepDown` m per frame.
 inline std::string trajectory(int frames, double stepDown) {
-    std::vector<suture::NeedleFrame> out;
+    std::vector<NeedleFrame> out;
     for (int f = 0; f < frames; ++f) {
-        suture::NeedleFrame fr;
+        NeedleFrame fr;
         fr.pose.linear() = Eigen::AngleAxisd(0.5 * 3.141592653589793, Vec3::UnitY()).toRotationMatrix(); // +x → −z
         fr.pose.translation() = Vec3(0.0051, 0.0049, 0.03 - stepDown * f);
         out.push_back(fr);
     }
-    return suture::formatTrajectory(out);
+    return formatTrajectory(out);
 }
 
 inline std::vector<std::unique_ptr<TetMesh>> slabs() {

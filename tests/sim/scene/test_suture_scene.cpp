@@ -39,7 +39,7 @@ TEST(SutureScene, ParsesRoundTripsAndNamesItsFeatures) {
     const SceneDesc s = parseScene(suture_fixture::kScene, "scene.json");
     ASSERT_TRUE(s.suture);
     EXPECT_EQ(s.solverType, "fem");
-    EXPECT_EQ(s.suture->settings.needle.shape, suture::NeedleSpec::Shape::Straight);
+    EXPECT_EQ(s.suture->settings.needle.shape, NeedleSpec::Shape::Straight);
     EXPECT_TRUE(s.suture->thread);
     EXPECT_FALSE(s.suture->contact);
     EXPECT_EQ(s.suture->trajectoryPath, "tools/needle.traj");

@@ -6,7 +6,6 @@
 #include <random>
 
 using namespace viscera::sim;
-using namespace viscera::sim::suture;
 
 TEST(NeedleCurve, ArcLengthParametrizationAndTangent) {
     const NeedleCurve a = NeedleCurve::arc(Vec3(1, 2, 3), Vec3(1, 0, 0), Vec3(0, 1, 0.2), 0.01);

@@ -10,7 +10,6 @@
 #include <random>
 
 using namespace viscera::sim;
-using namespace viscera::sim::suture;
 
 TEST(ThreadLinearization, GradientMatchesFiniteDifferencesAcrossLengths) {
     const double eps = 2e-4;

@@ -8,8 +8,7 @@
 #include <random>
 
 using namespace viscera::sim;
-using namespace viscera::sim::suture;
-using viscera::sim::suture::testing::Visit;
+using viscera::sim::suture_testing::Visit;
 
 namespace {
 
@@ -90,7 +89,7 @@ TEST(TipTracking, MatchesBruteForceOnRandomPaths) {
     for (int trial = 0; trial < 60; ++trial) {
         // Straight.
         const NeedleCurve s = NeedleCurve::straight(randomPoint(), randomUnit(rng));
-        const auto ref = suture::testing::bruteForceVisits(*m, x, s, 0, 1.5, minLen);
+        const auto ref = suture_testing::bruteForceVisits(*m, x, s, 0, 1.5, minLen);
         expectSameCells(trackedVisits(tr, s, 0, 1.5, minLen, &edgeOrVertex), ref, "straight " + std::to_string(trial));
         // Arc, up to one and a half turns.
         const Vec3 n = randomUnit(rng);
@@ -98,7 +97,7 @@ TEST(TipTracking, MatchesBruteForceOnRandomPaths) {
         const double r = 0.15 + 0.5 * u(rng);
         const NeedleCurve c = NeedleCurve::arc(randomPoint(), a, n.cross(a), r);
         const double a0 = r * 2 * std::numbers::pi * u(rng);
-        const auto refA = suture::testing::bruteForceVisits(*m, x, c, a0, a0 + 3 * std::numbers::pi * r, minLen);
+        const auto refA = suture_testing::bruteForceVisits(*m, x, c, a0, a0 + 3 * std::numbers::pi * r, minLen);
         expectSameCells(trackedVisits(tr, c, a0, a0 + 3 * std::numbers::pi * r, minLen, &edgeOrVertex), refA,
                         "arc " + std::to_string(trial));
         paths += 2;
@@ -134,7 +133,7 @@ TEST(TipTracking, MatchesBruteForceThroughVerticesAndEdges) {
         const Vec3 w = randomUnit(rng);
         const NeedleCurve s = NeedleCurve::straight(target - 0.4 * w, w);
         expectSameCells(trackedVisits(tr, s, 0, 0.9, minLen, &edgeOrVertex),
-                        suture::testing::bruteForceVisits(*m, x, s, 0, 0.9, minLen), "straight " + std::to_string(trial));
+                        suture_testing::bruteForceVisits(*m, x, s, 0, 0.9, minLen), "straight " + std::to_string(trial));
         // An arc through the same point: centre off the point, α = 0 at the point.
         const double r = 0.1 + 0.3 * u(rng);
         const Vec3 uu = randomUnit(rng);
@@ -142,7 +141,7 @@ TEST(TipTracking, MatchesBruteForceThroughVerticesAndEdges) {
         vv = (vv - vv.dot(uu) * uu).normalized();
         const NeedleCurve c = NeedleCurve::arc(target - r * uu, uu, vv, r);
         expectSameCells(trackedVisits(tr, c, -1.2 * r, 1.5 * r, minLen, &edgeOrVertex),
-                        suture::testing::bruteForceVisits(*m, x, c, -1.2 * r, 1.5 * r, minLen), "arc " + std::to_string(trial));
+                        suture_testing::bruteForceVisits(*m, x, c, -1.2 * r, 1.5 * r, minLen), "arc " + std::to_string(trial));
     }
     RecordProperty("edge_or_vertex_crossings", edgeOrVertex);
     EXPECT_GE(edgeOrVertex, 100); // the constructed paths do cross through edges and vertices

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <vector>
 
-namespace viscera::sim::suture::testing {
+namespace viscera::sim::suture_testing {
 
 struct Visit {
     int32_t cell;
@@ -51,4 +51,4 @@ inline std::vector<Visit> bruteForceVisits(const TetMesh& m, const std::vector<V
     return out;
 }
 
-} // namespace viscera::sim::suture::testing
+} // namespace viscera::sim::suture_testing
