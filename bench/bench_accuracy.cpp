@@ -63,8 +63,7 @@ Organ makeOrgan() {
     auto inside = [&](const Vec3& p) {
         const Vec3 d = p - centre;
         const double taper = 0.55 + 0.45 * p.x() / size.x(); // thickness grows along +x
-        const double a = d.x() / (0.5 * size.x()), b = d.y() / (0.5 * size.y()),
-                     c = d.z() / (0.5 * size.z() * taper);
+        const double a = d.x() / (0.5 * size.x()), b = d.y() / (0.5 * size.y()), c = d.z() / (0.5 * size.z() * taper);
         return a * a + b * b + c * c <= 1.0;
     };
     const auto& x = block->positions();
@@ -73,8 +72,7 @@ Organ makeOrgan() {
     std::vector<Tet> tets;
     for (const Tet& t : block->tets()) {
         const Vec3 centroid = 0.25 * (x[t[0]] + x[t[1]] + x[t[2]] + x[t[3]]);
-        const Vec3 cellCentre =
-            (centroid.cwiseQuotient(cell).array().floor() + 0.5).matrix().cwiseProduct(cell);
+        const Vec3 cellCentre = (centroid.cwiseQuotient(cell).array().floor() + 0.5).matrix().cwiseProduct(cell);
         if (!inside(cellCentre)) continue;
         Tet out;
         for (int k = 0; k < 4; ++k) {
@@ -143,8 +141,7 @@ void writeCsv(const std::filesystem::path& path, const AccuracyTrace& t) {
     out << "iteration,rel_error,time_ms\n";
     char line[128];
     for (size_t i = 0; i < t.iterations.size(); ++i) {
-        std::snprintf(line, sizeof line, "%d,%.9e,%.6f\n", t.iterations[i], t.relError[i],
-                      t.timeMs[i]);
+        std::snprintf(line, sizeof line, "%d,%.9e,%.6f\n", t.iterations[i], t.relError[i], t.timeMs[i]);
         out << line;
     }
     if (!out) throw std::runtime_error("cannot write " + path.string());
@@ -167,8 +164,7 @@ nlohmann::json toJson(const AccuracyTrace& t, int frame) {
               {"time_ms", t.referenceMs}}}};
 }
 
-PlotSeries series(const std::string& label, const AccuracyTrace& t, bool againstTime,
-                  double timeScale = 1) {
+PlotSeries series(const std::string& label, const AccuracyTrace& t, bool againstTime, double timeScale = 1) {
     PlotSeries s;
     s.label = label;
     s.markers = t.solver == "newton";
@@ -187,10 +183,9 @@ int run(const std::filesystem::path& outDir) {
     const Organ organ = makeOrgan();
     const Material material = organMaterial();
     const int motionFrames = 5;
-    std::printf(
-        "organ: %zu tets, %zu nodes, %zu fixed; E = %.0f Pa, nu = %.2f, rho = %.0f kg/m^3\n",
-        organ.mesh->tetCount(), organ.mesh->vertexCount(), organ.fixed.size(),
-        material.youngsModulus, material.poissonRatio, material.density);
+    std::printf("organ: %zu tets, %zu nodes, %zu fixed; E = %.0f Pa, nu = %.2f, rho = %.0f kg/m^3\n",
+                organ.mesh->tetCount(), organ.mesh->vertexCount(), organ.fixed.size(), material.youngsModulus,
+                material.poissonRatio, material.density);
 
     // Five frames of production motion; every configuration starts from that state.
     XpbdSettings production;
@@ -208,19 +203,17 @@ int run(const std::filesystem::path& outDir) {
         for (size_t v = 0; v < organ.mesh->vertexCount(); ++v)
             sag = std::max(sag, organ.mesh->positions()[v].z() - motion->positions()[v].z());
     }
-    std::printf("after %d frames of %dx%d XPBD: max sag %.2f mm, min det F %.3f\n", motionFrames,
-                production.substeps, production.iterations, 1e3 * sag, minJ);
+    std::printf("after %d frames of %dx%d XPBD: max sag %.2f mm, min det F %.3f\n", motionFrames, production.substeps,
+                production.iterations, 1e3 * sag, minJ);
 
     NewtonSettings reference; // default tolerances
     // 1, 5, 20 and 100 substeps, and the fewest the load-time stability check accepts.
-    const int checked = assessStability(*organ.mesh,
-                                        StableNeoHookeanModel(material.mu(), material.lambda()),
+    const int checked = assessStability(*organ.mesh, StableNeoHookeanModel(material.mu(), material.lambda()),
                                         material.density, {}, production)
                             .requiredSubsteps;
     std::vector<Config> configs = {{1, 200}, {5, 100}, {20, 50}, {100, 50}};
     if (checked != 20 && checked != 100 && checked > 5)
-        configs.insert(configs.begin() + (checked < 20 ? 2 : checked < 100 ? 3 : 4),
-                       {checked, 50});
+        configs.insert(configs.begin() + (checked < 20 ? 2 : checked < 100 ? 3 : 4), {checked, 50});
     std::vector<Measured> results;
     for (const Config& c : configs) {
         XpbdSettings s = production;
@@ -232,14 +225,11 @@ int run(const std::filesystem::path& outDir) {
         // 5 substeps, s = 6.9; it converges at 20, s = 0.43, which the load check's limit of
         // 0.25 refuses).
         const StabilityFigures stab = assessStability(
-            *organ.mesh, StableNeoHookeanModel(material.mu(), material.lambda()), material.density,
-            {}, s);
-        Measured m{c, measureXpbd(*solver, c.maxIterations, reference), {},
-                   measureNewton(*solver, reference)};
+            *organ.mesh, StableNeoHookeanModel(material.mu(), material.lambda()), material.density, {}, s);
+        Measured m{c, measureXpbd(*solver, c.maxIterations, reference), {}, measureNewton(*solver, reference)};
         keepFastestSweeps(*solver, XpbdIteration::Standard, m.xpbd);
         if (stab.maxStiffnessNumber <= 1.0) {
-            m.primal =
-                measureXpbd(*solver, c.maxIterations, reference, XpbdIteration::PrimalCorrected);
+            m.primal = measureXpbd(*solver, c.maxIterations, reference, XpbdIteration::PrimalCorrected);
             keepFastestSweeps(*solver, XpbdIteration::PrimalCorrected, m.primal);
         } else {
             std::printf("substeps %d: stiffness number %.2f > 1 (the load check asks for %d "
@@ -259,51 +249,46 @@ int run(const std::filesystem::path& outDir) {
     nlohmann::json accuracy = nlohmann::json::array();
     for (const Measured& m : results) {
         const int s = m.config.substeps;
-        std::printf("\n== substeps %d (h = %.3f ms), first substep of frame %d (0-based) ==\n", s,
-                    1e3 * m.xpbd.h, motionFrames);
+        std::printf("\n== substeps %d (h = %.3f ms), first substep of frame %d (0-based) ==\n", s, 1e3 * m.xpbd.h,
+                    motionFrames);
         std::printf("Newton reference: %s, %d iterations, %.1f ms, |grad f|_inf %.2e kg m; "
                     "rel error floor %.1e\n",
-                    m.xpbd.referenceStatus.c_str(), m.xpbd.referenceIterations,
-                    m.xpbd.referenceMs, m.xpbd.referenceGradientNorm, m.xpbd.relErrorFloor);
-        std::printf("  %-6s %12s %14s %14s %12s %14s %14s\n", "s x k", "xpbd error",
-                    "substep ms", "frame ms", "primal err", "substep ms", "frame ms");
+                    m.xpbd.referenceStatus.c_str(), m.xpbd.referenceIterations, m.xpbd.referenceMs,
+                    m.xpbd.referenceGradientNorm, m.xpbd.relErrorFloor);
+        std::printf("  %-6s %12s %14s %14s %12s %14s %14s\n", "s x k", "xpbd error", "substep ms", "frame ms",
+                    "primal err", "substep ms", "frame ms");
         const bool primal = !m.primal.relError.empty();
         for (int k : probes) {
             if (k >= static_cast<int>(m.xpbd.iterations.size())) break;
-            std::printf("  %2dx%-3d %12.3e %14.3f %14.3f", s, k, m.xpbd.relError[k],
-                        m.xpbd.timeMs[k], s * m.xpbd.timeMs[k]);
+            std::printf("  %2dx%-3d %12.3e %14.3f %14.3f", s, k, m.xpbd.relError[k], m.xpbd.timeMs[k],
+                        s * m.xpbd.timeMs[k]);
             if (primal)
-                std::printf(" %12.3e %14.3f %14.3f", m.primal.relError[k], m.primal.timeMs[k],
-                            s * m.primal.timeMs[k]);
+                std::printf(" %12.3e %14.3f %14.3f", m.primal.relError[k], m.primal.timeMs[k], s * m.primal.timeMs[k]);
             std::printf("\n");
         }
         for (const AccuracyTrace* x : {&m.xpbd, &m.primal}) {
             if (x->relError.empty()) continue;
             for (size_t k = 1; k < x->iterations.size(); ++k) {
                 char line[200];
-                std::snprintf(line, sizeof line, "%s,%d,%d,%.9g,%.9e,%.6f,%.6f\n",
-                              x->solver.c_str(), s, x->iterations[k], x->h, x->relError[k],
-                              x->timeMs[k], s * x->timeMs[k]);
+                std::snprintf(line, sizeof line, "%s,%d,%d,%.9g,%.9e,%.6f,%.6f\n", x->solver.c_str(), s,
+                              x->iterations[k], x->h, x->relError[k], x->timeMs[k], s * x->timeMs[k]);
                 sweep << line;
             }
             const int hit = firstBelow(*x, kTarget);
             if (hit >= 0)
                 std::printf("%s reaches rel error <= %.0e after %d iterations: %.2f ms per "
                             "substep, %.2f ms per frame\n",
-                            x->solver.c_str(), kTarget, x->iterations[hit], x->timeMs[hit],
-                            s * x->timeMs[hit]);
+                            x->solver.c_str(), kTarget, x->iterations[hit], x->timeMs[hit], s * x->timeMs[hit]);
             else
                 std::printf("%s does not reach %.0e within %d iterations: it ends at %.3e "
                             "(lowest %.3e)\n",
                             x->solver.c_str(), kTarget, x->iterations.back(), x->relError.back(),
                             *std::min_element(x->relError.begin(), x->relError.end()));
             char line[320];
-            std::snprintf(line, sizeof line, "%s,%d,%.9g,%s,%d,%.3f,%.3e,%.3e,%d,%.6f,%.6f,%.9e\n",
-                          x->solver.c_str(), s, x->h, x->referenceStatus.c_str(),
-                          x->referenceIterations, x->referenceMs, x->referenceGradientNorm,
-                          x->relErrorFloor, hit >= 0 ? x->iterations[hit] : -1,
-                          hit >= 0 ? x->timeMs[hit] : -1.0, hit >= 0 ? s * x->timeMs[hit] : -1.0,
-                          x->relError.back());
+            std::snprintf(line, sizeof line, "%s,%d,%.9g,%s,%d,%.3f,%.3e,%.3e,%d,%.6f,%.6f,%.9e\n", x->solver.c_str(),
+                          s, x->h, x->referenceStatus.c_str(), x->referenceIterations, x->referenceMs,
+                          x->referenceGradientNorm, x->relErrorFloor, hit >= 0 ? x->iterations[hit] : -1,
+                          hit >= 0 ? x->timeMs[hit] : -1.0, hit >= 0 ? s * x->timeMs[hit] : -1.0, x->relError.back());
             summary << line;
             writeCsv(outDir / (x->solver + "_s" + std::to_string(s) + ".csv"), *x);
             accuracy.push_back(toJson(*x, motionFrames));
@@ -315,8 +300,7 @@ int run(const std::filesystem::path& outDir) {
         writeCsv(outDir / ("newton_s" + std::to_string(s) + ".csv"), m.newton);
         accuracy.push_back(toJson(m.newton, motionFrames));
     }
-    std::ofstream(outDir / "accuracy.json")
-        << nlohmann::json{{"accuracy", accuracy}}.dump() << "\n";
+    std::ofstream(outDir / "accuracy.json") << nlohmann::json{{"accuracy", accuracy}}.dump() << "\n";
 
     // Plots: error against per-frame wall time (a frame runs s substeps) and against iterations.
     std::vector<PlotSeries> byTime, byIteration;
@@ -339,21 +323,16 @@ int run(const std::filesystem::path& outDir) {
     spec.yMarks = {kTarget};
     spec.yMin = 1e-12;
     spec.logX = true;
-    spec.title = "Relative error against frame wall time, " +
-                 std::to_string(organ.mesh->tetCount()) + " tets";
+    spec.title = "Relative error against frame wall time, " + std::to_string(organ.mesh->tetCount()) + " tets";
     spec.xLabel = "wall time per frame (ms, log scale; s substeps cost s x one substep)";
     spec.yLabel = "relative error (f(x_k) - f(x*)) / (f(x_0) - f(x*))";
-    std::string error =
-        viscera::bench::writeLinePlotPng((outDir / "error_vs_time.png").string(), spec, byTime);
-    spec.title =
-        "Relative error per iteration, " + std::to_string(organ.mesh->tetCount()) + " tets";
+    std::string error = viscera::bench::writeLinePlotPng((outDir / "error_vs_time.png").string(), spec, byTime);
+    spec.title = "Relative error per iteration, " + std::to_string(organ.mesh->tetCount()) + " tets";
     spec.xLabel = "iteration k (log scale)";
     if (error.empty())
-        error = viscera::bench::writeLinePlotPng((outDir / "error_vs_iteration.png").string(), spec,
-                                                 byIteration);
+        error = viscera::bench::writeLinePlotPng((outDir / "error_vs_iteration.png").string(), spec, byIteration);
     if (!error.empty()) throw std::runtime_error(error);
-    if (!sweep || !summary)
-        throw std::runtime_error("cannot write sweep.csv or summary.csv in " + outDir.string());
+    if (!sweep || !summary) throw std::runtime_error("cannot write sweep.csv or summary.csv in " + outDir.string());
     std::printf("\nwrote %s/{xpbd_s*.csv,xpbd-primal_s*.csv,newton_s*.csv,sweep.csv,summary.csv,accuracy.json,"
                 "error_vs_time.png,error_vs_iteration.png}\n",
                 outDir.string().c_str());
@@ -361,8 +340,7 @@ int run(const std::filesystem::path& outDir) {
 }
 
 int main(int argc, char** argv) {
-    if (argc > 2 ||
-        (argc == 2 && (std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help"))) {
+    if (argc > 2 || (argc == 2 && (std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help"))) {
         std::fprintf(stderr, "usage: bench_accuracy [output-dir]   (default ./accuracy_out)\n");
         return argc == 2 ? 0 : 2;
     }

@@ -42,7 +42,8 @@ Scene makeScene(int rings, double halfDepthMm) {
     d.jawNormal = Vec3::UnitY();
     for (int i = 0; i < 16; ++i)
         d.vertices.push_back(c + Vec3(i % 2 ? 0.004 : -0.004, i % 4 < 2 ? 0.003 : -0.003, i % 8 < 4 ? 0.001 : -0.001));
-    for (int i = 0; i < 64; ++i) d.contactPoints.push_back(c + Vec3(-0.004 + i * 1.25e-4, 0.003, 0));
+    for (int i = 0; i < 64; ++i)
+        d.contactPoints.push_back(c + Vec3(-0.004 + i * 1.25e-4, 0.003, 0));
     s.clip = ClipAttachment::apply(*s.mesh, s.mesh->positions(), d);
     // Two bent states (bending about x through the clip, ±) with a small shift.
     auto bent = [&](double k) {
@@ -56,9 +57,11 @@ Scene makeScene(int rings, double halfDepthMm) {
     s.xa = bent(5.0);
     s.xb = bent(-5.0);
     s.mesh->requireLevel(3);
-    for (int32_t v : s.mesh->boundaryVertexMap()) s.render.push_back(s.mesh->positions()[v]);
+    for (int32_t v : s.mesh->boundaryVertexMap())
+        s.render.push_back(s.mesh->positions()[v]);
     std::vector<Vec3> skeleton;
-    for (int i = 0; i <= 12; ++i) skeleton.emplace_back(0, 0, 0.005 * i);
+    for (int i = 0; i <= 12; ++i)
+        skeleton.emplace_back(0, 0, 0.005 * i);
     s.flat = ClipFlattening::create(*s.clip, s.render, skeleton);
     return s;
 }

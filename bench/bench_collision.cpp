@@ -71,7 +71,7 @@ constexpr double kLx = 0.06, kLy = 0.036, kTop = 0.012; // slab, m
 constexpr double kHalfLen = 0.012;                      // tool half length (along y), m
 constexpr double kSlide = 0.03;                         // slide distance along x, m
 constexpr double kX0 = 0.015;                           // tool x at the start, m
-bool g_trace = false; // --trace: per-frame figures of one run
+bool g_trace = false;                                   // --trace: per-frame figures of one run
 
 struct Slab {
     std::unique_ptr<TetMesh> mesh;
@@ -94,7 +94,8 @@ Slab makeSlab() {
     s.material.poissonRatio = 0.3;
     const std::vector<double> m = lumpedMasses(*s.mesh, s.material.density, s.fixed);
     s.invMass.resize(m.size());
-    for (size_t v = 0; v < m.size(); ++v) s.invMass[v] = m[v] > 0 ? 1.0 / m[v] : 0.0;
+    for (size_t v = 0; v < m.size(); ++v)
+        s.invMass[v] = m[v] > 0 ? 1.0 / m[v] : 0.0;
     XpbdSettings probe;
     probe.substeps = s.substeps;
     auto tmp = XpbdSolver::create(*s.mesh, s.material, s.fixed, probe);
@@ -120,9 +121,12 @@ ToolShape::Pose toolPose(double x, double z) {
 enum class Coupling { InIteration, InIterationInterp, PostSubstepInterp };
 const char* couplingName(Coupling c) {
     switch (c) {
-    case Coupling::InIteration: return "iter";
-    case Coupling::InIterationInterp: return "iter+interp";
-    case Coupling::PostSubstepInterp: return "post+interp";
+    case Coupling::InIteration:
+        return "iter";
+    case Coupling::InIterationInterp:
+        return "iter+interp";
+    case Coupling::PostSubstepInterp:
+        return "post+interp";
     }
     return "?";
 }
@@ -134,17 +138,17 @@ struct RunSpec {
     int iterations = 5;
     double speed = 0.1; // m/s, slide
     Coupling coupling = Coupling::InIteration;
-    double energyScale = CircumsphereParams{}.energyScale; // ς, m (--trace only)
+    double energyScale = CircumsphereParams{}.energyScale;               // ς, m (--trace only)
     double curvatureThreshold = CircumsphereParams{}.curvatureThreshold; // h, 1/m (--trace only)
     double safeAngle = CircumsphereParams{}.safeAngle;                   // θ, rad (--trace only)
-    bool safeCone = CollisionSettings{}.safeConeOnly; // contacts only through the safe cone
+    bool safeCone = CollisionSettings{}.safeConeOnly;                    // contacts only through the safe cone
 };
 
 struct RunResult {
     RunSpec spec;
     double relErrMean = 0, relErrMin = 0, relErrMax = 0;
     double stabilityHold = 0, stabilitySteady = 0, stabilitySlide = 0; // m per frame
-    double collisionMs = 0, frameMs = 0;          // per frame
+    double collisionMs = 0, frameMs = 0;                               // per frame
     double factorUpdatesPerFrame = 0, contactVerticesMean = 0;
     int tunnelledFrames = 0, tunnelledMax = 0, overFrames = 0, insideFrames = 0;
     double deepestInside = 0; // m, most negative signed distance of a top vertex
@@ -155,8 +159,7 @@ struct TunnelCount {
     int over = 0, inside = 0;
 };
 
-TunnelCount countTunnelled(const std::vector<Vec3>& x, const Slab& slab, const ToolShape& tool,
-                           double& deepest) {
+TunnelCount countTunnelled(const std::vector<Vec3>& x, const Slab& slab, const ToolShape& tool, double& deepest) {
     const Capsule& c = tool.parts()[0];
     TunnelCount n;
     for (int32_t v : slab.topVertices) {
@@ -165,8 +168,10 @@ TunnelCount countTunnelled(const std::vector<Vec3>& x, const Slab& slab, const T
         const double t = closestParameterOnSegment(x[v], c.a, c.b);
         const Vec3 q = c.a + t * (c.b - c.a);
         const double horizontal = std::hypot(x[v].x() - q.x(), x[v].y() - q.y());
-        if (t > 0 && t < 1 && horizontal < c.radius && x[v].z() > q.z()) ++n.over;
-        else if (d < -1e-3) ++n.inside;
+        if (t > 0 && t < 1 && horizontal < c.radius && x[v].z() > q.z())
+            ++n.over;
+        else if (d < -1e-3)
+            ++n.inside;
     }
     return n;
 }
@@ -191,29 +196,29 @@ RunResult run(const Slab& slab, const RunSpec& spec) {
     cs.circumsphere.safeAngle = spec.safeAngle;
     cs.safeConeOnly = spec.safeCone;
     cs.polygonMargin = 1e-3;
-    auto col =
-        CollisionSolver::create(CollisionSurfaceDesc::fromTetMesh(*slab.mesh, slab.invMass), cs);
+    auto col = CollisionSolver::create(CollisionSurfaceDesc::fromTetMesh(*slab.mesh, slab.invMass), cs);
     const double radius = spec.tool.radius;
     ToolShape tool = ToolShape::capsule(kHalfLen, radius);
 
     const double zStart = kTop + radius + 0.002, zPress = kTop + radius - spec.tool.depth;
     const int pressFrames = 12, holdFrames = 40,
-              slideFrames = static_cast<int>(std::ceil(kSlide / (spec.speed * kFrame) - 1e-9)),
-              endFrames = 10;
+              slideFrames = static_cast<int>(std::ceil(kSlide / (spec.speed * kFrame) - 1e-9)), endFrames = 10;
     struct Key {
         double x, z;
     };
     std::vector<Key> keys; // tool pose of each frame (device sample)
     for (int f = 1; f <= pressFrames; ++f)
         keys.push_back({kX0, zStart + (zPress - zStart) * f / pressFrames});
-    for (int f = 0; f < holdFrames; ++f) keys.push_back({kX0, zPress});
+    for (int f = 0; f < holdFrames; ++f)
+        keys.push_back({kX0, zPress});
     for (int f = 1; f <= slideFrames; ++f)
         keys.push_back({kX0 + std::min(kSlide, spec.speed * kFrame * f), zPress});
-    for (int f = 0; f < endFrames; ++f) keys.push_back({kX0 + kSlide, zPress});
+    for (int f = 0; f < endFrames; ++f)
+        keys.push_back({kX0 + kSlide, zPress});
 
     ToolShape::Pose prev = toolPose(kX0, zStart), next = prev;
     tool.setPose(prev);
-    double ct = 0;      // collision seconds of the frame, accumulated by the hook
+    double ct = 0;                         // collision seconds of the frame, accumulated by the hook
     double updates = 0, tracedUpdates = 0; // δ refreshes, all substeps
     if (!post)
         solver->setIterationHook([&](XpbdParticles& p, const XpbdIterationInfo& info) {
@@ -224,8 +229,7 @@ RunResult run(const Slab& slab, const RunSpec& spec) {
                 return;
             }
             if (info.iteration == 0 && interp)
-                tool.setPose(interpolatePose(prev, next,
-                                             static_cast<double>(info.substep + 1) / info.substeps));
+                tool.setPose(interpolatePose(prev, next, static_cast<double>(info.substep + 1) / info.substeps));
             const auto c0 = Clock::now();
             if (info.iteration == 0) {
                 col->beginStep(p, 0, tool, info.h);
@@ -240,8 +244,7 @@ RunResult run(const Slab& slab, const RunSpec& spec) {
     double steadySum = 0;
     r.relErrMin = 1e300;
     r.relErrMax = -1e300;
-    const int holdStart = pressFrames + 5, steadyStart = pressFrames + 20,
-              slideStart = pressFrames + holdFrames;
+    const int holdStart = pressFrames + 5, steadyStart = pressFrames + 20, slideStart = pressFrames + holdFrames;
     for (size_t f = 0; f < keys.size(); ++f) {
         next = toolPose(keys[f].x, keys[f].z);
         const auto t0 = Clock::now();
@@ -256,7 +259,8 @@ RunResult run(const Slab& slab, const RunSpec& spec) {
                 std::vector<Vec3> x = solver->positions();
                 const auto c0 = Clock::now();
                 col->beginStep(x, tool, xs.dt);
-                for (int k = 0; k < spec.iterations; ++k) col->iterate(x, tool);
+                for (int k = 0; k < spec.iterations; ++k)
+                    col->iterate(x, tool);
                 ct += std::chrono::duration<double>(Clock::now() - c0).count();
                 updates += col->stats().factorUpdates;
                 if (col->stats().candidates == 0) continue;
@@ -312,12 +316,12 @@ RunResult run(const Slab& slab, const RunSpec& spec) {
                 d += (x[v] - (c.a + closestParameterOnSegment(x[v], c.a, c.b) * (c.b - c.a))).norm();
                 move += (x[v] - last[v]).norm();
             }
-            for (size_t v = 0; v < x.size(); ++v) maxMove = std::max(maxMove, (x[v] - last[v]).norm());
+            for (size_t v = 0; v < x.size(); ++v)
+                maxMove = std::max(maxMove, (x[v] - last[v]).norm());
             std::printf("  frame %3zu: contacts %3zu  mean dist %.4f  mean move %.2e  max node "
                         "move %.2e  candidates %d  contacts(last sweep) %d  factor updates %.0f\n",
-                        f, cv.size(), cv.empty() ? 0.0 : d / cv.size(),
-                        cv.empty() ? 0.0 : move / cv.size(), maxMove, col->stats().candidates,
-                        col->stats().contacts, updates - tracedUpdates);
+                        f, cv.size(), cv.empty() ? 0.0 : d / cv.size(), cv.empty() ? 0.0 : move / cv.size(), maxMove,
+                        col->stats().candidates, col->stats().contacts, updates - tracedUpdates);
             tracedUpdates = updates;
         }
         last = x;
@@ -352,30 +356,28 @@ std::string label(const RunSpec& s) {
 void printHeader() {
     std::printf("\n%-34s %-11s %3s %5s %8s %8s %8s %9s %9s %9s %7s %7s %6s %5s %5s %5s %5s "
                 "%9s\n",
-                "tool method", "coupling", "it", "v", "relErr", "errMin", "errMax", "stab_hold",
-                "stab_stdy", "stab_slid", "col_ms", "frm_ms", "upd", "tunFr", "over", "insd", "tunMx",
-                "deepest");
+                "tool method", "coupling", "it", "v", "relErr", "errMin", "errMax", "stab_hold", "stab_stdy",
+                "stab_slid", "col_ms", "frm_ms", "upd", "tunFr", "over", "insd", "tunMx", "deepest");
 }
 
 void printRow(const RunResult& r) {
     std::printf("%-34s %-11s %3d %5.2f %+8.4f %+8.4f %+8.4f %9.3e %9.3e %9.3e %7.3f %7.2f %6.1f "
                 "%5d %5d %5d %5d %+9.2e%s\n",
-                label(r.spec).c_str(), couplingName(r.spec.coupling), r.spec.iterations,
-                r.spec.speed, r.relErrMean, r.relErrMin, r.relErrMax, r.stabilityHold,
-                r.stabilitySteady, r.stabilitySlide, r.collisionMs, r.frameMs, r.factorUpdatesPerFrame,
-                r.tunnelledFrames, r.overFrames, r.insideFrames, r.tunnelledMax, r.deepestInside,
-                r.finite ? "" : "  DIVERGED");
+                label(r.spec).c_str(), couplingName(r.spec.coupling), r.spec.iterations, r.spec.speed, r.relErrMean,
+                r.relErrMin, r.relErrMax, r.stabilityHold, r.stabilitySteady, r.stabilitySlide, r.collisionMs,
+                r.frameMs, r.factorUpdatesPerFrame, r.tunnelledFrames, r.overFrames, r.insideFrames, r.tunnelledMax,
+                r.deepestInside, r.finite ? "" : "  DIVERGED");
     std::fflush(stdout);
 }
 
 void writeRow(std::ofstream& o, const RunResult& r) {
-    o << r.spec.tool.name << ',' << toString(r.spec.method) << ',' << couplingName(r.spec.coupling)
-      << ',' << deltaName(r.spec.delta) << ',' << r.spec.iterations << ',' << r.spec.speed << ','
-      << r.relErrMean << ',' << r.relErrMin << ',' << r.relErrMax << ',' << r.stabilityHold << ','
-      << r.stabilitySteady << ',' << r.stabilitySlide << ',' << r.collisionMs << ',' << r.frameMs << ','
-      << r.factorUpdatesPerFrame << ',' << r.contactVerticesMean << ',' << r.tunnelledFrames << ','
-      << r.overFrames << ',' << r.insideFrames << ',' << r.tunnelledMax << ',' << r.deepestInside
-      << ',' << (r.finite ? 1 : 0) << ',' << (r.spec.safeCone ? 1 : 0) << '\n';
+    o << r.spec.tool.name << ',' << toString(r.spec.method) << ',' << couplingName(r.spec.coupling) << ','
+      << deltaName(r.spec.delta) << ',' << r.spec.iterations << ',' << r.spec.speed << ',' << r.relErrMean << ','
+      << r.relErrMin << ',' << r.relErrMax << ',' << r.stabilityHold << ',' << r.stabilitySteady << ','
+      << r.stabilitySlide << ',' << r.collisionMs << ',' << r.frameMs << ',' << r.factorUpdatesPerFrame << ','
+      << r.contactVerticesMean << ',' << r.tunnelledFrames << ',' << r.overFrames << ',' << r.insideFrames << ','
+      << r.tunnelledMax << ',' << r.deepestInside << ',' << (r.finite ? 1 : 0) << ',' << (r.spec.safeCone ? 1 : 0)
+      << '\n';
 }
 
 const char* kHeader =
@@ -397,9 +399,12 @@ int main(int argc, char** argv) {
                                  "[delta] [speed] [energy-scale]\n");
             return 0;
         }
-        if (a == "--quick") quick = true;
-        else if (a == "--trace") g_trace = true;
-        else outDir = a;
+        if (a == "--quick")
+            quick = true;
+        else if (a == "--trace")
+            g_trace = true;
+        else
+            outDir = a;
     }
     if (g_trace) { // --trace [tool 0|1] [method 0..3] [iterations] [delta] [speed] [ς m] [h 1/m] [θ deg] [cone]
         const Slab slab = makeSlab();
@@ -424,11 +429,10 @@ int main(int argc, char** argv) {
                 "Pa, nu = %.2f; %d substeps per 1/60 s frame; tools: %s (r %.1f mm, pressed %.1f "
                 "mm), %s (r %.1f mm, pressed %.1f mm); polygon margin 1 mm\n",
                 kLx * 1e3, kLy * 1e3, kTop * 1e3, slab.mesh->tetCount(), slab.mesh->vertexCount(),
-                slab.mesh->boundary().triangleCount(), slab.material.youngsModulus,
-                slab.material.poissonRatio, slab.substeps, kCylinder.name, kCylinder.radius * 1e3,
-                kCylinder.depth * 1e3, kShaft.name, kShaft.radius * 1e3, kShaft.depth * 1e3);
-    const std::vector<int> iterations =
-        quick ? std::vector<int>{1, 5} : std::vector<int>{1, 2, 3, 5, 10, 20};
+                slab.mesh->boundary().triangleCount(), slab.material.youngsModulus, slab.material.poissonRatio,
+                slab.substeps, kCylinder.name, kCylinder.radius * 1e3, kCylinder.depth * 1e3, kShaft.name,
+                kShaft.radius * 1e3, kShaft.depth * 1e3);
+    const std::vector<int> iterations = quick ? std::vector<int>{1, 5} : std::vector<int>{1, 2, 3, 5, 10, 20};
     const std::vector<double> deltas =
         quick ? std::vector<double>{0, 0.3}
               : std::vector<double>{0, 0.1, 0.3, 0.7, 0.9, std::numeric_limits<double>::infinity()};
@@ -455,7 +459,8 @@ int main(int argc, char** argv) {
         bool safeCone;
     };
     std::vector<Variant> variants;
-    for (CollisionMethod m : methods) variants.push_back({m, true});
+    for (CollisionMethod m : methods)
+        variants.push_back({m, true});
     variants.push_back({CollisionMethod::Circumsphere, false});
     for (const Tool& t : tools)
         for (const Variant& v : variants)
@@ -485,8 +490,7 @@ int main(int argc, char** argv) {
     std::ofstream tunnel(outDir / "collision_tunnelling.csv");
     tunnel << kHeader;
     std::vector<RunResult> tunRuns;
-    const std::vector<double> speeds =
-        quick ? std::vector<double>{0.5} : std::vector<double>{0.05, 0.1, 0.25, 0.5};
+    const std::vector<double> speeds = quick ? std::vector<double>{0.5} : std::vector<double>{0.05, 0.1, 0.25, 0.5};
     const std::vector<int> tunIts = quick ? std::vector<int>{1, 5} : std::vector<int>{1, 3, 5};
     for (const Tool& t : tools)
         for (double v : speeds)
@@ -511,8 +515,7 @@ int main(int argc, char** argv) {
                 record(s, tunRuns, tunnel);
             }
     if (!sweep || !tunnel) {
-        std::fprintf(stderr, "bench_collision: cannot write CSV files in %s\n",
-                     outDir.string().c_str());
+        std::fprintf(stderr, "bench_collision: cannot write CSV files in %s\n", outDir.string().c_str());
         return 1;
     }
 
@@ -524,12 +527,10 @@ int main(int argc, char** argv) {
         for (const Tool& t : tools)
             for (const Variant& v : variants) {
                 PlotSeries s;
-                s.label = std::string(t.name) + " " + toString(v.method) +
-                          (v.safeCone ? "" : " (no safe cone)");
+                s.label = std::string(t.name) + " " + toString(v.method) + (v.safeCone ? "" : " (no safe cone)");
                 s.markers = true;
                 for (const RunResult& r : main)
-                    if (r.spec.method == v.method && r.spec.tool.name == t.name &&
-                        r.spec.safeCone == v.safeCone) {
+                    if (r.spec.method == v.method && r.spec.tool.name == t.name && r.spec.safeCone == v.safeCone) {
                         s.x.push_back(r.spec.iterations);
                         s.y.push_back(value(r));
                     }
@@ -541,8 +542,7 @@ int main(int argc, char** argv) {
     auto plot = [&](const std::string& file, PlotSpec spec, const std::vector<PlotSeries>& series) {
         spec.width = 1200;
         spec.height = 700;
-        if (error.empty())
-            error = viscera::bench::writeLinePlotPng((outDir / file).string(), spec, series);
+        if (error.empty()) error = viscera::bench::writeLinePlotPng((outDir / file).string(), spec, series);
     };
     PlotSpec spec;
     spec.xLabel = "iterations per substep (log scale)";
@@ -551,24 +551,20 @@ int main(int argc, char** argv) {
     spec.title = "Accuracy: relative error of mean collided-vertex distance to the axis (Fig. 5.10)";
     spec.yLabel = "(d_ave - r) / r";
     spec.yMarks = {0.0};
-    plot("accuracy_vs_iterations.png", spec,
-         byIterations([](const RunResult& r) { return r.relErrMean; }));
+    plot("accuracy_vs_iterations.png", spec, byIterations([](const RunResult& r) { return r.relErrMean; }));
     spec.yMarks.clear();
     spec.logY = true;
     spec.title = "Stability: mean per-frame move of collided vertices, tool held (Fig. 5.12)";
     spec.yLabel = "m per frame";
-    plot("stability_hold_vs_iterations.png", spec,
-         byIterations([](const RunResult& r) { return r.stabilityHold; }));
+    plot("stability_hold_vs_iterations.png", spec, byIterations([](const RunResult& r) { return r.stabilityHold; }));
     spec.title = "Stability: mean per-frame move of collided vertices, last 20 frames of the hold";
     plot("stability_steady_vs_iterations.png", spec,
          byIterations([](const RunResult& r) { return r.stabilitySteady; }));
     spec.title = "Stability: mean per-frame move of collided vertices, tool sliding 0.1 m/s";
-    plot("stability_slide_vs_iterations.png", spec,
-         byIterations([](const RunResult& r) { return r.stabilitySlide; }));
+    plot("stability_slide_vs_iterations.png", spec, byIterations([](const RunResult& r) { return r.stabilitySlide; }));
     spec.title = "Time: collision detection and response per frame (Fig. 5.13)";
     spec.yLabel = "ms per frame";
-    plot("time_vs_iterations.png", spec,
-         byIterations([](const RunResult& r) { return r.collisionMs; }));
+    plot("time_vs_iterations.png", spec, byIterations([](const RunResult& r) { return r.collisionMs; }));
     auto byDelta = [&](auto value) {
         std::vector<PlotSeries> out;
         for (int k : quick ? std::vector<int>{5} : std::vector<int>{2, 5}) {

@@ -48,8 +48,8 @@ void print(const char* name, size_t elems, const char* kind, const Figures& f, i
     std::printf("%-7s %6zu %-9s threads %d: dissection %.3f ms/frame, full frame %.3f ms (%.1f "
                 "fps), worst %.3f ms; "
                 "cut %zu edges, %zu %s\n",
-                name, elems, kind, threads, f.dissectionMs, f.frameMs, 1000.0 / f.frameMs,
-                f.worstFrameMs, f.cutEdges, f.cutPrims, kind);
+                name, elems, kind, threads, f.dissectionMs, f.frameMs, 1000.0 / f.frameMs, f.worstFrameMs, f.cutEdges,
+                f.cutPrims, kind);
 }
 
 } // namespace

@@ -55,18 +55,20 @@ struct Law {
 Law makeLaw(int index) {
     switch (index) {
     case 0:
-        return {"vl_neo_hookean", std::make_shared<ValanisLandelDensity>(
-                                      "nh", valanisLandelCurves("neo_hookean", kMu, kLambda))};
+        return {"vl_neo_hookean",
+                std::make_shared<ValanisLandelDensity>("nh", valanisLandelCurves("neo_hookean", kMu, kLambda))};
     case 1:
-        return {"vl_corotated", std::make_shared<ValanisLandelDensity>(
-                                    "corot", valanisLandelCurves("corotated", kMu, kLambda))};
+        return {"vl_corotated",
+                std::make_shared<ValanisLandelDensity>("corot", valanisLandelCurves("corotated", kMu, kLambda))};
     case 2:
-        return {"vl_st_venant_kirchhoff",
-                std::make_shared<ValanisLandelDensity>(
-                    "stvk", valanisLandelCurves("st_venant_kirchhoff", kMu, kLambda))};
-    case 3: return {"corotated", std::make_shared<CorotatedLinearDensity>(kMu, kLambda)};
-    case 4: return {"st_venant_kirchhoff", std::make_shared<StVenantKirchhoffDensity>(kMu, kLambda)};
-    default: return {"neo_hookean", std::make_shared<NeoHookeanDensity>(kMu, kLambda)};
+        return {"vl_st_venant_kirchhoff", std::make_shared<ValanisLandelDensity>(
+                                              "stvk", valanisLandelCurves("st_venant_kirchhoff", kMu, kLambda))};
+    case 3:
+        return {"corotated", std::make_shared<CorotatedLinearDensity>(kMu, kLambda)};
+    case 4:
+        return {"st_venant_kirchhoff", std::make_shared<StVenantKirchhoffDensity>(kMu, kLambda)};
+    default:
+        return {"neo_hookean", std::make_shared<NeoHookeanDensity>(kMu, kLambda)};
     }
 }
 
@@ -112,7 +114,8 @@ void BM_StableNeoHookeanEvaluate(benchmark::State& state) {
 void BM_SignedSvd(benchmark::State& state) {
     const auto& fs = samples();
     std::size_t i = 0;
-    for (auto _ : state) benchmark::DoNotOptimize(signedSvd(fs[i++ & 1023]));
+    for (auto _ : state)
+        benchmark::DoNotOptimize(signedSvd(fs[i++ & 1023]));
     state.SetItemsProcessed(state.iterations());
 }
 
@@ -125,7 +128,8 @@ void BM_CurveValue(benchmark::State& state) {
                                            .shape = CurveShape::Unconstrained});
     const auto& fs = samples();
     std::size_t i = 0;
-    for (auto _ : state) benchmark::DoNotOptimize(curve.value(fs[i++ & 1023].determinant()));
+    for (auto _ : state)
+        benchmark::DoNotOptimize(curve.value(fs[i++ & 1023].determinant()));
     state.SetItemsProcessed(state.iterations());
 }
 

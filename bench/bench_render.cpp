@@ -43,7 +43,10 @@ const Mode kModes[] = {{"reference", SampleMode::Reference},
 SceneView benchView() {
     SceneView v;
     const uint32_t mat = v.addMaterial(defaultMaterialFor("liver"));
-    v.addMesh("liver", viscera::sim::makeLiverSurface(viscera::sim::Vec3::Zero(), viscera::sim::Vec3(0.1, 0.07, 0.04), 0.5, 192, 96), mat);
+    v.addMesh(
+        "liver",
+        viscera::sim::makeLiverSurface(viscera::sim::Vec3::Zero(), viscera::sim::Vec3(0.1, 0.07, 0.04), 0.5, 192, 96),
+        mat);
     return v;
 }
 
@@ -90,7 +93,8 @@ int runComparison(int w, int h, int frames, const std::string& outDir) {
         std::fprintf(stderr, "bench_render: no OpenGL context: %s\n", why.c_str());
         return 1;
     }
-    std::printf("bench_render: %dx%d, %zu vertices, %s\n", w, h, view.meshes()[0].vertexCount(), r->description().c_str());
+    std::printf("bench_render: %dx%d, %zu vertices, %s\n", w, h, view.meshes()[0].vertexCount(),
+                r->description().c_str());
 
     // Images and masks.
     std::map<std::string, Image> images;
@@ -98,7 +102,8 @@ int runComparison(int w, int h, int frames, const std::string& outDir) {
         r->setSettings(withMode(base, m.mode));
         r->renderFrame(view);
         images[m.name] = r->readPixels();
-        if (!outDir.empty()) writePng(std::filesystem::path(outDir) / (std::string("area_light_") + m.name + ".png"), images[m.name]);
+        if (!outDir.empty())
+            writePng(std::filesystem::path(outDir) / (std::string("area_light_") + m.name + ".png"), images[m.name]);
     }
     const std::vector<float> dist = r->renderer().distanceMap(r->renderer().light().center);
     std::vector<uint8_t> nearMask(dist.size()), organMask(dist.size());
@@ -111,7 +116,8 @@ int runComparison(int w, int h, int frames, const std::string& outDir) {
     // Frame times: interleaved, minimum over `frames` (the machine is shared and noisy).
     std::map<std::string, double> best;
     std::map<std::string, FrameStats> passStats;
-    for (const Mode& m : kModes) best[m.name] = 1e30;
+    for (const Mode& m : kModes)
+        best[m.name] = 1e30;
     for (int f = 0; f < frames; ++f)
         for (const Mode& m : kModes) {
             RenderSettings s = withMode(base, m.mode);
@@ -139,7 +145,8 @@ int runComparison(int w, int h, int frames, const std::string& outDir) {
         const ImageDifference dorg = compareImages(images["reference"], images[m.name], organMask);
         std::printf("%-10s %14.3f %14.3f %12.2f %10.3f  ", m.name, dn.rmse, dorg.rmse, best[m.name],
                     best[m.name] / best["uniform1"]);
-        for (const PassTiming& p : passStats[m.name].passes) std::printf(" %s %.2f", p.name.c_str(), p.ms);
+        for (const PassTiming& p : passStats[m.name].passes)
+            std::printf(" %s %.2f", p.name.c_str(), p.ms);
         std::printf("\n");
     }
     return 0;
@@ -158,7 +165,8 @@ void frameBenchmark(benchmark::State& state, SampleMode mode) {
         return;
     }
     r->renderFrame(view);
-    for (auto _ : state) benchmark::DoNotOptimize(r->renderFrame(view).totalMs);
+    for (auto _ : state)
+        benchmark::DoNotOptimize(r->renderFrame(view).totalMs);
     state.SetItemsProcessed(state.iterations() * 640 * 480);
 }
 
@@ -174,10 +182,14 @@ int main(int argc, char** argv) {
     int w = 640, h = 480, frames = 15;
     std::string out;
     for (int i = 1; i < argc; ++i) {
-        if (std::strncmp(argv[i], "--benchmark", 11) == 0) gbench = true;
-        else if (!std::strcmp(argv[i], "--size") && i + 1 < argc) std::sscanf(argv[++i], "%dx%d", &w, &h);
-        else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) frames = std::max(1, std::atoi(argv[++i]));
-        else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
+        if (std::strncmp(argv[i], "--benchmark", 11) == 0)
+            gbench = true;
+        else if (!std::strcmp(argv[i], "--size") && i + 1 < argc)
+            std::sscanf(argv[++i], "%dx%d", &w, &h);
+        else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc)
+            frames = std::max(1, std::atoi(argv[++i]));
+        else if (!std::strcmp(argv[i], "--out") && i + 1 < argc)
+            out = argv[++i];
         else if (!std::strcmp(argv[i], "--light") && i + 1 < argc) {
             float* v = g_light.v;
             g_light.set = std::sscanf(argv[++i], "%f,%f,%f,%f,%f,%f,%f,%f,%f", v, v + 1, v + 2, v + 3, v + 4, v + 5,

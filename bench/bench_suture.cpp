@@ -14,8 +14,8 @@ using namespace viscera::sim;
 
 int main(int argc, char** argv) {
     const int only = argc > 1 ? std::atoi(argv[1]) : 0;
-    std::printf("%-10s %-8s %-8s %-10s %-10s %-10s %-10s %-10s %-12s\n", "punctures", "stitches", "frames",
-                "mean_ms", "p50_ms", "p99_ms", "max_ms", "gap_mm", "penetr_mm");
+    std::printf("%-10s %-8s %-8s %-10s %-10s %-10s %-10s %-10s %-12s\n", "punctures", "stitches", "frames", "mean_ms",
+                "p50_ms", "p99_ms", "max_ms", "gap_mm", "penetr_mm");
     for (int stitches : {5, 13}) {
         if (only && only != stitches) continue;
         AnastomosisSpec spec;
@@ -43,8 +43,11 @@ int main(int argc, char** argv) {
         std::vector<double> sorted = ms;
         std::sort(sorted.begin(), sorted.end());
         double sum = 0;
-        for (double x : ms) sum += x;
-        auto pct = [&](double p) { return sorted[std::min(sorted.size() - 1, static_cast<size_t>(p * sorted.size()))]; };
+        for (double x : ms)
+            sum += x;
+        auto pct = [&](double p) {
+            return sorted[std::min(sorted.size() - 1, static_cast<size_t>(p * sorted.size()))];
+        };
         std::printf("%-10d %-8d %-8zu %-10.3f %-10.3f %-10.3f %-10.3f %-10.3f %-12.3f\n", punctures, stitches,
                     frames.size(), sum / ms.size(), pct(0.5), pct(0.99), sorted.back(), cm.maxGap * 1e3,
                     cm.maxPenetration * 1e3);

@@ -14,8 +14,7 @@ using namespace viscera::sim;
 
 namespace {
 
-void runFrames(benchmark::State& state, const BoxSpec& box, int threads, bool simd,
-               bool primal = false) {
+void runFrames(benchmark::State& state, const BoxSpec& box, int threads, bool simd, bool primal = false) {
     auto mesh = makeBoxTetMesh(box);
     std::vector<int32_t> fixed;
     for (int32_t v = 0; v < static_cast<int32_t>(mesh->vertexCount()); ++v)
@@ -39,37 +38,31 @@ void runFrames(benchmark::State& state, const BoxSpec& box, int threads, bool si
     state.counters["tets"] = double(mesh->tetCount());
     state.counters["colours"] = solver->colourCount();
     // Seconds per tet-iteration (printed with an SI prefix, e.g. "14n" = 14 ns).
-    state.counters["time_per_tet_iteration"] = benchmark::Counter(
-        tetIters, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    state.counters["time_per_tet_iteration"] =
+        benchmark::Counter(tetIters, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
     state.SetItemsProcessed(state.iterations() * int64_t(tetIters));
 }
 
 void BM_XpbdFrame(benchmark::State& state) {
     const int n = static_cast<int>(state.range(0));
-    runFrames(state, {Vec3::Zero(), Vec3(0.2, 0.1, 0.05), {2 * n, n, n / 2}},
-              static_cast<int>(state.range(1)), state.range(2) != 0);
+    runFrames(state, {Vec3::Zero(), Vec3(0.2, 0.1, 0.05), {2 * n, n, n / 2}}, static_cast<int>(state.range(1)),
+              state.range(2) != 0);
 }
 
 void BM_XpbdFrame30k(benchmark::State& state) {
-    runFrames(state, {Vec3::Zero(), Vec3(0.25, 0.2, 0.1), {25, 20, 10}},
-              static_cast<int>(state.range(0)), state.range(1) != 0);
+    runFrames(state, {Vec3::Zero(), Vec3(0.25, 0.2, 0.1), {25, 20, 10}}, static_cast<int>(state.range(0)),
+              state.range(1) != 0);
 }
 
 /// The same frame with the primal correction after every iteration (XpbdSettings::
 /// primalCorrection): the cost of converging to the implicit step instead of levelling off.
 void BM_XpbdFramePrimal(benchmark::State& state) {
-    runFrames(state, {Vec3::Zero(), Vec3(0.25, 0.2, 0.1), {25, 20, 10}},
-              static_cast<int>(state.range(0)), true, true);
+    runFrames(state, {Vec3::Zero(), Vec3(0.25, 0.2, 0.1), {25, 20, 10}}, static_cast<int>(state.range(0)), true, true);
 }
 
 } // namespace
 
-BENCHMARK(BM_XpbdFramePrimal)
-    ->ArgNames({"threads"})
-    ->Arg(1)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+BENCHMARK(BM_XpbdFramePrimal)->ArgNames({"threads"})->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_XpbdFrame)
     ->ArgNames({"cells", "threads", "simd"})
     ->Args({10, 1, 1})

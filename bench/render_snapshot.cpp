@@ -52,18 +52,27 @@ int main(int argc, char** argv) {
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-        if (a == "--frames") frames = std::max(0, std::atoi(next().c_str()));
-        else if (a == "-o") out = next();
+        if (a == "--frames")
+            frames = std::max(0, std::atoi(next().c_str()));
+        else if (a == "-o")
+            out = next();
         else if (a == "--size") {
             const std::string v = next();
             if (std::sscanf(v.c_str(), "%dx%d", &width, &height) != 2) return usage();
-        } else if (a == "--post") post = next();
-        else if (a == "--stereo") stereo = next();
-        else if (a == "--samples") samples = next();
-        else if (a == "--liver") liver = true;
-        else if (a == "--heat") heat = true;
-        else if (!a.empty() && a[0] == '-') return usage();
-        else input = a;
+        } else if (a == "--post")
+            post = next();
+        else if (a == "--stereo")
+            stereo = next();
+        else if (a == "--samples")
+            samples = next();
+        else if (a == "--liver")
+            liver = true;
+        else if (a == "--heat")
+            heat = true;
+        else if (!a.empty() && a[0] == '-')
+            return usage();
+        else
+            input = a;
     }
     if (input.empty() && !liver) return usage();
     try {
@@ -71,26 +80,33 @@ int main(int argc, char** argv) {
         player::LoadedCase loaded;
         if (liver) {
             const uint32_t mat = view.addMaterial(render::defaultMaterialFor("liver"));
-            view.addMesh("liver", sim::makeLiverSurface(sim::Vec3::Zero(), sim::Vec3(0.1, 0.07, 0.04), 0.5, 96, 48), mat);
+            view.addMesh("liver", sim::makeLiverSurface(sim::Vec3::Zero(), sim::Vec3(0.1, 0.07, 0.04), 0.5, 96, 48),
+                         mat);
         } else {
             loaded = player::loadCase(input);
-            for (int f = 0; f < frames; ++f) loaded.world->step();
+            for (int f = 0; f < frames; ++f)
+                loaded.world->step();
             view = render::SceneView::fromWorld(*loaded.world);
         }
         if (heat && !view.meshes().empty()) {
             // A dissection line across the first mesh: heat falls off with distance from the x = 0 plane.
             render::RenderMesh& m = view.meshes()[0];
             std::vector<float> h(m.vertexCount());
-            for (size_t v = 0; v < h.size(); ++v) h[v] = std::max(0.0f, 1.0f - std::abs(m.positions[3 * v]) / 0.012f);
+            for (size_t v = 0; v < h.size(); ++v)
+                h[v] = std::max(0.0f, 1.0f - std::abs(m.positions[3 * v]) / 0.012f);
             view.setHeat(0, h);
         }
         render::RenderSettings s = render::defaultSettingsFor(view, width, height);
         s.post.disableAll();
         enablePost(s.post, post);
-        if (stereo == "sbs") s.stereo.mode = render::StereoMode::SideBySide;
-        else if (stereo == "anaglyph") s.stereo.mode = render::StereoMode::Anaglyph;
-        if (samples == "uniform1") s.sampling.mode = render::SampleMode::Uniform;
-        else if (samples == "reference") s.sampling.mode = render::SampleMode::Reference;
+        if (stereo == "sbs")
+            s.stereo.mode = render::StereoMode::SideBySide;
+        else if (stereo == "anaglyph")
+            s.stereo.mode = render::StereoMode::Anaglyph;
+        if (samples == "uniform1")
+            s.sampling.mode = render::SampleMode::Uniform;
+        else if (samples == "reference")
+            s.sampling.mode = render::SampleMode::Reference;
         std::string why;
         auto r = render::HeadlessRenderer::create(s, &why);
         if (!r) {
@@ -102,7 +118,8 @@ int main(int argc, char** argv) {
         r->writePng(out);
         std::printf("%s: %dx%d, %zu meshes, device %s\n", out.c_str(), width, height, view.meshes().size(),
                     r->description().c_str());
-        for (const auto& p : st.passes) std::printf("  %-22s eye %d  %8.2f ms\n", p.name.c_str(), p.eye, p.ms);
+        for (const auto& p : st.passes)
+            std::printf("  %-22s eye %d  %8.2f ms\n", p.name.c_str(), p.eye, p.ms);
         std::printf("  %-22s        %8.2f ms\n  %-22s        %8.2f ms\n", "upload", st.uploadMs, "frame", st.totalMs);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "viscera-render-snapshot: %s\n", e.what());

@@ -18,11 +18,11 @@
 #include "render/scene_view.hpp"
 #include "runtime/report.hpp"
 #include "runtime/session.hpp"
-#include "window/window_mode.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/cli_main.hpp"
 #include "sim/util/error.hpp"
 #include "sim/util/log.hpp"
+#include "window/window_mode.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -30,8 +30,8 @@
 #include <filesystem>
 #include <optional>
 #include <string>
-#include <vector>
 #include <unistd.h>
+#include <vector>
 
 namespace {
 
@@ -48,7 +48,9 @@ void usage(std::FILE* out) {
                out);
 }
 
-int fail(int code, const std::string& message) { return sim::cliFail("viscera-player", code, message); }
+int fail(int code, const std::string& message) {
+    return sim::cliFail("viscera-player", code, message);
+}
 
 int cmdVerify(const std::vector<std::string>& args) {
     if (args.size() != 1) {
@@ -56,9 +58,10 @@ int cmdVerify(const std::vector<std::string>& args) {
         return kExitUsage;
     }
     vcase::Manifest m = vcase::verify(args[0]);
-    std::printf("%s: ok (case %s %s, %zu files, features:", args[0].c_str(), m.caseId.c_str(),
-                m.caseVersion.c_str(), m.files.size());
-    for (const auto& f : m.features) std::printf(" %s", f.c_str());
+    std::printf("%s: ok (case %s %s, %zu files, features:", args[0].c_str(), m.caseId.c_str(), m.caseVersion.c_str(),
+                m.files.size());
+    for (const auto& f : m.features)
+        std::printf(" %s", f.c_str());
     std::printf(")\n");
     return 0;
 }
@@ -76,7 +79,8 @@ int cmdRun(const std::vector<std::string>& args) {
             if (i + 1 >= args.size()) throw std::invalid_argument(std::string(flag) + " needs a value");
             return args[++i];
         };
-        if (a == "--headless") headless = true;
+        if (a == "--headless")
+            headless = true;
         else if (a == "--frames") {
             const std::string v = value("--frames");
             char* end = nullptr;
@@ -85,11 +89,16 @@ int cmdRun(const std::vector<std::string>& args) {
                 throw std::invalid_argument("--frames '" + v + "' must be an integer in [1, 10000000]");
             frames = static_cast<int>(n);
             framesGiven = true;
-        } else if (a == "--report") reportPath = value("--report");
-        else if (a == "--trace") tracePath = value("--trace");
-        else if (a == "--realtime") realtime = true;
-        else if (a == "--screenshot") screenshot = value("--screenshot");
-        else if (a == "--device") device = value("--device");
+        } else if (a == "--report")
+            reportPath = value("--report");
+        else if (a == "--trace")
+            tracePath = value("--trace");
+        else if (a == "--realtime")
+            realtime = true;
+        else if (a == "--screenshot")
+            screenshot = value("--screenshot");
+        else if (a == "--device")
+            device = value("--device");
         else if (a == "--servo") {
             const std::string v = value("--servo");
             auto cpuOf = [&](size_t at) { // "…:CPU", one this process may run on
@@ -98,33 +107,40 @@ int cmdRun(const std::vector<std::string>& args) {
                 const long c = std::strtol(v.c_str() + at, &end, 10);
                 if (v.size() == at || *end != '\0' || std::find(allowed.begin(), allowed.end(), c) == allowed.end()) {
                     std::string list;
-                    for (int a : allowed) list += (list.empty() ? "" : ", ") + std::to_string(a);
-                    throw std::invalid_argument("--servo '" + v + "': the CPU must be one this process may run on (" + list + ")");
+                    for (int a : allowed)
+                        list += (list.empty() ? "" : ", ") + std::to_string(a);
+                    throw std::invalid_argument("--servo '" + v + "': the CPU must be one this process may run on (" +
+                                                list + ")");
                 }
                 return static_cast<int>(c);
             };
-            if (v == "sleep") servoWait = haptics::ServoWait::SleepSpin;
+            if (v == "sleep")
+                servoWait = haptics::ServoWait::SleepSpin;
             else if (v.rfind("sleep:", 0) == 0) { // sleep + spin, pinned to a CPU the physics thread stays off
                 servoWait = haptics::ServoWait::SleepSpin;
                 servoCpu = cpuOf(6);
-            }
-            else if (v.rfind("spin:", 0) == 0) { // sleep, then spin the last US microseconds
+            } else if (v.rfind("spin:", 0) == 0) { // sleep, then spin the last US microseconds
                 char* end = nullptr;
                 const long us = std::strtol(v.c_str() + 5, &end, 10);
                 if (v.size() == 5 || *end != '\0' || us < 0 || us > 1000)
-                    throw std::invalid_argument("--servo '" + v + "': the spin must be an integer in [0, 1000] microseconds");
+                    throw std::invalid_argument("--servo '" + v +
+                                                "': the spin must be an integer in [0, 1000] microseconds");
                 servoWait = haptics::ServoWait::SleepSpin;
                 servoSpinNs = int64_t(us) * 1000;
-            }
-            else if (v == "busy") servoWait = haptics::ServoWait::Busy;
+            } else if (v == "busy")
+                servoWait = haptics::ServoWait::Busy;
             else if (v.rfind("busy:", 0) == 0) {
                 servoWait = haptics::ServoWait::Busy;
                 servoCpu = cpuOf(5);
-            } else throw std::invalid_argument("--servo '" + v + "': expected sleep, sleep:CPU, spin:US, busy or busy:CPU");
-        }
-        else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option '" + a + "'");
-        else if (!casePath) casePath = a;
-        else throw std::invalid_argument("unexpected argument '" + a + "'");
+            } else
+                throw std::invalid_argument("--servo '" + v +
+                                            "': expected sleep, sleep:CPU, spin:US, busy or busy:CPU");
+        } else if (!a.empty() && a[0] == '-')
+            throw std::invalid_argument("unknown option '" + a + "'");
+        else if (!casePath)
+            casePath = a;
+        else
+            throw std::invalid_argument("unexpected argument '" + a + "'");
     }
     if (!casePath) throw std::invalid_argument("run needs a case file");
     // Refused up front, before any work.
@@ -163,7 +179,8 @@ int cmdRun(const std::vector<std::string>& args) {
     player::SessionResult result;
     if (headless) {
         std::fprintf(stderr, "viscera-player: running %s for %d frames%s\n", casePath->c_str(), frames,
-                     dev ? (std::string(" with ") + *device + (opts.realtime ? " (real time)" : " (lockstep)")).c_str() : "");
+                     dev ? (std::string(" with ") + *device + (opts.realtime ? " (real time)" : " (lockstep)")).c_str()
+                         : "");
         const int every = std::max(1, frames / 10);
         opts.progress = [every](int done, int total) {
             if (done % every == 0 || done == total)
@@ -193,7 +210,8 @@ int cmdRun(const std::vector<std::string>& args) {
             fig.height = rs.height;
             fig.totalMs = st.totalMs;
             fig.uploadMs = st.uploadMs;
-            for (const auto& p : st.passes) fig.passes.push_back({p.name, p.eye, p.ms});
+            for (const auto& p : st.passes)
+                fig.passes.push_back({p.name, p.eye, p.ms});
             result.render = std::move(fig);
         } catch (const std::exception& e) {
             result.errors.push_back(std::string("--screenshot ") + *screenshot + ": " + e.what());

@@ -25,10 +25,9 @@ void ensureGuiApplication() {
     static QGuiApplication app(argc, argv);
 }
 
-const QColor kPalette[] = {QColor(31, 119, 180),  QColor(255, 127, 14),  QColor(44, 160, 44),
-                           QColor(214, 39, 40),   QColor(148, 103, 189), QColor(140, 86, 75),
-                           QColor(227, 119, 194), QColor(127, 127, 127), QColor(188, 189, 34),
-                           QColor(23, 190, 207)};
+const QColor kPalette[] = {QColor(31, 119, 180),  QColor(255, 127, 14), QColor(44, 160, 44),   QColor(214, 39, 40),
+                           QColor(148, 103, 189), QColor(140, 86, 75),  QColor(227, 119, 194), QColor(127, 127, 127),
+                           QColor(188, 189, 34),  QColor(23, 190, 207)};
 
 struct Axis {
     bool log = false;
@@ -69,8 +68,7 @@ bool fitAxis(Axis& a, const std::vector<double>& values, std::optional<double> f
 std::vector<std::pair<double, QString>> ticks(const Axis& a) {
     std::vector<std::pair<double, QString>> out;
     if (a.log) {
-        const int first = static_cast<int>(std::ceil(a.lo - 1e-9)),
-                  last = static_cast<int>(std::floor(a.hi + 1e-9));
+        const int first = static_cast<int>(std::ceil(a.lo - 1e-9)), last = static_cast<int>(std::floor(a.hi + 1e-9));
         const int step = std::max(1, (last - first + 11) / 12);
         for (int k = first; k <= last; k += step)
             out.emplace_back(std::pow(10.0, k), QString("1e%1").arg(k));
@@ -91,8 +89,7 @@ std::vector<std::pair<double, QString>> ticks(const Axis& a) {
 
 } // namespace
 
-std::string writeLinePlotPng(const std::string& path, const PlotSpec& spec,
-                             const std::vector<PlotSeries>& series) {
+std::string writeLinePlotPng(const std::string& path, const PlotSpec& spec, const std::vector<PlotSeries>& series) {
     ensureGuiApplication();
     Axis ax{spec.logX}, ay{spec.logY};
     std::vector<double> xs, ys(spec.yMarks);
@@ -102,8 +99,7 @@ std::string writeLinePlotPng(const std::string& path, const PlotSpec& spec,
                 xs.push_back(s.x[i]);
                 ys.push_back(s.y[i]);
             }
-    if (xs.empty() || !fitAxis(ax, xs, spec.xMin, spec.xMax) ||
-        !fitAxis(ay, ys, spec.yMin, spec.yMax))
+    if (xs.empty() || !fitAxis(ax, xs, spec.xMin, spec.xMax) || !fitAxis(ay, ys, spec.yMin, spec.yMax))
         return "no plottable point for " + path;
 
     QImage image(spec.width, spec.height, QImage::Format_ARGB32);
@@ -115,19 +111,15 @@ std::string writeLinePlotPng(const std::string& path, const PlotSpec& spec,
     p.setFont(font);
     double legendWidth = 0;
     for (const PlotSeries& s : series)
-        legendWidth = std::max(legendWidth, static_cast<double>(p.fontMetrics().horizontalAdvance(
-                                                QString::fromStdString(s.label))));
+        legendWidth = std::max(legendWidth,
+                               static_cast<double>(p.fontMetrics().horizontalAdvance(QString::fromStdString(s.label))));
     const double boxW = legendWidth + 60;
     const bool outside = spec.legend == LegendPlacement::OutsideRight;
     const double left = std::max(90.0, spec.width * 0.07);
     const double right = outside ? boxW + 30 : spec.width * 0.03;
     const QRectF plot(left, spec.height * 0.08, spec.width - left - right, spec.height * 0.80);
-    auto px = [&](double x) {
-        return plot.left() + (ax.t(x) - ax.lo) / (ax.hi - ax.lo) * plot.width();
-    };
-    auto py = [&](double y) {
-        return plot.bottom() - (ay.t(y) - ay.lo) / (ay.hi - ay.lo) * plot.height();
-    };
+    auto px = [&](double x) { return plot.left() + (ax.t(x) - ax.lo) / (ax.hi - ax.lo) * plot.width(); };
+    auto py = [&](double y) { return plot.bottom() - (ay.t(y) - ay.lo) / (ay.hi - ay.lo) * plot.height(); };
 
     // Grid, ticks and labels.
     const QPen gridPen(QColor(225, 225, 225), 1), axisPen(Qt::black, 1.5);
@@ -137,33 +129,30 @@ std::string writeLinePlotPng(const std::string& path, const PlotSpec& spec,
         p.setPen(gridPen);
         p.drawLine(QPointF(x, plot.top()), QPointF(x, plot.bottom()));
         p.setPen(Qt::black);
-        p.drawText(QRectF(x - 60, plot.bottom() + 4, 120, fh * 1.5),
-                   Qt::AlignHCenter | Qt::AlignTop, label);
+        p.drawText(QRectF(x - 60, plot.bottom() + 4, 120, fh * 1.5), Qt::AlignHCenter | Qt::AlignTop, label);
     }
     for (const auto& [v, label] : ticks(ay)) {
         const double y = py(v);
         p.setPen(gridPen);
         p.drawLine(QPointF(plot.left(), y), QPointF(plot.right(), y));
         p.setPen(Qt::black);
-        p.drawText(QRectF(0, y - fh, plot.left() - 8, 2 * fh), Qt::AlignRight | Qt::AlignVCenter,
-                   label);
+        p.drawText(QRectF(0, y - fh, plot.left() - 8, 2 * fh), Qt::AlignRight | Qt::AlignVCenter, label);
     }
     p.setPen(axisPen);
     p.drawRect(plot);
-    p.drawText(QRectF(plot.left(), plot.bottom() + fh * 1.8, plot.width(), fh * 1.6),
-               Qt::AlignHCenter, QString::fromStdString(spec.xLabel));
+    p.drawText(QRectF(plot.left(), plot.bottom() + fh * 1.8, plot.width(), fh * 1.6), Qt::AlignHCenter,
+               QString::fromStdString(spec.xLabel));
     p.save();
     p.translate(fh * 0.4, plot.center().y());
     p.rotate(-90);
-    p.drawText(QRectF(-plot.height() / 2, 0, plot.height(), fh * 1.6),
-               Qt::AlignHCenter | Qt::AlignTop, QString::fromStdString(spec.yLabel));
+    p.drawText(QRectF(-plot.height() / 2, 0, plot.height(), fh * 1.6), Qt::AlignHCenter | Qt::AlignTop,
+               QString::fromStdString(spec.yLabel));
     p.restore();
     QFont titleFont = font;
     titleFont.setPixelSize(static_cast<int>(fh * 1.3));
     titleFont.setBold(true);
     p.setFont(titleFont);
-    p.drawText(QRectF(0, 0, spec.width, plot.top()), Qt::AlignCenter,
-               QString::fromStdString(spec.title));
+    p.drawText(QRectF(0, 0, spec.width, plot.top()), Qt::AlignCenter, QString::fromStdString(spec.title));
     p.setFont(font);
 
     p.setClipRect(plot);
@@ -205,15 +194,10 @@ std::string writeLinePlotPng(const std::string& path, const PlotSpec& spec,
 
     // Legend: right of the plot, or in a corner inside it.
     const double rowH = fh * 1.5, boxH = rowH * series.size() + fh * 0.6;
-    const bool atLeft =
-        spec.legend == LegendPlacement::TopLeft || spec.legend == LegendPlacement::BottomLeft;
-    const bool atTop = outside || spec.legend == LegendPlacement::TopLeft ||
-                       spec.legend == LegendPlacement::TopRight;
-    const double boxX = outside  ? plot.right() + 20
-                        : atLeft ? plot.left() + 10
-                                 : plot.right() - boxW - 10;
-    const QRectF box(boxX, atTop ? plot.top() + (outside ? 0 : 10) : plot.bottom() - boxH - 10,
-                     boxW, boxH);
+    const bool atLeft = spec.legend == LegendPlacement::TopLeft || spec.legend == LegendPlacement::BottomLeft;
+    const bool atTop = outside || spec.legend == LegendPlacement::TopLeft || spec.legend == LegendPlacement::TopRight;
+    const double boxX = outside ? plot.right() + 20 : atLeft ? plot.left() + 10 : plot.right() - boxW - 10;
+    const QRectF box(boxX, atTop ? plot.top() + (outside ? 0 : 10) : plot.bottom() - boxH - 10, boxW, boxH);
     p.setPen(QPen(QColor(160, 160, 160), 1));
     p.setBrush(QColor(255, 255, 255, 230));
     p.drawRect(box);
@@ -222,8 +206,8 @@ std::string writeLinePlotPng(const std::string& path, const PlotSpec& spec,
         p.setPen(QPen(kPalette[s % std::size(kPalette)], 3));
         p.drawLine(QPointF(box.left() + 8, y), QPointF(box.left() + 40, y));
         p.setPen(Qt::black);
-        p.drawText(QRectF(box.left() + 48, y - rowH / 2, legendWidth + 10, rowH),
-                   Qt::AlignLeft | Qt::AlignVCenter, QString::fromStdString(series[s].label));
+        p.drawText(QRectF(box.left() + 48, y - rowH / 2, legendWidth + 10, rowH), Qt::AlignLeft | Qt::AlignVCenter,
+                   QString::fromStdString(series[s].label));
     }
     p.end();
     if (!image.save(QString::fromStdString(path), "PNG")) return "cannot write " + path;

@@ -30,7 +30,6 @@ struct PlotSpec {
 
 /// Renders the series and writes a PNG to `path`. Returns an empty string on success, otherwise
 /// what failed ("no plottable point", "cannot write <path>").
-std::string writeLinePlotPng(const std::string& path, const PlotSpec& spec,
-                             const std::vector<PlotSeries>& series);
+std::string writeLinePlotPng(const std::string& path, const PlotSpec& spec, const std::vector<PlotSeries>& series);
 
 } // namespace viscera::bench

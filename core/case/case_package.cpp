@@ -1,10 +1,10 @@
 #include "case/case_package.hpp"
 
 #include "case/detail/zip_archive.hpp"
-#include "sim/util/entry_name.hpp"
 #include "case/sha256.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/util/atomic_file.hpp"
+#include "sim/util/entry_name.hpp"
 #include "sim/util/error.hpp"
 
 #include <algorithm>
@@ -33,17 +33,15 @@ constexpr size_t kMinZipBytes = 22;
 
 /// Messages are "<package>: <rule>" or "<package>: <entry or field>: <rule>".
 class Failure {
-  public:
+public:
     explicit Failure(const std::string& package) : m_package(package) {}
-    [[noreturn]] void package(const std::string& rule) const {
-        throw InputError(m_package + ": " + rule);
-    }
+    [[noreturn]] void package(const std::string& rule) const { throw InputError(m_package + ": " + rule); }
     [[noreturn]] void entry(std::string_view name, const std::string& rule) const {
         throw InputError(m_package + ": " + displayName(name) + ": " + rule);
     }
     std::string origin(std::string_view name) const { return m_package + ": " + std::string(name); }
 
-  private:
+private:
     const std::string& m_package;
 };
 
@@ -71,8 +69,8 @@ void checkNames(const Failure& fail, const std::vector<Entry>& entries) {
     std::set<std::string, std::less<>> fileNames;
     for (const Entry& e : entries) {
         const std::string& name = e.info.name;
-        std::string_view path = e.directory ? std::string_view(name).substr(0, name.size() - 1)
-                                            : std::string_view(name);
+        std::string_view path =
+            e.directory ? std::string_view(name).substr(0, name.size() - 1) : std::string_view(name);
         if (auto problem = entryNameProblem(path)) fail.entry(name, *problem);
 
         uint32_t type = e.info.unixMode & kTypeMask;
@@ -80,8 +78,7 @@ void checkNames(const Failure& fail, const std::vector<Entry>& entries) {
         if (type != 0 && type != kTypeRegular && type != kTypeDirectory) {
             char octal[16];
             std::snprintf(octal, sizeof octal, "0%o", static_cast<unsigned>(type));
-            fail.entry(name,
-                       std::string("entry is not a regular file (Unix file type ") + octal + ")");
+            fail.entry(name, std::string("entry is not a regular file (Unix file type ") + octal + ")");
         }
         if (!e.directory && (type == kTypeDirectory || e.info.dosDirectory))
             fail.entry(name, "directory entry without a trailing '/'");
@@ -90,9 +87,8 @@ void checkNames(const Failure& fail, const std::vector<Entry>& entries) {
         if (!exact.insert(name).second) fail.entry(name, "duplicate entry");
         auto [it, fresh] = folded.emplace(lower(path), name);
         if (!fresh)
-            fail.entry(name,
-                       "entry name collides with '" + displayName(it->second) +
-                           "' (names must differ other than in letter case or a trailing '/')");
+            fail.entry(name, "entry name collides with '" + displayName(it->second) +
+                                 "' (names must differ other than in letter case or a trailing '/')");
         if (!e.directory) fileNames.insert(name);
     }
     for (const Entry& e : entries) {
@@ -104,11 +100,9 @@ void checkNames(const Failure& fail, const std::vector<Entry>& entries) {
                                  "files may appear)");
             continue;
         }
-        for (size_t slash = name.find('/'); slash != std::string::npos;
-             slash = name.find('/', slash + 1))
+        for (size_t slash = name.find('/'); slash != std::string::npos; slash = name.find('/', slash + 1))
             if (fileNames.count(std::string_view(name).substr(0, slash)))
-                fail.entry(name, "entry lies under the file entry '" +
-                                     displayName(name.substr(0, slash)) + "'");
+                fail.entry(name, "entry lies under the file entry '" + displayName(name.substr(0, slash)) + "'");
     }
 }
 
@@ -122,20 +116,17 @@ void checkSizes(const Failure& fail, const std::vector<Entry>& entries, const Li
             fail.entry(info.name, "compression method " + std::to_string(info.compressionMethod) +
                                       " is not supported (use store or deflate)");
         if (info.size > limits.maxEntryBytes)
-            fail.entry(info.name, "uncompressed size " + bytesText(info.size) +
-                                      " exceeds the per-entry limit of " +
+            fail.entry(info.name, "uncompressed size " + bytesText(info.size) + " exceeds the per-entry limit of " +
                                       bytesText(limits.maxEntryBytes));
         double ratio = double(info.size) / double(std::max<uint64_t>(info.compressedSize, 1));
         if (info.size >= limits.ratioMinBytes && ratio > limits.maxCompressionRatio)
-            fail.entry(info.name, "compression ratio " + std::to_string(std::llround(ratio)) +
-                                      ":1 exceeds the limit of " +
-                                      std::to_string(std::llround(limits.maxCompressionRatio)) +
-                                      ":1 (possible zip bomb)");
+            fail.entry(info.name,
+                       "compression ratio " + std::to_string(std::llround(ratio)) + ":1 exceeds the limit of " +
+                           std::to_string(std::llround(limits.maxCompressionRatio)) + ":1 (possible zip bomb)");
         total += info.size; // each term <= maxEntryBytes, so no overflow before the check below
         if (total > limits.maxTotalBytes)
-            fail.package("total uncompressed size exceeds the limit of " +
-                         bytesText(limits.maxTotalBytes) + " (reached at entry '" +
-                         displayName(info.name) + "')");
+            fail.package("total uncompressed size exceeds the limit of " + bytesText(limits.maxTotalBytes) +
+                         " (reached at entry '" + displayName(info.name) + "')");
     }
 }
 
@@ -143,8 +134,7 @@ std::string readEntry(const Failure& fail, const detail::ZipReader& zip, const E
     try {
         return zip.read(e.index, e.info.size);
     } catch (const detail::ZipError& error) {
-        fail.entry(e.info.name,
-                   std::string("cannot decompress entry (corrupt data: ") + error.what() + ")");
+        fail.entry(e.info.name, std::string("cannot decompress entry (corrupt data: ") + error.what() + ")");
     }
 }
 
@@ -170,8 +160,7 @@ Verified verifyBytes(std::string_view bytes, const std::string& name, const Limi
         if (bytes.size() < kMinZipBytes) throw detail::ZipError("too short for a zip archive");
         zip = detail::ZipReader::open(bytes);
     } catch (const detail::ZipError& error) {
-        fail.package(std::string("not a valid zip archive (truncated or corrupt): ") +
-                     error.what());
+        fail.package(std::string("not a valid zip archive (truncated or corrupt): ") + error.what());
     }
     const uint64_t count = zip->entryCount();
     if (count > limits.maxEntries)
@@ -184,8 +173,8 @@ Verified verifyBytes(std::string_view bytes, const std::string& name, const Limi
         try {
             e.info = zip->entry(i);
         } catch (const detail::ZipError& error) {
-            fail.package("not a valid zip archive (truncated or corrupt): entry " +
-                         std::to_string(i) + ": " + error.what());
+            fail.package("not a valid zip archive (truncated or corrupt): entry " + std::to_string(i) + ": " +
+                         error.what());
         }
         e.index = i;
         e.directory = !e.info.name.empty() && e.info.name.back() == '/';
@@ -201,12 +190,10 @@ Verified verifyBytes(std::string_view bytes, const std::string& name, const Limi
     for (const Entry& e : entries)
         if (!e.directory) files.emplace(e.info.name, &e);
     auto manifestEntry = files.find(kManifestName);
-    if (manifestEntry == files.end())
-        fail.entry(kManifestName, "missing (a package needs manifest.json at its root)");
+    if (manifestEntry == files.end()) fail.entry(kManifestName, "missing (a package needs manifest.json at its root)");
     const Entry& me = *manifestEntry->second;
     if (me.info.size > limits.maxManifestBytes)
-        fail.entry(kManifestName, "size " + bytesText(me.info.size) +
-                                      " exceeds the manifest limit of " +
+        fail.entry(kManifestName, "size " + bytesText(me.info.size) + " exceeds the manifest limit of " +
                                       bytesText(limits.maxManifestBytes));
     Verified out;
     out.manifest = Manifest::parse(readEntry(fail, *zip, me), fail.origin(kManifestName));
@@ -214,17 +201,15 @@ Verified verifyBytes(std::string_view bytes, const std::string& name, const Limi
     // (f) listed files: present, size, sha256; then nothing unlisted.
     for (const FileEntry& listed : out.manifest.files) {
         auto it = files.find(listed.path);
-        if (it == files.end())
-            fail.entry(listed.path, "listed in manifest.json but missing from the package");
+        if (it == files.end()) fail.entry(listed.path, "listed in manifest.json but missing from the package");
         const Entry& e = *it->second;
         if (e.info.size != listed.size)
-            fail.entry(listed.path, "size mismatch (manifest says " + bytesText(listed.size) +
-                                        ", entry has " + bytesText(e.info.size) + ")");
+            fail.entry(listed.path, "size mismatch (manifest says " + bytesText(listed.size) + ", entry has " +
+                                        bytesText(e.info.size) + ")");
         std::string data = readEntry(fail, *zip, e);
         std::string hash = sha256Hex(data);
         if (hash != listed.sha256)
-            fail.entry(listed.path, "sha256 mismatch (manifest says " + listed.sha256 +
-                                        ", file has " + hash + ")");
+            fail.entry(listed.path, "sha256 mismatch (manifest says " + listed.sha256 + ", file has " + hash + ")");
         out.files.emplace(listed.path, std::move(data));
     }
     for (const Entry& e : entries)
@@ -253,8 +238,7 @@ Verified verifyFile(const std::filesystem::path& path, const Limits& limits) {
     const Failure fail(name);
     std::error_code ec;
     fs::file_status status = fs::status(path, ec);
-    if (status.type() == fs::file_type::not_found)
-        fail.package("cannot open package (file does not exist)");
+    if (status.type() == fs::file_type::not_found) fail.package("cannot open package (file does not exist)");
     if (ec) fail.package("cannot open package (" + ec.message() + ")");
     if (!fs::is_regular_file(status)) fail.package("cannot open package (not a regular file)");
     uint64_t size = fs::file_size(path, ec);
@@ -268,8 +252,7 @@ Verified verifyFile(const std::filesystem::path& path, const Limits& limits) {
 
 } // namespace
 
-std::unique_ptr<CasePackage> CasePackage::open(const std::filesystem::path& path,
-                                               const Limits& limits) {
+std::unique_ptr<CasePackage> CasePackage::open(const std::filesystem::path& path, const Limits& limits) {
     Verified v = verifyFile(path, limits);
     std::unique_ptr<CasePackage> package(new CasePackage());
     package->m_name = path.string();
@@ -278,8 +261,7 @@ std::unique_ptr<CasePackage> CasePackage::open(const std::filesystem::path& path
     return package;
 }
 
-std::unique_ptr<CasePackage> CasePackage::fromBytes(std::string_view bytes, std::string name,
-                                                    const Limits& limits) {
+std::unique_ptr<CasePackage> CasePackage::fromBytes(std::string_view bytes, std::string name, const Limits& limits) {
     Verified v = verifyBytes(bytes, name, limits);
     std::unique_ptr<CasePackage> package(new CasePackage());
     package->m_name = std::move(name);
@@ -294,8 +276,7 @@ bool CasePackage::contains(std::string_view path) const {
 
 std::string_view CasePackage::read(std::string_view path) const {
     auto it = m_files.find(path);
-    if (it == m_files.end())
-        throw InputError(m_name + ": " + displayName(path) + ": not listed in manifest.json");
+    if (it == m_files.end()) throw InputError(m_name + ": " + displayName(path) + ": not listed in manifest.json");
     return it->second;
 }
 

@@ -33,15 +33,13 @@ namespace viscera::vcase {
 /// Memory: the uncompressed bytes of every listed file (at most Limits::maxTotalBytes); the
 /// archive itself is released once verified.
 class CasePackage {
-  public:
+public:
     /// Reads and verifies the package at `path`. Cost: one read of the file, one decompression
     /// and one SHA-256 pass over every entry, one parse of every .vtet. Throws viscera::InputError.
-    static std::unique_ptr<CasePackage> open(const std::filesystem::path& path,
-                                             const Limits& limits = {});
+    static std::unique_ptr<CasePackage> open(const std::filesystem::path& path, const Limits& limits = {});
     /// The same checks on a package already in memory (only (a)'s size rule applies); `name`
     /// stands for the file in messages. `bytes` is not retained.
-    static std::unique_ptr<CasePackage> fromBytes(std::string_view bytes, std::string name,
-                                                  const Limits& limits = {});
+    static std::unique_ptr<CasePackage> fromBytes(std::string_view bytes, std::string name, const Limits& limits = {});
 
     CasePackage(const CasePackage&) = delete;
     CasePackage& operator=(const CasePackage&) = delete;
@@ -56,7 +54,7 @@ class CasePackage {
     /// path that is not listed (manifest.json itself included: use manifest()).
     std::string_view read(std::string_view path) const;
 
-  private:
+private:
     CasePackage() = default;
 
     std::string m_name;

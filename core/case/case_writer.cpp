@@ -2,9 +2,9 @@
 
 #include "case/case_package.hpp"
 #include "case/detail/zip_archive.hpp"
-#include "sim/util/entry_name.hpp"
 #include "case/sha256.hpp"
 #include "sim/util/atomic_file.hpp"
+#include "sim/util/entry_name.hpp"
 #include "sim/util/error.hpp"
 
 #include <algorithm>
@@ -34,14 +34,12 @@ CaseWriter::CaseWriter(Manifest header) : m_header(std::move(header)) {
 void CaseWriter::addFile(std::string_view path, std::string bytes) {
     const std::string origin = "vcase::CaseWriter::addFile(): " + displayName(path) + ": ";
     if (auto problem = entryNameProblem(path)) throw InputError(origin + *problem);
-    if (path == kManifestName)
-        throw InputError(origin + "reserved name (the writer generates manifest.json)");
+    if (path == kManifestName) throw InputError(origin + "reserved name (the writer generates manifest.json)");
     auto [it, fresh] = m_foldedPaths.emplace(lower(path), std::string(path));
     if (!fresh)
         throw InputError(origin + (it->second == path
                                        ? "already added"
-                                       : "collides with '" + it->second +
-                                             "' (names differ only in letter case)"));
+                                       : "collides with '" + it->second + "' (names differ only in letter case)"));
     m_files.emplace(std::string(path), std::move(bytes));
 }
 
@@ -52,8 +50,7 @@ Manifest CaseWriter::manifest() const {
     return m;
 }
 
-std::string CaseWriter::buildNamed(const std::string& name, const Limits& limits,
-                                   Manifest* written) const {
+std::string CaseWriter::buildNamed(const std::string& name, const Limits& limits, Manifest* written) const {
     Manifest m = manifest();
     const std::string manifestText = m.toJsonText();
     std::vector<detail::ZipInput> inputs;

@@ -23,7 +23,7 @@
 namespace viscera::vcase {
 
 class CaseWriter {
-  public:
+public:
     /// `header` holds every manifest field but files, which must be empty (write() lists the
     /// added files). Throws viscera::InputError ("vcase::CaseWriter: caseId: ...") when a field
     /// breaks the manifest schema.
@@ -50,7 +50,7 @@ class CaseWriter {
     /// viscera::writeFileAtomic. Returns the manifest written. Throws viscera::InputError.
     Manifest write(const std::filesystem::path& path, const Limits& limits = {}) const;
 
-  private:
+private:
     std::string buildNamed(const std::string& name, const Limits& limits, Manifest* written) const;
 
     Manifest m_header;

@@ -1,8 +1,8 @@
 #include "case/manifest.hpp"
 
-#include "sim/util/entry_name.hpp"
 #include "case/semver.hpp"
 #include "case/sha256.hpp"
+#include "sim/util/entry_name.hpp"
 #include "sim/util/error.hpp"
 #include "sim/util/json_reader.hpp"
 
@@ -22,8 +22,7 @@ constexpr size_t kMaxIdLength = 64;
 
 /// SI units the player assumes for the quantities a manifest must state.
 const std::map<std::string, std::string>& requiredUnits() {
-    static const std::map<std::string, std::string> units = {
-        {"length", "m"}, {"mass", "kg"}, {"time", "s"}};
+    static const std::map<std::string, std::string> units = {{"length", "m"}, {"mass", "kg"}, {"time", "s"}};
     return units;
 }
 
@@ -31,9 +30,8 @@ bool isLowerId(std::string_view s, std::string_view extra) {
     if (s.empty() || s.size() > kMaxIdLength) return false;
     auto lowerAlnum = [](char c) { return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'); };
     if (!lowerAlnum(s[0])) return false;
-    return std::all_of(s.begin(), s.end(), [&](char c) {
-        return lowerAlnum(c) || extra.find(c) != std::string_view::npos;
-    });
+    return std::all_of(s.begin(), s.end(),
+                       [&](char c) { return lowerAlnum(c) || extra.find(c) != std::string_view::npos; });
 }
 
 FileEntry readFileEntry(const sim::JsonField& f) {
@@ -93,8 +91,7 @@ std::string Manifest::toJsonText() const {
 
 Manifest Manifest::fromJson(const nlohmann::json& j, std::string_view origin) {
     const std::string where(origin);
-    if (!j.is_object())
-        throw InputError(where + ": must be a JSON object (found " + j.type_name() + ")");
+    if (!j.is_object()) throw InputError(where + ": must be a JSON object (found " + j.type_name() + ")");
     const sim::JsonField root(j, "", where);
     root.object({"schemaVersion", "caseId", "caseVersion", "minPlayerVersion", "title", "features", "units", "device",
                  "files"});
@@ -117,12 +114,14 @@ Manifest Manifest::fromJson(const nlohmann::json& j, std::string_view origin) {
 
     const sim::JsonField units = root["units"];
     m.units.clear();
-    for (const auto& [quantity, value] : units.members()) m.units[quantity] = value.string();
+    for (const auto& [quantity, value] : units.members())
+        m.units[quantity] = value.string();
     for (const auto& [quantity, si] : requiredUnits()) {
         auto it = m.units.find(quantity);
         if (it == m.units.end()) units.failAt(quantity, "required field is missing");
         if (it->second != si)
-            units.failAt(quantity, "'" + displayName(it->second) + "' is not supported (the player uses SI: '" + si + "')");
+            units.failAt(quantity,
+                         "'" + displayName(it->second) + "' is not supported (the player uses SI: '" + si + "')");
     }
 
     m.device = root["device"].anyObject().value();
@@ -141,8 +140,7 @@ Manifest Manifest::parse(std::string_view text, std::string_view origin) {
 }
 
 const FileEntry* Manifest::findFile(std::string_view path) const {
-    auto it = std::find_if(files.begin(), files.end(),
-                           [&](const FileEntry& f) { return f.path == path; });
+    auto it = std::find_if(files.begin(), files.end(), [&](const FileEntry& f) { return f.path == path; });
     return it == files.end() ? nullptr : &*it;
 }
 
@@ -150,19 +148,17 @@ void checkPlayerCompatibility(const Manifest& manifest, std::string_view origin)
     const std::string prefix = std::string(origin) + ": ";
     const int schemaVersion = manifest.schemaVersion;
     if (schemaVersion < 1)
-        throw InputError(prefix + "schemaVersion " + std::to_string(schemaVersion) +
-                         " is not valid (must be >= 1)");
+        throw InputError(prefix + "schemaVersion " + std::to_string(schemaVersion) + " is not valid (must be >= 1)");
     if (schemaVersion > kSchemaVersion)
         throw InputError(prefix + "schemaVersion " + std::to_string(schemaVersion) +
-                         " is newer than this player supports (" + std::to_string(kSchemaVersion) +
-                         ")");
+                         " is newer than this player supports (" + std::to_string(kSchemaVersion) + ")");
     std::optional<SemVer> required = SemVer::parse(manifest.minPlayerVersion);
     if (!required)
         throw InputError(prefix + "minPlayerVersion: '" + displayName(manifest.minPlayerVersion) +
                          "' is not a semantic version");
     if (compare(*required, playerVersion()) > 0)
-        throw InputError(prefix + "minPlayerVersion " + manifest.minPlayerVersion +
-                         " is newer than this player (" + playerVersion().toString() + ")");
+        throw InputError(prefix + "minPlayerVersion " + manifest.minPlayerVersion + " is newer than this player (" +
+                         playerVersion().toString() + ")");
 }
 
 } // namespace viscera::vcase

@@ -8,8 +8,7 @@ namespace viscera::vcase {
 namespace {
 
 bool isDigits(std::string_view s) {
-    return !s.empty() &&
-           std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+    return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
 bool isIdentifierChar(char c) {
@@ -86,8 +85,7 @@ std::optional<SemVer> SemVer::parse(std::string_view text) {
 }
 
 std::string SemVer::toString() const {
-    std::string s =
-        std::to_string(major) + "." + std::to_string(minor) + "." + std::to_string(patch);
+    std::string s = std::to_string(major) + "." + std::to_string(minor) + "." + std::to_string(patch);
     if (!prerelease.empty()) s += "-" + prerelease;
     if (!build.empty()) s += "+" + build;
     return s;

@@ -10,8 +10,7 @@ namespace viscera::vcase {
 std::string sha256Hex(std::string_view bytes) {
     unsigned char digest[EVP_MAX_MD_SIZE];
     unsigned int length = 0;
-    if (EVP_Digest(bytes.data(), bytes.size(), digest, &length, EVP_sha256(), nullptr) != 1 ||
-        length != 32)
+    if (EVP_Digest(bytes.data(), bytes.size(), digest, &length, EVP_sha256(), nullptr) != 1 || length != 32)
         throw std::runtime_error("vcase::sha256Hex(): OpenSSL EVP_Digest failed");
     static constexpr char kHex[] = "0123456789abcdef";
     std::string hex(2 * length, '0');
@@ -23,9 +22,8 @@ std::string sha256Hex(std::string_view bytes) {
 }
 
 bool isSha256Hex(std::string_view text) {
-    return text.size() == 64 && std::all_of(text.begin(), text.end(), [](char c) {
-               return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
-           });
+    return text.size() == 64 && std::all_of(text.begin(), text.end(),
+                                            [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
 }
 
 } // namespace viscera::vcase

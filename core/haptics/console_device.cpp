@@ -64,7 +64,8 @@ void ConsoleDevice::poll(int64_t now_ns, DeviceState& out) {
         m_last.timestamp_ns = m_lastArrival_ns;
         m_last.sequence += 1;
         m_last.pedals = pkt.pedals;
-        for (int a = 0; a < kMaxArms; ++a) m_last.arms[a] = pkt.arm[a];
+        for (int a = 0; a < kMaxArms; ++a)
+            m_last.arms[a] = pkt.arm[a];
         m_count.received.fetch_add(1, std::memory_order_relaxed);
     }
     const bool connected = m_haveState && now_ns - m_lastArrival_ns <= m_opt.timeout_ns;

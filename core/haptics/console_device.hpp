@@ -20,7 +20,7 @@ namespace viscera::haptics {
 struct ConsoleDeviceOptions {
     int64_t timeout_ns = 100'000'000; ///< no valid packet for this long = disconnected
     int maxPacketsPerPoll = 64;
-    double maxForce = 15.0;           ///< N per arm, the console's motors [B §4]
+    double maxForce = 15.0; ///< N per arm, the console's motors [B §4]
 };
 
 class ConsoleDevice final : public Device {
@@ -44,10 +44,10 @@ private:
     DeviceCapabilities m_caps;
     UdpSocket m_socket;
     Counters m_count;
-    DeviceState m_last;          ///< newest accepted state
+    DeviceState m_last; ///< newest accepted state
     int64_t m_lastArrival_ns = 0;
     bool m_haveState = false;
-    bool m_seqValid = false;     ///< sequence order is checked while connected
+    bool m_seqValid = false; ///< sequence order is checked while connected
     bool m_connected = false;
     bool m_everConnected = false;
     uint32_t m_lastSeq = 0;

@@ -11,7 +11,8 @@ constexpr std::array<uint32_t, 256> makeCrcTable() {
     std::array<uint32_t, 256> t{};
     for (uint32_t i = 0; i < 256; ++i) {
         uint32_t c = i;
-        for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+        for (int k = 0; k < 8; ++k)
+            c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
         t[i] = c;
     }
     return t;
@@ -22,16 +23,29 @@ class Writer {
 public:
     explicit Writer(uint8_t* p) : m_p(p) {}
     void u8(uint8_t v) { m_p[m_n++] = v; }
-    void u16(uint16_t v) { for (int k = 0; k < 2; ++k) u8(uint8_t(v >> (8 * k))); }
-    void u32(uint32_t v) { for (int k = 0; k < 4; ++k) u8(uint8_t(v >> (8 * k))); }
-    void i64(int64_t v) { for (int k = 0; k < 8; ++k) u8(uint8_t(uint64_t(v) >> (8 * k))); }
+    void u16(uint16_t v) {
+        for (int k = 0; k < 2; ++k)
+            u8(uint8_t(v >> (8 * k)));
+    }
+    void u32(uint32_t v) {
+        for (int k = 0; k < 4; ++k)
+            u8(uint8_t(v >> (8 * k)));
+    }
+    void i64(int64_t v) {
+        for (int k = 0; k < 8; ++k)
+            u8(uint8_t(uint64_t(v) >> (8 * k)));
+    }
     void f32(double v) {
         float f = static_cast<float>(v);
         uint32_t b;
         std::memcpy(&b, &f, 4);
         u32(b);
     }
-    void vec3(const Vec3& v) { f32(v.x()); f32(v.y()); f32(v.z()); }
+    void vec3(const Vec3& v) {
+        f32(v.x());
+        f32(v.y());
+        f32(v.z());
+    }
     size_t size() const { return m_n; }
     uint8_t* data() const { return m_p; }
 
@@ -44,9 +58,24 @@ class Reader {
 public:
     explicit Reader(const uint8_t* p) : m_p(p) {}
     uint8_t u8() { return m_p[m_n++]; }
-    uint16_t u16() { uint16_t v = 0; for (int k = 0; k < 2; ++k) v |= uint16_t(u8()) << (8 * k); return v; }
-    uint32_t u32() { uint32_t v = 0; for (int k = 0; k < 4; ++k) v |= uint32_t(u8()) << (8 * k); return v; }
-    int64_t i64() { uint64_t v = 0; for (int k = 0; k < 8; ++k) v |= uint64_t(u8()) << (8 * k); return int64_t(v); }
+    uint16_t u16() {
+        uint16_t v = 0;
+        for (int k = 0; k < 2; ++k)
+            v |= uint16_t(u8()) << (8 * k);
+        return v;
+    }
+    uint32_t u32() {
+        uint32_t v = 0;
+        for (int k = 0; k < 4; ++k)
+            v |= uint32_t(u8()) << (8 * k);
+        return v;
+    }
+    int64_t i64() {
+        uint64_t v = 0;
+        for (int k = 0; k < 8; ++k)
+            v |= uint64_t(u8()) << (8 * k);
+        return int64_t(v);
+    }
     /// Reads a binary32; clears ok when it is not finite.
     double f32(bool& ok) {
         uint32_t b = u32();
@@ -55,7 +84,10 @@ public:
         if (!std::isfinite(f)) ok = false;
         return f;
     }
-    Vec3 vec3(bool& ok) { double x = f32(ok), y = f32(ok), z = f32(ok); return {x, y, z}; }
+    Vec3 vec3(bool& ok) {
+        double x = f32(ok), y = f32(ok), z = f32(ok);
+        return {x, y, z};
+    }
     void skip(size_t n) { m_n += n; }
     size_t offset() const { return m_n; }
 
@@ -95,22 +127,32 @@ DecodeError checkFrame(const uint8_t* data, size_t size, PacketType type, size_t
 
 const char* decodeErrorName(DecodeError e) {
     switch (e) {
-    case DecodeError::None: return "ok";
-    case DecodeError::TooShort: return "shorter than the header";
-    case DecodeError::BadMagic: return "bad magic";
-    case DecodeError::BadVersion: return "unsupported protocol version";
-    case DecodeError::BadType: return "unexpected packet type";
-    case DecodeError::BadSize: return "size does not match the packet type";
-    case DecodeError::BadReserved: return "reserved field not zero";
-    case DecodeError::BadChecksum: return "CRC-32 mismatch";
-    case DecodeError::BadField: return "field out of range";
+    case DecodeError::None:
+        return "ok";
+    case DecodeError::TooShort:
+        return "shorter than the header";
+    case DecodeError::BadMagic:
+        return "bad magic";
+    case DecodeError::BadVersion:
+        return "unsupported protocol version";
+    case DecodeError::BadType:
+        return "unexpected packet type";
+    case DecodeError::BadSize:
+        return "size does not match the packet type";
+    case DecodeError::BadReserved:
+        return "reserved field not zero";
+    case DecodeError::BadChecksum:
+        return "CRC-32 mismatch";
+    case DecodeError::BadField:
+        return "field out of range";
     }
     return "?";
 }
 
 uint32_t crc32(const uint8_t* data, size_t size) {
     uint32_t c = 0xFFFFFFFFu;
-    for (size_t i = 0; i < size; ++i) c = kCrcTable[(c ^ data[i]) & 0xFFu] ^ (c >> 8);
+    for (size_t i = 0; i < size; ++i)
+        c = kCrcTable[(c ^ data[i]) & 0xFFu] ^ (c >> 8);
     return c ^ 0xFFFFFFFFu;
 }
 
@@ -124,7 +166,10 @@ size_t encode(const StatePacket& p, uint8_t* out, size_t capacity) {
     for (const ArmState& a : p.arm) {
         w.vec3(a.measured_cp.position);
         const Quat& q = a.measured_cp.orientation;
-        w.f32(q.w()); w.f32(q.x()); w.f32(q.y()); w.f32(q.z());
+        w.f32(q.w());
+        w.f32(q.x());
+        w.f32(q.y());
+        w.f32(q.z());
         w.f32(a.jaw_measured_js);
         w.vec3(a.measured_cv.linear);
         w.vec3(a.measured_cv.angular);
@@ -154,7 +199,8 @@ size_t encode(const CommandPacket& p, uint8_t* out, size_t capacity) {
 DecodeError decode(const uint8_t* data, size_t size, StatePacket& out) {
     Reader r(data);
     StatePacket p;
-    if (auto e = checkFrame(data, size, PacketType::State, kStateSize, r, p.sequence, p.timestamp_ns); e != DecodeError::None)
+    if (auto e = checkFrame(data, size, PacketType::State, kStateSize, r, p.sequence, p.timestamp_ns);
+        e != DecodeError::None)
         return e;
     p.pedals = r.u8();
     p.arms = r.u8();
@@ -185,7 +231,8 @@ DecodeError decode(const uint8_t* data, size_t size, StatePacket& out) {
 DecodeError decode(const uint8_t* data, size_t size, CommandPacket& out) {
     Reader r(data);
     CommandPacket p;
-    if (auto e = checkFrame(data, size, PacketType::Command, kCommandSize, r, p.sequence, p.timestamp_ns); e != DecodeError::None)
+    if (auto e = checkFrame(data, size, PacketType::Command, kCommandSize, r, p.sequence, p.timestamp_ns);
+        e != DecodeError::None)
         return e;
     p.echoSequence = r.u32();
     p.flags = r.u32();

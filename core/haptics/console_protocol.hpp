@@ -18,7 +18,7 @@ constexpr uint16_t kVersion = 1;
 constexpr size_t kHeaderSize = 24;
 constexpr size_t kStateSize = 160;
 constexpr size_t kCommandSize = 100;
-constexpr size_t kMaxPacketSize = 512; ///< receive buffers; larger datagrams are malformed
+constexpr size_t kMaxPacketSize = 512;   ///< receive buffers; larger datagrams are malformed
 constexpr double kMaxWireForce = 1000.0; ///< N; a command beyond is malformed
 
 enum class PacketType : uint16_t { State = 1, Command = 2 };
@@ -41,7 +41,17 @@ struct CommandPacket {
     std::array<ArmCommand, kMaxArms> arm{};
 };
 
-enum class DecodeError : uint8_t { None, TooShort, BadMagic, BadVersion, BadType, BadSize, BadReserved, BadChecksum, BadField };
+enum class DecodeError : uint8_t {
+    None,
+    TooShort,
+    BadMagic,
+    BadVersion,
+    BadType,
+    BadSize,
+    BadReserved,
+    BadChecksum,
+    BadField
+};
 const char* decodeErrorName(DecodeError e);
 
 /// Write the packet into out (capacity ≥ the type's size); returns the byte count.
@@ -55,6 +65,8 @@ DecodeError decode(const uint8_t* data, size_t size, CommandPacket& out);
 uint32_t crc32(const uint8_t* data, size_t size);
 
 /// True when `a` is newer than `b` in 32-bit serial-number arithmetic (RFC 1982).
-inline bool newer(uint32_t a, uint32_t b) { return a != b && uint32_t(a - b) < 0x80000000u; }
+inline bool newer(uint32_t a, uint32_t b) {
+    return a != b && uint32_t(a - b) < 0x80000000u;
+}
 
 } // namespace viscera::haptics

@@ -19,12 +19,12 @@
 namespace viscera::haptics {
 
 struct ToolContactModel {
-    bool active = false;       ///< the physics has this tool
-    Vec3 p0 = Vec3::Zero();    ///< m, scene frame: tool centre used by the step
-    Vec3 n = Vec3::UnitZ();    ///< unit, scene frame
-    double f0 = 0;             ///< N
-    double gap = 1e9;          ///< m
-    double k = 0;              ///< N/m
+    bool active = false;    ///< the physics has this tool
+    Vec3 p0 = Vec3::Zero(); ///< m, scene frame: tool centre used by the step
+    Vec3 n = Vec3::UnitZ(); ///< unit, scene frame
+    double f0 = 0;          ///< N
+    double gap = 1e9;       ///< m
+    double k = 0;           ///< N/m
     double forceAt(const Vec3& x) const {
         if (!active) return 0;
         return std::max(0.0, f0 - k * ((x - p0).dot(n) + gap));
@@ -32,8 +32,8 @@ struct ToolContactModel {
 };
 
 struct LocalContactModel {
-    int64_t timestamp_ns = 0;  ///< servo clock, when the physics published it
-    int64_t frame = -1;        ///< physics frame that produced it (-1: none yet)
+    int64_t timestamp_ns = 0;   ///< servo clock, when the physics published it
+    int64_t frame = -1;         ///< physics frame that produced it (-1: none yet)
     double physicsPeriod_s = 0; ///< nominal time between physics steps
     std::array<ToolContactModel, kMaxArms> tools{};
 };
@@ -44,11 +44,11 @@ struct ToolPoseState {
     uint64_t tick = 0;
     bool connected = false;
     uint32_t pedals = 0;
-    std::array<Vec3, kMaxArms> proxy{Vec3::Zero(), Vec3::Zero()};   ///< m, scene: simulated tool centre
-    std::array<Vec3, kMaxArms> target{Vec3::Zero(), Vec3::Zero()};  ///< m, scene: where the master points
+    std::array<Vec3, kMaxArms> proxy{Vec3::Zero(), Vec3::Zero()};  ///< m, scene: simulated tool centre
+    std::array<Vec3, kMaxArms> target{Vec3::Zero(), Vec3::Zero()}; ///< m, scene: where the master points
     std::array<Quat, kMaxArms> orientation{Quat::Identity(), Quat::Identity()};
-    std::array<double, kMaxArms> grip{0, 0};        ///< rad
-    std::array<double, kMaxArms> force{0, 0};       ///< N, magnitude sent to the device (after safety)
+    std::array<double, kMaxArms> grip{0, 0};  ///< rad
+    std::array<double, kMaxArms> force{0, 0}; ///< N, magnitude sent to the device (after safety)
     uint32_t safetyRules = 0;
 };
 

@@ -22,7 +22,7 @@ struct DeviceSpec {
 DeviceSpec parseDeviceSpec(const std::string& spec);
 
 struct DeviceOpenOptions {
-    double maxForce = 15.0;             ///< N, the device's capability where the backend has none
+    double maxForce = 15.0; ///< N, the device's capability where the backend has none
     int64_t consoleTimeout_ns = 100'000'000;
     bool loopReplay = false;
 };

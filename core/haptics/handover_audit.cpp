@@ -56,12 +56,14 @@ HandoverFigures HandoverAudit::figures() const {
         if (periodNs > 0 && step > periodNs + kOverPeriodSlack_ns) ++f.stepsOverPeriod;
         if (m_lastUse[k] >= 0) {
             const double inProgress = double(m_done[k + 1] - m_stamp[k]);
-            if (inProgress > 0) f.maxAgeOverStep = std::max(f.maxAgeOverStep, double(m_lastUse[k] - m_stamp[k]) / inProgress);
+            if (inProgress > 0)
+                f.maxAgeOverStep = std::max(f.maxAgeOverStep, double(m_lastUse[k] - m_stamp[k]) / inProgress);
         }
     }
     if (!steps.empty()) {
         double sum = 0;
-        for (double s : steps) sum += s;
+        for (double s : steps)
+            sum += s;
         f.stepMean_ms = sum / double(steps.size());
         std::sort(steps.begin(), steps.end());
         const size_t i99 = std::min(steps.size() - 1, static_cast<size_t>(std::ceil(0.99 * double(steps.size()))) - 1);

@@ -25,15 +25,16 @@
 namespace viscera::haptics {
 
 struct HandoverFigures {
-    uint64_t ticksChecked = 0;     ///< ticks with a model
+    uint64_t ticksChecked = 0;      ///< ticks with a model
     uint64_t ticksOnOlderModel = 0; ///< ticks that used a model older than the newest published
-    double firstOlderTick_s = -1;  ///< time of the first such tick after the first publish (-1: none)
-    uint64_t logErrors = 0;        ///< publishes out of order or back in time, ticks on a frame never logged (internal errors; ignored)
-    double maxAgeOverStep = 0;     ///< max over ticks of age / (physics step in progress)
+    double firstOlderTick_s = -1;   ///< time of the first such tick after the first publish (-1: none)
+    uint64_t logErrors =
+        0; ///< publishes out of order or back in time, ticks on a frame never logged (internal errors; ignored)
+    double maxAgeOverStep = 0; ///< max over ticks of age / (physics step in progress)
     int64_t modelsPublished = 0;
     // publish-to-publish intervals (ms)
     double stepMean_ms = 0, stepP99_ms = 0, stepMax_ms = 0;
-    int64_t stepsOverPeriod = 0;   ///< intervals longer than the nominal period by more than one servo tick (1 ms)
+    int64_t stepsOverPeriod = 0; ///< intervals longer than the nominal period by more than one servo tick (1 ms)
 };
 
 class HandoverAudit {
@@ -50,8 +51,8 @@ public:
 
 private:
     double m_period_s;
-    std::vector<int64_t> m_stamp, m_done;  ///< per frame
-    std::vector<int64_t> m_lastUse;        ///< per frame: latest tick start that used it (-1: none)
+    std::vector<int64_t> m_stamp, m_done; ///< per frame
+    std::vector<int64_t> m_lastUse;       ///< per frame: latest tick start that used it (-1: none)
     uint64_t m_checked = 0, m_older = 0, m_logErrors = 0;
     int64_t m_firstOlder = -1;
 };

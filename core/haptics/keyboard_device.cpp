@@ -17,8 +17,10 @@ KeyboardDevice::KeyboardDevice(double speed, double metresPerPixel) : m_speed(sp
 }
 
 void KeyboardDevice::setKey(Key key, bool down) {
-    if (down) m_keys.fetch_or(key, std::memory_order_relaxed);
-    else m_keys.fetch_and(~uint32_t(key), std::memory_order_relaxed);
+    if (down)
+        m_keys.fetch_or(key, std::memory_order_relaxed);
+    else
+        m_keys.fetch_and(~uint32_t(key), std::memory_order_relaxed);
 }
 
 void KeyboardDevice::addMouse(double dx, double dy, double wheel) {
@@ -38,7 +40,8 @@ void KeyboardDevice::poll(int64_t now_ns, DeviceState& out) {
     m_pos += m_speed * dt * dir;
     const int64_t mx = m_mouseX.load(std::memory_order_relaxed), my = m_mouseY.load(std::memory_order_relaxed),
                   mw = m_wheel.load(std::memory_order_relaxed);
-    m_pos += Vec3(1e-3 * m_mpp * double(mx - m_seenX), -1e-3 * m_mpp * double(my - m_seenY), 1e-3 * 0.005 * double(mw - m_seenWheel));
+    m_pos += Vec3(1e-3 * m_mpp * double(mx - m_seenX), -1e-3 * m_mpp * double(my - m_seenY),
+                  1e-3 * 0.005 * double(mw - m_seenWheel));
     m_seenX = mx, m_seenY = my, m_seenWheel = mw;
     const ArmCapabilities& a = m_caps.arm[0];
     m_pos = m_pos.cwiseMax(a.workspaceMin).cwiseMin(a.workspaceMax);
@@ -53,7 +56,5 @@ void KeyboardDevice::poll(int64_t now_ns, DeviceState& out) {
     out.arms[0].measured_cv.angular.setZero();
     countPoll();
 }
-
-
 
 } // namespace viscera::haptics

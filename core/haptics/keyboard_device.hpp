@@ -13,7 +13,15 @@ namespace viscera::haptics {
 
 class KeyboardDevice final : public LocalDevice {
 public:
-    enum Key : uint32_t { KeyLeft = 1, KeyRight = 2, KeyUp = 4, KeyDown = 8, KeyPageUp = 16, KeyPageDown = 32, KeyClutch = 64 };
+    enum Key : uint32_t {
+        KeyLeft = 1,
+        KeyRight = 2,
+        KeyUp = 4,
+        KeyDown = 8,
+        KeyPageUp = 16,
+        KeyPageDown = 32,
+        KeyClutch = 64
+    };
     explicit KeyboardDevice(double speed = 0.05, double metresPerPixel = 2e-4);
     const DeviceCapabilities& capabilities() const override { return m_caps; }
     void poll(int64_t now_ns, DeviceState& out) override;

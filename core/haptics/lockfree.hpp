@@ -18,13 +18,15 @@
 
 namespace viscera::haptics {
 
-template <class T>
-class SeqLock {
+template <class T> class SeqLock {
     static_assert(std::is_trivially_destructible_v<T>, "SeqLock<T> needs a bitwise-copyable, trivially destructible T");
     static constexpr size_t kWords = (sizeof(T) + 7) / 8;
 
 public:
-    SeqLock() { write(T{}); m_writes.store(0, std::memory_order_relaxed); }
+    SeqLock() {
+        write(T{});
+        m_writes.store(0, std::memory_order_relaxed);
+    }
     explicit SeqLock(const T& v) { write(v); }
 
     void write(const T& v) noexcept {
@@ -33,7 +35,8 @@ public:
         const uint64_t s = m_seq.load(std::memory_order_relaxed);
         m_seq.store(s + 1, std::memory_order_relaxed);
         std::atomic_thread_fence(std::memory_order_release);
-        for (size_t i = 0; i < kWords; ++i) m_data[i].store(buf[i], std::memory_order_relaxed);
+        for (size_t i = 0; i < kWords; ++i)
+            m_data[i].store(buf[i], std::memory_order_relaxed);
         m_seq.store(s + 2, std::memory_order_release);
         m_writes.fetch_add(1, std::memory_order_relaxed);
     }
@@ -43,7 +46,8 @@ public:
         while (true) {
             const uint64_t s0 = m_seq.load(std::memory_order_acquire);
             if (s0 & 1) continue;
-            for (size_t i = 0; i < kWords; ++i) buf[i] = m_data[i].load(std::memory_order_relaxed);
+            for (size_t i = 0; i < kWords; ++i)
+                buf[i] = m_data[i].load(std::memory_order_relaxed);
             std::atomic_thread_fence(std::memory_order_acquire);
             if (m_seq.load(std::memory_order_relaxed) == s0) break;
         }
@@ -60,13 +64,13 @@ private:
     std::atomic<uint64_t> m_writes{0};
 };
 
-template <class T>
-class SpscRing {
+template <class T> class SpscRing {
 public:
     /// capacity is rounded up to a power of two.
     explicit SpscRing(size_t capacity) {
         size_t c = 1;
-        while (c < capacity) c <<= 1;
+        while (c < capacity)
+            c <<= 1;
         m_buf.resize(c);
         m_mask = c - 1;
     }

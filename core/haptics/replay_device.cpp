@@ -8,7 +8,8 @@ ReplayDevice::ReplayDevice(Trajectory trajectory, const ReplayOptions& options)
     m_caps.arms = std::max(1, m_traj.arms());
     m_caps.arm[0].hand = m_caps.arms == 2 ? Hand::Left : Hand::Either;
     m_caps.arm[1].hand = Hand::Right;
-    for (auto& a : m_caps.arm) a.maxForce = options.maxForce;
+    for (auto& a : m_caps.arm)
+        a.maxForce = options.maxForce;
     m_caps.pedals = 5;
     m_caps.realtime = false;
 }
@@ -24,7 +25,5 @@ void ReplayDevice::poll(int64_t now_ns, DeviceState& out) {
     out.connected = true;
     countPoll();
 }
-
-
 
 } // namespace viscera::haptics

@@ -10,8 +10,8 @@
 namespace viscera::haptics {
 
 struct ReplayOptions {
-    bool loop = false;       ///< wrap around at the end (otherwise the last sample holds)
-    double maxForce = 15.0;  ///< N, reported capability
+    bool loop = false;      ///< wrap around at the end (otherwise the last sample holds)
+    double maxForce = 15.0; ///< N, reported capability
     std::string name = "replay";
 };
 

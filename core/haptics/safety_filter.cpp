@@ -9,7 +9,8 @@ namespace {
 bool finite(const DeviceCommand& c, int arms) {
     for (int a = 0; a < arms; ++a) {
         const ArmCommand& x = c.arms[a];
-        if (!x.servo_cf.force.allFinite() || !x.servo_cf.torque.allFinite() || !std::isfinite(x.jaw_servo_jf)) return false;
+        if (!x.servo_cf.force.allFinite() || !x.servo_cf.torque.allFinite() || !std::isfinite(x.jaw_servo_jf))
+            return false;
     }
     return true;
 }
@@ -22,7 +23,9 @@ bool clampNorm(Vec3& v, double max) {
     return true;
 }
 
-double sane(double x) { return std::isfinite(x) && x > 0 ? x : 0.0; }
+double sane(double x) {
+    return std::isfinite(x) && x > 0 ? x : 0.0;
+}
 
 } // namespace
 
@@ -39,7 +42,8 @@ SafetyFilter::SafetyFilter(const DeviceCapabilities& device, const SafetyLimits&
 
 void SafetyFilter::reset() {
     m_havePrev = false;
-    for (auto& f : m_prevForce) f.setZero();
+    for (auto& f : m_prevForce)
+        f.setZero();
 }
 
 uint32_t SafetyFilter::apply(const SafetyInput& in, const DeviceCommand& desired, DeviceCommand& out) {
@@ -47,7 +51,8 @@ uint32_t SafetyFilter::apply(const SafetyInput& in, const DeviceCommand& desired
     out.timestamp_ns = desired.timestamp_ns;
     out.sequence = desired.sequence;
     out.flags = desired.flags & ~(kFlagForceEnabled | kFlagSimStale | kFlagDisconnected | kFlagDeadmanOpen);
-    for (auto& a : out.arms) a = ArmCommand{};
+    for (auto& a : out.arms)
+        a = ArmCommand{};
     const double dt = m_havePrev ? std::clamp(1e-9 * double(in.now_ns - m_prev_ns), 0.0, 0.010) : 0.001;
     m_havePrev = true;
     m_prev_ns = in.now_ns;
@@ -59,7 +64,8 @@ uint32_t SafetyFilter::apply(const SafetyInput& in, const DeviceCommand& desired
     if (age > m_limits.maxSimAge_ns || age < -m_limits.maxSimAge_ns) rules |= kRuleSimStale, out.flags |= kFlagSimStale;
     if (m_deadman && !(in.pedals & kPedalDeadman)) rules |= kRuleDeadman, out.flags |= kFlagDeadmanOpen;
     if (rules) {
-        for (auto& f : m_prevForce) f.setZero();
+        for (auto& f : m_prevForce)
+            f.setZero();
         if (rules & kRuleNonFinite) m_nonFinite.fetch_add(1, std::memory_order_relaxed);
         if (rules & kRuleDisconnected) m_disconnected.fetch_add(1, std::memory_order_relaxed);
         if (rules & kRuleSimStale) m_stale.fetch_add(1, std::memory_order_relaxed);

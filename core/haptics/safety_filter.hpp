@@ -21,10 +21,10 @@
 namespace viscera::haptics {
 
 struct SafetyLimits {
-    double maxForce = 15.0;       ///< N, the case's maximum (the device's own maximum also applies)
-    double maxTorque = 0.0;       ///< N·m
-    double maxGripForce = 0.0;    ///< N
-    double maxForceRate = 1000.0; ///< N/s per arm
+    double maxForce = 15.0;            ///< N, the case's maximum (the device's own maximum also applies)
+    double maxTorque = 0.0;            ///< N·m
+    double maxGripForce = 0.0;         ///< N
+    double maxForceRate = 1000.0;      ///< N/s per arm
     int64_t maxSimAge_ns = 50'000'000; ///< simulation output older than this zeroes the force
 };
 
@@ -42,7 +42,7 @@ struct SafetyInput {
     int64_t now_ns = 0;          ///< servo clock
     int64_t simTimestamp_ns = 0; ///< when the simulation output behind `desired` was produced
     bool deviceConnected = true;
-    uint32_t pedals = 0;         ///< Pedal bits from the device
+    uint32_t pedals = 0; ///< Pedal bits from the device
 };
 
 struct SafetyCounts {

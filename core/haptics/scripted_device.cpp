@@ -27,21 +27,28 @@ const std::vector<std::string>& ScriptedDevice::scripts() {
 }
 
 ScriptedDevice::ScriptedDevice(const std::string& script, double maxForce) {
-    if (script == "idle") m_script = Script::Idle;
-    else if (script == "press") m_script = Script::Press;
-    else if (script == "circle") m_script = Script::Circle;
-    else if (script == "bimanual") m_script = Script::Bimanual;
-    else if (script == "clutch") m_script = Script::Clutch;
+    if (script == "idle")
+        m_script = Script::Idle;
+    else if (script == "press")
+        m_script = Script::Press;
+    else if (script == "circle")
+        m_script = Script::Circle;
+    else if (script == "bimanual")
+        m_script = Script::Bimanual;
+    else if (script == "clutch")
+        m_script = Script::Clutch;
     else {
         std::string known;
-        for (const auto& s : scripts()) known += (known.empty() ? "" : ", ") + s;
+        for (const auto& s : scripts())
+            known += (known.empty() ? "" : ", ") + s;
         throw InputError("scripted:" + script + ": unknown script (known: " + known + ")");
     }
     m_caps.name = "scripted:" + script;
     m_caps.arms = (m_script == Script::Bimanual || m_script == Script::Idle) ? 2 : 1;
     m_caps.arm[0].hand = m_caps.arms == 2 ? Hand::Left : Hand::Either;
     m_caps.arm[1].hand = Hand::Right;
-    for (auto& a : m_caps.arm) a.maxForce = maxForce;
+    for (auto& a : m_caps.arm)
+        a.maxForce = maxForce;
     m_caps.pedals = 5;
 }
 
@@ -57,14 +64,17 @@ void ScriptedDevice::poll(int64_t now_ns, DeviceState& out) {
     out.pedals = kPedalDeadman;
     auto position = [&](int arm, double s, bool* rising) -> Vec3 {
         switch (m_script) {
-        case Script::Idle: return Vec3::Zero();
+        case Script::Idle:
+            return Vec3::Zero();
         case Script::Press:
-        case Script::Clutch: return arm == 0 ? Vec3(0, 0, pressHeight(s, 0.09, rising)) : Vec3::Zero();
+        case Script::Clutch:
+            return arm == 0 ? Vec3(0, 0, pressHeight(s, 0.09, rising)) : Vec3::Zero();
         case Script::Circle: {
             const double w = 2 * M_PI / 4.0;
             return arm == 0 ? Vec3(0.04 * std::cos(w * s), 0.04 * std::sin(w * s), -0.07) : Vec3::Zero();
         }
-        case Script::Bimanual: return Vec3(0, 0, pressHeight(std::max(0.0, s - (arm == 1 ? 2.5 : 0.0)), 0.09, rising));
+        case Script::Bimanual:
+            return Vec3(0, 0, pressHeight(std::max(0.0, s - (arm == 1 ? 2.5 : 0.0)), 0.09, rising));
         }
         return Vec3::Zero();
     };
@@ -73,7 +83,8 @@ void ScriptedDevice::poll(int64_t now_ns, DeviceState& out) {
         ArmState& st = out.arms[a];
         st.measured_cp.position = position(a, t, &rising);
         st.measured_cp.orientation = Quat::Identity();
-        st.measured_cv.linear = (position(a, t + h, nullptr) - position(a, std::max(0.0, t - h), nullptr)) / (t >= h ? 2 * h : h);
+        st.measured_cv.linear =
+            (position(a, t + h, nullptr) - position(a, std::max(0.0, t - h), nullptr)) / (t >= h ? 2 * h : h);
         st.measured_cv.angular.setZero();
         st.jaw_measured_js = 0.3;
         st.buttons = 0;
@@ -81,7 +92,5 @@ void ScriptedDevice::poll(int64_t now_ns, DeviceState& out) {
     }
     countPoll();
 }
-
-
 
 } // namespace viscera::haptics

@@ -5,23 +5,25 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 #include <pthread.h>
 #include <sched.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
 #include <time.h>
+#include <unistd.h>
 
 namespace viscera::haptics {
 namespace {
 
 void atomicMax(std::atomic<int64_t>& a, int64_t v) {
     int64_t cur = a.load(std::memory_order_relaxed);
-    while (v > cur && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {}
+    while (v > cur && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {
+    }
 }
 void atomicMin(std::atomic<int64_t>& a, int64_t v) {
     int64_t cur = a.load(std::memory_order_relaxed);
-    while (v < cur && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {}
+    while (v < cur && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {
+    }
 }
 
 bool pinCurrentThread(int cpu) {
@@ -111,7 +113,9 @@ ServoLoop::ServoLoop(Device& device, const Clock& clock, const ServoConfig& conf
     }
 }
 
-ServoLoop::~ServoLoop() { stop(); }
+ServoLoop::~ServoLoop() {
+    stop();
+}
 
 void ServoLoop::tick(int64_t now) {
     const int64_t t0 = monotonicNs();
@@ -154,8 +158,10 @@ void ServoLoop::tick(int64_t now) {
             m_haveTarget[a] = m_state.connected;
         }
         // Clutch or no device: the tool stays; the master is re-indexed on release/reconnection.
-        if (hold) m_offset[a] = m_target[a] - mapped;
-        else m_target[a] = mapped + m_offset[a];
+        if (hold)
+            m_offset[a] = m_target[a] - mapped;
+        else
+            m_target[a] = mapped + m_offset[a];
         const Vec3& x = m_target[a];
         const ToolContactModel& tm = contact.tools[a];
         Vec3 p = x;
@@ -188,7 +194,8 @@ void ServoLoop::tick(int64_t now) {
     const uint32_t rules = m_safety.apply(in, m_desired, m_out);
     m_device.send(m_out);
     poses.safetyRules = rules;
-    for (int a = 0; a < arms; ++a) poses.force[a] = m_out.arms[a].servo_cf.force.norm();
+    for (int a = 0; a < arms; ++a)
+        poses.force[a] = m_out.arms[a].servo_cf.force.norm();
     m_poses.write(poses);
     for (int a = 0; a < arms; ++a) {
         if (!m_config.tools[a].enabled) continue;
@@ -230,9 +237,10 @@ void ServoLoop::run() {
             // Highest SCHED_OTHER weight instead (nice -20, where allowed), so that other processes
             // landing on this CPU get short slices only.
             const bool niced = setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), -20) == 0;
-            m_priorityNote = std::string("busy wait: kernel.sched_rt_runtime_us is not -1, a real-time spinner would be "
-                                         "throttled (50 ms stalls each second); running SCHED_OTHER") +
-                             (niced ? " at nice -20" : "") + " on its own CPU";
+            m_priorityNote =
+                std::string("busy wait: kernel.sched_rt_runtime_us is not -1, a real-time spinner would be "
+                            "throttled (50 ms stalls each second); running SCHED_OTHER") +
+                (niced ? " at nice -20" : "") + " on its own CPU";
         } else {
             sched_param sp{};
             sp.sched_priority = std::min(80, sched_get_priority_max(SCHED_FIFO));

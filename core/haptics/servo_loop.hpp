@@ -29,11 +29,11 @@ namespace viscera::haptics {
 /// How one device arm drives one simulated tool.
 struct ToolMapping {
     bool enabled = false;
-    Vec3 sceneStart = Vec3::Zero(); ///< m, scene: tool centre when the master is at the workspace centre
-    double motionScale = 0.25;      ///< scene metres per device metre
-    double forceScale = 1.0;        ///< device newtons per scene newton
+    Vec3 sceneStart = Vec3::Zero();    ///< m, scene: tool centre when the master is at the workspace centre
+    double motionScale = 0.25;         ///< scene metres per device metre
+    double forceScale = 1.0;           ///< device newtons per scene newton
     double couplingStiffness = 2000.0; ///< N/m, scene: virtual coupling proxy ↔ master
-    double couplingDamping = 2.0;   ///< N·s/m, scene: damps the normal approach while in contact
+    double couplingDamping = 2.0;      ///< N·s/m, scene: damps the normal approach while in contact
 };
 
 /// How the servo thread waits for its deadline.
@@ -50,9 +50,10 @@ enum class ServoWait {
 struct ServoConfig {
     double rateHz = 1000.0;
     ServoWait wait = ServoWait::SleepSpin;
-    int64_t spin_ns = 940'000;   ///< SleepSpin: wake this early and spin to the deadline (see servo_loop.cpp)
-    int cpu = -1;                ///< pin the servo thread to this CPU (-1: Busy → the highest allowed CPU, SleepSpin → none; ServoLoop::config() has it resolved; the player passes defaultServoCpu())
-    bool realtimePriority = true;   ///< try SCHED_FIFO for the servo thread (ignored when refused)
+    int64_t spin_ns = 940'000; ///< SleepSpin: wake this early and spin to the deadline (see servo_loop.cpp)
+    int cpu = -1; ///< pin the servo thread to this CPU (-1: Busy → the highest allowed CPU, SleepSpin → none;
+                  ///< ServoLoop::config() has it resolved; the player passes defaultServoCpu())
+    bool realtimePriority = true; ///< try SCHED_FIFO for the servo thread (ignored when refused)
     SafetyLimits safety;
     std::array<ToolMapping, kMaxArms> tools{};
     size_t traceCapacity = 1 << 16; ///< samples (one per enabled arm per tick)
@@ -63,14 +64,14 @@ struct TraceSample {
     uint8_t arm = 0;
     uint8_t connected = 0;
     uint32_t pedals = 0;
-    uint32_t rules = 0;       ///< SafetyRule bits
+    uint32_t rules = 0;         ///< SafetyRule bits
     Vec3 device = Vec3::Zero(); ///< m, device frame: master position
     Vec3 tool = Vec3::Zero();   ///< m, scene: proxy (simulated tool) centre
     Vec3 force = Vec3::Zero();  ///< N, device frame: after the safety filter
-    double desired = 0;       ///< N, magnitude before the safety filter
-    double grip = 0;          ///< rad
-    double contactAge_s = -1; ///< age of the contact model at this tick (-1: none yet)
-    int64_t contactFrame = -1; ///< physics frame of that model (-1: none yet)
+    double desired = 0;         ///< N, magnitude before the safety filter
+    double grip = 0;            ///< rad
+    double contactAge_s = -1;   ///< age of the contact model at this tick (-1: none yet)
+    int64_t contactFrame = -1;  ///< physics frame of that model (-1: none yet)
 };
 
 /// Percentiles from a 1 µs histogram.
@@ -81,17 +82,17 @@ struct Distribution {
 
 struct ServoStats {
     uint64_t ticks = 0;
-    uint64_t overruns = 0;        ///< ticks that started more than one period late
+    uint64_t overruns = 0;         ///< ticks that started more than one period late
     bool realtimePriority = false; ///< SCHED_FIFO was granted
     ServoWait wait = ServoWait::SleepSpin;
     int cpu = -1;                  ///< CPU the thread was pinned to (-1: not pinned)
     int64_t spinNs = 0;            ///< SleepSpin: spin before each deadline
     std::string priorityNote;      ///< why SCHED_FIFO was not used, when it was not
-    Distribution period;          ///< tick-to-tick interval
-    Distribution jitter;          ///< |period − nominal|
-    Distribution wakeLatency;     ///< tick start − deadline
-    Distribution tickCost;        ///< duration of tick()
-    Distribution contactAge;      ///< age of the contact model at each tick (after the first publish)
+    Distribution period;           ///< tick-to-tick interval
+    Distribution jitter;           ///< |period − nominal|
+    Distribution wakeLatency;      ///< tick start − deadline
+    Distribution tickCost;         ///< duration of tick()
+    Distribution contactAge;       ///< age of the contact model at each tick (after the first publish)
     int64_t contactModelsSeen = 0; ///< distinct physics frames the ticks used
     int64_t maxStepsBehind = 0;    ///< max over ticks of (physics steps started − model's frame)
     SafetyCounts safety;

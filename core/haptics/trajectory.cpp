@@ -17,8 +17,10 @@ constexpr const char* kColumns = "t,arm,x,y,z,qw,qx,qy,qz,grip,buttons,pedals";
 constexpr size_t kMaxSamples = 20'000'000;
 
 std::string_view trim(std::string_view s) {
-    while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r')) s.remove_prefix(1);
-    while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+    while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r'))
+        s.remove_prefix(1);
+    while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
+        s.remove_suffix(1);
     return s;
 }
 
@@ -40,7 +42,9 @@ Trajectory Trajectory::parse(std::string_view text, const std::string& origin) {
         ++lineNo;
         if (line.empty()) continue;
         if (!sawMagic) {
-            if (line != kMagic) fail("the first line must be '" + std::string(kMagic) + "' (not a trajectory file, or another version)");
+            if (line != kMagic)
+                fail("the first line must be '" + std::string(kMagic) +
+                     "' (not a trajectory file, or another version)");
             sawMagic = true;
             continue;
         }
@@ -54,14 +58,17 @@ Trajectory Trajectory::parse(std::string_view text, const std::string& origin) {
         size_t field = 0, p = 0;
         while (true) {
             size_t comma = line.find(',', p);
-            std::string_view tok = trim(line.substr(p, comma == std::string_view::npos ? std::string_view::npos : comma - p));
+            std::string_view tok =
+                trim(line.substr(p, comma == std::string_view::npos ? std::string_view::npos : comma - p));
             if (field >= 12) fail("has more than 12 fields");
             std::string s(tok);
             char* stop = nullptr;
             errno = 0;
             v[field] = s.empty() ? NAN : std::strtod(s.c_str(), &stop);
-            if (s.empty() || stop != s.c_str() + s.size()) fail(std::string("field '") + names[field] + "': not a number");
-            if (!std::isfinite(v[field]) || errno == ERANGE) fail(std::string("field '") + names[field] + "': must be finite");
+            if (s.empty() || stop != s.c_str() + s.size())
+                fail(std::string("field '") + names[field] + "': not a number");
+            if (!std::isfinite(v[field]) || errno == ERANGE)
+                fail(std::string("field '") + names[field] + "': must be finite");
             ++field;
             if (comma == std::string_view::npos) break;
             p = comma + 1;
@@ -81,12 +88,15 @@ Trajectory Trajectory::parse(std::string_view text, const std::string& origin) {
         s.pose.orientation = q.normalized();
         if (v[9] < 0 || v[9] > M_PI) fail("field 'grip': must be in [0, pi] rad");
         s.grip = v[9];
-        if (v[10] != std::floor(v[10]) || v[10] < 0 || v[10] > 4294967295.0) fail("field 'buttons': must be an unsigned 32-bit integer");
+        if (v[10] != std::floor(v[10]) || v[10] < 0 || v[10] > 4294967295.0)
+            fail("field 'buttons': must be an unsigned 32-bit integer");
         s.buttons = static_cast<uint32_t>(v[10]);
-        if (v[11] != std::floor(v[11]) || v[11] < 0 || v[11] > double(uint32_t(kPedalMask))) fail("field 'pedals': must be an integer in [0, 31]");
+        if (v[11] != std::floor(v[11]) || v[11] < 0 || v[11] > double(uint32_t(kPedalMask)))
+            fail("field 'pedals': must be an integer in [0, 31]");
         s.pedals = static_cast<uint32_t>(v[11]);
         auto& a = traj.m_arms[arm];
-        if (!a.empty() && !(s.t > a.back().t)) fail("field 't': must increase from one sample of arm " + std::to_string(arm) + " to the next");
+        if (!a.empty() && !(s.t > a.back().t))
+            fail("field 't': must increase from one sample of arm " + std::to_string(arm) + " to the next");
         if (a.size() + 1 > kMaxSamples) fail("more than 20,000,000 samples");
         a.push_back(s);
     }
@@ -95,7 +105,9 @@ Trajectory Trajectory::parse(std::string_view text, const std::string& origin) {
     return traj;
 }
 
-Trajectory Trajectory::load(const std::filesystem::path& path) { return parse(readFile(path), path.string()); }
+Trajectory Trajectory::load(const std::filesystem::path& path) {
+    return parse(readFile(path), path.string());
+}
 
 std::string Trajectory::format() const {
     std::string out = std::string(kMagic) + "\n" + kColumns + "\n";
@@ -104,15 +116,16 @@ std::string Trajectory::format() const {
         for (const auto& s : m_arms[a]) {
             const Vec3& x = s.pose.position;
             const Quat& q = s.pose.orientation;
-            std::snprintf(buf, sizeof buf, "%.6f,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%u,%u\n", s.t, a, x.x(), x.y(),
-                          x.z(), q.w(), q.x(), q.y(), q.z(), s.grip, s.buttons, s.pedals);
+            std::snprintf(buf, sizeof buf, "%.6f,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%u,%u\n", s.t, a, x.x(),
+                          x.y(), x.z(), q.w(), q.x(), q.y(), q.z(), s.grip, s.buttons, s.pedals);
             out += buf;
         }
     return out;
 }
 
 void Trajectory::add(int arm, const TrajectorySample& s) {
-    if (arm < 0 || arm >= kMaxArms) throw std::invalid_argument("haptics::Trajectory::add(): arm " + std::to_string(arm) + " is out of range");
+    if (arm < 0 || arm >= kMaxArms)
+        throw std::invalid_argument("haptics::Trajectory::add(): arm " + std::to_string(arm) + " is out of range");
     auto& a = m_arms[arm];
     if (!a.empty() && !(s.t > a.back().t))
         throw std::invalid_argument("haptics::Trajectory::add(): t " + std::to_string(s.t) + " does not increase");

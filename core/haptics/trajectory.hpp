@@ -23,7 +23,7 @@ namespace viscera::haptics {
 struct TrajectorySample {
     double t = 0; ///< s
     Pose pose;
-    double grip = 0;      ///< rad
+    double grip = 0; ///< rad
     uint32_t buttons = 0;
     uint32_t pedals = 0;
 };
@@ -39,8 +39,8 @@ public:
     /// Appends a sample to arm `arm` (0..kMaxArms-1); t must exceed the arm's last t.
     /// Throws std::invalid_argument otherwise.
     void add(int arm, const TrajectorySample& s);
-    int arms() const;                 ///< 1 + highest arm index with samples (0 if empty)
-    double duration() const;          ///< s, the latest sample time over all arms
+    int arms() const;        ///< 1 + highest arm index with samples (0 if empty)
+    double duration() const; ///< s, the latest sample time over all arms
     const std::vector<TrajectorySample>& samples(int arm) const { return m_arms[arm]; }
 
     /// State at time t (s): pose, grip, buttons of each arm, pedals (OR over arms), twist from

@@ -51,51 +51,51 @@ struct Wrench {
 /// What one arm (master) of a device can do.
 struct ArmCapabilities {
     Hand hand = Hand::Either;
-    int dof = 7;               ///< 3 position + 3 orientation + grip
+    int dof = 7; ///< 3 position + 3 orientation + grip
     bool grip = true;
-    double maxForce = 15.0;    ///< N, magnitude
-    double maxTorque = 0.0;    ///< N·m, magnitude (0: no torque rendering)
-    double maxGripForce = 0.0; ///< N
+    double maxForce = 15.0;                     ///< N, magnitude
+    double maxTorque = 0.0;                     ///< N·m, magnitude (0: no torque rendering)
+    double maxGripForce = 0.0;                  ///< N
     Vec3 workspaceMin = Vec3(-0.4, -0.2, -0.2); ///< m, axis-aligned box in the base frame
     Vec3 workspaceMax = Vec3(0.4, 0.2, 0.2);    ///< m (80 × 40 × 40 cm, [B §4])
     Vec3 workspaceCentre() const { return 0.5 * (workspaceMin + workspaceMax); }
 };
 
 struct DeviceCapabilities {
-    std::string name;  ///< e.g. "console 127.0.0.1:7400"
-    int arms = 1;      ///< 1..kMaxArms
+    std::string name; ///< e.g. "console 127.0.0.1:7400"
+    int arms = 1;     ///< 1..kMaxArms
     std::array<ArmCapabilities, kMaxArms> arm{};
-    int pedals = 0;    ///< number of pedals (0 = none: the deadman rule does not apply)
+    int pedals = 0;        ///< number of pedals (0 = none: the deadman rule does not apply)
     bool realtime = false; ///< true when the device runs on wall-clock time (network, keyboard)
 };
 
 /// One arm's measured state (CRTK measured_*).
 struct ArmState {
-    Pose measured_cp;             ///< measured Cartesian position
-    Twist measured_cv;            ///< measured Cartesian velocity
-    double jaw_measured_js = 0;   ///< grip opening angle, rad
-    uint32_t buttons = 0;         ///< bit set of the arm's buttons
+    Pose measured_cp;           ///< measured Cartesian position
+    Twist measured_cv;          ///< measured Cartesian velocity
+    double jaw_measured_js = 0; ///< grip opening angle, rad
+    uint32_t buttons = 0;       ///< bit set of the arm's buttons
 };
 
 /// A device's measured state at one instant.
 struct DeviceState {
-    int64_t timestamp_ns = 0;     ///< when the sample was taken, device clock
-    uint64_t sequence = 0;        ///< increases with every new sample
-    bool connected = false;       ///< false while the device does not answer
-    uint32_t pedals = 0;          ///< Pedal bits
+    int64_t timestamp_ns = 0; ///< when the sample was taken, device clock
+    uint64_t sequence = 0;    ///< increases with every new sample
+    bool connected = false;   ///< false while the device does not answer
+    uint32_t pedals = 0;      ///< Pedal bits
     std::array<ArmState, kMaxArms> arms{};
 };
 
 /// One arm's command (CRTK servo_cf and jaw/servo_jf).
 struct ArmCommand {
-    Wrench servo_cf;              ///< Cartesian force/torque to render, N and N·m, base frame
-    double jaw_servo_jf = 0;      ///< grip force, N
+    Wrench servo_cf;         ///< Cartesian force/torque to render, N and N·m, base frame
+    double jaw_servo_jf = 0; ///< grip force, N
 };
 
 struct DeviceCommand {
-    int64_t timestamp_ns = 0;     ///< when the command was computed, servo clock
+    int64_t timestamp_ns = 0; ///< when the command was computed, servo clock
     uint64_t sequence = 0;
-    uint32_t flags = 0;           ///< CommandFlag bits (what the safety filter did)
+    uint32_t flags = 0; ///< CommandFlag bits (what the safety filter did)
     std::array<ArmCommand, kMaxArms> arms{};
 };
 

@@ -28,7 +28,8 @@ Endpoint parseEndpoint(const std::string& text, const std::string& what, bool al
     char* end = nullptr;
     const long p = std::strtol(port.c_str(), &end, 10);
     if (*end != '\0' || p < (allowZeroPort ? 0 : 1) || p > 65535)
-        throw InputError(what + ": port '" + port + "' must be an integer in [" + (allowZeroPort ? "0" : "1") + ", 65535]");
+        throw InputError(what + ": port '" + port + "' must be an integer in [" + (allowZeroPort ? "0" : "1") +
+                         ", 65535]");
     if (host == "localhost") host = "127.0.0.1";
     Endpoint e;
     e.addr.sin_family = AF_INET;
@@ -41,7 +42,8 @@ Endpoint parseEndpoint(const std::string& text, const std::string& what, bool al
 UdpSocket::UdpSocket(const Endpoint& local, int receiveBufferBytes) {
     m_fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
     if (m_fd < 0) throw InputError("udp " + local.text() + ": socket(): " + std::strerror(errno));
-    if (receiveBufferBytes > 0) ::setsockopt(m_fd, SOL_SOCKET, SO_RCVBUF, &receiveBufferBytes, sizeof receiveBufferBytes);
+    if (receiveBufferBytes > 0)
+        ::setsockopt(m_fd, SOL_SOCKET, SO_RCVBUF, &receiveBufferBytes, sizeof receiveBufferBytes);
     // Arrival stamps for the queue age receive() reports; without them the age reads 0.
     const int on = 1;
     ::setsockopt(m_fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
@@ -86,8 +88,8 @@ long UdpSocket::receive(uint8_t* buffer, size_t capacity, Endpoint* from, int64_
 }
 
 bool UdpSocket::sendTo(const uint8_t* data, size_t size, const Endpoint& to) noexcept {
-    const ssize_t n = ::sendto(m_fd, data, size, MSG_DONTWAIT | MSG_NOSIGNAL, reinterpret_cast<const sockaddr*>(&to.addr),
-                               sizeof to.addr);
+    const ssize_t n = ::sendto(m_fd, data, size, MSG_DONTWAIT | MSG_NOSIGNAL,
+                               reinterpret_cast<const sockaddr*>(&to.addr), sizeof to.addr);
     return n == static_cast<ssize_t>(size);
 }
 

@@ -40,10 +40,14 @@ int samplesForDistance(const std::vector<DistanceBand>& bands, float d) {
 
 int samplesFor(const SamplingSettings& s, float d, int painted) {
     switch (s.mode) {
-    case SampleMode::Uniform: return s.uniformSamples;
-    case SampleMode::Distance: return samplesForDistance(s.bands, d);
-    case SampleMode::Painted: return painted > 0 ? painted : s.uniformSamples;
-    case SampleMode::Reference: return s.referenceSamples;
+    case SampleMode::Uniform:
+        return s.uniformSamples;
+    case SampleMode::Distance:
+        return samplesForDistance(s.bands, d);
+    case SampleMode::Painted:
+        return painted > 0 ? painted : s.uniformSamples;
+    case SampleMode::Reference:
+        return s.referenceSamples;
     }
     return 1;
 }

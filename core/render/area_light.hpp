@@ -18,7 +18,7 @@ struct LightFrame {
     Eigen::Vector3f halfU{0.01f, 0.0f, 0.0f}; ///< m, half width along the rectangle's u axis
     Eigen::Vector3f halfV{0.0f, 0.005f, 0.0f};
     Eigen::Vector3f radiance = Eigen::Vector3f::Ones(); ///< colour · intensity / area
-    float area = 2e-4f; ///< m²
+    float area = 2e-4f;                                 ///< m²
 };
 /// Places the light (following the mono camera when light.followCamera).
 LightFrame lightFrame(const AreaLight& light, const EyeView& monoCamera);

@@ -28,9 +28,9 @@ struct PassContext {
 
 /// Counters a test can check (e.g. "meshes update without reallocating buffers").
 struct BackendStats {
-    uint64_t bufferAllocations = 0;  ///< GPU buffers created or resized
-    uint64_t bufferUpdates = 0;      ///< in-place sub-data writes
-    uint64_t targetAllocations = 0;  ///< render-target (re)allocations
+    uint64_t bufferAllocations = 0; ///< GPU buffers created or resized
+    uint64_t bufferUpdates = 0;     ///< in-place sub-data writes
+    uint64_t targetAllocations = 0; ///< render-target (re)allocations
     uint64_t drawCalls = 0;
     uint64_t passesRun = 0;
 };
@@ -74,8 +74,8 @@ public:
     struct MeshRecord {
         size_t vertices = 0, triangles = 0;
         uint64_t updates = 0;
-        size_t drawnTriangles = 0;   ///< faces the G-buffer pass would draw (face mask)
-        uint64_t maskUpdates = 0;    ///< updateFaceMask calls
+        size_t drawnTriangles = 0;          ///< faces the G-buffer pass would draw (face mask)
+        uint64_t maskUpdates = 0;           ///< updateFaceMask calls
         std::vector<uint32_t> drawnIndices; ///< what the index buffer holds, compacted
     };
     const char* name() const override { return "mock"; }

@@ -10,7 +10,8 @@ namespace viscera::render {
 Eigen::Matrix4f lookAt(const Eigen::Vector3f& eye, const Eigen::Vector3f& target, const Eigen::Vector3f& up) {
     const Eigen::Vector3f f = (target - eye).normalized();
     Eigen::Vector3f s = f.cross(up);
-    if (s.squaredNorm() < 1e-12f) s = f.cross(std::abs(f.z()) < 0.9f ? Eigen::Vector3f::UnitZ() : Eigen::Vector3f::UnitY());
+    if (s.squaredNorm() < 1e-12f)
+        s = f.cross(std::abs(f.z()) < 0.9f ? Eigen::Vector3f::UnitZ() : Eigen::Vector3f::UnitY());
     s.normalize();
     const Eigen::Vector3f u = s.cross(f);
     Eigen::Matrix4f m = Eigen::Matrix4f::Identity();

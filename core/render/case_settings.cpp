@@ -14,11 +14,15 @@ void applyCaseRender(RenderSettings& settings, std::string_view text, const std:
     s.subsurface = root.boolean("sss", s.subsurface);
     if (auto v = root.find("sampling")) {
         const std::string m = v->choice({"uniform", "distance", "painted"}, "a sampling mode");
-        s.sampling.mode = m == "uniform" ? SampleMode::Uniform : m == "distance" ? SampleMode::Distance : SampleMode::Painted;
+        s.sampling.mode = m == "uniform"    ? SampleMode::Uniform
+                          : m == "distance" ? SampleMode::Distance
+                                            : SampleMode::Painted;
     }
     if (auto v = root.find("stereo")) {
         const std::string m = v->choice({"off", "side_by_side", "anaglyph"}, "a stereo mode");
-        s.stereo.mode = m == "off" ? StereoMode::Off : m == "side_by_side" ? StereoMode::SideBySide : StereoMode::Anaglyph;
+        s.stereo.mode = m == "off"            ? StereoMode::Off
+                        : m == "side_by_side" ? StereoMode::SideBySide
+                                              : StereoMode::Anaglyph;
     }
     if (auto post = root.find("post")) {
         post->object({"chromatic_aberration", "colour_curve", "depth_of_field", "noise", "radial_mask", "sharpen",
@@ -30,7 +34,8 @@ void applyCaseRender(RenderSettings& settings, std::string_view text, const std:
                                                          {"sharpen", &s.post.sharpen.enabled},
                                                          {"noise", &s.post.noise.enabled},
                                                          {"radial_mask", &s.post.radialMask.enabled}};
-        for (const auto& [name, on] : effects) *on = post->boolean(name, *on);
+        for (const auto& [name, on] : effects)
+            *on = post->boolean(name, *on);
     }
     settings = std::move(s);
 }

@@ -15,11 +15,13 @@ FrameLayout frameLayout(const RenderSettings& s) {
 std::vector<PassDesc> planFrame(const RenderSettings& s) {
     const FrameLayout l = frameLayout(s);
     const PostSettings& p = s.post;
-    const std::pair<bool, PassKind> effects[] = {
-        {p.depthOfField.enabled, PassKind::DepthOfField}, {p.chromaticAberration.enabled, PassKind::ChromaticAberration},
-        {p.toneMapping.enabled, PassKind::ToneMapping},   {p.colourCurve.enabled, PassKind::ColourCurve},
-        {p.sharpen.enabled, PassKind::Sharpen},           {p.noise.enabled, PassKind::Noise},
-        {p.radialMask.enabled, PassKind::RadialMask}};
+    const std::pair<bool, PassKind> effects[] = {{p.depthOfField.enabled, PassKind::DepthOfField},
+                                                 {p.chromaticAberration.enabled, PassKind::ChromaticAberration},
+                                                 {p.toneMapping.enabled, PassKind::ToneMapping},
+                                                 {p.colourCurve.enabled, PassKind::ColourCurve},
+                                                 {p.sharpen.enabled, PassKind::Sharpen},
+                                                 {p.noise.enabled, PassKind::Noise},
+                                                 {p.radialMask.enabled, PassKind::RadialMask}};
     const Viewport eyeVp{0, 0, l.eyeWidth, l.eyeHeight};
     std::vector<PassDesc> plan;
     for (int eye = 0; eye < l.eyes; ++eye) {
@@ -45,21 +47,34 @@ std::vector<PassDesc> planFrame(const RenderSettings& s) {
 
 const char* passName(PassKind k) {
     switch (k) {
-    case PassKind::GBuffer: return "gbuffer";
-    case PassKind::Lighting: return "lighting";
-    case PassKind::DepthOfField: return "depth_of_field";
-    case PassKind::ChromaticAberration: return "chromatic_aberration";
-    case PassKind::ToneMapping: return "tone_mapping";
-    case PassKind::ColourCurve: return "colour_curve";
-    case PassKind::Sharpen: return "sharpen";
-    case PassKind::Noise: return "noise";
-    case PassKind::RadialMask: return "radial_mask";
-    case PassKind::Output: return "output";
-    case PassKind::StereoCompose: return "stereo_compose";
+    case PassKind::GBuffer:
+        return "gbuffer";
+    case PassKind::Lighting:
+        return "lighting";
+    case PassKind::DepthOfField:
+        return "depth_of_field";
+    case PassKind::ChromaticAberration:
+        return "chromatic_aberration";
+    case PassKind::ToneMapping:
+        return "tone_mapping";
+    case PassKind::ColourCurve:
+        return "colour_curve";
+    case PassKind::Sharpen:
+        return "sharpen";
+    case PassKind::Noise:
+        return "noise";
+    case PassKind::RadialMask:
+        return "radial_mask";
+    case PassKind::Output:
+        return "output";
+    case PassKind::StereoCompose:
+        return "stereo_compose";
     }
     return "?";
 }
 
-bool isPostEffect(PassKind k) { return k >= PassKind::DepthOfField && k <= PassKind::RadialMask; }
+bool isPostEffect(PassKind k) {
+    return k >= PassKind::DepthOfField && k <= PassKind::RadialMask;
+}
 
 } // namespace viscera::render

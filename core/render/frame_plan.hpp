@@ -21,8 +21,8 @@ enum class PassKind : uint8_t {
     Sharpen,
     Noise,
     RadialMask,
-    Output,        ///< HDR → 8-bit display values (clamp, sRGB) into the eye's viewport
-    StereoCompose  ///< anaglyph: left and right eye images → Final
+    Output,       ///< HDR → 8-bit display values (clamp, sRGB) into the eye's viewport
+    StereoCompose ///< anaglyph: left and right eye images → Final
 };
 
 enum class Target : uint8_t { None, GBuffer, Lit, PostA, PostB, EyeLeft, EyeRight, Final };
@@ -35,10 +35,10 @@ struct Viewport {
 
 struct PassDesc {
     PassKind kind = PassKind::GBuffer;
-    int eye = 0;            ///< 0 mono/left, 1 right
+    int eye = 0; ///< 0 mono/left, 1 right
     Target input = Target::None;
     Target output = Target::None;
-    Viewport viewport;      ///< where `output` is written
+    Viewport viewport; ///< where `output` is written
 };
 
 /// Sizes the backend allocates: one eye's G-buffer/HDR size and the output size.

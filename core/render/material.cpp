@@ -6,7 +6,9 @@
 namespace viscera::render {
 
 namespace {
-bool has(const std::string& name, const char* word) { return name.find(word) != std::string::npos; }
+bool has(const std::string& name, const char* word) {
+    return name.find(word) != std::string::npos;
+}
 } // namespace
 
 TissueMaterial defaultMaterialFor(const std::string& rawName) {

@@ -14,8 +14,8 @@ namespace viscera::render {
 
 struct TissueLayer {
     Eigen::Vector3f colour{0.6f, 0.2f, 0.2f}; ///< linear albedo
-    float weight = 1.0f;                       ///< blend weight in [0, 1]
-    float frequency = 300.0f;                  ///< pattern cells per metre (rest frame)
+    float weight = 1.0f;                      ///< blend weight in [0, 1]
+    float frequency = 300.0f;                 ///< pattern cells per metre (rest frame)
 };
 
 /// Bits of the G-buffer flag channel (RT3.a).
@@ -28,14 +28,14 @@ struct TissueMaterial {
     TissueLayer connective{{0.75f, 0.45f, 0.40f}, 0.25f, 250.0f};
     TissueLayer submucosa{{0.30f, 0.03f, 0.05f}, 0.35f, 120.0f};
     Eigen::Vector3f fibreAxis{1.0f, 0.0f, 0.0f};
-    float roughness = 0.42f;  ///< perceptual, α = roughness²
+    float roughness = 0.42f;         ///< perceptual, α = roughness²
     float granularRoughness = 0.15f; ///< roughness variation driven by the granular pattern
     float metallic = 0.0f;
-    float reflection = 0.25f; ///< mucus reflection weight (G-buffer "reflection")
-    float f0 = 0.028f;        ///< normal-incidence Fresnel reflectance (wet tissue ≈ water)
-    float sssWeight = 0.45f;  ///< k_sss [A eq. 6.5]
-    Eigen::Vector3f sssColour{1.0f, 0.35f, 0.25f};  ///< C [A eq. 6.8]
-    Eigen::Vector3f sigma{60.0f, 180.0f, 220.0f};   ///< absorption σ, 1/m, per channel
+    float reflection = 0.25f;                      ///< mucus reflection weight (G-buffer "reflection")
+    float f0 = 0.028f;                             ///< normal-incidence Fresnel reflectance (wet tissue ≈ water)
+    float sssWeight = 0.45f;                       ///< k_sss [A eq. 6.5]
+    Eigen::Vector3f sssColour{1.0f, 0.35f, 0.25f}; ///< C [A eq. 6.8]
+    Eigen::Vector3f sigma{60.0f, 180.0f, 220.0f};  ///< absorption σ, 1/m, per channel
     uint8_t flags = kFlagNone;
 };
 

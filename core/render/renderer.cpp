@@ -7,7 +7,9 @@ namespace viscera::render {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+double msSince(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
 } // namespace
 
 double FrameStats::passMs(const std::string& name) const {
@@ -17,8 +19,7 @@ double FrameStats::passMs(const std::string& name) const {
     return sum;
 }
 
-Renderer::Renderer(std::unique_ptr<Backend> backend, const RenderSettings& settings)
-    : m_backend(std::move(backend)) {
+Renderer::Renderer(std::unique_ptr<Backend> backend, const RenderSettings& settings) : m_backend(std::move(backend)) {
     if (!m_backend) throw std::invalid_argument("render::Renderer: backend is null");
     setSettings(settings);
 }
@@ -48,7 +49,8 @@ void Renderer::syncMeshes(const SceneView& view) {
         }
         if (m.vertexCount() != s.vertices || m.indices.size() != s.indices) {
             s.broken = true;
-            m_warnings.push_back("render::Renderer: mesh " + m.name + " changed its vertex or index count after "
+            m_warnings.push_back("render::Renderer: mesh " + m.name +
+                                 " changed its vertex or index count after "
                                  "upload; it is no longer drawn");
             continue;
         }
@@ -80,8 +82,10 @@ const FrameStats& Renderer::renderFrame(const SceneView& view) {
     const float aspect = float(layout.eyeWidth) / float(layout.eyeHeight);
     m_previousEyes = m_eyes;
     const EyeView mono = monoEye(m_settings.camera, aspect);
-    if (layout.eyes == 2) m_eyes = stereoEyes(m_settings.camera, m_settings.stereo, aspect);
-    else m_eyes = {mono, mono};
+    if (layout.eyes == 2)
+        m_eyes = stereoEyes(m_settings.camera, m_settings.stereo, aspect);
+    else
+        m_eyes = {mono, mono};
     if (m_frame == 0) m_previousEyes = m_eyes;
     m_light = lightFrame(m_settings.light, mono);
 
@@ -109,7 +113,8 @@ std::vector<float> Renderer::distanceMap(const Eigen::Vector3f& point) {
             const float d = depth[size_t(y) * w + x];
             if (d >= 1.0f) continue;
             // Rows are top to bottom; NDC y grows upwards.
-            const Eigen::Vector4f ndc(2.0f * (x + 0.5f) / w - 1.0f, 1.0f - 2.0f * (y + 0.5f) / h, 2.0f * d - 1.0f, 1.0f);
+            const Eigen::Vector4f ndc(2.0f * (x + 0.5f) / w - 1.0f, 1.0f - 2.0f * (y + 0.5f) / h, 2.0f * d - 1.0f,
+                                      1.0f);
             const Eigen::Vector4f p = e.inverseViewProjection * ndc;
             out[size_t(y) * w + x] = (p.head<3>() / p.w() - point).norm();
         }

@@ -14,7 +14,7 @@ namespace viscera::render {
 struct PassTiming {
     std::string name; ///< passName(), e.g. "lighting"
     int eye = 0;
-    double ms = 0;    ///< wall time to completion (the backend is waited for after each pass)
+    double ms = 0; ///< wall time to completion (the backend is waited for after each pass)
 };
 
 struct FrameStats {

@@ -16,7 +16,8 @@ using Tri3 = std::array<uint32_t, 3>;
 
 std::vector<Eigen::Vector3f> toFloat(const std::vector<sim::Vec3>& p) {
     std::vector<Eigen::Vector3f> out(p.size());
-    for (size_t i = 0; i < p.size(); ++i) out[i] = p[i].cast<float>();
+    for (size_t i = 0; i < p.size(); ++i)
+        out[i] = p[i].cast<float>();
     return out;
 }
 
@@ -25,19 +26,23 @@ void computeNormals(const std::vector<float>& pos, const std::vector<uint32_t>& 
     for (size_t t = 0; t + 2 < idx.size(); t += 3) {
         const Eigen::Map<const Eigen::Vector3f> a(&pos[3 * idx[t]]), b(&pos[3 * idx[t + 1]]), c(&pos[3 * idx[t + 2]]);
         const Eigen::Vector3f n = (b - a).cross(c - a); // area-weighted
-        for (int k = 0; k < 3; ++k) Eigen::Map<Eigen::Vector3f>(&nrm[3 * idx[t + k]]) += n;
+        for (int k = 0; k < 3; ++k)
+            Eigen::Map<Eigen::Vector3f>(&nrm[3 * idx[t + k]]) += n;
     }
     for (size_t v = 0; v < nrm.size(); v += 3) {
         Eigen::Map<Eigen::Vector3f> n(&nrm[v]);
         const float len = n.norm();
-        if (len > 0) n /= len;
-        else n = Eigen::Vector3f::UnitZ();
+        if (len > 0)
+            n /= len;
+        else
+            n = Eigen::Vector3f::UnitZ();
     }
 }
 
 std::vector<Eigen::Vector3f> asVectors(const std::vector<float>& flat) {
     std::vector<Eigen::Vector3f> out(flat.size() / 3);
-    for (size_t i = 0; i < out.size(); ++i) out[i] = Eigen::Vector3f(flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]);
+    for (size_t i = 0; i < out.size(); ++i)
+        out[i] = Eigen::Vector3f(flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]);
     return out;
 }
 
@@ -45,10 +50,12 @@ RenderMesh makeMesh(const std::string& name, const std::vector<Eigen::Vector3f>&
     RenderMesh m;
     m.name = name;
     m.indices.reserve(tris.size() * 3);
-    for (const Tri3& t : tris) m.indices.insert(m.indices.end(), t.begin(), t.end());
+    for (const Tri3& t : tris)
+        m.indices.insert(m.indices.end(), t.begin(), t.end());
     m.positions.resize(pos.size() * 3);
     for (size_t i = 0; i < pos.size(); ++i)
-        for (int k = 0; k < 3; ++k) m.positions[3 * i + k] = pos[i][k];
+        for (int k = 0; k < 3; ++k)
+            m.positions[3 * i + k] = pos[i][k];
     m.rest = m.positions;
     m.normals.resize(m.positions.size());
     computeNormals(m.positions, m.indices, m.normals);
@@ -61,7 +68,8 @@ RenderMesh makeMesh(const std::string& name, const std::vector<Eigen::Vector3f>&
 std::vector<Tri3> trianglesOf(const sim::TriMesh& mesh) {
     std::vector<Tri3> tris;
     tris.reserve(mesh.triangleCount());
-    for (const sim::Tri& t : mesh.triangles()) tris.push_back({uint32_t(t[0]), uint32_t(t[1]), uint32_t(t[2])});
+    for (const sim::Tri& t : mesh.triangles())
+        tris.push_back({uint32_t(t[0]), uint32_t(t[1]), uint32_t(t[2])});
     return tris;
 }
 
@@ -98,7 +106,8 @@ SceneView SceneView::fromWorld(const sim::World& world, const ThicknessBakeSetti
         const sim::TriMesh& boundary = mesh->boundary();
         const std::vector<int32_t>& map = mesh->boundaryVertexMap();
         std::vector<Eigen::Vector3f> pos(map.size());
-        for (size_t i = 0; i < map.size(); ++i) pos[i] = mesh->positions()[map[i]].cast<float>();
+        for (size_t i = 0; i < map.size(); ++i)
+            pos[i] = mesh->positions()[map[i]].cast<float>();
         const auto tris = trianglesOf(boundary);
         RenderMesh m = makeMesh(world.bodyName(b), pos, tris);
         m.material = view.addMaterial(defaultMaterialFor(world.bodyName(b)));
@@ -108,7 +117,8 @@ SceneView SceneView::fromWorld(const sim::World& world, const ThicknessBakeSetti
         m.thickness = bakeThickness(pos, asVectors(m.normals), TriangleBvh(pos, tris), bake);
         const uint32_t base = uint32_t(allPos.size());
         allPos.insert(allPos.end(), pos.begin(), pos.end());
-        for (const Tri3& t : tris) allTris.push_back({t[0] + base, t[1] + base, t[2] + base});
+        for (const Tri3& t : tris)
+            allTris.push_back({t[0] + base, t[1] + base, t[2] + base});
         view.m_meshes.push_back(std::move(m));
     }
     std::unique_ptr<TriangleBvh> bodies;
@@ -128,7 +138,8 @@ SceneView SceneView::fromWorld(const sim::World& world, const ThicknessBakeSetti
         m.source = RenderMesh::Source::Surface;
         m.sourceIndex = s;
         m.sourceVertex.resize(pos.size());
-        for (size_t i = 0; i < pos.size(); ++i) m.sourceVertex[i] = int32_t(i);
+        for (size_t i = 0; i < pos.size(); ++i)
+            m.sourceVertex[i] = int32_t(i);
         if (bodies) {
             // The membrane sits on a body: its normal points away from the body, so −n enters it.
             m.thickness = bakeThickness(pos, asVectors(m.normals), *bodies, bake);
@@ -178,14 +189,16 @@ void SceneView::setHeat(size_t i, const std::vector<float>& heat) {
         throw std::invalid_argument("render::SceneView::setHeat(): mesh " + m.name + " has " +
                                     std::to_string(m.vertexCount()) + " vertices, got " + std::to_string(heat.size()) +
                                     " heat values");
-    for (size_t v = 0; v < heat.size(); ++v) m.heat[v] = std::clamp(heat[v], 0.0f, 1.0f);
+    for (size_t v = 0; v < heat.size(); ++v)
+        m.heat[v] = std::clamp(heat[v], 0.0f, 1.0f);
     ++m.revision;
 }
 
 size_t RenderMesh::drawnTriangleCount() const {
     if (faceMask.size() != triangleCount()) return triangleCount();
     size_t n = 0;
-    for (uint8_t f : faceMask) n += f ? 1 : 0;
+    for (uint8_t f : faceMask)
+        n += f ? 1 : 0;
     return n;
 }
 
@@ -198,7 +211,8 @@ void RenderMesh::drawnIndicesInto(std::vector<uint32_t>& out) const {
     size_t k = 0;
     for (size_t f = 0; f < faceMask.size(); ++f)
         if (faceMask[f])
-            for (int c = 0; c < 3; ++c) out[k++] = indices[3 * f + c];
+            for (int c = 0; c < 3; ++c)
+                out[k++] = indices[3 * f + c];
 }
 
 void SceneView::setFaceMask(size_t i, const std::vector<uint8_t>& mask) {
@@ -208,10 +222,12 @@ void SceneView::setFaceMask(size_t i, const std::vector<uint8_t>& mask) {
                                     std::to_string(m.triangleCount()) + " triangles, got " +
                                     std::to_string(mask.size()) + " flags");
     bool same = mask.size() == m.faceMask.size();
-    for (size_t f = 0; same && f < mask.size(); ++f) same = (mask[f] != 0) == (m.faceMask[f] != 0);
+    for (size_t f = 0; same && f < mask.size(); ++f)
+        same = (mask[f] != 0) == (m.faceMask[f] != 0);
     if (same) return;
     m.faceMask.resize(mask.size());
-    for (size_t f = 0; f < mask.size(); ++f) m.faceMask[f] = mask[f] ? 1 : 0;
+    for (size_t f = 0; f < mask.size(); ++f)
+        m.faceMask[f] = mask[f] ? 1 : 0;
     ++m.faceMaskRevision;
 }
 

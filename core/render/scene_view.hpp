@@ -22,27 +22,27 @@ namespace viscera::render {
 
 struct RenderMesh {
     std::string name;
-    uint32_t material = 0;     ///< index into SceneView::materials()
-    bool doubleSided = false;  ///< open surfaces (fascia): no culling, normal faces the viewer
-    bool drawOnTop = false;    ///< polygon offset towards the camera (a layer lying on a body)
+    uint32_t material = 0;    ///< index into SceneView::materials()
+    bool doubleSided = false; ///< open surfaces (fascia): no culling, normal faces the viewer
+    bool drawOnTop = false;   ///< polygon offset towards the camera (a layer lying on a body)
     bool visible = true;
     // ---- fixed at creation ----------------------------------------------------------------
-    std::vector<uint32_t> indices;   ///< #F × 3, counter-clockwise from outside
-    std::vector<float> rest;         ///< #V × 3, m: rest positions (procedural pattern space)
-    std::vector<float> thickness;    ///< #V, m: baked thickness [A §6.3.1]
-    std::vector<float> sampleMap;    ///< #V: painted light samples (0 unpainted, else 1, 4 or 8)
+    std::vector<uint32_t> indices; ///< #F × 3, counter-clockwise from outside
+    std::vector<float> rest;       ///< #V × 3, m: rest positions (procedural pattern space)
+    std::vector<float> thickness;  ///< #V, m: baked thickness [A §6.3.1]
+    std::vector<float> sampleMap;  ///< #V: painted light samples (0 unpainted, else 1, 4 or 8)
     // ---- per frame ------------------------------------------------------------------------
-    std::vector<float> positions;    ///< #V × 3, m, world frame
-    std::vector<float> normals;      ///< #V × 3, unit, area-weighted vertex normals
-    std::vector<float> heat;         ///< #V in [0, 1]: 0 fresh, ~0.5 coagulated, 1 charred
+    std::vector<float> positions; ///< #V × 3, m, world frame
+    std::vector<float> normals;   ///< #V × 3, unit, area-weighted vertex normals
+    std::vector<float> heat;      ///< #V in [0, 1]: 0 fresh, ~0.5 coagulated, 1 charred
     /// Dissection [A §5.3.1]: empty (every face drawn) or #F flags, 0 = face not drawn. Set it
     /// with SceneView::setFaceMask (bumps faceMaskRevision); the backend then writes the visible
     /// faces' indices, compacted, into the same index buffer and draws only those (no buffer is
     /// created or resized).
     std::vector<uint8_t> faceMask;
     uint64_t faceMaskRevision = 0;
-    uint64_t revision = 0;           ///< bumped whenever per-frame data change
-    uint64_t staticRevision = 0;     ///< bumped when sampleMap or thickness change
+    uint64_t revision = 0;       ///< bumped whenever per-frame data change
+    uint64_t staticRevision = 0; ///< bumped when sampleMap or thickness change
     // ---- where the per-frame positions come from -----------------------------------------
     enum class Source : uint8_t { Static, Body, Surface } source = Source::Static;
     size_t sourceIndex = 0;            ///< body or surface index in sim::World

@@ -6,8 +6,8 @@
 namespace viscera::render {
 
 bool PostSettings::anyEnabled() const {
-    return depthOfField.enabled || chromaticAberration.enabled || toneMapping.enabled ||
-           colourCurve.enabled || sharpen.enabled || noise.enabled || radialMask.enabled;
+    return depthOfField.enabled || chromaticAberration.enabled || toneMapping.enabled || colourCurve.enabled ||
+           sharpen.enabled || noise.enabled || radialMask.enabled;
 }
 
 void PostSettings::disableAll() {
@@ -19,14 +19,15 @@ namespace {
 [[noreturn]] void fail(const std::string& field, const std::string& rule) {
     throw std::invalid_argument("render::RenderSettings: " + field + ": " + rule);
 }
-bool finite3(const Eigen::Vector3f& v) { return v.allFinite(); }
+bool finite3(const Eigen::Vector3f& v) {
+    return v.allFinite();
+}
 } // namespace
 
 void RenderSettings::validate() const {
     if (width < 8 || height < 8 || width > 8192 || height > 8192)
         fail("width/height", "must be in [8, 8192], got " + std::to_string(width) + "x" + std::to_string(height));
-    if (stereo.mode == StereoMode::SideBySide && width % 2 != 0)
-        fail("width", "must be even for side-by-side stereo");
+    if (stereo.mode == StereoMode::SideBySide && width % 2 != 0) fail("width", "must be even for side-by-side stereo");
     if (!finite3(camera.position) || !finite3(camera.target) || !finite3(camera.up))
         fail("camera", "position, target and up must be finite");
     if ((camera.target - camera.position).norm() <= 0.0f) fail("camera", "target equals position");
@@ -38,8 +39,7 @@ void RenderSettings::validate() const {
     if (!light.followCamera && light.direction.norm() <= 0.0f) fail("light.direction", "must be non-zero");
     const SamplingSettings& s = sampling;
     if (s.uniformSamples < 1 || s.uniformSamples > 255) fail("sampling.uniformSamples", "must be in [1, 255]");
-    if (s.referenceSamples < 1 || s.referenceSamples > 4096)
-        fail("sampling.referenceSamples", "must be in [1, 4096]");
+    if (s.referenceSamples < 1 || s.referenceSamples > 4096) fail("sampling.referenceSamples", "must be in [1, 4096]");
     if (s.bands.empty() || s.bands.size() > 8) fail("sampling.bands", "needs 1 to 8 bands");
     for (size_t i = 0; i < s.bands.size(); ++i) {
         const std::string f = "sampling.bands[" + std::to_string(i) + "]";

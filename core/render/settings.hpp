@@ -24,10 +24,10 @@ struct Camera {
 /// Uniformly emitting one-sided rectangle (the laparoscope light). Radiance is derived from
 /// `intensity` so that resizing the light keeps its power: L = intensity / (width · height).
 struct AreaLight {
-    Eigen::Vector3f center{0.0f, -0.08f, 0.08f}; ///< m, world (ignored when followCamera)
+    Eigen::Vector3f center{0.0f, -0.08f, 0.08f};        ///< m, world (ignored when followCamera)
     Eigen::Vector3f direction{0.0f, 0.7071f, -0.7071f}; ///< emitting normal (ignored when followCamera)
-    Eigen::Vector3f up{0.0f, 0.0f, 1.0f}; ///< orients the rectangle's height axis
-    float width = 0.02f, height = 0.01f;  ///< m
+    Eigen::Vector3f up{0.0f, 0.0f, 1.0f};               ///< orients the rectangle's height axis
+    float width = 0.02f, height = 0.01f;                ///< m
     Eigen::Vector3f colour{1.0f, 0.96f, 0.9f};
     float intensity = 0.03f; ///< W/sr-like units; irradiance at distance d on axis ≈ intensity / d²
     /// Coaxial scope light: centred at the camera plus `cameraOffset` (camera right, up, forward),
@@ -38,10 +38,10 @@ struct AreaLight {
 
 /// How many light samples a pixel takes [A eq. 6.15–6.16].
 enum class SampleMode : uint8_t {
-    Uniform,   ///< `uniformSamples` everywhere (1 = a point light)
-    Distance,  ///< m(d) from `bands`, d = distance from the shaded point to the light centre
-    Painted,   ///< the per-vertex sample map (1×/4×/8×); unpainted vertices take `uniformSamples`
-    Reference  ///< `referenceSamples` everywhere, no reflection cone: the ground truth
+    Uniform,  ///< `uniformSamples` everywhere (1 = a point light)
+    Distance, ///< m(d) from `bands`, d = distance from the shaded point to the light centre
+    Painted,  ///< the per-vertex sample map (1×/4×/8×); unpainted vertices take `uniformSamples`
+    Reference ///< `referenceSamples` everywhere, no reflection cone: the ground truth
 };
 
 /// m(d) = samples for h_{k+1} < d ≤ h_k = maxDistance [A eq. 6.16]; bands sorted by maxDistance.
@@ -120,7 +120,7 @@ enum class StereoMode : uint8_t { Off, SideBySide, Anaglyph };
 /// shifted by ±eyeSeparation/2, frustums sheared so that parallax is zero at `convergenceDistance`.
 struct StereoSettings {
     StereoMode mode = StereoMode::Off;
-    float eyeSeparation = 0.005f;     ///< m (stereo laparoscope baseline)
+    float eyeSeparation = 0.005f;      ///< m (stereo laparoscope baseline)
     float convergenceDistance = 0.12f; ///< m
 };
 
@@ -129,8 +129,8 @@ struct RenderSettings {
     Camera camera;
     AreaLight light;
     SamplingSettings sampling;
-    bool subsurface = true;        ///< SSS term [A eq. 6.10]; off: diffuse takes its weight
-    Eigen::Vector3f ambient{0.02f, 0.012f, 0.01f}; ///< constant fill, linear
+    bool subsurface = true;                             ///< SSS term [A eq. 6.10]; off: diffuse takes its weight
+    Eigen::Vector3f ambient{0.02f, 0.012f, 0.01f};      ///< constant fill, linear
     Eigen::Vector3f background{0.012f, 0.004f, 0.003f}; ///< linear
     PostSettings post;
     StereoSettings stereo;

@@ -17,9 +17,9 @@ TriangleBvh::TriangleBvh(const std::vector<Eigen::Vector3f>& positions,
     for (size_t t = 0; t < m_tris.size(); ++t)
         for (uint32_t i : m_tris[t])
             if (i >= m_v.size())
-                throw std::invalid_argument("render::TriangleBvh: triangle " + std::to_string(t) + " references vertex " +
-                                            std::to_string(i) + " (mesh has " + std::to_string(m_v.size()) +
-                                            " vertices)");
+                throw std::invalid_argument("render::TriangleBvh: triangle " + std::to_string(t) +
+                                            " references vertex " + std::to_string(i) + " (mesh has " +
+                                            std::to_string(m_v.size()) + " vertices)");
     if (!m_tris.empty()) {
         m_nodes.reserve(2 * m_tris.size());
         build(0, uint32_t(m_tris.size()));
@@ -50,7 +50,9 @@ int32_t TriangleBvh::build(uint32_t first, uint32_t count) {
     }
     int axis = 0;
     (chi - clo).maxCoeff(&axis);
-    auto centroid = [&](const std::array<uint32_t, 3>& t) { return m_v[t[0]][axis] + m_v[t[1]][axis] + m_v[t[2]][axis]; };
+    auto centroid = [&](const std::array<uint32_t, 3>& t) {
+        return m_v[t[0]][axis] + m_v[t[1]][axis] + m_v[t[2]][axis];
+    };
     const uint32_t mid = first + count / 2;
     std::nth_element(m_tris.begin() + first, m_tris.begin() + mid, m_tris.begin() + first + count,
                      [&](const auto& a, const auto& b) { return centroid(a) < centroid(b); });
@@ -62,8 +64,8 @@ int32_t TriangleBvh::build(uint32_t first, uint32_t count) {
 }
 
 namespace {
-bool hitBox(const Eigen::Vector3f& lo, const Eigen::Vector3f& hi, const Eigen::Vector3f& o,
-            const Eigen::Vector3f& inv, float tMin, float tMax) {
+bool hitBox(const Eigen::Vector3f& lo, const Eigen::Vector3f& hi, const Eigen::Vector3f& o, const Eigen::Vector3f& inv,
+            float tMin, float tMax) {
     for (int a = 0; a < 3; ++a) {
         float t0 = (lo[a] - o[a]) * inv[a], t1 = (hi[a] - o[a]) * inv[a];
         if (t0 > t1) std::swap(t0, t1);
@@ -128,8 +130,8 @@ std::vector<float> bakeThickness(const std::vector<Eigen::Vector3f>& positions,
     }
     std::vector<float> out(positions.size(), s.maxThickness);
     for (size_t i = 0; i < positions.size(); ++i) {
-        const Eigen::Vector3f n = normals[i].squaredNorm() > 0 ? Eigen::Vector3f(-normals[i].normalized())
-                                                              : Eigen::Vector3f(0, 0, -1);
+        const Eigen::Vector3f n =
+            normals[i].squaredNorm() > 0 ? Eigen::Vector3f(-normals[i].normalized()) : Eigen::Vector3f(0, 0, -1);
         const Eigen::Vector3f t = n.unitOrthogonal(), b = n.cross(t);
         const Eigen::Vector3f o = positions[i] + s.offset * n;
         double sum = 0;

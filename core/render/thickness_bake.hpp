@@ -36,9 +36,9 @@ private:
 };
 
 struct ThicknessBakeSettings {
-    int rays = 12;               ///< per vertex, within 37° of −n (deterministic spiral pattern)
-    float maxThickness = 0.05f;  ///< m, for rays that leave the mesh
-    float offset = 1e-5f;        ///< m, start offset along −n
+    int rays = 12;              ///< per vertex, within 37° of −n (deterministic spiral pattern)
+    float maxThickness = 0.05f; ///< m, for rays that leave the mesh
+    float offset = 1e-5f;       ///< m, start offset along −n
 };
 
 /// Thickness per vertex (m) of the points `positions` with unit outward `normals` against `target`.

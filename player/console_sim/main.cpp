@@ -10,7 +10,8 @@
 //
 // --pause-at/--pause-for simulate a disconnection: no state is sent during the pause (commands
 // are still recorded, dated by their arrival in the kernel queue; a command with force more than
-// 250 ms after the last state actually sent counts as paused_nonzero_after_timeout). Exit codes: 0 done, 1 bad input, 2 usage, 3 no player contacted it.
+// 250 ms after the last state actually sent counts as paused_nonzero_after_timeout). Exit codes: 0 done, 1 bad input, 2
+// usage, 3 no player contacted it.
 #include "haptics/clock.hpp"
 #include "haptics/console_protocol.hpp"
 #include "haptics/scripted_device.hpp"
@@ -54,7 +55,8 @@ double number(const std::string& flag, const std::string& v, double lo, double h
     char* end = nullptr;
     const double x = std::strtod(v.c_str(), &end);
     if (v.empty() || *end != '\0' || !std::isfinite(x) || x < lo || x > hi)
-        throw std::invalid_argument(flag + " '" + v + "' must be a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        throw std::invalid_argument(flag + " '" + v + "' must be a number in [" + std::to_string(lo) + ", " +
+                                    std::to_string(hi) + "]");
     return x;
 }
 
@@ -66,22 +68,37 @@ Options parse(const std::vector<std::string>& args) {
             if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
             return args[++i];
         };
-        if (a == "--listen") o.listen = value();
-        else if (a == "--trajectory") o.trajectory = value();
-        else if (a == "--script") o.script = value();
-        else if (a == "--record") o.record = value();
-        else if (a == "--summary") o.summary = value();
-        else if (a == "--port-file") o.portFile = value();
-        else if (a == "--write-trajectory") o.writeTrajectory = value();
-        else if (a == "--duration") o.duration = number(a, value(), 0.001, 86400);
-        else if (a == "--rate") o.rate = number(a, value(), 1, 10000);
-        else if (a == "--pause-at") o.pauseAt = number(a, value(), 0, 86400);
-        else if (a == "--pause-for") o.pauseFor = number(a, value(), 0, 86400);
-        else if (a == "--wait-player") o.waitPlayer = number(a, value(), 0.1, 3600);
-        else if (a == "--loop") o.loop = true;
-        else throw std::invalid_argument("unknown option '" + a + "'");
+        if (a == "--listen")
+            o.listen = value();
+        else if (a == "--trajectory")
+            o.trajectory = value();
+        else if (a == "--script")
+            o.script = value();
+        else if (a == "--record")
+            o.record = value();
+        else if (a == "--summary")
+            o.summary = value();
+        else if (a == "--port-file")
+            o.portFile = value();
+        else if (a == "--write-trajectory")
+            o.writeTrajectory = value();
+        else if (a == "--duration")
+            o.duration = number(a, value(), 0.001, 86400);
+        else if (a == "--rate")
+            o.rate = number(a, value(), 1, 10000);
+        else if (a == "--pause-at")
+            o.pauseAt = number(a, value(), 0, 86400);
+        else if (a == "--pause-for")
+            o.pauseFor = number(a, value(), 0, 86400);
+        else if (a == "--wait-player")
+            o.waitPlayer = number(a, value(), 0.1, 3600);
+        else if (a == "--loop")
+            o.loop = true;
+        else
+            throw std::invalid_argument("unknown option '" + a + "'");
     }
-    if (o.trajectory.has_value() == o.script.has_value()) throw std::invalid_argument("give exactly one of --trajectory FILE or --script NAME");
+    if (o.trajectory.has_value() == o.script.has_value())
+        throw std::invalid_argument("give exactly one of --trajectory FILE or --script NAME");
     if (o.writeTrajectory && (!o.script || o.duration <= 0))
         throw std::invalid_argument("--write-trajectory needs --script NAME and --duration S");
     return o;
@@ -91,19 +108,24 @@ void sleepUntil(int64_t t) {
     timespec ts{};
     ts.tv_sec = t / 1'000'000'000;
     ts.tv_nsec = t % 1'000'000'000;
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {}
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+    }
 }
 
 /// The motion source: a trajectory file or a scripted device, sampled at time t (s).
 class Source {
 public:
     explicit Source(const Options& o) : m_loop(o.loop) {
-        if (o.trajectory) m_traj = Trajectory::load(*o.trajectory);
-        else m_script = std::make_unique<ScriptedDevice>(*o.script);
+        if (o.trajectory)
+            m_traj = Trajectory::load(*o.trajectory);
+        else
+            m_script = std::make_unique<ScriptedDevice>(*o.script);
     }
     void sample(double t, DeviceState& s) {
-        if (m_traj) m_traj->sampleInto(t, m_loop, s);
-        else m_script->poll(int64_t(std::llround(t * 1e9)), s);
+        if (m_traj)
+            m_traj->sampleInto(t, m_loop, s);
+        else
+            m_script->poll(int64_t(std::llround(t * 1e9)), s);
     }
     int arms() const { return m_traj ? std::max(1, m_traj->arms()) : m_script->capabilities().arms; }
     double duration() const { return m_traj ? m_traj->duration() : 0; }
@@ -132,14 +154,16 @@ int writeTrajectory(const Options& o) {
         }
     }
     writeFileAtomic(*o.writeTrajectory, out.format());
-    std::printf("trajectory %s: %d samples per arm, %d arm(s), %.3f s\n", o.writeTrajectory->c_str(), n + 1, src.arms(), o.duration);
+    std::printf("trajectory %s: %d samples per arm, %d arm(s), %.3f s\n", o.writeTrajectory->c_str(), n + 1, src.arms(),
+                o.duration);
     return 0;
 }
 
 int run(const Options& o) {
     Source src(o);
     const double duration = o.duration > 0 ? o.duration : src.duration();
-    if (!(duration > 0)) throw std::invalid_argument("--duration is needed with a script (or a trajectory shorter than 1 ms)");
+    if (!(duration > 0))
+        throw std::invalid_argument("--duration is needed with a script (or a trajectory shorter than 1 ms)");
     UdpSocket sock(parseEndpoint(o.listen, "--listen", true), 1 << 20);
     const Endpoint local = sock.local();
     if (o.portFile) writeFileAtomic(*o.portFile, std::to_string(ntohs(local.addr.sin_port)) + "\n");
@@ -181,7 +205,8 @@ int run(const Options& o) {
     };
     while (!havePlayer) {
         if (monotonicNs() > waitEnd) {
-            std::fprintf(stderr, "viscera-console-sim: no player contacted %s within %.1f s\n", local.text().c_str(), o.waitPlayer);
+            std::fprintf(stderr, "viscera-console-sim: no player contacted %s within %.1f s\n", local.text().c_str(),
+                         o.waitPlayer);
             return 3;
         }
         sock.wait(50);
@@ -208,14 +233,16 @@ int run(const Options& o) {
             p.timestamp_ns = now;
             p.pedals = s.pedals;
             p.arms = static_cast<uint8_t>(src.arms());
-            for (int a = 0; a < kMaxArms; ++a) p.arm[a] = s.arms[a];
+            for (int a = 0; a < kMaxArms; ++a)
+                p.arm[a] = s.arms[a];
             const size_t n = encode(p, buf, sizeof buf);
             if (sock.sendTo(buf, n, player)) {
                 ++sent, sentAt.emplace_back(p.sequence, now);
                 // When the last state before the silence really left (this process may have
                 // been descheduled between reading the clock and sending).
                 const double left = 1e-9 * double(monotonicNs() - t0);
-                if (o.pauseAt >= 0 && left < o.pauseAt + o.pauseFor) lastStateBeforeResume = std::max(lastStateBeforeResume, left);
+                if (o.pauseAt >= 0 && left < o.pauseAt + o.pauseFor)
+                    lastStateBeforeResume = std::max(lastStateBeforeResume, left);
             } else
                 ++sendErrors;
         }
@@ -247,23 +274,27 @@ int run(const Options& o) {
             // its device timeout (100 ms) and the slack of a loaded machine.
             if (f > 0 && r.t > lastStateBeforeResume + 0.25) ++pausedNonZeroLate;
         }
-        while (j < sentAt.size() && newer(r.cmd.echoSequence, sentAt[j].first)) ++j;
+        while (j < sentAt.size() && newer(r.cmd.echoSequence, sentAt[j].first))
+            ++j;
         if (!r.paused && j < sentAt.size() && sentAt[j].first == r.cmd.echoSequence)
             latency.push_back(1e-6 * double(int64_t(std::llround(r.t * 1e9)) + t0 - sentAt[j].second));
     }
     std::sort(latency.begin(), latency.end());
-    auto pct = [&](double p) { return latency.empty() ? 0.0 : latency[std::min(latency.size() - 1, size_t(p * double(latency.size())))]; };
+    auto pct = [&](double p) {
+        return latency.empty() ? 0.0 : latency[std::min(latency.size() - 1, size_t(p * double(latency.size())))];
+    };
     uint64_t rejectedAll = 0;
-    for (uint64_t r : rejected) rejectedAll += r;
+    for (uint64_t r : rejected)
+        rejectedAll += r;
     if (o.record) {
         std::string csv = "t_s,seq,echo,flags,paused,f0x,f0y,f0z,f1x,f1y,f1z,grip0_n,grip1_n\n";
         char line[320];
         for (const Received& r : received) {
             const auto& a = r.cmd.arm;
-            std::snprintf(line, sizeof line, "%.6f,%u,%u,%u,%d,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.4g,%.4g\n", r.t, r.cmd.sequence,
-                          r.cmd.echoSequence, r.cmd.flags, int(r.paused), a[0].servo_cf.force.x(), a[0].servo_cf.force.y(),
-                          a[0].servo_cf.force.z(), a[1].servo_cf.force.x(), a[1].servo_cf.force.y(), a[1].servo_cf.force.z(),
-                          a[0].jaw_servo_jf, a[1].jaw_servo_jf);
+            std::snprintf(line, sizeof line, "%.6f,%u,%u,%u,%d,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.4g,%.4g\n", r.t,
+                          r.cmd.sequence, r.cmd.echoSequence, r.cmd.flags, int(r.paused), a[0].servo_cf.force.x(),
+                          a[0].servo_cf.force.y(), a[0].servo_cf.force.z(), a[1].servo_cf.force.x(),
+                          a[1].servo_cf.force.y(), a[1].servo_cf.force.z(), a[0].jaw_servo_jf, a[1].jaw_servo_jf);
             csv += line;
         }
         writeFileAtomic(*o.record, csv);
@@ -279,10 +310,16 @@ int run(const Options& o) {
                           {"paused_commands", pausedCmds},
                           {"paused_nonzero_after_timeout", pausedNonZeroLate},
                           {"last_state_before_resume_s", lastStateBeforeResume},
-                          {"echo_latency_ms", {{"count", latency.size()}, {"p50", pct(0.5)}, {"p99", pct(0.99)}, {"max", latency.empty() ? 0.0 : latency.back()}}}};
+                          {"echo_latency_ms",
+                           {{"count", latency.size()},
+                            {"p50", pct(0.5)},
+                            {"p99", pct(0.99)},
+                            {"max", latency.empty() ? 0.0 : latency.back()}}}};
     if (o.summary) writeFileAtomic(*o.summary, sum.dump(2) + "\n");
-    std::printf("console-sim   %llu states sent, %zu commands received (%llu rejected), %llu non-zero, max force %.3f N\n",
-                (unsigned long long)sent, received.size(), (unsigned long long)rejectedAll, (unsigned long long)nonZero, maxForce);
+    std::printf(
+        "console-sim   %llu states sent, %zu commands received (%llu rejected), %llu non-zero, max force %.3f N\n",
+        (unsigned long long)sent, received.size(), (unsigned long long)rejectedAll, (unsigned long long)nonZero,
+        maxForce);
     std::printf("latency       state -> command echo p50 %.3f ms, p99 %.3f ms\n", pct(0.5), pct(0.99));
     if (pausedCmds)
         std::printf("pause         %llu commands during the pause, %llu non-zero after the device timeout\n",

@@ -12,7 +12,6 @@ namespace {
 
 using haptics::kMaxArms;
 
-
 } // namespace
 
 HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& world, bool realtime, bool keepTrace)
@@ -25,8 +24,10 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
     for (size_t t = 0; t < world.toolCount(); ++t) {
         const sim::ToolDesc& d = world.toolDesc(t);
         int arm = -1;
-        if (arms == 2 && d.hand == "left") arm = 0;
-        else if (arms == 2 && d.hand == "right") arm = 1;
+        if (arms == 2 && d.hand == "left")
+            arm = 0;
+        else if (arms == 2 && d.hand == "right")
+            arm = 1;
         else
             for (int a = 0; a < arms; ++a)
                 if (!used[a]) {
@@ -232,7 +233,8 @@ LiveState HapticRig::live() const {
     for (int a = 0; a < kMaxArms; ++a) {
         s.force[a] = p.force[a];
         s.toolActive[a] = m_toolOfArm[a] >= 0;
-        s.tool[a] = m_toolOfArm[a] >= 0 ? m_world.toolContact(static_cast<size_t>(m_toolOfArm[a])).centre : sim::Vec3::Zero();
+        s.tool[a] =
+            m_toolOfArm[a] >= 0 ? m_world.toolContact(static_cast<size_t>(m_toolOfArm[a])).centre : sim::Vec3::Zero();
     }
     return s;
 }

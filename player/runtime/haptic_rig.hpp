@@ -24,18 +24,18 @@ namespace viscera::player {
 
 /// Task metrics of a session (report "metrics").
 struct TaskMetrics {
-    double time_s = 0;                 ///< simulated session time
-    double toolPathLength_m = 0;       ///< sum over tools, scene frame
+    double time_s = 0;           ///< simulated session time
+    double toolPathLength_m = 0; ///< sum over tools, scene frame
     std::vector<double> toolPathLengthPerTool_m;
-    double maxForce_n = 0;             ///< device force after the safety filter
-    double meanForce_n = 0;            ///< over all servo ticks of driven arms
-    double meanContactForce_n = 0;     ///< over ticks with a non-zero force
-    double tissueDamage_ns = 0;        ///< ∫ max(0, contact force − damage threshold) dt, N·s
-    int damageEvents = 0;              ///< times the contact force rose above the threshold
-    double maxContactForce_n = 0;      ///< N, tissue on tool, from the physics
-    int punctures = 0;                 ///< needle punctures (suturing cases)
-    int clips = 0;                     ///< clips applied (cases with a clip applier)
-    int cutEdges = 0;                  ///< edges dissected by energy (cases with an energy hook)
+    double maxForce_n = 0;         ///< device force after the safety filter
+    double meanForce_n = 0;        ///< over all servo ticks of driven arms
+    double meanContactForce_n = 0; ///< over ticks with a non-zero force
+    double tissueDamage_ns = 0;    ///< ∫ max(0, contact force − damage threshold) dt, N·s
+    int damageEvents = 0;          ///< times the contact force rose above the threshold
+    double maxContactForce_n = 0;  ///< N, tissue on tool, from the physics
+    int punctures = 0;             ///< needle punctures (suturing cases)
+    int clips = 0;                 ///< clips applied (cases with a clip applier)
+    int cutEdges = 0;              ///< edges dissected by energy (cases with an energy hook)
 };
 
 struct HapticsResult {
@@ -50,7 +50,7 @@ struct HapticsResult {
     haptics::ServoStats servo;
     haptics::LinkStats link;
     double physicsPeriod_s = 0;
-    double maxContactAgeSteps = 0; ///< max contact-model age / nominal physics period
+    double maxContactAgeSteps = 0;     ///< max contact-model age / nominal physics period
     haptics::HandoverFigures handover; ///< ticks against the physics thread's own publish log
     bool physicsRealtimePriority = false;
     std::vector<int> physicsCpus; ///< real time: the CPUs the physics thread may run on

@@ -11,10 +11,12 @@ StepTimeStats stepTimeStats(const std::vector<sim::FrameRecord>& frames) {
     if (frames.empty()) return s;
     std::vector<double> t;
     t.reserve(frames.size());
-    for (const auto& f : frames) t.push_back(f.stepMs);
+    for (const auto& f : frames)
+        t.push_back(f.stepMs);
     std::sort(t.begin(), t.end());
     double sum = 0;
-    for (double x : t) sum += x;
+    for (double x : t)
+        sum += x;
     s.mean = sum / static_cast<double>(t.size());
     auto pct = [&](double p) {
         size_t i = static_cast<size_t>(std::ceil(p * static_cast<double>(t.size()))) - 1;
@@ -29,13 +31,15 @@ StepTimeStats stepTimeStats(const std::vector<sim::FrameRecord>& frames) {
 namespace {
 
 nlohmann::json distribution(const haptics::Distribution& d) {
-    return {{"count", d.count}, {"mean", d.mean_us}, {"p50", d.p50_us}, {"p99", d.p99_us}, {"max", d.max_us}, {"min", d.min_us}};
+    return {{"count", d.count}, {"mean", d.mean_us}, {"p50", d.p50_us},
+            {"p99", d.p99_us},  {"max", d.max_us},   {"min", d.min_us}};
 }
 
 nlohmann::json hapticsJson(const HapticsResult& h) {
     using nlohmann::json;
     json tools = json::array();
-    for (const auto& t : h.tools) tools.push_back({{"name", t.name}, {"hand", t.hand}, {"arm", t.arm}});
+    for (const auto& t : h.tools)
+        tools.push_back({{"name", t.name}, {"hand", t.hand}, {"arm", t.arm}});
     const haptics::ServoStats& s = h.servo;
     json servo = {{"rate_hz", 1000.0}, {"ticks", s.ticks}, {"tick_cost_us", distribution(s.tickCost)}};
     if (h.mode == "realtime") {
@@ -52,24 +56,31 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
         servo["physics_cpus"] = h.physicsCpus;
     }
     const auto& a = s.contactAge;
-    json contact = {{"physics_period_ms", h.physicsPeriod_s * 1e3},
-                    {"age_ms", {{"mean", a.mean_us * 1e-3}, {"p50", a.p50_us * 1e-3}, {"p99", a.p99_us * 1e-3}, {"max", a.max_us * 1e-3}}},
-                    {"max_age_over_period", h.maxContactAgeSteps},
-                    {"max_steps_behind", s.maxStepsBehind},
-                    {"models_used", s.contactModelsSeen}};
+    json contact = {
+        {"physics_period_ms", h.physicsPeriod_s * 1e3},
+        {"age_ms",
+         {{"mean", a.mean_us * 1e-3}, {"p50", a.p50_us * 1e-3}, {"p99", a.p99_us * 1e-3}, {"max", a.max_us * 1e-3}}},
+        {"max_age_over_period", h.maxContactAgeSteps},
+        {"max_steps_behind", s.maxStepsBehind},
+        {"models_used", s.contactModelsSeen}};
     // The hand-over checked against the physics thread's own publish log (haptics/handover_audit).
     const haptics::HandoverFigures& ho = h.handover;
-    contact["handover"] = {{"ticks_checked", ho.ticksChecked},
-                           {"ticks_on_older_model", ho.ticksOnOlderModel},
-                           {"max_age_over_step", ho.maxAgeOverStep},
-                           {"models_published", ho.modelsPublished},
-                           {"physics_step_ms", {{"mean", ho.stepMean_ms}, {"p99", ho.stepP99_ms}, {"max", ho.stepMax_ms}}},
-                           {"steps_over_period", ho.stepsOverPeriod}};
+    contact["handover"] = {
+        {"ticks_checked", ho.ticksChecked},
+        {"ticks_on_older_model", ho.ticksOnOlderModel},
+        {"max_age_over_step", ho.maxAgeOverStep},
+        {"models_published", ho.modelsPublished},
+        {"physics_step_ms", {{"mean", ho.stepMean_ms}, {"p99", ho.stepP99_ms}, {"max", ho.stepMax_ms}}},
+        {"steps_over_period", ho.stepsOverPeriod}};
     if (ho.firstOlderTick_s >= 0) contact["handover"]["first_older_tick_s"] = ho.firstOlderTick_s;
     if (ho.logErrors) contact["handover"]["log_errors"] = ho.logErrors;
     const haptics::SafetyCounts& c = s.safety;
-    json safety = {{"ticks", c.ticks},       {"non_finite", c.nonFinite}, {"disconnected", c.disconnected},
-                   {"sim_stale", c.simStale}, {"deadman", c.deadman},     {"clamped", c.clamped},
+    json safety = {{"ticks", c.ticks},
+                   {"non_finite", c.nonFinite},
+                   {"disconnected", c.disconnected},
+                   {"sim_stale", c.simStale},
+                   {"deadman", c.deadman},
+                   {"clamped", c.clamped},
                    {"rate_limited", c.rateLimited}};
     const haptics::LinkStats& l = h.link;
     json link = {{"received", l.received},
@@ -82,8 +93,13 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
                  {"send_errors", l.sendErrors},
                  {"disconnects", l.disconnects},
                  {"reconnects", l.reconnects}};
-    return {{"device", {{"spec", h.spec}, {"backend", h.backend}, {"name", h.name}, {"arms", h.arms}, {"pedals", h.pedals},
-                        {"max_force_n", h.deviceMaxForce_n}}},
+    return {{"device",
+             {{"spec", h.spec},
+              {"backend", h.backend},
+              {"name", h.name},
+              {"arms", h.arms},
+              {"pedals", h.pedals},
+              {"max_force_n", h.deviceMaxForce_n}}},
             {"case_max_force_n", h.caseMaxForce_n},
             {"mode", h.mode},
             {"tools", tools},
@@ -98,17 +114,18 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
 } // namespace
 
 std::string traceCsv(const SessionResult& r) {
-    std::string out = "t_s,arm,device_x,device_y,device_z,tool_x,tool_y,tool_z,force_x,force_y,force_z,force_n,desired_n,"
-                      "grip_rad,pedals,connected,safety_rules,contact_age_ms,contact_frame\n";
+    std::string out =
+        "t_s,arm,device_x,device_y,device_z,tool_x,tool_y,tool_z,force_x,force_y,force_z,force_n,desired_n,"
+        "grip_rad,pedals,connected,safety_rules,contact_age_ms,contact_frame\n";
     out.reserve(out.size() + r.trace.size() * 160);
     const int64_t t0 = r.trace.empty() ? 0 : r.trace.front().t_ns;
     char buf[512];
     for (const TraceRow& s : r.trace) {
-        std::snprintf(buf, sizeof buf, "%.6f,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.5g,%.5g,%.5g,%.4g,%u,%d,%u,%.4f,%lld\n",
-                      1e-9 * double(s.t_ns - t0), int(s.arm), s.device.x(), s.device.y(), s.device.z(), s.tool.x(),
-                      s.tool.y(), s.tool.z(), s.force.x(), s.force.y(), s.force.z(), s.force.norm(), s.desired, s.grip,
-                      s.pedals, int(s.connected), s.rules, s.contactAge_s * 1e3,
-                      static_cast<long long>(s.contactFrame));
+        std::snprintf(
+            buf, sizeof buf, "%.6f,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.5g,%.5g,%.5g,%.4g,%u,%d,%u,%.4f,%lld\n",
+            1e-9 * double(s.t_ns - t0), int(s.arm), s.device.x(), s.device.y(), s.device.z(), s.tool.x(), s.tool.y(),
+            s.tool.z(), s.force.x(), s.force.y(), s.force.z(), s.force.norm(), s.desired, s.grip, s.pedals,
+            int(s.connected), s.rules, s.contactAge_s * 1e3, static_cast<long long>(s.contactFrame));
         out += buf;
     }
     return out;
@@ -120,26 +137,37 @@ static nlohmann::json interactionJson(const sim::InteractionSummary& s) {
     auto vec = [](const sim::Vec3& v) { return json::array({v.x(), v.y(), v.z()}); };
     json instruments = json::array();
     for (const auto& i : s.instruments)
-        instruments.push_back({{"name", i.name}, {"kind", i.kind}, {"tip_m", vec(i.tip)}, {"jaw", i.jaw},
-                               {"act", i.act}, {"contacts", i.contacts}, {"grasped_vertices", i.grasped}});
+        instruments.push_back({{"name", i.name},
+                               {"kind", i.kind},
+                               {"tip_m", vec(i.tip)},
+                               {"jaw", i.jaw},
+                               {"act", i.act},
+                               {"contacts", i.contacts},
+                               {"grasped_vertices", i.grasped}});
     json clips = json::array();
     for (const auto& c : s.clips)
-        clips.push_back({{"instrument", c.instrument}, {"target", c.target}, {"fired_at_s", c.firedAt},
-                         {"centre_m", vec(c.centre)}, {"travel_m", c.travel}, {"rotation_deg", c.rotationDeg},
-                         {"max_contact_drift_m", c.maxContactDrift}, {"region_vertices", c.regionVertices},
+        clips.push_back({{"instrument", c.instrument},
+                         {"target", c.target},
+                         {"fired_at_s", c.firedAt},
+                         {"centre_m", vec(c.centre)},
+                         {"travel_m", c.travel},
+                         {"rotation_deg", c.rotationDeg},
+                         {"max_contact_drift_m", c.maxContactDrift},
+                         {"region_vertices", c.regionVertices},
                          {"auxiliary_nodes", c.auxiliaryNodes}});
     return {{"instruments", instruments},
             {"max_contacts", s.maxContacts},
             {"grasps", s.grasps},
-            {"dissection", {{"fascia_edges_cut", s.fasciaEdgesCut},
-                            {"fascia_triangles_cut", s.fasciaTrianglesCut},
-                            {"fat_edges_cut", s.fatEdgesCut},
-                            {"fat_tets_cut", s.fatTetsCut},
-                            {"fascia_vertices", s.fasciaVertices},
-                            {"fascia_vertices_at_start", s.fasciaVerticesAtStart},
-                            {"max_edge_heat_c", s.maxEdgeHeat},
-                            {"grid_max_c", s.gridMaxC},
-                            {"ms_total", s.dissectionMs}}},
+            {"dissection",
+             {{"fascia_edges_cut", s.fasciaEdgesCut},
+              {"fascia_triangles_cut", s.fasciaTrianglesCut},
+              {"fat_edges_cut", s.fatEdgesCut},
+              {"fat_tets_cut", s.fatTetsCut},
+              {"fascia_vertices", s.fasciaVertices},
+              {"fascia_vertices_at_start", s.fasciaVerticesAtStart},
+              {"max_edge_heat_c", s.maxEdgeHeat},
+              {"grid_max_c", s.gridMaxC},
+              {"ms_total", s.dissectionMs}}},
             {"clips", clips},
             {"clip_ms_total", s.clipMs}};
 }
@@ -236,9 +264,12 @@ nlohmann::json reportJson(const SessionResult& r) {
         json passes = json::array();
         for (const auto& p : r.render->passes)
             passes.push_back({{"name", p.name}, {"eye", p.eye}, {"ms", p.ms}});
-        doc["render"] = {{"device", r.render->device},   {"image", r.render->image},
-                         {"width", r.render->width},     {"height", r.render->height},
-                         {"frame_ms", r.render->totalMs}, {"upload_ms", r.render->uploadMs},
+        doc["render"] = {{"device", r.render->device},
+                         {"image", r.render->image},
+                         {"width", r.render->width},
+                         {"height", r.render->height},
+                         {"frame_ms", r.render->totalMs},
+                         {"upload_ms", r.render->uploadMs},
                          {"passes", passes}};
     }
     doc["errors"] = r.errors;
@@ -248,7 +279,8 @@ nlohmann::json reportJson(const SessionResult& r) {
 std::string summaryText(const SessionResult& r) {
     const StepTimeStats st = stepTimeStats(r.frames);
     std::string subs;
-    for (const auto& s : r.activeSubsystems) subs += (subs.empty() ? "" : ", ") + s;
+    for (const auto& s : r.activeSubsystems)
+        subs += (subs.empty() ? "" : ", ") + s;
     char buf[1024];
     std::snprintf(buf, sizeof buf,
                   "case          %s %s%s%s\n"
@@ -260,11 +292,11 @@ std::string summaryText(const SessionResult& r) {
                   "invariants    all finite: %s, max energy %.4g J, max device force %.3g N\n"
                   "status        %s\n",
                   r.caseId.c_str(), r.caseVersion.c_str(), r.title.empty() ? "" : " — ", r.title.c_str(),
-                  subs.empty() ? "(none)" : subs.c_str(), r.nodes, r.tets, r.frames.size(), r.simTime,
-                  r.wallTime, st.mean, st.p50, st.p99, st.max, r.maxNodeDisplacement * 1e3,
-                  r.invariants.maxStepDisplacement * 1e3, r.invariants.allFinite ? "yes" : "NO",
-                  r.invariants.maxEnergy, r.invariants.maxForce,
-                  r.ok() ? "ok" : ("FAILED: " + (r.errors.empty() ? std::string("invariants") : r.errors.front())).c_str());
+                  subs.empty() ? "(none)" : subs.c_str(), r.nodes, r.tets, r.frames.size(), r.simTime, r.wallTime,
+                  st.mean, st.p50, st.p99, st.max, r.maxNodeDisplacement * 1e3, r.invariants.maxStepDisplacement * 1e3,
+                  r.invariants.allFinite ? "yes" : "NO", r.invariants.maxEnergy, r.invariants.maxForce,
+                  r.ok() ? "ok"
+                         : ("FAILED: " + (r.errors.empty() ? std::string("invariants") : r.errors.front())).c_str());
     std::string out = buf;
     if (r.haptics) {
         const HapticsResult& h = *r.haptics;
@@ -272,29 +304,33 @@ std::string summaryText(const SessionResult& r) {
         const auto& j = h.servo.jitter;
         char line[512];
         if (h.mode == "realtime")
-            std::snprintf(line, sizeof line, "haptics       %s (%s), %llu ticks, period mean %.1f us, jitter p99 %.1f us, max %.1f us\n",
-                          h.spec.c_str(), h.mode.c_str(), (unsigned long long)h.servo.ticks, p.mean_us, j.p99_us, j.max_us);
+            std::snprintf(line, sizeof line,
+                          "haptics       %s (%s), %llu ticks, period mean %.1f us, jitter p99 %.1f us, max %.1f us\n",
+                          h.spec.c_str(), h.mode.c_str(), (unsigned long long)h.servo.ticks, p.mean_us, j.p99_us,
+                          j.max_us);
         else
             std::snprintf(line, sizeof line, "haptics       %s (%s), %llu ticks\n", h.spec.c_str(), h.mode.c_str(),
                           (unsigned long long)h.servo.ticks);
         out += line;
-        std::snprintf(line, sizeof line,
-                      "task          path %.1f mm, force max %.2f N mean %.2f N, contact model age max %.2f ms (%.2f periods)\n",
-                      r.metrics.toolPathLength_m * 1e3, r.metrics.maxForce_n, r.metrics.meanForce_n,
-                      h.servo.contactAge.max_us * 1e-3, h.maxContactAgeSteps);
+        std::snprintf(
+            line, sizeof line,
+            "task          path %.1f mm, force max %.2f N mean %.2f N, contact model age max %.2f ms (%.2f periods)\n",
+            r.metrics.toolPathLength_m * 1e3, r.metrics.maxForce_n, r.metrics.meanForce_n,
+            h.servo.contactAge.max_us * 1e-3, h.maxContactAgeSteps);
         out += line;
         const haptics::HandoverFigures& ho = h.handover;
-        std::snprintf(line, sizeof line,
-                      "hand-over     %llu of %llu ticks on an older model than the newest published; age <= %.4f of the "
-                      "physics step in progress; steps mean %.2f ms, p99 %.2f, max %.2f (%lld over the period)\n",
-                      (unsigned long long)ho.ticksOnOlderModel, (unsigned long long)ho.ticksChecked, ho.maxAgeOverStep,
-                      ho.stepMean_ms, ho.stepP99_ms, ho.stepMax_ms, (long long)ho.stepsOverPeriod);
+        std::snprintf(
+            line, sizeof line,
+            "hand-over     %llu of %llu ticks on an older model than the newest published; age <= %.4f of the "
+            "physics step in progress; steps mean %.2f ms, p99 %.2f, max %.2f (%lld over the period)\n",
+            (unsigned long long)ho.ticksOnOlderModel, (unsigned long long)ho.ticksChecked, ho.maxAgeOverStep,
+            ho.stepMean_ms, ho.stepP99_ms, ho.stepMax_ms, (long long)ho.stepsOverPeriod);
         out += line;
         if (h.link.disconnects || h.link.rejectedMalformed || h.link.rejectedVersion || h.link.rejectedChecksum) {
             std::snprintf(line, sizeof line, "link          %llu disconnects, %llu reconnects, %llu packets rejected\n",
                           (unsigned long long)h.link.disconnects, (unsigned long long)h.link.reconnects,
-                          (unsigned long long)(h.link.rejectedMalformed + h.link.rejectedVersion + h.link.rejectedChecksum +
-                                               h.link.rejectedOrder));
+                          (unsigned long long)(h.link.rejectedMalformed + h.link.rejectedVersion +
+                                               h.link.rejectedChecksum + h.link.rejectedOrder));
             out += line;
         }
     }
@@ -312,7 +348,8 @@ std::string summaryText(const SessionResult& r) {
     }
     if (r.suture) {
         char line[256];
-        std::snprintf(line, sizeof line, "suture        %d punctures, thread tension %.3f N (max %.3f N), max %d rows, %d contacts\n",
+        std::snprintf(line, sizeof line,
+                      "suture        %d punctures, thread tension %.3f N (max %.3f N), max %d rows, %d contacts\n",
                       r.suture->punctures, r.suture->finalThreadTension, r.suture->maxThreadTension,
                       r.suture->maxActiveRows, r.suture->maxContacts);
         out += line;
@@ -325,14 +362,16 @@ std::string summaryText(const SessionResult& r) {
     if (r.interaction) {
         const sim::InteractionSummary& in = *r.interaction;
         char line[512];
-        std::snprintf(line, sizeof line,
-                      "instruments   %zu, max %d contacts, %d grasps; cut %d fascia edges (%d triangles), %d fat edges; "
-                      "fascia vertices %zu of %zu; %zu clips\n",
-                      in.instruments.size(), in.maxContacts, in.grasps, in.fasciaEdgesCut, in.fasciaTrianglesCut,
-                      in.fatEdgesCut, in.fasciaVertices, in.fasciaVerticesAtStart, in.clips.size());
+        std::snprintf(
+            line, sizeof line,
+            "instruments   %zu, max %d contacts, %d grasps; cut %d fascia edges (%d triangles), %d fat edges; "
+            "fascia vertices %zu of %zu; %zu clips\n",
+            in.instruments.size(), in.maxContacts, in.grasps, in.fasciaEdgesCut, in.fasciaTrianglesCut, in.fatEdgesCut,
+            in.fasciaVertices, in.fasciaVerticesAtStart, in.clips.size());
         out += line;
         for (const auto& c : in.clips) {
-            std::snprintf(line, sizeof line, "clip          on %s at %.2f s: travel %.2f mm, rotation %.1f deg, max drift %.3f mm\n",
+            std::snprintf(line, sizeof line,
+                          "clip          on %s at %.2f s: travel %.2f mm, rotation %.1f deg, max drift %.3f mm\n",
                           c.target.c_str(), c.firedAt, c.travel * 1e3, c.rotationDeg, c.maxContactDrift * 1e3);
             out += line;
         }
@@ -341,13 +380,17 @@ std::string summaryText(const SessionResult& r) {
     for (auto it = r.accuracy.rbegin(); it != r.accuracy.rend(); ++it) {
         if (it->solver != "xpbd" || it->relError.size() < 2) continue;
         size_t k = 1;
-        while (k < it->relError.size() && it->relError[k] > 1e-4) ++k;
+        while (k < it->relError.size() && it->relError[k] > 1e-4)
+            ++k;
         char line[256];
         if (k < it->relError.size())
-            std::snprintf(line, sizeof line, "accuracy      frame %d: XPBD rel. error %.2e after 1 iteration, <= 1e-4 after %d (%.3f ms)\n",
-                          it->frame, it->relError[1], it->iterations[k], it->timeMs[k]);
+            std::snprintf(
+                line, sizeof line,
+                "accuracy      frame %d: XPBD rel. error %.2e after 1 iteration, <= 1e-4 after %d (%.3f ms)\n",
+                it->frame, it->relError[1], it->iterations[k], it->timeMs[k]);
         else
-            std::snprintf(line, sizeof line, "accuracy      frame %d: XPBD rel. error %.2e after 1 iteration, %.2e after %d (%.3f ms)\n",
+            std::snprintf(line, sizeof line,
+                          "accuracy      frame %d: XPBD rel. error %.2e after 1 iteration, %.2e after %d (%.3f ms)\n",
                           it->frame, it->relError[1], it->relError.back(), it->iterations.back(), it->timeMs.back());
         out += line;
         break;

@@ -49,7 +49,8 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
     if (out.scene.suture) { // the recorded needle trajectory travels with the case
         const std::string& path = out.scene.suture->trajectoryPath;
         if (!pkg.contains(path))
-            throw InputError(pkg.name() + ": " + sceneName + ": suture.trajectory: '" + path + "' is not in the package");
+            throw InputError(pkg.name() + ": " + sceneName + ": suture.trajectory: '" + path +
+                             "' is not in the package");
         out.scene.suture->trajectoryText = pkg.read(path);
     }
     if (out.scene.interaction) // so do the instrument tracks
@@ -80,14 +81,16 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     r.frames.reserve(static_cast<size_t>(std::max(options.frames, 0)));
     std::unique_ptr<HapticRig> rig;
     if (options.device) {
-        rig = std::make_unique<HapticRig>(*options.device, options.deviceSpec, world, options.realtime, options.keepTrace);
+        rig = std::make_unique<HapticRig>(*options.device, options.deviceSpec, world, options.realtime,
+                                          options.keepTrace);
         rig->setServoWait(options.servoWait, options.servoCpu, options.servoSpinNs);
         rig->configure(loaded.scene.xpbd.dt);
         r.activeSubsystems.push_back("haptics");
     }
     if (options.live) {
         std::lock_guard<std::mutex> lock(options.live->mutex);
-        for (size_t t = 0; t < world.toolCount(); ++t) options.live->toolRadius.push_back(world.toolDesc(t).radius);
+        for (size_t t = 0; t < world.toolCount(); ++t)
+            options.live->toolRadius.push_back(world.toolDesc(t).radius);
     }
     const auto t0 = std::chrono::steady_clock::now();
     if (rig) rig->start();
@@ -126,7 +129,8 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
             r.errors.push_back("haptics: " + std::to_string(ho.ticksOnOlderModel) +
                                " servo ticks used an older contact model than the newest the physics had published");
         if (ho.logErrors)
-            r.errors.push_back("haptics: the hand-over log has " + std::to_string(ho.logErrors) + " publishes out of order");
+            r.errors.push_back("haptics: the hand-over log has " + std::to_string(ho.logErrors) +
+                               " publishes out of order");
     }
     r.metrics.time_s = world.time();
     if (options.live) {

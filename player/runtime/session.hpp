@@ -31,32 +31,32 @@ LoadedCase loadCase(const std::filesystem::path& casePath);
 struct LiveView {
     std::mutex mutex;
     LiveState state;
-    std::vector<sim::Vec3> nodes; ///< nodes of every body, m, scene
+    std::vector<sim::Vec3> nodes;                 ///< nodes of every body, m, scene
     std::vector<std::vector<sim::Vec3>> surfaces; ///< nodes of every fascia surface, m, scene
     std::vector<double> toolRadius;
     bool finished = false;
 };
 
 struct RunOptions {
-    int frames = 300;             ///< 0: run until *stop is set
+    int frames = 300; ///< 0: run until *stop is set
     /// Called after every frame with (frames done, frames total); may be empty.
     std::function<void(int, int)> progress;
     haptics::Device* device = nullptr; ///< non-owning; null: no haptics subsystem
     std::string deviceSpec;
-    bool realtime = false;        ///< servo thread + wall-clock pacing (console and keyboard need it)
-    bool keepTrace = false;       ///< keep every servo sample for the --trace CSV
+    bool realtime = false;  ///< servo thread + wall-clock pacing (console and keyboard need it)
+    bool keepTrace = false; ///< keep every servo sample for the --trace CSV
     /// How the servo thread waits (--servo sleep|busy[:CPU]); cpu -1 = default.
     haptics::ServoWait servoWait = haptics::ServoWait::SleepSpin;
     int servoCpu = -1;
-    int64_t servoSpinNs = -1; ///< SleepSpin: spin this long before each deadline (-1: default 0.94 ms)
+    int64_t servoSpinNs = -1;                ///< SleepSpin: spin this long before each deadline (-1: default 0.94 ms)
     const std::atomic<bool>* stop = nullptr; ///< set by the window when the trainee closes it
-    LiveView* live = nullptr;     ///< filled every frame when set
+    LiveView* live = nullptr;                ///< filled every frame when set
 };
 
 /// One rendered frame (--screenshot on the headless path): per-pass wall times.
 struct RenderFigures {
-    std::string device;   ///< e.g. "llvmpipe (LLVM 15.0.6, 256 bits) — EGL 1.5 (surfaceless), OpenGL 4.5 core"
-    std::string image;    ///< PNG path
+    std::string device; ///< e.g. "llvmpipe (LLVM 15.0.6, 256 bits) — EGL 1.5 (surfaceless), OpenGL 4.5 core"
+    std::string image;  ///< PNG path
     int width = 0, height = 0;
     double totalMs = 0, uploadMs = 0;
     struct Pass {
@@ -73,15 +73,15 @@ struct SessionResult {
     std::vector<sim::FrameRecord> frames;
     std::vector<sim::AccuracyRecord> accuracy;
     sim::Invariants invariants;
-    double simTime = 0;           ///< s
-    double wallTime = 0;          ///< s
+    double simTime = 0;             ///< s
+    double wallTime = 0;            ///< s
     double maxNodeDisplacement = 0; ///< m, from the rest configuration, at the end
     size_t nodes = 0, tets = 0;
     std::vector<std::string> errors;
     std::optional<HapticsResult> haptics; ///< present when the session ran a device
     TaskMetrics metrics;
-    std::vector<TraceRow> trace;          ///< when RunOptions::keepTrace
-    std::optional<RenderFigures> render;  ///< when a frame was rendered (--screenshot)
+    std::vector<TraceRow> trace;                        ///< when RunOptions::keepTrace
+    std::optional<RenderFigures> render;                ///< when a frame was rendered (--screenshot)
     std::optional<sim::SutureSummary> suture;           ///< solver "fem" cases (needle and thread)
     std::vector<sim::SutureFrameRecord> sutureFrames;   ///< one per frame of a "fem" case
     std::optional<sim::InteractionSummary> interaction; ///< cases with scripted instruments

@@ -64,14 +64,16 @@ public:
                     if (m.source == render::RenderMesh::Source::Body && m.sourceIndex < m_bodyOffset.size()) {
                         src = &m_live.nodes;
                         base = m_bodyOffset[m.sourceIndex];
-                    } else if (m.source == render::RenderMesh::Source::Surface && m.sourceIndex < m_live.surfaces.size()) {
+                    } else if (m.source == render::RenderMesh::Source::Surface &&
+                               m.sourceIndex < m_live.surfaces.size()) {
                         src = &m_live.surfaces[m.sourceIndex];
                     }
                     if (!src) continue;
                     for (size_t v = 0; v < m.sourceVertex.size(); ++v) {
                         const size_t k = base + static_cast<size_t>(m.sourceVertex[v]);
                         if (k >= src->size()) continue;
-                        for (int r = 0; r < 3; ++r) m.positions[3 * v + r] = static_cast<float>((*src)[k][r]);
+                        for (int r = 0; r < 3; ++r)
+                            m.positions[3 * v + r] = static_cast<float>((*src)[k][r]);
                     }
                     m_view.recomputeNormals(i);
                 }
@@ -98,8 +100,8 @@ class TraineeWindow final : public QRasterWindow {
 public:
     TraineeWindow(LiveView& live, std::string title, std::string instructions, KeyboardDevice* keyboard,
                   std::atomic<bool>& stop, const Viewport3D* viewport)
-        : m_live(live), m_title(std::move(title)), m_instructions(std::move(instructions)), m_keyboard(keyboard), m_stop(stop),
-          m_viewport(viewport) {
+        : m_live(live), m_title(std::move(title)), m_instructions(std::move(instructions)), m_keyboard(keyboard),
+          m_stop(stop), m_viewport(viewport) {
         setTitle(QString::fromStdString("Viscera — " + m_title));
         resize(960, 600);
     }
@@ -150,9 +152,12 @@ public:
             nodes.clear(); // no side view
         }
         double x0 = 1e9, x1 = -1e9, z0 = 1e9, z1 = -1e9;
-        for (const auto& n : nodes) x0 = std::min(x0, n.x()), x1 = std::max(x1, n.x()), z0 = std::min(z0, n.z()), z1 = std::max(z1, n.z());
+        for (const auto& n : nodes)
+            x0 = std::min(x0, n.x()), x1 = std::max(x1, n.x()), z0 = std::min(z0, n.z()), z1 = std::max(z1, n.z());
         for (int a = 0; a < haptics::kMaxArms; ++a)
-            if (s.toolActive[a]) x0 = std::min(x0, s.tool[a].x()), x1 = std::max(x1, s.tool[a].x()), z0 = std::min(z0, s.tool[a].z()), z1 = std::max(z1, s.tool[a].z());
+            if (s.toolActive[a])
+                x0 = std::min(x0, s.tool[a].x()), x1 = std::max(x1, s.tool[a].x()), z0 = std::min(z0, s.tool[a].z()),
+                z1 = std::max(z1, s.tool[a].z());
         if (x1 > x0 && z1 >= z0) {
             const double span = std::max(x1 - x0, z1 - z0) * 1.3 + 1e-3;
             const double scale = std::min(view.width(), view.height()) / span;
@@ -162,7 +167,8 @@ public:
             };
             p.setPen(Qt::NoPen);
             p.setBrush(QColor(214, 120, 110));
-            for (const auto& n : nodes) p.drawEllipse(map(n), 1.6, 1.6);
+            for (const auto& n : nodes)
+                p.drawEllipse(map(n), 1.6, 1.6);
             size_t t = 0;
             for (int a = 0; a < haptics::kMaxArms; ++a) {
                 if (!s.toolActive[a]) continue;
@@ -229,7 +235,8 @@ protected:
     void keyReleaseEvent(QKeyEvent* e) override { key(e, false); }
     void mouseMoveEvent(QMouseEvent* e) override {
         const QPointF pos = e->position();
-        if (m_keyboard && (e->buttons() & Qt::LeftButton)) m_keyboard->addMouse(pos.x() - m_mouse.x(), pos.y() - m_mouse.y(), 0);
+        if (m_keyboard && (e->buttons() & Qt::LeftButton))
+            m_keyboard->addMouse(pos.x() - m_mouse.x(), pos.y() - m_mouse.y(), 0);
         m_mouse = pos;
     }
     void mousePressEvent(QMouseEvent* e) override { m_mouse = e->position(); }
@@ -245,14 +252,29 @@ private:
     void key(QKeyEvent* e, bool down) {
         if (!m_keyboard || e->isAutoRepeat()) return;
         switch (e->key()) {
-        case Qt::Key_Left: m_keyboard->setKey(KeyboardDevice::KeyLeft, down); break;
-        case Qt::Key_Right: m_keyboard->setKey(KeyboardDevice::KeyRight, down); break;
-        case Qt::Key_Up: m_keyboard->setKey(KeyboardDevice::KeyUp, down); break;
-        case Qt::Key_Down: m_keyboard->setKey(KeyboardDevice::KeyDown, down); break;
-        case Qt::Key_PageUp: m_keyboard->setKey(KeyboardDevice::KeyPageUp, down); break;
-        case Qt::Key_PageDown: m_keyboard->setKey(KeyboardDevice::KeyPageDown, down); break;
-        case Qt::Key_Space: m_keyboard->setKey(KeyboardDevice::KeyClutch, down); break;
-        default: break;
+        case Qt::Key_Left:
+            m_keyboard->setKey(KeyboardDevice::KeyLeft, down);
+            break;
+        case Qt::Key_Right:
+            m_keyboard->setKey(KeyboardDevice::KeyRight, down);
+            break;
+        case Qt::Key_Up:
+            m_keyboard->setKey(KeyboardDevice::KeyUp, down);
+            break;
+        case Qt::Key_Down:
+            m_keyboard->setKey(KeyboardDevice::KeyDown, down);
+            break;
+        case Qt::Key_PageUp:
+            m_keyboard->setKey(KeyboardDevice::KeyPageUp, down);
+            break;
+        case Qt::Key_PageDown:
+            m_keyboard->setKey(KeyboardDevice::KeyPageDown, down);
+            break;
+        case Qt::Key_Space:
+            m_keyboard->setKey(KeyboardDevice::KeyClutch, down);
+            break;
+        default:
+            break;
         }
     }
     LiveView& m_live;

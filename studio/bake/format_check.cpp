@@ -122,8 +122,7 @@ float readF32le(std::string_view b, size_t at) {
 /// Each test returns an empty string when the content matches, else the rule it broke.
 std::string objRule(std::string_view b) {
     size_t nul = b.find('\0');
-    if (nul != std::string_view::npos)
-        return "expected text, found a NUL byte at offset " + std::to_string(nul);
+    if (nul != std::string_view::npos) return "expected text, found a NUL byte at offset " + std::to_string(nul);
     size_t pos = 0;
     while (pos < b.size()) {
         size_t end = b.find('\n', pos);
@@ -142,16 +141,14 @@ bool isBinaryStl(std::string_view b) {
 }
 
 bool isAsciiStl(std::string_view b) {
-    return startsWithNoCase(trimLeft(skipBom(b)), "solid") &&
-           b.find('\0') == std::string_view::npos;
+    return startsWithNoCase(trimLeft(skipBom(b)), "solid") && b.find('\0') == std::string_view::npos;
 }
 
 std::string stlRule(std::string_view b) {
     if (isBinaryStl(b) || isAsciiStl(b)) return {};
-    std::string rule =
-        "expected ASCII text starting with 'solid', or binary data of 84 + 50*n bytes "
-        "for the n triangles its header declares; the file has " +
-        std::to_string(b.size()) + " bytes";
+    std::string rule = "expected ASCII text starting with 'solid', or binary data of 84 + 50*n bytes "
+                       "for the n triangles its header declares; the file has " +
+                       std::to_string(b.size()) + " bytes";
     if (b.size() >= 84) rule += " and its header declares n = " + std::to_string(readU32le(b, 80));
     return rule;
 }
@@ -197,9 +194,8 @@ bool isAsciiFbx(std::string_view b) {
 }
 
 std::string fbxRule(std::string_view b) {
-    return (isBinaryFbx(b) || isAsciiFbx(b))
-               ? std::string{}
-               : "expected the 'Kaydara FBX Binary' magic or an ASCII '; FBX' header";
+    return (isBinaryFbx(b) || isAsciiFbx(b)) ? std::string{}
+                                             : "expected the 'Kaydara FBX Binary' magic or an ASCII '; FBX' header";
 }
 
 struct FormatEntry {
@@ -279,18 +275,16 @@ void checkObj(const std::string& label, std::string_view b) {
         if (tok[0] == "v") {
             const size_t vi = ++counts[0];
             if (tok.size() < 4)
-                throw InputError(where + "vertex " + std::to_string(vi) + " has " +
-                                 std::to_string(tok.size() - 1) + " coordinates (needs x y z)");
+                throw InputError(where + "vertex " + std::to_string(vi) + " has " + std::to_string(tok.size() - 1) +
+                                 " coordinates (needs x y z)");
             for (int k = 1; k <= 3; ++k) {
                 const auto v = parseDouble(tok[k]);
                 if (!v)
-                    throw InputError(where + "vertex " + std::to_string(vi) +
-                                     ": cannot parse coordinate " + quoted(tok[k]) +
-                                     " as a number");
+                    throw InputError(where + "vertex " + std::to_string(vi) + ": cannot parse coordinate " +
+                                     quoted(tok[k]) + " as a number");
                 if (!std::isfinite(*v))
-                    throw InputError(where + "vertex " + std::to_string(vi) +
-                                     " has a non-finite coordinate (" + std::string(tok[k]) +
-                                     "); coordinates must be finite");
+                    throw InputError(where + "vertex " + std::to_string(vi) + " has a non-finite coordinate (" +
+                                     std::string(tok[k]) + "); coordinates must be finite");
             }
         } else if (tok[0] == "vt") {
             ++counts[1];
@@ -317,17 +311,16 @@ void checkObj(const std::string& label, std::string_view b) {
                     const char kind = "vtn"[k];
                     const auto idx = parseInt(parts[k]);
                     if (!idx)
-                        throw InputError(faceWhere + ": cannot parse " + objKindName(kind) +
-                                         " index " + quoted(parts[k]));
+                        throw InputError(faceWhere + ": cannot parse " + objKindName(kind) + " index " +
+                                         quoted(parts[k]));
                     if (*idx == 0)
                         throw InputError(faceWhere + ": " + objKindName(kind) +
                                          " index 0 is invalid (OBJ indices start at 1)");
                     const size_t have = counts[k];
                     if (*idx < 0) {
                         if (static_cast<uint64_t>(-(*idx + 1)) >= have)
-                            throw InputError(faceWhere + ": " + objKindName(kind) + " index " +
-                                             std::to_string(*idx) + " is out of range (only " +
-                                             objCount(have, kind) + " defined before it)");
+                            throw InputError(faceWhere + ": " + objKindName(kind) + " index " + std::to_string(*idx) +
+                                             " is out of range (only " + objCount(have, kind) + " defined before it)");
                     } else if (static_cast<uint64_t>(*idx) > have) {
                         forward.push_back({firstLine, fi, *idx, kind});
                     }
@@ -339,10 +332,9 @@ void checkObj(const std::string& label, std::string_view b) {
     for (const ObjRef& r : forward) {
         const size_t have = counts[r.kind == 'v' ? 0 : r.kind == 't' ? 1 : 2];
         if (static_cast<uint64_t>(r.index) > have)
-            throw InputError(label + ": line " + std::to_string(r.line) + ": face " +
-                             std::to_string(r.face) + ": " + objKindName(r.kind) + " index " +
-                             std::to_string(r.index) + " is out of range (the file has " +
-                             objCount(have, r.kind) + ")");
+            throw InputError(label + ": line " + std::to_string(r.line) + ": face " + std::to_string(r.face) + ": " +
+                             objKindName(r.kind) + " index " + std::to_string(r.index) +
+                             " is out of range (the file has " + objCount(have, r.kind) + ")");
     }
     if (polygons == 0) fail(label, "no faces: the file has no 'f' line with 3 or more vertices");
 }
@@ -379,11 +371,9 @@ void checkStlAscii(const std::string& label, std::string_view b) {
                                 ": 'vertex' is followed by fewer than 3 coordinates (truncated)");
             for (int k = 1; k <= 3; ++k) {
                 const auto v = parseDouble(tok[i + k]);
-                const std::string where = "facet " + std::to_string(facets == 0 ? 0 : facets - 1) +
-                                          " vertex " + std::to_string(corner);
-                if (!v)
-                    fail(label, where + ": cannot parse coordinate " + quoted(tok[i + k]) +
-                                    " as a number");
+                const std::string where =
+                    "facet " + std::to_string(facets == 0 ? 0 : facets - 1) + " vertex " + std::to_string(corner);
+                if (!v) fail(label, where + ": cannot parse coordinate " + quoted(tok[i + k]) + " as a number");
                 if (!std::isfinite(*v))
                     fail(label, where + " has a non-finite coordinate (" + std::string(tok[i + k]) +
                                     "); coordinates must be finite");
@@ -456,7 +446,7 @@ enum class PlyEncoding { Ascii, BinaryLE, BinaryBE };
 
 /// Reads scalar values from the body of a PLY file, ASCII or binary.
 class PlyBodyReader {
-  public:
+public:
     PlyBodyReader(std::string_view body, PlyEncoding enc) : m_body(body), m_enc(enc) {}
 
     /// False when the body ends before the value.
@@ -501,7 +491,7 @@ class PlyBodyReader {
     /// Set when read() returned true but the ASCII token did not parse.
     bool parseError() const { return m_parseError; }
 
-  private:
+private:
     template <class T> static T load(const unsigned char* raw) {
         T v;
         std::memcpy(&v, raw, sizeof v);
@@ -581,20 +571,17 @@ void checkPly(const std::string& label, std::string_view b) {
             if (tok.size() != 3) fail(label, where + "expected 'element <name> <count>'");
             const auto count = parseInt(tok[2]);
             if (!count || *count < 0)
-                fail(label,
-                     where + "element count " + quoted(tok[2]) + " is not a non-negative integer");
+                fail(label, where + "element count " + quoted(tok[2]) + " is not a non-negative integer");
             elements.push_back({std::string(tok[1]), static_cast<uint64_t>(*count), {}});
         } else if (key == "property") {
             if (elements.empty()) fail(label, where + "'property' before any 'element'");
             PlyProperty prop;
             if (tok.size() >= 2 && tok[1] == "list") {
-                if (tok.size() != 5)
-                    fail(label, where + "expected 'property list <count type> <item type> <name>'");
+                if (tok.size() != 5) fail(label, where + "expected 'property list <count type> <item type> <name>'");
                 const auto ct = plyType(tok[2]);
                 const auto it = plyType(tok[3]);
                 if (!ct || !plyIsInteger(*ct))
-                    fail(label,
-                         where + "list count type " + quoted(tok[2]) + " is not an integer type");
+                    fail(label, where + "list count type " + quoted(tok[2]) + " is not an integer type");
                 if (!it) fail(label, where + "unknown property type " + quoted(tok[3]));
                 prop = {std::string(tok[4]), *it, true, *ct};
             } else {
@@ -623,8 +610,7 @@ void checkPly(const std::string& label, std::string_view b) {
             if (p.name == name && !p.list) return true;
         return false;
     };
-    if (!vertexElem || !hasScalar(vertexElem, "x") || !hasScalar(vertexElem, "y") ||
-        !hasScalar(vertexElem, "z"))
+    if (!vertexElem || !hasScalar(vertexElem, "x") || !hasScalar(vertexElem, "y") || !hasScalar(vertexElem, "z"))
         fail(label, "PLY header declares no 'vertex' element with x, y, z properties");
     if (!faceElem) fail(label, "no faces: the PLY header declares no 'face' element");
     if (faceElem->count == 0) fail(label, "no faces: the PLY header declares 0 faces");
@@ -646,8 +632,8 @@ void checkPly(const std::string& label, std::string_view b) {
         for (uint64_t i = 0; i < e.count; ++i) {
             auto where = [&] { return "PLY element '" + e.name + "' " + std::to_string(i); };
             auto truncated = [&]() {
-                fail(label, "PLY data ends inside element '" + e.name + "' " + std::to_string(i) +
-                                " of " + std::to_string(e.count) + " (truncated)");
+                fail(label, "PLY data ends inside element '" + e.name + "' " + std::to_string(i) + " of " +
+                                std::to_string(e.count) + " (truncated)");
             };
             auto get = [&](PlyType t, double& v) {
                 std::string_view bad;
@@ -660,11 +646,9 @@ void checkPly(const std::string& label, std::string_view b) {
                 double v = 0;
                 if (!p.list) {
                     get(p.type, v);
-                    if (isVertex && (p.name == "x" || p.name == "y" || p.name == "z") &&
-                        !std::isfinite(v))
-                        fail(label, "vertex " + std::to_string(i) + " has a non-finite " + p.name +
-                                        " coordinate (" + sim::formatNumber(v) +
-                                        "); coordinates must be finite");
+                    if (isVertex && (p.name == "x" || p.name == "y" || p.name == "z") && !std::isfinite(v))
+                        fail(label, "vertex " + std::to_string(i) + " has a non-finite " + p.name + " coordinate (" +
+                                        sim::formatNumber(v) + "); coordinates must be finite");
                     continue;
                 }
                 double nd = 0;
@@ -676,9 +660,8 @@ void checkPly(const std::string& label, std::string_view b) {
                     get(p.type, v);
                     if (indices && (v < 0 || v >= static_cast<double>(vertexCount)))
                         fail(label, "face " + std::to_string(i) + ": index " + std::to_string(k) +
-                                        " references vertex " + sim::formatNumber(v) +
-                                        " (the file has " + std::to_string(vertexCount) +
-                                        " vertices)");
+                                        " references vertex " + sim::formatNumber(v) + " (the file has " +
+                                        std::to_string(vertexCount) + " vertices)");
                 }
                 if (indices && n >= 3) ++polygons;
             }
@@ -703,10 +686,8 @@ void checkGlb(const std::string& label, std::string_view b) {
                         std::to_string(b.size()) + " (truncated or corrupt)");
     const uint64_t chunk = readU32le(b, 12);
     if (20 + chunk > b.size())
-        fail(label, "GLB first chunk of " + std::to_string(chunk) +
-                        " bytes runs past the end of the file");
-    if (version == 2 && b.substr(16, 4) != "JSON")
-        fail(label, "GLB first chunk is not of type 'JSON'");
+        fail(label, "GLB first chunk of " + std::to_string(chunk) + " bytes runs past the end of the file");
+    if (version == 2 && b.substr(16, 4) != "JSON") fail(label, "GLB first chunk is not of type 'JSON'");
 }
 
 } // namespace
@@ -726,8 +707,7 @@ void checkExtension(const std::string& label, std::string_view extension) {
                     " (accepted: " + acceptedList() + ")");
 }
 
-SurfaceFormat sniffFormat(const std::string& label, std::string_view extension,
-                          std::string_view bytes) {
+SurfaceFormat sniffFormat(const std::string& label, std::string_view extension, std::string_view bytes) {
     checkExtension(label, extension);
     const FormatEntry* entry = nullptr;
     for (const auto& f : kFormats)
@@ -735,8 +715,7 @@ SurfaceFormat sniffFormat(const std::string& label, std::string_view extension,
     if (bytes.empty()) fail(label, "file is empty (0 bytes)");
     const std::string rule = entry->rule(bytes);
     if (!rule.empty()) {
-        std::string msg =
-            "content does not look like " + std::string(entry->family) + " (" + rule + ")";
+        std::string msg = "content does not look like " + std::string(entry->family) + " (" + rule + ")";
         for (const auto& other : kFormats)
             if (&other != entry && other.rule(bytes).empty()) {
                 msg += "; it looks like " + std::string(other.family) + ", rename it to " +
@@ -746,8 +725,7 @@ SurfaceFormat sniffFormat(const std::string& label, std::string_view extension,
         fail(label, msg);
     }
     if (extension == ".obj") return SurfaceFormat::Obj;
-    if (extension == ".stl")
-        return isBinaryStl(bytes) ? SurfaceFormat::StlBinary : SurfaceFormat::StlAscii;
+    if (extension == ".stl") return isBinaryStl(bytes) ? SurfaceFormat::StlBinary : SurfaceFormat::StlAscii;
     if (extension == ".ply") return SurfaceFormat::Ply;
     if (extension == ".gltf") return SurfaceFormat::Gltf;
     if (extension == ".glb") return SurfaceFormat::Glb;

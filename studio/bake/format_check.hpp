@@ -20,8 +20,7 @@ void checkExtension(const std::string& label, std::string_view extension);
 
 /// Format from the extension, confirmed by the content. Throws on an empty file, an extension
 /// outside the whitelist, or content that does not match the extension.
-SurfaceFormat sniffFormat(const std::string& label, std::string_view extension,
-                          std::string_view bytes);
+SurfaceFormat sniffFormat(const std::string& label, std::string_view extension, std::string_view bytes);
 
 /// Format-specific structural checks on the raw bytes, done before assimp parses them:
 /// OBJ   vertex coordinates parse and are finite; face, texture and normal indices are in range;

@@ -27,8 +27,7 @@
 namespace viscera::bake {
 namespace {
 
-constexpr std::array<std::string_view, 6> kExtensions{".obj",  ".stl", ".ply",
-                                                      ".gltf", ".glb", ".fbx"};
+constexpr std::array<std::string_view, 6> kExtensions{".obj", ".stl", ".ply", ".gltf", ".glb", ".fbx"};
 constexpr int kMaxNodeDepth = 1024;
 constexpr std::string_view kMaxFileBytesName = "ImportOptions::maxFileBytes";
 
@@ -51,8 +50,7 @@ std::string formatVec(double x, double y, double z) {
 /// Checks of the scene exactly as the parser produced it, before any post-processing step can
 /// hide a problem (joining vertices with NaN coordinates, for one, silently merges them).
 void checkRawScene(const std::string& label, const aiScene* scene) {
-    if (scene->mNumMeshes == 0 || scene->mMeshes == nullptr)
-        fail(label, "empty scene: the file contains no meshes");
+    if (scene->mNumMeshes == 0 || scene->mMeshes == nullptr) fail(label, "empty scene: the file contains no meshes");
     size_t polygons = 0;
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
         const aiMesh* mesh = scene->mMeshes[m];
@@ -64,9 +62,8 @@ void checkRawScene(const std::string& label, const aiScene* scene) {
         for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
             const aiVector3D& p = mesh->mVertices[v];
             if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-                fail(label, meshName(mesh, m) + " vertex " + std::to_string(v) +
-                                " has a non-finite coordinate " + formatVec(p.x, p.y, p.z) +
-                                "; coordinates must be finite");
+                fail(label, meshName(mesh, m) + " vertex " + std::to_string(v) + " has a non-finite coordinate " +
+                                formatVec(p.x, p.y, p.z) + "; coordinates must be finite");
         }
         for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
             const aiFace& face = mesh->mFaces[f];
@@ -74,22 +71,20 @@ void checkRawScene(const std::string& label, const aiScene* scene) {
                 fail(label, meshName(mesh, m) + " face " + std::to_string(f) + " has no indices");
             for (unsigned k = 0; k < face.mNumIndices; ++k)
                 if (face.mIndices[k] >= mesh->mNumVertices)
-                    fail(label, meshName(mesh, m) + " face " + std::to_string(f) + ": index " +
-                                    std::to_string(k) + " references vertex " +
-                                    std::to_string(face.mIndices[k]) + " (the mesh has " +
+                    fail(label, meshName(mesh, m) + " face " + std::to_string(f) + ": index " + std::to_string(k) +
+                                    " references vertex " + std::to_string(face.mIndices[k]) + " (the mesh has " +
                                     std::to_string(mesh->mNumVertices) + " vertices)");
             if (face.mNumIndices >= 3) ++polygons;
         }
     }
     if (polygons == 0)
-        fail(label, "no faces: the scene's " + std::to_string(scene->mNumMeshes) +
-                        " mesh(es) hold no triangles or polygons");
+        fail(label,
+             "no faces: the scene's " + std::to_string(scene->mNumMeshes) + " mesh(es) hold no triangles or polygons");
 }
 
 Eigen::Matrix4d toEigen(const aiMatrix4x4& a) {
     Eigen::Matrix4d m;
-    m << a.a1, a.a2, a.a3, a.a4, a.b1, a.b2, a.b3, a.b4, a.c1, a.c2, a.c3, a.c4, a.d1, a.d2, a.d3,
-        a.d4;
+    m << a.a1, a.a2, a.a3, a.a4, a.b1, a.b2, a.b3, a.b4, a.c1, a.c2, a.c3, a.c4, a.d1, a.d2, a.d3, a.d4;
     return m;
 }
 
@@ -142,8 +137,7 @@ Merged mergeScene(const std::string& label, const aiScene* scene, double scale) 
         const aiNode* node = item.node;
         const std::string nodeName = "node '" + std::string(node->mName.C_Str()) + "'";
         if (item.depth > kMaxNodeDepth)
-            fail(label, nodeName + ": the node hierarchy is deeper than " +
-                            std::to_string(kMaxNodeDepth) + " levels");
+            fail(label, nodeName + ": the node hierarchy is deeper than " + std::to_string(kMaxNodeDepth) + " levels");
         const Eigen::Matrix4d world = item.parent * toEigen(node->mTransformation);
         const double det = world.topLeftCorner<3, 3>().determinant();
         if (!world.allFinite() || !std::isfinite(det) || det == 0.0)
@@ -152,8 +146,8 @@ Merged mergeScene(const std::string& label, const aiScene* scene, double scale) 
         for (unsigned i = 0; i < node->mNumMeshes; ++i) {
             const unsigned mi = node->mMeshes[i];
             if (mi >= scene->mNumMeshes)
-                fail(label, nodeName + " references mesh " + std::to_string(mi) +
-                                " (the scene has " + std::to_string(scene->mNumMeshes) + ")");
+                fail(label, nodeName + " references mesh " + std::to_string(mi) + " (the scene has " +
+                                std::to_string(scene->mNumMeshes) + ")");
             const aiMesh* mesh = scene->mMeshes[mi];
             ++out.instances;
             remap.assign(mesh->mNumVertices, 0);
@@ -165,23 +159,20 @@ Merged mergeScene(const std::string& label, const aiScene* scene, double scale) 
                     fail(label, meshName(mesh, mi) + " vertex " + std::to_string(v) +
                                     " is not finite after the node transform and unit scale " +
                                     formatVec(p.x(), p.y(), p.z()));
-                const auto [it, inserted] =
-                    index.try_emplace(keyOf(p), static_cast<int32_t>(out.positions.size()));
+                const auto [it, inserted] = index.try_emplace(keyOf(p), static_cast<int32_t>(out.positions.size()));
                 if (inserted) out.positions.push_back(p);
                 remap[v] = it->second;
             }
             for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
                 const aiFace& face = mesh->mFaces[f];
                 if (face.mNumIndices != 3) continue; // points and lines are not surface
-                sim::Tri t{remap[face.mIndices[0]], remap[face.mIndices[1]],
-                           remap[face.mIndices[2]]};
+                sim::Tri t{remap[face.mIndices[0]], remap[face.mIndices[1]], remap[face.mIndices[2]]};
                 if (mirrored) std::swap(t[1], t[2]);
                 out.triangles.push_back(t);
             }
         }
         for (unsigned c = node->mNumChildren; c-- > 0;)
-            if (node->mChildren[c] != nullptr)
-                stack.push_back({node->mChildren[c], world, item.depth + 1});
+            if (node->mChildren[c] != nullptr) stack.push_back({node->mChildren[c], world, item.depth + 1});
     }
     return out;
 }
@@ -218,11 +209,10 @@ SurfaceFormat detectSurfaceFormat(const std::filesystem::path& file) {
     return detail::sniffFormat(label, detail::lowerExtension(file), bytes);
 }
 
-ImportResult importSurfaceWithReport(const std::filesystem::path& file,
-                                     const ImportOptions& options) {
+ImportResult importSurfaceWithReport(const std::filesystem::path& file, const ImportOptions& options) {
     if (!std::isfinite(options.scale) || options.scale <= 0)
-        throw std::invalid_argument("bake::importSurface(): ImportOptions::scale is " +
-                                    std::to_string(options.scale) + " (must be finite and > 0)");
+        throw std::invalid_argument("bake::importSurface(): ImportOptions::scale is " + std::to_string(options.scale) +
+                                    " (must be finite and > 0)");
     const std::string label = file.string();
     ImportReport report;
     {
@@ -235,14 +225,12 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file,
     }
 
     Assimp::Importer importer;
-    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
-                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
-                                aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
-                                    aiComponent_COLORS | aiComponent_TEXCOORDS |
-                                    aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
-                                    aiComponent_TEXTURES | aiComponent_LIGHTS |
-                                    aiComponent_CAMERAS | aiComponent_MATERIALS);
+    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
+                                                            aiComponent_COLORS | aiComponent_TEXCOORDS |
+                                                            aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
+                                                            aiComponent_TEXTURES | aiComponent_LIGHTS |
+                                                            aiComponent_CAMERAS | aiComponent_MATERIALS);
     importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
 
     const aiScene* scene = nullptr;
@@ -250,8 +238,7 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file,
         // No post-processing yet: the raw scene is checked first.
         scene = importer.ReadFile(label, 0);
     } catch (const std::exception& e) {
-        fail(label,
-             "cannot be parsed as " + std::string(formatName(report.format)) + ": " + e.what());
+        fail(label, "cannot be parsed as " + std::string(formatName(report.format)) + ": " + e.what());
     }
     if (scene == nullptr) {
         std::string why = importer.GetErrorString();
@@ -262,20 +249,18 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file,
     checkRawScene(label, scene);
 
     try {
-        scene = importer.ApplyPostProcessing(
-            aiProcess_ValidateDataStructure | aiProcess_RemoveComponent | aiProcess_Triangulate |
-            aiProcess_SortByPType | aiProcess_JoinIdenticalVertices);
+        scene = importer.ApplyPostProcessing(aiProcess_ValidateDataStructure | aiProcess_RemoveComponent |
+                                             aiProcess_Triangulate | aiProcess_SortByPType |
+                                             aiProcess_JoinIdenticalVertices);
     } catch (const std::exception& e) {
         fail(label, std::string("invalid scene structure: ") + e.what());
     }
-    if (scene == nullptr)
-        fail(label, std::string("invalid scene structure: ") + importer.GetErrorString());
+    if (scene == nullptr) fail(label, std::string("invalid scene structure: ") + importer.GetErrorString());
 
     Merged merged = mergeScene(label, scene, options.scale);
     report.meshInstances = merged.instances;
     report.sourceTriangles = merged.triangles.size();
-    if (merged.triangles.empty())
-        fail(label, "no faces: no mesh instance in the scene graph holds triangles");
+    if (merged.triangles.empty()) fail(label, "no faces: no mesh instance in the scene graph holds triangles");
 
     // Drop triangles that collapsed when vertices were joined, then unreferenced vertices.
     std::vector<sim::Tri> triangles;
@@ -303,8 +288,7 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file,
                   " triangle(s) that collapse when identical vertices are joined");
 
     try {
-        return {sim::TriMesh::fromArrays(std::move(positions), std::move(triangles), label),
-                report};
+        return {sim::TriMesh::fromArrays(std::move(positions), std::move(triangles), label), report};
     } catch (const std::invalid_argument& e) {
         throw InputError(e.what());
     }

@@ -69,7 +69,6 @@ SurfaceFormat detectSurfaceFormat(const std::filesystem::path& file);
 sim::TriMesh importSurface(const std::filesystem::path& file, const ImportOptions& options = {});
 
 /// importSurface() with the figures of what was merged and cleaned up.
-ImportResult importSurfaceWithReport(const std::filesystem::path& file,
-                                     const ImportOptions& options = {});
+ImportResult importSurfaceWithReport(const std::filesystem::path& file, const ImportOptions& options = {});
 
 } // namespace viscera::bake

@@ -87,9 +87,7 @@ thread_local ScratchArena* ScratchArena::s_current = nullptr;
 /// as a whole), or from the heap when no arena is active.
 template <class T> struct ArenaAllocator {
     using value_type = T;
-    template <class U> struct rebind {
-        using other = ArenaAllocator<U>;
-    };
+    template <class U> struct rebind { using other = ArenaAllocator<U>; };
     ArenaAllocator() noexcept = default;
     template <class U> ArenaAllocator(const ArenaAllocator<U>&) noexcept {}
     T* allocate(size_t n) {
@@ -150,9 +148,9 @@ template <class T> struct ArenaAllocator {
 #include <limits>
 #include <numbers>
 #include <set>
-#include <type_traits>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -194,7 +192,6 @@ void validateParams(const SkeletonParams& p) {
                  "mediallyCenteredSpeedTradeoff", p.mediallyCenteredSpeedTradeoff, "must be finite and > 0");
 }
 
-
 double secondsSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -206,7 +203,8 @@ SkeletonResult extractSkeleton(const sim::TriMesh& surface, const SkeletonParams
     validateParams(params);
     const std::string& label = params.label;
     // Declared first, so every CGAL object of this call is destroyed before it (see above).
-    const size_t reserveBytes = std::min(size_t{1} << 40, (size_t{1} << 30) + (size_t{256} << 10) * surface.triangleCount());
+    const size_t reserveBytes =
+        std::min(size_t{1} << 40, (size_t{1} << 30) + (size_t{256} << 10) * surface.triangleCount());
     const detail::ScratchArena arena(reserveBytes);
 
     // ---- surface checks (indices of `surface` in every message) ------------------------------
@@ -291,7 +289,8 @@ SkeletonResult extractSkeleton(const sim::TriMesh& surface, const SkeletonParams
     for (size_t j = 0; j < m; ++j) {
         const auto& vm = cs[j];
         s.nodes[j] = sim::Vec3(vm.point.x(), vm.point.y(), vm.point.z()) / scale + centre;
-        if (!s.nodes[j].allFinite()) fail(label, "skeletonization produced a non-finite node (" + std::to_string(j) + ")");
+        if (!s.nodes[j].allFinite())
+            fail(label, "skeletonization produced a non-finite node (" + std::to_string(j) + ")");
         for (const SurfaceMesh::Vertex_index vd : vm.vertices) {
             const int32_t v = inputOf.at(static_cast<size_t>(vd));
             if (s.vertexNode[v] == sim::kNone) s.vertexNode[v] = static_cast<int32_t>(j);
@@ -304,7 +303,8 @@ SkeletonResult extractSkeleton(const sim::TriMesh& surface, const SkeletonParams
         if (a != b) edges.emplace(std::min(a, b), std::max(a, b));
     }
     s.edges.reserve(edges.size());
-    for (const auto& [a, b] : edges) s.edges.push_back({a, b});
+    for (const auto& [a, b] : edges)
+        s.edges.push_back({a, b});
 
     // Vertices the correspondence did not list (not expected): nearest node.
     SkeletonReport& r = result.report;

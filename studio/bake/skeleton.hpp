@@ -43,16 +43,16 @@ struct SkeletonParams {
 };
 
 struct SkeletonReport {
-    size_t surfaceVertices = 0;   ///< vertices referenced by the surface's triangles
+    size_t surfaceVertices = 0; ///< vertices referenced by the surface's triangles
     size_t surfaceTriangles = 0;
     size_t nodes = 0, edges = 0;
-    int32_t components = 0;       ///< connected components of the skeleton graph
-    int64_t cycleRank = 0;        ///< independent loops (the genus for a connected closed surface)
+    int32_t components = 0; ///< connected components of the skeleton graph
+    int64_t cycleRank = 0;  ///< independent loops (the genus for a connected closed surface)
     /// Surface vertices that CGAL's correspondence did not list (mapped to the nearest node);
     /// expected 0.
     size_t unlistedVertices = 0;
-    size_t scratchBytes = 0;      ///< memory CGAL allocated during the call (monotonic arena)
-    double seconds = 0;           ///< wall time of the whole call
+    size_t scratchBytes = 0; ///< memory CGAL allocated during the call (monotonic arena)
+    double seconds = 0;      ///< wall time of the whole call
 };
 
 struct SkeletonResult {

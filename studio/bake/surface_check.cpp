@@ -56,8 +56,8 @@ void checkInputSurface(const std::string& label, const sim::TriMesh& surface) {
             const int32_t b = std::max(tris[t][k], tris[t][(k + 1) % 3]);
             const auto& u = undirected.at(edgeKey(a, b));
             if (u[0] > 2)
-                fail(label, "surface is not manifold: " + edgeName(a, b) + " is shared by " +
-                                std::to_string(u[0]) + " triangles (a closed surface has 2)");
+                fail(label, "surface is not manifold: " + edgeName(a, b) + " is shared by " + std::to_string(u[0]) +
+                                " triangles (a closed surface has 2)");
         }
 
     std::unordered_map<uint64_t, int32_t> directed; // directed edge -> its triangle
@@ -68,15 +68,15 @@ void checkInputSurface(const std::string& label, const sim::TriMesh& surface) {
             const auto [it, inserted] = directed.try_emplace(edgeKey(a, b), t);
             if (!inserted)
                 fail(label, "surface is not consistently oriented: " + edgeName(a, b) +
-                                " is traversed in the same direction by triangles " +
-                                std::to_string(it->second) + " and " + std::to_string(t));
+                                " is traversed in the same direction by triangles " + std::to_string(it->second) +
+                                " and " + std::to_string(t));
         }
     for (int32_t t = 0; t < nt; ++t)
         for (int k = 0; k < 3; ++k) {
             const int32_t a = tris[t][k], b = tris[t][(k + 1) % 3];
             if (!directed.contains(edgeKey(b, a)))
-                fail(label, "surface is not closed: " + edgeName(a, b) +
-                                " belongs to only one triangle (" + std::to_string(t) + ")");
+                fail(label, "surface is not closed: " + edgeName(a, b) + " belongs to only one triangle (" +
+                                std::to_string(t) + ")");
         }
 
     // Fans: rotate around each vertex through the triangle owning the reversed previous edge.

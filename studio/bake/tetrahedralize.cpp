@@ -56,29 +56,27 @@ constexpr double kRegularTetVolumePerR3 = 0.5132002392796673;
 
 void requireParam(bool ok, const char* field, double value, const char* rule) {
     if (!ok)
-        throw std::invalid_argument(std::string("bake::tetrahedralize(): MeshingParams::") + field +
-                                    " is " + std::to_string(value) + " (" + rule + ")");
+        throw std::invalid_argument(std::string("bake::tetrahedralize(): MeshingParams::") + field + " is " +
+                                    std::to_string(value) + " (" + rule + ")");
 }
 
 void validateParams(const MeshingParams& p) {
-    requireParam(std::isfinite(p.facetAngleDeg) && p.facetAngleDeg > 0 && p.facetAngleDeg <= 30,
-                 "facetAngleDeg", p.facetAngleDeg, "must be in (0, 30]");
+    requireParam(std::isfinite(p.facetAngleDeg) && p.facetAngleDeg > 0 && p.facetAngleDeg <= 30, "facetAngleDeg",
+                 p.facetAngleDeg, "must be in (0, 30]");
     const std::pair<const char*, double> sizes[] = {{"facetSize", p.facetSize},
                                                     {"facetDistance", p.facetDistance},
                                                     {"cellSize", p.cellSize},
                                                     {"edgeSize", p.edgeSize}};
     for (const auto& [name, v] : sizes)
         requireParam(std::isfinite(v) && v >= 0, name, v, "must be finite and >= 0; 0 = automatic");
-    requireParam(std::isfinite(p.cellRadiusEdgeRatio) && p.cellRadiusEdgeRatio >= 2,
-                 "cellRadiusEdgeRatio", p.cellRadiusEdgeRatio, "must be >= 2");
-    requireParam(std::isfinite(p.featureAngleDeg) && p.featureAngleDeg < 180, "featureAngleDeg",
-                 p.featureAngleDeg, "must be below 180; <= 0 disables sharp features");
+    requireParam(std::isfinite(p.cellRadiusEdgeRatio) && p.cellRadiusEdgeRatio >= 2, "cellRadiusEdgeRatio",
+                 p.cellRadiusEdgeRatio, "must be >= 2");
+    requireParam(std::isfinite(p.featureAngleDeg) && p.featureAngleDeg < 180, "featureAngleDeg", p.featureAngleDeg,
+                 "must be below 180; <= 0 disables sharp features");
     requireParam(p.smoothingMaxIterations >= 0, "smoothingMaxIterations", p.smoothingMaxIterations,
                  "must be >= 0; 0 = until converged");
-    requireParam(p.maxEstimatedTets > 0, "maxEstimatedTets",
-                 static_cast<double>(p.maxEstimatedTets), "must be > 0");
+    requireParam(p.maxEstimatedTets > 0, "maxEstimatedTets", static_cast<double>(p.maxEstimatedTets), "must be > 0");
 }
-
 
 /// Builds the CGAL surface from the referenced vertices; checks degenerate triangles and
 /// self-intersections (the indices in messages are those of the input TriMesh).
@@ -99,10 +97,8 @@ SurfaceMesh buildSurfaceMesh(const std::string& label, const sim::TriMesh& surfa
         const auto& a = sm.point(vmap[tris[t][0]]);
         const auto& b = sm.point(vmap[tris[t][1]]);
         const auto& c = sm.point(vmap[tris[t][2]]);
-        if (CGAL::collinear(a, b, c))
-            fail(label, "triangle " + std::to_string(t) + " is degenerate (zero area)");
-        if (sm.add_face(vmap[tris[t][0]], vmap[tris[t][1]], vmap[tris[t][2]]) ==
-            SurfaceMesh::null_face())
+        if (CGAL::collinear(a, b, c)) fail(label, "triangle " + std::to_string(t) + " is degenerate (zero area)");
+        if (sm.add_face(vmap[tris[t][0]], vmap[tris[t][1]], vmap[tris[t][2]]) == SurfaceMesh::null_face())
             fail(label, "surface is not manifold at triangle " + std::to_string(t));
     }
     std::vector<std::pair<SurfaceMesh::Face_index, SurfaceMesh::Face_index>> pairs;
@@ -117,15 +113,15 @@ SurfaceMesh buildSurfaceMesh(const std::string& label, const sim::TriMesh& surfa
         for (const auto& pair : pairs)
             first = std::min(first, ordered(pair));
         fail(label, "surface self-intersects: triangles " + std::to_string(first.first) + " and " +
-                        std::to_string(first.second) + " intersect (" +
-                        std::to_string(pairs.size()) + " intersecting pair(s) in all)");
+                        std::to_string(first.second) + " intersect (" + std::to_string(pairs.size()) +
+                        " intersecting pair(s) in all)");
     }
     return sm;
 }
 
 /// Reseeds CGAL's default random generator (thread-local) for the duration of a call.
 class DefaultRandomScope {
-  public:
+public:
     explicit DefaultRandomScope(uint32_t seed) : m_saved(CGAL::get_default_random()) {
         CGAL::get_default_random() = CGAL::Random(seed);
     }
@@ -133,23 +129,22 @@ class DefaultRandomScope {
     DefaultRandomScope(const DefaultRandomScope&) = delete;
     DefaultRandomScope& operator=(const DefaultRandomScope&) = delete;
 
-  private:
+private:
     CGAL::Random m_saved;
 };
 
 /// Reports stage starts with an overall fraction from fixed stage weights.
 class Progress {
-  public:
+public:
     Progress(ProgressCallback cb, const MeshingParams& p) : m_cb(std::move(cb)) {
-        const std::pair<MeshingStage, double> all[] = {
-            {MeshingStage::CheckSurface, 0.03},
-            {MeshingStage::BuildDomain, 0.05},
-            {MeshingStage::Refine, 0.50},
-            {MeshingStage::Odt, p.odt ? 0.10 : 0.0},
-            {MeshingStage::Lloyd, p.lloyd ? 0.10 : 0.0},
-            {MeshingStage::Perturb, p.perturb ? 0.15 : 0.0},
-            {MeshingStage::Exude, p.exude ? 0.10 : 0.0},
-            {MeshingStage::Export, 0.05}};
+        const std::pair<MeshingStage, double> all[] = {{MeshingStage::CheckSurface, 0.03},
+                                                       {MeshingStage::BuildDomain, 0.05},
+                                                       {MeshingStage::Refine, 0.50},
+                                                       {MeshingStage::Odt, p.odt ? 0.10 : 0.0},
+                                                       {MeshingStage::Lloyd, p.lloyd ? 0.10 : 0.0},
+                                                       {MeshingStage::Perturb, p.perturb ? 0.15 : 0.0},
+                                                       {MeshingStage::Exude, p.exude ? 0.10 : 0.0},
+                                                       {MeshingStage::Export, 0.05}};
         double total = 0;
         for (const auto& [s, w] : all)
             total += w;
@@ -166,7 +161,7 @@ class Progress {
         if (m_cb) m_cb(MeshingStage::Export, 1.0);
     }
 
-  private:
+private:
     ProgressCallback m_cb;
     std::array<double, 8> m_start{};
 };
@@ -229,24 +224,21 @@ TetrahedralizeResult tetrahedralize(const sim::TriMesh& surface, const MeshingPa
         if (p.edgeSize == 0) p.edgeSize = p.facetSize;
         report.resolved = p;
         if (!(report.surfaceVolume > 1e-12 * diagonal * diagonal * diagonal))
-            fail(label,
-                 "surface encloses no volume (" + std::to_string(report.surfaceVolume) + " m^3)");
+            fail(label, "surface encloses no volume (" + std::to_string(report.surfaceVolume) + " m^3)");
         const double s = std::min(p.cellSize, p.facetSize);
         const double estimate = report.surfaceVolume / (kRegularTetVolumePerR3 * s * s * s);
         if (estimate > static_cast<double>(p.maxEstimatedTets))
-            fail(label, "sizes too small for the volume: cellSize " + std::to_string(p.cellSize) +
-                            " m and facetSize " + std::to_string(p.facetSize) + " m give about " +
-                            std::to_string(static_cast<long long>(estimate)) +
-                            " tets (limit MeshingParams::maxEstimatedTets = " +
-                            std::to_string(p.maxEstimatedTets) + ")");
+            fail(label,
+                 "sizes too small for the volume: cellSize " + std::to_string(p.cellSize) + " m and facetSize " +
+                     std::to_string(p.facetSize) + " m give about " + std::to_string(static_cast<long long>(estimate)) +
+                     " tets (limit MeshingParams::maxEstimatedTets = " + std::to_string(p.maxEstimatedTets) + ")");
 
         // ---- domain and refinement --------------------------------------------------------------
         progress.begin(MeshingStage::BuildDomain);
         const DefaultRandomScope randomScope(p.seed);
         CGAL::Random domainRandom(p.seed);
         if (p.featureAngleDeg > 0) {
-            auto sharp =
-                sm.add_property_map<SurfaceMesh::Edge_index, bool>("e:viscera_sharp", false).first;
+            auto sharp = sm.add_property_map<SurfaceMesh::Edge_index, bool>("e:viscera_sharp", false).first;
             PMP::detect_sharp_edges(sm, p.featureAngleDeg, sharp);
             for (auto e : sm.edges())
                 report.featureEdgeCount += sharp[e] ? 1 : 0;
@@ -258,24 +250,21 @@ TetrahedralizeResult tetrahedralize(const sim::TriMesh& surface, const MeshingPa
         namespace cp = CGAL::parameters;
         const Criteria criteria(cp::edge_size = p.edgeSize, cp::facet_angle = p.facetAngleDeg,
                                 cp::facet_size = p.facetSize, cp::facet_distance = p.facetDistance,
-                                cp::cell_radius_edge_ratio = p.cellRadiusEdgeRatio,
-                                cp::cell_size = p.cellSize);
+                                cp::cell_radius_edge_ratio = p.cellRadiusEdgeRatio, cp::cell_size = p.cellSize);
         progress.begin(MeshingStage::Refine);
-        C3t3 c3t3 = CGAL::make_mesh_3<C3t3>(domain, criteria, cp::no_perturb(), cp::no_exude(),
-                                            cp::no_odt(), cp::no_lloyd());
+        C3t3 c3t3 =
+            CGAL::make_mesh_3<C3t3>(domain, criteria, cp::no_perturb(), cp::no_exude(), cp::no_odt(), cp::no_lloyd());
         const auto tOpt = std::chrono::steady_clock::now();
         report.refineSeconds = std::chrono::duration<double>(tOpt - t0).count();
 
         // ---- optimizers (same order as make_mesh_3) ---------------------------------------------
         if (p.odt) {
             progress.begin(MeshingStage::Odt);
-            CGAL::odt_optimize_mesh_3(c3t3, domain,
-                                      cp::max_iteration_number = p.smoothingMaxIterations);
+            CGAL::odt_optimize_mesh_3(c3t3, domain, cp::max_iteration_number = p.smoothingMaxIterations);
         }
         if (p.lloyd) {
             progress.begin(MeshingStage::Lloyd);
-            CGAL::lloyd_optimize_mesh_3(c3t3, domain,
-                                        cp::max_iteration_number = p.smoothingMaxIterations);
+            CGAL::lloyd_optimize_mesh_3(c3t3, domain, cp::max_iteration_number = p.smoothingMaxIterations);
         }
         if (p.perturb) {
             progress.begin(MeshingStage::Perturb);
@@ -302,8 +291,7 @@ TetrahedralizeResult tetrahedralize(const sim::TriMesh& surface, const MeshingPa
             sim::Tet tet{};
             for (int i = 0; i < 4; ++i) {
                 const Tr::Vertex_handle vh = c->vertex(i);
-                const auto [it, inserted] =
-                    vertexIndex.try_emplace(vh, static_cast<int32_t>(positions.size()));
+                const auto [it, inserted] = vertexIndex.try_emplace(vh, static_cast<int32_t>(positions.size()));
                 if (inserted) {
                     const K::Point_3 q = point(tr.point(vh));
                     positions.emplace_back(q.x(), q.y(), q.z());
@@ -311,8 +299,7 @@ TetrahedralizeResult tetrahedralize(const sim::TriMesh& surface, const MeshingPa
                 tet[i] = it->second;
             }
             const sim::Vec3& a = positions[tet[0]];
-            const double vol =
-                (positions[tet[1]] - a).cross(positions[tet[2]] - a).dot(positions[tet[3]] - a);
+            const double vol = (positions[tet[1]] - a).cross(positions[tet[2]] - a).dot(positions[tet[3]] - a);
             if (vol < 0) std::swap(tet[2], tet[3]);
             tetVolume += std::abs(vol) / 6;
             tets.push_back(tet);
@@ -320,8 +307,8 @@ TetrahedralizeResult tetrahedralize(const sim::TriMesh& surface, const MeshingPa
         report.boundaryTriangleCount = c3t3.number_of_facets_in_complex();
 
         TetrahedralizeResult result;
-        result.mesh = sim::TetMesh::fromArrays(std::move(positions), std::move(tets),
-                                               "bake::tetrahedralize(" + label + ")");
+        result.mesh =
+            sim::TetMesh::fromArrays(std::move(positions), std::move(tets), "bake::tetrahedralize(" + label + ")");
         report.vertexCount = result.mesh->vertexCount();
         report.tetCount = result.mesh->tetCount();
         report.quality = result.mesh->quality();

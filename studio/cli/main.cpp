@@ -64,14 +64,14 @@ int cmdExport(const std::vector<std::string>& args) {
     if (!dir || !out) throw std::invalid_argument("export needs <project-dir> and -o <case.vcase>");
     const auto t0 = std::chrono::steady_clock::now();
     studio::Project project = studio::loadProject(*dir);
-    studio::ExportResult r = studio::exportCase(project, *out, [](const std::string& stage) {
-        std::fprintf(stderr, "viscera-studio: %s\n", stage.c_str());
-    });
+    studio::ExportResult r = studio::exportCase(
+        project, *out, [](const std::string& stage) { std::fprintf(stderr, "viscera-studio: %s\n", stage.c_str()); });
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("exported %s -> %s (%llu bytes, %.2f s)\n", project.caseId.c_str(), r.casePath.c_str(),
                 static_cast<unsigned long long>(r.bytes), secs);
     std::printf("  features:");
-    for (const auto& f : r.features) std::printf(" %s", f.c_str());
+    for (const auto& f : r.features)
+        std::printf(" %s", f.c_str());
     std::printf("\n");
     for (const auto& b : r.bodies) {
         std::printf("  body %s: %zu nodes, %zu tets, %zu fixed\n", b.name.c_str(), b.nodes, b.tets, b.fixedNodes);
@@ -91,14 +91,22 @@ int cmdImport(const std::vector<std::string>& args) {
             if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
             return args[++i];
         };
-        if (a == "--scale") opt.scale = parsePositive(a, value());
-        else if (a == "--tetrahedralize") tetra = true;
-        else if (a == "--cell-size") meshing.cellSize = parsePositive(a, value());
-        else if (a == "--facet-size") meshing.facetSize = parsePositive(a, value());
-        else if (a == "-o" || a == "--output") out = value();
-        else if (!a.empty() && a[0] == '-') throw std::invalid_argument("unknown option '" + a + "'");
-        else if (!in) in = a;
-        else throw std::invalid_argument("unexpected argument '" + a + "'");
+        if (a == "--scale")
+            opt.scale = parsePositive(a, value());
+        else if (a == "--tetrahedralize")
+            tetra = true;
+        else if (a == "--cell-size")
+            meshing.cellSize = parsePositive(a, value());
+        else if (a == "--facet-size")
+            meshing.facetSize = parsePositive(a, value());
+        else if (a == "-o" || a == "--output")
+            out = value();
+        else if (!a.empty() && a[0] == '-')
+            throw std::invalid_argument("unknown option '" + a + "'");
+        else if (!in)
+            in = a;
+        else
+            throw std::invalid_argument("unexpected argument '" + a + "'");
     }
     if (!in) throw std::invalid_argument("import needs a mesh file");
     if (out && !tetra) throw std::invalid_argument("-o writes a tet mesh; add --tetrahedralize");

@@ -81,7 +81,8 @@ MeshSource readMeshSource(const JsonField& m, const std::filesystem::path& dir) 
         const JsonField cells = m["cells"];
         if (!cells.value().is_array() || cells.value().size() != 3) cells.fail("must be an array of 3 integers");
         const std::vector<JsonField> c = cells.items();
-        for (int k = 0; k < 3; ++k) s.box.cells[k] = c[k].integer(1, 512);
+        for (int k = 0; k < 3; ++k)
+            s.box.cells[k] = c[k].integer(1, 512);
     } else if (gen == "ellipsoid" || gen == "liver") {
         const bool liver = gen == "liver";
         liver ? m.object({"generator", "center", "half_size", "wedge", "slices", "stacks", "meshing"})
@@ -157,7 +158,8 @@ StiffnessPaintProject readPaint(const JsonField& j) {
     StiffnessPaintProject p;
     if (auto sk = j.find("skeleton")) {
         sk->object({"min_edge_length_rel", "medially_centered", "max_iterations"});
-        p.skeleton.minEdgeLengthRel = sk->number("min_edge_length_rel", p.skeleton.minEdgeLengthRel, NumberRule::positive());
+        p.skeleton.minEdgeLengthRel =
+            sk->number("min_edge_length_rel", p.skeleton.minEdgeLengthRel, NumberRule::positive());
         p.skeleton.mediallyCentered = sk->boolean("medially_centered", p.skeleton.mediallyCentered);
         p.skeleton.maxIterations =
             static_cast<size_t>(sk->integer("max_iterations", static_cast<int>(p.skeleton.maxIterations), 1, 10000));
@@ -175,7 +177,8 @@ StiffnessPaintProject readPaint(const JsonField& j) {
         s.radius = st["radius"].number(NumberRule::closed(sim::kMinBrushRadius, sim::kMaxBrushRadius));
         s.amplitude = st["amplitude"].number();
         if (auto sc = st.find("scale"))
-            s.scale = sc->choice({"peak", "kernel"}, "a brush scale") == "peak" ? sim::BrushScale::Peak : sim::BrushScale::Kernel;
+            s.scale = sc->choice({"peak", "kernel"}, "a brush scale") == "peak" ? sim::BrushScale::Peak
+                                                                                : sim::BrushScale::Kernel;
         try {
             sim::validateStroke(s, k, st.origin() + ": " + st.path());
         } catch (const std::exception& e) {
@@ -236,7 +239,8 @@ Project loadProject(const std::filesystem::path& dir) {
         if (auto regions = b.find("stiffness_regions"))
             for (const JsonField& r : regions->items()) {
                 r.object({"min", "max", "weight"});
-                body.stiffnessRegions.push_back({r["min"].vec3(), r["max"].vec3(), r["weight"].number(NumberRule::positive())});
+                body.stiffnessRegions.push_back(
+                    {r["min"].vec3(), r["max"].vec3(), r["weight"].number(NumberRule::positive())});
             }
         if (auto sp = b.find("stiffness_paint")) body.paint = readPaint(*sp);
         if (auto fx = b.find("fixed")) body.fixedBox = readBox(*fx);
@@ -251,7 +255,8 @@ Project loadProject(const std::filesystem::path& dir) {
             const JsonField from = sj["from_boundary_of"];
             sp.scene.attachTo = from.string();
             bool found = false;
-            for (const BodyProject& b : p.bodies) found |= b.scene.name == sp.scene.attachTo;
+            for (const BodyProject& b : p.bodies)
+                found |= b.scene.name == sp.scene.attachTo;
             if (!found) from.fail("'" + sp.scene.attachTo + "' is not a body");
             if (auto r = sj.find("region")) sp.region = readBox(*r);
             p.surfaces.push_back(std::move(sp));
@@ -259,8 +264,10 @@ Project loadProject(const std::filesystem::path& dir) {
     if (auto in = root.find("interaction")) scene.interaction = readInteractionProject(*in, dir);
     // Cross-references (embedding cages, interaction names) are checked now, before any meshing.
     sim::SceneDesc whole = scene;
-    for (const BodyProject& b : p.bodies) whole.bodies.push_back(b.scene);
-    for (const SurfaceProject& s : p.surfaces) whole.surfaces.push_back(s.scene);
+    for (const BodyProject& b : p.bodies)
+        whole.bodies.push_back(b.scene);
+    for (const SurfaceProject& s : p.surfaces)
+        whole.surfaces.push_back(s.scene);
     sim::checkSceneReferences(whole, origin);
     return p;
 }
@@ -270,14 +277,16 @@ std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::
     bake::MeshingParams params = s.meshing;
     params.label = origin + ": body '" + body.scene.name + "'";
     switch (s.kind) {
-    case MeshSource::Kind::Box: return sim::makeBoxTetMesh(s.box);
+    case MeshSource::Kind::Box:
+        return sim::makeBoxTetMesh(s.box);
     case MeshSource::Kind::Ellipsoid:
         return bake::tetrahedralize(sim::makeEllipsoidSurface(s.center, s.radii, s.slices, s.stacks), params).mesh;
     case MeshSource::Kind::Liver:
         return bake::tetrahedralize(sim::makeLiverSurface(s.center, s.radii, s.wedge, s.slices, s.stacks), params).mesh;
     case MeshSource::Kind::Tube:
         return bake::tetrahedralize(sim::makeTubeSurface(s.center, s.end, s.radius, s.slices, s.stacks), params).mesh;
-    case MeshSource::Kind::HollowTube: return sim::makeHollowTubeTetMesh(s.hollow);
+    case MeshSource::Kind::HollowTube:
+        return sim::makeHollowTubeTetMesh(s.hollow);
     case MeshSource::Kind::File: {
         bake::ImportOptions opt;
         opt.scale = s.scale;
@@ -358,7 +367,8 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
         if (b.fixedBox) {
             for (int32_t v = 0; v < static_cast<int32_t>(pos.size()); ++v)
                 if (inBox(pos[v], (*b.fixedBox)[0], (*b.fixedBox)[1])) desc.fixedNodes.push_back(v);
-            if (desc.fixedNodes.empty()) throw InputError(origin + ": " + field + ".fixed: the box contains no mesh node");
+            if (desc.fixedNodes.empty())
+                throw InputError(origin + ": " + field + ".fixed: the box contains no mesh node");
         }
         if (!b.stiffnessRegions.empty()) {
             desc.nodeWeights.assign(pos.size(), 1.0);
@@ -377,9 +387,11 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
             } catch (const std::invalid_argument& e) {
                 throw InputError(origin + ": " + field + ".stiffness_paint: " + e.what());
             }
-            if (desc.nodeWeights.empty()) desc.nodeWeights = paint.weights;
+            if (desc.nodeWeights.empty())
+                desc.nodeWeights = paint.weights;
             else
-                for (size_t v = 0; v < pos.size(); ++v) desc.nodeWeights[v] *= paint.weights[v];
+                for (size_t v = 0; v < pos.size(); ++v)
+                    desc.nodeWeights[v] *= paint.weights[v];
             desc.nodeWeightsPath = "meshes/" + name + ".vweights";
             files.emplace_back(desc.nodeWeightsPath, sim::formatNodeWeights(desc.nodeWeights));
         }
@@ -395,13 +407,14 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
         const std::string& from = sp.scene.attachTo;
         stage("cutting surface '" + sp.scene.name + "'");
         size_t body = 0;
-        while (project.bodies[body].scene.name != from) ++body;
+        while (project.bodies[body].scene.name != from)
+            ++body;
         sim::TriMesh tri;
         try {
             tri = cutBoundary(*meshes[body], sp.region);
         } catch (const std::invalid_argument&) {
-            throw InputError(origin + ": surfaces[" + std::to_string(s) + "].region: contains no boundary triangle of '" + from +
-                             "'");
+            throw InputError(origin + ": surfaces[" + std::to_string(s) +
+                             "].region: contains no boundary triangle of '" + from + "'");
         }
         sim::SurfaceDesc sd = sp.scene;
         sd.meshPath = "meshes/" + sd.name + ".vtri";
@@ -424,10 +437,12 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     header.features = features;
     vcase::CaseWriter writer(header);
     writer.addFile("scene.json", sim::formatScene(scene));
-    for (auto& [path, bytes] : files) writer.addFile(path, std::move(bytes));
+    for (auto& [path, bytes] : files)
+        writer.addFile(path, std::move(bytes));
     if (scene.suture) writer.addFile(scene.suture->trajectoryPath, scene.suture->trajectoryText);
     if (scene.interaction)
-        for (const sim::InstrumentDesc& in : scene.interaction->instruments) writer.addFile(in.trackPath, in.trackText);
+        for (const sim::InstrumentDesc& in : scene.interaction->instruments)
+            writer.addFile(in.trackPath, in.trackText);
     vcase::Manifest written = writer.write(out);
     result.casePath = out;
     result.features = written.features;

@@ -46,8 +46,8 @@
 #include "sim/mesh/generators.hpp"
 #include "sim/mesh/tet_mesh.hpp"
 #include "sim/scene/interaction.hpp"
-#include "sim/skeleton/stiffness_paint.hpp"
 #include "sim/scene/scene.hpp"
+#include "sim/skeleton/stiffness_paint.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
 
 #include <filesystem>
@@ -64,9 +64,9 @@ struct MeshSource {
     sim::HollowTubeSpec hollow; ///< Kind::HollowTube
     sim::BoxSpec box;
     sim::Vec3 center = sim::Vec3::Zero(), radii = sim::Vec3::Constant(0.05); ///< tube: center = start
-    sim::Vec3 end = sim::Vec3::Zero();  ///< tube end
-    double radius = 0.005;              ///< tube radius, m
-    double wedge = 0.5;                 ///< liver thickness ratio
+    sim::Vec3 end = sim::Vec3::Zero();                                       ///< tube end
+    double radius = 0.005;                                                   ///< tube radius, m
+    double wedge = 0.5;                                                      ///< liver thickness ratio
     int slices = 48, stacks = 24;
     std::filesystem::path file; ///< absolute, resolved against the project folder
     double scale = 1.0;
@@ -141,8 +141,7 @@ using ExportProgress = std::function<void(const std::string& stage)>;
 /// inverted or degenerate element is an error naming the body and element), resolves fixed
 /// regions to node lists, and writes the case package atomically. Only what the scene uses is
 /// packaged, and the manifest's features list only the subsystems the scene needs.
-ExportResult exportCase(const Project& project, const std::filesystem::path& out,
-                        const ExportProgress& progress = {});
+ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress = {});
 
 /// Builds one body's tet mesh from its source (exposed for the import command and tests).
 std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::string& origin);

@@ -19,7 +19,7 @@ using test::RawEntry;
 using ::testing::HasSubstr;
 
 class VcasePackage : public ::testing::Test {
-  protected:
+protected:
     test::ScratchDir dir;
 
     /// The one-line InputError message of opening `bytes` as case.vcase, or a test failure.
@@ -59,8 +59,7 @@ TEST_F(VcasePackage, CraftedValidPackageOpens) {
 // ---- (a) the file ---------------------------------------------------------------------------
 
 TEST_F(VcasePackage, MissingFileIsRejected) {
-    EXPECT_THAT(rejectionOf(dir.path() / "case.vcase"),
-                HasSubstr(pkg() + "cannot open package (file does not exist)"));
+    EXPECT_THAT(rejectionOf(dir.path() / "case.vcase"), HasSubstr(pkg() + "cannot open package (file does not exist)"));
     EXPECT_THAT(rejectionOf(dir.path()), HasSubstr("cannot open package (not a regular file)"));
 }
 
@@ -68,8 +67,7 @@ TEST_F(VcasePackage, PackageSizeLimit) {
     const auto files = goodFiles();
     std::string bytes = craftPackage(manifestFor(files), files);
     EXPECT_EQ(rejection(bytes, Limits{.maxPackageBytes = 100}),
-              pkg() + "package is " + std::to_string(bytes.size()) +
-                  " bytes, larger than the limit of 100 bytes");
+              pkg() + "package is " + std::to_string(bytes.size()) + " bytes, larger than the limit of 100 bytes");
 }
 
 // ---- (b) the container ----------------------------------------------------------------------
@@ -81,8 +79,7 @@ TEST_F(VcasePackage, TruncatedZipIsRejected) {
         EXPECT_THAT(rejection(bytes.substr(0, keep)),
                     HasSubstr(pkg() + "not a valid zip archive (truncated or corrupt)"))
             << keep;
-    EXPECT_THAT(rejection(std::string(4096, 'x')),
-                HasSubstr(pkg() + "not a valid zip archive (truncated or corrupt)"));
+    EXPECT_THAT(rejection(std::string(4096, 'x')), HasSubstr(pkg() + "not a valid zip archive (truncated or corrupt)"));
 }
 
 TEST_F(VcasePackage, TooManyEntriesDefaultLimit) {
@@ -111,8 +108,7 @@ TEST_F(VcasePackage, DotDotEntryIsRejected) {
 
 TEST_F(VcasePackage, AbsoluteEntryIsRejected) {
     std::vector<RawEntry> files{{"/etc/passwd", "root"}};
-    EXPECT_EQ(rejection(craftPackage(manifestFor({}), files)),
-              pkg() + "/etc/passwd: absolute entry path");
+    EXPECT_EQ(rejection(craftPackage(manifestFor({}), files)), pkg() + "/etc/passwd: absolute entry path");
     files = {{"C:/Windows/x.dll", "x"}};
     EXPECT_EQ(rejection(craftPackage(manifestFor({}), files)),
               pkg() + "C:/Windows/x.dll: absolute entry path (drive letter)");
@@ -155,8 +151,7 @@ TEST_F(VcasePackage, NamesDifferingOnlyInCaseAreRejected) {
 
 TEST_F(VcasePackage, EntryUnderAFileIsRejected) {
     std::vector<RawEntry> files{{"a", "x"}, {"a/b", "y"}};
-    EXPECT_EQ(rejection(craftPackage(manifestFor(files), files)),
-              pkg() + "a/b: entry lies under the file entry 'a'");
+    EXPECT_EQ(rejection(craftPackage(manifestFor(files), files)), pkg() + "a/b: entry lies under the file entry 'a'");
 }
 
 TEST_F(VcasePackage, DirectoryEntriesOnlyAsParentsOfFiles) {
@@ -182,21 +177,18 @@ TEST_F(VcasePackage, CompressionRatioBombIsRejected) {
 }
 
 TEST_F(VcasePackage, EntryAndTotalSizeLimits) {
-    std::vector<RawEntry> files{{"a.bin", std::string(2000, 'a')},
-                                {"b.bin", std::string(2000, 'b')}};
+    std::vector<RawEntry> files{{"a.bin", std::string(2000, 'a')}, {"b.bin", std::string(2000, 'b')}};
     const std::string bytes = craftPackage(manifestFor(files), files);
     EXPECT_EQ(rejection(bytes, Limits{.maxEntryBytes = 1999}),
-              pkg() +
-                  "a.bin: uncompressed size 2000 bytes exceeds the per-entry limit of 1999 bytes");
+              pkg() + "a.bin: uncompressed size 2000 bytes exceeds the per-entry limit of 1999 bytes");
     const uint64_t manifestSize = manifestFor(files).toJsonText().size();
     EXPECT_EQ(rejection(bytes, Limits{.maxTotalBytes = manifestSize + 3000}),
-              pkg() + "total uncompressed size exceeds the limit of " +
-                  std::to_string(manifestSize + 3000) + " bytes (reached at entry 'b.bin')");
+              pkg() + "total uncompressed size exceeds the limit of " + std::to_string(manifestSize + 3000) +
+                  " bytes (reached at entry 'b.bin')");
 }
 
 TEST_F(VcasePackage, UnsupportedCompressionMethodIsRejected) {
-    if (!zip_compression_method_supported(ZIP_CM_BZIP2, 1))
-        GTEST_SKIP() << "this libzip cannot write bzip2";
+    if (!zip_compression_method_supported(ZIP_CM_BZIP2, 1)) GTEST_SKIP() << "this libzip cannot write bzip2";
     std::vector<RawEntry> files{{"a.txt", "hello", true, std::nullopt, ZIP_CM_BZIP2}};
     EXPECT_EQ(rejection(craftPackage(manifestFor(files), files)),
               pkg() + "a.txt: compression method 12 is not supported (use store or deflate)");
@@ -218,8 +210,7 @@ TEST_F(VcasePackage, ManifestMissingRequiredFieldIsRejected) {
     nlohmann::json j = manifestFor({}).toJson();
     j.erase("caseId");
     std::vector<RawEntry> entries{{"manifest.json", j.dump()}};
-    EXPECT_EQ(rejection(craftZip(entries)),
-              pkg() + "manifest.json: caseId: required field is missing");
+    EXPECT_EQ(rejection(craftZip(entries)), pkg() + "manifest.json: caseId: required field is missing");
 }
 
 TEST_F(VcasePackage, ManifestSizeLimit) {
@@ -239,18 +230,16 @@ TEST_F(VcasePackage, HashMismatchIsRejected) {
     files[0].bytes[files[0].bytes.size() - 2] = '2'; // same size, different content
     const std::string actual = sha256Hex(files[0].bytes);
     EXPECT_EQ(rejection(craftPackage(m, files)),
-              pkg() + "meshes/a.vtet: sha256 mismatch (manifest says " + listed + ", file has " +
-                  actual + ")");
+              pkg() + "meshes/a.vtet: sha256 mismatch (manifest says " + listed + ", file has " + actual + ")");
 }
 
 TEST_F(VcasePackage, SizeMismatchIsRejected) {
     const auto files = goodFiles();
     Manifest m = manifestFor(files);
     m.files[1].size += 1;
-    EXPECT_EQ(rejection(craftPackage(m, files)),
-              pkg() + "scene.json: size mismatch (manifest says " +
-                  std::to_string(m.files[1].size) + " bytes, entry has " +
-                  std::to_string(files[1].bytes.size()) + " bytes)");
+    EXPECT_EQ(rejection(craftPackage(m, files)), pkg() + "scene.json: size mismatch (manifest says " +
+                                                     std::to_string(m.files[1].size) + " bytes, entry has " +
+                                                     std::to_string(files[1].bytes.size()) + " bytes)");
 }
 
 TEST_F(VcasePackage, ListedFileMissingIsRejected) {
@@ -265,16 +254,14 @@ TEST_F(VcasePackage, UnlistedFileIsRejected) {
     auto files = goodFiles();
     const Manifest m = manifestFor(files);
     files.push_back({"extra.txt", "not in the manifest"});
-    EXPECT_EQ(rejection(craftPackage(m, files)),
-              pkg() + "extra.txt: file is not listed in manifest.json");
+    EXPECT_EQ(rejection(craftPackage(m, files)), pkg() + "extra.txt: file is not listed in manifest.json");
 }
 
 TEST_F(VcasePackage, CorruptEntryDataIsRejected) {
     std::vector<RawEntry> files{{"data.bin", "0123456789-PAYLOAD-0123456789", false}};
     std::string bytes = craftPackage(manifestFor(files), files);
     ASSERT_EQ(test::patchBytes(bytes, "-PAYLOAD-", "-PAYLOAX-"), 1u); // CRC-32 no longer matches
-    EXPECT_THAT(rejection(bytes),
-                HasSubstr(pkg() + "data.bin: cannot decompress entry (corrupt data: "));
+    EXPECT_THAT(rejection(bytes), HasSubstr(pkg() + "data.bin: cannot decompress entry (corrupt data: "));
 }
 
 // ---- (g) compatibility ------------------------------------------------------------------------
@@ -286,8 +273,7 @@ TEST_F(VcasePackage, SchemaVersionFromTheFutureIsRejected) {
     EXPECT_EQ(rejection(craftPackage(m, files)),
               pkg() + "manifest.json: schemaVersion 99 is newer than this player supports (1)");
     m.schemaVersion = 0;
-    EXPECT_EQ(rejection(craftPackage(m, files)),
-              pkg() + "manifest.json: schemaVersion 0 is not valid (must be >= 1)");
+    EXPECT_EQ(rejection(craftPackage(m, files)), pkg() + "manifest.json: schemaVersion 0 is not valid (must be >= 1)");
 }
 
 TEST_F(VcasePackage, MinPlayerVersionTooNewIsRejected) {
@@ -295,8 +281,7 @@ TEST_F(VcasePackage, MinPlayerVersionTooNewIsRejected) {
     Manifest m = manifestFor(files);
     m.minPlayerVersion = "99.0.0";
     EXPECT_EQ(rejection(craftPackage(m, files)),
-              pkg() + "manifest.json: minPlayerVersion 99.0.0 is newer than this player (" +
-                  VISCERA_VERSION + ")");
+              pkg() + "manifest.json: minPlayerVersion 99.0.0 is newer than this player (" + VISCERA_VERSION + ")");
 }
 
 // ---- (h) meshes -------------------------------------------------------------------------------
@@ -322,8 +307,7 @@ TEST_F(VcasePackage, ChecksRunInTheDocumentedOrder) {
     files[1].bytes[0] = '[';                      // (f) hash of scene.json
     EXPECT_THAT(rejection(craftPackage(m, files)), HasSubstr("scene.json: sha256 mismatch"));
     m.files[1].sha256 = sha256Hex(files[1].bytes);
-    EXPECT_THAT(rejection(craftPackage(m, files)),
-                HasSubstr("meshes/bad.vtet: file is not listed in manifest.json"));
+    EXPECT_THAT(rejection(craftPackage(m, files)), HasSubstr("meshes/bad.vtet: file is not listed in manifest.json"));
     files.push_back({"../x", "evil"}); // (c) beats everything after it
     EXPECT_THAT(rejection(craftZip(files)), HasSubstr("../x: entry name escapes the package"));
     EXPECT_THAT(rejection(craftPackage(m, files), Limits{.maxEntries = 3}),

@@ -105,8 +105,7 @@ TEST(VcaseWriter, ManifestComesFirstThenFilesSorted) {
     writer.addFile("z.txt", "z");
     writer.addFile("a/b.txt", "b");
     writer.addFile("a.txt", "a");
-    EXPECT_EQ(entryOrder(writer.build()),
-              (std::vector<std::string>{"manifest.json", "a.txt", "a/b.txt", "z.txt"}));
+    EXPECT_EQ(entryOrder(writer.build()), (std::vector<std::string>{"manifest.json", "a.txt", "a/b.txt", "z.txt"}));
 }
 
 TEST(VcaseWriter, OutputIsDeterministic) {
@@ -114,9 +113,7 @@ TEST(VcaseWriter, OutputIsDeterministic) {
     auto make = [](bool reversed) {
         CaseWriter writer(header());
         std::vector<std::pair<std::string, std::string>> files = {
-            {"meshes/liver.vtet", test::unitTetVtet()},
-            {"scene.json", "{}"},
-            {"textures/noise.bin", allByteValues()}};
+            {"meshes/liver.vtet", test::unitTetVtet()}, {"scene.json", "{}"}, {"textures/noise.bin", allByteValues()}};
         if (reversed) std::reverse(files.begin(), files.end());
         for (auto& [path, bytes] : files)
             writer.addFile(path, bytes);
@@ -147,10 +144,8 @@ TEST(VcaseWriter, RejectsBadEntryNamesAtAddTime) {
     const std::string prefix = "vcase::CaseWriter::addFile(): ";
     EXPECT_EQ(messageOf([&] { writer.addFile("../x", "x"); }),
               prefix + "../x: entry name escapes the package ('..' component)");
-    EXPECT_EQ(messageOf([&] { writer.addFile("/etc/passwd", "x"); }),
-              prefix + "/etc/passwd: absolute entry path");
-    EXPECT_EQ(messageOf([&] { writer.addFile("D:/x", "x"); }),
-              prefix + "D:/x: absolute entry path (drive letter)");
+    EXPECT_EQ(messageOf([&] { writer.addFile("/etc/passwd", "x"); }), prefix + "/etc/passwd: absolute entry path");
+    EXPECT_EQ(messageOf([&] { writer.addFile("D:/x", "x"); }), prefix + "D:/x: absolute entry path (drive letter)");
     EXPECT_EQ(messageOf([&] { writer.addFile("a\\b", "x"); }),
               prefix + "a\\b: entry name contains a backslash (paths use '/')");
     EXPECT_EQ(messageOf([&] { writer.addFile("meshes/", "x"); }),
@@ -158,8 +153,7 @@ TEST(VcaseWriter, RejectsBadEntryNamesAtAddTime) {
     EXPECT_EQ(messageOf([&] { writer.addFile("manifest.json", "{}"); }),
               prefix + "manifest.json: reserved name (the writer generates manifest.json)");
     writer.addFile("Scene.json", "{}");
-    EXPECT_EQ(messageOf([&] { writer.addFile("Scene.json", "{}"); }),
-              prefix + "Scene.json: already added");
+    EXPECT_EQ(messageOf([&] { writer.addFile("Scene.json", "{}"); }), prefix + "Scene.json: already added");
     EXPECT_EQ(messageOf([&] { writer.addFile("scene.json", "{}"); }),
               prefix + "scene.json: collides with 'Scene.json' (names differ only in letter case)");
     EXPECT_EQ(writer.fileCount(), 1u);
@@ -168,16 +162,13 @@ TEST(VcaseWriter, RejectsBadEntryNamesAtAddTime) {
 TEST(VcaseWriter, RejectsAnInvalidHeader) {
     Manifest bad = header();
     bad.caseId = "Liver Case";
-    EXPECT_THAT(messageOf([&] { CaseWriter w(bad); }),
-                HasSubstr("vcase::CaseWriter: caseId: 'Liver Case' must match"));
+    EXPECT_THAT(messageOf([&] { CaseWriter w(bad); }), HasSubstr("vcase::CaseWriter: caseId: 'Liver Case' must match"));
     bad = header();
     bad.files.push_back({"a.txt", 1, sha256Hex("a")});
-    EXPECT_THAT(messageOf([&] { CaseWriter w(bad); }),
-                HasSubstr("vcase::CaseWriter: files: must be empty"));
+    EXPECT_THAT(messageOf([&] { CaseWriter w(bad); }), HasSubstr("vcase::CaseWriter: files: must be empty"));
     bad = header();
     bad.units["length"] = "mm";
-    EXPECT_THAT(messageOf([&] { CaseWriter w(bad); }),
-                HasSubstr("units.length: 'mm' is not supported"));
+    EXPECT_THAT(messageOf([&] { CaseWriter w(bad); }), HasSubstr("units.length: 'mm' is not supported"));
 }
 
 TEST(VcaseWriter, NeverWritesAPackageThePlayerWouldReject) {
@@ -192,8 +183,7 @@ TEST(VcaseWriter, NeverWritesAPackageThePlayerWouldReject) {
 
     CaseWriter badMesh(header());
     badMesh.addFile("meshes/bad.vtet", "vtet 1\nvertices 1\n0 0 0\ntets 1\n0 0 0 0\n");
-    EXPECT_THAT(messageOf([&] { badMesh.write(path); }),
-                HasSubstr(path.string() + ":meshes/bad.vtet"));
+    EXPECT_THAT(messageOf([&] { badMesh.write(path); }), HasSubstr(path.string() + ":meshes/bad.vtet"));
     EXPECT_FALSE(std::filesystem::exists(path));
 
     CaseWriter many(header());

@@ -22,8 +22,7 @@ Manifest sample() {
     m.features = {"xpbd", "gravity", "fem", "needle"};
     m.units["temperature"] = "K";
     m.device = {{"haptics", {{"channels", 2}}}};
-    m.files = {{"meshes/liver.vtet", 1234, std::string(64, 'a')},
-               {"scene.json", 0, std::string(64, '0')}};
+    m.files = {{"meshes/liver.vtet", 1234, std::string(64, 'a')}, {"scene.json", 0, std::string(64, '0')}};
     return m;
 }
 
@@ -62,8 +61,8 @@ TEST(VcaseManifest, FindFile) {
 }
 
 TEST(VcaseManifest, MissingRequiredFieldsAreNamed) {
-    for (const char* field : {"schemaVersion", "caseId", "caseVersion", "minPlayerVersion",
-                              "features", "units", "device", "files"}) {
+    for (const char* field :
+         {"schemaVersion", "caseId", "caseVersion", "minPlayerVersion", "features", "units", "device", "files"}) {
         json j = sample().toJson();
         j.erase(field);
         EXPECT_EQ(errorOf(j), std::string(kOrigin) + ": " + field + ": required field is missing");
@@ -93,8 +92,7 @@ TEST(VcaseManifest, WrongTypesAreNamed) {
         {"/device", json::array(), "device: must be an object (found array)"},
         {"/files", json::object(), "files: must be an array (found object)"},
         {"/files/0", "meshes/liver.vtet", "files[0]: must be an object (found string)"},
-        {"/files/0/size", -1,
-         "files[0].size: must be a non-negative integer (found a negative integer)"},
+        {"/files/0/size", -1, "files[0].size: must be a non-negative integer (found a negative integer)"},
         {"/files/0/size", 12.5, "files[0].size: must be a non-negative integer (found number)"},
         {"/files/0/size", "12", "files[0].size: must be a non-negative integer (found string)"},
     };
@@ -103,8 +101,7 @@ TEST(VcaseManifest, WrongTypesAreNamed) {
         j[json::json_pointer(c.pointer)] = c.value;
         EXPECT_EQ(errorOf(j), std::string(kOrigin) + ": " + c.expected) << c.pointer;
     }
-    EXPECT_EQ(errorOf(json::array()),
-              std::string(kOrigin) + ": must be a JSON object (found array)");
+    EXPECT_EQ(errorOf(json::array()), std::string(kOrigin) + ": must be a JSON object (found array)");
 }
 
 TEST(VcaseManifest, FieldRulesAreNamed) {
@@ -118,8 +115,7 @@ TEST(VcaseManifest, FieldRulesAreNamed) {
         {"/caseId", "a/b", "caseId: 'a/b' must match"},
         {"/caseId", "", "caseId: '' must match"},
         {"/caseId", std::string(65, 'a'),
-         "caseId: '" + std::string(65, 'a') +
-             "' must match [a-z0-9][a-z0-9._-]* (at most 64 characters)"},
+         "caseId: '" + std::string(65, 'a') + "' must match [a-z0-9][a-z0-9._-]* (at most 64 characters)"},
         {"/caseVersion", "1.0", "caseVersion: '1.0' is not a semantic version"},
         {"/minPlayerVersion", "latest", "minPlayerVersion: 'latest' is not a semantic version"},
         {"/features/1", "xpbd", "features[1]: duplicate feature 'xpbd'"},
@@ -128,10 +124,8 @@ TEST(VcaseManifest, FieldRulesAreNamed) {
         {"/files/0/path", "../x", "files[0].path: entry name escapes the package ('..' component)"},
         {"/files/0/path", "/etc/passwd", "files[0].path: absolute entry path"},
         {"/files/0/path", "manifest.json", "files[0].path: manifest.json must not list itself"},
-        {"/files/1/path", "meshes/liver.vtet",
-         "files[1].path: 'meshes/liver.vtet' is listed more than once"},
-        {"/files/0/sha256", std::string(64, 'A'),
-         "files[0].sha256: must be 64 lowercase hex characters"},
+        {"/files/1/path", "meshes/liver.vtet", "files[1].path: 'meshes/liver.vtet' is listed more than once"},
+        {"/files/0/sha256", std::string(64, 'A'), "files[0].sha256: must be 64 lowercase hex characters"},
         {"/files/0/sha256", "abc", "files[0].sha256: must be 64 lowercase hex characters"},
         {"/titel", "typo", "titel: unknown field"},
         {"/files/0/mode", 420, "files[0].mode: unknown field"},
@@ -157,8 +151,7 @@ TEST(VcaseManifest, ParseRejectsInvalidJsonAndDuplicateKeys) {
         Manifest::parse(text, kOrigin);
         FAIL() << "duplicate key accepted";
     } catch (const InputError& e) {
-        EXPECT_THAT(e.what(), HasSubstr(std::string(kOrigin) +
-                                        ": invalid JSON (duplicate object key \"caseId\")"));
+        EXPECT_THAT(e.what(), HasSubstr(std::string(kOrigin) + ": invalid JSON (duplicate object key \"caseId\")"));
     }
     // The same key in different objects is fine (every files[] entry has "path").
     EXPECT_NO_THROW(Manifest::parse(sample().toJsonText(), kOrigin));

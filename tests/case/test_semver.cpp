@@ -17,9 +17,9 @@ TEST(VcaseSemVer, ParsesCoreFieldsPrereleaseAndBuild) {
 }
 
 TEST(VcaseSemVer, RejectsMalformedVersions) {
-    for (const char* text : {"", "1", "1.2", "1.2.3.4", "v1.2.3", "01.2.3", "1.02.3", "1.2.03",
-                             "1.2.3-", "1.2.3-a..b", "1.2.3-01", "1.2.3+", "1.2.3-a_b", "a.b.c",
-                             " 1.2.3", "1.2.3 ", "-1.2.3", "99999999999999999999.0.0"})
+    for (const char* text :
+         {"", "1", "1.2", "1.2.3.4", "v1.2.3", "01.2.3", "1.02.3", "1.2.03", "1.2.3-", "1.2.3-a..b", "1.2.3-01",
+          "1.2.3+", "1.2.3-a_b", "a.b.c", " 1.2.3", "1.2.3 ", "-1.2.3", "99999999999999999999.0.0"})
         EXPECT_FALSE(SemVer::parse(text)) << text;
     EXPECT_TRUE(SemVer::parse("1.2.3-0.a-b"));
     EXPECT_TRUE(SemVer::parse("1.2.3+001"));
@@ -41,8 +41,7 @@ TEST(VcaseSemVer, PrecedenceFollowsTheSpecificationExample) {
 }
 
 TEST(VcaseSemVer, BuildMetadataDoesNotAffectPrecedence) {
-    EXPECT_EQ(compare(*SemVer::parse("1.0.0+a"), *SemVer::parse("1.0.0+b")),
-              std::strong_ordering::equal);
+    EXPECT_EQ(compare(*SemVer::parse("1.0.0+a"), *SemVer::parse("1.0.0+b")), std::strong_ordering::equal);
 }
 
 TEST(VcaseSemVer, PlayerVersionIsTheBuildVersion) {

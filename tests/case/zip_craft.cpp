@@ -24,11 +24,9 @@ std::string craftZip(const std::vector<RawEntry>& entries) {
     for (const RawEntry& e : entries) {
         zip_source_t* src = zip_source_buffer(za, e.bytes.data(), e.bytes.size(), 0);
         zip_int64_t index = src ? zip_file_add(za, e.name.c_str(), src, ZIP_FL_ENC_RAW) : -1;
-        if (index < 0)
-            throw std::runtime_error("craftZip: cannot add " + e.name + ": " + zip_strerror(za));
+        if (index < 0) throw std::runtime_error("craftZip: cannot add " + e.name + ": " + zip_strerror(za));
         auto i = static_cast<zip_uint64_t>(index);
-        int32_t method =
-            e.method != RawEntry::kByFlag ? e.method : (e.deflate ? ZIP_CM_DEFLATE : ZIP_CM_STORE);
+        int32_t method = e.method != RawEntry::kByFlag ? e.method : (e.deflate ? ZIP_CM_DEFLATE : ZIP_CM_STORE);
         uint32_t mode = e.unixMode.value_or(0100644);
         if (zip_set_file_compression(za, i, method, 0) != 0 ||
             zip_file_set_external_attributes(za, i, 0, ZIP_OPSYS_UNIX, mode << 16) != 0)
@@ -90,8 +88,8 @@ size_t patchBytes(std::string& bytes, const std::string& from, const std::string
 ScratchDir::ScratchDir() {
     static std::atomic<int> counter{0};
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = "viscera_case_" + std::to_string(::getpid()) + "_" +
-                       std::to_string(counter++) + (info ? std::string("_") + info->name() : "");
+    std::string name = "viscera_case_" + std::to_string(::getpid()) + "_" + std::to_string(counter++) +
+                       (info ? std::string("_") + info->name() : "");
     m_path = std::filesystem::temp_directory_path() / name;
     std::filesystem::remove_all(m_path);
     std::filesystem::create_directories(m_path);

@@ -16,8 +16,7 @@ struct RawEntry {
 
     RawEntry(std::string name_, std::string bytes_, bool deflate_ = true,
              std::optional<uint32_t> unixMode_ = std::nullopt, int32_t method_ = kByFlag)
-        : name(std::move(name_)), bytes(std::move(bytes_)), deflate(deflate_), unixMode(unixMode_),
-          method(method_) {}
+        : name(std::move(name_)), bytes(std::move(bytes_)), deflate(deflate_), unixMode(unixMode_), method(method_) {}
 
     std::string name;
     std::string bytes;
@@ -43,7 +42,7 @@ size_t patchBytes(std::string& bytes, const std::string& from, const std::string
 
 /// A fresh folder under the system temp folder, removed with its contents on destruction.
 class ScratchDir {
-  public:
+public:
     ScratchDir();
     ~ScratchDir();
     ScratchDir(const ScratchDir&) = delete;
@@ -52,7 +51,7 @@ class ScratchDir {
     /// Writes `bytes` to `<dir>/<name>` and returns the path.
     std::filesystem::path write(const std::string& name, const std::string& bytes) const;
 
-  private:
+private:
     std::filesystem::path m_path;
 };
 

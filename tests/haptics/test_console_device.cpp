@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <chrono>
+#include <cstring>
 #include <random>
 #include <thread>
 #include <vector>
@@ -18,7 +18,9 @@ namespace {
 
 constexpr int64_t kMs = 1'000'000;
 
-Endpoint loopback(uint16_t port = 0) { return parseEndpoint("127.0.0.1:" + std::to_string(port), "test", true); }
+Endpoint loopback(uint16_t port = 0) {
+    return parseEndpoint("127.0.0.1:" + std::to_string(port), "test", true);
+}
 
 /// A fake console: a socket the device sends commands to and receives states from.
 struct FakeConsole {
@@ -57,7 +59,8 @@ ConsoleDeviceOptions withTimeout(int64_t ns) {
 
 void reseal(std::vector<uint8_t>& b) {
     const uint32_t c = crc32(b.data(), b.size() - 4);
-    for (int k = 0; k < 4; ++k) b[b.size() - 4 + k] = uint8_t(c >> (8 * k));
+    for (int k = 0; k < 4; ++k)
+        b[b.size() - 4 + k] = uint8_t(c >> (8 * k));
 }
 
 } // namespace
@@ -100,7 +103,8 @@ TEST(ConsoleDevice, MalformedTruncatedWrongVersionAndCorruptPacketsAreCountedAnd
     ASSERT_TRUE(st.connected);
     const auto good = console.state(Vec3(0.2, 0.2, 0.2));
     // Truncated at every length, an oversized datagram, garbage.
-    for (size_t n = 0; n < good.size(); n += 7) console.sendRaw(std::vector<uint8_t>(good.begin(), good.begin() + long(n)));
+    for (size_t n = 0; n < good.size(); n += 7)
+        console.sendRaw(std::vector<uint8_t>(good.begin(), good.begin() + long(n)));
     console.sendRaw(std::vector<uint8_t>(2000, 0xAB));
     // Wrong version (valid CRC), corrupted payload.
     auto v2 = good;
@@ -116,7 +120,8 @@ TEST(ConsoleDevice, MalformedTruncatedWrongVersionAndCorruptPacketsAreCountedAnd
     std::memcpy(&nan[28], &f, 4);
     reseal(nan);
     console.sendRaw(nan);
-    for (int k = 0; k < 5; ++k) dev.poll((2 + k) * kMs, st);
+    for (int k = 0; k < 5; ++k)
+        dev.poll((2 + k) * kMs, st);
     EXPECT_TRUE(st.connected);
     EXPECT_TRUE(st.arms[0].measured_cp.position.isApprox(Vec3(0.01, 0, 0), 1e-6)) << "no bad packet got through";
     EXPECT_TRUE(st.arms[0].measured_cp.position.allFinite());
@@ -138,7 +143,7 @@ TEST(ConsoleDevice, PacketsFromAnotherAddressAndOutOfOrderAreIgnored) {
     dev.poll(1 * kMs, st);
     EXPECT_FALSE(st.connected);
     console.sendRaw(console.state(Vec3(0.01, 0, 0), kPedalDeadman, 100));
-    console.sendRaw(console.state(Vec3(0.02, 0, 0), kPedalDeadman, 99)); // older
+    console.sendRaw(console.state(Vec3(0.02, 0, 0), kPedalDeadman, 99));  // older
     console.sendRaw(console.state(Vec3(0.03, 0, 0), kPedalDeadman, 100)); // duplicate
     dev.poll(2 * kMs, st);
     EXPECT_TRUE(st.arms[0].measured_cp.position.isApprox(Vec3(0.01, 0, 0), 1e-6));
@@ -247,8 +252,10 @@ TEST(ConsoleDevice, AFloodOfPacketsCausesNoForceSpikeAndNoNaN) {
     for (int tick = 0; tick < 400; ++tick) {
         const int burst = 1 + int(rng() % 200);
         for (int k = 0; k < burst; ++k) {
-            if (k % 17 == 3) console.sendRaw(std::vector<uint8_t>(size_t(rng() % 300), uint8_t(rng())));
-            else console.send(Vec3(0, 0, (k % 2 ? -0.2 : 0.2) * double(rng() % 100) / 100.0));
+            if (k % 17 == 3)
+                console.sendRaw(std::vector<uint8_t>(size_t(rng() % 300), uint8_t(rng())));
+            else
+                console.send(Vec3(0, 0, (k % 2 ? -0.2 : 0.2) * double(rng() % 100) / 100.0));
         }
         clock.advance(kMs);
         m.timestamp_ns = clock.now_ns();

@@ -30,7 +30,8 @@ StatePacket sampleState() {
 /// Rewrites the CRC after a deliberate change, so only the change is judged.
 void reseal(std::vector<uint8_t>& b) {
     const uint32_t c = crc32(b.data(), b.size() - 4);
-    for (int k = 0; k < 4; ++k) b[b.size() - 4 + k] = uint8_t(c >> (8 * k));
+    for (int k = 0; k < 4; ++k)
+        b[b.size() - 4 + k] = uint8_t(c >> (8 * k));
 }
 
 std::vector<uint8_t> bytes(const StatePacket& p) {
@@ -39,7 +40,9 @@ std::vector<uint8_t> bytes(const StatePacket& p) {
     return b;
 }
 
-void putF32(std::vector<uint8_t>& b, size_t at, float f) { std::memcpy(&b[at], &f, 4); }
+void putF32(std::vector<uint8_t>& b, size_t at, float f) {
+    std::memcpy(&b[at], &f, 4);
+}
 
 } // namespace
 
@@ -152,14 +155,18 @@ TEST(ConsoleProtocol, OutOfRangeAndNonFiniteFieldsAreRejected) {
     };
     // Offsets: payload at 24: pedals(1) arms(1) reserved(2), arm 0 at 28: pos 28..39, quat 40..55,
     // grip 56, lin vel 60..71, ang vel 72..83.
-    const Case cases[] = {{"NaN position", 28, NAN},          {"infinite position", 32, INFINITY},
-                          {"position beyond 10 m", 36, 11.f}, {"zero quaternion w", 40, 0.f},
-                          {"NaN grip", 56, NAN},              {"negative grip", 56, -0.1f},
+    const Case cases[] = {{"NaN position", 28, NAN},
+                          {"infinite position", 32, INFINITY},
+                          {"position beyond 10 m", 36, 11.f},
+                          {"zero quaternion w", 40, 0.f},
+                          {"NaN grip", 56, NAN},
+                          {"negative grip", 56, -0.1f},
                           {"huge velocity", 60, 1e6f}};
     for (const Case& c : cases) {
         auto b = bytes(sampleState());
         if (c.offset == 40) {
-            for (size_t k = 40; k < 56; k += 4) putF32(b, k, 0.f);
+            for (size_t k = 40; k < 56; k += 4)
+                putF32(b, k, 0.f);
         } else {
             putF32(b, c.offset, c.value);
         }
@@ -192,7 +199,8 @@ TEST(ConsoleProtocol, RandomBytesNeverDecodeAndNeverCrash) {
     int accepted = 0;
     for (int k = 0; k < 200000; ++k) {
         const size_t n = rng() % b.size();
-        for (size_t i = 0; i < n; ++i) b[i] = uint8_t(rng());
+        for (size_t i = 0; i < n; ++i)
+            b[i] = uint8_t(rng());
         if (k % 2 == 0 && n >= 8) { // valid magic and version, to reach the deeper checks
             b[0] = 'V', b[1] = 'S', b[2] = 'C', b[3] = 'N', b[4] = 1, b[5] = 0;
         }

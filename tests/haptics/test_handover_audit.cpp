@@ -32,7 +32,8 @@ HandoverFigures run(const std::vector<int64_t>& done, int64_t until, FrameAt fra
 
 std::vector<int64_t> regular(int frames, int64_t step) {
     std::vector<int64_t> d;
-    for (int k = 0; k < frames; ++k) d.push_back(k * step + 100'000);
+    for (int k = 0; k < frames; ++k)
+        d.push_back(k * step + 100'000);
     return d;
 }
 
@@ -57,7 +58,8 @@ TEST(HandoverAudit, ASlowPhysicsStepIsLongButNotStale) {
     // Step 10 takes 40 ms: the ticks keep the newest model, whose age grows to ~40 ms but stays
     // within the step in progress; the interval counts as one step over the period.
     std::vector<int64_t> done = regular(30, 16'666'667);
-    for (size_t k = 11; k < done.size(); ++k) done[k] += 40 * kMs - 16'666'667;
+    for (size_t k = 11; k < done.size(); ++k)
+        done[k] += 40 * kMs - 16'666'667;
     const HandoverFigures f = run(done, done.back() + kMs, [](int64_t, int64_t newest) { return newest; });
     EXPECT_EQ(f.ticksOnOlderModel, 0u);
     EXPECT_LT(f.maxAgeOverStep, 1.0);

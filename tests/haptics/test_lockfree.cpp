@@ -24,7 +24,8 @@ TEST(SeqLock, ReadersNeverSeeATornValue) {
         int64_t last = 0;
         while (!done.load()) {
             const Payload p = lock.read();
-            for (int64_t x : p.v) torn += x != p.v[0];
+            for (int64_t x : p.v)
+                torn += x != p.v[0];
             torn += p.v[0] < last; // never goes back in time
             last = p.v[0];
             ++reads;
@@ -56,17 +57,20 @@ TEST(SpscRing, KeepsOrderAcrossThreadsAndCountsDrops) {
         int64_t x;
         while (true) {
             const bool finished = done.load();
-            while (ring.pop(x)) got.push_back(x);
+            while (ring.pop(x))
+                got.push_back(x);
             if (finished) break;
         }
     });
     int64_t pushed = 0;
-    for (int64_t k = 0; k < 300000; ++k) pushed += ring.push(k);
+    for (int64_t k = 0; k < 300000; ++k)
+        pushed += ring.push(k);
     done = true;
     consumer.join();
     EXPECT_EQ(int64_t(got.size()), pushed);
     EXPECT_EQ(uint64_t(300000 - pushed), ring.dropped());
-    for (size_t i = 1; i < got.size(); ++i) ASSERT_LT(got[i - 1], got[i]);
+    for (size_t i = 1; i < got.size(); ++i)
+        ASSERT_LT(got[i - 1], got[i]);
     SpscRing<int> small(2);
     EXPECT_TRUE(small.push(1));
     EXPECT_TRUE(small.push(2));

@@ -44,20 +44,23 @@ SafetyInput ok(int64_t t_ms) {
 
 bool allFinite(const DeviceCommand& c) {
     for (const auto& a : c.arms)
-        if (!a.servo_cf.force.allFinite() || !a.servo_cf.torque.allFinite() || !std::isfinite(a.jaw_servo_jf)) return false;
+        if (!a.servo_cf.force.allFinite() || !a.servo_cf.torque.allFinite() || !std::isfinite(a.jaw_servo_jf))
+            return false;
     return true;
 }
 
 bool isZero(const DeviceCommand& c) {
     for (const auto& a : c.arms)
-        if (a.servo_cf.force.squaredNorm() != 0 || a.servo_cf.torque.squaredNorm() != 0 || a.jaw_servo_jf != 0) return false;
+        if (a.servo_cf.force.squaredNorm() != 0 || a.servo_cf.torque.squaredNorm() != 0 || a.jaw_servo_jf != 0)
+            return false;
     return true;
 }
 
 /// Ramps the filter up to a steady output of `f` on arm 0.
 void settle(SafetyFilter& s, const Vec3& f, int64_t& t) {
     DeviceCommand out;
-    for (int k = 0; k < 200; ++k) s.apply(ok(++t), force(f), out);
+    for (int k = 0; k < 200; ++k)
+        s.apply(ok(++t), force(f), out);
 }
 
 } // namespace
@@ -94,7 +97,8 @@ TEST(SafetyFilter, ClampsToTheDeviceMaximumWhenItIsLower) {
     EXPECT_DOUBLE_EQ(s.effectiveMaxForce(1), 3.0);
     int64_t t = 0;
     DeviceCommand out;
-    for (int k = 0; k < 200; ++k) s.apply(ok(++t), force(Vec3::Zero(), Vec3(-40, 0, 0)), out);
+    for (int k = 0; k < 200; ++k)
+        s.apply(ok(++t), force(Vec3::Zero(), Vec3(-40, 0, 0)), out);
     EXPECT_NEAR(out.arms[1].servo_cf.force.norm(), 3.0, 1e-12);
     // Torque and grip force are clamped too.
     DeviceCommand in = force(Vec3::Zero());

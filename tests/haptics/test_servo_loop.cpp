@@ -92,12 +92,12 @@ TEST(ServoLoop, NoForceBeforeTheSimulationPublishes) {
 
 TEST(ServoLoop, VirtualCouplingInSeriesWithTheLocalModel) {
     Rig r(2000);
-    r.tick(0.0);                       // connects: the tool starts at the scene start (origin)
+    r.tick(0.0); // connects: the tool starts at the scene start (origin)
     r.servo->publishContact(wall(r.clock.now_ns(), 0, 400));
-    r.tick(0.01);                      // above the surface: no force
+    r.tick(0.01); // above the surface: no force
     EXPECT_EQ(r.force(), 0.0);
     r.servo->publishContact(wall(r.clock.now_ns(), 1, 400));
-    r.tick(-0.005);                    // 5 mm into the surface
+    r.tick(-0.005); // 5 mm into the surface
     // Series stiffness 400·2000/2400 N/m over 5 mm.
     EXPECT_NEAR(r.force(), 400.0 * 2000 / 2400 * 0.005, 1e-9);
     const ToolPoseState poses = r.servo->toolPoses();
@@ -111,9 +111,9 @@ TEST(ServoLoop, StaleSimulationZeroesAndFreshOutputResumes) {
     Rig r;
     r.tick(0.0);
     r.servo->publishContact(wall(r.clock.now_ns(), 0));
-    r.tick(-0.004, 50);                // 50 ms: exactly the limit
+    r.tick(-0.004, 50); // 50 ms: exactly the limit
     EXPECT_GT(r.force(), 0.0);
-    r.tick(-0.004, 1);                 // 51 ms old
+    r.tick(-0.004, 1); // 51 ms old
     EXPECT_EQ(r.force(), 0.0);
     EXPECT_TRUE(r.dev.last.flags & kFlagSimStale);
     r.servo->publishContact(wall(r.clock.now_ns(), 1));

@@ -53,14 +53,16 @@ TEST(ToolProbe, PressingHarderGivesMoreForceOutOfTheTissue) {
     double previous = 0;
     for (double depth : {0.001, 0.002, 0.003}) { // up to half the radius
         auto w = block(0.02 + 0.006 - depth);
-        for (int f = 0; f < 5; ++f) w->step();
+        for (int f = 0; f < 5; ++f)
+            w->step();
         const ToolContact& c = w->toolContact(0);
         EXPECT_GT(c.nodes, 0) << depth;
         EXPECT_GT(c.force.z(), previous) << depth;
         EXPECT_GT(c.normal.z(), 0.9) << "pushes the probe up, out of the tissue";
         EXPECT_TRUE(w->invariants().allFinite);
         // Every free node ends outside the probe.
-        for (const Vec3& x : w->positions(0)) EXPECT_GE((x - c.centre).norm(), 0.006 - 1e-9);
+        for (const Vec3& x : w->positions(0))
+            EXPECT_GE((x - c.centre).norm(), 0.006 - 1e-9);
         previous = c.force.z();
     }
 }

@@ -25,11 +25,10 @@ std::string rejection(const std::string& body) {
 } // namespace
 
 TEST(Trajectory, ParsesAndInterpolates) {
-    const Trajectory t = Trajectory::parse(kHead +
-                                               "# a comment\n"
-                                               "0.0,0,0,0,0,1,0,0,0,0.0,0,4\n"
-                                               "1.0,0,0.1,0,0,1,0,0,0,0.5,1,5\n"
-                                               "0.5,1,0,0,0.2,1,0,0,0,0,0,0\n",
+    const Trajectory t = Trajectory::parse(kHead + "# a comment\n"
+                                                   "0.0,0,0,0,0,1,0,0,0,0.0,0,4\n"
+                                                   "1.0,0,0.1,0,0,1,0,0,0,0.5,1,5\n"
+                                                   "0.5,1,0,0,0.2,1,0,0,0,0,0,0\n",
                                            "traj.csv");
     EXPECT_EQ(t.arms(), 2);
     EXPECT_DOUBLE_EQ(t.duration(), 1.0);

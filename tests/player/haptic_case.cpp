@@ -9,7 +9,9 @@
 
 namespace viscera::test {
 namespace {
-sim::BoxSpec box() { return {sim::Vec3::Zero(), sim::Vec3(0.06, 0.04, 0.02), {8, 6, 3}}; }
+sim::BoxSpec box() {
+    return {sim::Vec3::Zero(), sim::Vec3(0.06, 0.04, 0.02), {8, 6, 3}};
+}
 } // namespace
 
 sim::SceneDesc hapticScene(int tools) {

@@ -27,8 +27,8 @@ using test::Scratch;
 /// Exports the tissue-slab sample project into the scratch folder; returns the case path.
 std::string exportTissueSlab(const Scratch& s) {
     const std::string vcase = s / "tissue-slab.vcase";
-    auto e = test::runProcess(VISCERA_STUDIO_EXE, {"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab",
-                                                   "-o", vcase});
+    auto e = test::runProcess(VISCERA_STUDIO_EXE,
+                              {"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab", "-o", vcase});
     EXPECT_EQ(e.exitCode, 0) << e.err;
     return vcase;
 }
@@ -43,8 +43,8 @@ TEST(PlayerScreenshot, HeadlessRunWritesARenderedFrameAndPassTimes) {
     const std::string vcase = exportTissueSlab(s);
     ASSERT_FALSE(::testing::Test::HasFailure());
     const auto png = s.dir / "frame.png", report = s.dir / "report.json";
-    auto r = test::runProcess(VISCERA_PLAYER_EXE, {"run", vcase, "--headless", "--frames", "20",
-                                                   "--screenshot", png.string(), "--report", report.string()});
+    auto r = test::runProcess(VISCERA_PLAYER_EXE, {"run", vcase, "--headless", "--frames", "20", "--screenshot",
+                                                   png.string(), "--report", report.string()});
     ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
     EXPECT_THAT(r.out, HasSubstr("render        640x480 frame"));
 

@@ -23,10 +23,16 @@ using vcase::test::ScratchDir;
 
 namespace {
 
-test::ProcessResult player(const std::vector<std::string>& args) { return test::runProcess(VISCERA_PLAYER_EXE, args); }
-test::ProcessResult studio(const std::vector<std::string>& args) { return test::runProcess(VISCERA_STUDIO_EXE, args); }
+test::ProcessResult player(const std::vector<std::string>& args) {
+    return test::runProcess(VISCERA_PLAYER_EXE, args);
+}
+test::ProcessResult studio(const std::vector<std::string>& args) {
+    return test::runProcess(VISCERA_STUDIO_EXE, args);
+}
 
-int lineCount(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+int lineCount(const std::string& s) {
+    return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
+}
 
 /// A small cantilever case: a box fixed at x = 0, with the given features.
 std::string writeSlabCase(const ScratchDir& dir, const std::string& name, std::vector<std::string> features,
@@ -176,8 +182,8 @@ TEST(PlayerCli, RunRejectsUnsupportedOrUndeclaredFeatures) {
     EXPECT_THAT(a.err, HasSubstr("features: 'laser' is not supported by this player"));
     // A declared feature the scene does not use creates nothing.
     const auto report = dir.path() / "clip.json";
-    auto c = player({"run", writeSlabCase(dir, "clip.vcase", {"clip", "gravity", "xpbd"}), "--headless", "--frames", "2",
-                     "--report", report.string()});
+    auto c = player({"run", writeSlabCase(dir, "clip.vcase", {"clip", "gravity", "xpbd"}), "--headless", "--frames",
+                     "2", "--report", report.string()});
     ASSERT_EQ(c.exitCode, 0) << c.err;
     EXPECT_EQ(readJson(report)["active_subsystems"], nlohmann::json({"gravity", "xpbd"}));
     auto b = player({"run", writeSlabCase(dir, "nograv.vcase", {"xpbd"}), "--headless"});
@@ -187,8 +193,8 @@ TEST(PlayerCli, RunRejectsUnsupportedOrUndeclaredFeatures) {
 
 TEST(PlayerCli, RunRejectsAMalformedRenderBlockAtLoad) {
     ScratchDir dir;
-    const auto bad = writeSlabCase(dir, "bad.vcase", {"gravity", "xpbd"}, sim::Vec3(0, 0, -9.81),
-                                   R"({"post": {"bloom": true}})");
+    const auto bad =
+        writeSlabCase(dir, "bad.vcase", {"gravity", "xpbd"}, sim::Vec3(0, 0, -9.81), R"({"post": {"bloom": true}})");
     auto r = player({"run", bad, "--headless", "--frames", "5"});
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_THAT(r.err, HasSubstr("bad.vcase:scene.json: render.post.bloom: unknown field"));
@@ -223,7 +229,9 @@ TEST(StudioCli, ExportsAndThePlayerRunsTheSampleProject) {
     EXPECT_TRUE(readJson(report)["invariants"]["all_finite"].get<bool>());
     // Exports are deterministic.
     const auto again = dir.path() / "again.vcase";
-    ASSERT_EQ(studio({"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab", "-o", again.string()}).exitCode, 0);
+    ASSERT_EQ(
+        studio({"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab", "-o", again.string()}).exitCode,
+        0);
     std::ifstream a(out, std::ios::binary), b(again, std::ios::binary);
     std::string sa((std::istreambuf_iterator<char>(a)), {}), sb((std::istreambuf_iterator<char>(b)), {});
     EXPECT_EQ(sa, sb);

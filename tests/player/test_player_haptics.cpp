@@ -35,7 +35,9 @@ namespace {
 
 using test::Scratch;
 
-test::ProcessResult player(const std::vector<std::string>& args) { return test::runProcess(VISCERA_PLAYER_EXE, args); }
+test::ProcessResult player(const std::vector<std::string>& args) {
+    return test::runProcess(VISCERA_PLAYER_EXE, args);
+}
 
 nlohmann::json readJson(const std::string& p) {
     std::ifstream in(p);
@@ -55,7 +57,8 @@ struct Background {
     Background(const std::string& exe, const std::vector<std::string>& args, const std::string& logPrefix) {
         std::vector<char*> argv;
         argv.push_back(const_cast<char*>(exe.c_str()));
-        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        for (const auto& a : args)
+            argv.push_back(const_cast<char*>(a.c_str()));
         argv.push_back(nullptr);
         posix_spawn_file_actions_t fa;
         posix_spawn_file_actions_init(&fa);
@@ -98,7 +101,8 @@ public:
         if (cpus.empty() || sched_getaffinity(0, sizeof(m_saved), &m_saved) != 0) return;
         cpu_set_t set;
         CPU_ZERO(&set);
-        for (int c : cpus) CPU_SET(c, &set);
+        for (int c : cpus)
+            CPU_SET(c, &set);
         m_active = sched_setaffinity(0, sizeof(set), &set) == 0;
     }
     ~OnCpus() {
@@ -118,9 +122,9 @@ private:
 /// and s/forces.csv (console side).
 void runLoopback(const Scratch& s, int frames, std::vector<std::string> simArgs) {
     test::writeHapticCase(s / "slab.vcase", 2);
-    const std::vector<std::string> common = {"--listen",  "127.0.0.1:0",     "--port-file", s / "port",
-                                             "--script",  "bimanual",        "--record",    s / "forces.csv",
-                                             "--summary", s / "sum.json",    "--wait-player", "20"};
+    const std::vector<std::string> common = {"--listen",  "127.0.0.1:0",  "--port-file",   s / "port",
+                                             "--script",  "bimanual",     "--record",      s / "forces.csv",
+                                             "--summary", s / "sum.json", "--wait-player", "20"};
     simArgs.insert(simArgs.end(), common.begin(), common.end());
     // The console is a machine of its own: its simulator inherits this thread's CPUs at the spawn,
     // so for that moment they leave out the CPU the player's servo will own; the player itself is
@@ -146,15 +150,16 @@ TEST(PlayerHaptics, ScriptedSessionIsRepeatableAndReportsTaskMetrics) {
     Scratch s;
     test::writeHapticCase(s / "slab.vcase");
     auto run = [&](const std::string& tag) {
-        auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "200", "--device", "scripted:press", "--report",
-                         s / (tag + ".json"), "--trace", s / (tag + ".csv")});
+        auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "200", "--device", "scripted:press",
+                         "--report", s / (tag + ".json"), "--trace", s / (tag + ".csv")});
         EXPECT_EQ(r.exitCode, 0) << r.err;
         return readJson(s / (tag + ".json"));
     };
     const nlohmann::json a = run("a"), b = run("b");
     EXPECT_EQ(a["active_subsystems"], nlohmann::json({"gravity", "probe", "xpbd", "haptics"}));
     const auto& m = a["metrics"];
-    for (const char* key : {"time_s", "tool_path_length_m", "max_force_n", "mean_force_n", "tissue_damage_ns", "punctures", "clips"})
+    for (const char* key :
+         {"time_s", "tool_path_length_m", "max_force_n", "mean_force_n", "tissue_damage_ns", "punctures", "clips"})
         EXPECT_TRUE(m.contains(key)) << key;
     EXPECT_GT(m["tool_path_length_m"].get<double>(), 0.005);
     EXPECT_GT(m["max_force_n"].get<double>(), 0.05) << "the probe pressed the tissue";
@@ -185,11 +190,12 @@ TEST(PlayerHaptics, ScriptedSessionIsRepeatableAndReportsTaskMetrics) {
 TEST(PlayerHaptics, ReplaysARecordedTrajectory) {
     Scratch s;
     test::writeHapticCase(s / "slab.vcase");
-    auto w = test::runProcess(VISCERA_CONSOLE_SIM_EXE, {"--write-trajectory", s / "press.csv", "--script", "press", "--duration", "3"});
+    auto w = test::runProcess(VISCERA_CONSOLE_SIM_EXE,
+                              {"--write-trajectory", s / "press.csv", "--script", "press", "--duration", "3"});
     ASSERT_EQ(w.exitCode, 0) << w.err;
     EXPECT_NO_THROW(haptics::Trajectory::load(s / "press.csv"));
-    auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "120", "--device", "replay:" + (s / "press.csv"),
-                     "--report", s / "r.json"});
+    auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "120", "--device",
+                     "replay:" + (s / "press.csv"), "--report", s / "r.json"});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const auto j = readJson(s / "r.json");
     EXPECT_EQ(j["haptics"]["device"]["backend"], "replay");
@@ -199,7 +205,8 @@ TEST(PlayerHaptics, ReplaysARecordedTrajectory) {
 TEST(PlayerHaptics, BadDeviceSpecsAndTrajectoriesGiveOneLineErrors) {
     Scratch s;
     test::writeHapticCase(s / "slab.vcase");
-    std::ofstream(s / "bad.csv") << "# viscera-trajectory 1\nt,arm,x,y,z,qw,qx,qy,qz,grip,buttons,pedals\n0,0,0,0,0,1,0,0,0,0,0,99\n";
+    std::ofstream(s / "bad.csv")
+        << "# viscera-trajectory 1\nt,arm,x,y,z,qw,qx,qy,qz,grip,buttons,pedals\n0,0,0,0,0,1,0,0,0,0,0,99\n";
     struct Bad {
         std::string spec, rule;
         int code;
@@ -270,8 +277,8 @@ TEST(PlayerHaptics, ConsoleLoopbackWithADisconnectMidSession) {
         double t, f[6];
         unsigned seq, echo, flags;
         int paused;
-        if (std::sscanf(line.c_str(), "%lf,%u,%u,%u,%d,%lf,%lf,%lf,%lf,%lf,%lf", &t, &seq, &echo, &flags, &paused, &f[0], &f[1],
-                        &f[2], &f[3], &f[4], &f[5]) == 11 &&
+        if (std::sscanf(line.c_str(), "%lf,%u,%u,%u,%d,%lf,%lf,%lf,%lf,%lf,%lf", &t, &seq, &echo, &flags, &paused,
+                        &f[0], &f[1], &f[2], &f[3], &f[4], &f[5]) == 11 &&
             t > 1.7 && (std::abs(f[2]) > 0.01 || std::abs(f[5]) > 0.01))
             after = true;
     }
@@ -297,7 +304,8 @@ TEST(PlayerHaptics, SixtySecondConsoleLoopback) {
     EXPECT_LE(ho["max_age_over_step"].get<double>(), 1.0);
     EXPECT_EQ(ho["models_published"].get<int>(), 3601);
     EXPECT_EQ(h["safety"]["non_finite"], 0);
-    for (const char* k : {"rejected_malformed", "rejected_version", "rejected_checksum", "rejected_order", "send_errors"})
+    for (const char* k :
+         {"rejected_malformed", "rejected_version", "rejected_checksum", "rejected_order", "send_errors"})
         EXPECT_EQ(h["link"][k], 0) << k;
     EXPECT_TRUE(j["invariants"]["all_finite"].get<bool>());
     EXPECT_LE(j["metrics"]["max_force_n"].get<double>(), h["case_max_force_n"].get<double>());
@@ -315,17 +323,18 @@ TEST(PlayerHaptics, SixtySecondConsoleLoopback) {
     ::testing::Test::RecordProperty("physics_step_max_ms", us(ho["physics_step_ms"], "max"));
     std::printf("servo %d ticks, period mean %.1f us, jitter p99 %.0f us, max %.0f us; contact age max %.2f ms, "
                 "physics step max %.2f ms, %d ticks on an older model\n",
-                servo["ticks"].get<int>(), servo["period_us"]["mean"].get<double>(), servo["jitter_us"]["p99"].get<double>(),
-                servo["jitter_us"]["max"].get<double>(), h["contact_model"]["age_ms"]["max"].get<double>(),
-                ho["physics_step_ms"]["max"].get<double>(), ho["ticks_on_older_model"].get<int>());
+                servo["ticks"].get<int>(), servo["period_us"]["mean"].get<double>(),
+                servo["jitter_us"]["p99"].get<double>(), servo["jitter_us"]["max"].get<double>(),
+                h["contact_model"]["age_ms"]["max"].get<double>(), ho["physics_step_ms"]["max"].get<double>(),
+                ho["ticks_on_older_model"].get<int>());
 }
 
 TEST(PlayerHaptics, TraineeWindowRunsOffscreenAndWritesAScreenshot) {
     Scratch s;
     test::writeHapticCase(s / "slab.vcase");
     ::setenv("QT_QPA_PLATFORM", "offscreen", 1);
-    auto r = player({"run", s / "slab.vcase", "--frames", "30", "--device", "scripted:press", "--screenshot", s / "shot.png",
-                     "--report", s / "r.json"});
+    auto r = player({"run", s / "slab.vcase", "--frames", "30", "--device", "scripted:press", "--screenshot",
+                     s / "shot.png", "--report", s / "r.json"});
     ::unsetenv("QT_QPA_PLATFORM");
     if (r.exitCode == 2 && r.err.find("Qt6 Gui") != std::string::npos) GTEST_SKIP() << "player built without Qt6 Gui";
     ASSERT_EQ(r.exitCode, 0) << r.err;
@@ -339,8 +348,8 @@ TEST(PlayerHaptics, TraineeWindowRunsOffscreenAndWritesAScreenshot) {
 TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
     Scratch s;
     test::writeHapticCase(s / "slab.vcase");
-    auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "60", "--device", "scripted:press", "--realtime",
-                     "--servo", "busy:0", "--report", s / "r.json"});
+    auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "60", "--device", "scripted:press",
+                     "--realtime", "--servo", "busy:0", "--report", s / "r.json"});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const auto servo = readJson(s / "r.json")["haptics"]["servo"];
     EXPECT_EQ(servo["wait"], "busy");
@@ -383,8 +392,10 @@ TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
     EXPECT_EQ(m["cpu"], -1);
     EXPECT_EQ(m["physics_cpus"].get<std::vector<int>>(), std::vector<int>{allowed.front()});
     EXPECT_EQ(outside.exitCode, 2);
-    EXPECT_THAT(outside.err, HasSubstr("the CPU must be one this process may run on (" + std::to_string(allowed.front()) + ")"));
-    for (const char* bad : {"busy:", "busy:x", "busy:-1", "busy:4096", "sleep:", "sleep:4096", "spin", "spin:", "spin:2000", "spin:-5"}) {
+    EXPECT_THAT(outside.err,
+                HasSubstr("the CPU must be one this process may run on (" + std::to_string(allowed.front()) + ")"));
+    for (const char* bad :
+         {"busy:", "busy:x", "busy:-1", "busy:4096", "sleep:", "sleep:4096", "spin", "spin:", "spin:2000", "spin:-5"}) {
         auto b = player({"run", s / "slab.vcase", "--headless", "--frames", "1", "--servo", bad});
         EXPECT_EQ(b.exitCode, 2) << bad;
         EXPECT_THAT(b.err, HasSubstr("--servo")) << bad;

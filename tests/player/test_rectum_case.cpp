@@ -19,8 +19,12 @@ using vcase::test::ScratchDir;
 
 namespace {
 
-test::ProcessResult player(const std::vector<std::string>& args) { return test::runProcess(VISCERA_PLAYER_EXE, args); }
-test::ProcessResult studio(const std::vector<std::string>& args) { return test::runProcess(VISCERA_STUDIO_EXE, args); }
+test::ProcessResult player(const std::vector<std::string>& args) {
+    return test::runProcess(VISCERA_PLAYER_EXE, args);
+}
+test::ProcessResult studio(const std::vector<std::string>& args) {
+    return test::runProcess(VISCERA_STUDIO_EXE, args);
+}
 
 nlohmann::json readJson(const std::filesystem::path& p) {
     std::ifstream in(p);
@@ -69,12 +73,14 @@ TEST(RectumCase, BrokenTracksAndSectionsAreRejectedAtExport) {
     const auto pdir = dir.path() / "p";
     std::filesystem::create_directories(pdir / "tools");
     for (const char* t : {"grasper", "hook", "clipper"})
-        std::filesystem::copy_file(src / "tools" / (std::string(t) + ".track"), pdir / "tools" / (std::string(t) + ".track"));
+        std::filesystem::copy_file(src / "tools" / (std::string(t) + ".track"),
+                                   pdir / "tools" / (std::string(t) + ".track"));
     auto exportWith = [&](const nlohmann::json& p) {
         std::ofstream(pdir / "project.json") << p.dump();
         return studio({"export", pdir.string(), "-o", (dir.path() / "x.vcase").string()});
     };
-    std::ofstream(pdir / "tools" / "hook.track") << "# viscera instrument track 1\n0 0 0 0 0 0 -1 1 0\n0 0 0 0 0 0 -1 1 0\n";
+    std::ofstream(pdir / "tools" / "hook.track")
+        << "# viscera instrument track 1\n0 0 0 0 0 0 -1 1 0\n0 0 0 0 0 0 -1 1 0\n";
     auto bad = exportWith(project);
     EXPECT_EQ(bad.exitCode, 1);
     EXPECT_THAT(bad.err, HasSubstr("hook.track:3: t: times must strictly increase"));

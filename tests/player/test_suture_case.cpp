@@ -18,8 +18,12 @@ using vcase::test::ScratchDir;
 
 namespace {
 
-test::ProcessResult player(const std::vector<std::string>& args) { return test::runProcess(VISCERA_PLAYER_EXE, args); }
-test::ProcessResult studio(const std::vector<std::string>& args) { return test::runProcess(VISCERA_STUDIO_EXE, args); }
+test::ProcessResult player(const std::vector<std::string>& args) {
+    return test::runProcess(VISCERA_PLAYER_EXE, args);
+}
+test::ProcessResult studio(const std::vector<std::string>& args) {
+    return test::runProcess(VISCERA_STUDIO_EXE, args);
+}
 
 nlohmann::json readJson(const std::filesystem::path& p) {
     std::ifstream in(p);
@@ -47,17 +51,19 @@ TEST(SutureCase, AnastomosisExportsRunsAndClosesTheGap) {
     EXPECT_THAT(r.out, HasSubstr("closure"));
     const nlohmann::json doc = readJson(report);
     const auto& active = doc["active_subsystems"];
-    for (const char* s : {"fem", "needle", "thread", "contact"}) EXPECT_TRUE(has(active, s)) << s;
+    for (const char* s : {"fem", "needle", "thread", "contact"})
+        EXPECT_TRUE(has(active, s)) << s;
     EXPECT_FALSE(has(active, "xpbd"));
     EXPECT_TRUE(doc["invariants"]["all_finite"].get<bool>());
     ASSERT_EQ(doc["frames"].size(), 2130u);
-    for (const auto& f : doc["frames"]) ASSERT_TRUE(std::isfinite(f["step_ms"].get<double>()));
+    for (const auto& f : doc["frames"])
+        ASSERT_TRUE(std::isfinite(f["step_ms"].get<double>()));
     const nlohmann::json& s = doc["suture"];
     EXPECT_GE(s["punctures"].get<int>(), 50);
     EXPECT_EQ(doc["metrics"]["punctures"].get<int>(), s["punctures"].get<int>());
     EXPECT_NEAR(s["initial_gap_m"].get<double>(), 0.002, 1e-6);
-    EXPECT_LT(s["max_gap_m"].get<double>(), 0.0002);         // 2 mm → closed (0.09 mm measured)
-    EXPECT_LE(s["max_penetration_m"].get<double>(), 1e-4);   // no interpenetration beyond 0.1 mm
+    EXPECT_LT(s["max_gap_m"].get<double>(), 0.0002);       // 2 mm → closed (0.09 mm measured)
+    EXPECT_LE(s["max_penetration_m"].get<double>(), 1e-4); // no interpenetration beyond 0.1 mm
     EXPECT_GT(s["max_thread_tension_n"].get<double>(), 0.0);
     ASSERT_EQ(s["frames"].size(), 2130u);
     int withRows = 0;

@@ -11,10 +11,10 @@ using namespace viscera::render;
 TEST(RenderGlFaceMask, MaskedFacesVanishWithoutReallocation) {
     SceneView view;
     const uint32_t mat = view.addMaterial(defaultMaterialFor("liver"));
-    view.addMesh("liver",
-                 viscera::sim::makeLiverSurface(viscera::sim::Vec3::Zero(),
-                                                viscera::sim::Vec3(0.1, 0.07, 0.04), 0.5, 64, 32),
-                 mat);
+    view.addMesh(
+        "liver",
+        viscera::sim::makeLiverSurface(viscera::sim::Vec3::Zero(), viscera::sim::Vec3(0.1, 0.07, 0.04), 0.5, 64, 32),
+        mat);
     RenderSettings s = defaultSettingsFor(view, 160, 120);
     s.post.disableAll();
     std::string why;

@@ -26,7 +26,10 @@ constexpr int kW = 160, kH = 120;
 SceneView organView() {
     SceneView v;
     const uint32_t mat = v.addMaterial(defaultMaterialFor("liver"));
-    v.addMesh("liver", viscera::sim::makeLiverSurface(viscera::sim::Vec3::Zero(), viscera::sim::Vec3(0.1, 0.07, 0.04), 0.5, 64, 32), mat);
+    v.addMesh(
+        "liver",
+        viscera::sim::makeLiverSurface(viscera::sim::Vec3::Zero(), viscera::sim::Vec3(0.1, 0.07, 0.04), 0.5, 64, 32),
+        mat);
     return v;
 }
 
@@ -87,7 +90,6 @@ void expectMatchesGolden(const std::string& name, const Image& image) {
     EXPECT_LE(d.maxChannel, 64) << name << ": rendered image written to " << actual;
 }
 
-
 } // namespace
 
 TEST_F(RenderGl, ContextIsOpenGl4) {
@@ -108,7 +110,8 @@ TEST_F(RenderGl, UnprocessedGolden) {
 TEST_F(RenderGl, AllEffectsOffEqualsUnprocessedExactly) {
     RenderSettings all = settings;
     all.post.depthOfField.enabled = all.post.chromaticAberration.enabled = all.post.toneMapping.enabled = true;
-    all.post.colourCurve.enabled = all.post.sharpen.enabled = all.post.noise.enabled = all.post.radialMask.enabled = true;
+    all.post.colourCurve.enabled = all.post.sharpen.enabled = all.post.noise.enabled = all.post.radialMask.enabled =
+        true;
     const Image processed = render(all);
     EXPECT_GT(compareImages(processed, renderer->readPixels(ImageStage::Unprocessed)).differing, 1000u);
 
@@ -125,7 +128,9 @@ struct EffectCase {
     void (*enable)(PostSettings&);
 };
 
-void PrintTo(const EffectCase& c, std::ostream* os) { *os << c.name; }
+void PrintTo(const EffectCase& c, std::ostream* os) {
+    *os << c.name;
+}
 
 class RenderGlEffect : public RenderGl, public ::testing::WithParamInterface<EffectCase> {};
 
@@ -184,7 +189,8 @@ TEST_F(RenderGl, HeatTintGolden) {
     const Image fresh = render(settings);
     RenderMesh& m = view.meshes()[0];
     std::vector<float> heat(m.vertexCount());
-    for (size_t v = 0; v < heat.size(); ++v) heat[v] = std::max(0.0f, 1.0f - std::abs(m.positions[3 * v]) / 0.02f);
+    for (size_t v = 0; v < heat.size(); ++v)
+        heat[v] = std::max(0.0f, 1.0f - std::abs(m.positions[3 * v]) / 0.02f);
     view.setHeat(0, heat);
     const Image hot = render(settings);
     // Coagulated tissue (x ≈ ±0.015 m) turns pale; the charred centre line darkens. Both change the image.
@@ -196,7 +202,8 @@ TEST_F(RenderGl, DeformingMeshesUpdateInPlace) {
     const Image first = render(settings);
     const BackendStats before = renderer->renderer().backend().stats();
     for (int f = 0; f < 4; ++f) {
-        for (size_t v = 0; v < view.meshes()[0].vertexCount(); ++v) view.meshes()[0].positions[3 * v + 2] *= 0.9f;
+        for (size_t v = 0; v < view.meshes()[0].vertexCount(); ++v)
+            view.meshes()[0].positions[3 * v + 2] *= 0.9f;
         view.recomputeNormals(0);
         renderer->renderFrame(view);
     }
@@ -225,7 +232,8 @@ TEST_F(RenderGl, AdaptiveSamplingBeatsUniformNearTheLight) {
     const std::vector<float> dist = renderer->renderer().distanceMap(renderer->renderer().light().center);
     std::vector<uint8_t> nearMask(dist.size());
     size_t nearPixels = 0;
-    for (size_t i = 0; i < dist.size(); ++i) nearPixels += nearMask[i] = dist[i] >= 0 && dist[i] <= 0.07f;
+    for (size_t i = 0; i < dist.size(); ++i)
+        nearPixels += nearMask[i] = dist[i] >= 0 && dist[i] <= 0.07f;
     ASSERT_GT(nearPixels, 300u);
     s.sampling.mode = SampleMode::Uniform;
     s.sampling.uniformSamples = 1;

@@ -19,7 +19,8 @@ TEST(Png, RoundTripIsExact) {
     img.width = 37;
     img.height = 11;
     img.rgba.resize(size_t(img.width) * img.height * 4);
-    for (size_t i = 0; i < img.rgba.size(); ++i) img.rgba[i] = uint8_t((i * 7919u) >> 3);
+    for (size_t i = 0; i < img.rgba.size(); ++i)
+        img.rgba[i] = uint8_t((i * 7919u) >> 3);
     const auto path = std::filesystem::path(VISCERA_BINARY_DIR) / "test_render_roundtrip.png";
     writePng(path, img);
     const Image back = readPng(path);
@@ -58,7 +59,8 @@ TEST(ThicknessBake, SphereAndEllipsoidByRayCasting) {
         pos.push_back(p.cast<float>());
         nrm.push_back(p.normalized().cast<float>());
     }
-    for (const auto& t : sphere.triangles()) tris.push_back({uint32_t(t[0]), uint32_t(t[1]), uint32_t(t[2])});
+    for (const auto& t : sphere.triangles())
+        tris.push_back({uint32_t(t[0]), uint32_t(t[1]), uint32_t(t[2])});
     const TriangleBvh bvh(pos, tris);
     EXPECT_NEAR(bvh.raycast(Eigen::Vector3f(0, 0, -1), Eigen::Vector3f(0, 0, 1), 0.0f, 10.0f), 1.0f - R, 2e-4f);
     EXPECT_LT(bvh.raycast(Eigen::Vector3f(0, 0, -1), Eigen::Vector3f(0, 1, 0), 0.0f, 10.0f), 0.0f); // miss
@@ -74,7 +76,8 @@ TEST(ThicknessBake, SphereAndEllipsoidByRayCasting) {
     view.addMesh("small", sim::makeEllipsoidSurface(sim::Vec3::Zero(), sim::Vec3(R / 2, R / 2, R / 2), 48, 24),
                  view.addMaterial(TissueMaterial{}));
     double smallMean = 0;
-    for (float v : view.meshes()[0].thickness) smallMean += v / view.meshes()[0].thickness.size();
+    for (float v : view.meshes()[0].thickness)
+        smallMean += v / view.meshes()[0].thickness.size();
     EXPECT_NEAR(smallMean / mean, 0.5, 0.02);
     // Rays that leave an open surface count as the maximum thickness.
     view.addMesh("sheet", sim::makeBoxSurface(sim::Vec3(0, 0, 0), sim::Vec3(0.01, 0.01, 0.01)), 0);
@@ -108,7 +111,8 @@ TEST(SceneView, FollowsTheWorldWithoutReallocating) {
     }
     const float* before = m.positions.data();
     const uint64_t revision = m.revision;
-    for (int f = 0; f < 3; ++f) world->step();
+    for (int f = 0; f < 3; ++f)
+        world->step();
     view.updateFromWorld(*world);
     EXPECT_EQ(m.positions.data(), before); // same storage
     EXPECT_GT(m.revision, revision);

@@ -13,8 +13,7 @@ using ::testing::HasSubstr;
 TEST(FaceMask, CutFacesAreDroppedWithoutReallocation) {
     SceneView view;
     view.addMaterial(defaultMaterialFor("liver"));
-    const auto box =
-        viscera::sim::makeBoxSurface(viscera::sim::Vec3(0, 0, 0), viscera::sim::Vec3(1, 1, 1));
+    const auto box = viscera::sim::makeBoxSurface(viscera::sim::Vec3(0, 0, 0), viscera::sim::Vec3(1, 1, 1));
     view.addMesh("box", box, 0);
     auto mock = std::make_unique<MockBackend>();
     MockBackend* m = mock.get();
@@ -62,9 +61,7 @@ TEST(FaceMask, CutFacesAreDroppedWithoutReallocation) {
 TEST(FaceMask, AMaskSetBeforeTheFirstFrameIsUploadedWithTheMesh) {
     SceneView view;
     view.addMaterial(defaultMaterialFor("liver"));
-    view.addMesh(
-        "box",
-        viscera::sim::makeBoxSurface(viscera::sim::Vec3(0, 0, 0), viscera::sim::Vec3(1, 1, 1)), 0);
+    view.addMesh("box", viscera::sim::makeBoxSurface(viscera::sim::Vec3(0, 0, 0), viscera::sim::Vec3(1, 1, 1)), 0);
     std::vector<uint8_t> mask(12, 0);
     mask[3] = 1;
     view.setFaceMask(0, mask);
@@ -78,16 +75,12 @@ TEST(FaceMask, AMaskSetBeforeTheFirstFrameIsUploadedWithTheMesh) {
 TEST(FaceMask, WrongSizeNamesTheMesh) {
     SceneView view;
     view.addMaterial(defaultMaterialFor("liver"));
-    view.addMesh(
-        "box",
-        viscera::sim::makeBoxSurface(viscera::sim::Vec3(0, 0, 0), viscera::sim::Vec3(1, 1, 1)), 0);
+    view.addMesh("box", viscera::sim::makeBoxSurface(viscera::sim::Vec3(0, 0, 0), viscera::sim::Vec3(1, 1, 1)), 0);
     try {
         view.setFaceMask(0, std::vector<uint8_t>(5, 1));
         FAIL();
     } catch (const std::invalid_argument& e) {
-        EXPECT_THAT(
-            e.what(),
-            HasSubstr("render::SceneView::setFaceMask(): mesh box has 12 triangles, got 5 flags"));
+        EXPECT_THAT(e.what(), HasSubstr("render::SceneView::setFaceMask(): mesh box has 12 triangles, got 5 flags"));
     }
 }
 
@@ -103,7 +96,8 @@ TEST(FaceMask, UpdateFromWorldDropsTheFasciaFacesTheHookCut) {
     ASSERT_LT(fascia, view.meshes().size());
     const size_t all = view.meshes()[fascia].triangleCount();
     EXPECT_EQ(view.meshes()[fascia].drawnTriangleCount(), all);
-    for (int f = 0; f < 20; ++f) w->step();
+    for (int f = 0; f < 20; ++f)
+        w->step();
     view.updateFromWorld(*w);
     const int cut = w->interaction()->summary().fasciaTrianglesCut;
     ASSERT_GT(cut, 0);

@@ -1,8 +1,8 @@
 // Renderer logic without GL: pass selection, mesh updates, sample counts [A eq. 6.15–6.16],
 // reflection cone [A eq. 6.21], stereo frustums [B ch. 4], settings validation.
 #include "render/area_light.hpp"
-#include "render/case_settings.hpp"
 #include "render/camera.hpp"
+#include "render/case_settings.hpp"
 #include "render/frame_plan.hpp"
 #include "render/renderer.hpp"
 #include "sim/mesh/generators.hpp"
@@ -20,33 +20,53 @@ namespace {
 
 std::vector<PassKind> kinds(const std::vector<PassDesc>& plan) {
     std::vector<PassKind> k;
-    for (const PassDesc& p : plan) k.push_back(p.kind);
+    for (const PassDesc& p : plan)
+        k.push_back(p.kind);
     return k;
 }
 
 SceneView sphereView() {
     SceneView v;
     const uint32_t mat = v.addMaterial(defaultMaterialFor("liver"));
-    v.addMesh("organ", viscera::sim::makeEllipsoidSurface(viscera::sim::Vec3::Zero(), viscera::sim::Vec3(0.05, 0.04, 0.03), 16, 8), mat);
+    v.addMesh(
+        "organ",
+        viscera::sim::makeEllipsoidSurface(viscera::sim::Vec3::Zero(), viscera::sim::Vec3(0.05, 0.04, 0.03), 16, 8),
+        mat);
     return v;
 }
 
 void enableOnly(PostSettings& p, PassKind kind) {
     p.disableAll();
     switch (kind) {
-    case PassKind::DepthOfField: p.depthOfField.enabled = true; break;
-    case PassKind::ChromaticAberration: p.chromaticAberration.enabled = true; break;
-    case PassKind::ToneMapping: p.toneMapping.enabled = true; break;
-    case PassKind::ColourCurve: p.colourCurve.enabled = true; break;
-    case PassKind::Sharpen: p.sharpen.enabled = true; break;
-    case PassKind::Noise: p.noise.enabled = true; break;
-    case PassKind::RadialMask: p.radialMask.enabled = true; break;
-    default: break;
+    case PassKind::DepthOfField:
+        p.depthOfField.enabled = true;
+        break;
+    case PassKind::ChromaticAberration:
+        p.chromaticAberration.enabled = true;
+        break;
+    case PassKind::ToneMapping:
+        p.toneMapping.enabled = true;
+        break;
+    case PassKind::ColourCurve:
+        p.colourCurve.enabled = true;
+        break;
+    case PassKind::Sharpen:
+        p.sharpen.enabled = true;
+        break;
+    case PassKind::Noise:
+        p.noise.enabled = true;
+        break;
+    case PassKind::RadialMask:
+        p.radialMask.enabled = true;
+        break;
+    default:
+        break;
     }
 }
 
-const PassKind kEffects[] = {PassKind::DepthOfField, PassKind::ChromaticAberration, PassKind::ToneMapping,
-                             PassKind::ColourCurve,  PassKind::Sharpen,             PassKind::Noise,
+const PassKind kEffects[] = {PassKind::DepthOfField, PassKind::ChromaticAberration,
+                             PassKind::ToneMapping,  PassKind::ColourCurve,
+                             PassKind::Sharpen,      PassKind::Noise,
                              PassKind::RadialMask};
 
 } // namespace
@@ -64,7 +84,8 @@ TEST(FramePlan, EachEffectAloneAddsExactlyItsPass) {
     for (PassKind k : kEffects) {
         RenderSettings s;
         enableOnly(s.post, k);
-        EXPECT_EQ(kinds(planFrame(s)), (std::vector<PassKind>{PassKind::GBuffer, PassKind::Lighting, k, PassKind::Output}))
+        EXPECT_EQ(kinds(planFrame(s)),
+                  (std::vector<PassKind>{PassKind::GBuffer, PassKind::Lighting, k, PassKind::Output}))
             << passName(k);
     }
 }
@@ -126,7 +147,8 @@ TEST(Renderer, MockRunsOnlyEnabledPassesAndTimesThem) {
     s.post.toneMapping.enabled = false;
     r.setSettings(s);
     r.renderFrame(view);
-    for (const PassDesc& p : m->passes()) EXPECT_FALSE(isPostEffect(p.kind)) << passName(p.kind);
+    for (const PassDesc& p : m->passes())
+        EXPECT_FALSE(isPostEffect(p.kind)) << passName(p.kind);
 }
 
 TEST(Renderer, MeshesUpdateInPlaceWithoutReallocation) {
@@ -139,13 +161,14 @@ TEST(Renderer, MeshesUpdateInPlaceWithoutReallocation) {
     const uint64_t allocations = m->stats().bufferAllocations;
     ASSERT_GT(allocations, 0u);
     for (int f = 0; f < 5; ++f) {
-        for (float& x : view.meshes()[0].positions) x *= 1.01f;
+        for (float& x : view.meshes()[0].positions)
+            x *= 1.01f;
         view.recomputeNormals(0);
         r.renderFrame(view);
     }
     EXPECT_EQ(m->stats().bufferAllocations, allocations);
     EXPECT_EQ(m->meshes()[0].updates, 6u); // first upload + 5 frames
-    r.renderFrame(view);                    // nothing changed: no update
+    r.renderFrame(view);                   // nothing changed: no update
     EXPECT_EQ(m->meshes()[0].updates, 6u);
 
     // A mesh that changes its vertex count is refused (warning), not reallocated.
@@ -231,7 +254,8 @@ TEST(AreaLight, SamplePatternIsStratified) {
             EXPECT_NEAR(p.x(), (i + 0.5f) / m, 1e-6f);
             ++rows[std::min(m - 1, int(p.y() * m))];
         }
-        for (int c : rows) EXPECT_EQ(c, 1) << "m = " << m; // one sample per row: a Latin square
+        for (int c : rows)
+            EXPECT_EQ(c, 1) << "m = " << m; // one sample per row: a Latin square
     }
 }
 
@@ -249,7 +273,7 @@ TEST(AreaLight, ReflectionConeHoldsTheLobeAboveTheCutoff) {
         EXPECT_NEAR(ratio, cutoff, 1e-4f) << rough;
     }
     EXPECT_FLOAT_EQ(reflectionConeHalfAngle(0.9f, cutoff), float(M_PI)); // wide lobe: every sample
-    EXPECT_LT(reflectionConeHalfAngle(0.1f, cutoff), 0.07f); // 3.4° for a mirror-like membrane
+    EXPECT_LT(reflectionConeHalfAngle(0.1f, cutoff), 0.07f);             // 3.4° for a mirror-like membrane
 }
 
 TEST(AreaLight, FollowsTheCamera) {
@@ -294,9 +318,10 @@ TEST(Stereo, ParallelCamerasWithZeroParallaxAtConvergence) {
         const Eigen::Vector4f q = e.viewProjection * p.homogeneous();
         return q.x() / q.w();
     };
-    for (const Eigen::Vector3f& offset : {Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(0.02f, 0, 0), Eigen::Vector3f(0, 0, 0.01f)}) {
-        const Eigen::Vector3f atConvergence = mono.position + st.convergenceDistance * mono.forward +
-                                              offset.x() * mono.right + offset.z() * mono.up;
+    for (const Eigen::Vector3f& offset :
+         {Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(0.02f, 0, 0), Eigen::Vector3f(0, 0, 0.01f)}) {
+        const Eigen::Vector3f atConvergence =
+            mono.position + st.convergenceDistance * mono.forward + offset.x() * mono.right + offset.z() * mono.up;
         EXPECT_NEAR(ndcX(eyes[0], atConvergence), ndcX(eyes[1], atConvergence), 1e-5f);
     }
     const Eigen::Vector3f far = mono.position + 0.3f * mono.forward, near = mono.position + 0.08f * mono.forward;
@@ -322,10 +347,14 @@ TEST(Settings, ValidationNamesTheField) {
     EXPECT_EQ(with([](RenderSettings&) {}), "accepted");
     EXPECT_THAT(with([](RenderSettings& s) { s.width = 4; }),
                 HasSubstr("render::RenderSettings: width/height: must be in [8, 8192]"));
-    EXPECT_THAT(with([](RenderSettings& s) { s.sampling.bands = {{0.1f, 8}, {0.05f, 4}}; }),
+    EXPECT_THAT(with([](RenderSettings& s) {
+                    s.sampling.bands = {{0.1f, 8}, {0.05f, 4}};
+                }),
                 HasSubstr("sampling.bands[1].maxDistance: bands must be sorted"));
     EXPECT_THAT(with([](RenderSettings& s) { s.sampling.uniformSamples = 0; }), HasSubstr("sampling.uniformSamples"));
-    EXPECT_THAT(with([](RenderSettings& s) { s.post.colourCurve.points = {{0.5f, 0.0f}, {0.2f, 1.0f}}; }),
+    EXPECT_THAT(with([](RenderSettings& s) {
+                    s.post.colourCurve.points = {{0.5f, 0.0f}, {0.2f, 1.0f}};
+                }),
                 HasSubstr("post.colourCurve.points[1]: x must increase"));
     RenderSettings s;
     s.width = 641;
@@ -350,7 +379,7 @@ TEST(CaseRender, TheCaseBlockSwitchesPassesOffAndOn) {
     RenderSettings mono = s;
     mono.stereo.mode = StereoMode::Off;
     EXPECT_EQ(kinds(planFrame(mono)), (std::vector<PassKind>{PassKind::GBuffer, PassKind::Lighting, PassKind::Sharpen,
-                                                            PassKind::RadialMask, PassKind::Output}));
+                                                             PassKind::RadialMask, PassKind::Output}));
     RenderSettings unchanged;
     applyCaseRender(unchanged, "", "x");
     EXPECT_EQ(unchanged.post.anyEnabled(), RenderSettings().post.anyEnabled());
@@ -368,9 +397,11 @@ TEST(CaseRender, MalformedBlocksNameTheFieldAndLeaveTheSettingsAlone) {
         }
         return std::string("accepted");
     };
-    EXPECT_EQ(why(R"({"post": {"bloom": true}})").rfind("liver.vcase:scene.json: render.post.bloom: unknown field", 0), 0u);
+    EXPECT_EQ(why(R"({"post": {"bloom": true}})").rfind("liver.vcase:scene.json: render.post.bloom: unknown field", 0),
+              0u);
     EXPECT_THAT(why(R"({"sss": false, "post": {"noise": 1}})"), HasSubstr("render.post.noise: must be true or false"));
-    EXPECT_THAT(why(R"({"sampling": "many"})"), HasSubstr("render.sampling: 'many' is not a sampling mode (uniform, distance, painted)"));
+    EXPECT_THAT(why(R"({"sampling": "many"})"),
+                HasSubstr("render.sampling: 'many' is not a sampling mode (uniform, distance, painted)"));
     EXPECT_THAT(why(R"({"stereo": 3})"), HasSubstr("render.stereo: must be a string (found number)"));
     EXPECT_THAT(why(R"({"shadows": true})"), HasSubstr("render.shadows: unknown field"));
     EXPECT_THAT(why(R"([1, 2])"), HasSubstr("render: must be an object (found array)"));

@@ -52,7 +52,8 @@ Rig rig(CollisionMethod method, bool inIteration, int iterations = 2, bool safeC
     r.solver = XpbdSolver::create(*r.mesh, m, r.fixed, s);
     const auto mass = lumpedMasses(*r.mesh, m.density, r.fixed);
     std::vector<double> w(mass.size());
-    for (size_t i = 0; i < w.size(); ++i) w[i] = mass[i] > 0 ? 1 / mass[i] : 0;
+    for (size_t i = 0; i < w.size(); ++i)
+        w[i] = mass[i] > 0 ? 1 / mass[i] : 0;
     CollisionSettings cs;
     cs.method = method;
     cs.safeConeOnly = safeCone;
@@ -79,27 +80,30 @@ int tunnelled(const Rig& r) {
     int n = 0;
     for (int32_t v : r.top) {
         const Vec3& p = r.solver->positions()[v];
-        const bool over = p.z() > c.a.z() && std::abs(p.x() - c.a.x()) < kR &&
-                          p.y() > std::min(c.a.y(), c.b.y()) && p.y() < std::max(c.a.y(), c.b.y());
+        const bool over = p.z() > c.a.z() && std::abs(p.x() - c.a.x()) < kR && p.y() > std::min(c.a.y(), c.b.y()) &&
+                          p.y() < std::max(c.a.y(), c.b.y());
         n += r.tool.signedDistance(p) < -1e-3 || over;
     }
     return n;
 }
 
 /// Press to `depth` (from `zStart`), then slide 3 cm along x at `speed`, checking every frame.
-Outcome run(CollisionMethod method, double speed, double zStart, double depth,
-            double energyBound = 0.05, double extraDisplacement = 0.01, bool inIteration = false) {
+Outcome run(CollisionMethod method, double speed, double zStart, double depth, double energyBound = 0.05,
+            double extraDisplacement = 0.01, bool inIteration = false) {
     Rig r = rig(method, inIteration);
     if (inIteration) r.solver->setIterationHook(makeCollisionHook(*r.collision, r.tool));
     Outcome o;
     const double zPress = kTop + kR - depth;
     std::vector<std::pair<double, double>> keys;
-    for (int f = 1; f <= 8; ++f) keys.push_back({0.015, zStart + (zPress - zStart) * f / 8.0});
-    for (int f = 0; f < 5; ++f) keys.push_back({0.015, zPress});
+    for (int f = 1; f <= 8; ++f)
+        keys.push_back({0.015, zStart + (zPress - zStart) * f / 8.0});
+    for (int f = 0; f < 5; ++f)
+        keys.push_back({0.015, zPress});
     const int slide = static_cast<int>(std::ceil(0.03 / (speed * kFrame)));
     for (int f = 1; f <= slide; ++f)
         keys.push_back({0.015 + std::min(0.03, speed * kFrame * f), zPress});
-    for (int f = 0; f < 10; ++f) keys.push_back({0.045, zPress});
+    for (int f = 0; f < 10; ++f)
+        keys.push_back({0.045, zPress});
     ToolShape::Pose prev = pose(0.015, zStart);
     r.tool.setPose(prev);
     for (size_t f = 0; f < keys.size(); ++f) {
@@ -115,9 +119,9 @@ Outcome run(CollisionMethod method, double speed, double zStart, double depth,
         }
         prev = next;
         EXPECT_TRUE(fr.finite) << "frame " << f;
-        for (const Vec3& p : r.solver->positions()) EXPECT_TRUE(p.allFinite()) << "frame " << f;
-        const double e = r.solver->elasticEnergy() + r.solver->kineticEnergy() +
-                         r.solver->potentialEnergy();
+        for (const Vec3& p : r.solver->positions())
+            EXPECT_TRUE(p.allFinite()) << "frame " << f;
+        const double e = r.solver->elasticEnergy() + r.solver->kineticEnergy() + r.solver->potentialEnergy();
         EXPECT_TRUE(std::isfinite(e)) << "frame " << f;
         // The slab weighs 75 g; a few mm of indentation stores millijoules.
         EXPECT_LT(e, energyBound) << "frame " << f;
@@ -149,7 +153,8 @@ double heldJitter(CollisionMethod method, int iterations, bool safeCone) {
         const std::vector<int32_t>& cv = r.collision->contactVertices();
         if (f > 88 && !cv.empty()) {
             double move = 0;
-            for (int32_t v : cv) move += (x[v] - last[v]).norm();
+            for (int32_t v : cv)
+                move += (x[v] - last[v]).norm();
             sum += move / cv.size();
             ++frames;
         }
@@ -173,7 +178,8 @@ TEST(CollisionStability, CircumsphereUnderAHeldToolComesToRest) {
         RecordProperty("jitter_cone_it" + std::to_string(iterations), std::to_string(cone));
         RecordProperty("jitter_whole_sphere_it" + std::to_string(iterations), std::to_string(whole));
         std::printf("held tool, %d iterations: mean move per frame %.3g m (safe cone), %.3g m "
-                    "(whole sphere)\n", iterations, cone, whole);
+                    "(whole sphere)\n",
+                    iterations, cone, whole);
         EXPECT_LT(cone, 1e-8);
         EXPECT_GT(whole, 100 * cone);
     }
@@ -227,9 +233,9 @@ TEST(CollisionStability, InIterationToolStartingInsideTheTissue) {
 
 TEST(CollisionStability, DegenerateAndSliverTriangles) {
     CollisionSurfaceDesc d;
-    d.restPositions = {Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.02, 0, 0),      // collinear
-                       Vec3(0, 0.01, 0), Vec3(0.01, 0.01, 0), Vec3(0.01, 0.01, 0), // coincident
-                       Vec3(0.005, 1e-9, 0)};                                    // sliver apex
+    d.restPositions = {Vec3(0, 0, 0),       Vec3(0.01, 0, 0),    Vec3(0.02, 0, 0),    // collinear
+                       Vec3(0, 0.01, 0),    Vec3(0.01, 0.01, 0), Vec3(0.01, 0.01, 0), // coincident
+                       Vec3(0.005, 1e-9, 0)};                                         // sliver apex
     d.triangles = {{0, 1, 2}, {3, 4, 5}, {0, 1, 6}, {0, 1, 4}};
     d.inverseMass.assign(d.restPositions.size(), 10.0);
     for (CollisionMethod m : kAllMethods) {
@@ -244,8 +250,10 @@ TEST(CollisionStability, DegenerateAndSliverTriangles) {
             p.translation() = Vec3(0.001 * step, 0.005, 0.004 - 0.0002 * step);
             tool.setPose(p);
             col->beginStep(x, tool, 1e-3);
-            for (int k = 0; k < 3; ++k) col->iterate(x, tool);
-            for (const Vec3& v : x) ASSERT_TRUE(v.allFinite()) << "step " << step;
+            for (int k = 0; k < 3; ++k)
+                col->iterate(x, tool);
+            for (const Vec3& v : x)
+                ASSERT_TRUE(v.allFinite()) << "step " << step;
             EXPECT_LT(col->stats().maxCorrection, 0.02) << "step " << step;
         }
     }

@@ -41,7 +41,8 @@ AnastomosisRun anastomosis(const AnastomosisSpec& spec) {
 }
 
 /// Two slabs 20 × 20 × 3 mm stacked along z with `gap` between them, sides fixed.
-std::unique_ptr<SutureSimulation> slabs(double gap, const Eigen::Isometry3d& pose, std::vector<int32_t>* fixedOut = nullptr) {
+std::unique_ptr<SutureSimulation> slabs(double gap, const Eigen::Isometry3d& pose,
+                                        std::vector<int32_t>* fixedOut = nullptr) {
     auto lower = makeBoxTetMesh({Vec3(0, 0, -0.003), Vec3(0.02, 0.02, 0.003), {8, 8, 2}});
     auto upper = makeBoxTetMesh({Vec3(0, 0, gap), Vec3(0.02, 0.02, 0.003), {8, 8, 2}});
     std::vector<int32_t> off;
@@ -73,8 +74,10 @@ Eigen::Isometry3d downAt(const Vec3& tip) {
 
 std::vector<NeedleFrame> pushDown(const Vec3& tip, double depth, int frames, double pullAtEnd = 0) {
     std::vector<NeedleFrame> out;
-    for (int f = 1; f <= frames; ++f) out.push_back({downAt(tip - depth * f / frames * Vec3::UnitZ()), 0});
-    for (int f = 1; f <= 10 && pullAtEnd > 0; ++f) out.push_back({out.back().pose, pullAtEnd * f / 10});
+    for (int f = 1; f <= frames; ++f)
+        out.push_back({downAt(tip - depth * f / frames * Vec3::UnitZ()), 0});
+    for (int f = 1; f <= 10 && pullAtEnd > 0; ++f)
+        out.push_back({out.back().pose, pullAtEnd * f / 10});
     return out;
 }
 
@@ -86,7 +89,8 @@ TEST(SutureStability, NeedleTenTimesFasterThanTheTrajectory) {
     spec.pullFrames = 40;
     AnastomosisRun a = anastomosis(spec);
     std::vector<NeedleFrame> fast;
-    for (size_t f = 0; f < a.frames.size(); f += 10) fast.push_back(a.frames[f]); // 30° per frame
+    for (size_t f = 0; f < a.frames.size(); f += 10)
+        fast.push_back(a.frames[f]); // 30° per frame
     fast.push_back(a.frames.back());
     int punctures = 0;
     runChecked(*a.sim, fast, &punctures);
@@ -99,8 +103,10 @@ TEST(SutureStability, ZeroLengthThreadSegment) {
     const Vec3 tip(0.0101, 0.0097, 0.0045);
     auto sim = slabs(0.0, downAt(tip));
     auto frames = pushDown(tip, 0.028, 80); // through both slabs and beyond
-    for (int f = 1; f <= 60; ++f) frames.push_back({downAt(tip - (0.028 + 0.0005 * f) * Vec3::UnitZ()), 0});
-    for (int f = 1; f <= 20; ++f) frames.push_back({frames.back().pose, 0.001 * f});
+    for (int f = 1; f <= 60; ++f)
+        frames.push_back({downAt(tip - (0.028 + 0.0005 * f) * Vec3::UnitZ()), 0});
+    for (int f = 1; f <= 20; ++f)
+        frames.push_back({frames.back().pose, 0.001 * f});
     runChecked(*sim, frames);
 }
 

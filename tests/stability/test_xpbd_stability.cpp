@@ -60,8 +60,10 @@ RunFigures runChecked(XpbdSolver& s, int frames, const Limits& lim) {
     for (int f = 0; f < frames; ++f) {
         const StepStats st = s.step();
         EXPECT_TRUE(st.finite) << "frame " << f;
-        for (const Vec3& p : s.positions()) EXPECT_TRUE(p.allFinite()) << "frame " << f;
-        for (const Vec3& v : s.velocities()) EXPECT_LE(v.norm(), s.settings().maxSpeed * (1 + 1e-9));
+        for (const Vec3& p : s.positions())
+            EXPECT_TRUE(p.allFinite()) << "frame " << f;
+        for (const Vec3& v : s.velocities())
+            EXPECT_LE(v.norm(), s.settings().maxSpeed * (1 + 1e-9));
         const double e = s.elasticEnergy() + s.kineticEnergy() + s.potentialEnergy();
         EXPECT_TRUE(std::isfinite(e)) << "frame " << f;
         EXPECT_LE(e - e0, lim.energyBound) << "frame " << f;
@@ -103,7 +105,9 @@ XpbdSettings checkedSettings(const Block& b, const Material& m, XpbdSettings st,
 }
 
 /// Work gravity can do on a block of mass m falling its own length: the energy scale of these runs.
-double gravityScale(const XpbdSolver& s) { return s.totalMass() * 9.81 * 0.08; }
+double gravityScale(const XpbdSolver& s) {
+    return s.totalMass() * 9.81 * 0.08;
+}
 
 void expectRepeatable(const Block& b, const Material& m, const XpbdSettings& st, int frames,
                       std::vector<double> weights = {}) {
@@ -124,7 +128,8 @@ TEST(Stability, InvertedStartRecovers) {
     Block b = block();
     XpbdSettings st = settings();
     st.gravity.setZero();
-    for (MaterialModel model : {MaterialModel::StableNeoHookean, MaterialModel::ValanisLandel, MaterialModel::Corotated}) {
+    for (MaterialModel model :
+         {MaterialModel::StableNeoHookean, MaterialModel::ValanisLandel, MaterialModel::Corotated}) {
         const Material m = material(model, 20000, 0.45);
         auto s = solver(b, m, checkedSettings(b, m, st));
         std::vector<Vec3> x = b.mesh->positions();
@@ -217,7 +222,8 @@ TEST(Stability, StiffnessRatioOfAMillionBetweenNeighbours) {
         if (b.mesh->positions()[v].x() < 0.04 - 1e-9) w[v] = 1e6;
     const Material m = material(MaterialModel::StableNeoHookean, 40, 0.45);
     // At the nominal 20 substeps the load check refuses it and says what would run.
-    const StabilityFigures nominal = assessStability(*b.mesh, *makeConstraintModel(m, "block"), m.density, w, settings());
+    const StabilityFigures nominal =
+        assessStability(*b.mesh, *makeConstraintModel(m, "block"), m.density, w, settings());
     EXPECT_FALSE(nominal.ok());
     EXPECT_THAT(stabilityProblem("block", nominal, settings()), HasSubstr("use at least"));
     const XpbdSettings st = checkedSettings(b, m, settings(), w);
@@ -259,11 +265,19 @@ TEST(Stability, MaterialCurvesAtTheEditorExtremes) {
     m.model = MaterialModel::ValanisLandel;
     m.youngsModulus = 20000;
     m.poissonRatio = 0.45;
-    m.fPrime = CurveDesc{{{0.7, -4500}, {0.8, -3000}, {0.9, -1500}, {1.0, 0.0}, {1.05, 750}, {1.1, 1500},
-                          {1.15, 1.5e4}, {1.2, 1.5e5}, {1.5, 1.5e6}, {2.0, 4e6}},
+    m.fPrime = CurveDesc{{{0.7, -4500},
+                          {0.8, -3000},
+                          {0.9, -1500},
+                          {1.0, 0.0},
+                          {1.05, 750},
+                          {1.1, 1500},
+                          {1.15, 1.5e4},
+                          {1.2, 1.5e5},
+                          {1.5, 1.5e6},
+                          {2.0, 4e6}},
                          false};
-    m.hPrime = CurveDesc{{{0.2, -8e4}, {0.5, -3e4}, {0.8, -1e4}, {0.9, -5000}, {1.0, 0.0}, {1.1, 5000}, {1.4, 2e4}, {3.0, 1e5}},
-                         false};
+    m.hPrime = CurveDesc{
+        {{0.2, -8e4}, {0.5, -3e4}, {0.8, -1e4}, {0.9, -5000}, {1.0, 0.0}, {1.1, 5000}, {1.4, 2e4}, {3.0, 1e5}}, false};
     auto s = solver(b, m, checkedSettings(b, m, settings()));
     RunFigures r = runChecked(*s, 300, {0.02, 0.05 * gravityScale(*s)});
     EXPECT_LT(r.finalKinetic, 1e-5);
@@ -300,7 +314,8 @@ TEST(Stability, CasesThatCannotBeStableAreRefusedAtLoad) {
     Material incompressible = material(MaterialModel::StableNeoHookean, 1000, 0.5);
     EXPECT_THAT(refuse(incompressible), HasSubstr("poisson_ratio"));
     XpbdSettings huge = settings(1, 0.5);
-    EXPECT_THAT(refuse(material(MaterialModel::StableNeoHookean, 1000, 0.45), huge), HasSubstr("dt must be in (0, 0.1] s"));
+    EXPECT_THAT(refuse(material(MaterialModel::StableNeoHookean, 1000, 0.45), huge),
+                HasSubstr("dt must be in (0, 0.1] s"));
     EXPECT_THAT(refuse(material(MaterialModel::StableNeoHookean, 20000, 0.499)),
                 HasSubstr("scene cannot be simulated stably: body 'slab': stiffness number"));
     EXPECT_EQ(refuse(material(MaterialModel::StableNeoHookean, 1000, 0.45)), "accepted");

@@ -67,8 +67,7 @@ ZipEntryInfo ZipReader::entry(uint64_t index) const {
     zip_stat_t st;
     zip_stat_init(&st);
     if (zip_stat_index(za, index, ZIP_FL_ENC_RAW, &st) != 0) throw ZipError(zip_strerror(za));
-    constexpr zip_uint64_t kNeeded =
-        ZIP_STAT_NAME | ZIP_STAT_SIZE | ZIP_STAT_COMP_SIZE | ZIP_STAT_COMP_METHOD;
+    constexpr zip_uint64_t kNeeded = ZIP_STAT_NAME | ZIP_STAT_SIZE | ZIP_STAT_COMP_SIZE | ZIP_STAT_COMP_METHOD;
     if ((st.valid & kNeeded) != kNeeded) throw ZipError("incomplete central directory entry");
     ZipEntryInfo info;
     info.name = st.name;
@@ -79,8 +78,7 @@ ZipEntryInfo ZipReader::entry(uint64_t index) const {
     info.encrypted = (st.valid & ZIP_STAT_ENCRYPTION_METHOD) && st.encryption_method != ZIP_EM_NONE;
     zip_uint8_t opsys = 0;
     zip_uint32_t attributes = 0;
-    if (zip_file_get_external_attributes(za, index, 0, &opsys, &attributes) != 0)
-        throw ZipError(zip_strerror(za));
+    if (zip_file_get_external_attributes(za, index, 0, &opsys, &attributes) != 0) throw ZipError(zip_strerror(za));
     if (opsys == ZIP_OPSYS_UNIX) info.unixMode = attributes >> 16;
     info.dosDirectory = (attributes & kDosDirectoryAttribute) != 0;
     return info;
@@ -99,8 +97,8 @@ std::string ZipReader::read(uint64_t index, uint64_t declaredSize) const {
             break;
         }
         if (n == 0) {
-            problem = "data ends after " + std::to_string(done) + " of " +
-                      std::to_string(declaredSize) + " declared bytes";
+            problem =
+                "data ends after " + std::to_string(done) + " of " + std::to_string(declaredSize) + " declared bytes";
             break;
         }
         done += static_cast<uint64_t>(n);
@@ -148,22 +146,19 @@ std::string writeZip(const std::vector<ZipInput>& entries) {
         auto i = static_cast<zip_uint64_t>(index);
         if (zip_set_file_compression(za, i, ZIP_CM_DEFLATE, 9) != 0 ||
             zip_file_set_dostime(za, i, kDosTimeMidnight, kDosDate1980Jan1, 0) != 0 ||
-            zip_file_set_external_attributes(za, i, 0, ZIP_OPSYS_UNIX,
-                                             kUnixRegularFile0644 << 16) != 0)
+            zip_file_set_external_attributes(za, i, 0, ZIP_OPSYS_UNIX, kUnixRegularFile0644 << 16) != 0)
             failWith(name);
     }
     if (zip_close(za) != 0) failWith("closing the archive");
 
     zip_stat_t st;
     zip_stat_init(&st);
-    if (zip_source_stat(output, &st) != 0 || !(st.valid & ZIP_STAT_SIZE) ||
-        zip_source_open(output) != 0)
+    if (zip_source_stat(output, &st) != 0 || !(st.valid & ZIP_STAT_SIZE) || zip_source_open(output) != 0)
         throw ZipError(zip_error_strerror(zip_source_error(output)));
     std::string bytes(st.size, '\0');
     zip_int64_t n = zip_source_read(output, bytes.data(), st.size);
     zip_source_close(output);
-    if (n < 0 || static_cast<zip_uint64_t>(n) != st.size)
-        throw ZipError("reading the finished archive back failed");
+    if (n < 0 || static_cast<zip_uint64_t>(n) != st.size) throw ZipError("reading the finished archive back failed");
     return bytes;
 }
 

@@ -12,7 +12,7 @@
 namespace viscera::vcase::detail {
 
 class ZipError : public std::runtime_error {
-  public:
+public:
     using std::runtime_error::runtime_error;
 };
 
@@ -30,7 +30,7 @@ struct ZipEntryInfo {
 
 /// Read-only view of an archive held in memory. Non-copyable.
 class ZipReader {
-  public:
+public:
     /// Opens the archive in `bytes`, which must outlive the reader. Consistency checks between
     /// the central directory and the local headers are on; an archive whose only defect is a
     /// repeated entry name still opens (the caller reports the duplicate). Throws ZipError.
@@ -45,7 +45,7 @@ class ZipReader {
     /// CRC-32; never allocates more than `declaredSize`. Throws ZipError otherwise. O(size).
     std::string read(uint64_t index, uint64_t declaredSize) const;
 
-  private:
+private:
     struct Impl;
     explicit ZipReader(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> m_impl;

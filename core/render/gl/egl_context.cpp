@@ -50,8 +50,17 @@ std::unique_ptr<EglContext> EglContext::create(std::string* whyNot) {
     }
     ctx->m_display = display;
     if (!eglBindAPI(EGL_OPENGL_API)) return fail("EGL: the display offers no desktop OpenGL API");
-    const EGLint configAttribs[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
-                                    EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8, EGL_NONE};
+    const EGLint configAttribs[] = {EGL_SURFACE_TYPE,
+                                    EGL_PBUFFER_BIT,
+                                    EGL_RENDERABLE_TYPE,
+                                    EGL_OPENGL_BIT,
+                                    EGL_RED_SIZE,
+                                    8,
+                                    EGL_GREEN_SIZE,
+                                    8,
+                                    EGL_BLUE_SIZE,
+                                    8,
+                                    EGL_NONE};
     EGLConfig config = nullptr;
     EGLint count = 0;
     if (!eglChooseConfig(display, configAttribs, &config, 1, &count) || count < 1)
@@ -60,8 +69,13 @@ std::unique_ptr<EglContext> EglContext::create(std::string* whyNot) {
     EGLContext context = EGL_NO_CONTEXT;
     int gotMajor = 0, gotMinor = 0;
     for (const auto& v : versions) {
-        const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, v[0], EGL_CONTEXT_MINOR_VERSION, v[1],
-                                  EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+        const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                  v[0],
+                                  EGL_CONTEXT_MINOR_VERSION,
+                                  v[1],
+                                  EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                  EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                  EGL_NONE};
         context = eglCreateContext(display, config, EGL_NO_CONTEXT, attribs);
         if (context != EGL_NO_CONTEXT) {
             gotMajor = v[0];
@@ -97,6 +111,8 @@ bool EglContext::makeCurrent() {
                           m_context) == EGL_TRUE;
 }
 
-void* EglContext::procAddress(const char* name, void*) { return reinterpret_cast<void*>(eglGetProcAddress(name)); }
+void* EglContext::procAddress(const char* name, void*) {
+    return reinterpret_cast<void*>(eglGetProcAddress(name));
+}
 
 } // namespace viscera::render::gl

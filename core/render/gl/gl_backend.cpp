@@ -1,7 +1,7 @@
 // OpenGL 4.1+ core backend: G-buffer [A Fig. 7.4], deferred lighting, post-effect chain, output
 // encoding and stereo composition, on whatever context is current (headless EGL or a window's).
-#include "render/gl/gl_api.hpp"
 #include "render/backend.hpp"
+#include "render/gl/gl_api.hpp"
 #include "render/shader_library.hpp"
 
 #include <algorithm>
@@ -49,9 +49,11 @@ public:
         GLuint shaders[2] = {compile(GL_VERTEX_SHADER, vs, error), compile(GL_FRAGMENT_SHADER, fs, error)};
         if (!shaders[0] || !shaders[1]) return;
         m_id = m_gl.CreateProgram();
-        for (GLuint s : shaders) m_gl.AttachShader(m_id, s);
+        for (GLuint s : shaders)
+            m_gl.AttachShader(m_id, s);
         m_gl.LinkProgram(m_id);
-        for (GLuint s : shaders) m_gl.DeleteShader(s);
+        for (GLuint s : shaders)
+            m_gl.DeleteShader(s);
         GLint ok = 0;
         m_gl.GetProgramiv(m_id, GL_LINK_STATUS, &ok);
         if (!ok) {
@@ -174,7 +176,8 @@ GlBackend::~GlBackend() {
         m_gl.DeleteBuffers(6, buffers);
         m_gl.DeleteVertexArrays(1, &m.vao);
     }
-    for (RenderTarget* t : {&m_gbufferTarget, &m_lit, &m_postA, &m_postB, &m_eyeLeft, &m_eyeRight, &m_final, &m_scratch})
+    for (RenderTarget* t :
+         {&m_gbufferTarget, &m_lit, &m_postA, &m_postB, &m_eyeLeft, &m_eyeRight, &m_final, &m_scratch})
         freeTarget(*t);
     if (m_emptyVao) m_gl.DeleteVertexArrays(1, &m_emptyVao);
 }
@@ -257,7 +260,8 @@ void GlBackend::freeTarget(RenderTarget& t) {
 void GlBackend::resize(const FrameLayout& l) {
     if (l == m_layout) return;
     m_layout = l;
-    for (RenderTarget* t : {&m_gbufferTarget, &m_lit, &m_postA, &m_postB, &m_eyeLeft, &m_eyeRight, &m_final, &m_scratch})
+    for (RenderTarget* t :
+         {&m_gbufferTarget, &m_lit, &m_postA, &m_postB, &m_eyeLeft, &m_eyeRight, &m_final, &m_scratch})
         freeTarget(*t);
     const int w = l.eyeWidth, h = l.eyeHeight;
     const std::array<GLenum, 3> hdr{GL_RGBA16F, GL_RGBA, GL_HALF_FLOAT}, ldr{GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE};
@@ -275,14 +279,22 @@ void GlBackend::resize(const FrameLayout& l) {
 
 RenderTarget& GlBackend::target(Target t) {
     switch (t) {
-    case Target::GBuffer: return m_gbufferTarget;
-    case Target::Lit: return m_lit;
-    case Target::PostA: return m_postA;
-    case Target::PostB: return m_postB;
-    case Target::EyeLeft: return m_eyeLeft;
-    case Target::EyeRight: return m_eyeRight;
-    case Target::Final: return m_final;
-    case Target::None: break;
+    case Target::GBuffer:
+        return m_gbufferTarget;
+    case Target::Lit:
+        return m_lit;
+    case Target::PostA:
+        return m_postA;
+    case Target::PostB:
+        return m_postB;
+    case Target::EyeLeft:
+        return m_eyeLeft;
+    case Target::EyeRight:
+        return m_eyeRight;
+    case Target::Final:
+        return m_final;
+    case Target::None:
+        break;
     }
     throw std::logic_error("render::GlBackend: no target");
 }
@@ -313,7 +325,8 @@ void GlBackend::createMesh(size_t index, const RenderMesh& mesh) {
     buffer(g.attributes, v * 20, GL_STATIC_DRAW); // rest xyz, thickness, samples
     m_gl.VertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, 20, nullptr);
     m_gl.VertexAttribPointer(5, 1, GL_FLOAT, GL_FALSE, 20, reinterpret_cast<const void*>(16));
-    for (GLuint a = 0; a < 6; ++a) m_gl.EnableVertexAttribArray(a);
+    for (GLuint a = 0; a < 6; ++a)
+        m_gl.EnableVertexAttribArray(a);
     m_gl.GenBuffers(1, &g.index);
     m_gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.index);
     m_gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(g.indices * 4), mesh.indices.data(), GL_DYNAMIC_DRAW);
@@ -386,11 +399,21 @@ void GlBackend::beginFullscreen(Program& p, const PassDesc& pass) {
 void GlBackend::runPass(const PassDesc& pass, const PassContext& ctx) {
     ++m_stats.passesRun;
     switch (pass.kind) {
-    case PassKind::GBuffer: gbufferPass(pass, ctx); break;
-    case PassKind::Lighting: lightingPass(pass, ctx); break;
-    case PassKind::Output: outputPass(pass); break;
-    case PassKind::StereoCompose: composePass(pass); break;
-    default: postPass(pass, ctx); break;
+    case PassKind::GBuffer:
+        gbufferPass(pass, ctx);
+        break;
+    case PassKind::Lighting:
+        lightingPass(pass, ctx);
+        break;
+    case PassKind::Output:
+        outputPass(pass);
+        break;
+    case PassKind::StereoCompose:
+        composePass(pass);
+        break;
+    default:
+        postPass(pass, ctx);
+        break;
     }
 }
 
@@ -402,7 +425,8 @@ void GlBackend::gbufferPass(const PassDesc& pass, const PassContext& ctx) {
     m_gl.Enable(GL_DEPTH_TEST);
     m_gl.DepthFunc(GL_LESS);
     const float zero[4] = {0, 0, 0, 0}, one = 1.0f;
-    for (int i = 0; i < 4; ++i) m_gl.ClearBufferfv(GL_COLOR, i, zero);
+    for (int i = 0; i < 4; ++i)
+        m_gl.ClearBufferfv(GL_COLOR, i, zero);
     m_gl.ClearBufferfv(GL_DEPTH, 0, &one);
     Program& p = *m_gbuffer;
     p.use();
@@ -433,7 +457,8 @@ void GlBackend::gbufferPass(const PassDesc& pass, const PassContext& ctx) {
         p.set("uReflection", mat.reflection);
         p.set("uFlags", float(mat.flags));
         p.set("uDoubleSided", m.doubleSided ? 1 : 0);
-        if (m.doubleSided) m_gl.Disable(GL_CULL_FACE);
+        if (m.doubleSided)
+            m_gl.Disable(GL_CULL_FACE);
         else {
             m_gl.Enable(GL_CULL_FACE);
             m_gl.CullFace(GL_BACK);
@@ -441,7 +466,8 @@ void GlBackend::gbufferPass(const PassDesc& pass, const PassContext& ctx) {
         if (m.drawOnTop) {
             m_gl.Enable(GL_POLYGON_OFFSET_FILL);
             m_gl.PolygonOffset(-2.0f, -4.0f);
-        } else m_gl.Disable(GL_POLYGON_OFFSET_FILL);
+        } else
+            m_gl.Disable(GL_POLYGON_OFFSET_FILL);
         if (g.drawIndices == 0) continue; // every face masked out
         m_gl.BindVertexArray(g.vao);
         m_gl.DrawElements(GL_TRIANGLES, GLsizei(g.drawIndices), GL_UNSIGNED_INT, nullptr);
@@ -522,7 +548,9 @@ void GlBackend::postPass(const PassDesc& pass, const PassContext& ctx) {
         p.set("uBlurPerMetre", s.depthOfField.blurPerMetre);
         p.set("uMaxRadius", s.depthOfField.maxRadiusPx);
         break;
-    case PassKind::ChromaticAberration: p.set("uStrength", s.chromaticAberration.strength); break;
+    case PassKind::ChromaticAberration:
+        p.set("uStrength", s.chromaticAberration.strength);
+        break;
     case PassKind::ToneMapping:
         p.set("uExposure", s.toneMapping.exposure);
         p.set("uOperator", int(s.toneMapping.op));
@@ -555,7 +583,8 @@ void GlBackend::postPass(const PassDesc& pass, const PassContext& ctx) {
         p.set("uOuter", s.radialMask.outer);
         p.set("uColour", s.radialMask.colour);
         break;
-    default: break;
+    default:
+        break;
     }
     m_gl.DrawArrays(GL_TRIANGLES, 0, 3);
 }

@@ -92,14 +92,12 @@ double ClipBounds::normalisedDistance(const Vec3& p) const {
 
 // ---- application -----------------------------------------------------------------------------
 
-std::unique_ptr<ClipAttachment> ClipAttachment::apply(const TetMesh& vessel,
-                                                      const std::vector<Vec3>& x,
-                                                      const ClipDesc& clip,
-                                                      const ClipSettings& settings) {
+std::unique_ptr<ClipAttachment> ClipAttachment::apply(const TetMesh& vessel, const std::vector<Vec3>& x,
+                                                      const ClipDesc& clip, const ClipSettings& settings) {
     const size_t nv = vessel.vertexCount();
     if (x.size() != nv)
-        fail("positions has " + std::to_string(x.size()) + " entries, the vessel mesh " +
-             std::to_string(nv) + " vertices");
+        fail("positions has " + std::to_string(x.size()) + " entries, the vessel mesh " + std::to_string(nv) +
+             " vertices");
     for (size_t i = 0; i < nv; ++i)
         if (!x[i].allFinite()) fail("positions[" + std::to_string(i) + "] is not finite");
     const ClipBounds& b = clip.bounds;
@@ -110,20 +108,16 @@ std::unique_ptr<ClipAttachment> ClipAttachment::apply(const TetMesh& vessel,
     } else {
         if (!(b.halfExtents.minCoeff() > 0) || !b.halfExtents.allFinite())
             fail("bounds.halfExtents must be finite and positive (or give a sphere radius)");
-        if (!b.axes.allFinite() ||
-            !((b.axes.transpose() * b.axes - Mat3::Identity()).cwiseAbs().maxCoeff() <= 1e-6))
+        if (!b.axes.allFinite() || !((b.axes.transpose() * b.axes - Mat3::Identity()).cwiseAbs().maxCoeff() <= 1e-6))
             fail("bounds.axes must be orthonormal columns");
     }
     if (!allFinite(clip.vertices)) fail("a clip vertex is not finite");
     if (!allFinite(clip.contactPoints)) fail("a clip contact point is not finite");
-    if (!clip.jawNormal.allFinite() || !(clip.jawNormal.norm() > 1e-12))
-        fail("jawNormal must be finite and non-zero");
+    if (!clip.jawNormal.allFinite() || !(clip.jawNormal.norm() > 1e-12)) fail("jawNormal must be finite and non-zero");
     if (settings.auxiliaryPerTet < 0 || settings.auxiliaryPerTet > 64)
         fail("settings.auxiliaryPerTet must be in [0, 64]");
-    if (!(settings.weightFloor > 0 && settings.weightFloor <= 1))
-        fail("settings.weightFloor must be in (0, 1]");
-    if (settings.rotation.maxIterations < 0 || !(settings.rotation.epsilon > 0) ||
-        !(settings.rotation.tolerance >= 0))
+    if (!(settings.weightFloor > 0 && settings.weightFloor <= 1)) fail("settings.weightFloor must be in (0, 1]");
+    if (settings.rotation.maxIterations < 0 || !(settings.rotation.epsilon > 0) || !(settings.rotation.tolerance >= 0))
         fail("settings.rotation needs maxIterations >= 0, epsilon > 0, tolerance >= 0");
 
     std::unique_ptr<ClipAttachment> c(new ClipAttachment());
@@ -148,7 +142,8 @@ std::unique_ptr<ClipAttachment> ClipAttachment::apply(const TetMesh& vessel,
         for (const auto& bary : pattern) {
             AuxiliaryNode a;
             a.tet = static_cast<int32_t>(t);
-            for (int k = 0; k < 4; ++k) a.nodes[k] = tets[t][k];
+            for (int k = 0; k < 4; ++k)
+                a.nodes[k] = tets[t][k];
             a.bary = bary;
             const Vec3 p = baryPoint(x, a);
             if (!b.contains(p)) continue;
@@ -212,8 +207,7 @@ std::unique_ptr<ClipAttachment> ClipAttachment::apply(const TetMesh& vessel,
 
 // ---- per frame -------------------------------------------------------------------------------
 
-bool ClipAttachment::accumulate(const std::vector<Vec3>& x, const Vec3& ref, Vec3& centre,
-                                Mat3& Apq) const {
+bool ClipAttachment::accumulate(const std::vector<Vec3>& x, const Vec3& ref, Vec3& centre, Mat3& Apq) const {
     // One pass: Σ w (x′ − ref) and Σ w (x′ − ref)(X′ − X′_cm)ᵀ about a reference point near the
     // region (conditioning); then Σ w (x′ − x′_cm) qᵀ = Σ w (x′ − ref) qᵀ − (x′_cm − ref) Σ w qᵀ,
     // with Σ w q (zero up to round-off) stored at application, so the result is eq. 5.15's.
@@ -281,10 +275,10 @@ void ClipAttachment::placeClipPoints() {
 void ClipAttachment::auxiliaryPositionsInto(const std::vector<Vec3>& x, std::vector<Vec3>& out) const {
     if (x.size() != m_vertexCount)
         throw std::invalid_argument("sim::ClipAttachment::auxiliaryPositionsInto(): positions has " +
-                                    std::to_string(x.size()) + " entries, expected " +
-                                    std::to_string(m_vertexCount));
+                                    std::to_string(x.size()) + " entries, expected " + std::to_string(m_vertexCount));
     out.resize(m_aux.size());
-    for (size_t j = 0; j < m_aux.size(); ++j) out[j] = baryPoint(x, m_aux[j]);
+    for (size_t j = 0; j < m_aux.size(); ++j)
+        out[j] = baryPoint(x, m_aux[j]);
 }
 
 } // namespace viscera::sim

@@ -53,10 +53,10 @@ namespace viscera::sim {
 
 /// The clip's bounding volume at application, world frame.
 struct ClipBounds {
-    Vec3 centre = Vec3::Zero();          ///< m
-    Mat3 axes = Mat3::Identity();        ///< box axes as orthonormal columns (box only)
-    Vec3 halfExtents = Vec3::Zero();     ///< box half sizes along the axes, m (box only)
-    double radius = 0;                   ///< > 0: a sphere of this radius (axes/halfExtents unused)
+    Vec3 centre = Vec3::Zero();      ///< m
+    Mat3 axes = Mat3::Identity();    ///< box axes as orthonormal columns (box only)
+    Vec3 halfExtents = Vec3::Zero(); ///< box half sizes along the axes, m (box only)
+    double radius = 0;               ///< > 0: a sphere of this radius (axes/halfExtents unused)
 
     static ClipBounds box(const Vec3& centre, const Mat3& axes, const Vec3& halfExtents);
     static ClipBounds sphere(const Vec3& centre, double radius);
@@ -74,8 +74,8 @@ struct ClipDesc {
 };
 
 struct ClipSettings {
-    int auxiliaryPerTet = 10;   ///< auxiliary pattern points per tet, in [0, 64] (0: none)
-    double weightFloor = 0.1;   ///< w at the bounds' boundary, in (0, 1]
+    int auxiliaryPerTet = 10; ///< auxiliary pattern points per tet, in [0, 64] (0: none)
+    double weightFloor = 0.1; ///< w at the bounds' boundary, in (0, 1]
     /// Per-frame exp-map update [A eq. 5.17–5.18], warm-started from the previous frame. Each
     /// iteration shrinks the error of R about the k-th principal axis of the stretch S (A = R S)
     /// by the factor s_k / tr S (1/3 for a rigid region, 1/2 about the in-plane axes of a
@@ -90,21 +90,19 @@ enum class ClipUpdateStatus { Ok, NonFiniteInput, SizeMismatch };
 /// A virtual auxiliary node: a fixed point of one vessel tet.
 struct AuxiliaryNode {
     int32_t tet = 0;
-    std::array<int32_t, 4> nodes{};                   ///< the tet's vertices
+    std::array<int32_t, 4> nodes{}; ///< the tet's vertices
     Eigen::Vector4d bary = Eigen::Vector4d::Constant(0.25);
 };
 
 class ClipAttachment {
-  public:
+public:
     /// Applies a clip. `vessel` is the rest mesh (X), `positions` the vessel's current positions
     /// (#V, m) at application. Throws std::invalid_argument ("sim::ClipAttachment::apply(): ...")
     /// on a size mismatch, non-finite positions or clip points, bounds that are not finite or not
     /// positive (or box axes that are not orthonormal within 1e-6), a zero jaw normal, bad
     /// settings, or a region that contains no vessel vertex and no auxiliary node.
-    static std::unique_ptr<ClipAttachment> apply(const TetMesh& vessel,
-                                                 const std::vector<Vec3>& positions,
-                                                 const ClipDesc& clip,
-                                                 const ClipSettings& settings = {});
+    static std::unique_ptr<ClipAttachment> apply(const TetMesh& vessel, const std::vector<Vec3>& positions,
+                                                 const ClipDesc& clip, const ClipSettings& settings = {});
     ClipAttachment(const ClipAttachment&) = delete;
     ClipAttachment& operator=(const ClipAttachment&) = delete;
 
@@ -113,13 +111,13 @@ class ClipAttachment {
     ClipUpdateStatus update(const std::vector<Vec3>& positions);
 
     // ---- pose --------------------------------------------------------------------------------
-    const Mat3& transform() const { return m_A; }          ///< A of [A eq. 5.15], rest → current
-    const Mat3& rotation() const { return m_R; }           ///< R (rest → current), exp-map state
-    const Mat3& applicationRotation() const { return m_R0; } ///< R₀ at application
+    const Mat3& transform() const { return m_A; }                    ///< A of [A eq. 5.15], rest → current
+    const Mat3& rotation() const { return m_R; }                     ///< R (rest → current), exp-map state
+    const Mat3& applicationRotation() const { return m_R0; }         ///< R₀ at application
     Mat3 relativeRotation() const { return m_R * m_R0.transpose(); } ///< Q = R R₀ᵀ
-    const Vec3& centre() const { return m_centre; }        ///< x′_cm(t), m
-    const Vec3& applicationCentre() const { return m_centre0; } ///< x′_cm(0), m
-    const Vec3& restCentre() const { return m_restCentre; } ///< X′_cm, m
+    const Vec3& centre() const { return m_centre; }                  ///< x′_cm(t), m
+    const Vec3& applicationCentre() const { return m_centre0; }      ///< x′_cm(0), m
+    const Vec3& restCentre() const { return m_restCentre; }          ///< X′_cm, m
     /// p(t) = Q (p₀ − x′_cm(0)) + x′_cm(t) for a point p₀ given at application.
     Vec3 transformPoint(const Vec3& pAtApplication) const;
 
@@ -147,7 +145,7 @@ class ClipAttachment {
     size_t vesselVertexCount() const { return m_vertexCount; }
     const ClipSettings& settings() const { return m_settings; }
 
-  private:
+private:
     ClipAttachment() = default;
     /// x′_cm = Σ w x′ / Σ w and Apq = Σ w (x′ − x′_cm)(X′ − X′_cm)ᵀ in one pass about `ref`;
     /// false if non-finite.
@@ -158,8 +156,8 @@ class ClipAttachment {
     size_t m_vertexCount = 0;
     std::vector<int32_t> m_regionVertices;
     std::vector<AuxiliaryNode> m_aux;
-    std::vector<double> m_weights;     ///< vertices, then auxiliary nodes
-    std::vector<Vec3> m_restOffsets;   ///< X′_i − X′_cm, same order
+    std::vector<double> m_weights;   ///< vertices, then auxiliary nodes
+    std::vector<Vec3> m_restOffsets; ///< X′_i − X′_cm, same order
     double m_weightSum = 0;
     Vec3 m_offsetSum = Vec3::Zero(); ///< Σ w (X′ − X′_cm), zero up to round-off
     Mat3 m_AqqPinv = Mat3::Zero();

@@ -16,8 +16,7 @@ namespace {
 }
 } // namespace
 
-Vec3 closestPointOnPolyline(const Vec3& p, const Vec3* P, size_t count,
-                            const std::vector<int32_t>& segments) {
+Vec3 closestPointOnPolyline(const Vec3& p, const Vec3* P, size_t count, const std::vector<int32_t>& segments) {
     if (count == 1) return P[0];
     double best = std::numeric_limits<double>::infinity();
     Vec3 q = P[0];
@@ -31,20 +30,19 @@ Vec3 closestPointOnPolyline(const Vec3& p, const Vec3* P, size_t count,
         }
     };
     if (segments.empty())
-        for (size_t i = 0; i + 1 < count; ++i) visit(i);
+        for (size_t i = 0; i + 1 < count; ++i)
+            visit(i);
     else
-        for (int32_t i : segments) visit(static_cast<size_t>(i));
+        for (int32_t i : segments)
+            visit(static_cast<size_t>(i));
     return q;
 }
 
-std::unique_ptr<ClipFlattening> ClipFlattening::create(const ClipAttachment& clip,
-                                                       const std::vector<Vec3>& x,
-                                                       const std::vector<Vec3>& skeleton,
-                                                       const FlattenSettings& s) {
+std::unique_ptr<ClipFlattening> ClipFlattening::create(const ClipAttachment& clip, const std::vector<Vec3>& x,
+                                                       const std::vector<Vec3>& skeleton, const FlattenSettings& s) {
     if (!(std::isfinite(s.eta) && s.eta >= 0)) fail("settings.eta must be finite and >= 0");
     if (!(std::isfinite(s.gamma) && s.gamma > 0)) fail("settings.gamma must be finite and > 0");
-    if (!(std::isfinite(s.minDistance) && s.minDistance > 0))
-        fail("settings.minDistance must be finite and > 0");
+    if (!(std::isfinite(s.minDistance) && s.minDistance > 0)) fail("settings.minDistance must be finite and > 0");
     if (!(std::isfinite(s.influence) && s.influence > s.minDistance))
         fail("settings.influence must be finite and > minDistance");
     if (!(s.maxSqueeze >= 0 && s.maxSqueeze < 1)) fail("settings.maxSqueeze must be in [0, 1)");
@@ -78,8 +76,7 @@ std::unique_ptr<ClipFlattening> ClipFlattening::create(const ClipAttachment& cli
     return f;
 }
 
-bool ClipFlattening::flattenInto(const ClipAttachment& clip, const std::vector<Vec3>& x,
-                                 std::vector<Vec3>& out) const {
+bool ClipFlattening::flattenInto(const ClipAttachment& clip, const std::vector<Vec3>& x, std::vector<Vec3>& out) const {
     return run(clip, x, nullptr, true, out);
 }
 
@@ -92,8 +89,8 @@ bool ClipFlattening::flattenInto(const ClipAttachment& clip, const std::vector<V
     return run(clip, x, skeletonNow.data(), false, out);
 }
 
-bool ClipFlattening::run(const ClipAttachment& clip, const std::vector<Vec3>& x, const Vec3* skel,
-                         bool carried, std::vector<Vec3>& out) const {
+bool ClipFlattening::run(const ClipAttachment& clip, const std::vector<Vec3>& x, const Vec3* skel, bool carried,
+                         std::vector<Vec3>& out) const {
     out.resize(x.size());
     std::copy(x.begin(), x.end(), out.begin());
     if (x.size() != m_renderCount) return false;

@@ -30,21 +30,20 @@
 namespace viscera::sim {
 
 struct FlattenSettings {
-    double eta = 2e-6;       ///< η, intensity, m^(1+γ) (f is in metres)
-    double gamma = 1.0;      ///< γ, fading exponent (> 0; the shifted factor vanishes at γ = 0)
-    double minDistance = 1e-3;  ///< s₀, m (> 0): clamp of the denominator
-    double influence = 6e-3;    ///< s_max, m (> s₀): no displacement beyond this along the skeleton
-    double maxSqueeze = 0.8;    ///< κ in [0, 1): cap as a fraction of the distance to the skeleton
+    double eta = 2e-6;         ///< η, intensity, m^(1+γ) (f is in metres)
+    double gamma = 1.0;        ///< γ, fading exponent (> 0; the shifted factor vanishes at γ = 0)
+    double minDistance = 1e-3; ///< s₀, m (> 0): clamp of the denominator
+    double influence = 6e-3;   ///< s_max, m (> s₀): no displacement beyond this along the skeleton
+    double maxSqueeze = 0.8;   ///< κ in [0, 1): cap as a fraction of the distance to the skeleton
 };
 
 class ClipFlattening {
-  public:
+public:
     /// Selects the render vertices (positions at application, #R, m) whose skeleton projection
     /// lies within s_max of the centre's, and keeps the polyline segments within reach of them.
     /// Throws std::invalid_argument ("sim::ClipFlattening::create(): ...") on bad settings, a
     /// polyline with fewer than 2 points, or non-finite positions.
-    static std::unique_ptr<ClipFlattening> create(const ClipAttachment& clip,
-                                                  const std::vector<Vec3>& renderPositions,
+    static std::unique_ptr<ClipFlattening> create(const ClipAttachment& clip, const std::vector<Vec3>& renderPositions,
                                                   const std::vector<Vec3>& skeleton,
                                                   const FlattenSettings& settings = {});
     ClipFlattening(const ClipFlattening&) = delete;
@@ -62,7 +61,7 @@ class ClipFlattening {
     const std::vector<int32_t>& candidates() const { return m_candidates; } ///< render indices
     const FlattenSettings& settings() const { return m_settings; }
 
-  private:
+private:
     ClipFlattening() = default;
     bool run(const ClipAttachment& clip, const std::vector<Vec3>& x, const Vec3* skel, bool carried,
              std::vector<Vec3>& out) const;
@@ -70,8 +69,8 @@ class ClipFlattening {
     FlattenSettings m_settings;
     size_t m_renderCount = 0, m_skeletonCount = 0;
     std::vector<int32_t> m_candidates;
-    std::vector<int32_t> m_segments;  ///< kept segments (i, i + 1) of the polyline
-    std::vector<Vec3> m_skeleton0;    ///< polyline at application
+    std::vector<int32_t> m_segments; ///< kept segments (i, i + 1) of the polyline
+    std::vector<Vec3> m_skeleton0;   ///< polyline at application
 };
 
 /// Closest point of a polyline to p over the segments starting at the listed indices (all when

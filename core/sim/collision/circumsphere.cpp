@@ -37,8 +37,7 @@ std::string validate(const CircumsphereParams& p) {
     if (!(p.scale >= 0) || !std::isfinite(p.scale)) return "scale phi must be finite and >= 0";
     if (!(p.curvatureThreshold > 0) || !std::isfinite(p.curvatureThreshold))
         return "curvature threshold h must be finite and > 0";
-    if (!(p.energyScale >= 0) || !std::isfinite(p.energyScale))
-        return "energy scale must be finite and >= 0";
+    if (!(p.energyScale >= 0) || !std::isfinite(p.energyScale)) return "energy scale must be finite and >= 0";
     if (!(p.updateThreshold >= 0)) return "update threshold delta must be >= 0";
     return {};
 }
@@ -66,12 +65,13 @@ Circumcircle circumcircle(const Vec3& a, const Vec3& b, const Vec3& c) {
     return cc;
 }
 
-double circumsphereOffset(double circumradius, double h3, double energy,
-                          const CircumsphereParams& p) {
+double circumsphereOffset(double circumradius, double h3, double energy, const CircumsphereParams& p) {
     return circumsphereOffset(circumradius, h3, energy, offsetPerRadius(p), p.energyScale);
 }
 
-double offsetPerRadius(const CircumsphereParams& p) { return p.scale / std::tan(p.safeAngle); }
+double offsetPerRadius(const CircumsphereParams& p) {
+    return p.scale / std::tan(p.safeAngle);
+}
 
 Sphere circumsphere(const Circumcircle& cc, double offset) {
     Sphere s;
@@ -92,8 +92,7 @@ bool Sphere::inSafeCone(const Vec3& p) const {
 
 Sphere boundingSphere(const Vec3& a, const Vec3& b, const Vec3& c) {
     const Vec3 g = (a + b + c) / 3.0;
-    return {g, std::sqrt(std::max({(a - g).squaredNorm(), (b - g).squaredNorm(),
-                                   (c - g).squaredNorm()}))};
+    return {g, std::sqrt(std::max({(a - g).squaredNorm(), (b - g).squaredNorm(), (c - g).squaredNorm()}))};
 }
 
 double triangleEnergyFactor(const std::array<Vec3, 3>& rest, const std::array<Vec3, 3>& current) {
@@ -116,8 +115,7 @@ double triangleEnergyFactor(const std::array<Vec3, 3>& rest, const std::array<Ve
     return std::isfinite(e) ? e / (1 + e) : 1.0;
 }
 
-SurfaceCurvature::SurfaceCurvature(size_t vertexCount, const std::vector<Tri>& triangles)
-    : m_tris(triangles) {
+SurfaceCurvature::SurfaceCurvature(size_t vertexCount, const std::vector<Tri>& triangles) : m_tris(triangles) {
     std::map<std::pair<int32_t, int32_t>, size_t> index;
     std::vector<int> uses;
     for (size_t t = 0; t < triangles.size(); ++t)
@@ -130,8 +128,10 @@ SurfaceCurvature::SurfaceCurvature(size_t vertexCount, const std::vector<Tri>& t
                 uses.push_back(1);
             } else {
                 Edge& e = m_edges[it->second];
-                if (++uses[it->second] == 2) e.t1 = static_cast<int32_t>(t);
-                else e.t1 = -1; // non-manifold: no contribution
+                if (++uses[it->second] == 2)
+                    e.t1 = static_cast<int32_t>(t);
+                else
+                    e.t1 = -1; // non-manifold: no contribution
             }
         }
     for (size_t e = 0; e < m_edges.size(); ++e)
@@ -143,7 +143,8 @@ SurfaceCurvature::SurfaceCurvature(size_t vertexCount, const std::vector<Tri>& t
         ++m_vEdgeStart[e.v1 + 1];
     }
     for (const Tri& t : triangles)
-        for (int32_t v : t) ++m_vTriStart[v + 1];
+        for (int32_t v : t)
+            ++m_vTriStart[v + 1];
     for (size_t v = 0; v < vertexCount; ++v) {
         m_vEdgeStart[v + 1] += m_vEdgeStart[v];
         m_vTriStart[v + 1] += m_vTriStart[v];
@@ -157,7 +158,8 @@ SurfaceCurvature::SurfaceCurvature(size_t vertexCount, const std::vector<Tri>& t
         m_vEdges[fe[m_edges[e].v1]++] = static_cast<int32_t>(e);
     }
     for (size_t t = 0; t < triangles.size(); ++t)
-        for (int32_t v : triangles[t]) m_vTris[ft[v]++] = static_cast<int32_t>(t);
+        for (int32_t v : triangles[t])
+            m_vTris[ft[v]++] = static_cast<int32_t>(t);
 }
 
 double SurfaceCurvature::vertexCurvature(int32_t v, const std::vector<Vec3>& x) const {

@@ -48,11 +48,11 @@ struct CircumsphereParams {
 std::string validate(const CircumsphereParams& p);
 
 struct Circumcircle {
-    Vec3 centre = Vec3::Zero();      ///< x_c, m
-    Vec3 normal = Vec3::UnitZ();     ///< N_c, unit, the triangle's (counter-clockwise) normal
-    double radius = 0;               ///< R_b, m
-    double area = 0;                 ///< m²
-    bool valid = false;              ///< false for a degenerate (zero-area) triangle
+    Vec3 centre = Vec3::Zero();  ///< x_c, m
+    Vec3 normal = Vec3::UnitZ(); ///< N_c, unit, the triangle's (counter-clockwise) normal
+    double radius = 0;           ///< R_b, m
+    double area = 0;             ///< m²
+    bool valid = false;          ///< false for a degenerate (zero-area) triangle
 };
 /// Circumcircle of triangle (a, b, c). Degenerate or needle-like triangles (circumradius above
 /// 4 × the longest edge): the centroid and the largest vertex distance stand in, valid = false.
@@ -72,13 +72,11 @@ struct Sphere {
 };
 
 /// Inward offset s of [A eq. 5.7] for the given curvature factor H3(K) and energy factor ε.
-double circumsphereOffset(double circumradius, double h3, double energy,
-                          const CircumsphereParams& p);
+double circumsphereOffset(double circumradius, double h3, double energy, const CircumsphereParams& p);
 /// φ cot θ of [A eq. 5.5]: the inward offset per metre of circumradius where H3 = 1.
 double offsetPerRadius(const CircumsphereParams& p);
 /// The same offset with φ cot θ already evaluated (offsetPerRadius), for the per-sweep loops.
-inline double circumsphereOffset(double circumradius, double h3, double energy, double perRadius,
-                                 double energyScale) {
+inline double circumsphereOffset(double circumradius, double h3, double energy, double perRadius, double energyScale) {
     return perRadius * circumradius * h3 + energyScale * energy;
 }
 /// The circumsphere: centre x_c − N_c s, radius √(R_b² + s²).

@@ -11,17 +11,21 @@ namespace viscera::sim {
 
 const char* toString(CollisionMethod m) {
     switch (m) {
-    case CollisionMethod::Circumsphere: return "circumsphere";
-    case CollisionMethod::BoundingSphere: return "bounding_sphere";
-    case CollisionMethod::Polygon: return "polygon";
-    case CollisionMethod::PolygonFeatures: return "polygon_features";
+    case CollisionMethod::Circumsphere:
+        return "circumsphere";
+    case CollisionMethod::BoundingSphere:
+        return "bounding_sphere";
+    case CollisionMethod::Polygon:
+        return "polygon";
+    case CollisionMethod::PolygonFeatures:
+        return "polygon_features";
     }
     return "unknown";
 }
 
 bool parseCollisionMethod(const std::string& name, CollisionMethod& out) {
-    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
-                              CollisionMethod::Polygon, CollisionMethod::PolygonFeatures})
+    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere, CollisionMethod::Polygon,
+                              CollisionMethod::PolygonFeatures})
         if (name == toString(m)) {
             out = m;
             return true;
@@ -31,66 +35,62 @@ bool parseCollisionMethod(const std::string& name, CollisionMethod& out) {
 
 std::string validate(const CollisionSettings& s) {
     if (std::string e = validate(s.circumsphere); !e.empty()) return e;
-    if (!(s.polygonMargin >= 0) || !std::isfinite(s.polygonMargin))
-        return "polygon margin must be finite and >= 0";
-    if (!(s.compliance >= 0) || !std::isfinite(s.compliance))
-        return "compliance must be finite and >= 0";
+    if (!(s.polygonMargin >= 0) || !std::isfinite(s.polygonMargin)) return "polygon margin must be finite and >= 0";
+    if (!(s.compliance >= 0) || !std::isfinite(s.compliance)) return "compliance must be finite and >= 0";
     if (!(s.cellSize >= 0) || !std::isfinite(s.cellSize)) return "cell size must be finite and >= 0";
     if (!(s.maxCorrectionPerStep > 0)) return "max correction per step must be > 0";
     return {};
 }
 
-CollisionSurfaceDesc CollisionSurfaceDesc::fromTetMesh(const TetMesh& mesh,
-                                                       std::vector<double> inverseMass) {
+CollisionSurfaceDesc CollisionSurfaceDesc::fromTetMesh(const TetMesh& mesh, std::vector<double> inverseMass) {
     CollisionSurfaceDesc d;
     const TriMesh& b = mesh.boundary();
     const std::vector<int32_t>& map = mesh.boundaryVertexMap();
     d.triangles.reserve(b.triangleCount());
-    for (const Tri& t : b.triangles()) d.triangles.push_back({map[t[0]], map[t[1]], map[t[2]]});
+    for (const Tri& t : b.triangles())
+        d.triangles.push_back({map[t[0]], map[t[1]], map[t[2]]});
     d.restPositions = mesh.positions();
     d.inverseMass = std::move(inverseMass);
     return d;
 }
 
-double unifiedTriangleConstraint(const std::array<Vec3, 3>& x, const std::array<Vec3, 3>& target,
-                                 bool squared, std::array<Vec3, 3>* grad) {
+double unifiedTriangleConstraint(const std::array<Vec3, 3>& x, const std::array<Vec3, 3>& target, bool squared,
+                                 std::array<Vec3, 3>* grad) {
     double sum = 0;
-    for (int k = 0; k < 3; ++k) sum += (x[k] - target[k]).squaredNorm();
+    for (int k = 0; k < 3; ++k)
+        sum += (x[k] - target[k]).squaredNorm();
     const double C = squared ? sum : std::sqrt(sum);
     if (grad)
         for (int k = 0; k < 3; ++k)
-            (*grad)[k] = squared ? Vec3(2 * (x[k] - target[k]))
-                                 : (C > 0 ? Vec3((x[k] - target[k]) / C) : Vec3::Zero());
+            (*grad)[k] = squared ? Vec3(2 * (x[k] - target[k])) : (C > 0 ? Vec3((x[k] - target[k]) / C) : Vec3::Zero());
     return C;
 }
 
-double pointTriangleConstraint(const std::array<Vec3, 3>& x, const Vec3& bary, const Vec3& q,
-                               double reach, std::array<Vec3, 3>* grad) {
+double pointTriangleConstraint(const std::array<Vec3, 3>& x, const Vec3& bary, const Vec3& q, double reach,
+                               std::array<Vec3, 3>* grad) {
     const Vec3 d = bary[0] * x[0] + bary[1] * x[1] + bary[2] * x[2] - q;
     const double dist = d.norm();
     if (grad) {
         const Vec3 n = dist > 0 ? Vec3(d / dist) : Vec3::Zero();
-        for (int k = 0; k < 3; ++k) (*grad)[k] = bary[k] * n;
+        for (int k = 0; k < 3; ++k)
+            (*grad)[k] = bary[k] * n;
     }
     return dist - reach;
 }
 
 CollisionSolver::~CollisionSolver() = default;
 
-std::unique_ptr<CollisionSolver> CollisionSolver::create(CollisionSurfaceDesc desc,
-                                                         const CollisionSettings& settings) {
+std::unique_ptr<CollisionSolver> CollisionSolver::create(CollisionSurfaceDesc desc, const CollisionSettings& settings) {
     const std::string where = "sim::CollisionSolver::create(): ";
     if (std::string e = validate(settings); !e.empty()) throw std::invalid_argument(where + e);
     const size_t nv = desc.restPositions.size();
     if (desc.triangles.empty()) throw std::invalid_argument(where + "the surface has no triangles");
     if (desc.inverseMass.size() != nv)
-        throw std::invalid_argument(where + "inverse masses: " +
-                                    std::to_string(desc.inverseMass.size()) + " values for " +
-                                    std::to_string(nv) + " vertices");
+        throw std::invalid_argument(where + "inverse masses: " + std::to_string(desc.inverseMass.size()) +
+                                    " values for " + std::to_string(nv) + " vertices");
     for (size_t v = 0; v < nv; ++v) {
         if (!desc.restPositions[v].allFinite())
-            throw std::invalid_argument(where + "vertex " + std::to_string(v) +
-                                        " has a non-finite rest position");
+            throw std::invalid_argument(where + "vertex " + std::to_string(v) + " has a non-finite rest position");
         if (!(desc.inverseMass[v] >= 0) || !std::isfinite(desc.inverseMass[v]))
             throw std::invalid_argument(where + "vertex " + std::to_string(v) +
                                         " has an inverse mass that is negative or not finite");
@@ -98,9 +98,8 @@ std::unique_ptr<CollisionSolver> CollisionSolver::create(CollisionSurfaceDesc de
     for (size_t t = 0; t < desc.triangles.size(); ++t)
         for (int32_t v : desc.triangles[t])
             if (v < 0 || static_cast<size_t>(v) >= nv)
-                throw std::invalid_argument(where + "triangle " + std::to_string(t) +
-                                            " references vertex " + std::to_string(v) +
-                                            " (surface has " + std::to_string(nv) + " vertices)");
+                throw std::invalid_argument(where + "triangle " + std::to_string(t) + " references vertex " +
+                                            std::to_string(v) + " (surface has " + std::to_string(nv) + " vertices)");
     std::unique_ptr<CollisionSolver> s(new CollisionSolver());
     s->m_settings = settings;
     s->m_tris = std::move(desc.triangles);
@@ -113,7 +112,8 @@ std::unique_ptr<CollisionSolver> CollisionSolver::create(CollisionSurfaceDesc de
     if (cell <= 0) {
         double sum = 0;
         for (const Tri& t : s->m_tris)
-            for (int k = 0; k < 3; ++k) sum += (s->m_rest[t[k]] - s->m_rest[t[(k + 1) % 3]]).norm();
+            for (int k = 0; k < 3; ++k)
+                sum += (s->m_rest[t[k]] - s->m_rest[t[(k + 1) % 3]]).norm();
         cell = 2 * sum / (3.0 * s->m_tris.size());
         if (!(cell > 0)) cell = 1e-3;
     }
@@ -131,8 +131,7 @@ std::unique_ptr<CollisionSolver> CollisionSolver::create(CollisionSurfaceDesc de
 void CollisionSolver::refreshFactors(int32_t t, const std::vector<Vec3>& x, double area) {
     const Tri& f = m_tris[t];
     m_h3[t] = m_h3Spline.value(m_curv.triangleCurvature(t, x));
-    m_energy[t] = triangleEnergyFactor({m_rest[f[0]], m_rest[f[1]], m_rest[f[2]]},
-                                       {x[f[0]], x[f[1]], x[f[2]]});
+    m_energy[t] = triangleEnergyFactor({m_rest[f[0]], m_rest[f[1]], m_rest[f[2]]}, {x[f[0]], x[f[1]], x[f[2]]});
     m_refArea[t] = area;
 }
 
@@ -147,8 +146,7 @@ void CollisionSolver::refreshAllFactors(const std::vector<Vec3>& x) {
 
 Sphere CollisionSolver::triangleSphere(int32_t t, const std::vector<Vec3>& x) const {
     const Tri& f = m_tris[t];
-    if (m_settings.method != CollisionMethod::Circumsphere)
-        return boundingSphere(x[f[0]], x[f[1]], x[f[2]]);
+    if (m_settings.method != CollisionMethod::Circumsphere) return boundingSphere(x[f[0]], x[f[1]], x[f[2]]);
     const Circumcircle cc = circumcircle(x[f[0]], x[f[1]], x[f[2]]);
     return circumsphere(cc, circumsphereOffset(cc.radius, m_h3[t], m_energy[t], m_offsetPerRadius,
                                                m_settings.circumsphere.energyScale));
@@ -163,8 +161,8 @@ void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& too
     if (x.size() != m_rest.size() || !(h > 0)) return;
     m_alphaTilde = m_settings.compliance / (h * h);
     m_start = x;
-    const bool polygon = m_settings.method == CollisionMethod::Polygon ||
-                         m_settings.method == CollisionMethod::PolygonFeatures;
+    const bool polygon =
+        m_settings.method == CollisionMethod::Polygon || m_settings.method == CollisionMethod::PolygonFeatures;
     for (size_t t = 0; t < m_tris.size(); ++t) {
         const Tri& f = m_tris[t];
         Aabb& b = m_boxes[t];
@@ -234,22 +232,24 @@ size_t CollisionSolver::constraintsPerPart() const {
     return n;
 }
 
-bool CollisionSolver::projectDistance(const int32_t* v, const double* b, int n, const Vec3& q,
-                                      double reach, const Vec3& fallback, double& lambda,
-                                      std::vector<Vec3>& x) {
+bool CollisionSolver::projectDistance(const int32_t* v, const double* b, int n, const Vec3& q, double reach,
+                                      const Vec3& fallback, double& lambda, std::vector<Vec3>& x) {
     Vec3 p = Vec3::Zero();
-    for (int k = 0; k < n; ++k) p += b[k] * x[v[k]];
+    for (int k = 0; k < n; ++k)
+        p += b[k] * x[v[k]];
     const Vec3 d = p - q;
     const double dist = d.norm();
     if (!(dist < reach)) return false;
     const Vec3 dir = dist > 1e-12 * std::max(1.0, reach) ? Vec3(d / dist) : fallback;
     if (!(dir.squaredNorm() > 0)) return false;
     double denom = m_alphaTilde;
-    for (int k = 0; k < n; ++k) denom += m_w[v[k]] * b[k] * b[k];
+    for (int k = 0; k < n; ++k)
+        denom += m_w[v[k]] * b[k] * b[k];
     if (!(denom > 0)) return true;
     const double dl = (-(dist - reach) - m_alphaTilde * lambda) / denom;
     lambda += dl;
-    for (int k = 0; k < n; ++k) applyCorrection(v[k], m_w[v[k]] * b[k] * dl * dir, x);
+    for (int k = 0; k < n; ++k)
+        applyCorrection(v[k], m_w[v[k]] * b[k] * dl * dir, x);
     return true;
 }
 
@@ -289,8 +289,8 @@ int CollisionSolver::iterateFeatures(std::vector<Vec3>& x, const std::vector<Cap
             const Capsule& c = parts[p];
             const Vec3 q = c.a + closestParameterOnSegment(x[v], c.a, c.b) * (c.b - c.a);
             const double b[1] = {1.0};
-            contacts += projectDistance(&v, b, 1, q, c.radius + reachExtra, Vec3::Zero(),
-                                        m_lambda[(nf + ne + k) * np + p], x);
+            contacts +=
+                projectDistance(&v, b, 1, q, c.radius + reachExtra, Vec3::Zero(), m_lambda[(nf + ne + k) * np + p], x);
         }
     }
     return contacts;
@@ -319,16 +319,17 @@ bool CollisionSolver::projectSphere(int32_t t, const Sphere& s, const Capsule& c
     std::array<Vec3, 3> grad;
     const double C = unifiedTriangleConstraint(xs, target, m_settings.squaredForm, &grad);
     double denom = m_alphaTilde;
-    for (int k = 0; k < 3; ++k) denom += m_w[f[k]] * grad[k].squaredNorm();
+    for (int k = 0; k < 3; ++k)
+        denom += m_w[f[k]] * grad[k].squaredNorm();
     if (!(denom > 0) || !(C > 0)) return true;
     const double dl = (-C - m_alphaTilde * lambda) / denom;
     lambda += dl;
-    for (int k = 0; k < 3; ++k) applyCorrection(f[k], m_w[f[k]] * dl * grad[k], x);
+    for (int k = 0; k < 3; ++k)
+        applyCorrection(f[k], m_w[f[k]] * dl * grad[k], x);
     return true;
 }
 
-bool CollisionSolver::projectPolygon(int32_t t, const Capsule& c, double& lambda,
-                                     std::vector<Vec3>& x) {
+bool CollisionSolver::projectPolygon(int32_t t, const Capsule& c, double& lambda, std::vector<Vec3>& x) {
     const Tri& f = m_tris[t];
     const SegmentTrianglePair st = closestPointsSegmentTriangle(c.a, c.b, x[f[0]], x[f[1]], x[f[2]]);
     const double reach = c.radius + m_settings.polygonMargin;
@@ -388,8 +389,7 @@ int CollisionSolver::iterate(std::vector<Vec3>& x, const ToolShape& tool) {
     return contacts;
 }
 
-void CollisionSolver::beginStep(const XpbdParticles& particles, size_t offset,
-                                const ToolShape& tool, double h) {
+void CollisionSolver::beginStep(const XpbdParticles& particles, size_t offset, const ToolShape& tool, double h) {
     const size_t nv = m_rest.size();
     m_viewValid = offset <= particles.size() && nv <= particles.size() - offset;
     m_candVerts.clear();
@@ -398,7 +398,8 @@ void CollisionSolver::beginStep(const XpbdParticles& particles, size_t offset,
         return;
     }
     m_x.resize(nv);
-    for (size_t v = 0; v < nv; ++v) m_x[v] = particles.position(offset + v);
+    for (size_t v = 0; v < nv; ++v)
+        m_x[v] = particles.position(offset + v);
     beginStep(m_x, tool, h);
     m_mark.assign(nv, 0);
     for (int32_t t : m_candidates)
@@ -411,10 +412,10 @@ void CollisionSolver::beginStep(const XpbdParticles& particles, size_t offset,
 }
 
 int CollisionSolver::iterate(XpbdParticles& particles, size_t offset, const ToolShape& tool) {
-    if (!m_viewValid || m_candidates.empty() || offset > particles.size() ||
-        m_rest.size() > particles.size() - offset)
+    if (!m_viewValid || m_candidates.empty() || offset > particles.size() || m_rest.size() > particles.size() - offset)
         return 0;
-    for (int32_t v : m_candVerts) m_x[v] = particles.position(offset + v);
+    for (int32_t v : m_candVerts)
+        m_x[v] = particles.position(offset + v);
     const int contacts = iterate(m_x, tool);
     if (contacts)
         for (int32_t v : m_candVerts)
@@ -443,8 +444,7 @@ int CollisionSolver::endStep(XpbdParticles& particles, size_t offset) {
     return changed;
 }
 
-XpbdIterationHook makeCollisionHook(CollisionSolver& collision, const ToolShape& tool,
-                                    size_t particleOffset) {
+XpbdIterationHook makeCollisionHook(CollisionSolver& collision, const ToolShape& tool, size_t particleOffset) {
     return [&collision, &tool, particleOffset](XpbdParticles& p, const XpbdIterationInfo& info) {
         if (info.velocityPass) {
             collision.endStep(p, particleOffset);
@@ -465,8 +465,7 @@ const std::vector<int32_t>& CollisionSolver::contactVertices() const {
     return m_contactVerts;
 }
 
-bool collisionVelocityUpdate(const std::vector<Vec3>& before, const std::vector<Vec3>& after,
-                             std::vector<Vec3>& v) {
+bool collisionVelocityUpdate(const std::vector<Vec3>& before, const std::vector<Vec3>& after, std::vector<Vec3>& v) {
     bool finite = true;
     for (size_t i = 0; i < after.size() && i < before.size() && i < v.size(); ++i) {
         const Vec3 d = after[i] - before[i];
@@ -481,9 +480,9 @@ bool collisionVelocityUpdate(const std::vector<Vec3>& before, const std::vector<
     return finite;
 }
 
-CollisionFrameResult stepWithCollision(XpbdSolver& solver, CollisionSolver& collision,
-                                       ToolShape& tool, const ToolShape::Pose& from,
-                                       const ToolShape::Pose& to, int substeps, int iterations) {
+CollisionFrameResult stepWithCollision(XpbdSolver& solver, CollisionSolver& collision, ToolShape& tool,
+                                       const ToolShape::Pose& from, const ToolShape::Pose& to, int substeps,
+                                       int iterations) {
     CollisionFrameResult r;
     const double h = solver.settings().dt;
     const std::vector<Vec3> start = solver.positions();
@@ -495,7 +494,8 @@ CollisionFrameResult stepWithCollision(XpbdSolver& solver, CollisionSolver& coll
         if (!st.finite) r.finite = false;
         x = solver.positions();
         collision.beginStep(x, tool, h);
-        for (int k = 0; k < iterations; ++k) collision.iterate(x, tool);
+        for (int k = 0; k < iterations; ++k)
+            collision.iterate(x, tool);
         r.last = collision.stats();
         if (collision.stats().candidates == 0) continue;
         v = solver.velocities();

@@ -94,30 +94,29 @@ struct CollisionSurfaceDesc {
 };
 
 struct CollisionStats {
-    int candidates = 0;    ///< broad-phase candidate triangles of the step
-    int contacts = 0;      ///< constraint projections in the last sweep
-    int factorUpdates = 0; ///< triangles whose curvature/energy factors were refreshed (δ test)
+    int candidates = 0;       ///< broad-phase candidate triangles of the step
+    int contacts = 0;         ///< constraint projections in the last sweep
+    int factorUpdates = 0;    ///< triangles whose curvature/energy factors were refreshed (δ test)
     double maxCorrection = 0; ///< m, largest vertex move of the last sweep
 };
 
 /// The unified triangle constraint of [A eq. 5.8] for vertices x and targets x' (fixed):
 /// squared: C = Σ |x_i − x'_i|², ∇_i C = 2 (x_i − x'_i); otherwise its root
 /// C = √(Σ |x_i − x'_i|²), ∇_i C = (x_i − x'_i) / C (zero gradient at C = 0). grad may be null.
-double unifiedTriangleConstraint(const std::array<Vec3, 3>& x, const std::array<Vec3, 3>& target,
-                                 bool squared, std::array<Vec3, 3>* grad);
+double unifiedTriangleConstraint(const std::array<Vec3, 3>& x, const std::array<Vec3, 3>& target, bool squared,
+                                 std::array<Vec3, 3>* grad);
 /// The polygon method's point–triangle constraint for fixed barycentric weights b and axis point
 /// q: C = |Σ b_i x_i − q| − reach, ∇_i C = b_i n with n the unit direction from q (zero gradient
 /// when the point is on q). grad may be null.
-double pointTriangleConstraint(const std::array<Vec3, 3>& x, const Vec3& bary, const Vec3& q,
-                               double reach, std::array<Vec3, 3>* grad);
+double pointTriangleConstraint(const std::array<Vec3, 3>& x, const Vec3& bary, const Vec3& q, double reach,
+                               std::array<Vec3, 3>* grad);
 
 class CollisionSolver {
 public:
     /// Throws std::invalid_argument ("sim::CollisionSolver::create(): triangle 4 references
     /// vertex 99 (surface has 50 vertices)") on invalid settings, sizes, indices, non-finite or
     /// negative inverse masses.
-    static std::unique_ptr<CollisionSolver> create(CollisionSurfaceDesc desc,
-                                                   const CollisionSettings& settings);
+    static std::unique_ptr<CollisionSolver> create(CollisionSurfaceDesc desc, const CollisionSettings& settings);
     CollisionSolver(const CollisionSolver&) = delete;
     CollisionSolver& operator=(const CollisionSolver&) = delete;
     ~CollisionSolver();
@@ -162,13 +161,12 @@ public:
 private:
     CollisionSolver() = default;
     void refreshFactors(int32_t t, const std::vector<Vec3>& x, double area);
-    bool projectSphere(int32_t t, const Sphere& s, const Capsule& c, double& lambda,
-                       std::vector<Vec3>& x);
+    bool projectSphere(int32_t t, const Sphere& s, const Capsule& c, double& lambda, std::vector<Vec3>& x);
     bool projectPolygon(int32_t t, const Capsule& c, double& lambda, std::vector<Vec3>& x);
     /// Distance constraint C = |Σ b_k x_{v_k} − q| − reach on n (1–3) vertices; false when not
     /// violated. `fallback` is the push direction when the point lies on the axis.
-    bool projectDistance(const int32_t* v, const double* b, int n, const Vec3& q, double reach,
-                         const Vec3& fallback, double& lambda, std::vector<Vec3>& x);
+    bool projectDistance(const int32_t* v, const double* b, int n, const Vec3& q, double reach, const Vec3& fallback,
+                         double& lambda, std::vector<Vec3>& x);
     int iterateFeatures(std::vector<Vec3>& x, const std::vector<Capsule>& parts);
     /// Contact constraints of the step per tool part: the candidate triangles (PolygonFeatures:
     /// and their unique edges and vertices). Sizes the multipliers.
@@ -190,14 +188,14 @@ private:
     std::vector<int32_t> m_candidates;
     std::vector<double> m_lambda; ///< #candidates × #parts (PolygonFeatures: faces, edges, vertices)
     std::vector<std::array<int32_t, 2>> m_candEdges; ///< PolygonFeatures: edges of the candidates
-    std::vector<int32_t> m_featVerts;                 ///< PolygonFeatures: vertices of the candidates
-    std::vector<char> m_touched;  ///< per vertex, this step
-    std::vector<Vec3> m_start;    ///< positions at beginStep
-    std::vector<Vec3> m_push;     ///< per vertex, sum of the contact moves of this step
-    std::vector<Vec3> m_x;        ///< particle-view steps: the surface's positions
-    std::vector<int32_t> m_candVerts; ///< particle-view steps: vertices of the candidates
-    std::vector<char> m_mark;         ///< per vertex, scratch
-    bool m_viewValid = false;         ///< particle-view step begun with a large enough view
+    std::vector<int32_t> m_featVerts;                ///< PolygonFeatures: vertices of the candidates
+    std::vector<char> m_touched;                     ///< per vertex, this step
+    std::vector<Vec3> m_start;                       ///< positions at beginStep
+    std::vector<Vec3> m_push;                        ///< per vertex, sum of the contact moves of this step
+    std::vector<Vec3> m_x;                           ///< particle-view steps: the surface's positions
+    std::vector<int32_t> m_candVerts;                ///< particle-view steps: vertices of the candidates
+    std::vector<char> m_mark;                        ///< per vertex, scratch
+    bool m_viewValid = false;                        ///< particle-view step begun with a large enough view
     mutable std::vector<int32_t> m_contactVerts;
     mutable bool m_contactDirty = false;
     double m_alphaTilde = 0;
@@ -213,8 +211,7 @@ private:
 /// `particleOffset + v` (0 for an XpbdSolver; XpbdSystem::tetParticleOffset(b) for tet body b).
 /// collision and tool are held by reference and must outlive the hook; set the tool's pose
 /// between frames (device rate: the pose then holds for all substeps of the frame).
-XpbdIterationHook makeCollisionHook(CollisionSolver& collision, const ToolShape& tool,
-                                    size_t particleOffset = 0);
+XpbdIterationHook makeCollisionHook(CollisionSolver& collision, const ToolShape& tool, size_t particleOffset = 0);
 
 /// One frame of an XpbdSolver body with tool collision coupled per substep: the solver must run
 /// one substep per step() (settings().substeps == 1, settings().dt == frame dt / substeps). For
@@ -229,8 +226,7 @@ XpbdIterationHook makeCollisionHook(CollisionSolver& collision, const ToolShape&
 /// (#V each): the velocity component against each vertex's correction is removed (an inelastic
 /// contact; a separating push adds no velocity, so a tool that starts inside the tissue or a
 /// deep overlap cannot inject kinetic energy). Returns false when a value is not finite.
-bool collisionVelocityUpdate(const std::vector<Vec3>& before, const std::vector<Vec3>& after,
-                             std::vector<Vec3>& v);
+bool collisionVelocityUpdate(const std::vector<Vec3>& before, const std::vector<Vec3>& after, std::vector<Vec3>& v);
 
 struct CollisionFrameResult {
     bool finite = true;
@@ -238,8 +234,8 @@ struct CollisionFrameResult {
     CollisionStats last;        ///< stats of the last substep
 };
 class XpbdSolver;
-CollisionFrameResult stepWithCollision(XpbdSolver& solver, CollisionSolver& collision,
-                                       ToolShape& tool, const ToolShape::Pose& from,
-                                       const ToolShape::Pose& to, int substeps, int iterations);
+CollisionFrameResult stepWithCollision(XpbdSolver& solver, CollisionSolver& collision, ToolShape& tool,
+                                       const ToolShape::Pose& from, const ToolShape::Pose& to, int substeps,
+                                       int iterations);
 
 } // namespace viscera::sim

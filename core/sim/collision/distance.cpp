@@ -92,8 +92,8 @@ SegmentPair closestPointsSegments(const Vec3& p0, const Vec3& p1, const Vec3& q0
     return {s, t, p0 + s * d1, q0 + t * d2};
 }
 
-SegmentTrianglePair closestPointsSegmentTriangle(const Vec3& s0, const Vec3& s1, const Vec3& a,
-                                                 const Vec3& b, const Vec3& c) {
+SegmentTrianglePair closestPointsSegmentTriangle(const Vec3& s0, const Vec3& s1, const Vec3& a, const Vec3& b,
+                                                 const Vec3& c) {
     SegmentTrianglePair best;
     best.distance = 1e300;
     auto consider = [&](const Vec3& onSeg, const TrianglePoint& onTri) {

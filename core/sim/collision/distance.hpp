@@ -30,7 +30,7 @@ struct SegmentTrianglePair {
     TrianglePoint onTriangle;
     double distance = 0;
 };
-SegmentTrianglePair closestPointsSegmentTriangle(const Vec3& s0, const Vec3& s1, const Vec3& a,
-                                                 const Vec3& b, const Vec3& c);
+SegmentTrianglePair closestPointsSegmentTriangle(const Vec3& s0, const Vec3& s1, const Vec3& a, const Vec3& b,
+                                                 const Vec3& c);
 
 } // namespace viscera::sim

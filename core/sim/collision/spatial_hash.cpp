@@ -13,7 +13,8 @@ constexpr double kMaxCellsPerBox = 512;
 
 bool isLarge(const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) {
     double cells = 1;
-    for (int a = 0; a < 3; ++a) cells *= static_cast<double>(hi[a] - lo[a] + 1);
+    for (int a = 0; a < 3; ++a)
+        cells *= static_cast<double>(hi[a] - lo[a] + 1);
     return cells > kMaxCellsPerBox;
 }
 
@@ -31,25 +32,20 @@ size_t nextPrime(size_t n) {
 }
 } // namespace
 
-SpatialHash::SpatialHash(double cellSize, size_t tableSize)
-    : m_cell(cellSize), m_requestedTable(tableSize) {
+SpatialHash::SpatialHash(double cellSize, size_t tableSize) : m_cell(cellSize), m_requestedTable(tableSize) {
     if (!(cellSize > 0) || !std::isfinite(cellSize))
-        throw std::invalid_argument("sim::SpatialHash: cell size must be > 0, got " +
-                                    std::to_string(cellSize));
+        throw std::invalid_argument("sim::SpatialHash: cell size must be > 0, got " + std::to_string(cellSize));
 }
 
 std::array<int64_t, 3> SpatialHash::cellOf(const Vec3& p) const {
     // Clamped far beyond any scene so that the integer conversion stays defined.
-    auto c = [&](double v) {
-        return static_cast<int64_t>(std::clamp(std::floor(v / m_cell), -1e12, 1e12));
-    };
+    auto c = [&](double v) { return static_cast<int64_t>(std::clamp(std::floor(v / m_cell), -1e12, 1e12)); };
     return {c(p.x()), c(p.y()), c(p.z())};
 }
 
 size_t SpatialHash::bucketOf(int64_t i, int64_t j, int64_t k) const {
     // The primes of Teschner et al.; unsigned arithmetic wraps deterministically.
-    const uint64_t h = (static_cast<uint64_t>(i) * 73856093ull) ^
-                       (static_cast<uint64_t>(j) * 19349663ull) ^
+    const uint64_t h = (static_cast<uint64_t>(i) * 73856093ull) ^ (static_cast<uint64_t>(j) * 19349663ull) ^
                        (static_cast<uint64_t>(k) * 83492791ull);
     return static_cast<size_t>(h % (m_buckets.size() - 1));
 }
@@ -67,15 +63,17 @@ void SpatialHash::build(const std::vector<Aabb>& boxes) {
         if (isLarge(lo, hi)) return;
         for (int64_t i = lo[0]; i <= hi[0]; ++i)
             for (int64_t j = lo[1]; j <= hi[1]; ++j)
-                for (int64_t k = lo[2]; k <= hi[2]; ++k) f(bucketOf(i, j, k));
+                for (int64_t k = lo[2]; k <= hi[2]; ++k)
+                    f(bucketOf(i, j, k));
     };
     // Counting sort: sizes, prefix sums, fill.
-    for (const Aabb& b : boxes) forCells(b, [&](size_t h) { ++m_buckets[h + 1]; });
-    for (size_t h = 1; h < m_buckets.size(); ++h) m_buckets[h] += m_buckets[h - 1];
+    for (const Aabb& b : boxes)
+        forCells(b, [&](size_t h) { ++m_buckets[h + 1]; });
+    for (size_t h = 1; h < m_buckets.size(); ++h)
+        m_buckets[h] += m_buckets[h - 1];
     m_large.clear();
     for (size_t p = 0; p < boxes.size(); ++p)
-        if (boxes[p].lo.allFinite() && boxes[p].hi.allFinite() &&
-            isLarge(cellOf(boxes[p].lo), cellOf(boxes[p].hi)))
+        if (boxes[p].lo.allFinite() && boxes[p].hi.allFinite() && isLarge(cellOf(boxes[p].lo), cellOf(boxes[p].hi)))
             m_large.push_back(static_cast<int32_t>(p));
     m_entries.assign(m_buckets.back(), -1);
     std::vector<uint32_t> fill(m_buckets.begin(), m_buckets.end() - 1);
@@ -93,7 +91,8 @@ void SpatialHash::queryInto(const Aabb& q, std::vector<int32_t>& out) const {
     const auto lo = cellOf(q.lo);
     const auto hi = cellOf(q.hi);
     double cells = 1;
-    for (int a = 0; a < 3; ++a) cells *= static_cast<double>(hi[a] - lo[a] + 1);
+    for (int a = 0; a < 3; ++a)
+        cells *= static_cast<double>(hi[a] - lo[a] + 1);
     if (cells > static_cast<double>(m_boxes.size())) {
         // A query box larger than the whole set: a linear scan is cheaper and exact.
         for (size_t p = 0; p < m_boxes.size(); ++p)

@@ -45,9 +45,9 @@ private:
     double m_cell;
     size_t m_requestedTable;
     std::vector<Aabb> m_boxes;
-    std::vector<uint32_t> m_buckets;    ///< bucket b holds m_entries[m_buckets[b], m_buckets[b+1])
-    std::vector<int32_t> m_entries;     ///< primitive ids
-    std::vector<int32_t> m_large;       ///< primitives too large for the grid
+    std::vector<uint32_t> m_buckets;       ///< bucket b holds m_entries[m_buckets[b], m_buckets[b+1])
+    std::vector<int32_t> m_entries;        ///< primitive ids
+    std::vector<int32_t> m_large;          ///< primitives too large for the grid
     mutable std::vector<uint32_t> m_stamp; ///< per primitive: last query that reported it
     mutable uint32_t m_query = 0;
 };

@@ -40,7 +40,8 @@ void checkCapsule(const Capsule& c, size_t i, const std::string& where) {
 ToolShape ToolShape::fromCapsules(std::vector<Capsule> parts, const std::string& name) {
     const std::string where = "sim::ToolShape::fromCapsules()";
     if (parts.empty()) throw std::invalid_argument(where + ": a tool needs at least one part");
-    for (size_t i = 0; i < parts.size(); ++i) checkCapsule(parts[i], i, where);
+    for (size_t i = 0; i < parts.size(); ++i)
+        checkCapsule(parts[i], i, where);
     ToolShape t;
     t.m_name = name;
     t.m_local = std::move(parts);
@@ -50,16 +51,14 @@ ToolShape ToolShape::fromCapsules(std::vector<Capsule> parts, const std::string&
 
 ToolShape ToolShape::sphere(double radius) {
     if (!(radius > 0) || !std::isfinite(radius))
-        throw std::invalid_argument("sim::ToolShape::sphere(): radius must be > 0, got " +
-                                    std::to_string(radius));
+        throw std::invalid_argument("sim::ToolShape::sphere(): radius must be > 0, got " + std::to_string(radius));
     return fromCapsules({Capsule{Vec3::Zero(), Vec3::Zero(), radius}}, "sphere");
 }
 
 ToolShape ToolShape::capsule(double halfLength, double radius) {
     if (!(radius > 0) || !(halfLength >= 0) || !std::isfinite(radius) || !std::isfinite(halfLength))
         throw std::invalid_argument("sim::ToolShape::capsule(): need radius > 0 and halfLength >= 0");
-    return fromCapsules({Capsule{Vec3(-halfLength, 0, 0), Vec3(halfLength, 0, 0), radius}},
-                        "capsule");
+    return fromCapsules({Capsule{Vec3(-halfLength, 0, 0), Vec3(halfLength, 0, 0), radius}}, "capsule");
 }
 
 ToolShape ToolShape::jaws(double length, double radius, double opening) {
@@ -68,9 +67,8 @@ ToolShape ToolShape::jaws(double length, double radius, double opening) {
     if (!(opening >= 0 && opening < M_PI))
         throw std::invalid_argument("sim::ToolShape::jaws(): opening must be in [0, pi) rad, got " +
                                     std::to_string(opening));
-    ToolShape t = fromCapsules({Capsule{Vec3::Zero(), Vec3(length, 0, 0), radius},
-                                Capsule{Vec3::Zero(), Vec3(length, 0, 0), radius}},
-                               "jaws");
+    ToolShape t = fromCapsules(
+        {Capsule{Vec3::Zero(), Vec3(length, 0, 0), radius}, Capsule{Vec3::Zero(), Vec3(length, 0, 0), radius}}, "jaws");
     t.m_isJaws = true;
     t.m_jawLength = length;
     t.m_jawRadius = radius;
@@ -104,7 +102,8 @@ void ToolShape::refresh() {
 
 double ToolShape::signedDistance(const Vec3& p) const {
     double d = 1e300;
-    for (const Capsule& c : m_world) d = std::min(d, sim::signedDistance(c, p));
+    for (const Capsule& c : m_world)
+        d = std::min(d, sim::signedDistance(c, p));
     return d;
 }
 

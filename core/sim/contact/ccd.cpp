@@ -63,7 +63,8 @@ int cubicRoots01(const double k[4], double out[3]) {
 }
 
 /// Coplanarity cubic of four linearly moving points: ((x1−x0) × (x2−x0)) · (x3−x0).
-void coplanarity(const std::array<Vec3, 4>& p0, const std::array<Vec3, 4>& p1, int o, int a, int b, int c, double k[4]) {
+void coplanarity(const std::array<Vec3, 4>& p0, const std::array<Vec3, 4>& p1, int o, int a, int b, int c,
+                 double k[4]) {
     const Vec3 e1 = p0[a] - p0[o], e2 = p0[b] - p0[o], e3 = p0[c] - p0[o];
     const Vec3 d1 = (p1[a] - p1[o]) - e1, d2 = (p1[b] - p1[o]) - e2, d3 = (p1[c] - p1[o]) - e3;
     const Vec3 c0 = e1.cross(e2), c1 = e1.cross(d2) + d1.cross(e2), c2 = d1.cross(d2);
@@ -154,13 +155,16 @@ ContactDetector::ContactDetector(const TetMesh& mesh, bool selfContact) : m_self
         throw std::logic_error("sim::ContactDetector(): requires adjacency level 3; call mesh.requireLevel(3) first");
     // Bodies: connected components of the tets (union–find).
     std::vector<int32_t> parent(mesh.vertexCount());
-    for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int32_t>(i);
+    for (size_t i = 0; i < parent.size(); ++i)
+        parent[i] = static_cast<int32_t>(i);
     auto root = [&](int32_t v) {
-        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        while (parent[v] != v)
+            v = parent[v] = parent[parent[v]];
         return v;
     };
     for (const Tet& t : mesh.tets())
-        for (int k = 1; k < 4; ++k) parent[root(t[k])] = root(t[0]);
+        for (int k = 1; k < 4; ++k)
+            parent[root(t[k])] = root(t[0]);
     m_body.resize(parent.size());
     std::map<int32_t, int> bodyIndex;
     for (size_t i = 0; i < parent.size(); ++i) {
@@ -190,8 +194,10 @@ ContactDetector::ContactDetector(const TetMesh& mesh, bool selfContact) : m_self
     m_triTrees.assign(bodies, {});
     m_edgeTrees.assign(bodies, {});
     std::vector<std::vector<int>> triIds(bodies), edgeIds(bodies);
-    for (size_t i = 0; i < m_tris.size(); ++i) triIds[m_selfContact ? 0 : m_body[m_tris[i][0]]].push_back(static_cast<int>(i));
-    for (size_t i = 0; i < m_edges.size(); ++i) edgeIds[m_selfContact ? 0 : m_body[m_edges[i][0]]].push_back(static_cast<int>(i));
+    for (size_t i = 0; i < m_tris.size(); ++i)
+        triIds[m_selfContact ? 0 : m_body[m_tris[i][0]]].push_back(static_cast<int>(i));
+    for (size_t i = 0; i < m_edges.size(); ++i)
+        edgeIds[m_selfContact ? 0 : m_body[m_edges[i][0]]].push_back(static_cast<int>(i));
     for (int b = 0; b < bodies; ++b) {
         build(m_triTrees[b], tc, std::move(triIds[b]));
         build(m_edgeTrees[b], ec, std::move(edgeIds[b]));
@@ -216,13 +222,13 @@ void ContactDetector::build(Tree& tree, const std::vector<Vec3>& c, std::vector<
             continue;
         }
         Eigen::AlignedBox3d box;
-        for (int i = 0; i < j.count; ++i) box.extend(c[tree.order[j.first + i]]);
+        for (int i = 0; i < j.count; ++i)
+            box.extend(c[tree.order[j.first + i]]);
         int axis;
         box.sizes().maxCoeff(&axis);
         const int half = j.count / 2;
         std::nth_element(tree.order.begin() + j.first, tree.order.begin() + j.first + half,
-                         tree.order.begin() + j.first + j.count,
-                         [&](int a, int b) { return c[a][axis] < c[b][axis]; });
+                         tree.order.begin() + j.first + j.count, [&](int a, int b) { return c[a][axis] < c[b][axis]; });
         const int l = static_cast<int>(tree.nodes.size());
         tree.nodes.push_back({});
         tree.nodes.push_back({});
@@ -239,7 +245,8 @@ template <class BoxOf> void ContactDetector::refit(Tree& tree, BoxOf&& boxOf) {
         Node& n = tree.nodes[i];
         n.box.setEmpty();
         if (n.left < 0) {
-            for (int k = 0; k < n.count; ++k) n.box.extend(boxOf(tree.order[n.first + k]));
+            for (int k = 0; k < n.count; ++k)
+                n.box.extend(boxOf(tree.order[n.first + k]));
         } else {
             n.box.extend(tree.nodes[n.left].box);
             n.box.extend(tree.nodes[n.right].box);
@@ -262,8 +269,10 @@ void ContactDetector::detect(const std::vector<Vec3>& x0, const std::vector<Vec3
         b.max() += pad;
         return b;
     };
-    for (Tree& t : m_triTrees) refit(t, [&](int i) { return swept({m_tris[i][0], m_tris[i][1], m_tris[i][2]}); });
-    for (Tree& t : m_edgeTrees) refit(t, [&](int i) { return swept({m_edges[i][0], m_edges[i][1]}); });
+    for (Tree& t : m_triTrees)
+        refit(t, [&](int i) { return swept({m_tris[i][0], m_tris[i][1], m_tris[i][2]}); });
+    for (Tree& t : m_edgeTrees)
+        refit(t, [&](int i) { return swept({m_edges[i][0], m_edges[i][1]}); });
     const int bodies = static_cast<int>(m_triTrees.size());
     std::vector<int> stack;
     auto query = [&](const Tree& tree, const Eigen::AlignedBox3d& q, auto&& visit) {
@@ -274,7 +283,8 @@ void ContactDetector::detect(const std::vector<Vec3>& x0, const std::vector<Vec3
             stack.pop_back();
             if (!n.box.intersects(q)) continue;
             if (n.left < 0) {
-                for (int k = 0; k < n.count; ++k) visit(tree.order[n.first + k]);
+                for (int k = 0; k < n.count; ++k)
+                    visit(tree.order[n.first + k]);
             } else {
                 stack.push_back(n.left);
                 stack.push_back(n.right);
@@ -285,28 +295,29 @@ void ContactDetector::detect(const std::vector<Vec3>& x0, const std::vector<Vec3
     for (int32_t v : m_verts) {
         const Eigen::AlignedBox3d q = swept({v});
         for (int tb = 0; tb < bodies; ++tb) {
-        if (!m_selfContact && tb == m_body[v]) continue;
-        query(m_triTrees[tb], q, [&](int ti) {
-            const auto& f = m_tris[ti];
-            if (f[0] == v || f[1] == v || f[2] == v) return;
-            if (!m_selfContact && m_body[f[0]] == m_body[v]) return;
-            ++m_candidates;
-            const std::array<Vec3, 4> a = {x0[v], x0[f[0]], x0[f[1]], x0[f[2]]};
-            const std::array<Vec3, 4> b = {x1[v], x1[f[0]], x1[f[1]], x1[f[2]]};
-            Collision c;
-            if (!vertexFaceCcd(a, b, thickness, c.t, c.w)) return;
-            c.kind = CollisionKind::VertexFace;
-            c.v = {v, f[0], f[1], f[2]};
-            const auto x = lerp(a, b, c.t);
-            Vec3 n = (x[2] - x[1]).cross(x[3] - x[1]);
-            if (!(n.norm() > 0)) return;
-            n.normalize();
-            const Vec3 rel0 = a[0] - (c.w[0] * a[1] + c.w[1] * a[2] + c.w[2] * a[3]);
-            const Vec3 rel1 = b[0] - (c.w[0] * b[1] + c.w[1] * b[2] + c.w[2] * b[3]);
-            const double side = std::abs(n.dot(rel0)) > 1e-12 * (1 + rel0.norm()) ? n.dot(rel0) : -n.dot(rel1 - rel0);
-            c.normal = side >= 0 ? n : Vec3(-n);
-            out.push_back(c);
-        });
+            if (!m_selfContact && tb == m_body[v]) continue;
+            query(m_triTrees[tb], q, [&](int ti) {
+                const auto& f = m_tris[ti];
+                if (f[0] == v || f[1] == v || f[2] == v) return;
+                if (!m_selfContact && m_body[f[0]] == m_body[v]) return;
+                ++m_candidates;
+                const std::array<Vec3, 4> a = {x0[v], x0[f[0]], x0[f[1]], x0[f[2]]};
+                const std::array<Vec3, 4> b = {x1[v], x1[f[0]], x1[f[1]], x1[f[2]]};
+                Collision c;
+                if (!vertexFaceCcd(a, b, thickness, c.t, c.w)) return;
+                c.kind = CollisionKind::VertexFace;
+                c.v = {v, f[0], f[1], f[2]};
+                const auto x = lerp(a, b, c.t);
+                Vec3 n = (x[2] - x[1]).cross(x[3] - x[1]);
+                if (!(n.norm() > 0)) return;
+                n.normalize();
+                const Vec3 rel0 = a[0] - (c.w[0] * a[1] + c.w[1] * a[2] + c.w[2] * a[3]);
+                const Vec3 rel1 = b[0] - (c.w[0] * b[1] + c.w[1] * b[2] + c.w[2] * b[3]);
+                const double side =
+                    std::abs(n.dot(rel0)) > 1e-12 * (1 + rel0.norm()) ? n.dot(rel0) : -n.dot(rel1 - rel0);
+                c.normal = side >= 0 ? n : Vec3(-n);
+                out.push_back(c);
+            });
         }
     }
     // Edge–edge (each unordered pair once).
@@ -314,31 +325,32 @@ void ContactDetector::detect(const std::vector<Vec3>& x0, const std::vector<Vec3
         const auto& e = m_edges[ei];
         const Eigen::AlignedBox3d q = swept({e[0], e[1]});
         for (int tb = 0; tb < bodies; ++tb) {
-        if (!m_selfContact && tb <= m_body[e[0]]) continue; // each pair of bodies once
-        query(m_edgeTrees[tb], q, [&](int ej) {
-            if (m_selfContact && static_cast<size_t>(ej) <= ei) return;
-            const auto& g = m_edges[ej];
-            if (g[0] == e[0] || g[0] == e[1] || g[1] == e[0] || g[1] == e[1]) return;
-            if (!m_selfContact && m_body[g[0]] == m_body[e[0]]) return;
-            ++m_candidates;
-            const std::array<Vec3, 4> a = {x0[e[0]], x0[e[1]], x0[g[0]], x0[g[1]]};
-            const std::array<Vec3, 4> b = {x1[e[0]], x1[e[1]], x1[g[0]], x1[g[1]]};
-            Collision c;
-            if (!edgeEdgeCcd(a, b, thickness, c.t, c.w)) return;
-            c.kind = CollisionKind::EdgeEdge;
-            c.v = {e[0], e[1], g[0], g[1]};
-            const auto x = lerp(a, b, c.t);
-            Vec3 n = (x[1] - x[0]).cross(x[3] - x[2]);
-            if (!(n.norm() > 1e-12 * (x[1] - x[0]).norm() * (x[3] - x[2]).norm())) return; // parallel: VF handles it
-            n.normalize();
-            auto sep = [&](const std::array<Vec3, 4>& p) {
-                return (p[0] + c.w[0] * (p[1] - p[0])) - (p[2] + c.w[1] * (p[3] - p[2]));
-            };
-            const Vec3 r0 = sep(a), r1 = sep(b);
-            const double side = std::abs(n.dot(r0)) > 1e-12 * (1 + r0.norm()) ? n.dot(r0) : -n.dot(r1 - r0);
-            c.normal = side >= 0 ? n : Vec3(-n);
-            out.push_back(c);
-        });
+            if (!m_selfContact && tb <= m_body[e[0]]) continue; // each pair of bodies once
+            query(m_edgeTrees[tb], q, [&](int ej) {
+                if (m_selfContact && static_cast<size_t>(ej) <= ei) return;
+                const auto& g = m_edges[ej];
+                if (g[0] == e[0] || g[0] == e[1] || g[1] == e[0] || g[1] == e[1]) return;
+                if (!m_selfContact && m_body[g[0]] == m_body[e[0]]) return;
+                ++m_candidates;
+                const std::array<Vec3, 4> a = {x0[e[0]], x0[e[1]], x0[g[0]], x0[g[1]]};
+                const std::array<Vec3, 4> b = {x1[e[0]], x1[e[1]], x1[g[0]], x1[g[1]]};
+                Collision c;
+                if (!edgeEdgeCcd(a, b, thickness, c.t, c.w)) return;
+                c.kind = CollisionKind::EdgeEdge;
+                c.v = {e[0], e[1], g[0], g[1]};
+                const auto x = lerp(a, b, c.t);
+                Vec3 n = (x[1] - x[0]).cross(x[3] - x[2]);
+                if (!(n.norm() > 1e-12 * (x[1] - x[0]).norm() * (x[3] - x[2]).norm()))
+                    return; // parallel: VF handles it
+                n.normalize();
+                auto sep = [&](const std::array<Vec3, 4>& p) {
+                    return (p[0] + c.w[0] * (p[1] - p[0])) - (p[2] + c.w[1] * (p[3] - p[2]));
+                };
+                const Vec3 r0 = sep(a), r1 = sep(b);
+                const double side = std::abs(n.dot(r0)) > 1e-12 * (1 + r0.norm()) ? n.dot(r0) : -n.dot(r1 - r0);
+                c.normal = side >= 0 ? n : Vec3(-n);
+                out.push_back(c);
+            });
         }
     }
     std::sort(out.begin() + static_cast<long>(first), out.end(),

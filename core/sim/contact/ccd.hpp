@@ -16,7 +16,7 @@ enum class CollisionKind { VertexFace, EdgeEdge };
 
 struct Collision {
     CollisionKind kind = CollisionKind::VertexFace;
-    double t = 0;                 ///< time of contact in [0, 1] (fraction of the step)
+    double t = 0; ///< time of contact in [0, 1] (fraction of the step)
     /// VertexFace: {vertex, face0, face1, face2}; EdgeEdge: {a0, a1, b0, b1} (mesh vertex ids).
     std::array<int32_t, 4> v{};
     /// VertexFace: barycentric coordinates of the contact point on the face; EdgeEdge: (α, β, 0) with

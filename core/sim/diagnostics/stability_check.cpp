@@ -23,7 +23,8 @@ double probedStiffness(const TetConstraintModel& model) {
                 if (mode == 1) m(1, 1) = m(2, 2) = l;
                 return m;
             };
-            const double kk = (model.energyDensityGradient(F(l + d))(0, 0) - model.energyDensityGradient(F(l - d))(0, 0)) / (2 * d);
+            const double kk =
+                (model.energyDensityGradient(F(l + d))(0, 0) - model.energyDensityGradient(F(l - d))(0, 0)) / (2 * d);
             if (std::isfinite(kk)) k = std::max(k, kk);
         }
     }
@@ -43,7 +44,8 @@ StabilityFigures assessStability(const TetMesh& mesh, const TetConstraintModel& 
         double w = 1.0;
         if (!nodeWeights.empty()) {
             w = 0;
-            for (int32_t v : mesh.tets()[t]) w += nodeWeights[v] / 4.0;
+            for (int32_t v : mesh.tets()[t])
+                w += nodeWeights[v] / 4.0;
         }
         const double L = std::cbrt(6.0 * vol);
         const double s = k * w * h * h / (density * L * L);
@@ -54,9 +56,10 @@ StabilityFigures assessStability(const TetMesh& mesh, const TetConstraintModel& 
     }
     // s scales with h², so the substep count that brings it under the limit scales with sqrt(s).
     // Extra iterations per substep are not credited: the suite measured the limit at one sweep.
-    f.requiredSubsteps = f.maxStiffnessNumber > kMaxStiffnessNumber
-                             ? static_cast<int>(std::ceil(settings.substeps * std::sqrt(f.maxStiffnessNumber / kMaxStiffnessNumber)))
-                             : settings.substeps;
+    f.requiredSubsteps =
+        f.maxStiffnessNumber > kMaxStiffnessNumber
+            ? static_cast<int>(std::ceil(settings.substeps * std::sqrt(f.maxStiffnessNumber / kMaxStiffnessNumber)))
+            : settings.substeps;
     return f;
 }
 

@@ -24,7 +24,7 @@ inline constexpr double kMaxStiffnessNumber = 0.25;
 struct StabilityFigures {
     double maxStiffnessNumber = 0; ///< largest s over the tets
     int worstTet = -1;
-    int requiredSubsteps = 1;      ///< smallest substep count with s ≤ limit
+    int requiredSubsteps = 1; ///< smallest substep count with s ≤ limit
     bool ok() const { return maxStiffnessNumber <= kMaxStiffnessNumber; }
 };
 

@@ -19,8 +19,7 @@ std::string checkTissue(const TissueDissectionParams& t) {
         return "conductivity is " + formatNumber(t.conductivity) + " (must be finite and > 0)";
     for (int a = 0; a < 3; ++a)
         if (!(t.shrink[a] >= 0.01 && t.shrink[a] <= 10.0))
-            return "shrink[" + std::to_string(a) + "] is " + formatNumber(t.shrink[a]) +
-                   " (must be in [0.01, 10])";
+            return "shrink[" + std::to_string(a) + "] is " + formatNumber(t.shrink[a]) + " (must be in [0.01, 10])";
     return {};
 }
 
@@ -69,32 +68,26 @@ Vec3 anyPerpendicular(const Vec3& n) {
 std::unique_ptr<Dissection> Dissection::create(const DissectionDesc& d) {
     const std::string where = "sim::Dissection::create(): ";
     if (!d.system) throw std::invalid_argument(where + "system is null");
-    if (!d.fascia && !d.fat)
-        throw std::invalid_argument(where + "no layer (fascia and fat meshes are both null)");
-    if (auto why = validate(d.grid); !why.empty())
-        throw std::invalid_argument(where + "grid: " + why);
+    if (!d.fascia && !d.fat) throw std::invalid_argument(where + "no layer (fascia and fat meshes are both null)");
+    if (auto why = validate(d.grid); !why.empty()) throw std::invalid_argument(where + "grid: " + why);
     if (!std::isfinite(d.referenceTime) || !(d.referenceTime > 0))
-        throw std::invalid_argument(where + "referenceTime is " + formatNumber(d.referenceTime) +
-                                    " (must be > 0)");
+        throw std::invalid_argument(where + "referenceTime is " + formatNumber(d.referenceTime) + " (must be > 0)");
     std::unique_ptr<Dissection> out(new Dissection(d.grid));
     out->m_sys = d.system;
     out->m_tref = d.referenceTime;
     const XpbdSystem& sys = *d.system;
     if (d.fascia) {
         const std::string label = where + "fascia: ";
-        if (auto why = checkTissue(d.fasciaTissue); !why.empty())
-            throw std::invalid_argument(label + why);
+        if (auto why = checkTissue(d.fasciaTissue); !why.empty()) throw std::invalid_argument(label + why);
         if (d.surface >= sys.surfaceCount())
-            throw std::invalid_argument(label + "surface " + std::to_string(d.surface) +
-                                        " does not exist");
+            throw std::invalid_argument(label + "surface " + std::to_string(d.surface) + " does not exist");
         if (d.fascia->vertexCount() != sys.surfacePositions(d.surface).size() ||
             d.fascia->triangleCount() != sys.triangleCount(d.surface))
-            throw std::invalid_argument(
-                label + "mesh has " + std::to_string(d.fascia->vertexCount()) + " vertices and " +
-                std::to_string(d.fascia->triangleCount()) + " triangles, surface '" +
-                sys.surfaceName(d.surface) + "' has " +
-                std::to_string(sys.surfacePositions(d.surface).size()) + " and " +
-                std::to_string(sys.triangleCount(d.surface)));
+            throw std::invalid_argument(label + "mesh has " + std::to_string(d.fascia->vertexCount()) +
+                                        " vertices and " + std::to_string(d.fascia->triangleCount()) +
+                                        " triangles, surface '" + sys.surfaceName(d.surface) + "' has " +
+                                        std::to_string(sys.surfacePositions(d.surface).size()) + " and " +
+                                        std::to_string(sys.triangleCount(d.surface)));
         Layer L;
         L.tets = false;
         L.body = d.surface;
@@ -106,18 +99,14 @@ std::unique_ptr<Dissection> Dissection::create(const DissectionDesc& d) {
     }
     if (d.fat) {
         const std::string label = where + "fat: ";
-        if (auto why = checkTissue(d.fatTissue); !why.empty())
-            throw std::invalid_argument(label + why);
+        if (auto why = checkTissue(d.fatTissue); !why.empty()) throw std::invalid_argument(label + why);
         if (d.tetBody >= sys.tetBodyCount())
-            throw std::invalid_argument(label + "tet body " + std::to_string(d.tetBody) +
-                                        " does not exist");
-        if (d.fat->vertexCount() != sys.tetPositions(d.tetBody).size() ||
-            d.fat->tetCount() != sys.tetCount(d.tetBody))
-            throw std::invalid_argument(label + "mesh has " + std::to_string(d.fat->vertexCount()) +
-                                        " vertices and " + std::to_string(d.fat->tetCount()) +
-                                        " tets, body '" + sys.tetBodyName(d.tetBody) + "' has " +
-                                        std::to_string(sys.tetPositions(d.tetBody).size()) +
-                                        " and " + std::to_string(sys.tetCount(d.tetBody)));
+            throw std::invalid_argument(label + "tet body " + std::to_string(d.tetBody) + " does not exist");
+        if (d.fat->vertexCount() != sys.tetPositions(d.tetBody).size() || d.fat->tetCount() != sys.tetCount(d.tetBody))
+            throw std::invalid_argument(
+                label + "mesh has " + std::to_string(d.fat->vertexCount()) + " vertices and " +
+                std::to_string(d.fat->tetCount()) + " tets, body '" + sys.tetBodyName(d.tetBody) + "' has " +
+                std::to_string(sys.tetPositions(d.tetBody).size()) + " and " + std::to_string(sys.tetCount(d.tetBody)));
         Layer L;
         L.tets = true;
         L.body = d.tetBody;
@@ -145,18 +134,16 @@ DissectionFrameStats Dissection::update(const EnergyTool& tool, double dt) {
     if (!tool.centre.allFinite() || !std::isfinite(tool.radius) || !std::isfinite(tool.temperature))
         throw std::invalid_argument(where + "tool centre, radius or temperature is not finite");
     if (!(tool.radius > 0))
-        throw std::invalid_argument(where + "tool radius is " + formatNumber(tool.radius) +
-                                    " (must be > 0)");
+        throw std::invalid_argument(where + "tool radius is " + formatNumber(tool.radius) + " (must be > 0)");
     if (tool.temperature < -273.15)
-        throw std::invalid_argument(where + "tool temperature is " +
-                                    formatNumber(tool.temperature) + " (must be >= -273.15)");
+        throw std::invalid_argument(where + "tool temperature is " + formatNumber(tool.temperature) +
+                                    " (must be >= -273.15)");
     if (!std::isfinite(dt) || !(dt > 0))
         throw std::invalid_argument(where + "dt is " + formatNumber(dt) + " (must be > 0)");
 
     DissectionFrameStats st;
-    st.heatSubsteps = tool.energized
-                          ? m_heat.advance({tool.centre, tool.radius, tool.temperature}, dt)
-                          : m_heat.advanceUnheated(tool.centre, dt);
+    st.heatSubsteps = tool.energized ? m_heat.advance({tool.centre, tool.radius, tool.temperature}, dt)
+                                     : m_heat.advanceUnheated(tool.centre, dt);
     st.gridMin = m_heat.minTemperature();
     st.gridMax = m_heat.maxTemperature();
     const Vec3 from = m_prevCentre.value_or(tool.centre);
@@ -166,10 +153,8 @@ DissectionFrameStats Dissection::update(const EnergyTool& tool, double dt) {
     return st;
 }
 
-void Dissection::updateLayer(Layer& L, const EnergyTool& tool, const Vec3& from, double dt,
-                             DissectionLayerStats& st) {
-    const std::vector<Vec3>& x =
-        L.tets ? m_sys->tetPositions(L.body) : m_sys->surfacePositions(L.body);
+void Dissection::updateLayer(Layer& L, const EnergyTool& tool, const Vec3& from, double dt, DissectionLayerStats& st) {
+    const std::vector<Vec3>& x = L.tets ? m_sys->tetPositions(L.body) : m_sys->surfacePositions(L.body);
     st.vertexCount = x.size();
     EdgeStructure& E = L.edges;
     std::vector<int32_t> ignite;
@@ -182,9 +167,7 @@ void Dissection::updateLayer(Layer& L, const EnergyTool& tool, const Vec3& from,
             if (E.isDissected(e)) continue;
             const Vec3& a = x[E.edge(e)[0]];
             const Vec3& b = x[E.edge(e)[1]];
-            if ((a.cwiseMax(b).array() < lo.array()).any() ||
-                (a.cwiseMin(b).array() > hi.array()).any())
-                continue;
+            if ((a.cwiseMax(b).array() < lo.array()).any() || (a.cwiseMin(b).array() > hi.array()).any()) continue;
             const double f = overlapFraction(from, tool.centre, r, a, b);
             if (!(f > 0)) continue;
             ++st.edgesTouched;
@@ -226,8 +209,7 @@ void Dissection::updateLayer(Layer& L, const EnergyTool& tool, const Vec3& from,
         if (!E.isDissected(e)) st.maxEdgeHeat = std::max(st.maxEdgeHeat, L.heat[e]);
 }
 
-Mat3 Dissection::shrinkFrame(const Layer& L, const std::vector<Vec3>& x, size_t p,
-                             const EnergyTool& tool) const {
+Mat3 Dissection::shrinkFrame(const Layer& L, const std::vector<Vec3>& x, size_t p, const EnergyTool& tool) const {
     const auto& e = L.prims[p];
     const int nv = L.tets ? 4 : 3;
     Vec3 centre = Vec3::Zero();
@@ -296,9 +278,8 @@ void Dissection::fatTetMaskInto(std::vector<uint8_t>& out) const {
 void Dissection::fatBoundaryMaskInto(std::vector<uint8_t>& out) const {
     const EdgeStructure& E = fatEdges();
     if (!m_hasFatBoundary)
-        throw std::logic_error(
-            "sim::Dissection::fatBoundaryMaskInto(): the fat mesh had no boundary at create(); "
-            "call TetMesh::requireLevel(3) before Dissection::create()");
+        throw std::logic_error("sim::Dissection::fatBoundaryMaskInto(): the fat mesh had no boundary at create(); "
+                               "call TetMesh::requireLevel(3) before Dissection::create()");
     out.resize(m_fatBoundaryTet.size());
     for (size_t k = 0; k < out.size(); ++k)
         out[k] = E.isCut(static_cast<size_t>(m_fatBoundaryTet[k])) ? 0 : 1;

@@ -103,7 +103,7 @@ struct DissectionFrameStats {
 };
 
 class Dissection {
-  public:
+public:
     /// Throws std::invalid_argument ("sim::Dissection::create(): fascia: surface 2 does not
     /// exist") on a null system, no layer, a body index out of range, a mesh whose vertex or
     /// element count differs from the system's, bad tissue parameters, grid settings or t_ref.
@@ -134,7 +134,7 @@ class Dissection {
     void fatBoundaryMaskInto(std::vector<uint8_t>& out) const;
     const HeatGrid& heat() const { return m_heat; }
 
-  private:
+private:
     struct Layer {
         bool tets = false;
         size_t body = 0;
@@ -145,10 +145,8 @@ class Dissection {
         std::vector<std::array<int32_t, 4>> prims;
     };
     explicit Dissection(const HeatGridSettings& grid) : m_heat(grid) {}
-    void updateLayer(Layer& L, const EnergyTool& tool, const Vec3& from, double dt,
-                     DissectionLayerStats& st);
-    Mat3 shrinkFrame(const Layer& L, const std::vector<Vec3>& x, size_t p,
-                     const EnergyTool& tool) const;
+    void updateLayer(Layer& L, const EnergyTool& tool, const Vec3& from, double dt, DissectionLayerStats& st);
+    Mat3 shrinkFrame(const Layer& L, const std::vector<Vec3>& x, size_t p, const EnergyTool& tool) const;
 
     XpbdSystem* m_sys = nullptr;
     std::optional<Layer> m_fascia, m_fat;

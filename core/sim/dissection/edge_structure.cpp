@@ -7,8 +7,8 @@
 namespace viscera::sim {
 
 template <size_t K>
-EdgeStructure EdgeStructure::build(const std::vector<std::array<int32_t, K>>& prims,
-                                   size_t vertexCount, const char* where, const char* primName) {
+EdgeStructure EdgeStructure::build(const std::vector<std::array<int32_t, K>>& prims, size_t vertexCount,
+                                   const char* where, const char* primName) {
     const std::string w = std::string("sim::EdgeStructure::") + where + "(): ";
     if (prims.empty()) throw std::invalid_argument(w + "no " + primName);
     constexpr int kEdges = K == 3 ? 3 : 6;
@@ -18,13 +18,12 @@ EdgeStructure EdgeStructure::build(const std::vector<std::array<int32_t, K>>& pr
         for (size_t k = 0; k < K; ++k) {
             const int32_t v = prims[p][k];
             if (v < 0 || static_cast<size_t>(v) >= vertexCount)
-                throw std::invalid_argument(w + primName + " " + std::to_string(p) +
-                                            " references vertex " + std::to_string(v) + " (" +
-                                            std::to_string(vertexCount) + " vertices)");
+                throw std::invalid_argument(w + primName + " " + std::to_string(p) + " references vertex " +
+                                            std::to_string(v) + " (" + std::to_string(vertexCount) + " vertices)");
             for (size_t j = 0; j < k; ++j)
                 if (prims[p][j] == v)
-                    throw std::invalid_argument(w + primName + " " + std::to_string(p) +
-                                                " repeats vertex " + std::to_string(v));
+                    throw std::invalid_argument(w + primName + " " + std::to_string(p) + " repeats vertex " +
+                                                std::to_string(v));
         }
     }
     // (a, b, primitive, local edge) sorted by (a, b, primitive).
@@ -83,8 +82,7 @@ int32_t EdgeStructure::findEdge(int32_t a, int32_t b) const {
     if (a < 0 || static_cast<size_t>(b) >= m_vertexCount) return -1;
     const auto first = m_edges.begin() + m_vertexEdgeStart[a];
     const auto last = m_edges.begin() + m_vertexEdgeStart[a + 1];
-    const auto it =
-        std::lower_bound(first, last, b, [](const Edge& e, int32_t v) { return e[1] < v; });
+    const auto it = std::lower_bound(first, last, b, [](const Edge& e, int32_t v) { return e[1] < v; });
     return it != last && (*it)[1] == b ? static_cast<int32_t>(it - m_edges.begin()) : -1;
 }
 
@@ -96,8 +94,8 @@ bool EdgeStructure::isOrphaned(size_t e) const {
 
 bool EdgeStructure::dissect(size_t e, std::vector<int32_t>* newlyCut) {
     if (e >= m_edges.size())
-        throw std::out_of_range("sim::EdgeStructure::dissect(): edge " + std::to_string(e) +
-                                " is out of range (" + std::to_string(m_edges.size()) + " edges)");
+        throw std::out_of_range("sim::EdgeStructure::dissect(): edge " + std::to_string(e) + " is out of range (" +
+                                std::to_string(m_edges.size()) + " edges)");
     if (m_dissected[e]) return false;
     m_dissected[e] = 1;
     ++m_dissectedCount;

@@ -20,7 +20,7 @@
 namespace viscera::sim {
 
 class EdgeStructure {
-  public:
+public:
     using Edge = std::array<int32_t, 2>;
 
     /// Triangles (#F × 3 vertex indices < vertexCount). Throws std::invalid_argument
@@ -39,8 +39,7 @@ class EdgeStructure {
     const Edge& edge(size_t e) const { return m_edges[e]; }
     /// Primitives sharing edge e (ascending).
     std::span<const int32_t> primitivesOf(size_t e) const {
-        return {m_edgePrims.data() + m_edgePrimStart[e],
-                m_edgePrims.data() + m_edgePrimStart[e + 1]};
+        return {m_edgePrims.data() + m_edgePrimStart[e], m_edgePrims.data() + m_edgePrimStart[e + 1]};
     }
     /// Edges of primitive p (3 or 6).
     std::span<const int32_t> edgesOf(size_t p) const {
@@ -67,10 +66,10 @@ class EdgeStructure {
     /// Back to the initial state (nothing dissected).
     void reset();
 
-  private:
+private:
     template <size_t K>
-    static EdgeStructure build(const std::vector<std::array<int32_t, K>>& prims, size_t vertexCount,
-                               const char* where, const char* primName);
+    static EdgeStructure build(const std::vector<std::array<int32_t, K>>& prims, size_t vertexCount, const char* where,
+                               const char* primName);
 
     size_t m_vertexCount = 0;
     int m_edgesPerPrim = 3;

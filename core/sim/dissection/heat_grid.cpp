@@ -15,21 +15,18 @@ constexpr double kAbsoluteZero = -273.15;
 } // namespace
 
 std::string validate(const HeatGridSettings& s) {
-    if (s.nodes < 4 || s.nodes > 256)
-        return "nodes is " + std::to_string(s.nodes) + " (must be 4..256)";
+    if (s.nodes < 4 || s.nodes > 256) return "nodes is " + std::to_string(s.nodes) + " (must be 4..256)";
     if (!std::isfinite(s.spacing) || !(s.spacing > 0))
         return "spacing is " + formatNumber(s.spacing) + " (must be > 0)";
     if (!std::isfinite(s.diffusivity) || !(s.diffusivity > 0))
         return "diffusivity is " + formatNumber(s.diffusivity) + " (must be > 0)";
     if (!std::isfinite(s.bodyTemperature) || s.bodyTemperature < kAbsoluteZero)
-        return "bodyTemperature is " + formatNumber(s.bodyTemperature) +
-               " (must be finite and >= -273.15)";
+        return "bodyTemperature is " + formatNumber(s.bodyTemperature) + " (must be finite and >= -273.15)";
     return {};
 }
 
 HeatGrid::HeatGrid(const HeatGridSettings& settings) : m_settings(settings), m_n(settings.nodes) {
-    if (auto why = validate(settings); !why.empty())
-        throw std::invalid_argument("sim::HeatGrid: " + why);
+    if (auto why = validate(settings); !why.empty()) throw std::invalid_argument("sim::HeatGrid: " + why);
     const size_t n3 = size_t(m_n) * m_n * m_n;
     m_u.assign(n3, settings.bodyTemperature);
     m_next.assign(n3, settings.bodyTemperature);
@@ -44,8 +41,7 @@ void HeatGrid::reset() {
 
 Vec3 HeatGrid::origin() const {
     const double dl = m_settings.spacing;
-    return Vec3(double(m_originIndex[0]) * dl, double(m_originIndex[1]) * dl,
-                double(m_originIndex[2]) * dl);
+    return Vec3(double(m_originIndex[0]) * dl, double(m_originIndex[1]) * dl, double(m_originIndex[2]) * dl);
 }
 
 int HeatGrid::substepsFor(double dt) const {
@@ -67,14 +63,12 @@ void HeatGrid::place(const Vec3& centre) {
     if (!m_placed) {
         std::fill(m_u.begin(), m_u.end(), body);
     } else {
-        const int64_t dx = o[0] - m_originIndex[0], dy = o[1] - m_originIndex[1],
-                      dz = o[2] - m_originIndex[2];
+        const int64_t dx = o[0] - m_originIndex[0], dy = o[1] - m_originIndex[1], dz = o[2] - m_originIndex[2];
         for (int k = 0; k < m_n; ++k)
             for (int j = 0; j < m_n; ++j)
                 for (int i = 0; i < m_n; ++i) {
                     const int64_t si = i + dx, sj = j + dy, sk = k + dz;
-                    const bool inside =
-                        si >= 0 && si < m_n && sj >= 0 && sj < m_n && sk >= 0 && sk < m_n;
+                    const bool inside = si >= 0 && si < m_n && sj >= 0 && sj < m_n && sk >= 0 && sk < m_n;
                     m_next[id(i, j, k)] = inside ? m_u[id(int(si), int(sj), int(sk))] : body;
                 }
         m_u.swap(m_next);
@@ -84,18 +78,15 @@ void HeatGrid::place(const Vec3& centre) {
 }
 
 int HeatGrid::advance(const HeatSource& src, double dt) {
-    if (!src.centre.allFinite() || !std::isfinite(src.radius) || !std::isfinite(src.temperature) ||
-        !std::isfinite(dt))
+    if (!src.centre.allFinite() || !std::isfinite(src.radius) || !std::isfinite(src.temperature) || !std::isfinite(dt))
         throw std::invalid_argument("sim::HeatGrid::advance(): source or dt is not finite");
     if (!(src.radius > 0))
-        throw std::invalid_argument("sim::HeatGrid::advance(): radius is " +
-                                    formatNumber(src.radius) + " (must be > 0)");
-    if (dt < 0)
-        throw std::invalid_argument("sim::HeatGrid::advance(): dt is " + formatNumber(dt) +
-                                    " (must be >= 0)");
+        throw std::invalid_argument("sim::HeatGrid::advance(): radius is " + formatNumber(src.radius) +
+                                    " (must be > 0)");
+    if (dt < 0) throw std::invalid_argument("sim::HeatGrid::advance(): dt is " + formatNumber(dt) + " (must be >= 0)");
     if (src.temperature < kAbsoluteZero)
-        throw std::invalid_argument("sim::HeatGrid::advance(): temperature is " +
-                                    formatNumber(src.temperature) + " (must be >= -273.15)");
+        throw std::invalid_argument("sim::HeatGrid::advance(): temperature is " + formatNumber(src.temperature) +
+                                    " (must be >= -273.15)");
     place(src.centre);
     m_source = src;
     m_hasSource = true;
@@ -104,8 +95,7 @@ int HeatGrid::advance(const HeatSource& src, double dt) {
 
 int HeatGrid::advanceUnheated(const Vec3& centre, double dt) {
     if (!centre.allFinite() || !std::isfinite(dt) || dt < 0)
-        throw std::invalid_argument(
-            "sim::HeatGrid::advanceUnheated(): centre or dt is not finite or dt < 0");
+        throw std::invalid_argument("sim::HeatGrid::advanceUnheated(): centre or dt is not finite or dt < 0");
     place(centre);
     m_hasSource = false;
     return run(dt, nullptr);
@@ -130,8 +120,7 @@ int HeatGrid::run(double dt, const HeatSource* src) {
                     hot = (x - src->centre).squaredNorm() <= r2 ||
                           (i == nearest[0] && j == nearest[1] && k == nearest[2]);
                 }
-                const bool edge =
-                    i == 0 || j == 0 || k == 0 || i == m_n - 1 || j == m_n - 1 || k == m_n - 1;
+                const bool edge = i == 0 || j == 0 || k == 0 || i == m_n - 1 || j == m_n - 1 || k == m_n - 1;
                 m_fixed[n] = hot ? 2 : (edge ? 1 : 0);
                 if (hot)
                     m_u[n] = src->temperature;
@@ -178,8 +167,7 @@ double HeatGrid::temperatureAt(const Vec3& x) const {
     for (int dz = 0; dz < 2; ++dz)
         for (int dy = 0; dy < 2; ++dy)
             for (int dx = 0; dx < 2; ++dx) {
-                const double w =
-                    (dx ? f[0] : 1 - f[0]) * (dy ? f[1] : 1 - f[1]) * (dz ? f[2] : 1 - f[2]);
+                const double w = (dx ? f[0] : 1 - f[0]) * (dy ? f[1] : 1 - f[1]) * (dz ? f[2] : 1 - f[2]);
                 v += w * m_u[id(c[0] + dx, c[1] + dy, c[2] + dz)];
             }
     return v;

@@ -43,7 +43,7 @@ struct HeatSource {
 };
 
 class HeatGrid {
-  public:
+public:
     /// Throws std::invalid_argument ("sim::HeatGrid: nodes is 2 (must be 4..256)") on bad settings.
     explicit HeatGrid(const HeatGridSettings& settings);
 
@@ -61,9 +61,7 @@ class HeatGrid {
     double temperatureAt(const Vec3& x) const;
     /// Substeps for a frame of dt seconds (ceil(dt / (dl²/(6α))), at least 1).
     int substepsFor(double dt) const;
-    double stableSubstep() const {
-        return m_settings.spacing * m_settings.spacing / (6.0 * m_settings.diffusivity);
-    }
+    double stableSubstep() const { return m_settings.spacing * m_settings.spacing / (6.0 * m_settings.diffusivity); }
 
     const HeatGridSettings& settings() const { return m_settings; }
     /// Grid values (N³, index (k·N + j)·N + i), °C.
@@ -76,7 +74,7 @@ class HeatGrid {
     /// Back to the unplaced state (all nodes at body temperature).
     void reset();
 
-  private:
+private:
     void place(const Vec3& centre);
     int run(double dt, const HeatSource* source);
     size_t id(int i, int j, int k) const { return (size_t(k) * m_n + j) * m_n + i; }

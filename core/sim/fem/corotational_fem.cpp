@@ -33,7 +33,7 @@ struct Group {
 /// A row of the current solve: free-node terms only, right-hand side in displacement form.
 struct SolveRow {
     int group = 0, row = 0;
-    std::vector<std::pair<int, Vec3>> terms; // (cache slot, coefficient)
+    std::vector<std::pair<int, Vec3>> terms;         // (cache slot, coefficient)
     std::vector<std::pair<int32_t, Vec3>> nodeTerms; // (node, coefficient), free nodes
     double bu = 0;
 };
@@ -43,11 +43,15 @@ struct SolveRow {
 std::string validate(const FemSettings& s) {
     if (!(s.youngsModulus > 0) || !std::isfinite(s.youngsModulus))
         return "youngs_modulus " + formatNumber(s.youngsModulus, 3) + " must be positive";
-    if (!(s.poissonRatio >= 0 && s.poissonRatio < 0.5)) return "poisson_ratio " + formatNumber(s.poissonRatio, 3) + " must be in [0, 0.5)";
-    if (!(s.refactorDisplacement > 0)) return "refactor_displacement " + formatNumber(s.refactorDisplacement, 3) + " must be positive";
+    if (!(s.poissonRatio >= 0 && s.poissonRatio < 0.5))
+        return "poisson_ratio " + formatNumber(s.poissonRatio, 3) + " must be in [0, 0.5)";
+    if (!(s.refactorDisplacement > 0))
+        return "refactor_displacement " + formatNumber(s.refactorDisplacement, 3) + " must be positive";
     if (s.refactorLatencySteps < 1) return "refactor_latency_steps must be >= 1";
-    if (!(s.rankTolerance > 0 && s.rankTolerance < 1)) return "rank_tolerance " + formatNumber(s.rankTolerance, 3) + " must be in (0, 1)";
-    if (!(s.releaseTolerance >= 0) || !(s.activationTolerance >= 0)) return "release/activation tolerances must be >= 0";
+    if (!(s.rankTolerance > 0 && s.rankTolerance < 1))
+        return "rank_tolerance " + formatNumber(s.rankTolerance, 3) + " must be in (0, 1)";
+    if (!(s.releaseTolerance >= 0) || !(s.activationTolerance >= 0))
+        return "release/activation tolerances must be >= 0";
     if (s.maxActiveSetIterations < 1) return "max_active_set_iterations must be >= 1";
     if (s.cacheEvictSteps < 1) return "cache_evict_steps must be >= 1";
     return {};
@@ -105,7 +109,8 @@ struct CorotationalFem::Impl {
 
     void assemble(const std::vector<Mat3>& R, std::vector<double>& values, Eigen::VectorXd& f) const {
         values.assign(pattern.rowIdx.size(), 0.0);
-        for (int d : fixedDiag) values[d] = 1.0;
+        for (int d : fixedDiag)
+            values[d] = 1.0;
         f = fext;
         const auto& X0 = *x0;
         for (size_t t = 0; t < tets.size(); ++t) {
@@ -113,7 +118,8 @@ struct CorotationalFem::Impl {
             const Mat3& r = R[t];
             Mat12 KR;
             for (int a = 0; a < 4; ++a)
-                for (int b = 0; b < 4; ++b) KR.block<3, 3>(3 * a, 3 * b) = r * K.block<3, 3>(3 * a, 3 * b) * r.transpose();
+                for (int b = 0; b < 4; ++b)
+                    KR.block<3, 3>(3 * a, 3 * b) = r * K.block<3, 3>(3 * a, 3 * b) * r.transpose();
             const int* map = &scatter[t * 144];
             for (int i = 0; i < 144; ++i)
                 if (map[i] >= 0) values[map[i]] += KR(i / 12, i % 12);
@@ -124,7 +130,8 @@ struct CorotationalFem::Impl {
                 d.segment<3>(3 * a) = p - r.transpose() * p;
             }
             const Vec12 kd = K * d;
-            for (int a = 0; a < 4; ++a) f.segment<3>(3 * tets[t][a]) += r * kd.segment<3>(3 * a);
+            for (int a = 0; a < 4; ++a)
+                f.segment<3>(3 * tets[t][a]) += r * kd.segment<3>(3 * a);
         }
         for (size_t v = 0; v < fixed->size(); ++v)
             if ((*fixed)[v]) f.segment<3>(3 * v).setZero();
@@ -158,10 +165,12 @@ struct CorotationalFem::Impl {
         const int k = static_cast<int>(nodes.size());
         Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n3, 3 * k);
         for (int i = 0; i < k; ++i)
-            for (int c = 0; c < 3; ++c) rhs(3 * nodes[i] + c, 3 * i + c) = 1.0;
+            for (int c = 0; c < 3; ++c)
+                rhs(3 * nodes[i] + c, 3 * i + c) = 1.0;
         if (!F.chol->solveInPlace(rhs.data(), 3 * k, error)) return false;
         out.resize(3 * k, 3 * k);
-        for (int i = 0; i < k; ++i) out.middleRows(3 * i, 3) = rhs.middleRows(3 * nodes[i], 3);
+        for (int i = 0; i < k; ++i)
+            out.middleRows(3 * i, 3) = rhs.middleRows(3 * nodes[i], 3);
         full.swap(rhs);
         return true;
     }
@@ -196,10 +205,12 @@ struct CorotationalFem::Impl {
         const int n = n3();
         rhsWork.assign(static_cast<size_t>(n) * 3 * k, 0.0);
         for (int i = 0; i < k; ++i)
-            for (int c = 0; c < 3; ++c) rhsWork[static_cast<size_t>(3 * i + c) * n + 3 * nodes[i] + c] = 1.0;
+            for (int c = 0; c < 3; ++c)
+                rhsWork[static_cast<size_t>(3 * i + c) * n + 3 * nodes[i] + c] = 1.0;
         if (!cur.chol->solveInPlace(rhsWork.data(), 3 * k, error)) return false;
         std::vector<int> slots(k);
-        for (int i = 0; i < k; ++i) slots[i] = allocateSlot(nodes[i]);
+        for (int i = 0; i < k; ++i)
+            slots[i] = allocateSlot(nodes[i]);
         if (cols.rows() != n || cols.cols() < kinv.cols()) cols.conservativeResize(n, kinv.cols());
         for (int i = 0; i < k; ++i) {
             const int si = slots[i];
@@ -282,7 +293,8 @@ struct CorotationalFem::Impl {
 CorotationalFem::~CorotationalFem() = default;
 
 std::unique_ptr<CorotationalFem> CorotationalFem::create(const TetMesh& mesh, const std::vector<int32_t>& fixedNodes,
-                                                         const FemSettings& settings, std::vector<Vec3> externalForces) {
+                                                         const FemSettings& settings,
+                                                         std::vector<Vec3> externalForces) {
     auto fail = [](const std::string& why) { throw std::invalid_argument(std::string(kWhere) + "create(): " + why); };
     if (auto why = validate(settings); !why.empty()) fail(why);
     const size_t nv = mesh.vertexCount();
@@ -330,7 +342,8 @@ std::unique_ptr<CorotationalFem> CorotationalFem::create(const TetMesh& mesh, co
     // Pattern: upper triangle over free DOFs plus the diagonal of every DOF.
     const int n = static_cast<int>(3 * nv);
     std::vector<std::vector<int>> cols(n);
-    for (int d = 0; d < n; ++d) cols[d].push_back(d);
+    for (int d = 0; d < n; ++d)
+        cols[d].push_back(d);
     for (const Tet& e : m.tets)
         for (int a = 0; a < 4; ++a)
             for (int b = 0; b < 4; ++b) {
@@ -347,7 +360,8 @@ std::unique_ptr<CorotationalFem> CorotationalFem::create(const TetMesh& mesh, co
         cols[c].erase(std::unique(cols[c].begin(), cols[c].end()), cols[c].end());
         m.pattern.colPtr[c + 1] = m.pattern.colPtr[c] + static_cast<int>(cols[c].size());
     }
-    for (auto& c : cols) m.pattern.rowIdx.insert(m.pattern.rowIdx.end(), c.begin(), c.end());
+    for (auto& c : cols)
+        m.pattern.rowIdx.insert(m.pattern.rowIdx.end(), c.begin(), c.end());
     m.scatter.assign(m.tets.size() * 144, -1);
     for (size_t t = 0; t < m.tets.size(); ++t) {
         const Tet& e = m.tets[t];
@@ -360,12 +374,14 @@ std::unique_ptr<CorotationalFem> CorotationalFem::create(const TetMesh& mesh, co
     }
     for (size_t v = 0; v < nv; ++v)
         if (w->m_fixed[v])
-            for (int c = 0; c < 3; ++c) m.fixedDiag.push_back(m.pattern.find(3 * static_cast<int>(v) + c, 3 * static_cast<int>(v) + c));
+            for (int c = 0; c < 3; ++c)
+                m.fixedDiag.push_back(m.pattern.find(3 * static_cast<int>(v) + c, 3 * static_cast<int>(v) + c));
     m.slotOf.assign(nv, -1);
     std::string error;
     if (!m.buildFactor(w->m_x0, m.cur, error)) fail(error);
     w->m_factorizations = 1;
-    for (size_t v = 0; v < nv; ++v) w->m_x[v] = w->m_x0[v] + m.cur.u0.segment<3>(3 * v);
+    for (size_t v = 0; v < nv; ++v)
+        w->m_x[v] = w->m_x0[v] + m.cur.u0.segment<3>(3 * v);
     return w;
 }
 
@@ -407,7 +423,9 @@ void CorotationalFem::setRows(int id, std::vector<ConstraintRow> rows) {
     g.st.status.assign(g.desc.rows.size(), RowStatus::Inactive);
 }
 
-void CorotationalFem::setRhs(int id, int row, double b) { m->groups.at(id).desc.rows.at(row).b = b; }
+void CorotationalFem::setRhs(int id, int row, double b) {
+    m->groups.at(id).desc.rows.at(row).b = b;
+}
 
 void CorotationalFem::removeConstraint(int id) {
     if (!hasConstraint(id)) return;
@@ -418,13 +436,20 @@ void CorotationalFem::removeConstraint(int id) {
 bool CorotationalFem::hasConstraint(int id) const {
     return id >= 0 && static_cast<size_t>(id) < m->groups.size() && m->groups[id].alive;
 }
-const ConstraintState& CorotationalFem::state(int id) const { return m->groups.at(id).st; }
-const ConstraintDesc& CorotationalFem::constraint(int id) const { return m->groups.at(id).desc; }
-size_t CorotationalFem::constraintCount() const { return m->liveGroups; }
+const ConstraintState& CorotationalFem::state(int id) const {
+    return m->groups.at(id).st;
+}
+const ConstraintDesc& CorotationalFem::constraint(int id) const {
+    return m->groups.at(id).desc;
+}
+size_t CorotationalFem::constraintCount() const {
+    return m->liveGroups;
+}
 
 int CorotationalFem::cachedNodes() const {
     int c = 0;
-    for (int n : m->nodeOf) c += n >= 0;
+    for (int n : m->nodeOf)
+        c += n >= 0;
     return c;
 }
 
@@ -518,15 +543,18 @@ FemSolveStats CorotationalFem::solve() {
         for (int r = 0; r < mrows; ++r) {
             auto w = W.col(r);
             w.setZero();
-            for (const auto& [slot, a] : rows[r].terms) w.noalias() += I.kinv.block(0, 3 * slot, 3 * S, 3) * a;
+            for (const auto& [slot, a] : rows[r].terms)
+                w.noalias() += I.kinv.block(0, 3 * slot, 3 * S, 3) * a;
             double cu0 = 0;
-            for (const auto& [node, a] : rows[r].nodeTerms) cu0 += a.dot(I.cur.u0.segment<3>(3 * node));
+            for (const auto& [node, a] : rows[r].nodeTerms)
+                cu0 += a.dot(I.cur.u0.segment<3>(3 * node));
             q[r] = cu0 - rows[r].bu;
         }
         for (int r = 0; r < mrows; ++r)
             for (int c = 0; c <= r; ++c) {
                 double v = 0;
-                for (const auto& [slot, a] : rows[c].terms) v += a.dot(W.col(r).segment<3>(3 * slot));
+                for (const auto& [slot, a] : rows[c].terms)
+                    v += a.dot(W.col(r).segment<3>(3 * slot));
                 M(r, c) = M(c, r) = v;
             }
         // Pivoted incremental Cholesky in row order; a row whose pivot is too small is rejected.
@@ -538,7 +566,8 @@ FemSolveStats CorotationalFem::solve() {
             const int k = static_cast<int>(acc.size());
             for (int i = 0; i < k; ++i) {
                 double v = M(acc[i], r);
-                for (int j = 0; j < i; ++j) v -= L(i, j) * l[j];
+                for (int j = 0; j < i; ++j)
+                    v -= L(i, j) * l[j];
                 l[i] = v / L(i, i);
             }
             const double d = M(r, r) - l.head(k).squaredNorm();
@@ -552,12 +581,14 @@ FemSolveStats CorotationalFem::solve() {
         }
         const int k = static_cast<int>(acc.size());
         Eigen::VectorXd qa(k);
-        for (int i = 0; i < k; ++i) qa[i] = q[acc[i]];
+        for (int i = 0; i < k; ++i)
+            qa[i] = q[acc[i]];
         const auto Lk = L.topLeftCorner(k, k).triangularView<Eigen::Lower>();
         Eigen::VectorXd y = Lk.solve(qa);
         Eigen::VectorXd la = Lk.transpose().solve(y);
         lam = Eigen::VectorXd::Zero(mrows);
-        for (int i = 0; i < k; ++i) lam[acc[i]] = la[i];
+        for (int i = 0; i < k; ++i)
+            lam[acc[i]] = la[i];
         // Classify rejected rows by the residual they would keep.
         for (int r = 0; r < mrows; ++r) {
             auto& status = I.groups[rows[r].group].st.status[rows[r].row];
@@ -566,9 +597,11 @@ FemSolveStats CorotationalFem::solve() {
                 continue;
             }
             double res = q[r];
-            for (int i = 0; i < k; ++i) res -= M(r, acc[i]) * la[i];
+            for (int i = 0; i < k; ++i)
+                res -= M(r, acc[i]) * la[i];
             double cn = 0;
-            for (const auto& [node, a] : rows[r].nodeTerms) cn += a.squaredNorm();
+            for (const auto& [node, a] : rows[r].nodeTerms)
+                cn += a.squaredNorm();
             const bool consistent = std::abs(res) <= I.s.activationTolerance * std::max(1.0, std::sqrt(cn));
             status = consistent ? RowStatus::Redundant : RowStatus::Incompatible;
         }
@@ -608,11 +641,14 @@ FemSolveStats CorotationalFem::solve() {
                 if (lam[r] != 0)
                     for (const auto& [slot, a] : rows[r].terms) {
                         auto it = std::find_if(g.begin(), g.end(), [&](const auto& e) { return e.first == slot; });
-                        if (it == g.end()) g.emplace_back(slot, lam[r] * a);
-                        else it->second += lam[r] * a;
+                        if (it == g.end())
+                            g.emplace_back(slot, lam[r] * a);
+                        else
+                            it->second += lam[r] * a;
                     }
             u = I.cur.u0;
-            for (const auto& [slot, gv] : g) u.noalias() -= I.cols.middleCols(3 * slot, 3) * gv;
+            for (const auto& [slot, gv] : g)
+                u.noalias() -= I.cols.middleCols(3 * slot, 3) * gv;
         }
         // Activate violated unilateral groups.
         for (int g : order) {
@@ -653,14 +689,16 @@ FemSolveStats CorotationalFem::solve() {
     }
     I.lastRows = rows;
     I.lastLambda = lam;
-    for (size_t v = 0; v < m_x.size(); ++v) m_x[v] = X0[v] + u.segment<3>(3 * v);
+    for (size_t v = 0; v < m_x.size(); ++v)
+        m_x[v] = X0[v] + u.segment<3>(3 * v);
     // Rotations go stale when edges turn, not with translation or stretch: the largest change of an
     // edge vector normal to itself since the factorization.
     if (I.edges.empty()) {
         std::vector<std::array<int32_t, 2>> e;
         for (const Tet& t : I.tets)
             for (int a = 0; a < 4; ++a)
-                for (int b = a + 1; b < 4; ++b) e.push_back({std::min(t[a], t[b]), std::max(t[a], t[b])});
+                for (int b = a + 1; b < 4; ++b)
+                    e.push_back({std::min(t[a], t[b]), std::max(t[a], t[b])});
         std::sort(e.begin(), e.end());
         e.erase(std::unique(e.begin(), e.end()), e.end());
         I.edges = std::move(e);
@@ -697,7 +735,8 @@ double CorotationalFem::elasticEnergy() const {
         const Tet& T = m->tets[t];
         const Mat3& R = m->cur.rotations[t];
         Vec12 d;
-        for (int a = 0; a < 4; ++a) d.segment<3>(3 * a) = R.transpose() * m_x[T[a]] - m_x0[T[a]];
+        for (int a = 0; a < 4; ++a)
+            d.segment<3>(3 * a) = R.transpose() * m_x[T[a]] - m_x0[T[a]];
         e += 0.5 * d.dot(m->elems[t].stiffness * d);
     }
     return e;
@@ -720,21 +759,23 @@ Eigen::SparseMatrix<double> CorotationalFem::stiffnessMatrix() const {
     return K;
 }
 
-Eigen::VectorXd CorotationalFem::forceVector() const { return m->cur.f; }
+Eigen::VectorXd CorotationalFem::forceVector() const {
+    return m->cur.f;
+}
 
 void CorotationalFem::lastSystem(Eigen::MatrixXd& C, Eigen::VectorXd& bu, Eigen::VectorXd& lambda) const {
     const auto& rows = m->lastRows;
     std::vector<int> keep;
     for (size_t r = 0; r < rows.size(); ++r)
-        if (m->groups[rows[r].group].alive &&
-            m->groups[rows[r].group].st.status[rows[r].row] == RowStatus::Enforced)
+        if (m->groups[rows[r].group].alive && m->groups[rows[r].group].st.status[rows[r].row] == RowStatus::Enforced)
             keep.push_back(static_cast<int>(r));
     C = Eigen::MatrixXd::Zero(keep.size(), m->n3());
     bu.resize(keep.size());
     lambda.resize(keep.size());
     for (size_t i = 0; i < keep.size(); ++i) {
         const SolveRow& sr = rows[keep[i]];
-        for (const auto& [node, a] : sr.nodeTerms) C.row(i).segment<3>(3 * node) += a.transpose();
+        for (const auto& [node, a] : sr.nodeTerms)
+            C.row(i).segment<3>(3 * node) += a.transpose();
         bu[i] = sr.bu;
         lambda[i] = m->lastLambda[keep[i]];
     }

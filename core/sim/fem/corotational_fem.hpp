@@ -16,10 +16,9 @@
 ///    exactly `refactorLatencySteps` solves later (deterministic; the solve waits only if the worker
 ///    is late). u0 = K_R⁻¹ f_R is cached with the factor.
 ///  - K_R⁻¹ restricted to the constrained nodes is cached (three substitutions per node, once, when
-///    a node first appears in a constraint; the full columns are kept too). Every constraint row's column K_R⁻¹cᵀ at the
-///    constrained nodes is a combination of these blocks, so rows may be added, removed or change
-///    their coefficients without any substitution, and M = C K_R⁻¹ Cᵀ [B eq. 2.67] costs a small
-///    dense product.
+///    a node first appears in a constraint; the full columns are kept too). Every constraint row's column K_R⁻¹cᵀ at
+///    the constrained nodes is a combination of these blocks, so rows may be added, removed or change their
+///    coefficients without any substitution, and M = C K_R⁻¹ Cᵀ [B eq. 2.67] costs a small dense product.
 ///  - a solve is: build M and q = C u0 − b, a pivoted dense Cholesky that rejects rows whose pivot
 ///    falls below `rankTolerance` (redundant or incompatible rows, [B §2.2.6]) instead of producing a
 ///    singular system, the multipliers λ, and u = u0 − Σ_nodes K_R⁻¹[:, node](Cᵀλ)_node from the
@@ -51,12 +50,12 @@ struct FemSettings {
     /// to the edge) since the last factorization (the rotations are then re-extracted).
     double refactorDisplacement = 0.25;
     RefactorMode refactorMode = RefactorMode::Background;
-    int refactorLatencySteps = 3;  ///< Background: solves between the request and the swap, >= 1
-    double rankTolerance = 1e-9;   ///< relative pivot below which a row is rejected
-    double releaseTolerance = 0;   ///< N; unilateral group released when Σ w λ exceeds it
+    int refactorLatencySteps = 3;      ///< Background: solves between the request and the swap, >= 1
+    double rankTolerance = 1e-9;       ///< relative pivot below which a row is rejected
+    double releaseTolerance = 0;       ///< N; unilateral group released when Σ w λ exceeds it
     double activationTolerance = 1e-7; ///< m; inactive unilateral group activated when violated by more
     int maxActiveSetIterations = 6;
-    int cacheEvictSteps = 400;     ///< constrained-node cache entries unused this long are freed
+    int cacheEvictSteps = 400; ///< constrained-node cache entries unused this long are freed
 };
 
 /// Empty when valid, else the rule that failed ("poisson_ratio 0.5 must be in [0, 0.5)").
@@ -81,24 +80,24 @@ struct ConstraintDesc {
     /// Unilateral only: per-row weights w of the release test Σ w_r λ_r > releaseTolerance and of
     /// the violation measure Σ w_r (c_r x − b_r) < −activationTolerance; empty = all 1.
     std::vector<double> weights;
-    int priority = 0;       ///< rows are kept in (priority, id) order when they conflict
+    int priority = 0;        ///< rows are kept in (priority, id) order when they conflict
     bool startActive = true; ///< Unilateral: enforced from the first solve
 };
 
 enum class RowStatus { Inactive, Enforced, Redundant, Incompatible };
 
 struct ConstraintState {
-    bool active = false;              ///< Unilateral: currently enforced
-    std::vector<double> lambda;       ///< per row, N (per unit coefficient); 0 when not enforced
-    std::vector<RowStatus> status;    ///< per row
+    bool active = false;           ///< Unilateral: currently enforced
+    std::vector<double> lambda;    ///< per row, N (per unit coefficient); 0 when not enforced
+    std::vector<RowStatus> status; ///< per row
 };
 
 struct FemSolveStats {
-    int rows = 0;            ///< rows enforced
-    int redundant = 0;       ///< rows rejected: dependent and consistent
-    int incompatible = 0;    ///< rows rejected: dependent and inconsistent
+    int rows = 0;         ///< rows enforced
+    int redundant = 0;    ///< rows rejected: dependent and consistent
+    int incompatible = 0; ///< rows rejected: dependent and inconsistent
     int activeSetIterations = 0;
-    int substitutions = 0;   ///< forward/backward substitutions (columns) this solve
+    int substitutions = 0; ///< forward/backward substitutions (columns) this solve
     int newCachedNodes = 0;
     bool refactored = false; ///< a new factor was taken into use
     bool finite = true;      ///< false: the result was not finite and was discarded
@@ -111,8 +110,7 @@ public:
     /// element with non-positive rest volume, external forces of the wrong size, or a stiffness
     /// matrix that is not positive definite (too few fixed nodes).
     static std::unique_ptr<CorotationalFem> create(const TetMesh& mesh, const std::vector<int32_t>& fixedNodes,
-                                                   const FemSettings& settings,
-                                                   std::vector<Vec3> externalForces = {});
+                                                   const FemSettings& settings, std::vector<Vec3> externalForces = {});
     ~CorotationalFem();
     CorotationalFem(const CorotationalFem&) = delete;
     CorotationalFem& operator=(const CorotationalFem&) = delete;

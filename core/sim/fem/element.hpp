@@ -14,10 +14,10 @@ using Vec12 = Eigen::Matrix<double, 12, 1>;
 using Mat12 = Eigen::Matrix<double, 12, 12>;
 
 struct LinearTet {
-    Mat12 stiffness;                 ///< K_e = v Bᵀ E B, N/m, node-major (3a + i)
+    Mat12 stiffness;                  ///< K_e = v Bᵀ E B, N/m, node-major (3a + i)
     Eigen::Matrix<double, 4, 3> grad; ///< ∇N_a of the four shape functions, 1/m, rest frame
-    Mat3 dmInv;                      ///< inverse of the rest edge matrix [x1−x0, x2−x0, x3−x0]
-    double volume = 0;               ///< m^3, rest
+    Mat3 dmInv;                       ///< inverse of the rest edge matrix [x1−x0, x2−x0, x3−x0]
+    double volume = 0;                ///< m^3, rest
 };
 
 /// Element stiffness from rest positions and Lamé parameters (Pa):

@@ -29,12 +29,23 @@ struct SparseCholesky::Impl {
     std::string why(const char* call) const {
         const char* w = "error";
         switch (common.status) {
-        case CHOLMOD_OUT_OF_MEMORY: w = "out of memory"; break;
-        case CHOLMOD_TOO_LARGE: w = "problem too large"; break;
-        case CHOLMOD_NOT_POSDEF: w = "matrix not positive definite"; break;
-        case CHOLMOD_INVALID: w = "invalid input"; break;
-        case CHOLMOD_NOT_INSTALLED: w = "method not installed"; break;
-        default: break;
+        case CHOLMOD_OUT_OF_MEMORY:
+            w = "out of memory";
+            break;
+        case CHOLMOD_TOO_LARGE:
+            w = "problem too large";
+            break;
+        case CHOLMOD_NOT_POSDEF:
+            w = "matrix not positive definite";
+            break;
+        case CHOLMOD_INVALID:
+            w = "invalid input";
+            break;
+        case CHOLMOD_NOT_INSTALLED:
+            w = "method not installed";
+            break;
+        default:
+            break;
         }
         return std::string("CHOLMOD: ") + call + " failed: " + w + " (status " + std::to_string(common.status) + ")";
     }
@@ -89,8 +100,12 @@ SparseCholesky::~SparseCholesky() {
     cholmod_finish(&m->common);
 }
 
-int SparseCholesky::size() const { return m->n; }
-bool SparseCholesky::factorized() const { return m->ok; }
+int SparseCholesky::size() const {
+    return m->n;
+}
+bool SparseCholesky::factorized() const {
+    return m->ok;
+}
 long SparseCholesky::factorNonZeros() const {
     if (!m->ok) return 0;
     if (m->factor->is_super) {

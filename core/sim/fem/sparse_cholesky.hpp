@@ -26,8 +26,7 @@ public:
     /// std::runtime_error when CHOLMOD fails (out of memory).
     explicit SparseCholesky(const UpperPattern& pattern);
     /// As the constructor, but a CHOLMOD failure is returned: null with `error` set.
-    static std::unique_ptr<SparseCholesky> tryCreate(const UpperPattern& pattern,
-                                                     std::string& error);
+    static std::unique_ptr<SparseCholesky> tryCreate(const UpperPattern& pattern, std::string& error);
     ~SparseCholesky();
     SparseCholesky(const SparseCholesky&) = delete;
     SparseCholesky& operator=(const SparseCholesky&) = delete;
@@ -36,8 +35,7 @@ public:
     /// Numeric factorization of `values` (pattern order). False with a message when the matrix is
     /// not positive definite or CHOLMOD fails; the previous factor is then invalid. When not null,
     /// `notPositiveDefinite` tells that case apart; failedColumn() then names the column.
-    bool factorize(const std::vector<double>& values, std::string& error,
-                   bool* notPositiveDefinite = nullptr);
+    bool factorize(const std::vector<double>& values, std::string& error, bool* notPositiveDefinite = nullptr);
     /// Column at which the last factorize() found the matrix not positive definite; size() if none.
     int failedColumn() const;
     bool factorized() const;

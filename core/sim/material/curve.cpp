@@ -14,8 +14,7 @@ namespace {
 
 /// Derivative at nodes[i] of the polynomial interpolating (x_j, y_j), j in [lo, hi]:
 /// Σ_{j≠i} L′_j(x_i) (y_j − y_i) (Σ_j L′_j = 0, so the differences avoid cancellation).
-double lagrangeSlope(const std::vector<CurvePoint>& p, std::size_t lo, std::size_t hi,
-                     std::size_t i) {
+double lagrangeSlope(const std::vector<CurvePoint>& p, std::size_t lo, std::size_t hi, std::size_t i) {
     const double xi = p[i].x;
     double slope = 0;
     for (std::size_t j = lo; j <= hi; ++j) {
@@ -33,28 +32,23 @@ double lagrangeSlope(const std::vector<CurvePoint>& p, std::size_t lo, std::size
 
 } // namespace
 
-MonotoneCurve::MonotoneCurve(std::string name, std::vector<CurvePoint> points, CurveShape shape,
-                             std::string context)
-    : m_name(std::move(name)), m_context(std::move(context)), m_shape(shape),
-      m_points(std::move(points)) {
+MonotoneCurve::MonotoneCurve(std::string name, std::vector<CurvePoint> points, CurveShape shape, std::string context)
+    : m_name(std::move(name)), m_context(std::move(context)), m_shape(shape), m_points(std::move(points)) {
     check(m_points);
     rebuild();
 }
 
-MonotoneCurve MonotoneCurve::fit(std::string name, const std::function<double(double)>& fn,
-                                 const CurveFitSpec& spec) {
+MonotoneCurve MonotoneCurve::fit(std::string name, const std::function<double(double)>& fn, const CurveFitSpec& spec) {
     const std::string where = "sim::MonotoneCurve::fit(): curve " + name + ": ";
     if (!fn) throw std::invalid_argument(where + "no function given");
     if (spec.count < 2)
-        throw std::invalid_argument(where + "count " + std::to_string(spec.count) +
-                                    " must be at least 2");
+        throw std::invalid_argument(where + "count " + std::to_string(spec.count) + " must be at least 2");
     if (!std::isfinite(spec.xmin) || !std::isfinite(spec.xmax) || !(spec.xmin < spec.xmax))
         throw std::invalid_argument(where + "range [" + formatNumber(spec.xmin, 12) + ", " +
-                                    formatNumber(spec.xmax, 12) +
-                                    "] must be finite with xmin < xmax");
+                                    formatNumber(spec.xmax, 12) + "] must be finite with xmin < xmax");
     if (spec.spacing == CurveSpacing::Geometric && !(spec.xmin > 0))
-        throw std::invalid_argument(
-            where + "geometric spacing needs xmin > 0 (xmin=" + formatNumber(spec.xmin, 12) + ")");
+        throw std::invalid_argument(where + "geometric spacing needs xmin > 0 (xmin=" + formatNumber(spec.xmin, 12) +
+                                    ")");
     std::vector<CurvePoint> pts(static_cast<std::size_t>(spec.count));
     const double last = spec.count - 1;
     for (int k = 0; k < spec.count; ++k) {
@@ -73,24 +67,20 @@ MonotoneCurve MonotoneCurve::fit(std::string name, const std::function<double(do
 }
 
 void MonotoneCurve::check(const std::vector<CurvePoint>& p) const {
-    const std::string where =
-        (m_context.empty() ? std::string() : m_context + ": ") + "curve " + m_name + ": ";
+    const std::string where = (m_context.empty() ? std::string() : m_context + ": ") + "curve " + m_name + ": ";
     if (p.size() < 2)
-        throw InputError(where + "needs at least 2 control points (has " +
-                         std::to_string(p.size()) + ")");
+        throw InputError(where + "needs at least 2 control points (has " + std::to_string(p.size()) + ")");
     for (std::size_t i = 0; i < p.size(); ++i) {
-        const std::string point = "control point " + std::to_string(i) +
-                                  " (x=" + formatNumber(p[i].x, 12) +
+        const std::string point = "control point " + std::to_string(i) + " (x=" + formatNumber(p[i].x, 12) +
                                   ", y=" + formatNumber(p[i].y, 12) + ")";
-        if (!std::isfinite(p[i].x) || !std::isfinite(p[i].y))
-            throw InputError(where + point + " is not finite");
+        if (!std::isfinite(p[i].x) || !std::isfinite(p[i].y)) throw InputError(where + point + " is not finite");
         if (i == 0) continue;
         if (!(p[i].x > p[i - 1].x))
-            throw InputError(where + point + " does not lie right of point " +
-                             std::to_string(i - 1) + " (x=" + formatNumber(p[i - 1].x, 12) + ")");
+            throw InputError(where + point + " does not lie right of point " + std::to_string(i - 1) +
+                             " (x=" + formatNumber(p[i - 1].x, 12) + ")");
         if (m_shape == CurveShape::StrictlyIncreasing && !(p[i].y > p[i - 1].y))
-            throw InputError(where + point + " does not increase over point " +
-                             std::to_string(i - 1) + " (y=" + formatNumber(p[i - 1].y, 12) + ")");
+            throw InputError(where + point + " does not increase over point " + std::to_string(i - 1) +
+                             " (y=" + formatNumber(p[i - 1].y, 12) + ")");
     }
 }
 
@@ -189,10 +179,8 @@ void MonotoneCurve::buildLookup() {
     const std::size_t segments = n - 1;
     const auto build = [&](BucketMap map, std::size_t buckets) {
         m_bucketMap = map;
-        const double lo = map == BucketMap::Log2 ? log2Monotone(m_points.front().x)
-                                                 : m_points.front().x;
-        const double hi =
-            map == BucketMap::Log2 ? log2Monotone(m_points.back().x) : m_points.back().x;
+        const double lo = map == BucketMap::Log2 ? log2Monotone(m_points.front().x) : m_points.front().x;
+        const double hi = map == BucketMap::Log2 ? log2Monotone(m_points.back().x) : m_points.back().x;
         m_bucketOrigin = lo;
         m_bucketScale = static_cast<double>(buckets) / (hi - lo);
         m_bucketMax = static_cast<double>(buckets - 1);
@@ -210,11 +198,10 @@ void MonotoneCurve::buildLookup() {
             single = m_bucketFirst[b + 1] - m_bucketFirst[b] <= 1;
         return single;
     };
-    const bool logOk = m_points.front().x >= std::numeric_limits<double>::min() &&
-                       std::isfinite(log2Monotone(m_points.back().x));
+    const bool logOk =
+        m_points.front().x >= std::numeric_limits<double>::min() && std::isfinite(log2Monotone(m_points.back().x));
     constexpr std::size_t kMaxBucketsPerSegment = 16;
-    for (std::size_t buckets = 2 * segments; buckets <= kMaxBucketsPerSegment * segments;
-         buckets *= 2) {
+    for (std::size_t buckets = 2 * segments; buckets <= kMaxBucketsPerSegment * segments; buckets *= 2) {
         // Prefer the map that separates the points with fewer buckets (a smaller table).
         if (build(BucketMap::Linear, buckets) || (logOk && build(BucketMap::Log2, buckets))) {
             m_singleStep = true;
@@ -239,8 +226,8 @@ std::size_t MonotoneCurve::searchBucket(std::size_t lo, std::size_t hi, double x
 
 std::size_t MonotoneCurve::segment(double x) const {
     // First point with x_k > x, minus one, clamped to a valid segment.
-    const auto it = std::upper_bound(m_points.begin(), m_points.end(), x,
-                                     [](double v, const CurvePoint& q) { return v < q.x; });
+    const auto it =
+        std::upper_bound(m_points.begin(), m_points.end(), x, [](double v, const CurvePoint& q) { return v < q.x; });
     const std::size_t idx = static_cast<std::size_t>(it - m_points.begin());
     return std::clamp<std::size_t>(idx == 0 ? 0 : idx - 1, 0, m_points.size() - 2);
 }
@@ -306,16 +293,13 @@ double MonotoneCurve::integral(double a, double b) const {
         if (ku == kv) {
             sum += segmentPrimitive(ku, sv) - segmentPrimitive(ku, su);
         } else if (kv - ku <= 16) {
-            const auto whole = [&](std::size_t k) {
-                return segmentPrimitive(k, m_points[k + 1].x - m_points[k].x);
-            };
+            const auto whole = [&](std::size_t k) { return segmentPrimitive(k, m_points[k + 1].x - m_points[k].x); };
             sum += whole(ku) - segmentPrimitive(ku, su);
             for (std::size_t k = ku + 1; k < kv; ++k)
                 sum += whole(k);
             sum += segmentPrimitive(kv, sv);
         } else {
-            sum += (m_cumulative[kv] - m_cumulative[ku]) + segmentPrimitive(kv, sv) -
-                   segmentPrimitive(ku, su);
+            sum += (m_cumulative[kv] - m_cumulative[ku]) + segmentPrimitive(kv, sv) - segmentPrimitive(ku, su);
         }
     }
     return sum;
@@ -323,9 +307,9 @@ double MonotoneCurve::integral(double a, double b) const {
 
 void MonotoneCurve::setControlPoint(std::size_t i, double x, double y) {
     if (i >= m_points.size())
-        throw std::out_of_range("sim::MonotoneCurve::setControlPoint(): index " +
-                                std::to_string(i) + " out of range (curve " + m_name + " has " +
-                                std::to_string(m_points.size()) + " control points)");
+        throw std::out_of_range("sim::MonotoneCurve::setControlPoint(): index " + std::to_string(i) +
+                                " out of range (curve " + m_name + " has " + std::to_string(m_points.size()) +
+                                " control points)");
     auto edited = m_points;
     edited[i] = {x, y};
     check(edited);
@@ -335,8 +319,8 @@ void MonotoneCurve::setControlPoint(std::size_t i, double x, double y) {
 
 std::size_t MonotoneCurve::insertControlPoint(double x, double y) {
     auto edited = m_points;
-    const auto it = std::lower_bound(edited.begin(), edited.end(), x,
-                                     [](const CurvePoint& q, double v) { return q.x < v; });
+    const auto it =
+        std::lower_bound(edited.begin(), edited.end(), x, [](const CurvePoint& q, double v) { return q.x < v; });
     const std::size_t idx = static_cast<std::size_t>(it - edited.begin());
     edited.insert(it, CurvePoint{x, y});
     check(edited);
@@ -347,9 +331,9 @@ std::size_t MonotoneCurve::insertControlPoint(double x, double y) {
 
 void MonotoneCurve::removeControlPoint(std::size_t i) {
     if (i >= m_points.size())
-        throw std::out_of_range("sim::MonotoneCurve::removeControlPoint(): index " +
-                                std::to_string(i) + " out of range (curve " + m_name + " has " +
-                                std::to_string(m_points.size()) + " control points)");
+        throw std::out_of_range("sim::MonotoneCurve::removeControlPoint(): index " + std::to_string(i) +
+                                " out of range (curve " + m_name + " has " + std::to_string(m_points.size()) +
+                                " control points)");
     auto edited = m_points;
     edited.erase(edited.begin() + static_cast<std::ptrdiff_t>(i));
     check(edited);

@@ -69,15 +69,14 @@ public:
     /// `name` names the curve in messages ("f'", "h'"); `context` prefixes them
     /// ("material 'liver'"). Throws viscera::InputError when the points are invalid (see
     /// validate()).
-    MonotoneCurve(std::string name, std::vector<CurvePoint> points,
-                  CurveShape shape = CurveShape::StrictlyIncreasing, std::string context = {});
+    MonotoneCurve(std::string name, std::vector<CurvePoint> points, CurveShape shape = CurveShape::StrictlyIncreasing,
+                  std::string context = {});
 
     /// Control points x_k = spaced over [xmin, xmax], y_k = fn(x_k): the interpolant of the
     /// samples. Throws std::invalid_argument for a bad spec (count < 2, xmin ≥ xmax, Geometric
     /// with xmin ≤ 0) and viscera::InputError when a sample is non-finite or, with
     /// StrictlyIncreasing, does not increase.
-    static MonotoneCurve fit(std::string name, const std::function<double(double)>& fn,
-                             const CurveFitSpec& spec);
+    static MonotoneCurve fit(std::string name, const std::function<double(double)>& fn, const CurveFitSpec& spec);
 
     double value(double x) const;      ///< y(x)
     double derivative(double x) const; ///< dy/dx
@@ -156,9 +155,7 @@ private:
     /// Non-decreasing, piecewise-linear stand-in for 2^52 (log2 x + 1022) (x > 0): the bits of x
     /// read as an integer (biased exponent, then mantissa). Exact monotonicity is all the bucket
     /// table relies on.
-    static double log2Monotone(double x) {
-        return static_cast<double>(std::bit_cast<std::int64_t>(x));
-    }
+    static double log2Monotone(double x) { return static_cast<double>(std::bit_cast<std::int64_t>(x)); }
     /// Integrand primitive of a record at offset s: s (y + s (m/2 + s (c/3 + s d/4))), in
     /// Estrin's order (shorter dependency chain than Horner's). The rest table is built with
     /// the same expression, so that integralFromRest(1) is exactly 0.
@@ -188,8 +185,7 @@ private:
 };
 
 inline double MonotoneCurve::bucketCoordinate(double x) const {
-    const double t = ((m_bucketMap == BucketMap::Log2 ? log2Monotone(x) : x) - m_bucketOrigin) *
-                     m_bucketScale;
+    const double t = ((m_bucketMap == BucketMap::Log2 ? log2Monotone(x) : x) - m_bucketOrigin) * m_bucketScale;
     return std::max(0.0, std::min(t, m_bucketMax)); // NaN → 0 (min keeps t, max drops it)
 }
 
@@ -220,8 +216,7 @@ inline MonotoneCurve::Sample MonotoneCurve::sample(double x) const {
 
 inline std::size_t MonotoneCurve::locate(double y) const {
     // n − 1 (no segment) for the linear paths of sample().
-    if (m_linear || !(y > m_segments.front().x && y < m_segments.back().x))
-        return m_segments.size() - 1;
+    if (m_linear || !(y > m_segments.front().x && y < m_segments.back().x)) return m_segments.size() - 1;
     return lookupInterior(y);
 }
 

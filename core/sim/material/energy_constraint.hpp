@@ -46,7 +46,7 @@ public:
 private:
     std::shared_ptr<const EnergyDensity> m_density;
     const CombinedEnergyDensity* m_combined = nullptr; ///< m_density's fused path, if it has one
-    double m_restEnergy; ///< kRestEnergyTolerance · restStiffness()
+    double m_restEnergy;                               ///< kRestEnergyTolerance · restStiffness()
 };
 
 } // namespace viscera::sim

@@ -15,9 +15,8 @@ namespace {
 
 void checkLame(const char* where, double mu, double lambda) {
     if (!(mu > 0) || !std::isfinite(mu) || !(lambda >= 0) || !std::isfinite(lambda))
-        throw std::invalid_argument(std::string(where) + ": mu " + formatNumber(mu, 12) +
-                                    " and lambda " + formatNumber(lambda, 12) +
-                                    " must be finite with mu > 0, lambda >= 0");
+        throw std::invalid_argument(std::string(where) + ": mu " + formatNumber(mu, 12) + " and lambda " +
+                                    formatNumber(lambda, 12) + " must be finite with mu > 0, lambda >= 0");
 }
 
 /// ∂J/∂F = cof(F), columns as cross products of the other two columns of F.
@@ -59,8 +58,7 @@ double LinearElasticDensity::psiAndStress(const Mat3& F, Mat3& P) const {
 
 // --- St. Venant–Kirchhoff ---------------------------------------------------------------------
 
-StVenantKirchhoffDensity::StVenantKirchhoffDensity(double mu, double lambda)
-    : m_mu(mu), m_lambda(lambda) {
+StVenantKirchhoffDensity::StVenantKirchhoffDensity(double mu, double lambda) : m_mu(mu), m_lambda(lambda) {
     checkLame("sim::StVenantKirchhoffDensity()", mu, lambda);
 }
 
@@ -84,8 +82,7 @@ double StVenantKirchhoffDensity::psiAndStress(const Mat3& F, Mat3& P) const {
 
 // --- corotated linear -------------------------------------------------------------------------
 
-CorotatedLinearDensity::CorotatedLinearDensity(double mu, double lambda)
-    : m_mu(mu), m_lambda(lambda) {
+CorotatedLinearDensity::CorotatedLinearDensity(double mu, double lambda) : m_mu(mu), m_lambda(lambda) {
     checkLame("sim::CorotatedLinearDensity()", mu, lambda);
 }
 
@@ -112,12 +109,10 @@ double CorotatedLinearDensity::psiAndStress(const Mat3& F, Mat3& P) const {
 
 // --- Neo-Hookean ------------------------------------------------------------------------------
 
-NeoHookeanDensity::NeoHookeanDensity(double mu, double lambda, double jMin)
-    : m_mu(mu), m_lambda(lambda), m_jMin(jMin) {
+NeoHookeanDensity::NeoHookeanDensity(double mu, double lambda, double jMin) : m_mu(mu), m_lambda(lambda), m_jMin(jMin) {
     checkLame("sim::NeoHookeanDensity()", mu, lambda);
     if (!(jMin > 0 && jMin < 1))
-        throw std::invalid_argument("sim::NeoHookeanDensity(): jMin " + formatNumber(jMin, 12) +
-                                    " must be in (0, 1)");
+        throw std::invalid_argument("sim::NeoHookeanDensity(): jMin " + formatNumber(jMin, 12) + " must be in (0, 1)");
 }
 
 void NeoHookeanDensity::phi(double J, double& value, double& slope) const {
@@ -157,11 +152,9 @@ double NeoHookeanDensity::psiAndStress(const Mat3& F, Mat3& P) const {
 
 // --- factories --------------------------------------------------------------------------------
 
-std::unique_ptr<EnergyDensity> makeEnergyDensity(const std::string& name, double mu,
-                                                 double lambda) {
+std::unique_ptr<EnergyDensity> makeEnergyDensity(const std::string& name, double mu, double lambda) {
     if (name == "linear") return std::make_unique<LinearElasticDensity>(mu, lambda);
-    if (name == "st_venant_kirchhoff")
-        return std::make_unique<StVenantKirchhoffDensity>(mu, lambda);
+    if (name == "st_venant_kirchhoff") return std::make_unique<StVenantKirchhoffDensity>(mu, lambda);
     if (name == "corotated") return std::make_unique<CorotatedLinearDensity>(mu, lambda);
     if (name == "neo_hookean") return std::make_unique<NeoHookeanDensity>(mu, lambda);
     throw InputError("unknown energy density '" + name + "' (supported: " + kLawNames + ")");
@@ -171,13 +164,9 @@ ValanisLandelCurves stVenantKirchhoffCurves(double mu, double lambda) {
     checkLame("sim::stVenantKirchhoffCurves()", mu, lambda);
     ValanisLandelCurves curves;
     const double a = mu + 0.5 * lambda;
-    curves.fPrime =
-        MonotoneCurve::fit("f'", [a, lambda](double x) { return a * (x * x * x - x) - lambda * x; },
-                           {.xmin = -4.0,
-                            .xmax = 4.0,
-                            .count = 17,
-                            .spacing = CurveSpacing::Uniform,
-                            .shape = CurveShape::Unconstrained});
+    curves.fPrime = MonotoneCurve::fit(
+        "f'", [a, lambda](double x) { return a * (x * x * x - x) - lambda * x; },
+        {.xmin = -4.0, .xmax = 4.0, .count = 17, .spacing = CurveSpacing::Uniform, .shape = CurveShape::Unconstrained});
     if (lambda > 0)
         curves.gPrime = MonotoneCurve::fit("g'", [lambda](double y) { return 0.5 * lambda * y; },
                                            {.xmin = -16.0,
@@ -191,13 +180,13 @@ ValanisLandelCurves stVenantKirchhoffCurves(double mu, double lambda) {
 ValanisLandelCurves corotatedCurves(double mu, double lambda) {
     checkLame("sim::corotatedCurves()", mu, lambda);
     ValanisLandelCurves curves;
-    curves.fPrime = MonotoneCurve::fit(
-        "f'", [mu, lambda](double x) { return (2.0 * mu + lambda) * (x - 1.0) - 2.0 * lambda; },
-        {.xmin = -4.0,
-         .xmax = 4.0,
-         .count = 9,
-         .spacing = CurveSpacing::Uniform,
-         .shape = CurveShape::StrictlyIncreasing});
+    curves.fPrime =
+        MonotoneCurve::fit("f'", [mu, lambda](double x) { return (2.0 * mu + lambda) * (x - 1.0) - 2.0 * lambda; },
+                           {.xmin = -4.0,
+                            .xmax = 4.0,
+                            .count = 9,
+                            .spacing = CurveSpacing::Uniform,
+                            .shape = CurveShape::StrictlyIncreasing});
     if (lambda > 0)
         curves.gPrime = MonotoneCurve::fit("g'", [lambda](double) { return lambda; },
                                            {.xmin = -16.0,

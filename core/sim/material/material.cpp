@@ -18,18 +18,22 @@ struct ModelName {
     const char* name;
 };
 constexpr ModelName kNames[] = {
-    {MaterialModel::StableNeoHookean, "stable_neo_hookean"}, {MaterialModel::NeoHookean, "neo_hookean"},
-    {MaterialModel::Linear, "linear"},                       {MaterialModel::StVenantKirchhoff, "st_venant_kirchhoff"},
-    {MaterialModel::Corotated, "corotated"},                 {MaterialModel::ValanisLandel, "valanis_landel"},
+    {MaterialModel::StableNeoHookean, "stable_neo_hookean"},
+    {MaterialModel::NeoHookean, "neo_hookean"},
+    {MaterialModel::Linear, "linear"},
+    {MaterialModel::StVenantKirchhoff, "st_venant_kirchhoff"},
+    {MaterialModel::Corotated, "corotated"},
+    {MaterialModel::ValanisLandel, "valanis_landel"},
 };
 
 std::optional<MonotoneCurve> curveFrom(const std::optional<CurveDesc>& d, const char* name, const std::string& ctx) {
     if (!d) return std::nullopt;
     std::vector<CurvePoint> pts;
     pts.reserve(d->points.size());
-    for (const auto& p : d->points) pts.push_back({p[0], p[1]});
-    return MonotoneCurve(name, std::move(pts), d->unconstrained ? CurveShape::Unconstrained : CurveShape::StrictlyIncreasing,
-                         ctx);
+    for (const auto& p : d->points)
+        pts.push_back({p[0], p[1]});
+    return MonotoneCurve(name, std::move(pts),
+                         d->unconstrained ? CurveShape::Unconstrained : CurveShape::StrictlyIncreasing, ctx);
 }
 
 } // namespace
@@ -54,7 +58,8 @@ MaterialModel materialModelFromName(const std::string& name) {
     for (const auto& n : kNames)
         if (name == n.name) return n.model;
     std::string list;
-    for (const auto& n : kNames) list += (list.empty() ? "" : ", ") + std::string(n.name);
+    for (const auto& n : kNames)
+        list += (list.empty() ? "" : ", ") + std::string(n.name);
     throw std::invalid_argument("unknown material model '" + name + "' (supported: " + list + ")");
 }
 
@@ -67,7 +72,8 @@ std::string materialModelName(MaterialModel model) {
 const std::vector<std::string>& materialModelNames() {
     static const std::vector<std::string> names = [] {
         std::vector<std::string> v;
-        for (const auto& n : kNames) v.push_back(n.name);
+        for (const auto& n : kNames)
+            v.push_back(n.name);
         return v;
     }();
     return names;
@@ -77,7 +83,8 @@ std::shared_ptr<const TetConstraintModel> makeConstraintModel(const Material& m,
     const std::string ctx = "material '" + materialName + "'";
     if (auto why = validate(m); !why.empty()) throw InputError(ctx + ": " + why);
     switch (m.model) {
-    case MaterialModel::StableNeoHookean: return std::make_shared<StableNeoHookeanModel>(m.mu(), m.lambda());
+    case MaterialModel::StableNeoHookean:
+        return std::make_shared<StableNeoHookeanModel>(m.mu(), m.lambda());
     case MaterialModel::NeoHookean:
     case MaterialModel::Linear:
     case MaterialModel::StVenantKirchhoff:

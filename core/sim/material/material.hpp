@@ -37,8 +37,8 @@ struct Material {
     std::string curvePreset;
     std::optional<CurveDesc> fPrime, gPrime, hPrime;
 
-    double mu() const { return youngsModulus / (2.0 * (1.0 + poissonRatio)); }     ///< Pa
-    double lambda() const {                                                          ///< Pa
+    double mu() const { return youngsModulus / (2.0 * (1.0 + poissonRatio)); } ///< Pa
+    double lambda() const {                                                    ///< Pa
         return youngsModulus * poissonRatio / ((1.0 + poissonRatio) * (1.0 - 2.0 * poissonRatio));
     }
 };

@@ -28,13 +28,12 @@ double curveSlope(const std::optional<MonotoneCurve>& c, double x) {
 /// evaluated in Estrin's order. The root is analytic on [0, 1] (its branch point is r = −1);
 /// error below 7e-16 (3 ulp) in double, so p β has the accuracy of the cubic's coefficients.
 double largestDepressedCubicRoot(double r) {
-    constexpr double c[18] = {
-        1.8793852415718166,     0.13164361454489953,    -0.012862827975309531,
-        0.002213309911670022,   -0.0004672905593236235, 0.00010982883739243108,
-        -2.7582551520811382e-05, 7.2465777463647e-06,   -1.967100732486947e-06,
-        5.473607998941967e-07,  -1.552200855299401e-07, 4.473191705071068e-08,
-        -1.3186905785460066e-08, 3.8929562920498784e-09, -1.032444158601723e-09,
-        3.08997060034581e-10,   -1.610559523763899e-10, 4.9182677563478205e-11};
+    constexpr double c[18] = {1.8793852415718166,      0.13164361454489953,    -0.012862827975309531,
+                              0.002213309911670022,    -0.0004672905593236235, 0.00010982883739243108,
+                              -2.7582551520811382e-05, 7.2465777463647e-06,    -1.967100732486947e-06,
+                              5.473607998941967e-07,   -1.552200855299401e-07, 4.473191705071068e-08,
+                              -1.3186905785460066e-08, 3.8929562920498784e-09, -1.032444158601723e-09,
+                              3.08997060034581e-10,    -1.610559523763899e-10, 4.9182677563478205e-11};
     const double t = 2.0 * r - 1.0;
     const double t2 = t * t, t4 = t2 * t2, t8 = t4 * t4, t16 = t8 * t8;
     const auto pair = [&](int i) { return c[i] + c[i + 1] * t; };
@@ -87,20 +86,19 @@ struct EigenFrame {
     V3 c[3];
     double k[3];
 };
-[[gnu::always_inline]] inline EigenFrame eigenFrame(double a00, double a11, double a22,
-                                                    double a01, double a02, double a12) {
+[[gnu::always_inline]] inline EigenFrame eigenFrame(double a00, double a11, double a22, double a01, double a02,
+                                                    double a12) {
     const EigenFrame identity{{{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}}, {1.0, 1.0, 1.0}};
     // B = A − qI: eigenvalues q + p β with p² = tr(B²)/6 (the spread) and β³ − 3β = 2r,
     // r = det(B) / (2p³) in [−1, 1].
     const double q = (a00 + a11 + a22) * (1.0 / 3.0);
     const double b00 = a00 - q, b11 = a11 - q, b22 = a22 - q;
-    const double p2 = (b00 * b00 + b11 * b11 + b22 * b22) * (1.0 / 6.0) +
-                      (a01 * a01 + a02 * a02 + a12 * a12) * (1.0 / 3.0);
+    const double p2 =
+        (b00 * b00 + b11 * b11 + b22 * b22) * (1.0 / 6.0) + (a01 * a01 + a02 * a02 + a12 * a12) * (1.0 / 3.0);
     // Isotropic to far below rounding (spread < 1e-30 q): every basis diagonalizes A.
     if (!(p2 > 1e-60 * q * q)) return identity;
     const double p = std::sqrt(p2);
-    const double detB = b00 * (b11 * b22 - a12 * a12) - a01 * (a01 * b22 - a12 * a02) +
-                        a02 * (a01 * a12 - b11 * a02);
+    const double detB = b00 * (b11 * b22 - a12 * a12) - a01 * (a01 * b22 - a12 * a02) + a02 * (a01 * a12 - b11 * a02);
     const double r = std::clamp(detB / (2.0 * p2 * p2) * p, -1.0, 1.0);
     // The extreme root on the side of r (largest for r ≥ 0, smallest for r < 0) has
     // |β| ≥ √3 while the other two lie in [−√3, 1] (resp. [−1, √3]): a simple eigenvalue,
@@ -153,7 +151,7 @@ struct EigenFrame {
     double norm2 = 2.0 * rr * big; // |(ca, sa)|²
     // (ca, sa) ∝ eigenvector of the larger eigenvalue: (big, m) for h ≥ 0, else (m, big).
     double ca = h >= 0 ? big : m, sa = h >= 0 ? m : big; // compiled to compare masks
-    if (!(norm2 > 0)) { // equal eigenvalues: any rotation
+    if (!(norm2 > 0)) {                                  // equal eigenvalues: any rotation
         ca = 1.0;
         sa = 0.0;
         norm2 = 1.0;
@@ -174,8 +172,7 @@ struct EigenFrame {
 /// possible, since U = F V diag(1/σ) does not depend on their lengths.
 [[gnu::always_inline]] inline SignedSvd signedSvdScaled(const Mat3& F) {
     const V3 f0 = column(F, 0), f1 = column(F, 1), f2 = column(F, 2);
-    const EigenFrame e = eigenFrame(dot(f0, f0), dot(f1, f1), dot(f2, f2), dot(f0, f1),
-                                    dot(f0, f2), dot(f1, f2));
+    const EigenFrame e = eigenFrame(dot(f0, f0), dot(f1, f1), dot(f2, f2), dot(f0, f1), dot(f0, f2), dot(f1, f2));
     const V3 c0 = e.c[0], c1 = e.c[1], c2 = e.c[2];
     const double k0 = e.k[0], k1 = e.k[1], k2 = e.k[2];
     SignedSvd out;
@@ -233,9 +230,7 @@ struct EigenFrame {
             u1 = (1.0 / n1) * h1;
         } else { // rank 1: any unit vector orthogonal to u0
             const double ax = std::abs(u0.x), ay = std::abs(u0.y), az = std::abs(u0.z);
-            const V3 axis = ax <= ay && ax <= az ? V3{1.0, 0.0, 0.0}
-                            : ay <= az           ? V3{0.0, 1.0, 0.0}
-                                                 : V3{0.0, 0.0, 1.0};
+            const V3 axis = ax <= ay && ax <= az ? V3{1.0, 0.0, 0.0} : ay <= az ? V3{0.0, 1.0, 0.0} : V3{0.0, 0.0, 1.0};
             const V3 t = cross(u0, axis);
             u1 = (1.0 / std::sqrt(dot(t, t))) * t;
         }
@@ -319,32 +314,27 @@ ValanisLandelDensity::ValanisLandelDensity(std::string materialName, ValanisLand
     const auto describe = [&](const char* label, const std::optional<MonotoneCurve>& c, double v) {
         return std::string(label) + (c ? "(1)=" + formatNumber(v, 12) : " absent");
     };
-    const std::string values =
-        describe("f'", f, f1) + ", " + describe("g'", g, g1) + ", " + describe("h'", h, h1);
+    const std::string values = describe("f'", f, f1) + ", " + describe("g'", g, g1) + ", " + describe("h'", h, h1);
     const double rest = f1 + 2.0 * g1 + h1;
-    const double scale =
-        std::max({std::abs(f1), std::abs(2.0 * g1), std::abs(h1), std::abs(m_restStiffness)});
+    const double scale = std::max({std::abs(f1), std::abs(2.0 * g1), std::abs(h1), std::abs(m_restStiffness)});
     if (!(std::abs(rest) <= kRestStressTolerance * scale))
-        throw InputError(where + ": stress at rest f'(1) + 2 g'(1) + h'(1) = " +
-                         formatNumber(rest, 12) + " Pa is not zero (" + values + ")");
+        throw InputError(where + ": stress at rest f'(1) + 2 g'(1) + h'(1) = " + formatNumber(rest, 12) +
+                         " Pa is not zero (" + values + ")");
     if (!(m_restStiffness > 0))
         throw InputError(where + ": stiffness at rest f''(1) + 2 g''(1) + h''(1) = " +
-                         formatNumber(m_restStiffness, 12) + " Pa is not positive (" + values +
-                         ")");
+                         formatNumber(m_restStiffness, 12) + " Pa is not positive (" + values + ")");
     if (!(m_shearModulus > 0))
         throw InputError(where + ": shear modulus at rest (f''(1) + g''(1) - g'(1) - h'(1))/2 = " +
                          formatNumber(m_shearModulus, 12) + " Pa is not positive (" + values + ")");
 }
 
-inline double ValanisLandelDensity::principal(const Eigen::Vector3d& s,
-                                              const MonotoneCurve::Sample& hJ,
-                                       Eigen::Vector3d* d) const {
+inline double ValanisLandelDensity::principal(const Eigen::Vector3d& s, const MonotoneCurve::Sample& hJ,
+                                              Eigen::Vector3d* d) const {
     const auto& c = m_curves;
     double e = 0;
     Eigen::Vector3d dpsi = Eigen::Vector3d::Zero();
     if (c.fPrime) {
-        const auto f0 = c.fPrime->sample(s(0)), f1 = c.fPrime->sample(s(1)),
-                   f2 = c.fPrime->sample(s(2));
+        const auto f0 = c.fPrime->sample(s(0)), f1 = c.fPrime->sample(s(1)), f2 = c.fPrime->sample(s(2));
         e += f0.integralFromRest + f1.integralFromRest + f2.integralFromRest;
         dpsi = Eigen::Vector3d(f0.value, f1.value, f2.value);
     }
@@ -407,12 +397,10 @@ double ValanisLandelDensity::psiAndStress(const Mat3& F, Mat3& P) const {
     return evaluate(F, &P);
 }
 
-ValanisLandelCurves neoHookeanCurves(double mu, double lambda,
-                                     const NeoHookeanCurveOptions& options) {
+ValanisLandelCurves neoHookeanCurves(double mu, double lambda, const NeoHookeanCurveOptions& options) {
     if (!(mu > 0) || !std::isfinite(mu) || !(lambda >= 0) || !std::isfinite(lambda))
-        throw std::invalid_argument("sim::neoHookeanCurves(): mu " + formatNumber(mu, 12) +
-                                    " and lambda " + formatNumber(lambda, 12) +
-                                    " must be finite with mu > 0, lambda >= 0");
+        throw std::invalid_argument("sim::neoHookeanCurves(): mu " + formatNumber(mu, 12) + " and lambda " +
+                                    formatNumber(lambda, 12) + " must be finite with mu > 0, lambda >= 0");
     ValanisLandelCurves curves;
     curves.fPrime = MonotoneCurve::fit("f'", [mu](double x) { return mu * x; },
                                        {.xmin = options.stretchMin,
@@ -421,16 +409,14 @@ ValanisLandelCurves neoHookeanCurves(double mu, double lambda,
                                         .spacing = CurveSpacing::Geometric,
                                         .shape = CurveShape::StrictlyIncreasing});
     // h′ peaks at J = exp(1 + μ/λ) (h″ = (μ + λ(1 − log J))/J²).
-    const double peak =
-        lambda > 0 ? std::exp(1.0 + mu / lambda) : std::numeric_limits<double>::infinity();
-    curves.hPrime =
-        MonotoneCurve::fit("h'", [mu, lambda](double J) { return (lambda * std::log(J) - mu) / J; },
-                           {.xmin = options.volumeMin,
-                            .xmax = options.volumeMax,
-                            .count = options.volumeCount,
-                            .spacing = CurveSpacing::Geometric,
-                            .shape = options.volumeMax < peak ? CurveShape::StrictlyIncreasing
-                                                              : CurveShape::Unconstrained});
+    const double peak = lambda > 0 ? std::exp(1.0 + mu / lambda) : std::numeric_limits<double>::infinity();
+    curves.hPrime = MonotoneCurve::fit(
+        "h'", [mu, lambda](double J) { return (lambda * std::log(J) - mu) / J; },
+        {.xmin = options.volumeMin,
+         .xmax = options.volumeMax,
+         .count = options.volumeCount,
+         .spacing = CurveSpacing::Geometric,
+         .shape = options.volumeMax < peak ? CurveShape::StrictlyIncreasing : CurveShape::Unconstrained});
     return curves;
 }
 

@@ -86,8 +86,7 @@ public:
 private:
     /// Ψ at signed stretches s, with hJ = h′ and h at J = s1 s2 s3 (zero when h′ is absent);
     /// writes ∂Ψ/∂s_i into d when d is not null.
-    double principal(const Eigen::Vector3d& s, const MonotoneCurve::Sample& hJ,
-                     Eigen::Vector3d* d) const;
+    double principal(const Eigen::Vector3d& s, const MonotoneCurve::Sample& hJ, Eigen::Vector3d* d) const;
     /// Ψ(F), and P(F) into P when not null: the one path behind psi(), stress(), psiAndStress().
     double evaluate(const Mat3& F, Mat3* P) const;
 
@@ -117,7 +116,6 @@ struct NeoHookeanCurveOptions {
 /// (λ = 10μ), past which Ψ would decrease with J: keep volumeMax above the volume ratios a
 /// simulation reaches (the default allows a stretch of 4.6 in every direction).
 /// Lamé μ > 0, λ ≥ 0 (Pa); throws std::invalid_argument otherwise.
-ValanisLandelCurves neoHookeanCurves(double mu, double lambda,
-                                     const NeoHookeanCurveOptions& options = {});
+ValanisLandelCurves neoHookeanCurves(double mu, double lambda, const NeoHookeanCurveOptions& options = {});
 
 } // namespace viscera::sim

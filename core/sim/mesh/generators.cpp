@@ -18,8 +18,8 @@ std::unique_ptr<TetMesh> makeBoxTetMesh(const BoxSpec& spec) {
     for (int k = 0; k <= nz; ++k)
         for (int j = 0; j <= ny; ++j)
             for (int i = 0; i <= nx; ++i)
-                pos.push_back(spec.origin + Vec3(spec.size.x() * i / nx, spec.size.y() * j / ny,
-                                                 spec.size.z() * k / nz));
+                pos.push_back(spec.origin +
+                              Vec3(spec.size.x() * i / nx, spec.size.y() * j / ny, spec.size.z() * k / nz));
     // Kuhn subdivision: 6 tets per cube along monotone paths from corner (0,0,0) to (1,1,1).
     static constexpr int kPerm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
     std::vector<Tet> tets;
@@ -53,20 +53,21 @@ TriMesh makeEllipsoidSurface(const Vec3& center, const Vec3& radii, int slices, 
         for (int l = 0; l < slices; ++l) {
             const double ph = 2.0 * std::numbers::pi * l / slices;
             pos.push_back(center + Vec3(radii.x() * std::sin(th) * std::cos(ph),
-                                        radii.y() * std::sin(th) * std::sin(ph),
-                                        radii.z() * std::cos(th)));
+                                        radii.y() * std::sin(th) * std::sin(ph), radii.z() * std::cos(th)));
         }
     }
     pos.push_back(center - Vec3(0, 0, radii.z())); // south pole
     const auto south = static_cast<int32_t>(pos.size() - 1);
     auto ring = [&](int s, int l) { return static_cast<int32_t>(1 + (s - 1) * slices + (l % slices)); };
-    for (int l = 0; l < slices; ++l) tris.push_back({0, ring(1, l), ring(1, l + 1)});
+    for (int l = 0; l < slices; ++l)
+        tris.push_back({0, ring(1, l), ring(1, l + 1)});
     for (int s = 1; s + 1 < stacks; ++s)
         for (int l = 0; l < slices; ++l) {
             tris.push_back({ring(s, l), ring(s + 1, l), ring(s + 1, l + 1)});
             tris.push_back({ring(s, l), ring(s + 1, l + 1), ring(s, l + 1)});
         }
-    for (int l = 0; l < slices; ++l) tris.push_back({south, ring(stacks - 1, l + 1), ring(stacks - 1, l)});
+    for (int l = 0; l < slices; ++l)
+        tris.push_back({south, ring(stacks - 1, l + 1), ring(stacks - 1, l)});
     return TriMesh::fromArrays(std::move(pos), std::move(tris), "sim::makeEllipsoidSurface()");
 }
 

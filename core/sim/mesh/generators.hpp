@@ -9,8 +9,8 @@
 namespace viscera::sim {
 
 struct BoxSpec {
-    Vec3 origin = Vec3::Zero();          ///< minimum corner, metres
-    Vec3 size = Vec3(0.1, 0.02, 0.04);   ///< edge lengths, metres
+    Vec3 origin = Vec3::Zero();            ///< minimum corner, metres
+    Vec3 size = Vec3(0.1, 0.02, 0.04);     ///< edge lengths, metres
     std::array<int, 3> cells = {10, 2, 4}; ///< hexahedral cells per axis (each split into 6 tets)
 };
 
@@ -38,12 +38,12 @@ TriMesh makeBoxSurface(const Vec3& min, const Vec3& max);
 namespace viscera::sim {
 
 struct HollowTubeSpec {
-    Vec3 start = Vec3::Zero();           ///< axis start, metres
-    Vec3 end = Vec3(0, 0, 0.02);         ///< axis end, metres
+    Vec3 start = Vec3::Zero();                       ///< axis start, metres
+    Vec3 end = Vec3(0, 0, 0.02);                     ///< axis end, metres
     double innerRadius = 0.003, outerRadius = 0.004; ///< metres, 0 < inner < outer
-    int slices = 32;                     ///< cells around (>= 3)
-    int layers = 2;                      ///< cells through the wall (>= 1)
-    int rings = 8;                       ///< cells along the axis (>= 1)
+    int slices = 32;                                 ///< cells around (>= 3)
+    int layers = 2;                                  ///< cells through the wall (>= 1)
+    int rings = 8;                                   ///< cells along the axis (>= 1)
 };
 
 /// Structured hollow tube (a vessel): (slices × layers × rings) hexahedral cells in (θ, r, axis),

@@ -102,7 +102,9 @@ std::unique_ptr<TetMesh> parseVtet(std::string_view text, const std::string& ori
     }
 }
 
-std::string formatVtet(const TetMesh& mesh) { return formatElements<4>("vtet", "tets", mesh.positions(), mesh.tets()); }
+std::string formatVtet(const TetMesh& mesh) {
+    return formatElements<4>("vtet", "tets", mesh.positions(), mesh.tets());
+}
 
 TriMesh parseVtri(std::string_view text, const std::string& origin) {
     LineReader in(text, origin);

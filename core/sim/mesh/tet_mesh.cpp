@@ -34,25 +34,22 @@ bool containsValue(const std::vector<int32_t>& v, int32_t x) {
 std::unique_ptr<TetMesh> TetMesh::fromArrays(std::vector<Vec3> positions, std::vector<Tet> tets,
                                              const std::string& origin) {
     if (tets.empty()) throw std::invalid_argument(origin + ": mesh has no tets");
-    if (tets.size() > (size_t{1} << 29))
-        throw std::invalid_argument(origin + ": mesh has more than 2^29 tets");
+    if (tets.size() > (size_t{1} << 29)) throw std::invalid_argument(origin + ": mesh has more than 2^29 tets");
     for (size_t v = 0; v < positions.size(); ++v)
         if (!positions[v].allFinite())
-            throw std::invalid_argument(origin + ": vertex " + std::to_string(v) +
-                                        " has a non-finite coordinate");
+            throw std::invalid_argument(origin + ": vertex " + std::to_string(v) + " has a non-finite coordinate");
     const auto n = static_cast<int64_t>(positions.size());
     for (size_t t = 0; t < tets.size(); ++t) {
         const Tet& e = tets[t];
         for (int k = 0; k < 4; ++k)
             if (e[k] < 0 || e[k] >= n)
-                throw std::invalid_argument(origin + ": tet " + std::to_string(t) +
-                                            " references vertex " + std::to_string(e[k]) +
-                                            " (mesh has " + std::to_string(n) + " vertices)");
+                throw std::invalid_argument(origin + ": tet " + std::to_string(t) + " references vertex " +
+                                            std::to_string(e[k]) + " (mesh has " + std::to_string(n) + " vertices)");
         for (int a = 0; a < 4; ++a)
             for (int b = a + 1; b < 4; ++b)
                 if (e[a] == e[b])
-                    throw std::invalid_argument(origin + ": tet " + std::to_string(t) +
-                                                " repeats vertex " + std::to_string(e[a]));
+                    throw std::invalid_argument(origin + ": tet " + std::to_string(t) + " repeats vertex " +
+                                                std::to_string(e[a]));
     }
     std::unique_ptr<TetMesh> m(new TetMesh());
     m->m_positions = std::move(positions);
@@ -93,8 +90,7 @@ double TetMesh::signedVolume(int32_t t) const {
 Eigen::Vector4d TetMesh::barycentric(int32_t t, const Vec3& p) const {
     // Cramer's rule [B eq. 2.3]: xi_i = vol(tet with v_i replaced by p) / vol(tet).
     const Tet& e = m_tets[t];
-    const Vec3* v[4] = {&m_positions[e[0]], &m_positions[e[1]], &m_positions[e[2]],
-                        &m_positions[e[3]]};
+    const Vec3* v[4] = {&m_positions[e[0]], &m_positions[e[1]], &m_positions[e[2]], &m_positions[e[3]]};
     const double vol = tetVolume(*v[0], *v[1], *v[2], *v[3]);
     Eigen::Vector4d xi;
     for (int i = 0; i < 4; ++i) {
@@ -115,7 +111,9 @@ HalfEdge TetMesh::hePrev(HalfEdge e) {
     return {e.f, base + kP[e.f & 3][e.v & 3]};
 }
 
-HalfEdge TetMesh::heMate(HalfEdge e) { return {hePrev(e).v, heNext(e).v}; }
+HalfEdge TetMesh::heMate(HalfEdge e) {
+    return {hePrev(e).v, heNext(e).v};
+}
 
 HalfEdge TetMesh::heRadial(HalfEdge e) const {
     requireAtLeast(1, "heRadial");
@@ -138,8 +136,7 @@ std::array<int32_t, 2> TetMesh::halfEdgeVertices(HalfEdge e) const {
 void TetMesh::requireAtLeast(int level, const char* query) const {
     if (m_level < level)
         throw std::logic_error(std::string("sim::TetMesh::") + query + "(): requires adjacency level " +
-                               std::to_string(level) + "; call requireLevel(" +
-                               std::to_string(level) + ") first");
+                               std::to_string(level) + "; call requireLevel(" + std::to_string(level) + ") first");
 }
 
 int32_t TetMesh::opp(int32_t f) const {
@@ -169,18 +166,18 @@ void TetMesh::buildLevel1(const std::string& origin) {
         std::sort(v.begin(), v.end());
         keys[f] = {v, f};
     }
-    std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
-        return a.v != b.v ? a.v < b.v : a.hf < b.hf;
-    });
+    std::sort(keys.begin(), keys.end(),
+              [](const Key& a, const Key& b) { return a.v != b.v ? a.v < b.v : a.hf < b.hf; });
     m_opp.assign(nhf, kNone);
     for (int32_t i = 0; i < nhf;) {
         int32_t j = i + 1;
-        while (j < nhf && keys[j].v == keys[i].v) ++j;
+        while (j < nhf && keys[j].v == keys[i].v)
+            ++j;
         if (j - i > 2)
-            throw std::invalid_argument(
-                origin + ": facet (" + std::to_string(keys[i].v[0]) + ", " +
-                std::to_string(keys[i].v[1]) + ", " + std::to_string(keys[i].v[2]) + ") is shared by " +
-                std::to_string(j - i) + " tets (non-manifold; at most 2 allowed)");
+            throw std::invalid_argument(origin + ": facet (" + std::to_string(keys[i].v[0]) + ", " +
+                                        std::to_string(keys[i].v[1]) + ", " + std::to_string(keys[i].v[2]) +
+                                        ") is shared by " + std::to_string(j - i) +
+                                        " tets (non-manifold; at most 2 allowed)");
         if (j - i == 2) {
             m_opp[keys[i].hf] = keys[i + 1].hf;
             m_opp[keys[i + 1].hf] = keys[i].hf;
@@ -228,8 +225,7 @@ void TetMesh::buildLevel2() {
                 // In `face`, the half-edge starting at i goes to kP[i][face]; pick the direction
                 // that lies along (i, j).
                 const int start = kP[i][face] == j ? i : j;
-                keys.push_back({std::min(e[i], e[j]), std::max(e[i], e[j]),
-                                HalfEdge{4 * t + face, 4 * t + start}});
+                keys.push_back({std::min(e[i], e[j]), std::max(e[i], e[j]), HalfEdge{4 * t + face, 4 * t + start}});
             }
         }
     }
@@ -254,8 +250,10 @@ void TetMesh::buildLevel2() {
         i = j;
     }
     m_vertEdgeStart.assign(m_positions.size() + 1, 0);
-    for (const auto& ev : m_edgeVerts) ++m_vertEdgeStart[ev[0] + 1];
-    for (size_t v = 0; v < m_positions.size(); ++v) m_vertEdgeStart[v + 1] += m_vertEdgeStart[v];
+    for (const auto& ev : m_edgeVerts)
+        ++m_vertEdgeStart[ev[0] + 1];
+    for (size_t v = 0; v < m_positions.size(); ++v)
+        m_vertEdgeStart[v + 1] += m_vertEdgeStart[v];
     // Vertex -> half-facet, preferring boundary half-facets.
     m_vertHf.assign(m_positions.size(), kNone);
     for (int32_t f = 0; f < nhf; ++f) {
@@ -289,7 +287,8 @@ void TetMesh::buildLevel3() {
     }
     std::vector<Vec3> pos;
     pos.reserve(m_boundaryVerts.size());
-    for (int32_t v : m_boundaryVerts) pos.push_back(m_positions[v]);
+    for (int32_t v : m_boundaryVerts)
+        pos.push_back(m_positions[v]);
     m_boundary = TriMesh::fromArrays(std::move(pos), std::move(tris), "sim::TetMesh boundary");
     m_level = 3;
 }
@@ -361,7 +360,8 @@ void TetMesh::starFacetsOfVertexInto(int32_t v, std::vector<int32_t>& out) const
     cellsOfVertexInto(v, cells);
     out.clear();
     for (int32_t t : cells)
-        for (int i = 0; i < 4; ++i) out.push_back(4 * t + i);
+        for (int i = 0; i < 4; ++i)
+            out.push_back(4 * t + i);
 }
 
 void TetMesh::openStarFacetsOfVertexInto(int32_t v, std::vector<int32_t>& out) const {
@@ -387,8 +387,7 @@ namespace {
 /// EdgeSweep of [B Alg. 2.4/2.5]: alternates mate (same cell) and radial (next cell) from a,
 /// calling visit(half-edge, mate) once per cell, until the boundary or the start is reached.
 /// Returns false when it stopped at the boundary.
-template <class Visit>
-bool edgeSweep(const TetMesh& m, HalfEdge a, int32_t stopF, Visit&& visit) {
+template <class Visit> bool edgeSweep(const TetMesh& m, HalfEdge a, int32_t stopF, Visit&& visit) {
     do {
         const HalfEdge mate = TetMesh::heMate(a);
         visit(a, mate);
@@ -455,14 +454,14 @@ QualityReport TetMesh::quality(const QualityRules& rules) const {
     double sumRatio = 0;
     for (int32_t t = 0; t < static_cast<int32_t>(m_tets.size()); ++t) {
         const Tet& e = m_tets[t];
-        const Vec3 p[4] = {m_positions[e[0]], m_positions[e[1]], m_positions[e[2]],
-                           m_positions[e[3]]};
+        const Vec3 p[4] = {m_positions[e[0]], m_positions[e[1]], m_positions[e[2]], m_positions[e[3]]};
         const double vol = tetVolume(p[0], p[1], p[2], p[3]);
         r.minVolume = std::min(r.minVolume, vol);
         r.maxVolume = std::max(r.maxVolume, vol);
         r.totalVolume += vol;
         double sumSq = 0;
-        for (const auto& k : kEdge) sumSq += (p[k[0]] - p[k[1]]).squaredNorm();
+        for (const auto& k : kEdge)
+            sumSq += (p[k[0]] - p[k[1]]).squaredNorm();
         const double meanEdge = std::sqrt(sumSq / 6.0);
         const double ratio = sumSq > 0 ? 12.0 * std::cbrt(9.0 * vol * vol) / sumSq : 0.0;
         r.minMeanRatio = std::min(r.minMeanRatio, ratio);
@@ -504,9 +503,9 @@ QualityReport TetMesh::quality(const QualityRules& rules) const {
 size_t TetMesh::adjacencyBytes() const {
     return m_opp.capacity() * sizeof(int32_t) + m_facetHf.capacity() * sizeof(int32_t) +
            m_hfFacet.capacity() * sizeof(int32_t) + m_edgeHe.capacity() * sizeof(HalfEdge) +
-           m_edgeVerts.capacity() * sizeof(std::array<int32_t, 2>) +
-           m_vertEdgeStart.capacity() * sizeof(int32_t) + m_vertHf.capacity() * sizeof(int32_t) +
-           m_boundaryHf.capacity() * sizeof(int32_t) + m_boundaryVerts.capacity() * sizeof(int32_t);
+           m_edgeVerts.capacity() * sizeof(std::array<int32_t, 2>) + m_vertEdgeStart.capacity() * sizeof(int32_t) +
+           m_vertHf.capacity() * sizeof(int32_t) + m_boundaryHf.capacity() * sizeof(int32_t) +
+           m_boundaryVerts.capacity() * sizeof(int32_t);
 }
 
 } // namespace viscera::sim

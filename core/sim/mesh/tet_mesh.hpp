@@ -38,9 +38,9 @@ struct HalfEdge {
 
 /// Per-element quality figures and the elements that fail the rules.
 struct QualityReport {
-    std::vector<int32_t> inverted;   ///< signed volume < 0
-    std::vector<int32_t> degenerate; ///< |volume| <= degenerateRelVolume · (mean edge)^3
-    std::vector<int32_t> slivers;    ///< not degenerate, min dihedral angle < sliverAngleDeg
+    std::vector<int32_t> inverted;                        ///< signed volume < 0
+    std::vector<int32_t> degenerate;                      ///< |volume| <= degenerateRelVolume · (mean edge)^3
+    std::vector<int32_t> slivers;                         ///< not degenerate, min dihedral angle < sliverAngleDeg
     double minVolume = 0, maxVolume = 0, totalVolume = 0; ///< m^3, signed
     double minDihedralDeg = 0, maxDihedralDeg = 0;
     double minMeanRatio = 0, meanMeanRatio = 0; ///< mean-ratio quality in (0, 1], 1 = regular
@@ -163,12 +163,12 @@ private:
     // level 1
     std::vector<int32_t> m_opp;
     // level 2
-    std::vector<int32_t> m_facetHf;      // F
-    std::vector<int32_t> m_hfFacet;      // half-facet -> facet
-    std::vector<HalfEdge> m_edgeHe;      // E
+    std::vector<int32_t> m_facetHf; // F
+    std::vector<int32_t> m_hfFacet; // half-facet -> facet
+    std::vector<HalfEdge> m_edgeHe; // E
     std::vector<std::array<int32_t, 2>> m_edgeVerts;
     std::vector<int32_t> m_vertEdgeStart; // CSR by smaller vertex into m_edgeVerts (sorted)
-    std::vector<int32_t> m_vertHf;       // I
+    std::vector<int32_t> m_vertHf;        // I
     // level 3
     TriMesh m_boundary;
     std::vector<int32_t> m_boundaryHf;

@@ -9,24 +9,20 @@
 
 namespace viscera::sim {
 
-TriMesh TriMesh::fromArrays(std::vector<Vec3> positions, std::vector<Tri> triangles,
-                            const std::string& origin) {
+TriMesh TriMesh::fromArrays(std::vector<Vec3> positions, std::vector<Tri> triangles, const std::string& origin) {
     if (triangles.empty()) throw std::invalid_argument(origin + ": mesh has no triangles");
     for (size_t v = 0; v < positions.size(); ++v)
         if (!positions[v].allFinite())
-            throw std::invalid_argument(origin + ": vertex " + std::to_string(v) +
-                                        " has a non-finite coordinate");
+            throw std::invalid_argument(origin + ": vertex " + std::to_string(v) + " has a non-finite coordinate");
     const auto n = static_cast<int64_t>(positions.size());
     for (size_t f = 0; f < triangles.size(); ++f) {
         const Tri& t = triangles[f];
         for (int k = 0; k < 3; ++k)
             if (t[k] < 0 || t[k] >= n)
-                throw std::invalid_argument(origin + ": triangle " + std::to_string(f) +
-                                            " references vertex " + std::to_string(t[k]) +
-                                            " (mesh has " + std::to_string(n) + " vertices)");
+                throw std::invalid_argument(origin + ": triangle " + std::to_string(f) + " references vertex " +
+                                            std::to_string(t[k]) + " (mesh has " + std::to_string(n) + " vertices)");
         if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
-            throw std::invalid_argument(origin + ": triangle " + std::to_string(f) +
-                                        " repeats a vertex");
+            throw std::invalid_argument(origin + ": triangle " + std::to_string(f) + " repeats a vertex");
     }
     TriMesh m;
     m.m_positions = std::move(positions);
@@ -44,9 +40,7 @@ Vec3 TriMesh::triangleNormal(size_t i) const {
 double TriMesh::area() const {
     double a = 0;
     for (const Tri& t : m_triangles)
-        a += 0.5 * (m_positions[t[1]] - m_positions[t[0]])
-                       .cross(m_positions[t[2]] - m_positions[t[0]])
-                       .norm();
+        a += 0.5 * (m_positions[t[1]] - m_positions[t[0]]).cross(m_positions[t[2]] - m_positions[t[0]]).norm();
     return a;
 }
 

@@ -25,22 +25,20 @@ void setReference(AccuracyTrace& trace, const StepProblem& problem, const Newton
     trace.fStar = reference.f;
     trace.referenceStatus = newtonStatusName(reference.status);
     trace.referenceIterations = reference.iterations;
-    trace.referenceGradientNorm =
-        reference.gradientNorms.empty() ? 0.0 : reference.gradientNorms.back();
+    trace.referenceGradientNorm = reference.gradientNorms.empty() ? 0.0 : reference.gradientNorms.back();
     trace.referenceMs = 1e3 * reference.totalSeconds;
 }
 
 } // namespace
 
-AccuracyRecorder::AccuracyRecorder(std::string solver, const StepProblem& problem,
-                                   const NewtonResult& reference, const std::vector<Vec3>& x0)
+AccuracyRecorder::AccuracyRecorder(std::string solver, const StepProblem& problem, const NewtonResult& reference,
+                                   const std::vector<Vec3>& x0)
     : m_problem(problem) {
     const size_t nv = problem.xTilde.size();
     if (x0.size() != nv || reference.x.size() != nv)
         throw std::invalid_argument("sim::AccuracyRecorder(): x0 (" + std::to_string(x0.size()) +
                                     ") and the reference (" + std::to_string(reference.x.size()) +
-                                    ") must have one position per node (" + std::to_string(nv) +
-                                    ")");
+                                    ") must have one position per node (" + std::to_string(nv) + ")");
     m_trace.solver = std::move(solver);
     setReference(m_trace, problem, reference);
     m_trace.f0 = problem.objective(x0);
@@ -53,33 +51,28 @@ AccuracyRecorder::AccuracyRecorder(std::string solver, const StepProblem& proble
 void AccuracyRecorder::observe(int k, const std::vector<Vec3>& xk, double seconds) {
     if (k == 0) return;
     if (k <= m_trace.iterations.back())
-        throw std::invalid_argument("sim::AccuracyRecorder::observe(): iteration " +
-                                    std::to_string(k) + " does not follow " +
-                                    std::to_string(m_trace.iterations.back()));
+        throw std::invalid_argument("sim::AccuracyRecorder::observe(): iteration " + std::to_string(k) +
+                                    " does not follow " + std::to_string(m_trace.iterations.back()));
     if (xk.size() != m_problem.xTilde.size())
-        throw std::invalid_argument("sim::AccuracyRecorder::observe(): x_k has " +
-                                    std::to_string(xk.size()) + " nodes, the problem has " +
-                                    std::to_string(m_problem.xTilde.size()));
+        throw std::invalid_argument("sim::AccuracyRecorder::observe(): x_k has " + std::to_string(xk.size()) +
+                                    " nodes, the problem has " + std::to_string(m_problem.xTilde.size()));
     m_trace.iterations.push_back(k);
     m_trace.relError.push_back(relativeError(m_problem.objective(xk), m_trace.f0, m_trace.fStar));
     m_trace.timeMs.push_back(1e3 * seconds);
 }
 
-AccuracyTrace measureXpbd(const XpbdSolver& solver, int maxIterations,
-                          const NewtonSettings& settings, XpbdIteration mode) {
+AccuracyTrace measureXpbd(const XpbdSolver& solver, int maxIterations, const NewtonSettings& settings,
+                          XpbdIteration mode) {
     if (maxIterations < 1)
-        throw std::invalid_argument("sim::measureXpbd(): max_iterations " +
-                                    std::to_string(maxIterations) + " must be >= 1");
+        throw std::invalid_argument("sim::measureXpbd(): max_iterations " + std::to_string(maxIterations) +
+                                    " must be >= 1");
     const StepProblem problem = solver.nextSubstepProblem();
     const NewtonResult reference = solveNewton(problem, problem.xTilde, settings);
-    AccuracyRecorder recorder(mode == XpbdIteration::Standard ? "xpbd" : "xpbd-primal", problem,
-                              reference, problem.xTilde);
+    AccuracyRecorder recorder(mode == XpbdIteration::Standard ? "xpbd" : "xpbd-primal", problem, reference,
+                              problem.xTilde);
     solver.iterateOn(
         problem, maxIterations,
-        [&](int k, const std::vector<Vec3>& xk, double seconds) {
-            recorder.observe(k, xk, seconds);
-        },
-        mode);
+        [&](int k, const std::vector<Vec3>& xk, double seconds) { recorder.observe(k, xk, seconds); }, mode);
     return recorder.take();
 }
 

@@ -65,13 +65,12 @@ private:
 /// dt / substeps, from its current state): a Newton reference from x̃, then `maxIterations`
 /// production sweeps from x_0 = x̃, λ = 0 (XpbdSolver::iterateOn()), one trace entry per sweep,
 /// timed by the sweeps alone. Entry k is what the setting "substeps × k iterations" computes for
-/// this substep (with 1 substep: for the frame). XPBD's e_k levels off above 0 after a few sweeps, at a level set by h: its
-/// fixed point is not x* (XPBD drops the g-residual of [A eq. 4.41]; measured 1.4e-2 at
-/// h = 0.83 ms, 2.4e-5 at h = 0.17 ms on a 4,944-tet body, bench/bench_accuracy.cpp). The
-/// solver's state is untouched. Throws std::invalid_argument when maxIterations < 1 or the
-/// settings are invalid. Cost: one Newton solve plus the sweeps plus one f evaluation per sweep.
-AccuracyTrace measureXpbd(const XpbdSolver& solver, int maxIterations,
-                          const NewtonSettings& settings = {},
+/// this substep (with 1 substep: for the frame). XPBD's e_k levels off above 0 after a few sweeps, at a level set by h:
+/// its fixed point is not x* (XPBD drops the g-residual of [A eq. 4.41]; measured 1.4e-2 at h = 0.83 ms, 2.4e-5 at h =
+/// 0.17 ms on a 4,944-tet body, bench/bench_accuracy.cpp). The solver's state is untouched. Throws
+/// std::invalid_argument when maxIterations < 1 or the settings are invalid. Cost: one Newton solve plus the sweeps
+/// plus one f evaluation per sweep.
+AccuracyTrace measureXpbd(const XpbdSolver& solver, int maxIterations, const NewtonSettings& settings = {},
                           XpbdIteration mode = XpbdIteration::Standard);
 
 /// Newton's own iterates on `problem` from x_0 = x̃, measured against its final iterate

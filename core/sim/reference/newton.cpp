@@ -42,16 +42,12 @@ bool allFinite(const std::vector<Vec3>& v) {
 void checkProblem(const StepProblem& p, const std::vector<Vec3>& x0) {
     const size_t nv = p.xTilde.size();
     auto fail = [](const std::string& why) { throw std::invalid_argument(kWhere + why); };
-    if (!(p.h > 0) || !std::isfinite(p.h))
-        fail("step h " + formatNumber(p.h, 3) + " must be positive");
+    if (!(p.h > 0) || !std::isfinite(p.h)) fail("step h " + formatNumber(p.h, 3) + " must be positive");
     if (!p.model) fail("problem has no constraint model");
-    if (x0.size() != nv)
-        fail("x0 has " + std::to_string(x0.size()) + " nodes, the problem has " +
-             std::to_string(nv));
+    if (x0.size() != nv) fail("x0 has " + std::to_string(x0.size()) + " nodes, the problem has " + std::to_string(nv));
     if (p.mass.size() != nv || p.fixed.size() != nv)
-        fail("mass (" + std::to_string(p.mass.size()) + ") and fixed (" +
-             std::to_string(p.fixed.size()) + ") must have one entry per node (" +
-             std::to_string(nv) + ")");
+        fail("mass (" + std::to_string(p.mass.size()) + ") and fixed (" + std::to_string(p.fixed.size()) +
+             ") must have one entry per node (" + std::to_string(nv) + ")");
     const size_t nt = p.tets.size();
     if (p.dmInv.size() != nt || p.volume.size() != nt || p.weight.size() != nt)
         fail("dmInv, volume and weight must have one entry per tet (" + std::to_string(nt) + ")");
@@ -62,22 +58,22 @@ void checkProblem(const StepProblem& p, const std::vector<Vec3>& x0) {
     for (size_t t = 0; t < nt; ++t) {
         for (int32_t v : p.tets[t])
             if (v < 0 || static_cast<size_t>(v) >= nv)
-                fail("tet " + std::to_string(t) + " references node " + std::to_string(v) +
-                     " (problem has " + std::to_string(nv) + " nodes)");
+                fail("tet " + std::to_string(t) + " references node " + std::to_string(v) + " (problem has " +
+                     std::to_string(nv) + " nodes)");
         if (!(p.volume[t] > 0) || !std::isfinite(p.volume[t]))
             fail("tet " + std::to_string(t) + " has rest volume " + formatNumber(p.volume[t], 3) +
                  " m^3 (must be positive)");
         if (!(p.weight[t] >= 0) || !std::isfinite(p.weight[t]))
-            fail("tet " + std::to_string(t) + " has stiffness weight " +
-                 formatNumber(p.weight[t], 3) + " (must be finite and >= 0)");
+            fail("tet " + std::to_string(t) + " has stiffness weight " + formatNumber(p.weight[t], 3) +
+                 " (must be finite and >= 0)");
         if (!p.dmInv[t].allFinite()) fail("tet " + std::to_string(t) + " has a non-finite dmInv");
     }
 }
 
 /// Numeric factorization of `values` with the analysed pattern; the Newton wording of a Hessian
 /// that is not positive definite (notPositiveDefinite tells that case apart).
-bool factorizeHessian(SparseCholesky& llt, const std::vector<double>& values,
-                      std::string& error, bool* notPositiveDefinite = nullptr) {
+bool factorizeHessian(SparseCholesky& llt, const std::vector<double>& values, std::string& error,
+                      bool* notPositiveDefinite = nullptr) {
     bool indefinite = false;
     if (llt.factorize(values, error, &indefinite)) return true;
     if (indefinite)
@@ -231,16 +227,11 @@ void validate(const NewtonSettings& s) {
         fail("tolerance " + formatNumber(s.tolerance, 3) + " must be positive");
     if (!(s.relativeTolerance > 0 && s.relativeTolerance <= 1))
         fail("relative_tolerance " + formatNumber(s.relativeTolerance, 3) + " must be in (0, 1]");
-    if (s.maxIterations < 1)
-        fail("max_iterations " + std::to_string(s.maxIterations) + " must be >= 1");
-    if (!(s.armijo > 0 && s.armijo < 1))
-        fail("armijo " + formatNumber(s.armijo, 3) + " must be in (0, 1)");
-    if (!(s.backtrack > 0 && s.backtrack < 1))
-        fail("backtrack " + formatNumber(s.backtrack, 3) + " must be in (0, 1)");
-    if (s.maxBacktracks < 0)
-        fail("max_backtracks " + std::to_string(s.maxBacktracks) + " must be >= 0");
-    if (!(s.fdStep > 0 && s.fdStep < 0.1))
-        fail("fd_step " + formatNumber(s.fdStep, 3) + " must be in (0, 0.1)");
+    if (s.maxIterations < 1) fail("max_iterations " + std::to_string(s.maxIterations) + " must be >= 1");
+    if (!(s.armijo > 0 && s.armijo < 1)) fail("armijo " + formatNumber(s.armijo, 3) + " must be in (0, 1)");
+    if (!(s.backtrack > 0 && s.backtrack < 1)) fail("backtrack " + formatNumber(s.backtrack, 3) + " must be in (0, 1)");
+    if (s.maxBacktracks < 0) fail("max_backtracks " + std::to_string(s.maxBacktracks) + " must be >= 0");
+    if (!(s.fdStep > 0 && s.fdStep < 0.1)) fail("fd_step " + formatNumber(s.fdStep, 3) + " must be in (0, 0.1)");
     if (!(s.stepTolerance >= 0) || !std::isfinite(s.stepTolerance))
         fail("step_tolerance " + formatNumber(s.stepTolerance, 3) + " must be finite and >= 0");
 }
@@ -261,8 +252,7 @@ const char* newtonStatusName(NewtonStatus status) {
     return "unknown";
 }
 
-NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
-                         const NewtonSettings& s) {
+NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0, const NewtonSettings& s) {
     validate(s);
     checkProblem(p, x0);
     const auto start = Clock::now();
@@ -298,16 +288,14 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
     // more than rounding allows), stalled otherwise.
     auto stall = [&](const std::string& why) {
         if (gNorm <= absoluteThreshold)
-            return finish(NewtonStatus::Converged,
-                          "relative tolerance not reached, at the rounding floor: " + why);
+            return finish(NewtonStatus::Converged, "relative tolerance not reached, at the rounding floor: " + why);
         return finish(NewtonStatus::Stalled, why);
     };
     if (gNorm <= threshold) return finish(NewtonStatus::Converged, {});
 
     HessianAssembler assembler(p, s);
     std::string error;
-    const std::unique_ptr<SparseCholesky> llt =
-        SparseCholesky::tryCreate(assembler.pattern(), error);
+    const std::unique_ptr<SparseCholesky> llt = SparseCholesky::tryCreate(assembler.pattern(), error);
     if (!llt) return finish(NewtonStatus::FactorizationFailed, error);
 
     double meanSize = 0;
@@ -322,8 +310,7 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
     constexpr double eps = std::numeric_limits<double>::epsilon();
     for (int k = 0; k < s.maxIterations; ++k) {
         if (!assembler.assemble(r.x, projected.data(), tryExact ? exact.data() : nullptr))
-            return finish(NewtonStatus::NonFinite,
-                          "element Hessian not finite at iteration " + std::to_string(k));
+            return finish(NewtonStatus::NonFinite, "element Hessian not finite at iteration " + std::to_string(k));
         bool factored = false;
         if (tryExact) {
             bool indefinite = false;
@@ -331,26 +318,21 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
             if (!factored && !indefinite) return finish(NewtonStatus::FactorizationFailed, error);
         }
         if (!factored) {
-            if (!factorizeHessian(*llt, projected, error))
-                return finish(NewtonStatus::FactorizationFailed, error);
+            if (!factorizeHessian(*llt, projected, error)) return finish(NewtonStatus::FactorizationFailed, error);
             ++r.projectedSteps;
         }
         for (size_t i = 0; i < nv; ++i)
             for (int c = 0; c < 3; ++c)
                 d[3 * i + c] = assembler.active(i) ? -g[i][c] : 0.0;
-        if (!llt->solveInPlace(d.data(), 1, error))
-            return finish(NewtonStatus::FactorizationFailed, error);
+        if (!llt->solveInPlace(d.data(), 1, error)) return finish(NewtonStatus::FactorizationFailed, error);
         double gd = 0, dNorm = 0;
         for (size_t i = 0; i < nv; ++i)
             for (int c = 0; c < 3; ++c) {
                 gd += g[i][c] * d[3 * i + c];
                 dNorm = std::max(dNorm, std::abs(d[3 * i + c]));
             }
-        if (!std::isfinite(gd))
-            return finish(NewtonStatus::NonFinite, "Newton direction not finite");
-        if (!(gd < 0))
-            return stall("Newton direction is not a descent direction at iteration " +
-                         std::to_string(k));
+        if (!std::isfinite(gd)) return finish(NewtonStatus::NonFinite, "Newton direction not finite");
+        if (!(gd < 0)) return stall("Newton direction is not a descent direction at iteration " + std::to_string(k));
 
         // Backtracking Armijo. Once the predicted decrease is below the rounding noise of f, f can
         // no longer rank trial points; the full step is then accepted when f stays within the noise
@@ -373,8 +355,8 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
             if (accepted) break;
         }
         if (!accepted)
-            return stall("line search found no decrease of f at iteration " + std::to_string(k) +
-                         " (|grad f| " + formatNumber(gNorm, 3) + ")");
+            return stall("line search found no decrease of f at iteration " + std::to_string(k) + " (|grad f| " +
+                         formatNumber(gNorm, 3) + ")");
         std::swap(r.x, xTry);
         r.f = fTry;
         p.gradientInto(r.x, g);
@@ -386,10 +368,9 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0,
         if (alpha * dNorm <= s.stepTolerance * std::max(infNorm(r.x), meanSize))
             return stall("step below floating-point resolution at iteration " + std::to_string(k));
     }
-    return finish(NewtonStatus::MaxIterations,
-                  "no convergence in " + std::to_string(s.maxIterations) +
-                      " iterations (|grad f| " + formatNumber(gNorm, 3) + ", threshold " +
-                      formatNumber(threshold, 3) + ")");
+    return finish(NewtonStatus::MaxIterations, "no convergence in " + std::to_string(s.maxIterations) +
+                                                   " iterations (|grad f| " + formatNumber(gNorm, 3) + ", threshold " +
+                                                   formatNumber(threshold, 3) + ")");
 }
 
 } // namespace viscera::sim

@@ -48,7 +48,7 @@ struct NewtonSettings {
     /// 1 disables it (the first test alone).
     double relativeTolerance = 1e-8;
     int maxIterations = 100;
-    double armijo = 1e-4; ///< sufficient-decrease constant c₁ in f(x+αd) ≤ f(x) + c₁ α ∇fᵀd
+    double armijo = 1e-4;   ///< sufficient-decrease constant c₁ in f(x+αd) ≤ f(x) + c₁ α ∇fᵀd
     double backtrack = 0.5; ///< step shrink factor per rejected trial, in (0, 1)
     int maxBacktracks = 40; ///< rejected trials before the solve stops (see above)
     /// Central-difference step for the element Hessians, relative to the tet's size ∛(6 V_e).
@@ -91,7 +91,6 @@ struct NewtonResult {
 /// problem.xTilde and stay there. Throws std::invalid_argument when the problem is inconsistent
 /// (array sizes, tet indices, h ≤ 0, no model) or the settings are invalid; everything else is
 /// reported through NewtonResult::status.
-NewtonResult solveNewton(const StepProblem& problem, const std::vector<Vec3>& x0,
-                         const NewtonSettings& settings = {});
+NewtonResult solveNewton(const StepProblem& problem, const std::vector<Vec3>& x0, const NewtonSettings& settings = {});
 
 } // namespace viscera::sim

@@ -21,13 +21,15 @@ const char* kCollision = "collision";
 const char* kDissection = "dissection";
 const char* kClip = "clip";
 
-bool has(const std::vector<std::string>& v, const std::string& x) { return std::find(v.begin(), v.end(), x) != v.end(); }
+bool has(const std::vector<std::string>& v, const std::string& x) {
+    return std::find(v.begin(), v.end(), x) != v.end();
+}
 } // namespace
 
 const std::vector<std::string>& supportedFeatures() {
-    static const std::vector<std::string> f = {kAccuracy, kClip,   kCollision,   kContact, kDissection, kEmbedding,
-                                               kFascia,   kFem,    kGravity,     kNeedle,  kProbe,      kStrainLimit,
-                                               kThread,   kXpbd};
+    static const std::vector<std::string> f = {kAccuracy,  kClip,        kCollision, kContact, kDissection,
+                                               kEmbedding, kFascia,      kFem,       kGravity, kNeedle,
+                                               kProbe,     kStrainLimit, kThread,    kXpbd};
     return f;
 }
 
@@ -59,10 +61,12 @@ std::vector<std::string> requiredFeatures(const SceneDesc& scene) {
 
 void checkSupportedFeatures(const std::vector<std::string>& features, const std::string& origin) {
     std::string list;
-    for (const auto& s : supportedFeatures()) list += (list.empty() ? "" : ", ") + s;
+    for (const auto& s : supportedFeatures())
+        list += (list.empty() ? "" : ", ") + s;
     for (const std::string& f : features)
         if (!has(supportedFeatures(), f))
-            throw InputError(origin + ": features: '" + f + "' is not supported by this player (supported: " + list + ")");
+            throw InputError(origin + ": features: '" + f + "' is not supported by this player (supported: " + list +
+                             ")");
 }
 
 std::vector<std::string> checkDeclaredFeatures(const SceneDesc& scene, const std::vector<std::string>& features,
@@ -71,9 +75,11 @@ std::vector<std::string> checkDeclaredFeatures(const SceneDesc& scene, const std
     for (const std::string& f : needed)
         if (!has(features, f)) {
             if (f == scene.solverType)
-                throw InputError(origin + ": features: the scene uses solver '" + f + "' but the manifest does not declare it");
+                throw InputError(origin + ": features: the scene uses solver '" + f +
+                                 "' but the manifest does not declare it");
             if (f == kGravity)
-                throw InputError(origin + ": features: the scene sets gravity but the manifest does not declare 'gravity'");
+                throw InputError(origin +
+                                 ": features: the scene sets gravity but the manifest does not declare 'gravity'");
             throw InputError(origin + ": features: the scene uses '" + f + "' but the manifest does not declare it");
         }
     return needed;

@@ -32,7 +32,8 @@ std::unique_ptr<FemSceneSolver> FemSceneSolver::create(const SceneSolverInputs& 
             fail("bodies[" + std::to_string(i) + "]: embedding, strain limits and node weights are not supported");
         if (b.material.youngsModulus != scene.bodies[0].material.youngsModulus ||
             b.material.poissonRatio != scene.bodies[0].material.poissonRatio)
-            fail("bodies[" + std::to_string(i) + "].material: all bodies need the same youngs_modulus and poisson_ratio");
+            fail("bodies[" + std::to_string(i) +
+                 "].material: all bodies need the same youngs_modulus and poisson_ratio");
         for (int32_t v : b.fixedNodes) {
             if (v >= static_cast<int32_t>(meshes[i]->vertexCount()))
                 fail("bodies[" + std::to_string(i) + "].fixed_nodes: node " + std::to_string(v) + " is out of range");
@@ -50,22 +51,22 @@ std::unique_ptr<FemSceneSolver> FemSceneSolver::create(const SceneSolverInputs& 
     settings.fem.refactorMode = RefactorMode::Synchronous;
     std::unique_ptr<FemSceneSolver> f(new FemSceneSolver());
     try {
-        f->m_suture = SutureSimulation::create(mergeMeshes(parts, nullptr), fixed, settings,
-                                                       trajectory.front().pose);
+        f->m_suture = SutureSimulation::create(mergeMeshes(parts, nullptr), fixed, settings, trajectory.front().pose);
     } catch (const std::invalid_argument& e) {
         throw InputError(origin + ": scene cannot be simulated stably: " + e.what());
     }
     if (!sd.gauge[0].empty()) {
         for (int k = 0; k < 2; ++k) {
             size_t i = 0;
-            while (i < scene.bodies.size() && scene.bodies[i].name != sd.gauge[k]) ++i;
+            while (i < scene.bodies.size() && scene.bodies[i].name != sd.gauge[k])
+                ++i;
             if (i == scene.bodies.size()) fail("suture.gauge: '" + sd.gauge[k] + "' is not a body of the scene");
             f->m_gaugeBodies[k] = i;
         }
         f->m_gaugeMesh = mergeMeshes({parts[f->m_gaugeBodies[0]], parts[f->m_gaugeBodies[1]]}, nullptr);
         f->m_gaugeMesh->requireLevel(3);
-        f->m_gauge = std::make_unique<ClosureGauge>(
-            *f->m_gaugeMesh, static_cast<int32_t>(parts[f->m_gaugeBodies[0]]->vertexCount()));
+        f->m_gauge = std::make_unique<ClosureGauge>(*f->m_gaugeMesh,
+                                                    static_cast<int32_t>(parts[f->m_gaugeBodies[0]]->vertexCount()));
     }
     f->m_trajectory = std::move(trajectory);
     f->m_thread = sd.thread;
@@ -133,7 +134,9 @@ const std::vector<Vec3>& FemSceneSolver::surfacePositions(size_t) const {
     throw std::out_of_range("sim::FemSceneSolver::surfacePositions(): the suturing FEM has no surfaces");
 }
 
-double FemSceneSolver::totalEnergy() const { return m_suture->fem().elasticEnergy(); }
+double FemSceneSolver::totalEnergy() const {
+    return m_suture->fem().elasticEnergy();
+}
 
 void FemSceneSolver::setState(size_t, const std::vector<Vec3>&, const std::vector<Vec3>&) {
     throw std::invalid_argument("sim::FemSceneSolver::setState(): the quasi-static FEM has no settable state");

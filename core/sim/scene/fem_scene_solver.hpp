@@ -48,7 +48,7 @@ private:
     std::unique_ptr<TetMesh> m_gaugeMesh;   ///< the two gauged bodies, merged
     std::unique_ptr<ClosureGauge> m_gauge;
     std::array<size_t, 2> m_gaugeBodies{};
-    SutureStepStats m_last;         ///< of the last step()
+    SutureStepStats m_last; ///< of the last step()
     std::vector<SutureFrameRecord> m_frames;
     double m_initialGap = 0, m_sampledPenetration = 0;
 };

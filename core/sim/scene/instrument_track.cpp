@@ -21,7 +21,8 @@ std::string checkKeys(const std::vector<InstrumentKey>& keys) {
         if (!std::isfinite(k.t) || k.t < 0) return at + ".t: must be finite and >= 0";
         if (i > 0 && !(k.t > keys[i - 1].t)) return at + ".t: times must strictly increase";
         if (!k.position.allFinite()) return at + ".position: must be finite";
-        if (!k.direction.allFinite() || k.direction.norm() < 1e-9) return at + ".direction: must be finite and non-zero";
+        if (!k.direction.allFinite() || k.direction.norm() < 1e-9)
+            return at + ".direction: must be finite and non-zero";
         if (!(k.jaw >= 0 && k.jaw <= 1)) return at + ".jaw: must be in [0, 1]";
     }
     return {};
@@ -31,7 +32,8 @@ std::string checkKeys(const std::vector<InstrumentKey>& keys) {
 
 InstrumentTrack::InstrumentTrack(std::vector<InstrumentKey> keys) : m_keys(std::move(keys)) {
     if (auto why = checkKeys(m_keys); !why.empty()) throw std::invalid_argument("sim::InstrumentTrack: " + why);
-    for (InstrumentKey& k : m_keys) k.direction.normalize();
+    for (InstrumentKey& k : m_keys)
+        k.direction.normalize();
 }
 
 InstrumentTrack InstrumentTrack::parse(std::string_view text, const std::string& origin) {
@@ -85,8 +87,9 @@ std::string InstrumentTrack::format() const {
     std::string out = std::string(kHeader) + "\n# t x y z dx dy dz jaw act\n";
     char buf[256];
     for (const InstrumentKey& k : m_keys) {
-        std::snprintf(buf, sizeof buf, "%.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %d\n", k.t, k.position.x(), k.position.y(),
-                      k.position.z(), k.direction.x(), k.direction.y(), k.direction.z(), k.jaw, k.act ? 1 : 0);
+        std::snprintf(buf, sizeof buf, "%.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %d\n", k.t, k.position.x(),
+                      k.position.y(), k.position.z(), k.direction.x(), k.direction.y(), k.direction.z(), k.jaw,
+                      k.act ? 1 : 0);
         out += buf;
     }
     return out;
@@ -97,7 +100,8 @@ InstrumentKey InstrumentTrack::sample(double t) const {
     if (!(t > m_keys.front().t)) return m_keys.front();
     if (t >= m_keys.back().t) return m_keys.back();
     size_t i = 1;
-    while (m_keys[i].t <= t) ++i;
+    while (m_keys[i].t <= t)
+        ++i;
     const InstrumentKey& a = m_keys[i - 1];
     const InstrumentKey& b = m_keys[i];
     const double s = (t - a.t) / (b.t - a.t);

@@ -23,11 +23,11 @@ namespace viscera::sim {
 using Vec3 = Eigen::Vector3d;
 
 struct InstrumentKey {
-    double t = 0;               ///< s
-    Vec3 position = Vec3::Zero(); ///< m, scene: tip
+    double t = 0;                    ///< s
+    Vec3 position = Vec3::Zero();    ///< m, scene: tip
     Vec3 direction = -Vec3::UnitZ(); ///< unit, shaft towards the tip
-    double jaw = 1;             ///< 0 closed … 1 open
-    bool act = false;           ///< energy on / clip fired
+    double jaw = 1;                  ///< 0 closed … 1 open
+    bool act = false;                ///< energy on / clip fired
 };
 
 class InstrumentTrack {

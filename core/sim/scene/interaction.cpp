@@ -1,8 +1,8 @@
 #include "sim/scene/interaction.hpp"
 
 #include "sim/collision/collision_solver.hpp"
-#include "sim/util/error.hpp"
 #include "sim/scene/scene_json.hpp"
+#include "sim/util/error.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -16,9 +16,12 @@ using nlohmann::json;
 
 const char* kindName(InstrumentDesc::Kind k) {
     switch (k) {
-    case InstrumentDesc::Kind::Grasper: return "grasper";
-    case InstrumentDesc::Kind::EnergyHook: return "energy_hook";
-    case InstrumentDesc::Kind::ClipApplier: return "clip_applier";
+    case InstrumentDesc::Kind::Grasper:
+        return "grasper";
+    case InstrumentDesc::Kind::EnergyHook:
+        return "energy_hook";
+    case InstrumentDesc::Kind::ClipApplier:
+        return "clip_applier";
     }
     return "?";
 }
@@ -42,17 +45,22 @@ InteractionDesc readInteractionSection(const JsonField& doc) {
         InstrumentDesc in;
         in.name = readName(j["name"], names); // it names the track file of the case
         const std::string kind = j["kind"].choice({"grasper", "energy_hook", "clip_applier"}, "an instrument");
-        if (kind == "grasper") in.kind = InstrumentDesc::Kind::Grasper;
-        else if (kind == "energy_hook") in.kind = InstrumentDesc::Kind::EnergyHook;
-        else in.kind = InstrumentDesc::Kind::ClipApplier;
+        if (kind == "grasper")
+            in.kind = InstrumentDesc::Kind::Grasper;
+        else if (kind == "energy_hook")
+            in.kind = InstrumentDesc::Kind::EnergyHook;
+        else
+            in.kind = InstrumentDesc::Kind::ClipApplier;
         in.trackPath = j["track"].entryPath();
         in.radius = j.number("radius", in.radius, NumberRule::closed(2e-4, 0.02));
         in.jawLength = j.number("jaw_length", in.jawLength, NumberRule::closed(1e-3, 0.05));
         if (j.has("temperature_c") && in.kind != InstrumentDesc::Kind::EnergyHook)
             j.failAt("temperature_c", "only an energy_hook has a temperature");
         in.temperatureC = j.number("temperature_c", in.temperatureC, NumberRule::closed(40, 400));
-        if (in.kind == InstrumentDesc::Kind::ClipApplier) in.target = j["target"].nonEmptyString();
-        else if (j.has("target")) j.failAt("target", "only a clip_applier has a target");
+        if (in.kind == InstrumentDesc::Kind::ClipApplier)
+            in.target = j["target"].nonEmptyString();
+        else if (j.has("target"))
+            j.failAt("target", "only a clip_applier has a target");
         d.instruments.push_back(std::move(in));
     }
     if (auto t = doc.find("tissues")) {
@@ -84,14 +92,17 @@ void checkInteractionNames(const InteractionDesc& d, const std::vector<std::stri
     auto fail = [&](const std::string& field, const std::string& rule) {
         throw InputError(origin + ": interaction." + field + ": " + rule);
     };
-    auto in = [](const std::vector<std::string>& v, const std::string& n) { return std::find(v.begin(), v.end(), n) != v.end(); };
+    auto in = [](const std::vector<std::string>& v, const std::string& n) {
+        return std::find(v.begin(), v.end(), n) != v.end();
+    };
     for (size_t i = 0; i < d.instruments.size(); ++i)
         if (d.instruments[i].kind == InstrumentDesc::Kind::ClipApplier && !in(bodies, d.instruments[i].target))
-            fail("instruments[" + std::to_string(i) + "].target", "'" + d.instruments[i].target + "' is not a body of the scene");
+            fail("instruments[" + std::to_string(i) + "].target",
+                 "'" + d.instruments[i].target + "' is not a body of the scene");
     for (size_t i = 0; i < d.tissues.size(); ++i)
         if (!in(bodies, d.tissues[i].layer) && !in(surfaces, d.tissues[i].layer))
             fail("tissues[" + std::to_string(i) + "].layer",
-                   "'" + d.tissues[i].layer + "' is not a body or surface of the scene");
+                 "'" + d.tissues[i].layer + "' is not a body or surface of the scene");
 }
 
 json interactionJson(const InteractionDesc& d) {
@@ -99,7 +110,10 @@ json interactionJson(const InteractionDesc& d) {
     doc["collision"] = {{"method", d.collisionMethod}, {"delta", d.delta}};
     doc["instruments"] = json::array();
     for (const InstrumentDesc& in : d.instruments) {
-        json j = {{"name", in.name}, {"kind", kindName(in.kind)}, {"track", in.trackPath}, {"radius", in.radius},
+        json j = {{"name", in.name},
+                  {"kind", kindName(in.kind)},
+                  {"track", in.trackPath},
+                  {"radius", in.radius},
                   {"jaw_length", in.jawLength}};
         if (in.kind == InstrumentDesc::Kind::EnergyHook) j["temperature_c"] = in.temperatureC;
         if (in.kind == InstrumentDesc::Kind::ClipApplier) j["target"] = in.target;
@@ -116,6 +130,8 @@ json interactionJson(const InteractionDesc& d) {
     return doc;
 }
 
-std::string formatInteractionSection(const InteractionDesc& d) { return interactionJson(d).dump(); }
+std::string formatInteractionSection(const InteractionDesc& d) {
+    return interactionJson(d).dump();
+}
 
 } // namespace viscera::sim

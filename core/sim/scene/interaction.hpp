@@ -42,9 +42,9 @@ struct InstrumentDesc {
 };
 
 struct DissectionTissueDesc {
-    std::string layer;          ///< a surface (fascia) or tet body name
-    double ignitionC = 160;     ///< °C
-    double conductivity = 0.4;  ///< ξ of [A eq. 5.11]
+    std::string layer;                 ///< a surface (fascia) or tet body name
+    double ignitionC = 160;            ///< °C
+    double conductivity = 0.4;         ///< ξ of [A eq. 5.11]
     Vec3 shrink = Vec3(0.1, 0.3, 1.0); ///< S_x, S_y, S_z of [A eq. 5.12], each in (0, 1]
 };
 

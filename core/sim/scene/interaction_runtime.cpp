@@ -12,7 +12,7 @@
 namespace viscera::sim {
 namespace {
 
-constexpr double kGraspClose = 0.5; ///< jaw below this holds, above releases
+constexpr double kGraspClose = 0.5;    ///< jaw below this holds, above releases
 constexpr double kMaxJawOpening = 0.6; ///< rad, grasper jaws fully open (jaw = 1)
 
 double msSince(std::chrono::steady_clock::time_point t0) {
@@ -33,11 +33,14 @@ std::vector<double> surfaceInverseMass(const TriMesh& mesh, double arealDensity,
     const auto& x = mesh.positions();
     for (const Tri& t : mesh.triangles()) {
         const double a = 0.5 * (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).norm();
-        for (int k = 0; k < 3; ++k) m[t[k]] += arealDensity * a / 3;
+        for (int k = 0; k < 3; ++k)
+            m[t[k]] += arealDensity * a / 3;
     }
     std::vector<double> w(m.size(), 0.0);
-    for (size_t i = 0; i < m.size(); ++i) w[i] = m[i] > 0 ? 1.0 / m[i] : 0.0;
-    for (int32_t f : fixed) w[f] = 0;
+    for (size_t i = 0; i < m.size(); ++i)
+        w[i] = m[i] > 0 ? 1.0 / m[i] : 0.0;
+    for (int32_t f : fixed)
+        w[f] = 0;
     return w;
 }
 
@@ -47,14 +50,14 @@ struct InteractionRuntime::Instrument {
     InstrumentDesc desc;
     InstrumentTrack track;
     InstrumentKey key;
-    std::unique_ptr<ToolShape> shape;             ///< null: no collision (clip applier)
+    std::unique_ptr<ToolShape> shape; ///< null: no collision (clip applier)
     std::unique_ptr<CollisionSolver> collision;
     XpbdIterationHook hook;
-    bool colliding = false;                       ///< this frame
+    bool colliding = false; ///< this frame
     // grasp
     bool holding = false;
-    std::vector<int32_t> held;                    ///< collision-surface vertices
-    std::vector<Vec3> heldLocal;                  ///< in the instrument frame at the grasp
+    std::vector<int32_t> held;   ///< collision-surface vertices
+    std::vector<Vec3> heldLocal; ///< in the instrument frame at the grasp
     ToolShape::Pose pose = ToolShape::Pose::Identity();
     // clip applier
     size_t target = 0; ///< tet body it clips
@@ -75,7 +78,8 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
                                                                const std::vector<const TetMesh*>& bodies,
                                                                const std::vector<const TriMesh*>& surfaces,
                                                                const std::string& origin) {
-    if (!scene.interaction) throw std::invalid_argument("sim::InteractionRuntime::create(): the scene has no interaction");
+    if (!scene.interaction)
+        throw std::invalid_argument("sim::InteractionRuntime::create(): the scene has no interaction");
     const InteractionDesc& desc = *scene.interaction;
     auto fail = [&](const std::string& field, const std::string& rule) {
         throw InputError(origin + ": interaction." + field + ": " + rule);
@@ -98,13 +102,15 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
     } else {
         const TetMesh& m = *bodies.at(0);
         std::vector<double> w(m.vertexCount(), 1.0);
-        for (int32_t f : scene.bodies[0].fixedNodes) w[f] = 0;
+        for (int32_t f : scene.bodies[0].fixedNodes)
+            w[f] = 0;
         surface = CollisionSurfaceDesc::fromTetMesh(m, std::move(w));
         r->m_particleOffset = static_cast<size_t>(system.tetParticleOffset(0));
         r->m_surfaceVertices = m.vertexCount();
     }
     CollisionSettings cs;
-    if (!parseCollisionMethod(desc.collisionMethod, cs.method)) fail("collision", "unknown method '" + desc.collisionMethod + "'");
+    if (!parseCollisionMethod(desc.collisionMethod, cs.method))
+        fail("collision", "unknown method '" + desc.collisionMethod + "'");
     cs.circumsphere.updateThreshold = desc.delta;
     if (auto why = validate(cs); !why.empty()) fail("collision", why);
 
@@ -115,14 +121,16 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
         in->key = in->track.sample(0);
         switch (in->desc.kind) {
         case InstrumentDesc::Kind::Grasper:
-            in->shape = std::make_unique<ToolShape>(ToolShape::jaws(in->desc.jawLength, in->desc.radius, kMaxJawOpening));
+            in->shape =
+                std::make_unique<ToolShape>(ToolShape::jaws(in->desc.jawLength, in->desc.radius, kMaxJawOpening));
             break;
         case InstrumentDesc::Kind::EnergyHook:
             in->shape = std::make_unique<ToolShape>(ToolShape::capsule(0.5 * in->desc.jawLength, in->desc.radius));
             break;
         case InstrumentDesc::Kind::ClipApplier: {
             size_t b = 0;
-            while (b < scene.bodies.size() && scene.bodies[b].name != in->desc.target) ++b;
+            while (b < scene.bodies.size() && scene.bodies[b].name != in->desc.target)
+                ++b;
             if (b == scene.bodies.size())
                 fail("instruments[" + std::to_string(i) + "].target", "'" + in->desc.target + "' is not a body");
             in->target = b;
@@ -186,7 +194,8 @@ void InteractionRuntime::beforeStep(double t, double dt) {
     // The collision surface's box, grown by what it can move in a frame: a tool outside it runs no
     // broad phase at all this frame (the hash rebuild per substep is the main collision cost).
     Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-    for (const Vec3& p : sx) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    for (const Vec3& p : sx)
+        lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     const double grow = 0.005;
     lo.array() -= grow;
     hi.array() += grow;
@@ -197,7 +206,8 @@ void InteractionRuntime::beforeStep(double t, double dt) {
         if (in.shape) {
             // Jaws and the hook's shaft end at the track's tip: the frame origin sits one jaw
             // length (grasper) or half the shaft piece (hook capsule centre) behind it.
-            const double back = in.desc.kind == InstrumentDesc::Kind::Grasper ? in.desc.jawLength : 0.5 * in.desc.jawLength;
+            const double back =
+                in.desc.kind == InstrumentDesc::Kind::Grasper ? in.desc.jawLength : 0.5 * in.desc.jawLength;
             in.pose = framePose(in.key.position - back * dir, dir);
             in.shape->setPose(in.pose);
             in.shape->setOpening(kMaxJawOpening * in.key.jaw);

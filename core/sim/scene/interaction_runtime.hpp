@@ -36,16 +36,16 @@ struct InstrumentState {
     Vec3 direction = -Vec3::UnitZ();
     double jaw = 1;
     bool act = false;
-    int contacts = 0;    ///< collision projections in the last sweep of the frame
-    int grasped = 0;     ///< vertices held
+    int contacts = 0; ///< collision projections in the last sweep of the frame
+    int grasped = 0;  ///< vertices held
 };
 
 struct ClipState {
     std::string instrument, target;
-    double firedAt = 0;        ///< s
+    double firedAt = 0;         ///< s
     Vec3 centre = Vec3::Zero(); ///< m, current
-    double rotationDeg = 0;    ///< since application
-    double travel = 0;         ///< m, centre moved since application
+    double rotationDeg = 0;     ///< since application
+    double travel = 0;          ///< m, centre moved since application
     /// m: largest distance between a contact point carried by the clip and the vessel vertex it
     /// was on at application (how well the clip follows the vessel material).
     double maxContactDrift = 0;
@@ -58,8 +58,8 @@ struct InteractionSummary {
     int grasps = 0;
     int fasciaEdgesCut = 0, fasciaTrianglesCut = 0, fatEdgesCut = 0, fatTetsCut = 0;
     size_t fasciaVertices = 0, fasciaVerticesAtStart = 0;
-    double maxEdgeHeat = 0;    ///< °C
-    double gridMaxC = 0;       ///< °C, hottest heat-grid value seen
+    double maxEdgeHeat = 0; ///< °C
+    double gridMaxC = 0;    ///< °C, hottest heat-grid value seen
     std::vector<ClipState> clips;
     double dissectionMs = 0, clipMs = 0; ///< wall time summed over frames (collision runs inside the XPBD step)
 };

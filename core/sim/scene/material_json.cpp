@@ -27,7 +27,8 @@ CurveDesc readCurve(const JsonField& c) {
 
 json curveJson(const CurveDesc& d) {
     json pts = json::array();
-    for (const auto& p : d.points) pts.push_back({p[0], p[1]});
+    for (const auto& p : d.points)
+        pts.push_back({p[0], p[1]});
     json j = {{"points", pts}};
     if (d.unconstrained) j["unconstrained"] = true;
     return j;
@@ -80,6 +81,8 @@ Material parseMaterial(std::string_view text, const std::string& origin) {
     return readMaterial(JsonField(doc, "material", origin));
 }
 
-std::string formatMaterial(const Material& m) { return materialJson(m).dump(); }
+std::string formatMaterial(const Material& m) {
+    return materialJson(m).dump();
+}
 
 } // namespace viscera::sim

@@ -17,7 +17,8 @@ TetStrainLimits readStrainLimits(const JsonField& j) {
     if (auto a = j.find("axes")) {
         if (!a->value().is_array() || a->value().size() != 3) a->fail("must be 3 axis vectors");
         const std::vector<JsonField> axes = a->items();
-        for (int c = 0; c < 3; ++c) s.axes.col(c) = axes[c].vec3();
+        for (int c = 0; c < 3; ++c)
+            s.axes.col(c) = axes[c].vec3();
         if (!(s.axes.transpose() * s.axes).isIdentity(1e-9)) a->fail("must be orthonormal");
     }
     for (const JsonField& l : j["limits"].items(1)) {
@@ -58,7 +59,9 @@ std::vector<ToolDesc> readTools(const JsonField& tools, std::set<std::string>& n
     return out;
 }
 
-json limitNumber(double v) { return std::isfinite(v) ? json(v) : json(); }
+json limitNumber(double v) {
+    return std::isfinite(v) ? json(v) : json();
+}
 
 } // namespace
 
@@ -100,7 +103,8 @@ std::optional<AccuracySampling> readAccuracy(const JsonField& doc) {
 std::string readName(const JsonField& field, std::set<std::string>& names) {
     const std::string name = field.string();
     bool ok = !name.empty() && name.size() <= 64;
-    for (char c : name) ok = ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_');
+    for (char c : name)
+        ok = ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_');
     if (!ok) field.fail("must be 1-64 characters of [A-Za-z0-9_-]");
     if (!names.insert(name).second) field.fail("'" + name + "' is used twice");
     return name;
@@ -134,12 +138,15 @@ void checkSceneReferences(const SceneDesc& scene, const std::string& origin) {
     for (size_t i = 0; i < scene.bodies.size(); ++i) {
         const BodyDesc& b = scene.bodies[i];
         if (!b.embeddedIn.empty() && (!isBody(b.embeddedIn) || b.embeddedIn == b.name))
-            fail("bodies[" + std::to_string(i) + "].embedded_in", "'" + b.embeddedIn + "' is not another body of the scene");
+            fail("bodies[" + std::to_string(i) + "].embedded_in",
+                 "'" + b.embeddedIn + "' is not another body of the scene");
     }
     if (scene.interaction) {
         std::vector<std::string> bodies, surfaces;
-        for (const BodyDesc& b : scene.bodies) bodies.push_back(b.name);
-        for (const SurfaceDesc& s : scene.surfaces) surfaces.push_back(s.name);
+        for (const BodyDesc& b : scene.bodies)
+            bodies.push_back(b.name);
+        for (const SurfaceDesc& s : scene.surfaces)
+            surfaces.push_back(s.name);
         checkInteractionNames(*scene.interaction, bodies, surfaces, origin);
     }
 }
@@ -165,7 +172,8 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
         body.meshPath = b["mesh"].entryPath();
         if (auto f = b.find("fixed_nodes")) body.fixedNodes = f->indices();
         if (auto w = b.find("node_weights"))
-            for (const JsonField& x : w->items()) body.nodeWeights.push_back(x.number(NumberRule::positive()));
+            for (const JsonField& x : w->items())
+                body.nodeWeights.push_back(x.number(NumberRule::positive()));
         if (auto f = b.find("node_weights_file")) {
             if (b.has("node_weights")) f->fail("give node_weights or node_weights_file, not both");
             body.nodeWeightsPath = f->entryPath();
@@ -182,7 +190,8 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
             if (auto a = sj.find("attach_to")) {
                 sd.attachTo = a->string();
                 bool found = false;
-                for (const auto& b : scene.bodies) found |= b.name == sd.attachTo;
+                for (const auto& b : scene.bodies)
+                    found |= b.name == sd.attachTo;
                 if (!found) a->fail("'" + sd.attachTo + "' is not a body of the scene");
             }
             if (auto f = sj.find("fixed_nodes")) sd.fixedNodes = f->indices();
@@ -197,7 +206,7 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
 json sceneJson(const SceneDesc& scene) {
     json doc;
     const XpbdSettings& s = scene.xpbd;
-    doc["solver"] = {{"type", scene.solverType}, {"dt", s.dt},           {"substeps", s.substeps},
+    doc["solver"] = {{"type", scene.solverType},   {"dt", s.dt},           {"substeps", s.substeps},
                      {"iterations", s.iterations}, {"damping", s.damping}, {"max_speed", s.maxSpeed},
                      {"threads", s.threads}};
     if (s.primalCorrection) doc["solver"]["primal_correction"] = true;
@@ -208,24 +217,34 @@ json sceneJson(const SceneDesc& scene) {
     if (!scene.instructions.empty()) doc["instructions"] = scene.instructions;
     if (!scene.render.empty()) doc["render"] = json::parse(scene.render);
     if (scene.accuracy)
-        doc["accuracy"] = {{"every_frames", scene.accuracy->everyFrames}, {"max_iterations", scene.accuracy->maxIterations}};
+        doc["accuracy"] = {{"every_frames", scene.accuracy->everyFrames},
+                           {"max_iterations", scene.accuracy->maxIterations}};
     doc["bodies"] = json::array();
     for (const BodyDesc& b : scene.bodies) {
-        json j = {{"name", b.name}, {"mesh", b.meshPath}, {"material", materialJson(b.material)}, {"fixed_nodes", b.fixedNodes}};
-        if (!b.nodeWeightsPath.empty()) j["node_weights_file"] = b.nodeWeightsPath;
-        else if (!b.nodeWeights.empty()) j["node_weights"] = b.nodeWeights;
+        json j = {{"name", b.name},
+                  {"mesh", b.meshPath},
+                  {"material", materialJson(b.material)},
+                  {"fixed_nodes", b.fixedNodes}};
+        if (!b.nodeWeightsPath.empty())
+            j["node_weights_file"] = b.nodeWeightsPath;
+        else if (!b.nodeWeights.empty())
+            j["node_weights"] = b.nodeWeights;
         if (b.strainLimits) {
             json lim = json::array();
             for (const StrainLimit& l : b.strainLimits->limits)
-                lim.push_back({{"i", l.i}, {"j", l.j}, {"lower", limitNumber(l.lower)}, {"upper", limitNumber(l.upper)},
+                lim.push_back({{"i", l.i},
+                               {"j", l.j},
+                               {"lower", limitNumber(l.lower)},
+                               {"upper", limitNumber(l.upper)},
                                {"compliance", l.compliance}});
             // Infinite bounds are written as absent.
             for (auto& l : lim)
                 for (const char* k : {"lower", "upper"})
                     if (l[k].is_null()) l.erase(k);
             const Mat3& a = b.strainLimits->axes;
-            j["strain_limits"] = {{"axes", {{a(0, 0), a(1, 0), a(2, 0)}, {a(0, 1), a(1, 1), a(2, 1)}, {a(0, 2), a(1, 2), a(2, 2)}}},
-                                  {"limits", lim}};
+            j["strain_limits"] = {
+                {"axes", {{a(0, 0), a(1, 0), a(2, 0)}, {a(0, 1), a(1, 1), a(2, 1)}, {a(0, 2), a(1, 2), a(2, 2)}}},
+                {"limits", lim}};
         }
         if (!b.embeddedIn.empty()) {
             j["embedded_in"] = b.embeddedIn;
@@ -248,13 +267,21 @@ json sceneJson(const SceneDesc& scene) {
         }
     }
     for (const ToolDesc& t : scene.tools)
-        doc["tools"].push_back({{"name", t.name}, {"shape", "sphere"}, {"radius", t.radius}, {"hand", t.hand},
-                                {"start", {t.start.x(), t.start.y(), t.start.z()}}, {"motion_scale", t.motionScale},
-                                {"force_scale", t.forceScale}, {"stiffness", t.stiffness}, {"max_force_n", t.maxForceN},
+        doc["tools"].push_back({{"name", t.name},
+                                {"shape", "sphere"},
+                                {"radius", t.radius},
+                                {"hand", t.hand},
+                                {"start", {t.start.x(), t.start.y(), t.start.z()}},
+                                {"motion_scale", t.motionScale},
+                                {"force_scale", t.forceScale},
+                                {"stiffness", t.stiffness},
+                                {"max_force_n", t.maxForceN},
                                 {"damage_force_n", t.damageForceN}});
     return doc;
 }
 
-std::string formatScene(const SceneDesc& scene) { return sceneJson(scene).dump(2) + "\n"; }
+std::string formatScene(const SceneDesc& scene) {
+    return sceneJson(scene).dump(2) + "\n";
+}
 
 } // namespace viscera::sim

@@ -58,7 +58,7 @@ struct BodyDesc {
 
 struct SurfaceDesc {
     std::string name;
-    std::string meshPath; ///< path of the .vtri inside the case
+    std::string meshPath;           ///< path of the .vtri inside the case
     double arealDensity = 0.1;      ///< kg/m^2
     double stretchStiffness = 50.0; ///< N/m
     std::string attachTo;           ///< tet body name; empty = free
@@ -82,7 +82,7 @@ struct SceneDesc {
     std::optional<AccuracySampling> accuracy;
     std::vector<BodyDesc> bodies;
     std::vector<SurfaceDesc> surfaces;
-    std::vector<ToolDesc> tools; ///< haptic probes (feature "probe")
+    std::vector<ToolDesc> tools;           ///< haptic probes (feature "probe")
     std::optional<SutureSceneDesc> suture; ///< solver "fem" only (features fem, needle, thread, contact)
     /// Scripted instruments (features collision, dissection, clip); XPBD scenes only.
     std::optional<InteractionDesc> interaction;

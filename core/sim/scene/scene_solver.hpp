@@ -21,7 +21,7 @@ class InteractionRuntime;
 /// One sampled frame of "error against run time" [A eq. 4.45].
 struct AccuracyRecord {
     int frame = 0;
-    std::string solver;              ///< "xpbd" or "newton"
+    std::string solver; ///< "xpbd" or "newton"
     std::vector<int> iterations;
     std::vector<double> relError;
     std::vector<double> timeMs;
@@ -37,7 +37,7 @@ struct SutureFrameRecord {
     double threadTension = 0; ///< N, from the pull multipliers
     double needleForce = 0;   ///< N, resultant of the tissue on the needle
     bool threadEngaged = false;
-    double maxGap = -1;       ///< m, closure gauge on sampled frames (every 10th), else −1
+    double maxGap = -1;         ///< m, closure gauge on sampled frames (every 10th), else −1
     double maxPenetration = -1; ///< m, same sampling
 };
 
@@ -45,11 +45,11 @@ struct SutureSummary {
     int punctures = 0;
     double finalThreadTension = 0, maxThreadTension = 0; ///< N
     int maxActiveRows = 0, maxContacts = 0;
-    bool gauge = false;            ///< the scene names two bodies to gauge
-    double initialGap = 0;         ///< m
-    double finalGap = 0;           ///< m, measured on the current state
-    double maxPenetration = 0;     ///< m, over the sampled frames and the current state
-    bool finite = true;            ///< the gauge's figures (the World adds its invariants)
+    bool gauge = false;        ///< the scene names two bodies to gauge
+    double initialGap = 0;     ///< m
+    double finalGap = 0;       ///< m, measured on the current state
+    double maxPenetration = 0; ///< m, over the sampled frames and the current state
+    bool finite = true;        ///< the gauge's figures (the World adds its invariants)
 };
 
 /// Suturing figures of a solver that sutures (the session report's suture block).
@@ -102,13 +102,13 @@ public:
     /// every 10th frame the closure gauge). False when one of them is not finite. Never throws.
     virtual bool recordFrame(const FrameClock& clock) = 0;
     /// On a sampled frame, before step(): appends the frame's AccuracyRecords [A eq. 4.45] (up to
-    /// scene.accuracy's max_iterations), measured on a copy (the simulation is unchanged). A back-end without accuracy sampling
-    /// rejects 'accuracy' at assembly and appends nothing. Never throws (a failed measurement is
-    /// recorded as an empty trace).
+    /// scene.accuracy's max_iterations), measured on a copy (the simulation is unchanged). A back-end without accuracy
+    /// sampling rejects 'accuracy' at assembly and appends nothing. Never throws (a failed measurement is recorded as
+    /// an empty trace).
     virtual void sampleAccuracy(const FrameClock& clock, std::vector<AccuracyRecord>& out) = 0;
 
-    virtual const std::vector<Vec3>& positions(size_t body) const = 0;      ///< #V of the body, m
-    virtual const std::vector<Vec3>& surfacePositions(size_t s) const = 0;  ///< #V of surface s, m
+    virtual const std::vector<Vec3>& positions(size_t body) const = 0;     ///< #V of the body, m
+    virtual const std::vector<Vec3>& surfacePositions(size_t s) const = 0; ///< #V of surface s, m
     virtual double totalEnergy() const = 0; ///< J, what the back-end simulates (elastic, kinetic, gravity)
 
     // ---- dynamic state, for the haptic probes (back-ends without it reject probes at assembly) --

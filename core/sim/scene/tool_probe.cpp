@@ -10,7 +10,8 @@ std::vector<double> lumpedMasses(const TetMesh& mesh, double density, const std:
     const auto& x = mesh.positions();
     for (const auto& t : mesh.tets()) {
         const double vol = std::abs((x[t[1]] - x[t[0]]).dot((x[t[2]] - x[t[0]]).cross(x[t[3]] - x[t[0]]))) / 6.0;
-        for (int k = 0; k < 4; ++k) m[t[k]] += density * vol / 4.0;
+        for (int k = 0; k < 4; ++k)
+            m[t[k]] += density * vol / 4.0;
     }
     for (int32_t f : fixedNodes)
         if (f >= 0 && static_cast<size_t>(f) < m.size()) m[f] = 0;
@@ -20,9 +21,11 @@ std::vector<double> lumpedMasses(const TetMesh& mesh, double density, const std:
 ToolProbes::ToolProbes(std::vector<ToolDesc> tools, std::vector<Body> bodies, double dt)
     : m_tools(std::move(tools)), m_bodies(std::move(bodies)), m_dt(dt) {
     m_contacts.resize(m_tools.size());
-    for (const auto& t : m_tools) m_pos.push_back(t.start);
+    for (const auto& t : m_tools)
+        m_pos.push_back(t.start);
     m_stepStart = m_pos;
-    for (size_t t = 0; t < m_tools.size(); ++t) m_contacts[t].centre = m_pos[t];
+    for (size_t t = 0; t < m_tools.size(); ++t)
+        m_contacts[t].centre = m_pos[t];
 }
 
 void ToolProbes::setPosition(size_t t, const Vec3& centre) {
@@ -33,7 +36,8 @@ void ToolProbes::setPosition(size_t t, const Vec3& centre) {
     m_pos[t] += d;
 }
 
-std::vector<char> ToolProbes::apply(std::vector<std::vector<Vec3>>& x, std::vector<std::vector<Vec3>>& v, bool measure) {
+std::vector<char> ToolProbes::apply(std::vector<std::vector<Vec3>>& x, std::vector<std::vector<Vec3>>& v,
+                                    bool measure) {
     std::vector<char> changed(x.size(), 0);
     for (size_t t = 0; t < m_tools.size(); ++t) {
         const Vec3 c = m_pos[t];
@@ -76,7 +80,8 @@ std::vector<char> ToolProbes::apply(std::vector<std::vector<Vec3>>& x, std::vect
         }
         const ToolDesc& td = m_tools[t];
         if (modulus <= 0)
-            for (const auto& body : m_bodies) modulus = std::max(modulus, body.modulus);
+            for (const auto& body : m_bodies)
+                modulus = std::max(modulus, body.modulus);
         if (out.nodes > 0 && dir.norm() > 0) {
             out.normal = dir.normalized();
             out.penetration = depth;

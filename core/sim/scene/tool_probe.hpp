@@ -23,14 +23,14 @@ namespace viscera::sim {
 ///   "max_force_n": 15, "damage_force_n": 4}]
 struct ToolDesc {
     std::string name;
-    std::string hand = "any";    ///< "left", "right" or "any": which master drives it
-    double radius = 0.005;       ///< m
-    Vec3 start = Vec3::Zero();   ///< m, scene: centre when the master is at its workspace centre
-    double motionScale = 0.25;   ///< scene metres per device metre
-    double forceScale = 1.0;     ///< device newtons per scene newton
-    double stiffness = 0;        ///< N/m linear contact stiffness; 0 = Hertz from the body's material
-    double maxForceN = 15.0;     ///< N, the case's maximum device force
-    double damageForceN = 4.0;   ///< N, contact force above which tissue is damaged (session metric)
+    std::string hand = "any";  ///< "left", "right" or "any": which master drives it
+    double radius = 0.005;     ///< m
+    Vec3 start = Vec3::Zero(); ///< m, scene: centre when the master is at its workspace centre
+    double motionScale = 0.25; ///< scene metres per device metre
+    double forceScale = 1.0;   ///< device newtons per scene newton
+    double stiffness = 0;      ///< N/m linear contact stiffness; 0 = Hertz from the body's material
+    double maxForceN = 15.0;   ///< N, the case's maximum device force
+    double damageForceN = 4.0; ///< N, contact force above which tissue is damaged (session metric)
 };
 
 /// One probe's contact after the last frame.
@@ -48,8 +48,8 @@ struct ToolContact {
 class ToolProbes {
 public:
     struct Body {
-        std::vector<double> mass;   ///< kg per node (0: do not push, e.g. fixed)
-        double modulus = 0;         ///< Pa, E / (1 − ν²)
+        std::vector<double> mass; ///< kg per node (0: do not push, e.g. fixed)
+        double modulus = 0;       ///< Pa, E / (1 − ν²)
     };
     ToolProbes(std::vector<ToolDesc> tools, std::vector<Body> bodies, double dt);
     size_t size() const { return m_tools.size(); }

@@ -22,7 +22,8 @@ std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::
     w->m_meshes = std::move(meshes);
     w->m_surfaces = std::move(surfaces);
     w->m_solver = makeSceneSolver({w->m_scene, w->m_meshes, w->m_surfaces, origin});
-    for (const BodyDesc& b : scene.bodies) w->m_names.push_back(b.name);
+    for (const BodyDesc& b : scene.bodies)
+        w->m_names.push_back(b.name);
     if (!scene.tools.empty()) {
         std::vector<ToolProbes::Body> pb;
         for (size_t i = 0; i < scene.bodies.size(); ++i) {

@@ -17,7 +17,7 @@ namespace viscera::sim {
 
 struct FrameRecord {
     int index = 0;
-    double stepMs = 0;          ///< wall time of the physics step, ms
+    double stepMs = 0; ///< wall time of the physics step, ms
     int substeps = 0;
     int iterations = 0;
     double energy = 0;          ///< J, elastic + kinetic + gravitational

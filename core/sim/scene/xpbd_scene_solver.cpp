@@ -31,7 +31,8 @@ std::unique_ptr<XpbdSceneSolver> XpbdSceneSolver::create(const SceneSolverInputs
         tb.nodeWeights = b.nodeWeights;
         tb.strainLimits = b.strainLimits;
         if (tb.nodeWeights.empty() || tb.nodeWeights.size() == in.meshes[i]->vertexCount()) {
-            const StabilityFigures fig = assessStability(*in.meshes[i], *tb.model, tb.density, tb.nodeWeights, scene.xpbd);
+            const StabilityFigures fig =
+                assessStability(*in.meshes[i], *tb.model, tb.density, tb.nodeWeights, scene.xpbd);
             if (auto why = stabilityProblem(b.name, fig, scene.xpbd); !why.empty())
                 throw InputError(origin + ": scene cannot be simulated stably: " + why);
         }
@@ -85,9 +86,11 @@ std::unique_ptr<XpbdSceneSolver> XpbdSceneSolver::create(const SceneSolverInputs
     }
     if (scene.interaction) {
         std::vector<const TetMesh*> bodies;
-        for (const auto& m : in.meshes) bodies.push_back(m.get());
+        for (const auto& m : in.meshes)
+            bodies.push_back(m.get());
         std::vector<const TriMesh*> layers;
-        for (const TriMesh& m : in.surfaces) layers.push_back(&m);
+        for (const TriMesh& m : in.surfaces)
+            layers.push_back(&m);
         x->m_interaction = InteractionRuntime::create(scene, *x->m_sys, bodies, layers, origin);
     }
     x->m_accuracy = scene.accuracy;

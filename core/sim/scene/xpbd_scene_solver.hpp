@@ -34,9 +34,9 @@ public:
 
 private:
     XpbdSceneSolver();
-    std::unique_ptr<XpbdSolver> m_single; ///< one tet body, no layers (accuracy hooks); or null
-    std::unique_ptr<XpbdSystem> m_layered; ///< several bodies and layers; or null
-    XpbdSystem* m_sys = nullptr;           ///< the one that runs: m_single's system or m_layered
+    std::unique_ptr<XpbdSolver> m_single;              ///< one tet body, no layers (accuracy hooks); or null
+    std::unique_ptr<XpbdSystem> m_layered;             ///< several bodies and layers; or null
+    XpbdSystem* m_sys = nullptr;                       ///< the one that runs: m_single's system or m_layered
     std::unique_ptr<InteractionRuntime> m_interaction; ///< null unless the scene has "interaction"
     std::optional<AccuracySampling> m_accuracy;
     bool m_primalCorrection = false;

@@ -43,7 +43,8 @@ std::vector<double> parseNodeWeights(std::string_view text, const std::string& o
         if (!(std::isfinite(x) && x > 0)) in.fail(what + " is " + std::string(tok[0]) + " (must be finite and > 0)");
         w.push_back(x);
     }
-    if (in.next(tok)) in.fail("unexpected content after the last weight (file declares " + std::to_string(n) + " nodes)");
+    if (in.next(tok))
+        in.fail("unexpected content after the last weight (file declares " + std::to_string(n) + " nodes)");
     return w;
 }
 

@@ -26,7 +26,8 @@ int32_t Skeleton::components(std::vector<int32_t>& componentOfNode) const {
     std::vector<int32_t> parent(nodes.size());
     std::iota(parent.begin(), parent.end(), 0);
     auto find = [&](int32_t a) {
-        while (parent[a] != a) a = parent[a] = parent[parent[a]];
+        while (parent[a] != a)
+            a = parent[a] = parent[parent[a]];
         return a;
     };
     for (const auto& e : edges) {
@@ -59,8 +60,8 @@ void validateSkeleton(const Skeleton& s, size_t vertexCount, const std::string& 
     std::set<std::pair<int32_t, int32_t>> seen;
     for (size_t e = 0; e < s.edges.size(); ++e) {
         const auto [a, b] = s.edges[e];
-        const std::string name = "skeleton edge " + std::to_string(e) + " (" + std::to_string(a) + ", " +
-                                 std::to_string(b) + ")";
+        const std::string name =
+            "skeleton edge " + std::to_string(e) + " (" + std::to_string(a) + ", " + std::to_string(b) + ")";
         if (a < 0 || b < 0 || a >= m || b >= m)
             fail(name + " references a node out of range (skeleton has " + std::to_string(m) + " nodes)");
         if (a == b) fail(name + " is a self loop");
@@ -83,7 +84,8 @@ void validateSkeleton(const Skeleton& s, size_t vertexCount, const std::string& 
 
 size_t SkeletonNodeMap::coveredCount() const {
     std::vector<char> covered(meshNodeCount, 0);
-    for (int32_t i : members) covered[i] = 1;
+    for (int32_t i : members)
+        covered[i] = 1;
     return static_cast<size_t>(std::count(covered.begin(), covered.end(), 1));
 }
 
@@ -120,8 +122,7 @@ int32_t projectOnSkeleton(const Vec3& p, const Skeleton& s, const std::vector<in
 
 } // namespace
 
-SkeletonNodeMap mapNodesToSkeleton(const std::vector<Vec3>& positions, const Skeleton& s,
-                                   const std::string& origin) {
+SkeletonNodeMap mapNodesToSkeleton(const std::vector<Vec3>& positions, const Skeleton& s, const std::string& origin) {
     validateSkeleton(s, positions.size(), origin);
     for (size_t i = 0; i < positions.size(); ++i)
         if (!positions[i].allFinite())
@@ -162,12 +163,15 @@ SkeletonNodeMap mapNodesToSkeleton(const std::vector<Vec3>& positions, const Ske
         map.fallbackNode.push_back(j);
         pi[j].push_back(static_cast<int32_t>(i));
     }
-    for (auto& members : pi) std::sort(members.begin(), members.end());
+    for (auto& members : pi)
+        std::sort(members.begin(), members.end());
 
     map.start.assign(m + 1, 0);
-    for (size_t j = 0; j < m; ++j) map.start[j + 1] = map.start[j] + static_cast<int32_t>(pi[j].size());
+    for (size_t j = 0; j < m; ++j)
+        map.start[j + 1] = map.start[j] + static_cast<int32_t>(pi[j].size());
     map.members.reserve(static_cast<size_t>(map.start[m]));
-    for (size_t j = 0; j < m; ++j) map.members.insert(map.members.end(), pi[j].begin(), pi[j].end());
+    for (size_t j = 0; j < m; ++j)
+        map.members.insert(map.members.end(), pi[j].begin(), pi[j].end());
     return map;
 }
 

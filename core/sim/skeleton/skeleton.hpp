@@ -17,8 +17,8 @@ namespace viscera::sim {
 /// A curve skeleton: nodes p_j (#m, metres), undirected edges and, for every vertex of the mesh
 /// it was extracted from, the node that vertex contracted to (its surface correspondence).
 struct Skeleton {
-    std::vector<Vec3> nodes;                        ///< p_j, #m, metres
-    std::vector<std::array<int32_t, 2>> edges;      ///< node pairs (a < b), unique, no self loop
+    std::vector<Vec3> nodes;                   ///< p_j, #m, metres
+    std::vector<std::array<int32_t, 2>> edges; ///< node pairs (a < b), unique, no self loop
     /// One entry per vertex of the mesh the skeleton was extracted from (a TriMesh, or a TetMesh
     /// whose interior vertices are kNone): the node the vertex contracted to, or kNone for a
     /// vertex that is not on the skeletonized surface.
@@ -52,9 +52,9 @@ void validateSkeleton(const Skeleton& skeleton, size_t vertexCount, const std::s
 /// closest segment nearer to the projection (ties: the lower node index). Every node therefore
 /// belongs to at least one Π_j.
 struct SkeletonNodeMap {
-    std::vector<double> radius;      ///< r_j, metres, #m
-    std::vector<int32_t> start;      ///< CSR: Π_j = members[start[j], start[j+1]), #m + 1
-    std::vector<int32_t> members;    ///< mesh node indices, ascending within each Π_j
+    std::vector<double> radius;         ///< r_j, metres, #m
+    std::vector<int32_t> start;         ///< CSR: Π_j = members[start[j], start[j+1]), #m + 1
+    std::vector<int32_t> members;       ///< mesh node indices, ascending within each Π_j
     std::vector<int32_t> fallbackNodes; ///< nodes mapped by the fallback, ascending
     std::vector<int32_t> fallbackNode;  ///< the node each fallback node was given (same order)
     size_t meshNodeCount = 0;

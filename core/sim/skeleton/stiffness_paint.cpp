@@ -99,7 +99,8 @@ void applyBrushStroke(const std::vector<Vec3>& positions, const Skeleton& skelet
         }
         next[k] = w;
     }
-    for (size_t k = 0; k < selected.size(); ++k) weights[selected[k]] = next[k];
+    for (size_t k = 0; k < selected.size(); ++k)
+        weights[selected[k]] = next[k];
     if (report) {
         report->strokeSelected.push_back(selected.size());
         report->strokeChanged.push_back(changed);
@@ -111,7 +112,8 @@ void applyBrushStroke(const std::vector<Vec3>& positions, const Skeleton& skelet
 StiffnessPaintResult bakeStiffnessPaint(const TetMesh& mesh, const Skeleton& skeleton,
                                         const std::vector<BrushStroke>& strokes, const PaintParams& params) {
     validateParams(params);
-    for (size_t k = 0; k < strokes.size(); ++k) validateStroke(strokes[k], k, params.origin);
+    for (size_t k = 0; k < strokes.size(); ++k)
+        validateStroke(strokes[k], k, params.origin);
     StiffnessPaintResult r;
     r.map = mapNodesToSkeleton(mesh.positions(), skeleton, params.origin);
     r.weights.assign(mesh.vertexCount(), params.baseWeight);

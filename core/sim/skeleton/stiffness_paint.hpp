@@ -36,14 +36,14 @@ inline constexpr double kMaxBrushRadius = 1e3;
 
 /// One brush stroke: an implicit sphere (centre c, support radius h) and an amplitude.
 struct BrushStroke {
-    Vec3 center = Vec3::Zero();     ///< c, metres, mesh frame
-    double radius = 0.01;           ///< h, metres, in [kMinBrushRadius, kMaxBrushRadius]
-    double amplitude = 1.0;         ///< weight to add (see BrushScale); < 0 softens
+    Vec3 center = Vec3::Zero(); ///< c, metres, mesh frame
+    double radius = 0.01;       ///< h, metres, in [kMinBrushRadius, kMaxBrushRadius]
+    double amplitude = 1.0;     ///< weight to add (see BrushScale); < 0 softens
     BrushScale scale = BrushScale::Peak;
 };
 
 struct PaintParams {
-    double baseWeight = 1.0;  ///< W before the first stroke, > 0
+    double baseWeight = 1.0; ///< W before the first stroke, > 0
     /// Weights are clamped to [minWeight, maxWeight] after every stroke (0 < min <= base <= max).
     /// The floor keeps every weight positive: XPBD divides compliances by it.
     double minWeight = 1e-3;
@@ -53,11 +53,11 @@ struct PaintParams {
 
 /// Figures of a bake, for the studio log.
 struct StiffnessPaintReport {
-    std::vector<size_t> strokeSelected;  ///< per stroke: nodes selected through the skeleton
-    std::vector<size_t> strokeChanged;   ///< per stroke: selected nodes with a non-zero kernel
+    std::vector<size_t> strokeSelected;     ///< per stroke: nodes selected through the skeleton
+    std::vector<size_t> strokeChanged;      ///< per stroke: selected nodes with a non-zero kernel
     size_t clampedLow = 0, clampedHigh = 0; ///< clamp events over all strokes
-    size_t fallbackNodes = 0;            ///< nodes mapped by SkeletonNodeMap's fallback
-    double minWeight = 0, maxWeight = 0; ///< of the result
+    size_t fallbackNodes = 0;               ///< nodes mapped by SkeletonNodeMap's fallback
+    double minWeight = 0, maxWeight = 0;    ///< of the result
 };
 
 struct StiffnessPaintResult {

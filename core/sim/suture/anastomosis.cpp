@@ -43,7 +43,9 @@ AnastomosisModel makeAnastomosisTubes(const AnastomosisSpec& s) {
     return m;
 }
 
-double anastomosisHandle(const AnastomosisSpec& s) { return 0.5 * std::numbers::pi * s.needleRadius; }
+double anastomosisHandle(const AnastomosisSpec& s) {
+    return 0.5 * std::numbers::pi * s.needleRadius;
+}
 
 std::vector<NeedleFrame> makeAnastomosisTrajectory(const AnastomosisSpec& s) {
     std::vector<NeedleFrame> out;
@@ -57,9 +59,12 @@ std::vector<NeedleFrame> makeAnastomosisTrajectory(const AnastomosisSpec& s) {
             for (int f = 1; f <= s.transferFrames; ++f) // out
                 out.push_back({needlePose(prev, s.needleCentre + s.transferDistance * f / s.transferFrames, g0), 0});
             for (int f = 1; f <= s.transferFrames; ++f) // around
-                out.push_back({needlePose(prev + dPhi * f / s.transferFrames, s.needleCentre + s.transferDistance, g0), 0});
+                out.push_back(
+                    {needlePose(prev + dPhi * f / s.transferFrames, s.needleCentre + s.transferDistance, g0), 0});
             for (int f = 1; f <= s.transferFrames; ++f) // in
-                out.push_back({needlePose(phi, s.needleCentre + s.transferDistance * (1.0 - double(f) / s.transferFrames), g0), 0});
+                out.push_back(
+                    {needlePose(phi, s.needleCentre + s.transferDistance * (1.0 - double(f) / s.transferFrames), g0),
+                     0});
         }
         for (int f = 1; f <= turnFrames; ++f)
             out.push_back({needlePose(phi, s.needleCentre, g0 + 2 * std::numbers::pi * f / turnFrames), 0});
@@ -71,7 +76,8 @@ std::vector<NeedleFrame> makeAnastomosisTrajectory(const AnastomosisSpec& s) {
     for (int f = 1; f <= s.transferFrames; ++f)
         out.push_back({needlePose(phiEnd, s.needleCentre + s.transferDistance * f / s.transferFrames, g0), 0});
     const Eigen::Isometry3d park = needlePose(phiEnd, s.needleCentre + s.transferDistance, g0);
-    for (int f = 1; f <= s.pullFrames; ++f) out.push_back({park, total * f / s.pullFrames});
+    for (int f = 1; f <= s.pullFrames; ++f)
+        out.push_back({park, total * f / s.pullFrames});
     return out;
 }
 
@@ -81,8 +87,8 @@ std::string formatTrajectory(const std::vector<NeedleFrame>& frames) {
     for (const NeedleFrame& f : frames) {
         const Eigen::Quaterniond q(f.pose.linear());
         const Vec3 p = f.pose.translation();
-        std::snprintf(buf, sizeof buf, "%.9g %.9g %.9g %.12g %.12g %.12g %.12g %.9g\n", p.x(), p.y(), p.z(), q.w(), q.x(),
-                      q.y(), q.z(), f.pull);
+        std::snprintf(buf, sizeof buf, "%.9g %.9g %.9g %.12g %.12g %.12g %.12g %.9g\n", p.x(), p.y(), p.z(), q.w(),
+                      q.x(), q.y(), q.z(), f.pull);
         out += buf;
     }
     return out;
@@ -101,12 +107,15 @@ std::vector<NeedleFrame> parseTrajectory(std::string_view text, const std::strin
         std::istringstream ls(line);
         double v[8];
         int n = 0;
-        while (n < 8 && ls >> v[n]) ++n;
+        while (n < 8 && ls >> v[n])
+            ++n;
         std::string rest;
         if (n != 8 || (ls >> rest))
-            throw InputError(origin + ": line " + std::to_string(lineNo) + ": expected 8 numbers (px py pz qw qx qy qz pull)");
+            throw InputError(origin + ": line " + std::to_string(lineNo) +
+                             ": expected 8 numbers (px py pz qw qx qy qz pull)");
         for (double d : v)
-            if (!std::isfinite(d)) throw InputError(origin + ": line " + std::to_string(lineNo) + ": values must be finite");
+            if (!std::isfinite(d))
+                throw InputError(origin + ": line " + std::to_string(lineNo) + ": values must be finite");
         Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
         if (std::abs(q.norm() - 1) > 1e-6)
             throw InputError(origin + ": line " + std::to_string(lineNo) + ": quaternion must have unit norm");
@@ -130,7 +139,8 @@ std::unique_ptr<TetMesh> mergeMeshes(const std::vector<const TetMesh*>& meshes, 
         if (offsets) offsets->push_back(off);
         pos.insert(pos.end(), m->positions().begin(), m->positions().end());
         for (Tet t : m->tets()) {
-            for (auto& v : t) v += off;
+            for (auto& v : t)
+                v += off;
             tets.push_back(t);
         }
     }
@@ -175,16 +185,20 @@ ClosureGauge::ClosureGauge(const TetMesh& m, int32_t firstB) {
     const auto& x = m.positions();
     const auto& vmap = m.boundaryVertexMap();
     std::vector<int32_t> bA, bB;
-    for (int32_t v : vmap) (v < firstB ? bA : bB).push_back(v);
+    for (int32_t v : vmap)
+        (v < firstB ? bA : bB).push_back(v);
     auto nearest = [&](int32_t v, const std::vector<int32_t>& other) {
         double d = std::numeric_limits<double>::infinity();
-        for (int32_t o : other) d = std::min(d, (x[v] - x[o]).norm());
+        for (int32_t o : other)
+            d = std::min(d, (x[v] - x[o]).norm());
         return d;
     };
     std::vector<double> dist(x.size(), std::numeric_limits<double>::infinity());
     double minD = std::numeric_limits<double>::infinity();
-    for (int32_t v : bA) minD = std::min(minD, dist[v] = nearest(v, bB));
-    for (int32_t v : bB) dist[v] = nearest(v, bA);
+    for (int32_t v : bA)
+        minD = std::min(minD, dist[v] = nearest(v, bB));
+    for (int32_t v : bB)
+        dist[v] = nearest(v, bA);
     std::vector<uint8_t> facing(x.size(), 0), near(x.size(), 0);
     for (int32_t v : bA) {
         if (dist[v] <= 1.5 * minD) m_facingA.push_back(v), facing[v] = 1;
@@ -203,7 +217,8 @@ ClosureGauge::ClosureGauge(const TetMesh& m, int32_t firstB) {
     }
     for (const Tet& t : m.tets()) {
         bool close = false;
-        for (int32_t v : t) close |= nearest(v, v < firstB ? bB : bA) <= 3 * minD;
+        for (int32_t v : t)
+            close |= nearest(v, v < firstB ? bB : bA) <= 3 * minD;
         if (close) (t[0] < firstB ? m_tetsA : m_tetsB).push_back(t);
     }
     // Vertices that face the other body's surface: their rest projection onto the nearest facing
@@ -233,7 +248,8 @@ ClosureMetrics ClosureGauge::measure(const std::vector<Vec3>& x) const {
     ClosureMetrics r;
     auto distanceTo = [&](const Vec3& p, const std::vector<std::array<int32_t, 3>>& tris) {
         double best = std::numeric_limits<double>::infinity();
-        for (const auto& t : tris) best = std::min(best, (p - closestPointOnTriangle(p, x[t[0]], x[t[1]], x[t[2]])).norm());
+        for (const auto& t : tris)
+            best = std::min(best, (p - closestPointOnTriangle(p, x[t[0]], x[t[1]], x[t[2]])).norm());
         return best;
     };
     auto inside = [&](const Vec3& p, const std::vector<Tet>& tets) {
@@ -269,7 +285,8 @@ AnastomosisRun makeAnastomosisRun(const AnastomosisSpec& spec, SutureSettings se
     std::vector<int32_t> off;
     auto merged = mergeMeshes({model.wide.get(), model.narrow.get()}, &off);
     std::vector<int32_t> fixed = model.wideFixed;
-    for (int32_t v : model.narrowFixed) fixed.push_back(v + off[1]);
+    for (int32_t v : model.narrowFixed)
+        fixed.push_back(v + off[1]);
     settings.needle.radius = spec.needleRadius;
     settings.needle.handle = anastomosisHandle(spec);
     AnastomosisRun run;

@@ -15,15 +15,15 @@ namespace viscera::sim {
 struct AnastomosisSpec {
     HollowTubeSpec wide{Vec3(0, 0, -0.013), Vec3(0, 0, -0.001), 0.0038, 0.0050, 33, 2, 8}; ///< lower tube
     HollowTubeSpec narrow{Vec3(0, 0, 0.001), Vec3(0, 0, 0.013), 0.0034, 0.0045, 28, 2, 8}; ///< upper tube
-    double needleRadius = 0.0042;     ///< m
-    double needleCentre = 0.0062;     ///< radial distance of the needle's centre from the axis, m
-    int stitches = 5;                 ///< 4 punctures each
-    double degreesPerFrame = 3.0;     ///< needle rotation per frame while driving
-    int transferFrames = 10;          ///< per leg (out, around, in) between stitches
-    double transferDistance = 0.003;  ///< m, radial retreat between stitches
+    double needleRadius = 0.0042;                                                          ///< m
+    double needleCentre = 0.0062;    ///< radial distance of the needle's centre from the axis, m
+    int stitches = 5;                ///< 4 punctures each
+    double degreesPerFrame = 3.0;    ///< needle rotation per frame while driving
+    int transferFrames = 10;         ///< per leg (out, around, in) between stitches
+    double transferDistance = 0.003; ///< m, radial retreat between stitches
     int pullFrames = 200;
-    double pullPerSegment = 0.0026;   ///< m of pull per outside thread segment (tuned: the gap stops closing beyond)
-    double slack = 0.002;             ///< m
+    double pullPerSegment = 0.0026; ///< m of pull per outside thread segment (tuned: the gap stops closing beyond)
+    double slack = 0.002;           ///< m
 };
 
 struct AnastomosisModel {
@@ -64,8 +64,8 @@ std::unique_ptr<TetMesh> mergeMeshes(const std::vector<const TetMesh*>& meshes, 
 /// distance to the other body's surface of a facing vertex that lies inside one of its tets (the
 /// tets of its end region: within 3× the smallest distance). Cost: O(facing × (tets + triangles)).
 struct ClosureMetrics {
-    double maxGap = 0;            ///< m
-    double maxPenetration = 0;    ///< m, 0 when no vertex is inside the other body
+    double maxGap = 0;         ///< m
+    double maxPenetration = 0; ///< m, 0 when no vertex is inside the other body
     bool finite = true;
 };
 class ClosureGauge {

@@ -58,7 +58,8 @@ int NeedleCurve::planeCrossings(const Vec3& n, double d, double a, double b, dou
         // All θ = base + 2πk in (th0, th1].
         double th = base + twoPi * std::ceil((th0 - base) / twoPi);
         if (th <= th0) th += twoPi;
-        for (; th <= th1 && k < cap; th += twoPi) out[k++] = th * r;
+        for (; th <= th1 && k < cap; th += twoPi)
+            out[k++] = th * r;
         if (acos == 0) break; // tangent: one root
     }
     std::sort(out, out + k);

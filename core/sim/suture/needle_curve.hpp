@@ -12,17 +12,17 @@ namespace viscera::sim {
 struct NeedleCurve {
     enum class Kind { Straight, Arc };
     Kind kind = Kind::Straight;
-    Vec3 p = Vec3::Zero();   ///< straight: end point; arc: circle centre, m
-    Vec3 w = Vec3::UnitX();  ///< straight: unit axis
-    Vec3 u = Vec3::UnitX();  ///< arc: unit vector to the end point (α = 0)
-    Vec3 v = Vec3::UnitY();  ///< arc: unit vector, u ⟂ v, direction of increasing α
-    double r = 0.01;         ///< arc radius, m
+    Vec3 p = Vec3::Zero();  ///< straight: end point; arc: circle centre, m
+    Vec3 w = Vec3::UnitX(); ///< straight: unit axis
+    Vec3 u = Vec3::UnitX(); ///< arc: unit vector to the end point (α = 0)
+    Vec3 v = Vec3::UnitY(); ///< arc: unit vector, u ⟂ v, direction of increasing α
+    double r = 0.01;        ///< arc radius, m
 
     static NeedleCurve straight(const Vec3& p, const Vec3& w);
     static NeedleCurve arc(const Vec3& centre, const Vec3& u, const Vec3& v, double radius);
 
     Vec3 point(double alpha) const;
-    Vec3 tangent(double alpha) const; ///< unit
+    Vec3 tangent(double alpha) const;          ///< unit
     Vec3 normal() const { return u.cross(v); } ///< arc: plane normal
 
     /// Parameters α in (a, b] at which the curve crosses the plane n·x = d, ascending; returns the

@@ -30,7 +30,8 @@ SutureSceneDesc readSutureSection(const JsonField& doc, bool readTrajectory) {
         s.thread.length = t->number("length", s.thread.length, NumberRule::positive());
         s.thread.slack = t->number("slack", s.thread.slack, NumberRule::nonNegative());
         s.thread.stabilization = t->number("stabilization", s.thread.stabilization, NumberRule::positive());
-        s.thread.maxStrainPerStep = t->number("max_strain_per_step", s.thread.maxStrainPerStep, NumberRule{0, 1, true, true});
+        s.thread.maxStrainPerStep =
+            t->number("max_strain_per_step", s.thread.maxStrainPerStep, NumberRule{0, 1, true, true});
     }
     d.contact = doc.has("contact");
     s.contact = d.contact;
@@ -79,6 +80,8 @@ SutureSceneDesc parseSutureSection(std::string_view text, const std::string& ori
     return readSutureSection(JsonField(doc, "suture", origin));
 }
 
-std::string formatSutureSection(const SutureSceneDesc& d) { return sutureJson(d).dump(); }
+std::string formatSutureSection(const SutureSceneDesc& d) {
+    return sutureJson(d).dump();
+}
 
 } // namespace viscera::sim

@@ -21,11 +21,11 @@
 namespace viscera::sim {
 
 struct SutureSceneDesc {
-    SutureSettings settings;      ///< fem.youngsModulus / poissonRatio come from the bodies' material
-    bool thread = false;          ///< "thread" present: pulls in the trajectory are applied
-    bool contact = false;         ///< "contact" present: VF/EE contact between bodies
-    std::string trajectoryPath;   ///< file inside the case
-    std::string trajectoryText;   ///< its contents, filled by whoever reads the case (not serialized)
+    SutureSettings settings;          ///< fem.youngsModulus / poissonRatio come from the bodies' material
+    bool thread = false;              ///< "thread" present: pulls in the trajectory are applied
+    bool contact = false;             ///< "contact" present: VF/EE contact between bodies
+    std::string trajectoryPath;       ///< file inside the case
+    std::string trajectoryText;       ///< its contents, filled by whoever reads the case (not serialized)
     std::array<std::string, 2> gauge; ///< body names; empty = no closure figures
 };
 

@@ -9,7 +9,9 @@
 namespace viscera::sim {
 namespace {
 
-bool finitePose(const Eigen::Isometry3d& p) { return p.matrix().allFinite(); }
+bool finitePose(const Eigen::Isometry3d& p) {
+    return p.matrix().allFinite();
+}
 
 /// Orthonormal pair spanning the plane normal to w [B eq. 3.30–3.31].
 void normalPlane(const Vec3& w, Vec3& u, Vec3& v) {
@@ -39,13 +41,16 @@ ThreadSegmentLinearization linearizeThreadSegment(const Vec3& ra, const Vec3& rb
     return l;
 }
 
-double NeedleSpec::length_() const { return shape == Shape::Semicircle ? std::numbers::pi * radius : length; }
+double NeedleSpec::length_() const {
+    return shape == Shape::Semicircle ? std::numbers::pi * radius : length;
+}
 
 std::string validate(const SutureSettings& s) {
     if (auto why = validate(s.fem); !why.empty()) return why;
     const NeedleSpec& n = s.needle;
     if (!(n.radius > 0) || !(n.length > 0)) return "needle radius and length must be positive";
-    if (!(n.handle >= 0 && n.handle <= n.length_())) return "needle handle must lie on the needle (0 <= handle <= length)";
+    if (!(n.handle >= 0 && n.handle <= n.length_()))
+        return "needle handle must lie on the needle (0 <= handle <= length)";
     if (!(n.punctureForce > 0) || !std::isfinite(n.punctureForce)) return "needle puncture_force must be positive";
     if (!(s.thread.length > 0) || !(s.thread.slack >= 0) || !(s.thread.stabilization > 0))
         return "thread length and stabilization must be positive, slack >= 0";
@@ -86,7 +91,8 @@ double slidingAmount(const NeedleSpec& spec, const Eigen::Isometry3d& from, cons
 
 SutureSimulation::~SutureSimulation() = default;
 
-std::unique_ptr<SutureSimulation> SutureSimulation::create(std::unique_ptr<TetMesh> mesh, const std::vector<int32_t>& fixed,
+std::unique_ptr<SutureSimulation> SutureSimulation::create(std::unique_ptr<TetMesh> mesh,
+                                                           const std::vector<int32_t>& fixed,
                                                            const SutureSettings& settings,
                                                            const Eigen::Isometry3d& initialPose) {
     if (auto why = validate(settings); !why.empty())
@@ -120,7 +126,9 @@ ConstraintRow SutureSimulation::pointRow(int32_t face, const Vec3& xi, const Vec
     return r;
 }
 
-int32_t SutureSimulation::topCell() const { return m_history.empty() ? kNone : m_history.back().cell; }
+int32_t SutureSimulation::topCell() const {
+    return m_history.empty() ? kNone : m_history.back().cell;
+}
 
 std::vector<Vec3> SutureSimulation::puncturePoints() const {
     std::vector<Vec3> out;
@@ -160,11 +168,14 @@ void SutureSimulation::trackForward(const NeedleCurve& curve, double sigma, bool
 
 void SutureSimulation::shiftParameters(double sigma) {
     const double l = m_s.needle.length_();
-    for (HistoryEntry& e : m_history) e.alpha -= sigma; // eq. 3.26
-    while (!m_history.empty() && m_history.back().alpha > l + 1e-12) m_history.pop_back(); // backward sliding
+    for (HistoryEntry& e : m_history)
+        e.alpha -= sigma; // eq. 3.26
+    while (!m_history.empty() && m_history.back().alpha > l + 1e-12)
+        m_history.pop_back(); // backward sliding
     const double eta = m_s.thread.length;
-    m_history.erase(std::remove_if(m_history.begin(), m_history.end(), [&](const HistoryEntry& e) { return e.alpha < -eta; }),
-                    m_history.end());
+    m_history.erase(
+        std::remove_if(m_history.begin(), m_history.end(), [&](const HistoryEntry& e) { return e.alpha < -eta; }),
+        m_history.end());
 }
 
 void SutureSimulation::replay(const Eigen::Isometry3d& from, const std::vector<Eigen::Isometry3d>& log,
@@ -183,7 +194,8 @@ void SutureSimulation::replay(const Eigen::Isometry3d& from, const std::vector<E
 }
 
 void SutureSimulation::clearNeedleConstraints() {
-    for (int id : m_needleIds) m_fem->removeConstraint(id);
+    for (int id : m_needleIds)
+        m_fem->removeConstraint(id);
     m_needleIds.clear();
     m_needleEntryOf.clear();
 }
@@ -203,7 +215,8 @@ void SutureSimulation::addNeedleConstraints(bool slip) {
             normalPlane(c.tangent(e.alpha), u, v);
             d.rows = {pointRow(e.face, e.xi, u, u.dot(target)), pointRow(e.face, e.xi, v, v.dot(target))};
         } else { // eq. 3.28
-            for (int k = 0; k < 3; ++k) d.rows.push_back(pointRow(e.face, e.xi, Vec3::Unit(k), target[k]));
+            for (int k = 0; k < 3; ++k)
+                d.rows.push_back(pointRow(e.face, e.xi, Vec3::Unit(k), target[k]));
         }
         m_needleIds.push_back(m_fem->addConstraint(std::move(d)));
         m_needleEntryOf.push_back(static_cast<int>(i));
@@ -216,14 +229,16 @@ void SutureSimulation::updateThreadConstraint(double pull, SutureStepStats& st) 
     const HistoryEntry* lastExit = nullptr;
     for (const HistoryEntry& e : m_history) {
         if (e.alpha >= 0 || !e.puncture()) continue;
-        if (e.exitsMesh) lastExit = &e;
+        if (e.exitsMesh)
+            lastExit = &e;
         else if (e.entersMesh && lastExit) {
             segs.emplace_back(lastExit, &e);
             lastExit = nullptr;
         }
     }
     auto dropAll = [&] {
-        for (int id : m_pullIds) m_fem->removeConstraint(id);
+        for (int id : m_pullIds)
+            m_fem->removeConstraint(id);
         m_pullIds.clear();
     };
     if (!(pull > 0) || segs.empty()) {
@@ -316,8 +331,10 @@ void SutureSimulation::updateContacts() {
         }
         r.b = 0;
         if (m_fem->hasConstraint(c.id)) {
-            if (!m_fem->state(c.id).active) ++c.inactiveSteps;
-            else c.inactiveSteps = 0;
+            if (!m_fem->state(c.id).active)
+                ++c.inactiveSteps;
+            else
+                c.inactiveSteps = 0;
             if (c.inactiveSteps > 3) drop = true;
         } else {
             drop = true;
@@ -344,7 +361,8 @@ void SutureSimulation::processContacts(const std::vector<Vec3>& before, SutureSt
         auto keyOf = [](const Collision& c) {
             return std::array<int32_t, 5>{static_cast<int32_t>(c.kind), c.v[0], c.v[1], c.v[2], c.v[3]};
         };
-        for (const Contact& c : m_contacts) held.insert(keyOf(c.c));
+        for (const Contact& c : m_contacts)
+            held.insert(keyOf(c.c));
         int added = 0;
         for (const Collision& h : hits) { // time order [B §3.3.1]
             if (added >= m_s.contactsPerRound || m_contacts.size() >= static_cast<size_t>(m_s.maxContacts)) break;
@@ -357,7 +375,10 @@ void SutureSimulation::processContacts(const std::vector<Vec3>& before, SutureSt
             if (h.kind == CollisionKind::VertexFace)
                 r.terms = {{h.v[0], n}, {h.v[1], -h.w[0] * n}, {h.v[2], -h.w[1] * n}, {h.v[3], -h.w[2] * n}};
             else
-                r.terms = {{h.v[0], (1 - h.w[0]) * n}, {h.v[1], h.w[0] * n}, {h.v[2], -(1 - h.w[1]) * n}, {h.v[3], -h.w[1] * n}};
+                r.terms = {{h.v[0], (1 - h.w[0]) * n},
+                           {h.v[1], h.w[0] * n},
+                           {h.v[2], -(1 - h.w[1]) * n},
+                           {h.v[3], -h.w[1] * n}};
             r.b = 0;
             if (!n_finite(r)) continue;
             d.rows = {r};
@@ -459,7 +480,8 @@ SutureStepStats SutureSimulation::step(const NeedleFrame& frame) {
         const Vec3 tip = curve().point(l);
         ConstraintDesc d;
         d.priority = 0;
-        for (int k = 0; k < 3; ++k) d.rows.push_back(pointRow(m_tip.face, m_tip.xi, Vec3::Unit(k), tip[k]));
+        for (int k = 0; k < 3; ++k)
+            d.rows.push_back(pointRow(m_tip.face, m_tip.xi, Vec3::Unit(k), tip[k]));
         if (m_fem->hasConstraint(m_tip.id)) m_fem->removeConstraint(m_tip.id);
         m_tip.id = m_fem->addConstraint(std::move(d));
         addNeedleConstraints(true);

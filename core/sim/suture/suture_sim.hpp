@@ -32,17 +32,17 @@ namespace viscera::sim {
 struct NeedleSpec {
     enum class Shape { Straight, Semicircle };
     Shape shape = Shape::Semicircle;
-    double radius = 0.004;        ///< semicircle radius, m (length = π r)
-    double length = 0.02;         ///< straight length, m
-    double handle = 0.0;          ///< α of the grasp point used for the decomposition, m
-    double punctureForce = 0.05;  ///< axial force at which the tip punctures a boundary facet, N
-    double length_() const;       ///< axial length ℓ, m
+    double radius = 0.004;       ///< semicircle radius, m (length = π r)
+    double length = 0.02;        ///< straight length, m
+    double handle = 0.0;         ///< α of the grasp point used for the decomposition, m
+    double punctureForce = 0.05; ///< axial force at which the tip punctures a boundary facet, N
+    double length_() const;      ///< axial length ℓ, m
 };
 
 struct ThreadSpec {
-    double length = 1.0;          ///< η: entries behind the needle end beyond −η are dropped, m
-    double slack = 0.002;         ///< outside length above the taut length when the pull starts, m
-    double stabilization = 2e-4;  ///< ε of the small-distance linearization, m
+    double length = 1.0;            ///< η: entries behind the needle end beyond −η are dropped, m
+    double slack = 0.002;           ///< outside length above the taut length when the pull starts, m
+    double stabilization = 2e-4;    ///< ε of the small-distance linearization, m
     double maxStrainPerStep = 0.05; ///< largest relative shortening κ of a segment per step [eq. 3.37]
 };
 
@@ -97,19 +97,19 @@ struct HistoryEntry {
 struct SutureStepStats {
     bool finite = true;
     int solves = 0;
-    int activeRows = 0;          ///< constraint rows enforced in the last solve
-    int rejectedRows = 0;        ///< redundant or incompatible rows in the last solve
-    int needleEntries = 0;       ///< history entries coupled to the needle
+    int activeRows = 0;    ///< constraint rows enforced in the last solve
+    int rejectedRows = 0;  ///< redundant or incompatible rows in the last solve
+    int needleEntries = 0; ///< history entries coupled to the needle
     int threadEntries = 0;
-    int punctures = 0;           ///< boundary punctures so far
-    int contacts = 0;            ///< contact constraints in force
+    int punctures = 0; ///< boundary punctures so far
+    int contacts = 0;  ///< contact constraints in force
     int newContacts = 0;
     bool tipInContact = false;
-    bool punctured = false;      ///< a puncture happened this step
-    double sigma = 0;            ///< sliding amount, m
-    double needleForce = 0;      ///< resultant force of the tissue on the needle, N
-    double tipAxialForce = 0;    ///< axial force at a boundary contact, N
-    double threadTension = 0;    ///< from the pull multiplier, N
+    bool punctured = false;   ///< a puncture happened this step
+    double sigma = 0;         ///< sliding amount, m
+    double needleForce = 0;   ///< resultant force of the tissue on the needle, N
+    double tipAxialForce = 0; ///< axial force at a boundary contact, N
+    double threadTension = 0; ///< from the pull multiplier, N
     bool threadEngaged = false;
     bool refactored = false;
     std::string error;

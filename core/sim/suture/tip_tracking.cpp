@@ -155,8 +155,10 @@ int32_t TipTracker::track(const std::vector<Vec3>& x, const NeedleCurve& c, doub
             const auto v = m_mesh.halfFacetVertices(bestF);
             int zeros = 0, keep[3], nk = 0;
             for (int i = 0; i < 3; ++i) {
-                if (cr.xi[i] <= m_epsB) ++zeros;
-                else keep[nk++] = v[i];
+                if (cr.xi[i] <= m_epsB)
+                    ++zeros;
+                else
+                    keep[nk++] = v[i];
             }
             if (zeros == 0) {
                 cr.kind = CrossingKind::Face;
@@ -175,8 +177,10 @@ int32_t TipTracker::track(const std::vector<Vec3>& x, const NeedleCurve& c, doub
             const Tet& T = m_mesh.tets()[t];
             int zeros = 0, keep[4], nk = 0;
             for (int i = 0; i < 4; ++i) {
-                if (i == ex.face || l[i] <= m_epsB) ++zeros;
-                else keep[nk++] = T[i];
+                if (i == ex.face || l[i] <= m_epsB)
+                    ++zeros;
+                else
+                    keep[nk++] = T[i];
             }
             if (zeros == 1) {
                 cr.kind = CrossingKind::Face;
@@ -200,7 +204,8 @@ int32_t TipTracker::track(const std::vector<Vec3>& x, const NeedleCurve& c, doub
                 m_mesh.linkFacetsOfVertexInto(vertexA, link);
             }
             cands.clear();
-            for (int32_t f : link) cands.push_back(TetMesh::cellOf(f));
+            for (int32_t f : link)
+                cands.push_back(TetMesh::cellOf(f));
             std::sort(cands.begin(), cands.end());
             cands.erase(std::unique(cands.begin(), cands.end()), cands.end());
             cr.toCell = chooseNext(x, c, cands, t, cr.alpha, b);

@@ -19,13 +19,13 @@ namespace viscera::sim {
 enum class CrossingKind { Face, Edge, Vertex };
 
 struct Crossing {
-    double alpha = 0;             ///< curve parameter of the crossing point, m
-    int32_t fromCell = kNone;     ///< cell left (kNone = ⊥)
-    int32_t toCell = kNone;       ///< cell entered (kNone = ⊥)
+    double alpha = 0;         ///< curve parameter of the crossing point, m
+    int32_t fromCell = kNone; ///< cell left (kNone = ⊥)
+    int32_t toCell = kNone;   ///< cell entered (kNone = ⊥)
     /// A half-facet carrying the crossing point: a facet of toCell, or the boundary half-facet of
     /// fromCell when toCell is ⊥.
     int32_t face = kNone;
-    Vec3 xi = Vec3::Zero();       ///< barycentric coordinates of the point on `face` (its vertex order)
+    Vec3 xi = Vec3::Zero(); ///< barycentric coordinates of the point on `face` (its vertex order)
     CrossingKind kind = CrossingKind::Face;
     bool boundary() const { return fromCell == kNone || toCell == kNone; }
 };
@@ -66,8 +66,8 @@ private:
     void faceBary(const std::vector<Vec3>& x, int32_t f, const Vec3& p, Vec3& xi) const;
 
     const TetMesh& m_mesh;
-    double m_h = 1;      // mean edge length
-    double m_epsS = 0;   // parameter tolerance
+    double m_h = 1;       // mean edge length
+    double m_epsS = 0;    // parameter tolerance
     double m_epsB = 1e-9; // barycentric tolerance
 };
 

@@ -12,11 +12,9 @@
 namespace viscera::sim {
 
 /// Exit codes of every Viscera program.
-inline constexpr int kExitOk = 0; ///< success
-inline constexpr int kExitInput =
-    1; ///< bad input (case, project, file, argument value) or an internal error
-inline constexpr int kExitUsage =
-    2; ///< wrong usage (unknown subcommand, missing or malformed argument)
+inline constexpr int kExitOk = 0;        ///< success
+inline constexpr int kExitInput = 1;     ///< bad input (case, project, file, argument value) or an internal error
+inline constexpr int kExitUsage = 2;     ///< wrong usage (unknown subcommand, missing or malformed argument)
 inline constexpr int kExitInvariant = 3; ///< the run broke an invariant
 
 using CliArgs = std::vector<std::string>;
@@ -29,10 +27,9 @@ struct CliSubcommand {
 };
 
 struct CliProgram {
-    const char* name = "";         ///< "viscera-player": prefixes every stderr line
-    const char* version = nullptr; ///< --version prints "<name> <version>"; null: none
-    void (*usage)(std::FILE* out) =
-        nullptr; ///< --help / -h print it to stdout, a usage error to stderr
+    const char* name = "";                   ///< "viscera-player": prefixes every stderr line
+    const char* version = nullptr;           ///< --version prints "<name> <version>"; null: none
+    void (*usage)(std::FILE* out) = nullptr; ///< --help / -h print it to stdout, a usage error to stderr
     std::vector<CliSubcommand> subcommands;
     /// Runs with all the arguments when the first one is no subcommand, --help, -h or --version;
     /// empty: usage on stderr, kExitUsage.

@@ -4,8 +4,8 @@ namespace viscera::sim {
 namespace {
 
 bool isPortable(char c) {
-    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' ||
-           c == '_' || c == '-';
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' ||
+           c == '-';
 }
 
 std::string hexByte(unsigned char c) {
@@ -18,13 +18,12 @@ std::string hexByte(unsigned char c) {
 std::optional<std::string> entryNameProblem(std::string_view path) {
     if (path.empty()) return "empty entry name";
     if (path.size() > kMaxEntryNameBytes)
-        return "entry name is " + std::to_string(path.size()) +
-               " bytes, longer than the limit of " + std::to_string(kMaxEntryNameBytes);
+        return "entry name is " + std::to_string(path.size()) + " bytes, longer than the limit of " +
+               std::to_string(kMaxEntryNameBytes);
     if (path.front() == '/') return "absolute entry path";
     bool letter = (path[0] >= 'A' && path[0] <= 'Z') || (path[0] >= 'a' && path[0] <= 'z');
     if (path.size() >= 2 && letter && path[1] == ':') return "absolute entry path (drive letter)";
-    if (path.find('\\') != std::string_view::npos)
-        return "entry name contains a backslash (paths use '/')";
+    if (path.find('\\') != std::string_view::npos) return "entry name contains a backslash (paths use '/')";
     size_t start = 0;
     while (start <= path.size()) {
         size_t end = path.find('/', start);

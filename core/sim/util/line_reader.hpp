@@ -29,10 +29,12 @@ public:
             tokens.clear();
             size_t i = 0;
             while (i < line.size()) {
-                while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+                while (i < line.size() && (line[i] == ' ' || line[i] == '\t'))
+                    ++i;
                 if (i >= line.size() || line[i] == '#') break;
                 size_t j = i;
-                while (j < line.size() && line[j] != ' ' && line[j] != '\t') ++j;
+                while (j < line.size() && line[j] != ' ' && line[j] != '\t')
+                    ++j;
                 tokens.push_back(line.substr(i, j - i));
                 i = j;
             }

@@ -8,7 +8,9 @@ Sink& sink() {
 }
 } // namespace
 
-void setSink(Sink s) { sink() = std::move(s); }
+void setSink(Sink s) {
+    sink() = std::move(s);
+}
 
 void write(Level level, std::string_view message) {
     if (auto& s = sink()) s(level, message);

@@ -12,8 +12,14 @@ using Sink = std::function<void(Level, std::string_view)>;
 /// install once at start-up.
 void setSink(Sink sink);
 void write(Level level, std::string_view message);
-inline void info(std::string_view m) { write(Level::Info, m); }
-inline void warn(std::string_view m) { write(Level::Warn, m); }
-inline void error(std::string_view m) { write(Level::Error, m); }
+inline void info(std::string_view m) {
+    write(Level::Info, m);
+}
+inline void warn(std::string_view m) {
+    write(Level::Warn, m);
+}
+inline void error(std::string_view m) {
+    write(Level::Error, m);
+}
 
 } // namespace viscera::log

@@ -12,7 +12,7 @@ namespace {
 
 /// Uniform grid over element bounding boxes; query by box. Build O(#elements · cells per box).
 class BoxGrid {
-  public:
+public:
     BoxGrid(const std::vector<Eigen::AlignedBox3d>& boxes, double pad) {
         Eigen::AlignedBox3d all;
         double extent = 0;
@@ -75,18 +75,14 @@ class BoxGrid {
                 }
     }
 
-  private:
+private:
     void range(const Vec3& lo, const Vec3& hi, std::array<int, 3>& a, std::array<int, 3>& b) const {
         for (int d = 0; d < 3; ++d) {
-            a[d] = std::clamp(static_cast<int>(std::floor((lo[d] - m_origin[d]) / m_cell[d])), 0,
-                              m_dims[d] - 1);
-            b[d] = std::clamp(static_cast<int>(std::floor((hi[d] - m_origin[d]) / m_cell[d])), 0,
-                              m_dims[d] - 1);
+            a[d] = std::clamp(static_cast<int>(std::floor((lo[d] - m_origin[d]) / m_cell[d])), 0, m_dims[d] - 1);
+            b[d] = std::clamp(static_cast<int>(std::floor((hi[d] - m_origin[d]) / m_cell[d])), 0, m_dims[d] - 1);
         }
     }
-    size_t index(int i, int j, int k) const {
-        return (static_cast<size_t>(k) * m_dims[1] + j) * m_dims[0] + i;
-    }
+    size_t index(int i, int j, int k) const { return (static_cast<size_t>(k) * m_dims[1] + j) * m_dims[0] + i; }
 
     Vec3 m_origin;
     std::array<int, 3> m_dims{};
@@ -105,8 +101,7 @@ Vec3 couplingResidual(const Vec3& xp, const Vec3* targets, const double* bary, i
     return c;
 }
 
-Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
-                            Eigen::Vector3d& bary) {
+Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Eigen::Vector3d& bary) {
     // Voronoi-region walk (Ericson, Real-Time Collision Detection §5.1.5).
     const Vec3 ab = b - a, ac = c - a, ap = p - a;
     const double d1 = ab.dot(ap), d2 = ac.dot(ap);
@@ -150,11 +145,10 @@ Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
     return a + ab * v + ac * w;
 }
 
-std::vector<BoundaryProjection>
-projectOntoBoundary(const TetMesh& cage, const std::vector<Vec3>& points, double maxDistance) {
+std::vector<BoundaryProjection> projectOntoBoundary(const TetMesh& cage, const std::vector<Vec3>& points,
+                                                    double maxDistance) {
     if (!(maxDistance >= 0) || !std::isfinite(maxDistance))
-        throw std::invalid_argument(
-            "sim::projectOntoBoundary(): maxDistance must be finite and >= 0");
+        throw std::invalid_argument("sim::projectOntoBoundary(): maxDistance must be finite and >= 0");
     const auto& x = cage.positions();
     std::vector<std::array<int32_t, 3>> tris;
     for (int32_t f = 0; f < static_cast<int32_t>(4 * cage.tetCount()); ++f)
@@ -178,8 +172,7 @@ projectOntoBoundary(const TetMesh& cage, const std::vector<Vec3>& points, double
         best.distance = std::numeric_limits<double>::infinity();
         for (int32_t t : cand) {
             Eigen::Vector3d bary;
-            const Vec3 q = closestPointOnTriangle(points[i], x[tris[t][0]], x[tris[t][1]],
-                                                  x[tris[t][2]], bary);
+            const Vec3 q = closestPointOnTriangle(points[i], x[tris[t][0]], x[tris[t][1]], x[tris[t][2]], bary);
             const double d = (q - points[i]).norm();
             if (d < best.distance) {
                 best.distance = d;
@@ -195,8 +188,7 @@ projectOntoBoundary(const TetMesh& cage, const std::vector<Vec3>& points, double
     return out;
 }
 
-std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Vec3>& points,
-                                       double tolerance) {
+std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Vec3>& points, double tolerance) {
     const std::string where = "sim::locateInCage(): ";
     if (!(tolerance >= 0) || !std::isfinite(tolerance))
         throw std::invalid_argument(where + "tolerance must be finite and >= 0");
@@ -231,8 +223,7 @@ std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Ve
                 dist = std::numeric_limits<double>::infinity();
                 for (const auto& f : kFace) {
                     Eigen::Vector3d fb;
-                    const Vec3 q = closestPointOnTriangle(p, x[tets[t][f[0]]], x[tets[t][f[1]]],
-                                                          x[tets[t][f[2]]], fb);
+                    const Vec3 q = closestPointOnTriangle(p, x[tets[t][f[0]]], x[tets[t][f[1]]], x[tets[t][f[2]]], fb);
                     dist = std::min(dist, (q - p).norm());
                 }
             }
@@ -244,8 +235,9 @@ std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Ve
             }
         }
         if (best.tet < 0 || bestDist > tolerance) {
-            const std::string howFar = best.tet < 0 ? "lies more than " + std::to_string(tolerance) + " m outside the cage"
-                                                    : "lies " + std::to_string(bestDist) + " m outside the cage";
+            const std::string howFar = best.tet < 0
+                                           ? "lies more than " + std::to_string(tolerance) + " m outside the cage"
+                                           : "lies " + std::to_string(bestDist) + " m outside the cage";
             throw OutsideCageError(where, static_cast<int32_t>(i), howFar);
         }
         best.point = static_cast<int32_t>(i);

@@ -8,8 +8,8 @@
 ///     its barycentric coordinates, [A eq. 4.1]);
 ///   - embedded tissue in fat: each embedded node → the fat tet that contains it (a cage, as in
 ///     free-form deformation), with its four barycentric coordinates.
-#include "sim/util/error.hpp"
 #include "sim/mesh/tet_mesh.hpp"
+#include "sim/util/error.hpp"
 
 #include <Eigen/Core>
 
@@ -23,8 +23,7 @@ namespace viscera::sim {
 Vec3 couplingResidual(const Vec3& xp, const Vec3* targets, const double* bary, int n);
 
 /// Closest point to p on triangle (a, b, c); its barycentric coordinates (≥ 0, sum 1) into bary.
-Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
-                            Eigen::Vector3d& bary);
+Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Eigen::Vector3d& bary);
 
 struct BoundaryProjection {
     int32_t point = -1;                             ///< index into the query points
@@ -36,8 +35,8 @@ struct BoundaryProjection {
 /// For every point within maxDistance (m) of the boundary of `cage`, the closest boundary point;
 /// farther points are left out. Uses the mesh's level-1 adjacency only. Cost: a uniform grid,
 /// about O(#points + #boundary triangles).
-std::vector<BoundaryProjection>
-projectOntoBoundary(const TetMesh& cage, const std::vector<Vec3>& points, double maxDistance);
+std::vector<BoundaryProjection> projectOntoBoundary(const TetMesh& cage, const std::vector<Vec3>& points,
+                                                    double maxDistance);
 
 struct CageLocation {
     int32_t point = -1;                             ///< index into the query points
@@ -56,7 +55,6 @@ struct OutsideCageError : PreconditionError {
     int32_t point;
     std::string howFar;
 };
-std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Vec3>& points,
-                                       double tolerance);
+std::vector<CageLocation> locateInCage(const TetMesh& cage, const std::vector<Vec3>& points, double tolerance);
 
 } // namespace viscera::sim

@@ -19,14 +19,14 @@
 namespace viscera::sim {
 
 struct StepProblem {
-    double h = 0;                           ///< step, s
-    std::vector<Vec3> xTilde;               ///< #V, predicted positions, m
-    std::vector<double> mass;               ///< #V, kg
-    std::vector<uint8_t> fixed;             ///< #V, 1 = held at xTilde
-    std::vector<Tet> tets;                  ///< #T
-    std::vector<Mat3> dmInv;                ///< #T, inverse rest shape matrices, 1/m
-    std::vector<double> volume;             ///< #T, rest volumes, m^3
-    std::vector<double> weight;             ///< #T, stiffness weights (1 = material as given)
+    double h = 0;               ///< step, s
+    std::vector<Vec3> xTilde;   ///< #V, predicted positions, m
+    std::vector<double> mass;   ///< #V, kg
+    std::vector<uint8_t> fixed; ///< #V, 1 = held at xTilde
+    std::vector<Tet> tets;      ///< #T
+    std::vector<Mat3> dmInv;    ///< #T, inverse rest shape matrices, 1/m
+    std::vector<double> volume; ///< #T, rest volumes, m^3
+    std::vector<double> weight; ///< #T, stiffness weights (1 = material as given)
     std::shared_ptr<const TetConstraintModel> model;
 
     /// Deformation gradient of tet t at x.

@@ -36,7 +36,7 @@ using Mat2 = Eigen::Matrix2d;
 struct StrainLimit {
     int i = 0, j = 0; ///< Green-strain entry in material axes: 0..2 for tets, 0..1 for triangles
     double lower = -std::numeric_limits<double>::infinity(); ///< ε_ij ≥ lower; −∞ = no lower limit
-    double upper = std::numeric_limits<double>::infinity(); ///< ε_ij ≤ upper; +∞ = no upper limit
+    double upper = std::numeric_limits<double>::infinity();  ///< ε_ij ≤ upper; +∞ = no upper limit
     /// 0 = hard. Tets: 1/Pa (per unit rest volume, energy V C²/(2α));
     /// triangles: m/N (per unit rest area, energy A C²/(2α)).
     double compliance = 0;
@@ -65,15 +65,13 @@ std::string validateAxes(const Mat3& axes);
 Mat3 tetMaterialDmInv(const std::array<Vec3, 4>& rest, const Mat3& axes);
 /// ε_ij of the tet x with M from tetMaterialDmInv; the gradient with respect to x_0..x_3 into
 /// grad when not null. Cost: ~60 flops.
-double tetGreenStrain(const std::array<Vec3, 4>& x, const Mat3& M, int i, int j,
-                      std::array<Vec3, 4>* grad = nullptr);
+double tetGreenStrain(const std::array<Vec3, 4>& x, const Mat3& M, int i, int j, std::array<Vec3, 4>* grad = nullptr);
 
 /// D'_m⁻¹ of the UV frame of a triangle [A eq. 4.23–4.24] (1/m). False when the triangle or its
 /// UV image is degenerate.
 bool triangleUvDmInv(const std::array<Vec3, 3>& rest, const std::array<Vec2, 3>& uv, Mat2& M);
 /// ε_ij (i, j in 0..1) of the triangle x with F = D_s M [A eq. 4.25]; gradient with respect to
 /// x_0..x_2 into grad when not null.
-double triGreenStrain(const std::array<Vec3, 3>& x, const Mat2& M, int i, int j,
-                      std::array<Vec3, 3>* grad = nullptr);
+double triGreenStrain(const std::array<Vec3, 3>& x, const Mat2& M, int i, int j, std::array<Vec3, 3>* grad = nullptr);
 
 } // namespace viscera::sim

@@ -28,20 +28,21 @@ struct XpbdSettings {
     /// After every iteration, the primal correction x ← x̃ + M⁻¹ ∇C(x)ᵀ λ (XpbdIteration::
     /// PrimalCorrected): iterations then converge to the implicit step's solution instead of
     /// levelling off O(h² k/m) away from it, at about 4 times the cost of a plain iteration
-    /// (parallel like the sweeps, bit-identical for any thread count). Elastic tets only (no strain limits, membranes or ties); converges while the
-    /// stiffness number h² k w/(ρ L²) is small, which the load-time stability check enforces.
+    /// (parallel like the sweeps, bit-identical for any thread count). Elastic tets only (no strain limits, membranes
+    /// or ties); converges while the stiffness number h² k w/(ρ L²) is small, which the load-time stability check
+    /// enforces.
     bool primalCorrection = false;
 };
 
 /// Admissible ranges of XpbdSettings: validate() and the scene readers (scene_json.hpp) use
 /// these, so scene.json and project.json get one rule.
 struct XpbdLimits {
-    static constexpr double maxDt = 0.1;          ///< s; dt in (0, maxDt]
-    static constexpr int maxSubsteps = 1000;      ///< substeps in [1, maxSubsteps]
-    static constexpr int maxIterations = 1000;    ///< iterations in [1, maxIterations]
-    static constexpr double maxDamping = 1000;    ///< 1/s; damping in [0, maxDamping]
-    static constexpr double maxGravity = 1000;    ///< m/s^2, |gravity|
-    static constexpr int maxThreads = 64;         ///< threads in [1, maxThreads]
+    static constexpr double maxDt = 0.1;       ///< s; dt in (0, maxDt]
+    static constexpr int maxSubsteps = 1000;   ///< substeps in [1, maxSubsteps]
+    static constexpr int maxIterations = 1000; ///< iterations in [1, maxIterations]
+    static constexpr double maxDamping = 1000; ///< 1/s; damping in [0, maxDamping]
+    static constexpr double maxGravity = 1000; ///< m/s^2, |gravity|
+    static constexpr int maxThreads = 64;      ///< threads in [1, maxThreads]
 };
 
 /// Checks settings; empty string when valid, otherwise the rule that failed.
@@ -61,7 +62,7 @@ struct StepStats {
 /// at its particle offset (XpbdSystem::tetParticleOffset; 0 for the single body of an
 /// XpbdSolver). Valid only during the hook call. O(1) per access, no bounds check.
 class XpbdParticles {
-  public:
+public:
     /// xw: 4 doubles per particle (x, y, z, inverse mass); v: one per particle or null.
     XpbdParticles(double* xw, Vec3* v, size_t count) : m_xw(xw), m_v(v), m_count(count) {}
     size_t size() const { return m_count; }
@@ -83,7 +84,7 @@ class XpbdParticles {
         if (m_v) m_v[i] = v;
     }
 
-  private:
+private:
     double* m_xw;
     Vec3* m_v;
     size_t m_count;

@@ -15,8 +15,7 @@ namespace viscera::sim {
 XpbdSolver::XpbdSolver() = default;
 XpbdSolver::~XpbdSolver() = default;
 
-std::unique_ptr<XpbdSolver> XpbdSolver::create(const TetBodyDesc& body,
-                                               const XpbdSettings& settings) {
+std::unique_ptr<XpbdSolver> XpbdSolver::create(const TetBodyDesc& body, const XpbdSettings& settings) {
     const std::string where = "sim::XpbdSolver::create(): ";
     XpbdSystemDesc desc;
     desc.tetBodies.push_back(body);
@@ -45,10 +44,8 @@ std::unique_ptr<XpbdSolver> XpbdSolver::create(const TetBodyDesc& body,
 }
 
 std::unique_ptr<XpbdSolver> XpbdSolver::create(const TetMesh& rest, const Material& material,
-                                               const std::vector<int32_t>& fixedNodes,
-                                               const XpbdSettings& settings) {
-    if (auto why = validate(material); !why.empty())
-        throw PreconditionError("sim::XpbdSolver::create(): ", why);
+                                               const std::vector<int32_t>& fixedNodes, const XpbdSettings& settings) {
+    if (auto why = validate(material); !why.empty()) throw PreconditionError("sim::XpbdSolver::create(): ", why);
     TetBodyDesc body;
     body.mesh = &rest;
     body.model = std::make_shared<StableNeoHookeanModel>(material.mu(), material.lambda());
@@ -122,8 +119,7 @@ void XpbdSolver::iterateOn(const StepProblem& p, int iterations, const IterateOb
                            XpbdIteration mode) const {
     const std::string where = "sim::XpbdSolver::iterateOn(): ";
     if (iterations < 1) throw std::invalid_argument(where + "iterations must be >= 1");
-    if (!(p.h > 0) || !std::isfinite(p.h))
-        throw std::invalid_argument(where + "h must be positive and finite");
+    if (!(p.h > 0) || !std::isfinite(p.h)) throw std::invalid_argument(where + "h must be positive and finite");
     const size_t nv = p.xTilde.size(), nt = p.tets.size();
     if (p.mass.size() != nv || p.fixed.size() != nv)
         throw std::invalid_argument(where + "xTilde, mass and fixed must have one entry per node");
@@ -135,17 +131,14 @@ void XpbdSolver::iterateOn(const StepProblem& p, int iterations, const IterateOb
     for (size_t t = 0; t < nt; ++t) {
         for (int32_t v : p.tets[t])
             if (v < 0 || static_cast<size_t>(v) >= nv)
-                throw std::invalid_argument(where + "tet " + std::to_string(t) +
-                                            " references node " + std::to_string(v) +
-                                            " (problem has " + std::to_string(nv) + " nodes)");
+                throw std::invalid_argument(where + "tet " + std::to_string(t) + " references node " +
+                                            std::to_string(v) + " (problem has " + std::to_string(nv) + " nodes)");
         if (!(p.volume[t] > 0) || !(p.weight[t] > 0))
-            throw std::invalid_argument(where + "tet " + std::to_string(t) +
-                                        " needs a positive volume and weight");
+            throw std::invalid_argument(where + "tet " + std::to_string(t) + " needs a positive volume and weight");
     }
     detail::Engine eng;
     eng.addParticles(p.xTilde, p.mass, p.fixed);
-    eng.blocks.push_back(
-        detail::makeElasticBlock({p.tets, p.dmInv, p.volume, p.weight, p.model}, settings().simd));
+    eng.blocks.push_back(detail::makeElasticBlock({p.tets, p.dmInv, p.volume, p.weight, p.model}, settings().simd));
     eng.colour();
     const double h2inv = 1.0 / (p.h * p.h);
     double seconds = 0;

@@ -56,20 +56,18 @@ enum class XpbdIteration {
 };
 
 class XpbdSolver {
-  public:
+public:
     /// body.mesh is read during create only. Throws viscera::PreconditionError (a
     /// std::invalid_argument whose rule has no function prefix, sim/util/error.hpp)
     /// ("sim::XpbdSolver::create(): fixed node 12 is out of range (mesh has 10 vertices)") on
     /// invalid settings, a null mesh or model, a model with other than 1 or 2 constraints, bad
     /// density, node weights or strain limits, a fixed node out of range, a tet with non-positive
     /// rest volume, or a body with no free node.
-    static std::unique_ptr<XpbdSolver> create(const TetBodyDesc& body,
-                                              const XpbdSettings& settings);
+    static std::unique_ptr<XpbdSolver> create(const TetBodyDesc& body, const XpbdSettings& settings);
     /// Convenience: a StableNeoHookeanModel from the material's Lamé parameters, its density, all
     /// weights 1, no strain limits. Also throws on an invalid material.
     static std::unique_ptr<XpbdSolver> create(const TetMesh& rest, const Material& material,
-                                              const std::vector<int32_t>& fixedNodes,
-                                              const XpbdSettings& settings);
+                                              const std::vector<int32_t>& fixedNodes, const XpbdSettings& settings);
     ~XpbdSolver();
     XpbdSolver(const XpbdSolver&) = delete;
     XpbdSolver& operator=(const XpbdSolver&) = delete;
@@ -93,12 +91,12 @@ class XpbdSolver {
 
     /// Installs (empty function: removes) a hook called after every sweep of every substep of
     /// step(), with the particles (this body's nodes, index = node) at the current iterate, and
-    /// once per substep after its velocity update; see XpbdIterationHook. Tool contacts: sim::makeCollisionHook (collision_solver.hpp). Between
-    /// frames only. Without a hook step() is bit-identical to a solver that never had one.
+    /// once per substep after its velocity update; see XpbdIterationHook. Tool contacts: sim::makeCollisionHook
+    /// (collision_solver.hpp). Between frames only. Without a hook step() is bit-identical to a solver that never had
+    /// one.
     void setIterationHook(XpbdIterationHook hook);
 
-    double elasticEnergy()
-        const; ///< J, relative to the rest state (plus violated compliant strain limits)
+    double elasticEnergy() const;   ///< J, relative to the rest state (plus violated compliant strain limits)
     double kineticEnergy() const;   ///< J
     double potentialEnergy() const; ///< J, gravity relative to the rest configuration
     double totalMass() const;       ///< kg
@@ -132,7 +130,7 @@ class XpbdSolver {
     XpbdSystem& system() { return *m_sys; }
     const XpbdSystem& system() const { return *m_sys; }
 
-  private:
+private:
     XpbdSolver();
     std::unique_ptr<XpbdSystem> m_sys;
     StepProblem m_template; ///< h and xTilde empty; the rest as in nextSubstepProblem()

@@ -24,24 +24,23 @@ struct Failer {
     }
 };
 
-void checkFixed(const std::vector<int32_t>& fixed, size_t nv, const std::string& label,
-                const Failer& fail) {
+void checkFixed(const std::vector<int32_t>& fixed, size_t nv, const std::string& label, const Failer& fail) {
     for (int32_t f : fixed)
         if (f < 0 || static_cast<size_t>(f) >= nv)
-            fail(label, "fixed node " + std::to_string(f) + " is out of range (mesh has " +
-                            std::to_string(nv) + " vertices)");
+            fail(label,
+                 "fixed node " + std::to_string(f) + " is out of range (mesh has " + std::to_string(nv) + " vertices)");
 }
 
-void checkLimits(const std::vector<StrainLimit>& limits, int dim, const std::vector<int32_t>& elems,
-                 size_t count, const char* elemName, const std::string& label, const Failer& fail) {
+void checkLimits(const std::vector<StrainLimit>& limits, int dim, const std::vector<int32_t>& elems, size_t count,
+                 const char* elemName, const std::string& label, const Failer& fail) {
     if (limits.empty()) fail(label, "strain limits: no limit given");
     for (size_t k = 0; k < limits.size(); ++k)
         if (auto why = validate(limits[k], dim); !why.empty())
             fail(label, "strain limit " + std::to_string(k) + ": " + why);
     for (int32_t e : elems)
         if (e < 0 || static_cast<size_t>(e) >= count)
-            fail(label, std::string("strain limits: ") + elemName + " " + std::to_string(e) +
-                            " is out of range (" + std::to_string(count) + " " + elemName + "s)");
+            fail(label, std::string("strain limits: ") + elemName + " " + std::to_string(e) + " is out of range (" +
+                            std::to_string(count) + " " + elemName + "s)");
 }
 
 std::vector<int32_t> allOr(const std::vector<int32_t>& subset, size_t count) {
@@ -57,13 +56,11 @@ std::vector<int32_t> allOr(const std::vector<int32_t>& subset, size_t count) {
 XpbdSystem::XpbdSystem() : m_engine(std::make_unique<detail::Engine>()) {}
 XpbdSystem::~XpbdSystem() = default;
 
-std::unique_ptr<XpbdSystem> XpbdSystem::create(const XpbdSystemDesc& desc,
-                                               const XpbdSettings& settings) {
+std::unique_ptr<XpbdSystem> XpbdSystem::create(const XpbdSystemDesc& desc, const XpbdSettings& settings) {
     return build(desc, settings, "sim::XpbdSystem::create(): ", false);
 }
 
-std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
-                                              const XpbdSettings& settings,
+std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const XpbdSettings& settings,
                                               const std::string& where, bool singleBody) {
     const Failer fail{where};
     if (auto why = validate(settings); !why.empty()) fail("", why);
@@ -73,13 +70,9 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
     detail::Engine& eng = *sys->m_engine;
 
     auto tetLabel = [&](size_t b) {
-        return singleBody
-                   ? std::string()
-                   : "tet body " + std::to_string(b) + " ('" + desc.tetBodies[b].name + "'): ";
+        return singleBody ? std::string() : "tet body " + std::to_string(b) + " ('" + desc.tetBodies[b].name + "'): ";
     };
-    auto surfLabel = [&](size_t s) {
-        return "surface " + std::to_string(s) + " ('" + desc.surfaces[s].name + "'): ";
-    };
+    auto surfLabel = [&](size_t s) { return "surface " + std::to_string(s) + " ('" + desc.surfaces[s].name + "'): "; };
 
     // Particle layout: tet bodies, then surfaces.
     std::vector<int32_t> tetFirst, surfFirst;
@@ -112,19 +105,17 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
         const auto alpha = d.model->compliance();
         for (int k = 0; k < count; ++k)
             if (!std::isfinite(alpha[k]) || alpha[k] < 0)
-                fail(label, "constraint model '" + d.model->name() + "' has compliance " +
-                                formatNumber(alpha[k]) + " (must be finite and >= 0)");
-        if (!std::isfinite(d.density) || d.density <= 0)
-            fail(label, "density must be positive and finite");
+                fail(label, "constraint model '" + d.model->name() + "' has compliance " + formatNumber(alpha[k]) +
+                                " (must be finite and >= 0)");
+        if (!std::isfinite(d.density) || d.density <= 0) fail(label, "density must be positive and finite");
         const size_t nv = mesh.vertexCount();
         if (!d.nodeWeights.empty()) {
             if (d.nodeWeights.size() != nv)
-                fail(label, "node weights: " + std::to_string(d.nodeWeights.size()) +
-                                " given for " + std::to_string(nv) + " vertices");
+                fail(label, "node weights: " + std::to_string(d.nodeWeights.size()) + " given for " +
+                                std::to_string(nv) + " vertices");
             for (size_t i = 0; i < nv; ++i)
                 if (!std::isfinite(d.nodeWeights[i]) || d.nodeWeights[i] <= 0)
-                    fail(label, "node weight " + std::to_string(i) + " is " +
-                                    formatNumber(d.nodeWeights[i]) +
+                    fail(label, "node weight " + std::to_string(i) + " is " + formatNumber(d.nodeWeights[i]) +
                                     " (must be positive and finite)");
         }
         const auto& x = mesh.positions();
@@ -139,15 +130,13 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
                 dm.col(k) = x[e[k + 1]] - x[e[0]];
             const double vol = dm.determinant() / 6.0;
             if (!(vol > 0))
-                fail(label, "tet " + std::to_string(t) + " has non-positive rest volume " +
-                                formatNumber(vol) + " m^3");
+                fail(label, "tet " + std::to_string(t) + " has non-positive rest volume " + formatNumber(vol) + " m^3");
             et.tets.push_back({e[0] + off, e[1] + off, e[2] + off, e[3] + off});
             et.dmInv.push_back(dm.inverse());
             et.volume.push_back(vol);
             double w = 1.0;
             if (!d.nodeWeights.empty())
-                w = 0.25 * (d.nodeWeights[e[0]] + d.nodeWeights[e[1]] + d.nodeWeights[e[2]] +
-                            d.nodeWeights[e[3]]);
+                w = 0.25 * (d.nodeWeights[e[0]] + d.nodeWeights[e[1]] + d.nodeWeights[e[2]] + d.nodeWeights[e[3]]);
             et.weight.push_back(w);
             for (int k = 0; k < 4; ++k)
                 mass[e[k]] += d.density * vol / 4.0;
@@ -158,8 +147,7 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
             fixed[f] = 1;
         if (d.strainLimits) {
             const TetStrainLimits& sl = *d.strainLimits;
-            if (auto why = validateAxes(sl.axes); !why.empty())
-                fail(label, "strain limits: " + why);
+            if (auto why = validateAxes(sl.axes); !why.empty()) fail(label, "strain limits: " + why);
             checkLimits(sl.limits, 3, sl.tets, mesh.tetCount(), "tet", label, fail);
             std::vector<Tet> tets;
             std::vector<Mat3> M;
@@ -170,9 +158,8 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
                 M.push_back(tetMaterialDmInv({x[e[0]], x[e[1]], x[e[2]], x[e[3]]}, sl.axes));
                 vol.push_back(et.volume[t]);
             }
-            strainBlocks.push_back(
-                detail::makeTetStrainBlock(std::move(tets), std::move(M), std::move(vol),
-                                           detail::expandStrainLimits(sl.limits)));
+            strainBlocks.push_back(detail::makeTetStrainBlock(std::move(tets), std::move(M), std::move(vol),
+                                                              detail::expandStrainLimits(sl.limits)));
             strainBlockBody.push_back(b);
         }
         Range r;
@@ -210,16 +197,14 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
             fail(label, "surface " + std::to_string(at.surface) + " does not exist");
         if (at.tetBody >= desc.tetBodies.size())
             fail(label, "tet body " + std::to_string(at.tetBody) + " does not exist");
-        if (!std::isfinite(at.compliance) || at.compliance < 0)
-            fail(label, "compliance must be finite and >= 0");
-        if (!std::isfinite(at.maxDistance) || at.maxDistance < 0)
-            fail(label, "max distance must be finite and >= 0");
+        if (!std::isfinite(at.compliance) || at.compliance < 0) fail(label, "compliance must be finite and >= 0");
+        if (!std::isfinite(at.maxDistance) || at.maxDistance < 0) fail(label, "max distance must be finite and >= 0");
         const TetMesh& cage = *desc.tetBodies[at.tetBody].mesh;
         const auto proj = projectOntoBoundary(cage, surfX[at.surface], at.maxDistance);
         if (proj.empty())
-            fail(label, "no vertex of surface '" + desc.surfaces[at.surface].name +
-                            "' lies within " + formatNumber(at.maxDistance) +
-                            " m of the boundary of '" + desc.tetBodies[at.tetBody].name + "'");
+            fail(label, "no vertex of surface '" + desc.surfaces[at.surface].name + "' lies within " +
+                            formatNumber(at.maxDistance) + " m of the boundary of '" + desc.tetBodies[at.tetBody].name +
+                            "'");
         for (const BoundaryProjection& p : proj) {
             detail::Tie t;
             t.p = surfFirst[at.surface] + p.point;
@@ -251,8 +236,7 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
         if (!std::isfinite(d.stretchStiffness) || d.stretchStiffness < 0)
             fail(label, "stretch stiffness must be finite and >= 0");
         if (!d.uv.empty() && d.uv.size() != nv)
-            fail(label, "uv: " + std::to_string(d.uv.size()) + " given for " + std::to_string(nv) +
-                            " vertices");
+            fail(label, "uv: " + std::to_string(d.uv.size()) + " given for " + std::to_string(nv) + " vertices");
         for (size_t i = 0; i < d.uv.size(); ++i)
             if (!d.uv[i].allFinite()) fail(label, "uv " + std::to_string(i) + " is not finite");
         checkFixed(d.fixedNodes, nv, label, fail);
@@ -265,8 +249,8 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
             area[t] = 0.5 * (x[e[1]] - x[e[0]]).cross(x[e[2]] - x[e[0]]).norm();
             Mat2 M;
             if (!triangleRestDmInv({x[e[0]], x[e[1]], x[e[2]]}, M))
-                fail(label, "triangle " + std::to_string(t) + " is degenerate (area " +
-                                formatNumber(area[t]) + " m^2)");
+                fail(label,
+                     "triangle " + std::to_string(t) + " is degenerate (area " + formatNumber(area[t]) + " m^2)");
             tris.push_back({e[0] + off, e[1] + off, e[2] + off});
             restInv.push_back(M);
             for (int k = 0; k < 3; ++k)
@@ -293,8 +277,7 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
         sys->m_surf.push_back(std::move(r));
         eng.addParticles(x, mass, fixed);
         if (d.stretchStiffness > 0)
-            eng.blocks.push_back(
-                detail::makeMembraneBlock(tris, restInv, area, d.stretchStiffness));
+            eng.blocks.push_back(detail::makeMembraneBlock(tris, restInv, area, d.stretchStiffness));
         if (d.strainLimits) {
             const TriStrainLimits& sl = *d.strainLimits;
             if (d.uv.empty()) fail(label, "strain limits need per-vertex uv coordinates");
@@ -305,15 +288,14 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
             for (int32_t t : allOr(sl.triangles, mesh.triangleCount())) {
                 const Tri& e = mesh.triangles()[t];
                 Mat2 m;
-                if (!triangleUvDmInv({x[e[0]], x[e[1]], x[e[2]]},
-                                     {d.uv[e[0]], d.uv[e[1]], d.uv[e[2]]}, m))
+                if (!triangleUvDmInv({x[e[0]], x[e[1]], x[e[2]]}, {d.uv[e[0]], d.uv[e[1]], d.uv[e[2]]}, m))
                     fail(label, "triangle " + std::to_string(t) + " has a degenerate uv frame");
                 lt.push_back(tris[t]);
                 M.push_back(m);
                 la.push_back(area[t]);
             }
-            eng.blocks.push_back(detail::makeTriStrainBlock(
-                std::move(lt), std::move(M), std::move(la), detail::expandStrainLimits(sl.limits)));
+            eng.blocks.push_back(detail::makeTriStrainBlock(std::move(lt), std::move(M), std::move(la),
+                                                            detail::expandStrainLimits(sl.limits)));
         }
     }
 
@@ -322,15 +304,13 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
         const EmbeddingDesc& em = desc.embeddings[k];
         const std::string label = "embedding " + std::to_string(k) + ": ";
         if (em.embedded >= desc.tetBodies.size() || em.cage >= desc.tetBodies.size())
-            fail(label,
-                 "tet body " + std::to_string(std::max(em.embedded, em.cage)) + " does not exist");
+            fail(label, "tet body " + std::to_string(std::max(em.embedded, em.cage)) + " does not exist");
         if (em.embedded == em.cage) fail(label, "a body cannot be embedded in itself");
-        if (!std::isfinite(em.compliance) || em.compliance < 0)
-            fail(label, "compliance must be finite and >= 0");
+        if (!std::isfinite(em.compliance) || em.compliance < 0) fail(label, "compliance must be finite and >= 0");
         std::vector<CageLocation> loc;
         try {
-            loc = locateInCage(*desc.tetBodies[em.cage].mesh,
-                               desc.tetBodies[em.embedded].mesh->positions(), em.tolerance);
+            loc = locateInCage(*desc.tetBodies[em.cage].mesh, desc.tetBodies[em.embedded].mesh->positions(),
+                               em.tolerance);
         } catch (const OutsideCageError& e) {
             fail(label, "'" + desc.tetBodies[em.embedded].name + "' in '" + desc.tetBodies[em.cage].name + "': node " +
                             std::to_string(e.point) + " " + e.howFar);
@@ -357,15 +337,13 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc,
     bool anyFree = false;
     for (size_t i = 0; i < eng.particleCount() && !anyFree; ++i)
         anyFree = detail::particleInvMass(eng.xw.data(), i) > 0;
-    if (!anyFree)
-        fail("", singleBody ? "body has no free node" : "the system has no free particle");
+    if (!anyFree) fail("", singleBody ? "body has no free node" : "the system has no free particle");
 
     if (settings.primalCorrection && !eng.supportsPrimalCorrection())
         fail("", "primal_correction is available for elastic tets only (no strain limits, "
                  "membranes or couplings)");
     eng.colour();
-    if (eng.usefulThreads(settings.threads) > 1)
-        sys->m_pool = std::make_unique<detail::WorkerPool>(settings.threads);
+    if (eng.usefulThreads(settings.threads) > 1) sys->m_pool = std::make_unique<detail::WorkerPool>(settings.threads);
     sys->m_rest.reserve(eng.particleCount());
     for (size_t i = 0; i < eng.particleCount(); ++i)
         sys->m_rest.push_back(detail::particlePosition(eng.xw.data(), i));
@@ -405,14 +383,11 @@ StepStats XpbdSystem::step() {
     return st;
 }
 
-void XpbdSystem::setState(Range& r, const std::vector<Vec3>& x, const std::vector<Vec3>& v,
-                          const char* what) {
+void XpbdSystem::setState(Range& r, const std::vector<Vec3>& x, const std::vector<Vec3>& v, const char* what) {
     const std::string where = std::string("sim::XpbdSystem::") + what + "(): ";
     if (x.size() != r.x.size() || v.size() != r.x.size())
-        throw PreconditionError(where, "expected " + std::to_string(r.x.size()) +
-                                           " positions and velocities, got " +
-                                           std::to_string(x.size()) + " and " +
-                                           std::to_string(v.size()));
+        throw PreconditionError(where, "expected " + std::to_string(r.x.size()) + " positions and velocities, got " +
+                                           std::to_string(x.size()) + " and " + std::to_string(v.size()));
     for (size_t i = 0; i < x.size(); ++i)
         if (!x[i].allFinite() || !v[i].allFinite())
             throw PreconditionError(where, "node " + std::to_string(i) + " is not finite");
@@ -439,8 +414,7 @@ void XpbdSystem::setSurfaceState(size_t s, const std::vector<Vec3>& x, const std
 
 void XpbdSystem::syncStrainUnit(Range& r, size_t t) {
     if (r.strainBlock < 0 || r.strainUnit[t] < 0) return;
-    m_engine->blocks[r.strainBlock]->setUnitActive(static_cast<size_t>(r.strainUnit[t]),
-                                                   r.active[t] && !r.reshaped[t]);
+    m_engine->blocks[r.strainBlock]->setUnitActive(static_cast<size_t>(r.strainUnit[t]), r.active[t] && !r.reshaped[t]);
 }
 
 void XpbdSystem::setTetActive(size_t b, size_t t, bool active) {
@@ -457,12 +431,11 @@ bool XpbdSystem::tetActive(size_t b, size_t t) const {
 void XpbdSystem::setTetRestShape(size_t b, size_t t, const Mat3& Fs) {
     Range& r = m_tet.at(b);
     const auto& e = r.elems.at(t);
-    const std::string where = "sim::XpbdSystem::setTetRestShape(): tet body " + std::to_string(b) +
-                              " ('" + r.name + "'), tet " + std::to_string(t) + ": ";
+    const std::string where = "sim::XpbdSystem::setTetRestShape(): tet body " + std::to_string(b) + " ('" + r.name +
+                              "'), tet " + std::to_string(t) + ": ";
     if (!Fs.allFinite()) throw std::invalid_argument(where + "Fs is not finite");
     const double det = Fs.determinant();
-    if (!(det > 1e-12))
-        throw std::invalid_argument(where + "det Fs = " + formatNumber(det) + " (must be > 1e-12)");
+    if (!(det > 1e-12)) throw std::invalid_argument(where + "det Fs = " + formatNumber(det) + " (must be > 1e-12)");
     Mat3 dm;
     for (int k = 0; k < 3; ++k)
         dm.col(k) = m_rest[e[k + 1]] - m_rest[e[0]];
@@ -491,9 +464,8 @@ bool XpbdSystem::triangleActive(size_t s, size_t t) const {
 void XpbdSystem::setTriangleRestShape(size_t s, size_t t, const Mat3& Fs) {
     Range& r = m_surf.at(s);
     const auto& e = r.elems.at(t);
-    const std::string where = "sim::XpbdSystem::setTriangleRestShape(): surface " +
-                              std::to_string(s) + " ('" + r.name + "'), triangle " +
-                              std::to_string(t) + ": ";
+    const std::string where = "sim::XpbdSystem::setTriangleRestShape(): surface " + std::to_string(s) + " ('" + r.name +
+                              "'), triangle " + std::to_string(t) + ": ";
     if (!Fs.allFinite()) throw std::invalid_argument(where + "Fs is not finite");
     const Vec3 x0 = m_rest[e[0]];
     Mat2 M;
@@ -535,8 +507,7 @@ double XpbdSystem::potentialEnergy() const {
     double e = 0;
     const double* xw = m_engine->xw.data();
     for (size_t i = 0; i < m_engine->particleCount(); ++i)
-        e -=
-            m_engine->mass[i] * m_settings.gravity.dot(detail::particlePosition(xw, i) - m_rest[i]);
+        e -= m_engine->mass[i] * m_settings.gravity.dot(detail::particlePosition(xw, i) - m_rest[i]);
     return e;
 }
 

@@ -46,8 +46,8 @@ class WorkerPool;
 } // namespace detail
 
 struct TetBodyDesc {
-    std::string name;              ///< used in messages
-    const TetMesh* mesh = nullptr; ///< rest state; non-owning, read during create only
+    std::string name;                                ///< used in messages
+    const TetMesh* mesh = nullptr;                   ///< rest state; non-owning, read during create only
     std::shared_ptr<const TetConstraintModel> model; ///< elasticity (count() 1 or 2)
     double density = 1050.0;                         ///< kg/m^3
     std::vector<int32_t> fixedNodes;                 ///< held where they are (see setTetState)
@@ -78,11 +78,10 @@ struct SurfaceAttachmentDesc {
 };
 
 struct EmbeddingDesc {
-    size_t embedded = 0;   ///< tet body whose nodes are tied (index into tetBodies)
-    size_t cage = 0;       ///< tet body that contains them
-    double compliance = 0; ///< m/N; 0 = hard
-    double tolerance =
-        1e-6; ///< m; nodes outside the cage by at most this are tied to the nearest tet
+    size_t embedded = 0;     ///< tet body whose nodes are tied (index into tetBodies)
+    size_t cage = 0;         ///< tet body that contains them
+    double compliance = 0;   ///< m/N; 0 = hard
+    double tolerance = 1e-6; ///< m; nodes outside the cage by at most this are tied to the nearest tet
 };
 
 struct XpbdSystemDesc {
@@ -93,15 +92,14 @@ struct XpbdSystemDesc {
 };
 
 class XpbdSystem {
-  public:
+public:
     /// Throws viscera::PreconditionError, a std::invalid_argument whose rule has no function
     /// prefix (sim/util/error.hpp) ("sim::XpbdSystem::create(): tet body 1 ('vessel'): tet 3
     /// has non-positive rest volume -1e-9 m^3") on invalid settings, a missing mesh or model, a
     /// model with other than 1 or 2 constraints, bad density, weights, fixed nodes or strain
     /// limits, a degenerate element, an attachment that ties nothing, an embedded node outside its
     /// cage, or a system without a free particle.
-    static std::unique_ptr<XpbdSystem> create(const XpbdSystemDesc& desc,
-                                              const XpbdSettings& settings);
+    static std::unique_ptr<XpbdSystem> create(const XpbdSystemDesc& desc, const XpbdSettings& settings);
     ~XpbdSystem();
     XpbdSystem(const XpbdSystem&) = delete;
     XpbdSystem& operator=(const XpbdSystem&) = delete;
@@ -154,8 +152,7 @@ class XpbdSystem {
     /// Largest |x_p − Σ b_k x_k| over all ties, m (0 without ties).
     double maxTieGap() const;
 
-    double elasticEnergy()
-        const; ///< J: elasticity, membranes, compliant ties and strain limits, relative to rest
+    double elasticEnergy() const;   ///< J: elasticity, membranes, compliant ties and strain limits, relative to rest
     double kineticEnergy() const;   ///< J
     double potentialEnergy() const; ///< J, gravity relative to the rest configuration
     double totalMass() const;       ///< kg
@@ -175,7 +172,7 @@ class XpbdSystem {
     /// True when the stable Neo-Hookean AVX2 kernel runs (settings().simd and CPU support).
     bool usesSimd() const { return m_simd; }
 
-  private:
+private:
     friend class XpbdSolver;
     struct Range {
         std::string name;
@@ -197,12 +194,10 @@ class XpbdSystem {
         int n;
     };
     XpbdSystem();
-    static std::unique_ptr<XpbdSystem> build(const XpbdSystemDesc& desc,
-                                             const XpbdSettings& settings, const std::string& where,
-                                             bool singleBody);
+    static std::unique_ptr<XpbdSystem> build(const XpbdSystemDesc& desc, const XpbdSettings& settings,
+                                             const std::string& where, bool singleBody);
     void refreshMirrors();
-    void setState(Range& r, const std::vector<Vec3>& x, const std::vector<Vec3>& v,
-                  const char* what);
+    void setState(Range& r, const std::vector<Vec3>& x, const std::vector<Vec3>& v, const char* what);
 
     XpbdSettings m_settings;
     std::unique_ptr<detail::Engine> m_engine;

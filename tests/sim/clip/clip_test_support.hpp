@@ -32,8 +32,7 @@ inline std::unique_ptr<TetMesh> clipTube(double length = 0.06, int rings = 16, i
 inline ClipDesc clipAcross(const Vec3& centre, const Vec3& axis, const Vec3& normal, double gap,
                            double halfWidth = 0.004, double halfDepth = 0.001, int grid = 9) {
     ClipDesc d;
-    const Vec3 a = axis.normalized(), n = (normal - normal.dot(a) * a).normalized(),
-               w = a.cross(n);
+    const Vec3 a = axis.normalized(), n = (normal - normal.dot(a) * a).normalized(), w = a.cross(n);
     Mat3 axes;
     axes << w, n, a;
     const double plate = 0.0005;
@@ -56,7 +55,8 @@ inline ClipDesc clipAcross(const Vec3& centre, const Vec3& axis, const Vec3& nor
 inline std::vector<Vec3> transformed(const std::vector<Vec3>& x, const Mat3& M, const Vec3& t,
                                      const Vec3& about = Vec3::Zero()) {
     std::vector<Vec3> y(x.size());
-    for (size_t i = 0; i < x.size(); ++i) y[i] = M * (x[i] - about) + about + t;
+    for (size_t i = 0; i < x.size(); ++i)
+        y[i] = M * (x[i] - about) + about + t;
     return y;
 }
 
@@ -66,7 +66,8 @@ inline Mat3 rotationAbout(const Vec3& axis, double angle) {
 
 inline double maxDeviation(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
     double m = 0;
-    for (size_t i = 0; i < a.size(); ++i) m = std::max(m, (a[i] - b[i]).norm());
+    for (size_t i = 0; i < a.size(); ++i)
+        m = std::max(m, (a[i] - b[i]).norm());
     return m;
 }
 

@@ -25,14 +25,12 @@ ClipSettings converged() {
     return s;
 }
 
-std::unique_ptr<ClipAttachment> clipAtMid(const TetMesh& m, const std::vector<Vec3>& x,
-                                          ClipSettings s = converged()) {
+std::unique_ptr<ClipAttachment> clipAtMid(const TetMesh& m, const std::vector<Vec3>& x, ClipSettings s = converged()) {
     return ClipAttachment::apply(m, x, clipAcross(kMid, Vec3::UnitZ(), Vec3::UnitY(), 0.003), s);
 }
 
 /// Expected clip points for a rigid motion x → M (x − about) + about + t of the vessel.
-void expectRigidFollow(const ClipAttachment& c, const Mat3& M, const Vec3& t, const Vec3& about,
-                       double tol) {
+void expectRigidFollow(const ClipAttachment& c, const Mat3& M, const Vec3& t, const Vec3& about, double tol) {
     const auto v = transformed(c.applicationVertices(), M, t, about);
     const auto p = transformed(c.applicationContactPoints(), M, t, about);
     EXPECT_LT(maxDeviation(v, c.vertices()), tol);
@@ -79,7 +77,8 @@ TEST(ClipRegion, WeightsAndAuxiliaryPattern) {
         // The pattern is uniform: its mean is close to the centroid (exact for n → ∞).
         if (perTet == 64) {
             Eigen::Vector4d mean = Eigen::Vector4d::Zero();
-            for (int k = 0; k < 64; ++k) mean += all->auxiliaryNodes()[k].bary / 64.0;
+            for (int k = 0; k < 64; ++k)
+                mean += all->auxiliaryNodes()[k].bary / 64.0;
             EXPECT_LT((mean - Eigen::Vector4d::Constant(0.25)).cwiseAbs().maxCoeff(), 0.03);
         }
     }
@@ -114,8 +113,7 @@ TEST(ClipMls, TransformRecoversAGeneralLinearMap) {
     M << 1.2, 0.1, -0.05, -0.2, 0.9, 0.15, 0.05, 0.3, 1.1;
     const Vec3 t(0.001, -0.002, 0.0005);
     const auto x = transformed(m->positions(), M, t, kMid);
-    auto c = ClipAttachment::apply(*m, x, clipAcross(kMid + t, M * Vec3::UnitZ(), Vec3::UnitY(), 0.003),
-                                   converged());
+    auto c = ClipAttachment::apply(*m, x, clipAcross(kMid + t, M * Vec3::UnitZ(), Vec3::UnitY(), 0.003), converged());
     EXPECT_EQ(c->regionRank(), 3);
     EXPECT_LT((c->transform() - M).cwiseAbs().maxCoeff(), 1e-9);
     EXPECT_LT((c->centre() - (M * (c->restCentre() - kMid) + kMid + t)).norm(), 1e-12);
@@ -125,7 +123,8 @@ TEST(ClipMls, TransformRecoversAGeneralLinearMap) {
     Mat3 M2 = rotationAbout(Vec3(1, 1, 0), 0.4) * M;
     const Vec3 t2(-0.01, 0.0, 0.02);
     const auto x2 = transformed(m->positions(), M2, t2, kMid);
-    for (int k = 0; k < 5; ++k) ASSERT_EQ(c->update(x2), ClipUpdateStatus::Ok);
+    for (int k = 0; k < 5; ++k)
+        ASSERT_EQ(c->update(x2), ClipUpdateStatus::Ok);
     EXPECT_LT((c->transform() - M2).cwiseAbs().maxCoeff(), 1e-9);
     EXPECT_LT(rotationAngleBetween(c->rotation(), polarRotation(M2)), 1e-9);
     const Mat3 Q = polarRotation(M2) * polarRotation(M).transpose();
@@ -242,11 +241,11 @@ TEST(ClipStability, CoplanarCollinearAndSinglePointRegions) {
             ASSERT_TRUE(a->transform().allFinite());
             ASSERT_TRUE(a->rotation().allFinite());
             EXPECT_LT((a->rotation().transpose() * a->rotation() - Mat3::Identity()).norm(), 1e-12);
-            for (const Vec3& v : a->vertices()) ASSERT_TRUE(v.allFinite());
+            for (const Vec3& v : a->vertices())
+                ASSERT_TRUE(v.allFinite());
         }
         EXPECT_LT((line->centre() - (line->applicationCentre() +
-                                     rotationAbout(Vec3::UnitZ(), 0.05 * f) *
-                                         (line->applicationCentre() - p0) -
+                                     rotationAbout(Vec3::UnitZ(), 0.05 * f) * (line->applicationCentre() - p0) -
                                      (line->applicationCentre() - p0) + t))
                       .norm(),
                   1e-12);
@@ -263,12 +262,10 @@ TEST(ClipStability, TwistAndFlipBy180Degrees) {
         auto c = clipAtMid(*m, m->positions());
         for (int f = 1; f <= 60; ++f) {
             const Mat3 M = rotationAbout(axis, std::numbers::pi * f / 60);
-            ASSERT_EQ(c->update(transformed(m->positions(), M, Vec3::Zero(), kMid)),
-                      ClipUpdateStatus::Ok);
+            ASSERT_EQ(c->update(transformed(m->positions(), M, Vec3::Zero(), kMid)), ClipUpdateStatus::Ok);
             expectRigidFollow(*c, M, Vec3::Zero(), kMid, 1e-9);
         }
-        EXPECT_NEAR(rotationAngleBetween(c->relativeRotation(), Mat3::Identity()), std::numbers::pi,
-                    1e-9);
+        EXPECT_NEAR(rotationAngleBetween(c->relativeRotation(), Mat3::Identity()), std::numbers::pi, 1e-9);
         EXPECT_EQ(c->fallbackCount(), 0);
     }
     // (b) A real twist: the section at height z turns by 2π z / L (0 at the base, 180° at the
@@ -282,11 +279,13 @@ TEST(ClipStability, TwistAndFlipBy180Degrees) {
         for (int f = 1; f <= 90; ++f) {
             const double s = f / 90.0;
             std::vector<Vec3> x = m->positions();
-            for (Vec3& p : x) p = rotationAbout(axis, 2 * std::numbers::pi * s * p.z() / L) * p;
+            for (Vec3& p : x)
+                p = rotationAbout(axis, 2 * std::numbers::pi * s * p.z() / L) * p;
             ASSERT_EQ(c->update(x), ClipUpdateStatus::Ok);
             const Mat3 expect = rotationAbout(axis, std::numbers::pi * s);
             worst = std::max(worst, rotationAngleBetween(c->relativeRotation(), expect));
-            for (const Vec3& v : c->contactPoints()) ASSERT_TRUE(v.allFinite());
+            for (const Vec3& v : c->contactPoints())
+                ASSERT_TRUE(v.allFinite());
         }
         EXPECT_LT(worst, 1e-2);
         RecordProperty("twist_section_deviation_rad", ::testing::PrintToString(worst));
@@ -388,5 +387,6 @@ TEST(ClipStability, RepeatRunsAreBitIdentical) {
     };
     const auto a = run(), b = run();
     ASSERT_EQ(a.size(), b.size());
-    for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << i;
+    for (size_t i = 0; i < a.size(); ++i)
+        ASSERT_EQ(a[i], b[i]) << i;
 }

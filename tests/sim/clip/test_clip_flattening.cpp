@@ -21,7 +21,8 @@ const Vec3 kMid(0, 0, 0.03);
 
 std::vector<Vec3> axisPolyline() {
     std::vector<Vec3> p;
-    for (int i = 0; i <= 6; ++i) p.emplace_back(0, 0, 0.01 * i);
+    for (int i = 0; i <= 6; ++i)
+        p.emplace_back(0, 0, 0.01 * i);
     return p;
 }
 
@@ -31,11 +32,10 @@ struct Fixture {
     std::unique_ptr<ClipAttachment> clip;
     Fixture() {
         render = mesh->positions();
-        render.push_back(kMid);                  // on the axis, at the centre (s = 0, ρ = 0)
-        render.emplace_back(0, 0, 0.031);        // on the axis, off centre
+        render.push_back(kMid);                    // on the axis, at the centre (s = 0, ρ = 0)
+        render.emplace_back(0, 0, 0.031);          // on the axis, off centre
         render.emplace_back(0.0001, 0.0025, 0.03); // inside the lumen, at the centre
-        clip = ClipAttachment::apply(*mesh, mesh->positions(),
-                                     clipAcross(kMid, Vec3::UnitZ(), Vec3::UnitY(), 0.003));
+        clip = ClipAttachment::apply(*mesh, mesh->positions(), clipAcross(kMid, Vec3::UnitZ(), Vec3::UnitY(), 0.003));
     }
 };
 
@@ -61,8 +61,8 @@ TEST(ClipFlattening, MatchesClosedFormOnAStraightTube) {
             const double si = std::abs(x.z() - fx.clip->centre().z()), rho = std::hypot(x.x(), x.y());
             Vec3 expect = x;
             if (si < s.influence && rho > 1e-12) {
-                const double f = s.eta / std::pow(std::max(si, s.minDistance), gamma) -
-                                 s.eta / std::pow(s.influence, gamma);
+                const double f =
+                    s.eta / std::pow(std::max(si, s.minDistance), gamma) - s.eta / std::pow(s.influence, gamma);
                 expect.y() -= std::min(f, s.maxSqueeze * rho) * x.y() / rho;
             }
             EXPECT_LT((out[i] - expect).norm(), 1e-15) << i;

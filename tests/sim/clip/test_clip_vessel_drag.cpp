@@ -29,12 +29,15 @@ namespace {
 constexpr int kSlices = 16, kRings = 16;
 constexpr double kLength = 0.06;
 
-int32_t node(int ring, int layer, int slice) { return (ring * 2 + layer) * kSlices + slice; }
+int32_t node(int ring, int layer, int slice) {
+    return (ring * 2 + layer) * kSlices + slice;
+}
 
 Vec3 ringCentre(const std::vector<Vec3>& x, int ring) {
     Vec3 c = Vec3::Zero();
     for (int l = 0; l < 2; ++l)
-        for (int i = 0; i < kSlices; ++i) c += x[node(ring, l, i)];
+        for (int i = 0; i < kSlices; ++i)
+            c += x[node(ring, l, i)];
     return c / (2 * kSlices);
 }
 
@@ -44,8 +47,8 @@ struct DragResult {
     bool finite = true;
     int frames = 0, fallbacks = 0, rejected = 0;
     double maxFlattenShift = 0;
-    double maxRotation = 0; ///< largest clip rotation from the application pose, rad
-    double clipTravel = 0; ///< largest contact point displacement from application to the end, m
+    double maxRotation = 0;    ///< largest clip rotation from the application pose, rad
+    double clipTravel = 0;     ///< largest contact point displacement from application to the end, m
     std::vector<double> trace; ///< per-frame max distance
     std::vector<Vec3> finalContacts;
 };
@@ -65,15 +68,16 @@ DragResult runDrag(const Vec3& drag, bool holdBottom, bool flatten) {
     TetBodyDesc body;
     body.name = "vessel";
     body.mesh = mesh.get();
-    body.model = std::make_shared<StableNeoHookeanModel>(E / (2 * (1 + nu)),
-                                                         E * nu / ((1 + nu) * (1 - 2 * nu)));
+    body.model = std::make_shared<StableNeoHookeanModel>(E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu)));
     body.density = 1050;
     for (int l = 0; l < 2; ++l)
-        for (int i = 0; i < kSlices; ++i) body.fixedNodes.push_back(node(0, l, i));
+        for (int i = 0; i < kSlices; ++i)
+            body.fixedNodes.push_back(node(0, l, i));
     const size_t dragged = body.fixedNodes.size(); // the top ring moves, the bottom one (if held) not
     if (holdBottom)
         for (int l = 0; l < 2; ++l)
-            for (int i = 0; i < kSlices; ++i) body.fixedNodes.push_back(node(kRings, l, i));
+            for (int i = 0; i < kSlices; ++i)
+                body.fixedNodes.push_back(node(kRings, l, i));
     XpbdSystemDesc desc;
     desc.tetBodies.push_back(body);
     XpbdSettings settings;
@@ -82,7 +86,8 @@ DragResult runDrag(const Vec3& drag, bool holdBottom, bool flatten) {
     settings.substeps = std::max(10, assessStability(*mesh, *body.model, body.density, {}, settings).requiredSubsteps);
     auto sys = XpbdSystem::create(desc, settings);
 
-    for (int f = 0; f < 60; ++f) sys->step(); // settle under gravity
+    for (int f = 0; f < 60; ++f)
+        sys->step(); // settle under gravity
 
     // Clip across the middle ring, jaws closing along y, inner faces touching the outer wall.
     const auto& x0 = sys->tetPositions(0);
@@ -90,7 +95,8 @@ DragResult runDrag(const Vec3& drag, bool holdBottom, bool flatten) {
     const Vec3 axis = ringCentre(x0, kRings / 2 - 1) - ringCentre(x0, kRings / 2 + 1);
     const Vec3 n = (Vec3::UnitY() - Vec3::UnitY().dot(axis.normalized()) * axis.normalized()).normalized();
     double gap = 0;
-    for (int i = 0; i < kSlices; ++i) gap = std::max(gap, std::abs((x0[node(kRings / 2, 1, i)] - centre).dot(n)));
+    for (int i = 0; i < kSlices; ++i)
+        gap = std::max(gap, std::abs((x0[node(kRings / 2, 1, i)] - centre).dot(n)));
     ClipDesc clip = clipAcross(centre, axis, n, gap, 0.004, 0.001, 33);
 
     const TriMesh& bnd = mesh->boundary();
@@ -125,14 +131,17 @@ DragResult runDrag(const Vec3& drag, bool holdBottom, bool flatten) {
     DragResult r;
     auto att = ClipAttachment::apply(*mesh, x0, clip);
     r.contacts = touching.size();
-    for (const Vec3& p : att->contactPoints()) r.maxAtApplication = std::max(r.maxAtApplication, distance(x0, p));
+    for (const Vec3& p : att->contactPoints())
+        r.maxAtApplication = std::max(r.maxAtApplication, distance(x0, p));
 
     // Render mesh = the boundary vertices; skeleton = the ring centres at application.
     std::vector<Vec3> skeleton;
-    for (int k = 0; k <= kRings; ++k) skeleton.push_back(ringCentre(x0, k));
+    for (int k = 0; k <= kRings; ++k)
+        skeleton.push_back(ringCentre(x0, k));
     auto renderOf = [&](const std::vector<Vec3>& x) {
         std::vector<Vec3> v(bmap.size());
-        for (size_t i = 0; i < bmap.size(); ++i) v[i] = x[bmap[i]];
+        for (size_t i = 0; i < bmap.size(); ++i)
+            v[i] = x[bmap[i]];
         return v;
     };
     std::unique_ptr<ClipFlattening> fl;
@@ -140,7 +149,8 @@ DragResult runDrag(const Vec3& drag, bool holdBottom, bool flatten) {
     if (flatten) fl = ClipFlattening::create(*att, renderOf(x0), skeleton, fs);
 
     std::vector<Vec3> fixed0;
-    for (int32_t v : body.fixedNodes) fixed0.push_back(x0[v]);
+    for (int32_t v : body.fixedNodes)
+        fixed0.push_back(x0[v]);
     const int dragFrames = 90, holdFrames = 30;
     const double dt = settings.dt;
     double sum = 0;
@@ -158,7 +168,8 @@ DragResult runDrag(const Vec3& drag, bool holdBottom, bool flatten) {
         const StepStats st = sys->step();
         const auto& xs = sys->tetPositions(0);
         r.finite = r.finite && st.finite;
-        for (const Vec3& p : xs) r.finite = r.finite && p.allFinite();
+        for (const Vec3& p : xs)
+            r.finite = r.finite && p.allFinite();
         if (att->update(xs) != ClipUpdateStatus::Ok) ++r.rejected;
         r.maxRotation = std::max(r.maxRotation, rotationAngleBetween(att->relativeRotation(), Mat3::Identity()));
         double frameMax = 0;
@@ -169,7 +180,8 @@ DragResult runDrag(const Vec3& drag, bool holdBottom, bool flatten) {
             sum += d;
             ++count;
         }
-        for (const Vec3& p : att->vertices()) r.finite = r.finite && p.allFinite();
+        for (const Vec3& p : att->vertices())
+            r.finite = r.finite && p.allFinite();
         r.trace.push_back(frameMax);
         r.maxDistance = std::max(r.maxDistance, frameMax);
         if (fl) {
@@ -196,15 +208,16 @@ void check(const std::string& name, const Vec3& drag, bool holdBottom, double mi
     ::testing::Test::RecordProperty(name + "_mean_mm", formatNumber(a.meanDistance * 1e3, 4));
     ::testing::Test::RecordProperty(name + "_contacts", std::to_string(a.contacts));
     ::testing::Test::RecordProperty(name + "_max_flatten_shift_mm", formatNumber(a.maxFlattenShift * 1e3, 4));
-    ::testing::Test::RecordProperty(name + "_max_clip_rotation_deg", formatNumber(a.maxRotation * 180 / 3.141592653589793, 4));
+    ::testing::Test::RecordProperty(name + "_max_clip_rotation_deg",
+                                    formatNumber(a.maxRotation * 180 / 3.141592653589793, 4));
     EXPECT_GE(a.maxRotation, minRotation);
     EXPECT_TRUE(a.finite);
     EXPECT_EQ(a.rejected, 0);
     EXPECT_EQ(a.frames, 120);
     EXPECT_GE(a.contacts, 20u);
     EXPECT_LE(a.maxAtApplication, 0.05e-3);
-    EXPECT_LE(a.maxDistance, 0.5e-3) << name << ": max " << a.maxDistance * 1e3 << " mm, mean "
-                                     << a.meanDistance * 1e3 << " mm";
+    EXPECT_LE(a.maxDistance, 0.5e-3) << name << ": max " << a.maxDistance * 1e3 << " mm, mean " << a.meanDistance * 1e3
+                                     << " mm";
     EXPECT_GT(a.maxFlattenShift, 0.0);
     EXPECT_LE(a.maxFlattenShift, 0.8 * 0.003 + 1e-4); // κ × (a bit more than) the outer radius
     // The clip really travelled with the vessel (the check is not vacuous).
@@ -218,7 +231,9 @@ void check(const std::string& name, const Vec3& drag, bool holdBottom, double mi
 
 } // namespace
 
-TEST(ClipVesselDrag, StraightDragAlongTheVessel) { check("straight", Vec3(0, 0, 0.03), false, 0.0); }
+TEST(ClipVesselDrag, StraightDragAlongTheVessel) {
+    check("straight", Vec3(0, 0, 0.03), false, 0.0);
+}
 
 TEST(ClipVesselDrag, SidewaysDragBendsTheVessel) {
     // The bottom ring is held as well, so the top ring dragged sideways bends and stretches the

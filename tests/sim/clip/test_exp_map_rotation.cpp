@@ -32,8 +32,7 @@ Mat3 randomSpd(std::mt19937& rng) {
 TEST(ExpMapRotation, RodriguesMatchesAngleAxis) {
     std::mt19937 rng(3);
     std::normal_distribution<double> n(0, 1);
-    for (double angle : {0.0, 1e-12, 1e-9, 1e-5, 1e-4, 0.3, 1.0, 2.5, std::numbers::pi - 1e-9,
-                         std::numbers::pi}) {
+    for (double angle : {0.0, 1e-12, 1e-9, 1e-5, 1e-4, 0.3, 1.0, 2.5, std::numbers::pi - 1e-9, std::numbers::pi}) {
         for (int k = 0; k < 5; ++k) {
             const Vec3 axis = Vec3(n(rng), n(rng), n(rng)).normalized();
             const Mat3 R = expMapRotation(angle * axis);
@@ -142,7 +141,7 @@ TEST(ExpMapRotation, SingularAndNonFiniteA) {
 TEST(ExpMapRotation, AngleBetweenIsAccurateAtBothEnds) {
     const Mat3 I = Mat3::Identity();
     for (double a : {1e-9, 1e-5, 0.7, 3.0, std::numbers::pi - 1e-7, std::numbers::pi})
-        EXPECT_NEAR(rotationAngleBetween(I, Eigen::AngleAxisd(a, Vec3::UnitZ()).toRotationMatrix()),
-                    a, 1e-12 + 1e-9 * a)
+        EXPECT_NEAR(rotationAngleBetween(I, Eigen::AngleAxisd(a, Vec3::UnitZ()).toRotationMatrix()), a,
+                    1e-12 + 1e-9 * a)
             << a;
 }

@@ -41,7 +41,8 @@ TEST(Circumsphere, SafeAngleOfEquation52) {
             EXPECT_NEAR(s, phi * cc.radius / std::tan(p.safeAngle), 1e-15);
             const Sphere sp = circumsphere(cc, s);
             EXPECT_LT((sp.centre - (cc.centre - s * cc.normal)).norm(), 1e-15);
-            for (const Vec3& v : {a, b, c}) EXPECT_NEAR((v - sp.centre).norm(), sp.radius, 1e-14);
+            for (const Vec3& v : {a, b, c})
+                EXPECT_NEAR((v - sp.centre).norm(), sp.radius, 1e-14);
             // The centre is on the inner side (against the counter-clockwise normal).
             EXPECT_LT((sp.centre - a).dot(cc.normal), 0);
             if (phi == 1.0) {
@@ -106,16 +107,19 @@ TEST(Circumsphere, EnergyFactor) {
     // Rigid motion: 0.
     const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
     std::array<Vec3, 3> moved;
-    for (int k = 0; k < 3; ++k) moved[k] = R * rest[k] + Vec3(1, -2, 0.5);
+    for (int k = 0; k < 3; ++k)
+        moved[k] = R * rest[k] + Vec3(1, -2, 0.5);
     EXPECT_NEAR(triangleEnergyFactor(rest, moved), 0.0, 1e-24);
     // Uniform in-plane stretch s: e = ½ (s² − 1)², ε = e / (1 + e).
     for (double s : {0.8, 1.1, 1.5, 3.0}) {
-        for (int k = 0; k < 3; ++k) moved[k] = R * (s * rest[k]);
+        for (int k = 0; k < 3; ++k)
+            moved[k] = R * (s * rest[k]);
         const double e = 0.5 * std::pow(s * s - 1, 2);
         EXPECT_NEAR(triangleEnergyFactor(rest, moved), e / (1 + e), 1e-12) << "s " << s;
     }
     // Monotone in the stretch, bounded by 1.
-    for (int k = 0; k < 3; ++k) moved[k] = 100.0 * rest[k];
+    for (int k = 0; k < 3; ++k)
+        moved[k] = 100.0 * rest[k];
     EXPECT_LT(triangleEnergyFactor(rest, moved), 1.0);
     // Degenerate rest triangle: 0.
     EXPECT_EQ(triangleEnergyFactor({Vec3::Zero(), Vec3::Zero(), Vec3::UnitX()}, moved), 0.0);
@@ -126,13 +130,15 @@ TEST(Circumsphere, DiscreteCurvatureOnPlaneAndCylinder) {
     const TriMesh box = makeBoxSurface(Vec3::Zero(), Vec3(1, 1, 1));
     SurfaceCurvature boxK(box.vertexCount(), box.triangles());
     // Every box vertex is a corner: positive curvature.
-    for (int v = 0; v < 8; ++v) EXPECT_GT(boxK.vertexCurvature(v, box.positions()), 0);
+    for (int v = 0; v < 8; ++v)
+        EXPECT_GT(boxK.vertexCurvature(v, box.positions()), 0);
     // A flat grid: zero everywhere.
     std::vector<Vec3> grid;
     std::vector<Tri> tris;
     const int n = 6;
     for (int j = 0; j <= n; ++j)
-        for (int i = 0; i <= n; ++i) grid.emplace_back(0.01 * i, 0.01 * j, 0.0);
+        for (int i = 0; i <= n; ++i)
+            grid.emplace_back(0.01 * i, 0.01 * j, 0.0);
     for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i) {
             const int a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;

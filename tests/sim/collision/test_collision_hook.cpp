@@ -34,7 +34,8 @@ Slab slab(const Vec3& size, const std::array<int, 3>& cells) {
     s.material.poissonRatio = 0.3;
     const auto m = lumpedMasses(*s.mesh, s.material.density, s.fixed);
     s.invMass.resize(m.size());
-    for (size_t i = 0; i < m.size(); ++i) s.invMass[i] = m[i] > 0 ? 1 / m[i] : 0;
+    for (size_t i = 0; i < m.size(); ++i)
+        s.invMass[i] = m[i] > 0 ? 1 / m[i] : 0;
     return s;
 }
 
@@ -157,19 +158,21 @@ TEST(CollisionHook, ParticleViewOffsetFixedAndSize) {
     // 2 unrelated particles, then the 4 surface vertices; vertex 2 (particle 4) fixed.
     std::vector<double> xw = {9, 9, 9, 1, 8, 8, 8, 1};
     for (size_t v = 0; v < 4; ++v)
-        xw.insert(xw.end(), {d.restPositions[v].x(), d.restPositions[v].y(),
-                             d.restPositions[v].z(), v == 2 ? 0.0 : 1.0});
+        xw.insert(xw.end(),
+                  {d.restPositions[v].x(), d.restPositions[v].y(), d.restPositions[v].z(), v == 2 ? 0.0 : 1.0});
     XpbdParticles view(xw.data(), nullptr, 6);
     col->beginStep(view, 2, tool, 1e-3);
     EXPECT_EQ(col->stats().candidates, 2);
     int contacts = 0;
-    for (int k = 0; k < 20; ++k) contacts += col->iterate(view, 2, tool);
+    for (int k = 0; k < 20; ++k)
+        contacts += col->iterate(view, 2, tool);
     EXPECT_GT(contacts, 0);
     EXPECT_EQ(view.position(0), Vec3(9, 9, 9));
     EXPECT_EQ(view.position(1), Vec3(8, 8, 8));
     EXPECT_EQ(view.position(4), d.restPositions[2]); // fixed in the view
     // The others were pushed down, away from the sphere (polygon: below the reach r + margin).
-    for (size_t p : {2u, 3u, 5u}) EXPECT_LT(view.position(p).z(), -1e-4) << "particle " << p;
+    for (size_t p : {2u, 3u, 5u})
+        EXPECT_LT(view.position(p).z(), -1e-4) << "particle " << p;
     // Too small a view: nothing happens.
     const std::vector<double> before = xw;
     XpbdParticles small(xw.data(), nullptr, 5);
@@ -189,8 +192,7 @@ struct SphereRun {
 
 /// A sphere of radius 8 mm pressed 3 mm into a 4 × 4 × 1.2 cm slab and held (set once, from the
 /// first frame: the tissue is pushed out over the first substeps), collision in the iteration.
-SphereRun restingSphere(const Slab& s, CollisionMethod method, int threads, int frames,
-                        Vec3* centre) {
+SphereRun restingSphere(const Slab& s, CollisionMethod method, int threads, int frames, Vec3* centre) {
     const double r = 0.008;
     auto solver = XpbdSolver::create(*s.mesh, s.material, s.fixed, settings(20, 3, threads));
     CollisionSettings cs;
@@ -217,8 +219,8 @@ SphereRun restingSphere(const Slab& s, CollisionMethod method, int threads, int 
 // and thread counts give bit-identical frames.
 TEST(CollisionHook, RestingSphereOnSlabConvergesAndIsDeterministic) {
     const Slab s = slab(Vec3(0.04, 0.04, 0.012), {10, 10, 4});
-    for (CollisionMethod method : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
-                                   CollisionMethod::Polygon}) {
+    for (CollisionMethod method :
+         {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere, CollisionMethod::Polygon}) {
         SCOPED_TRACE(toString(method));
         Vec3 c;
         const SphereRun a = restingSphere(s, method, 1, 90, &c);
@@ -247,7 +249,8 @@ TEST(CollisionHook, RestingSphereOnSlabConvergesAndIsDeterministic) {
         EXPECT_GT(mean, 0.008);
         EXPECT_LT(mean, 0.008 * 1.5);
         // Every node outside the tool (no tunnelling of a resting contact).
-        for (const Vec3& x : a.frames.back()) EXPECT_GT((x - c).norm(), 0.008 - 2e-4);
+        for (const Vec3& x : a.frames.back())
+            EXPECT_GT((x - c).norm(), 0.008 - 2e-4);
         // Repeat run and two threads: bit-identical frames.
         Vec3 c2;
         const SphereRun b = restingSphere(s, method, 1, 30, &c2);

@@ -93,13 +93,15 @@ TEST(CollisionSolver, CircumsphereContactTranslatesTheTriangleAsOne) {
     EXPECT_GT(col->iterate(x, tool), 0);
     // Triangle 0 moved rigidly by one vector (its vertex 0 and 2 are shared with triangle 1,
     // which also collides; check the sphere of each no longer overlaps after a few sweeps).
-    for (int k = 0; k < 10; ++k) col->iterate(x, tool);
+    for (int k = 0; k < 10; ++k)
+        col->iterate(x, tool);
     for (int32_t t = 0; t < 2; ++t) {
         const Sphere sp = col->triangleSphere(t, x);
         EXPECT_GE((sp.centre - tool.parts()[0].a).norm(), sp.radius + 0.005 - 1e-9);
     }
     // Pushed down (into the tissue), not sideways much.
-    for (int v = 0; v < 4; ++v) EXPECT_LT(x[v].z(), x0[v].z());
+    for (int v = 0; v < 4; ++v)
+        EXPECT_LT(x[v].z(), x0[v].z());
     EXPECT_EQ(col->contactVertices(), (std::vector<int32_t>{0, 1, 2, 3}));
 }
 
@@ -115,7 +117,8 @@ TEST(CollisionSolver, UnifiedResponseMovesAllThreeVerticesEqually) {
         col->beginStep(x, tool, 1e-3);
         ASSERT_EQ(col->iterate(x, tool), 1);
         const Vec3 m0 = x[0] - d.restPositions[0];
-        for (int v = 1; v < 3; ++v) EXPECT_LT((x[v] - d.restPositions[v] - m0).norm(), 1e-15);
+        for (int v = 1; v < 3; ++v)
+            EXPECT_LT((x[v] - d.restPositions[v] - m0).norm(), 1e-15);
         // Root form resolves the 1 mm overlap in one projection; the squared form halves it.
         EXPECT_NEAR(m0.z(), squared ? -0.0005 : -0.001, 1e-12);
     }
@@ -137,8 +140,8 @@ TEST(CollisionSolver, CircumsphereContactsOnlyThroughTheSafeCone) {
         EXPECT_NEAR(sp.coneAxis.z(), 1.0, 1e-12);
         const double toolR = 0.003;
         for (double angleDeg : {0.0, 20.0, 45.0, 80.0}) {
-            SCOPED_TRACE("cone only " + std::to_string(coneOnly) + ", tool at " +
-                         std::to_string(angleDeg) + " deg from the normal");
+            SCOPED_TRACE("cone only " + std::to_string(coneOnly) + ", tool at " + std::to_string(angleDeg) +
+                         " deg from the normal");
             const double a = angleDeg * M_PI / 180;
             // 1 mm overlap with the sphere, in direction a from the normal.
             const Vec3 dir(std::sin(a), 0, std::cos(a));
@@ -166,7 +169,8 @@ TEST(CollisionSolver, PolygonContactKeepsTheMargin) {
     ToolShape tool = sphereAt(0.004, Vec3(0.012, 0.006, 0.003)); // 1 mm into the face
     std::vector<Vec3> x = square(0.02).restPositions;
     col->beginStep(x, tool, 1e-3);
-    for (int k = 0; k < 20; ++k) col->iterate(x, tool);
+    for (int k = 0; k < 20; ++k)
+        col->iterate(x, tool);
     const TrianglePoint tp = closestPointOnTriangle(tool.parts()[0].a, x[0], x[1], x[2]);
     EXPECT_NEAR((tp.point - tool.parts()[0].a).norm(), 0.005, 1e-9);
 }
@@ -183,8 +187,8 @@ TEST(CollisionSolver, PolygonFeaturesResolveFaceEdgeAndVertexContacts) {
         const char* feature;
         Vec3 centre;
     };
-    const Case cases[] = {{"face", Vec3(0.012, 0.006, 0.003)},     // 1 mm into the face
-                          {"edge", Vec3(0.010, -0.003, 0.0025)},   // beyond edge (0, 1)
+    const Case cases[] = {{"face", Vec3(0.012, 0.006, 0.003)},          // 1 mm into the face
+                          {"edge", Vec3(0.010, -0.003, 0.0025)},        // beyond edge (0, 1)
                           {"vertex", Vec3(L + 0.003, -0.003, 0.0015)}}; // beyond corner 1
     for (const Case& c : cases) {
         auto col = CollisionSolver::create(square(L), s);
@@ -195,26 +199,29 @@ TEST(CollisionSolver, PolygonFeaturesResolveFaceEdgeAndVertexContacts) {
         ASSERT_LT(before, reach - 2e-4) << c.feature << ": the case starts in contact";
         col->beginStep(x, tool, 1e-3);
         int contacts = 0;
-        for (int k = 0; k < 40; ++k) contacts += col->iterate(x, tool);
+        for (int k = 0; k < 40; ++k)
+            contacts += col->iterate(x, tool);
         EXPECT_GT(contacts, 0) << c.feature;
         const double after = std::min(closestPointsSegmentTriangle(c.centre, c.centre, x[0], x[1], x[2]).distance,
                                       closestPointsSegmentTriangle(c.centre, c.centre, x[0], x[2], x[3]).distance);
         EXPECT_NEAR(after, reach, 1e-6) << c.feature;
-        for (const Vec3& p : x) EXPECT_TRUE(p.allFinite()) << c.feature;
+        for (const Vec3& p : x)
+            EXPECT_TRUE(p.allFinite()) << c.feature;
     }
     // The vertex case moves vertex 1 to the reach along the line from the centre.
     auto col = CollisionSolver::create(square(L), s);
     ToolShape tool = sphereAt(0.004, cases[2].centre);
     std::vector<Vec3> x = square(L).restPositions;
     col->beginStep(x, tool, 1e-3);
-    for (int k = 0; k < 40; ++k) col->iterate(x, tool);
+    for (int k = 0; k < 40; ++k)
+        col->iterate(x, tool);
     EXPECT_NEAR((x[1] - cases[2].centre).norm(), reach, 1e-6);
     EXPECT_EQ(x[3], square(L).restPositions[3]) << "the far corner is not a candidate contact";
 }
 
 TEST(CollisionSolver, MethodNamesRoundTrip) {
-    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
-                              CollisionMethod::Polygon, CollisionMethod::PolygonFeatures}) {
+    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere, CollisionMethod::Polygon,
+                              CollisionMethod::PolygonFeatures}) {
         CollisionMethod back = CollisionMethod::Circumsphere;
         EXPECT_TRUE(parseCollisionMethod(toString(m), back)) << toString(m);
         EXPECT_EQ(back, m);
@@ -232,21 +239,23 @@ TEST(CollisionSolver, CorrectionPerStepIsCapped) {
     ToolShape tool = sphereAt(0.006, Vec3(0.005, 0.005, 0.0)); // deep inside
     std::vector<Vec3> x = square().restPositions;
     col->beginStep(x, tool, 1e-3);
-    for (int k = 0; k < 10; ++k) col->iterate(x, tool);
+    for (int k = 0; k < 10; ++k)
+        col->iterate(x, tool);
     for (int v = 0; v < 4; ++v)
         EXPECT_LE((x[v] - square().restPositions[v]).norm(), 0.001 + 1e-15);
 }
 
 TEST(CollisionSolver, FixedVerticesNeverMove) {
-    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere,
-                              CollisionMethod::Polygon, CollisionMethod::PolygonFeatures}) {
+    for (CollisionMethod m : {CollisionMethod::Circumsphere, CollisionMethod::BoundingSphere, CollisionMethod::Polygon,
+                              CollisionMethod::PolygonFeatures}) {
         CollisionSettings s;
         s.method = m;
         auto col = CollisionSolver::create(square(0.01, {0, 1, 1, 0}), s);
         ToolShape tool = sphereAt(0.004, Vec3(0.005, 0.005, 0.001));
         std::vector<Vec3> x = square().restPositions;
         col->beginStep(x, tool, 1e-3);
-        for (int k = 0; k < 5; ++k) col->iterate(x, tool);
+        for (int k = 0; k < 5; ++k)
+            col->iterate(x, tool);
         EXPECT_EQ(x[0], Vec3(0, 0, 0)) << toString(m);
         EXPECT_EQ(x[3], Vec3(0, 0.01, 0)) << toString(m);
         EXPECT_LT(x[1].z(), 0) << toString(m);
@@ -260,7 +269,7 @@ TEST(CollisionSolver, UpdateThresholdTriggers) {
     s.circumsphere.energyScale = 0.01;
     auto col = CollisionSolver::create(square(), s);
     ToolShape tool = sphereAt(0.001, Vec3(0.005, 0.005, 0.05)); // far above
-    ToolShape big = sphereAt(0.05, Vec3(0.005, 0.005, 0.04)); // its box covers the square
+    ToolShape big = sphereAt(0.05, Vec3(0.005, 0.005, 0.04));   // its box covers the square
     std::vector<Vec3> x = square().restPositions;
     col->beginStep(x, big, 1e-3);
     EXPECT_EQ(col->stats().candidates, 2);
@@ -302,8 +311,8 @@ TEST(CollisionSolver, CurvatureFactorShrinksSpheresOnEdgesOfABox) {
         const Tri& f = col->triangles()[t];
         bool onTopInterior = true;
         for (int32_t v : f)
-            onTopInterior &= x[v].z() > 0.02 - 1e-9 && x[v].x() > 1e-9 && x[v].x() < 0.04 - 1e-9 &&
-                             x[v].y() > 1e-9 && x[v].y() < 0.04 - 1e-9;
+            onTopInterior &= x[v].z() > 0.02 - 1e-9 && x[v].x() > 1e-9 && x[v].x() < 0.04 - 1e-9 && x[v].y() > 1e-9 &&
+                             x[v].y() < 0.04 - 1e-9;
         bool touchesCorner = false;
         for (int32_t v : f)
             touchesCorner |= (x[v].x() < 1e-9 || x[v].x() > 0.04 - 1e-9) &&

@@ -55,7 +55,8 @@ Outcome slide(CollisionMethod method, double speed) {
     auto solver = XpbdSolver::create(*mesh, m, fixed, s);
     const auto mass = lumpedMasses(*mesh, m.density, fixed);
     std::vector<double> w(mass.size());
-    for (size_t i = 0; i < w.size(); ++i) w[i] = mass[i] > 0 ? 1 / mass[i] : 0;
+    for (size_t i = 0; i < w.size(); ++i)
+        w[i] = mass[i] > 0 ? 1 / mass[i] : 0;
     CollisionSettings cs;
     cs.method = method;
     cs.polygonMargin = 1e-3;
@@ -63,16 +64,19 @@ Outcome slide(CollisionMethod method, double speed) {
     ToolShape tool = ToolShape::capsule(0.006, kR);
     solver->setIterationHook(makeCollisionHook(*col, tool));
 
-    const double x0 = 0.009, slideLen = 0.018, zStart = kTop + kR + 0.002,
-                 zPress = kTop + kR - kDepth, perFrame = speed / 60.0;
+    const double x0 = 0.009, slideLen = 0.018, zStart = kTop + kR + 0.002, zPress = kTop + kR - kDepth,
+                 perFrame = speed / 60.0;
     std::vector<Vec3> keys; // (x, z) per frame
-    for (int f = 1; f <= 8; ++f) keys.push_back(Vec3(x0, 0, zStart + (zPress - zStart) * f / 8));
-    for (int f = 0; f < 6; ++f) keys.push_back(Vec3(x0, 0, zPress));
-    for (double d = perFrame; ; d += perFrame) {
+    for (int f = 1; f <= 8; ++f)
+        keys.push_back(Vec3(x0, 0, zStart + (zPress - zStart) * f / 8));
+    for (int f = 0; f < 6; ++f)
+        keys.push_back(Vec3(x0, 0, zPress));
+    for (double d = perFrame;; d += perFrame) {
         keys.push_back(Vec3(x0 + std::min(d, slideLen), 0, zPress));
         if (d >= slideLen - 1e-12) break;
     }
-    for (int f = 0; f < 5; ++f) keys.push_back(Vec3(x0 + slideLen, 0, zPress));
+    for (int f = 0; f < 5; ++f)
+        keys.push_back(Vec3(x0 + slideLen, 0, zPress));
     tool.setPose(pose(x0, zStart));
     Outcome o;
     for (const Vec3& k : keys) {

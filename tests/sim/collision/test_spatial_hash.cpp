@@ -93,8 +93,7 @@ TEST(Distance, SegmentTriangleDistanceAgainstSampling) {
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(-1, 1);
     for (int trial = 0; trial < 100; ++trial) {
-        const Vec3 a(u(rng), u(rng), 0.2 * u(rng)), b(u(rng), u(rng), 0.2 * u(rng)),
-            c(u(rng), u(rng), 0.2 * u(rng));
+        const Vec3 a(u(rng), u(rng), 0.2 * u(rng)), b(u(rng), u(rng), 0.2 * u(rng)), c(u(rng), u(rng), 0.2 * u(rng));
         const Vec3 s0(u(rng), u(rng), u(rng)), s1(u(rng), u(rng), u(rng));
         const SegmentTrianglePair st = closestPointsSegmentTriangle(s0, s1, a, b, c);
         EXPECT_NEAR((st.onSegment - st.onTriangle.point).norm(), st.distance, 1e-12);
@@ -107,8 +106,8 @@ TEST(Distance, SegmentTriangleDistanceAgainstSampling) {
         EXPECT_GE(st.distance, best - 0.02);
     }
     // Piercing segment: distance 0 at the crossing point.
-    const SegmentTrianglePair p = closestPointsSegmentTriangle(
-        Vec3(0.2, 0.2, -1), Vec3(0.2, 0.2, 1), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0));
+    const SegmentTrianglePair p = closestPointsSegmentTriangle(Vec3(0.2, 0.2, -1), Vec3(0.2, 0.2, 1), Vec3(0, 0, 0),
+                                                               Vec3(1, 0, 0), Vec3(0, 1, 0));
     EXPECT_EQ(p.distance, 0);
     EXPECT_LT((p.onSegment - Vec3(0.2, 0.2, 0)).norm(), 1e-15);
 }

@@ -51,7 +51,8 @@ TEST(Ccd, EdgeEdgeTimeMatchesAnalyticCrossing) {
     // origin's neighbourhood: contact when z = 0, with α, β from where they cross.
     for (double h0 : {0.3, 1.0})
         for (double h1 : {-0.2, -2.0}) {
-            const std::array<Vec3, 4> x0 = {Vec3(-0.4, 0.1, h0), Vec3(0.6, 0.1, h0), Vec3(0.2, -0.5, 0), Vec3(0.2, 0.5, 0)};
+            const std::array<Vec3, 4> x0 = {Vec3(-0.4, 0.1, h0), Vec3(0.6, 0.1, h0), Vec3(0.2, -0.5, 0),
+                                            Vec3(0.2, 0.5, 0)};
             std::array<Vec3, 4> x1 = x0;
             x1[0].z() = x1[1].z() = h1;
             double t;
@@ -111,15 +112,18 @@ TEST(Ccd, DetectorEqualsBruteForceBetweenBodies) {
             x1[v] += Vec3(0.0005 * u(rng), 0.0005 * u(rng), -0.0015 - 0.001 * u(rng));
         std::vector<Collision> got;
         det.detect(x0, x1, 1e-9, got);
-        for (size_t i = 1; i < got.size(); ++i) EXPECT_LE(got[i - 1].t, got[i].t); // time order
+        for (size_t i = 1; i < got.size(); ++i)
+            EXPECT_LE(got[i - 1].t, got[i].t); // time order
         std::set<Key> a, b;
-        for (const Collision& c : got) a.insert({c.kind, c.v});
+        for (const Collision& c : got)
+            a.insert({c.kind, c.v});
         for (int32_t v : vmap)
             for (const auto& f : tris) {
                 if (body(v) == body(f[0])) continue;
                 double t;
                 Vec3 w;
-                if (vertexFaceCcd({x0[v], x0[f[0]], x0[f[1]], x0[f[2]]}, {x1[v], x1[f[0]], x1[f[1]], x1[f[2]]}, 1e-9, t, w))
+                if (vertexFaceCcd({x0[v], x0[f[0]], x0[f[1]], x0[f[2]]}, {x1[v], x1[f[0]], x1[f[1]], x1[f[2]]}, 1e-9, t,
+                                  w))
                     b.insert({CollisionKind::VertexFace, {v, f[0], f[1], f[2]}});
             }
         for (size_t i = 0; i < edges.size(); ++i)
@@ -139,13 +143,15 @@ TEST(Ccd, DetectorEqualsBruteForceBetweenBodies) {
             }
         // Every detected collision is a brute-force one; brute-force edge–edge pairs missing from the
         // detector must be (near-)parallel at contact, which the detector hands to vertex–face.
-        for (const Key& k : a) EXPECT_TRUE(b.count(k)) << "spurious collision";
+        for (const Key& k : a)
+            EXPECT_TRUE(b.count(k)) << "spurious collision";
         for (const Key& k : b) {
             if (a.count(k)) continue;
             ASSERT_EQ(k.kind, CollisionKind::EdgeEdge) << "vertex-face collision missed";
             const Vec3 d1 = x1[k.v[1]] - x1[k.v[0]], d2 = x1[k.v[3]] - x1[k.v[2]];
             const Vec3 c1 = x0[k.v[1]] - x0[k.v[0]], c2 = x0[k.v[3]] - x0[k.v[2]];
-            EXPECT_TRUE(d1.cross(d2).norm() < 1e-6 * d1.norm() * d2.norm() || c1.cross(c2).norm() < 1e-6 * c1.norm() * c2.norm())
+            EXPECT_TRUE(d1.cross(d2).norm() < 1e-6 * d1.norm() * d2.norm() ||
+                        c1.cross(c2).norm() < 1e-6 * c1.norm() * c2.norm())
                 << "edge-edge collision missed";
         }
         totalHits += static_cast<int>(a.size());
@@ -157,7 +163,8 @@ TEST(Ccd, SameBodyPairsSkippedUnlessSelfContact) {
     auto box = makeBoxTetMesh({Vec3(0, 0, 0), Vec3(0.01, 0.01, 0.004), {3, 3, 2}});
     box->requireLevel(3);
     std::vector<Vec3> x1 = box->positions();
-    for (Vec3& p : x1) if (p.z() > 0.003) p.z() -= 0.006; // the top falls through the bottom
+    for (Vec3& p : x1)
+        if (p.z() > 0.003) p.z() -= 0.006; // the top falls through the bottom
     std::vector<Collision> none, self;
     ContactDetector between(*box);
     between.detect(box->positions(), x1, 1e-9, none);

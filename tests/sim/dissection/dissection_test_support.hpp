@@ -12,15 +12,13 @@ namespace viscera::sim::dissection_test {
 /// Flat sheet in the plane z = 0, centred on the origin: nx × ny square cells of side size/n,
 /// two triangles each (2 nx ny triangles), counter-clockwise seen from +z. Border vertices listed
 /// in `border`.
-inline TriMesh makeSheet(int nx, int ny, double sizeX, double sizeY,
-                         std::vector<int32_t>* border = nullptr) {
+inline TriMesh makeSheet(int nx, int ny, double sizeX, double sizeY, std::vector<int32_t>* border = nullptr) {
     std::vector<Vec3> x;
     std::vector<Tri> t;
     for (int j = 0; j <= ny; ++j)
         for (int i = 0; i <= nx; ++i) {
             x.emplace_back(-0.5 * sizeX + sizeX * i / nx, -0.5 * sizeY + sizeY * j / ny, 0.0);
-            if (border && (i == 0 || j == 0 || i == nx || j == ny))
-                border->push_back(int32_t(x.size() - 1));
+            if (border && (i == 0 || j == 0 || i == nx || j == ny)) border->push_back(int32_t(x.size() - 1));
         }
     auto v = [&](int i, int j) { return int32_t(j * (nx + 1) + i); };
     for (int j = 0; j < ny; ++j)
@@ -45,8 +43,7 @@ struct FasciaScene {
     std::unique_ptr<Dissection> dissection;
 };
 
-inline FasciaScene makeFasciaScene(int threads = 1,
-                                   TissueDissectionParams tissue = fasciaDissectionDefaults(),
+inline FasciaScene makeFasciaScene(int threads = 1, TissueDissectionParams tissue = fasciaDissectionDefaults(),
                                    HeatGridSettings grid = {}) {
     FasciaScene s;
     std::vector<int32_t> border;
@@ -80,8 +77,7 @@ struct FatScene {
     std::unique_ptr<Dissection> dissection;
 };
 
-inline FatScene makeFatScene(int threads = 1,
-                             TissueDissectionParams tissue = fatDissectionDefaults()) {
+inline FatScene makeFatScene(int threads = 1, TissueDissectionParams tissue = fatDissectionDefaults()) {
     FatScene s;
     BoxSpec spec;
     spec.origin = Vec3(-0.025, -0.02, -0.02);
@@ -94,8 +90,7 @@ inline FatScene makeFatScene(int threads = 1,
     b.name = "fat";
     b.mesh = s.mesh.get();
     const double E = 3000, nu = 0.45;
-    b.model = std::make_shared<StableNeoHookeanModel>(E / (2 * (1 + nu)),
-                                                      E * nu / ((1 + nu) * (1 - 2 * nu)));
+    b.model = std::make_shared<StableNeoHookeanModel>(E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu)));
     b.density = 950;
     for (size_t i = 0; i < s.mesh->vertexCount(); ++i)
         if (s.mesh->positions()[i].z() < -0.02 + 1e-9) b.fixedNodes.push_back(int32_t(i));

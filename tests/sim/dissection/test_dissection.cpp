@@ -41,8 +41,8 @@ struct RunResult {
     std::vector<Vec3> cutMidpoints; ///< world midpoints of the cut edges when they were cut
 };
 
-RunResult runFascia(FasciaScene& s, const std::function<Vec3(int)>& centreAt, int frames,
-                    double radius = 1e-3, double temperature = 170.0) {
+RunResult runFascia(FasciaScene& s, const std::function<Vec3(int)>& centreAt, int frames, double radius = 1e-3,
+                    double temperature = 170.0) {
     RunResult r;
     const EdgeStructure& E = s.dissection->fasciaEdges();
     std::vector<uint8_t> seen(E.edgeCount(), 0);
@@ -86,8 +86,7 @@ RunResult runFascia(FasciaScene& s, const std::function<Vec3(int)>& centreAt, in
 bool cutFollowsPath(const RunResult& r, double margin, double reach) {
     const auto& path = r.path;
     for (size_t i = 0; i < path.size(); ++i) {
-        if ((path[i] - path.front()).norm() < margin || (path[i] - path.back()).norm() < margin)
-            continue;
+        if ((path[i] - path.front()).norm() < margin || (path[i] - path.back()).norm() < margin) continue;
         bool found = false;
         for (size_t k = 0; k < r.cutMidpoints.size() && !found; ++k)
             found = (r.cutMidpoints[k] - path[i]).norm() <= reach;
@@ -102,8 +101,7 @@ TEST(Dissection, EdgeAtToolTemperatureIgnitesAfterTheFramesOfEq511) {
     // Two triangles sharing edge (1, 2); the tool sphere encloses vertices 1 and 2 only.
     for (const double dt : {1.0 / 60.0, 1.0 / 120.0}) {
         const TriMesh m = TriMesh::fromArrays(
-            {Vec3(-5e-3, 0, 0), Vec3(0, -0.3e-3, 0), Vec3(0, 0.3e-3, 0), Vec3(5e-3, 0, 0)},
-            {{0, 1, 2}, {1, 3, 2}});
+            {Vec3(-5e-3, 0, 0), Vec3(0, -0.3e-3, 0), Vec3(0, 0.3e-3, 0), Vec3(5e-3, 0, 0)}, {{0, 1, 2}, {1, 3, 2}});
         XpbdSystemDesc d;
         SurfaceBodyDesc sd;
         sd.name = "fascia";
@@ -166,8 +164,7 @@ TEST(Dissection, AcceptanceStraightPathCutsAlongThePathOnly) {
     for (size_t t = 0; t < s.sheet.triangleCount(); ++t) {
         double d = 1;
         for (int k = 0; k < 3; ++k)
-            d = std::min(
-                d, distanceToPolyline(s.sheet.positions()[s.sheet.triangles()[t][k]], r.path));
+            d = std::min(d, distanceToPolyline(s.sheet.positions()[s.sheet.triangles()[t][k]], r.path));
         if (d > 3e-3) ASSERT_FALSE(E.isCut(t)) << t;
         EXPECT_EQ(s.system->triangleActive(0, t), !E.isCut(t));
     }
@@ -330,22 +327,14 @@ TEST(Dissection, BadInputNamesTheField) {
         }
         return std::string("no throw");
     };
-    EXPECT_THAT(
-        msg([&] {
-            s.dissection->update({Vec3(NAN, 0, 0), 1e-3, 170, true}, kDt);
-        }),
-        HasSubstr("sim::Dissection::update(): tool centre, radius or temperature is not finite"));
     EXPECT_THAT(msg([&] {
-                    s.dissection->update({Vec3::Zero(), -1, 170, true}, kDt);
+                    s.dissection->update({Vec3(NAN, 0, 0), 1e-3, 170, true}, kDt);
                 }),
-                HasSubstr("tool radius is -1"));
-    EXPECT_THAT(msg([&] {
-                    s.dissection->update({Vec3::Zero(), 1e-3, 170, true}, 0);
-                }),
-                HasSubstr("dt is 0"));
+                HasSubstr("sim::Dissection::update(): tool centre, radius or temperature is not finite"));
+    EXPECT_THAT(msg([&] { s.dissection->update({Vec3::Zero(), -1, 170, true}, kDt); }), HasSubstr("tool radius is -1"));
+    EXPECT_THAT(msg([&] { s.dissection->update({Vec3::Zero(), 1e-3, 170, true}, 0); }), HasSubstr("dt is 0"));
     DissectionDesc d;
-    EXPECT_THAT(msg([&] { Dissection::create(d); }),
-                HasSubstr("sim::Dissection::create(): system is null"));
+    EXPECT_THAT(msg([&] { Dissection::create(d); }), HasSubstr("sim::Dissection::create(): system is null"));
     d.system = s.system.get();
     EXPECT_THAT(msg([&] { Dissection::create(d); }), HasSubstr("no layer"));
     d.fascia = &s.sheet;
@@ -360,7 +349,6 @@ TEST(Dissection, BadInputNamesTheField) {
     const TriMesh other = makeSheet(3, 3, 0.01, 0.01);
     d.fasciaTissue = fasciaDissectionDefaults();
     d.fascia = &other;
-    EXPECT_THAT(msg([&] { Dissection::create(d); }),
-                HasSubstr("fascia: mesh has 16 vertices and 18 triangles"));
+    EXPECT_THAT(msg([&] { Dissection::create(d); }), HasSubstr("fascia: mesh has 16 vertices and 18 triangles"));
     EXPECT_THROW(s.dissection->fatEdges(), std::logic_error);
 }

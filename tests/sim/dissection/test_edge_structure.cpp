@@ -12,15 +12,13 @@ using ::testing::HasSubstr;
 
 namespace {
 
-template <class Prims>
-void expectMatchesBruteForce(const EdgeStructure& E, const Prims& prims, int perPrim) {
+template <class Prims> void expectMatchesBruteForce(const EdgeStructure& E, const Prims& prims, int perPrim) {
     // Brute force: every vertex pair of every primitive.
     std::map<std::pair<int32_t, int32_t>, std::set<int32_t>> ref;
     for (size_t p = 0; p < prims.size(); ++p)
         for (int a = 0; a < perPrim; ++a)
             for (int b = a + 1; b < perPrim; ++b) {
-                const int32_t u = std::min(prims[p][a], prims[p][b]),
-                              v = std::max(prims[p][a], prims[p][b]);
+                const int32_t u = std::min(prims[p][a], prims[p][b]), v = std::max(prims[p][a], prims[p][b]);
                 ref[{u, v}].insert(int32_t(p));
             }
     ASSERT_EQ(E.edgeCount(), ref.size());
@@ -121,12 +119,10 @@ TEST(EdgeStructure, BadInputNamesTheElement) {
         }
         return std::string("no throw");
     };
-    EXPECT_THAT(
-        msg([] {
-            EdgeStructure::fromTriangles({{0, 1, 9}}, 3);
-        }),
-        HasSubstr(
-            "sim::EdgeStructure::fromTriangles(): triangle 0 references vertex 9 (3 vertices)"));
+    EXPECT_THAT(msg([] {
+                    EdgeStructure::fromTriangles({{0, 1, 9}}, 3);
+                }),
+                HasSubstr("sim::EdgeStructure::fromTriangles(): triangle 0 references vertex 9 (3 vertices)"));
     EXPECT_THAT(msg([] {
                     EdgeStructure::fromTets({{0, 1, 2, 1}}, 4);
                 }),

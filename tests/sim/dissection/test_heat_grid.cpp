@@ -45,8 +45,7 @@ TEST(HeatGrid, OneSubstepMatchesTheFiniteDifferenceStencil) {
     const double h = g.stableSubstep(); // r = α h / dl² = 1/6
     EXPECT_EQ(g.advance({c, 0.1 * dl, T}, h), 1);
     const Vec3 o = g.origin();
-    const int ci = int(std::lround((c.x() - o.x()) / dl)),
-              cj = int(std::lround((c.y() - o.y()) / dl)),
+    const int ci = int(std::lround((c.x() - o.x()) / dl)), cj = int(std::lround((c.y() - o.y()) / dl)),
               ck = int(std::lround((c.z() - o.z()) / dl));
     EXPECT_EQ(ci, 5);
     const auto& u = g.values();
@@ -56,8 +55,7 @@ TEST(HeatGrid, OneSubstepMatchesTheFiniteDifferenceStencil) {
         for (int s : {-1, 1}) {
             int d[3] = {0, 0, 0};
             d[a] = s;
-            EXPECT_NEAR(u[node(g, ci + d[0], cj + d[1], ck + d[2])], body + (T - body) / 6.0,
-                        1e-12);
+            EXPECT_NEAR(u[node(g, ci + d[0], cj + d[1], ck + d[2])], body + (T - body) / 6.0, 1e-12);
         }
     EXPECT_DOUBLE_EQ(u[node(g, ci + 1, cj + 1, ck)], body);
     EXPECT_DOUBLE_EQ(u[node(g, ci + 1, cj + 1, ck + 1)], body);

@@ -15,8 +15,7 @@ using ::testing::HasSubstr;
 namespace {
 
 std::shared_ptr<StableNeoHookeanModel> snh(double E = 5000, double nu = 0.3) {
-    return std::make_shared<StableNeoHookeanModel>(E / (2 * (1 + nu)),
-                                                   E * nu / ((1 + nu) * (1 - 2 * nu)));
+    return std::make_shared<StableNeoHookeanModel>(E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu)));
 }
 
 XpbdSettings quiet(int threads = 1, bool simd = true) {
@@ -35,8 +34,8 @@ Mat3 someRotation() {
     return (Eigen::AngleAxisd(0.4, Vec3(1, 2, 3).normalized())).toRotationMatrix();
 }
 
-double edgeLengthError(const std::vector<Vec3>& x, const std::vector<Vec3>& rest,
-                       const std::vector<int32_t>& v, const Mat3& Fs) {
+double edgeLengthError(const std::vector<Vec3>& x, const std::vector<Vec3>& rest, const std::vector<int32_t>& v,
+                       const Mat3& Fs) {
     double worst = 0;
     for (size_t a = 0; a < v.size(); ++a)
         for (size_t b = a + 1; b < v.size(); ++b) {
@@ -51,8 +50,8 @@ double edgeLengthError(const std::vector<Vec3>& x, const std::vector<Vec3>& rest
 
 TEST(XpbdDissection, DeactivatedTetExertsNoForce) {
     for (bool simd : {true, false}) {
-        auto tet = TetMesh::fromArrays(
-            {Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0), Vec3(0, 0, 0.01)}, {{0, 1, 2, 3}});
+        auto tet =
+            TetMesh::fromArrays({Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0), Vec3(0, 0, 0.01)}, {{0, 1, 2, 3}});
         XpbdSystemDesc d;
         TetBodyDesc b;
         b.name = "t";
@@ -80,8 +79,7 @@ TEST(XpbdDissection, DeactivatedTetExertsNoForce) {
 }
 
 TEST(XpbdDissection, DeactivatedTriangleExertsNoForce) {
-    const TriMesh tri =
-        TriMesh::fromArrays({Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0)}, {{0, 1, 2}});
+    const TriMesh tri = TriMesh::fromArrays({Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0)}, {{0, 1, 2}});
     XpbdSystemDesc d;
     SurfaceBodyDesc s;
     s.name = "f";
@@ -108,8 +106,7 @@ TEST(XpbdDissection, ShrunkTetRestShapeIsReachedInEquilibrium) {
     const Mat3 Fs = R.transpose() * Vec3(0.5, 0.8, 1.0).asDiagonal() * R; // eq. 5.12
     for (bool simd : {true, false}) {
         auto tet = TetMesh::fromArrays(
-            {Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.002, 0.01, 0), Vec3(0.001, 0.002, 0.01)},
-            {{0, 1, 2, 3}});
+            {Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.002, 0.01, 0), Vec3(0.001, 0.002, 0.01)}, {{0, 1, 2, 3}});
         XpbdSystemDesc d;
         TetBodyDesc b;
         b.name = "t";
@@ -117,29 +114,24 @@ TEST(XpbdDissection, ShrunkTetRestShapeIsReachedInEquilibrium) {
         b.model = snh();
         d.tetBodies.push_back(b);
         auto sys = XpbdSystem::create(d, quiet(1, simd));
-        const double before =
-            edgeLengthError(sys->tetPositions(0), tet->positions(), {0, 1, 2, 3}, Fs);
+        const double before = edgeLengthError(sys->tetPositions(0), tet->positions(), {0, 1, 2, 3}, Fs);
         EXPECT_GT(before, 0.2);
         sys->setTetRestShape(0, 0, Fs);
         EXPECT_GT(sys->elasticEnergy(), 0); // the rest state is now strained
         for (int f = 0; f < 300; ++f)
             ASSERT_TRUE(sys->step().finite);
-        EXPECT_LT(edgeLengthError(sys->tetPositions(0), tet->positions(), {0, 1, 2, 3}, Fs), 1e-3)
-            << "simd " << simd;
+        EXPECT_LT(edgeLengthError(sys->tetPositions(0), tet->positions(), {0, 1, 2, 3}, Fs), 1e-3) << "simd " << simd;
         EXPECT_LT(sys->elasticEnergy(), 1e-9);
         // Fs = I restores the original rest shape.
         sys->setTetRestShape(0, 0, Mat3::Identity());
         for (int f = 0; f < 300; ++f)
             sys->step();
-        EXPECT_LT(
-            edgeLengthError(sys->tetPositions(0), tet->positions(), {0, 1, 2, 3}, Mat3::Identity()),
-            1e-3);
+        EXPECT_LT(edgeLengthError(sys->tetPositions(0), tet->positions(), {0, 1, 2, 3}, Mat3::Identity()), 1e-3);
     }
 }
 
 TEST(XpbdDissection, ShrunkTriangleRestShapeIsReachedInEquilibrium) {
-    const TriMesh tri =
-        TriMesh::fromArrays({Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.003, 0.01, 0)}, {{0, 1, 2}});
+    const TriMesh tri = TriMesh::fromArrays({Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.003, 0.01, 0)}, {{0, 1, 2}});
     XpbdSystemDesc d;
     SurfaceBodyDesc s;
     s.name = "f";
@@ -194,8 +186,7 @@ TEST(XpbdDissection, SwitchedSystemIsBitIdenticalAcrossThreadCounts) {
 TEST(XpbdDissection, StrainLimitsOfCutElementsAreOff) {
     // A triangle with a tight upper limit on ε_00: the limit holds the stretch while the triangle
     // is active and lets go when it is switched off.
-    const TriMesh tri =
-        TriMesh::fromArrays({Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0)}, {{0, 1, 2}});
+    const TriMesh tri = TriMesh::fromArrays({Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0)}, {{0, 1, 2}});
     XpbdSystemDesc d;
     SurfaceBodyDesc s;
     s.name = "f";
@@ -226,10 +217,9 @@ TEST(XpbdDissection, StrainLimitsOfCutElementsAreOff) {
 }
 
 TEST(XpbdDissection, BadRestShapeNamesTheElement) {
-    const TriMesh tri =
-        TriMesh::fromArrays({Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0)}, {{0, 1, 2}});
-    auto tet = TetMesh::fromArrays(
-        {Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0), Vec3(0, 0, 0.01)}, {{0, 1, 2, 3}});
+    const TriMesh tri = TriMesh::fromArrays({Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0)}, {{0, 1, 2}});
+    auto tet =
+        TetMesh::fromArrays({Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0), Vec3(0, 0, 0.01)}, {{0, 1, 2, 3}});
     XpbdSystemDesc d;
     SurfaceBodyDesc s;
     s.name = "f";
@@ -245,9 +235,7 @@ TEST(XpbdDissection, BadRestShapeNamesTheElement) {
         sys->setTetRestShape(0, 0, Mat3(Vec3(1, 1, -1).asDiagonal()));
         FAIL();
     } catch (const std::invalid_argument& e) {
-        EXPECT_THAT(
-            e.what(),
-            HasSubstr("sim::XpbdSystem::setTetRestShape(): tet body 0 ('t'), tet 0: det Fs = -1"));
+        EXPECT_THAT(e.what(), HasSubstr("sim::XpbdSystem::setTetRestShape(): tet body 0 ('t'), tet 0: det Fs = -1"));
     }
     try {
         sys->setTriangleRestShape(0, 0, Mat3(Vec3(1, 0, 1).asDiagonal())); // flattens the triangle

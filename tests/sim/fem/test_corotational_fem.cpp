@@ -28,21 +28,26 @@ Bar makeBar(std::array<int, 3> cells = {6, 2, 2}) {
     return b;
 }
 
-double maxAbs(const Eigen::VectorXd& v) { return v.size() ? v.cwiseAbs().maxCoeff() : 0.0; }
+double maxAbs(const Eigen::VectorXd& v) {
+    return v.size() ? v.cwiseAbs().maxCoeff() : 0.0;
+}
 
 Eigen::VectorXd displacement(const CorotationalFem& fem) {
     Eigen::VectorXd u(3 * fem.nodeCount());
-    for (size_t v = 0; v < fem.nodeCount(); ++v) u.segment<3>(3 * v) = fem.positions()[v] - fem.restPositions()[v];
+    for (size_t v = 0; v < fem.nodeCount(); ++v)
+        u.segment<3>(3 * v) = fem.positions()[v] - fem.restPositions()[v];
     return u;
 }
 
 /// Point constraint: the material point with barycentric coordinates w in tet t goes to target.
-ConstraintDesc pointConstraint(const TetMesh& m, int t, const Eigen::Vector4d& w, const Vec3& target, int priority = 0) {
+ConstraintDesc pointConstraint(const TetMesh& m, int t, const Eigen::Vector4d& w, const Vec3& target,
+                               int priority = 0) {
     ConstraintDesc d;
     d.priority = priority;
     for (int k = 0; k < 3; ++k) {
         ConstraintRow r;
-        for (int a = 0; a < 4; ++a) r.terms.push_back({m.tets()[t][a], w[a] * Vec3::Unit(k)});
+        for (int a = 0; a < 4; ++a)
+            r.terms.push_back({m.tets()[t][a], w[a] * Vec3::Unit(k)});
         r.b = target[k];
         d.rows.push_back(r);
     }
@@ -51,7 +56,8 @@ ConstraintDesc pointConstraint(const TetMesh& m, int t, const Eigen::Vector4d& w
 
 Vec3 materialPoint(const CorotationalFem& fem, const TetMesh& m, int t, const Eigen::Vector4d& w) {
     Vec3 p = Vec3::Zero();
-    for (int a = 0; a < 4; ++a) p += w[a] * fem.positions()[m.tets()[t][a]];
+    for (int a = 0; a < 4; ++a)
+        p += w[a] * fem.positions()[m.tets()[t][a]];
     return p;
 }
 
@@ -61,7 +67,8 @@ void fullKkt(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& f, con
     const int n = static_cast<int>(K.rows()), m = static_cast<int>(C.rows());
     std::vector<Eigen::Triplet<double>> t;
     for (int k = 0; k < K.outerSize(); ++k)
-        for (Eigen::SparseMatrix<double>::InnerIterator it(K, k); it; ++it) t.emplace_back(it.row(), it.col(), it.value());
+        for (Eigen::SparseMatrix<double>::InnerIterator it(K, k); it; ++it)
+            t.emplace_back(it.row(), it.col(), it.value());
     for (int r = 0; r < m; ++r)
         for (int c = 0; c < n; ++c)
             if (C(r, c) != 0) {
@@ -132,7 +139,8 @@ TEST(CorotationalFem, ConstraintsMatchFullKktSolve) {
             w /= w.sum();
             const int t = tet(rng);
             Vec3 rest = Vec3::Zero();
-            for (int a = 0; a < 4; ++a) rest += w[a] * m.positions()[m.tets()[t][a]];
+            for (int a = 0; a < 4; ++a)
+                rest += w[a] * m.positions()[m.tets()[t][a]];
             fem->addConstraint(pointConstraint(m, t, w, rest + 2e-3 * Vec3(d(rng), d(rng), d(rng))));
         }
         for (int k = 0; k < 4; ++k) { // single rows along random directions (contact-like)
@@ -180,7 +188,8 @@ TEST(CorotationalFem, RedundantAndIncompatibleRowsAreRejected) {
     const Eigen::Vector4d w = Eigen::Vector4d::Constant(0.25);
     const int t = static_cast<int>(m.tetCount()) - 5;
     Vec3 rest = Vec3::Zero();
-    for (int a = 0; a < 4; ++a) rest += 0.25 * m.positions()[m.tets()[t][a]];
+    for (int a = 0; a < 4; ++a)
+        rest += 0.25 * m.positions()[m.tets()[t][a]];
     const Vec3 target = rest + Vec3(0, 0, 1e-3);
     const int a = fem->addConstraint(pointConstraint(m, t, w, target, 0));
     ASSERT_TRUE(fem->solve().finite);
@@ -198,7 +207,8 @@ TEST(CorotationalFem, RedundantAndIncompatibleRowsAreRejected) {
     EXPECT_EQ(st.incompatible, 1); // only x disagrees
     EXPECT_EQ(st.redundant, 5);
     EXPECT_EQ(fem->state(clash).status[0], RowStatus::Incompatible);
-    for (size_t v = 0; v < alone.size(); ++v) EXPECT_LT((fem->positions()[v] - alone[v]).norm(), 1e-12);
+    for (size_t v = 0; v < alone.size(); ++v)
+        EXPECT_LT((fem->positions()[v] - alone[v]).norm(), 1e-12);
     // A row on fixed nodes only is a zero row: rejected, never singular.
     ConstraintDesc z;
     z.rows.push_back({{{bar.fixed[0], Vec3(1, 0, 0)}}, 5.0});
@@ -219,8 +229,10 @@ TEST(CorotationalFem, ConstraintsChangeWithoutRefactorization) {
     for (int k = 0; k < 20; ++k) {
         const int t = (k * 37) % static_cast<int>(m.tetCount());
         Vec3 rest = Vec3::Zero();
-        for (int a = 0; a < 4; ++a) rest += 0.25 * m.positions()[m.tets()[t][a]];
-        ids.push_back(fem->addConstraint(pointConstraint(m, t, Eigen::Vector4d::Constant(0.25), rest + Vec3(0, 0, 1e-4 * k))));
+        for (int a = 0; a < 4; ++a)
+            rest += 0.25 * m.positions()[m.tets()[t][a]];
+        ids.push_back(
+            fem->addConstraint(pointConstraint(m, t, Eigen::Vector4d::Constant(0.25), rest + Vec3(0, 0, 1e-4 * k))));
         const FemSolveStats st = fem->solve();
         ASSERT_TRUE(st.finite);
         if (k % 3 == 2) fem->removeConstraint(ids[k - 1]);
@@ -239,7 +251,8 @@ TEST(CorotationalFem, UnilateralGroupsReleaseAndActivate) {
     ASSERT_TRUE(fem->solve().finite);
     int tip = 0;
     for (int v = 0; v < static_cast<int>(m.vertexCount()); ++v)
-        if (m.positions()[v].x() > m.positions()[tip].x() - 1e-12 && m.positions()[v].z() <= m.positions()[tip].z()) tip = v;
+        if (m.positions()[v].x() > m.positions()[tip].x() - 1e-12 && m.positions()[v].z() <= m.positions()[tip].z())
+            tip = v;
     const double sag = m.positions()[tip].z() - fem->positions()[tip].z();
     ASSERT_GT(sag, 1e-6);
     // A floor half-way down the free sag: enforced, pushing (λ < 0 in K u + Cᵀλ = f).
@@ -269,11 +282,13 @@ TEST(CorotationalFem, BackgroundRefactorIsDeterministicAndOffThePath) {
         auto fem = CorotationalFem::create(*bar.mesh, bar.fixed, s, bar.gravity);
         const int t = static_cast<int>(bar.mesh->tetCount()) - 1;
         Vec3 rest = Vec3::Zero();
-        for (int a = 0; a < 4; ++a) rest += 0.25 * bar.mesh->positions()[bar.mesh->tets()[t][a]];
+        for (int a = 0; a < 4; ++a)
+            rest += 0.25 * bar.mesh->positions()[bar.mesh->tets()[t][a]];
         const int id = fem->addConstraint(pointConstraint(*bar.mesh, t, Eigen::Vector4d::Constant(0.25), rest));
         std::vector<int> refactorSteps;
         for (int k = 0; k < 40; ++k) {
-            for (int c = 0; c < 3; ++c) fem->setRhs(id, c, rest[c] + (c == 2 ? 1e-3 * k : 0.0));
+            for (int c = 0; c < 3; ++c)
+                fem->setRhs(id, c, rest[c] + (c == 2 ? 1e-3 * k : 0.0));
             const FemSolveStats st = fem->solve();
             EXPECT_TRUE(st.finite);
             EXPECT_TRUE(st.error.empty()) << st.error;
@@ -315,6 +330,7 @@ TEST(CorotationalFem, CreateRejectsBadInputWithMessages) {
     FemSettings s;
     s.poissonRatio = 0.5;
     expectMessage([&] { CorotationalFem::create(*bar.mesh, bar.fixed, s); }, "poisson_ratio 0.5 must be in [0, 0.5)");
-    expectMessage([&] { CorotationalFem::create(*bar.mesh, {99999}, FemSettings{}); }, "fixed node 99999 is out of range");
+    expectMessage([&] { CorotationalFem::create(*bar.mesh, {99999}, FemSettings{}); },
+                  "fixed node 99999 is out of range");
     expectMessage([&] { CorotationalFem::create(*bar.mesh, {}, FemSettings{}); }, "not positive definite");
 }

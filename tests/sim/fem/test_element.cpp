@@ -13,9 +13,11 @@ namespace {
 std::array<Vec3, 4> randomTet(std::mt19937& rng) {
     std::uniform_real_distribution<double> u(-0.3, 0.3);
     std::array<Vec3, 4> x = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
-    for (auto& p : x) p = 0.01 * (p + Vec3(u(rng), u(rng), u(rng)));
+    for (auto& p : x)
+        p = 0.01 * (p + Vec3(u(rng), u(rng), u(rng)));
     Mat3 dm;
-    for (int k = 0; k < 3; ++k) dm.col(k) = x[k + 1] - x[0];
+    for (int k = 0; k < 3; ++k)
+        dm.col(k) = x[k + 1] - x[0];
     if (dm.determinant() < 0) std::swap(x[1], x[2]);
     return x;
 }
@@ -49,7 +51,8 @@ TEST(FemElement, StiffnessIsEnergyHessianByFiniteDifferences) {
                 EXPECT_LT((H - e.stiffness).cwiseAbs().maxCoeff(), 1e-6 * scale) << "E " << E << " nu " << nu;
                 // Rigid translations produce no force.
                 Vec12 t;
-                for (int a = 0; a < 4; ++a) t.segment<3>(3 * a) = Vec3(0.3, -0.2, 0.7);
+                for (int a = 0; a < 4; ++a)
+                    t.segment<3>(3 * a) = Vec3(0.3, -0.2, 0.7);
                 EXPECT_LT((e.stiffness * t).norm(), 1e-9 * scale);
             }
 }
@@ -69,13 +72,16 @@ TEST(FemElement, PolarRotationRecoversTheRotation) {
     const LinearTet e = makeLinearTet(x0, 1e4, 2e4);
     const Mat3 R = Eigen::AngleAxisd(1.1, Vec3(1, 2, 3).normalized()).toRotationMatrix();
     std::array<Vec3, 4> x;
-    for (int a = 0; a < 4; ++a) x[a] = R * x0[a] + Vec3(0.1, 0.2, 0.3);
+    for (int a = 0; a < 4; ++a)
+        x[a] = R * x0[a] + Vec3(0.1, 0.2, 0.3);
     const Mat3 Re = elementRotation(deformationGradient(e, x));
     EXPECT_LT((Re - R).norm(), 1e-10);
     Vec12 d;
-    for (int a = 0; a < 4; ++a) d.segment<3>(3 * a) = Re.transpose() * x[a] - x0[a];
+    for (int a = 0; a < 4; ++a)
+        d.segment<3>(3 * a) = Re.transpose() * x[a] - x0[a];
     Vec12 dc = d;
-    for (int a = 0; a < 4; ++a) dc.segment<3>(3 * a) -= d.segment<3>(0); // remove the translation
+    for (int a = 0; a < 4; ++a)
+        dc.segment<3>(3 * a) -= d.segment<3>(0); // remove the translation
     EXPECT_LT((e.stiffness * d).norm(), 1e-9 * e.stiffness.norm() * 1e-2);
     EXPECT_EQ(elementRotation(Mat3::Constant(std::numeric_limits<double>::quiet_NaN())), Mat3::Identity());
     EXPECT_THROW(makeLinearTet({x0[0], x0[2], x0[1], x0[3]}, 1, 1), std::invalid_argument);

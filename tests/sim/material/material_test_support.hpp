@@ -27,8 +27,7 @@ inline std::vector<Lame> lameSweep() {
     std::vector<Lame> out;
     for (double E : {1e3, 3e4, 1e6})
         for (double nu : {0.3, 0.45, 0.49, 0.499})
-            out.push_back(
-                {E, nu, E / (2.0 * (1.0 + nu)), E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))});
+            out.push_back({E, nu, E / (2.0 * (1.0 + nu)), E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))});
     return out;
 }
 
@@ -58,8 +57,7 @@ inline std::vector<FSample> sampleDeformations(int perKind, unsigned seed) {
     const auto diagStretch = [&](double lo, double hi) {
         Mat3 F;
         do {
-            const Eigen::Vector3d s(lo + (hi - lo) * u(rng), lo + (hi - lo) * u(rng),
-                                    lo + (hi - lo) * u(rng));
+            const Eigen::Vector3d s(lo + (hi - lo) * u(rng), lo + (hi - lo) * u(rng), lo + (hi - lo) * u(rng));
             F = randomRotation(rng) * s.asDiagonal() * randomRotation(rng).transpose();
         } while (!wellSeparated(F));
         return F;
@@ -125,11 +123,9 @@ inline double relativeGradientError(const Mat3& analytic, const Mat3& fd, double
 /// f′(1) + 2g′(1) + h′(1) = 200 + 2·100 − 400 = 0.
 inline ValanisLandelCurves authoredTissueCurves() {
     ValanisLandelCurves c;
-    c.fPrime =
-        MonotoneCurve("f'", {{0.2, -3000}, {0.6, -600}, {1.0, 200}, {1.3, 1500}, {2.0, 12000}});
+    c.fPrime = MonotoneCurve("f'", {{0.2, -3000}, {0.6, -600}, {1.0, 200}, {1.3, 1500}, {2.0, 12000}});
     c.gPrime = MonotoneCurve("g'", {{0.1, -500}, {1.0, 100}, {3.0, 1500}});
-    c.hPrime =
-        MonotoneCurve("h'", {{0.05, -60000}, {0.5, -6000}, {1.0, -400}, {2.0, 2000}, {8.0, 6000}});
+    c.hPrime = MonotoneCurve("h'", {{0.05, -60000}, {0.5, -6000}, {1.0, -400}, {2.0, 2000}, {8.0, 6000}});
     return c;
 }
 
@@ -148,10 +144,9 @@ inline std::vector<NamedDensity> allDensities(double mu, double lambda) {
     out.push_back({"corotated", std::make_shared<CorotatedLinearDensity>(mu, lambda)});
     out.push_back({"neo_hookean", std::make_shared<NeoHookeanDensity>(mu, lambda)});
     for (const char* law : {"st_venant_kirchhoff", "corotated", "neo_hookean"})
-        out.push_back({std::string("vl_") + law, std::make_shared<ValanisLandelDensity>(
-                                                     law, valanisLandelCurves(law, mu, lambda))});
-    out.push_back({"vl_authored_tissue",
-                   std::make_shared<ValanisLandelDensity>("tissue", authoredTissueCurves())});
+        out.push_back({std::string("vl_") + law,
+                       std::make_shared<ValanisLandelDensity>(law, valanisLandelCurves(law, mu, lambda))});
+    out.push_back({"vl_authored_tissue", std::make_shared<ValanisLandelDensity>("tissue", authoredTissueCurves())});
     return out;
 }
 

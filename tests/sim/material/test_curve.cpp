@@ -91,8 +91,7 @@ TEST(MonotoneCurve, StrictlyIncreasingDataGivesAMonotoneCurve) {
 
 TEST(MonotoneCurve, FilterIsWhatKeepsStepDataMonotone) {
     // A step: flat, jump, flat. Plain 4th-order Hermite overshoots; the filtered curve does not.
-    const std::vector<CurvePoint> step{{0, 0},  {1, 0.001},  {2, 0.002},
-                                       {3, 10}, {4, 10.001}, {5, 10.002}};
+    const std::vector<CurvePoint> step{{0, 0}, {1, 0.001}, {2, 0.002}, {3, 10}, {4, 10.001}, {5, 10.002}};
     MonotoneCurve mono("f'", step);
     MonotoneCurve plain("f'", step, CurveShape::Unconstrained);
     double minSlopeMono = 1e300, minSlopePlain = 1e300;
@@ -160,8 +159,7 @@ TEST(MonotoneCurve, LinearExtrapolationIsC1AtBothEnds) {
         EXPECT_NEAR(c.value(xn + d), yn + mn * d, 1e-9 * (std::abs(yn) + mn * d));
         EXPECT_DOUBLE_EQ(c.derivative(x0 - d), m0);
         EXPECT_DOUBLE_EQ(c.derivative(xn + d), mn);
-        EXPECT_NEAR(c.integral(x0 - d, x0), d * y0 - 0.5 * m0 * d * d,
-                    1e-12 * (std::abs(d * y0) + m0 * d * d));
+        EXPECT_NEAR(c.integral(x0 - d, x0), d * y0 - 0.5 * m0 * d * d, 1e-12 * (std::abs(d * y0) + m0 * d * d));
     }
     EXPECT_GT(m0, 0.0);
     EXPECT_GT(mn, 0.0);
@@ -171,12 +169,9 @@ TEST(MonotoneCurve, LinearExtrapolationIsC1AtBothEnds) {
 
 TEST(MonotoneCurve, ReproducesCubicsExactlyInsideTheRange) {
     const auto cubic = [](double x) { return 2.0 * x * x * x - 3.0 * x + 0.5; };
-    auto c = MonotoneCurve::fit("f'", cubic,
-                                {.xmin = -2,
-                                 .xmax = 2,
-                                 .count = 9,
-                                 .spacing = CurveSpacing::Uniform,
-                                 .shape = CurveShape::Unconstrained});
+    auto c = MonotoneCurve::fit(
+        "f'", cubic,
+        {.xmin = -2, .xmax = 2, .count = 9, .spacing = CurveSpacing::Uniform, .shape = CurveShape::Unconstrained});
     double worst = 0;
     for (int s = 0; s <= 400; ++s) {
         const double x = -2 + 4.0 * s / 400;
@@ -222,10 +217,8 @@ TEST(MonotoneCurve, FitRejectsBadSpecsAndNonIncreasingSamples) {
     const auto id = [](double x) { return x; };
     EXPECT_THROW(MonotoneCurve::fit("f'", id, {.xmin = 0, .xmax = 1, .count = 5}),
                  std::invalid_argument); // geometric needs xmin > 0
-    EXPECT_THROW(MonotoneCurve::fit("f'", id, {.xmin = 1, .xmax = 1, .count = 5}),
-                 std::invalid_argument);
-    EXPECT_THROW(MonotoneCurve::fit("f'", id, {.xmin = 1, .xmax = 2, .count = 1}),
-                 std::invalid_argument);
+    EXPECT_THROW(MonotoneCurve::fit("f'", id, {.xmin = 1, .xmax = 1, .count = 5}), std::invalid_argument);
+    EXPECT_THROW(MonotoneCurve::fit("f'", id, {.xmin = 1, .xmax = 2, .count = 1}), std::invalid_argument);
     const std::string msg = messageOf([] {
         MonotoneCurve::fit("h'", [](double x) { return -x; },
                            {.xmin = 1, .xmax = 2, .count = 3, .spacing = CurveSpacing::Uniform});
@@ -241,9 +234,7 @@ TEST(MonotoneCurve, FitRejectsBadSpecsAndNonIncreasingSamples) {
 
 TEST(MonotoneCurve, RejectionMessagesNameTheCurveAndThePoint) {
     const std::vector<CurvePoint> bad{{0.5, -3}, {0.8, -1}, {1.0, 0.7}, {1.2, 0.5}, {1.5, 2}};
-    EXPECT_EQ(messageOf([&] {
-                  MonotoneCurve("h'", bad, CurveShape::StrictlyIncreasing, "material 'liver'");
-              }),
+    EXPECT_EQ(messageOf([&] { MonotoneCurve("h'", bad, CurveShape::StrictlyIncreasing, "material 'liver'"); }),
               "material 'liver': curve h': control point 3 (x=1.2, y=0.5) does not increase over "
               "point 2 (y=0.7)");
     EXPECT_THROW(MonotoneCurve("h'", bad), viscera::InputError);
@@ -257,10 +248,7 @@ TEST(MonotoneCurve, RejectionMessagesNameTheCurveAndThePoint) {
                   MonotoneCurve("g'", {{1, 0}, {2, INFINITY}});
               }),
               "curve g': control point 1 (x=2, y=inf) is not finite");
-    EXPECT_EQ(messageOf([] {
-                  MonotoneCurve("g'", {{1, 0}});
-              }),
-              "curve g': needs at least 2 control points (has 1)");
+    EXPECT_EQ(messageOf([] { MonotoneCurve("g'", {{1, 0}}); }), "curve g': needs at least 2 control points (has 1)");
 }
 
 TEST(MonotoneCurve, EditsValidateAndLeaveTheCurveUnchangedOnFailure) {
@@ -290,7 +278,6 @@ TEST(MonotoneCurve, EditsValidateAndLeaveTheCurveUnchangedOnFailure) {
     EXPECT_EQ(c.size(), toeCurve().size());
     EXPECT_THROW(c.removeControlPoint(42), std::out_of_range);
     MonotoneCurve two("g'", {{0, 0}, {1, 1}});
-    EXPECT_EQ(messageOf([&] { two.removeControlPoint(0); }),
-              "curve g': needs at least 2 control points (has 1)");
+    EXPECT_EQ(messageOf([&] { two.removeControlPoint(0); }), "curve g': needs at least 2 control points (has 1)");
     EXPECT_EQ(two.size(), 2u);
 }

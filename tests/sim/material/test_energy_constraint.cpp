@@ -76,8 +76,7 @@ TEST(EnergyConstraint, ModelEnergyAndGradientAreTheDensity) {
                 EXPECT_NEAR(0.5 * v.C[0] * v.C[0], psi, 1e-12 * psi);
                 EXPECT_NEAR(model.energyDensity(s.F), psi, 1e-12 * psi);
                 const Mat3 P = d.density->stress(s.F);
-                EXPECT_LT((model.energyDensityGradient(s.F) - P).norm(), 1e-12 * P.norm())
-                    << d.label;
+                EXPECT_LT((model.energyDensityGradient(s.F) - P).norm(), 1e-12 * P.norm()) << d.label;
             }
         }
 }
@@ -104,8 +103,7 @@ TEST(EnergyConstraint, RestReportsZeroConstraintAndGradient) {
 
 TEST(EnergyConstraint, InvertedElementsGiveFiniteConstraints) {
     const std::vector<Mat3> Fs{Eigen::Vector3d(1, 1, -1).asDiagonal(), Mat3::Zero(),
-                               Eigen::Vector3d(2, 0.5, -0.01).asDiagonal(),
-                               Eigen::Vector3d(1, 1, 0).asDiagonal()};
+                               Eigen::Vector3d(2, 0.5, -0.01).asDiagonal(), Eigen::Vector3d(1, 1, 0).asDiagonal()};
     for (const Lame& m : lameSweep())
         for (const auto& d : allDensities(m.mu, m.lambda)) {
             const EnergyConstraintModel model(d.density);

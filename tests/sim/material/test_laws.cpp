@@ -32,15 +32,12 @@ TEST(Laws, TableValuesForUniaxialStretch) {
     EXPECT_DOUBLE_EQ(LinearElasticDensity(mu, lambda).psi(F), mu + lambda / 2);
     EXPECT_DOUBLE_EQ(StVenantKirchhoffDensity(mu, lambda).psi(F), 2.25 * mu + 1.125 * lambda);
     EXPECT_NEAR(CorotatedLinearDensity(mu, lambda).psi(F), mu + lambda / 2, 1e-14);
-    EXPECT_NEAR(NeoHookeanDensity(mu, lambda).psi(F), 1.5 * mu - mu * l2 + lambda / 2 * l2 * l2,
-                1e-14);
+    EXPECT_NEAR(NeoHookeanDensity(mu, lambda).psi(F), 1.5 * mu - mu * l2 + lambda / 2 * l2 * l2, 1e-14);
     // Stresses: P11 of each law.
     EXPECT_DOUBLE_EQ(LinearElasticDensity(mu, lambda).stress(F)(0, 0), 2 * mu + lambda);
-    EXPECT_DOUBLE_EQ(StVenantKirchhoffDensity(mu, lambda).stress(F)(0, 0),
-                     2 * (3 * mu + 1.5 * lambda));
+    EXPECT_DOUBLE_EQ(StVenantKirchhoffDensity(mu, lambda).stress(F)(0, 0), 2 * (3 * mu + 1.5 * lambda));
     EXPECT_NEAR(CorotatedLinearDensity(mu, lambda).stress(F)(0, 0), 2 * mu + lambda, 1e-14);
-    EXPECT_NEAR(NeoHookeanDensity(mu, lambda).stress(F)(0, 0), mu * (2 - 0.5) + lambda * l2 * 0.5,
-                1e-14);
+    EXPECT_NEAR(NeoHookeanDensity(mu, lambda).stress(F)(0, 0), mu * (2 - 0.5) + lambda * l2 * 0.5, 1e-14);
     EXPECT_NEAR(NeoHookeanDensity(mu, lambda).stress(F)(1, 1), lambda * l2, 1e-14);
 }
 
@@ -52,9 +49,7 @@ TEST(Laws, RestStateHasZeroEnergyAndStress) {
             worstPsi = std::max(worstPsi, std::abs(d.density->psi(Mat3::Identity())) / scale);
             worstP = std::max(worstP, d.density->stress(Mat3::Identity()).norm() / scale);
             if (d.label != "vl_authored_tissue") { // VL moduli: 4th-order curve slopes
-                EXPECT_NEAR(d.density->restStiffness(), m.lambda + 2 * m.mu,
-                            1e-7 * (m.lambda + 2 * m.mu))
-                    << d.label;
+                EXPECT_NEAR(d.density->restStiffness(), m.lambda + 2 * m.mu, 1e-7 * (m.lambda + 2 * m.mu)) << d.label;
             }
         }
     EXPECT_EQ(worstPsi, 0.0);
@@ -70,13 +65,11 @@ TEST(Laws, StressMatchesCentralDifferencesOverParameterSweep) {
         for (const auto& d : allDensities(m.mu, m.lambda))
             for (const auto& s : samples) {
                 const Mat3 P = d.density->stress(s.F);
-                const Mat3 fd =
-                    centralDifference([&](const Mat3& F) { return d.density->psi(F); }, s.F);
+                const Mat3 fd = centralDifference([&](const Mat3& F) { return d.density->psi(F); }, s.F);
                 const double err = relativeGradientError(P, fd, d.density->restStiffness());
                 worst[d.label] = std::max(worst[d.label], err);
-                EXPECT_LT(err, 1e-6)
-                    << d.label << " E=" << m.youngs << " nu=" << m.poisson << " " << s.kind << "\n"
-                    << s.F;
+                EXPECT_LT(err, 1e-6) << d.label << " E=" << m.youngs << " nu=" << m.poisson << " " << s.kind << "\n"
+                                     << s.F;
                 ++cases;
             }
     EXPECT_EQ(cases, 12 * 8 * 48);
@@ -139,9 +132,7 @@ TEST(Laws, InversionIsPenalizedExceptByStVenantKirchhoff) {
     // Ψ(diag(1, 1, t)) for t from 0.5 down through 0 to −1.
     for (const Lame& m : lameSweep())
         for (const auto& d : allDensities(m.mu, m.lambda)) {
-            const auto psiAt = [&](double t) {
-                return d.density->psi(Mat3(Eigen::Vector3d(1, 1, t).asDiagonal()));
-            };
+            const auto psiAt = [&](double t) { return d.density->psi(Mat3(Eigen::Vector3d(1, 1, t).asDiagonal())); };
             if (d.label == "st_venant_kirchhoff" || d.label == "vl_st_venant_kirchhoff") {
                 // Inversion-blind: the same energy for t and −t.
                 for (double t : {0.1, 0.5, 0.9})
@@ -161,12 +152,8 @@ TEST(Laws, InversionIsPenalizedExceptByStVenantKirchhoff) {
 TEST(Laws, NeoHookeanLogExtensionIsC2AtJMin) {
     const double mu = 1e4, lambda = 2e5;
     NeoHookeanDensity nh(mu, lambda, 0.05);
-    const auto psiAt = [&](double t) {
-        return nh.psi(Mat3(Eigen::Vector3d(1, 1, t).asDiagonal()));
-    };
-    const auto p33 = [&](double t) {
-        return nh.stress(Mat3(Eigen::Vector3d(1, 1, t).asDiagonal()))(2, 2);
-    };
+    const auto psiAt = [&](double t) { return nh.psi(Mat3(Eigen::Vector3d(1, 1, t).asDiagonal())); };
+    const auto p33 = [&](double t) { return nh.stress(Mat3(Eigen::Vector3d(1, 1, t).asDiagonal()))(2, 2); };
     // C0 of Ψ and P33 across J = jMin: the change over [j − e, j + e] is slope · 2e, no jump.
     const double e = 1e-7, j = 0.05;
     const double dP = (p33(j + 1e-4) - p33(j - 1e-4)) / 2e-4; // ≈ μ + φ″(jMin)
@@ -216,14 +203,12 @@ TEST(Laws, ValanisLandelFormsMatchTheAnalyticLaws) {
         const ValanisLandelDensity vlStvk("stvk", stVenantKirchhoffCurves(m.mu, m.lambda));
         const ValanisLandelDensity vlCorot("corot", corotatedCurves(m.mu, m.lambda));
         for (const auto& s : samples) {
-            const std::pair<const EnergyDensity*, const EnergyDensity*> pairs[] = {
-                {&stvk, &vlStvk}, {&corot, &vlCorot}};
+            const std::pair<const EnergyDensity*, const EnergyDensity*> pairs[] = {{&stvk, &vlStvk},
+                                                                                   {&corot, &vlCorot}};
             for (const auto& [a, b] : pairs) {
                 const double scale = m.mu + m.lambda;
-                const double ePsi =
-                    std::abs(a->psi(s.F) - b->psi(s.F)) / std::max(scale, std::abs(a->psi(s.F)));
-                const double eP = (a->stress(s.F) - b->stress(s.F)).norm() /
-                                  std::max(scale, a->stress(s.F).norm());
+                const double ePsi = std::abs(a->psi(s.F) - b->psi(s.F)) / std::max(scale, std::abs(a->psi(s.F)));
+                const double eP = (a->stress(s.F) - b->stress(s.F)).norm() / std::max(scale, a->stress(s.F).norm());
                 worst = std::max({worst, ePsi, eP});
                 EXPECT_LT(ePsi, 1e-11) << a->name() << " " << s.kind;
                 EXPECT_LT(eP, 1e-11) << a->name() << " " << s.kind;

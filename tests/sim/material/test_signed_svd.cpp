@@ -74,8 +74,7 @@ std::vector<Case> degenerateCases() {
         {"uniform compression", 0.01 * Mat3::Identity()},
         {"permutation odd", (Mat3() << 0, 1, 0, 1, 0, 0, 0, 0, 1).finished(), true},
         {"permutation even", (Mat3() << 0, 1, 0, 0, 0, 1, 1, 0, 0).finished()},
-        {"rank 1 outer", Eigen::Vector3d(1, -2, 0.5) * Eigen::Vector3d(0.3, 0.2, -1).transpose(),
-         true},
+        {"rank 1 outer", Eigen::Vector3d(1, -2, 0.5) * Eigen::Vector3d(0.3, 0.2, -1).transpose(), true},
     };
     const std::vector<std::pair<std::string, Eigen::Vector3d>> spectra{
         {"isotropic", {1.3, 1.3, 1.3}},
@@ -101,10 +100,8 @@ std::vector<Case> degenerateCases() {
     };
     for (const auto& [label, s] : spectra)
         for (int k = 0; k < 4; ++k)
-            out.push_back({"rotated " + label,
-                           randomRotation(rng) * s.asDiagonal() * randomRotation(rng).transpose(),
-                           (s(2) < 0 && std::abs(std::abs(s(2)) - s(1)) < 1e-6 * s(1)) ||
-                               s(1) == 0});
+            out.push_back({"rotated " + label, randomRotation(rng) * s.asDiagonal() * randomRotation(rng).transpose(),
+                           (s(2) < 0 && std::abs(std::abs(s(2)) - s(1)) < 1e-6 * s(1)) || s(1) == 0});
     for (double eps : {1e-4, 1e-8, 1e-12, 1e-15})
         for (int k = 0; k < 4; ++k)
             out.push_back({"near identity " + sci(eps), Mat3(Mat3::Identity() + eps * gaussian())});
@@ -122,8 +119,7 @@ std::vector<Mat3> randomSweep(int count, unsigned seed) {
     std::uniform_real_distribution<double> logS(-3.0, 2.0);
     std::vector<Mat3> out;
     for (int i = 0; i < count; ++i) {
-        Eigen::Vector3d s(std::pow(10.0, logS(rng)), std::pow(10.0, logS(rng)),
-                          std::pow(10.0, logS(rng)));
+        Eigen::Vector3d s(std::pow(10.0, logS(rng)), std::pow(10.0, logS(rng)), std::pow(10.0, logS(rng)));
         if (i % 4 == 3) s(2) = -s(2);
         out.push_back(randomRotation(rng) * s.asDiagonal() * randomRotation(rng).transpose());
     }
@@ -182,8 +178,7 @@ TEST(SignedSvd, ScalesExactlyWithF) {
     // Outside [2^-60, 2^60] F is rescaled by a power of two (exact): σ(cF) = c σ(F) to rounding.
     std::mt19937 rng(5);
     for (int k = 0; k < 20; ++k) {
-        const Mat3 F =
-            randomRotation(rng) * Eigen::Vector3d(1.7, 0.6, -0.2).asDiagonal() * randomRotation(rng);
+        const Mat3 F = randomRotation(rng) * Eigen::Vector3d(1.7, 0.6, -0.2).asDiagonal() * randomRotation(rng);
         const Eigen::Vector3d s = signedSvd(F).sigma;
         for (double c : {1e-300, 1e-200, 1e-30, 1e30, 1e200, 1e300}) {
             const std::string label = "scale " + sci(c);
@@ -220,8 +215,7 @@ TEST(SignedSvd, ValanisLandelMatchesTheJacobiReferenceOnDegenerateStates) {
         for (const auto& vl : presets)
             for (const Case& c : cases) {
                 const Eigen::Vector3d sigma = jacobiSignedSvd(c.F).sigma;
-                const double conditioning =
-                    std::min(1e4, sigma(0) / std::max(std::abs(sigma(2)), 1e-300));
+                const double conditioning = std::min(1e4, sigma(0) / std::max(std::abs(sigma(2)), 1e-300));
                 const double tol = 1e-13 * std::max(100.0, conditioning);
                 Mat3 Pref;
                 const double psiRef = referencePsi(vl, c.F, &Pref);
@@ -248,9 +242,8 @@ TEST(SignedSvd, ValanisLandelStressIsContinuousAcrossRepeatedSingularValues) {
     std::mt19937 rng(8);
     for (int k = 0; k < 10; ++k) {
         const Mat3 R = randomRotation(rng), S = randomRotation(rng);
-        for (const Eigen::Vector3d& base :
-             {Eigen::Vector3d(1.3, 1.3, 0.7), Eigen::Vector3d(1.4, 0.8, 0.8),
-              Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(0.6, 0.6, 0.6)}) {
+        for (const Eigen::Vector3d& base : {Eigen::Vector3d(1.3, 1.3, 0.7), Eigen::Vector3d(1.4, 0.8, 0.8),
+                                            Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(0.6, 0.6, 0.6)}) {
             const Mat3 P0 = vl.stress(R * base.asDiagonal() * S.transpose());
             const auto change = [&](double d) {
                 const Eigen::Vector3d s = base + Eigen::Vector3d(0, d, -d);

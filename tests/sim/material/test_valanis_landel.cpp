@@ -46,8 +46,7 @@ TEST(SignedSvd, ProperRotationsAndSignedSmallestStretch) {
         const SignedSvd s = signedSvd(F);
         EXPECT_NEAR(s.U.determinant(), 1.0, 1e-12);
         EXPECT_NEAR(s.V.determinant(), 1.0, 1e-12);
-        EXPECT_LT((s.U * s.sigma.asDiagonal() * s.V.transpose() - F).norm(),
-                  1e-12 * (1 + F.norm()));
+        EXPECT_LT((s.U * s.sigma.asDiagonal() * s.V.transpose() - F).norm(), 1e-12 * (1 + F.norm()));
         EXPECT_GE(s.sigma(0), s.sigma(1));
         EXPECT_GE(s.sigma(1), std::abs(s.sigma(2)));
         if (std::abs(F.determinant()) > 1e-12) {
@@ -60,8 +59,7 @@ TEST(SignedSvd, ProperRotationsAndSignedSmallestStretch) {
 TEST(ValanisLandel, NeoHookeanPresetMatchesAnalyticNeoHookean) {
     // Acceptance: principal stretches over [0.3, 3]³ (J from 0.027 to 27), random rotations,
     // every Lamé pair of the sweep; error relative to max(μ + λ, |value|).
-    const std::vector<double> grid{0.3,  0.37, 0.45, 0.55, 0.68, 0.82, 1.0,
-                                   1.15, 1.35, 1.6,  1.9,  2.2,  2.6,  3.0};
+    const std::vector<double> grid{0.3, 0.37, 0.45, 0.55, 0.68, 0.82, 1.0, 1.15, 1.35, 1.6, 1.9, 2.2, 2.6, 3.0};
     std::mt19937 rng(4);
     double worstPsi = 0, worstP = 0;
     int cases = 0;
@@ -71,8 +69,8 @@ TEST(ValanisLandel, NeoHookeanPresetMatchesAnalyticNeoHookean) {
         for (double a : grid)
             for (double b : grid)
                 for (double c : grid) {
-                    const Mat3 F = randomRotation(rng) * Eigen::Vector3d(a, b, c).asDiagonal() *
-                                   randomRotation(rng).transpose();
+                    const Mat3 F =
+                        randomRotation(rng) * Eigen::Vector3d(a, b, c).asDiagonal() * randomRotation(rng).transpose();
                     const double psi = nhPsi(F, m.mu, m.lambda);
                     const Mat3 P = nhStress(F, m.mu, m.lambda);
                     const double ePsi = std::abs(vl.psi(F) - psi) / std::max(scale, std::abs(psi));
@@ -99,10 +97,8 @@ TEST(ValanisLandel, NeoHookeanPresetMatchesTheAnalyticLawThroughInversion) {
         const double scale = m.mu + m.lambda;
         for (double t = 0.05; t >= -1.0; t -= 0.01) {
             const Mat3 F = Eigen::Vector3d(1.3, 0.9, t).asDiagonal();
-            const double e1 =
-                std::abs(vl.psi(F) - law.psi(F)) / std::max(scale, std::abs(law.psi(F)));
-            const double e2 =
-                (vl.stress(F) - law.stress(F)).norm() / std::max(scale, law.stress(F).norm());
+            const double e1 = std::abs(vl.psi(F) - law.psi(F)) / std::max(scale, std::abs(law.psi(F)));
+            const double e2 = (vl.stress(F) - law.stress(F)).norm() / std::max(scale, law.stress(F).norm());
             worst = std::max({worst, e1, e2});
         }
     }
@@ -127,8 +123,7 @@ TEST(ValanisLandel, NeoHookeanPresetCurvesAndModuli) {
         EXPECT_NEAR(vl.restStiffness(), m.lambda + 2 * m.mu, 1e-7 * (m.mu + m.lambda));
     }
     // Below the peak the same preset is a strictly increasing (authorable) curve.
-    const auto narrow =
-        neoHookeanCurves(1000, 1000, {.volumeMin = 0.05, .volumeMax = 5.0, .volumeCount = 301});
+    const auto narrow = neoHookeanCurves(1000, 1000, {.volumeMin = 0.05, .volumeMax = 5.0, .volumeCount = 301});
     EXPECT_EQ(narrow.hPrime->shape(), CurveShape::StrictlyIncreasing);
     EXPECT_EQ(neoHookeanCurves(1000, 0).hPrime->shape(), CurveShape::StrictlyIncreasing);
     EXPECT_THROW(neoHookeanCurves(-1, 1), std::invalid_argument);
@@ -151,10 +146,8 @@ TEST(ValanisLandel, RejectsAnUnbalancedRestStateNamingTheCurves) {
     // Only a volume term: no shear stiffness.
     ValanisLandelCurves h;
     h.hPrime = MonotoneCurve("h'", {{0.5, -1000}, {1.0, 0}, {2.0, 1000}});
-    EXPECT_THAT(messageOf([&] { ValanisLandelDensity("gel", h); }),
-                HasSubstr("material 'gel': shear modulus at rest"));
-    EXPECT_THAT(messageOf([] { ValanisLandelDensity("void", {}); }),
-                HasSubstr("material 'void': stiffness at rest"));
+    EXPECT_THAT(messageOf([&] { ValanisLandelDensity("gel", h); }), HasSubstr("material 'gel': shear modulus at rest"));
+    EXPECT_THAT(messageOf([] { ValanisLandelDensity("void", {}); }), HasSubstr("material 'void': stiffness at rest"));
 }
 
 TEST(ValanisLandel, CurveErrorsCarryTheMaterialName) {
@@ -194,9 +187,8 @@ TEST(ValanisLandel, EditingFPrimeAwayFromRestKeepsTheRestState) {
 TEST(ValanisLandel, PrincipalStressIsTheGradientOfPrincipalEnergy) {
     const ValanisLandelDensity vl("tissue", authoredTissueCurves());
     double worst = 0;
-    for (const Eigen::Vector3d& s :
-         {Eigen::Vector3d(1.2, 0.8, 0.6), Eigen::Vector3d(2.5, 1.1, -0.3),
-          Eigen::Vector3d(0.15, 0.1, 0.04), Eigen::Vector3d(3, 2.5, 2)}) {
+    for (const Eigen::Vector3d& s : {Eigen::Vector3d(1.2, 0.8, 0.6), Eigen::Vector3d(2.5, 1.1, -0.3),
+                                     Eigen::Vector3d(0.15, 0.1, 0.04), Eigen::Vector3d(3, 2.5, 2)}) {
         const Eigen::Vector3d d = vl.stressPrincipal(s);
         for (int i = 0; i < 3; ++i) {
             Eigen::Vector3d sp = s, sm = s;
@@ -219,8 +211,8 @@ TEST(ValanisLandel, NeoHookeanPresetIsAccurateNearRest) {
         for (double eps : {1e-2, 1e-3, 1e-4}) {
             Mat3 shear = Mat3::Identity();
             shear(0, 1) = eps;
-            const Mat3 Fs[] = {Mat3(Eigen::Vector3d(1 + eps, 1, 1).asDiagonal()),
-                               Mat3((1 - eps) * Mat3::Identity()), shear};
+            const Mat3 Fs[] = {Mat3(Eigen::Vector3d(1 + eps, 1, 1).asDiagonal()), Mat3((1 - eps) * Mat3::Identity()),
+                               shear};
             for (const Mat3& F : Fs) {
                 const double psi = nhPsi(F, m.mu, m.lambda);
                 const Mat3 P = nhStress(F, m.mu, m.lambda);

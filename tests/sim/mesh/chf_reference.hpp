@@ -18,7 +18,9 @@ inline std::vector<int32_t> sorted(std::vector<int32_t> v) {
     return v;
 }
 
-inline bool tetHas(const Tet& t, int32_t v) { return std::find(t.begin(), t.end(), v) != t.end(); }
+inline bool tetHas(const Tet& t, int32_t v) {
+    return std::find(t.begin(), t.end(), v) != t.end();
+}
 
 /// Checks every CHF level against brute force. `samples` bounds the number of vertices and edges
 /// checked on large meshes (all of them on small ones).
@@ -70,7 +72,8 @@ inline void expectChfMatchesBruteForce(TetMesh& m, size_t samples, uint32_t seed
     std::set<std::array<int32_t, 2>> edges;
     for (const Tet& t : tets)
         for (int a = 0; a < 4; ++a)
-            for (int b = a + 1; b < 4; ++b) edges.insert({std::min(t[a], t[b]), std::max(t[a], t[b])});
+            for (int b = a + 1; b < 4; ++b)
+                edges.insert({std::min(t[a], t[b]), std::max(t[a], t[b])});
     ASSERT_EQ(m.edgeCount(), edges.size());
     for (int32_t i = 0; i < static_cast<int32_t>(m.edgeCount()); ++i) {
         auto ev = m.edgeVertices(i);
@@ -82,12 +85,11 @@ inline void expectChfMatchesBruteForce(TetMesh& m, size_t samples, uint32_t seed
     // Euler characteristic of a tetrahedralized ball.
     const auto usedVerts = [&] {
         std::set<int32_t> s;
-        for (const Tet& t : tets) s.insert(t.begin(), t.end());
+        for (const Tet& t : tets)
+            s.insert(t.begin(), t.end());
         return static_cast<int64_t>(s.size());
     }();
-    EXPECT_EQ(usedVerts - static_cast<int64_t>(m.edgeCount()) + static_cast<int64_t>(m.facetCount()) -
-                  nt,
-              1);
+    EXPECT_EQ(usedVerts - static_cast<int64_t>(m.edgeCount()) + static_cast<int64_t>(m.facetCount()) - nt, 1);
 
     // Half-edge navigation on every half-edge of every cell.
     for (int32_t f = 0; f < 4 * nt; ++f) {
@@ -120,7 +122,8 @@ inline void expectChfMatchesBruteForce(TetMesh& m, size_t samples, uint32_t seed
     // Vertex queries (Alg. 2.1–2.3) on a sample of vertices.
     std::mt19937 rng(seed);
     std::vector<int32_t> verts;
-    for (int32_t v = 0; v < static_cast<int32_t>(m.vertexCount()); ++v) verts.push_back(v);
+    for (int32_t v = 0; v < static_cast<int32_t>(m.vertexCount()); ++v)
+        verts.push_back(v);
     std::shuffle(verts.begin(), verts.end(), rng);
     if (verts.size() > samples) verts.resize(samples);
     std::vector<int32_t> out;
@@ -144,13 +147,15 @@ inline void expectChfMatchesBruteForce(TetMesh& m, size_t samples, uint32_t seed
         EXPECT_EQ(sorted(out), link);
         bool onBoundary = false;
         for (int32_t f : m.boundaryHalfFacets())
-            for (int32_t w : m.halfFacetVertices(f)) onBoundary |= w == v;
+            for (int32_t w : m.halfFacetVertices(f))
+                onBoundary |= w == v;
         EXPECT_EQ(m.isBoundaryVertex(v), onBoundary);
     }
 
     // Edge queries (Alg. 2.4–2.5) on a sample of edges, from every half-edge of the edge.
     std::vector<int32_t> edgeIds(m.edgeCount());
-    for (size_t i = 0; i < edgeIds.size(); ++i) edgeIds[i] = static_cast<int32_t>(i);
+    for (size_t i = 0; i < edgeIds.size(); ++i)
+        edgeIds[i] = static_cast<int32_t>(i);
     std::shuffle(edgeIds.begin(), edgeIds.end(), rng);
     if (edgeIds.size() > samples) edgeIds.resize(samples);
     for (int32_t id : edgeIds) {
@@ -197,7 +202,8 @@ inline void expectChfMatchesBruteForce(TetMesh& m, size_t samples, uint32_t seed
     const TriMesh& surf = m.boundary();
     EXPECT_TRUE(surf.isClosedOriented());
     double vol = 0;
-    for (int32_t t = 0; t < nt; ++t) vol += m.signedVolume(t);
+    for (int32_t t = 0; t < nt; ++t)
+        vol += m.signedVolume(t);
     EXPECT_NEAR(surf.signedVolume(), vol, 1e-9 * std::abs(vol));
 }
 

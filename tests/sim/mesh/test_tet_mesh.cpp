@@ -18,7 +18,8 @@ std::unique_ptr<TetMesh> jitteredBox(std::array<int, 3> cells, double jitter, ui
     std::uniform_real_distribution<double> u(-jitter, jitter);
     auto pos = box->positions();
     const double h = 0.6 / cells[2];
-    for (Vec3& p : pos) p += h * Vec3(u(rng), u(rng), u(rng));
+    for (Vec3& p : pos)
+        p += h * Vec3(u(rng), u(rng), u(rng));
     return TetMesh::fromArrays(std::move(pos), box->tets());
 }
 
@@ -70,8 +71,11 @@ TEST(TetMesh, FromArraysRejectsBadInputWithMessages) {
         }
     };
     expectMessage([&] { TetMesh::fromArrays(p, {}); }, "mesh has no tets");
-    expectMessage([&] { TetMesh::fromArrays(p, {{0, 1, 2, 9}}); },
-                  "sim::TetMesh::fromArrays(): tet 0 references vertex 9 (mesh has 4 vertices)");
+    expectMessage(
+        [&] {
+            TetMesh::fromArrays(p, {{0, 1, 2, 9}});
+        },
+        "sim::TetMesh::fromArrays(): tet 0 references vertex 9 (mesh has 4 vertices)");
     expectMessage([&] { TetMesh::fromArrays(p, {{0, 1, 1, 3}}); }, "tet 0 repeats vertex 1");
     auto bad = p;
     bad[2].y() = std::numeric_limits<double>::quiet_NaN();
@@ -80,8 +84,11 @@ TEST(TetMesh, FromArraysRejectsBadInputWithMessages) {
     auto q = p;
     q.push_back(Vec3(0.2, 0.2, -1));
     q.push_back(Vec3(0.3, 0.3, -2));
-    expectMessage([&] { TetMesh::fromArrays(q, {{0, 1, 2, 3}, {0, 2, 1, 4}, {0, 2, 1, 5}}); },
-                  "is shared by 3 tets (non-manifold");
+    expectMessage(
+        [&] {
+            TetMesh::fromArrays(q, {{0, 1, 2, 3}, {0, 2, 1, 4}, {0, 2, 1, 5}});
+        },
+        "is shared by 3 tets (non-manifold");
 }
 
 TEST(TetMesh, BarycentricCoordinates) {
@@ -98,7 +105,8 @@ TEST(TetMesh, BarycentricCoordinates) {
         Eigen::Vector4d w(u(rng), u(rng), u(rng), u(rng));
         w /= w.sum();
         Vec3 p = Vec3::Zero();
-        for (int i = 0; i < 4; ++i) p += w[i] * m->positions()[e[i]];
+        for (int i = 0; i < 4; ++i)
+            p += w[i] * m->positions()[e[i]];
         EXPECT_LT((m->barycentric(t, p) - w).norm(), 1e-12);
     }
     // Triangle barycentrics, with a point off the plane projected onto it.

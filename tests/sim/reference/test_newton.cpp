@@ -122,8 +122,8 @@ TEST(Newton, SolutionDoesNotDependOnTheStartingPoint) {
     for (const StepProblem& p : {makeBlockProblem({}), bentBlock(), stiffStep()}) {
         const NewtonResult a = solveNewton(p, p.xTilde);
         ASSERT_TRUE(a.converged()) << a.message;
-        const std::vector<std::vector<Vec3>> starts = {
-            restPositions({}), jittered(p.xTilde, p, 2e-3), squashed(p, false), squashed(p, true)};
+        const std::vector<std::vector<Vec3>> starts = {restPositions({}), jittered(p.xTilde, p, 2e-3),
+                                                       squashed(p, false), squashed(p, true)};
         for (size_t i = 0; i < starts.size(); ++i) {
             for (const NewtonSettings& s : {NewtonSettings{}, exactWhenDefinite()}) {
                 const NewtonResult b = solveNewton(p, starts[i], s);
@@ -282,8 +282,7 @@ TEST(Newton, RejectsInconsistentInputWithAMessage) {
     bad.tolerance = 0;
     EXPECT_EQ(message(p, p.xTilde, bad), "sim::solveNewton(): tolerance 0 must be positive");
     EXPECT_EQ(message(p, {Vec3::Zero()}, {}),
-              "sim::solveNewton(): x0 has 1 nodes, the problem has " +
-                  std::to_string(p.xTilde.size()));
+              "sim::solveNewton(): x0 has 1 nodes, the problem has " + std::to_string(p.xTilde.size()));
     StepProblem q = p;
     q.model.reset();
     EXPECT_EQ(message(q, p.xTilde, {}), "sim::solveNewton(): problem has no constraint model");

@@ -20,7 +20,8 @@ inline constexpr double kTop = 0.01;
 inline TriMesh fasciaSheet(int nx, int ny, double sx, double sy) {
     std::vector<Vec3> p;
     for (int j = 0; j <= ny; ++j)
-        for (int i = 0; i <= nx; ++i) p.emplace_back(sx * i / nx, sy * j / ny, kTop);
+        for (int i = 0; i <= nx; ++i)
+            p.emplace_back(sx * i / nx, sy * j / ny, kTop);
     std::vector<Tri> t;
     for (int j = 0; j < ny; ++j)
         for (int i = 0; i < nx; ++i) {

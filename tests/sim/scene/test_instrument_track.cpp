@@ -51,13 +51,18 @@ TEST(InstrumentTrack, ParsesInterpolatesAndRoundTrips) {
 TEST(InstrumentTrack, RejectsMalformedFilesWithFileLineAndRule) {
     EXPECT_THAT(errorOf(""), HasSubstr("tools/hook.track:1: header"));
     EXPECT_THAT(errorOf("0 0 0 0 0 0 1 1 0\n"), HasSubstr("tools/hook.track:1: header"));
-    EXPECT_THAT(errorOf("# viscera instrument track 1\n# nothing\n"), HasSubstr("keys: a track needs at least one key"));
+    EXPECT_THAT(errorOf("# viscera instrument track 1\n# nothing\n"),
+                HasSubstr("keys: a track needs at least one key"));
     EXPECT_THAT(errorOf("# viscera instrument track 1\n0 0 0 0 0 0 1 1\n"), HasSubstr(":2: key: expected 9 numbers"));
-    EXPECT_THAT(errorOf("# viscera instrument track 1\n0 0 0 0 0 0 1 1 0 7\n"), HasSubstr(":2: key: expected 9 numbers"));
-    EXPECT_THAT(errorOf("# viscera instrument track 1\n0 0 zero 0 0 0 1 1 0\n"), HasSubstr(":2: key: 'zero' is not a number"));
-    EXPECT_THAT(errorOf("# viscera instrument track 1\n0 nan 0 0 0 0 1 1 0\n"), HasSubstr(":2: position: must be finite"));
+    EXPECT_THAT(errorOf("# viscera instrument track 1\n0 0 0 0 0 0 1 1 0 7\n"),
+                HasSubstr(":2: key: expected 9 numbers"));
+    EXPECT_THAT(errorOf("# viscera instrument track 1\n0 0 zero 0 0 0 1 1 0\n"),
+                HasSubstr(":2: key: 'zero' is not a number"));
+    EXPECT_THAT(errorOf("# viscera instrument track 1\n0 nan 0 0 0 0 1 1 0\n"),
+                HasSubstr(":2: position: must be finite"));
     EXPECT_THAT(errorOf("# viscera instrument track 1\n0 0 0 0 0 0 0 1 0\n"), HasSubstr(":2: direction"));
-    EXPECT_THAT(errorOf("# viscera instrument track 1\n0 0 0 0 0 0 1 1.5 0\n"), HasSubstr(":2: jaw: must be in [0, 1]"));
+    EXPECT_THAT(errorOf("# viscera instrument track 1\n0 0 0 0 0 0 1 1.5 0\n"),
+                HasSubstr(":2: jaw: must be in [0, 1]"));
     EXPECT_THAT(errorOf("# viscera instrument track 1\n0 0 0 0 0 0 1 1 2\n"), HasSubstr(":2: act: must be 0 or 1"));
     EXPECT_THAT(errorOf("# viscera instrument track 1\n1 0 0 0 0 0 1 1 0\n1 0 0 0 0 0 1 1 0\n"),
                 HasSubstr(":3: t: times must strictly increase"));

@@ -50,21 +50,26 @@ TEST(Interaction, RejectsBadSectionsNamingTheField) {
     const std::string ok = R"({"instruments": [{"name": "g", "kind": "grasper", "track": "t.track"}]})";
     EXPECT_EQ(sectionError(ok), "accepted");
     EXPECT_THAT(sectionError("{"), HasSubstr("scene.json: invalid JSON ("));
-    EXPECT_THAT(sectionError(R"({"instruments": []})"), HasSubstr("interaction.instruments: must have 1 to 8 elements"));
+    EXPECT_THAT(sectionError(R"({"instruments": []})"),
+                HasSubstr("interaction.instruments: must have 1 to 8 elements"));
     EXPECT_THAT(sectionError(R"({"instruments": [{"name": "g", "kind": "saw", "track": "t"}]})"),
                 HasSubstr("instruments[0].kind: 'saw' is not an instrument (grasper, energy_hook, clip_applier)"));
     EXPECT_THAT(sectionError(R"({"instruments": [{"name": "g", "kind": "grasper", "track": "/etc/t"}]})"),
                 HasSubstr("instruments[0].track: '/etc/t': absolute entry path"));
-    EXPECT_THAT(sectionError(R"({"instruments": [{"name": "g", "kind": "grasper", "track": "t", "temperature_c": 90}]})"),
-                HasSubstr("instruments[0].temperature_c: only an energy_hook"));
+    EXPECT_THAT(
+        sectionError(R"({"instruments": [{"name": "g", "kind": "grasper", "track": "t", "temperature_c": 90}]})"),
+        HasSubstr("instruments[0].temperature_c: only an energy_hook"));
     EXPECT_THAT(sectionError(R"({"instruments": [{"name": "h", "kind": "energy_hook", "track": "t"}]})"),
                 HasSubstr("interaction.tissues: an energy_hook needs at least one tissue"));
     EXPECT_THAT(sectionError(R"({"instruments": [{"name": "c", "kind": "clip_applier", "track": "t"}]})"),
                 HasSubstr("instruments[0].target: required field is missing"));
-    EXPECT_THAT(sectionError(R"({"collision": {"delta": -1}, "instruments": [{"name": "g", "kind": "grasper", "track": "t"}]})"),
+    EXPECT_THAT(sectionError(
+                    R"({"collision": {"delta": -1}, "instruments": [{"name": "g", "kind": "grasper", "track": "t"}]})"),
                 HasSubstr("collision.delta: must be in [0, 10]"));
-    EXPECT_THAT(sectionError(R"({"collision": {"method": "sdf"}, "instruments": [{"name": "g", "kind": "grasper", "track": "t"}]})"),
-                HasSubstr("collision.method: 'sdf' is not a method"));
+    EXPECT_THAT(
+        sectionError(
+            R"({"collision": {"method": "sdf"}, "instruments": [{"name": "g", "kind": "grasper", "track": "t"}]})"),
+        HasSubstr("collision.method: 'sdf' is not a method"));
     EXPECT_THAT(sectionError(R"({"instruments": [{"name": "g", "kind": "grasper", "track": "t"},
                                                  {"name": "g", "kind": "grasper", "track": "u"}]})"),
                 HasSubstr("instruments[1].name: 'g' is used twice"));
@@ -114,8 +119,8 @@ TEST(Interaction, WorldGraspsCutsAndClipsAndIsRepeatable) {
         std::printf("fascia edges cut %d (triangles %d), grasped %d vertices, lift %.2f mm, max contacts %d, "
                     "clip drift %.4f mm (region %d + %d auxiliary)\n",
                     s.fasciaEdgesCut, s.fasciaTrianglesCut, s.instruments.at(0).grasped, maxLift * 1e3, s.maxContacts,
-                    s.clips.empty() ? -1.0 : s.clips[0].maxContactDrift * 1e3, s.clips.empty() ? 0 : s.clips[0].regionVertices,
-                    s.clips.empty() ? 0 : s.clips[0].auxiliaryNodes);
+                    s.clips.empty() ? -1.0 : s.clips[0].maxContactDrift * 1e3,
+                    s.clips.empty() ? 0 : s.clips[0].regionVertices, s.clips.empty() ? 0 : s.clips[0].auxiliaryNodes);
         std::vector<uint8_t> mask;
         w->interaction()->surfaceFaceMaskInto(0, mask);
         EXPECT_EQ(mask.size(), w->surfaceMesh(0).triangleCount());
@@ -126,5 +131,6 @@ TEST(Interaction, WorldGraspsCutsAndClipsAndIsRepeatable) {
     run(&a);
     run(&b);
     ASSERT_EQ(a.size(), b.size());
-    for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << "repeat runs are bit-identical (vertex " << i << ")";
+    for (size_t i = 0; i < a.size(); ++i)
+        ASSERT_EQ(a[i], b[i]) << "repeat runs are bit-identical (vertex " << i << ")";
 }

@@ -38,7 +38,9 @@ SceneDesc oneBodyScene() {
     return s;
 }
 
-std::unique_ptr<TetMesh> box(double x0) { return makeBoxTetMesh({Vec3(x0, 0, 0), Vec3(0.1, 0.02, 0.04), {10, 2, 4}}); }
+std::unique_ptr<TetMesh> box(double x0) {
+    return makeBoxTetMesh({Vec3(x0, 0, 0), Vec3(0.1, 0.02, 0.04), {10, 2, 4}});
+}
 
 TetBodyDesc tetBody(const BodyDesc& b, const TetMesh& mesh) {
     TetBodyDesc tb;
@@ -122,7 +124,8 @@ TEST(SceneSolver, LayeredXpbdIsTheXpbdSystemBitForBit) {
     std::unique_ptr<SceneSolver> solver = makeSceneSolver({s, meshes, surfaces, "case"});
     ASSERT_NE(dynamic_cast<XpbdSceneSolver*>(solver.get()), nullptr);
     XpbdSystemDesc desc;
-    for (size_t i = 0; i < 2; ++i) desc.tetBodies.push_back(tetBody(s.bodies[i], *meshes[i]));
+    for (size_t i = 0; i < 2; ++i)
+        desc.tetBodies.push_back(tetBody(s.bodies[i], *meshes[i]));
     auto ref = XpbdSystem::create(desc, s.xpbd);
     std::vector<AccuracyRecord> acc;
     for (int f = 0; f < 3; ++f) {
@@ -131,7 +134,8 @@ TEST(SceneSolver, LayeredXpbdIsTheXpbdSystemBitForBit) {
         const SolverStep st = solver->step(clock);
         const StepStats rs = ref->step();
         EXPECT_EQ(st.maxDisplacement, rs.maxDisplacement);
-        for (size_t b = 0; b < 2; ++b) ASSERT_EQ(solver->positions(b), ref->tetPositions(b)) << f;
+        for (size_t b = 0; b < 2; ++b)
+            ASSERT_EQ(solver->positions(b), ref->tetPositions(b)) << f;
         EXPECT_EQ(solver->totalEnergy(), ref->elasticEnergy() + ref->kineticEnergy() + ref->potentialEnergy());
     }
     EXPECT_TRUE(acc.empty());
@@ -141,8 +145,10 @@ TEST(SceneSolver, LayeredXpbdIsTheXpbdSystemBitForBit) {
     again.push_back(box(0));
     again.push_back(box(0.2));
     auto w = World::assemble(s, std::move(again), {}, requiredFeatures(s), "case");
-    for (int f = 0; f < 3; ++f) w->step();
-    for (size_t b = 0; b < 2; ++b) EXPECT_EQ(w->positions(b), ref->tetPositions(b));
+    for (int f = 0; f < 3; ++f)
+        w->step();
+    for (size_t b = 0; b < 2; ++b)
+        EXPECT_EQ(w->positions(b), ref->tetPositions(b));
     EXPECT_FALSE(w->hasSuture());
     EXPECT_TRUE(w->sutureFrames().empty());
 }
@@ -181,9 +187,11 @@ TEST(SceneSolver, FemRunsTheSuturingAndReportsIt) {
     // The World reports the solver's figures: same positions, same frames.
     auto w = World::assemble(s, slabs(), {}, requiredFeatures(s), "case");
     EXPECT_EQ(w->invariants().maxEnergy, 0.0);
-    for (int f = 0; f < 12; ++f) w->step();
+    for (int f = 0; f < 12; ++f)
+        w->step();
     ASSERT_TRUE(w->hasSuture());
-    for (size_t b = 0; b < 2; ++b) EXPECT_EQ(w->positions(b), solver->positions(b));
+    for (size_t b = 0; b < 2; ++b)
+        EXPECT_EQ(w->positions(b), solver->positions(b));
     ASSERT_EQ(w->sutureFrames().size(), 12u);
     EXPECT_EQ(w->sutureFrames()[11].threadTension, report->frames()[11].threadTension);
     EXPECT_EQ(w->sutureSummary().finalGap, sum.finalGap);
@@ -213,7 +221,8 @@ TEST(SceneSolver, RejectsWhatTheBackEndCannotRun) {
     two.push_back(box(0));
     two.push_back(box(0.2));
     EXPECT_EQ(err(s, std::move(two)), "c.vcase: scene cannot be simulated stably: tet body 0 ('slab'): fixed node "
-                                      "100000 is out of range (mesh has " + nv + " vertices)");
+                                      "100000 is out of range (mesh has " +
+                                          nv + " vertices)");
     SceneDesc f = femScene();
     f.tools.push_back(ToolDesc{});
     EXPECT_EQ(err(f, slabs()), "c.vcase: scene: solver 'fem': haptic probes are not supported");

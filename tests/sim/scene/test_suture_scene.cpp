@@ -57,24 +57,32 @@ TEST(SutureScene, RejectsBadSectionsNamingTheField) {
                 HasSubstr("suture.needle.radius: must be positive"));
     EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"].erase("trajectory"); })),
                 HasSubstr("suture.trajectory: required"));
-    EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"]["contact"] = {{"rounds", 99}}; })),
+    EXPECT_THAT(parseError(withChange([](auto& j) {
+                    j["suture"]["contact"] = {{"rounds", 99}};
+                })),
                 HasSubstr("suture.contact.rounds: must be an integer in [0, 16]"));
-    EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"]["knot"] = 1; })), HasSubstr("suture.knot: unknown field"));
-    EXPECT_THAT(parseError(withChange([](auto& j) { j.erase("suture"); })), HasSubstr("solver 'fem' needs a 'suture' section"));
-    EXPECT_THAT(parseError(withChange([](auto& j) { j["solver"]["type"] = "xpbd"; })), HasSubstr("suture: needs solver.type 'fem'"));
-    EXPECT_THAT(parseError(withChange([](auto& j) { j["solver"]["substeps"] = 3; })), HasSubstr("solver.substeps: unknown field"));
+    EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"]["knot"] = 1; })),
+                HasSubstr("suture.knot: unknown field"));
+    EXPECT_THAT(parseError(withChange([](auto& j) { j.erase("suture"); })),
+                HasSubstr("solver 'fem' needs a 'suture' section"));
+    EXPECT_THAT(parseError(withChange([](auto& j) { j["solver"]["type"] = "xpbd"; })),
+                HasSubstr("suture: needs solver.type 'fem'"));
+    EXPECT_THAT(parseError(withChange([](auto& j) { j["solver"]["substeps"] = 3; })),
+                HasSubstr("solver.substeps: unknown field"));
 }
 
 TEST(SutureScene, WorldCreatesOnlyTheDeclaredSubsystemsAndSteps) {
     SceneDesc s = parseScene(suture_fixture::kScene, "scene.json");
     s.suture->trajectoryText = suture_fixture::trajectory(40, 0.0007);
     // Undeclared feature: refused.
-    EXPECT_THROW(World::assemble(s, suture_fixture::slabs(), {}, {"fem", "needle"}, "case: manifest.json"), viscera::InputError);
+    EXPECT_THROW(World::assemble(s, suture_fixture::slabs(), {}, {"fem", "needle"}, "case: manifest.json"),
+                 viscera::InputError);
     auto w = World::assemble(s, suture_fixture::slabs(), {}, {"fem", "needle", "thread"}, "case: manifest.json");
     ASSERT_TRUE(w->hasSuture());
     EXPECT_EQ(w->activeSubsystems(), (std::vector<std::string>{"fem", "needle", "thread"}));
     EXPECT_EQ(w->bodyCount(), 2u);
-    for (int f = 0; f < 45; ++f) ASSERT_TRUE(w->step().finite) << f; // runs past the trajectory's end
+    for (int f = 0; f < 45; ++f)
+        ASSERT_TRUE(w->step().finite) << f; // runs past the trajectory's end
     ASSERT_EQ(w->sutureFrames().size(), 45u);
     const SutureSummary sum = w->sutureSummary();
     EXPECT_GE(sum.punctures, 2); // through the upper slab at least

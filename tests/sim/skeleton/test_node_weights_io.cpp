@@ -29,7 +29,8 @@ TEST(NodeWeightsIo, RoundTripIsBitExact) {
     std::mt19937_64 rng(3);
     std::uniform_real_distribution<double> logw(-300, 300);
     std::vector<double> w = {1.0, 0.1, 1.0 / 3.0, 1e-3, 1e6, 5e-324, 1.7976931348623157e308, std::nextafter(1.0, 2.0)};
-    for (int i = 0; i < 1000; ++i) w.push_back(std::pow(10.0, logw(rng)));
+    for (int i = 0; i < 1000; ++i)
+        w.push_back(std::pow(10.0, logw(rng)));
     const std::string text = formatNodeWeights(w);
     EXPECT_EQ(text.rfind("vweights 1\nnodes 1008\n", 0), 0u);
     EXPECT_EQ(parseNodeWeights(text, "mem"), w);
@@ -48,7 +49,8 @@ TEST(NodeWeightsIo, WriteIsAtomicAndReadable) {
     writeNodeWeights(path, {4.0, 0.25}); // overwrite in place
     EXPECT_EQ(readNodeWeights(path), (std::vector<double>{4.0, 0.25}));
     size_t files = 0;
-    for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++files;
+    for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir))
+        ++files;
     EXPECT_EQ(files, 1u) << "no temporary file left behind";
     try {
         readNodeWeights(path, 3);

@@ -28,8 +28,10 @@ Bar makeBar(int m, std::array<int, 3> cells = {20, 4, 4}) {
     Bar b;
     b.mesh = makeBoxTetMesh({Vec3(0, -0.01, -0.01), Vec3(0.1, 0.02, 0.02), cells});
     b.mesh->requireLevel(2);
-    for (int j = 0; j < m; ++j) b.skeleton.nodes.emplace_back(0.1 * (j + 0.5) / m, 0, 0);
-    for (int j = 0; j + 1 < m; ++j) b.skeleton.edges.push_back({j, j + 1});
+    for (int j = 0; j < m; ++j)
+        b.skeleton.nodes.emplace_back(0.1 * (j + 0.5) / m, 0, 0);
+    for (int j = 0; j + 1 < m; ++j)
+        b.skeleton.edges.push_back({j, j + 1});
     b.skeleton.vertexNode.assign(b.mesh->vertexCount(), kNone);
     for (size_t i = 0; i < b.mesh->vertexCount(); ++i) {
         if (!b.mesh->isBoundaryVertex(static_cast<int32_t>(i))) continue;
@@ -44,7 +46,8 @@ std::vector<std::set<int32_t>> bruteForcePi(const std::vector<Vec3>& x, const Sk
     const size_t m = s.nodes.size();
     r.assign(m, 0.0);
     for (size_t i = 0; i < x.size(); ++i)
-        if (s.vertexNode[i] >= 0) r[s.vertexNode[i]] = std::max(r[s.vertexNode[i]], (x[i] - s.nodes[s.vertexNode[i]]).norm());
+        if (s.vertexNode[i] >= 0)
+            r[s.vertexNode[i]] = std::max(r[s.vertexNode[i]], (x[i] - s.nodes[s.vertexNode[i]]).norm());
     std::vector<std::set<int32_t>> pi(m);
     for (size_t j = 0; j < m; ++j)
         for (size_t i = 0; i < x.size(); ++i)
@@ -87,7 +90,8 @@ TEST(SkeletonMap, MatchesTheThesisRuleAndCoversEveryNode) {
         // The fallback nodes are exactly those that no ball reaches.
         for (size_t i = 0; i < x.size(); ++i) {
             bool reached = false;
-            for (int j = 0; j < m; ++j) reached |= pi[j].count(static_cast<int32_t>(i)) > 0;
+            for (int j = 0; j < m; ++j)
+                reached |= pi[j].count(static_cast<int32_t>(i)) > 0;
             EXPECT_EQ(fallback.count(static_cast<int32_t>(i)) > 0, !reached) << "node " << i;
         }
         EXPECT_EQ(map.coveredCount(), x.size()) << "coverage must be 100 %";
@@ -145,7 +149,8 @@ TEST(SkeletonMap, IsolatedNodesAndRepeatRunsAreBitIdentical) {
     for (size_t k = 0; k < a.fallbackNodes.size(); ++k) {
         const Vec3& p = x[a.fallbackNodes[k]];
         double best = std::numeric_limits<double>::infinity();
-        for (const Vec3& q : b.skeleton.nodes) best = std::min(best, (p - q).norm());
+        for (const Vec3& q : b.skeleton.nodes)
+            best = std::min(best, (p - q).norm());
         EXPECT_EQ((p - b.skeleton.nodes[a.fallbackNode[k]]).norm(), best);
     }
 }

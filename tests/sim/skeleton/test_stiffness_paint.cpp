@@ -41,8 +41,10 @@ Bar makeBar(int m) {
     Bar b;
     b.mesh = makeBoxTetMesh({Vec3(0, -0.01, -0.01), Vec3(0.1, 0.02, 0.02), {20, 4, 4}});
     b.mesh->requireLevel(2);
-    for (int j = 0; j < m; ++j) b.skeleton.nodes.emplace_back(0.1 * (j + 0.5) / m, 0, 0);
-    for (int j = 0; j + 1 < m; ++j) b.skeleton.edges.push_back({j, j + 1});
+    for (int j = 0; j < m; ++j)
+        b.skeleton.nodes.emplace_back(0.1 * (j + 0.5) / m, 0, 0);
+    for (int j = 0; j + 1 < m; ++j)
+        b.skeleton.edges.push_back({j, j + 1});
     b.skeleton.vertexNode.assign(b.mesh->vertexCount(), kNone);
     for (size_t i = 0; i < b.mesh->vertexCount(); ++i)
         if (b.mesh->isBoundaryVertex(static_cast<int32_t>(i)))
@@ -125,14 +127,15 @@ TEST(StiffnessPaint, StrokesAddTheKernelToNodesSelectedThroughTheSkeleton) {
         std::set<int32_t> selected;
         for (size_t j = 0; j < b.skeleton.nodes.size(); ++j)
             if ((b.skeleton.nodes[j] - s.center).norm() < s.radius)
-                for (int32_t q = r.map.start[j]; q < r.map.start[j + 1]; ++q) selected.insert(r.map.members[q]);
+                for (int32_t q = r.map.start[j]; q < r.map.start[j + 1]; ++q)
+                    selected.insert(r.map.members[q]);
         EXPECT_EQ(r.report.strokeSelected[k], selected.size());
         EXPECT_GT(selected.size(), 0u);
         for (int32_t i : selected) {
             const long double v = (x[i] - s.center).norm();
             const long double w = referenceKernel(v, s.radius);
-            expected[i] += s.scale == BrushScale::Peak ? s.amplitude * w / referenceKernel(0.0L, s.radius)
-                                                       : s.amplitude * w;
+            expected[i] +=
+                s.scale == BrushScale::Peak ? s.amplitude * w / referenceKernel(0.0L, s.radius) : s.amplitude * w;
         }
     }
     size_t changed = 0;
@@ -168,10 +171,12 @@ TEST(StiffnessPaint, SelectionGoesThroughTheSkeleton) {
     // A brush that covers mesh nodes but no skeleton node changes nothing: the skeleton selects.
     Bar b = makeBar(4); // nodes at x = 0.0125, 0.0375, 0.0625, 0.0875
     BrushStroke s{Vec3(0.025, 0.01, 0.01), 0.011, 5.0, BrushScale::Peak};
-    for (const Vec3& p : b.skeleton.nodes) ASSERT_GE((p - s.center).norm(), s.radius);
+    for (const Vec3& p : b.skeleton.nodes)
+        ASSERT_GE((p - s.center).norm(), s.radius);
     const StiffnessPaintResult r = bakeStiffnessPaint(*b.mesh, b.skeleton, {s});
     EXPECT_EQ(r.report.strokeSelected[0], 0u);
-    for (double w : r.weights) EXPECT_EQ(w, 1.0);
+    for (double w : r.weights)
+        EXPECT_EQ(w, 1.0);
 }
 
 TEST(StiffnessPaint, WeightsAreClampedToThePositiveFloorAndCeiling) {

@@ -27,7 +27,9 @@ TEST(ThreadLinearization, GradientMatchesFiniteDifferencesAcrossLengths) {
             for (int k = 0; k < 3; ++k) {
                 Vec3 e = Vec3::Zero();
                 e[k] = h;
-                fd[k] = (linearizeThreadSegment(ra, rb + e, eps).length - linearizeThreadSegment(ra, rb - e, eps).length) / (2 * h);
+                fd[k] =
+                    (linearizeThreadSegment(ra, rb + e, eps).length - linearizeThreadSegment(ra, rb - e, eps).length) /
+                    (2 * h);
             }
             EXPECT_NEAR((fd - l.direction).norm(), 0, 1e-6) << "length " << len; // ∂L/∂r_b = d̂ [eq. 3.36]
             // The first-order model L(d') ≈ d̂·d' + offset is exact at d' = d.

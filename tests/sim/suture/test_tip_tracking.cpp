@@ -18,7 +18,8 @@ std::unique_ptr<TetMesh> jitteredBox(std::array<int, 3> cells, double jitter, ui
     std::uniform_real_distribution<double> u(-jitter, jitter);
     auto pos = box->positions();
     const double h = 0.6 / cells[2];
-    for (Vec3& p : pos) p += h * Vec3(u(rng), u(rng), u(rng));
+    for (Vec3& p : pos)
+        p += h * Vec3(u(rng), u(rng), u(rng));
     auto m = TetMesh::fromArrays(std::move(pos), box->tets());
     m->requireLevel(3);
     return m;
@@ -54,8 +55,10 @@ std::vector<Visit> trackedVisits(const TipTracker& tr, const NeedleCurve& c, dou
 void expectSameCells(const std::vector<Visit>& got, const std::vector<Visit>& ref, const std::string& what) {
     if (got.size() != ref.size()) {
         std::string g, r;
-        for (const Visit& v : got) g += " " + std::to_string(v.cell) + "[" + std::to_string(v.a) + "," + std::to_string(v.b) + "]";
-        for (const Visit& v : ref) r += " " + std::to_string(v.cell) + "[" + std::to_string(v.a) + "," + std::to_string(v.b) + "]";
+        for (const Visit& v : got)
+            g += " " + std::to_string(v.cell) + "[" + std::to_string(v.a) + "," + std::to_string(v.b) + "]";
+        for (const Visit& v : ref)
+            r += " " + std::to_string(v.cell) + "[" + std::to_string(v.a) + "," + std::to_string(v.b) + "]";
         ADD_FAILURE() << what << "\n got:" << g << "\n ref:" << r;
         return;
     }
@@ -122,18 +125,23 @@ TEST(TipTracking, MatchesBruteForceThroughVerticesAndEdges) {
         Vec3 target;
         if (trial % 2 == 0) {
             int32_t v;
-            do v = static_cast<int32_t>(u(rng) * m->vertexCount()); while (m->isBoundaryVertex(v));
+            do
+                v = static_cast<int32_t>(u(rng) * m->vertexCount());
+            while (m->isBoundaryVertex(v));
             target = x[v];
         } else {
             int32_t e;
-            do e = static_cast<int32_t>(u(rng) * m->edgeCount()); while (m->isBoundaryEdge(e));
+            do
+                e = static_cast<int32_t>(u(rng) * m->edgeCount());
+            while (m->isBoundaryEdge(e));
             const auto ev = m->edgeVertices(e);
             target = 0.5 * (x[ev[0]] + x[ev[1]]);
         }
         const Vec3 w = randomUnit(rng);
         const NeedleCurve s = NeedleCurve::straight(target - 0.4 * w, w);
         expectSameCells(trackedVisits(tr, s, 0, 0.9, minLen, &edgeOrVertex),
-                        suture_testing::bruteForceVisits(*m, x, s, 0, 0.9, minLen), "straight " + std::to_string(trial));
+                        suture_testing::bruteForceVisits(*m, x, s, 0, 0.9, minLen),
+                        "straight " + std::to_string(trial));
         // An arc through the same point: centre off the point, α = 0 at the point.
         const double r = 0.1 + 0.3 * u(rng);
         const Vec3 uu = randomUnit(rng);
@@ -141,7 +149,8 @@ TEST(TipTracking, MatchesBruteForceThroughVerticesAndEdges) {
         vv = (vv - vv.dot(uu) * uu).normalized();
         const NeedleCurve c = NeedleCurve::arc(target - r * uu, uu, vv, r);
         expectSameCells(trackedVisits(tr, c, -1.2 * r, 1.5 * r, minLen, &edgeOrVertex),
-                        suture_testing::bruteForceVisits(*m, x, c, -1.2 * r, 1.5 * r, minLen), "arc " + std::to_string(trial));
+                        suture_testing::bruteForceVisits(*m, x, c, -1.2 * r, 1.5 * r, minLen),
+                        "arc " + std::to_string(trial));
     }
     RecordProperty("edge_or_vertex_crossings", edgeOrVertex);
     EXPECT_GE(edgeOrVertex, 100); // the constructed paths do cross through edges and vertices

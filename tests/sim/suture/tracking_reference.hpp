@@ -14,8 +14,8 @@ struct Visit {
     double a, b;
 };
 
-inline std::vector<Visit> bruteForceVisits(const TetMesh& m, const std::vector<Vec3>& x, const NeedleCurve& c,
-                                           double a, double b, double minLength) {
+inline std::vector<Visit> bruteForceVisits(const TetMesh& m, const std::vector<Vec3>& x, const NeedleCurve& c, double a,
+                                           double b, double minLength) {
     std::vector<Visit> out;
     double roots[16];
     for (int32_t t = 0; t < static_cast<int32_t>(m.tetCount()); ++t) {
@@ -36,7 +36,8 @@ inline std::vector<Visit> bruteForceVisits(const TetMesh& m, const std::vector<V
             const double p0 = params[k], p1 = params[k + 1];
             bool inside = p1 > p0;
             const Vec3 mid = c.point(0.5 * (p0 + p1));
-            for (int i = 0; i < 4 && inside; ++i) inside = n[i].dot(mid) - d[i] <= 0;
+            for (int i = 0; i < 4 && inside; ++i)
+                inside = n[i].dot(mid) - d[i] <= 0;
             if (inside && !open) {
                 start = p0;
                 open = true;

@@ -69,9 +69,7 @@ TEST(RunCli, MapsExceptionsToExitCodes) {
     EXPECT_EQ(kExitInvariant, 3);
     ::testing::internal::CaptureStderr();
     EXPECT_EQ(runWith(throwing([] { throw viscera::InputError("bad case"); }), {"go"}), kExitInput);
-    EXPECT_EQ(runWith(throwing([] { throw std::invalid_argument("bad flag"); }), {"go"}),
-              kExitUsage);
+    EXPECT_EQ(runWith(throwing([] { throw std::invalid_argument("bad flag"); }), {"go"}), kExitUsage);
     EXPECT_EQ(runWith(throwing([] { throw std::runtime_error("bug"); }), {"go"}), kExitInput);
-    EXPECT_EQ(::testing::internal::GetCapturedStderr(),
-              "prog: bad case\nprog: bad flag\nprog: internal error: bug\n");
+    EXPECT_EQ(::testing::internal::GetCapturedStderr(), "prog: bad case\nprog: bad flag\nprog: internal error: bug\n");
 }

@@ -29,8 +29,7 @@ TEST(VcaseEntryName, NamesTheRuleEachBadNameBreaks) {
     EXPECT_NE(problem("a b").find("character \\x20"), std::string::npos);
     EXPECT_NE(problem("ab:c").find("character \\x3a"), std::string::npos);
     EXPECT_NE(problem("caf\xc3\xa9").find("character \\xc3"), std::string::npos);
-    EXPECT_NE(problem(std::string(256, 'a')).find("longer than the limit of 255"),
-              std::string::npos);
+    EXPECT_NE(problem(std::string(256, 'a')).find("longer than the limit of 255"), std::string::npos);
     EXPECT_EQ(problem(std::string(255, 'a')), "ok");
 }
 

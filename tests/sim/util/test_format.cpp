@@ -9,10 +9,9 @@
 using viscera::sim::formatNumber;
 
 TEST(FormatNumber, IsPrintfG) {
-    for (double v :
-         {0.0, -0.0, 1.0, 0.1, 1e-9, 123456789.0, -2.5e300, 3.14159265358979, 1e6, 999999.5,
-          std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
-          std::numeric_limits<double>::denorm_min()})
+    for (double v : {0.0, -0.0, 1.0, 0.1, 1e-9, 123456789.0, -2.5e300, 3.14159265358979, 1e6, 999999.5,
+                     std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                     std::numeric_limits<double>::denorm_min()})
         for (int digits : {1, 3, 4, 6, 12, 17}) {
             char expected[64];
             std::snprintf(expected, sizeof expected, "%.*g", digits, v);

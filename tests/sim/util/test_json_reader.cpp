@@ -1,8 +1,8 @@
 #include "sim/util/error.hpp"
 #include "sim/util/json_reader.hpp"
 
-#include <gmock/gmock.h>
 #include <cmath>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 namespace viscera::sim {
@@ -14,8 +14,7 @@ using ::testing::HasSubstr;
 const std::string kOrigin = "scene.json";
 
 /// The message of `read` on the document `text`, or "accepted".
-template <class F>
-std::string errorOf(const std::string& text, F read) {
+template <class F> std::string errorOf(const std::string& text, F read) {
     try {
         const json doc = parseJsonText(text, kOrigin);
         read(JsonField(doc, "", kOrigin));
@@ -42,8 +41,9 @@ TEST(JsonReader, RulesAreDescribedAsTheyCheck) {
 TEST(JsonReader, MessagesNameTheOriginThePathAndTheRule) {
     const std::string doc = R"({"bodies": [{"material": {"poisson_ratio": 0.7, "density": "heavy"}}]})";
     auto material = [](const JsonField& root) { return root["bodies"].items()[0]["material"]; };
-    EXPECT_EQ(errorOf(doc, [&](const JsonField& r) { material(r)["poisson_ratio"].number(NumberRule::fromBelow(0, 0.5)); }),
-              "scene.json: bodies[0].material.poisson_ratio: must be in [0, 0.5)");
+    EXPECT_EQ(
+        errorOf(doc, [&](const JsonField& r) { material(r)["poisson_ratio"].number(NumberRule::fromBelow(0, 0.5)); }),
+        "scene.json: bodies[0].material.poisson_ratio: must be in [0, 0.5)");
     EXPECT_EQ(errorOf(doc, [&](const JsonField& r) { material(r)["density"].number(); }),
               "scene.json: bodies[0].material.density: must be a number (found string)");
     EXPECT_EQ(errorOf(doc, [&](const JsonField& r) { material(r)["model"]; }),
@@ -52,7 +52,8 @@ TEST(JsonReader, MessagesNameTheOriginThePathAndTheRule) {
               "scene.json: bodies[0].material.density: unknown field");
     EXPECT_EQ(errorOf(doc, [&](const JsonField& r) { r["bodies"].items(2); }),
               "scene.json: bodies: must have at least 2 elements");
-    EXPECT_EQ(errorOf("[1]", [&](const JsonField& r) { r.anyObject(); }), "scene.json: (root): must be an object (found array)");
+    EXPECT_EQ(errorOf("[1]", [&](const JsonField& r) { r.anyObject(); }),
+              "scene.json: (root): must be an object (found array)");
 }
 
 TEST(JsonReader, IntegersVectorsIndicesChoicesAndPaths) {
@@ -70,7 +71,10 @@ TEST(JsonReader, IntegersVectorsIndicesChoicesAndPaths) {
               "scene.json: v[2]: must be positive");
     EXPECT_EQ(errorOf(R"({"i": [0, -1]})", [](const JsonField& r) { r["i"].indices(); }),
               "scene.json: i[1]: must not be negative");
-    EXPECT_EQ(errorOf(R"({"k": "cube"})", [](const JsonField& r) { r["k"].choice({"box", "tube"}, "a generator"); }),
+    EXPECT_EQ(errorOf(R"({"k": "cube"})",
+                      [](const JsonField& r) {
+                          r["k"].choice({"box", "tube"}, "a generator");
+                      }),
               "scene.json: k: 'cube' is not a generator (box, tube)");
     EXPECT_EQ(errorOf(R"({"f": "../etc/passwd"})", [](const JsonField& r) { r["f"].entryPath(); }),
               "scene.json: f: '../etc/passwd': entry name escapes the package ('..' component)");

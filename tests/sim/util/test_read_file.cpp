@@ -14,8 +14,7 @@ using ::testing::HasSubstr;
 
 namespace {
 
-std::string readError(const std::filesystem::path& path,
-                      std::uintmax_t maxBytes = kReadFileMaxBytes,
+std::string readError(const std::filesystem::path& path, std::uintmax_t maxBytes = kReadFileMaxBytes,
                       std::string_view limitName = {}) {
     try {
         readFile(path, maxBytes, limitName);
@@ -54,13 +53,12 @@ TEST(ReadFile, MissingOrDirectoryIsOneLineNamingThePath) {
     test::Scratch scratch("viscera-read-file");
     const std::string missing = scratch / "absent.txt";
     EXPECT_EQ(readError(missing), missing + ": cannot open for reading (file not found)");
-    EXPECT_EQ(readError(scratch.dir),
-              scratch.dir.string() + ": cannot open for reading (is a directory, not a file)");
+    EXPECT_EQ(readError(scratch.dir), scratch.dir.string() + ": cannot open for reading (is a directory, not a file)");
 }
 
 TEST(ReadFile, StreamWithoutASizeIsCappedToo) {
     // /dev/zero has no size and no end: the cap alone stops the read.
-    EXPECT_THAT(readError("/dev/zero", 100000),
-                AllOf(HasSubstr("/dev/zero: file is larger than the limit of 100000 bytes"),
-                      ::testing::Not(HasSubstr("\n"))));
+    EXPECT_THAT(
+        readError("/dev/zero", 100000),
+        AllOf(HasSubstr("/dev/zero: file is larger than the limit of 100000 bytes"), ::testing::Not(HasSubstr("\n"))));
 }

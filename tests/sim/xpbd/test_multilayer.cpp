@@ -21,8 +21,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// A (nu × nv)-cell triangulated sheet origin + s·du + t·dv, s, t ∈ [0, 1]; uv = (s |du|, t |dv|).
-TriMesh sheet(const Vec3& origin, const Vec3& du, const Vec3& dv, int nu, int nv,
-              std::vector<Vec2>* uv = nullptr) {
+TriMesh sheet(const Vec3& origin, const Vec3& du, const Vec3& dv, int nu, int nv, std::vector<Vec2>* uv = nullptr) {
     std::vector<Vec3> x;
     std::vector<Tri> tris;
     for (int j = 0; j <= nv; ++j)
@@ -51,10 +50,8 @@ std::shared_ptr<const TetConstraintModel> snh(double E, double nu = 0.45) {
 /// Element sizes and stiffnesses keep h² (λ + 2μ)/(ρ L²) below 1 for the stable Neo-Hookean
 /// bodies (see xpbd_solver.hpp: its two-constraint split is only stable there).
 struct Layers {
-    std::unique_ptr<TetMesh> fat =
-        makeBoxTetMesh({Vec3::Zero(), Vec3(0.06, 0.02, 0.02), {12, 4, 4}});
-    std::unique_ptr<TetMesh> vessel =
-        makeBoxTetMesh({Vec3(0.01, 0.006, 0.006), Vec3(0.04, 0.008, 0.008), {8, 1, 1}});
+    std::unique_ptr<TetMesh> fat = makeBoxTetMesh({Vec3::Zero(), Vec3(0.06, 0.02, 0.02), {12, 4, 4}});
+    std::unique_ptr<TetMesh> vessel = makeBoxTetMesh({Vec3(0.01, 0.006, 0.006), Vec3(0.04, 0.008, 0.008), {8, 1, 1}});
     std::vector<Vec2> uv; // filled by the fascia initialiser below (declared first)
     TriMesh fascia = sheet(Vec3(0, 0, 0.02), Vec3(0.06, 0, 0), Vec3(0, 0.02, 0), 15, 5, &uv);
     std::vector<int32_t> fatFixed;
@@ -119,9 +116,7 @@ TEST(Membrane, ConstraintGradientsMatchFiniteDifferences) {
         std::array<std::array<Vec3, 3>, 3> g;
         membraneConstraints({x[0], x[1], x[2]}, M, &g);
         for (int c = 0; c < 3; ++c) {
-            const auto f = [&](const std::vector<Vec3>& y) {
-                return membraneConstraints({y[0], y[1], y[2]}, M)[c];
-            };
+            const auto f = [&](const std::vector<Vec3>& y) { return membraneConstraints({y[0], y[1], y[2]}, M)[c]; };
             worst = std::max(worst, fdRelativeError(f, x, {g[c].begin(), g[c].end()}));
         }
     }
@@ -301,8 +296,8 @@ TEST(XpbdSystem, StiffnessRatioOfAMillionStaysFiniteAndBounded) {
     // Everything stays near the 6 cm cantilever it hangs from, and comes to rest.
     auto inBox = [](const std::vector<Vec3>& x) {
         for (const Vec3& p : x)
-            if (!p.allFinite() || p.x() < -0.05 || p.x() > 0.11 || std::abs(p.y() - 0.01) > 0.06 ||
-                p.z() < -0.1 || p.z() > 0.07)
+            if (!p.allFinite() || p.x() < -0.05 || p.x() > 0.11 || std::abs(p.y() - 0.01) > 0.06 || p.z() < -0.1 ||
+                p.z() > 0.07)
                 return false;
         return true;
     };
@@ -348,9 +343,8 @@ TEST(XpbdSystem, SurfaceStrainLimitsInTheUvFrame) {
         double lo = kInf, hi = -kInf;
         for (const Tri& t : mesh.triangles()) {
             Mat2 M;
-            triangleUvDmInv(
-                {mesh.positions()[t[0]], mesh.positions()[t[1]], mesh.positions()[t[2]]},
-                {uv[t[0]], uv[t[1]], uv[t[2]]}, M);
+            triangleUvDmInv({mesh.positions()[t[0]], mesh.positions()[t[1]], mesh.positions()[t[2]]},
+                            {uv[t[0]], uv[t[1]], uv[t[2]]}, M);
             const double e = triGreenStrain({x[t[0]], x[t[1]], x[t[2]]}, M, i, j);
             lo = std::min(lo, e);
             hi = std::max(hi, e);
@@ -434,8 +428,7 @@ TEST(XpbdSystem, RejectsInvalidCouplings) {
     d = L.desc();
     d.surfaces[0].uv.clear();
     d.surfaces[0].strainLimits = TriStrainLimits{{{0, 0, -kInf, 0.1, 0.0}}, {}};
-    EXPECT_THAT(msg(d),
-                HasSubstr("surface 0 ('fascia'): strain limits need per-vertex uv coordinates"));
+    EXPECT_THAT(msg(d), HasSubstr("surface 0 ('fascia'): strain limits need per-vertex uv coordinates"));
     d = L.desc();
     d.embeddings[0].cage = 1;
     EXPECT_THAT(msg(d), HasSubstr("cannot be embedded in itself"));

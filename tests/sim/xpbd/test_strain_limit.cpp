@@ -26,8 +26,7 @@ std::array<Vec3, 3> toArray3(const std::vector<Vec3>& x) {
 }
 
 /// Largest and smallest ε_ij over the tets of a body, in material axes.
-std::pair<double, double> strainRange(const TetMesh& rest, const std::vector<Vec3>& x,
-                                      const Mat3& axes, int i, int j) {
+std::pair<double, double> strainRange(const TetMesh& rest, const std::vector<Vec3>& x, const Mat3& axes, int i, int j) {
     double lo = kInf, hi = -kInf;
     for (const Tet& e : rest.tets()) {
         const auto& X = rest.positions();
@@ -53,8 +52,7 @@ TEST(StrainLimit, TetStrainGradientMatchesFiniteDifferences) {
             p += 0.003 * Vec3(u(rng), u(rng), u(rng));
         if ((X[1] - X[0]).cross(X[2] - X[0]).dot(X[3] - X[0]) <= 1e-8) continue;
         const Mat3 axes =
-            Eigen::Quaterniond(Eigen::Vector4d(u(rng), u(rng), u(rng), u(rng)).normalized())
-                .toRotationMatrix();
+            Eigen::Quaterniond(Eigen::Vector4d(u(rng), u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
         const Mat3 M = tetMaterialDmInv(toArray4(X), axes);
         const Mat3 F = randomF(rng, 0.4);
         std::vector<Vec3> x(4);
@@ -64,9 +62,7 @@ TEST(StrainLimit, TetStrainGradientMatchesFiniteDifferences) {
             for (int j = 0; j < 3; ++j) {
                 std::array<Vec3, 4> g;
                 tetGreenStrain(toArray4(x), M, i, j, &g);
-                const auto f = [&](const std::vector<Vec3>& y) {
-                    return tetGreenStrain(toArray4(y), M, i, j);
-                };
+                const auto f = [&](const std::vector<Vec3>& y) { return tetGreenStrain(toArray4(y), M, i, j); };
                 worst = std::max(worst, fdRelativeError(f, x, {g.begin(), g.end()}));
             }
     }
@@ -93,9 +89,7 @@ TEST(StrainLimit, TriangleStrainGradientMatchesFiniteDifferences) {
             for (int j = 0; j < 2; ++j) {
                 std::array<Vec3, 3> g;
                 triGreenStrain(toArray3(x), M, i, j, &g);
-                const auto f = [&](const std::vector<Vec3>& y) {
-                    return triGreenStrain(toArray3(y), M, i, j);
-                };
+                const auto f = [&](const std::vector<Vec3>& y) { return triGreenStrain(toArray3(y), M, i, j); };
                 worst = std::max(worst, fdRelativeError(f, x, {g.begin(), g.end()}));
             }
     }
@@ -134,8 +128,7 @@ TEST(StrainLimit, UvFrameFollowsTheTextureDirection) {
 }
 
 TEST(StrainLimit, TetMaterialAxesRotateTheStrain) {
-    const std::array<Vec3, 4> X = {Vec3::Zero(), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0),
-                                   Vec3(0, 0, 0.01)};
+    const std::array<Vec3, 4> X = {Vec3::Zero(), Vec3(0.01, 0, 0), Vec3(0, 0.01, 0), Vec3(0, 0, 0.01)};
     const Mat3 axes = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
     const Mat3 M = tetMaterialDmInv(X, axes);
     // Stretch s along material axis 1 (a column of axes).
@@ -155,8 +148,7 @@ namespace {
 /// A 9 × 1 × 1 cm bar along x, fixed at x = 0 and pulled at x = L by moving its end nodes; the
 /// middle third is 100 times softer (node weights), so the strain gathers there.
 struct PulledBar {
-    std::unique_ptr<TetMesh> mesh =
-        makeBoxTetMesh({Vec3::Zero(), Vec3(0.09, 0.01, 0.01), {9, 1, 1}});
+    std::unique_ptr<TetMesh> mesh = makeBoxTetMesh({Vec3::Zero(), Vec3(0.09, 0.01, 0.01), {9, 1, 1}});
     std::vector<int32_t> fixed, pulled;
     std::vector<double> weights;
 
@@ -219,8 +211,7 @@ TEST(StrainLimit, CompliantLimitYieldsPartially) {
     TetStrainLimits hard, soft;
     hard.limits.push_back({0, 0, -kInf, 0.1, 0.0});
     soft.limits.push_back({0, 0, -kInf, 0.1, 1.0 / 2e4}); // compliance 1/(20 kPa)
-    const double unlimited =
-        strainRange(*bar.mesh, bar.run(std::nullopt), Mat3::Identity(), 0, 0).second;
+    const double unlimited = strainRange(*bar.mesh, bar.run(std::nullopt), Mat3::Identity(), 0, 0).second;
     const double h = strainRange(*bar.mesh, bar.run(hard), Mat3::Identity(), 0, 0).second;
     const double s = strainRange(*bar.mesh, bar.run(soft), Mat3::Identity(), 0, 0).second;
     EXPECT_GT(s, h + 1e-3);
@@ -240,8 +231,7 @@ TEST(StrainLimit, RotatedMaterialAxesAndLowerAndBilateralLimits) {
     limits.limits.push_back({0, 0, -0.01, kInf, 0.0});
     limits.limits.push_back({0, 1, 0.0, 0.0, 0.0});
     const auto free = bar.run(std::nullopt);
-    EXPECT_LT(strainRange(*bar.mesh, free, axes, 0, 0).first, -0.02)
-        << "without limits the bar narrows";
+    EXPECT_LT(strainRange(*bar.mesh, free, axes, 0, 0).first, -0.02) << "without limits the bar narrows";
     const auto held = bar.run(limits, 20);
     EXPECT_LE(strainRange(*bar.mesh, held, axes, 2, 2).second, 0.1 + 2e-3);
     EXPECT_GE(strainRange(*bar.mesh, held, axes, 0, 0).first, -0.01 - 2e-3);

@@ -41,24 +41,20 @@ TEST(XpbdMeasurement, NextSubstepProblemIsThePrediction) {
         fixed[f] = 1;
     EXPECT_EQ(p.fixed, fixed);
     for (size_t i = 0; i < p.xTilde.size(); ++i) {
-        const Vec3 expected =
-            fixed[i]
-                ? solver->positions()[i]
-                : Vec3(solver->positions()[i] + h * solver->velocities()[i] + h * h * s.gravity);
+        const Vec3 expected = fixed[i] ? solver->positions()[i]
+                                       : Vec3(solver->positions()[i] + h * solver->velocities()[i] + h * h * s.gravity);
         EXPECT_LT((p.xTilde[i] - expected).norm(), 1e-15) << i;
     }
     for (size_t t = 0; t < p.tets.size(); ++t) {
         EXPECT_EQ(p.weight[t], 1.0);
         EXPECT_GT(p.volume[t], 0.0);
-        EXPECT_LT(
-            (p.dmInv[t] *
-                 (Mat3() << c.mesh->positions()[p.tets[t][1]] - c.mesh->positions()[p.tets[t][0]],
-                  c.mesh->positions()[p.tets[t][2]] - c.mesh->positions()[p.tets[t][0]],
-                  c.mesh->positions()[p.tets[t][3]] - c.mesh->positions()[p.tets[t][0]])
-                     .finished() -
-             Mat3::Identity())
-                .norm(),
-            1e-12);
+        EXPECT_LT((p.dmInv[t] * (Mat3() << c.mesh->positions()[p.tets[t][1]] - c.mesh->positions()[p.tets[t][0]],
+                                 c.mesh->positions()[p.tets[t][2]] - c.mesh->positions()[p.tets[t][0]],
+                                 c.mesh->positions()[p.tets[t][3]] - c.mesh->positions()[p.tets[t][0]])
+                                    .finished() -
+                   Mat3::Identity())
+                      .norm(),
+                  1e-12);
     }
     // The objective and its gradient are those of the step (finite, decreasing from x̃ under
     // the iteration below).
@@ -108,8 +104,7 @@ TEST(XpbdMeasurement, IterateOnUsesTheProblemItIsGiven) {
     const Material m = tissue();
     p.model = std::make_shared<GenericSnhModel>(m.mu(), m.lambda());
     std::vector<double> f;
-    solver->iterateOn(
-        p, 30, [&](int, const std::vector<Vec3>& xk, double) { f.push_back(p.objective(xk)); });
+    solver->iterateOn(p, 30, [&](int, const std::vector<Vec3>& xk, double) { f.push_back(p.objective(xk)); });
     ASSERT_EQ(f.size(), 30u);
     EXPECT_LT(f.back(), p.objective(p.xTilde));
     EXPECT_TRUE(std::isfinite(f.back()));
@@ -175,8 +170,8 @@ double patchError(const Patch& p, const std::vector<Vec3>& x) {
     return err;
 }
 
-std::unique_ptr<XpbdSolver> patchSolver(const Patch& p, double density, int substeps,
-                                        bool primalCorrection = false, int iterations = 1) {
+std::unique_ptr<XpbdSolver> patchSolver(const Patch& p, double density, int substeps, bool primalCorrection = false,
+                                        int iterations = 1) {
     const Material m = tissue();
     TetBodyDesc body;
     body.mesh = p.mesh.get();

@@ -166,8 +166,7 @@ TEST(XpbdSolver, GenericModelPathMatchesTheStableNeoHookeanFastPath) {
     for (size_t v = 0; v < fast->positions().size(); ++v)
         diff = std::max(diff, (fast->positions()[v] - generic->positions()[v]).norm());
     EXPECT_LT(diff, 1e-9);
-    EXPECT_NEAR(fast->elasticEnergy(), generic->elasticEnergy(),
-                1e-9 * std::abs(fast->elasticEnergy()));
+    EXPECT_NEAR(fast->elasticEnergy(), generic->elasticEnergy(), 1e-9 * std::abs(fast->elasticEnergy()));
 }
 
 TEST(XpbdSolver, OneConstraintModelRestsAndSags) {
@@ -264,8 +263,7 @@ TEST(XpbdSolver, BitIdenticalAcrossRunsAndThreadCounts) {
             energies.push_back(solver->elasticEnergy());
         }
         for (size_t k = 1; k < results.size(); ++k) {
-            EXPECT_EQ(results[k], results[0]) << "simd " << simd << ", primal correction " << primal
-                                              << ", run " << k;
+            EXPECT_EQ(results[k], results[0]) << "simd " << simd << ", primal correction " << primal << ", run " << k;
             EXPECT_EQ(energies[k], energies[0]);
         }
     }
@@ -294,7 +292,7 @@ namespace {
 /// A broken model whose constraint turns NaN once the tet is stretched: drives a frame
 /// non-finite.
 class PoisonModel final : public TetConstraintModel {
-  public:
+public:
     std::string name() const override { return "test_poison"; }
     int count() const override { return 1; }
     std::array<double, kMaxTetConstraints> compliance() const override { return {1e-3, 1e-3}; }
@@ -350,8 +348,7 @@ TEST(XpbdSolver, SetStateTeleportsAndValidates) {
         EXPECT_THAT(e.what(), HasSubstr("sim::XpbdSolver::setState(): expected"));
     }
     x[3].x() = std::numeric_limits<double>::quiet_NaN();
-    EXPECT_THROW(solver->setState(x, std::vector<Vec3>(x.size(), Vec3::Zero())),
-                 std::invalid_argument);
+    EXPECT_THROW(solver->setState(x, std::vector<Vec3>(x.size(), Vec3::Zero())), std::invalid_argument);
 }
 
 TEST(XpbdSolver, RejectsUnsupportedModelsAndSettings) {

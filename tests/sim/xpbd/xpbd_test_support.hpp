@@ -38,14 +38,11 @@ inline Material tissue(double E = 20000, double nu = 0.45) {
 /// Stable Neo-Hookean written as a generic model (not StableNeoHookeanModel), so that the
 /// solver takes its generic path: C_D = |F|, C_H = det F − γ.
 class GenericSnhModel final : public TetConstraintModel {
-  public:
-    GenericSnhModel(double mu, double lambda)
-        : m_mu(mu), m_lambda(lambda), m_gamma(1 + mu / lambda) {}
+public:
+    GenericSnhModel(double mu, double lambda) : m_mu(mu), m_lambda(lambda), m_gamma(1 + mu / lambda) {}
     std::string name() const override { return "test_generic_snh"; }
     int count() const override { return 2; }
-    std::array<double, kMaxTetConstraints> compliance() const override {
-        return {1 / m_mu, 1 / m_lambda};
-    }
+    std::array<double, kMaxTetConstraints> compliance() const override { return {1 / m_mu, 1 / m_lambda}; }
     void evaluate(const Mat3& F, TetConstraintValues& out) const override {
         out.count = 2;
         out.C[0] = F.norm();
@@ -57,14 +54,14 @@ class GenericSnhModel final : public TetConstraintModel {
     }
     double restStiffness() const override { return m_lambda + 2 * m_mu; }
 
-  private:
+private:
     double m_mu, m_lambda, m_gamma;
 };
 
 /// One constraint C = sqrt(2Ψ) with Ψ = μ |E|² + λ/2 tr²E (St. Venant–Kirchhoff), α = 1;
 /// C = 0 and zero gradient at rest.
 class OneConstraintStvkModel final : public TetConstraintModel {
-  public:
+public:
     OneConstraintStvkModel(double mu, double lambda) : m_mu(mu), m_lambda(lambda) {}
     std::string name() const override { return "test_sqrt_stvk"; }
     int count() const override { return 1; }
@@ -84,15 +81,14 @@ class OneConstraintStvkModel final : public TetConstraintModel {
     }
     double restStiffness() const override { return m_lambda + 2 * m_mu; }
 
-  private:
+private:
     double m_mu, m_lambda;
 };
 
 /// Relative error of an analytic gradient against central differences of f, over all
 /// coordinates of the points x: max |g − g_fd| / max(|g|_∞, scale).
-inline double fdRelativeError(const std::function<double(const std::vector<Vec3>&)>& f,
-                              const std::vector<Vec3>& x, const std::vector<Vec3>& g,
-                              double step = 1e-6, double scale = 1e-8) {
+inline double fdRelativeError(const std::function<double(const std::vector<Vec3>&)>& f, const std::vector<Vec3>& x,
+                              const std::vector<Vec3>& g, double step = 1e-6, double scale = 1e-8) {
     double err = 0, norm = scale;
     for (size_t i = 0; i < x.size(); ++i)
         for (int a = 0; a < 3; ++a) {

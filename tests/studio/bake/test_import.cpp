@@ -54,8 +54,7 @@ std::string num(double v) {
 }
 
 std::string base64(std::string_view in) {
-    static constexpr char tbl[] =
-        "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    static constexpr char tbl[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     std::string out;
     size_t i = 0;
     for (; i + 2 < in.size(); i += 3) {
@@ -82,8 +81,8 @@ const sim::TriMesh& unitCube() {
 std::string cubeObj() {
     std::string s = "# unit cube\nmtllib none.mtl\n";
     for (int k = 0; k < 8; ++k)
-        s += "v " + std::to_string(k & 1) + " " + std::to_string((k >> 1) & 1) + " " +
-             std::to_string((k >> 2) & 1) + "\n";
+        s += "v " + std::to_string(k & 1) + " " + std::to_string((k >> 1) & 1) + " " + std::to_string((k >> 2) & 1) +
+             "\n";
     s += "vt 0 0\nvn 0 0 1\n";
     s += "usemtl a\nf 1 3 4 2\nf 5/1 6/1 8/1 7/1\nf 1//1 2//1 6//1 5//1\n";
     s += "usemtl b\nf 3/1/1 7/1/1 8/1/1 4/1/1\nf -8 -4 -2 -6\nf 2 4 8 6\n";
@@ -94,8 +93,7 @@ std::string stlAscii(const sim::TriMesh& m) {
     std::string s = "solid shape\n";
     for (size_t t = 0; t < m.triangleCount(); ++t) {
         const sim::Vec3 n = m.triangleNormal(t);
-        s += "  facet normal " + num(n.x()) + " " + num(n.y()) + " " + num(n.z()) +
-             "\n    outer loop\n";
+        s += "  facet normal " + num(n.x()) + " " + num(n.y()) + " " + num(n.z()) + "\n    outer loop\n";
         for (int32_t v : m.triangles()[t]) {
             const sim::Vec3& p = m.positions()[v];
             s += "      vertex " + num(p.x()) + " " + num(p.y()) + " " + num(p.z()) + "\n";
@@ -126,27 +124,22 @@ enum class PlyEnc { Ascii, LittleEndian, BigEndian };
 std::string ply(const sim::TriMesh& m, PlyEnc enc) {
     const char* names[] = {"ascii", "binary_little_endian", "binary_big_endian"};
     std::string s = "ply\nformat " + std::string(names[static_cast<int>(enc)]) +
-                    " 1.0\ncomment viscera test\nelement vertex " +
-                    std::to_string(m.vertexCount()) +
+                    " 1.0\ncomment viscera test\nelement vertex " + std::to_string(m.vertexCount()) +
                     "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
-                    std::to_string(m.triangleCount()) +
-                    "\nproperty list uchar int vertex_indices\nend_header\n";
+                    std::to_string(m.triangleCount()) + "\nproperty list uchar int vertex_indices\nend_header\n";
     for (const sim::Vec3& p : m.positions()) {
         if (enc == PlyEnc::Ascii) s += num(p.x()) + " " + num(p.y()) + " " + num(p.z()) + "\n";
         for (int k = 0; k < 3 && enc != PlyEnc::Ascii; ++k)
-            enc == PlyEnc::BigEndian ? putF32be(s, static_cast<float>(p[k]))
-                                     : putF32(s, static_cast<float>(p[k]));
+            enc == PlyEnc::BigEndian ? putF32be(s, static_cast<float>(p[k])) : putF32(s, static_cast<float>(p[k]));
     }
     for (const sim::Tri& t : m.triangles()) {
         if (enc == PlyEnc::Ascii) {
-            s += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " +
-                 std::to_string(t[2]) + "\n";
+            s += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
             continue;
         }
         s.push_back(3);
         for (int32_t v : t)
-            enc == PlyEnc::BigEndian ? putU32be(s, static_cast<uint32_t>(v))
-                                     : putU32(s, static_cast<uint32_t>(v));
+            enc == PlyEnc::BigEndian ? putU32be(s, static_cast<uint32_t>(v)) : putU32(s, static_cast<uint32_t>(v));
     }
     return s;
 }
@@ -166,8 +159,7 @@ std::string gltfBuffer(const sim::TriMesh& m) {
 }
 
 /// glTF 2.0 document; `nodes` is the JSON array of nodes, all referring to mesh 0.
-std::string gltfJson(const sim::TriMesh& m, const std::string& bufferUri,
-                     const std::string& nodes = R"([{"mesh":0}])",
+std::string gltfJson(const sim::TriMesh& m, const std::string& bufferUri, const std::string& nodes = R"([{"mesh":0}])",
                      const std::string& scene = "[0]") {
     const size_t posBytes = 12 * m.vertexCount();
     const size_t idxBytes = 6 * m.triangleCount();
@@ -180,10 +172,9 @@ std::string gltfJson(const sim::TriMesh& m, const std::string& bufferUri,
            scene + R"(}],"nodes":)" + nodes +
            R"(,"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
            R"("buffers":[)" +
-           buffer + R"(],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":)" +
-           std::to_string(posBytes) + R"(},{"buffer":0,"byteOffset":)" + std::to_string(posBytes) +
-           R"(,"byteLength":)" + std::to_string(idxBytes) +
-           R"(}],"accessors":[{"bufferView":0,"componentType":5126,"count":)" +
+           buffer + R"(],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":)" + std::to_string(posBytes) +
+           R"(},{"buffer":0,"byteOffset":)" + std::to_string(posBytes) + R"(,"byteLength":)" +
+           std::to_string(idxBytes) + R"(}],"accessors":[{"bufferView":0,"componentType":5126,"count":)" +
            std::to_string(m.vertexCount()) +
            R"(,"type":"VEC3","min":[0,0,0],"max":[1,1,1]},{"bufferView":1,"componentType":5123,"count":)" +
            std::to_string(3 * m.triangleCount()) + R"(,"type":"SCALAR"}]})";
@@ -191,8 +182,7 @@ std::string gltfJson(const sim::TriMesh& m, const std::string& bufferUri,
 
 std::string gltf(const sim::TriMesh& m, const std::string& nodes = R"([{"mesh":0}])",
                  const std::string& scene = "[0]") {
-    return gltfJson(m, "data:application/octet-stream;base64," + base64(gltfBuffer(m)), nodes,
-                    scene);
+    return gltfJson(m, "data:application/octet-stream;base64," + base64(gltfBuffer(m)), nodes, scene);
 }
 
 std::string glb(const sim::TriMesh& m) {
@@ -227,7 +217,7 @@ std::string fbxTetrahedron() {
 // ---- fixture -------------------------------------------------------------------------------
 
 class ImportTest : public ::testing::Test {
-  protected:
+protected:
     void SetUp() override {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
         m_dir = fs::path(::testing::TempDir()) /
@@ -296,15 +286,13 @@ TEST_F(bake_import, ObjUnitScale) {
 }
 
 TEST_F(bake_import, AsciiStlWithFacetNormalsIsJoined) {
-    const bake::ImportResult r =
-        bake::importSurfaceWithReport(write("cube.stl", stlAscii(unitCube())));
+    const bake::ImportResult r = bake::importSurfaceWithReport(write("cube.stl", stlAscii(unitCube())));
     expectUnitCube(r.mesh);
     EXPECT_EQ(r.report.format, bake::SurfaceFormat::StlAscii);
 }
 
 TEST_F(bake_import, BinaryStl) {
-    const bake::ImportResult r =
-        bake::importSurfaceWithReport(write("cube.stl", stlBinary(unitCube())));
+    const bake::ImportResult r = bake::importSurfaceWithReport(write("cube.stl", stlBinary(unitCube())));
     expectUnitCube(r.mesh);
     EXPECT_EQ(r.report.format, bake::SurfaceFormat::StlBinary);
 }
@@ -322,8 +310,7 @@ TEST_F(bake_import, PlyAsciiAndBinaryBothEndians) {
 }
 
 TEST_F(bake_import, GltfWithEmbeddedBuffer) {
-    const bake::ImportResult r =
-        bake::importSurfaceWithReport(write("cube.gltf", gltf(unitCube())));
+    const bake::ImportResult r = bake::importSurfaceWithReport(write("cube.gltf", gltf(unitCube())));
     expectUnitCube(r.mesh);
     EXPECT_EQ(r.report.format, bake::SurfaceFormat::Gltf);
 }
@@ -345,11 +332,9 @@ TEST_F(bake_import, AsciiFbx) {
 
 TEST_F(bake_import, NodeTransformsAndInstancesAreApplied) {
     // Two instances of the cube: one translated by 2 in x and scaled by 3, one mirrored in x.
-    const std::string nodes =
-        R"([{"children":[1,2]},{"mesh":0,"translation":[2,0,0],"scale":[3,3,3]},)"
-        R"({"mesh":0,"scale":[-1,1,1]}])";
-    const bake::ImportResult r =
-        bake::importSurfaceWithReport(write("two.gltf", gltf(unitCube(), nodes)));
+    const std::string nodes = R"([{"children":[1,2]},{"mesh":0,"translation":[2,0,0],"scale":[3,3,3]},)"
+                              R"({"mesh":0,"scale":[-1,1,1]}])";
+    const bake::ImportResult r = bake::importSurfaceWithReport(write("two.gltf", gltf(unitCube(), nodes)));
     EXPECT_EQ(r.report.meshInstances, 2u);
     EXPECT_EQ(r.mesh.vertexCount(), 16u);
     EXPECT_EQ(r.mesh.triangleCount(), 24u);
@@ -370,8 +355,7 @@ TEST_F(bake_import, CollapsedTrianglesAreDroppedAndReported) {
 }
 
 TEST_F(bake_import, AcceptedExtensions) {
-    std::vector<std::string_view> ext(bake::acceptedExtensions().begin(),
-                                      bake::acceptedExtensions().end());
+    std::vector<std::string_view> ext(bake::acceptedExtensions().begin(), bake::acceptedExtensions().end());
     EXPECT_THAT(ext, ::testing::ElementsAre(".obj", ".stl", ".ply", ".gltf", ".glb", ".fbx"));
 }
 
@@ -383,21 +367,17 @@ TEST_F(bake_import, UnknownExtensionIsRejectedBeforeReading) {
                                       HasSubstr("(accepted: .obj .stl .ply .gltf .glb .fbx)")));
     const fs::path noExt = write("organ", cubeObj());
     EXPECT_THAT(importError(noExt), HasSubstr("unsupported format (no extension)"));
-    EXPECT_THAT(importError(write("scene.dae", "<COLLADA/>")),
-                HasSubstr("unsupported format '.dae'"));
+    EXPECT_THAT(importError(write("scene.dae", "<COLLADA/>")), HasSubstr("unsupported format '.dae'"));
 }
 
 TEST_F(bake_import, ContentMustMatchTheExtension) {
     const fs::path plyAsStl = write("liver.stl", ply(unitCube(), PlyEnc::Ascii));
-    EXPECT_THAT(importError(plyAsStl),
-                AllOf(HasSubstr(plyAsStl.string()), HasSubstr("content does not look like STL"),
-                      HasSubstr("it looks like PLY")));
+    EXPECT_THAT(importError(plyAsStl), AllOf(HasSubstr(plyAsStl.string()), HasSubstr("content does not look like STL"),
+                                             HasSubstr("it looks like PLY")));
     const fs::path objAsGlb = write("liver.glb", cubeObj());
-    EXPECT_THAT(importError(objAsGlb),
-                AllOf(HasSubstr("content does not look like GLB"), HasSubstr("'glTF' magic")));
+    EXPECT_THAT(importError(objAsGlb), AllOf(HasSubstr("content does not look like GLB"), HasSubstr("'glTF' magic")));
     const fs::path stlAsObj = write("liver.obj", stlBinary(unitCube()));
-    EXPECT_THAT(importError(stlAsObj),
-                AllOf(HasSubstr("content does not look like OBJ"), HasSubstr("NUL byte")));
+    EXPECT_THAT(importError(stlAsObj), AllOf(HasSubstr("content does not look like OBJ"), HasSubstr("NUL byte")));
     const fs::path jsonWithoutAsset = write("liver.gltf", R"({"scenes":[]})");
     EXPECT_THAT(importError(jsonWithoutAsset),
                 AllOf(HasSubstr("content does not look like glTF"), HasSubstr("\"asset\"")));
@@ -405,11 +385,10 @@ TEST_F(bake_import, ContentMustMatchTheExtension) {
     EXPECT_THAT(importError(objAsFbx),
                 AllOf(HasSubstr("content does not look like FBX"), HasSubstr("it looks like OBJ")));
     const fs::path textAsPly = write("liver.ply", "solid x\nendsolid x\n");
-    EXPECT_THAT(importError(textAsPly),
-                AllOf(HasSubstr("content does not look like PLY"), HasSubstr("'ply' magic")));
+    EXPECT_THAT(importError(textAsPly), AllOf(HasSubstr("content does not look like PLY"), HasSubstr("'ply' magic")));
     const fs::path glbAsGltf = write("liver.gltf", glb(unitCube()));
-    EXPECT_THAT(importError(glbAsGltf), AllOf(HasSubstr("content does not look like glTF"),
-                                              HasSubstr("it looks like GLB")));
+    EXPECT_THAT(importError(glbAsGltf),
+                AllOf(HasSubstr("content does not look like glTF"), HasSubstr("it looks like GLB")));
 }
 
 TEST_F(bake_import, EmptyFilesAreRejected) {
@@ -428,15 +407,13 @@ TEST_F(bake_import, RandomBytesAreRejected) {
                 c = static_cast<char>(rng() & 0xff);
             bytes[k] = '\0'; // binary junk always holds a NUL somewhere
             const fs::path p = write("junk" + std::to_string(k) + ext, bytes);
-            EXPECT_THAT(importError(p),
-                        AllOf(HasSubstr(p.string()), HasSubstr("content does not look like")));
+            EXPECT_THAT(importError(p), AllOf(HasSubstr(p.string()), HasSubstr("content does not look like")));
         }
     }
 }
 
 TEST_F(bake_import, MissingFileAndDirectory) {
-    EXPECT_THAT(importError(m_dir / "absent.obj"),
-                AllOf(HasSubstr("absent.obj"), HasSubstr("file not found")));
+    EXPECT_THAT(importError(m_dir / "absent.obj"), AllOf(HasSubstr("absent.obj"), HasSubstr("file not found")));
     fs::create_directories(m_dir / "folder.obj");
     EXPECT_THAT(importError(m_dir / "folder.obj"), HasSubstr("is a directory"));
 }
@@ -473,13 +450,11 @@ TEST_F(bake_import, NonFiniteCoordinatesNameTheVertex) {
     const fs::path stlA = write("nan_ascii.stl", stlAscii(cube));
     EXPECT_THAT(importError(stlA), AllOf(HasSubstr(stlA.string()), HasSubstr("non-finite")));
     const fs::path plyA = write("nan.ply", ply(cube, PlyEnc::Ascii));
-    EXPECT_THAT(importError(plyA),
-                AllOf(HasSubstr(plyA.string()), HasSubstr("vertex 5 has a non-finite y")));
+    EXPECT_THAT(importError(plyA), AllOf(HasSubstr(plyA.string()), HasSubstr("vertex 5 has a non-finite y")));
     const fs::path plyB = write("nan_bin.ply", ply(cube, PlyEnc::LittleEndian));
     EXPECT_THAT(importError(plyB), HasSubstr("vertex 5 has a non-finite y"));
     const fs::path gl = write("nan.gltf", gltf(cube));
-    EXPECT_THAT(importError(gl),
-                AllOf(HasSubstr(gl.string()), HasSubstr("vertex 5"), HasSubstr("non-finite")));
+    EXPECT_THAT(importError(gl), AllOf(HasSubstr(gl.string()), HasSubstr("vertex 5"), HasSubstr("non-finite")));
 }
 
 TEST_F(bake_import, NoFaces) {
@@ -493,22 +468,18 @@ TEST_F(bake_import, NoFaces) {
     EXPECT_THAT(importError(stl0), AllOf(HasSubstr(stl0.string()), HasSubstr("no faces")));
     const fs::path stlA = write("empty_solid.stl", "solid x\nendsolid x\n");
     EXPECT_THAT(importError(stlA), HasSubstr("no faces"));
-    const fs::path gl =
-        write("empty.gltf", R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[]}],"scene":0})");
+    const fs::path gl = write("empty.gltf", R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[]}],"scene":0})");
     EXPECT_THAT(importError(gl),
-                AllOf(HasSubstr(gl.string()),
-                      ::testing::AnyOf(HasSubstr("empty scene"), HasSubstr("no faces"))));
+                AllOf(HasSubstr(gl.string()), ::testing::AnyOf(HasSubstr("empty scene"), HasSubstr("no faces"))));
 }
 
 TEST_F(bake_import, FaceIndexOutOfRangeNamesFaceAndIndex) {
     const std::string v3 = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
     const fs::path big = write("oor.obj", v3 + "f 1 2 3\nf 1 2 9\n");
-    EXPECT_THAT(importError(big),
-                AllOf(HasSubstr(big.string()), HasSubstr("line 5: face 2"),
-                      HasSubstr("vertex index 9 is out of range (the file has 3 vertices)")));
+    EXPECT_THAT(importError(big), AllOf(HasSubstr(big.string()), HasSubstr("line 5: face 2"),
+                                        HasSubstr("vertex index 9 is out of range (the file has 3 vertices)")));
     const fs::path zero = write("zero.obj", v3 + "f 1 2 0\n");
-    EXPECT_THAT(importError(zero),
-                HasSubstr("face 1: vertex index 0 is invalid (OBJ indices start at 1)"));
+    EXPECT_THAT(importError(zero), HasSubstr("face 1: vertex index 0 is invalid (OBJ indices start at 1)"));
     const fs::path neg = write("neg.obj", v3 + "f -1 -2 -4\n");
     EXPECT_THAT(importError(neg), HasSubstr("face 1: vertex index -4 is out of range"));
     const fs::path tex = write("tex.obj", v3 + "vt 0 0\nf 1/1 2/1 3/2\n");
@@ -518,14 +489,12 @@ TEST_F(bake_import, FaceIndexOutOfRangeNamesFaceAndIndex) {
     const fs::path junk = write("junk.obj", v3 + "f 1 2 x\n");
     EXPECT_THAT(importError(junk), HasSubstr("face 1: cannot parse vertex index 'x'"));
 
-    const fs::path plyBad =
-        write("oor.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
-                         "property float x\nproperty float y\nproperty float z\n"
-                         "element face 1\nproperty list uchar int vertex_indices\n"
-                         "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
-    EXPECT_THAT(importError(plyBad),
-                AllOf(HasSubstr(plyBad.string()),
-                      HasSubstr("face 0: index 2 references vertex 7 (the file has 3 vertices)")));
+    const fs::path plyBad = write("oor.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
+                                             "property float x\nproperty float y\nproperty float z\n"
+                                             "element face 1\nproperty list uchar int vertex_indices\n"
+                                             "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
+    EXPECT_THAT(importError(plyBad), AllOf(HasSubstr(plyBad.string()),
+                                           HasSubstr("face 0: index 2 references vertex 7 (the file has 3 vertices)")));
 }
 
 TEST_F(bake_import, TruncatedAndMalformedPly) {
@@ -537,8 +506,7 @@ TEST_F(bake_import, TruncatedAndMalformedPly) {
     EXPECT_THAT(importError(write("noend.ply", noEnd)), HasSubstr("unknown keyword 'end_headex'"));
     std::string badType = ply(unitCube(), PlyEnc::Ascii);
     badType.replace(badType.find("float y"), 5, "flo6t");
-    EXPECT_THAT(importError(write("type.ply", badType)),
-                HasSubstr("unknown property type 'flo6t'"));
+    EXPECT_THAT(importError(write("type.ply", badType)), HasSubstr("unknown property type 'flo6t'"));
 }
 
 TEST_F(bake_import, TruncatedGlbIsRejected) {

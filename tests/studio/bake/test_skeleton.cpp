@@ -44,7 +44,8 @@ sim::TriMesh torusSurface(double R, double r, int nu, int nv) {
         }
     sim::TriMesh m = sim::TriMesh::fromArrays(pos, tris);
     if (m.signedVolume() < 0) {
-        for (auto& t : tris) std::swap(t[1], t[2]);
+        for (auto& t : tris)
+            std::swap(t[1], t[2]);
         m = sim::TriMesh::fromArrays(pos, tris);
     }
     return m;
@@ -79,7 +80,8 @@ sim::TriMesh bentTubeSurface(double R, double r, int rings, int slices) {
     }
     sim::TriMesh m = sim::TriMesh::fromArrays(pos, tris);
     if (m.signedVolume() < 0) {
-        for (auto& t : tris) std::swap(t[1], t[2]);
+        for (auto& t : tris)
+            std::swap(t[1], t[2]);
         m = sim::TriMesh::fromArrays(pos, tris);
     }
     return m;
@@ -125,8 +127,8 @@ bake::MeshingParams coarse(double size) {
 } // namespace
 
 TEST(bake_skeleton, StraightTubeGivesACentredPath) {
-    const sim::TriMesh tube = sim::makeTubeSurface(sim::Vec3(0.02, -0.01, 0.03),
-                                                   sim::Vec3(0.02, -0.01, 0.03 + kLength), kRadius, 48, 50);
+    const sim::TriMesh tube =
+        sim::makeTubeSurface(sim::Vec3(0.02, -0.01, 0.03), sim::Vec3(0.02, -0.01, 0.03 + kLength), kRadius, 48, 50);
     ASSERT_EQ(tube.triangleCount(), 4896u);
     const bake::SkeletonResult r = bake::extractSkeleton(tube);
     RecordProperty("skeletonize_tube_4896_tris_seconds", std::to_string(r.report.seconds));
@@ -169,8 +171,10 @@ TEST(bake_skeleton, SameSurfaceSameSkeletonAtAnyScale) {
     const sim::TriMesh big = sim::makeTubeSurface(sim::Vec3::Zero(), sim::Vec3(0, 0, 20), 2, 24, 20);
     const bake::SkeletonResult c = bake::extractSkeleton(big);
     expectPath(c.skeleton);
-    for (const sim::Vec3& p : a.skeleton.nodes) EXPECT_LT(std::hypot(p.x(), p.y()), 0.1 * 0.002);
-    for (const sim::Vec3& p : c.skeleton.nodes) EXPECT_LT(std::hypot(p.x(), p.y()), 0.1 * 2);
+    for (const sim::Vec3& p : a.skeleton.nodes)
+        EXPECT_LT(std::hypot(p.x(), p.y()), 0.1 * 0.002);
+    for (const sim::Vec3& p : c.skeleton.nodes)
+        EXPECT_LT(std::hypot(p.x(), p.y()), 0.1 * 2);
 }
 
 TEST(bake_skeleton, BentTubeFollowsItsArc) {
@@ -198,15 +202,16 @@ TEST(bake_skeleton, TorusGivesOneCentredLoop) {
     EXPECT_EQ(res.report.cycleRank, 1);
     EXPECT_EQ(res.report.components, 1);
     const auto deg = s.degrees();
-    for (int32_t d : deg) EXPECT_EQ(d, 2);
+    for (int32_t d : deg)
+        EXPECT_EQ(d, 2);
     expectEverySurfaceVertexMapped(s, res.report);
-    for (const sim::Vec3& p : s.nodes) EXPECT_LT(std::hypot(std::hypot(p.x(), p.y()) - R, p.z()), 0.15 * r);
+    for (const sim::Vec3& p : s.nodes)
+        EXPECT_LT(std::hypot(std::hypot(p.x(), p.y()) - R, p.z()), 0.15 * r);
 }
 
 TEST(bake_skeleton, TetTubeBoundaryMapsEveryNodeAndPaints) {
-    bake::TetrahedralizeResult tet =
-        bake::tetrahedralize(sim::makeTubeSurface(sim::Vec3::Zero(), sim::Vec3(0, 0, 0.08), kRadius, 32, 24),
-                             coarse(0.004));
+    bake::TetrahedralizeResult tet = bake::tetrahedralize(
+        sim::makeTubeSurface(sim::Vec3::Zero(), sim::Vec3(0, 0, 0.08), kRadius, 32, 24), coarse(0.004));
     sim::TetMesh& mesh = *tet.mesh;
     const bake::SkeletonResult sk = bake::extractSkeleton(mesh);
     const sim::Skeleton& s = sk.skeleton;
@@ -223,7 +228,8 @@ TEST(bake_skeleton, TetTubeBoundaryMapsEveryNodeAndPaints) {
         interior += !boundary;
     }
     EXPECT_GT(interior, 10u);
-    for (const sim::Vec3& p : s.nodes) EXPECT_LT(std::hypot(p.x(), p.y()), 0.15 * kRadius);
+    for (const sim::Vec3& p : s.nodes)
+        EXPECT_LT(std::hypot(p.x(), p.y()), 0.15 * kRadius);
 
     const sim::SkeletonNodeMap map = sim::mapNodesToSkeleton(mesh, s);
     EXPECT_EQ(map.coveredCount(), mesh.vertexCount()) << "coverage must be 100 %";
@@ -316,7 +322,8 @@ TEST(bake_skeleton, BadSurfacesAreRejectedNamingTheRule) {
         remap[k] = static_cast<int32_t>(pos.size());
         pos.push_back(b2.positions()[k]);
     }
-    for (const sim::Tri& t : b2.triangles()) tris.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
+    for (const sim::Tri& t : b2.triangles())
+        tris.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
     EXPECT_EQ(inputError(sim::TriMesh::fromArrays(pos, tris)),
               "vessel.obj: surface is not manifold at vertex 7: its triangles form more than one fan (surfaces "
               "touch there)");
@@ -325,8 +332,10 @@ TEST(bake_skeleton, BadSurfacesAreRejectedNamingTheRule) {
     const sim::TriMesh b3 = sim::makeBoxSurface(sim::Vec3::Constant(0.005), sim::Vec3::Constant(0.015));
     pos = b1.positions();
     tris = b1.triangles();
-    for (const sim::Vec3& p : b3.positions()) pos.push_back(p);
-    for (const sim::Tri& t : b3.triangles()) tris.push_back({t[0] + 8, t[1] + 8, t[2] + 8});
+    for (const sim::Vec3& p : b3.positions())
+        pos.push_back(p);
+    for (const sim::Tri& t : b3.triangles())
+        tris.push_back({t[0] + 8, t[1] + 8, t[2] + 8});
     EXPECT_THAT(inputError(sim::TriMesh::fromArrays(pos, tris)), HasSubstr("vessel.obj: surface self-intersects"));
 }
 
@@ -342,7 +351,8 @@ TEST(bake_skeleton, ParametersAreChecked) {
     };
     bake::SkeletonParams p;
     p.maxTriangleAngleDeg = 80;
-    EXPECT_EQ(error(p), "bake::extractSkeleton(): SkeletonParams::maxTriangleAngleDeg is 80.000000 (must be in (90, 180))");
+    EXPECT_EQ(error(p),
+              "bake::extractSkeleton(): SkeletonParams::maxTriangleAngleDeg is 80.000000 (must be in (90, 180))");
     p = {};
     p.minEdgeLengthRel = 0;
     EXPECT_THAT(error(p), HasSubstr("SkeletonParams::minEdgeLengthRel"));

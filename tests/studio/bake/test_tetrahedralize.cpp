@@ -75,8 +75,8 @@ std::string inputError(const sim::TriMesh& s, const bake::MeshingParams& p) {
 TEST(bake_tetrahedralize, EllipsoidVolumeNearAnalytic) {
     const sim::TriMesh s = ellipsoid();
     std::vector<std::pair<bake::MeshingStage, double>> stages;
-    const bake::TetrahedralizeResult r = bake::tetrahedralize(
-        s, coarse(0.006), [&](bake::MeshingStage st, double f) { stages.emplace_back(st, f); });
+    const bake::TetrahedralizeResult r =
+        bake::tetrahedralize(s, coarse(0.006), [&](bake::MeshingStage st, double f) { stages.emplace_back(st, f); });
     expectValidMesh(r);
     const double exact = 4.0 / 3.0 * std::numbers::pi * kRadii.prod();
     EXPECT_NEAR(r.report.tetVolume, exact, 0.03 * exact);
@@ -137,9 +137,8 @@ TEST(bake_tetrahedralize, OpenSurfaceIsRejectedNamingAnEdge) {
     std::vector<sim::Tri> tris = box.triangles();
     tris.pop_back();
     const sim::TriMesh open = sim::TriMesh::fromArrays(box.positions(), tris);
-    EXPECT_THAT(inputError(open, coarse(0.2)),
-                AllOf(HasSubstr("test surface: surface is not closed: edge ("),
-                      HasSubstr("belongs to only one triangle")));
+    EXPECT_THAT(inputError(open, coarse(0.2)), AllOf(HasSubstr("test surface: surface is not closed: edge ("),
+                                                     HasSubstr("belongs to only one triangle")));
 }
 
 TEST(bake_tetrahedralize, InconsistentOrientationIsRejected) {
@@ -147,9 +146,8 @@ TEST(bake_tetrahedralize, InconsistentOrientationIsRejected) {
     std::vector<sim::Tri> tris = box.triangles();
     std::swap(tris[3][1], tris[3][2]);
     const sim::TriMesh flipped = sim::TriMesh::fromArrays(box.positions(), tris);
-    EXPECT_THAT(inputError(flipped, coarse(0.2)),
-                AllOf(HasSubstr("surface is not consistently oriented: edge ("),
-                      HasSubstr("traversed in the same direction by triangles")));
+    EXPECT_THAT(inputError(flipped, coarse(0.2)), AllOf(HasSubstr("surface is not consistently oriented: edge ("),
+                                                        HasSubstr("traversed in the same direction by triangles")));
 }
 
 TEST(bake_tetrahedralize, InwardOrientationIsAccepted) {
@@ -157,8 +155,7 @@ TEST(bake_tetrahedralize, InwardOrientationIsAccepted) {
     std::vector<sim::Tri> tris = box.triangles();
     for (sim::Tri& t : tris)
         std::swap(t[1], t[2]);
-    const auto r =
-        bake::tetrahedralize(sim::TriMesh::fromArrays(box.positions(), tris), coarse(0.006));
+    const auto r = bake::tetrahedralize(sim::TriMesh::fromArrays(box.positions(), tris), coarse(0.006));
     expectValidMesh(r);
     EXPECT_NEAR(r.report.tetVolume, 8e-6, 0.01 * 8e-6);
 }
@@ -208,8 +205,7 @@ TEST(bake_tetrahedralize, ParametersAreChecked) {
 
     // Sizes far too small for the volume are refused before meshing starts.
     p = coarse(1e-4);
-    EXPECT_THAT(inputError(s, p),
-                AllOf(HasSubstr("sizes too small"), HasSubstr("maxEstimatedTets")));
+    EXPECT_THAT(inputError(s, p), AllOf(HasSubstr("sizes too small"), HasSubstr("maxEstimatedTets")));
 }
 
 TEST(bake_tetrahedralize, StageNames) {

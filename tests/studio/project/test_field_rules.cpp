@@ -27,8 +27,8 @@ const std::filesystem::path kProjects = std::filesystem::path(VISCERA_SOURCE_DIR
 const std::vector<std::string> kSamples = {"tissue-slab", "organ-blob", "liver", "rectum", "anastomosis"};
 
 /// Keys whose numbers may be negative (positions, directions, signed curve values, brush amplitude).
-const std::set<std::string> kSigned = {"origin", "center", "start", "end", "min", "max", "gravity", "points",
-                                       "amplitude", "slack", "lower", "upper", "axes", "needle_centre"};
+const std::set<std::string> kSigned = {"origin", "center",    "start", "end",   "min",   "max",  "gravity",
+                                       "points", "amplitude", "slack", "lower", "upper", "axes", "needle_centre"};
 
 struct Leaf {
     json::json_pointer pointer;
@@ -43,7 +43,8 @@ void collect(const json& j, const json::json_pointer& ptr, const std::string& pa
         for (auto it = j.begin(); it != j.end(); ++it)
             collect(it.value(), ptr / it.key(), path.empty() ? it.key() : path + "." + it.key(), it.key(), out);
     } else if (j.is_array()) {
-        for (size_t i = 0; i < j.size(); ++i) collect(j[i], ptr / i, path + "[" + std::to_string(i) + "]", key, out);
+        for (size_t i = 0; i < j.size(); ++i)
+            collect(j[i], ptr / i, path + "[" + std::to_string(i) + "]", key, out);
     } else if (j.is_number()) {
         out.push_back({ptr, path, key, j.is_number_integer()});
     }
@@ -61,7 +62,8 @@ std::string withValue(const json& doc, const Leaf& leaf, const std::string& raw)
 
 /// Feeds every numeric leaf of `doc` the wrong values; `read` parses a text and returns its
 /// error ("accepted" when it passes). Returns the number of refusals checked.
-int checkEveryNumber(const json& doc, const std::string& file, const std::function<std::string(const std::string&)>& read) {
+int checkEveryNumber(const json& doc, const std::string& file,
+                     const std::function<std::string(const std::string&)>& read) {
     std::vector<Leaf> leaves;
     collect(doc, json::json_pointer(), "", "", leaves);
     EXPECT_GT(leaves.size(), 5u) << file;
@@ -71,7 +73,8 @@ int checkEveryNumber(const json& doc, const std::string& file, const std::functi
         // The field itself, or (for a rule between fields, "min must not exceed max") the object
         // that holds it.
         std::string element = leaf.path;
-        while (element.back() == ']') element = element.substr(0, element.rfind('['));
+        while (element.back() == ']')
+            element = element.substr(0, element.rfind('['));
         const size_t dot = element.rfind('.');
         const std::string holder = dot == std::string::npos ? std::string() : element.substr(0, dot);
         auto namesTheField = [&](const std::string& why) {
@@ -199,7 +202,8 @@ TEST(FieldRulesScene, ToolsStrainLimitsAndNodeWeights) {
 TEST_F(FieldRules, NegativeStretchStiffnessIsRefusedAtLoadNotAtExport) {
     json doc = copySample("liver");
     doc["surfaces"][0]["stretch_stiffness"] = -5;
-    EXPECT_EQ(loadError(doc.dump(1)), (m_dir / "project.json").string() + ": surfaces[0].stretch_stiffness: must not be negative");
+    EXPECT_EQ(loadError(doc.dump(1)),
+              (m_dir / "project.json").string() + ": surfaces[0].stretch_stiffness: must not be negative");
     // The same field in the scene the player reads, by the same rule.
     doc["surfaces"][0]["stretch_stiffness"] = 50;
     writeFileAtomic(m_dir / "project.json", doc.dump(1));
@@ -213,11 +217,15 @@ TEST_F(FieldRules, ProjectAndSceneShareTheRangeOfEverySharedField) {
     json doc = copySample("liver");
     writeFileAtomic(m_dir / "project.json", doc.dump(1));
     const json scene = json::parse(sceneOf(studio::loadProject(m_dir)));
-    const std::vector<std::pair<std::string, std::string>> shared = {
-        {"/solver/substeps", "0"},        {"/solver/substeps", "1001"},  {"/solver/dt", "0.5"},
-        {"/solver/damping", "-1"},        {"/bodies/0/material/poisson_ratio", "0.5"},
-        {"/bodies/0/material/density", "0"}, {"/bodies/1/embedding_compliance", "-1"},
-        {"/surfaces/0/areal_density", "0"},  {"/surfaces/0/attach_distance", "0"}};
+    const std::vector<std::pair<std::string, std::string>> shared = {{"/solver/substeps", "0"},
+                                                                     {"/solver/substeps", "1001"},
+                                                                     {"/solver/dt", "0.5"},
+                                                                     {"/solver/damping", "-1"},
+                                                                     {"/bodies/0/material/poisson_ratio", "0.5"},
+                                                                     {"/bodies/0/material/density", "0"},
+                                                                     {"/bodies/1/embedding_compliance", "-1"},
+                                                                     {"/surfaces/0/areal_density", "0"},
+                                                                     {"/surfaces/0/attach_distance", "0"}};
     for (const auto& [pointer, raw] : shared) {
         SCOPED_TRACE(pointer + " = " + raw);
         json p = doc, s = scene;

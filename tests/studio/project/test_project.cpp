@@ -18,9 +18,9 @@ namespace {
 class ProjectTest : public ::testing::Test {
 protected:
     void SetUp() override {
-        m_dir = std::filesystem::temp_directory_path() /
-                ("viscera_project_" + std::to_string(::getpid()) + "_" +
-                 ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        m_dir =
+            std::filesystem::temp_directory_path() / ("viscera_project_" + std::to_string(::getpid()) + "_" +
+                                                      ::testing::UnitTest::GetInstance()->current_test_info()->name());
         std::filesystem::create_directories(m_dir);
     }
     void TearDown() override { std::filesystem::remove_all(m_dir); }
@@ -87,7 +87,9 @@ TEST_F(ProjectTest, LoadErrorsNameFileFieldAndRule) {
     EXPECT_THAT(loadError(), HasSubstr("bodies[0].mesh.generator: 'torus' is not a known generator"));
     write(replaced(kGood, "\"mesh\": {\"generator\": \"box\", \"size\": [0.04, 0.01, 0.01], \"cells\": [4, 1, 1]}",
                    "\"mesh\": {\"file\": \"../../etc/organ.obj\"}"));
-    EXPECT_THAT(loadError(), HasSubstr("bodies[0].mesh.file: '../../etc/organ.obj': entry name escapes the package ('..' component)"));
+    EXPECT_THAT(
+        loadError(),
+        HasSubstr("bodies[0].mesh.file: '../../etc/organ.obj': entry name escapes the package ('..' component)"));
     std::filesystem::remove(m_dir / "project.json");
     EXPECT_THAT(loadError(), HasSubstr("project.json: cannot open for reading"));
 }

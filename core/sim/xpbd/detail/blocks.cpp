@@ -34,7 +34,7 @@ void scatterTetGradient(const Tet& e, const Mat3& G, double* f) {
 // ---- stable Neo-Hookean, packed ---------------------------------------------------------------
 
 class SnhBlock final : public Block {
-  public:
+public:
     SnhBlock(ElasticTets t, const StableNeoHookeanModel& m, bool avx2)
         : m_t(std::move(t)), m_mu(m.mu()), m_lambda(m.lambda()), m_gamma(m.gamma()), m_avx2(avx2),
           m_active(m_t.tets.size(), 1) {}
@@ -83,9 +83,8 @@ class SnhBlock final : public Block {
             const Mat3 ds = edgeMatrix(xw, e);
             const Mat3 F = ds * m_t.dmInv[u];
             const double J = F.determinant();
-            const double psi =
-                0.5 * m_mu * (F.squaredNorm() - 3.0) +
-                0.5 * m_lambda * ((J - m_gamma) * (J - m_gamma) - (1 - m_gamma) * (1 - m_gamma));
+            const double psi = 0.5 * m_mu * (F.squaredNorm() - 3.0) +
+                               0.5 * m_lambda * ((J - m_gamma) * (J - m_gamma) - (1 - m_gamma) * (1 - m_gamma));
             sum += m_t.volume[u] * m_t.weight[u] * psi;
         }
         return sum;
@@ -104,7 +103,7 @@ class SnhBlock final : public Block {
         return true;
     }
 
-  protected:
+protected:
     void build(const std::vector<int32_t>& slots) override {
         m_slotOf.assign(m_t.tets.size(), 0);
         for (size_t s = 0; s < slots.size(); ++s)
@@ -129,7 +128,7 @@ class SnhBlock final : public Block {
         }
     }
 
-  private:
+private:
     /// Rewrites Dm⁻¹ of unit u in its pack lane (and in the padding lanes that repeat it).
     void writeLane(size_t u) {
         if (m_packs.empty()) return; // not arranged yet: build() reads m_t and m_active
@@ -154,7 +153,7 @@ class SnhBlock final : public Block {
 // ---- any TetConstraintModel ---------------------------------------------------------------------
 
 class ModelBlock final : public Block {
-  public:
+public:
     explicit ModelBlock(ElasticTets t) : m_t(std::move(t)) {
         m_count = m_t.model->count();
         m_alpha = m_t.model->compliance();
@@ -257,13 +256,12 @@ class ModelBlock final : public Block {
             if (!m_active[u]) continue;
             const Tet& e = m_t.tets[u];
             const Mat3 ds = edgeMatrix(xw, e);
-            sum += m_t.volume[u] * m_t.weight[u] *
-                   (m_t.model->energyDensity(ds * m_t.dmInv[u]) - m_restDensity);
+            sum += m_t.volume[u] * m_t.weight[u] * (m_t.model->energyDensity(ds * m_t.dmInv[u]) - m_restDensity);
         }
         return sum;
     }
 
-  protected:
+protected:
     void build(const std::vector<int32_t>& slots) override {
         m_units.assign(slots.size(), Unit{});
         for (size_t s = 0; s < slots.size(); ++s) {
@@ -272,7 +270,7 @@ class ModelBlock final : public Block {
         }
     }
 
-  private:
+private:
     struct Unit {
         int32_t unit = -1;
         double vw = 1;
@@ -291,8 +289,7 @@ class ModelBlock final : public Block {
 /// Applies one scalar strain-limit update; returns the new multiplier.
 template <int N>
 double strainLimitUpdate(const ScalarStrainLimit& lim, double eps, const std::array<Vec3, N>& g,
-                         const std::array<int32_t, N>& p, double measure, double lam,
-                         const SolveContext& ctx) {
+                         const std::array<int32_t, N>& p, double measure, double lam, const SolveContext& ctx) {
     double den = 0;
     double w[N];
     for (int k = 0; k < N; ++k) {
@@ -323,7 +320,7 @@ double strainLimitEnergy(const ScalarStrainLimit& lim, double eps, double measur
 }
 
 template <int N, class MatM> class StrainBlock final : public Block {
-  public:
+public:
     using Elem = std::array<int32_t, N>;
     StrainBlock(std::vector<Elem> elems, std::vector<MatM> dmInv, std::vector<double> measure,
                 std::vector<ScalarStrainLimit> limits)
@@ -365,21 +362,19 @@ template <int N, class MatM> class StrainBlock final : public Block {
             for (int i = 0; i < N; ++i)
                 x[i] = particlePosition(xw, m_elems[u][i]);
             for (const auto& lim : m_limits)
-                sum += strainLimitEnergy(lim, strain(x, m_dmInv[u], lim.i, lim.j, nullptr),
-                                         m_measure[u]);
+                sum += strainLimitEnergy(lim, strain(x, m_dmInv[u], lim.i, lim.j, nullptr), m_measure[u]);
         }
         return sum;
     }
 
-  protected:
+protected:
     void build(const std::vector<int32_t>& slots) override {
         m_slots = slots;
         m_lam.assign(slots.size() * m_limits.size(), 0.0);
     }
 
-  private:
-    static double strain(const std::array<Vec3, N>& x, const MatM& M, int i, int j,
-                         std::array<Vec3, N>* g) {
+private:
+    static double strain(const std::array<Vec3, N>& x, const MatM& M, int i, int j, std::array<Vec3, N>* g) {
         if constexpr (N == 4)
             return tetGreenStrain(x, M, i, j, g);
         else
@@ -397,9 +392,8 @@ template <int N, class MatM> class StrainBlock final : public Block {
 // ---- membrane -----------------------------------------------------------------------------------
 
 class MembraneBlock final : public Block {
-  public:
-    MembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area,
-                  double k)
+public:
+    MembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area, double k)
         : m_tris(std::move(tris)), m_dmInv(std::move(dmInv)), m_area(std::move(area)), m_k(k),
           m_active(m_tris.size(), 1) {}
     bool setUnitActive(size_t u, bool active) override {
@@ -463,13 +457,13 @@ class MembraneBlock final : public Block {
         return sum;
     }
 
-  protected:
+protected:
     void build(const std::vector<int32_t>& slots) override {
         m_slots = slots;
         m_lam.assign(3 * slots.size(), 0.0);
     }
 
-  private:
+private:
     std::vector<Tri> m_tris;
     std::vector<Mat2> m_dmInv;
     std::vector<double> m_area;
@@ -482,7 +476,7 @@ class MembraneBlock final : public Block {
 // ---- coupling ties ------------------------------------------------------------------------------
 
 class CouplingBlock final : public Block {
-  public:
+public:
     explicit CouplingBlock(std::vector<Tie> ties) : m_ties(std::move(ties)) {}
 
     size_t unitCount() const override { return m_ties.size(); }
@@ -534,13 +528,13 @@ class CouplingBlock final : public Block {
         return sum;
     }
 
-  protected:
+protected:
     void build(const std::vector<int32_t>& slots) override {
         m_slots = slots;
         m_lam.assign(slots.size(), Vec3::Zero());
     }
 
-  private:
+private:
     std::vector<Tie> m_ties;
     std::vector<int32_t> m_slots;
     std::vector<Vec3> m_lam;
@@ -571,24 +565,21 @@ std::vector<ScalarStrainLimit> expandStrainLimits(const std::vector<StrainLimit>
     return out;
 }
 
-std::unique_ptr<Block> makeTetStrainBlock(std::vector<Tet> tets, std::vector<Mat3> dmInv,
-                                          std::vector<double> volume,
+std::unique_ptr<Block> makeTetStrainBlock(std::vector<Tet> tets, std::vector<Mat3> dmInv, std::vector<double> volume,
                                           std::vector<ScalarStrainLimit> limits) {
-    return std::make_unique<StrainBlock<4, Mat3>>(std::move(tets), std::move(dmInv),
-                                                  std::move(volume), std::move(limits));
+    return std::make_unique<StrainBlock<4, Mat3>>(std::move(tets), std::move(dmInv), std::move(volume),
+                                                  std::move(limits));
 }
 
-std::unique_ptr<Block> makeTriStrainBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv,
-                                          std::vector<double> area,
+std::unique_ptr<Block> makeTriStrainBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area,
                                           std::vector<ScalarStrainLimit> limits) {
-    return std::make_unique<StrainBlock<3, Mat2>>(std::move(tris), std::move(dmInv),
-                                                  std::move(area), std::move(limits));
+    return std::make_unique<StrainBlock<3, Mat2>>(std::move(tris), std::move(dmInv), std::move(area),
+                                                  std::move(limits));
 }
 
-std::unique_ptr<Block> makeMembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv,
-                                         std::vector<double> area, double stiffness) {
-    return std::make_unique<MembraneBlock>(std::move(tris), std::move(dmInv), std::move(area),
-                                           stiffness);
+std::unique_ptr<Block> makeMembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area,
+                                         double stiffness) {
+    return std::make_unique<MembraneBlock>(std::move(tris), std::move(dmInv), std::move(area), stiffness);
 }
 
 std::unique_ptr<Block> makeCouplingBlock(std::vector<Tie> ties) {

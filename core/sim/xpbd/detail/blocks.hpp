@@ -38,16 +38,14 @@ struct ScalarStrainLimit {
 std::vector<ScalarStrainLimit> expandStrainLimits(const std::vector<StrainLimit>& limits);
 
 /// Strain limits on tets; dmInv in material axes (tetMaterialDmInv).
-std::unique_ptr<Block> makeTetStrainBlock(std::vector<Tet> tets, std::vector<Mat3> dmInv,
-                                          std::vector<double> volume,
+std::unique_ptr<Block> makeTetStrainBlock(std::vector<Tet> tets, std::vector<Mat3> dmInv, std::vector<double> volume,
                                           std::vector<ScalarStrainLimit> limits);
 /// Strain limits on triangles; dmInv of the UV frame (triangleUvDmInv).
-std::unique_ptr<Block> makeTriStrainBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv,
-                                          std::vector<double> area,
+std::unique_ptr<Block> makeTriStrainBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area,
                                           std::vector<ScalarStrainLimit> limits);
 /// Membrane constraints (membrane.hpp), α = 1/(k A).
-std::unique_ptr<Block> makeMembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv,
-                                         std::vector<double> area, double stiffness);
+std::unique_ptr<Block> makeMembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area,
+                                         double stiffness);
 
 /// C = x_p − Σ_{k<n} b_k x_k, n = 3 or 4.
 struct Tie {

@@ -36,8 +36,7 @@ int32_t Engine::addParticles(const std::vector<Vec3>& x, const std::vector<doubl
                              const std::vector<uint8_t>& fixed) {
     const auto first = static_cast<int32_t>(particleCount());
     for (size_t i = 0; i < x.size(); ++i) {
-        xw.insert(xw.end(),
-                  {x[i].x(), x[i].y(), x[i].z(), (fixed[i] || !(m[i] > 0)) ? 0.0 : 1.0 / m[i]});
+        xw.insert(xw.end(), {x[i].x(), x[i].y(), x[i].z(), (fixed[i] || !(m[i] > 0)) ? 0.0 : 1.0 / m[i]});
         v.push_back(Vec3::Zero());
         mass.push_back(m[i]);
     }
@@ -69,19 +68,16 @@ void Engine::colour() {
                             taken |= used[static_cast<size_t>(p[k]) * words + wd];
                         if (~taken) found = wd * 64 + __builtin_ctzll(~taken);
                     }
-                    if (found <
-                        0) { // every colour so far is taken around this unit: widen the sets
+                    if (found < 0) { // every colour so far is taken around this unit: widen the sets
                         std::vector<uint64_t> wider(n * (words + 1), 0);
                         for (size_t i = 0; i < n; ++i)
-                            std::copy_n(used.begin() + i * words, words,
-                                        wider.begin() + i * (words + 1));
+                            std::copy_n(used.begin() + i * words, words, wider.begin() + i * (words + 1));
                         used.swap(wider);
                         ++words;
                     }
                 }
                 for (int k = 0; k < np; ++k)
-                    used[static_cast<size_t>(p[k]) * words + found / 64] |= uint64_t(1)
-                                                                            << (found % 64);
+                    used[static_cast<size_t>(p[k]) * words + found / 64] |= uint64_t(1) << (found % 64);
                 colourOf[b][u] = base + found;
                 m_colours = std::max(m_colours, base + found + 1);
             }
@@ -125,8 +121,7 @@ int Engine::usefulThreads(int threads) const {
     return static_cast<int>(std::min<size_t>(threads, most));
 }
 
-template <class Fn>
-void Engine::forColourChunk(int c, uint32_t chunk, uint32_t chunks, const Fn& fn) {
+template <class Fn> void Engine::forColourChunk(int c, uint32_t chunk, uint32_t chunks, const Fn& fn) {
     const size_t total = m_colourPacks[c];
     const size_t gb = total * chunk / chunks, ge = total * (chunk + 1) / chunks;
     size_t offset = 0;
@@ -140,8 +135,7 @@ void Engine::forColourChunk(int c, uint32_t chunk, uint32_t chunks, const Fn& fn
 }
 
 void Engine::solveColourChunk(int c, uint32_t chunk, uint32_t chunks, const SolveContext& ctx) {
-    forColourChunk(c, chunk, chunks,
-                   [&](Block& b, size_t pb, size_t pe) { b.solve(pb, pe, ctx); });
+    forColourChunk(c, chunk, chunks, [&](Block& b, size_t pb, size_t pe) { b.solve(pb, pe, ctx); });
 }
 
 void Engine::forceColourChunk(int c, uint32_t chunk, uint32_t chunks) {
@@ -166,26 +160,23 @@ void Engine::correctParticles(uint32_t chunk) {
 void Engine::appendCorrectionPhases(int threads) {
     for (int c = 0; c < m_colours; ++c) {
         Phase ph{c, false, false, false,
-                 static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1,
-                                                          kChunksPerThread * threads))};
+                 static_cast<uint32_t>(
+                     std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1, kChunksPerThread * threads))};
         ph.forces = true;
         m_phases.push_back(ph);
     }
     m_phases.push_back({kCorrect, false, false, false,
-                        static_cast<uint32_t>((particleCount() + kChunkParticles - 1) /
-                                              kChunkParticles)});
+                        static_cast<uint32_t>((particleCount() + kChunkParticles - 1) / kChunkParticles)});
 }
 
 void Engine::buildSchedule(Schedule kind, const XpbdSettings* s, int threads) {
     m_phases.clear();
-    const auto particleChunks =
-        static_cast<uint32_t>((particleCount() + kChunkParticles - 1) / kChunkParticles);
+    const auto particleChunks = static_cast<uint32_t>((particleCount() + kChunkParticles - 1) / kChunkParticles);
     auto colourPhases = [&](bool first, bool last) {
         for (int c = 0; c < m_colours; ++c)
-            m_phases.push_back(
-                {c, first, last, false,
-                 static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1,
-                                                          kChunksPerThread * threads))});
+            m_phases.push_back({c, first, last, false,
+                                static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1,
+                                                                         kChunksPerThread * threads))});
     };
     if (kind == Schedule::Sweep) {
         colourPhases(false, false);
@@ -212,8 +203,7 @@ void Engine::buildSchedule(Schedule kind, const XpbdSettings* s, int threads) {
                 ph.substep = sub;
                 ph.iteration = s->iterations;
                 m_phases.push_back(ph);
-                if (sub + 1 < s->substeps)
-                    m_phases.push_back({kPredictOnly, false, false, true, particleChunks});
+                if (sub + 1 < s->substeps) m_phases.push_back({kPredictOnly, false, false, true, particleChunks});
             } else {
                 m_phases.push_back({-1, false, false, sub + 1 < s->substeps, particleChunks});
             }
@@ -324,8 +314,7 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
             if (ph.forces)
                 forceColourChunk(ph.colour, chunk, ph.chunks);
             else
-                solveColourChunk(ph.colour, chunk, ph.chunks,
-                                 SolveContext{x, h2inv, ph.first, ph.last});
+                solveColourChunk(ph.colour, chunk, ph.chunks, SolveContext{x, h2inv, ph.first, ph.last});
             return;
         }
         if (ph.colour == kCorrect) {
@@ -334,8 +323,8 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
         }
         if (ph.colour == kHook) {
             XpbdParticles view(x, v.data(), n);
-            const XpbdIterationInfo info{ph.substep, ph.iteration, substeps, s.iterations, h,
-                                         ph.iteration == s.iterations};
+            const XpbdIterationInfo info{
+                ph.substep, ph.iteration, substeps, s.iterations, h, ph.iteration == s.iterations};
             try {
                 iterationHook(view, info);
             } catch (...) {

@@ -26,9 +26,7 @@ template <class T, std::size_t Align> struct AlignedAllocator {
     AlignedAllocator() = default;
     template <class U> AlignedAllocator(const AlignedAllocator<U, Align>&) {}
     template <class U> struct rebind { using other = AlignedAllocator<U, Align>; };
-    T* allocate(std::size_t n) {
-        return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(Align)));
-    }
+    T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(Align))); }
     void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t(Align)); }
     friend bool operator==(const AlignedAllocator&, const AlignedAllocator&) { return true; }
 };
@@ -59,7 +57,7 @@ struct SolveContext {
 inline constexpr int kMaxUnitParticles = 8;
 
 class Block {
-  public:
+public:
     virtual ~Block() = default;
     virtual size_t unitCount() const = 0;
     /// Particles of unit u into out (at most kMaxUnitParticles); returns their count.
@@ -95,16 +93,16 @@ class Block {
     size_t colourBegin(int c) const { return m_colourStart[c]; }
     size_t colourEnd(int c) const { return m_colourStart[c + 1]; }
 
-  protected:
+protected:
     /// slots: four per pack, a unit index or −1 for padding, in colour order.
     virtual void build(const std::vector<int32_t>& slots) = 0;
 
-  private:
+private:
     std::vector<size_t> m_colourStart;
 };
 
 class Engine {
-  public:
+public:
     ParticleArray xw;         ///< 4 per particle: x, y, z (m), inverse mass (1/kg, 0 = fixed)
     std::vector<Vec3> v;      ///< velocities, m/s
     std::vector<double> mass; ///< kg (fixed particles keep theirs)
@@ -116,8 +114,7 @@ class Engine {
     size_t particleCount() const { return mass.size(); }
     /// Appends particles (positions, masses, fixed flags; all the same size); returns the index
     /// of the first. Inverse mass: 0 when fixed or massless, else 1/m.
-    int32_t addParticles(const std::vector<Vec3>& x, const std::vector<double>& m,
-                         const std::vector<uint8_t>& fixed);
+    int32_t addParticles(const std::vector<Vec3>& x, const std::vector<double>& m, const std::vector<uint8_t>& fixed);
     /// Greedy colouring of all units of all blocks by shared particles (stage by stage, each
     /// stage with its own colours), then arranges the blocks. Call once, after the last block is
     /// added.
@@ -142,7 +139,7 @@ class Engine {
     /// Threads worth using (≤ threads): 1 when no colour is large enough to split.
     int usefulThreads(int threads) const;
 
-  private:
+private:
     /// A step of the schedule: a colour sweep (colour ≥ 0) or a particle pass (colour < 0: end of
     /// a substep and, when predictNext, start of the next; or, with colour == kPredictOnly, only
     /// the start of the first substep). Its work is cut into chunks (a colour: a few per thread;
@@ -154,7 +151,7 @@ class Engine {
         bool last = false;        ///< colour sweep: last iteration of the substep
         bool predictNext = false; ///< particle pass: also start the next substep
         uint32_t chunks = 0;
-        bool forces = false; ///< colour pass of the primal correction: Σ ∇Cᵀλ into m_force
+        bool forces = false;            ///< colour pass of the primal correction: Σ ∇Cᵀλ into m_force
         int substep = 0, iteration = 0; ///< kHook: where in the frame
     };
     static constexpr int kPredictOnly = -2;
@@ -191,7 +188,7 @@ class Engine {
     std::vector<Vec3> m_prev;
     ParticleArray m_frameStart;
     std::vector<Vec3> m_v0;
-    std::vector<int> m_clamps; ///< per thread
+    std::vector<int> m_clamps;   ///< per thread
     std::vector<double> m_force; ///< primal correction: Σ ∇Cᵀλ, 3 per particle (0 between uses)
     std::vector<Vec3> m_xTilde;  ///< prediction of the current substep (primal correction)
     bool m_hookFailed = false;   ///< the iteration hook threw during this frame

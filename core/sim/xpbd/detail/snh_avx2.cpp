@@ -55,14 +55,12 @@ inline void storeRows(double* xw, const int32_t* idx, V X, V Y, V Z, V W) {
 
 /// Solves K packs (4K tets of one colour, so no shared particle) with their instructions
 /// interleaved: the square root and divisions of one pack overlap the arithmetic of the other.
-template <int K>
-inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first, bool keep) {
+template <int K> inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first, bool keep) {
     const V one = _mm256_set1_pd(1.0), tiny = _mm256_set1_pd(1e-24);
     const V huge = _mm256_set1_pd(__builtin_huge_val());
     const V laneIndex = _mm256_set_pd(3, 2, 1, 0);
     const V signMask = _mm256_set1_pd(-0.0);
-    V X[K][4], Y[K][4], Z[K][4], W[K][4], gFx[K][4], gFy[K][4], gFz[K][4], gHx[K][4], gHy[K][4],
-        gHz[K][4];
+    V X[K][4], Y[K][4], Z[K][4], W[K][4], gFx[K][4], gFy[K][4], gFz[K][4], gHx[K][4], gHy[K][4], gHz[K][4];
     V sFF[K], sHH[K], sFH[K], cD2[K], J[K];
     for (int k = 0; k < K; ++k) {
         for (int s = 0; s < 4; ++s) {
@@ -70,15 +68,11 @@ inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first, boo
             toColumns(_mm256_load_pd(xw + 4 * static_cast<size_t>(id[0])),
                       _mm256_load_pd(xw + 4 * static_cast<size_t>(id[1])),
                       _mm256_load_pd(xw + 4 * static_cast<size_t>(id[2])),
-                      _mm256_load_pd(xw + 4 * static_cast<size_t>(id[3])), X[k][s], Y[k][s],
-                      Z[k][s], W[k][s]);
+                      _mm256_load_pd(xw + 4 * static_cast<size_t>(id[3])), X[k][s], Y[k][s], Z[k][s], W[k][s]);
         }
-        const V d0x = sub(X[k][1], X[k][0]), d0y = sub(Y[k][1], Y[k][0]),
-                d0z = sub(Z[k][1], Z[k][0]);
-        const V d1x = sub(X[k][2], X[k][0]), d1y = sub(Y[k][2], Y[k][0]),
-                d1z = sub(Z[k][2], Z[k][0]);
-        const V d2x = sub(X[k][3], X[k][0]), d2y = sub(Y[k][3], Y[k][0]),
-                d2z = sub(Z[k][3], Z[k][0]);
+        const V d0x = sub(X[k][1], X[k][0]), d0y = sub(Y[k][1], Y[k][0]), d0z = sub(Z[k][1], Z[k][0]);
+        const V d1x = sub(X[k][2], X[k][0]), d1y = sub(Y[k][2], Y[k][0]), d1z = sub(Z[k][2], Z[k][0]);
+        const V d2x = sub(X[k][3], X[k][0]), d2y = sub(Y[k][3], Y[k][0]), d2z = sub(Z[k][3], Z[k][0]);
         V m[9];
         for (int e = 0; e < 9; ++e)
             m[e] = _mm256_load_pd(P[k].m[e]);
@@ -123,18 +117,9 @@ inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first, boo
         gHz[k][0] = _mm256_xor_pd(add(add(gHz[k][1], gHz[k][2]), gHz[k][3]), signMask);
         V ff = _mm256_setzero_pd(), hh = ff, fh = ff;
         for (int s = 0; s < 4; ++s) {
-            ff = madd(
-                W[k][s],
-                madd(gFz[k][s], gFz[k][s], madd(gFy[k][s], gFy[k][s], mul(gFx[k][s], gFx[k][s]))),
-                ff);
-            hh = madd(
-                W[k][s],
-                madd(gHz[k][s], gHz[k][s], madd(gHy[k][s], gHy[k][s], mul(gHx[k][s], gHx[k][s]))),
-                hh);
-            fh = madd(
-                W[k][s],
-                madd(gFz[k][s], gHz[k][s], madd(gFy[k][s], gHy[k][s], mul(gFx[k][s], gHx[k][s]))),
-                fh);
+            ff = madd(W[k][s], madd(gFz[k][s], gFz[k][s], madd(gFy[k][s], gFy[k][s], mul(gFx[k][s], gFx[k][s]))), ff);
+            hh = madd(W[k][s], madd(gHz[k][s], gHz[k][s], madd(gHy[k][s], gHy[k][s], mul(gHx[k][s], gHx[k][s]))), hh);
+            fh = madd(W[k][s], madd(gFz[k][s], gHz[k][s], madd(gFy[k][s], gHy[k][s], mul(gFx[k][s], gHx[k][s]))), fh);
         }
         sFF[k] = ff;
         sHH[k] = hh;
@@ -152,14 +137,13 @@ inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first, boo
         const V cD = _mm256_sqrt_pd(cD2[k]);
         const V lD = first ? _mm256_setzero_pd() : _mm256_load_pd(P[k].lamD);
         const V lH = first ? _mm256_setzero_pd() : _mm256_load_pd(P[k].lamH);
-        const V tD = mul(_mm256_load_pd(P[k].alphaD), h2inv),
-                tH = mul(_mm256_load_pd(P[k].alphaH), h2inv);
+        const V tD = mul(_mm256_load_pd(P[k].alphaD), h2inv), tH = mul(_mm256_load_pd(P[k].alphaH), h2inv);
         const V a00 = madd(tD, cD2[k], sFF[k]);
         const V a11 = add(sHH[k], tH);
         const V a01 = sFH[k];
         const V det = msub(a00, a11, mul(a01, a01));
-        const V detOk = _mm256_and_pd(_mm256_cmp_pd(det, _mm256_setzero_pd(), _CMP_GT_OQ),
-                                      _mm256_cmp_pd(det, huge, _CMP_LT_OQ));
+        const V detOk =
+            _mm256_and_pd(_mm256_cmp_pd(det, _mm256_setzero_pd(), _CMP_GT_OQ), _mm256_cmp_pd(det, huge, _CMP_LT_OQ));
         const V ok = _mm256_and_pd(_mm256_and_pd(laneOk, normOk), detOk);
         const V invDet = _mm256_div_pd(one, _mm256_blendv_pd(one, det, ok));
         const V r0 = _mm256_xor_pd(madd(mul(tD, lD), cD, cD2[k]), signMask);
@@ -177,8 +161,7 @@ inline void solvePacks(SnhPack* P, double* xw, V h2inv, V gamma, bool first, boo
             const V DX = mul(W[k][s], madd(dH[k], gHx[k][s], mul(cF[k], gFx[k][s])));
             const V DY = mul(W[k][s], madd(dH[k], gHy[k][s], mul(cF[k], gFy[k][s])));
             const V DZ = mul(W[k][s], madd(dH[k], gHz[k][s], mul(cF[k], gFz[k][s])));
-            storeRows(xw, P[k].idx[s], add(X[k][s], DX), add(Y[k][s], DY), add(Z[k][s], DZ),
-                      W[k][s]);
+            storeRows(xw, P[k].idx[s], add(X[k][s], DX), add(Y[k][s], DY), add(Z[k][s], DZ), W[k][s]);
         }
 }
 
@@ -198,8 +181,7 @@ void snhSolveAvx2(SnhPack* packs, size_t count, const SnhParams& prm) {
         for (size_t n = q + 2; n < q + 4 && n < count; ++n)
             for (int s = 0; s < 4; ++s)
                 for (int l = 0; l < 4; ++l)
-                    _mm_prefetch(reinterpret_cast<const char*>(
-                                     prm.xw + 4 * static_cast<size_t>(packs[n].idx[s][l])),
+                    _mm_prefetch(reinterpret_cast<const char*>(prm.xw + 4 * static_cast<size_t>(packs[n].idx[s][l])),
                                  _MM_HINT_T0);
         solvePacks<2>(packs + q, prm.xw, h2inv, gamma, first, keep);
     }

@@ -24,7 +24,7 @@ struct alignas(64) SnhPack {
 };
 
 struct SnhParams {
-    double* xw; ///< particles: x, y, z (m) and inverse mass (1/kg), 4 doubles each, 32-byte aligned
+    double* xw;   ///< particles: x, y, z (m) and inverse mass (1/kg), 4 doubles each, 32-byte aligned
     double h2inv; ///< 1/h², 1/s²
     double gamma; ///< 1 + μ/λ
     int first;    ///< 1: first iteration of a substep (multipliers start from 0)

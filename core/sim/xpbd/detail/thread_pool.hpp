@@ -12,7 +12,7 @@
 namespace viscera::sim::detail {
 
 class WorkerPool {
-  public:
+public:
     explicit WorkerPool(int threads); ///< threads ≥ 1 (threads − 1 workers are started)
     ~WorkerPool();
     WorkerPool(const WorkerPool&) = delete;
@@ -25,7 +25,7 @@ class WorkerPool {
             n, [](const void* j, int tid) { (*static_cast<const Job*>(j))(tid); }, &job);
     }
 
-  private:
+private:
     using Trampoline = void (*)(const void*, int);
     void run(int n, Trampoline call, const void* job);
     void workerLoop(int tid);
