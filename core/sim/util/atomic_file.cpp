@@ -13,7 +13,9 @@
 namespace viscera {
 namespace {
 
-std::string errnoText() { return std::strerror(errno); }
+std::string errnoText() {
+    return std::strerror(errno);
+}
 
 void writeAll(int fd, std::string_view bytes, const std::filesystem::path& tmp) {
     size_t done = 0;
@@ -35,7 +37,10 @@ void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes) 
     if (dir.empty()) dir = ".";
     std::error_code ec;
     fs::create_directories(dir, ec);
-    std::string tmpl = (dir / ("." + path.filename().string() + ".tmpXXXXXX")).string();
+    std::string name = ".";
+    name += path.filename().string();
+    name += ".tmpXXXXXX";
+    std::string tmpl = (dir / name).string();
     int fd = ::mkstemp(tmpl.data());
     if (fd < 0) throw InputError(path.string() + ": cannot create a temporary file: " + errnoText());
     fs::path tmp = tmpl;
@@ -61,8 +66,7 @@ void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes) 
     }
 }
 
-std::string readFile(const std::filesystem::path& path, std::uintmax_t maxBytes,
-                     std::string_view limitName) {
+std::string readFile(const std::filesystem::path& path, std::uintmax_t maxBytes, std::string_view limitName) {
     namespace fs = std::filesystem;
     auto fail = [&](const std::string& rule) { throw InputError(path.string() + ": " + rule); };
     auto tooLarge = [&](const std::string& size) { // size: "300000000 bytes, " or ""

@@ -56,13 +56,16 @@ const JsonField& JsonField::object(std::initializer_list<std::string_view> keys)
     anyObject();
     for (auto it = m_value->begin(); it != m_value->end(); ++it) {
         bool known = false;
-        for (std::string_view k : keys) known |= it.key() == k;
+        for (std::string_view k : keys)
+            known |= it.key() == k;
         if (!known) failAt(displayName(it.key()), "unknown field");
     }
     return *this;
 }
 
-bool JsonField::has(std::string_view key) const { return m_value->is_object() && m_value->contains(key); }
+bool JsonField::has(std::string_view key) const {
+    return m_value->is_object() && m_value->contains(key);
+}
 
 JsonField JsonField::operator[](std::string_view key) const {
     anyObject();
@@ -83,12 +86,14 @@ std::vector<JsonField> JsonField::items(size_t minSize, size_t maxSize) const {
     const size_t n = m_value->size();
     if (n < minSize || n > maxSize) {
         if (minSize == maxSize) fail("must have " + std::to_string(minSize) + " elements");
-        if (maxSize == SIZE_MAX) fail(minSize == 1 ? "must not be empty" : "must have at least " + std::to_string(minSize) + " elements");
+        if (maxSize == SIZE_MAX)
+            fail(minSize == 1 ? "must not be empty" : "must have at least " + std::to_string(minSize) + " elements");
         fail("must have " + std::to_string(minSize) + " to " + std::to_string(maxSize) + " elements");
     }
     std::vector<JsonField> out;
     out.reserve(n);
-    for (size_t i = 0; i < n; ++i) out.emplace_back((*m_value)[i], m_path + "[" + std::to_string(i) + "]", *m_origin);
+    for (size_t i = 0; i < n; ++i)
+        out.emplace_back((*m_value)[i], m_path + "[" + std::to_string(i) + "]", *m_origin);
     return out;
 }
 
@@ -138,12 +143,16 @@ std::string JsonField::nonEmptyString() const {
 
 std::string JsonField::choice(std::initializer_list<std::string_view> options, std::string_view what) const {
     std::string list;
-    for (std::string_view o : options) list += (list.empty() ? "" : ", ") + std::string(o);
+    for (std::string_view o : options)
+        list += (list.empty() ? "" : ", ") + std::string(o);
     const std::string s = string();
     for (std::string_view o : options)
         if (s == o) return s;
-    fail("'" + displayName(s) + "' is not " + (what.empty() ? std::string("one of") : std::string(what)) + " (" + list +
-         ")");
+    std::string rule = "'";
+    rule += displayName(s);
+    rule += "' is not ";
+    rule += what.empty() ? std::string_view("one of") : what;
+    fail(rule + " (" + list + ")");
 }
 
 std::string JsonField::entryPath() const {
@@ -160,7 +169,8 @@ Vec3 JsonField::vec3(const NumberRule& rule) const {
 
 std::vector<int32_t> JsonField::indices() const {
     std::vector<int32_t> out;
-    for (const JsonField& e : items()) out.push_back(e.integer(0, INT32_MAX));
+    for (const JsonField& e : items())
+        out.push_back(e.integer(0, INT32_MAX));
     return out;
 }
 
@@ -186,12 +196,18 @@ json parseJsonText(std::string_view text, const std::string& origin) {
     std::optional<std::string> repeated;
     json::parser_callback_t track = [&](int, json::parse_event_t event, json& parsed) {
         switch (event) {
-        case json::parse_event_t::object_start: open.emplace_back(); break;
-        case json::parse_event_t::object_end: open.pop_back(); break;
-        case json::parse_event_t::key:
-            if (!open.back().insert(parsed.get<std::string>()).second && !repeated) repeated = parsed.get<std::string>();
+        case json::parse_event_t::object_start:
+            open.emplace_back();
             break;
-        default: break;
+        case json::parse_event_t::object_end:
+            open.pop_back();
+            break;
+        case json::parse_event_t::key:
+            if (!open.back().insert(parsed.get<std::string>()).second && !repeated)
+                repeated = parsed.get<std::string>();
+            break;
+        default:
+            break;
         }
         return true;
     };
