@@ -167,6 +167,8 @@ StiffnessPaintProject readPaint(const JsonField& j) {
     p.params.baseWeight = j.number("base_weight", p.params.baseWeight, NumberRule::positive());
     p.params.minWeight = j.number("min_weight", p.params.minWeight, NumberRule::positive());
     p.params.maxWeight = j.number("max_weight", p.params.maxWeight, NumberRule::positive());
+    if (!(p.params.minWeight <= p.params.baseWeight && p.params.baseWeight <= p.params.maxWeight))
+        j.fail("min_weight <= base_weight <= max_weight must hold"); // the rule of sim::bakeStiffnessPaint, at load
     p.params.origin = j.origin() + ": " + j.path();
     const std::vector<JsonField> strokes = j["strokes"].items(1);
     for (size_t k = 0; k < strokes.size(); ++k) {

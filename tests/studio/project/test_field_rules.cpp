@@ -212,6 +212,16 @@ TEST_F(FieldRules, NegativeStretchStiffnessIsRefusedAtLoadNotAtExport) {
     EXPECT_EQ(sceneError(scene.dump()), "scene.json: surfaces[0].stretch_stiffness: must not be negative");
 }
 
+TEST_F(FieldRules, PaintWeightsAreOrderedAtLoad) {
+    json doc = copySample("rectum");
+    doc["bodies"][0]["stiffness_paint"]["min_weight"] = 2;
+    EXPECT_EQ(loadError(doc.dump(1)),
+              (m_dir / "project.json").string() +
+                  ": bodies[0].stiffness_paint: min_weight <= base_weight <= max_weight must hold");
+    doc["bodies"][0]["stiffness_paint"]["min_weight"] = 0.5;
+    EXPECT_EQ(loadError(doc.dump(1)), "accepted");
+}
+
 TEST_F(FieldRules, ProjectAndSceneShareTheRangeOfEverySharedField) {
     // A shared field refused in one file with a rule is refused in the other with the same rule.
     json doc = copySample("liver");
