@@ -36,7 +36,9 @@ TEST(NeedleCurve, PlaneCrossingsAreRootsInOrder) {
             EXPECT_GT(roots[i], a);
             EXPECT_LE(roots[i], b);
             EXPECT_NEAR(n.dot(c.point(roots[i])), d, 1e-12);
-            if (i) EXPECT_LE(roots[i - 1], roots[i]);
+            if (i) {
+                EXPECT_LE(roots[i - 1], roots[i]);
+            }
         }
         // Sign changes of n·s(α) − d on a fine grid are all found.
         int changes = 0;

@@ -85,7 +85,9 @@ int checkEveryNumber(const json& doc, const std::string& file,
         const std::string prefix = file + ": " + leaf.path + ": ";
         const std::string fraction = read(withValue(doc, leaf, "2.5"));
         const bool integer = fraction == prefix + "must be an integer (found number)";
-        if (fraction != "accepted") EXPECT_TRUE(namesTheField(fraction)) << fraction;
+        if (fraction != "accepted") {
+            EXPECT_TRUE(namesTheField(fraction)) << fraction;
+        }
         EXPECT_EQ(read(withValue(doc, leaf, "\"7\"")),
                   prefix + (integer ? "must be an integer (found string)" : "must be a number (found string)"));
         EXPECT_EQ(read(withValue(doc, leaf, "null")),
@@ -96,7 +98,9 @@ int checkEveryNumber(const json& doc, const std::string& file,
         for (const char* raw : {"-5", "1e13", "1e308"}) {
             const std::string why = read(withValue(doc, leaf, raw));
             if (why == "accepted") {
-                if (std::string(raw) == "-5") EXPECT_TRUE(kSigned.count(leaf.key)) << "a negative value passes";
+                if (std::string(raw) == "-5") {
+                    EXPECT_TRUE(kSigned.count(leaf.key)) << "a negative value passes";
+                }
                 continue;
             }
             EXPECT_TRUE(namesTheField(why)) << "value " << raw << ": " << why;
