@@ -35,6 +35,17 @@ constexpr std::string_view kMaxFileBytesName = "ImportOptions::maxFileBytes";
     throw InputError(label + ": " + message);
 }
 
+/// The bytes of a mesh file for the format checks: a regular file only (a FIFO or device would
+/// be read here and then again, differently, by assimp), at most `maxBytes`.
+std::string readMeshBytes(const std::filesystem::path& file, std::uintmax_t maxBytes) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(file, ec);
+    if (std::filesystem::exists(status) && !std::filesystem::is_directory(status) &&
+        !std::filesystem::is_regular_file(status))
+        fail(file.string(), "is not a regular file");
+    return readFile(file, maxBytes, kMaxFileBytesName); // missing, directory, size: its messages
+}
+
 std::string meshName(const aiMesh* mesh, unsigned index) {
     std::string s = "mesh " + std::to_string(index);
     if (mesh->mName.length > 0) s += " ('" + std::string(mesh->mName.C_Str()) + "')";
@@ -205,7 +216,7 @@ std::span<const std::string_view> acceptedExtensions() {
 
 SurfaceFormat detectSurfaceFormat(const std::filesystem::path& file) {
     const std::string label = file.string();
-    const std::string bytes = readFile(file, ImportOptions{}.maxFileBytes, kMaxFileBytesName);
+    const std::string bytes = readMeshBytes(file, ImportOptions{}.maxFileBytes);
     return detail::sniffFormat(label, detail::lowerExtension(file), bytes);
 }
 
@@ -219,7 +230,7 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file, const Im
         // The bytes are only needed for the checks; release them before assimp reads the file.
         const std::string ext = detail::lowerExtension(file);
         detail::checkExtension(label, ext); // before reading a file that is rejected anyway
-        const std::string bytes = readFile(file, options.maxFileBytes, kMaxFileBytesName);
+        const std::string bytes = readMeshBytes(file, options.maxFileBytes);
         report.format = detail::sniffFormat(label, ext, bytes);
         detail::checkStructure(label, report.format, bytes);
     }

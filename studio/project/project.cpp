@@ -265,12 +265,13 @@ Project loadProject(const std::filesystem::path& dir) {
         }
     if (auto in = root.find("interaction")) scene.interaction = readInteractionProject(*in, dir);
     // Cross-references (embedding cages, interaction names) are checked now, before any meshing.
-    sim::SceneDesc whole = scene;
+    std::vector<const sim::BodyDesc*> bodies;
     for (const BodyProject& b : p.bodies)
-        whole.bodies.push_back(b.scene);
+        bodies.push_back(&b.scene);
+    std::vector<const sim::SurfaceDesc*> surfaces;
     for (const SurfaceProject& s : p.surfaces)
-        whole.surfaces.push_back(s.scene);
-    sim::checkSceneReferences(whole, origin);
+        surfaces.push_back(&s.scene);
+    sim::checkSceneReferences(bodies, surfaces, scene.interaction ? &*scene.interaction : nullptr, origin);
     return p;
 }
 

@@ -18,7 +18,7 @@
 ///          | {"generator": "hollow_tube", "start": [..], "end": [..], "inner_radius": 0.0038,
 ///             "outer_radius": 0.005, "slices": 33, "layers": 2, "rings": 8}   (structured, no CGAL)
 ///          | {"file": "liver.obj", "scale": 0.001, "meshing": {..}},
-///     "material": {see core/sim/scene/material_json.hpp},
+///     "material": {see readMaterial in core/sim/scene/scene_json.hpp},
 ///     "fixed": {"min": [..], "max": [..]},     nodes inside this box (metres) are fixed
 ///     "stiffness_regions": [{"min": [..], "max": [..], "weight": 4}],
 ///     "stiffness_paint": {"skeleton": {"min_edge_length_rel": 0.002, "medially_centered": true},

@@ -85,11 +85,11 @@ std::vector<Vec3> FemSceneSolver::gaugePositions() const {
     return x;
 }
 
-SolverStep FemSceneSolver::step(const FrameClock& clock) {
+StepStats FemSceneSolver::step(const FrameClock& clock) {
     NeedleFrame frame = m_trajectory[std::min<size_t>(static_cast<size_t>(clock.frame), m_trajectory.size() - 1)];
     if (!m_thread) frame.pull = 0;
     m_last = m_suture->step(frame);
-    SolverStep rec;
+    StepStats rec;
     rec.substeps = 1;
     rec.iterations = m_last.solves;
     const auto& x = m_suture->positions();

@@ -19,7 +19,7 @@ public:
     static std::unique_ptr<FemSceneSolver> create(const SceneSolverInputs& in);
     ~FemSceneSolver() override;
 
-    SolverStep step(const FrameClock& clock) override;
+    StepStats step(const FrameClock& clock) override;
     bool recordFrame(const FrameClock& clock) override;
     void sampleAccuracy(const FrameClock&, std::vector<AccuracyRecord>&) override {} // rejected at create()
     const std::vector<Vec3>& positions(size_t body) const override { return m_bodyX[body]; }

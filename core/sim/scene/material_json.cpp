@@ -1,5 +1,3 @@
-#include "sim/scene/material_json.hpp"
-
 #include "sim/scene/scene_json.hpp"
 #include "sim/util/error.hpp"
 
@@ -74,15 +72,6 @@ json materialJson(const Material& m) {
         j["curves"] = c;
     }
     return j;
-}
-
-Material parseMaterial(std::string_view text, const std::string& origin) {
-    const json doc = parseJsonText(text, origin);
-    return readMaterial(JsonField(doc, "material", origin));
-}
-
-std::string formatMaterial(const Material& m) {
-    return materialJson(m).dump();
 }
 
 } // namespace viscera::sim

@@ -3,6 +3,7 @@
 #include "sim/scene/scene_json.hpp"
 #include "sim/util/error.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 
@@ -87,7 +88,6 @@ void readSolver(const JsonField& doc, SceneDesc& scene) {
         s.gravity = g->vec3();
         if (s.gravity.norm() > L::maxGravity) g->fail("must be at most 1000 m/s^2 in magnitude");
     }
-    if (auto why = validate(s); !why.empty()) solver.fail(why); // unreachable with the ranges above
 }
 
 std::optional<AccuracySampling> readAccuracy(const JsonField& doc) {
@@ -126,29 +126,21 @@ void readSurfaceCommon(const JsonField& sj, SurfaceDesc& sd, std::set<std::strin
     sd.attachCompliance = sj.number("attach_compliance", sd.attachCompliance, NumberRule::nonNegative());
 }
 
-void checkSceneReferences(const SceneDesc& scene, const std::string& origin) {
-    auto fail = [&](const std::string& field, const std::string& rule) {
-        throw InputError(origin + ": " + field + ": " + rule);
-    };
-    auto isBody = [&](const std::string& n) {
-        for (const BodyDesc& b : scene.bodies)
-            if (b.name == n) return true;
-        return false;
-    };
-    for (size_t i = 0; i < scene.bodies.size(); ++i) {
-        const BodyDesc& b = scene.bodies[i];
-        if (!b.embeddedIn.empty() && (!isBody(b.embeddedIn) || b.embeddedIn == b.name))
-            fail("bodies[" + std::to_string(i) + "].embedded_in",
-                 "'" + b.embeddedIn + "' is not another body of the scene");
+void checkSceneReferences(const std::vector<const BodyDesc*>& bodies, const std::vector<const SurfaceDesc*>& surfaces,
+                          const InteractionDesc* interaction, const std::string& origin) {
+    std::vector<std::string> bodyNames, surfaceNames;
+    for (const BodyDesc* b : bodies)
+        bodyNames.push_back(b->name);
+    for (const SurfaceDesc* s : surfaces)
+        surfaceNames.push_back(s->name);
+    for (size_t i = 0; i < bodies.size(); ++i) {
+        const std::string& cage = bodies[i]->embeddedIn;
+        if (!cage.empty() &&
+            (cage == bodies[i]->name || std::find(bodyNames.begin(), bodyNames.end(), cage) == bodyNames.end()))
+            throw InputError(origin + ": bodies[" + std::to_string(i) + "].embedded_in: '" + cage +
+                             "' is not another body of the scene");
     }
-    if (scene.interaction) {
-        std::vector<std::string> bodies, surfaces;
-        for (const BodyDesc& b : scene.bodies)
-            bodies.push_back(b.name);
-        for (const SurfaceDesc& s : scene.surfaces)
-            surfaces.push_back(s.name);
-        checkInteractionNames(*scene.interaction, bodies, surfaces, origin);
-    }
+    if (interaction) checkInteractionNames(*interaction, bodyNames, surfaceNames, origin);
 }
 
 SceneDesc parseScene(std::string_view text, const std::string& origin) {
@@ -199,7 +191,13 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
         }
     if (auto t = root.find("tools")) scene.tools = readTools(*t, names);
     if (auto in = root.find("interaction")) scene.interaction = readInteractionSection(*in);
-    checkSceneReferences(scene, origin);
+    std::vector<const BodyDesc*> bodies;
+    for (const BodyDesc& b : scene.bodies)
+        bodies.push_back(&b);
+    std::vector<const SurfaceDesc*> surfaces;
+    for (const SurfaceDesc& s : scene.surfaces)
+        surfaces.push_back(&s);
+    checkSceneReferences(bodies, surfaces, scene.interaction ? &*scene.interaction : nullptr, origin);
     return scene;
 }
 

@@ -10,7 +10,7 @@
 ///   "instructions": "Watch the slab settle under gravity.",
 ///   "accuracy": {"every_frames": 60, "max_iterations": 100},          optional
 ///   "bodies": [{"name": "organ", "mesh": "meshes/organ.vtet",
-///               "material": {...see material_json.hpp...},
+///               "material": {...see scene_json.hpp, readMaterial...},
 ///               "fixed_nodes": [0, 1, 2],
 ///               "node_weights": [1.0, ...],                            optional, one per node
 ///               "node_weights_file": "meshes/organ.vweights",         optional, instead

@@ -28,9 +28,23 @@ void readBodyCommon(const JsonField& body, BodyDesc& out, std::set<std::string>&
 /// The surface fields both files carry: name, areal_density, stretch_stiffness,
 /// attach_distance, attach_compliance.
 void readSurfaceCommon(const JsonField& surface, SurfaceDesc& out, std::set<std::string>& names);
-/// Cross-references: embedded_in and attach_to name other bodies, interaction names.
-void checkSceneReferences(const SceneDesc& scene, const std::string& origin);
+/// Cross-references: every embedded_in names another body; the interaction's clip targets and
+/// tissue layers name bodies or surfaces (checkInteractionNames). Non-owning views, so that the
+/// studio checks its bodies without copying them into a scene.
+void checkSceneReferences(const std::vector<const BodyDesc*>& bodies, const std::vector<const SurfaceDesc*>& surfaces,
+                          const InteractionDesc* interaction, const std::string& origin);
 
+/// The "material" object (material_json.cpp):
+///
+///   {"model": "stable_neo_hookean" | "neo_hookean" | "linear" | "st_venant_kirchhoff" |
+///             "corotated" | "valanis_landel",
+///    "youngs_modulus": 3000, "poisson_ratio": 0.45, "density": 1050,
+///    "curves": {"preset": "neo_hookean"}                              (valanis_landel only)
+///           | {"f_prime": {"points": [[0.5, -900], [1, 0], [2, 2400]]},
+///              "h_prime": {"points": [...], "unconstrained": true}}}
+///
+/// Ranges: sim::MaterialLimits; the other material rules: sim::validate(Material); curve rules
+/// are checked when the material becomes constraints.
 Material readMaterial(const JsonField& material);
 nlohmann::json materialJson(const Material& m);
 

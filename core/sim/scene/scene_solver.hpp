@@ -9,6 +9,7 @@
 #include "sim/mesh/tet_mesh.hpp"
 #include "sim/mesh/tri_mesh.hpp"
 #include "sim/scene/scene.hpp"
+#include "sim/xpbd/xpbd_settings.hpp"
 
 #include <memory>
 #include <string>
@@ -71,15 +72,6 @@ struct FrameClock {
     double dt = 0;   ///< s, frame length
 };
 
-/// What one step reports to the World's FrameRecord and invariants.
-struct SolverStep {
-    int substeps = 0;
-    int iterations = 0;         ///< per substep (XPBD) or linear solves (FEM)
-    double maxDisplacement = 0; ///< m, largest node displacement in this frame
-    bool finite = true;         ///< false: a non-finite value appeared (and was rolled back)
-    int speedClamps = 0;        ///< node-substeps clamped to the solver's maximum speed
-};
-
 /// What a back-end is built from. The meshes and surfaces are owned by the World and outlive
 /// the solver; meshes[i] belongs to scene.bodies[i], surfaces[s] to scene.surfaces[s].
 struct SceneSolverInputs {
@@ -96,8 +88,10 @@ public:
     SceneSolver(const SceneSolver&) = delete;
     SceneSolver& operator=(const SceneSolver&) = delete;
 
-    /// Advances every body by clock.dt (the part of World::step that is timed). Never throws.
-    virtual SolverStep step(const FrameClock& clock) = 0;
+    /// Advances every body by clock.dt (the part of World::step that is timed) and reports the
+    /// frame's StepStats (sim/xpbd/xpbd_settings.hpp; the FEM gives one substep and its linear
+    /// solves as iterations). Never throws.
+    virtual StepStats step(const FrameClock& clock) = 0;
     /// After step(), untimed: the solver's own per-frame figures (FEM: the suture frame record and
     /// every 10th frame the closure gauge). False when one of them is not finite. Never throws.
     virtual bool recordFrame(const FrameClock& clock) = 0;

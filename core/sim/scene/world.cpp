@@ -46,7 +46,7 @@ FrameRecord World::step() {
     rec.index = m_frame;
     const auto t0 = std::chrono::steady_clock::now();
     if (m_probes) applyTools(false);
-    const SolverStep st = m_solver->step(clock);
+    const StepStats st = m_solver->step(clock);
     if (m_probes) applyTools(true);
     rec.stepMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     rec.substeps = st.substeps;

@@ -98,17 +98,11 @@ std::unique_ptr<XpbdSceneSolver> XpbdSceneSolver::create(const SceneSolverInputs
     return x;
 }
 
-SolverStep XpbdSceneSolver::step(const FrameClock& clock) {
+StepStats XpbdSceneSolver::step(const FrameClock& clock) {
     if (m_interaction) m_interaction->beforeStep(clock.time + clock.dt, clock.dt);
     const StepStats st = m_sys->step();
     if (m_interaction) m_interaction->afterStep();
-    SolverStep r;
-    r.substeps = st.substeps;
-    r.iterations = st.iterations;
-    r.maxDisplacement = st.maxDisplacement;
-    r.finite = st.finite;
-    r.speedClamps = st.speedClamps;
-    return r;
+    return st;
 }
 
 void XpbdSceneSolver::sampleAccuracy(const FrameClock& clock, std::vector<AccuracyRecord>& out) {

@@ -22,7 +22,7 @@ public:
     static std::unique_ptr<XpbdSceneSolver> create(const SceneSolverInputs& in);
     ~XpbdSceneSolver() override;
 
-    SolverStep step(const FrameClock& clock) override;
+    StepStats step(const FrameClock& clock) override;
     bool recordFrame(const FrameClock&) override { return true; }
     void sampleAccuracy(const FrameClock& clock, std::vector<AccuracyRecord>& out) override;
     const std::vector<Vec3>& positions(size_t body) const override { return m_sys->tetPositions(body); }

@@ -75,13 +75,4 @@ json sutureJson(const SutureSceneDesc& d) {
     return doc;
 }
 
-SutureSceneDesc parseSutureSection(std::string_view text, const std::string& origin) {
-    const json doc = parseJsonText(text, origin);
-    return readSutureSection(JsonField(doc, "suture", origin));
-}
-
-std::string formatSutureSection(const SutureSceneDesc& d) {
-    return sutureJson(d).dump();
-}
-
 } // namespace viscera::sim

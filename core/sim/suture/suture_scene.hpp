@@ -29,9 +29,6 @@ struct SutureSceneDesc {
     std::array<std::string, 2> gauge; ///< body names; empty = no closure figures
 };
 
-/// `json` is the text of the section object. Throws viscera::InputError "<origin>: suture.<field>: <rule>".
-SutureSceneDesc parseSutureSection(std::string_view json, const std::string& origin);
-/// The section object as JSON text (parseSutureSection reads it back).
-std::string formatSutureSection(const SutureSceneDesc& desc);
+/// Read and written by readSutureSection / sutureJson (sim/scene/scene_json.hpp).
 
 } // namespace viscera::sim

@@ -84,7 +84,7 @@ TEST(SceneSolver, OneBodyXpbdIsTheXpbdSolverBitForBit) {
         EXPECT_EQ(acc[2 * f].iterations, xpbd.iterations);
         EXPECT_EQ(acc[2 * f].relError, xpbd.relError);
         EXPECT_EQ(acc[2 * f + 1].relError, newton.relError);
-        const SolverStep st = solver->step(clock);
+        const StepStats st = solver->step(clock);
         EXPECT_TRUE(solver->recordFrame(clock));
         const StepStats rs = ref->step();
         EXPECT_EQ(st.substeps, rs.substeps);
@@ -131,7 +131,7 @@ TEST(SceneSolver, LayeredXpbdIsTheXpbdSystemBitForBit) {
     for (int f = 0; f < 3; ++f) {
         const FrameClock clock{f, f * s.xpbd.dt, s.xpbd.dt};
         solver->sampleAccuracy(clock, acc); // not sampled on layered scenes
-        const SolverStep st = solver->step(clock);
+        const StepStats st = solver->step(clock);
         const StepStats rs = ref->step();
         EXPECT_EQ(st.maxDisplacement, rs.maxDisplacement);
         for (size_t b = 0; b < 2; ++b)
@@ -166,7 +166,7 @@ TEST(SceneSolver, FemRunsTheSuturingAndReportsIt) {
     for (int f = 0; f < 12; ++f) {
         const FrameClock clock{f, f * s.xpbd.dt, s.xpbd.dt};
         solver->sampleAccuracy(clock, acc);
-        const SolverStep st = solver->step(clock);
+        const StepStats st = solver->step(clock);
         ASSERT_TRUE(st.finite) << f;
         EXPECT_EQ(st.substeps, 1);
         EXPECT_TRUE(solver->recordFrame(clock));

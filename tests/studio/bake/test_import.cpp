@@ -8,6 +8,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <bit>
@@ -416,6 +417,12 @@ TEST_F(bake_import, MissingFileAndDirectory) {
     EXPECT_THAT(importError(m_dir / "absent.obj"), AllOf(HasSubstr("absent.obj"), HasSubstr("file not found")));
     fs::create_directories(m_dir / "folder.obj");
     EXPECT_THAT(importError(m_dir / "folder.obj"), HasSubstr("is a directory"));
+}
+
+TEST_F(bake_import, FifoIsNotReadAsAMesh) {
+    const fs::path fifo = m_dir / "pipe.obj";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    EXPECT_EQ(importError(fifo), fifo.string() + ": is not a regular file"); // returns at once, no writer needed
 }
 
 TEST_F(bake_import, TooLargeFileIsRejectedBeforeParsing) {
