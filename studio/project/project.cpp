@@ -12,14 +12,19 @@
 #include "sim/skeleton/node_weights_io.hpp"
 #include "sim/suture/anastomosis.hpp"
 #include "sim/util/atomic_file.hpp"
+#include "sim/util/entry_name.hpp"
 #include "sim/util/error.hpp"
 
 #include <algorithm>
 #include <cctype>
 #include <nlohmann/json.hpp>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <set>
+
+#include <unistd.h>
 
 namespace viscera::studio {
 namespace {
@@ -28,6 +33,10 @@ using nlohmann::json;
 using sim::JsonField;
 using sim::NumberRule;
 
+json vec3Json(const sim::Vec3& v) {
+    return {v.x(), v.y(), v.z()};
+}
+
 std::array<sim::Vec3, 2> readBox(const JsonField& f) {
     f.object({"min", "max"});
     const sim::Vec3 lo = f["min"].vec3(), hi = f["max"].vec3();
@@ -35,10 +44,32 @@ std::array<sim::Vec3, 2> readBox(const JsonField& f) {
     return {lo, hi};
 }
 
+json boxJson(const std::array<sim::Vec3, 2>& box) {
+    return {{"min", vec3Json(box[0])}, {"max", vec3Json(box[1])}};
+}
+
 /// A file of the project folder: a relative path by the entry-name rule (no '..', not
 /// absolute), so that nothing outside the folder the user gave is read.
 std::filesystem::path projectFile(const JsonField& f, const std::filesystem::path& dir) {
     return dir / f.entryPath();
+}
+
+/// Where the writers of project.json report to: the file and the project folder.
+struct WriteContext {
+    std::filesystem::path dir;
+    std::string origin; ///< <dir>/project.json
+};
+
+/// The project.json form of a file of the project (projectFile's inverse): `file` relative to
+/// the project folder. Lexical, so that dir / "a/b.obj" gives back "a/b.obj" exactly.
+std::string projectFileJson(const std::filesystem::path& file, const WriteContext& w, const std::string& field) {
+    namespace fs = std::filesystem;
+    const fs::path base = fs::absolute(w.dir.empty() ? fs::path(".") : w.dir).lexically_normal();
+    const std::string rel = fs::absolute(file).lexically_normal().lexically_relative(base).generic_string();
+    if (rel.empty() || sim::entryNameProblem(rel))
+        throw InputError(w.origin + ": " + field + ": '" + file.string() + "' is not inside the project folder '" +
+                         w.dir.string() + "'");
+    return rel;
 }
 
 bake::MeshingParams readMeshing(const JsonField& mesh) {
@@ -53,6 +84,15 @@ bake::MeshingParams readMeshing(const JsonField& mesh) {
     p.cellSize = m->number("cell_size", p.cellSize, NumberRule::positive());
     p.seed = static_cast<unsigned>(m->integer("seed", static_cast<int>(p.seed), 0, 1 << 30));
     return p;
+}
+
+/// The sizes are written when set (0 = derived from the surface, absent in the file).
+json meshingJson(const bake::MeshingParams& p) {
+    json j = {{"facet_angle", p.facetAngleDeg}, {"cell_radius_edge_ratio", p.cellRadiusEdgeRatio}, {"seed", p.seed}};
+    if (p.facetSize > 0) j["facet_size"] = p.facetSize;
+    if (p.facetDistance > 0) j["facet_distance"] = p.facetDistance;
+    if (p.cellSize > 0) j["cell_size"] = p.cellSize;
+    return j;
 }
 
 sim::Vec3 positiveVec3(const JsonField& f, const char* rule) {
@@ -121,36 +161,109 @@ MeshSource readMeshSource(const JsonField& m, const std::filesystem::path& dir) 
     return s;
 }
 
+json meshSourceJson(const MeshSource& s, const WriteContext& w, const std::string& field) {
+    using K = MeshSource::Kind;
+    switch (s.kind) {
+    case K::File:
+        return {{"file", projectFileJson(s.file, w, field + ".file")},
+                {"scale", s.scale},
+                {"meshing", meshingJson(s.meshing)}};
+    case K::Box:
+        return {{"generator", "box"},
+                {"origin", vec3Json(s.box.origin)},
+                {"size", vec3Json(s.box.size)},
+                {"cells", s.box.cells}};
+    case K::Ellipsoid:
+        return {{"generator", "ellipsoid"}, {"center", vec3Json(s.center)}, {"radii", vec3Json(s.radii)},
+                {"slices", s.slices},       {"stacks", s.stacks},           {"meshing", meshingJson(s.meshing)}};
+    case K::Liver:
+        return {{"generator", "liver"},
+                {"center", vec3Json(s.center)},
+                {"half_size", vec3Json(s.radii)},
+                {"wedge", s.wedge},
+                {"slices", s.slices},
+                {"stacks", s.stacks},
+                {"meshing", meshingJson(s.meshing)}};
+    case K::Tube:
+        return {{"generator", "tube"},
+                {"start", vec3Json(s.center)},
+                {"end", vec3Json(s.end)},
+                {"radius", s.radius},
+                {"slices", s.slices},
+                {"rings", s.stacks},
+                {"meshing", meshingJson(s.meshing)}};
+    case K::HollowTube:
+        return {{"generator", "hollow_tube"},
+                {"start", vec3Json(s.hollow.start)},
+                {"end", vec3Json(s.hollow.end)},
+                {"inner_radius", s.hollow.innerRadius},
+                {"outer_radius", s.hollow.outerRadius},
+                {"slices", s.hollow.slices},
+                {"layers", s.hollow.layers},
+                {"rings", s.hollow.rings}};
+    }
+    throw InputError(w.origin + ": " + field + ": unknown mesh source");
+}
+
+/// {"generator": "anastomosis", ...}: the trajectory fields of the spec.
+sim::AnastomosisSpec readAnastomosisTrajectory(const JsonField& t) {
+    t["generator"].choice({"anastomosis"}, "a known generator");
+    t.object({"generator", "stitches", "needle_radius", "needle_centre", "degrees_per_frame", "transfer_frames",
+              "transfer_distance", "pull_frames", "pull_per_segment", "slack"});
+    sim::AnastomosisSpec a;
+    a.stitches = t.integer("stitches", a.stitches, 1, 64);
+    a.needleRadius = t.number("needle_radius", a.needleRadius, NumberRule::positive());
+    a.needleCentre = t.number("needle_centre", a.needleCentre, NumberRule::positive());
+    a.degreesPerFrame = t.number("degrees_per_frame", a.degreesPerFrame, NumberRule::aboveUpTo(0, 90));
+    a.transferFrames = t.integer("transfer_frames", a.transferFrames, 1, 10000);
+    a.transferDistance = t.number("transfer_distance", a.transferDistance, NumberRule::positive());
+    a.pullFrames = t.integer("pull_frames", a.pullFrames, 1, 100000);
+    a.pullPerSegment = t.number("pull_per_segment", a.pullPerSegment, NumberRule::positive());
+    a.slack = t.number("slack", a.slack);
+    return a;
+}
+
+json anastomosisTrajectoryJson(const sim::AnastomosisSpec& a) {
+    return {{"generator", "anastomosis"},
+            {"stitches", a.stitches},
+            {"needle_radius", a.needleRadius},
+            {"needle_centre", a.needleCentre},
+            {"degrees_per_frame", a.degreesPerFrame},
+            {"transfer_frames", a.transferFrames},
+            {"transfer_distance", a.transferDistance},
+            {"pull_frames", a.pullFrames},
+            {"pull_per_segment", a.pullPerSegment},
+            {"slack", a.slack}};
+}
+
 /// The suture section: the scene's section (sim::readSutureSection) whose trajectory is
 /// generated (anastomosis) or read from a project file, checked, and exported as
-/// tools/needle.traj.
-sim::SutureSceneDesc readSutureProject(const JsonField& su, const std::filesystem::path& dir) {
+/// tools/needle.traj. `source` keeps where it came from.
+sim::SutureSceneDesc readSutureProject(const JsonField& su, const std::filesystem::path& dir,
+                                       TrajectorySource& source) {
     sim::SutureSceneDesc d = sim::readSutureSection(su, /*readTrajectory=*/false);
     const JsonField t = su["trajectory"];
     t.anyObject();
+    source = {};
     if (auto file = t.find("file")) {
         t.object({"file"});
-        const std::filesystem::path path = projectFile(*file, dir);
-        d.trajectoryText = readFile(path);
-        sim::parseTrajectory(d.trajectoryText, path.string()); // checked now, not in the player
+        source.file = projectFile(*file, dir);
+        d.trajectoryText = readFile(source.file);
+        sim::parseTrajectory(d.trajectoryText, source.file.string()); // checked now, not in the player
     } else {
-        t["generator"].choice({"anastomosis"}, "a known generator");
-        t.object({"generator", "stitches", "needle_radius", "needle_centre", "degrees_per_frame", "transfer_frames",
-                  "transfer_distance", "pull_frames", "pull_per_segment", "slack"});
-        sim::AnastomosisSpec a;
-        a.stitches = t.integer("stitches", a.stitches, 1, 64);
-        a.needleRadius = t.number("needle_radius", a.needleRadius, NumberRule::positive());
-        a.needleCentre = t.number("needle_centre", a.needleCentre, NumberRule::positive());
-        a.degreesPerFrame = t.number("degrees_per_frame", a.degreesPerFrame, NumberRule::aboveUpTo(0, 90));
-        a.transferFrames = t.integer("transfer_frames", a.transferFrames, 1, 10000);
-        a.transferDistance = t.number("transfer_distance", a.transferDistance, NumberRule::positive());
-        a.pullFrames = t.integer("pull_frames", a.pullFrames, 1, 100000);
-        a.pullPerSegment = t.number("pull_per_segment", a.pullPerSegment, NumberRule::positive());
-        a.slack = t.number("slack", a.slack);
-        d.trajectoryText = sim::formatTrajectory(sim::makeAnastomosisTrajectory(a));
+        source.generator = readAnastomosisTrajectory(t);
+        d.trajectoryText = sim::formatTrajectory(sim::makeAnastomosisTrajectory(*source.generator));
     }
     d.trajectoryPath = "tools/needle.traj";
     return d;
+}
+
+/// The scene's suture section (sim::sutureJson) with the project's "trajectory".
+json sutureProjectJson(const sim::SutureSceneDesc& d, const TrajectorySource& source, const WriteContext& w) {
+    json j = sim::sutureJson(d);
+    j["trajectory"] = source.generator ? anastomosisTrajectoryJson(*source.generator)
+                                       : json{{"file", projectFileJson(source.file, w, "suture.trajectory.file")}};
+    return j;
 }
 
 StiffnessPaintProject readPaint(const JsonField& j) {
@@ -191,24 +304,60 @@ StiffnessPaintProject readPaint(const JsonField& j) {
     return p;
 }
 
+json paintJson(const StiffnessPaintProject& p) {
+    json strokes = json::array();
+    for (const sim::BrushStroke& s : p.strokes)
+        strokes.push_back({{"center", vec3Json(s.center)},
+                           {"radius", s.radius},
+                           {"amplitude", s.amplitude},
+                           {"scale", s.scale == sim::BrushScale::Peak ? "peak" : "kernel"}});
+    return {{"skeleton",
+             {{"min_edge_length_rel", p.skeleton.minEdgeLengthRel},
+              {"medially_centered", p.skeleton.mediallyCentered},
+              {"max_iterations", p.skeleton.maxIterations}}},
+            {"base_weight", p.params.baseWeight},
+            {"min_weight", p.params.minWeight},
+            {"max_weight", p.params.maxWeight},
+            {"strokes", strokes}};
+}
+
 /// The interaction section (sim::readInteractionSection): every instrument's track is read from
-/// a project file, checked, and exported as tools/<instrument>.track.
-sim::InteractionDesc readInteractionProject(const JsonField& section, const std::filesystem::path& dir) {
+/// a project file (kept in `trackFiles`), checked, and exported as tools/<instrument>.track.
+sim::InteractionDesc readInteractionProject(const JsonField& section, const std::filesystem::path& dir,
+                                            std::vector<std::filesystem::path>& trackFiles) {
     sim::InteractionDesc d = sim::readInteractionSection(section);
+    trackFiles.clear();
     for (sim::InstrumentDesc& in : d.instruments) {
-        in.trackText = readFile(dir / in.trackPath);
-        sim::InstrumentTrack::parse(in.trackText, (dir / in.trackPath).string()); // checked now, not in the player
+        const std::filesystem::path file = dir / in.trackPath;
+        in.trackText = readFile(file);
+        sim::InstrumentTrack::parse(in.trackText, file.string()); // checked now, not in the player
         in.trackPath = "tools/" + in.name + ".track";
+        trackFiles.push_back(file);
     }
     return d;
+}
+
+/// The scene's interaction section (sim::interactionJson) with the project's track files.
+json interactionProjectJson(sim::InteractionDesc d, const std::vector<std::filesystem::path>& trackFiles,
+                            const WriteContext& w) {
+    if (trackFiles.size() != d.instruments.size())
+        throw std::invalid_argument("studio::projectJsonText(): " + std::to_string(d.instruments.size()) +
+                                    " instruments but " + std::to_string(trackFiles.size()) + " track files");
+    for (size_t i = 0; i < d.instruments.size(); ++i)
+        d.instruments[i].trackPath =
+            projectFileJson(trackFiles[i], w, "interaction.instruments[" + std::to_string(i) + "].track");
+    return sim::interactionJson(d);
 }
 
 } // namespace
 
 Project loadProject(const std::filesystem::path& dir) {
     const std::filesystem::path file = dir / "project.json";
-    const std::string origin = file.string();
-    const json doc = sim::parseJsonText(readFile(file), origin);
+    return loadProjectText(readFile(file), dir, file.string());
+}
+
+Project loadProjectText(const std::string& text, const std::filesystem::path& dir, const std::string& origin) {
+    const json doc = sim::parseJsonText(text, origin);
     const JsonField root(doc, "", origin);
     root.object({"schemaVersion", "caseId", "caseVersion", "title", "instructions", "solver", "gravity", "bodies",
                  "surfaces", "accuracy", "render", "suture", "interaction"});
@@ -222,7 +371,7 @@ Project loadProject(const std::filesystem::path& dir) {
     // The scene part: the same readers as the player's scene.json.
     sim::SceneDesc& scene = p.scene;
     sim::readSolver(root, scene);
-    if (auto su = root.find("suture")) scene.suture = readSutureProject(*su, dir);
+    if (auto su = root.find("suture")) scene.suture = readSutureProject(*su, dir, p.trajectory);
     if (auto v = root.find("instructions")) scene.instructions = v->string();
     if (auto v = root.find("render")) {
         scene.render = v->anyObject().value().dump();
@@ -263,7 +412,7 @@ Project loadProject(const std::filesystem::path& dir) {
             if (auto r = sj.find("region")) sp.region = readBox(*r);
             p.surfaces.push_back(std::move(sp));
         }
-    if (auto in = root.find("interaction")) scene.interaction = readInteractionProject(*in, dir);
+    if (auto in = root.find("interaction")) scene.interaction = readInteractionProject(*in, dir, p.trackFiles);
     // Cross-references (embedding cages, interaction names) are checked now, before any meshing.
     std::vector<const sim::BodyDesc*> bodies;
     for (const BodyProject& b : p.bodies)
@@ -272,6 +421,91 @@ Project loadProject(const std::filesystem::path& dir) {
     for (const SurfaceProject& s : p.surfaces)
         surfaces.push_back(&s.scene);
     sim::checkSceneReferences(bodies, surfaces, scene.interaction ? &*scene.interaction : nullptr, origin);
+    return p;
+}
+
+std::string projectJsonText(const Project& p) {
+    const WriteContext w{p.dir, (p.dir / "project.json").string()};
+    const sim::SceneDesc& scene = p.scene;
+    json doc = {{"schemaVersion", p.schemaVersion}, {"caseId", p.caseId}, {"caseVersion", p.caseVersion}};
+    if (!p.title.empty()) doc["title"] = p.title;
+    // The scene part: the same writers as the player's scene.json.
+    sim::writeSolver(scene, doc);
+    if (!scene.instructions.empty()) doc["instructions"] = scene.instructions;
+    if (!scene.render.empty()) doc["render"] = json::parse(scene.render);
+    sim::writeAccuracy(scene.accuracy, doc);
+    if (scene.suture) doc["suture"] = sutureProjectJson(*scene.suture, p.trajectory, w);
+    if (scene.interaction) doc["interaction"] = interactionProjectJson(*scene.interaction, p.trackFiles, w);
+
+    doc["bodies"] = json::array();
+    for (size_t i = 0; i < p.bodies.size(); ++i) {
+        const BodyProject& b = p.bodies[i];
+        json j = {{"mesh", meshSourceJson(b.mesh, w, "bodies[" + std::to_string(i) + "].mesh")}};
+        sim::writeBodyCommon(b.scene, j);
+        if (b.fixedBox) j["fixed"] = boxJson(*b.fixedBox);
+        if (!b.stiffnessRegions.empty()) {
+            json regions = json::array();
+            for (const StiffnessRegion& r : b.stiffnessRegions)
+                regions.push_back({{"min", vec3Json(r.min)}, {"max", vec3Json(r.max)}, {"weight", r.weight}});
+            j["stiffness_regions"] = regions;
+        }
+        if (b.paint) j["stiffness_paint"] = paintJson(*b.paint);
+        doc["bodies"].push_back(j);
+    }
+    if (!p.surfaces.empty()) {
+        doc["surfaces"] = json::array();
+        for (const SurfaceProject& s : p.surfaces) {
+            json j = {{"from_boundary_of", s.scene.attachTo}};
+            sim::writeSurfaceCommon(s.scene, j);
+            if (s.region) j["region"] = boxJson(*s.region);
+            doc["surfaces"].push_back(j);
+        }
+    }
+    return doc.dump(2) + "\n";
+}
+
+void saveProject(const Project& project, const std::filesystem::path& dir) {
+    namespace fs = std::filesystem;
+    const fs::path file = dir / "project.json";
+    const std::string text = projectJsonText(project); // before touching the folder: a bad model writes nothing
+    std::error_code ec;
+    const fs::file_status st = fs::status(dir, ec);
+    if (st.type() == fs::file_type::not_found)
+        throw InputError(file.string() + ": cannot save: the folder '" + dir.string() + "' does not exist");
+    if (!fs::is_directory(st))
+        throw InputError(file.string() + ": cannot save: '" + dir.string() + "' is not a folder");
+    if (::access(dir.c_str(), W_OK | X_OK) != 0)
+        throw InputError(file.string() + ": cannot save: the folder is not writable (" + std::strerror(errno) + ")");
+    writeFileAtomic(file, text);
+}
+
+Project newProject(const std::filesystem::path& dir, const std::string& caseId) {
+    const std::string origin = (dir / "project.json").string();
+    Project p;
+    p.dir = dir;
+    p.caseId = vcase::readCaseId(JsonField(json(caseId), "caseId", origin));
+    p.caseVersion = "1.0.0";
+    p.title = caseId;
+    sim::SceneDesc& scene = p.scene;
+    scene.solverType = "xpbd";
+    scene.xpbd.dt = 1.0 / 60.0;
+    scene.xpbd.substeps = 40; // the load-time stability check asks for at least 32 (E 3000 Pa, 5 mm cells)
+    scene.xpbd.iterations = 1;
+    scene.xpbd.damping = 2.0;
+    scene.xpbd.gravity = sim::Vec3(0, 0, -9.81);
+
+    BodyProject body;
+    body.scene.name = "tissue";
+    body.scene.material.model = sim::MaterialModel::StableNeoHookean;
+    body.scene.material.youngsModulus = 3000;
+    body.scene.material.poissonRatio = 0.45;
+    body.scene.material.density = 1050;
+    body.mesh.kind = MeshSource::Kind::Box;
+    body.mesh.box.origin = sim::Vec3::Zero();
+    body.mesh.box.size = sim::Vec3(0.1, 0.02, 0.04);
+    body.mesh.box.cells = {20, 4, 8};
+    body.fixedBox = std::array<sim::Vec3, 2>{sim::Vec3(-0.001, -0.001, -0.001), sim::Vec3(0.0001, 0.021, 0.041)};
+    p.bodies.push_back(std::move(body));
     return p;
 }
 

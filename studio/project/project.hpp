@@ -38,6 +38,8 @@
 /// }
 /// The suture trajectory is generated (or read and checked) at load and exported as
 /// tools/needle.traj; instrument tracks are checked at load and exported as tools/<name>.track.
+/// Every file reference ("file" of a mesh or trajectory, "track") is a path relative to the
+/// project folder: no '..', not absolute (sim/util/entry_name.hpp).
 /// "meshing" (CGAL Mesh_3, metres and degrees): facet_angle, facet_size, facet_distance,
 /// cell_radius_edge_ratio, cell_size, seed.
 #include "bake/skeleton.hpp"
@@ -48,6 +50,7 @@
 #include "sim/scene/interaction.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/skeleton/stiffness_paint.hpp"
+#include "sim/suture/anastomosis.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
 
 #include <filesystem>
@@ -68,7 +71,7 @@ struct MeshSource {
     double radius = 0.005;                                                   ///< tube radius, m
     double wedge = 0.5;                                                      ///< liver thickness ratio
     int slices = 48, stacks = 24;
-    std::filesystem::path file; ///< absolute, resolved against the project folder
+    std::filesystem::path file; ///< Kind::File: resolved against the project folder (dir / "file")
     double scale = 1.0;
     bake::MeshingParams meshing;
 };
@@ -106,10 +109,28 @@ struct SurfaceProject {
     std::optional<std::array<sim::Vec3, 2>> region;
 };
 
+/// Where the suture's needle trajectory comes from ("suture.trajectory" of project.json): the
+/// anastomosis generator with its spec, or else a trajectory file of the project.
+struct TrajectorySource {
+    /// {"generator": "anastomosis", ...}: the trajectory fields of the spec (stitches, needle_radius,
+    /// needle_centre, degrees_per_frame, transfer_frames, transfer_distance, pull_frames,
+    /// pull_per_segment, slack); the tube fields of AnastomosisSpec are not part of project.json.
+    std::optional<sim::AnastomosisSpec> generator;
+    std::filesystem::path file; ///< {"file": ...} when no generator: resolved against the project folder
+};
+
 /// The project model the studio edits and exports: the scene description the player reads
-/// (`scene`: solver, gravity, accuracy, render, suture with its trajectory text, interaction
-/// with its track texts; its bodies and surfaces live in `bodies` / `surfaces` with their
-/// authoring settings) plus the case header.
+/// (`scene`: solver, gravity, accuracy, render, instructions, suture with its trajectory text,
+/// interaction with its track texts; its bodies and surfaces live in `bodies` / `surfaces` with
+/// their authoring settings) plus the case header and where the project's files come from.
+///
+/// Files of the project are held resolved against `dir` (dir / <path in project.json>):
+/// MeshSource::file, TrajectorySource::file and trackFiles. projectJsonText writes them back
+/// relative to `dir`, so a path must lie inside `dir`. The texts derived from files and
+/// generators (scene.suture->trajectoryText, the instruments' trackText) are filled at load and
+/// are what exportCase packages, under the case paths of `scene` (tools/needle.traj,
+/// tools/<instrument>.track); loadProjectText(projectJsonText(p), ...) refreshes them after an
+/// edit of their source.
 struct Project {
     std::filesystem::path dir;
     int schemaVersion = 1;
@@ -117,10 +138,38 @@ struct Project {
     sim::SceneDesc scene; ///< bodies and surfaces empty: see below
     std::vector<BodyProject> bodies;
     std::vector<SurfaceProject> surfaces;
+    TrajectorySource trajectory; ///< when scene.suture is set
+    /// The "track" file of every instrument of scene.interaction, in the same order (one each).
+    std::vector<std::filesystem::path> trackFiles;
 };
 
-/// Reads <dir>/project.json. Throws viscera::InputError.
+/// Reads <dir>/project.json: loadProjectText of the file's text. Throws viscera::InputError.
 Project loadProject(const std::filesystem::path& dir);
+
+/// The project reader on text: `text` is a project.json whose file references resolve against
+/// `dir` (the files are read and checked now); `origin` names the text in every message
+/// ("<origin>: bodies[0].fixed.min: must be an array of 3 numbers"). Throws viscera::InputError.
+Project loadProjectText(const std::string& text, const std::filesystem::path& dir, const std::string& origin);
+
+/// The project.json text of `project`: a JSON object with a 2-space indent, keys sorted (the
+/// same model gives the same bytes), a final newline. Defaults that the file left out are
+/// written explicitly; loadProjectText of the text gives an equal model. File references are
+/// written relative to project.dir. Throws viscera::InputError when a file lies outside
+/// project.dir ("<dir>/project.json: bodies[0].mesh.file: '/x/liver.obj' is not inside the
+/// project folder"), std::invalid_argument when trackFiles does not match the instruments.
+std::string projectJsonText(const Project& project);
+
+/// Writes projectJsonText(project) to <dir>/project.json atomically (a crash leaves the old file
+/// or the new one). `dir` must be an existing, writable folder; file references stay relative to
+/// project.dir (saving into another folder: copy the project's files there with the same layout).
+/// Throws viscera::InputError naming <dir>/project.json; nothing is left behind on failure.
+void saveProject(const Project& project, const std::filesystem::path& dir);
+
+/// The model of File → New: one box body "tissue" (0.1 × 0.02 × 0.04 m, 20 × 4 × 8 cells, stable
+/// Neo-Hookean, E 3000 Pa, ν 0.45, 1050 kg/m³) fixed at its x = 0 end, under gravity, XPBD at
+/// dt 1/60 s with enough substeps for the load-time stability check; case version 1.0.0. Throws
+/// viscera::InputError when `caseId` breaks the case-id rule.
+Project newProject(const std::filesystem::path& dir, const std::string& caseId);
 
 struct BodyExport {
     std::string name;

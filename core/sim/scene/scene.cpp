@@ -37,6 +37,19 @@ TetStrainLimits readStrainLimits(const JsonField& j) {
     return s;
 }
 
+json strainLimitsJson(const TetStrainLimits& s) {
+    json lim = json::array();
+    for (const StrainLimit& l : s.limits) {
+        json j = {{"i", l.i}, {"j", l.j}, {"compliance", l.compliance}};
+        if (std::isfinite(l.lower)) j["lower"] = l.lower; // infinite bounds are written as absent
+        if (std::isfinite(l.upper)) j["upper"] = l.upper;
+        lim.push_back(j);
+    }
+    const Mat3& a = s.axes;
+    return {{"axes", {{a(0, 0), a(1, 0), a(2, 0)}, {a(0, 1), a(1, 1), a(2, 1)}, {a(0, 2), a(1, 2), a(2, 2)}}},
+            {"limits", lim}};
+}
+
 std::vector<ToolDesc> readTools(const JsonField& tools, std::set<std::string>& names) {
     std::vector<ToolDesc> out;
     const std::vector<JsonField> list = tools.items();
@@ -58,10 +71,6 @@ std::vector<ToolDesc> readTools(const JsonField& tools, std::set<std::string>& n
         out.push_back(d);
     }
     return out;
-}
-
-json limitNumber(double v) {
-    return std::isfinite(v) ? json(v) : json();
 }
 
 } // namespace
@@ -90,6 +99,16 @@ void readSolver(const JsonField& doc, SceneDesc& scene) {
     }
 }
 
+void writeSolver(const SceneDesc& scene, json& doc) {
+    const XpbdSettings& s = scene.xpbd;
+    doc["solver"] = {{"type", scene.solverType},   {"dt", s.dt},           {"substeps", s.substeps},
+                     {"iterations", s.iterations}, {"damping", s.damping}, {"max_speed", s.maxSpeed},
+                     {"threads", s.threads}};
+    if (s.primalCorrection) doc["solver"]["primal_correction"] = true;
+    if (scene.solverType == "fem") doc["solver"] = {{"type", "fem"}, {"dt", s.dt}};
+    doc["gravity"] = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
+}
+
 std::optional<AccuracySampling> readAccuracy(const JsonField& doc) {
     auto a = doc.find("accuracy");
     if (!a) return std::nullopt;
@@ -98,6 +117,11 @@ std::optional<AccuracySampling> readAccuracy(const JsonField& doc) {
     acc.everyFrames = a->integer("every_frames", acc.everyFrames, 1, INT32_MAX);
     acc.maxIterations = a->integer("max_iterations", acc.maxIterations, 1, 10000);
     return acc;
+}
+
+void writeAccuracy(const std::optional<AccuracySampling>& accuracy, json& doc) {
+    if (accuracy)
+        doc["accuracy"] = {{"every_frames", accuracy->everyFrames}, {"max_iterations", accuracy->maxIterations}};
 }
 
 std::string readName(const JsonField& field, std::set<std::string>& names) {
@@ -118,12 +142,29 @@ void readBodyCommon(const JsonField& b, BodyDesc& body, std::set<std::string>& n
     body.embeddingCompliance = b.number("embedding_compliance", body.embeddingCompliance, NumberRule::nonNegative());
 }
 
+void writeBodyCommon(const BodyDesc& desc, json& body) {
+    body["name"] = desc.name;
+    body["material"] = materialJson(desc.material);
+    if (desc.strainLimits) body["strain_limits"] = strainLimitsJson(*desc.strainLimits);
+    if (!desc.embeddedIn.empty()) body["embedded_in"] = desc.embeddedIn;
+    if (!desc.embeddedIn.empty() || desc.embeddingCompliance != 0)
+        body["embedding_compliance"] = desc.embeddingCompliance;
+}
+
 void readSurfaceCommon(const JsonField& sj, SurfaceDesc& sd, std::set<std::string>& names) {
     sd.name = readName(sj["name"], names);
     sd.arealDensity = sj.number("areal_density", sd.arealDensity, NumberRule::positive());
     sd.stretchStiffness = sj.number("stretch_stiffness", sd.stretchStiffness, NumberRule::nonNegative());
     sd.attachDistance = sj.number("attach_distance", sd.attachDistance, NumberRule::positive());
     sd.attachCompliance = sj.number("attach_compliance", sd.attachCompliance, NumberRule::nonNegative());
+}
+
+void writeSurfaceCommon(const SurfaceDesc& desc, json& surface) {
+    surface["name"] = desc.name;
+    surface["areal_density"] = desc.arealDensity;
+    surface["stretch_stiffness"] = desc.stretchStiffness;
+    surface["attach_distance"] = desc.attachDistance;
+    surface["attach_compliance"] = desc.attachCompliance;
 }
 
 void checkSceneReferences(const std::vector<const BodyDesc*>& bodies, const std::vector<const SurfaceDesc*>& surfaces,
@@ -203,63 +244,27 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
 
 json sceneJson(const SceneDesc& scene) {
     json doc;
-    const XpbdSettings& s = scene.xpbd;
-    doc["solver"] = {{"type", scene.solverType},   {"dt", s.dt},           {"substeps", s.substeps},
-                     {"iterations", s.iterations}, {"damping", s.damping}, {"max_speed", s.maxSpeed},
-                     {"threads", s.threads}};
-    if (s.primalCorrection) doc["solver"]["primal_correction"] = true;
-    if (scene.solverType == "fem") doc["solver"] = {{"type", "fem"}, {"dt", s.dt}};
+    writeSolver(scene, doc);
     if (scene.suture) doc["suture"] = sutureJson(*scene.suture);
     if (scene.interaction) doc["interaction"] = interactionJson(*scene.interaction);
-    doc["gravity"] = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
     if (!scene.instructions.empty()) doc["instructions"] = scene.instructions;
     if (!scene.render.empty()) doc["render"] = json::parse(scene.render);
-    if (scene.accuracy)
-        doc["accuracy"] = {{"every_frames", scene.accuracy->everyFrames},
-                           {"max_iterations", scene.accuracy->maxIterations}};
+    writeAccuracy(scene.accuracy, doc);
     doc["bodies"] = json::array();
     for (const BodyDesc& b : scene.bodies) {
-        json j = {{"name", b.name},
-                  {"mesh", b.meshPath},
-                  {"material", materialJson(b.material)},
-                  {"fixed_nodes", b.fixedNodes}};
+        json j = {{"mesh", b.meshPath}, {"fixed_nodes", b.fixedNodes}};
+        writeBodyCommon(b, j);
         if (!b.nodeWeightsPath.empty())
             j["node_weights_file"] = b.nodeWeightsPath;
         else if (!b.nodeWeights.empty())
             j["node_weights"] = b.nodeWeights;
-        if (b.strainLimits) {
-            json lim = json::array();
-            for (const StrainLimit& l : b.strainLimits->limits)
-                lim.push_back({{"i", l.i},
-                               {"j", l.j},
-                               {"lower", limitNumber(l.lower)},
-                               {"upper", limitNumber(l.upper)},
-                               {"compliance", l.compliance}});
-            // Infinite bounds are written as absent.
-            for (auto& l : lim)
-                for (const char* k : {"lower", "upper"})
-                    if (l[k].is_null()) l.erase(k);
-            const Mat3& a = b.strainLimits->axes;
-            j["strain_limits"] = {
-                {"axes", {{a(0, 0), a(1, 0), a(2, 0)}, {a(0, 1), a(1, 1), a(2, 1)}, {a(0, 2), a(1, 2), a(2, 2)}}},
-                {"limits", lim}};
-        }
-        if (!b.embeddedIn.empty()) {
-            j["embedded_in"] = b.embeddedIn;
-            j["embedding_compliance"] = b.embeddingCompliance;
-        }
         doc["bodies"].push_back(j);
     }
     if (!scene.surfaces.empty()) {
         doc["surfaces"] = json::array();
         for (const SurfaceDesc& sd : scene.surfaces) {
-            json j = {{"name", sd.name},
-                      {"mesh", sd.meshPath},
-                      {"areal_density", sd.arealDensity},
-                      {"stretch_stiffness", sd.stretchStiffness},
-                      {"attach_distance", sd.attachDistance},
-                      {"attach_compliance", sd.attachCompliance},
-                      {"fixed_nodes", sd.fixedNodes}};
+            json j = {{"mesh", sd.meshPath}, {"fixed_nodes", sd.fixedNodes}};
+            writeSurfaceCommon(sd, j);
             if (!sd.attachTo.empty()) j["attach_to"] = sd.attachTo;
             doc["surfaces"].push_back(j);
         }

@@ -1,8 +1,9 @@
 #pragma once
 /// The JSON readers and writers of the scene model, one per section, shared by the case's
-/// scene.json (parseScene) and the studio's project.json (studio/project): a field that both
-/// files carry is read by the same function here, so the studio and the player apply one rule.
-/// Every error is "<origin>: <JSON path>: <rule>" (sim/util/json_reader.hpp).
+/// scene.json (parseScene, formatScene) and the studio's project.json (studio/project): a field
+/// that both files carry is read and written by the same pair of functions here, so the studio
+/// and the player apply one rule. Every writer gives back what its reader reads (defaults written
+/// explicitly). Every error is "<origin>: <JSON path>: <rule>" (sim/util/json_reader.hpp).
 ///
 /// Header for .cpp files only (nlohmann::json).
 #include "sim/scene/scene.hpp"
@@ -18,16 +19,24 @@ namespace viscera::sim {
 /// against the ranges of sim/xpbd/xpbd_settings.hpp; also which sections the solver admits
 /// ("suture" with fem only and required there, "interaction" with xpbd only).
 void readSolver(const JsonField& doc, SceneDesc& scene);
+/// Writes "solver" and "gravity" into the document `doc`.
+void writeSolver(const SceneDesc& scene, nlohmann::json& doc);
 std::optional<AccuracySampling> readAccuracy(const JsonField& doc);
+/// Writes "accuracy" into `doc` when `accuracy` is set.
+void writeAccuracy(const std::optional<AccuracySampling>& accuracy, nlohmann::json& doc);
 /// The name rule of bodies, surfaces and tools: 1–64 characters of [A-Za-z0-9_-] (it names the
 /// files of the case), unique among all of them (`names`).
 std::string readName(const JsonField& name, std::set<std::string>& names);
 /// The body fields both files carry: name, material, strain_limits, embedded_in,
 /// embedding_compliance (the caller checks the object's key set).
 void readBodyCommon(const JsonField& body, BodyDesc& out, std::set<std::string>& names);
+/// Writes those fields into the body object `body` (embedding_compliance with embedded_in, or
+/// when not 0).
+void writeBodyCommon(const BodyDesc& desc, nlohmann::json& body);
 /// The surface fields both files carry: name, areal_density, stretch_stiffness,
 /// attach_distance, attach_compliance.
 void readSurfaceCommon(const JsonField& surface, SurfaceDesc& out, std::set<std::string>& names);
+void writeSurfaceCommon(const SurfaceDesc& desc, nlohmann::json& surface);
 /// Cross-references: every embedded_in names another body; the interaction's clip targets and
 /// tissue layers name bodies or surfaces (checkInteractionNames). Non-owning views, so that the
 /// studio checks its bodies without copying them into a scene.
