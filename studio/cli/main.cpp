@@ -1,14 +1,27 @@
 // viscera-studio command line (headless; needs no display).
 //
-//   viscera-studio export <project-dir> -o <case.vcase>
+//   viscera-studio export <project-dir> -o <case.vcase> [--project-file <json>]
 //   viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M] [--facet-size M]
 //                         [-o out.vtet]
+//
+// export --project-file reads the project text from <json> instead of <project-dir>/project.json
+// (its file references still resolve against <project-dir>): the authoring window exports its
+// unsaved model this way, as a child process.
+//
+// Export progress goes to stderr, one line per stage, in a format other programs may parse:
+//
+//   viscera-studio: stage <i>/<n>: <what>      e.g. "viscera-studio: stage 3/9: meshing body 'organ'"
+//
+// <i> counts 1..<n>; <n> is the same on every line of one export (studio::ExportProgress). A
+// failure is one line "viscera-studio: <message>" (no "stage"), exit code 1. The summary goes to
+// stdout.
 //
 // Exit codes: 0 success, 1 bad input (project, mesh), 2 usage.
 #include "bake/import.hpp"
 #include "bake/tetrahedralize.hpp"
 #include "project/project.hpp"
 #include "sim/mesh/tet_io.hpp"
+#include "sim/util/atomic_file.hpp"
 #include "sim/util/cli_main.hpp"
 #include "sim/util/error.hpp"
 
@@ -25,7 +38,7 @@ namespace {
 using namespace viscera;
 
 void usage(std::FILE* out) {
-    std::fputs("usage: viscera-studio export <project-dir> -o <case.vcase>\n"
+    std::fputs("usage: viscera-studio export <project-dir> -o <case.vcase> [--project-file <json>]\n"
                "       viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M]\n"
                "                             [--facet-size M] [-o out.vtet]\n"
                "       viscera-studio --version\n",
@@ -48,11 +61,12 @@ void printQuality(const sim::QualityReport& q) {
 }
 
 int cmdExport(const std::vector<std::string>& args) {
-    std::optional<std::string> dir, out;
+    std::optional<std::string> dir, out, projectFile;
     for (size_t i = 0; i < args.size(); ++i) {
-        if (args[i] == "-o" || args[i] == "--output") {
+        if (args[i] == "-o" || args[i] == "--output" || args[i] == "--project-file") {
             if (i + 1 >= args.size()) throw std::invalid_argument(args[i] + " needs a value");
-            out = args[++i];
+            std::optional<std::string>& value = args[i] == "--project-file" ? projectFile : out;
+            value = args[++i];
         } else if (!args[i].empty() && args[i][0] == '-') {
             throw std::invalid_argument("unknown option '" + args[i] + "'");
         } else if (!dir) {
@@ -63,9 +77,12 @@ int cmdExport(const std::vector<std::string>& args) {
     }
     if (!dir || !out) throw std::invalid_argument("export needs <project-dir> and -o <case.vcase>");
     const auto t0 = std::chrono::steady_clock::now();
-    studio::Project project = studio::loadProject(*dir);
-    studio::ExportResult r = studio::exportCase(
-        project, *out, [](const std::string& stage) { std::fprintf(stderr, "viscera-studio: %s\n", stage.c_str()); });
+    studio::Project project =
+        projectFile ? studio::loadProjectText(readFile(*projectFile), *dir, *projectFile) : studio::loadProject(*dir);
+    studio::ExportResult r =
+        studio::exportCase(project, *out, [](size_t index, size_t total, const std::string& stage) {
+            std::fprintf(stderr, "viscera-studio: stage %zu/%zu: %s\n", index, total, stage.c_str());
+        });
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("exported %s -> %s (%llu bytes, %.2f s)\n", project.caseId.c_str(), r.casePath.c_str(),
                 static_cast<unsigned long long>(r.bytes), secs);

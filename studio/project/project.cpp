@@ -567,8 +567,13 @@ sim::TriMesh cutBoundary(sim::TetMesh& mesh, const std::optional<std::array<sim:
 } // namespace
 
 ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress) {
+    // Stages: meshing per body, paint per painted body, cutting per surface, checking, packaging.
+    size_t total = project.bodies.size() + project.surfaces.size() + 2, done = 0;
+    for (const BodyProject& b : project.bodies)
+        total += b.paint ? 1 : 0;
     auto stage = [&](const std::string& s) {
-        if (progress) progress(s);
+        ++done;
+        if (progress) progress(done, total, s);
     };
     const std::string origin = (project.dir / "project.json").string();
     sim::SceneDesc scene = project.scene; // what the player reads; the bodies follow with their meshes

@@ -184,7 +184,10 @@ struct ExportResult {
     std::vector<BodyExport> bodies;
 };
 
-using ExportProgress = std::function<void(const std::string& stage)>;
+/// Export progress: stage `index` of `total` (1-based; total is fixed for one export) and what it
+/// does ("meshing body 'organ'", "skeleton and stiffness paint of 'fat'", "cutting surface
+/// 'fascia'", "checking the scene", "packaging").
+using ExportProgress = std::function<void(size_t index, size_t total, const std::string& stage)>;
 
 /// Builds every body mesh (generator or import + tetrahedralization), checks its quality (an
 /// inverted or degenerate element is an error naming the body and element), resolves fixed

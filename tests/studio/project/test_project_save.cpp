@@ -195,3 +195,13 @@ TEST(ProjectSave, NewProjectExportsAndSaves) {
         EXPECT_THAT(e.what(), HasSubstr("project.json: caseId:"));
     }
 }
+
+TEST(ProjectSave, ExportReportsNumberedStages) {
+    std::vector<std::string> lines;
+    test::Scratch scratch("viscera-stages");
+    studio::exportCase(studio::loadProject(kProjects / "tissue-slab"), scratch.dir / "slab.vcase",
+                       [&](size_t index, size_t total, const std::string& stage) {
+                           lines.push_back(std::to_string(index) + "/" + std::to_string(total) + " " + stage);
+                       });
+    EXPECT_EQ(lines, (std::vector<std::string>{"1/3 meshing body 'slab'", "2/3 checking the scene", "3/3 packaging"}));
+}

@@ -1,0 +1,84 @@
+// viscera-studio export --project-file: the project text comes from another file, its file
+// references resolve against <project-dir>; the progress lines on stderr are numbered stages.
+#include "case/case_package.hpp"
+#include "sim/util/atomic_file.hpp"
+#include "support/run_process.hpp"
+#include "support/scratch_dir.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace viscera;
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+namespace {
+
+test::ProcessResult studio(const std::vector<std::string>& args) {
+    return test::runProcess(VISCERA_STUDIO_EXE, args);
+}
+
+std::vector<std::string> lines(const std::string& text) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string l; std::getline(in, l);)
+        out.push_back(l);
+    return out;
+}
+
+const char* kProject = R"({
+  "schemaVersion": 1, "caseId": "cube", "caseVersion": "1.0.0", "title": "From the project file",
+  "solver": {"type": "xpbd", "substeps": 100},
+  "bodies": [{"name": "cube",
+              "mesh": {"file": "meshes/cube.obj", "scale": 0.001,
+                       "meshing": {"cell_size": 0.004, "facet_size": 0.004, "seed": 1}},
+              "material": {"model": "stable_neo_hookean", "youngs_modulus": 20000, "poisson_ratio": 0.4,
+                           "density": 1000},
+              "fixed": {"min": [-1, -1, -1], "max": [0.0001, 1, 1]}}]
+})";
+
+} // namespace
+
+TEST(StudioCli, ExportReadsTheProjectFileAndNumbersItsStages) {
+    test::Scratch scratch("viscera-studio-cli");
+    // The project folder holds the mesh but no project.json; the text lies elsewhere.
+    const fs::path dir = scratch.dir / "project";
+    writeFileAtomic(dir / "meshes" / "cube.obj",
+                    "v 0 0 0\nv 10 0 0\nv 0 10 0\nv 10 10 0\nv 0 0 10\nv 10 0 10\nv 0 10 10\nv 10 10 10\n"
+                    "f 1 3 4\nf 1 4 2\nf 5 6 8\nf 5 8 7\nf 1 2 6\nf 1 6 5\nf 3 7 8\nf 3 8 4\nf 1 5 7\nf 1 7 3\n"
+                    "f 2 4 8\nf 2 8 6\n");
+    const fs::path text = scratch.dir / "unsaved" / "edit.json";
+    writeFileAtomic(text, kProject);
+    const fs::path out = scratch.dir / "cube.vcase";
+    auto r = studio({"export", dir.string(), "-o", out.string(), "--project-file", text.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_THAT(r.out, HasSubstr("exported cube -> "));
+    EXPECT_EQ(vcase::CasePackage::open(out)->manifest().title.value_or(""), "From the project file");
+    const std::vector<std::string> progress = lines(r.err);
+    const std::regex stage(R"(viscera-studio: stage (\d+)/3: .+)");
+    ASSERT_EQ(progress.size(), 3u) << r.err;
+    for (size_t i = 0; i < progress.size(); ++i) {
+        std::smatch m;
+        ASSERT_TRUE(std::regex_match(progress[i], m, stage)) << progress[i];
+        EXPECT_EQ(m[1].str(), std::to_string(i + 1));
+    }
+    EXPECT_EQ(progress[0], "viscera-studio: stage 1/3: meshing body 'cube'");
+
+    // Errors name the project file that was given; without it, <project-dir>/project.json is read.
+    writeFileAtomic(text, "{");
+    auto bad = studio({"export", dir.string(), "-o", out.string(), "--project-file", text.string()});
+    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_THAT(bad.err, HasSubstr(text.string() + ": invalid JSON"));
+    auto none = studio({"export", dir.string(), "-o", out.string()});
+    EXPECT_EQ(none.exitCode, 1);
+    EXPECT_THAT(none.err, HasSubstr((dir / "project.json").string() + ": cannot open for reading"));
+    auto usage = studio({"export", dir.string(), "-o", out.string(), "--project-file"});
+    EXPECT_EQ(usage.exitCode, 2);
+    EXPECT_THAT(usage.err, HasSubstr("--project-file needs a value"));
+}
