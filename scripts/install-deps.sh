@@ -17,7 +17,7 @@ PKGS=(
   # rendering, headless EGL on Mesa (llvmpipe)
   libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri mesa-utils libpng-dev
   # Qt6 (studio widgets; the player uses QtGui at most)
-  qt6-base-dev libqt6opengl6-dev
+  qt6-base-dev libqt6opengl6-dev xvfb xauth
   # tests and benchmarks; clang-format for the formatting check (tests/lint)
   libgtest-dev libgmock-dev googletest libbenchmark-dev clang-format
   # peer solver for error-time comparisons

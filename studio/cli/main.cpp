@@ -1,5 +1,7 @@
-// viscera-studio command line (headless; needs no display).
+// viscera-studio: the desktop studio, and the headless authoring commands (no display, no Qt
+// application object).
 //
+//   viscera-studio [open <project-dir>]
 //   viscera-studio export <project-dir> -o <case.vcase> [--project-file <json>]
 //   viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M] [--facet-size M]
 //                         [-o out.vtet]
@@ -17,6 +19,7 @@
 // stdout.
 //
 // Exit codes: 0 success, 1 bad input (project, mesh), 2 usage.
+#include "app/studio_app.hpp"
 #include "bake/import.hpp"
 #include "bake/tetrahedralize.hpp"
 #include "project/project.hpp"
@@ -38,7 +41,8 @@ namespace {
 using namespace viscera;
 
 void usage(std::FILE* out) {
-    std::fputs("usage: viscera-studio export <project-dir> -o <case.vcase> [--project-file <json>]\n"
+    std::fputs("usage: viscera-studio [open <project-dir>]           the desktop studio\n"
+               "       viscera-studio export <project-dir> -o <case.vcase> [--project-file <json>]\n"
                "       viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M]\n"
                "                             [--facet-size M] [-o out.vtet]\n"
                "       viscera-studio --version\n",
@@ -146,13 +150,24 @@ int cmdImport(const std::vector<std::string>& args) {
     return 0;
 }
 
+int g_argc = 0;
+char** g_argv = nullptr;
+
+int cmdOpen(const std::vector<std::string>& args) {
+    if (args.size() != 1) throw std::invalid_argument("open needs one <project-dir>");
+    return studio::runStudio(g_argc, g_argv, QString::fromStdString(args[0]));
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
+    g_argc = argc;
+    g_argv = argv;
     sim::CliProgram program;
     program.name = "viscera-studio";
     program.version = VISCERA_VERSION;
     program.usage = usage;
-    program.subcommands = {{"export", cmdExport}, {"import", cmdImport}};
-    return sim::runCli(program, argc, argv); // no arguments: usage (later: the authoring window)
+    program.subcommands = {{"export", cmdExport}, {"import", cmdImport}, {"open", cmdOpen}};
+    program.noArguments = [] { return studio::runStudio(g_argc, g_argv, {}); };
+    return sim::runCli(program, argc, argv);
 }

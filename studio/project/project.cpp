@@ -566,21 +566,27 @@ sim::TriMesh cutBoundary(sim::TetMesh& mesh, const std::optional<std::array<sim:
 
 } // namespace
 
-ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress) {
-    // Stages: meshing per body, paint per painted body, cutting per surface, checking, packaging.
-    size_t total = project.bodies.size() + project.surfaces.size() + 2, done = 0;
-    for (const BodyProject& b : project.bodies)
-        total += b.paint ? 1 : 0;
-    auto stage = [&](const std::string& s) {
-        ++done;
-        if (progress) progress(done, total, s);
-    };
-    const std::string origin = (project.dir / "project.json").string();
-    sim::SceneDesc scene = project.scene; // what the player reads; the bodies follow with their meshes
+namespace {
 
-    ExportResult result;
-    std::vector<std::pair<std::string, std::string>> files;
-    std::vector<std::unique_ptr<sim::TetMesh>> meshes;
+/// Numbers the stages of an export for its progress callback.
+struct StageCounter {
+    const ExportProgress& progress;
+    size_t total, done = 0;
+    void operator()(const std::string& what) {
+        ++done;
+        if (progress) progress(done, total, what);
+    }
+};
+
+BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
+    const std::string origin = (project.dir / "project.json").string();
+    BuiltScene built;
+    built.scene = project.scene; // what the player reads; the bodies follow with their meshes
+    sim::SceneDesc& scene = built.scene;
+    ExportResult& result = built.result;
+    auto& files = built.files;
+    auto& meshes = built.meshes;
+    auto& surfaces = built.surfaces;
     for (size_t i = 0; i < project.bodies.size(); ++i) {
         const BodyProject& b = project.bodies[i];
         const std::string& name = b.scene.name;
@@ -643,7 +649,6 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
         result.bodies.push_back(std::move(be));
         meshes.push_back(std::move(mesh));
     }
-    std::vector<sim::TriMesh> surfaces;
     for (size_t s = 0; s < project.surfaces.size(); ++s) {
         const SurfaceProject& sp = project.surfaces[s];
         const std::string& from = sp.scene.attachTo;
@@ -664,11 +669,43 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
         scene.surfaces.push_back(std::move(sd));
         surfaces.push_back(std::move(tri));
     }
-    // Features: only what the scene needs. The player runs what it loads, so assemble the world
-    // here exactly as the player will and refuse a case that cannot be simulated stably.
-    const std::vector<std::string> features = sim::requiredFeatures(scene);
+    built.features = sim::requiredFeatures(scene); // only what the scene needs
+    return built;
+}
+
+} // namespace
+
+size_t exportStageCount(const Project& project) {
+    size_t n = project.bodies.size() + project.surfaces.size() + 2; // + checking the scene, packaging
+    for (const BodyProject& b : project.bodies)
+        n += b.paint ? 1 : 0;
+    return n;
+}
+
+BuiltScene buildScene(const Project& project, const ExportProgress& progress) {
+    StageCounter stage{progress, exportStageCount(project) - 2};
+    return buildSceneCounted(project, stage);
+}
+
+std::unique_ptr<sim::World> assembleWorld(const BuiltScene& built, const std::string& origin) {
+    std::vector<std::unique_ptr<sim::TetMesh>> meshes;
+    for (const auto& m : built.meshes)
+        meshes.push_back(m->clone());
+    return sim::World::assemble(built.scene, std::move(meshes), built.surfaces, built.features, origin);
+}
+
+ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress) {
+    StageCounter stage{progress, exportStageCount(project)};
+    const std::string origin = (project.dir / "project.json").string();
+    BuiltScene built = buildSceneCounted(project, stage);
+    // The player runs what it loads, so assemble the world here exactly as the player will and
+    // refuse a case that cannot be simulated stably.
     stage("checking the scene");
-    sim::World::assemble(scene, std::move(meshes), std::move(surfaces), features, origin);
+    sim::World::assemble(built.scene, std::move(built.meshes), std::move(built.surfaces), built.features, origin);
+    const sim::SceneDesc& scene = built.scene;
+    const std::vector<std::string>& features = built.features;
+    ExportResult result = std::move(built.result);
+    auto& files = built.files;
 
     stage("packaging");
     vcase::Manifest header;

@@ -59,6 +59,10 @@
 #include <string>
 #include <vector>
 
+namespace viscera::sim {
+class World;
+}
+
 namespace viscera::studio {
 
 struct MeshSource {
@@ -188,6 +192,31 @@ struct ExportResult {
 /// does ("meshing body 'organ'", "skeleton and stiffness paint of 'fat'", "cutting surface
 /// 'fascia'", "checking the scene", "packaging").
 using ExportProgress = std::function<void(size_t index, size_t total, const std::string& stage)>;
+
+/// What a project becomes before it is packaged: the scene the player will read (bodies and
+/// surfaces with their fixed nodes and weights filled in), the built meshes, the files of the
+/// case other than scene.json, and the features the scene needs. The studio's live preview
+/// simulates it (assembleWorld) without writing a case.
+struct BuiltScene {
+    sim::SceneDesc scene;
+    std::vector<std::unique_ptr<sim::TetMesh>> meshes;      ///< meshes[i] of scene.bodies[i]
+    std::vector<sim::TriMesh> surfaces;                     ///< surfaces[s] of scene.surfaces[s]
+    std::vector<std::pair<std::string, std::string>> files; ///< case path, bytes
+    std::vector<std::string> features;
+    ExportResult result; ///< per-body figures (casePath and bytes empty)
+};
+
+/// Stages exportCase reports: meshing per body, stiffness paint per painted body, cutting per
+/// surface, checking the scene, packaging.
+size_t exportStageCount(const Project& project);
+
+/// Builds every body mesh and surface and fills in the scene (the first stages of exportCase).
+/// Throws viscera::InputError naming the body or surface and the rule.
+BuiltScene buildScene(const Project& project, const ExportProgress& progress = {});
+
+/// World::assemble on copies of the built meshes: the world the player would run. Throws
+/// viscera::InputError (unstable material, bad curves, ...) naming `origin`.
+std::unique_ptr<sim::World> assembleWorld(const BuiltScene& built, const std::string& origin);
 
 /// Builds every body mesh (generator or import + tetrahedralization), checks its quality (an
 /// inverted or degenerate element is an error naming the body and element), resolves fixed

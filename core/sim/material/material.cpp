@@ -79,6 +79,41 @@ const std::vector<std::string>& materialModelNames() {
     return names;
 }
 
+ValanisLandelCurves materialCurves(const Material& m, const std::string& materialName) {
+    const std::string ctx = "material '" + materialName + "'";
+    if (m.model != MaterialModel::ValanisLandel)
+        throw InputError(ctx + ": model " + materialModelName(m.model) + " has no curves");
+    ValanisLandelCurves curves;
+    if (!m.curvePreset.empty()) {
+        try {
+            curves = valanisLandelCurves(m.curvePreset, m.mu(), m.lambda());
+        } catch (const std::exception& e) {
+            throw InputError(ctx + ": curve preset '" + m.curvePreset + "': " + e.what());
+        }
+    } else {
+        curves.fPrime = curveFrom(m.fPrime, "f'", ctx);
+        curves.gPrime = curveFrom(m.gPrime, "g'", ctx);
+        curves.hPrime = curveFrom(m.hPrime, "h'", ctx);
+    }
+    return curves;
+}
+
+void setMaterialCurves(Material& m, const ValanisLandelCurves& c) {
+    auto desc = [](const std::optional<MonotoneCurve>& curve) -> std::optional<CurveDesc> {
+        if (!curve) return std::nullopt;
+        CurveDesc d;
+        for (const CurvePoint& q : curve->controlPoints())
+            d.points.push_back({q.x, q.y});
+        d.unconstrained = curve->shape() == CurveShape::Unconstrained;
+        return d;
+    };
+    m.model = MaterialModel::ValanisLandel;
+    m.curvePreset.clear();
+    m.fPrime = desc(c.fPrime);
+    m.gPrime = desc(c.gPrime);
+    m.hPrime = desc(c.hPrime);
+}
+
 std::shared_ptr<const TetConstraintModel> makeConstraintModel(const Material& m, const std::string& materialName) {
     const std::string ctx = "material '" + materialName + "'";
     if (auto why = validate(m); !why.empty()) throw InputError(ctx + ": " + why);
@@ -92,18 +127,7 @@ std::shared_ptr<const TetConstraintModel> makeConstraintModel(const Material& m,
         return std::make_shared<EnergyConstraintModel>(
             std::shared_ptr<const EnergyDensity>(makeEnergyDensity(materialModelName(m.model), m.mu(), m.lambda())));
     case MaterialModel::ValanisLandel: {
-        ValanisLandelCurves curves;
-        if (!m.curvePreset.empty()) {
-            try {
-                curves = valanisLandelCurves(m.curvePreset, m.mu(), m.lambda());
-            } catch (const std::exception& e) {
-                throw InputError(ctx + ": curve preset '" + m.curvePreset + "': " + e.what());
-            }
-        } else {
-            curves.fPrime = curveFrom(m.fPrime, "f'", ctx);
-            curves.gPrime = curveFrom(m.gPrime, "g'", ctx);
-            curves.hPrime = curveFrom(m.hPrime, "h'", ctx);
-        }
+        ValanisLandelCurves curves = materialCurves(m, materialName);
         return std::make_shared<EnergyConstraintModel>(
             std::make_shared<const ValanisLandelDensity>(materialName, std::move(curves)));
     }

@@ -2,6 +2,7 @@
 /// Material description (SI units) as authored in projects and carried by cases, and the factory
 /// that turns it into XPBD tet constraints.
 #include "sim/material/constraint_model.hpp"
+#include "sim/material/valanis_landel.hpp"
 
 #include <array>
 #include <memory>
@@ -57,6 +58,15 @@ MaterialModel materialModelFromName(const std::string& name); ///< throws std::i
 std::string materialModelName(MaterialModel model);
 /// All model names, for messages and editors.
 const std::vector<std::string>& materialModelNames();
+
+/// The Valanis–Landel curves of a material (model valanis_landel): its preset generated from the
+/// Lamé parameters, or its explicit curves (absent curve = zero term). Throws viscera::InputError
+/// naming the material, the curve and the control point (the rules of makeConstraintModel).
+ValanisLandelCurves materialCurves(const Material& m, const std::string& materialName);
+
+/// Makes `m` a Valanis–Landel material with explicit curves `c` (the preset name cleared; an
+/// absent curve stays absent): what the studio's curve editor, presets and fit write.
+void setMaterialCurves(Material& m, const ValanisLandelCurves& c);
 
 /// Builds the constraint model of a material. Throws viscera::InputError naming `materialName`,
 /// the curve and the control point for invalid curves (not increasing, stress at rest not zero).

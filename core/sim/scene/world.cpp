@@ -8,6 +8,11 @@ namespace viscera::sim {
 
 World::~World() = default;
 
+void World::setState(size_t i, const std::vector<Vec3>& x, const std::vector<Vec3>& v) {
+    if (i >= m_meshes.size()) throw std::invalid_argument("sim::World::setState(): no body " + std::to_string(i));
+    m_solver->setState(i, x, v);
+}
+
 std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::unique_ptr<TetMesh>> meshes,
                                        std::vector<TriMesh> surfaces, const std::vector<std::string>& features,
                                        const std::string& origin) {

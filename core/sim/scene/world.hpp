@@ -55,6 +55,11 @@ public:
     const std::string& bodyName(size_t i) const { return m_names[i]; }
     const TetMesh& restMesh(size_t i) const { return *m_meshes[i]; }
     const std::vector<Vec3>& positions(size_t i) const { return m_solver->positions(i); }
+    const std::vector<Vec3>& velocities(size_t i) const { return m_solver->velocities(i); } ///< m/s
+    /// Replaces body i's positions and velocities (#V each; the studio's preview carries the
+    /// motion over when it swaps in a world with an edited material). Throws
+    /// std::invalid_argument on a size mismatch or a non-finite value.
+    void setState(size_t i, const std::vector<Vec3>& x, const std::vector<Vec3>& v);
     size_t surfaceCount() const { return m_surfaces.size(); }
     const std::vector<Vec3>& surfacePositions(size_t s) const { return m_solver->surfacePositions(s); }
     /// Surface s as assembled (rest positions, triangles) and its scene name (renderer input).

@@ -1,0 +1,198 @@
+// Live preview under a continuous drag (issue: studio application): the liver project open in
+// the studio's main window, a Valanis–Landel material on the organ, and a 5 s drag of one f′
+// control point with a mouse event every 16 ms. Measures, in one run:
+//   - frames from an edit to the preview showing it: for every edit, the preview frames that
+//     completed after the edit before the frame that simulates it started (0: the next frame to
+//     start shows it; 1: the frame in progress at the edit finished first);
+//   - the UI thread's longest stall: the largest gap between two runs of a 1 ms timer, and the
+//     longest single mouse-event handling (edit, check, undo command, plots) and viewport paint;
+//   - the preview's physics cost per frame.
+// Writes <out>/studio_preview.json and screenshots of the main window (<out>/studio_main.png,
+// the material dock, the viewport). Run under a display (Xvfb):
+//   xvfb-run -a -s "-screen 0 1920x1200x24" ./build/bench/bench_studio_preview [out-dir] [seconds]
+#include "app/curve_editor.hpp"
+#include "app/main_window.hpp"
+#include "app/material_panel.hpp"
+#include "app/plot_widget.hpp"
+#include "app/studio_app.hpp"
+#include "app/viewport.hpp"
+
+#include <QApplication>
+#include <QDockWidget>
+#include <QElapsedTimer>
+#include <QLabel>
+#include <QMouseEvent>
+#include <QTimer>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <numeric>
+
+namespace {
+
+using namespace viscera;
+
+void send(QWidget* w, QEvent::Type type, QPointF pos, Qt::MouseButton button, Qt::MouseButtons buttons) {
+    QMouseEvent e(type, pos, w->mapToGlobal(pos), button, buttons, Qt::NoModifier);
+    QApplication::sendEvent(w, &e);
+}
+
+bool waitFor(const std::function<bool()>& done, int ms) {
+    QElapsedTimer t;
+    t.start();
+    while (!done() && t.elapsed() < ms)
+        QCoreApplication::processEvents(QEventLoop::AllEvents, 10);
+    return done();
+}
+
+double percentile(std::vector<double> v, double q) {
+    if (v.empty()) return 0;
+    std::sort(v.begin(), v.end());
+    return v[std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5))];
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    const std::filesystem::path out = argc > 1 ? argv[1] : "bench-out/studio";
+    const double seconds = argc > 2 ? std::atof(argv[2]) : 5.0;
+    std::filesystem::create_directories(out);
+    studio::setStudioSurfaceFormat();
+    QApplication app(argc, argv);
+    QCoreApplication::setOrganizationName("VisceraBench");
+    QCoreApplication::setApplicationName("StudioPreview");
+    studio::MainWindow w;
+    w.setConfirmDiscard(false);
+    w.resize(1600, 1000);
+    w.show();
+    const std::string project = std::string(VISCERA_SOURCE_DIR) + "/projects/liver";
+    if (!w.openProject(QString::fromStdString(project))) return 1;
+    w.selectBody(0);
+    if (auto why = w.materialPanel()->applyPreset("neo_hookean", 8000, 0.45); !why.isEmpty()) {
+        std::fprintf(stderr, "preset: %s\n", why.toUtf8().constData());
+        return 1;
+    }
+    w.preview()->setAccuracyEvery(30);
+    std::printf("waiting for the preview (meshing the liver)...\n");
+    if (!waitFor([&] { return w.viewport()->meshCount() > 0 && w.preview()->snapshot().frames > 40; }, 300000)) {
+        std::fprintf(stderr, "the preview did not start: %s\n", w.verdictLabel()->text().toUtf8().constData());
+        return 1;
+    }
+    waitFor([&] { return !w.errorPlot()->series().empty(); }, 60000);
+
+    // the drag: the first movable point of f′ moves up and down by ±30 % of its neighbours' gap
+    studio::CurveEditor* e = w.materialPanel()->editor(0);
+    const auto& pts = e->points();
+    size_t i = 1;
+    while (i + 1 < pts.size() && (pts[i].x == 1.0 || pts[i - 1].x == 1.0 || pts[i + 1].x == 1.0))
+        ++i;
+    const QPointF start = e->toWidget({pts[i].x, pts[i].y});
+    const double lo = pts[i - 1].y, hi = pts[i + 1].y, y0 = pts[i].y;
+
+    std::vector<double> timerGaps, handlerMs, latencyFrames, paintMs;
+    QElapsedTimer clock;
+    clock.start();
+    qint64 lastTick = clock.nsecsElapsed();
+    QTimer probe;
+    probe.setTimerType(Qt::PreciseTimer);
+    probe.setInterval(1);
+    QObject::connect(&probe, &QTimer::timeout, [&] {
+        const qint64 now = clock.nsecsElapsed();
+        timerGaps.push_back((now - lastTick) * 1e-6);
+        lastTick = now;
+    });
+    struct PendingEdit {
+        uint64_t serial, framesAtEdit;
+    };
+    std::vector<PendingEdit> pending;
+    const auto s0 = w.preview()->snapshot();
+    const uint64_t frames0 = s0.frames;
+    probe.start();
+    send(e, QEvent::MouseButtonPress, start, Qt::LeftButton, Qt::LeftButton);
+    int events = 0;
+    const qint64 dragStart = clock.elapsed();
+    qint64 nextMove = dragStart;
+    while (clock.elapsed() - dragStart < seconds * 1000) {
+        const qint64 now = clock.elapsed();
+        if (now >= nextMove) {
+            nextMove += 16;
+            const double phase = (now - dragStart) / 1000.0 * 2.0; // one cycle per 0.5 s
+            const double y = y0 + 0.3 * std::sin(phase * 3.14159265) * std::min(hi - y0, y0 - lo);
+            const QPointF p(start.x(), e->toWidget({pts[i].x, y}).y());
+            QElapsedTimer h;
+            h.start();
+            send(e, QEvent::MouseMove, p, Qt::NoButton, Qt::LeftButton);
+            handlerMs.push_back(h.nsecsElapsed() * 1e-6);
+            ++events;
+            const auto [serial, framesAtSubmit] = w.lastPreviewSubmit();
+            pending.push_back({serial, framesAtSubmit});
+        }
+        QElapsedTimer pt;
+        pt.start();
+        QCoreApplication::processEvents(QEventLoop::AllEvents, 2);
+        const double spent = pt.nsecsElapsed() * 1e-6;
+        if (spent > 2.0) paintMs.push_back(spent);
+        // resolve edits the preview has now simulated
+        const auto s = w.preview()->snapshot();
+        pending.erase(std::remove_if(pending.begin(), pending.end(),
+                                     [&](const PendingEdit& p) {
+                                         if (s.serial < p.serial) return false;
+                                         // frames completed after the edit before the frame that shows it
+                                         latencyFrames.push_back(static_cast<double>(s.appliedAfter - p.framesAtEdit));
+                                         return true;
+                                     }),
+                      pending.end());
+    }
+    send(e, QEvent::MouseButtonRelease, e->toWidget({pts[i].x, pts[i].y}), Qt::LeftButton, Qt::NoButton);
+    probe.stop();
+    const auto s1 = w.preview()->snapshot();
+    waitFor([&] { return false; }, 300); // let the last frames and plots land
+    w.pollPreview();
+
+    // screenshots of what the user sees
+    w.grab().save(QString::fromStdString((out / "studio_main.png").string()));
+    if (auto* d = w.findChild<QDockWidget*>("materialDock"))
+        d->grab().save(QString::fromStdString((out / "studio_material.png").string()));
+    if (auto* d = w.findChild<QDockWidget*>("plotsDock"))
+        d->grab().save(QString::fromStdString((out / "studio_plots.png").string()));
+    w.viewport()->grabFramebuffer().save(QString::fromStdString((out / "studio_viewport.png").string()));
+
+    const double maxGap = timerGaps.empty() ? 0 : *std::max_element(timerGaps.begin(), timerGaps.end());
+    const double maxHandler = handlerMs.empty() ? 0 : *std::max_element(handlerMs.begin(), handlerMs.end());
+    const double maxLatency =
+        latencyFrames.empty() ? -1 : *std::max_element(latencyFrames.begin(), latencyFrames.end());
+    std::vector<double> physics(s1.frameMs.begin(), s1.frameMs.end());
+    nlohmann::json j;
+    j["project"] = "liver (organ: Valanis-Landel, Neo-Hookean preset E 8000 Pa, nu 0.45)";
+    j["drag_seconds"] = seconds;
+    j["drag_events"] = events;
+    j["preview_frames_during_drag"] = s1.frames - frames0;
+    j["edits_resolved"] = latencyFrames.size();
+    j["edit_to_preview_frames"] = {
+        {"max", maxLatency},
+        {"mean", latencyFrames.empty()
+                     ? -1
+                     : std::accumulate(latencyFrames.begin(), latencyFrames.end(), 0.0) / latencyFrames.size()}};
+    j["ui_timer_gap_ms"] = {{"max", maxGap}, {"p99", percentile(timerGaps, 0.99)}, {"p50", percentile(timerGaps, 0.5)}};
+    j["mouse_event_ms"] = {
+        {"max", maxHandler},
+        {"p99", percentile(handlerMs, 0.99)},
+        {"mean", handlerMs.empty() ? 0 : std::accumulate(handlerMs.begin(), handlerMs.end(), 0.0) / handlerMs.size()}};
+    j["event_loop_pass_over_2ms"] = {{"count", paintMs.size()},
+                                     {"max", paintMs.empty() ? 0 : *std::max_element(paintMs.begin(), paintMs.end())},
+                                     {"p50", percentile(paintMs, 0.5)}};
+    j["physics_ms_per_frame"] = {
+        {"mean", physics.empty() ? 0 : std::accumulate(physics.begin(), physics.end(), 0.0) / physics.size()},
+        {"p99", percentile(physics, 0.99)}};
+    j["verdict"] = w.verdictLabel()->text().toStdString();
+    j["renderer"] = w.viewport()->rendererInfo().toStdString();
+    std::ofstream(out / "studio_preview.json") << j.dump(2) << "\n";
+    std::printf("%s\n", j.dump(2).c_str());
+    w.preview()->stop();
+    return 0;
+}

@@ -1,0 +1,328 @@
+#include "app/curve_editor.hpp"
+
+#include "sim/util/format.hpp"
+
+#include <QKeyEvent>
+#include <QMouseEvent>
+#include <QPainter>
+#include <QPainterPath>
+#include <QWheelEvent>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace viscera::studio {
+namespace {
+
+/// Smallest gap kept between neighbouring control values (relative to their magnitude), so that
+/// a strictly increasing list stays strictly increasing in floating point.
+double gap(double a, double b) {
+    return 1e-6 * std::max({std::abs(a), std::abs(b), 1e-3});
+}
+
+QString label(double v) {
+    return QString::fromStdString(sim::formatNumber(v));
+}
+
+} // namespace
+
+CurveEditor::CurveEditor(QWidget* parent) : QWidget(parent) {
+    setFocusPolicy(Qt::StrongFocus);
+    setMouseTracking(false);
+    setMinimumSize(240, 160);
+    setAutoFillBackground(false);
+}
+
+void CurveEditor::setCurve(const QString& name, const std::vector<sim::CurvePoint>& points, bool strictlyIncreasing,
+                           bool frame) {
+    const bool sameCount = points.size() == m_points.size() && name == m_name;
+    m_name = name;
+    m_message.clear();
+    m_points = points;
+    m_strict = strictlyIncreasing;
+    m_curve.reset();
+    try {
+        m_curve.emplace(name.toStdString(), points,
+                        strictlyIncreasing ? sim::CurveShape::StrictlyIncreasing : sim::CurveShape::Unconstrained);
+    } catch (const std::exception& e) {
+        m_message = QString::fromStdString(e.what());
+    }
+    if (!sameCount) {
+        m_selected = -1;
+        m_dragging = -1;
+    }
+    if (frame || !sameCount) frameAll();
+    update();
+}
+
+void CurveEditor::clearCurve(const QString& name, const QString& message) {
+    m_name = name;
+    m_message = message;
+    m_points.clear();
+    m_curve.reset();
+    m_selected = m_dragging = -1;
+    update();
+}
+
+void CurveEditor::setSelected(int index) {
+    if (index < -1 || index >= static_cast<int>(m_points.size())) index = -1;
+    if (index == m_selected) return;
+    m_selected = index;
+    emit selectionChanged(index);
+    update();
+}
+
+bool CurveEditor::removable(int index) const {
+    const int n = static_cast<int>(m_points.size());
+    return index > 0 && index < n - 1 && !isRestPoint(m_points[index]) && n > 3;
+}
+
+QPointF CurveEditor::constrain(int index, QPointF want) const {
+    const int n = static_cast<int>(m_points.size());
+    if (index < 0 || index >= n) return want;
+    const sim::CurvePoint& p = m_points[index];
+    if (isRestPoint(p)) return {p.x, p.y};
+    double x = want.x(), y = want.y();
+    if (!std::isfinite(x)) x = p.x;
+    if (!std::isfinite(y)) y = p.y;
+    x = std::max(x, 0.01); // stretches and volume ratios are positive
+    if (index > 0) x = std::max(x, m_points[index - 1].x + gap(m_points[index - 1].x, x));
+    if (index < n - 1) x = std::min(x, m_points[index + 1].x - gap(m_points[index + 1].x, x));
+    // the neighbours' own gap may leave no room: keep the point where it is
+    if ((index > 0 && !(x > m_points[index - 1].x)) || (index < n - 1 && !(x < m_points[index + 1].x))) x = p.x;
+    if (m_strict) {
+        if (index > 0) y = std::max(y, m_points[index - 1].y + gap(m_points[index - 1].y, y));
+        if (index < n - 1) y = std::min(y, m_points[index + 1].y - gap(m_points[index + 1].y, y));
+        if ((index > 0 && !(y > m_points[index - 1].y)) || (index < n - 1 && !(y < m_points[index + 1].y))) y = p.y;
+    }
+    return {x, y};
+}
+
+QRectF CurveEditor::plotArea() const {
+    return QRectF(56, 22, std::max(10, width() - 66), std::max(10, height() - 48));
+}
+
+QPointF CurveEditor::toWidget(QPointF d) const {
+    const QRectF a = plotArea();
+    return {a.left() + (d.x() - m_view.left()) / m_view.width() * a.width(),
+            a.bottom() - (d.y() - m_view.top()) / m_view.height() * a.height()};
+}
+
+QPointF CurveEditor::toData(QPointF w) const {
+    const QRectF a = plotArea();
+    return {m_view.left() + (w.x() - a.left()) / a.width() * m_view.width(),
+            m_view.top() + (a.bottom() - w.y()) / a.height() * m_view.height()};
+}
+
+double CurveEditor::niceStep(double range) {
+    if (!(range > 0) || !std::isfinite(range)) return 1.0;
+    const double raw = range / 6.0;
+    const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+    const double f = raw / mag;
+    return mag * (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0);
+}
+
+double CurveEditor::gridStepX() const {
+    return niceStep(m_view.width());
+}
+double CurveEditor::gridStepY() const {
+    return niceStep(m_view.height());
+}
+
+double CurveEditor::curveValue(double x) const {
+    return m_curve ? m_curve->value(x) : std::numeric_limits<double>::quiet_NaN();
+}
+
+void CurveEditor::frameAll() {
+    if (m_points.empty()) {
+        m_view = QRectF(0.0, -1.0, 3.0, 2.0);
+        update();
+        return;
+    }
+    double x0 = m_points.front().x, x1 = m_points.back().x;
+    double y0 = m_points.front().y, y1 = y0;
+    for (const auto& p : m_points) {
+        y0 = std::min(y0, p.y);
+        y1 = std::max(y1, p.y);
+    }
+    if (!(x1 > x0)) x1 = x0 + 1;
+    if (!(y1 > y0)) {
+        y0 -= std::max(1.0, std::abs(y0) * 0.5);
+        y1 += std::max(1.0, std::abs(y1) * 0.5);
+    }
+    const double mx = 0.06 * (x1 - x0), my = 0.08 * (y1 - y0);
+    m_view = QRectF(x0 - mx, y0 - my, (x1 - x0) + 2 * mx, (y1 - y0) + 2 * my);
+    update();
+}
+
+int CurveEditor::pointAt(QPointF w) const {
+    int best = -1;
+    double bestD = kPickPixels;
+    for (int i = 0; i < static_cast<int>(m_points.size()); ++i) {
+        const QPointF q = toWidget({m_points[i].x, m_points[i].y});
+        const double d = std::hypot(q.x() - w.x(), q.y() - w.y());
+        if (d <= bestD) {
+            bestD = d;
+            best = i;
+        }
+    }
+    return best;
+}
+
+void CurveEditor::paintEvent(QPaintEvent*) {
+    QPainter p(this);
+    p.setRenderHint(QPainter::Antialiasing);
+    p.fillRect(rect(), palette().base());
+    const QRectF a = plotArea();
+    // grid and labels
+    const double sx = gridStepX(), sy = gridStepY();
+    QPen grid(palette().mid().color(), 0, Qt::DotLine);
+    p.setFont(QFont(font().family(), 8));
+    for (double gx = std::ceil(m_view.left() / sx) * sx; gx <= m_view.right(); gx += sx) {
+        const double px = toWidget({gx, 0}).x();
+        p.setPen(grid);
+        p.drawLine(QPointF(px, a.top()), QPointF(px, a.bottom()));
+        p.setPen(palette().text().color());
+        p.drawText(QRectF(px - 30, a.bottom() + 2, 60, 14), Qt::AlignHCenter,
+                   label(std::abs(gx) < 1e-12 * sx ? 0 : gx));
+    }
+    for (double gy = std::ceil(m_view.top() / sy) * sy; gy <= m_view.bottom(); gy += sy) {
+        const double py = toWidget({0, gy}).y();
+        p.setPen(grid);
+        p.drawLine(QPointF(a.left(), py), QPointF(a.right(), py));
+        p.setPen(palette().text().color());
+        p.drawText(QRectF(0, py - 7, a.left() - 4, 14), Qt::AlignRight | Qt::AlignVCenter,
+                   label(std::abs(gy) < 1e-12 * sy ? 0 : gy));
+    }
+    p.setPen(QPen(palette().text().color(), 1));
+    p.drawRect(a);
+    // rest line x = 1 and y = 0
+    p.setPen(QPen(QColor(150, 150, 150), 1, Qt::DashLine));
+    if (m_view.left() < 1 && m_view.right() > 1)
+        p.drawLine(QPointF(toWidget({1, 0}).x(), a.top()), QPointF(toWidget({1, 0}).x(), a.bottom()));
+    if (m_view.top() < 0 && m_view.bottom() > 0)
+        p.drawLine(QPointF(a.left(), toWidget({0, 0}).y()), QPointF(a.right(), toWidget({0, 0}).y()));
+    p.setPen(palette().text().color());
+    p.drawText(QRectF(a.left(), 2, a.width(), 18), Qt::AlignLeft | Qt::AlignVCenter,
+               m_name + (m_strict ? tr("  (strictly increasing)") : tr("  (any shape)")) + tr("  [Pa]"));
+    if (!m_message.isEmpty()) {
+        p.drawText(a.adjusted(8, 8, -8, -8), Qt::AlignCenter | Qt::TextWordWrap, m_message);
+        if (m_points.empty()) return;
+    }
+    p.setClipRect(a);
+    if (m_curve) {
+        QPainterPath path;
+        const int steps = std::max(64, static_cast<int>(a.width()));
+        for (int k = 0; k <= steps; ++k) {
+            const double x = m_view.left() + m_view.width() * k / steps;
+            const double y = m_curve->value(x);
+            if (!std::isfinite(y)) continue;
+            QPointF q = toWidget({x, y});
+            q.setY(std::clamp(q.y(), -1e5, 1e5));
+            k == 0 ? path.moveTo(q) : path.lineTo(q);
+        }
+        p.setPen(QPen(QColor(200, 60, 40), 2));
+        p.drawPath(path);
+    }
+    for (int i = 0; i < static_cast<int>(m_points.size()); ++i) {
+        const QPointF q = toWidget({m_points[i].x, m_points[i].y});
+        const bool rest = isRestPoint(m_points[i]);
+        p.setPen(QPen(i == m_selected ? QColor(20, 90, 220) : QColor(40, 40, 40), i == m_selected ? 2.5 : 1.2));
+        p.setBrush(rest ? QColor(250, 200, 60) : (i == m_selected ? QColor(120, 170, 255) : QColor(255, 255, 255)));
+        if (rest) {
+            QPolygonF d;
+            d << q + QPointF(0, -6) << q + QPointF(6, 0) << q + QPointF(0, 6) << q + QPointF(-6, 0);
+            p.drawPolygon(d);
+        } else {
+            p.drawEllipse(q, 4.5, 4.5);
+        }
+    }
+}
+
+void CurveEditor::mousePressEvent(QMouseEvent* e) {
+    setFocus(Qt::MouseFocusReason);
+    if (e->button() == Qt::MiddleButton) {
+        m_panning = true;
+        m_panStart = e->position();
+        m_panView = m_view;
+        return;
+    }
+    if (e->button() != Qt::LeftButton || m_points.empty()) return;
+    const int hit = pointAt(e->position());
+    if (hit >= 0) {
+        setSelected(hit);
+        if (!isRestPoint(m_points[hit])) {
+            m_dragging = hit;
+            emit dragStarted(hit);
+        }
+        return;
+    }
+    const QPointF d = toData(e->position());
+    const double y = curveValue(d.x());
+    if (std::isfinite(y) && std::abs(toWidget({d.x(), y}).y() - e->position().y()) <= kPickPixels &&
+        d.x() > m_points.front().x && d.x() < m_points.back().x) {
+        emit insertRequested(d.x(), y);
+        return;
+    }
+    setSelected(-1);
+}
+
+void CurveEditor::mouseMoveEvent(QMouseEvent* e) {
+    if (m_panning) {
+        const QRectF a = plotArea();
+        const QPointF dp = e->position() - m_panStart;
+        m_view = m_panView.translated(-dp.x() / a.width() * m_view.width(), dp.y() / a.height() * m_view.height());
+        update();
+        return;
+    }
+    if (m_dragging < 0) return;
+    QPointF d = toData(e->position());
+    if (e->modifiers() & Qt::ControlModifier) {
+        const double sx = gridStepX(), sy = gridStepY();
+        d = QPointF(std::round(d.x() / sx) * sx, std::round(d.y() / sy) * sy);
+    }
+    const QPointF c = constrain(m_dragging, d);
+    emit pointDragged(m_dragging, c.x(), c.y());
+}
+
+void CurveEditor::mouseReleaseEvent(QMouseEvent* e) {
+    if (e->button() == Qt::MiddleButton) {
+        m_panning = false;
+        return;
+    }
+    if (e->button() == Qt::LeftButton && m_dragging >= 0) {
+        const int i = m_dragging;
+        m_dragging = -1;
+        emit dragFinished(i);
+    }
+}
+
+void CurveEditor::wheelEvent(QWheelEvent* e) {
+    const double steps = e->angleDelta().y() / 120.0;
+    if (steps == 0) return;
+    const double f = std::pow(1.25, -steps);
+    const QPointF c = toData(e->position());
+    m_view = QRectF(c.x() - (c.x() - m_view.left()) * f, c.y() - (c.y() - m_view.top()) * f, m_view.width() * f,
+                    m_view.height() * f);
+    update();
+    e->accept();
+}
+
+void CurveEditor::keyPressEvent(QKeyEvent* e) {
+    if (e->key() == Qt::Key_Home) {
+        frameAll();
+        return;
+    }
+    if ((e->key() == Qt::Key_Delete || e->key() == Qt::Key_Backspace) && m_selected >= 0) {
+        if (removable(m_selected)) emit removeRequested(m_selected);
+        return;
+    }
+    QWidget::keyPressEvent(e);
+}
+
+void CurveEditor::resizeEvent(QResizeEvent*) {
+    update();
+}
+
+} // namespace viscera::studio

@@ -1,0 +1,137 @@
+#include "app/document.hpp"
+
+#include "sim/material/material.hpp"
+#include "sim/util/error.hpp"
+
+#include <QDir>
+
+#include <QUndoCommand>
+#include <filesystem>
+
+namespace viscera::studio {
+
+/// One edit: the model before and after. Consecutive commands with the same nonzero key merge
+/// (keeping the first `before`), so a drag of many mouse events is one undo step.
+class ProjectCommand : public QUndoCommand {
+public:
+    ProjectCommand(Document* doc, const QString& text, Project before, Project after, int key)
+        : QUndoCommand(text), m_doc(doc), m_before(std::move(before)), m_after(std::move(after)), m_key(key) {}
+    int id() const override { return m_key ? 1 : -1; }
+    bool mergeWith(const QUndoCommand* other) override {
+        const auto* o = static_cast<const ProjectCommand*>(other);
+        if (o->m_key != m_key) return false;
+        m_after = o->m_after;
+        return true;
+    }
+    void redo() override { m_doc->replace(m_after); }
+    void undo() override { m_doc->replace(m_before); }
+
+private:
+    Document* m_doc;
+    Project m_before, m_after;
+    int m_key;
+};
+
+Document::Document(QObject* parent) : QObject(parent) {}
+Document::~Document() = default;
+
+void Document::replace(const Project& p) {
+    *m_project = p;
+    ++m_revision;
+    emit changed();
+}
+
+void Document::open(const QString& folder) {
+    auto p = std::make_unique<Project>(loadProject(QDir(folder).absolutePath().toStdString()));
+    m_undo.clear();
+    m_project = std::move(p);
+    m_folder = QDir(folder).absolutePath();
+    ++m_revision;
+    emit logMessage(tr("opened %1").arg(m_folder));
+    emit changed();
+}
+
+void Document::createNew(const QString& folder, const QString& caseId) {
+    const QString abs = QDir(folder).absolutePath();
+    if (!QDir().mkpath(abs)) throw InputError(abs.toStdString() + ": the folder cannot be created");
+    Project p = newProject(abs.toStdString(), caseId.toStdString());
+    saveProject(p, abs.toStdString());
+    m_undo.clear();
+    m_project = std::make_unique<Project>(std::move(p));
+    m_folder = abs;
+    ++m_revision;
+    emit logMessage(tr("created %1").arg(abs));
+    emit changed();
+}
+
+void Document::save() {
+    if (!m_project) return;
+    saveProject(*m_project, m_folder.toStdString());
+    m_undo.setClean();
+    emit logMessage(tr("saved %1/project.json").arg(m_folder));
+}
+
+void Document::saveAs(const QString& folder) {
+    if (!m_project) return;
+    const QString abs = QDir(folder).absolutePath();
+    if (abs == m_folder) return save();
+    if (!QDir().mkpath(abs)) throw InputError(abs.toStdString() + ": the folder cannot be created");
+    // The project's files (imported meshes, trajectory, instrument tracks) go along, in the same
+    // layout, so that the saved project is complete; then project.json, atomically.
+    Project p = *m_project;
+    p.dir = abs.toStdString();
+    namespace fs = std::filesystem;
+    std::vector<std::pair<fs::path, fs::path>> copies;
+    auto relocate = [&](fs::path& f) {
+        if (f.empty()) return;
+        const fs::path rel = f.lexically_normal().lexically_relative(m_project->dir.lexically_normal());
+        if (rel.empty() || *rel.begin() == "..")
+            throw InputError(f.string() + ": is not inside the project folder " + m_project->dir.string());
+        copies.emplace_back(f, p.dir / rel);
+        f = p.dir / rel;
+    };
+    for (BodyProject& b : p.bodies)
+        if (b.mesh.kind == MeshSource::Kind::File) relocate(b.mesh.file);
+    if (p.scene.suture && !p.trajectory.generator) relocate(p.trajectory.file);
+    for (fs::path& t : p.trackFiles)
+        relocate(t);
+    for (const auto& [from, to] : copies) {
+        std::error_code ec;
+        fs::create_directories(to.parent_path(), ec);
+        if (!ec && from != to) fs::copy_file(from, to, fs::copy_options::overwrite_existing, ec);
+        if (ec) throw InputError(to.string() + ": cannot be written (" + ec.message() + ")");
+    }
+    saveProject(p, p.dir);
+    *m_project = std::move(p);
+    m_folder = abs;
+    m_undo.setClean();
+    emit logMessage(tr("saved %1/project.json").arg(abs));
+    emit changed();
+}
+
+QString Document::check(const Project& p) {
+    try {
+        const std::string origin = (p.dir / "project.json").string();
+        loadProjectText(projectJsonText(p), p.dir, origin);
+        for (const BodyProject& b : p.bodies)
+            sim::makeConstraintModel(b.scene.material, b.scene.name);
+    } catch (const std::exception& e) {
+        return QString::fromStdString(e.what());
+    }
+    return {};
+}
+
+QString Document::edit(const QString& text, const std::function<void(Project&)>& fn, int mergeKey) {
+    if (!m_project) return tr("no project is open");
+    Project after = *m_project;
+    try {
+        fn(after);
+    } catch (const std::exception& e) {
+        return QString::fromStdString(e.what());
+    }
+    if (QString why = check(after); !why.isEmpty()) return why;
+    m_undo.push(new ProjectCommand(this, text, *m_project, std::move(after), mergeKey));
+    return {};
+}
+
+} // namespace viscera::studio

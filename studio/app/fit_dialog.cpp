@@ -1,0 +1,137 @@
+#include "app/fit_dialog.hpp"
+
+#include "app/document.hpp"
+#include "app/material_panel.hpp"
+#include "sim/material/material_response.hpp"
+#include "sim/util/format.hpp"
+
+#include <QComboBox>
+#include <QDialogButtonBox>
+#include <QFileDialog>
+#include <QFormLayout>
+#include <QHBoxLayout>
+#include <QLabel>
+#include <QLineEdit>
+#include <QPushButton>
+#include <QVBoxLayout>
+
+namespace viscera::studio {
+namespace {
+
+QString num(double v, int d = 4) {
+    return QString::fromStdString(sim::formatNumber(v, d));
+}
+
+} // namespace
+
+FitDialog::FitDialog(Document* doc, int body, QWidget* parent) : QDialog(parent), m_doc(doc), m_body(body) {
+    setWindowTitle(tr("Fit material curves to a uniaxial test"));
+    setObjectName("fitDialog");
+    auto* root = new QVBoxLayout(this);
+    auto* form = new QFormLayout;
+    auto* fileRow = new QHBoxLayout;
+    m_file = new QLineEdit(this);
+    m_file->setObjectName("fitFile");
+    auto* browse = new QPushButton(tr("Browse…"), this);
+    fileRow->addWidget(m_file, 1);
+    fileRow->addWidget(browse);
+    form->addRow(tr("Test data (two columns)"), fileRow);
+    m_measure = new QComboBox(this);
+    m_measure->setObjectName("fitMeasure");
+    m_measure->addItems({tr("stretch λ = l/L (dimensionless)"), tr("engineering strain ε = (l − L)/L")});
+    form->addRow(tr("Column 1"), m_measure);
+    form->addRow(tr("Column 2"), new QLabel(tr("nominal stress (force / undeformed area), Pa"), this));
+    m_curves = new QComboBox(this);
+    m_curves->setObjectName("fitCurves");
+    m_curves->addItems({tr("f′ and h′"), tr("f′ only")});
+    form->addRow(tr("Fit"), m_curves);
+    root->addLayout(form);
+    m_plot = new PlotWidget(this);
+    m_plot->setObjectName("fitPlot");
+    m_plot->setTitle(tr("Data and fitted response"));
+    m_plot->setAxes(tr("stretch λ"), tr("nominal stress [Pa]"));
+    m_plot->setMinimumSize(420, 260);
+    root->addWidget(m_plot, 1);
+    m_result = new QLabel(this);
+    m_result->setObjectName("fitResult");
+    m_result->setWordWrap(true);
+    root->addWidget(m_result);
+    auto* buttons = new QDialogButtonBox(this);
+    m_fitButton = buttons->addButton(tr("Fit"), QDialogButtonBox::ActionRole);
+    m_apply = buttons->addButton(tr("Apply to material"), QDialogButtonBox::AcceptRole);
+    buttons->addButton(QDialogButtonBox::Close);
+    m_apply->setEnabled(false);
+    root->addWidget(buttons);
+    connect(browse, &QPushButton::clicked, this, [this] {
+        const QString f = QFileDialog::getOpenFileName(this, tr("Uniaxial test data"), QString(),
+                                                       tr("Text and CSV (*.csv *.txt *.dat);;All files (*)"));
+        if (!f.isEmpty()) m_file->setText(f);
+    });
+    connect(m_fitButton, &QPushButton::clicked, this, [this] { runFit(); });
+    connect(m_apply, &QPushButton::clicked, this, [this] {
+        const QString why = apply();
+        if (why.isEmpty())
+            accept();
+        else
+            m_result->setText(why);
+    });
+    connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
+}
+
+bool FitDialog::runFit() {
+    m_fitResult.reset();
+    m_apply->setEnabled(false);
+    try {
+        if (!m_doc->hasProject() || m_body < 0 || m_body >= static_cast<int>(m_doc->project().bodies.size()))
+            throw std::invalid_argument("no body selected");
+        const sim::Material& m = m_doc->project().bodies[m_body].scene.material;
+        const auto start = MaterialPanel::curvesOf(m);
+        if (!start) throw std::invalid_argument("the material has no editable curves: apply a preset first");
+        m_data = sim::readUniaxialData(m_file->text().toStdString(), m_measure->currentIndex() == 0
+                                                                         ? sim::StrainMeasure::Stretch
+                                                                         : sim::StrainMeasure::EngineeringStrain);
+        sim::FitOptions opt;
+        opt.curves = m_curves->currentIndex() == 0 ? sim::FitCurves::FPrimeAndHPrime : sim::FitCurves::FPrime;
+        m_fitResult = sim::fitUniaxial(*start, *m_data, opt);
+    } catch (const std::exception& e) {
+        m_result->setText(QString::fromStdString(e.what()));
+        m_plot->setSeries({});
+        return false;
+    }
+    const sim::CurveFitResult& r = *m_fitResult;
+    const QString text = tr("SSE %1 Pa²   R² %2   largest relative error %3 %   data covers stretch %4–%5   "
+                            "(%6 iterations, %7)")
+                             .arg(num(r.sse), QString::number(r.rSquared, 'f', 6), num(100 * r.maxRelativeError, 3),
+                                  num(r.stretchMin), num(r.stretchMax))
+                             .arg(r.iterations)
+                             .arg(r.converged ? tr("converged") : tr("iteration limit"));
+    m_result->setText(text);
+    m_plot->setNote(text);
+    PlotWidget::Series data{tr("test data"), m_data->stretch, m_data->nominalStress, QColor(30, 30, 30), true};
+    PlotWidget::Series fit{tr("fitted curves"), {}, {}, QColor(200, 60, 40)};
+    try {
+        sim::ValanisLandelDensity d("fit", r.curves);
+        sim::ResponseSampling s;
+        s.stretchMin = std::min(0.6, r.stretchMin);
+        s.stretchMax = std::max(1.6, r.stretchMax);
+        const sim::ResponseCurves rc = sim::sampleResponses(d, s);
+        for (size_t i = 0; i < rc.stretch.size(); ++i) {
+            fit.x.push_back(rc.stretch[i]);
+            fit.y.push_back(rc.solved[i] ? rc.nominalStress[i] : NAN);
+        }
+    } catch (const std::exception&) {
+    }
+    m_plot->setSeries({fit, data});
+    m_apply->setEnabled(true);
+    return true;
+}
+
+QString FitDialog::apply() {
+    if (!m_fitResult) return tr("nothing fitted yet");
+    const sim::ValanisLandelCurves c = m_fitResult->curves;
+    const int b = m_body;
+    return m_doc->edit(tr("Fit curves to test data"),
+                       [&](Project& p) { sim::setMaterialCurves(p.bodies.at(b).scene.material, c); });
+}
+
+} // namespace viscera::studio

@@ -1,0 +1,619 @@
+#include "app/main_window.hpp"
+
+#include "app/export_runner.hpp"
+#include "app/fit_dialog.hpp"
+#include "app/material_panel.hpp"
+#include "app/plot_widget.hpp"
+#include "app/viewport.hpp"
+#include "sim/material/material.hpp"
+#include "sim/util/format.hpp"
+
+#include <QAction>
+#include <QApplication>
+#include <QCloseEvent>
+#include <QComboBox>
+#include <QDateTime>
+#include <QDockWidget>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QFormLayout>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QInputDialog>
+#include <QLabel>
+#include <QLineEdit>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QPlainTextEdit>
+#include <QProgressDialog>
+#include <QSettings>
+#include <QSplitter>
+#include <QStatusBar>
+#include <QTimer>
+#include <QToolBar>
+#include <QTreeWidget>
+#include <QVBoxLayout>
+
+#include <cmath>
+
+namespace viscera::studio {
+namespace {
+
+enum ItemKind { kGroup = 0, kBody, kSurface, kMaterial, kInstrument, kRender, kSolver };
+constexpr int kKindRole = Qt::UserRole, kIndexRole = Qt::UserRole + 1;
+
+QString num(double v) {
+    return QString::fromStdString(sim::formatNumber(v));
+}
+
+const char* const kBodyFields[] = {"youngs_modulus", "poisson_ratio", "density"};
+const char* const kSolverFields[] = {"dt", "substeps", "iterations", "damping"};
+
+} // namespace
+
+MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_export(std::make_unique<ExportRunner>()) {
+    setObjectName("studioMainWindow");
+    setDockNestingEnabled(true);
+    m_viewport = new Viewport(this);
+    m_viewport->setObjectName("viewport");
+    setCentralWidget(m_viewport);
+    buildDocks();
+    buildActions();
+    statusBar()->showMessage(tr("Open or create a project (File menu)"));
+    connect(&m_doc, &Document::changed, this, &MainWindow::onDocumentChanged);
+    connect(&m_doc, &Document::logMessage, this, &MainWindow::logLine);
+    connect(&m_preview, &Preview::logMessage, this, &MainWindow::logLine, Qt::QueuedConnection);
+    connect(m_doc.undoStack(), &QUndoStack::cleanChanged, this, &MainWindow::updateTitle);
+    connect(m_viewport, &Viewport::bodyClicked, this, [this](const QString& name) {
+        if (!m_doc.hasProject()) return;
+        const auto& bodies = m_doc.project().bodies;
+        for (size_t i = 0; i < bodies.size(); ++i)
+            if (QString::fromStdString(bodies[i].scene.name) == name) selectBody(static_cast<int>(i));
+    });
+    connect(m_viewport, &Viewport::rendererFailed, this, &MainWindow::logLine);
+    connect(m_material, &MaterialPanel::fitRequested, this, [this](int body) {
+        FitDialog dlg(&m_doc, body, this);
+        dlg.exec();
+    });
+    connect(m_export.get(), &ExportRunner::progress, this, [this](int done, int total, const QString& stage) {
+        if (!m_progress) return;
+        m_progress->setMaximum(total);
+        m_progress->setValue(done);
+        m_progress->setLabelText(tr("Exporting: %1").arg(stage));
+    });
+    connect(m_export.get(), &ExportRunner::finished, this, [this](bool ok, const QString& message) {
+        logLine(message);
+        statusBar()->showMessage(message);
+        if (m_progress) {
+            m_progress->reset();
+            m_progress->hide();
+        }
+        Q_UNUSED(ok);
+    });
+    m_poll = new QTimer(this);
+    m_poll->setInterval(16);
+    connect(m_poll, &QTimer::timeout, this, &MainWindow::pollPreview);
+    m_poll->start();
+    QSettings settings;
+    restoreGeometry(settings.value("window/geometry").toByteArray());
+    restoreState(settings.value("window/state").toByteArray());
+    rebuildRecentMenu();
+    updateTitle();
+}
+
+MainWindow::~MainWindow() {
+    m_preview.stop();
+}
+
+void MainWindow::buildDocks() {
+    auto dock = [this](const QString& name, const QString& title, QWidget* w, Qt::DockWidgetArea area) {
+        auto* d = new QDockWidget(title, this);
+        d->setObjectName(name);
+        d->setWidget(w);
+        addDockWidget(area, d);
+        return d;
+    };
+    m_tree = new QTreeWidget(this);
+    m_tree->setObjectName("projectTree");
+    m_tree->setHeaderLabels({tr("Project"), tr("")});
+    m_tree->header()->setSectionResizeMode(0, QHeaderView::ResizeToContents);
+    connect(m_tree, &QTreeWidget::currentItemChanged, this, [this](QTreeWidgetItem* item) {
+        if (m_rebuilding || !item) return;
+        const int kind = item->data(0, kKindRole).toInt(), index = item->data(0, kIndexRole).toInt();
+        if (kind == kBody || kind == kMaterial) {
+            selectBody(index);
+            return;
+        }
+        m_body = -1;
+        m_selKind = kind;
+        m_selIndex = index;
+        m_material->setBody(-1);
+        m_viewport->setSelectedName(kind == kSurface ? item->text(0) : QString());
+        scheduleRefresh(false);
+    });
+    dock("projectDock", tr("Project"), m_tree, Qt::LeftDockWidgetArea);
+
+    m_propertiesHost = new QWidget(this);
+    auto* pv = new QVBoxLayout(m_propertiesHost);
+    m_properties = new QFormLayout;
+    pv->addLayout(m_properties);
+    m_propertyError = new QLabel(m_propertiesHost);
+    m_propertyError->setObjectName("propertyError");
+    m_propertyError->setWordWrap(true);
+    m_propertyError->setStyleSheet("color: #b00020");
+    pv->addWidget(m_propertyError);
+    pv->addStretch();
+    dock("propertiesDock", tr("Properties"), m_propertiesHost, Qt::LeftDockWidgetArea);
+
+    m_material = new MaterialPanel(&m_doc, this);
+    m_material->setObjectName("materialPanel");
+    dock("materialDock", tr("Material curves"), m_material, Qt::BottomDockWidgetArea);
+
+    m_log = new QPlainTextEdit(this);
+    m_log->setObjectName("log");
+    m_log->setReadOnly(true);
+    m_log->setMaximumBlockCount(2000);
+    dock("logDock", tr("Log"), m_log, Qt::BottomDockWidgetArea);
+
+    auto* plots = new QWidget(this);
+    auto* pl = new QVBoxLayout(plots);
+    auto* modeRow = new QHBoxLayout;
+    m_previewMode = new QComboBox(plots);
+    m_previewMode->setObjectName("previewMode");
+    m_previewMode->addItems({tr("Preview: the scene"), tr("Preview: uniaxial specimen of the selected material")});
+    connect(m_previewMode, &QComboBox::currentIndexChanged, this, [this](int) { submitPreview(); });
+    modeRow->addWidget(m_previewMode, 1);
+    pl->addLayout(modeRow);
+    m_verdict = new QLabel(plots);
+    m_verdict->setObjectName("stabilityVerdict");
+    m_verdict->setWordWrap(true);
+    pl->addWidget(m_verdict);
+    m_errorPlot = new PlotWidget(plots);
+    m_errorPlot->setObjectName("errorPlot");
+    m_errorPlot->setTitle(tr("Relative error against the Newton reference [A eq. 4.45]"));
+    m_errorPlot->setAxes(tr("wall time [ms]"), tr("relative error"));
+    m_errorPlot->setLogY(true);
+    pl->addWidget(m_errorPlot, 1);
+    m_costPlot = new PlotWidget(plots);
+    m_costPlot->setObjectName("costPlot");
+    m_costPlot->setTitle(tr("Physics cost per frame"));
+    m_costPlot->setAxes(tr("frame"), tr("ms"));
+    pl->addWidget(m_costPlot, 1);
+    dock("plotsDock", tr("Preview and plots"), plots, Qt::RightDockWidgetArea);
+}
+
+void MainWindow::buildActions() {
+    auto* toolbar = addToolBar(tr("Main"));
+    toolbar->setObjectName("mainToolBar");
+    QMenu* file = menuBar()->addMenu(tr("&File"));
+    auto add = [&](QMenu* menu, const QString& text, QKeySequence key, auto fn, bool onToolbar = false) {
+        QAction* a = menu->addAction(text);
+        a->setShortcut(key);
+        connect(a, &QAction::triggered, this, fn);
+        if (onToolbar) toolbar->addAction(a);
+        return a;
+    };
+    add(
+        file, tr("&New project…"), QKeySequence::New,
+        [this] {
+            const QString dir = QFileDialog::getExistingDirectory(this, tr("Folder of the new project"));
+            if (!dir.isEmpty()) newProject(dir);
+        },
+        true);
+    add(
+        file, tr("&Open project…"), QKeySequence::Open,
+        [this] {
+            const QString dir = QFileDialog::getExistingDirectory(this, tr("Project folder (with project.json)"));
+            if (!dir.isEmpty()) openProject(dir);
+        },
+        true);
+    m_recentMenu = file->addMenu(tr("Open &recent"));
+    add(
+        file, tr("&Save"), QKeySequence::Save, [this] { saveProject(); }, true);
+    add(file, tr("Save &as…"), QKeySequence::SaveAs, [this] {
+        const QString dir = QFileDialog::getExistingDirectory(this, tr("Save the project into folder"));
+        if (!dir.isEmpty()) saveProjectAs(dir);
+    });
+    file->addSeparator();
+    add(
+        file, tr("&Export case…"), QKeySequence(tr("Ctrl+E")),
+        [this] {
+            if (!m_doc.hasProject()) return;
+            const QString out = QFileDialog::getSaveFileName(
+                this, tr("Export case package"),
+                m_doc.folder() + "/" + QString::fromStdString(m_doc.project().caseId) + ".vcase",
+                tr("Case packages (*.vcase)"));
+            if (!out.isEmpty()) startExport(out);
+        },
+        true);
+    file->addSeparator();
+    add(file, tr("&Quit"), QKeySequence::Quit, [this] { close(); });
+
+    QMenu* edit = menuBar()->addMenu(tr("&Edit"));
+    QAction* undo = m_doc.undoStack()->createUndoAction(this, tr("&Undo"));
+    undo->setShortcut(QKeySequence::Undo);
+    QAction* redo = m_doc.undoStack()->createRedoAction(this, tr("&Redo"));
+    redo->setShortcut(QKeySequence::Redo);
+    edit->addAction(undo);
+    edit->addAction(redo);
+    toolbar->addSeparator();
+    toolbar->addAction(undo);
+    toolbar->addAction(redo);
+
+    QMenu* view = menuBar()->addMenu(tr("&View"));
+    add(view, tr("&Frame all"), QKeySequence(Qt::Key_F), [this] { m_viewport->frameAll(); });
+    view->addSeparator();
+    for (QDockWidget* d : findChildren<QDockWidget*>())
+        view->addAction(d->toggleViewAction());
+    view->addAction(toolbar->toggleViewAction());
+}
+
+QStringList MainWindow::recentProjects() const {
+    return QSettings().value("recentProjects").toStringList();
+}
+
+void MainWindow::addRecent(const QString& folder) {
+    QStringList list = recentProjects();
+    list.removeAll(folder);
+    list.prepend(folder);
+    while (list.size() > kMaxRecent)
+        list.removeLast();
+    QSettings().setValue("recentProjects", list);
+    rebuildRecentMenu();
+}
+
+void MainWindow::rebuildRecentMenu() {
+    m_recentMenu->clear();
+    const QStringList list = recentProjects();
+    for (const QString& f : list) {
+        QAction* a = m_recentMenu->addAction(f);
+        connect(a, &QAction::triggered, this, [this, f] { openProject(f); });
+    }
+    m_recentMenu->setEnabled(!list.isEmpty());
+}
+
+void MainWindow::logLine(const QString& line) {
+    m_log->appendPlainText(QDateTime::currentDateTime().toString("hh:mm:ss  ") + line);
+}
+
+bool MainWindow::maybeDiscard() {
+    if (!m_confirm || !m_doc.hasProject() || m_doc.undoStack()->isClean()) return true;
+    const auto r = QMessageBox::question(this, tr("Unsaved changes"), tr("Save the changes to the project first?"),
+                                         QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel);
+    if (r == QMessageBox::Cancel) return false;
+    if (r == QMessageBox::Save) return saveProject();
+    return true;
+}
+
+bool MainWindow::openProject(const QString& folder) {
+    if (!maybeDiscard()) return false;
+    try {
+        m_doc.open(folder);
+    } catch (const std::exception& e) {
+        const QString why = QString::fromStdString(e.what());
+        logLine(why);
+        statusBar()->showMessage(why);
+        return false;
+    }
+    addRecent(m_doc.folder());
+    m_body = -1;
+    selectBody(m_doc.project().bodies.empty() ? -1 : 0);
+    statusBar()->showMessage(tr("Opened %1").arg(m_doc.folder()));
+    return true;
+}
+
+bool MainWindow::newProject(const QString& folder) {
+    if (!maybeDiscard()) return false;
+    try {
+        const QString id = QFileInfo(folder).fileName().toLower().replace(QRegularExpression("[^a-z0-9-]"), "-");
+        m_doc.createNew(folder, id.isEmpty() ? QStringLiteral("new-case") : id);
+    } catch (const std::exception& e) {
+        logLine(QString::fromStdString(e.what()));
+        return false;
+    }
+    addRecent(m_doc.folder());
+    selectBody(0);
+    return true;
+}
+
+bool MainWindow::saveProject() {
+    if (!m_doc.hasProject()) return false;
+    try {
+        m_doc.save();
+    } catch (const std::exception& e) {
+        const QString why = QString::fromStdString(e.what());
+        logLine(why);
+        statusBar()->showMessage(why);
+        return false;
+    }
+    statusBar()->showMessage(tr("Saved"));
+    return true;
+}
+
+bool MainWindow::saveProjectAs(const QString& folder) {
+    if (!m_doc.hasProject()) return false;
+    try {
+        m_doc.saveAs(folder);
+    } catch (const std::exception& e) {
+        logLine(QString::fromStdString(e.what()));
+        return false;
+    }
+    addRecent(m_doc.folder());
+    return true;
+}
+
+bool MainWindow::startExport(const QString& out) {
+    if (!m_doc.hasProject()) return false;
+    QString why;
+    if (!m_export->start(m_doc.project(), out, &why)) {
+        logLine(why);
+        statusBar()->showMessage(why);
+        return false;
+    }
+    if (!m_progress) {
+        m_progress = new QProgressDialog(this);
+        m_progress->setObjectName("exportProgress");
+        m_progress->setWindowTitle(tr("Export case"));
+        m_progress->setMinimumDuration(0);
+        m_progress->setAutoReset(false);
+        m_progress->setAutoClose(false);
+        connect(m_progress, &QProgressDialog::canceled, m_export.get(), &ExportRunner::cancel);
+    }
+    m_progress->setMaximum(m_export->stageCount());
+    m_progress->setValue(0);
+    m_progress->setLabelText(tr("Exporting %1").arg(out));
+    m_progress->show();
+    logLine(tr("exporting to %1").arg(out));
+    return true;
+}
+
+void MainWindow::closeEvent(QCloseEvent* e) {
+    if (!maybeDiscard()) {
+        e->ignore();
+        return;
+    }
+    QSettings settings;
+    settings.setValue("window/geometry", saveGeometry());
+    settings.setValue("window/state", saveState());
+    m_preview.stop();
+    e->accept();
+}
+
+void MainWindow::updateTitle() {
+    QString title = tr("Viscera Studio");
+    if (m_doc.hasProject())
+        title = QStringLiteral("%1 [*] — %2 — %3")
+                    .arg(QString::fromStdString(m_doc.project().caseId), m_doc.folder(), tr("Viscera Studio"));
+    setWindowTitle(title);
+    setWindowModified(m_doc.hasProject() && !m_doc.undoStack()->isClean());
+}
+
+void MainWindow::onDocumentChanged() {
+    if (m_doc.hasProject() && m_body >= static_cast<int>(m_doc.project().bodies.size())) m_body = -1;
+    updateTitle();
+    submitPreview();
+    scheduleRefresh();
+}
+
+void MainWindow::scheduleRefresh(bool tree) {
+    m_treePending = m_treePending || tree;
+    // The tree and the property fields are rebuilt on the next pass of the event loop: an edit
+    // often comes from one of those fields' own signals, which must not delete it, and a drag's
+    // many edits then cost one rebuild per pass.
+    if (m_refreshPending) return;
+    m_refreshPending = true;
+    QTimer::singleShot(0, this, [this] {
+        m_refreshPending = false;
+        if (m_treePending) rebuildTree();
+        m_treePending = false;
+        rebuildProperties();
+    });
+}
+
+void MainWindow::submitPreview() {
+    if (!m_doc.hasProject()) return;
+    uint64_t frames = 0;
+    const uint64_t serial = m_preview.submit(
+        m_doc.project(), m_previewMode->currentIndex() == 1 ? Preview::Mode::Specimen : Preview::Mode::Scene,
+        std::max(0, m_body), &frames);
+    m_lastSubmit = {serial, frames};
+}
+
+void MainWindow::selectBody(int index) {
+    m_body = index;
+    m_selKind = index >= 0 ? kBody : kGroup;
+    m_selIndex = index;
+    m_material->setBody(index);
+    const bool ok = m_doc.hasProject() && index >= 0 && index < static_cast<int>(m_doc.project().bodies.size());
+    m_viewport->setSelectedName(ok ? QString::fromStdString(m_doc.project().bodies[index].scene.name) : QString());
+    // the tree follows
+    m_rebuilding = true;
+    for (QTreeWidgetItemIterator it(m_tree); *it; ++it)
+        if ((*it)->data(0, kKindRole).toInt() == kBody && (*it)->data(0, kIndexRole).toInt() == index) {
+            m_tree->setCurrentItem(*it);
+            break;
+        }
+    m_rebuilding = false;
+    scheduleRefresh(false);
+    if (m_previewMode->currentIndex() == 1) submitPreview();
+}
+
+void MainWindow::rebuildTree() {
+    m_rebuilding = true;
+    m_tree->clear();
+    if (m_doc.hasProject()) {
+        const Project& p = m_doc.project();
+        auto group = [&](const QString& name, int kind) {
+            auto* g = new QTreeWidgetItem(m_tree, {name});
+            g->setData(0, kKindRole, kind == kSolver || kind == kRender ? kind : kGroup);
+            g->setData(0, kIndexRole, -1);
+            if (kind == m_selKind && (kind == kSolver || kind == kRender)) m_tree->setCurrentItem(g);
+            return g;
+        };
+        auto leaf = [&](QTreeWidgetItem* g, const QString& name, const QString& info, int kind, int index) {
+            auto* it = new QTreeWidgetItem(g, {name, info});
+            it->setData(0, kKindRole, kind);
+            it->setData(0, kIndexRole, index);
+            if (kind == m_selKind && index == m_selIndex) m_tree->setCurrentItem(it);
+        };
+        QTreeWidgetItem* bodies = group(tr("Bodies"), kGroup);
+        QTreeWidgetItem* materials = group(tr("Materials"), kGroup);
+        for (size_t i = 0; i < p.bodies.size(); ++i) {
+            const auto& b = p.bodies[i].scene;
+            leaf(bodies, QString::fromStdString(b.name), tr("tet body"), kBody, static_cast<int>(i));
+            leaf(materials, QString::fromStdString(b.name) + tr(" material"),
+                 QString::fromStdString(sim::materialModelName(b.material.model)), kMaterial, static_cast<int>(i));
+        }
+        QTreeWidgetItem* surfaces = group(tr("Surfaces"), kGroup);
+        for (size_t s = 0; s < p.surfaces.size(); ++s)
+            leaf(surfaces, QString::fromStdString(p.surfaces[s].scene.name),
+                 tr("on %1").arg(QString::fromStdString(p.surfaces[s].scene.attachTo)), kSurface, static_cast<int>(s));
+        QTreeWidgetItem* instruments = group(tr("Instruments"), kGroup);
+        if (p.scene.interaction)
+            for (size_t t = 0; t < p.scene.interaction->instruments.size(); ++t)
+                leaf(instruments, QString::fromStdString(p.scene.interaction->instruments[t].name), tr("scripted"),
+                     kInstrument, static_cast<int>(t));
+        if (p.scene.suture) leaf(instruments, tr("needle"), tr("suture trajectory"), kInstrument, -1);
+        group(tr("Render settings"), kRender);
+        group(tr("Solver (%1)").arg(QString::fromStdString(p.scene.solverType)), kSolver);
+        m_tree->expandAll();
+    }
+    m_rebuilding = false;
+}
+
+void MainWindow::rebuildProperties() {
+    while (m_properties->rowCount() > 0)
+        m_properties->removeRow(0);
+    if (!m_doc.hasProject()) return;
+    const Project& p = m_doc.project();
+    auto field = [&](const QString& name, const QString& label, const QString& value) {
+        auto* e = new QLineEdit(value, m_propertiesHost);
+        e->setObjectName(name);
+        connect(e, &QLineEdit::editingFinished, this, [this, e, name] {
+            if (e->isModified()) {
+                e->setModified(false);
+                setProperty(name, e->text());
+            }
+        });
+        m_properties->addRow(label, e);
+    };
+    const int kind = m_selKind;
+    if (m_body >= 0 && m_body < static_cast<int>(p.bodies.size())) {
+        const sim::Material& m = p.bodies[m_body].scene.material;
+        m_properties->addRow(tr("Body"), new QLabel(QString::fromStdString(p.bodies[m_body].scene.name)));
+        auto* model = new QComboBox(m_propertiesHost);
+        model->setObjectName("model");
+        for (auto mm :
+             {sim::MaterialModel::StableNeoHookean, sim::MaterialModel::NeoHookean, sim::MaterialModel::Linear,
+              sim::MaterialModel::StVenantKirchhoff, sim::MaterialModel::Corotated, sim::MaterialModel::ValanisLandel})
+            model->addItem(QString::fromStdString(sim::materialModelName(mm)));
+        model->setCurrentText(QString::fromStdString(sim::materialModelName(m.model)));
+        connect(model, &QComboBox::currentTextChanged, this, [this](const QString& t) { setProperty("model", t); });
+        m_properties->addRow(tr("Material model"), model);
+        field("youngs_modulus", tr("Young's modulus E [Pa]"), num(m.youngsModulus));
+        field("poisson_ratio", tr("Poisson ratio ν"), num(m.poissonRatio));
+        field("density", tr("Density [kg/m³]"), num(m.density));
+    } else if (kind == kSolver && p.scene.solverType == "xpbd") {
+        field("dt", tr("Frame step dt [s]"), num(p.scene.xpbd.dt));
+        field("substeps", tr("Substeps per frame"), QString::number(p.scene.xpbd.substeps));
+        field("iterations", tr("Iterations per substep"), QString::number(p.scene.xpbd.iterations));
+        field("damping", tr("Damping [1/s]"), num(p.scene.xpbd.damping));
+    } else if (kind == kRender) {
+        auto* l = new QLabel(p.scene.render.empty() ? tr("renderer defaults") : QString::fromStdString(p.scene.render));
+        l->setWordWrap(true);
+        m_properties->addRow(tr("Render"), l);
+    } else if (kind == kSurface && m_selIndex >= 0 && m_selIndex < static_cast<int>(p.surfaces.size())) {
+        const auto& s = p.surfaces.at(m_selIndex).scene;
+        m_properties->addRow(tr("Surface"), new QLabel(QString::fromStdString(s.name)));
+        m_properties->addRow(tr("Stretch stiffness"), new QLabel(num(s.stretchStiffness)));
+        m_properties->addRow(tr("Areal density"), new QLabel(num(s.arealDensity)));
+    }
+}
+
+QString MainWindow::setProperty(const QString& field, const QString& text) {
+    QString why;
+    auto show = [&](const QString& w) {
+        m_propertyError->setText(w);
+        if (!w.isEmpty()) {
+            logLine(w);
+            scheduleRefresh(); // the field shows the model's value again
+        }
+        return w;
+    };
+    if (field == "model") {
+        if (m_body < 0) return show(tr("no body selected"));
+        const int b = m_body;
+        if (text == "valanis_landel") {
+            const sim::Material& m = m_doc.project().bodies[b].scene.material;
+            if (m.model == sim::MaterialModel::ValanisLandel) return show({});
+            return show(m_material->applyPreset("neo_hookean", m.youngsModulus, m.poissonRatio));
+        }
+        return show(m_doc.edit(tr("Set material model"), [&](Project& p) {
+            sim::Material& m = p.bodies.at(b).scene.material;
+            m.model = sim::materialModelFromName(text.toStdString());
+            m.curvePreset.clear();
+            m.fPrime.reset();
+            m.gPrime.reset();
+            m.hPrime.reset();
+        }));
+    }
+    bool ok = false;
+    const double v = text.trimmed().toDouble(&ok);
+    if (!ok || !std::isfinite(v)) return show(tr("%1: '%2' is not a finite number").arg(field, text));
+    const int b = m_body;
+    for (const char* f : kBodyFields)
+        if (field == f) {
+            if (b < 0) return show(tr("no body selected"));
+            return show(m_doc.edit(tr("Set %1").arg(field), [&](Project& p) {
+                sim::Material& m = p.bodies.at(b).scene.material;
+                if (field == "youngs_modulus") m.youngsModulus = v;
+                if (field == "poisson_ratio") m.poissonRatio = v;
+                if (field == "density") m.density = v;
+            }));
+        }
+    for (const char* f : kSolverFields)
+        if (field == f) {
+            if ((field == "substeps" || field == "iterations") && (v != std::floor(v) || std::abs(v) > 1e6))
+                return show(tr("solver.%1: '%2' must be a whole number").arg(field, text));
+            return show(m_doc.edit(tr("Set solver %1").arg(field), [&](Project& p) {
+                if (field == "dt") p.scene.xpbd.dt = v;
+                if (field == "substeps") p.scene.xpbd.substeps = static_cast<int>(v);
+                if (field == "iterations") p.scene.xpbd.iterations = static_cast<int>(v);
+                if (field == "damping") p.scene.xpbd.damping = v;
+            }));
+        }
+    return show(tr("%1: not a property of the selection").arg(field));
+}
+
+void MainWindow::pollPreview() {
+    if (!m_doc.hasProject()) return;
+    const Preview::Snapshot s = m_preview.snapshot();
+    if (s.frames == m_shownFrames && s.scene == m_shownScene && m_verdict->text() == s.verdict) return;
+    if (s.scene != m_shownScene) {
+        if (auto view = m_preview.sceneView()) m_viewport->setScene(*view);
+        m_shownScene = s.scene;
+    }
+    m_shownFrames = s.frames;
+    m_viewport->setPositions(s.bodies, s.surfaces);
+    QString verdict = s.verdict;
+    if (!s.error.isEmpty()) verdict += (verdict.isEmpty() ? "" : "\n") + s.error;
+    m_verdict->setText(verdict);
+    m_verdict->setStyleSheet(s.verdictOk && s.error.isEmpty() ? "color: #106010" : "color: #b00020");
+    if (s.accuracy) {
+        PlotWidget::Series e{tr("XPBD, frame %1").arg(s.accuracy->frame), s.accuracy->timeMs, s.accuracy->relError,
+                             QColor(200, 60, 40)};
+        m_errorPlot->setSeries({e});
+        m_errorPlot->setNote(tr("%1 iterations; each point one more iteration of the frame's first substep")
+                                 .arg(s.accuracy->iterations.empty() ? 0 : s.accuracy->iterations.back()));
+    }
+    PlotWidget::Series c{tr("physics ms"), {}, {}, QColor(40, 90, 200)};
+    const double first = static_cast<double>(s.frames) - static_cast<double>(s.frameMs.size());
+    for (size_t i = 0; i < s.frameMs.size(); ++i) {
+        c.x.push_back(first + static_cast<double>(i));
+        c.y.push_back(s.frameMs[i]);
+    }
+    m_costPlot->setSeries({c});
+    m_costPlot->setNote(tr("last %1 ms, frame %2").arg(num(s.stepMs)).arg(s.frame));
+}
+
+} // namespace viscera::studio

@@ -1,0 +1,122 @@
+#pragma once
+/// The studio's main window: the project tree (bodies, surfaces, materials, instruments, render
+/// settings, solver), properties, the curve-based material editor, log and plots around the 3D
+/// viewport. Every dock and toolbar has an object name, so the layout is saved and restored
+/// (QSettings "Viscera/Studio"); up to kMaxRecent recent projects; New / Open / Save / Save As of
+/// a project folder (atomic writes); the title marks unsaved changes from the undo stack's clean
+/// state; File → Export case… runs the export with progress and Cancel.
+#include "app/document.hpp"
+#include "app/preview.hpp"
+
+#include <QMainWindow>
+#include <QStringList>
+
+#include <memory>
+
+class QComboBox;
+class QLabel;
+class QLineEdit;
+class QMenu;
+class QPlainTextEdit;
+class QProgressDialog;
+class QTimer;
+class QTreeWidget;
+class QTreeWidgetItem;
+class QFormLayout;
+
+namespace viscera::studio {
+
+class ExportRunner;
+class MaterialPanel;
+class PlotWidget;
+class Viewport;
+
+class MainWindow : public QMainWindow {
+    Q_OBJECT
+public:
+    static constexpr int kMaxRecent = 5;
+
+    explicit MainWindow(QWidget* parent = nullptr);
+    ~MainWindow() override;
+
+    /// Opens a project folder; on failure the message (file, field, rule) goes to the log and
+    /// the status bar and false is returned (the open project stays).
+    bool openProject(const QString& folder);
+    bool saveProject();
+    bool saveProjectAs(const QString& folder);
+    bool newProject(const QString& folder);
+    /// Starts File → Export case… to `out` (no file dialog). False with the reason logged.
+    bool startExport(const QString& out);
+
+    /// Selects the body (tree, material editor, viewport highlight). -1: none.
+    void selectBody(int index);
+    int selectedBody() const { return m_body; }
+    /// Sets a property field of the selection as if typed (name as the field's object name,
+    /// e.g. "youngs_modulus"). Returns the error shown, empty when accepted.
+    QString setProperty(const QString& field, const QString& text);
+
+    Document* document() { return &m_doc; }
+    Preview* preview() { return &m_preview; }
+    Viewport* viewport() { return m_viewport; }
+    MaterialPanel* materialPanel() { return m_material; }
+    QTreeWidget* tree() { return m_tree; }
+    PlotWidget* errorPlot() { return m_errorPlot; }
+    PlotWidget* costPlot() { return m_costPlot; }
+    QLabel* verdictLabel() { return m_verdict; }
+    QLabel* propertyError() { return m_propertyError; }
+    QPlainTextEdit* log() { return m_log; }
+    ExportRunner* exportRunner() { return m_export.get(); }
+    QProgressDialog* exportProgress() { return m_progress; }
+    QComboBox* previewMode() { return m_previewMode; }
+    QStringList recentProjects() const;
+    /// Ask before discarding unsaved changes (off in tests).
+    void setConfirmDiscard(bool on) { m_confirm = on; }
+    /// The last model handed to the preview: its serial and the frames completed then.
+    std::pair<uint64_t, uint64_t> lastPreviewSubmit() const { return m_lastSubmit; }
+    /// Applies the preview's latest frame to the viewport and the plots (a 60 Hz timer calls it).
+    void pollPreview();
+
+protected:
+    void closeEvent(QCloseEvent*) override;
+
+private:
+    void buildActions();
+    void buildDocks();
+    void rebuildTree();
+    void rebuildProperties();
+    /// Rebuilds the property fields (and the tree) on the next pass of the event loop.
+    void scheduleRefresh(bool tree = true);
+    void onDocumentChanged();
+    void updateTitle();
+    void addRecent(const QString& folder);
+    void rebuildRecentMenu();
+    bool maybeDiscard();
+    void logLine(const QString& line);
+    void submitPreview();
+
+    Document m_doc;
+    Preview m_preview;
+    std::unique_ptr<ExportRunner> m_export;
+    Viewport* m_viewport = nullptr;
+    MaterialPanel* m_material = nullptr;
+    QTreeWidget* m_tree = nullptr;
+    QWidget* m_propertiesHost = nullptr;
+    QFormLayout* m_properties = nullptr;
+    QLabel* m_propertyError = nullptr;
+    QPlainTextEdit* m_log = nullptr;
+    PlotWidget *m_errorPlot = nullptr, *m_costPlot = nullptr;
+    QLabel* m_verdict = nullptr;
+    QComboBox* m_previewMode = nullptr;
+    QMenu* m_recentMenu = nullptr;
+    QProgressDialog* m_progress = nullptr;
+    QTimer* m_poll = nullptr;
+    int m_body = -1;
+    uint64_t m_shownScene = 0, m_shownFrames = 0;
+    std::pair<uint64_t, uint64_t> m_lastSubmit{0, 0};
+    bool m_confirm = true;
+    bool m_rebuilding = false;
+    bool m_refreshPending = false, m_treePending = false;
+    int m_selKind = 0, m_selIndex = -1; ///< the tree's selection (ItemKind, index)
+};
+
+} // namespace viscera::studio

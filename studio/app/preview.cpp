@@ -1,0 +1,266 @@
+#include "app/preview.hpp"
+
+#include "sim/diagnostics/stability_check.hpp"
+#include "sim/material/material.hpp"
+#include "sim/scene/features.hpp"
+#include "sim/scene/world.hpp"
+#include "sim/util/format.hpp"
+
+#include <chrono>
+#include <cmath>
+
+namespace viscera::studio {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// The project text with every material replaced by the default one: equal keys mean that two
+/// models differ in their materials at most, so the built meshes can be kept.
+std::string structureKey(const Project& p, Preview::Mode mode, int body) {
+    Project q = p;
+    for (BodyProject& b : q.bodies)
+        b.scene.material = sim::Material{};
+    return projectJsonText(q) + (mode == Preview::Mode::Specimen ? "#specimen" : "#scene");
+}
+
+bool allFinite(const std::vector<sim::Vec3>& x) {
+    for (const sim::Vec3& p : x)
+        if (!p.allFinite()) return false;
+    return true;
+}
+
+/// "body 'organ': stiffness number 0.21 at 110 substeps, needs at least 92" per XPBD body;
+/// `ok` false when a body is over the limit.
+QString stabilityVerdict(const BuiltScene& built, bool& ok) {
+    ok = true;
+    if (built.scene.solverType != "xpbd")
+        return QObject::tr("solver %1: no XPBD stability rule").arg(QString::fromStdString(built.scene.solverType));
+    QStringList lines;
+    for (size_t i = 0; i < built.scene.bodies.size(); ++i) {
+        const sim::BodyDesc& b = built.scene.bodies[i];
+        const auto model = sim::makeConstraintModel(b.material, b.name);
+        const sim::StabilityFigures f =
+            sim::assessStability(*built.meshes[i], *model, b.material.density, b.nodeWeights, built.scene.xpbd);
+        const QString head =
+            QObject::tr("body '%1': stiffness number %2 (limit %3)")
+                .arg(QString::fromStdString(b.name), QString::fromStdString(sim::formatNumber(f.maxStiffnessNumber, 3)),
+                     QString::fromStdString(sim::formatNumber(sim::kMaxStiffnessNumber)));
+        if (f.ok()) {
+            lines << head + QObject::tr(": stable at %1 substeps (needs at least %2)")
+                                .arg(built.scene.xpbd.substeps)
+                                .arg(f.requiredSubsteps);
+        } else {
+            ok = false;
+            lines << head + QObject::tr(": UNSTABLE at %1 substeps, needs at least %2 substeps")
+                                .arg(built.scene.xpbd.substeps)
+                                .arg(f.requiredSubsteps);
+        }
+    }
+    return lines.join('\n');
+}
+
+} // namespace
+
+Preview::Preview(QObject* parent) : QObject(parent) {}
+
+Preview::~Preview() {
+    stop();
+}
+
+void Preview::stop() {
+    m_stop = true;
+    m_wake.notify_all();
+    if (m_thread.joinable()) m_thread.join();
+    m_stop = false;
+}
+
+uint64_t Preview::submit(const Project& project, Mode mode, int body, uint64_t* framesAtSubmit) {
+    uint64_t serial;
+    {
+        std::lock_guard lock(m_mutex);
+        serial = ++m_serial;
+        if (framesAtSubmit) *framesAtSubmit = m_snapshot.frames;
+        m_pending = Pending{project, mode, body, serial};
+    }
+    if (!m_thread.joinable()) m_thread = std::thread([this] { run(); });
+    m_wake.notify_all();
+    return serial;
+}
+
+Preview::Snapshot Preview::snapshot() const {
+    std::lock_guard lock(m_mutex);
+    return m_snapshot;
+}
+
+std::shared_ptr<const render::SceneView> Preview::sceneView() const {
+    std::lock_guard lock(m_mutex);
+    return m_view;
+}
+
+Project Preview::specimenProject(const Project& source, const sim::Material& material) {
+    Project p;
+    p.dir = source.dir;
+    p.caseId = source.caseId.empty() ? "specimen" : source.caseId;
+    p.caseVersion = source.caseVersion.empty() ? "1.0.0" : source.caseVersion;
+    p.title = "Uniaxial specimen";
+    if (source.scene.solverType == "xpbd") p.scene.xpbd = source.scene.xpbd;
+    p.scene.xpbd.gravity = sim::Vec3(0, 0, -9.81);
+    BodyProject b;
+    b.scene.name = "specimen";
+    b.scene.material = material;
+    b.mesh.kind = MeshSource::Kind::Box;
+    b.mesh.box.origin = sim::Vec3(-0.01, -0.01, -0.06);
+    b.mesh.box.size = sim::Vec3(0.02, 0.02, 0.06);
+    b.mesh.box.cells = {4, 4, 12};
+    b.fixedBox = std::array<sim::Vec3, 2>{sim::Vec3(-1, -1, -0.0001), sim::Vec3(1, 1, 1)};
+    p.bodies.push_back(std::move(b));
+    return p;
+}
+
+void Preview::run() {
+    std::string builtKey;
+    std::optional<BuiltScene> built;
+    std::unique_ptr<sim::World> world;
+    uint64_t sceneRevision = 0, frames = 0;
+    std::deque<double> history;
+    std::optional<sim::AccuracyRecord> lastAccuracy;
+    auto publishStatus = [&](auto&& fn) {
+        std::lock_guard lock(m_mutex);
+        fn(m_snapshot);
+    };
+    while (!m_stop) {
+        const auto frameStart = Clock::now();
+        std::optional<Pending> job;
+        uint64_t takenAfter = 0;
+        {
+            std::lock_guard lock(m_mutex);
+            job.swap(m_pending);
+            takenAfter = m_snapshot.frames;
+        }
+        if (job) {
+            Project project = job->project;
+            if (job->mode == Mode::Specimen) {
+                const int i = std::clamp(job->body, 0, std::max(0, static_cast<int>(project.bodies.size()) - 1));
+                project = specimenProject(job->project,
+                                          project.bodies.empty() ? sim::Material{} : project.bodies[i].scene.material);
+            }
+            const std::string origin = (project.dir / "project.json").string();
+            try {
+                const std::string key = structureKey(project, job->mode, job->body);
+                std::unique_ptr<sim::World> next;
+                if (!built || key != builtKey) {
+                    emit logMessage(tr("preview: building meshes"));
+                    BuiltScene b = buildScene(project);
+                    b.scene.accuracy = sim::AccuracySampling{std::max(1, m_accuracyEvery.load()), 100};
+                    b.features = sim::requiredFeatures(b.scene); // the preview adds accuracy sampling
+                    bool ok = true;
+                    const QString verdict = stabilityVerdict(b, ok);
+                    publishStatus([&](Snapshot& s) {
+                        s.verdict = verdict;
+                        s.verdictOk = ok;
+                    });
+                    if (!ok) throw std::runtime_error(tr("the preview keeps the last stable model").toStdString());
+                    next = assembleWorld(b, origin);
+                    auto view = std::make_shared<render::SceneView>(render::SceneView::fromWorld(*next));
+                    built = std::move(b);
+                    builtKey = key;
+                    {
+                        std::lock_guard lock(m_mutex);
+                        m_view = std::move(view);
+                        m_snapshot.scene = ++sceneRevision;
+                    }
+                    emit logMessage(tr("preview: %1 bodies, %2 substeps per frame")
+                                        .arg(built->scene.bodies.size())
+                                        .arg(built->scene.xpbd.substeps));
+                } else {
+                    BuiltScene& b = *built;
+                    std::vector<sim::Material> old;
+                    for (size_t i = 0; i < b.scene.bodies.size(); ++i) {
+                        old.push_back(b.scene.bodies[i].material);
+                        b.scene.bodies[i].material = project.bodies[i].scene.material;
+                    }
+                    bool ok = true;
+                    QString verdict;
+                    try {
+                        verdict = stabilityVerdict(b, ok);
+                        if (ok) next = assembleWorld(b, origin);
+                    } catch (...) {
+                        for (size_t i = 0; i < old.size(); ++i)
+                            b.scene.bodies[i].material = old[i];
+                        throw;
+                    }
+                    publishStatus([&](Snapshot& s) {
+                        s.verdict = verdict;
+                        s.verdictOk = ok;
+                    });
+                    if (!ok) {
+                        for (size_t i = 0; i < old.size(); ++i)
+                            b.scene.bodies[i].material = old[i];
+                        throw std::runtime_error(tr("the preview keeps the last stable material").toStdString());
+                    }
+                    if (world && world->bodyCount() == next->bodyCount() && b.scene.solverType == "xpbd")
+                        for (size_t i = 0; i < next->bodyCount(); ++i)
+                            next->setState(i, world->positions(i), world->velocities(i));
+                }
+                world = std::move(next);
+                publishStatus([&](Snapshot& s) {
+                    s.serial = job->serial;
+                    s.appliedAfter = takenAfter;
+                    s.error.clear();
+                });
+            } catch (const std::exception& e) {
+                const QString why = QString::fromStdString(e.what());
+                publishStatus([&](Snapshot& s) {
+                    s.serial = job->serial; // seen, not shown
+                    s.appliedAfter = takenAfter;
+                    s.error = why;
+                });
+                emit logMessage(tr("preview: %1").arg(why));
+                emit frameReady();
+            }
+        }
+        if (!world) {
+            std::unique_lock lock(m_mutex);
+            m_wake.wait_for(lock, std::chrono::milliseconds(50), [&] { return m_stop || m_pending.has_value(); });
+            continue;
+        }
+        const sim::FrameRecord r = world->step();
+        ++frames;
+        bool finite = r.finite;
+        for (size_t i = 0; finite && i < world->bodyCount(); ++i)
+            finite = allFinite(world->positions(i));
+        if (!finite) {
+            emit logMessage(tr("preview: the state became non-finite at frame %1; restarting from rest").arg(r.index));
+            world = assembleWorld(*built, "preview");
+            continue;
+        }
+        if (!world->accuracy().empty() && world->accuracy().back().frame == r.index)
+            lastAccuracy = world->accuracy().back();
+        history.push_back(r.stepMs);
+        while (history.size() > kHistory)
+            history.pop_front();
+        {
+            std::lock_guard lock(m_mutex);
+            Snapshot& s = m_snapshot;
+            s.frame = r.index;
+            s.frames = frames;
+            s.stepMs = r.stepMs;
+            s.frameMs = history;
+            s.accuracy = lastAccuracy;
+            s.bodies.resize(world->bodyCount());
+            for (size_t i = 0; i < world->bodyCount(); ++i)
+                s.bodies[i] = world->positions(i);
+            s.surfaces.resize(world->surfaceCount());
+            for (size_t i = 0; i < world->surfaceCount(); ++i)
+                s.surfaces[i] = world->surfacePositions(i);
+        }
+        emit frameReady();
+        if (m_realTime && built) {
+            const auto due = frameStart + std::chrono::duration<double>(built->scene.xpbd.dt);
+            std::unique_lock lock(m_mutex);
+            m_wake.wait_until(lock, due, [&] { return m_stop || m_pending.has_value(); });
+        }
+    }
+}
+
+} // namespace viscera::studio

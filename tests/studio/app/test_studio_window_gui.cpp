@@ -1,0 +1,285 @@
+// The studio's main window under Xvfb with Mesa (label gui): docks and layout, title and undo,
+// property validation by the export's rules, save / save as / recent, the viewport's renderer
+// and picking, the live preview, fit to test data, and export with progress and cancel (the
+// package equals the CLI's; cancel leaves no file).
+#include "app/document.hpp"
+#include "app/export_runner.hpp"
+#include "app/fit_dialog.hpp"
+#include "app/main_window.hpp"
+#include "app/material_panel.hpp"
+#include "app/plot_widget.hpp"
+#include "app/viewport.hpp"
+#include "case/case_package.hpp"
+#include "gui_test_support.hpp"
+#include "sim/material/laws.hpp"
+#include "sim/material/material_response.hpp"
+
+#include <QComboBox>
+#include <QDockWidget>
+#include <QLabel>
+#include <QLineEdit>
+#include <QProgressDialog>
+#include <QPushButton>
+#include <QSettings>
+#include <QToolBar>
+#include <QTreeWidget>
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+namespace {
+
+using namespace viscera;
+namespace fs = std::filesystem;
+
+struct WindowFixture : ::testing::Test {
+    test::Scratch scratch{"viscera-gui-window"};
+    std::unique_ptr<studio::MainWindow> w;
+
+    void SetUp() override {
+        test::guiApp();
+        QSettings().clear();
+        w = std::make_unique<studio::MainWindow>();
+        w->setConfirmDiscard(false);
+        w->exportRunner()->setProgram(VISCERA_STUDIO_EXE);
+        w->resize(1500, 950);
+        w->show();
+        ASSERT_TRUE(QTest::qWaitForWindowExposed(w.get()));
+    }
+    void TearDown() override {
+        w->preview()->stop();
+        w.reset();
+    }
+    fs::path open(const std::string& sample) {
+        const fs::path dir = test::copySample(scratch, sample);
+        EXPECT_TRUE(w->openProject(QString::fromStdString(dir.string())));
+        return dir;
+    }
+    bool waitForPreview(int ms = 120000) {
+        return test::waitFor([&] { return w->viewport()->meshCount() > 0 && w->preview()->snapshot().frames > 3; }, ms);
+    }
+};
+
+std::vector<vcase::FileEntry> manifestFiles(const fs::path& p) {
+    return vcase::verify(p).files;
+}
+
+TEST_F(WindowFixture, EveryDockAndToolbarIsNamedAndTheLayoutIsRestored) {
+    const auto docks = w->findChildren<QDockWidget*>();
+    ASSERT_GE(docks.size(), 5);
+    for (QDockWidget* d : docks)
+        EXPECT_FALSE(d->objectName().isEmpty()) << d->windowTitle().toStdString();
+    for (QToolBar* t : w->findChildren<QToolBar*>())
+        EXPECT_FALSE(t->objectName().isEmpty());
+    QDockWidget* log = w->findChild<QDockWidget*>("logDock");
+    ASSERT_NE(log, nullptr);
+    log->hide();
+    w->close(); // saves the layout
+    studio::MainWindow again;
+    again.show();
+    ASSERT_TRUE(QTest::qWaitForWindowExposed(&again));
+    EXPECT_FALSE(again.findChild<QDockWidget*>("logDock")->isVisible());
+    again.preview()->stop();
+}
+
+TEST_F(WindowFixture, TitleMarksUnsavedChangesAndUndoRestoresExactly) {
+    const fs::path dir = open("tissue-slab");
+    EXPECT_FALSE(w->isWindowModified());
+    const std::string before = studio::projectJsonText(w->document()->project());
+    EXPECT_EQ(w->setProperty("youngs_modulus", "25000"), "");
+    EXPECT_TRUE(w->isWindowModified());
+    EXPECT_TRUE(w->windowTitle().contains("[*]"));
+    w->document()->undoStack()->undo();
+    EXPECT_FALSE(w->isWindowModified());
+    EXPECT_EQ(studio::projectJsonText(w->document()->project()), before);
+}
+
+TEST_F(WindowFixture, ARejectedPropertyNamesTheFieldAndTheRuleAndChangesNothing) {
+    open("tissue-slab");
+    const std::string before = studio::projectJsonText(w->document()->project());
+    const int undo = w->document()->undoStack()->count();
+    // typed into the real field
+    QLineEdit* nu = nullptr;
+    ASSERT_TRUE(test::waitFor([&] { return (nu = w->findChild<QLineEdit*>("poisson_ratio")) != nullptr; }, 5000));
+    nu->setFocus();
+    nu->selectAll();
+    QTest::keyClicks(nu, "0.7");
+    QTest::keyClick(nu, Qt::Key_Return);
+    const QString why = w->propertyError()->text();
+    EXPECT_TRUE(why.contains("poisson_ratio")) << why.toStdString();
+    EXPECT_TRUE(why.contains("0.5")) << why.toStdString();
+    EXPECT_EQ(w->document()->undoStack()->count(), undo);
+    EXPECT_EQ(studio::projectJsonText(w->document()->project()), before);
+    EXPECT_TRUE(w->setProperty("substeps", "2.5").isEmpty() == false);
+    EXPECT_TRUE(w->setProperty("density", "nan").contains("not a finite number"));
+}
+
+TEST_F(WindowFixture, SaveAsWritesTheProjectAndRecentKeepsFive) {
+    open("tissue-slab");
+    ASSERT_EQ(w->setProperty("density", "1100"), "");
+    const fs::path copy = scratch.dir / "saved-as";
+    ASSERT_TRUE(w->saveProjectAs(QString::fromStdString(copy.string())));
+    EXPECT_FALSE(w->isWindowModified());
+    const studio::Project p = studio::loadProject(copy);
+    EXPECT_EQ(p.bodies[0].scene.material.density, 1100);
+    for (int i = 0; i < 6; ++i) {
+        std::string name = "r";
+        name += std::to_string(i);
+        const fs::path d = scratch.dir / name;
+        fs::copy(copy, d, fs::copy_options::recursive);
+        ASSERT_TRUE(w->openProject(QString::fromStdString(d.string())));
+    }
+    const QStringList recent = w->recentProjects();
+    EXPECT_EQ(recent.size(), studio::MainWindow::kMaxRecent);
+    EXPECT_TRUE(recent.front().endsWith("r5"));
+    // a broken project is refused with the reader's line and the open one stays
+    const fs::path bad = scratch.dir / "bad";
+    fs::create_directories(bad);
+    std::ofstream(bad / "project.json") << "{\"schemaVersion\": 1, \"caseId\": \"x\"";
+    EXPECT_FALSE(w->openProject(QString::fromStdString(bad.string())));
+    EXPECT_TRUE(w->windowTitle().contains("r5"));
+}
+
+TEST_F(WindowFixture, ViewportDrawsThePreviewAndAClickSelectsTheBody) {
+    open("organ-blob");
+    ASSERT_TRUE(w->viewport()->rendererReady()) << w->viewport()->rendererInfo().toStdString();
+    ASSERT_TRUE(waitForPreview()) << w->verdictLabel()->text().toStdString();
+    w->selectBody(-1);
+    w->viewport()->frameAll();
+    QTest::qWait(100);
+    const QImage img = w->viewport()->grabFramebuffer();
+    ASSERT_FALSE(img.isNull());
+    const QRgb bg = img.pixel(2, 2);
+    int differing = 0;
+    for (int y = 0; y < img.height(); y += 2)
+        for (int x = 0; x < img.width(); x += 2)
+            differing += img.pixel(x, y) != bg;
+    const double share = differing / (img.width() / 2.0 * img.height() / 2.0);
+    EXPECT_GT(share, 0.05) << "the grab is blank";
+    // the centre shows the body: a click there selects it
+    const QPoint centre(w->viewport()->width() / 2, w->viewport()->height() / 2);
+    ASSERT_FALSE(w->viewport()->pick(centre).isEmpty());
+    test::click(w->viewport(), centre);
+    EXPECT_EQ(w->selectedBody(), 0);
+    ASSERT_NE(w->tree()->currentItem(), nullptr);
+    EXPECT_EQ(w->tree()->currentItem()->text(0).toStdString(), w->document()->project().bodies[0].scene.name);
+}
+
+TEST_F(WindowFixture, LivePreviewShowsAnEditTheNextFrameAndTheStabilityVerdict) {
+    open("tissue-slab");
+    ASSERT_TRUE(waitForPreview()) << w->verdictLabel()->text().toStdString();
+    EXPECT_TRUE(test::waitFor([&] { return w->verdictLabel()->text().contains("stable"); }, 10000));
+    // far too stiff for the substeps: the verdict says how many are needed, the preview stays finite
+    ASSERT_EQ(w->setProperty("youngs_modulus", "3e8"), "");
+    const uint64_t serial = w->preview()->snapshot().serial;
+    ASSERT_TRUE(test::waitFor([&] { return w->verdictLabel()->text().contains("UNSTABLE"); }, 20000));
+    EXPECT_TRUE(w->verdictLabel()->text().contains("needs at least")) << w->verdictLabel()->text().toStdString();
+    EXPECT_TRUE(w->verdictLabel()->text().contains("keeps the last stable")) << w->verdictLabel()->text().toStdString();
+    const auto s = w->preview()->snapshot();
+    EXPECT_GT(s.serial, serial - 1);
+    for (const auto& b : s.bodies)
+        for (const auto& p : b)
+            ASSERT_TRUE(p.allFinite());
+    // the accuracy sample arrives (every 60 frames by default)
+    w->preview()->setAccuracyEvery(5);
+    ASSERT_EQ(w->setProperty("youngs_modulus", "20000"), "");
+    EXPECT_TRUE(test::waitFor([&] { return !w->errorPlot()->series().empty(); }, 60000));
+    EXPECT_FALSE(w->costPlot()->series().empty());
+}
+
+TEST_F(WindowFixture, FitToSyntheticNeoHookeanData) {
+    open("tissue-slab");
+    ASSERT_EQ(w->materialPanel()->applyPreset("neo_hookean", 6000, 0.3), "");
+    // synthetic compressible Neo-Hookean test: μ = 1 kPa, λ = 10 kPa, stretch 0.7–1.5, 41 points
+    auto nh = sim::makeEnergyDensity("neo_hookean", 1000.0, 10000.0);
+    const fs::path data = scratch.dir / "nh.csv";
+    {
+        std::ofstream f(data);
+        f << "stretch,nominal stress (Pa)\n";
+        for (int i = 0; i < 41; ++i) {
+            const double l = 0.7 + 0.8 * i / 40.0;
+            f.precision(17);
+            f << l << "," << sim::uniaxialNominalStress(*nh, l).nominalStress << "\n";
+        }
+    }
+    studio::FitDialog dlg(w->document(), 0, w.get());
+    dlg.show();
+    dlg.fileField()->setText(QString::fromStdString(data.string()));
+    QTest::mouseClick(dlg.fitButton(), Qt::LeftButton);
+    ASSERT_TRUE(dlg.result().has_value()) << dlg.resultLabel()->text().toStdString();
+    const auto& r = *dlg.result();
+    std::printf("fit: SSE %.6g Pa^2, R^2 %.9f, max relative error %.4g %%, %d iterations\n", r.sse, r.rSquared,
+                100 * r.maxRelativeError, r.iterations);
+    EXPECT_GT(r.rSquared, 0.999);
+    EXPECT_LT(r.maxRelativeError, 0.01);
+    EXPECT_EQ(dlg.plot()->series().size(), 2u);
+    const int undo = w->document()->undoStack()->count();
+    EXPECT_EQ(dlg.apply(), "");
+    EXPECT_EQ(w->document()->undoStack()->count(), undo + 1);
+    // a bad file: one line naming the line and the column
+    std::ofstream(scratch.dir / "bad.csv") << "1.0,0\n1.1,abc\n1.2,5\n";
+    dlg.fileField()->setText(QString::fromStdString((scratch.dir / "bad.csv").string()));
+    EXPECT_FALSE(dlg.runFit());
+    const std::string why = dlg.resultLabel()->text().toStdString();
+    EXPECT_NE(why.find("line 2"), std::string::npos) << why;
+    EXPECT_NE(why.find("column 2"), std::string::npos) << why;
+}
+
+TEST_F(WindowFixture, GuiExportEqualsCliExport) {
+    const fs::path dir = open("tissue-slab");
+    const fs::path gui = scratch.dir / "gui.vcase", cli = scratch.dir / "cli.vcase";
+    bool done = false, ok = false;
+    QObject::connect(w->exportRunner(), &studio::ExportRunner::finished, [&](bool success, const QString&) {
+        done = true;
+        ok = success;
+    });
+    int progressEvents = 0;
+    QObject::connect(w->exportRunner(), &studio::ExportRunner::progress,
+                     [&](int, int, const QString&) { ++progressEvents; });
+    ASSERT_TRUE(w->startExport(QString::fromStdString(gui.string())));
+    ASSERT_TRUE(test::waitFor([&] { return done; }, 120000));
+    ASSERT_TRUE(ok) << w->exportRunner()->output().toStdString();
+    EXPECT_GE(progressEvents, 3);
+    const std::string cmd =
+        std::string(VISCERA_STUDIO_EXE) + " export '" + dir.string() + "' -o '" + cli.string() + "' > /dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    EXPECT_EQ(manifestFiles(gui), manifestFiles(cli));
+    // nothing else left in the folder
+    for (const auto& e : fs::directory_iterator(scratch.dir))
+        EXPECT_EQ(e.path().filename().string().rfind(".viscera-export", 0), std::string::npos) << e.path();
+}
+
+TEST_F(WindowFixture, CancelTakesEffectWithinHalfASecondAndLeavesNoFile) {
+    open("liver"); // CGAL meshing: seconds of work to cancel
+    w->preview()->stop();
+    const fs::path out = scratch.dir / "liver.vcase";
+    bool done = false;
+    QString message;
+    QObject::connect(w->exportRunner(), &studio::ExportRunner::finished, [&](bool, const QString& m) {
+        done = true;
+        message = m;
+    });
+    ASSERT_TRUE(w->startExport(QString::fromStdString(out.string())));
+    ASSERT_NE(w->exportProgress(), nullptr);
+    EXPECT_TRUE(w->exportProgress()->isVisible());
+    ASSERT_TRUE(test::waitFor([&] { return w->exportRunner()->stagesDone() >= 1; }, 30000));
+    QElapsedTimer t;
+    t.start();
+    QTest::mouseClick(w->exportProgress()->findChild<QPushButton*>(), Qt::LeftButton); // its Cancel button
+    ASSERT_TRUE(test::waitFor([&] { return done; }, 5000));
+    const qint64 ms = t.elapsed();
+    std::printf("cancel took %lld ms\n", static_cast<long long>(ms));
+    EXPECT_LE(ms, 500);
+    EXPECT_EQ(message, "cancelled");
+    EXPECT_FALSE(fs::exists(out));
+    for (const auto& e : fs::directory_iterator(scratch.dir))
+        EXPECT_EQ(e.path().filename().string().rfind(".viscera-export", 0), std::string::npos) << e.path();
+    // an output folder that is not writable is refused before anything runs
+    QString why;
+    studio::ExportRunner r;
+    EXPECT_FALSE(r.start(w->document()->project(), "/proc/nonexistent/x.vcase", &why));
+    EXPECT_TRUE(why.contains("does not exist")) << why.toStdString();
+}
+
+} // namespace
