@@ -78,6 +78,14 @@ int main(int argc, char** argv) {
         return 1;
     }
     w.preview()->setAccuracyEvery(30);
+    QObject::connect(w.preview(), &studio::Preview::logMessage,
+                     [](const QString& m) { std::fprintf(stderr, "%s\n", m.toUtf8().constData()); });
+    std::vector<double> viewportPaintMs, viewportScale;
+    QTimer paintProbe;
+    QObject::connect(&paintProbe, &QTimer::timeout, [&] {
+        viewportPaintMs.push_back(w.viewport()->lastPaintMs());
+        viewportScale.push_back(w.viewport()->renderScale());
+    });
     std::printf("waiting for the preview (meshing the liver)...\n");
     if (!waitFor([&] { return w.viewport()->meshCount() > 0 && w.preview()->snapshot().frames > 40; }, 300000)) {
         std::fprintf(stderr, "the preview did not start: %s\n", w.verdictLabel()->text().toUtf8().constData());
@@ -85,6 +93,34 @@ int main(int argc, char** argv) {
     }
     waitFor([&] { return !w.errorPlot()->series().empty(); }, 60000);
 
+    if (std::getenv("BENCH_PROFILE")) {
+        auto timeIt = [&](const char* what, const std::function<void()>& fn) {
+            QElapsedTimer t;
+            t.start();
+            for (int k = 0; k < 5; ++k)
+                fn();
+            std::fprintf(stderr, "PROFILE %s: %.1f ms\n", what, t.nsecsElapsed() * 1e-6 / 5);
+        };
+        timeIt("window repaint", [&] { w.repaint(); });
+        timeIt("material panel repaint", [&] { w.materialPanel()->repaint(); });
+        timeIt("curve editor repaint", [&] { w.materialPanel()->editor(0)->repaint(); });
+        timeIt("error plot repaint", [&] { w.errorPlot()->repaint(); });
+        timeIt("viewport repaint", [&] { w.viewport()->repaint(); });
+        timeIt("pollPreview", [&] { w.pollPreview(); });
+        timeIt("processEvents", [&] { QCoreApplication::processEvents(); });
+        w.preview()->stop();
+        timeIt("window repaint, preview stopped", [&] { w.repaint(); });
+        timeIt("material panel repaint, preview stopped", [&] { w.materialPanel()->repaint(); });
+        timeIt("viewport repaint, preview stopped", [&] {
+            w.viewport()->update();
+            QCoreApplication::processEvents();
+        });
+        timeIt("one curve edit + processEvents, preview stopped", [&] {
+            w.materialPanel()->applyPreset("neo_hookean", 8000 + std::rand() % 100, 0.45);
+            QCoreApplication::processEvents();
+        });
+        return 0;
+    }
     // the drag: the first movable point of f′ moves up and down by ±30 % of its neighbours' gap
     studio::CurveEditor* e = w.materialPanel()->editor(0);
     const auto& pts = e->points();
@@ -113,6 +149,7 @@ int main(int argc, char** argv) {
     const auto s0 = w.preview()->snapshot();
     const uint64_t frames0 = s0.frames;
     probe.start();
+    paintProbe.start(50);
     send(e, QEvent::MouseButtonPress, start, Qt::LeftButton, Qt::LeftButton);
     int events = 0;
     const qint64 dragStart = clock.elapsed();
@@ -131,6 +168,15 @@ int main(int argc, char** argv) {
             ++events;
             const auto [serial, framesAtSubmit] = w.lastPreviewSubmit();
             pending.push_back({serial, framesAtSubmit});
+        }
+        if (std::getenv("BENCH_DEBUG")) {
+            static qint64 lastPrint = 0;
+            if (clock.elapsed() - lastPrint > 500) {
+                lastPrint = clock.elapsed();
+                const auto d = w.preview()->snapshot();
+                std::fprintf(stderr, "t=%lld frames=%llu serial=%llu\n", (long long)lastPrint,
+                             (unsigned long long)d.frames, (unsigned long long)d.serial);
+            }
         }
         QElapsedTimer pt;
         pt.start();
@@ -189,6 +235,22 @@ int main(int argc, char** argv) {
     j["physics_ms_per_frame"] = {
         {"mean", physics.empty() ? 0 : std::accumulate(physics.begin(), physics.end(), 0.0) / physics.size()},
         {"p99", percentile(physics, 0.99)}};
+    j["viewport_paint_ms"] = {
+        {"max", viewportPaintMs.empty() ? 0 : *std::max_element(viewportPaintMs.begin(), viewportPaintMs.end())},
+        {"p50", percentile(viewportPaintMs, 0.5)}};
+    j["viewport_render_scale"] = {
+        {"min", viewportScale.empty() ? 1 : *std::min_element(viewportScale.begin(), viewportScale.end())},
+        {"last", viewportScale.empty() ? 1 : viewportScale.back()}};
+    if (s1.accuracy) {
+        j["error_sample"] = {{"frame", s1.accuracy->frame},
+                             {"of", s1.accuracyOf.toStdString()},
+                             {"xpbd_iterations", s1.accuracy->iterations},
+                             {"xpbd_rel_error", s1.accuracy->relError},
+                             {"xpbd_time_ms", s1.accuracy->timeMs}};
+        if (s1.accuracyNewton)
+            j["error_sample"]["newton"] = {{"rel_error", s1.accuracyNewton->relError},
+                                           {"time_ms", s1.accuracyNewton->timeMs}};
+    }
     j["verdict"] = w.verdictLabel()->text().toStdString();
     j["renderer"] = w.viewport()->rendererInfo().toStdString();
     std::ofstream(out / "studio_preview.json") << j.dump(2) << "\n";

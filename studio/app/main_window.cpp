@@ -173,6 +173,7 @@ void MainWindow::buildDocks() {
     m_errorPlot->setTitle(tr("Relative error against the Newton reference [A eq. 4.45]"));
     m_errorPlot->setAxes(tr("wall time [ms]"), tr("relative error"));
     m_errorPlot->setLogY(true);
+    m_errorPlot->setLogX(true);
     pl->addWidget(m_errorPlot, 1);
     m_costPlot = new PlotWidget(plots);
     m_costPlot->setObjectName("costPlot");
@@ -404,9 +405,14 @@ void MainWindow::scheduleRefresh(bool tree) {
     m_refreshPending = true;
     QTimer::singleShot(0, this, [this] {
         m_refreshPending = false;
-        if (m_treePending) rebuildTree();
-        m_treePending = false;
-        rebuildProperties();
+        // Rebuilt only when what they show changed: a curve drag changes neither, and building
+        // widgets is what costs in a pass of the event loop.
+        const QString tree = treeKey(), props = propertiesKey();
+        if ((m_treePending || m_forceRefresh) && tree != m_treeKey) rebuildTree();
+        if (props != m_propertiesKey || m_forceRefresh) rebuildProperties();
+        m_treeKey = tree;
+        m_propertiesKey = props;
+        m_treePending = m_forceRefresh = false;
     });
 }
 
@@ -436,6 +442,36 @@ void MainWindow::selectBody(int index) {
     m_rebuilding = false;
     scheduleRefresh(false);
     if (m_previewMode->currentIndex() == 1) submitPreview();
+}
+
+QString MainWindow::treeKey() const {
+    if (!m_doc.hasProject()) return {};
+    const Project& p = m_doc.project();
+    QString k =
+        QString::fromStdString(p.scene.solverType) + QString::number(m_selKind) + ":" + QString::number(m_selIndex);
+    for (const BodyProject& b : p.bodies)
+        k += "|" + QString::fromStdString(b.scene.name + ":" + sim::materialModelName(b.scene.material.model));
+    for (const SurfaceProject& sp : p.surfaces)
+        k += "|s" + QString::fromStdString(sp.scene.name + ":" + sp.scene.attachTo);
+    if (p.scene.interaction)
+        for (const auto& in : p.scene.interaction->instruments)
+            k += "|i" + QString::fromStdString(in.name);
+    return k + (p.scene.suture ? "|needle" : "");
+}
+
+QString MainWindow::propertiesKey() const {
+    if (!m_doc.hasProject()) return {};
+    const Project& p = m_doc.project();
+    QString k = QString::number(m_selKind) + ":" + QString::number(m_selIndex) + ":" + QString::number(m_body);
+    if (m_body >= 0 && m_body < static_cast<int>(p.bodies.size())) {
+        const sim::Material& m = p.bodies[m_body].scene.material;
+        k += QString::fromStdString(sim::materialModelName(m.model)) + num(m.youngsModulus) + "," +
+             num(m.poissonRatio) + "," + num(m.density);
+    }
+    const auto& x = p.scene.xpbd;
+    k += "|" + num(x.dt) + "," + QString::number(x.substeps) + "," + QString::number(x.iterations) + "," +
+         num(x.damping);
+    return k + "|" + QString::fromStdString(p.scene.render);
 }
 
 void MainWindow::rebuildTree() {
@@ -536,7 +572,8 @@ QString MainWindow::setProperty(const QString& field, const QString& text) {
         m_propertyError->setText(w);
         if (!w.isEmpty()) {
             logLine(w);
-            scheduleRefresh(); // the field shows the model's value again
+            m_forceRefresh = true; // the field shows the model's value again
+            scheduleRefresh();
         }
         return w;
     };
@@ -600,10 +637,15 @@ void MainWindow::pollPreview() {
     m_verdict->setText(verdict);
     m_verdict->setStyleSheet(s.verdictOk && s.error.isEmpty() ? "color: #106010" : "color: #b00020");
     if (s.accuracy) {
-        PlotWidget::Series e{tr("XPBD, frame %1").arg(s.accuracy->frame), s.accuracy->timeMs, s.accuracy->relError,
-                             QColor(200, 60, 40)};
-        m_errorPlot->setSeries({e});
-        m_errorPlot->setNote(tr("%1 iterations; each point one more iteration of the frame's first substep")
+        std::vector<PlotWidget::Series> series{
+            {tr("XPBD, current settings"), s.accuracy->timeMs, s.accuracy->relError, QColor(200, 60, 40)}};
+        if (s.accuracyNewton)
+            series.push_back(
+                {tr("Newton (reference)"), s.accuracyNewton->timeMs, s.accuracyNewton->relError, QColor(40, 90, 200)});
+        m_errorPlot->setSeries(std::move(series));
+        m_errorPlot->setNote(tr("frame %1 of %2: %3 iterations of its first substep, one point each")
+                                 .arg(s.accuracy->frame)
+                                 .arg(s.accuracyOf)
                                  .arg(s.accuracy->iterations.empty() ? 0 : s.accuracy->iterations.back()));
     }
     PlotWidget::Series c{tr("physics ms"), {}, {}, QColor(40, 90, 200)};
@@ -613,7 +655,7 @@ void MainWindow::pollPreview() {
         c.y.push_back(s.frameMs[i]);
     }
     m_costPlot->setSeries({c});
-    m_costPlot->setNote(tr("last %1 ms, frame %2").arg(num(s.stepMs)).arg(s.frame));
+    m_costPlot->setNote(tr("last %1 ms, frame %2").arg(num(s.stepMs)).arg(s.frames));
 }
 
 } // namespace viscera::studio

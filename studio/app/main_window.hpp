@@ -86,6 +86,9 @@ private:
     void rebuildProperties();
     /// Rebuilds the property fields (and the tree) on the next pass of the event loop.
     void scheduleRefresh(bool tree = true);
+    /// What the tree and the property fields show (rebuilt only when it changes).
+    QString treeKey() const;
+    QString propertiesKey() const;
     void onDocumentChanged();
     void updateTitle();
     void addRecent(const QString& folder);
@@ -115,7 +118,8 @@ private:
     std::pair<uint64_t, uint64_t> m_lastSubmit{0, 0};
     bool m_confirm = true;
     bool m_rebuilding = false;
-    bool m_refreshPending = false, m_treePending = false;
+    bool m_refreshPending = false, m_treePending = false, m_forceRefresh = false;
+    QString m_treeKey, m_propertiesKey;
     int m_selKind = 0, m_selIndex = -1; ///< the tree's selection (ItemKind, index)
 };
 

@@ -116,11 +116,16 @@ MaterialPanel::MaterialPanel(Document* doc, QWidget* parent) : QWidget(parent), 
     m_rest = new QLabel(this);
     m_rest->setObjectName("restLabel");
     m_rest->setWordWrap(true);
+    // fixed height: its figures change on every drag event, which must not relayout the panel
+    m_rest->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+    m_rest->setFixedHeight(2 * m_rest->fontMetrics().lineSpacing() + 4);
     root->addWidget(m_rest);
     m_status = new QLabel(this);
     m_status->setObjectName("materialStatus");
     m_status->setWordWrap(true);
     m_status->setStyleSheet("color: #b00020");
+    m_status->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+    m_status->setFixedHeight(2 * m_status->fontMetrics().lineSpacing() + 4);
     root->addWidget(m_status);
 
     connect(m_x, &QLineEdit::editingFinished, this, [this] { setStatus(applyTypedPoint()); });

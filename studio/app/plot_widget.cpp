@@ -40,14 +40,15 @@ void PlotWidget::paintEvent(QPaintEvent*) {
     p.fillRect(rect(), palette().base());
     const int top = m_note.isEmpty() ? 22 : 36;
     const QRectF a(60, top, std::max(10, width() - 72), std::max(10, height() - top - 34));
-    auto ty = [&](double y) { return m_logY ? std::log10(y) : y; };
+    auto ty = [&](double y) { return m_logY ? std::log10(y) : y; }; // ≤ 0 on a log axis: NaN, skipped
+    auto tx = [&](double x) { return m_logX ? std::log10(x) : x; };
     double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
     for (const Series& s : m_series)
         for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
-            const double y = ty(s.y[i]);
-            if (!std::isfinite(s.x[i]) || !std::isfinite(y)) continue;
-            x0 = std::min(x0, s.x[i]);
-            x1 = std::max(x1, s.x[i]);
+            const double x = tx(s.x[i]), y = ty(s.y[i]);
+            if (!std::isfinite(x) || !std::isfinite(y)) continue;
+            x0 = std::min(x0, x);
+            x1 = std::max(x1, x);
             y0 = std::min(y0, y);
             y1 = std::max(y1, y);
         }
@@ -73,16 +74,19 @@ void PlotWidget::paintEvent(QPaintEvent*) {
     y0 -= my;
     y1 += my;
     auto map = [&](double x, double y) {
-        return QPointF(a.left() + (x - x0) / (x1 - x0) * a.width(), a.bottom() - (ty(y) - y0) / (y1 - y0) * a.height());
+        return QPointF(a.left() + (tx(x) - x0) / (x1 - x0) * a.width(),
+                       a.bottom() - (ty(y) - y0) / (y1 - y0) * a.height());
     };
     QPen grid(palette().mid().color(), 0, Qt::DotLine);
-    const double sx = niceStep(x1 - x0);
+    const double sx = m_logX ? 1.0 : niceStep(x1 - x0);
     for (double gx = std::ceil(x0 / sx) * sx; gx <= x1 + 1e-12 * sx; gx += sx) {
         const double px = a.left() + (gx - x0) / (x1 - x0) * a.width();
         p.setPen(grid);
         p.drawLine(QPointF(px, a.top()), QPointF(px, a.bottom()));
         p.setPen(palette().text().color());
-        p.drawText(QRectF(px - 30, a.bottom() + 2, 60, 14), Qt::AlignHCenter, label(std::abs(gx) < 1e-9 * sx ? 0 : gx));
+        p.drawText(QRectF(px - 30, a.bottom() + 2, 60, 14), Qt::AlignHCenter,
+                   m_logX ? QStringLiteral("1e%1").arg(static_cast<int>(std::lround(gx)))
+                          : label(std::abs(gx) < 1e-9 * sx ? 0 : gx));
     }
     const double sy = m_logY ? 1.0 : niceStep(y1 - y0);
     for (double gy = std::ceil(y0 / sy) * sy; gy <= y1; gy += sy) {
@@ -101,12 +105,12 @@ void PlotWidget::paintEvent(QPaintEvent*) {
         if (s.points) {
             p.setBrush(Qt::NoBrush);
             for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i)
-                if (std::isfinite(s.x[i]) && std::isfinite(ty(s.y[i]))) p.drawEllipse(map(s.x[i], s.y[i]), 3, 3);
+                if (std::isfinite(tx(s.x[i])) && std::isfinite(ty(s.y[i]))) p.drawEllipse(map(s.x[i], s.y[i]), 3, 3);
         } else {
             QPainterPath path;
             bool open = false;
             for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
-                if (!std::isfinite(s.x[i]) || !std::isfinite(ty(s.y[i]))) {
+                if (!std::isfinite(tx(s.x[i])) || !std::isfinite(ty(s.y[i]))) {
                     open = false;
                     continue;
                 }

@@ -34,6 +34,10 @@ public:
         m_logY = on;
         update();
     }
+    void setLogX(bool on) {
+        m_logX = on;
+        update();
+    }
     void setSeries(std::vector<Series> series);
     const std::vector<Series>& series() const { return m_series; }
     /// A line of text under the title (figures such as SSE and R²).
@@ -48,7 +52,7 @@ protected:
 
 private:
     QString m_title, m_xLabel, m_yLabel, m_note;
-    bool m_logY = false;
+    bool m_logX = false, m_logY = false;
     std::vector<Series> m_series;
 };
 

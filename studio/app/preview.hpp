@@ -12,9 +12,12 @@
 /// no NaN reaches the screen. A frame whose state is not finite is never published; the world
 /// restarts from rest instead.
 ///
-/// Every `accuracyEvery` frames the frame's first substep is also solved to convergence
-/// (World's accuracy sampling): relative error [A eq. 4.45] against wall time for the current
-/// settings, shown as the live error plot.
+/// Every `accuracyEvery` frames the selected body's state goes to a sampler thread (lower
+/// priority; the preview never waits for it) that solves the frame's first substep from it with
+/// XPBD iteration by iteration and with Newton to convergence (World's accuracy sampling on a
+/// world of that body alone): relative error [A eq. 4.45] against wall time for the current
+/// settings, the live error plot. The Newton reference takes one tet body, so in a layered scene
+/// the body's couplings to the other layers are left out, which the snapshot says (accuracyOf).
 #include "project/project.hpp"
 #include "render/scene_view.hpp"
 #include "sim/scene/scene_solver.hpp"
@@ -49,8 +52,10 @@ public:
         double stepMs = 0;          ///< physics wall time of the last frame
         std::deque<double> frameMs; ///< the last kHistory frames' physics ms
         std::vector<std::vector<sim::Vec3>> bodies, surfaces; ///< current positions, m
-        std::optional<sim::AccuracyRecord> accuracy;          ///< last sampled frame
-        QString verdict;                                      ///< stability verdict of the submitted materials
+        std::optional<sim::AccuracyRecord> accuracy;          ///< XPBD trace of the last sampled frame
+        std::optional<sim::AccuracyRecord> accuracyNewton;    ///< Newton's trace of that frame
+        QString accuracyOf; ///< what was sampled: the scene, or one body of a layered scene alone
+        QString verdict;    ///< stability verdict of the submitted materials
         bool verdictOk = true;
         QString error; ///< why the last submitted model is not shown (empty: it is)
     };
@@ -88,6 +93,15 @@ private:
         uint64_t serial;
     };
     void run();
+    void sample();
+
+    /// A state to sample: the probe world (one body, accuracy on every frame) and the body's
+    /// positions and velocities at preview frame `frame`.
+    struct SampleJob {
+        std::shared_ptr<sim::World> probe;
+        std::vector<sim::Vec3> x, v;
+        int frame = 0;
+    };
 
     mutable std::mutex m_mutex;
     std::condition_variable m_wake;
@@ -95,6 +109,11 @@ private:
     Snapshot m_snapshot;
     std::shared_ptr<const render::SceneView> m_view;
     std::thread m_thread;
+    std::thread m_sampler; ///< error sampling, at a lower priority than the preview
+    std::mutex m_sampleMutex;
+    std::condition_variable m_sampleWake;
+    std::optional<SampleJob> m_sampleJob;
+    bool m_sampling = false;
     std::atomic<bool> m_stop{false};
     std::atomic<int> m_accuracyEvery{60};
     std::atomic<bool> m_realTime{true};

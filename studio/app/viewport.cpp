@@ -4,6 +4,7 @@
 #include "render/headless.hpp"
 
 #include <Eigen/Geometry>
+#include <QElapsedTimer>
 #include <QMouseEvent>
 #include <QOpenGLContext>
 #include <QOpenGLFunctions>
@@ -166,8 +167,11 @@ void Viewport::paintGL() {
         f->glClear(GL_COLOR_BUFFER_BIT);
         return;
     }
-    if (s.width != w || s.height != h || !m_framed) {
-        render::RenderSettings d = render::defaultSettingsFor(m_view, w, h);
+    QElapsedTimer timer;
+    timer.start();
+    const int rw = std::max(1, static_cast<int>(w * m_scale)), rh = std::max(1, static_cast<int>(h * m_scale));
+    if (s.width != rw || s.height != rh || !m_framed) {
+        render::RenderSettings d = render::defaultSettingsFor(m_view, rw, rh);
         d.timePasses = false;
         s = d;
     }
@@ -177,10 +181,16 @@ void Viewport::paintGL() {
     try {
         m_renderer->setSettings(s);
         m_renderer->renderFrame(m_view);
-        m_renderer->present(defaultFramebufferObject(), w, h);
+        m_renderer->present(defaultFramebufferObject(), w, h); // scaled up when rendered smaller
     } catch (const std::exception& e) {
         m_info = tr("viewport: %1").arg(QString::fromStdString(e.what()));
     }
+    m_lastPaintMs = timer.nsecsElapsed() * 1e-6;
+    // resolution follows the paint budget (the cost scales with the pixel count, ~scale²)
+    if (m_lastPaintMs > kPaintBudgetMs && m_scale > kMinScale)
+        m_scale = std::max(kMinScale, m_scale * std::sqrt(kPaintBudgetMs / m_lastPaintMs) * 0.9);
+    else if (m_lastPaintMs < 0.4 * kPaintBudgetMs && m_scale < 1.0)
+        m_scale = std::min(1.0, m_scale * 1.25);
 }
 
 void Viewport::ray(QPoint pos, Eigen::Vector3f& origin, Eigen::Vector3f& dir) const {

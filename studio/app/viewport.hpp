@@ -40,6 +40,13 @@ public:
     bool rendererReady() const { return m_renderer != nullptr; }
     int meshCount() const { return static_cast<int>(m_view.meshes().size()); }
     const render::Camera& camera() const { return m_camera; }
+    /// Wall time of the last paint (render + present), ms, and the resolution scale in use: the
+    /// viewport renders at a lower resolution (down to kMinScale of the widget's pixels, blitted
+    /// up) while a frame takes longer than kPaintBudgetMs, so that painting never stalls the UI
+    /// thread for long on a software renderer; it returns to full resolution when there is time.
+    double lastPaintMs() const { return m_lastPaintMs; }
+    double renderScale() const { return m_scale; }
+    static constexpr double kPaintBudgetMs = 12.0, kMinScale = 0.25;
 
 signals:
     void bodyClicked(const QString& name);
@@ -72,6 +79,7 @@ private:
     Qt::MouseButton m_button = Qt::NoButton;
     bool m_dragged = false;
     bool m_framed = false;
+    double m_lastPaintMs = 0, m_scale = 1.0;
 };
 
 } // namespace viscera::studio

@@ -234,6 +234,24 @@ TEST(Stability, StiffnessRatioOfAMillionBetweenNeighbours) {
     expectRepeatable(b, m, st, 10, w);
 }
 
+TEST(Stability, RequiredSubstepsIsTheFewestTheCheckAccepts) {
+    // Whether the current count is over the limit or has room to spare, requiredSubsteps is the
+    // smallest count that passes (what the studio's live verdict shows).
+    Block b = block();
+    const Material m = material(MaterialModel::StableNeoHookean, 20000, 0.45);
+    const auto model = makeConstraintModel(m, "block");
+    for (int substeps : {1, 7, 40, 400}) {
+        const StabilityFigures f = assessStability(*b.mesh, *model, m.density, {}, settings(substeps));
+        const int r = f.requiredSubsteps;
+        ASSERT_GE(r, 1);
+        EXPECT_TRUE(assessStability(*b.mesh, *model, m.density, {}, settings(r)).ok()) << substeps;
+        if (r > 1) {
+            EXPECT_FALSE(assessStability(*b.mesh, *model, m.density, {}, settings(r - 1)).ok()) << substeps;
+        }
+        EXPECT_EQ(f.ok(), substeps >= r);
+    }
+}
+
 TEST(Stability, TimeStepHundredTimesTheNominal) {
     Block b = block();
     const Material m = material(MaterialModel::StableNeoHookean, 20000, 0.45);

@@ -33,6 +33,11 @@ const std::vector<std::string>& supportedFeatures() {
     return f;
 }
 
+bool supportsAccuracySampling(const SceneDesc& scene) {
+    return scene.solverType == "xpbd" && scene.surfaces.empty() && scene.bodies.size() == 1 &&
+           !scene.interaction.has_value();
+}
+
 std::vector<std::string> requiredFeatures(const SceneDesc& scene) {
     std::vector<std::string> f;
     if (!scene.bodies.empty()) f.push_back(scene.solverType);

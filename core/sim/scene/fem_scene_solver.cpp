@@ -142,6 +142,14 @@ void FemSceneSolver::setState(size_t, const std::vector<Vec3>&, const std::vecto
     throw std::invalid_argument("sim::FemSceneSolver::setState(): the quasi-static FEM has no settable state");
 }
 
+const std::vector<Vec3>& FemSceneSolver::surfaceVelocities(size_t) const {
+    throw std::invalid_argument("sim::FemSceneSolver::surfaceVelocities(): the suturing scene has no surfaces");
+}
+
+void FemSceneSolver::setSurfaceState(size_t, const std::vector<Vec3>&, const std::vector<Vec3>&) {
+    throw std::invalid_argument("sim::FemSceneSolver::setSurfaceState(): the suturing scene has no surfaces");
+}
+
 SutureSummary FemSceneSolver::summary() const {
     SutureSummary s;
     for (const SutureFrameRecord& r : m_frames) {

@@ -30,6 +30,8 @@ public:
     const std::vector<Vec3>& velocities(size_t body) const override { return m_zeroV[body]; }
     /// Not supported (probes are rejected at create()): throws std::invalid_argument.
     void setState(size_t body, const std::vector<Vec3>& x, const std::vector<Vec3>& v) override;
+    const std::vector<Vec3>& surfaceVelocities(size_t s) const override;
+    void setSurfaceState(size_t s, const std::vector<Vec3>& x, const std::vector<Vec3>& v) override;
     const SutureReport* suture() const override { return this; }
 
     const std::vector<SutureFrameRecord>& frames() const override { return m_frames; }

@@ -110,6 +110,9 @@ public:
     /// Teleports a body between frames. Throws std::invalid_argument on a size mismatch or
     /// non-finite value.
     virtual void setState(size_t body, const std::vector<Vec3>& x, const std::vector<Vec3>& v) = 0;
+    /// The same for surface s (fascia); back-ends without surfaces throw std::invalid_argument.
+    virtual const std::vector<Vec3>& surfaceVelocities(size_t s) const = 0; ///< #V of surface s, m/s
+    virtual void setSurfaceState(size_t s, const std::vector<Vec3>& x, const std::vector<Vec3>& v) = 0;
 
     /// The scripted instruments (scene "interaction"), null when the scene has none.
     virtual const InteractionRuntime* interaction() const { return nullptr; }

@@ -13,6 +13,12 @@ void World::setState(size_t i, const std::vector<Vec3>& x, const std::vector<Vec
     m_solver->setState(i, x, v);
 }
 
+void World::setSurfaceState(size_t s, const std::vector<Vec3>& x, const std::vector<Vec3>& v) {
+    if (s >= m_surfaces.size())
+        throw std::invalid_argument("sim::World::setSurfaceState(): no surface " + std::to_string(s));
+    m_solver->setSurfaceState(s, x, v);
+}
+
 std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::unique_ptr<TetMesh>> meshes,
                                        std::vector<TriMesh> surfaces, const std::vector<std::string>& features,
                                        const std::string& origin) {

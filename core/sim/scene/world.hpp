@@ -49,6 +49,8 @@ public:
     const std::vector<std::string>& activeSubsystems() const { return m_active; }
     const Invariants& invariants() const { return m_invariants; }
     const std::vector<AccuracyRecord>& accuracy() const { return m_accuracy; }
+    /// Forgets the accuracy records so far (a long-running sampler keeps only what it reads).
+    void clearAccuracy() { m_accuracy.clear(); }
     double time() const { return m_time; }
     int frameCount() const { return m_frame; }
     size_t bodyCount() const { return m_meshes.size(); }
@@ -60,6 +62,8 @@ public:
     /// motion over when it swaps in a world with an edited material). Throws
     /// std::invalid_argument on a size mismatch or a non-finite value.
     void setState(size_t i, const std::vector<Vec3>& x, const std::vector<Vec3>& v);
+    const std::vector<Vec3>& surfaceVelocities(size_t s) const { return m_solver->surfaceVelocities(s); }
+    void setSurfaceState(size_t s, const std::vector<Vec3>& x, const std::vector<Vec3>& v);
     size_t surfaceCount() const { return m_surfaces.size(); }
     const std::vector<Vec3>& surfacePositions(size_t s) const { return m_solver->surfacePositions(s); }
     /// Surface s as assembled (rest positions, triangles) and its scene name (renderer input).

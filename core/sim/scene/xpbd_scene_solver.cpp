@@ -2,6 +2,7 @@
 
 #include "sim/diagnostics/stability_check.hpp"
 #include "sim/reference/accuracy.hpp"
+#include "sim/scene/features.hpp"
 #include "sim/scene/interaction_runtime.hpp"
 #include "sim/util/error.hpp"
 
@@ -13,7 +14,9 @@ XpbdSceneSolver::~XpbdSceneSolver() = default;
 std::unique_ptr<XpbdSceneSolver> XpbdSceneSolver::create(const SceneSolverInputs& in) {
     const SceneDesc& scene = in.scene;
     const std::string& origin = in.origin;
-    const bool layered = !scene.surfaces.empty() || scene.bodies.size() > 1 || scene.interaction.has_value();
+    // One tet body without layers runs on the single-body solver, the one the Newton reference of
+    // accuracy sampling mirrors.
+    const bool layered = !supportsAccuracySampling(scene);
     if (scene.accuracy && layered)
         throw InputError(origin + ": features: 'accuracy' sampling needs a scene with a single tet body and no layers");
 
@@ -135,6 +138,14 @@ double XpbdSceneSolver::totalEnergy() const {
 
 void XpbdSceneSolver::setState(size_t body, const std::vector<Vec3>& x, const std::vector<Vec3>& v) {
     m_sys->setTetState(body, x, v);
+}
+
+const std::vector<Vec3>& XpbdSceneSolver::surfaceVelocities(size_t s) const {
+    return m_sys->surfaceVelocities(s);
+}
+
+void XpbdSceneSolver::setSurfaceState(size_t s, const std::vector<Vec3>& x, const std::vector<Vec3>& v) {
+    m_sys->setSurfaceState(s, x, v);
 }
 
 } // namespace viscera::sim

@@ -30,6 +30,8 @@ public:
     double totalEnergy() const override;
     const std::vector<Vec3>& velocities(size_t body) const override { return m_sys->tetVelocities(body); }
     void setState(size_t body, const std::vector<Vec3>& x, const std::vector<Vec3>& v) override;
+    const std::vector<Vec3>& surfaceVelocities(size_t s) const override;
+    void setSurfaceState(size_t s, const std::vector<Vec3>& x, const std::vector<Vec3>& v) override;
     const InteractionRuntime* interaction() const override { return m_interaction.get(); }
 
 private:
