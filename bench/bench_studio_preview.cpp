@@ -11,6 +11,7 @@
 // the material dock, the viewport). Run under a display (Xvfb):
 //   xvfb-run -a -s "-screen 0 1920x1200x24" ./build/bench/bench_studio_preview [out-dir] [seconds]
 #include "app/curve_editor.hpp"
+#include "app/fit_dialog.hpp"
 #include "app/main_window.hpp"
 #include "app/material_panel.hpp"
 #include "app/plot_widget.hpp"
@@ -21,8 +22,12 @@
 #include <QDockWidget>
 #include <QElapsedTimer>
 #include <QLabel>
+#include <QLineEdit>
 #include <QMouseEvent>
 #include <QTimer>
+
+#include "sim/material/laws.hpp"
+#include "sim/material/material_response.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -93,34 +98,6 @@ int main(int argc, char** argv) {
     }
     waitFor([&] { return !w.errorPlot()->series().empty(); }, 60000);
 
-    if (std::getenv("BENCH_PROFILE")) {
-        auto timeIt = [&](const char* what, const std::function<void()>& fn) {
-            QElapsedTimer t;
-            t.start();
-            for (int k = 0; k < 5; ++k)
-                fn();
-            std::fprintf(stderr, "PROFILE %s: %.1f ms\n", what, t.nsecsElapsed() * 1e-6 / 5);
-        };
-        timeIt("window repaint", [&] { w.repaint(); });
-        timeIt("material panel repaint", [&] { w.materialPanel()->repaint(); });
-        timeIt("curve editor repaint", [&] { w.materialPanel()->editor(0)->repaint(); });
-        timeIt("error plot repaint", [&] { w.errorPlot()->repaint(); });
-        timeIt("viewport repaint", [&] { w.viewport()->repaint(); });
-        timeIt("pollPreview", [&] { w.pollPreview(); });
-        timeIt("processEvents", [&] { QCoreApplication::processEvents(); });
-        w.preview()->stop();
-        timeIt("window repaint, preview stopped", [&] { w.repaint(); });
-        timeIt("material panel repaint, preview stopped", [&] { w.materialPanel()->repaint(); });
-        timeIt("viewport repaint, preview stopped", [&] {
-            w.viewport()->update();
-            QCoreApplication::processEvents();
-        });
-        timeIt("one curve edit + processEvents, preview stopped", [&] {
-            w.materialPanel()->applyPreset("neo_hookean", 8000 + std::rand() % 100, 0.45);
-            QCoreApplication::processEvents();
-        });
-        return 0;
-    }
     // the drag: the first movable point of f′ moves up and down by ±30 % of its neighbours' gap
     studio::CurveEditor* e = w.materialPanel()->editor(0);
     const auto& pts = e->points();
@@ -169,15 +146,6 @@ int main(int argc, char** argv) {
             const auto [serial, framesAtSubmit] = w.lastPreviewSubmit();
             pending.push_back({serial, framesAtSubmit});
         }
-        if (std::getenv("BENCH_DEBUG")) {
-            static qint64 lastPrint = 0;
-            if (clock.elapsed() - lastPrint > 500) {
-                lastPrint = clock.elapsed();
-                const auto d = w.preview()->snapshot();
-                std::fprintf(stderr, "t=%lld frames=%llu serial=%llu\n", (long long)lastPrint,
-                             (unsigned long long)d.frames, (unsigned long long)d.serial);
-            }
-        }
         QElapsedTimer pt;
         pt.start();
         QCoreApplication::processEvents(QEventLoop::AllEvents, 2);
@@ -197,6 +165,15 @@ int main(int argc, char** argv) {
     send(e, QEvent::MouseButtonRelease, e->toWidget({pts[i].x, pts[i].y}), Qt::LeftButton, Qt::NoButton);
     probe.stop();
     const auto s1 = w.preview()->snapshot();
+    // after the drag, the error sampler takes the new state (once no edit came for 0.5 s)
+    const int sampledBefore = s1.accuracy ? s1.accuracy->frame : -1;
+    waitFor(
+        [&] {
+            const auto s = w.preview()->snapshot();
+            return s.accuracy && s.accuracy->frame > sampledBefore &&
+                   static_cast<uint64_t>(s.accuracy->frame) > s1.frames;
+        },
+        60000);
     waitFor([&] { return false; }, 300); // let the last frames and plots land
     w.pollPreview();
 
@@ -207,6 +184,27 @@ int main(int argc, char** argv) {
     if (auto* d = w.findChild<QDockWidget*>("plotsDock"))
         d->grab().save(QString::fromStdString((out / "studio_plots.png").string()));
     w.viewport()->grabFramebuffer().save(QString::fromStdString((out / "studio_viewport.png").string()));
+    {
+        // the fit dialog on synthetic Neo-Hookean data (mu 1 kPa, lambda 10 kPa, stretch 0.7-1.5)
+        auto nh = sim::makeEnergyDensity("neo_hookean", 1000.0, 10000.0);
+        const auto csv = out / "nh_uniaxial.csv";
+        {
+            std::ofstream f(csv);
+            f.precision(17);
+            f << "stretch,nominal stress (Pa)\n";
+            for (int k = 0; k < 41; ++k) {
+                const double l = 0.7 + 0.8 * k / 40.0;
+                f << l << "," << sim::uniaxialNominalStress(*nh, l).nominalStress << "\n";
+            }
+        }
+        studio::FitDialog dlg(w.document(), 0, &w);
+        dlg.resize(760, 560);
+        dlg.show();
+        dlg.fileField()->setText(QString::fromStdString(csv.string()));
+        dlg.runFit();
+        waitFor([&] { return false; }, 200);
+        dlg.grab().save(QString::fromStdString((out / "studio_fit.png").string()));
+    }
 
     const double maxGap = timerGaps.empty() ? 0 : *std::max_element(timerGaps.begin(), timerGaps.end());
     const double maxHandler = handlerMs.empty() ? 0 : *std::max_element(handlerMs.begin(), handlerMs.end());
@@ -241,15 +239,15 @@ int main(int argc, char** argv) {
     j["viewport_render_scale"] = {
         {"min", viewportScale.empty() ? 1 : *std::min_element(viewportScale.begin(), viewportScale.end())},
         {"last", viewportScale.empty() ? 1 : viewportScale.back()}};
-    if (s1.accuracy) {
-        j["error_sample"] = {{"frame", s1.accuracy->frame},
-                             {"of", s1.accuracyOf.toStdString()},
-                             {"xpbd_iterations", s1.accuracy->iterations},
-                             {"xpbd_rel_error", s1.accuracy->relError},
-                             {"xpbd_time_ms", s1.accuracy->timeMs}};
-        if (s1.accuracyNewton)
-            j["error_sample"]["newton"] = {{"rel_error", s1.accuracyNewton->relError},
-                                           {"time_ms", s1.accuracyNewton->timeMs}};
+    if (const auto s2 = w.preview()->snapshot(); s2.accuracy) {
+        j["error_sample"] = {{"frame", s2.accuracy->frame},
+                             {"of", s2.accuracyOf.toStdString()},
+                             {"xpbd_iterations", s2.accuracy->iterations},
+                             {"xpbd_rel_error", s2.accuracy->relError},
+                             {"xpbd_time_ms", s2.accuracy->timeMs}};
+        if (s2.accuracyNewton)
+            j["error_sample"]["newton"] = {{"rel_error", s2.accuracyNewton->relError},
+                                           {"time_ms", s2.accuracyNewton->timeMs}};
     }
     j["verdict"] = w.verdictLabel()->text().toStdString();
     j["renderer"] = w.viewport()->rendererInfo().toStdString();

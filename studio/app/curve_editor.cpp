@@ -17,8 +17,8 @@ namespace {
 
 /// Smallest gap kept between neighbouring control values (relative to their magnitude), so that
 /// a strictly increasing list stays strictly increasing in floating point.
-double gap(double a, double b) {
-    return 1e-6 * std::max({std::abs(a), std::abs(b), 1e-3});
+double gap(double neighbour) {
+    return 1e-6 * std::max(std::abs(neighbour), 1e-3);
 }
 
 QString label(double v) {
@@ -87,13 +87,13 @@ QPointF CurveEditor::constrain(int index, QPointF want) const {
     if (!std::isfinite(x)) x = p.x;
     if (!std::isfinite(y)) y = p.y;
     x = std::max(x, 0.01); // stretches and volume ratios are positive
-    if (index > 0) x = std::max(x, m_points[index - 1].x + gap(m_points[index - 1].x, x));
-    if (index < n - 1) x = std::min(x, m_points[index + 1].x - gap(m_points[index + 1].x, x));
+    if (index > 0) x = std::max(x, m_points[index - 1].x + gap(m_points[index - 1].x));
+    if (index < n - 1) x = std::min(x, m_points[index + 1].x - gap(m_points[index + 1].x));
     // the neighbours' own gap may leave no room: keep the point where it is
     if ((index > 0 && !(x > m_points[index - 1].x)) || (index < n - 1 && !(x < m_points[index + 1].x))) x = p.x;
     if (m_strict) {
-        if (index > 0) y = std::max(y, m_points[index - 1].y + gap(m_points[index - 1].y, y));
-        if (index < n - 1) y = std::min(y, m_points[index + 1].y - gap(m_points[index + 1].y, y));
+        if (index > 0) y = std::max(y, m_points[index - 1].y + gap(m_points[index - 1].y));
+        if (index < n - 1) y = std::min(y, m_points[index + 1].y - gap(m_points[index + 1].y));
         if ((index > 0 && !(y > m_points[index - 1].y)) || (index < n - 1 && !(y < m_points[index + 1].y))) y = p.y;
     }
     return {x, y};

@@ -99,12 +99,15 @@ bool FitDialog::runFit() {
         return false;
     }
     const sim::CurveFitResult& r = *m_fitResult;
-    const QString text = tr("SSE %1 Pa²   R² %2   largest relative error %3 %   data covers stretch %4–%5   "
-                            "(%6 iterations, %7)")
-                             .arg(num(r.sse), QString::number(r.rSquared, 'f', 6), num(100 * r.maxRelativeError, 3),
-                                  num(r.stretchMin), num(r.stretchMax))
-                             .arg(r.iterations)
-                             .arg(r.converged ? tr("converged") : tr("iteration limit"));
+    const QString text =
+        tr("SSE %1 Pa²   R² %2   largest relative error %3 %   data covers stretch %4–%5   "
+           "(%6 iterations, %7)")
+            .arg(num(r.sse),
+                 r.rSquared > 0.9999 && r.rSquared < 1 ? QStringLiteral("1 − %1").arg(num(1 - r.rSquared, 2))
+                                                       : QString::number(r.rSquared, 'f', 6),
+                 num(100 * r.maxRelativeError, 3), num(r.stretchMin), num(r.stretchMax))
+            .arg(r.iterations)
+            .arg(r.converged ? tr("converged") : tr("iteration limit"));
     m_result->setText(text);
     m_plot->setNote(text);
     PlotWidget::Series data{tr("test data"), m_data->stretch, m_data->nominalStress, QColor(30, 30, 30), true};

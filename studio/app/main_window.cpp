@@ -170,7 +170,7 @@ void MainWindow::buildDocks() {
     pl->addWidget(m_verdict);
     m_errorPlot = new PlotWidget(plots);
     m_errorPlot->setObjectName("errorPlot");
-    m_errorPlot->setTitle(tr("Relative error against the Newton reference [A eq. 4.45]"));
+    m_errorPlot->setTitle(tr("Relative error vs Newton [A eq. 4.45]"));
     m_errorPlot->setAxes(tr("wall time [ms]"), tr("relative error"));
     m_errorPlot->setLogY(true);
     m_errorPlot->setLogX(true);

@@ -242,6 +242,12 @@ void MaterialPanel::setBody(int index) {
     m_body = index;
     for (CurveEditor* e : m_editors)
         e->setSelected(-1);
+    if (m_doc->hasProject() && index >= 0 && index < static_cast<int>(m_doc->project().bodies.size())) {
+        // the preset starts from the body's own E and ν
+        const sim::Material& m = m_doc->project().bodies[index].scene.material;
+        m_E->setText(num(m.youngsModulus));
+        m_nu->setText(num(m.poissonRatio));
+    }
     refresh();
     for (CurveEditor* e : m_editors)
         e->frameAll();

@@ -141,6 +141,7 @@ uint64_t Preview::submit(const Project& project, Mode mode, int body, uint64_t* 
         std::lock_guard lock(m_mutex);
         serial = ++m_serial;
         if (framesAtSubmit) *framesAtSubmit = m_snapshot.frames;
+        m_lastSubmitNs = Clock::now().time_since_epoch().count();
         m_pending = Pending{project, mode, body, serial};
     }
     if (!m_thread.joinable()) m_thread = std::thread([this] { run(); });
@@ -325,13 +326,18 @@ void Preview::run() {
             world = assembleWorld(*built, "preview");
             continue;
         }
-        if (probe && frames % static_cast<uint64_t>(std::max(1, m_accuracyEvery.load())) == 0) {
+        // Sampling waits for a quiet moment (no edit for kQuietMs): during a drag its reference
+        // solve would take the core the UI and the preview need.
+        const bool quiet = Clock::now().time_since_epoch().count() - m_lastSubmitNs.load() >
+                           std::chrono::duration_cast<Clock::duration>(std::chrono::milliseconds(kQuietMs)).count();
+        if (probe && quiet && frames >= m_nextSample) {
             // the selected body's state goes to the sampler thread, which solves the first
             // substep from it to convergence; the preview does not wait for it
             std::lock_guard lock(m_sampleMutex);
             if (!m_sampleJob && !m_sampling) {
                 const auto b = static_cast<size_t>(probeBody);
                 m_sampleJob = SampleJob{probe, world->positions(b), world->velocities(b), static_cast<int>(frames)};
+                m_nextSample = frames + static_cast<uint64_t>(std::max(1, m_accuracyEvery.load()));
                 m_sampleWake.notify_all();
             }
         }

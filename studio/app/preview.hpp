@@ -12,12 +12,12 @@
 /// no NaN reaches the screen. A frame whose state is not finite is never published; the world
 /// restarts from rest instead.
 ///
-/// Every `accuracyEvery` frames the selected body's state goes to a sampler thread (lower
-/// priority; the preview never waits for it) that solves the frame's first substep from it with
-/// XPBD iteration by iteration and with Newton to convergence (World's accuracy sampling on a
-/// world of that body alone): relative error [A eq. 4.45] against wall time for the current
-/// settings, the live error plot. The Newton reference takes one tet body, so in a layered scene
-/// the body's couplings to the other layers are left out, which the snapshot says (accuracyOf).
+/// Every `accuracyEvery` frames, once no edit came for kQuietMs, the selected body's state goes to a sampler thread
+/// (lower priority; the preview never waits for it) that solves the frame's first substep from it with XPBD iteration
+/// by iteration and with Newton to convergence (World's accuracy sampling on a world of that body alone): relative
+/// error [A eq. 4.45] against wall time for the current settings, the live error plot. The Newton reference takes one
+/// tet body, so in a layered scene the body's couplings to the other layers are left out, which the snapshot says
+/// (accuracyOf).
 #include "project/project.hpp"
 #include "render/scene_view.hpp"
 #include "sim/scene/scene_solver.hpp"
@@ -60,6 +60,8 @@ public:
         QString error; ///< why the last submitted model is not shown (empty: it is)
     };
     static constexpr size_t kHistory = 240;
+    /// Error sampling waits until no model was submitted for this long (ms).
+    static constexpr int kQuietMs = 500;
 
     explicit Preview(QObject* parent = nullptr);
     ~Preview() override;
@@ -117,6 +119,8 @@ private:
     std::atomic<bool> m_stop{false};
     std::atomic<int> m_accuracyEvery{60};
     std::atomic<bool> m_realTime{true};
+    std::atomic<int64_t> m_lastSubmitNs{0}; ///< steady clock, at the last submit()
+    uint64_t m_nextSample = 0;              ///< worker only: first frame of the next sample
     uint64_t m_serial = 0;
 };
 

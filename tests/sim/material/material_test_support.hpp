@@ -18,6 +18,16 @@
 
 namespace viscera::sim::testing {
 
+/// The message of what `fn` throws, or "(no exception)".
+inline std::string messageOf(const std::function<void()>& fn) {
+    try {
+        fn();
+    } catch (const std::exception& e) {
+        return e.what();
+    }
+    return "(no exception)";
+}
+
 struct Lame {
     double youngs, poisson, mu, lambda;
 };

@@ -11,6 +11,7 @@
 
 using namespace viscera::sim;
 using ::testing::HasSubstr;
+using viscera::sim::testing::messageOf;
 using viscera::sim::testing::sci;
 
 namespace {
@@ -36,15 +37,6 @@ double simpsonIntegral(const MonotoneCurve& c, double a, double b) {
         sum += (r - l) / 6.0 * (c.value(l) + 4.0 * c.value(m) + c.value(r));
     }
     return sum;
-}
-
-std::string messageOf(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    return "(no exception)";
 }
 
 } // namespace

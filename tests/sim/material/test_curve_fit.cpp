@@ -19,15 +19,6 @@ using ::testing::HasSubstr;
 
 namespace {
 
-std::string messageOf(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    return "(no exception)";
-}
-
 /// Synthetic uniaxial data of the analytic compressible Neo-Hookean law: `count` stretches over
 /// [lo, hi], the lateral stretch solved independently (bisection on μ(t² − 1) + λ log(λt²) = 0).
 UniaxialData neoHookeanData(double mu, double lambda, double lo, double hi, int count) {

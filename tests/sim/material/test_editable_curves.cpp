@@ -14,15 +14,6 @@ using ::testing::HasSubstr;
 
 namespace {
 
-std::string messageOf(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    return "(no exception)";
-}
-
 const char* const kLaws[] = {"neo_hookean", "st_venant_kirchhoff", "corotated"};
 
 void expectEditable(const std::optional<MonotoneCurve>& c, double xmin, double xmax, const std::string& what) {

@@ -12,18 +12,7 @@ using namespace viscera::sim;
 using namespace viscera::sim::testing;
 using ::testing::HasSubstr;
 
-namespace {
-
-std::string messageOf(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    return "(no exception)";
-}
-
-} // namespace
+namespace {} // namespace
 
 TEST(Laws, TableValuesForUniaxialStretch) {
     // F = diag(2, 1, 1), μ = 3, λ = 5: closed forms of [A Table 4.1].

@@ -17,15 +17,6 @@ using ::testing::HasSubstr;
 
 namespace {
 
-std::string messageOf(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    return "(no exception)";
-}
-
 /// Analytic compressible Neo-Hookean uniaxial state, solved independently in long double:
 /// F = diag(λ, t, t), J = λt², P22 = μ(t − 1/t) + λ_L log J / t = 0 ⇔ μ(t² − 1) + λ_L log(λt²) = 0
 /// (strictly increasing in t), by bisection to the last bit; P11 = μ(λ − 1/λ) + λ_L log J / λ.

@@ -13,15 +13,6 @@ using ::testing::HasSubstr;
 
 namespace {
 
-std::string messageOf(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    return "(no exception)";
-}
-
 /// Analytic compressible Neo-Hookean for J > 0 (no extension), written out independently.
 double nhPsi(const Mat3& F, double mu, double lambda) {
     const double J = F.determinant(), l = std::log(J);

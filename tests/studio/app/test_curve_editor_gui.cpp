@@ -124,6 +124,10 @@ TEST_F(PanelFixture, FiftyEventDragIsOneUndoStepAndUndoRestoresBitExactly) {
     EXPECT_NE(after, before);
     EXPECT_LT(after[i][0], before[i + 1][0]) << "the point never passes its neighbour";
     EXPECT_GT(after[i][1], before[i - 1][1]);
+    // the rule is enforced during the drag: the point follows the mouse up to its neighbours
+    // (clamped there), it is not merely left where a refused event found it
+    EXPECT_NEAR(after[i][0], before[i + 1][0], 1e-5 * before[i + 1][0]);
+    EXPECT_NEAR(after[i][1], before[i - 1][1], 1e-5 * std::abs(before[i - 1][1]) + 1e-9);
     expectShapeRule();
     doc.undoStack()->undo();
     EXPECT_EQ(f(), before) << "bit-exact";

@@ -8,6 +8,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <regex>
 #include <sstream>
@@ -81,4 +82,40 @@ TEST(StudioCli, ExportReadsTheProjectFileAndNumbersItsStages) {
     auto usage = studio({"export", dir.string(), "-o", out.string(), "--project-file"});
     EXPECT_EQ(usage.exitCode, 2);
     EXPECT_THAT(usage.err, HasSubstr("--project-file needs a value"));
+}
+
+namespace {
+
+/// The headless commands need no display: no DISPLAY, WAYLAND_DISPLAY or QT_QPA_PLATFORM.
+void withoutDisplay() {
+    ::unsetenv("DISPLAY");
+    ::unsetenv("WAYLAND_DISPLAY");
+    ::unsetenv("QT_QPA_PLATFORM");
+}
+
+} // namespace
+
+TEST(StudioCli, ExportRunsWithoutADisplayOrQtPlatform) {
+    withoutDisplay();
+    test::Scratch s("viscera-studio-cli");
+    const std::string out = s / "slab.vcase";
+    const auto r = studio({"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab", "-o", out});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_THAT(r.out, HasSubstr("exported tissue-slab"));
+    EXPECT_NO_THROW(vcase::verify(out));
+}
+
+TEST(StudioCli, TheWindowWithoutADisplayIsRefusedWithOneLine) {
+    withoutDisplay();
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{}, {"open", std::string(VISCERA_SOURCE_DIR) + "/projects/liver"}}) {
+        const auto r = studio(args);
+        EXPECT_EQ(r.exitCode, 1);
+        const auto l = lines(r.err);
+        ASSERT_EQ(l.size(), 1u) << r.err;
+        EXPECT_THAT(l[0], HasSubstr("no display"));
+    }
+    const auto help = studio({"--help"});
+    EXPECT_EQ(help.exitCode, 0);
+    EXPECT_THAT(help.out, HasSubstr("open <project-dir>"));
 }
