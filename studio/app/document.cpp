@@ -4,6 +4,7 @@
 #include "sim/util/error.hpp"
 
 #include <QDir>
+#include <QFileInfo>
 
 #include <QUndoCommand>
 #include <filesystem>
@@ -54,6 +55,9 @@ void Document::open(const QString& folder) {
 void Document::createNew(const QString& folder, const QString& caseId) {
     const QString abs = QDir(folder).absolutePath();
     if (!QDir().mkpath(abs)) throw InputError(abs.toStdString() + ": the folder cannot be created");
+    if (QFileInfo::exists(abs + "/project.json"))
+        throw InputError((abs + "/project.json").toStdString() +
+                         ": the folder already holds a project (open it instead)");
     Project p = newProject(abs.toStdString(), caseId.toStdString());
     saveProject(p, abs.toStdString());
     m_undo.clear();

@@ -10,6 +10,7 @@
 
 #include <QAction>
 #include <QApplication>
+#include <QCheckBox>
 #include <QCloseEvent>
 #include <QComboBox>
 #include <QDateTime>
@@ -19,15 +20,14 @@
 #include <QFormLayout>
 #include <QHBoxLayout>
 #include <QHeaderView>
-#include <QInputDialog>
 #include <QLabel>
 #include <QLineEdit>
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QPlainTextEdit>
 #include <QProgressDialog>
+#include <QRegularExpression>
 #include <QSettings>
-#include <QSplitter>
 #include <QStatusBar>
 #include <QTimer>
 #include <QToolBar>
@@ -163,6 +163,10 @@ void MainWindow::buildDocks() {
     m_previewMode->addItems({tr("Preview: the scene"), tr("Preview: uniaxial specimen of the selected material")});
     connect(m_previewMode, &QComboBox::currentIndexChanged, this, [this](int) { submitPreview(); });
     modeRow->addWidget(m_previewMode, 1);
+    auto* pause = new QCheckBox(tr("Pause"), plots);
+    pause->setObjectName("previewPause");
+    connect(pause, &QCheckBox::toggled, this, [this](bool on) { m_preview.setPaused(on); });
+    modeRow->addWidget(pause);
     pl->addLayout(modeRow);
     m_verdict = new QLabel(plots);
     m_verdict->setObjectName("stabilityVerdict");
@@ -391,6 +395,7 @@ void MainWindow::updateTitle() {
 
 void MainWindow::onDocumentChanged() {
     if (m_doc.hasProject() && m_body >= static_cast<int>(m_doc.project().bodies.size())) m_body = -1;
+    if (m_doc.hasProject()) m_viewport->setCaseRender(m_doc.project().scene.render);
     updateTitle();
     submitPreview();
     scheduleRefresh();
@@ -623,9 +628,9 @@ QString MainWindow::setProperty(const QString& field, const QString& text) {
 }
 
 void MainWindow::pollPreview() {
-    if (!m_doc.hasProject()) return;
+    if (!m_doc.hasProject() || m_preview.revision() == m_shownRevision) return;
+    m_shownRevision = m_preview.revision();
     const Preview::Snapshot s = m_preview.snapshot();
-    if (s.frames == m_shownFrames && s.scene == m_shownScene && m_verdict->text() == s.verdict) return;
     if (s.scene != m_shownScene) {
         if (auto view = m_preview.sceneView()) m_viewport->setScene(*view);
         m_shownScene = s.scene;

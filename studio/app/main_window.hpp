@@ -114,7 +114,7 @@ private:
     QProgressDialog* m_progress = nullptr;
     QTimer* m_poll = nullptr;
     int m_body = -1;
-    uint64_t m_shownScene = 0, m_shownFrames = 0;
+    uint64_t m_shownScene = 0, m_shownFrames = 0, m_shownRevision = ~uint64_t(0);
     std::pair<uint64_t, uint64_t> m_lastSubmit{0, 0};
     bool m_confirm = true;
     bool m_rebuilding = false;

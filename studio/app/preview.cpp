@@ -128,6 +128,7 @@ void Preview::sample() {
                 xpbd->frame = newton ? (newton->frame = job.frame) : job.frame;
                 m_snapshot.accuracy = xpbd;
                 m_snapshot.accuracyNewton = newton;
+                ++m_revision;
             }
         }
         std::lock_guard lock(m_sampleMutex);
@@ -194,6 +195,7 @@ void Preview::run() {
     auto publishStatus = [&](auto&& fn) {
         std::lock_guard lock(m_mutex);
         fn(m_snapshot);
+        ++m_revision;
     };
     while (!m_stop) {
         const auto frameStart = Clock::now();
@@ -235,6 +237,7 @@ void Preview::run() {
                         std::lock_guard lock(m_mutex);
                         m_view = std::move(view);
                         m_snapshot.scene = ++sceneRevision;
+                        ++m_revision;
                     }
                     emit logMessage(tr("preview: %1 bodies, %2 substeps per frame")
                                         .arg(built->scene.bodies.size())
@@ -311,7 +314,7 @@ void Preview::run() {
                 emit frameReady();
             }
         }
-        if (!world) {
+        if (!world || m_paused) {
             std::unique_lock lock(m_mutex);
             m_wake.wait_for(lock, std::chrono::milliseconds(50), [&] { return m_stop || m_pending.has_value(); });
             continue;
@@ -323,7 +326,12 @@ void Preview::run() {
             finite = allFinite(world->positions(i));
         if (!finite) {
             emit logMessage(tr("preview: the state became non-finite at frame %1; restarting from rest").arg(r.index));
-            world = assembleWorld(*built, "preview");
+            try {
+                world = assembleWorld(*built, "preview");
+            } catch (const std::exception& e) {
+                world.reset(); // shows nothing until the next model comes
+                emit logMessage(tr("preview: %1").arg(QString::fromStdString(e.what())));
+            }
             continue;
         }
         // Sampling waits for a quiet moment (no edit for kQuietMs): during a drag its reference
@@ -357,6 +365,7 @@ void Preview::run() {
             s.surfaces.resize(world->surfaceCount());
             for (size_t i = 0; i < world->surfaceCount(); ++i)
                 s.surfaces[i] = world->surfacePositions(i);
+            ++m_revision;
         }
         emit frameReady();
         if (m_realTime && built) {

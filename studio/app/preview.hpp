@@ -72,10 +72,18 @@ public:
     uint64_t submit(const Project& project, Mode mode, int body, uint64_t* framesAtSubmit = nullptr);
     void setAccuracyEvery(int frames) { m_accuracyEvery = frames; }
     void setRealTime(bool on) { m_realTime = on; }
+    /// Paused: edits are still taken (verdict, new world), no frame is simulated.
+    void setPaused(bool on) {
+        m_paused = on;
+        m_wake.notify_all();
+    }
+    bool paused() const { return m_paused; }
     void stop();
     bool running() const { return m_thread.joinable(); }
 
     Snapshot snapshot() const;
+    /// Bumped whenever the snapshot changes: a poll compares it before copying the snapshot.
+    uint64_t revision() const { return m_revision; }
     /// The render meshes of the current world (rebuilt when Snapshot::scene changes).
     std::shared_ptr<const render::SceneView> sceneView() const;
 
@@ -119,6 +127,8 @@ private:
     std::atomic<bool> m_stop{false};
     std::atomic<int> m_accuracyEvery{60};
     std::atomic<bool> m_realTime{true};
+    std::atomic<bool> m_paused{false};
+    std::atomic<uint64_t> m_revision{0};
     std::atomic<int64_t> m_lastSubmitNs{0}; ///< steady clock, at the last submit()
     uint64_t m_nextSample = 0;              ///< worker only: first frame of the next sample
     uint64_t m_serial = 0;

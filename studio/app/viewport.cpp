@@ -1,6 +1,7 @@
 #include "app/viewport.hpp"
 
 #include "render/camera.hpp"
+#include "render/case_settings.hpp"
 #include "render/headless.hpp"
 
 #include <Eigen/Geometry>
@@ -84,16 +85,24 @@ void Viewport::setScene(const render::SceneView& view) {
     }
     for (const render::RenderMesh& m : m_view.meshes())
         m_baseMaterial.push_back(m.material);
-    if (makeCurrent(), context() && m_renderer) {
+    if (m_renderer && context()) {
         // a new scene gets new GPU buffers: a fresh renderer on the same context
+        makeCurrent();
         std::string why;
-        render::RenderSettings s = m_renderer->settings();
+        const render::RenderSettings s = m_renderer->settings();
         m_renderer = render::createRendererForCurrentContext(resolve, context(), s, &why);
         if (!m_renderer) m_info = tr("viewport: no renderer (%1)").arg(QString::fromStdString(why));
+        doneCurrent();
     }
-    doneCurrent();
     if (!m_framed) frameAll();
     setSelectedName(m_selected);
+    update();
+}
+
+void Viewport::setCaseRender(const std::string& json) {
+    if (json == m_caseRender) return;
+    m_caseRender = json;
+    m_framed = false; // settings are made again on the next paint
     update();
 }
 
@@ -172,6 +181,12 @@ void Viewport::paintGL() {
     const int rw = std::max(1, static_cast<int>(w * m_scale)), rh = std::max(1, static_cast<int>(h * m_scale));
     if (s.width != rw || s.height != rh || !m_framed) {
         render::RenderSettings d = render::defaultSettingsFor(m_view, rw, rh);
+        try {
+            render::applyCaseRender(d, m_caseRender, "project.json");
+        } catch (const std::exception& e) {
+            m_info = tr("viewport: %1").arg(QString::fromStdString(e.what())); // load checked it already
+        }
+        d.stereo.mode = render::StereoMode::Off; // the author's view is mono
         d.timePasses = false;
         s = d;
     }

@@ -29,6 +29,9 @@ public:
     /// New positions per body and surface (m), as the preview publishes them.
     void setPositions(const std::vector<std::vector<Eigen::Vector3d>>& bodies,
                       const std::vector<std::vector<Eigen::Vector3d>>& surfaces);
+    /// The case's "render" block (project.json; empty: renderer defaults): the viewport shows the
+    /// case's look (SSS, light sampling, post effects), in mono.
+    void setCaseRender(const std::string& json);
     /// Highlights the body (or surface) named `name` (empty: none).
     void setSelectedName(const QString& name);
     void frameAll();
@@ -71,6 +74,7 @@ private:
     render::SceneView m_view;
     render::Camera m_camera;
     QString m_info, m_selected;
+    std::string m_caseRender;
     std::vector<uint32_t> m_baseMaterial; ///< per mesh, its material before highlighting
     // orbit camera
     Eigen::Vector3f m_target = Eigen::Vector3f::Zero();

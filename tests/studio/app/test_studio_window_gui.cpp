@@ -13,11 +13,13 @@
 #include "gui_test_support.hpp"
 #include "sim/material/laws.hpp"
 #include "sim/material/material_response.hpp"
+#include "sim/util/atomic_file.hpp"
 
 #include <QComboBox>
 #include <QDockWidget>
 #include <QLabel>
 #include <QLineEdit>
+#include <QPlainTextEdit>
 #include <QProgressDialog>
 #include <QPushButton>
 #include <QSettings>
@@ -139,6 +141,21 @@ TEST_F(WindowFixture, SaveAsWritesTheProjectAndRecentKeepsFive) {
     std::ofstream(bad / "project.json") << "{\"schemaVersion\": 1, \"caseId\": \"x\"";
     EXPECT_FALSE(w->openProject(QString::fromStdString(bad.string())));
     EXPECT_TRUE(w->windowTitle().contains("r5"));
+}
+
+TEST_F(WindowFixture, NewProjectIsWrittenAndAnExistingOneIsNotOverwritten) {
+    const fs::path dir = scratch.dir / "fresh-case";
+    ASSERT_TRUE(w->newProject(QString::fromStdString(dir.string())));
+    EXPECT_TRUE(fs::exists(dir / "project.json"));
+    EXPECT_EQ(w->document()->project().caseId, "fresh-case");
+    EXPECT_FALSE(w->isWindowModified());
+    const std::string before = viscera::readFile(dir / "project.json");
+    ASSERT_EQ(w->setProperty("density", "1200"), "");
+    EXPECT_FALSE(w->newProject(QString::fromStdString(dir.string()))) << "a folder with a project stays as it is";
+    EXPECT_EQ(viscera::readFile(dir / "project.json"), before);
+    EXPECT_TRUE(w->log()->toPlainText().contains("already holds a project"));
+    EXPECT_TRUE(w->saveProject());
+    EXPECT_EQ(studio::loadProject(dir).bodies[0].scene.material.density, 1200);
 }
 
 TEST_F(WindowFixture, ViewportDrawsThePreviewAndAClickSelectsTheBody) {
