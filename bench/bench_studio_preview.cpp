@@ -10,7 +10,8 @@
 //   - the preview's physics cost per frame.
 // Writes <out>/studio_preview.json and screenshots of the main window (<out>/studio_main.png,
 // the material dock, the viewport). Run under a display (Xvfb):
-//   xvfb-run -a -s "-screen 0 1920x1200x24" ./build/bench/bench_studio_preview [out-dir] [seconds] [paused]
+//   xvfb-run -a -s "-screen 0 1920x1200x24" ./build/bench/bench_studio_preview [out-dir] [seconds] [scene|paused]
+//   [width height]
 #include "app/curve_editor.hpp"
 #include "app/fit_dialog.hpp"
 #include "app/main_window.hpp"
@@ -82,7 +83,7 @@ int main(int argc, char** argv) {
     QCoreApplication::setApplicationName("StudioPreview");
     studio::MainWindow w;
     w.setConfirmDiscard(false);
-    w.resize(1600, 1000);
+    w.resize(argc > 4 ? std::atoi(argv[4]) : 1600, argc > 5 ? std::atoi(argv[5]) : 1000);
     w.show();
     const std::string project = std::string(VISCERA_SOURCE_DIR) + "/projects/liver";
     if (!w.openProject(QString::fromStdString(project))) return 1;

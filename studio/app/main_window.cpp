@@ -631,17 +631,34 @@ void MainWindow::pollPreview() {
     if (!m_doc.hasProject() || m_preview.revision() == m_shownRevision) return;
     m_shownRevision = m_preview.revision();
     const Preview::Snapshot s = m_preview.snapshot();
-    if (s.scene != m_shownScene) {
+    // Only what changed is redrawn: an edit alone changes the verdict, not the positions, and a
+    // repaint of the viewport or a plot is what costs on the UI thread.
+    const bool newScene = s.scene != m_shownScene;
+    if (newScene) {
         if (auto view = m_preview.sceneView()) m_viewport->setScene(*view);
         m_shownScene = s.scene;
     }
-    m_shownFrames = s.frames;
-    m_viewport->setPositions(s.bodies, s.surfaces);
+    if (newScene || s.frames != m_shownFrames) {
+        m_shownFrames = s.frames;
+        m_viewport->setPositions(s.bodies, s.surfaces);
+        PlotWidget::Series c{tr("physics ms"), {}, {}, QColor(40, 90, 200)};
+        const double first = static_cast<double>(s.frames) - static_cast<double>(s.frameMs.size());
+        for (size_t i = 0; i < s.frameMs.size(); ++i) {
+            c.x.push_back(first + static_cast<double>(i));
+            c.y.push_back(s.frameMs[i]);
+        }
+        m_costPlot->setSeries({c});
+        m_costPlot->setNote(tr("last %1 ms, frame %2").arg(num(s.stepMs)).arg(s.frames));
+    }
     QString verdict = s.verdict;
     if (!s.error.isEmpty()) verdict += (verdict.isEmpty() ? "" : "\n") + s.error;
-    m_verdict->setText(verdict);
-    m_verdict->setStyleSheet(s.verdictOk && s.error.isEmpty() ? "color: #106010" : "color: #b00020");
-    if (s.accuracy) {
+    if (verdict != m_verdict->text()) {
+        m_verdict->setText(verdict);
+        m_verdict->setStyleSheet(s.verdictOk && s.error.isEmpty() ? "color: #106010" : "color: #b00020");
+    }
+    const int sampled = s.accuracy ? s.accuracy->frame : -1;
+    if (s.accuracy && sampled != m_shownSample) {
+        m_shownSample = sampled;
         std::vector<PlotWidget::Series> series{
             {tr("XPBD, current settings"), s.accuracy->timeMs, s.accuracy->relError, QColor(200, 60, 40)}};
         if (s.accuracyNewton)
@@ -653,14 +670,6 @@ void MainWindow::pollPreview() {
                                  .arg(s.accuracyOf)
                                  .arg(s.accuracy->iterations.empty() ? 0 : s.accuracy->iterations.back()));
     }
-    PlotWidget::Series c{tr("physics ms"), {}, {}, QColor(40, 90, 200)};
-    const double first = static_cast<double>(s.frames) - static_cast<double>(s.frameMs.size());
-    for (size_t i = 0; i < s.frameMs.size(); ++i) {
-        c.x.push_back(first + static_cast<double>(i));
-        c.y.push_back(s.frameMs[i]);
-    }
-    m_costPlot->setSeries({c});
-    m_costPlot->setNote(tr("last %1 ms, frame %2").arg(num(s.stepMs)).arg(s.frames));
 }
 
 } // namespace viscera::studio

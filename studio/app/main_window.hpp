@@ -115,6 +115,7 @@ private:
     QTimer* m_poll = nullptr;
     int m_body = -1;
     uint64_t m_shownScene = 0, m_shownFrames = 0, m_shownRevision = ~uint64_t(0);
+    int m_shownSample = -2; ///< frame of the error sample on the plot
     std::pair<uint64_t, uint64_t> m_lastSubmit{0, 0};
     bool m_confirm = true;
     bool m_rebuilding = false;
