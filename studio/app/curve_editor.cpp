@@ -1,6 +1,6 @@
 #include "app/curve_editor.hpp"
 
-#include "sim/util/format.hpp"
+#include "app/number_text.hpp"
 
 #include <QKeyEvent>
 #include <QMouseEvent>
@@ -19,10 +19,6 @@ namespace {
 /// a strictly increasing list stays strictly increasing in floating point.
 double gap(double neighbour) {
     return 1e-6 * std::max(std::abs(neighbour), 1e-3);
-}
-
-QString label(double v) {
-    return QString::fromStdString(sim::formatNumber(v));
 }
 
 } // namespace
@@ -185,7 +181,7 @@ void CurveEditor::paintEvent(QPaintEvent*) {
         p.drawLine(QPointF(px, a.top()), QPointF(px, a.bottom()));
         p.setPen(palette().text().color());
         p.drawText(QRectF(px - 30, a.bottom() + 2, 60, 14), Qt::AlignHCenter,
-                   label(std::abs(gx) < 1e-12 * sx ? 0 : gx));
+                   numberText(std::abs(gx) < 1e-12 * sx ? 0 : gx));
     }
     for (double gy = std::ceil(m_view.top() / sy) * sy; gy <= m_view.bottom(); gy += sy) {
         const double py = toWidget({0, gy}).y();
@@ -193,7 +189,7 @@ void CurveEditor::paintEvent(QPaintEvent*) {
         p.drawLine(QPointF(a.left(), py), QPointF(a.right(), py));
         p.setPen(palette().text().color());
         p.drawText(QRectF(0, py - 7, a.left() - 4, 14), Qt::AlignRight | Qt::AlignVCenter,
-                   label(std::abs(gy) < 1e-12 * sy ? 0 : gy));
+                   numberText(std::abs(gy) < 1e-12 * sy ? 0 : gy));
     }
     p.setPen(QPen(palette().text().color(), 1));
     p.drawRect(a);

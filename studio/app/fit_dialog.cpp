@@ -1,9 +1,10 @@
 #include "app/fit_dialog.hpp"
 
+#include "app/number_text.hpp"
+
 #include "app/document.hpp"
 #include "app/material_panel.hpp"
 #include "sim/material/material_response.hpp"
-#include "sim/util/format.hpp"
 
 #include <QComboBox>
 #include <QDialogButtonBox>
@@ -16,14 +17,6 @@
 #include <QVBoxLayout>
 
 namespace viscera::studio {
-namespace {
-
-QString num(double v, int d = 4) {
-    return QString::fromStdString(sim::formatNumber(v, d));
-}
-
-} // namespace
-
 FitDialog::FitDialog(Document* doc, int body, QWidget* parent) : QDialog(parent), m_doc(doc), m_body(body) {
     setWindowTitle(tr("Fit material curves to a uniaxial test"));
     setObjectName("fitDialog");
@@ -102,10 +95,10 @@ bool FitDialog::runFit() {
     const QString text =
         tr("SSE %1 Pa²   R² %2   largest relative error %3 %   data covers stretch %4–%5   "
            "(%6 iterations, %7)")
-            .arg(num(r.sse),
-                 r.rSquared > 0.9999 && r.rSquared < 1 ? QStringLiteral("1 − %1").arg(num(1 - r.rSquared, 2))
+            .arg(numberText(r.sse, 4),
+                 r.rSquared > 0.9999 && r.rSquared < 1 ? QStringLiteral("1 − %1").arg(numberText(1 - r.rSquared, 2))
                                                        : QString::number(r.rSquared, 'f', 6),
-                 num(100 * r.maxRelativeError, 3), num(r.stretchMin), num(r.stretchMax))
+                 numberText(100 * r.maxRelativeError, 3), numberText(r.stretchMin, 4), numberText(r.stretchMax, 4))
             .arg(r.iterations)
             .arg(r.converged ? tr("converged") : tr("iteration limit"));
     m_result->setText(text);

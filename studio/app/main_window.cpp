@@ -1,12 +1,13 @@
 #include "app/main_window.hpp"
 
+#include "app/number_text.hpp"
+
 #include "app/export_runner.hpp"
 #include "app/fit_dialog.hpp"
 #include "app/material_panel.hpp"
 #include "app/plot_widget.hpp"
 #include "app/viewport.hpp"
 #include "sim/material/material.hpp"
-#include "sim/util/format.hpp"
 
 #include <QAction>
 #include <QApplication>
@@ -41,10 +42,6 @@ namespace {
 
 enum ItemKind { kGroup = 0, kBody, kSurface, kMaterial, kInstrument, kRender, kSolver };
 constexpr int kKindRole = Qt::UserRole, kIndexRole = Qt::UserRole + 1;
-
-QString num(double v) {
-    return QString::fromStdString(sim::formatNumber(v));
-}
 
 const char* const kBodyFields[] = {"youngs_modulus", "poisson_ratio", "density"};
 const char* const kSolverFields[] = {"dt", "substeps", "iterations", "damping"};
@@ -470,12 +467,12 @@ QString MainWindow::propertiesKey() const {
     QString k = QString::number(m_selKind) + ":" + QString::number(m_selIndex) + ":" + QString::number(m_body);
     if (m_body >= 0 && m_body < static_cast<int>(p.bodies.size())) {
         const sim::Material& m = p.bodies[m_body].scene.material;
-        k += QString::fromStdString(sim::materialModelName(m.model)) + num(m.youngsModulus) + "," +
-             num(m.poissonRatio) + "," + num(m.density);
+        k += QString::fromStdString(sim::materialModelName(m.model)) + numberText(m.youngsModulus) + "," +
+             numberText(m.poissonRatio) + "," + numberText(m.density);
     }
     const auto& x = p.scene.xpbd;
-    k += "|" + num(x.dt) + "," + QString::number(x.substeps) + "," + QString::number(x.iterations) + "," +
-         num(x.damping);
+    k += "|" + numberText(x.dt) + "," + QString::number(x.substeps) + "," + QString::number(x.iterations) + "," +
+         numberText(x.damping);
     return k + "|" + QString::fromStdString(p.scene.render);
 }
 
@@ -551,14 +548,14 @@ void MainWindow::rebuildProperties() {
         model->setCurrentText(QString::fromStdString(sim::materialModelName(m.model)));
         connect(model, &QComboBox::currentTextChanged, this, [this](const QString& t) { setProperty("model", t); });
         m_properties->addRow(tr("Material model"), model);
-        field("youngs_modulus", tr("Young's modulus E [Pa]"), num(m.youngsModulus));
-        field("poisson_ratio", tr("Poisson ratio ν"), num(m.poissonRatio));
-        field("density", tr("Density [kg/m³]"), num(m.density));
+        field("youngs_modulus", tr("Young's modulus E [Pa]"), numberText(m.youngsModulus));
+        field("poisson_ratio", tr("Poisson ratio ν"), numberText(m.poissonRatio));
+        field("density", tr("Density [kg/m³]"), numberText(m.density));
     } else if (kind == kSolver && p.scene.solverType == "xpbd") {
-        field("dt", tr("Frame step dt [s]"), num(p.scene.xpbd.dt));
+        field("dt", tr("Frame step dt [s]"), numberText(p.scene.xpbd.dt));
         field("substeps", tr("Substeps per frame"), QString::number(p.scene.xpbd.substeps));
         field("iterations", tr("Iterations per substep"), QString::number(p.scene.xpbd.iterations));
-        field("damping", tr("Damping [1/s]"), num(p.scene.xpbd.damping));
+        field("damping", tr("Damping [1/s]"), numberText(p.scene.xpbd.damping));
     } else if (kind == kRender) {
         auto* l = new QLabel(p.scene.render.empty() ? tr("renderer defaults") : QString::fromStdString(p.scene.render));
         l->setWordWrap(true);
@@ -566,8 +563,8 @@ void MainWindow::rebuildProperties() {
     } else if (kind == kSurface && m_selIndex >= 0 && m_selIndex < static_cast<int>(p.surfaces.size())) {
         const auto& s = p.surfaces.at(m_selIndex).scene;
         m_properties->addRow(tr("Surface"), new QLabel(QString::fromStdString(s.name)));
-        m_properties->addRow(tr("Stretch stiffness"), new QLabel(num(s.stretchStiffness)));
-        m_properties->addRow(tr("Areal density"), new QLabel(num(s.arealDensity)));
+        m_properties->addRow(tr("Stretch stiffness"), new QLabel(numberText(s.stretchStiffness)));
+        m_properties->addRow(tr("Areal density"), new QLabel(numberText(s.arealDensity)));
     }
 }
 
@@ -648,7 +645,7 @@ void MainWindow::pollPreview() {
             c.y.push_back(s.frameMs[i]);
         }
         m_costPlot->setSeries({c});
-        m_costPlot->setNote(tr("last %1 ms, frame %2").arg(num(s.stepMs)).arg(s.frames));
+        m_costPlot->setNote(tr("last %1 ms, frame %2").arg(numberText(s.stepMs)).arg(s.frames));
     }
     QString verdict = s.verdict;
     if (!s.error.isEmpty()) verdict += (verdict.isEmpty() ? "" : "\n") + s.error;

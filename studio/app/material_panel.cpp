@@ -1,10 +1,11 @@
 #include "app/material_panel.hpp"
 
+#include "app/number_text.hpp"
+
 #include "app/document.hpp"
 #include "sim/material/editable_curves.hpp"
 #include "sim/material/laws.hpp"
 #include "sim/material/material_response.hpp"
-#include "sim/util/format.hpp"
 
 #include <QComboBox>
 #include <QFormLayout>
@@ -30,10 +31,6 @@ std::vector<sim::CurvePoint> toPoints(const sim::CurveDesc& d) {
     for (const auto& q : d.points)
         p.push_back({q[0], q[1]});
     return p;
-}
-
-QString num(double v, int digits = 6) {
-    return QString::fromStdString(sim::formatNumber(v, digits));
 }
 
 /// A typed number: finite, else the field and the rule.
@@ -227,12 +224,12 @@ QString MaterialPanel::applyTypedPoint() {
         return tr("%1 point %2: x = %3 must lie strictly between its neighbours' x")
             .arg(kNames[m_active])
             .arg(i)
-            .arg(num(*x));
+            .arg(numberText(*x));
     if (c.y() != *y)
         return tr("%1 point %2: y = %3 must lie strictly between its neighbours' y (the curve is strictly increasing)")
             .arg(kNames[m_active])
             .arg(i)
-            .arg(num(*y));
+            .arg(numberText(*y));
     const int k = m_active;
     return editPoints(k, tr("Set %1 point").arg(kNames[k]), [&](auto& pts) { pts.at(i) = {*x, *y}; });
 }
@@ -245,8 +242,8 @@ void MaterialPanel::setBody(int index) {
     if (m_doc->hasProject() && index >= 0 && index < static_cast<int>(m_doc->project().bodies.size())) {
         // the preset starts from the body's own E and ν
         const sim::Material& m = m_doc->project().bodies[index].scene.material;
-        m_E->setText(num(m.youngsModulus));
-        m_nu->setText(num(m.poissonRatio));
+        m_E->setText(numberText(m.youngsModulus));
+        m_nu->setText(numberText(m.poissonRatio));
     }
     refresh();
     for (CurveEditor* e : m_editors)
@@ -261,8 +258,8 @@ void MaterialPanel::showSelected() {
         m_y->clear();
         return;
     }
-    m_x->setText(num(e->points()[i].x, 10));
-    m_y->setText(num(e->points()[i].y, 10));
+    m_x->setText(numberText(e->points()[i].x, 10));
+    m_y->setText(numberText(e->points()[i].y, 10));
 }
 
 void MaterialPanel::refresh() {
@@ -311,18 +308,18 @@ void MaterialPanel::refresh() {
             auto vl = std::make_unique<sim::ValanisLandelDensity>(body.scene.name, *curves);
             const sim::RestNormalization r = sim::restNormalization(*curves);
             const sim::SmallStrainConstants s = sim::smallStrainConstants(*curves);
-            restText =
-                tr("Rest normalization (§4.3.3, applied): Ψ(1,1,1) = %1 J/m³, stress at rest f′(1) + 2g′(1) + "
-                   "h′(1) = %2 Pa %3.  Small strain: E = %4 Pa, ν = %5, μ = %6 Pa")
-                    .arg(num(r.restEnergy, 3), num(r.restStress, 3), r.balanced ? tr("(zero)") : tr("(NOT ZERO)"),
-                         num(s.youngsModulus, 4), num(s.poissonRatio, 3), num(s.shearModulus, 4));
+            restText = tr("Rest normalization (§4.3.3, applied): Ψ(1,1,1) = %1 J/m³, stress at rest f′(1) + 2g′(1) + "
+                          "h′(1) = %2 Pa %3.  Small strain: E = %4 Pa, ν = %5, μ = %6 Pa")
+                           .arg(numberText(r.restEnergy, 3), numberText(r.restStress, 3),
+                                r.balanced ? tr("(zero)") : tr("(NOT ZERO)"), numberText(s.youngsModulus, 4),
+                                numberText(s.poissonRatio, 3), numberText(s.shearModulus, 4));
             density = std::move(vl);
         } else if (m.model != sim::MaterialModel::ValanisLandel && m.model != sim::MaterialModel::StableNeoHookean) {
             density = sim::makeEnergyDensity(sim::materialModelName(m.model), m.mu(), m.lambda());
         } else {
             density = sim::makeEnergyDensity("neo_hookean", m.mu(), m.lambda());
             restText = tr("Response shown for the Neo-Hookean law at E = %1 Pa, ν = %2.")
-                           .arg(num(m.youngsModulus), num(m.poissonRatio));
+                           .arg(numberText(m.youngsModulus), numberText(m.poissonRatio));
         }
     } catch (const std::exception& e) {
         restText = QString::fromStdString(e.what());

@@ -1,6 +1,6 @@
 #include "app/plot_widget.hpp"
 
-#include "sim/util/format.hpp"
+#include "app/number_text.hpp"
 
 #include <QPainter>
 #include <QPainterPath>
@@ -17,10 +17,6 @@ double niceStep(double range) {
     const double mag = std::pow(10.0, std::floor(std::log10(raw)));
     const double f = raw / mag;
     return mag * (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0);
-}
-
-QString label(double v) {
-    return QString::fromStdString(sim::formatNumber(v));
 }
 
 } // namespace
@@ -86,7 +82,7 @@ void PlotWidget::paintEvent(QPaintEvent*) {
         p.setPen(palette().text().color());
         p.drawText(QRectF(px - 30, a.bottom() + 2, 60, 14), Qt::AlignHCenter,
                    m_logX ? QStringLiteral("1e%1").arg(static_cast<int>(std::lround(gx)))
-                          : label(std::abs(gx) < 1e-9 * sx ? 0 : gx));
+                          : numberText(std::abs(gx) < 1e-9 * sx ? 0 : gx));
     }
     const double sy = m_logY ? 1.0 : niceStep(y1 - y0);
     for (double gy = std::ceil(y0 / sy) * sy; gy <= y1; gy += sy) {
@@ -95,7 +91,7 @@ void PlotWidget::paintEvent(QPaintEvent*) {
         p.drawLine(QPointF(a.left(), py), QPointF(a.right(), py));
         p.setPen(palette().text().color());
         const QString t = m_logY ? QStringLiteral("1e%1").arg(static_cast<int>(std::lround(gy)))
-                                 : label(std::abs(gy) < 1e-9 * sy ? 0 : gy);
+                                 : numberText(std::abs(gy) < 1e-9 * sy ? 0 : gy);
         p.drawText(QRectF(0, py - 7, a.left() - 4, 14), Qt::AlignRight | Qt::AlignVCenter, t);
     }
     p.setClipRect(a);
