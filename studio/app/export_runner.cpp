@@ -92,7 +92,9 @@ void ExportRunner::cancel() {
     if (!running()) return;
     m_cancelled = true;
     m_process->kill();
-    m_process->waitForFinished(400);
+    // SIGKILL cannot be ignored: the child is gone at once (the bound is for one stuck in the
+    // kernel); finished() — and the clean-up — has run when this returns.
+    m_process->waitForFinished(2000);
 }
 
 void ExportRunner::cleanUp() {

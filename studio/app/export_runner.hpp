@@ -32,7 +32,8 @@ public:
     /// Starts exporting `project` to `out`. Returns false and sets `why` (one line naming the
     /// path and the rule) when it cannot start.
     bool start(const Project& project, const QString& out, QString* why);
-    /// Kills the export and removes what it wrote; finished(false, "cancelled") follows.
+    /// Kills the export and removes what it wrote; finished(false, "cancelled") has been emitted
+    /// when it returns.
     void cancel();
     bool running() const { return m_process && m_process->state() != QProcess::NotRunning; }
     int stageCount() const { return m_total; }

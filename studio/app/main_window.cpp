@@ -569,7 +569,6 @@ void MainWindow::rebuildProperties() {
 }
 
 QString MainWindow::setProperty(const QString& field, const QString& text) {
-    QString why;
     auto show = [&](const QString& w) {
         m_propertyError->setText(w);
         if (!w.isEmpty()) {
@@ -596,9 +595,10 @@ QString MainWindow::setProperty(const QString& field, const QString& text) {
             m.hPrime.reset();
         }));
     }
-    bool ok = false;
-    const double v = text.trimmed().toDouble(&ok);
-    if (!ok || !std::isfinite(v)) return show(tr("%1: '%2' is not a finite number").arg(field, text));
+    QString why;
+    const std::optional<double> parsed = parseNumberText(text, field, why);
+    if (!parsed) return show(why);
+    const double v = *parsed;
     const int b = m_body;
     for (const char* f : kBodyFields)
         if (field == f) {

@@ -33,17 +33,6 @@ std::vector<sim::CurvePoint> toPoints(const sim::CurveDesc& d) {
     return p;
 }
 
-/// A typed number: finite, else the field and the rule.
-std::optional<double> parseNumber(const QString& text, const QString& field, QString& why) {
-    bool ok = false;
-    const double v = text.trimmed().toDouble(&ok);
-    if (!ok || !std::isfinite(v)) {
-        why = QObject::tr("%1: '%2' is not a finite number").arg(field, text);
-        return std::nullopt;
-    }
-    return v;
-}
-
 } // namespace
 
 std::optional<sim::ValanisLandelCurves> MaterialPanel::curvesOf(const sim::Material& m) {
@@ -129,8 +118,8 @@ MaterialPanel::MaterialPanel(Document* doc, QWidget* parent) : QWidget(parent), 
     connect(m_y, &QLineEdit::editingFinished, this, [this] { setStatus(applyTypedPoint()); });
     connect(m_applyPreset, &QPushButton::clicked, this, [this] {
         QString why;
-        const auto E = parseNumber(m_E->text(), tr("E"), why);
-        const auto nu = E ? parseNumber(m_nu->text(), tr("ν"), why) : std::nullopt;
+        const auto E = parseNumberText(m_E->text(), tr("E"), why);
+        const auto nu = E ? parseNumberText(m_nu->text(), tr("ν"), why) : std::nullopt;
         setStatus(nu ? applyPreset(m_law->currentText(), *E, *nu) : why);
     });
     connect(m_fit, &QPushButton::clicked, this, [this] {
@@ -210,8 +199,9 @@ QString MaterialPanel::applyTypedPoint() {
     const int i = e->selected();
     if (i < 0 || !e->hasCurve()) return {};
     QString why;
-    const auto x = parseNumber(m_x->text(), tr("%1 point %2: x").arg(kNames[m_active]).arg(i), why);
-    const auto y = x ? parseNumber(m_y->text(), tr("%1 point %2: y").arg(kNames[m_active]).arg(i), why) : std::nullopt;
+    const auto x = parseNumberText(m_x->text(), tr("%1 point %2: x").arg(kNames[m_active]).arg(i), why);
+    const auto y =
+        x ? parseNumberText(m_y->text(), tr("%1 point %2: y").arg(kNames[m_active]).arg(i), why) : std::nullopt;
     if (!y) return why;
     const sim::CurvePoint& p = e->points()[i];
     if (*x == p.x && *y == p.y) return {};
