@@ -6,7 +6,9 @@
 //     start shows it; 1: the frame in progress at the edit finished first);
 //   - the UI thread's longest stall: the largest gap between two runs of a 1 ms timer (the event
 //     loop runs as in a session: moves come from a 16 ms timer), the longest single mouse-event
-//     handling (edit, check, undo command, plots) and the viewport's paint;
+//     handling (edit, check, undo command, plots), the viewport's frame time (on its render
+//     thread with the default host), the slowest event deliveries on the UI thread (receiver,
+//     event type, and how much of it was widget painting) and each widget's paint cost;
 //   - the preview's physics cost per frame.
 // Writes <out>/studio_preview.json and screenshots of the main window (<out>/studio_main.png,
 // the material dock, the viewport). Run under a display (Xvfb):
@@ -27,6 +29,7 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QMouseEvent>
+#include <QScreen>
 #include <QTimer>
 
 #include "sim/material/laws.hpp"
@@ -39,6 +42,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <numeric>
 
 namespace {
@@ -68,6 +72,68 @@ double percentile(std::vector<double> v, double q) {
     return v[std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5))];
 }
 
+/// Times every top-level event delivery on the UI thread, to name what the longest stalls are
+/// made of (receiver class and event type).
+class TimingApplication : public QApplication {
+public:
+    using QApplication::QApplication;
+    struct Delivery {
+        double ms;
+        std::string what;
+        double paintMs; ///< of which widget paint events
+    };
+    bool recording = false;
+    std::vector<Delivery> slowest; ///< the 8 slowest while recording
+    struct PaintCost {
+        double max = 0, total = 0;
+        int count = 0;
+    };
+    std::map<std::string, PaintCost> paintMs; ///< paint events per widget
+
+    bool notify(QObject* receiver, QEvent* e) override {
+        if (recording && m_depth > 0 && e->type() == QEvent::Paint) {
+            QElapsedTimer t;
+            t.start();
+            ++m_depth;
+            const bool r = QApplication::notify(receiver, e);
+            --m_depth;
+            auto& v =
+                paintMs[std::string(receiver->metaObject()->className()) + "/" + receiver->objectName().toStdString()];
+            const double ms = t.nsecsElapsed() * 1e-6;
+            v.max = std::max(v.max, ms);
+            v.total += ms;
+            ++v.count;
+            if (m_depth == 1) m_nestedPaintMs += ms;
+            return r;
+        }
+        if (m_depth > 0 || !recording) {
+            ++m_depth;
+            const bool r = QApplication::notify(receiver, e);
+            --m_depth;
+            return r;
+        }
+        const std::string what = std::string(receiver->metaObject()->className()) + "/" +
+                                 receiver->objectName().toStdString() + " event " + std::to_string(e->type());
+        QElapsedTimer t;
+        t.start();
+        m_nestedPaintMs = 0;
+        ++m_depth;
+        const bool r = QApplication::notify(receiver, e);
+        --m_depth;
+        const double ms = t.nsecsElapsed() * 1e-6;
+        if (slowest.size() < 8 || ms > slowest.back().ms) {
+            slowest.push_back({ms, what, m_nestedPaintMs});
+            std::sort(slowest.begin(), slowest.end(), [](auto& a, auto& b) { return a.ms > b.ms; });
+            if (slowest.size() > 8) slowest.pop_back();
+        }
+        return r;
+    }
+
+private:
+    int m_depth = 0;
+    double m_nestedPaintMs = 0;
+};
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -78,7 +144,7 @@ int main(int argc, char** argv) {
     const bool paused = argc > 3 && std::string(argv[3]) == "paused";
     std::filesystem::create_directories(out);
     studio::setStudioSurfaceFormat();
-    QApplication app(argc, argv);
+    TimingApplication app(argc, argv);
     QCoreApplication::setOrganizationName("VisceraBench");
     QCoreApplication::setApplicationName("StudioPreview");
     studio::MainWindow w;
@@ -137,6 +203,7 @@ int main(int argc, char** argv) {
     const uint64_t frames0 = s0.frames;
     w.preview()->setPaused(paused);
     probe.start();
+    app.recording = true;
     paintProbe.start(50);
     // Event-driven, like a user's session: a mouse move every 16 ms from a timer, the event loop
     // sleeping in between (no polling loop of the bench's own on the UI thread).
@@ -179,6 +246,7 @@ int main(int argc, char** argv) {
     QTimer::singleShot(static_cast<int>(seconds * 1000), &loop, &QEventLoop::quit);
     loop.exec();
     mover.stop();
+    app.recording = false;
     resolve();
     send(e, QEvent::MouseButtonRelease, e->toWidget({pts[i].x, pts[i].y}), Qt::LeftButton, Qt::NoButton);
     probe.stop();
@@ -197,7 +265,9 @@ int main(int argc, char** argv) {
     w.pollPreview();
 
     // screenshots of what the user sees
-    w.grab().save(QString::fromStdString((out / "studio_main.png").string()));
+    // from the screen, as the user sees it: the viewport is a native window of its own, which a
+    // widget grab (QWidget::grab) does not contain
+    w.screen()->grabWindow(w.winId()).save(QString::fromStdString((out / "studio_main.png").string()));
     if (auto* d = w.findChild<QDockWidget*>("materialDock"))
         d->grab().save(QString::fromStdString((out / "studio_material.png").string()));
     if (auto* d = w.findChild<QDockWidget*>("plotsDock"))
@@ -243,6 +313,16 @@ int main(int argc, char** argv) {
                      ? -1
                      : std::accumulate(latencyFrames.begin(), latencyFrames.end(), 0.0) / latencyFrames.size()}};
     j["ui_timer_gap_ms"] = {{"max", maxGap}, {"p99", percentile(timerGaps, 0.99)}, {"p50", percentile(timerGaps, 0.5)}};
+    auto top = [](std::vector<double> v) {
+        std::sort(v.rbegin(), v.rend());
+        v.resize(std::min<size_t>(v.size(), 5));
+        return v;
+    };
+    j["ui_timer_gap_ms"]["largest"] = top(timerGaps);
+    for (const auto& d : app.slowest)
+        j["slowest_event_deliveries"].push_back({{"ms", d.ms}, {"what", d.what}, {"widget_paint_ms", d.paintMs}});
+    for (const auto& [what, c] : app.paintMs)
+        if (c.max > 0.5) j["widget_paint_ms"][what] = {{"max", c.max}, {"mean", c.total / c.count}, {"count", c.count}};
     j["mouse_event_ms"] = {
         {"max", maxHandler},
         {"p99", percentile(handlerMs, 0.99)},

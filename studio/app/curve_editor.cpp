@@ -33,6 +33,11 @@ CurveEditor::CurveEditor(QWidget* parent) : QWidget(parent) {
 void CurveEditor::setCurve(const QString& name, const std::vector<sim::CurvePoint>& points, bool strictlyIncreasing,
                            bool frame) {
     const bool sameCount = points.size() == m_points.size() && name == m_name;
+    const bool same =
+        sameCount && strictlyIncreasing == m_strict && m_message.isEmpty() && m_curve &&
+        std::equal(points.begin(), points.end(), m_points.begin(),
+                   [](const sim::CurvePoint& a, const sim::CurvePoint& b) { return a.x == b.x && a.y == b.y; });
+    if (same && !frame) return; // an edit of another curve: nothing to redraw
     m_name = name;
     m_message.clear();
     m_points = points;
@@ -53,6 +58,7 @@ void CurveEditor::setCurve(const QString& name, const std::vector<sim::CurvePoin
 }
 
 void CurveEditor::clearCurve(const QString& name, const QString& message) {
+    if (name == m_name && message == m_message && m_points.empty() && !m_curve) return;
     m_name = name;
     m_message = message;
     m_points.clear();

@@ -51,9 +51,7 @@ const char* const kSolverFields[] = {"dt", "substeps", "iterations", "damping"};
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_export(std::make_unique<ExportRunner>()) {
     setObjectName("studioMainWindow");
     setDockNestingEnabled(true);
-    m_viewport = new Viewport(this);
-    m_viewport->setObjectName("viewport");
-    setCentralWidget(m_viewport);
+    setViewportHost(viewportHostFromText(QSettings().value("viewport/host").toString()).value_or(ViewportHost::Window));
     buildDocks();
     buildActions();
     statusBar()->showMessage(tr("Open or create a project (File menu)"));
@@ -61,13 +59,6 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_export(std::mak
     connect(&m_doc, &Document::logMessage, this, &MainWindow::logLine);
     connect(&m_preview, &Preview::logMessage, this, &MainWindow::logLine, Qt::QueuedConnection);
     connect(m_doc.undoStack(), &QUndoStack::cleanChanged, this, &MainWindow::updateTitle);
-    connect(m_viewport, &Viewport::bodyClicked, this, [this](const QString& name) {
-        if (!m_doc.hasProject()) return;
-        const auto& bodies = m_doc.project().bodies;
-        for (size_t i = 0; i < bodies.size(); ++i)
-            if (QString::fromStdString(bodies[i].scene.name) == name) selectBody(static_cast<int>(i));
-    });
-    connect(m_viewport, &Viewport::rendererFailed, this, &MainWindow::logLine);
     connect(m_material, &MaterialPanel::fitRequested, this, [this](int body) {
         FitDialog dlg(&m_doc, body, this);
         dlg.exec();
@@ -244,10 +235,51 @@ void MainWindow::buildActions() {
 
     QMenu* view = menuBar()->addMenu(tr("&View"));
     add(view, tr("&Frame all"), QKeySequence(Qt::Key_F), [this] { m_viewport->frameAll(); });
+    m_widgetHostAction = view->addAction(tr("Compatibility viewport (QOpenGLWidget, slower)"));
+    m_widgetHostAction->setObjectName("actionWidgetViewport");
+    m_widgetHostAction->setCheckable(true);
+    m_widgetHostAction->setChecked(m_viewport->host() == ViewportHost::Widget);
+    m_widgetHostAction->setToolTip(tr("Draw the viewport in a QOpenGLWidget instead of an embedded window: for "
+                                      "displays where the embedded window misbehaves; every repaint of the "
+                                      "main window then composes through OpenGL"));
+    connect(m_widgetHostAction, &QAction::toggled, this,
+            [this](bool on) { setViewportHost(on ? ViewportHost::Widget : ViewportHost::Window); });
     view->addSeparator();
     for (QDockWidget* d : findChildren<QDockWidget*>())
         view->addAction(d->toggleViewAction());
     view->addAction(toolbar->toggleViewAction());
+}
+
+void MainWindow::setViewportHost(ViewportHost host) {
+    if (m_viewport && m_viewport->host() == host) return;
+    const QString selected = m_viewport ? m_viewport->selectedName() : QString();
+    // The old viewport goes first: a QOpenGLWidget added to the window makes Qt recreate the
+    // top-level native window, which would take an embedded window still in it along.
+    if (m_viewport) {
+        m_viewport = nullptr;
+        delete takeCentralWidget();
+    }
+    auto* v = new Viewport(host, this);
+    v->setObjectName("viewport");
+    connect(v, &Viewport::bodyClicked, this, [this](const QString& name) {
+        if (!m_doc.hasProject()) return;
+        const auto& bodies = m_doc.project().bodies;
+        for (size_t i = 0; i < bodies.size(); ++i)
+            if (QString::fromStdString(bodies[i].scene.name) == name) selectBody(static_cast<int>(i));
+    });
+    connect(v, &Viewport::rendererFailed, this, &MainWindow::logLine);
+    setCentralWidget(v);
+    m_viewport = v;
+    // the new host shows what the old one did
+    if (m_doc.hasProject()) v->setCaseRender(m_doc.project().scene.render);
+    if (auto view = m_preview.sceneView()) {
+        v->setScene(*view);
+        const Preview::Snapshot s = m_preview.snapshot();
+        v->setPositions(s.bodies, s.surfaces);
+    }
+    v->setSelectedName(selected);
+    QSettings().setValue("viewport/host", viewportHostText(host));
+    if (m_widgetHostAction) m_widgetHostAction->setChecked(host == ViewportHost::Widget);
 }
 
 QStringList MainWindow::recentProjects() const {

@@ -7,6 +7,7 @@
 /// state; File → Export case… runs the export with progress and Cancel.
 #include "app/document.hpp"
 #include "app/preview.hpp"
+#include "app/viewport.hpp"
 
 #include <QMainWindow>
 #include <QStringList>
@@ -29,7 +30,6 @@ namespace viscera::studio {
 class ExportRunner;
 class MaterialPanel;
 class PlotWidget;
-class Viewport;
 
 class MainWindow : public QMainWindow {
     Q_OBJECT
@@ -58,6 +58,9 @@ public:
     Document* document() { return &m_doc; }
     Preview* preview() { return &m_preview; }
     Viewport* viewport() { return m_viewport; }
+    /// Replaces the viewport by one on `host` showing the same scene, selection and look (View
+    /// menu; saved in the settings as "viewport/host").
+    void setViewportHost(ViewportHost host);
     MaterialPanel* materialPanel() { return m_material; }
     QTreeWidget* tree() { return m_tree; }
     PlotWidget* errorPlot() { return m_errorPlot; }
@@ -101,6 +104,7 @@ private:
     Preview m_preview;
     std::unique_ptr<ExportRunner> m_export;
     Viewport* m_viewport = nullptr;
+    QAction* m_widgetHostAction = nullptr;
     MaterialPanel* m_material = nullptr;
     QTreeWidget* m_tree = nullptr;
     QWidget* m_propertiesHost = nullptr;

@@ -5,7 +5,8 @@
 
 namespace viscera::studio {
 
-/// Requests an OpenGL 4.1 core context for every QOpenGLWidget (the renderer's minimum); call
+/// Requests an OpenGL 4.1 core context (the renderer's minimum) for every GL surface of the studio
+/// (the viewport's render-thread window and its QOpenGLWidget host); call
 /// before the QApplication is created.
 void setStudioSurfaceFormat();
 

@@ -5,15 +5,33 @@
 #include "render/headless.hpp"
 
 #include <Eigen/Geometry>
+#include <QCoreApplication>
 #include <QElapsedTimer>
 #include <QMouseEvent>
+#include <QOffscreenSurface>
 #include <QOpenGLContext>
+#include <QOpenGLFramebufferObject>
 #include <QOpenGLFunctions>
+#include <QOpenGLWidget>
+#include <QPlatformSurfaceEvent>
+#include <QPointer>
+#include <QThread>
+#include <QVBoxLayout>
 #include <QWheelEvent>
+#include <QWindow>
+
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <future>
 #include <limits>
+#include <mutex>
 
 namespace viscera::studio {
 namespace {
@@ -42,39 +60,473 @@ float hitTriangle(const Eigen::Vector3f& o, const Eigen::Vector3f& d, const Eige
 
 } // namespace
 
-Viewport::Viewport(QWidget* parent) : QOpenGLWidget(parent) {
+struct ViewportFrame {
+    std::shared_ptr<const render::SceneView> view;
+    uint64_t sceneSerial = 0; ///< a new scene gets new GPU buffers: a fresh renderer
+    uint64_t lookSerial = 0;  ///< the case's render block changed: settings made again
+    std::string caseRender;
+    render::Camera camera;
+};
+
+namespace {
+
+/// Draws frames on whatever context is current: the renderer, its resolution scale and the
+/// figures the viewport reports. One per host; used by one thread at a time.
+class FrameRenderer {
+public:
+    struct Figures {
+        QString info;
+        bool ready = false;
+        double lastMs = 0, scale = 1.0;
+        uint64_t paints = 0;
+    };
+
+    /// Renders `f` into framebuffer `fbo` of `w`×`h` device pixels with `ctx` current; `onScreen`:
+    /// a frame on screen, which counts and drives the resolution scale (a grab does not).
+    /// Returns the failure to report when the renderer could not be made (once), else empty.
+    QString render(QOpenGLContext* ctx, const ViewportFrame& f, unsigned fbo, int w, int h, bool onScreen) {
+        QString failed;
+        if (!m_renderer || f.sceneSerial != m_scene) {
+            std::string why;
+            render::RenderSettings s; // made for the scene below
+            s.width = w;
+            s.height = h;
+            try {
+                m_renderer = render::createRendererForCurrentContext(resolve, ctx, s, &why);
+            } catch (const std::exception& e) {
+                m_renderer.reset();
+                why = e.what();
+            }
+            m_scene = f.sceneSerial;
+            m_look = ~uint64_t(0);
+            std::lock_guard lock(m_mutex);
+            m_figures.ready = m_renderer != nullptr;
+            if (m_renderer) {
+                m_figures.info = QString::fromStdString(m_renderer->backend().deviceName());
+            } else {
+                m_figures.info = QObject::tr("viewport: no renderer (%1)").arg(QString::fromStdString(why));
+                if (!m_reportedFailure) failed = m_figures.info;
+                m_reportedFailure = true;
+            }
+        }
+        QOpenGLFunctions* gl = ctx->functions();
+        if (!m_renderer || !f.view || f.view->meshes().empty()) {
+            gl->glBindFramebuffer(GL_FRAMEBUFFER, fbo); // nothing to draw (yet)
+            gl->glClearColor(0.05f, 0.02f, 0.02f, 1.0f);
+            gl->glClear(GL_COLOR_BUFFER_BIT);
+            return failed;
+        }
+        QElapsedTimer timer;
+        timer.start();
+        const double scale = figures().scale;
+        const int rw = std::max(1, static_cast<int>(w * scale)), rh = std::max(1, static_cast<int>(h * scale));
+        render::RenderSettings s = m_renderer->settings();
+        QString note;
+        if (s.width != rw || s.height != rh || f.lookSerial != m_look) {
+            render::RenderSettings d = render::defaultSettingsFor(*f.view, rw, rh);
+            try {
+                render::applyCaseRender(d, f.caseRender, "project.json");
+            } catch (const std::exception& e) {
+                note = QObject::tr("viewport: %1").arg(QString::fromStdString(e.what())); // load checked it already
+            }
+            d.stereo.mode = render::StereoMode::Off; // the author's view is mono
+            d.timePasses = false;
+            s = d;
+            m_look = f.lookSerial;
+        }
+        s.camera = f.camera;
+        s.light.followCamera = true;
+        try {
+            m_renderer->setSettings(s);
+            m_renderer->renderFrame(*f.view);
+            m_renderer->present(fbo, w, h); // scaled up when rendered smaller
+        } catch (const std::exception& e) {
+            note = QObject::tr("viewport: %1").arg(QString::fromStdString(e.what()));
+        }
+        if (onScreen) gl->glFinish(); // the frame's cost includes the rasterization
+        const double ms = timer.nsecsElapsed() * 1e-6;
+        std::lock_guard lock(m_mutex);
+        if (!note.isEmpty()) m_figures.info = note;
+        if (!onScreen) return failed;
+        ++m_figures.paints;
+        m_figures.lastMs = ms;
+        // resolution follows the paint budget (the cost scales with the pixel count, ~scale²)
+        double& sc = m_figures.scale;
+        if (ms > Viewport::kPaintBudgetMs && sc > Viewport::kMinScale)
+            sc = std::max(Viewport::kMinScale, sc * std::sqrt(Viewport::kPaintBudgetMs / ms) * 0.9);
+        else if (ms < 0.4 * Viewport::kPaintBudgetMs && sc < 1.0)
+            sc = std::min(1.0, sc * 1.25);
+        return failed;
+    }
+
+    /// With the renderer's context current.
+    void release() { m_renderer.reset(); }
+
+    Figures figures() const {
+        std::lock_guard lock(m_mutex);
+        return m_figures;
+    }
+
+private:
+    std::unique_ptr<render::Renderer> m_renderer;
+    uint64_t m_scene = ~uint64_t(0), m_look = ~uint64_t(0);
+    bool m_reportedFailure = false;
+    mutable std::mutex m_mutex;
+    Figures m_figures;
+};
+
+} // namespace
+
+class ViewportCanvas {
+public:
+    virtual ~ViewportCanvas() = default;
+    /// Draws the viewport's current frame soon (never waits for it on the Window host).
+    virtual void schedule() = 0;
+    /// Renders the current frame offscreen and reads it back (null: nothing to read).
+    virtual QImage grab() = 0;
+    /// Ends drawing and releases the GL objects (before the viewport goes).
+    virtual void shutdown() = 0;
+    FrameRenderer::Figures figures() const { return m_frames.figures(); }
+
+protected:
+    explicit ViewportCanvas(Viewport* owner) : m_owner(owner) {}
+    ViewportFrame frame() { return m_owner->frame(); }
+    /// Hands a mouse, wheel or key event of the host to the Viewport's handlers.
+    bool deliver(QEvent* e) { return m_owner->event(e); }
+    /// Emits rendererFailed on the UI thread (from any thread).
+    void reportFailure(const QString& why) {
+        if (why.isEmpty()) return;
+        QPointer<Viewport> v(m_owner);
+        QMetaObject::invokeMethod(
+            m_owner,
+            [v, why] {
+                if (v) emit v->rendererFailed(why);
+            },
+            Qt::QueuedConnection);
+    }
+    static QImage grabInto(FrameRenderer& frames, QOpenGLContext* ctx, const ViewportFrame& f, QSize px) {
+        QOpenGLFramebufferObject fbo(px, QOpenGLFramebufferObject::CombinedDepthStencil);
+        if (!fbo.isValid()) return {};
+        frames.render(ctx, f, fbo.handle(), px.width(), px.height(), false);
+        return fbo.toImage();
+    }
+
+    Viewport* m_owner;
+    FrameRenderer m_frames;
+};
+
+namespace {
+
+constexpr int kRenderNice = 3; ///< below the UI thread (0), above the preview's physics (5)
+
+/// Mesa's software rasterizer (llvmpipe) draws with worker threads of its own, started at the
+/// UI thread's priority when Qt made its first context. They are the viewport's work: they get
+/// the render thread's priority, so that on a machine without a GPU a frame yields to the UI
+/// thread instead of competing with it. Other drivers have no such threads; nothing changes.
+void yieldSoftwareRasterizer() {
+    std::error_code ec;
+    for (const auto& task : std::filesystem::directory_iterator("/proc/self/task", ec)) {
+        std::ifstream comm(task.path() / "comm");
+        std::string name;
+        if (!std::getline(comm, name) || name.rfind("llvmpipe-", 0) != 0) continue;
+        const long tid = std::strtol(task.path().filename().c_str(), nullptr, 10);
+        if (tid > 0) ::setpriority(PRIO_PROCESS, static_cast<id_t>(tid), kRenderNice);
+    }
+}
+
+QSize devicePixels(QSize logical, qreal dpr) {
+    return {std::max(1, static_cast<int>(logical.width() * dpr)),
+            std::max(1, static_cast<int>(logical.height() * dpr))};
+}
+
+/// The default host: a native child window drawn by a render thread with its own context. The
+/// UI thread posts the newest frame and returns; the thread draws the newest frame it has,
+/// skipping any that were replaced meanwhile.
+class WindowCanvas final : public QWindow, public ViewportCanvas {
+public:
+    explicit WindowCanvas(Viewport* owner) : ViewportCanvas(owner) {
+        setSurfaceType(QSurface::OpenGLSurface);
+        setFormat(QSurfaceFormat::defaultFormat());
+        // The context is made here, on the UI thread (Qt's GLX integration makes its first
+        // context's helpers on the GUI thread only), and then handed to the render thread.
+        m_context = std::make_unique<QOpenGLContext>();
+        m_context->setFormat(QSurfaceFormat::defaultFormat());
+        m_created = m_context->create();
+        // for releasing the GL objects when the window's surface is gone
+        m_offscreen = std::make_unique<QOffscreenSurface>();
+        m_offscreen->setFormat(m_context->format());
+        m_offscreen->create();
+        m_thread.reset(QThread::create([this] { run(); }));
+        m_thread->setObjectName("viewportRender");
+        m_context->moveToThread(m_thread.get());
+        m_thread->start();
+    }
+    ~WindowCanvas() override { shutdown(); }
+
+    void schedule() override {
+        if (!isExposed()) return; // drawn on exposure
+        post(frame(), devicePixels(size(), devicePixelRatio()));
+    }
+
+    QImage grab() override {
+        if (!isExposed()) return {};
+        std::future<QImage> image;
+        {
+            std::lock_guard lock(m_mutex);
+            if (m_quit) return {};
+            m_grab.emplace();
+            image = m_grab->get_future();
+            m_grabFrame = frame();
+            m_grabSize = devicePixels(size(), devicePixelRatio());
+        }
+        m_wake.notify_one();
+        return image.get();
+    }
+
+    void shutdown() override {
+        {
+            std::lock_guard lock(m_mutex);
+            if (m_quit) return;
+            m_quit = true;
+        }
+        m_wake.notify_one();
+        m_thread->wait();
+    }
+
+protected:
+    void exposeEvent(QExposeEvent*) override { schedule(); }
+    void resizeEvent(QResizeEvent*) override { schedule(); }
+    bool event(QEvent* e) override {
+        switch (e->type()) {
+        case QEvent::PlatformSurface:
+            // The UI thread makes and destroys the native window (showing, reparenting,
+            // closing): the render thread never draws on a surface being destroyed.
+            setSurfaceUsable(static_cast<QPlatformSurfaceEvent*>(e)->surfaceEventType() ==
+                             QPlatformSurfaceEvent::SurfaceCreated);
+            return QWindow::event(e);
+        case QEvent::MouseButtonPress:
+        case QEvent::MouseButtonRelease:
+        case QEvent::MouseMove:
+        case QEvent::Wheel:
+        case QEvent::KeyPress:
+            return deliver(e);
+        default:
+            return QWindow::event(e);
+        }
+    }
+
+private:
+    /// false: waits until the render thread is off the surface; it then leaves it alone until
+    /// the surface is made again.
+    void setSurfaceUsable(bool usable) {
+        std::unique_lock lock(m_mutex);
+        m_surfaceUsable = usable;
+        m_idle.wait(lock, [&] { return !m_onSurface; });
+    }
+
+    void post(ViewportFrame f, QSize px) {
+        {
+            std::lock_guard lock(m_mutex);
+            m_next = std::move(f);
+            m_nextSize = px;
+        }
+        m_wake.notify_one();
+    }
+
+    void run() {
+        // a frame yields to the UI thread and stays ahead of the preview's physics
+        ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), kRenderNice);
+        bool yielded = false;
+        QOpenGLContext& ctx = *m_context;
+        const bool created = m_created;
+        for (;;) {
+            std::optional<ViewportFrame> f, grabFrame;
+            std::optional<std::promise<QImage>> grab;
+            QSize px, grabPx;
+            {
+                std::unique_lock lock(m_mutex);
+                m_wake.wait(lock, [&] { return m_quit || m_next || m_grab; });
+                if (m_quit) break;
+                std::swap(f, m_next);
+                px = m_nextSize;
+                std::swap(grab, m_grab);
+                std::swap(grabFrame, m_grabFrame);
+                grabPx = m_grabSize;
+                m_onSurface = m_surfaceUsable;
+            }
+            if (!m_onSurface || !created || !ctx.makeCurrent(this)) {
+                if (m_onSurface) reportFailure(failOnce(tr("viewport: no OpenGL context for the viewport window")));
+                if (grab) grab->set_value({});
+                leaveSurface();
+                continue;
+            }
+            if (f) {
+                reportFailure(m_frames.render(&ctx, *f, ctx.defaultFramebufferObject(), px.width(), px.height(), true));
+                ctx.swapBuffers(this);
+                if (!yielded) yieldSoftwareRasterizer(); // its threads exist once a frame was drawn
+                yielded = true;
+            }
+            if (grab) grab->set_value(grabInto(m_frames, &ctx, *grabFrame, grabPx));
+            ctx.doneCurrent();
+            leaveSurface();
+        }
+        std::optional<std::promise<QImage>> grab;
+        {
+            std::lock_guard lock(m_mutex);
+            std::swap(grab, m_grab);
+        }
+        if (grab) grab->set_value({});
+        if (created && ctx.makeCurrent(m_offscreen.get())) {
+            m_frames.release(); // GL objects go with this thread's context
+            ctx.doneCurrent();
+        }
+        ctx.moveToThread(QCoreApplication::instance()->thread()); // deleted with the window
+    }
+
+    void leaveSurface() {
+        {
+            std::lock_guard lock(m_mutex);
+            m_onSurface = false;
+        }
+        m_idle.notify_all();
+    }
+
+    QString failOnce(const QString& why) {
+        if (m_failed) return {};
+        m_failed = true;
+        return why;
+    }
+
+    std::unique_ptr<QOpenGLContext> m_context;
+    std::unique_ptr<QOffscreenSurface> m_offscreen;
+    bool m_created = false;
+    std::unique_ptr<QThread> m_thread;
+    std::mutex m_mutex;
+    std::condition_variable m_wake, m_idle;
+    bool m_quit = false, m_failed = false;
+    bool m_surfaceUsable = false, m_onSurface = false; ///< guarded by m_mutex
+    std::optional<ViewportFrame> m_next, m_grabFrame;
+    QSize m_nextSize, m_grabSize;
+    std::optional<std::promise<QImage>> m_grab;
+};
+
+/// The compatibility host, painting on the UI thread. Its input events are not handled here, so
+/// Qt passes them on to the parent Viewport.
+class WidgetCanvas final : public QOpenGLWidget, public ViewportCanvas {
+public:
+    explicit WidgetCanvas(Viewport* owner) : QOpenGLWidget(owner), ViewportCanvas(owner) {
+        setFocusPolicy(Qt::NoFocus);
+    }
+    ~WidgetCanvas() override { shutdown(); }
+    void schedule() override { update(); }
+    QImage grab() override {
+        if (!context()) return {};
+        makeCurrent();
+        QImage img = grabInto(m_frames, context(), frame(), devicePixels(size(), devicePixelRatioF()));
+        doneCurrent();
+        return img;
+    }
+    void shutdown() override {
+        if (!context()) return;
+        makeCurrent();
+        m_frames.release(); // GL objects go with the widget's context
+        doneCurrent();
+    }
+
+protected:
+    void paintGL() override {
+        const QSize px = devicePixels(size(), devicePixelRatioF());
+        reportFailure(m_frames.render(context(), frame(), defaultFramebufferObject(), px.width(), px.height(), true));
+    }
+};
+
+} // namespace
+
+std::optional<ViewportHost> viewportHostFromText(const QString& text) {
+    if (text == "window") return ViewportHost::Window;
+    if (text == "widget") return ViewportHost::Widget;
+    return std::nullopt;
+}
+
+QString viewportHostText(ViewportHost host) {
+    return host == ViewportHost::Window ? QStringLiteral("window") : QStringLiteral("widget");
+}
+
+Viewport::Viewport(ViewportHost host, QWidget* parent) : QWidget(parent), m_host(host) {
     setFocusPolicy(Qt::StrongFocus);
     setMinimumSize(320, 240);
+    auto* layout = new QVBoxLayout(this);
+    layout->setContentsMargins(0, 0, 0, 0);
+    if (host == ViewportHost::Window) {
+        auto* window = new WindowCanvas(this);
+        QWidget* container = QWidget::createWindowContainer(window, this); // takes the window
+        container->setObjectName("viewportCanvas");
+        container->setFocusPolicy(Qt::NoFocus);
+        layout->addWidget(container);
+        m_canvas = window;
+    } else {
+        auto* widget = new WidgetCanvas(this);
+        widget->setObjectName("viewportCanvas");
+        layout->addWidget(widget);
+        m_canvas = widget;
+    }
 }
 
 Viewport::~Viewport() {
-    makeCurrent();
-    m_renderer.reset(); // GL objects go with the widget's context
-    doneCurrent();
+    m_canvas->shutdown(); // before the host's window or widget goes with the children
 }
 
-void Viewport::initializeGL() {
-    std::string why;
-    render::RenderSettings s; // framed on the first frame that has meshes
-    s.width = std::max(1, width());
-    s.height = std::max(1, height());
-    try {
-        m_renderer = render::createRendererForCurrentContext(resolve, context(), s, &why);
-    } catch (const std::exception& e) {
-        why = e.what();
-    }
-    if (m_renderer) {
-        m_info = QString::fromStdString(m_renderer->backend().deviceName());
-    } else {
-        m_info = tr("viewport: no renderer (%1)").arg(QString::fromStdString(why));
-        emit rendererFailed(m_info);
-    }
+QWindow* Viewport::canvasWindow() const {
+    return m_host == ViewportHost::Window ? static_cast<WindowCanvas*>(m_canvas) : nullptr;
 }
 
-void Viewport::resizeGL(int, int) {}
+QWidget* Viewport::canvasWidget() const {
+    return m_host == ViewportHost::Widget ? static_cast<WidgetCanvas*>(m_canvas) : nullptr;
+}
+
+QString Viewport::rendererInfo() const {
+    return m_canvas->figures().info;
+}
+bool Viewport::rendererReady() const {
+    return m_canvas->figures().ready;
+}
+double Viewport::lastPaintMs() const {
+    return m_canvas->figures().lastMs;
+}
+double Viewport::renderScale() const {
+    return m_canvas->figures().scale;
+}
+uint64_t Viewport::paintCount() const {
+    return m_canvas->figures().paints;
+}
+
+ViewportFrame Viewport::frame() {
+    if (!m_published) m_published = std::make_shared<const render::SceneView>(m_view);
+    ViewportFrame f;
+    f.view = m_published;
+    f.sceneSerial = m_sceneSerial;
+    f.lookSerial = m_lookSerial;
+    f.caseRender = m_caseRender;
+    f.camera = m_camera;
+    return f;
+}
+
+void Viewport::viewChanged() {
+    m_published.reset(); // the next frame takes a new snapshot
+    requestFrame();
+}
+
+void Viewport::requestFrame() {
+    m_canvas->schedule();
+}
+
+QImage Viewport::grabFramebuffer() {
+    return m_canvas->grab();
+}
 
 void Viewport::setScene(const render::SceneView& view) {
     m_view = view;
+    ++m_sceneSerial;
     m_baseMaterial.clear();
     const size_t base = m_view.materials().size();
     for (size_t i = 0; i < base; ++i) {
@@ -85,25 +537,15 @@ void Viewport::setScene(const render::SceneView& view) {
     }
     for (const render::RenderMesh& m : m_view.meshes())
         m_baseMaterial.push_back(m.material);
-    if (m_renderer && context()) {
-        // a new scene gets new GPU buffers: a fresh renderer on the same context
-        makeCurrent();
-        std::string why;
-        const render::RenderSettings s = m_renderer->settings();
-        m_renderer = render::createRendererForCurrentContext(resolve, context(), s, &why);
-        if (!m_renderer) m_info = tr("viewport: no renderer (%1)").arg(QString::fromStdString(why));
-        doneCurrent();
-    }
     if (!m_framed) frameAll();
-    setSelectedName(m_selected);
-    update();
+    setSelectedName(m_selected); // hands the new view over
 }
 
 void Viewport::setCaseRender(const std::string& json) {
     if (json == m_caseRender) return;
     m_caseRender = json;
-    m_framed = false; // settings are made again on the next paint
-    update();
+    ++m_lookSerial; // settings are made again on the next frame
+    requestFrame();
 }
 
 void Viewport::setPositions(const std::vector<std::vector<Eigen::Vector3d>>& bodies,
@@ -129,7 +571,7 @@ void Viewport::setPositions(const std::vector<std::vector<Eigen::Vector3d>>& bod
         }
         m_view.recomputeNormals(i);
     }
-    update();
+    viewChanged();
 }
 
 void Viewport::setSelectedName(const QString& name) {
@@ -138,7 +580,7 @@ void Viewport::setSelectedName(const QString& name) {
     const size_t base = m_view.materials().size() / 2;
     for (size_t i = 0; i < meshes.size() && i < m_baseMaterial.size(); ++i)
         meshes[i].material = m_baseMaterial[i] + (QString::fromStdString(meshes[i].name) == name && base ? base : 0);
-    update();
+    viewChanged();
 }
 
 void Viewport::frameAll() {
@@ -150,7 +592,7 @@ void Viewport::frameAll() {
     m_distance = radius / std::sin(0.5f * 55.0f * 3.14159265f / 180.0f) * 1.1f;
     m_framed = true;
     updateCamera();
-    update();
+    requestFrame();
 }
 
 void Viewport::updateCamera() {
@@ -163,49 +605,6 @@ void Viewport::updateCamera() {
     m_camera.up = Eigen::Vector3f(0, 0, 1);
     m_camera.nearPlane = std::max(1e-4f, 0.02f * m_distance);
     m_camera.farPlane = 20.0f * m_distance + 1.0f;
-}
-
-void Viewport::paintGL() {
-    if (!m_renderer) return;
-    const qreal dpr = devicePixelRatioF();
-    const int w = std::max(1, static_cast<int>(width() * dpr)), h = std::max(1, static_cast<int>(height() * dpr));
-    render::RenderSettings s = m_renderer->settings();
-    if (m_view.meshes().empty()) {
-        QOpenGLFunctions* f = context()->functions(); // nothing to draw yet
-        f->glClearColor(0.05f, 0.02f, 0.02f, 1.0f);
-        f->glClear(GL_COLOR_BUFFER_BIT);
-        return;
-    }
-    QElapsedTimer timer;
-    timer.start();
-    const int rw = std::max(1, static_cast<int>(w * m_scale)), rh = std::max(1, static_cast<int>(h * m_scale));
-    if (s.width != rw || s.height != rh || !m_framed) {
-        render::RenderSettings d = render::defaultSettingsFor(m_view, rw, rh);
-        try {
-            render::applyCaseRender(d, m_caseRender, "project.json");
-        } catch (const std::exception& e) {
-            m_info = tr("viewport: %1").arg(QString::fromStdString(e.what())); // load checked it already
-        }
-        d.stereo.mode = render::StereoMode::Off; // the author's view is mono
-        d.timePasses = false;
-        s = d;
-    }
-    updateCamera();
-    s.camera = m_camera;
-    s.light.followCamera = true;
-    try {
-        m_renderer->setSettings(s);
-        m_renderer->renderFrame(m_view);
-        m_renderer->present(defaultFramebufferObject(), w, h); // scaled up when rendered smaller
-    } catch (const std::exception& e) {
-        m_info = tr("viewport: %1").arg(QString::fromStdString(e.what()));
-    }
-    m_lastPaintMs = timer.nsecsElapsed() * 1e-6;
-    // resolution follows the paint budget (the cost scales with the pixel count, ~scale²)
-    if (m_lastPaintMs > kPaintBudgetMs && m_scale > kMinScale)
-        m_scale = std::max(kMinScale, m_scale * std::sqrt(kPaintBudgetMs / m_lastPaintMs) * 0.9);
-    else if (m_lastPaintMs < 0.4 * kPaintBudgetMs && m_scale < 1.0)
-        m_scale = std::min(1.0, m_scale * 1.25);
 }
 
 void Viewport::ray(QPoint pos, Eigen::Vector3f& origin, Eigen::Vector3f& dir) const {
@@ -267,7 +666,7 @@ void Viewport::mouseMoveEvent(QMouseEvent* e) {
         return;
     }
     updateCamera();
-    update();
+    requestFrame();
 }
 
 void Viewport::mouseReleaseEvent(QMouseEvent* e) {
@@ -281,7 +680,7 @@ void Viewport::mouseReleaseEvent(QMouseEvent* e) {
 void Viewport::wheelEvent(QWheelEvent* e) {
     m_distance *= std::pow(0.85f, e->angleDelta().y() / 120.0f);
     updateCamera();
-    update();
+    requestFrame();
     e->accept();
 }
 
@@ -290,7 +689,7 @@ void Viewport::keyPressEvent(QKeyEvent* e) {
         frameAll();
         return;
     }
-    QOpenGLWidget::keyPressEvent(e);
+    QWidget::keyPressEvent(e);
 }
 
 } // namespace viscera::studio

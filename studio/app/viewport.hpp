@@ -1,28 +1,68 @@
 #pragma once
-/// The studio's 3D viewport: a QOpenGLWidget drawing the preview's bodies and surfaces with
-/// core/render on the widget's own OpenGL context (render::createRendererForCurrentContext:
-/// the deferred PBR renderer of the player, presented into the widget's framebuffer).
+/// The studio's 3D viewport: the preview's bodies and surfaces drawn with core/render on the
+/// viewport's own OpenGL context (render::createRendererForCurrentContext: the deferred PBR
+/// renderer of the player, presented into the viewport's framebuffer).
+///
+/// Two hosts, chosen by the user (View menu, saved in the settings):
+///   - Window (default): a QWindow embedded with QWidget::createWindowContainer, drawn by a
+///     render thread of its own (its own GL context, as Qt Quick's threaded render loop). The
+///     UI thread only hands over a snapshot of what to draw (the scene, shared and immutable,
+///     the camera, the look) and never waits for a frame: on a software renderer a frame of
+///     the liver costs ~10 ms of rasterization that would otherwise stall every edit. The main
+///     window also keeps Qt's raster backing store.
+///   - Widget: a QOpenGLWidget painting on the UI thread. Qt then composes the whole top-level
+///     window through OpenGL on every repaint of any widget in it (QOpenGLWidget's
+///     documentation, "Performance considerations"): measured on the liver with Mesa llvmpipe
+///     at 1600×1000, 20 ms per event-loop pass (median) against 1 ms without it
+///     (bench_studio_preview). It stays for platforms where native child windows misbehave
+///     (stacking under floating docks, some remote displays).
 ///
 /// Left drag orbits about the target, middle drag (or Shift + left) pans, the wheel zooms,
 /// F (or frameAll()) frames every mesh; a left click without a drag picks the body under the
-/// cursor (a ray against the drawn triangles) and emits bodyClicked.
+/// cursor (a ray against the drawn triangles, on the UI thread's copy of the scene) and emits
+/// bodyClicked. The host's input events reach the Viewport's own handlers, so either host
+/// behaves the same.
 #include "render/renderer.hpp"
 #include "render/scene_view.hpp"
 
-#include <QOpenGLWidget>
+#include <QImage>
 #include <QPoint>
 #include <QString>
+#include <QWidget>
 
 #include <memory>
+#include <optional>
 #include <vector>
+
+class QOpenGLContext;
+class QWindow;
 
 namespace viscera::studio {
 
-class Viewport : public QOpenGLWidget {
+enum class ViewportHost { Window, Widget };
+/// "window" or "widget" (the settings' and command line's spelling); nullopt for anything else.
+std::optional<ViewportHost> viewportHostFromText(const QString& text);
+QString viewportHostText(ViewportHost host);
+
+/// A host of the viewport's GL drawing (viewport.cpp): the render-thread window or the widget.
+class ViewportCanvas;
+/// What one frame draws: an immutable snapshot the UI thread hands to the host.
+struct ViewportFrame;
+
+class Viewport : public QWidget {
     Q_OBJECT
 public:
-    explicit Viewport(QWidget* parent = nullptr);
+    explicit Viewport(ViewportHost host = ViewportHost::Window, QWidget* parent = nullptr);
     ~Viewport() override;
+
+    ViewportHost host() const { return m_host; }
+    /// The surface the user's mouse and keys land on: the embedded QWindow (Window host) or
+    /// the QOpenGLWidget (Widget host). Tests send their synthetic events there.
+    QWindow* canvasWindow() const;
+    QWidget* canvasWidget() const;
+    /// Renders the current view into an offscreen framebuffer of the viewport's size and reads
+    /// it back (null when no renderer exists). Waits for the render thread (Window host).
+    QImage grabFramebuffer();
 
     /// The meshes to draw (the preview's SceneView; copied, the viewport then owns its data).
     void setScene(const render::SceneView& view);
@@ -34,31 +74,32 @@ public:
     void setCaseRender(const std::string& json);
     /// Highlights the body (or surface) named `name` (empty: none).
     void setSelectedName(const QString& name);
+    const QString& selectedName() const { return m_selected; }
     void frameAll();
 
     /// The mesh name under widget position `pos` (empty: none): what a click selects.
     QString pick(QPoint pos) const;
-    /// One line: "llvmpipe (...)", or why the renderer could not be made.
-    const QString& rendererInfo() const { return m_info; }
-    bool rendererReady() const { return m_renderer != nullptr; }
+    /// One line: "llvmpipe (...)", or why the renderer could not be made (empty before the
+    /// first frame).
+    QString rendererInfo() const;
+    bool rendererReady() const;
     int meshCount() const { return static_cast<int>(m_view.meshes().size()); }
     const render::Camera& camera() const { return m_camera; }
-    /// Wall time of the last paint (render + present), ms, and the resolution scale in use: the
-    /// viewport renders at a lower resolution (down to kMinScale of the widget's pixels, blitted
-    /// up) while a frame takes longer than kPaintBudgetMs, so that painting never stalls the UI
-    /// thread for long on a software renderer; it returns to full resolution when there is time.
-    double lastPaintMs() const { return m_lastPaintMs; }
-    double renderScale() const { return m_scale; }
-    static constexpr double kPaintBudgetMs = 12.0, kMinScale = 0.25;
+    /// Wall time of the last frame on screen (render + present), ms, and the resolution scale
+    /// in use: the viewport renders at a lower resolution (down to kMinScale of the pixels,
+    /// blitted up) while a frame takes longer than kPaintBudgetMs, and returns to full
+    /// resolution when there is time.
+    double lastPaintMs() const;
+    double renderScale() const;
+    /// Frames drawn on screen so far (grabs not counted).
+    uint64_t paintCount() const;
+    static constexpr double kPaintBudgetMs = 25.0, kMinScale = 0.25;
 
 signals:
     void bodyClicked(const QString& name);
     void rendererFailed(const QString& why);
 
 protected:
-    void initializeGL() override;
-    void paintGL() override;
-    void resizeGL(int w, int h) override;
     void mousePressEvent(QMouseEvent*) override;
     void mouseMoveEvent(QMouseEvent*) override;
     void mouseReleaseEvent(QMouseEvent*) override;
@@ -66,14 +107,23 @@ protected:
     void keyPressEvent(QKeyEvent*) override;
 
 private:
+    friend class ViewportCanvas;
+    /// The snapshot of what to draw now (the scene is shared until it changes).
+    ViewportFrame frame();
+    void requestFrame();
+    /// m_view changed: the next frame hands over a new snapshot.
+    void viewChanged();
     void updateCamera();
     /// The eye ray through widget position `pos`: origin and unit direction, world frame.
     void ray(QPoint pos, Eigen::Vector3f& origin, Eigen::Vector3f& dir) const;
 
-    std::unique_ptr<render::Renderer> m_renderer;
-    render::SceneView m_view;
+    ViewportHost m_host;
+    ViewportCanvas* m_canvas = nullptr;                   ///< owned through the Qt object tree
+    render::SceneView m_view;                             ///< the UI thread's copy: picking and the next snapshot
+    std::shared_ptr<const render::SceneView> m_published; ///< m_view as last handed over
+    uint64_t m_sceneSerial = 0, m_lookSerial = 0;
     render::Camera m_camera;
-    QString m_info, m_selected;
+    QString m_selected;
     std::string m_caseRender;
     std::vector<uint32_t> m_baseMaterial; ///< per mesh, its material before highlighting
     // orbit camera
@@ -83,7 +133,6 @@ private:
     Qt::MouseButton m_button = Qt::NoButton;
     bool m_dragged = false;
     bool m_framed = false;
-    double m_lastPaintMs = 0, m_scale = 1.0;
 };
 
 } // namespace viscera::studio
