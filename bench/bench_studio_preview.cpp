@@ -13,7 +13,7 @@
 // Writes <out>/studio_preview.json and screenshots of the main window (<out>/studio_main.png,
 // the material dock, the viewport). Run under a display (Xvfb):
 //   xvfb-run -a -s "-screen 0 1920x1200x24" ./build/bench/bench_studio_preview [out-dir] [seconds] [scene|paused]
-//   [width height]
+//   [width height] [window|widget]     (the viewport's host; default window)
 #include "app/curve_editor.hpp"
 #include "app/fit_dialog.hpp"
 #include "app/main_window.hpp"
@@ -147,7 +147,13 @@ int main(int argc, char** argv) {
     TimingApplication app(argc, argv);
     QCoreApplication::setOrganizationName("VisceraBench");
     QCoreApplication::setApplicationName("StudioPreview");
+    const auto host = studio::viewportHostFromText(argc > 6 ? argv[6] : "window");
+    if (!host) {
+        std::fprintf(stderr, "viewport host: '%s' is not window or widget\n", argv[6]);
+        return 2;
+    }
     studio::MainWindow w;
+    w.setViewportHost(*host);
     w.setConfirmDiscard(false);
     w.resize(argc > 4 ? std::atoi(argv[4]) : 1600, argc > 5 ? std::atoi(argv[5]) : 1000);
     w.show();
@@ -348,6 +354,7 @@ int main(int argc, char** argv) {
     }
     j["verdict"] = w.verdictLabel()->text().toStdString();
     j["renderer"] = w.viewport()->rendererInfo().toStdString();
+    j["viewport_host"] = studio::viewportHostText(*host).toStdString();
     std::ofstream(out / "studio_preview.json") << j.dump(2) << "\n";
     std::printf("%s\n", j.dump(2).c_str());
     w.preview()->stop();
