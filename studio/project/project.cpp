@@ -286,7 +286,7 @@ StiffnessPaintProject readPaint(const JsonField& j) {
     const std::vector<JsonField> strokes = j["strokes"].items(1);
     for (size_t k = 0; k < strokes.size(); ++k) {
         const JsonField& st = strokes[k];
-        st.object({"center", "radius", "amplitude", "scale"});
+        st.object({"center", "radius", "amplitude", "scale", "mode", "target"});
         sim::BrushStroke s;
         s.center = st["center"].vec3();
         s.radius = st["radius"].number(NumberRule::closed(sim::kMinBrushRadius, sim::kMaxBrushRadius));
@@ -294,6 +294,19 @@ StiffnessPaintProject readPaint(const JsonField& j) {
         if (auto sc = st.find("scale"))
             s.scale = sc->choice({"peak", "kernel"}, "a brush scale") == "peak" ? sim::BrushScale::Peak
                                                                                 : sim::BrushScale::Kernel;
+        if (auto m = st.find("mode")) {
+            const std::string mode = m->choice({"add", "subtract", "mix", "smooth"}, "a brush mode");
+            s.mode = mode == "add"        ? sim::BrushMode::Add
+                     : mode == "subtract" ? sim::BrushMode::Subtract
+                     : mode == "mix"      ? sim::BrushMode::Mix
+                                          : sim::BrushMode::Smooth;
+        }
+        if (auto t = st.find("target")) {
+            if (s.mode != sim::BrushMode::Mix) t->fail("only a mix stroke has a target");
+            s.target = t->number(NumberRule::positive());
+        } else if (s.mode == sim::BrushMode::Mix) {
+            st.failAt("target", "a mix stroke needs the weight it mixes towards");
+        }
         try {
             sim::validateStroke(s, k, st.origin() + ": " + st.path());
         } catch (const std::exception& e) {
@@ -306,11 +319,18 @@ StiffnessPaintProject readPaint(const JsonField& j) {
 
 json paintJson(const StiffnessPaintProject& p) {
     json strokes = json::array();
-    for (const sim::BrushStroke& s : p.strokes)
-        strokes.push_back({{"center", vec3Json(s.center)},
-                           {"radius", s.radius},
-                           {"amplitude", s.amplitude},
-                           {"scale", s.scale == sim::BrushScale::Peak ? "peak" : "kernel"}});
+    for (const sim::BrushStroke& s : p.strokes) {
+        json j = {{"center", vec3Json(s.center)},
+                  {"radius", s.radius},
+                  {"amplitude", s.amplitude},
+                  {"scale", s.scale == sim::BrushScale::Peak ? "peak" : "kernel"}};
+        if (s.mode != sim::BrushMode::Add)
+            j["mode"] = s.mode == sim::BrushMode::Subtract ? "subtract"
+                        : s.mode == sim::BrushMode::Mix    ? "mix"
+                                                           : "smooth";
+        if (s.mode == sim::BrushMode::Mix) j["target"] = s.target;
+        strokes.push_back(std::move(j));
+    }
     return {{"skeleton",
              {{"min_edge_length_rel", p.skeleton.minEdgeLengthRel},
               {"medially_centered", p.skeleton.mediallyCentered},

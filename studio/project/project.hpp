@@ -24,7 +24,9 @@
 ///     "stiffness_paint": {"skeleton": {"min_edge_length_rel": 0.002, "medially_centered": true},
 ///                         "base_weight": 1, "min_weight": 0.001, "max_weight": 1e6,
 ///                         "strokes": [{"center": [..], "radius": 0.02, "amplitude": 4,
-///                                      "scale": "peak" | "kernel"}]},   weights × region weights
+///                                      "scale": "peak" | "kernel",
+///                                      "mode": "add" | "subtract" | "mix" | "smooth",
+///                                      "target": 3 (mix only)}]},   weights × region weights
 ///     "embedded_in": "organ", "embedding_compliance": 0
 ///   }],
 ///   "surfaces": [{"name": "fascia", "from_boundary_of": "organ", "region": {"min": .., "max": ..},

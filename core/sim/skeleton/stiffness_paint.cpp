@@ -36,10 +36,20 @@ void validateParams(const PaintParams& p) {
         failParam(p.origin, "baseWeight", p.baseWeight, "must be finite and in [minWeight, maxWeight]");
 }
 
-/// Added weight for a node at distance v from the centre.
+/// The kernel factor k of a node at distance v from the centre (BrushMode).
+double kernelFactor(const BrushStroke& s, double v) {
+    if (s.scale == BrushScale::Peak) return poly6Kernel(v, s.radius) / poly6Kernel(0.0, s.radius);
+    return poly6Kernel(v, s.radius);
+}
+
+/// Added weight (Add, Subtract) or blend factor (Mix, Smooth) at distance v.
 double strokeIncrement(const BrushStroke& s, double v) {
-    if (s.scale == BrushScale::Peak) return s.amplitude * (poly6Kernel(v, s.radius) / poly6Kernel(0.0, s.radius));
-    return s.amplitude * poly6Kernel(v, s.radius);
+    const double k = s.amplitude * kernelFactor(s, v);
+    return s.mode == BrushMode::Subtract ? -k : k;
+}
+
+bool blends(BrushMode m) {
+    return m == BrushMode::Mix || m == BrushMode::Smooth;
 }
 
 } // namespace
@@ -53,6 +63,13 @@ void validateStroke(const BrushStroke& s, size_t index, const std::string& origi
         throw std::invalid_argument(p + "amplitude is " + std::to_string(s.amplitude) + " (must be finite)");
     if (s.scale != BrushScale::Peak && s.scale != BrushScale::Kernel)
         throw std::invalid_argument(p + "scale is not a BrushScale value");
+    if (s.mode != BrushMode::Add && s.mode != BrushMode::Subtract && !blends(s.mode))
+        throw std::invalid_argument(p + "mode is not a BrushMode value");
+    if (blends(s.mode) && s.amplitude < 0)
+        throw std::invalid_argument(p + "amplitude is " + std::to_string(s.amplitude) +
+                                    " (a mix or smooth strength must be >= 0)");
+    if (s.mode == BrushMode::Mix && !(std::isfinite(s.target) && s.target > 0))
+        throw std::invalid_argument(p + "target is " + std::to_string(s.target) + " (must be finite and > 0)");
     // The peak increment must be finite too (BrushScale::Kernel multiplies by up to 315/(64π h³)).
     if (!std::isfinite(strokeIncrement(s, 0.0)))
         throw std::invalid_argument(p + "amplitude × kernel at the centre is not finite");
@@ -60,7 +77,7 @@ void validateStroke(const BrushStroke& s, size_t index, const std::string& origi
 
 void applyBrushStroke(const std::vector<Vec3>& positions, const Skeleton& skeleton, const SkeletonNodeMap& map,
                       const BrushStroke& stroke, const PaintParams& params, std::vector<double>& weights,
-                      StiffnessPaintReport* report) {
+                      StiffnessPaintReport* report, const NodeNeighbours* neighbours) {
     validateParams(params);
     const size_t index = report ? report->strokeSelected.size() : 0;
     validateStroke(stroke, index, params.origin);
@@ -70,6 +87,9 @@ void applyBrushStroke(const std::vector<Vec3>& positions, const Skeleton& skelet
                                     std::to_string(weights.size()) + " weights, " + std::to_string(n) +
                                     " positions, a map of " + std::to_string(map.meshNodeCount) +
                                     " nodes: sizes must agree (and the map must come from this skeleton)");
+    if (stroke.mode == BrushMode::Smooth && (!neighbours || neighbours->nodeCount() != n))
+        throw std::invalid_argument(params.origin + ": stroke " + std::to_string(index) +
+                                    ": smoothing needs the neighbours of the mesh's " + std::to_string(n) + " nodes");
 
     // Selection through the skeleton: skeleton nodes strictly inside the brush select their Π_j.
     std::vector<int32_t> selected;
@@ -85,7 +105,21 @@ void applyBrushStroke(const std::vector<Vec3>& positions, const Skeleton& skelet
     for (size_t k = 0; k < selected.size(); ++k) {
         const int32_t i = selected[k];
         const double inc = strokeIncrement(stroke, (positions[i] - stroke.center).norm());
-        double w = weights[i] + inc;
+        double w = weights[i];
+        if (stroke.mode == BrushMode::Mix) {
+            w += std::min(1.0, inc) * (stroke.target - w);
+        } else if (stroke.mode == BrushMode::Smooth) {
+            // Jacobi: the neighbours' weights before this stroke (weights is written after the loop)
+            const int32_t b = neighbours->start[i], e = neighbours->start[i + 1];
+            if (e > b) {
+                double sum = 0;
+                for (int32_t q = b; q < e; ++q)
+                    sum += weights[neighbours->members[q]];
+                w += std::min(1.0, inc) * (sum / (e - b) - w);
+            }
+        } else {
+            w += inc;
+        }
         if (!std::isfinite(w))
             throw std::invalid_argument(params.origin + ": stroke " + std::to_string(index) + ": weight of node " +
                                         std::to_string(i) + " is not finite");
@@ -109,6 +143,29 @@ void applyBrushStroke(const std::vector<Vec3>& positions, const Skeleton& skelet
     }
 }
 
+NodeNeighbours nodeNeighbours(const TetMesh& mesh) {
+    // the six edges of every tet, each pair once
+    std::vector<std::pair<int32_t, int32_t>> pairs;
+    pairs.reserve(mesh.tetCount() * 12);
+    for (const Tet& t : mesh.tets())
+        for (int a = 0; a < 4; ++a)
+            for (int b = 0; b < 4; ++b)
+                if (a != b) pairs.emplace_back(t[a], t[b]);
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    const size_t n = mesh.vertexCount();
+    NodeNeighbours nb;
+    nb.start.assign(n + 1, 0);
+    for (const auto& [a, b] : pairs)
+        ++nb.start[a + 1];
+    for (size_t i = 0; i < n; ++i)
+        nb.start[i + 1] += nb.start[i];
+    nb.members.reserve(pairs.size());
+    for (const auto& pr : pairs)
+        nb.members.push_back(pr.second); // sorted by first: node order
+    return nb;
+}
+
 StiffnessPaintResult bakeStiffnessPaint(const TetMesh& mesh, const Skeleton& skeleton,
                                         const std::vector<BrushStroke>& strokes, const PaintParams& params) {
     validateParams(params);
@@ -117,8 +174,11 @@ StiffnessPaintResult bakeStiffnessPaint(const TetMesh& mesh, const Skeleton& ske
     StiffnessPaintResult r;
     r.map = mapNodesToSkeleton(mesh.positions(), skeleton, params.origin);
     r.weights.assign(mesh.vertexCount(), params.baseWeight);
+    const bool smooth =
+        std::any_of(strokes.begin(), strokes.end(), [](const BrushStroke& s) { return s.mode == BrushMode::Smooth; });
+    const NodeNeighbours nb = smooth ? nodeNeighbours(mesh) : NodeNeighbours{};
     for (const BrushStroke& s : strokes)
-        applyBrushStroke(mesh.positions(), skeleton, r.map, s, params, r.weights, &r.report);
+        applyBrushStroke(mesh.positions(), skeleton, r.map, s, params, r.weights, &r.report, smooth ? &nb : nullptr);
     r.report.fallbackNodes = r.map.fallbackNodes.size();
     const auto [lo, hi] = std::minmax_element(r.weights.begin(), r.weights.end());
     r.report.minWeight = *lo;

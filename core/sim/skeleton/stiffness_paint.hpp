@@ -30,6 +30,16 @@ enum class BrushScale {
     Kernel,
 };
 
+/// What a stroke does to the weight w of each selected node, with k its kernel factor at the node
+/// (BrushScale: Peak gives (1 − v²/h²)³ ∈ [0, 1] at distance v, Kernel gives W_poly6(v, h)):
+///   Add       w += a·k                               (eq. 4.26)
+///   Subtract  w −= a·k
+///   Mix       w += t·(target − w),  t = min(1, a·k)  (towards a target weight)
+///   Smooth    w += t·(w̄ − w),       t = min(1, a·k)  (w̄: mean weight of the node's mesh
+///                                                      neighbours before the stroke)
+/// Mix and Smooth take a >= 0 as the brush's strength; t never overshoots.
+enum class BrushMode { Add, Subtract, Mix, Smooth };
+
 /// Accepted brush radii, metres (keeps 1/h⁹ and the peak 315/(64π h³) finite).
 inline constexpr double kMinBrushRadius = 1e-6;
 inline constexpr double kMaxBrushRadius = 1e3;
@@ -40,7 +50,18 @@ struct BrushStroke {
     double radius = 0.01;       ///< h, metres, in [kMinBrushRadius, kMaxBrushRadius]
     double amplitude = 1.0;     ///< weight to add (see BrushScale); < 0 softens
     BrushScale scale = BrushScale::Peak;
+    BrushMode mode = BrushMode::Add;
+    double target = 1.0; ///< Mix: the weight approached (finite, > 0)
 };
+
+/// The mesh neighbours of every node (its edges), compressed: node i's are
+/// members[start[i] .. start[i+1]). What the Smooth mode averages over.
+struct NodeNeighbours {
+    std::vector<int32_t> start, members;
+    size_t nodeCount() const { return start.empty() ? 0 : start.size() - 1; }
+};
+/// From the tets' edges. O(#T log #T).
+NodeNeighbours nodeNeighbours(const TetMesh& mesh);
 
 struct PaintParams {
     double baseWeight = 1.0; ///< W before the first stroke, > 0
@@ -68,17 +89,19 @@ struct StiffnessPaintResult {
 
 /// Validates a stroke; throws std::invalid_argument "<origin>: stroke 2: radius is 0.000000 m
 /// (must be in [1e-6, 1e3] m)" naming the field and the rule: centre finite, radius in range,
-/// amplitude finite, amplitude × peak increment finite.
+/// amplitude finite (>= 0 for Mix and Smooth), amplitude × peak increment finite, a Mix target
+/// finite and > 0.
 void validateStroke(const BrushStroke& stroke, size_t index, const std::string& origin);
 
 /// Applies one stroke to `weights` (#n, one per node of `positions`) [A eq. 4.26]: the selected
-/// nodes are ∪ Π_j over skeleton nodes with |p_j − c| < h; each selected node i gets
-/// amplitude·kernel(|x_i − c|, h) (zero outside the sphere), then the selected nodes are clamped to
-/// [minWeight, maxWeight]. Updates the stroke figures of `report`. Throws std::invalid_argument
+/// nodes are ∪ Π_j over skeleton nodes with |p_j − c| < h; each selected node i changes by the
+/// stroke's mode (BrushMode) with k = kernel(|x_i − c|, h) (zero outside the sphere), then the
+/// selected nodes are clamped to [minWeight, maxWeight]. `neighbours` (of the same nodes) is
+/// needed by Smooth only. Updates the stroke figures of `report`. Throws std::invalid_argument
 /// on a bad stroke or parameters, or when a result is not finite (weights are then unchanged).
 void applyBrushStroke(const std::vector<Vec3>& positions, const Skeleton& skeleton, const SkeletonNodeMap& map,
                       const BrushStroke& stroke, const PaintParams& params, std::vector<double>& weights,
-                      StiffnessPaintReport* report = nullptr);
+                      StiffnessPaintReport* report = nullptr, const NodeNeighbours* neighbours = nullptr);
 
 /// Maps every node of `mesh` to the skeleton (mapNodesToSkeleton) and applies `strokes` in order to
 /// W = baseWeight. Throws std::invalid_argument naming the stroke/field on bad input.

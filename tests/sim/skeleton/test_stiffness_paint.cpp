@@ -260,3 +260,146 @@ TEST(StiffnessPaint, BadStrokesAndParametersAreRejected) {
     std::vector<double> w(3, 1.0);
     EXPECT_THROW(applyBrushStroke(b.mesh->positions(), b.skeleton, map, strokes[0], {}, w), std::invalid_argument);
 }
+
+namespace {
+
+/// The nodes a stroke selects through the skeleton (independently of applyBrushStroke).
+std::set<int32_t> selectedBy(const Bar& b, const SkeletonNodeMap& map, const BrushStroke& s) {
+    std::set<int32_t> out;
+    for (size_t j = 0; j < b.skeleton.nodes.size(); ++j)
+        if ((b.skeleton.nodes[j] - s.center).norm() < s.radius)
+            for (int32_t q = map.start[j]; q < map.start[j + 1]; ++q)
+                out.insert(map.members[q]);
+    return out;
+}
+
+/// Peak-normalised eq. 4.28: (1 − v²/h²)³, in long double.
+long double peakFactor(long double v, long double h) {
+    return referenceKernel(v, h) / referenceKernel(0.0L, h);
+}
+
+/// Neighbours straight from the tets (brute force), for checking nodeNeighbours.
+std::vector<std::set<int32_t>> bruteNeighbours(const TetMesh& m) {
+    std::vector<std::set<int32_t>> nb(m.vertexCount());
+    for (const Tet& t : m.tets())
+        for (int a = 0; a < 4; ++a)
+            for (int c = 0; c < 4; ++c)
+                if (a != c) nb[t[a]].insert(t[c]);
+    return nb;
+}
+
+} // namespace
+
+TEST(StiffnessPaint, SubtractIsAddOfTheNegatedAmplitude) {
+    Bar b = makeBar(10);
+    BrushStroke add{Vec3(0.05, 0.002, 0), 0.02, -0.7, BrushScale::Peak};
+    BrushStroke sub = add;
+    sub.amplitude = 0.7;
+    sub.mode = BrushMode::Subtract;
+    EXPECT_EQ(bakeStiffnessPaint(*b.mesh, b.skeleton, {add}).weights,
+              bakeStiffnessPaint(*b.mesh, b.skeleton, {sub}).weights);
+}
+
+TEST(StiffnessPaint, MixMovesTowardsTheTargetByTheKernelAndNeverOvershoots) {
+    Bar b = makeBar(10);
+    const auto& x = b.mesh->positions();
+    PaintParams p;
+    p.baseWeight = 2.0;
+    BrushStroke mix{Vec3(0.05, 0.001, -0.002), 0.025, 0.8, BrushScale::Peak, BrushMode::Mix, 5.0};
+    const StiffnessPaintResult r = bakeStiffnessPaint(*b.mesh, b.skeleton, {mix}, p);
+    const std::set<int32_t> sel = selectedBy(b, r.map, mix);
+    ASSERT_GT(sel.size(), 10u);
+    for (size_t i = 0; i < x.size(); ++i) {
+        long double expected = 2.0L;
+        if (sel.count(static_cast<int32_t>(i))) {
+            const long double t = std::min(1.0L, 0.8L * peakFactor((x[i] - mix.center).norm(), mix.radius));
+            expected += t * (5.0L - 2.0L);
+        }
+        EXPECT_NEAR(r.weights[i], static_cast<double>(expected), 1e-12 * static_cast<double>(expected)) << i;
+        EXPECT_LE(r.weights[i], 5.0) << "overshoot at node " << i;
+    }
+    // full strength at the centre reaches the target there; repeated strokes converge to it
+    mix.amplitude = 1.0;
+    const StiffnessPaintResult many = bakeStiffnessPaint(*b.mesh, b.skeleton, std::vector<BrushStroke>(200, mix), p);
+    for (int32_t i : sel) {
+        // n strokes of factor t leave (1 − t)ⁿ of the distance to the target
+        const long double t = peakFactor((x[i] - mix.center).norm(), mix.radius);
+        const long double expected = 5.0L - 3.0L * std::pow(1.0L - t, 200.0L);
+        EXPECT_NEAR(many.weights[i], static_cast<double>(expected), 1e-10) << i;
+        EXPECT_LE(many.weights[i], 5.0) << i;
+    }
+    const auto centre = std::min_element(x.begin(), x.end(), [&](const Vec3& a, const Vec3& c) {
+        return (a - mix.center).norm() < (c - mix.center).norm();
+    });
+    BrushStroke onNode = mix;
+    onNode.center = *centre;
+    EXPECT_EQ(bakeStiffnessPaint(*b.mesh, b.skeleton, {onNode}, p).weights[centre - x.begin()], 5.0)
+        << "one full-strength stroke reaches the target at its centre";
+}
+
+TEST(StiffnessPaint, SmoothBlendsTowardsTheNeighbourMeanOfTheWeightsBeforeTheStroke) {
+    Bar b = makeBar(10);
+    const auto& x = b.mesh->positions();
+    const NodeNeighbours nb = nodeNeighbours(*b.mesh);
+    const auto brute = bruteNeighbours(*b.mesh);
+    ASSERT_EQ(nb.nodeCount(), x.size());
+    for (size_t i = 0; i < x.size(); ++i)
+        ASSERT_EQ(std::set<int32_t>(nb.members.begin() + nb.start[i], nb.members.begin() + nb.start[i + 1]), brute[i])
+            << "neighbours of node " << i;
+    // a sharp bump, then one smoothing stroke over it
+    const BrushStroke bump{Vec3(0.05, 0, 0), 0.01, 6.0, BrushScale::Peak};
+    const BrushStroke smooth{Vec3(0.05, 0, 0), 0.03, 0.6, BrushScale::Peak, BrushMode::Smooth};
+    const StiffnessPaintResult before = bakeStiffnessPaint(*b.mesh, b.skeleton, {bump});
+    const StiffnessPaintResult after = bakeStiffnessPaint(*b.mesh, b.skeleton, {bump, smooth});
+    const std::set<int32_t> sel = selectedBy(b, after.map, smooth);
+    for (size_t i = 0; i < x.size(); ++i) {
+        long double expected = before.weights[i];
+        if (sel.count(static_cast<int32_t>(i))) {
+            long double mean = 0;
+            for (int32_t q : brute[i])
+                mean += before.weights[q];
+            mean /= brute[i].size();
+            const long double t = std::min(1.0L, 0.6L * peakFactor((x[i] - smooth.center).norm(), smooth.radius));
+            expected += t * (mean - expected);
+        }
+        EXPECT_NEAR(after.weights[i], static_cast<double>(expected), 1e-12 * static_cast<double>(expected)) << i;
+    }
+    // smoothing lowers the roughness Σ over edges of (w_a − w_b)²
+    auto roughness = [&](const std::vector<double>& w) {
+        double r = 0;
+        for (size_t i = 0; i < x.size(); ++i)
+            for (int32_t q : brute[i])
+                r += (w[i] - w[q]) * (w[i] - w[q]);
+        return r;
+    };
+    EXPECT_LT(roughness(after.weights), 0.8 * roughness(before.weights));
+    EXPECT_EQ(bakeStiffnessPaint(*b.mesh, b.skeleton, {bump, smooth}).weights, after.weights) << "repeatable";
+}
+
+TEST(StiffnessPaint, BadMixAndSmoothStrokesAreRefusedAndChangeNothing) {
+    BrushStroke s{Vec3(0.05, 0, 0), 0.02, 0.5, BrushScale::Peak, BrushMode::Mix, 0.0};
+    EXPECT_THAT(strokeError(s), HasSubstr("vessel: stroke 4: target is 0"));
+    s.target = NAN;
+    EXPECT_THAT(strokeError(s), HasSubstr("target is nan"));
+    s.target = 2;
+    s.amplitude = -0.1;
+    EXPECT_THAT(strokeError(s), HasSubstr("a mix or smooth strength must be >= 0"));
+    s.mode = BrushMode::Smooth;
+    EXPECT_THAT(strokeError(s), HasSubstr("a mix or smooth strength must be >= 0"));
+    s.mode = static_cast<BrushMode>(9);
+    s.amplitude = 1;
+    EXPECT_THAT(strokeError(s), HasSubstr("mode is not a BrushMode value"));
+    // smoothing without the mesh's neighbours: refused, weights as they were
+    Bar b = makeBar(8);
+    const SkeletonNodeMap map = mapNodesToSkeleton(*b.mesh, b.skeleton);
+    std::vector<double> w(b.mesh->vertexCount(), 1.5);
+    const auto w0 = w;
+    s.mode = BrushMode::Smooth;
+    try {
+        applyBrushStroke(b.mesh->positions(), b.skeleton, map, s, {}, w);
+        FAIL() << "no error";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_THAT(e.what(), HasSubstr("smoothing needs the neighbours"));
+    }
+    EXPECT_EQ(w, w0);
+}

@@ -226,6 +226,49 @@ TEST_F(FieldRules, PaintWeightsAreOrderedAtLoad) {
     EXPECT_EQ(loadError(doc.dump(1)), "accepted");
 }
 
+TEST_F(FieldRules, BrushModesRoundTripAndBadModesNameTheRule) {
+    json doc = copySample("rectum");
+    json& strokes = doc["bodies"][0]["stiffness_paint"]["strokes"];
+    const json first = strokes[0];
+    json sub = first, mix = first, smooth = first;
+    sub["mode"] = "subtract";
+    mix["mode"] = "mix";
+    mix["target"] = 3.5;
+    mix["amplitude"] = 0.5;
+    smooth["mode"] = "smooth";
+    smooth["amplitude"] = 0.25;
+    strokes.push_back(sub);
+    strokes.push_back(mix);
+    strokes.push_back(smooth);
+    ASSERT_EQ(loadError(doc.dump(1)), "accepted");
+    const studio::Project p = studio::loadProject(m_dir);
+    const auto& s = p.bodies[0].paint->strokes;
+    ASSERT_EQ(s.size(), strokes.size());
+    EXPECT_EQ(s[s.size() - 3].mode, sim::BrushMode::Subtract);
+    EXPECT_EQ(s[s.size() - 2].mode, sim::BrushMode::Mix);
+    EXPECT_EQ(s[s.size() - 2].target, 3.5);
+    EXPECT_EQ(s[s.size() - 1].mode, sim::BrushMode::Smooth);
+    // written and read back, the model is the same
+    const studio::Project again =
+        studio::loadProjectText(studio::projectJsonText(p), m_dir, (m_dir / "project.json").string());
+    EXPECT_EQ(studio::projectJsonText(again), studio::projectJsonText(p));
+    const std::string where = (m_dir / "project.json").string() + ": bodies[0].stiffness_paint.strokes[";
+    const std::string last = std::to_string(strokes.size() - 1);
+    json bad = doc;
+    bad["bodies"][0]["stiffness_paint"]["strokes"].back()["mode"] = "blur";
+    EXPECT_THAT(loadError(bad.dump(1)), StartsWith(where + last + "].mode: "));
+    bad = doc;
+    bad["bodies"][0]["stiffness_paint"]["strokes"].back()["target"] = 2;
+    EXPECT_EQ(loadError(bad.dump(1)), where + last + "].target: only a mix stroke has a target");
+    bad = doc;
+    bad["bodies"][0]["stiffness_paint"]["strokes"][strokes.size() - 2].erase("target");
+    EXPECT_EQ(loadError(bad.dump(1)),
+              where + std::to_string(strokes.size() - 2) + "].target: a mix stroke needs the weight it mixes towards");
+    bad = doc;
+    bad["bodies"][0]["stiffness_paint"]["strokes"].back()["amplitude"] = -1;
+    EXPECT_THAT(loadError(bad.dump(1)), HasSubstr("a mix or smooth strength must be >= 0"));
+}
+
 TEST_F(FieldRules, ProjectAndSceneShareTheRangeOfEverySharedField) {
     // A shared field refused in one file with a rule is refused in the other with the same rule.
     json doc = copySample("liver");
