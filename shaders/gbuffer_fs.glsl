@@ -9,6 +9,7 @@ in vec3 vRest;
 in float vThickness;
 in float vSamples;
 in float vHeat;
+in vec4 vOverlay;
 in vec4 vClip;
 in vec4 vPrevClip;
 in float vViewDepth;
@@ -51,6 +52,7 @@ void main() {
     diffuse = mix(diffuse, uGranularColour, uLayerWeights.y * granule);
     diffuse = mix(diffuse, uConnectiveColour, uLayerWeights.z * fibre);
     diffuse = mix(diffuse, uSubmucosaColour, uLayerWeights.w * vessel);
+    diffuse = mix(diffuse, vOverlay.rgb, clamp(vOverlay.a, 0.0, 1.0)); // authoring overlay
     float roughness = clamp(uRoughness + uGranularRoughness * (granule - 0.5), 0.04, 1.0);
 
     vec2 ndc = vClip.xy / vClip.w, prevNdc = vPrevClip.xy / vPrevClip.w;

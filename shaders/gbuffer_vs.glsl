@@ -1,11 +1,13 @@
 // G-buffer fill [A Fig. 7.4]: per-vertex world position (current and previous frame for velocity),
-// normal, rest position (pattern space), baked thickness, painted light samples and heat.
+// normal, rest position (pattern space), baked thickness, painted light samples, heat and the
+// authoring overlay (RGBA, blended over the diffuse colour by its alpha; zero when unused).
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aPrevPosition;
 layout(location = 2) in vec3 aNormal;
 layout(location = 3) in float aHeat;
 layout(location = 4) in vec4 aRestThickness;
 layout(location = 5) in float aSamples;
+layout(location = 6) in vec4 aOverlay;
 
 uniform mat4 uViewProj;
 uniform mat4 uPrevViewProj;
@@ -16,6 +18,7 @@ out vec3 vRest;
 out float vThickness;
 out float vSamples;
 out float vHeat;
+out vec4 vOverlay;
 out vec4 vClip;
 out vec4 vPrevClip;
 out float vViewDepth;
@@ -26,6 +29,7 @@ void main() {
     vThickness = aRestThickness.w;
     vSamples = aSamples;
     vHeat = aHeat;
+    vOverlay = aOverlay;
     vClip = uViewProj * vec4(aPosition, 1.0);
     vPrevClip = uPrevViewProj * vec4(aPrevPosition, 1.0);
     vViewDepth = -(uView * vec4(aPosition, 1.0)).z;

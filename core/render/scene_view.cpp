@@ -5,6 +5,7 @@
 #include "sim/scene/world.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -181,6 +182,18 @@ void SceneView::recomputeNormals(size_t i) {
     RenderMesh& m = m_meshes.at(i);
     computeNormals(m.positions, m.indices, m.normals);
     ++m.revision;
+}
+
+void SceneView::setOverlay(size_t i, const std::vector<float>& rgba) {
+    RenderMesh& m = m_meshes.at(i);
+    if (!rgba.empty() && rgba.size() != 4 * m.vertexCount())
+        throw std::invalid_argument("render::SceneView::setOverlay(): mesh " + m.name + " has " +
+                                    std::to_string(m.vertexCount()) + " vertices, got " + std::to_string(rgba.size()) +
+                                    " overlay values (4 per vertex, or none)");
+    m.overlay.resize(rgba.size());
+    for (size_t k = 0; k < rgba.size(); ++k)
+        m.overlay[k] = std::isfinite(rgba[k]) ? std::clamp(rgba[k], 0.0f, 1.0f) : 0.0f;
+    ++m.staticRevision;
 }
 
 void SceneView::setHeat(size_t i, const std::vector<float>& heat) {

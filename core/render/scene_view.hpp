@@ -31,6 +31,9 @@ struct RenderMesh {
     std::vector<float> rest;       ///< #V × 3, m: rest positions (procedural pattern space)
     std::vector<float> thickness;  ///< #V, m: baked thickness [A §6.3.1]
     std::vector<float> sampleMap;  ///< #V: painted light samples (0 unpainted, else 1, 4 or 8)
+    /// #V × 4 (RGBA) or empty: an authoring overlay (the studio's weight ramp) blended over the
+    /// diffuse colour by its alpha. Set with SceneView::setOverlay.
+    std::vector<float> overlay;
     // ---- per frame ------------------------------------------------------------------------
     std::vector<float> positions; ///< #V × 3, m, world frame
     std::vector<float> normals;   ///< #V × 3, unit, area-weighted vertex normals
@@ -42,7 +45,7 @@ struct RenderMesh {
     std::vector<uint8_t> faceMask;
     uint64_t faceMaskRevision = 0;
     uint64_t revision = 0;       ///< bumped whenever per-frame data change
-    uint64_t staticRevision = 0; ///< bumped when sampleMap or thickness change
+    uint64_t staticRevision = 0; ///< bumped when sampleMap, thickness or overlay change
     // ---- where the per-frame positions come from -----------------------------------------
     enum class Source : uint8_t { Static, Body, Surface } source = Source::Static;
     size_t sourceIndex = 0;            ///< body or surface index in sim::World
@@ -79,6 +82,9 @@ public:
     /// Sets the heat of every vertex of mesh `i` (values clamped to [0, 1]); `heat` has #V entries
     /// (std::invalid_argument otherwise).
     void setHeat(size_t i, const std::vector<float>& heat);
+    /// Sets the overlay of mesh `i`: empty (none) or #V × 4 values (RGBA, clamped to [0, 1]);
+    /// std::invalid_argument otherwise. Bumps staticRevision.
+    void setOverlay(size_t i, const std::vector<float>& rgba);
     /// Sets the face mask of mesh `i` [A §5.3.1]: empty (draw every face) or one flag per
     /// triangle (#F entries, std::invalid_argument otherwise), nonzero = drawn. Allocation-free
     /// after the first call. Bumps the mesh's faceMaskRevision only when the mask changed.

@@ -198,6 +198,36 @@ TEST_F(RenderGl, HeatTintGolden) {
     expectMatchesGolden("heat_tint", hot);
 }
 
+TEST_F(RenderGl, OverlayTintsTheSurfaceByItsAlphaAndNoneLeavesItAsItWas) {
+    const Image plain = render(settings);
+    RenderMesh& m = view.meshes()[0];
+    // left half (x < 0) fully blue, right half untouched (alpha 0)
+    std::vector<float> rgba(4 * m.vertexCount(), 0.0f);
+    for (size_t v = 0; v < m.vertexCount(); ++v)
+        if (m.positions[3 * v] < 0) {
+            rgba[4 * v + 2] = 1.0f;
+            rgba[4 * v + 3] = 1.0f;
+        }
+    view.setOverlay(0, rgba);
+    const Image tinted = render(settings);
+    EXPECT_GT(compareImages(plain, tinted).differing, size_t(kW * kH / 50));
+    // the painted side is bluer than it was, on average over the pixels that changed
+    double blueGain = 0, redGain = 0;
+    size_t changed = 0;
+    for (size_t p = 0; p + 3 < plain.rgba.size(); p += 4)
+        if (plain.rgba[p] != tinted.rgba[p] || plain.rgba[p + 2] != tinted.rgba[p + 2]) {
+            blueGain += double(tinted.rgba[p + 2]) - plain.rgba[p + 2];
+            redGain += double(tinted.rgba[p]) - plain.rgba[p];
+            ++changed;
+        }
+    ASSERT_GT(changed, 0u);
+    EXPECT_GT(blueGain / changed, 5.0);
+    EXPECT_LT(redGain / changed, 0.0);
+    // clearing the overlay gives the plain frame back exactly
+    view.setOverlay(0, {});
+    EXPECT_EQ(compareImages(plain, render(settings)).differing, 0u);
+}
+
 TEST_F(RenderGl, DeformingMeshesUpdateInPlace) {
     const Image first = render(settings);
     const BackendStats before = renderer->renderer().backend().stats();

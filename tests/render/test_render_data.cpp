@@ -121,4 +121,17 @@ TEST(SceneView, FollowsTheWorldWithoutReallocating) {
         ASSERT_FLOAT_EQ(m.positions[3 * v + 2], float(p.z()));
     }
     EXPECT_THROW(view.setHeat(0, {1.0f}), std::invalid_argument);
+    // the overlay: 4 values per vertex or none, clamped, non-finite dropped; a static change
+    EXPECT_THROW(view.setOverlay(0, {1.0f, 0.0f, 0.0f}), std::invalid_argument);
+    const uint64_t statics = m.staticRevision;
+    std::vector<float> rgba(4 * m.vertexCount(), 2.0f);
+    rgba[1] = NAN;
+    rgba[2] = -1.0f;
+    view.setOverlay(0, rgba);
+    EXPECT_EQ(m.overlay[0], 1.0f);
+    EXPECT_EQ(m.overlay[1], 0.0f);
+    EXPECT_EQ(m.overlay[2], 0.0f);
+    EXPECT_GT(m.staticRevision, statics);
+    view.setOverlay(0, {});
+    EXPECT_TRUE(m.overlay.empty());
 }

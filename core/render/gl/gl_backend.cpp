@@ -322,10 +322,11 @@ void GlBackend::createMesh(size_t index, const RenderMesh& mesh) {
     m_gl.VertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
     buffer(g.heat, v * 4, GL_DYNAMIC_DRAW);
     m_gl.VertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, 0, nullptr);
-    buffer(g.attributes, v * 20, GL_STATIC_DRAW); // rest xyz, thickness, samples
-    m_gl.VertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, 20, nullptr);
-    m_gl.VertexAttribPointer(5, 1, GL_FLOAT, GL_FALSE, 20, reinterpret_cast<const void*>(16));
-    for (GLuint a = 0; a < 6; ++a)
+    buffer(g.attributes, v * 36, GL_STATIC_DRAW); // rest xyz, thickness, samples, overlay rgba
+    m_gl.VertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, 36, nullptr);
+    m_gl.VertexAttribPointer(5, 1, GL_FLOAT, GL_FALSE, 36, reinterpret_cast<const void*>(16));
+    m_gl.VertexAttribPointer(6, 4, GL_FLOAT, GL_FALSE, 36, reinterpret_cast<const void*>(20));
+    for (GLuint a = 0; a < 7; ++a)
         m_gl.EnableVertexAttribArray(a);
     m_gl.GenBuffers(1, &g.index);
     m_gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.index);
@@ -366,13 +367,18 @@ void GlBackend::updateMesh(size_t index, const RenderMesh& mesh, bool staticChan
     write(g.normal, mesh.normals.data(), v * 12);
     write(g.heat, mesh.heat.data(), v * 4);
     if (staticChanged) {
-        std::vector<float> attr(v * 5);
+        const bool overlay = mesh.overlay.size() == 4 * v;
+        std::vector<float> attr(v * 9, 0.0f);
         for (size_t i = 0; i < v; ++i) {
-            attr[5 * i + 0] = mesh.rest[3 * i + 0];
-            attr[5 * i + 1] = mesh.rest[3 * i + 1];
-            attr[5 * i + 2] = mesh.rest[3 * i + 2];
-            attr[5 * i + 3] = mesh.thickness[i];
-            attr[5 * i + 4] = mesh.sampleMap[i];
+            float* a = &attr[9 * i];
+            a[0] = mesh.rest[3 * i + 0];
+            a[1] = mesh.rest[3 * i + 1];
+            a[2] = mesh.rest[3 * i + 2];
+            a[3] = mesh.thickness[i];
+            a[4] = mesh.sampleMap[i];
+            if (overlay)
+                for (int c = 0; c < 4; ++c)
+                    a[5 + c] = mesh.overlay[4 * i + c];
         }
         write(g.attributes, attr.data(), attr.size() * 4);
     }
