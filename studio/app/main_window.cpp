@@ -16,6 +16,7 @@
 #include <QComboBox>
 #include <QDateTime>
 #include <QDockWidget>
+#include <QDoubleSpinBox>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QFormLayout>
@@ -32,6 +33,7 @@
 #include <QStatusBar>
 #include <QTimer>
 #include <QToolBar>
+#include <QToolButton>
 #include <QTreeWidget>
 #include <QVBoxLayout>
 
@@ -235,6 +237,17 @@ void MainWindow::buildActions() {
 
     QMenu* view = menuBar()->addMenu(tr("&View"));
     add(view, tr("&Frame all"), QKeySequence(Qt::Key_F), [this] { m_viewport->frameAll(); });
+    m_paintAction = new QAction(tr("&Paint stiffness"), this);
+    m_paintAction->setObjectName("actionPaintStiffness");
+    m_paintAction->setCheckable(true);
+    m_paintAction->setShortcut(QKeySequence(Qt::Key_P));
+    m_paintAction->setToolTip(tr("Paint the selected body's stiffness weights through its curve skeleton "
+                                 "(left drag paints, Esc cancels a stroke, Alt + left drag orbits)"));
+    connect(m_paintAction, &QAction::toggled, this, [this](bool on) { setPainting(on); });
+    view->addAction(m_paintAction);
+    toolbar->addSeparator();
+    toolbar->addAction(m_paintAction);
+    buildPaintDock();
     m_widgetHostAction = view->addAction(tr("Compatibility viewport (QOpenGLWidget, slower)"));
     m_widgetHostAction->setObjectName("actionWidgetViewport");
     m_widgetHostAction->setCheckable(true);
@@ -268,6 +281,7 @@ void MainWindow::setViewportHost(ViewportHost host) {
             if (QString::fromStdString(bodies[i].scene.name) == name) selectBody(static_cast<int>(i));
     });
     connect(v, &Viewport::rendererFailed, this, &MainWindow::logLine);
+    connectPainting(v);
     setCentralWidget(v);
     m_viewport = v;
     // the new host shows what the old one did
@@ -278,8 +292,150 @@ void MainWindow::setViewportHost(ViewportHost host) {
         v->setPositions(s.bodies, s.surfaces);
     }
     v->setSelectedName(selected);
+    v->setPaintMode(painting());
+    showPaintWeights();
     QSettings().setValue("viewport/host", viewportHostText(host));
     if (m_widgetHostAction) m_widgetHostAction->setChecked(host == ViewportHost::Widget);
+}
+
+bool MainWindow::painting() const {
+    return m_paintAction && m_paintAction->isChecked();
+}
+
+void MainWindow::setPainting(bool on) {
+    if (m_paintAction && m_paintAction->isChecked() != on) {
+        m_paintAction->setChecked(on); // toggled() comes back here
+        return;
+    }
+    m_viewport->setPaintMode(on);
+    if (on) {
+        if (auto* d = findChild<QDockWidget*>("paintDock")) d->show();
+        retargetPainter();
+    }
+    showPaintWeights();
+}
+
+void MainWindow::retargetPainter() {
+    if (!painting()) return;
+    m_painter.setTarget(m_body, m_body >= 0 ? m_preview.bodyMesh(m_body) : nullptr);
+}
+
+void MainWindow::connectPainting(Viewport* v) {
+    // a dab only on the painted body's own surface
+    auto onBody = [this](const Viewport::SurfaceHit& hit) {
+        const auto& meshes = m_viewport->view().meshes();
+        return hit.mesh >= 0 && hit.mesh < static_cast<int>(meshes.size()) &&
+               meshes[hit.mesh].source == render::RenderMesh::Source::Body &&
+               static_cast<int>(meshes[hit.mesh].sourceIndex) == m_painter.body();
+    };
+    connect(v, &Viewport::paintPressed, this, [this, onBody](const Viewport::SurfaceHit& hit) {
+        if (onBody(hit)) m_painter.begin(hit.rest.cast<double>());
+    });
+    connect(v, &Viewport::paintMoved, this, [this, onBody](const Viewport::SurfaceHit& hit) {
+        if (onBody(hit)) m_painter.move(hit.rest.cast<double>());
+    });
+    connect(v, &Viewport::paintReleased, this, [this] {
+        const QString why = m_painter.end();
+        if (!why.isEmpty()) logLine(why);
+    });
+    connect(v, &Viewport::paintCancelled, this, [this] { m_painter.cancel(); });
+}
+
+void MainWindow::showPaintWeights() {
+    if (!m_viewport) return;
+    const auto& meshes = m_viewport->view().meshes();
+    const std::vector<double>& w = m_painter.weights();
+    const bool show = painting() && m_painter.ready() && !w.empty();
+    const double base = m_painter.params().baseWeight;
+    for (size_t k = 0; k < meshes.size(); ++k) {
+        const render::RenderMesh& m = meshes[k];
+        const bool painted =
+            show && m.source == render::RenderMesh::Source::Body && static_cast<int>(m.sourceIndex) == m_painter.body();
+        if (!painted) {
+            if (!m.overlay.empty()) m_viewport->setOverlay(static_cast<int>(k), {});
+            continue;
+        }
+        // ramp on log(w / base) over a factor of 4 either way: blue softer, red stiffer; an
+        // unpainted node (exactly the base weight) stays faint grey
+        std::vector<float> rgba(4 * m.vertexCount());
+        for (size_t v = 0; v < m.vertexCount(); ++v) {
+            const int32_t node = m.sourceVertex[v];
+            const double wv = node >= 0 && static_cast<size_t>(node) < w.size() ? w[node] : base;
+            const float t = static_cast<float>(std::clamp(std::log(wv / base) / std::log(4.0), -1.0, 1.0));
+            const Eigen::Vector3f grey(0.55f, 0.55f, 0.55f), hot(0.9f, 0.1f, 0.05f), cold(0.1f, 0.3f, 0.95f);
+            const Eigen::Vector3f c = t >= 0 ? grey + t * (hot - grey) : grey + (-t) * (cold - grey);
+            rgba[4 * v] = c.x();
+            rgba[4 * v + 1] = c.y();
+            rgba[4 * v + 2] = c.z();
+            rgba[4 * v + 3] = wv == base ? 0.35f : 0.9f;
+        }
+        m_viewport->setOverlay(static_cast<int>(k), rgba);
+    }
+}
+
+void MainWindow::buildPaintDock() {
+    auto* host = new QWidget(this);
+    auto* form = new QFormLayout(host);
+    auto* tool = new QToolButton(host);
+    tool->setDefaultAction(m_paintAction);
+    tool->setToolButtonStyle(Qt::ToolButtonTextOnly);
+    form->addRow(tool);
+    auto* mode = new QComboBox(host);
+    mode->setObjectName("paintMode");
+    mode->addItems({tr("Add"), tr("Subtract"), tr("Mix (towards target)"), tr("Smooth")});
+    form->addRow(tr("Mode"), mode);
+    auto spin = [&](const char* name, double lo, double hi, double value, int decimals, const QString& suffix) {
+        auto* s = new QDoubleSpinBox(host);
+        s->setObjectName(name);
+        s->setRange(lo, hi);
+        s->setDecimals(decimals);
+        s->setValue(value);
+        s->setSuffix(suffix);
+        return s;
+    };
+    auto* radius = spin("paintRadius", 0.5, 200, m_painter.brush.radius * 1000, 1, tr(" mm"));
+    auto* strength = spin("paintStrength", 0, 100, m_painter.brush.strength, 3, {});
+    auto* target = spin("paintTarget", 0.001, 1e6, m_painter.brush.target, 3, {});
+    radius->setToolTip(tr("The poly6 kernel's support h [A eq. 4.28]"));
+    strength->setToolTip(tr("Add / Subtract: weight added at the brush centre. Mix / Smooth: blend in [0, 1]"));
+    target->setToolTip(tr("Mix: the weight the stroke moves towards"));
+    form->addRow(tr("Radius"), radius);
+    form->addRow(tr("Strength"), strength);
+    form->addRow(tr("Target weight"), target);
+    auto sync = [this, mode, radius, strength, target] {
+        m_painter.brush.mode = static_cast<sim::BrushMode>(mode->currentIndex());
+        m_painter.brush.radius = radius->value() / 1000.0;
+        m_painter.brush.strength = strength->value();
+        m_painter.brush.target = target->value();
+        target->setEnabled(m_painter.brush.mode == sim::BrushMode::Mix);
+        if (m_painter.brush.mode == sim::BrushMode::Mix || m_painter.brush.mode == sim::BrushMode::Smooth)
+            strength->setMaximum(1.0);
+        else
+            strength->setMaximum(100.0);
+    };
+    connect(mode, &QComboBox::currentIndexChanged, this, sync);
+    for (QDoubleSpinBox* s : {radius, strength, target})
+        connect(s, &QDoubleSpinBox::valueChanged, this, sync);
+    sync();
+    auto* legend = new QLabel(tr("<span style='color:#1a4df2'>■</span> softer (¼× base) · "
+                                 "<span style='color:#8c8c8c'>■</span> base (faint: unpainted) · "
+                                 "<span style='color:#e61a0d'>■</span> stiffer (4× base)"),
+                              host);
+    legend->setObjectName("paintLegend");
+    legend->setWordWrap(true);
+    form->addRow(legend);
+    m_paintStatus = new QLabel(tr("Select a tet body to paint its stiffness."), host);
+    m_paintStatus->setObjectName("paintStatus");
+    m_paintStatus->setWordWrap(true);
+    form->addRow(m_paintStatus);
+    auto* d = new QDockWidget(tr("Stiffness paint"), this);
+    d->setObjectName("paintDock");
+    d->setWidget(host);
+    addDockWidget(Qt::LeftDockWidgetArea, d);
+    d->hide(); // shown when painting starts
+    connect(&m_painter, &StiffnessPainter::statusChanged, m_paintStatus, &QLabel::setText);
+    connect(&m_painter, &StiffnessPainter::weightsChanged, this, &MainWindow::showPaintWeights);
+    connect(&m_painter, &StiffnessPainter::readyChanged, this, &MainWindow::showPaintWeights);
 }
 
 QStringList MainWindow::recentProjects() const {
@@ -464,6 +620,7 @@ void MainWindow::selectBody(int index) {
     m_selKind = index >= 0 ? kBody : kGroup;
     m_selIndex = index;
     m_material->setBody(index);
+    retargetPainter();
     const bool ok = m_doc.hasProject() && index >= 0 && index < static_cast<int>(m_doc.project().bodies.size());
     m_viewport->setSelectedName(ok ? QString::fromStdString(m_doc.project().bodies[index].scene.name) : QString());
     // the tree follows
@@ -665,6 +822,8 @@ void MainWindow::pollPreview() {
     const bool newScene = s.scene != m_shownScene;
     if (newScene) {
         if (auto view = m_preview.sceneView()) m_viewport->setScene(*view);
+        retargetPainter(); // the same mesh keeps its skeleton; a new one is mapped again
+        showPaintWeights();
         m_shownScene = s.scene;
     }
     if (newScene || s.frames != m_shownFrames) {

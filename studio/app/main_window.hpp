@@ -7,6 +7,7 @@
 /// state; File → Export case… runs the export with progress and Cancel.
 #include "app/document.hpp"
 #include "app/preview.hpp"
+#include "app/stiffness_painter.hpp"
 #include "app/viewport.hpp"
 
 #include <QMainWindow>
@@ -62,6 +63,11 @@ public:
     /// menu; saved in the settings as "viewport/host").
     void setViewportHost(ViewportHost host);
     MaterialPanel* materialPanel() { return m_material; }
+    StiffnessPainter* painter() { return &m_painter; }
+    /// Paint stiffness mode (the toolbar's Paint action): the viewport's left drag paints the
+    /// selected body's node weights, shown as a colour ramp.
+    void setPainting(bool on);
+    bool painting() const;
     QTreeWidget* tree() { return m_tree; }
     PlotWidget* errorPlot() { return m_errorPlot; }
     PlotWidget* costPlot() { return m_costPlot; }
@@ -105,6 +111,14 @@ private:
     std::unique_ptr<ExportRunner> m_export;
     Viewport* m_viewport = nullptr;
     QAction* m_widgetHostAction = nullptr;
+    QAction* m_paintAction = nullptr;
+    StiffnessPainter m_painter{&m_doc};
+    QLabel* m_paintStatus = nullptr;
+    void buildPaintDock();
+    void connectPainting(Viewport* v);
+    /// The painter's weights as an overlay on the painted body's render meshes (none when off).
+    void showPaintWeights();
+    void retargetPainter();
     MaterialPanel* m_material = nullptr;
     QTreeWidget* m_tree = nullptr;
     QWidget* m_propertiesHost = nullptr;

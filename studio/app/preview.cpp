@@ -156,6 +156,11 @@ Preview::Snapshot Preview::snapshot() const {
     return m_snapshot;
 }
 
+std::shared_ptr<const sim::TetMesh> Preview::bodyMesh(int i) const {
+    std::lock_guard lock(m_mutex);
+    return i >= 0 && i < static_cast<int>(m_bodyMeshes.size()) ? m_bodyMeshes[i] : nullptr;
+}
+
 std::shared_ptr<const render::SceneView> Preview::sceneView() const {
     std::lock_guard lock(m_mutex);
     return m_view;
@@ -231,11 +236,16 @@ void Preview::run() {
                     if (!ok) throw std::runtime_error(tr("the preview keeps the last stable model").toStdString());
                     next = assembleWorld(b, origin);
                     auto view = std::make_shared<render::SceneView>(render::SceneView::fromWorld(*next));
+                    std::vector<std::shared_ptr<const sim::TetMesh>> meshes;
+                    if (job->mode == Mode::Scene)
+                        for (const auto& m : b.meshes)
+                            meshes.push_back(std::shared_ptr<const sim::TetMesh>(m->clone()));
                     built = std::move(b);
                     builtKey = key;
                     {
                         std::lock_guard lock(m_mutex);
                         m_view = std::move(view);
+                        m_bodyMeshes = std::move(meshes);
                         m_snapshot.scene = ++sceneRevision;
                         ++m_revision;
                     }

@@ -86,6 +86,9 @@ public:
     uint64_t revision() const { return m_revision; }
     /// The render meshes of the current world (rebuilt when Snapshot::scene changes).
     std::shared_ptr<const render::SceneView> sceneView() const;
+    /// The built tet mesh of body `i` of the scene shown (rest state; null: none yet). What the
+    /// stiffness painter maps its strokes through.
+    std::shared_ptr<const sim::TetMesh> bodyMesh(int i) const;
 
     /// A project holding the specimen of `material` (exposed for tests).
     static Project specimenProject(const Project& source, const sim::Material& material);
@@ -118,6 +121,7 @@ private:
     std::optional<Pending> m_pending;
     Snapshot m_snapshot;
     std::shared_ptr<const render::SceneView> m_view;
+    std::vector<std::shared_ptr<const sim::TetMesh>> m_bodyMeshes; ///< of the scene shown
     std::thread m_thread;
     std::thread m_sampler; ///< error sampling, at a lower priority than the preview
     std::mutex m_sampleMutex;

@@ -618,25 +618,67 @@ void Viewport::ray(QPoint pos, Eigen::Vector3f& origin, Eigen::Vector3f& dir) co
     dir = (b.head<3>() / b.w() - origin).normalized();
 }
 
-QString Viewport::pick(QPoint pos) const {
+std::optional<Viewport::SurfaceHit> Viewport::hitAt(QPoint pos) const {
     Eigen::Vector3f o, d;
     ray(pos, o, d);
     float best = INFINITY;
-    QString name;
-    for (const render::RenderMesh& m : m_view.meshes()) {
+    int bestMesh = -1;
+    size_t bestFace = 0;
+    const auto& meshes = m_view.meshes();
+    auto corner = [](const std::vector<float>& xyz, uint32_t v) {
+        return Eigen::Vector3f(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]);
+    };
+    for (size_t k = 0; k < meshes.size(); ++k) {
+        const render::RenderMesh& m = meshes[k];
         if (!m.visible) continue;
-        const auto P = [&](uint32_t v) {
-            return Eigen::Vector3f(m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]);
-        };
         for (size_t f = 0; f + 2 < m.indices.size(); f += 3) {
-            const float t = hitTriangle(o, d, P(m.indices[f]), P(m.indices[f + 1]), P(m.indices[f + 2]));
+            const float t = hitTriangle(o, d, corner(m.positions, m.indices[f]), corner(m.positions, m.indices[f + 1]),
+                                        corner(m.positions, m.indices[f + 2]));
             if (t < best) {
                 best = t;
-                name = QString::fromStdString(m.name);
+                bestMesh = static_cast<int>(k);
+                bestFace = f;
             }
         }
     }
-    return name;
+    if (bestMesh < 0) return std::nullopt;
+    const render::RenderMesh& m = meshes[bestMesh];
+    SurfaceHit hit;
+    hit.mesh = bestMesh;
+    hit.name = QString::fromStdString(m.name);
+    hit.world = o + best * d;
+    // barycentric coordinates on the drawn triangle carry the point to the rest surface
+    const Eigen::Vector3f a = corner(m.positions, m.indices[bestFace]),
+                          b = corner(m.positions, m.indices[bestFace + 1]),
+                          c = corner(m.positions, m.indices[bestFace + 2]);
+    const Eigen::Vector3f n = (b - a).cross(c - a);
+    const float area = n.squaredNorm();
+    float u = 1.0f / 3, v = 1.0f / 3;
+    if (area > 0) {
+        u = (c - b).cross(hit.world - b).dot(n) / area; // weight of a
+        v = (a - c).cross(hit.world - c).dot(n) / area; // weight of b
+    }
+    hit.rest = u * corner(m.rest, m.indices[bestFace]) + v * corner(m.rest, m.indices[bestFace + 1]) +
+               (1 - u - v) * corner(m.rest, m.indices[bestFace + 2]);
+    return hit;
+}
+
+QString Viewport::pick(QPoint pos) const {
+    const auto hit = hitAt(pos);
+    return hit ? hit->name : QString();
+}
+
+void Viewport::setOverlay(int mesh, const std::vector<float>& rgba) {
+    if (mesh < 0 || mesh >= static_cast<int>(m_view.meshes().size())) return;
+    m_view.setOverlay(static_cast<size_t>(mesh), rgba);
+    viewChanged();
+}
+
+void Viewport::setPaintMode(bool on) {
+    if (m_painting && !on) emit paintCancelled();
+    m_painting = false;
+    m_paintMode = on;
+    setCursor(on ? Qt::CrossCursor : Qt::ArrowCursor);
 }
 
 void Viewport::mousePressEvent(QMouseEvent* e) {
@@ -644,6 +686,13 @@ void Viewport::mousePressEvent(QMouseEvent* e) {
     m_pressPos = m_lastPos = e->position().toPoint();
     m_button = e->button();
     m_dragged = false;
+    if (m_paintMode && m_button == Qt::LeftButton && !(e->modifiers() & Qt::AltModifier)) {
+        if (const auto hit = hitAt(m_pressPos)) {
+            m_painting = true;
+            emit paintPressed(*hit);
+        }
+        return;
+    }
 }
 
 void Viewport::mouseMoveEvent(QMouseEvent* e) {
@@ -651,6 +700,10 @@ void Viewport::mouseMoveEvent(QMouseEvent* e) {
     const QPoint dp = p - m_lastPos;
     m_lastPos = p;
     if ((p - m_pressPos).manhattanLength() > 3) m_dragged = true;
+    if (m_painting) {
+        if (const auto hit = hitAt(p)) emit paintMoved(*hit); // off the surface: no dab
+        return;
+    }
     const bool pan =
         m_button == Qt::MiddleButton || (m_button == Qt::LeftButton && (e->modifiers() & Qt::ShiftModifier));
     if (pan) {
@@ -670,6 +723,16 @@ void Viewport::mouseMoveEvent(QMouseEvent* e) {
 }
 
 void Viewport::mouseReleaseEvent(QMouseEvent* e) {
+    if (m_painting && e->button() == Qt::LeftButton) {
+        m_painting = false;
+        m_button = Qt::NoButton;
+        emit paintReleased();
+        return;
+    }
+    if (m_paintMode && e->button() == Qt::LeftButton) {
+        m_button = Qt::NoButton;
+        return; // a click in paint mode paints, it does not select
+    }
     if (e->button() == Qt::LeftButton && !m_dragged) {
         const QString name = pick(e->position().toPoint());
         if (!name.isEmpty()) emit bodyClicked(name);
@@ -685,6 +748,11 @@ void Viewport::wheelEvent(QWheelEvent* e) {
 }
 
 void Viewport::keyPressEvent(QKeyEvent* e) {
+    if (e->key() == Qt::Key_Escape && m_painting) {
+        m_painting = false;
+        emit paintCancelled();
+        return;
+    }
     if (e->key() == Qt::Key_F || e->key() == Qt::Key_Home) {
         frameAll();
         return;

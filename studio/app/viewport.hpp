@@ -77,6 +77,24 @@ public:
     const QString& selectedName() const { return m_selected; }
     void frameAll();
 
+    /// Where the eye ray through `pos` meets a drawn mesh first.
+    struct SurfaceHit {
+        int mesh = -1;                                   ///< index into the view's meshes
+        QString name;                                    ///< the mesh's name
+        Eigen::Vector3f world = Eigen::Vector3f::Zero(); ///< on the drawn (deformed) surface
+        Eigen::Vector3f rest = Eigen::Vector3f::Zero();  ///< the same surface point at rest
+    };
+    std::optional<SurfaceHit> hitAt(QPoint pos) const;
+    /// The meshes drawn (the UI thread's copy).
+    const render::SceneView& view() const { return m_view; }
+    /// RGBA per vertex over mesh `mesh` (empty: none), as render::SceneView::setOverlay.
+    void setOverlay(int mesh, const std::vector<float>& rgba);
+    /// Paint mode: a left drag paints (paintPressed/Moved/Released at the surface under the
+    /// cursor, Esc: paintCancelled) instead of orbiting; Alt + left drag orbits, middle drag
+    /// pans, the wheel zooms.
+    void setPaintMode(bool on);
+    bool paintMode() const { return m_paintMode; }
+
     /// The mesh name under widget position `pos` (empty: none): what a click selects.
     QString pick(QPoint pos) const;
     /// One line: "llvmpipe (...)", or why the renderer could not be made (empty before the
@@ -97,6 +115,10 @@ public:
 
 signals:
     void bodyClicked(const QString& name);
+    void paintPressed(const Viewport::SurfaceHit& hit);
+    void paintMoved(const Viewport::SurfaceHit& hit);
+    void paintReleased();
+    void paintCancelled();
     void rendererFailed(const QString& why);
 
 protected:
@@ -133,6 +155,7 @@ private:
     Qt::MouseButton m_button = Qt::NoButton;
     bool m_dragged = false;
     bool m_framed = false;
+    bool m_paintMode = false, m_painting = false;
 };
 
 } // namespace viscera::studio

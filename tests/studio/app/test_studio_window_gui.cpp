@@ -8,16 +8,19 @@
 #include "app/main_window.hpp"
 #include "app/material_panel.hpp"
 #include "app/plot_widget.hpp"
+#include "app/stiffness_painter.hpp"
 #include "app/viewport.hpp"
 #include "case/case_package.hpp"
 #include "gui_test_support.hpp"
 #include "sim/material/laws.hpp"
 #include "sim/material/material_response.hpp"
+#include "sim/skeleton/skeleton.hpp"
 #include "sim/util/atomic_file.hpp"
 
 #include <QAction>
 #include <QComboBox>
 #include <QDockWidget>
+#include <QDoubleSpinBox>
 #include <QLabel>
 #include <QLineEdit>
 #include <QPlainTextEdit>
@@ -30,6 +33,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <set>
 
 namespace {
 
@@ -379,3 +383,128 @@ TEST_F(WindowFixture, CancelTakesEffectWithinHalfASecondAndLeavesNoFile) {
 }
 
 } // namespace
+
+namespace {
+
+/// eq. 4.28 (peak-normalised, sign-corrected as in sim/skeleton/stiffness_paint.hpp) in long double.
+long double peakKernel(long double v, long double h) {
+    if (v >= h) return 0.0L;
+    const long double d = (h - v) * (h + v) / (h * h);
+    return d * d * d;
+}
+
+/// The weights a list of Add / Mix dabs gives, evaluated independently of the painter: nodes
+/// selected through the skeleton (a skeleton node inside the brush selects its members), then
+/// the mode's update with the kernel above, then the clamp.
+std::vector<long double> referenceWeights(const sim::TetMesh& mesh, const sim::Skeleton& sk,
+                                          const std::vector<sim::BrushStroke>& dabs, const sim::PaintParams& p) {
+    const sim::SkeletonNodeMap map = sim::mapNodesToSkeleton(mesh, sk);
+    std::vector<long double> w(mesh.vertexCount(), p.baseWeight);
+    for (const sim::BrushStroke& s : dabs) {
+        std::set<int32_t> sel;
+        for (size_t j = 0; j < sk.nodes.size(); ++j)
+            if ((sk.nodes[j] - s.center).norm() < s.radius)
+                for (int32_t q = map.start[j]; q < map.start[j + 1]; ++q)
+                    sel.insert(map.members[q]);
+        for (int32_t i : sel) {
+            const long double k = s.amplitude * peakKernel((mesh.positions()[i] - s.center).norm(), s.radius);
+            if (s.mode == sim::BrushMode::Mix)
+                w[i] += std::min(1.0L, k) * (s.target - w[i]);
+            else
+                w[i] += s.mode == sim::BrushMode::Subtract ? -k : k;
+            w[i] = std::clamp<long double>(w[i], p.minWeight, p.maxWeight);
+        }
+    }
+    return w;
+}
+
+} // namespace
+
+TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWeights) {
+    open("tissue-slab");
+    ASSERT_TRUE(waitForPreview()) << w->verdictLabel()->text().toStdString();
+    w->selectBody(0);
+    studio::StiffnessPainter* painter = w->painter();
+    auto* action = w->findChild<QAction*>("actionPaintStiffness");
+    ASSERT_NE(action, nullptr);
+    action->trigger();
+    ASSERT_TRUE(w->painting());
+    ASSERT_TRUE(test::waitFor(
+        [&] {
+            painter->waitUntilReady();
+            return painter->ready();
+        },
+        60000))
+        << painter->status().toStdString();
+    const auto mesh = w->preview()->bodyMesh(0);
+    ASSERT_NE(mesh, nullptr);
+    const std::vector<double> before = painter->weights();
+    const std::string textBefore = studio::projectJsonText(w->document()->project());
+    const int undoBefore = w->document()->undoStack()->count();
+    studio::Viewport* v = w->viewport();
+    v->frameAll();
+    QTest::qWait(50);
+    const QPoint centre(v->width() / 2, v->height() / 2);
+    ASSERT_TRUE(v->hitAt(centre).has_value());
+
+    // Add stroke: a drag across the body's surface
+    // the brush selects through the skeleton: it must reach the slab's centre line from its surface
+    w->findChild<QDoubleSpinBox*>("paintRadius")->setValue(25.0);
+    w->findChild<QDoubleSpinBox*>("paintStrength")->setValue(1.5);
+    hostDrag(v, centre - QPoint(30, 0), centre + QPoint(30, 0));
+    ASSERT_EQ(w->document()->undoStack()->count(), undoBefore + 1) << "one stroke, one undo step";
+    const auto& strokes = w->document()->project().bodies[0].paint->strokes;
+    ASSERT_GT(strokes.size(), 2u) << "dabs along the drag";
+    for (const sim::BrushStroke& s : strokes) {
+        EXPECT_EQ(s.mode, sim::BrushMode::Add);
+        EXPECT_DOUBLE_EQ(s.radius, 0.025);
+        EXPECT_DOUBLE_EQ(s.amplitude, 1.5);
+    }
+    const std::vector<long double> ref =
+        referenceWeights(*mesh, painter->skeleton(), strokes, w->document()->project().bodies[0].paint->params);
+    ASSERT_EQ(painter->weights().size(), ref.size());
+    size_t raised = 0;
+    for (size_t i = 0; i < ref.size(); ++i) {
+        EXPECT_NEAR(painter->weights()[i], static_cast<double>(ref[i]), 1e-12 * static_cast<double>(ref[i])) << i;
+        raised += painter->weights()[i] > before[i];
+    }
+    EXPECT_GT(raised, 5u);
+    // the ramp is on the body: some overlay vertices are painted (alpha 0.9)
+    bool ramp = false;
+    for (const render::RenderMesh& m : v->view().meshes())
+        for (size_t k = 3; k < m.overlay.size(); k += 4)
+            ramp = ramp || m.overlay[k] > 0.5f;
+    EXPECT_TRUE(ramp);
+
+    // Esc during a stroke: nothing changes
+    const std::vector<double> painted = painter->weights();
+    const std::string textPainted = studio::projectJsonText(w->document()->project());
+    if (QWindow* win = v->canvasWindow()) {
+        QTest::mousePress(win, Qt::LeftButton, Qt::NoModifier, centre);
+        QTest::mouseMove(win, centre + QPoint(10, 5));
+        EXPECT_TRUE(painter->stroking());
+        QTest::keyClick(win, Qt::Key_Escape);
+        QTest::mouseRelease(win, Qt::LeftButton, Qt::NoModifier, centre + QPoint(10, 5));
+    }
+    EXPECT_FALSE(painter->stroking());
+    EXPECT_EQ(painter->weights(), painted);
+    EXPECT_EQ(studio::projectJsonText(w->document()->project()), textPainted);
+    EXPECT_EQ(w->document()->undoStack()->count(), undoBefore + 1);
+
+    // Mix stroke, then undo twice: the model and the weights are as before, bit for bit
+    w->findChild<QComboBox*>("paintMode")->setCurrentIndex(2);
+    w->findChild<QDoubleSpinBox*>("paintStrength")->setValue(0.5);
+    w->findChild<QDoubleSpinBox*>("paintTarget")->setValue(0.4);
+    hostDrag(v, centre + QPoint(0, -20), centre + QPoint(0, 20));
+    const auto& all = w->document()->project().bodies[0].paint->strokes;
+    const std::vector<long double> mixRef =
+        referenceWeights(*mesh, painter->skeleton(), all, w->document()->project().bodies[0].paint->params);
+    for (size_t i = 0; i < mixRef.size(); ++i)
+        EXPECT_NEAR(painter->weights()[i], static_cast<double>(mixRef[i]), 1e-12 * static_cast<double>(mixRef[i])) << i;
+    EXPECT_EQ(w->document()->undoStack()->count(), undoBefore + 2);
+    w->document()->undoStack()->undo();
+    EXPECT_EQ(painter->weights(), painted);
+    w->document()->undoStack()->undo();
+    EXPECT_EQ(studio::projectJsonText(w->document()->project()), textBefore);
+    EXPECT_EQ(painter->weights(), before);
+}
