@@ -351,6 +351,9 @@ void MainWindow::showPaintWeights() {
         const render::RenderMesh& m = meshes[k];
         const bool painted =
             show && m.source == render::RenderMesh::Source::Body && static_cast<int>(m.sourceIndex) == m_painter.body();
+        // while painting, the painted body alone is drawn (a fascia on it or a neighbour would
+        // hide its ramp and take the brush's hits)
+        m_viewport->setMeshVisible(static_cast<int>(k), painted || !show);
         if (!painted) {
             if (!m.overlay.empty()) m_viewport->setOverlay(static_cast<int>(k), {});
             continue;

@@ -674,6 +674,13 @@ void Viewport::setOverlay(int mesh, const std::vector<float>& rgba) {
     viewChanged();
 }
 
+void Viewport::setMeshVisible(int mesh, bool visible) {
+    if (mesh < 0 || mesh >= static_cast<int>(m_view.meshes().size())) return;
+    if (m_view.meshes()[mesh].visible == visible) return;
+    m_view.meshes()[mesh].visible = visible;
+    viewChanged();
+}
+
 void Viewport::setPaintMode(bool on) {
     if (m_painting && !on) emit paintCancelled();
     m_painting = false;

@@ -89,6 +89,8 @@ public:
     const render::SceneView& view() const { return m_view; }
     /// RGBA per vertex over mesh `mesh` (empty: none), as render::SceneView::setOverlay.
     void setOverlay(int mesh, const std::vector<float>& rgba);
+    /// Shows or hides mesh `mesh` (a hidden mesh is neither drawn nor hit).
+    void setMeshVisible(int mesh, bool visible);
     /// Paint mode: a left drag paints (paintPressed/Moved/Released at the surface under the
     /// cursor, Esc: paintCancelled) instead of orbiting; Alt + left drag orbits, middle drag
     /// pans, the wheel zooms.
