@@ -4,6 +4,8 @@
 // thread (weights + overlay), and the painted weights; writes the window from the screen and
 // the viewport. Run under a display (Xvfb):
 //   xvfb-run -a -s "-screen 0 1920x1200x24" ./build/bench/bench_studio_paint [out-dir] [project] [body] [radius-mm]
+//   [cut view|x|y|z]     (then also the cut-away view at the middle, facing the camera or
+//                         across an axis: paint_cut.png)
 #include "app/main_window.hpp"
 #include "app/stiffness_painter.hpp"
 #include "app/studio_app.hpp"
@@ -11,6 +13,8 @@
 
 #include <QAction>
 #include <QApplication>
+#include <QCheckBox>
+#include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QElapsedTimer>
 #include <QEventLoop>
@@ -106,6 +110,14 @@ int main(int argc, char** argv) {
     waitFor([] { return false; }, 1500);
     w.screen()->grabWindow(w.winId()).save(QString::fromStdString((out / "paint_main.png").string()));
     v->grabFramebuffer().save(QString::fromStdString((out / "paint_viewport.png").string()));
+    const std::string axis = argc > 5 ? argv[5] : "";
+    if (axis == "view" || axis == "x" || axis == "y" || axis == "z") {
+        w.findChild<QComboBox*>("paintCutAxis")->setCurrentIndex(axis == "view" ? 0 : 1 + (axis[0] - 'x'));
+        w.findChild<QCheckBox*>("paintCut")->setChecked(true);
+        waitFor([] { return false; }, 800);
+        w.screen()->grabWindow(w.winId()).save(QString::fromStdString((out / "paint_cut_main.png").string()));
+        v->grabFramebuffer().save(QString::fromStdString((out / "paint_cut.png").string()));
+    }
 
     const auto& wts = painter->weights();
     const double base = painter->params().baseWeight;

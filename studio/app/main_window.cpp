@@ -5,6 +5,7 @@
 #include "app/export_runner.hpp"
 #include "app/fit_dialog.hpp"
 #include "app/material_panel.hpp"
+#include "app/paint_overlays.hpp"
 #include "app/plot_widget.hpp"
 #include "app/viewport.hpp"
 #include "sim/material/material.hpp"
@@ -30,6 +31,7 @@
 #include <QProgressDialog>
 #include <QRegularExpression>
 #include <QSettings>
+#include <QSlider>
 #include <QStatusBar>
 #include <QTimer>
 #include <QToolBar>
@@ -347,6 +349,23 @@ void MainWindow::showPaintWeights() {
     const std::vector<double>& w = m_painter.weights();
     const bool show = painting() && m_painter.ready() && !w.empty();
     const double base = m_painter.params().baseWeight;
+    // the painted body at rest: the brush, the skeleton and the section share its frame
+    m_viewport->setRestPose(show ? m_painter.body() : -1);
+    std::optional<CutPlane> cut;
+    const auto mesh = show ? m_preview.bodyMesh(m_painter.body()) : nullptr;
+    if (show && mesh && m_paintCut && m_paintCut->isChecked()) {
+        // the normal: towards the camera (the section faces the viewer), or an axis
+        const int axis = m_paintCutAxis->currentIndex() - 1;
+        const render::Camera& cam = m_viewport->camera();
+        const Eigen::Vector3d n = axis < 0 ? Eigen::Vector3d((cam.position - cam.target).cast<double>().normalized())
+                                           : Eigen::Vector3d::Unit(axis);
+        double lo = INFINITY, hi = -INFINITY;
+        for (const sim::Vec3& p : mesh->positions()) {
+            lo = std::min(lo, n.dot(p));
+            hi = std::max(hi, n.dot(p));
+        }
+        cut = CutPlane{n, lo + (hi - lo) * m_paintCutAt->value() / 100.0};
+    }
     for (size_t k = 0; k < meshes.size(); ++k) {
         const render::RenderMesh& m = meshes[k];
         const bool painted =
@@ -354,26 +373,25 @@ void MainWindow::showPaintWeights() {
         // while painting, the painted body alone is drawn (a fascia on it or a neighbour would
         // hide its ramp and take the brush's hits)
         m_viewport->setMeshVisible(static_cast<int>(k), painted || !show);
+        m_viewport->setFaceMask(static_cast<int>(k), painted && cut ? cutAwayMask(m, *cut) : std::vector<uint8_t>{});
         if (!painted) {
             if (!m.overlay.empty()) m_viewport->setOverlay(static_cast<int>(k), {});
             continue;
         }
-        // ramp on log(w / base) over a factor of 4 either way: blue softer, red stiffer; an
-        // unpainted node (exactly the base weight) stays faint grey
         std::vector<float> rgba(4 * m.vertexCount());
         for (size_t v = 0; v < m.vertexCount(); ++v) {
             const int32_t node = m.sourceVertex[v];
-            const double wv = node >= 0 && static_cast<size_t>(node) < w.size() ? w[node] : base;
-            const float t = static_cast<float>(std::clamp(std::log(wv / base) / std::log(4.0), -1.0, 1.0));
-            const Eigen::Vector3f grey(0.55f, 0.55f, 0.55f), hot(0.9f, 0.1f, 0.05f), cold(0.1f, 0.3f, 0.95f);
-            const Eigen::Vector3f c = t >= 0 ? grey + t * (hot - grey) : grey + (-t) * (cold - grey);
-            rgba[4 * v] = c.x();
-            rgba[4 * v + 1] = c.y();
-            rgba[4 * v + 2] = c.z();
-            rgba[4 * v + 3] = wv == base ? 0.35f : 0.9f;
+            const Eigen::Vector4f c =
+                weightColour(node >= 0 && static_cast<size_t>(node) < w.size() ? w[node] : base, base);
+            std::copy(c.data(), c.data() + 4, rgba.begin() + 4 * v);
         }
         m_viewport->setOverlay(static_cast<int>(k), rgba);
     }
+    std::vector<render::RenderMesh> extra;
+    if (show && m_paintSkeleton && m_paintSkeleton->isChecked() && !m_painter.skeleton().nodes.empty())
+        extra.push_back(skeletonMesh(m_painter.skeleton(), 0.0006f, 0));
+    if (cut && mesh) extra.push_back(sliceMesh(*mesh, w, base, *cut, 0));
+    m_viewport->setAuthoringMeshes(std::move(extra));
 }
 
 void MainWindow::buildPaintDock() {
@@ -420,6 +438,28 @@ void MainWindow::buildPaintDock() {
     for (QDoubleSpinBox* s : {radius, strength, target})
         connect(s, &QDoubleSpinBox::valueChanged, this, sync);
     sync();
+    m_paintSkeleton = new QCheckBox(tr("Show the curve skeleton"), host);
+    m_paintSkeleton->setObjectName("paintSkeleton");
+    m_paintSkeleton->setChecked(true);
+    form->addRow(m_paintSkeleton);
+    m_paintCut = new QCheckBox(tr("Cut away (interior nodes on the section)"), host);
+    m_paintCut->setObjectName("paintCut");
+    m_paintCutAxis = new QComboBox(host);
+    m_paintCutAxis->setObjectName("paintCutAxis");
+    m_paintCutAxis->addItems({tr("facing the camera"), tr("x"), tr("y"), tr("z")});
+    m_paintCutAt = new QSlider(Qt::Horizontal, host);
+    m_paintCutAt->setObjectName("paintCutAt");
+    m_paintCutAt->setRange(0, 100);
+    m_paintCutAt->setValue(50);
+    auto* cutRow = new QHBoxLayout;
+    cutRow->addWidget(m_paintCutAxis);
+    cutRow->addWidget(m_paintCutAt, 1);
+    form->addRow(m_paintCut);
+    form->addRow(tr("Section"), cutRow);
+    connect(m_paintSkeleton, &QCheckBox::toggled, this, &MainWindow::showPaintWeights);
+    connect(m_paintCut, &QCheckBox::toggled, this, &MainWindow::showPaintWeights);
+    connect(m_paintCutAxis, &QComboBox::currentIndexChanged, this, &MainWindow::showPaintWeights);
+    connect(m_paintCutAt, &QSlider::valueChanged, this, &MainWindow::showPaintWeights);
     auto* legend = new QLabel(tr("<span style='color:#1a4df2'>■</span> softer (¼× base) · "
                                  "<span style='color:#8c8c8c'>■</span> base (faint: unpainted) · "
                                  "<span style='color:#e61a0d'>■</span> stiffer (4× base)"),

@@ -15,7 +15,9 @@
 
 #include <memory>
 
+class QCheckBox;
 class QComboBox;
+class QSlider;
 class QLabel;
 class QLineEdit;
 class QMenu;
@@ -114,6 +116,9 @@ private:
     QAction* m_paintAction = nullptr;
     StiffnessPainter m_painter{&m_doc};
     QLabel* m_paintStatus = nullptr;
+    QCheckBox *m_paintSkeleton = nullptr, *m_paintCut = nullptr;
+    QComboBox* m_paintCutAxis = nullptr;
+    QSlider* m_paintCutAt = nullptr;
     void buildPaintDock();
     void connectPainting(Viewport* v);
     /// The painter's weights as an overlay on the painted body's render meshes (none when off).

@@ -501,7 +501,12 @@ uint64_t Viewport::paintCount() const {
 }
 
 ViewportFrame Viewport::frame() {
-    if (!m_published) m_published = std::make_shared<const render::SceneView>(m_view);
+    if (!m_published) {
+        auto view = std::make_shared<render::SceneView>(m_view);
+        for (const render::RenderMesh& m : m_authoring)
+            view->meshes().push_back(m);
+        m_published = std::move(view);
+    }
     ViewportFrame f;
     f.view = m_published;
     f.sceneSerial = m_sceneSerial;
@@ -538,6 +543,7 @@ void Viewport::setScene(const render::SceneView& view) {
     for (const render::RenderMesh& m : m_view.meshes())
         m_baseMaterial.push_back(m.material);
     if (!m_framed) frameAll();
+    applyRestPose();
     setSelectedName(m_selected); // hands the new view over
 }
 
@@ -558,6 +564,7 @@ void Viewport::setPositions(const std::vector<std::vector<Eigen::Vector3d>>& bod
         if (m.source == render::RenderMesh::Source::Surface && m.sourceIndex < surfaces.size())
             src = &surfaces[m.sourceIndex];
         if (!src) continue;
+        if (m.source == render::RenderMesh::Source::Body && static_cast<int>(m.sourceIndex) == m_restBody) continue;
         bool ok = true;
         for (size_t v = 0; v < m.sourceVertex.size() && ok; ++v)
             ok = m.sourceVertex[v] >= 0 && static_cast<size_t>(m.sourceVertex[v]) < src->size() &&
@@ -678,6 +685,37 @@ void Viewport::setMeshVisible(int mesh, bool visible) {
     if (mesh < 0 || mesh >= static_cast<int>(m_view.meshes().size())) return;
     if (m_view.meshes()[mesh].visible == visible) return;
     m_view.meshes()[mesh].visible = visible;
+    viewChanged();
+}
+
+void Viewport::setFaceMask(int mesh, const std::vector<uint8_t>& mask) {
+    if (mesh < 0 || mesh >= static_cast<int>(m_view.meshes().size())) return;
+    if (m_view.meshes()[mesh].faceMask == mask) return;
+    m_view.setFaceMask(static_cast<size_t>(mesh), mask);
+    viewChanged();
+}
+
+void Viewport::applyRestPose() {
+    auto& meshes = m_view.meshes();
+    for (size_t i = 0; i < meshes.size(); ++i) {
+        render::RenderMesh& m = meshes[i];
+        if (m.source != render::RenderMesh::Source::Body || static_cast<int>(m.sourceIndex) != m_restBody) continue;
+        m.positions = m.rest;
+        m_view.recomputeNormals(i);
+    }
+}
+
+void Viewport::setRestPose(int body) {
+    if (body == m_restBody) return;
+    m_restBody = body;
+    applyRestPose(); // back to simulated positions with the preview's next frame
+    viewChanged();
+}
+
+void Viewport::setAuthoringMeshes(std::vector<render::RenderMesh> meshes) {
+    if (meshes.empty() && m_authoring.empty()) return;
+    m_authoring = std::move(meshes);
+    ++m_sceneSerial; // other meshes: new GPU buffers
     viewChanged();
 }
 

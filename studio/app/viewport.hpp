@@ -91,6 +91,14 @@ public:
     void setOverlay(int mesh, const std::vector<float>& rgba);
     /// Shows or hides mesh `mesh` (a hidden mesh is neither drawn nor hit).
     void setMeshVisible(int mesh, bool visible);
+    /// Face mask of mesh `mesh` (empty: every face), as render::SceneView::setFaceMask.
+    void setFaceMask(int mesh, const std::vector<uint8_t>& mask);
+    /// Draws body `body` at its rest positions (the preview's positions are not applied to it);
+    /// -1: every body as simulated.
+    void setRestPose(int body);
+    /// Static meshes drawn after the scene's (the paint tool's skeleton and section); not hit.
+    void setAuthoringMeshes(std::vector<render::RenderMesh> meshes);
+    size_t authoringMeshCount() const { return m_authoring.size(); }
     /// Paint mode: a left drag paints (paintPressed/Moved/Released at the surface under the
     /// cursor, Esc: paintCancelled) instead of orbiting; Alt + left drag orbits, middle drag
     /// pans, the wheel zooms.
@@ -158,6 +166,9 @@ private:
     bool m_dragged = false;
     bool m_framed = false;
     bool m_paintMode = false, m_painting = false;
+    int m_restBody = -1;
+    std::vector<render::RenderMesh> m_authoring;
+    void applyRestPose();
 };
 
 } // namespace viscera::studio

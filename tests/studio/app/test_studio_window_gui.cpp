@@ -451,7 +451,7 @@ TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWe
     // the brush selects through the skeleton: it must reach the slab's centre line from its surface
     w->findChild<QDoubleSpinBox*>("paintRadius")->setValue(25.0);
     w->findChild<QDoubleSpinBox*>("paintStrength")->setValue(1.5);
-    hostDrag(v, centre - QPoint(30, 0), centre + QPoint(30, 0));
+    hostDrag(v, centre - QPoint(90, 0), centre + QPoint(90, 0));
     ASSERT_EQ(w->document()->undoStack()->count(), undoBefore + 1) << "one stroke, one undo step";
     const auto& strokes = w->document()->project().bodies[0].paint->strokes;
     ASSERT_GT(strokes.size(), 2u) << "dabs along the drag";

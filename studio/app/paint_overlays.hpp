@@ -1,0 +1,41 @@
+#pragma once
+/// What the stiffness paint tool draws besides the body (studio viewport, authoring only):
+/// the weight ramp, the curve skeleton as thin tubes, and a cut through the body that shows the
+/// weights of interior nodes. All in the body's rest frame (the body is shown at rest while it
+/// is painted).
+#include "render/scene_view.hpp"
+#include "sim/mesh/tet_mesh.hpp"
+#include "sim/skeleton/skeleton.hpp"
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace viscera::studio {
+
+/// The ramp of weight w against the base weight, RGBA: log(w / base) over a factor of 4 either
+/// way, blue softer, grey at the base, red stiffer; alpha 0.9 for a painted node and 0.35 for
+/// one exactly at the base (unpainted).
+Eigen::Vector4f weightColour(double w, double base);
+
+/// The skeleton's edges as six-sided tubes of radius `radius` (m) and its nodes' positions,
+/// coloured by an opaque yellow overlay. Empty mesh for an empty skeleton.
+render::RenderMesh skeletonMesh(const sim::Skeleton& skeleton, float radius, uint32_t material);
+
+/// A plane {x : n·x = offset} with unit normal n; the side n·x > offset is cut away.
+struct CutPlane {
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitX();
+    double offset = 0;
+};
+
+/// The section of `mesh` by `plane`: one or two triangles per cut tet, each vertex on a tet edge
+/// with the weight interpolated linearly between the edge's nodes and coloured by weightColour.
+/// Faces towards the kept side's outside (−n), drawn double-sided.
+render::RenderMesh sliceMesh(const sim::TetMesh& mesh, const std::vector<double>& weights, double base,
+                             const CutPlane& plane, uint32_t material);
+
+/// Face mask of a body render mesh for the cut-away: faces whose rest centroid lies on the cut
+/// side are not drawn.
+std::vector<uint8_t> cutAwayMask(const render::RenderMesh& body, const CutPlane& plane);
+
+} // namespace viscera::studio
