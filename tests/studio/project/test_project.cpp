@@ -124,3 +124,60 @@ TEST_F(ProjectTest, ImportedSurfaceIsTetrahedralized) {
     EXPECT_NEAR(r.bodies[0].quality.totalVolume, 1e-6, 0.02e-6);
     EXPECT_GT(r.bodies[0].fixedNodes, 0u);
 }
+
+namespace {
+
+/// Painted weight mass of a body: ∫ (w − base) dV with w linear on each tet (its nodes' mean), m³.
+double paintedMass(const sim::TetMesh& mesh, const std::vector<double>& w, double base) {
+    double m = 0;
+    for (size_t t = 0; t < mesh.tetCount(); ++t) {
+        double mean = 0;
+        for (int32_t v : mesh.tets()[t])
+            mean += w[v];
+        m += std::abs(mesh.signedVolume(static_cast<int32_t>(t))) * (mean / 4 - base);
+    }
+    return m;
+}
+
+} // namespace
+
+TEST_F(ProjectTest, RemeshingABodyKeepsItsPaintedWeightMass) {
+    // Strokes are stored by position (mesh frame): a body meshed again with other parameters is
+    // painted by the same strokes. The rectum's fat (box) and vessel (hollow tube), each meshed
+    // two ways: at least 99 % of the painted mass is kept (and it does not grow by more than the
+    // discretization can explain, 5 %: the poly6 field is sampled at other nodes).
+    studio::Project p = studio::loadProject(std::filesystem::path(VISCERA_SOURCE_DIR) / "projects/rectum");
+    p.dir = m_dir;
+    ASSERT_GE(p.bodies.size(), 2u);
+    studio::BodyProject& fat = p.bodies[0];
+    studio::BodyProject& vessel = p.bodies[1];
+    ASSERT_TRUE(fat.paint.has_value());
+    fat.paint->strokes.push_back({sim::Vec3(0.02, -0.01, -0.004), 0.025, 3.0});
+    sim::BrushStroke mix{sim::Vec3(-0.03, 0.02, -0.004), 0.02, 0.7};
+    mix.mode = sim::BrushMode::Mix;
+    mix.target = 0.3;
+    fat.paint->strokes.push_back(mix);
+    const sim::Vec3 a = vessel.mesh.hollow.start, b = vessel.mesh.hollow.end;
+    vessel.paint = studio::StiffnessPaintProject{};
+    vessel.paint->strokes.push_back({0.5 * (a + b), 0.015, 4.0});
+    vessel.paint->strokes.push_back({0.8 * a + 0.2 * b, 0.01, -0.5});
+
+    studio::Project q = p;
+    q.bodies[0].mesh.box.cells = {48, 40, 3};
+    q.bodies[1].mesh.hollow.rings = 31;
+    q.bodies[1].mesh.hollow.slices = 16;
+    q.bodies[1].mesh.hollow.layers = 2;
+    const studio::BuiltScene A = studio::buildScene(p), B = studio::buildScene(q);
+    for (size_t i = 0; i < 2; ++i) {
+        SCOPED_TRACE(p.bodies[i].scene.name);
+        ASSERT_NE(A.meshes[i]->vertexCount(), B.meshes[i]->vertexCount()) << "meshed again, differently";
+        const double base = p.bodies[i].paint->params.baseWeight;
+        const double ma = paintedMass(*A.meshes[i], A.scene.bodies[i].nodeWeights, base);
+        const double mb = paintedMass(*B.meshes[i], B.scene.bodies[i].nodeWeights, base);
+        std::printf("%s: %zu -> %zu nodes, painted mass %.6g -> %.6g m^3 (%.2f %%)\n", p.bodies[i].scene.name.c_str(),
+                    A.meshes[i]->vertexCount(), B.meshes[i]->vertexCount(), ma, mb, 100.0 * mb / ma);
+        ASSERT_GT(ma, 0.0);
+        EXPECT_GE(mb / ma, 0.99);
+        EXPECT_LE(mb / ma, 1.05);
+    }
+}
