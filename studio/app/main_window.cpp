@@ -238,7 +238,7 @@ void MainWindow::buildActions() {
     toolbar->addAction(redo);
 
     QMenu* view = menuBar()->addMenu(tr("&View"));
-    add(view, tr("&Frame all"), QKeySequence(Qt::Key_F), [this] { m_viewport->frameAll(); });
+    m_frameAction = add(view, tr("&Frame all"), QKeySequence(Qt::Key_F), [this] { m_viewport->frameAll(); });
     m_paintAction = new QAction(tr("&Paint stiffness"), this);
     m_paintAction->setObjectName("actionPaintStiffness");
     m_paintAction->setCheckable(true);
@@ -310,6 +310,8 @@ void MainWindow::setPainting(bool on) {
         return;
     }
     m_viewport->setPaintMode(on);
+    // in paint mode F and Shift+F size the brush (the viewport's own keys); Home still frames
+    m_frameAction->setShortcut(on ? QKeySequence(Qt::Key_Home) : QKeySequence(Qt::Key_F));
     if (on) {
         if (auto* d = findChild<QDockWidget*>("paintDock")) d->show();
         retargetPainter();
@@ -341,6 +343,25 @@ void MainWindow::connectPainting(Viewport* v) {
         if (!why.isEmpty()) logLine(why);
     });
     connect(v, &Viewport::paintCancelled, this, [this] { m_painter.cancel(); });
+    connect(v, &Viewport::brushAdjusted, this, [this](bool strength, double dx, bool done) {
+        // a drag to the right grows the brush: ×2 per 200 px for the radius, +1 (or +0.2 for a
+        // blend) per 100 px for the strength; Esc restores (done with dx 0)
+        auto* radius = findChild<QDoubleSpinBox*>("paintRadius");
+        auto* amount = findChild<QDoubleSpinBox*>("paintStrength");
+        if (!m_adjustStarted) {
+            m_adjustRadius = radius->value();
+            m_adjustStrength = amount->value();
+            m_adjustStarted = true;
+        }
+        if (strength) {
+            const bool blend =
+                m_painter.brush.mode == sim::BrushMode::Mix || m_painter.brush.mode == sim::BrushMode::Smooth;
+            amount->setValue(m_adjustStrength + dx / 100.0 * (blend ? 0.2 : 1.0));
+        } else {
+            radius->setValue(m_adjustRadius * std::pow(2.0, dx / 200.0));
+        }
+        if (done) m_adjustStarted = false;
+    });
 }
 
 void MainWindow::showPaintWeights() {

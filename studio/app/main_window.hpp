@@ -114,6 +114,9 @@ private:
     Viewport* m_viewport = nullptr;
     QAction* m_widgetHostAction = nullptr;
     QAction* m_paintAction = nullptr;
+    QAction* m_frameAction = nullptr;
+    bool m_adjustStarted = false;
+    double m_adjustRadius = 0, m_adjustStrength = 0;
     StiffnessPainter m_painter{&m_doc};
     QLabel* m_paintStatus = nullptr;
     QCheckBox *m_paintSkeleton = nullptr, *m_paintCut = nullptr;

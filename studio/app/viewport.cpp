@@ -719,6 +719,11 @@ void Viewport::setAuthoringMeshes(std::vector<render::RenderMesh> meshes) {
     viewChanged();
 }
 
+void Viewport::trackMouse(bool on) {
+    setMouseTracking(on); // moves without a button reach the viewport (a window host sends all)
+    if (QWidget* w = canvasWidget()) w->setMouseTracking(on);
+}
+
 void Viewport::setPaintMode(bool on) {
     if (m_painting && !on) emit paintCancelled();
     m_painting = false;
@@ -728,6 +733,12 @@ void Viewport::setPaintMode(bool on) {
 
 void Viewport::mousePressEvent(QMouseEvent* e) {
     setFocus(Qt::MouseFocusReason);
+    if (m_adjust != Adjust::None) { // the click sets the brush size or strength
+        emit brushAdjusted(m_adjust == Adjust::Strength, e->position().x() - m_adjustFrom.x(), true);
+        m_adjust = Adjust::None;
+        trackMouse(false);
+        return;
+    }
     m_pressPos = m_lastPos = e->position().toPoint();
     m_button = e->button();
     m_dragged = false;
@@ -744,6 +755,10 @@ void Viewport::mouseMoveEvent(QMouseEvent* e) {
     const QPoint p = e->position().toPoint();
     const QPoint dp = p - m_lastPos;
     m_lastPos = p;
+    if (m_adjust != Adjust::None) {
+        emit brushAdjusted(m_adjust == Adjust::Strength, p.x() - m_adjustFrom.x(), false);
+        return;
+    }
     if ((p - m_pressPos).manhattanLength() > 3) m_dragged = true;
     if (m_painting) {
         if (const auto hit = hitAt(p)) emit paintMoved(*hit); // off the surface: no dab
@@ -793,6 +808,19 @@ void Viewport::wheelEvent(QWheelEvent* e) {
 }
 
 void Viewport::keyPressEvent(QKeyEvent* e) {
+    if (m_paintMode && e->key() == Qt::Key_F && !m_painting) {
+        m_adjust = e->modifiers() & Qt::ShiftModifier ? Adjust::Strength : Adjust::Radius;
+        m_adjustFrom = m_lastPos; // the cursor's last position over the viewport
+        trackMouse(true);
+        emit brushAdjusted(m_adjust == Adjust::Strength, 0, false);
+        return;
+    }
+    if (e->key() == Qt::Key_Escape && m_adjust != Adjust::None) {
+        emit brushAdjusted(m_adjust == Adjust::Strength, 0, true);
+        m_adjust = Adjust::None;
+        trackMouse(false);
+        return;
+    }
     if (e->key() == Qt::Key_Escape && m_painting) {
         m_painting = false;
         emit paintCancelled();

@@ -129,6 +129,9 @@ signals:
     void paintMoved(const Viewport::SurfaceHit& hit);
     void paintReleased();
     void paintCancelled();
+    /// Paint mode, F (radius) or Shift+F (strength) then a mouse move: `dx` pixels moved right
+    /// since the key; `done` on the click that sets it (Esc: done with dx 0, the value restored).
+    void brushAdjusted(bool strength, double dx, bool done);
     void rendererFailed(const QString& why);
 
 protected:
@@ -167,8 +170,11 @@ private:
     bool m_framed = false;
     bool m_paintMode = false, m_painting = false;
     int m_restBody = -1;
+    enum class Adjust { None, Radius, Strength } m_adjust = Adjust::None;
+    QPoint m_adjustFrom;
     std::vector<render::RenderMesh> m_authoring;
     void applyRestPose();
+    void trackMouse(bool on);
 };
 
 } // namespace viscera::studio

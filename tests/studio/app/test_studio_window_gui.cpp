@@ -491,6 +491,27 @@ TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWe
     EXPECT_EQ(studio::projectJsonText(w->document()->project()), textPainted);
     EXPECT_EQ(w->document()->undoStack()->count(), undoBefore + 1);
 
+    // F then a move sizes the brush (×2 per 200 px), the click sets it; Shift+F, Esc restores
+    if (QWindow* win = v->canvasWindow()) {
+        auto* radius = w->findChild<QDoubleSpinBox*>("paintRadius");
+        QTest::mouseMove(win, centre);
+        QTest::keyClick(win, Qt::Key_F);
+        QTest::mouseMove(win, centre + QPoint(200, 0));
+        EXPECT_NEAR(radius->value(), 50.0, 0.05);
+        QTest::mouseClick(win, Qt::LeftButton, Qt::NoModifier, centre + QPoint(200, 0));
+        EXPECT_NEAR(radius->value(), 50.0, 0.05);
+        EXPECT_FALSE(painter->stroking()) << "the click sets the size, it does not paint";
+        EXPECT_EQ(w->document()->undoStack()->count(), undoBefore + 1);
+        auto* amount = w->findChild<QDoubleSpinBox*>("paintStrength");
+        const double s0 = amount->value();
+        QTest::keyClick(win, Qt::Key_F, Qt::ShiftModifier);
+        QTest::mouseMove(win, centre + QPoint(300, 0));
+        EXPECT_NEAR(amount->value(), s0 + 1.0, 1e-3);
+        QTest::keyClick(win, Qt::Key_Escape);
+        EXPECT_NEAR(amount->value(), s0, 1e-9);
+        radius->setValue(25.0);
+    }
+
     // Mix stroke, then undo twice: the model and the weights are as before, bit for bit
     w->findChild<QComboBox*>("paintMode")->setCurrentIndex(2);
     w->findChild<QDoubleSpinBox*>("paintStrength")->setValue(0.5);
