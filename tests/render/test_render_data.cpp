@@ -1,6 +1,7 @@
 // Renderer data without GL: PNG round trip, image comparison, thickness bake by ray casting
 // [A §6.3.1], SceneView built from and updated by a simulated World.
 #include "render/image.hpp"
+#include "render/sample_map.hpp"
 #include "render/scene_view.hpp"
 #include "render/thickness_bake.hpp"
 #include "sim/mesh/generators.hpp"
@@ -134,4 +135,59 @@ TEST(SceneView, FollowsTheWorldWithoutReallocating) {
     EXPECT_GT(m.staticRevision, statics);
     view.setOverlay(0, {});
     EXPECT_TRUE(m.overlay.empty());
+}
+
+TEST(SampleMap, ConnectedFillStopsAtSharpEdgesAndUvBordersAndAreasAddUp) {
+    SceneView view;
+    const uint32_t material = view.addMaterial(TissueMaterial{});
+    const size_t i =
+        view.addMesh("box", sim::makeBoxSurface(sim::Vec3(0, 0, 0), sim::Vec3(0.04, 0.02, 0.01)), material);
+    RenderMesh& m = view.meshes()[i];
+    auto normal = [&](size_t f) {
+        auto p = [&](int k) {
+            const uint32_t v = m.indices[3 * f + k];
+            return Eigen::Vector3d(m.rest[3 * v], m.rest[3 * v + 1], m.rest[3 * v + 2]);
+        };
+        return Eigen::Vector3d((p(1) - p(0)).cross(p(2) - p(0)).normalized());
+    };
+    const double total = 2 * (0.04 * 0.02 + 0.04 * 0.01 + 0.02 * 0.01);
+    const auto none = sampleClassAreas(m);
+    EXPECT_NEAR(none[0], total, 1e-6 * total); // rest positions are floats
+    // a 40° fill from face 0 reaches exactly the faces of its side (the box's edges are 90°)
+    const uint64_t statics = m.staticRevision;
+    const size_t reached = fillSampleClass(m, 0, 8, 40.0f);
+    size_t sameSide = 0;
+    for (size_t f = 0; f < m.triangleCount(); ++f)
+        sameSide += normal(f).dot(normal(0)) > 0.999;
+    EXPECT_EQ(reached, sameSide);
+    EXPECT_GT(m.staticRevision, statics);
+    for (size_t f = 0; f < m.triangleCount(); ++f) {
+        const bool onSide = normal(f).dot(normal(0)) > 0.999;
+        for (int k = 0; k < 3 && onSide; ++k)
+            EXPECT_EQ(m.sampleMap[m.indices[3 * f + k]], 8.0f);
+    }
+    auto areas = sampleClassAreas(m);
+    EXPECT_NEAR(areas[0] + areas[1] + areas[2] + areas[3], total, 1e-6 * total); // rest positions are floats
+    EXPECT_GT(areas[3], 0.0);
+    // 180°: everything; then erase with 0
+    EXPECT_EQ(fillSampleClass(m, 0, 4, 180.0f), m.triangleCount());
+    EXPECT_NEAR(sampleClassAreas(m)[2], total, 1e-6 * total); // rest positions are floats
+    // a UV border: two islands split by x; the fill stays in the seed's island
+    std::vector<int32_t> island(m.triangleCount());
+    for (size_t f = 0; f < m.triangleCount(); ++f) {
+        double cx = 0;
+        for (int k = 0; k < 3; ++k)
+            cx += m.rest[3 * m.indices[3 * f + k]];
+        island[f] = cx / 3 < 0.02 ? 0 : 1;
+    }
+    const size_t seedIsland0 = std::find(island.begin(), island.end(), 0) - island.begin();
+    const size_t inIsland = fillSampleClass(m, seedIsland0, 1, 180.0f, island);
+    EXPECT_EQ(inIsland, static_cast<size_t>(std::count(island.begin(), island.end(), 0)));
+    // bad input: named, nothing changed
+    const auto before = m.sampleMap;
+    EXPECT_THROW(fillSampleClass(m, 0, 3, 40.0f), std::invalid_argument);
+    EXPECT_THROW(fillSampleClass(m, m.triangleCount(), 8, 40.0f), std::invalid_argument);
+    EXPECT_THROW(fillSampleClass(m, 0, 8, NAN), std::invalid_argument);
+    EXPECT_THROW(fillSampleClass(m, 0, 8, 40.0f, {1, 2}), std::invalid_argument);
+    EXPECT_EQ(m.sampleMap, before);
 }
