@@ -17,12 +17,15 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// The project text with every material replaced by the default one: equal keys mean that two
-/// models differ in their materials at most, so the built meshes can be kept.
+/// The project text with every material replaced by the default one and no paint strokes:
+/// equal keys mean that two models differ in their materials and strokes at most, so the built
+/// meshes (and the skeletons the strokes go through) can be kept.
 std::string structureKey(const Project& p, Preview::Mode mode, int body) {
     Project q = p;
-    for (BodyProject& b : q.bodies)
+    for (BodyProject& b : q.bodies) {
         b.scene.material = sim::Material{};
+        if (b.paint) b.paint->strokes.clear();
+    }
     return projectJsonText(q) + (mode == Preview::Mode::Specimen ? "#specimen" : "#scene");
 }
 
@@ -255,18 +258,30 @@ void Preview::run() {
                 } else {
                     BuiltScene& b = *built;
                     std::vector<sim::Material> old;
-                    for (size_t i = 0; i < b.scene.bodies.size(); ++i) {
-                        old.push_back(b.scene.bodies[i].material);
-                        b.scene.bodies[i].material = project.bodies[i].scene.material;
-                    }
+                    std::vector<std::vector<double>> oldWeights;
+                    auto restore = [&] {
+                        for (size_t i = 0; i < old.size(); ++i) {
+                            b.scene.bodies[i].material = old[i];
+                            b.scene.bodies[i].nodeWeights = oldWeights[i];
+                        }
+                    };
                     bool ok = true;
                     QString verdict;
                     try {
+                        for (size_t i = 0; i < b.scene.bodies.size(); ++i) {
+                            old.push_back(b.scene.bodies[i].material);
+                            oldWeights.push_back(b.scene.bodies[i].nodeWeights);
+                            b.scene.bodies[i].material = project.bodies[i].scene.material;
+                            // painted bodies: their strokes again, through the skeleton already made
+                            if (project.bodies[i].paint && i < b.skeletons.size())
+                                b.scene.bodies[i].nodeWeights =
+                                    bodyNodeWeights(project.bodies[i], *b.meshes[i], b.skeletons[i], origin,
+                                                    "bodies[" + std::to_string(i) + "]");
+                        }
                         verdict = stabilityVerdict(b, ok);
                         if (ok) next = assembleWorld(b, origin);
                     } catch (...) {
-                        for (size_t i = 0; i < old.size(); ++i)
-                            b.scene.bodies[i].material = old[i];
+                        restore();
                         throw;
                     }
                     publishStatus([&](Snapshot& s) {
@@ -274,8 +289,7 @@ void Preview::run() {
                         s.verdictOk = ok;
                     });
                     if (!ok) {
-                        for (size_t i = 0; i < old.size(); ++i)
-                            b.scene.bodies[i].material = old[i];
+                        restore();
                         throw std::runtime_error(tr("the preview keeps the last stable material").toStdString());
                     }
                     if (world && world->bodyCount() == next->bodyCount() &&

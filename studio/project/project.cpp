@@ -598,6 +598,38 @@ struct StageCounter {
     }
 };
 
+} // namespace
+
+std::vector<double> bodyNodeWeights(const BodyProject& b, sim::TetMesh& mesh, std::optional<sim::Skeleton>& skeleton,
+                                    const std::string& origin, const std::string& field) {
+    const auto& pos = mesh.positions();
+    std::vector<double> w;
+    if (!b.stiffnessRegions.empty()) {
+        w.assign(pos.size(), 1.0);
+        for (size_t v = 0; v < pos.size(); ++v)
+            for (const StiffnessRegion& r : b.stiffnessRegions)
+                if (inBox(pos[v], r.min, r.max)) w[v] = r.weight;
+    }
+    if (!b.paint) return w;
+    sim::StiffnessPaintResult paint;
+    try {
+        if (!skeleton) {
+            bake::SkeletonParams skp = b.paint->skeleton;
+            skp.label = origin + ": " + field + ".stiffness_paint.skeleton";
+            skeleton = bake::extractSkeleton(mesh, skp).skeleton;
+        }
+        paint = sim::bakeStiffnessPaint(mesh, *skeleton, b.paint->strokes, b.paint->params);
+    } catch (const std::invalid_argument& e) {
+        throw InputError(origin + ": " + field + ".stiffness_paint: " + e.what());
+    }
+    if (w.empty()) return paint.weights;
+    for (size_t v = 0; v < pos.size(); ++v)
+        w[v] *= paint.weights[v];
+    return w;
+}
+
+namespace {
+
 BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
     const std::string origin = (project.dir / "project.json").string();
     BuiltScene built;
@@ -638,31 +670,14 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
             if (desc.fixedNodes.empty())
                 throw InputError(origin + ": " + field + ".fixed: the box contains no mesh node");
         }
-        if (!b.stiffnessRegions.empty()) {
-            desc.nodeWeights.assign(pos.size(), 1.0);
-            for (size_t v = 0; v < pos.size(); ++v)
-                for (const StiffnessRegion& r : b.stiffnessRegions)
-                    if (inBox(pos[v], r.min, r.max)) desc.nodeWeights[v] = r.weight;
-        }
+        if (b.paint) stage("skeleton and stiffness paint of '" + name + "'");
+        std::optional<sim::Skeleton> skeleton;
+        desc.nodeWeights = bodyNodeWeights(b, *mesh, skeleton, origin, field);
         if (b.paint) {
-            stage("skeleton and stiffness paint of '" + name + "'");
-            sim::StiffnessPaintResult paint;
-            try {
-                bake::SkeletonParams skp = b.paint->skeleton;
-                skp.label = origin + ": " + field + ".stiffness_paint.skeleton";
-                const bake::SkeletonResult sk = bake::extractSkeleton(*mesh, skp);
-                paint = sim::bakeStiffnessPaint(*mesh, sk.skeleton, b.paint->strokes, b.paint->params);
-            } catch (const std::invalid_argument& e) {
-                throw InputError(origin + ": " + field + ".stiffness_paint: " + e.what());
-            }
-            if (desc.nodeWeights.empty())
-                desc.nodeWeights = paint.weights;
-            else
-                for (size_t v = 0; v < pos.size(); ++v)
-                    desc.nodeWeights[v] *= paint.weights[v];
             desc.nodeWeightsPath = "meshes/" + name + ".vweights";
             files.emplace_back(desc.nodeWeightsPath, sim::formatNodeWeights(desc.nodeWeights));
         }
+        built.skeletons.push_back(std::move(skeleton));
         be.fixedNodes = desc.fixedNodes.size();
         files.emplace_back(desc.meshPath, sim::formatVtet(*mesh));
         scene.bodies.push_back(std::move(desc));

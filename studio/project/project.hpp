@@ -206,7 +206,16 @@ struct BuiltScene {
     std::vector<std::pair<std::string, std::string>> files; ///< case path, bytes
     std::vector<std::string> features;
     ExportResult result; ///< per-body figures (casePath and bytes empty)
+    /// per body: the curve skeleton its stiffness paint went through (empty: no paint)
+    std::vector<std::optional<sim::Skeleton>> skeletons;
 };
+
+/// The node weights of body `b` on `mesh`: its stiffness regions times its stiffness paint
+/// (empty: neither). The paint's skeleton is extracted into `skeleton` when it is empty, and
+/// reused when given (the same mesh, painted again). Throws viscera::InputError naming
+/// `origin`, `field` and the rule.
+std::vector<double> bodyNodeWeights(const BodyProject& b, sim::TetMesh& mesh, std::optional<sim::Skeleton>& skeleton,
+                                    const std::string& origin, const std::string& field);
 
 /// Stages exportCase reports: meshing per body, stiffness paint per painted body, cutting per
 /// surface, checking the scene, packaging.
