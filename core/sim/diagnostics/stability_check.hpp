@@ -31,6 +31,14 @@ struct StabilityFigures {
 /// nodeWeights: empty (all 1) or one per node (tet weight = mean of its nodes).
 StabilityFigures assessStability(const TetMesh& mesh, const TetConstraintModel& model, double density,
                                  const std::vector<double>& nodeWeights, const XpbdSettings& settings);
+/// The same for a body some of whose nodes are hard-tied to another body (an embedded vessel in its
+/// cage): tiedMass, empty or one per node (kg, ≥ 0, may be +inf; XpbdSystem::tiedInertia), is the
+/// inertia the ties add. A tet's constraints then move m_i + tiedMass_i at node i instead of its own
+/// lumped mass m_i (ρ V / 4 summed over the node's tets), so s is divided by the smallest
+/// (m_i + tiedMass_i) / m_i over its four nodes. All zero: the figures of the overload above.
+StabilityFigures assessStability(const TetMesh& mesh, const TetConstraintModel& model, double density,
+                                 const std::vector<double>& nodeWeights, const XpbdSettings& settings,
+                                 const std::vector<double>& tiedMass);
 
 /// Empty when stable, else one line: "body 'slab': stiffness number 22 at tet 17 exceeds 1
 /// (substep 0.83 ms); use at least 95 substeps per frame or a softer material".

@@ -33,12 +33,6 @@ std::unique_ptr<XpbdSceneSolver> XpbdSceneSolver::create(const SceneSolverInputs
         tb.fixedNodes = b.fixedNodes;
         tb.nodeWeights = b.nodeWeights;
         tb.strainLimits = b.strainLimits;
-        if (tb.nodeWeights.empty() || tb.nodeWeights.size() == in.meshes[i]->vertexCount()) {
-            const StabilityFigures fig =
-                assessStability(*in.meshes[i], *tb.model, tb.density, tb.nodeWeights, scene.xpbd);
-            if (auto why = stabilityProblem(b.name, fig, scene.xpbd); !why.empty())
-                throw InputError(origin + ": scene cannot be simulated stably: " + why);
-        }
         desc.tetBodies.push_back(std::move(tb));
     }
     auto bodyIndex = [&](const std::string& name) {
@@ -86,6 +80,16 @@ std::unique_ptr<XpbdSceneSolver> XpbdSceneSolver::create(const SceneSolverInputs
         throw InputError(origin + ": scene cannot be simulated stably: " + e.rule);
     } catch (const std::invalid_argument& e) {
         throw InputError(origin + ": scene cannot be simulated stably: " + e.what());
+    }
+    // Load-time stability rule, per body, with the inertia that hard ties add to its nodes (an
+    // embedded body moves with its cage). Bodies whose weights do not match were refused above.
+    for (size_t i = 0; i < scene.bodies.size(); ++i) {
+        const TetBodyDesc& tb = desc.tetBodies[i];
+        const StabilityFigures fig =
+            assessStability(*in.meshes[i], *tb.model, tb.density, tb.nodeWeights, scene.xpbd,
+                            x->m_layered ? x->m_layered->tiedInertia(i) : std::vector<double>{});
+        if (auto why = stabilityProblem(scene.bodies[i].name, fig, scene.xpbd); !why.empty())
+            throw InputError(origin + ": scene cannot be simulated stably: " + why);
     }
     if (scene.interaction) {
         std::vector<const TetMesh*> bodies;
