@@ -17,12 +17,14 @@
 // fixed where the sample fixes them is not known here: their nodes below the 5th height percentile.
 //
 // Usage: bench_stability_margin [output-dir] [--frames N] [--vtet name:E:nu:density:path ...]
-// Writes <dir>/stability_margin.csv: body,nu,substeps,stiffness_number,accepted,finite,
-// max_energy_gain_rel,final_ke_per_kg,settled,speed_clamps,ms_per_frame.
+// Writes <dir>/stability_margin.csv: body,nu,tets,substeps,stiffness_number,accepted,finite,
+// max_energy_gain_rel,final_ke_per_kg,settled,speed_clamps,ms_per_frame, and
+// <dir>/stability_margin.png (energy gain against s, log-log, one line per body).
+#include "line_plot.hpp"
+#include "sample_bodies.hpp"
+
 #include "sim/diagnostics/stability_check.hpp"
 #include "sim/material/material.hpp"
-#include "sim/mesh/generators.hpp"
-#include "sim/mesh/tet_io.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
 
 #include <algorithm>
@@ -32,44 +34,18 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
 using namespace viscera::sim;
+using viscera::bench::boxBody;
+using viscera::bench::SampleBody;
+using viscera::bench::sampleBoxBodies;
+using viscera::bench::vtetBody;
 
 namespace {
 
-struct Body {
-    std::string name;
-    std::unique_ptr<TetMesh> mesh;
-    std::vector<int32_t> fixed;
-    Material material;
-    double scaleLength = 0.08; ///< m, for the gravity energy scale m g L
-};
-
-Material snh(double E, double nu, double density) {
-    Material m;
-    m.model = MaterialModel::StableNeoHookean;
-    m.youngsModulus = E;
-    m.poissonRatio = nu;
-    m.density = density;
-    return m;
-}
-
-Body box(std::string name, const BoxSpec& spec, const Material& m, bool fixBottom) {
-    Body b;
-    b.name = std::move(name);
-    b.mesh = makeBoxTetMesh(spec);
-    b.material = m;
-    b.scaleLength = spec.size.maxCoeff();
-    for (int32_t v = 0; v < static_cast<int32_t>(b.mesh->vertexCount()); ++v) {
-        const Vec3& p = b.mesh->positions()[v];
-        const bool fix = fixBottom ? p.z() < spec.origin.z() + 1e-9 : p.x() < spec.origin.x() + 1e-9;
-        if (fix) b.fixed.push_back(v);
-    }
-    return b;
-}
+constexpr double kPlotFloor = 1e-5; ///< no energy gain at all is drawn here on the log axis
 
 struct Run {
     bool finite = true;
@@ -77,7 +53,7 @@ struct Run {
     int clamps = 0;
 };
 
-Run run(const Body& b, int substeps, int frames) {
+Run run(const SampleBody& b, int substeps, int frames) {
     XpbdSettings s;
     s.substeps = substeps;
     s.damping = 2.0;
@@ -97,7 +73,7 @@ Run run(const Body& b, int substeps, int frames) {
         v[f].setZero();
     solver->setState(b.mesh->positions(), v);
     const double mass = solver->totalMass();
-    const double scale = mass * 9.81 * b.scaleLength;
+    const double scale = mass * 9.81 * b.extent;
     const double e0 = solver->elasticEnergy() + solver->kineticEnergy() + solver->potentialEnergy();
     Run r;
     const auto t0 = std::chrono::steady_clock::now();
@@ -121,7 +97,6 @@ Run run(const Body& b, int substeps, int frames) {
 int main(int argc, char** argv) {
     std::filesystem::path out = "stability_margin_out";
     int frames = 240;
-    std::vector<Body> bodies;
     std::vector<std::string> extra;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -132,53 +107,30 @@ int main(int argc, char** argv) {
         else
             out = a;
     }
-    bodies.push_back(
-        box("tissue-slab", {Vec3::Zero(), Vec3(0.08, 0.04, 0.03), {16, 8, 6}}, snh(30000, 0.45, 1050), false));
-    bodies.push_back(box("rectum-fat", {Vec3(-0.06, -0.05, -0.008), Vec3(0.12, 0.10, 0.008), {60, 50, 2}},
-                         snh(3000, 0.45, 950), true));
-    bodies.push_back(
-        box("block30k", {Vec3::Zero(), Vec3(0.25, 0.2, 0.1), {25, 20, 10}}, snh(20000, 0.45, 1050), false));
+    std::vector<SampleBody> bodies = sampleBoxBodies();
     for (double nu : {0.45, 0.49, 0.499})
         bodies.push_back(
-            box("cantilever", {Vec3::Zero(), Vec3(0.08, 0.02, 0.02), {8, 2, 2}}, snh(20000, nu, 1050), false));
-    for (const std::string& spec : extra) {
-        // name:E:nu:density:path
-        std::vector<std::string> f;
-        std::stringstream ss(spec);
-        for (std::string part; std::getline(ss, part, ':');)
-            f.push_back(part);
-        if (f.size() != 5) {
-            std::fprintf(stderr, "bench_stability_margin: --vtet %s: expected name:E:nu:density:path\n", spec.c_str());
-            return 2;
-        }
-        std::ifstream in(f[4]);
-        std::stringstream text;
-        text << in.rdbuf();
-        Body b;
-        b.name = f[0];
-        b.mesh = parseVtet(text.str(), f[4]);
-        b.material = snh(std::stod(f[1]), std::stod(f[2]), std::stod(f[3]));
-        std::vector<double> z;
-        for (const Vec3& p : b.mesh->positions())
-            z.push_back(p.z());
-        std::vector<double> sorted = z;
-        std::sort(sorted.begin(), sorted.end());
-        const double cut = sorted[sorted.size() / 20];
-        for (size_t v = 0; v < z.size(); ++v)
-            if (z[v] <= cut) b.fixed.push_back(static_cast<int32_t>(v));
-        const auto lo = b.mesh->positions()[0];
-        double ext = 0;
-        for (const Vec3& p : b.mesh->positions())
-            ext = std::max(ext, (p - lo).norm());
-        b.scaleLength = ext;
-        bodies.push_back(std::move(b));
+            boxBody("cantilever", {Vec3::Zero(), Vec3(0.08, 0.02, 0.02), {8, 2, 2}}, 20000, nu, 1050, false));
+    try {
+        for (const std::string& spec : extra)
+            bodies.push_back(vtetBody(spec));
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_stability_margin: %s\n", e.what());
+        return 2;
     }
     std::filesystem::create_directories(out);
     std::ofstream csv(out / "stability_margin.csv");
     csv << "body,nu,tets,substeps,stiffness_number,accepted,finite,max_energy_gain_rel,final_ke_per_kg,settled,"
            "speed_clamps,ms_per_frame\n";
-    for (const Body& b : bodies) {
+    std::vector<viscera::bench::PlotSeries> plot;
+    for (const SampleBody& b : bodies) {
         const auto model = makeConstraintModel(b.material, b.name);
+        viscera::bench::PlotSeries series;
+        char label[160];
+        std::snprintf(label, sizeof label, "%s, %zu tets, nu %.3f", b.name.c_str(), b.mesh->tetCount(),
+                      b.material.poissonRatio);
+        series.label = label;
+        series.markers = true;
         for (int substeps : {5, 10, 15, 20, 30, 40, 60, 100}) {
             XpbdSettings s;
             s.substeps = substeps;
@@ -193,8 +145,23 @@ int main(int argc, char** argv) {
             csv << line;
             std::fputs(line, stdout);
             std::fflush(stdout);
+            series.x.push_back(fig.maxStiffnessNumber);
+            series.y.push_back(std::max(r.finite ? r.maxGainRel : 1e3, kPlotFloor));
         }
+        plot.push_back(std::move(series));
     }
-    std::printf("wrote %s\n", (out / "stability_margin.csv").string().c_str());
+    viscera::bench::PlotSpec spec;
+    spec.title = "Energy gain of plain XPBD against the stiffness number (load rule refuses s > 1)";
+    spec.xLabel = "largest stiffness number s = k w h^2 / (rho L^2) (log scale; fewer substeps to the right)";
+    spec.yLabel = "max energy gain / (m g L) (log; 1e-5 = no gain; 0.05 = the suite's bound)";
+    spec.logX = true;
+    spec.yMarks = {0.05};
+    spec.yMin = kPlotFloor;
+    if (const std::string e = viscera::bench::writeLinePlotPng((out / "stability_margin.png").string(), spec, plot);
+        !e.empty()) {
+        std::fprintf(stderr, "bench_stability_margin: %s\n", e.c_str());
+        return 1;
+    }
+    std::printf("wrote %s and stability_margin.png\n", (out / "stability_margin.csv").string().c_str());
     return 0;
 }
