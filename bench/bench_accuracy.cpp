@@ -19,6 +19,7 @@
 // <dir>/sweep.csv (s × k settings), <dir>/summary.csv, <dir>/accuracy.json (session-report
 // "accuracy" entries), <dir>/error_vs_time.png and <dir>/error_vs_iteration.png (log-scale error).
 #include "line_plot.hpp"
+#include "sample_bodies.hpp"
 
 #include "sim/diagnostics/stability_check.hpp"
 #include "sim/material/stable_neo_hookean.hpp"
@@ -40,6 +41,9 @@
 using namespace viscera::sim;
 using viscera::bench::PlotSeries;
 using viscera::bench::PlotSpec;
+using viscera::bench::SampleBody;
+using viscera::bench::sampleBoxBodies;
+using viscera::bench::vtetBody;
 
 namespace {
 
@@ -339,13 +343,116 @@ int run(const std::filesystem::path& outDir) {
     return 0;
 }
 
+namespace {
+
+/// --variants: the sample bodies (and the 30,000-tet block) at the substep counts of the
+/// load-time rule, old and new, and at 20 substeps: error of plain and primal-corrected XPBD
+/// against the Newton reference of the same substep, against the frame time (s × substep time).
+int runVariants(const std::filesystem::path& outDir, const std::vector<std::string>& vtets) {
+    std::filesystem::create_directories(outDir);
+    std::vector<SampleBody> bodies = sampleBoxBodies();
+    for (const std::string& v : vtets)
+        bodies.push_back(vtetBody(v));
+    std::ofstream csv(outDir / "variants.csv");
+    csv << "body,tets,variant,substeps,stiffness_number,iterations,h_s,rel_error,substep_time_ms,frame_time_ms\n";
+    std::ofstream summary(outDir / "variants_summary.csv");
+    summary << "body,tets,variant,substeps,stiffness_number,rel_error_1_iteration,frame_time_ms_1_iteration,"
+               "best_rel_error,newton_status\n";
+    NewtonSettings reference;
+    constexpr double kOldLimit = 0.25; // the rule before bench_stability_margin
+    for (const SampleBody& b : bodies) {
+        const auto model = makeConstraintModel(b.material, b.name);
+        XpbdSettings production;
+        production.substeps = 20;
+        production.damping = 2.0;
+        const StabilityFigures at20 = assessStability(*b.mesh, *model, b.material.density, {}, production);
+        const int now = at20.requiredSubsteps;
+        const int old =
+            std::max(1, static_cast<int>(std::ceil(20 * std::sqrt(at20.maxStiffnessNumber / kOldLimit) - 1e-9)));
+        // Motion first: five frames at the new rule's setting; every variant starts from there.
+        XpbdSettings ms = production;
+        ms.substeps = std::max(now, 20);
+        auto motion = XpbdSolver::create(*b.mesh, b.material, b.fixed, ms);
+        for (int f = 0; f < 5; ++f)
+            motion->step();
+        std::vector<PlotSeries> plot;
+        std::vector<int> counts = {20, now, old};
+        std::sort(counts.begin(), counts.end());
+        counts.erase(std::unique(counts.begin(), counts.end()), counts.end());
+        for (int sub : counts) {
+            XpbdSettings s = production;
+            s.substeps = sub;
+            auto solver = XpbdSolver::create(*b.mesh, b.material, b.fixed, s);
+            solver->setState(motion->positions(), motion->velocities());
+            const StabilityFigures fig = assessStability(*b.mesh, *model, b.material.density, {}, s);
+            const std::string tag = std::to_string(sub) + " substeps" + (sub == now ? " (rule, limit 1)" : "") +
+                                    (sub == old ? " (old rule, limit 0.25)" : "");
+            std::vector<std::pair<std::string, AccuracyTrace>> traces;
+            traces.emplace_back("xpbd", measureXpbd(*solver, 10, reference));
+            keepFastestSweeps(*solver, XpbdIteration::Standard, traces.back().second);
+            if (fig.maxStiffnessNumber <= 1.0) { // the primal correction diverges above (see run())
+                traces.emplace_back("xpbd-primal", measureXpbd(*solver, 10, reference, XpbdIteration::PrimalCorrected));
+                keepFastestSweeps(*solver, XpbdIteration::PrimalCorrected, traces.back().second);
+            }
+            for (const auto& [variant, t] : traces) {
+                for (size_t k = 1; k < t.iterations.size(); ++k) {
+                    char line[256];
+                    std::snprintf(line, sizeof line, "%s,%zu,%s,%d,%.4g,%d,%.9g,%.6e,%.6f,%.6f\n", b.name.c_str(),
+                                  b.mesh->tetCount(), variant.c_str(), sub, fig.maxStiffnessNumber, t.iterations[k],
+                                  t.h, t.relError[k], t.timeMs[k], sub * t.timeMs[k]);
+                    csv << line;
+                }
+                char line[256];
+                std::snprintf(line, sizeof line, "%s,%zu,%s,%d,%.4g,%.6e,%.4f,%.6e,%s\n", b.name.c_str(),
+                              b.mesh->tetCount(), variant.c_str(), sub, fig.maxStiffnessNumber, t.relError.at(1),
+                              sub * t.timeMs.at(1), *std::min_element(t.relError.begin(), t.relError.end()),
+                              t.referenceStatus.c_str());
+                summary << line;
+                std::printf("%-12s %-11s %3d substeps (s = %6.3f): 1 iteration rel error %.3e, %.2f ms per frame\n",
+                            b.name.c_str(), variant.c_str(), sub, fig.maxStiffnessNumber, t.relError.at(1),
+                            sub * t.timeMs.at(1));
+                plot.push_back(
+                    series((variant == "xpbd" ? "XPBD, " : "XPBD + primal correction, ") + tag, t, true, sub));
+            }
+        }
+        PlotSpec spec;
+        spec.yMarks = {kTarget};
+        spec.logX = true;
+        spec.title = b.name + " (" + std::to_string(b.mesh->tetCount()) +
+                     " tets): relative error of one substep against frame time";
+        spec.xLabel = "wall time per frame (ms, log scale; s substeps cost s x one substep; k iterations along a line)";
+        spec.yLabel = "relative error (f(x_k) - f(x*)) / (f(x_0) - f(x*))";
+        const std::string error =
+            viscera::bench::writeLinePlotPng((outDir / ("variants_" + b.name + ".png")).string(), spec, plot);
+        if (!error.empty()) throw std::runtime_error(error);
+    }
+    if (!csv || !summary) throw std::runtime_error("cannot write variants.csv in " + outDir.string());
+    std::printf("wrote %s/{variants.csv,variants_summary.csv,variants_*.png}\n", outDir.string().c_str());
+    return 0;
+}
+
+} // namespace
+
 int main(int argc, char** argv) {
-    if (argc > 2 || (argc == 2 && (std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help"))) {
-        std::fprintf(stderr, "usage: bench_accuracy [output-dir]   (default ./accuracy_out)\n");
-        return argc == 2 ? 0 : 2;
+    std::vector<std::string> args(argv + 1, argv + argc);
+    if (!args.empty() && (args[0] == "-h" || args[0] == "--help")) {
+        std::fprintf(stderr, "usage: bench_accuracy [output-dir]   (default ./accuracy_out)\n"
+                             "       bench_accuracy --variants output-dir [--vtet name:E:nu:density:path ...]\n");
+        return 0;
     }
     try {
-        return run(argc == 2 ? argv[1] : "accuracy_out");
+        if (!args.empty() && args[0] == "--variants") {
+            if (args.size() < 2) throw std::runtime_error("--variants needs an output directory");
+            std::vector<std::string> vtets;
+            for (size_t i = 2; i + 1 < args.size(); i += 2)
+                if (args[i] == "--vtet") vtets.push_back(args[i + 1]);
+            return runVariants(args[1], vtets);
+        }
+        if (args.size() > 1) {
+            std::fprintf(stderr, "usage: bench_accuracy [output-dir]   (see --help)\n");
+            return 2;
+        }
+        return run(args.size() == 1 ? args[0] : "accuracy_out");
     } catch (const std::exception& e) {
         std::fprintf(stderr, "bench_accuracy: %s\n", e.what());
         return 1;

@@ -71,6 +71,10 @@ struct LiveState {
     std::array<sim::Vec3, haptics::kMaxArms> tool{sim::Vec3::Zero(), sim::Vec3::Zero()};
     std::array<bool, haptics::kMaxArms> toolActive{false, false};
     double maxForce_n = 15;
+    /// Physics speed over the last frames (session.cpp): mean step wall time, ms, and the
+    /// real-time factor, simulated time per physics wall time (≥ 1: keeps up with real time).
+    double physicsMs = 0;
+    double realTimeFactor = 0;
 };
 
 class HapticRig {

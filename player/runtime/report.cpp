@@ -28,6 +28,16 @@ StepTimeStats stepTimeStats(const std::vector<sim::FrameRecord>& frames) {
     return s;
 }
 
+RealTimeFigures realTimeFigures(const SessionResult& r) {
+    RealTimeFigures f;
+    const StepTimeStats st = stepTimeStats(r.frames);
+    f.factorMean = realTimeFactor(r.frameDt, st.mean);
+    f.factorP99 = realTimeFactor(r.frameDt, st.p99);
+    for (const auto& fr : r.frames)
+        f.framesOver += fr.stepMs > r.frameDt * 1e3 ? 1 : 0;
+    return f;
+}
+
 namespace {
 
 nlohmann::json distribution(const haptics::Distribution& d) {
@@ -243,6 +253,12 @@ nlohmann::json reportJson(const SessionResult& r) {
                       {"nodes", r.nodes},
                       {"tets", r.tets},
                       {"max_node_displacement_m", r.maxNodeDisplacement}};
+    const RealTimeFigures rt = realTimeFigures(r);
+    doc["metrics"]["frame_dt_s"] = r.frameDt;
+    doc["metrics"]["real_time_factor"] = rt.factorMean;
+    doc["metrics"]["real_time_factor_p99"] = rt.factorP99;
+    doc["metrics"]["frames_slower_than_real_time"] = rt.framesOver;
+    doc["metrics"]["slower_than_real_time"] = rt.slower();
     // Task metrics [issue 7]: time, tool path, forces, tissue damage, punctures, clips.
     const TaskMetrics& tm = r.metrics;
     doc["metrics"]["time_s"] = tm.time_s;
@@ -298,6 +314,14 @@ std::string summaryText(const SessionResult& r) {
                   r.ok() ? "ok"
                          : ("FAILED: " + (r.errors.empty() ? std::string("invariants") : r.errors.front())).c_str());
     std::string out = buf;
+    if (const RealTimeFigures rt = realTimeFigures(r); rt.factorMean > 0) {
+        char line[320];
+        std::snprintf(line, sizeof line,
+                      "real time     factor %.2f (p99 step %.2f); %zu of %zu frames over %.1f ms%s\n", rt.factorMean,
+                      rt.factorP99, rt.framesOver, r.frames.size(), r.frameDt * 1e3,
+                      rt.slower() ? " — PHYSICS SLOWER THAN REAL TIME" : "");
+        out += line;
+    }
     if (r.haptics) {
         const HapticsResult& h = *r.haptics;
         const auto& p = h.servo.period;

@@ -23,4 +23,13 @@ struct StepTimeStats {
 };
 StepTimeStats stepTimeStats(const std::vector<sim::FrameRecord>& frames);
 
+/// Physics against real time over a session: the real-time factor (realTimeFactor()) of the mean
+/// and of the p99 step, and the frames whose step took longer than the frame time step.
+struct RealTimeFigures {
+    double factorMean = 0, factorP99 = 0;
+    size_t framesOver = 0;
+    bool slower() const { return factorMean > 0 && factorMean < 1; } ///< physics slower than real time
+};
+RealTimeFigures realTimeFigures(const SessionResult& r);
+
 } // namespace viscera::player

@@ -94,6 +94,9 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     }
     const auto t0 = std::chrono::steady_clock::now();
     if (rig) rig->start();
+    const double frameDt = world.dt();
+    r.frameDt = frameDt;
+    constexpr size_t kRateWindow = 60; // frames the live real-time factor averages over
     for (int f = 0; options.frames == 0 || f < options.frames; ++f) {
         if (options.stop && options.stop->load()) break;
         if (rig) rig->beforeStep();
@@ -105,6 +108,12 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
             if (rig) lv.state = rig->live();
             lv.state.time_s = world.time();
             lv.state.frame = world.frameCount();
+            double ms = rec.stepMs;
+            size_t n = 1;
+            for (size_t k = r.frames.size(); k > 0 && n < kRateWindow; --k, ++n)
+                ms += r.frames[k - 1].stepMs;
+            lv.state.physicsMs = ms / static_cast<double>(n);
+            lv.state.realTimeFactor = realTimeFactor(frameDt, lv.state.physicsMs);
             lv.nodes.clear();
             for (size_t b = 0; b < world.bodyCount(); ++b)
                 lv.nodes.insert(lv.nodes.end(), world.positions(b).begin(), world.positions(b).end());

@@ -75,6 +75,7 @@ struct SessionResult {
     sim::Invariants invariants;
     double simTime = 0;             ///< s
     double wallTime = 0;            ///< s
+    double frameDt = 0;             ///< s, the scene's frame time step (real time: one frame per dt)
     double maxNodeDisplacement = 0; ///< m, from the rest configuration, at the end
     size_t nodes = 0, tets = 0;
     std::vector<std::string> errors;
@@ -87,6 +88,13 @@ struct SessionResult {
     std::optional<sim::InteractionSummary> interaction; ///< cases with scripted instruments
     bool ok() const { return errors.empty() && invariants.allFinite; }
 };
+
+/// Real-time factor of physics: simulated time per wall time of the physics step, dt / step
+/// (dt in s, step in ms). ≥ 1: physics keeps up with real time; below 1 the trainee sees the
+/// tissue in slow motion. 0 when the step time is unknown (≤ 0).
+inline double realTimeFactor(double dt, double stepMs) {
+    return stepMs > 0 ? dt * 1e3 / stepMs : 0.0;
+}
 
 /// Steps the world `frames` times, recording per-frame figures and invariants. Never throws.
 SessionResult runSession(LoadedCase& loaded, const RunOptions& options);

@@ -215,6 +215,15 @@ public:
         if (s.safetyRules & haptics::kRuleSimStale) p.drawText(px, y, "Forces off: simulation stale"), y += 20;
         if (s.safetyRules & haptics::kRuleDisconnected) p.drawText(px, y, "Forces off: device not answering"), y += 20;
         if (s.safetyRules & haptics::kRuleDeadman) p.drawText(px, y, "Forces off: hold the deadman pedal"), y += 20;
+        if (s.realTimeFactor > 0) {
+            // Physics slower than real time: the tissue moves in slow motion; say so in red.
+            const bool slow = s.realTimeFactor < 1;
+            p.setPen(slow ? QColor(230, 80, 60) : QColor(140, 140, 140));
+            p.drawText(px, h - 36,
+                       slow ? QString::asprintf("Physics %.1f ms/frame: %.2fx real time (SLOWER)", s.physicsMs,
+                                                s.realTimeFactor)
+                            : QString::asprintf("Physics %.1f ms/frame: real time", s.physicsMs));
+        }
         p.setPen(QColor(140, 140, 140));
         p.drawText(px, h - 16, QString::asprintf("frame %d", s.frame));
     }

@@ -200,6 +200,23 @@ TEST(PlayerHaptics, ReplaysARecordedTrajectory) {
     const auto j = readJson(s / "r.json");
     EXPECT_EQ(j["haptics"]["device"]["backend"], "replay");
     EXPECT_GT(j["metrics"]["max_force_n"].get<double>(), 0.05);
+    // Real-time factor: simulated time per physics wall time, from the same step times as the
+    // step statistics (whatever this machine's speed), and the summary line that says it.
+    const auto& m = j["metrics"];
+    const double dt = m["frame_dt_s"].get<double>(), mean = m["step_ms_mean"].get<double>();
+    EXPECT_NEAR(dt, 1.0 / 60, 1e-6);
+    ASSERT_GT(mean, 0.0);
+    EXPECT_NEAR(m["real_time_factor"].get<double>(), dt * 1e3 / mean, 1e-9 * dt * 1e3 / mean);
+    EXPECT_NEAR(m["real_time_factor_p99"].get<double>(), dt * 1e3 / m["step_ms_p99"].get<double>(),
+                1e-9 * m["real_time_factor_p99"].get<double>());
+    EXPECT_LE(m["real_time_factor_p99"].get<double>(), m["real_time_factor"].get<double>() * (1 + 1e-12));
+    int over = 0;
+    for (const auto& f : j["frames"])
+        over += f["step_ms"].get<double>() > dt * 1e3 ? 1 : 0;
+    EXPECT_EQ(m["frames_slower_than_real_time"].get<int>(), over);
+    EXPECT_EQ(m["slower_than_real_time"].get<bool>(), m["real_time_factor"].get<double>() < 1);
+    EXPECT_NE(r.out.find("real time     factor"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("PHYSICS SLOWER THAN REAL TIME") != std::string::npos, m["slower_than_real_time"].get<bool>());
 }
 
 TEST(PlayerHaptics, BadDeviceSpecsAndTrajectoriesGiveOneLineErrors) {

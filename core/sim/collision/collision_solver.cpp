@@ -37,7 +37,6 @@ std::string validate(const CollisionSettings& s) {
     if (std::string e = validate(s.circumsphere); !e.empty()) return e;
     if (!(s.polygonMargin >= 0) || !std::isfinite(s.polygonMargin)) return "polygon margin must be finite and >= 0";
     if (!(s.compliance >= 0) || !std::isfinite(s.compliance)) return "compliance must be finite and >= 0";
-    if (!(s.cellSize >= 0) || !std::isfinite(s.cellSize)) return "cell size must be finite and >= 0";
     if (!(s.maxCorrectionPerStep > 0)) return "max correction per step must be > 0";
     return {};
 }
@@ -108,21 +107,10 @@ std::unique_ptr<CollisionSolver> CollisionSolver::create(CollisionSurfaceDesc de
     s->m_curv = SurfaceCurvature(nv, s->m_tris);
     s->m_h3Spline = curvatureHermite(settings.circumsphere.curvatureThreshold);
     s->m_offsetPerRadius = offsetPerRadius(settings.circumsphere);
-    double cell = settings.cellSize;
-    if (cell <= 0) {
-        double sum = 0;
-        for (const Tri& t : s->m_tris)
-            for (int k = 0; k < 3; ++k)
-                sum += (s->m_rest[t[k]] - s->m_rest[t[(k + 1) % 3]]).norm();
-        cell = 2 * sum / (3.0 * s->m_tris.size());
-        if (!(cell > 0)) cell = 1e-3;
-    }
-    s->m_hash = std::make_unique<SpatialHash>(cell);
     const size_t nt = s->m_tris.size();
     s->m_h3.assign(nt, 1.0);
     s->m_energy.assign(nt, 0.0);
     s->m_refArea.assign(nt, -1.0);
-    s->m_boxes.resize(nt);
     s->m_touched.assign(nv, 0);
     s->refreshAllFactors(s->m_rest);
     return s;
@@ -163,14 +151,35 @@ void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& too
     m_start = x;
     const bool polygon =
         m_settings.method == CollisionMethod::Polygon || m_settings.method == CollisionMethod::PolygonFeatures;
-    for (size_t t = 0; t < m_tris.size(); ++t) {
+    const bool circum = m_settings.method == CollisionMethod::Circumsphere;
+    // Broad phase: one query (the tool's box) per step, so each triangle's box is tested directly,
+    // in triangle order (a spatial hash rebuilt every substep for a single query cost more than
+    // the test). Circumsphere: a triangle whose vertex box, grown by a bound on how far its sphere
+    // can reach beyond it, misses the tool is no candidate, and its sphere is not computed. The
+    // bound: the circumradius r is at most 4 × the longest edge ℓ (else the bounding sphere,
+    // radius ≤ ℓ, is used), ℓ ≤ the box diagonal d, the circumcentre is within r of every vertex,
+    // and the sphere (or its safe-cone part) lies within r + 2|offset| of the circumcentre, with
+    // |offset| ≤ φ cot θ · r · |H3| + energyScale · |ε| (circumsphere.hpp) from the cached factors.
+    const auto tb = tool.bounds();
+    const Aabb toolBox{tb[0], tb[1]};
+    const bool toolFinite = toolBox.lo.allFinite() && toolBox.hi.allFinite();
+    for (size_t t = 0; t < m_tris.size() && toolFinite; ++t) {
         const Tri& f = m_tris[t];
-        Aabb& b = m_boxes[t];
+        Aabb b;
+        const Vec3 lo = x[f[0]].cwiseMin(x[f[1]]).cwiseMin(x[f[2]]);
+        const Vec3 hi = x[f[0]].cwiseMax(x[f[1]]).cwiseMax(x[f[2]]);
         if (polygon) {
             const Vec3 m = Vec3::Constant(m_settings.polygonMargin);
-            b.lo = x[f[0]].cwiseMin(x[f[1]]).cwiseMin(x[f[2]]) - m;
-            b.hi = x[f[0]].cwiseMax(x[f[1]]).cwiseMax(x[f[2]]) + m;
+            b.lo = lo - m;
+            b.hi = hi + m;
         } else {
+            if (circum) {
+                const double r = 4 * (hi - lo).norm();
+                const double offset = m_offsetPerRadius * r * std::abs(m_h3[t]) +
+                                      m_settings.circumsphere.energyScale * std::abs(m_energy[t]);
+                const Vec3 reach = Vec3::Constant(2 * r + 2 * offset);
+                if (!Aabb{lo - reach, hi + reach}.overlaps(toolBox)) continue; // also skips non-finite vertices
+            }
             const Sphere s = triangleSphere(static_cast<int32_t>(t), x);
             if (m_settings.safeConeOnly && s.coneCos > -1) {
                 // Only the safe cone inside the sphere can hold a contact: the cap lies within
@@ -187,11 +196,9 @@ void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& too
                 b.hi = s.centre + Vec3::Constant(s.radius);
             }
         }
+        if (b.lo.allFinite() && b.hi.allFinite() && b.overlaps(toolBox))
+            m_candidates.push_back(static_cast<int32_t>(t));
     }
-
-    m_hash->build(m_boxes);
-    const auto tb = tool.bounds();
-    m_hash->queryInto(Aabb{tb[0], tb[1]}, m_candidates);
     m_stats.candidates = static_cast<int>(m_candidates.size());
     if (m_settings.method == CollisionMethod::Circumsphere) {
         const double delta = m_settings.circumsphere.updateThreshold;

@@ -6,8 +6,9 @@
 /// stepWithCollision is the older after-the-substep coupling.
 ///
 /// Pipeline per substep (beginStep): the surface triangles' boxes (sphere methods: the sphere's;
-/// circumsphere with the safe cone: the part of the sphere inside the cone) go into a spatial
-/// hash (spatial_hash.hpp) and the tool's box selects candidates; for the circumsphere method the
+/// circumsphere with the safe cone: the part of the sphere inside the cone) are tested against
+/// the tool's box (Aabb of spatial_hash.hpp; one query per step, so no hash is built), which selects
+/// the candidates in triangle order; for the circumsphere method the
 /// candidates whose area changed by |S/S_ref − 1| >= δ since their last refresh get new curvature
 /// and energy factors [A §5.2.4]. Then every iterate() is one Gauss–Seidel sweep over the
 /// candidates × tool parts: narrow phase at the current positions, projection of each violated
@@ -74,7 +75,6 @@ struct CollisionSettings {
     double compliance = 0;       ///< m/N per contact constraint (0 = hard), divided by h²
     bool squaredForm = false;    ///< use [A eq. 5.8] literally (see above)
     bool safeConeOnly = true;    ///< circumsphere: contacts only through the safe cone (above)
-    double cellSize = 0;         ///< m, spatial hash grid; 0 = twice the mean rest edge length
     /// m: no vertex is moved farther than this by the sweeps of one step (a tool that starts
     /// deep inside the tissue pushes it out over several substeps instead of in one jump).
     double maxCorrectionPerStep = 0.002;
@@ -181,10 +181,8 @@ private:
     std::vector<double> m_w;
     SurfaceCurvature m_curv;
     CubicHermite m_h3Spline;
-    double m_offsetPerRadius = 0; ///< φ cot θ
-    std::unique_ptr<SpatialHash> m_hash;
+    double m_offsetPerRadius = 0;                  ///< φ cot θ
     std::vector<double> m_h3, m_energy, m_refArea; ///< per triangle; m_refArea < 0: never set
-    std::vector<Aabb> m_boxes;
     std::vector<int32_t> m_candidates;
     std::vector<double> m_lambda; ///< #candidates × #parts (PolygonFeatures: faces, edges, vertices)
     std::vector<std::array<int32_t, 2>> m_candEdges; ///< PolygonFeatures: edges of the candidates

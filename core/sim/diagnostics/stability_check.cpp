@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <stdexcept>
 
 namespace viscera::sim {
 
@@ -35,9 +37,26 @@ double probedStiffness(const TetConstraintModel& model) {
 
 StabilityFigures assessStability(const TetMesh& mesh, const TetConstraintModel& model, double density,
                                  const std::vector<double>& nodeWeights, const XpbdSettings& settings) {
+    return assessStability(mesh, model, density, nodeWeights, settings, {});
+}
+
+StabilityFigures assessStability(const TetMesh& mesh, const TetConstraintModel& model, double density,
+                                 const std::vector<double>& nodeWeights, const XpbdSettings& settings,
+                                 const std::vector<double>& tiedMass) {
     StabilityFigures f;
     const double h = settings.dt / settings.substeps;
     const double k = probedStiffness(model);
+    // Lumped own masses (without the density, which cancels) for the tied-inertia ratio.
+    if (!tiedMass.empty() && tiedMass.size() != mesh.vertexCount())
+        throw std::invalid_argument("sim::assessStability(): tiedMass has " + std::to_string(tiedMass.size()) +
+                                    " values for " + std::to_string(mesh.vertexCount()) + " nodes");
+    std::vector<double> own;
+    if (!tiedMass.empty()) {
+        own.assign(mesh.vertexCount(), 0.0);
+        for (int32_t t = 0; t < static_cast<int32_t>(mesh.tetCount()); ++t)
+            for (int32_t v : mesh.tets()[t])
+                own[v] += std::abs(mesh.signedVolume(t)) / 4.0;
+    }
     for (int32_t t = 0; t < static_cast<int32_t>(mesh.tetCount()); ++t) {
         const double vol = std::abs(mesh.signedVolume(t));
         if (!(vol > 0)) continue;
@@ -48,7 +67,13 @@ StabilityFigures assessStability(const TetMesh& mesh, const TetConstraintModel& 
                 w += nodeWeights[v] / 4.0;
         }
         const double L = std::cbrt(6.0 * vol);
-        const double s = k * w * h * h / (density * L * L);
+        double inertia = 1.0; // smallest (m_i + tied_i) / m_i over the tet's nodes
+        if (!tiedMass.empty()) {
+            inertia = std::numeric_limits<double>::infinity();
+            for (int32_t v : mesh.tets()[t])
+                inertia = std::min(inertia, 1.0 + tiedMass[v] / (density * own[v]));
+        }
+        const double s = k * w * h * h / (density * L * L) / inertia;
         if (s > f.maxStiffnessNumber) {
             f.maxStiffnessNumber = s;
             f.worstTet = t;

@@ -52,6 +52,7 @@ public:
     /// Forgets the accuracy records so far (a long-running sampler keeps only what it reads).
     void clearAccuracy() { m_accuracy.clear(); }
     double time() const { return m_time; }
+    double dt() const { return m_dt; } ///< s, the frame time step of the scene's solver
     int frameCount() const { return m_frame; }
     size_t bodyCount() const { return m_meshes.size(); }
     const std::string& bodyName(size_t i) const { return m_names[i]; }

@@ -11,17 +11,12 @@ namespace viscera::sim {
 XpbdSceneSolver::XpbdSceneSolver() = default;
 XpbdSceneSolver::~XpbdSceneSolver() = default;
 
-std::unique_ptr<XpbdSceneSolver> XpbdSceneSolver::create(const SceneSolverInputs& in) {
-    const SceneDesc& scene = in.scene;
-    const std::string& origin = in.origin;
-    // One tet body without layers runs on the single-body solver, the one the Newton reference of
-    // accuracy sampling mirrors.
-    const bool layered = !supportsAccuracySampling(scene);
-    if (scene.accuracy && layered)
-        throw InputError(origin + ": features: 'accuracy' sampling needs a scene with a single tet body and no layers");
+namespace {
 
-    if (auto why = validate(scene.xpbd); !why.empty())
-        throw InputError(origin + ": scene cannot be simulated stably: solver: " + why);
+/// The XpbdSystem description of the scene's bodies, surfaces and couplings (pointers into `in`).
+/// Throws InputError on a material the model factory refuses.
+XpbdSystemDesc describe(const SceneSolverInputs& in) {
+    const SceneDesc& scene = in.scene;
     XpbdSystemDesc desc;
     for (size_t i = 0; i < scene.bodies.size(); ++i) {
         const BodyDesc& b = scene.bodies[i];
@@ -33,12 +28,6 @@ std::unique_ptr<XpbdSceneSolver> XpbdSceneSolver::create(const SceneSolverInputs
         tb.fixedNodes = b.fixedNodes;
         tb.nodeWeights = b.nodeWeights;
         tb.strainLimits = b.strainLimits;
-        if (tb.nodeWeights.empty() || tb.nodeWeights.size() == in.meshes[i]->vertexCount()) {
-            const StabilityFigures fig =
-                assessStability(*in.meshes[i], *tb.model, tb.density, tb.nodeWeights, scene.xpbd);
-            if (auto why = stabilityProblem(b.name, fig, scene.xpbd); !why.empty())
-                throw InputError(origin + ": scene cannot be simulated stably: " + why);
-        }
         desc.tetBodies.push_back(std::move(tb));
     }
     auto bodyIndex = [&](const std::string& name) {
@@ -72,9 +61,58 @@ std::unique_ptr<XpbdSceneSolver> XpbdSceneSolver::create(const SceneSolverInputs
             desc.attachments.push_back(a);
         }
     }
-    std::unique_ptr<XpbdSceneSolver> x(new XpbdSceneSolver());
+    return desc;
+}
+
+/// XpbdSystem::create with its precondition failures as InputError naming the case file.
+template <class Build> auto buildOrRefuse(const std::string& origin, const Build& build) {
     // The rule without the function prefix: the message names the case file instead.
     try {
+        return build();
+    } catch (const PreconditionError& e) {
+        throw InputError(origin + ": scene cannot be simulated stably: " + e.rule);
+    } catch (const std::invalid_argument& e) {
+        throw InputError(origin + ": scene cannot be simulated stably: " + e.what());
+    }
+}
+
+/// The load-time rule per tet body, with the inertia that hard ties of `system` (null: none) add.
+std::vector<StabilityFigures> figuresOf(const SceneSolverInputs& in, const XpbdSystemDesc& desc,
+                                        const XpbdSystem* system) {
+    std::vector<StabilityFigures> out;
+    for (size_t i = 0; i < desc.tetBodies.size(); ++i) {
+        const TetBodyDesc& tb = desc.tetBodies[i];
+        out.push_back(assessStability(*in.meshes[i], *tb.model, tb.density, tb.nodeWeights, in.scene.xpbd,
+                                      system ? system->tiedInertia(i) : std::vector<double>{}));
+    }
+    return out;
+}
+
+} // namespace
+
+std::vector<StabilityFigures> assessSceneStability(const SceneSolverInputs& in) {
+    if (auto why = validate(in.scene.xpbd); !why.empty())
+        throw InputError(in.origin + ": scene cannot be simulated stably: solver: " + why);
+    const XpbdSystemDesc desc = describe(in);
+    if (desc.embeddings.empty() && desc.attachments.empty()) return figuresOf(in, desc, nullptr);
+    const auto system = buildOrRefuse(in.origin, [&] { return XpbdSystem::create(desc, in.scene.xpbd); });
+    return figuresOf(in, desc, system.get());
+}
+
+std::unique_ptr<XpbdSceneSolver> XpbdSceneSolver::create(const SceneSolverInputs& in) {
+    const SceneDesc& scene = in.scene;
+    const std::string& origin = in.origin;
+    // One tet body without layers runs on the single-body solver, the one the Newton reference of
+    // accuracy sampling mirrors.
+    const bool layered = !supportsAccuracySampling(scene);
+    if (scene.accuracy && layered)
+        throw InputError(origin + ": features: 'accuracy' sampling needs a scene with a single tet body and no layers");
+
+    if (auto why = validate(scene.xpbd); !why.empty())
+        throw InputError(origin + ": scene cannot be simulated stably: solver: " + why);
+    const XpbdSystemDesc desc = describe(in);
+    std::unique_ptr<XpbdSceneSolver> x(new XpbdSceneSolver());
+    buildOrRefuse(origin, [&] {
         if (layered) {
             x->m_layered = XpbdSystem::create(desc, scene.xpbd);
             x->m_sys = x->m_layered.get();
@@ -82,11 +120,14 @@ std::unique_ptr<XpbdSceneSolver> XpbdSceneSolver::create(const SceneSolverInputs
             x->m_single = XpbdSolver::create(desc.tetBodies.front(), scene.xpbd);
             x->m_sys = &x->m_single->system();
         }
-    } catch (const PreconditionError& e) {
-        throw InputError(origin + ": scene cannot be simulated stably: " + e.rule);
-    } catch (const std::invalid_argument& e) {
-        throw InputError(origin + ": scene cannot be simulated stably: " + e.what());
-    }
+        return 0;
+    });
+    // Load-time stability rule, per body, with the inertia that hard ties add to its nodes (an
+    // embedded body moves with its cage).
+    const std::vector<StabilityFigures> figures = figuresOf(in, desc, x->m_layered.get());
+    for (size_t i = 0; i < figures.size(); ++i)
+        if (auto why = stabilityProblem(scene.bodies[i].name, figures[i], scene.xpbd); !why.empty())
+            throw InputError(origin + ": scene cannot be simulated stably: " + why);
     if (scene.interaction) {
         std::vector<const TetMesh*> bodies;
         for (const auto& m : in.meshes)

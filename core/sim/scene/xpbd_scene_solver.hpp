@@ -4,14 +4,23 @@
 /// an XpbdSolver (the same system with one-body messages), which also carries the accuracy hooks
 /// [A §4.4.3]; all state calls go through that solver's system. Scripted instruments (scene
 /// "interaction") act inside the system's iterations and are stepped with it.
+#include "sim/diagnostics/stability_check.hpp"
 #include "sim/scene/scene_solver.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
 #include "sim/xpbd/xpbd_system.hpp"
 
 #include <memory>
 #include <optional>
+#include <vector>
 
 namespace viscera::sim {
+
+/// The load-time stability figures of every tet body of an XPBD scene (in.scene.bodies order), as
+/// XpbdSceneSolver::create checks them: with the inertia that hard ties add to embedded bodies
+/// (XpbdSystem::tiedInertia), which the body-alone assessStability cannot see. For the studio's
+/// live verdict. Throws viscera::InputError as create() does when the system cannot be built (bad
+/// settings, material, embedding); an unstable body is no error here (its figures say so).
+std::vector<StabilityFigures> assessSceneStability(const SceneSolverInputs& in);
 
 class XpbdSceneSolver final : public SceneSolver {
 public:

@@ -19,8 +19,10 @@
 /// Limits of the method (measured, see tests/sim/xpbd):
 ///   - Stability: the stable Neo-Hookean split carries a rest pretension (C_D = √3 at F = I)
 ///     whose geometric stiffness XPBD ignores; with multipliers restarted every substep it is
-///     stable only while the stiffness number h² (λ + 2μ) w / (ρ L²) stays below about 1
-///     (sim/diagnostics/stability_check.hpp refuses bodies above 0.25). More iterations do not
+///     stable only while the stiffness number h² k w / (ρ L²) stays below about 2 (energy gain
+///     measured by bench/bench_stability_margin: first above bound between 1.3 and 2.4 on a small
+///     cantilever at ν = 0.49, between 2.8 and 44 on the samples' bodies;
+///     sim/diagnostics/stability_check.hpp refuses bodies above 1). More iterations do not
 ///     help, more substeps do. Constraints that vanish at rest (a one-constraint
 ///     EnergyConstraintModel, strain limits, membranes, ties) have no such limit: far beyond it
 ///     they behave like PBD, as stiff as the iterations make them.

@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace viscera::sim {
@@ -331,7 +332,7 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
         }
     }
     for (const detail::Tie& t : ties)
-        sys->m_ties.push_back({t.p, t.t, t.b, t.n});
+        sys->m_ties.push_back({t.p, t.t, t.b, t.n, t.compliance});
     if (!ties.empty()) eng.blocks.push_back(detail::makeCouplingBlock(std::move(ties)));
 
     bool anyFree = false;
@@ -487,6 +488,26 @@ double XpbdSystem::maxTieGap() const {
         gap = std::max(gap, c.norm());
     }
     return gap;
+}
+
+std::vector<double> XpbdSystem::tiedInertia(size_t b) const {
+    const Range& r = m_tet.at(b);
+    std::vector<double> added(r.x.size(), 0.0);
+    const double* xw = m_engine->xw.data();
+    std::vector<double> share(m_engine->particleCount(), 0.0); // B_k
+    for (const TieRecord& t : m_ties)
+        if (t.compliance == 0)
+            for (int k = 0; k < t.n; ++k)
+                share[t.t[k]] += std::max(t.b[k], 0.0);
+    for (const TieRecord& t : m_ties) {
+        if (t.compliance != 0 || t.p < r.first || t.p >= r.first + static_cast<int32_t>(added.size())) continue;
+        double inv = 0; // Σ b_k B_k / m_k; fixed nodes (inverse mass 0) add nothing
+        for (int k = 0; k < t.n; ++k)
+            if (detail::particleInvMass(xw, t.t[k]) > 0 && t.b[k] > 0)
+                inv += t.b[k] * share[t.t[k]] / m_engine->mass[t.t[k]];
+        added[t.p - r.first] += inv > 0 ? 1.0 / inv : std::numeric_limits<double>::infinity();
+    }
+    return added;
 }
 
 double XpbdSystem::elasticEnergy() const {

@@ -151,6 +151,14 @@ public:
     size_t tieCount() const { return m_ties.size(); }
     /// Largest |x_p − Σ b_k x_k| over all ties, m (0 without ties).
     double maxTieGap() const;
+    /// Inertia that hard ties (compliance 0) add to the nodes of tet body b, kg (one per node; 0
+    /// where a node is not hard-tied; +inf where it is tied to fixed nodes only). A node tied to the
+    /// point Σ b_k x_k of another body (an embedded node to its cage tet) moves with that point
+    /// within every sweep (the tie stage follows elasticity), so its own constraints move its mass
+    /// plus the point's, 1 / Σ_k b_k B_k / m_k: node k's mass m_k is shared among all the ties that
+    /// use it in proportion to their weights (B_k: the sum of those weights), so that no mass counts
+    /// twice. The load-time stability check (stability_check.hpp) divides by it. O(ties).
+    std::vector<double> tiedInertia(size_t b) const;
 
     double elasticEnergy() const;   ///< J: elasticity, membranes, compliant ties and strain limits, relative to rest
     double kineticEnergy() const;   ///< J
@@ -192,6 +200,7 @@ private:
         std::array<int32_t, 4> t;
         std::array<double, 4> b;
         int n;
+        double compliance;
     };
     XpbdSystem();
     static std::unique_ptr<XpbdSystem> build(const XpbdSystemDesc& desc, const XpbdSettings& settings,

@@ -342,3 +342,55 @@ TEST(CollisionSolver, CreateRejectsBadInputWithMessages) {
     EXPECT_THAT([&] { CollisionSolver::create(square(), s); },
                 ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("safe angle")));
 }
+
+TEST(CollisionSolver, BroadPhaseFindsEveryTriangleWhoseSphereBoxMeetsTheTool) {
+    // The broad phase skips the sphere of a triangle whose vertex box, grown by a bound on the
+    // sphere's reach, misses the tool: it must still find exactly the triangles whose sphere box
+    // (safe-cone part or whole sphere) meets the tool's box. Checked by brute force on a box
+    // surface with random dents, some triangles squashed to slivers, stale factors and tools all
+    // over it.
+    auto mesh = makeBoxTetMesh({Vec3::Zero(), Vec3(0.04, 0.03, 0.01), {8, 6, 2}});
+    mesh->requireLevel(3);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    int found = 0, missed = 0; // the trials must both find and leave out triangles
+    for (bool safeCone : {true, false}) {
+        CollisionSettings s;
+        s.safeConeOnly = safeCone;
+        s.circumsphere.energyScale = 0.002;
+        auto col = CollisionSolver::create(
+            CollisionSurfaceDesc::fromTetMesh(*mesh, std::vector<double>(mesh->vertexCount(), 1.0)), s);
+        for (int trial = 0; trial < 30; ++trial) {
+            std::vector<Vec3> x = mesh->positions();
+            for (Vec3& p : x)
+                p += 0.0015 * Vec3(u(rng), u(rng), u(rng));
+            for (size_t t = 0; t < col->triangleCount(); t += 7) { // slivers: a vertex onto an edge midpoint
+                const Tri& f = col->triangles()[t];
+                x[f[2]] = 0.5 * (x[f[0]] + x[f[1]]) + 1e-5 * Vec3(u(rng), u(rng), u(rng));
+            }
+            if (trial % 3 == 0) col->refreshAllFactors(x); // else factors from an earlier shape
+            const ToolShape tool = sphereAt(0.001 + 0.004 * (u(rng) + 1),
+                                            Vec3(0.02 + 0.03 * u(rng), 0.015 + 0.025 * u(rng), 0.005 + 0.015 * u(rng)));
+            const auto tb = tool.bounds();
+            int expected = 0;
+            for (int32_t t = 0; t < static_cast<int32_t>(col->triangleCount()); ++t) {
+                const Sphere sp = col->triangleSphere(t, x);
+                Vec3 lo = sp.centre - Vec3::Constant(sp.radius), hi = sp.centre + Vec3::Constant(sp.radius);
+                if (safeCone && sp.coneCos > -1) {
+                    const double c = std::clamp(sp.coneCos, 0.0, 1.0);
+                    const Vec3 rim = sp.centre + sp.radius * c * sp.coneAxis;
+                    const Vec3 R = Vec3::Constant(sp.radius * std::sqrt(1 - c * c));
+                    lo = (rim - R).cwiseMin(sp.centre);
+                    hi = (rim + R).cwiseMax(sp.centre);
+                }
+                expected += (lo.array() <= tb[1].array()).all() && (tb[0].array() <= hi.array()).all();
+            }
+            col->beginStep(x, tool, 1e-3);
+            EXPECT_EQ(col->stats().candidates, expected) << "trial " << trial << (safeCone ? " safe cone" : "");
+            found += expected;
+            missed += static_cast<int>(col->triangleCount()) - expected;
+        }
+    }
+    EXPECT_GT(found, 0);
+    EXPECT_GT(missed, 0);
+}

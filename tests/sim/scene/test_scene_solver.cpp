@@ -262,3 +262,96 @@ TEST(PreconditionError, KeepsTheRuleApartFromTheFunction) {
         EXPECT_EQ(std::string(e.what()), "sim::XpbdSolver::setState(): " + e.rule);
     }
 }
+
+namespace {
+
+/// A fat cantilever (6 × 2 × 2 cm, 5 mm cells, 3 kPa) with a stiffer vessel bar embedded in it
+/// (4 × 0.8 × 0.8 cm, 20 kPa): the vessel's stiffness number limits the scene.
+struct EmbeddedScene {
+    SceneDesc scene;
+    std::vector<std::unique_ptr<TetMesh>> meshes;
+    explicit EmbeddedScene(int substeps) {
+        scene.xpbd.substeps = substeps;
+        scene.xpbd.damping = 2.0;
+        meshes.push_back(makeBoxTetMesh({Vec3::Zero(), Vec3(0.06, 0.02, 0.02), {12, 4, 4}}));
+        meshes.push_back(makeBoxTetMesh({Vec3(0.01, 0.006, 0.006), Vec3(0.04, 0.008, 0.008), {8, 1, 1}}));
+        BodyDesc fat;
+        fat.name = "fat";
+        fat.meshPath = "meshes/fat.vtet";
+        fat.material.youngsModulus = 3000;
+        fat.material.density = 950;
+        for (int32_t v = 0; v < static_cast<int32_t>(meshes[0]->vertexCount()); ++v)
+            if (meshes[0]->positions()[v].x() < 1e-9) fat.fixedNodes.push_back(v);
+        BodyDesc vessel;
+        vessel.name = "vessel";
+        vessel.meshPath = "meshes/vessel.vtet";
+        vessel.material.youngsModulus = 20000;
+        vessel.material.density = 1050;
+        vessel.embeddedIn = "fat";
+        scene.bodies = {fat, vessel};
+    }
+    std::vector<StabilityFigures> figures() const {
+        const std::vector<TriMesh> none;
+        return assessSceneStability({scene, meshes, none, "case"});
+    }
+};
+
+} // namespace
+
+TEST(SceneSolver, EmbeddedBodiesCountTheInertiaOfTheirCage) {
+    // The vessel's nodes move with the fat they are tied to, so the scene rule divides its
+    // stiffness number by (own + tied mass) / own mass; the body-alone figure cannot see that.
+    EmbeddedScene probe(20);
+    const auto scene = probe.figures();
+    ASSERT_EQ(scene.size(), 2u);
+    const BodyDesc& v = probe.scene.bodies[1];
+    const StabilityFigures alone = assessStability(*probe.meshes[1], *makeConstraintModel(v.material, v.name),
+                                                   v.material.density, {}, probe.scene.xpbd);
+    EXPECT_GT(alone.maxStiffnessNumber, scene[1].maxStiffnessNumber * 1.2);
+    EXPECT_GT(scene[1].maxStiffnessNumber, scene[0].maxStiffnessNumber) << "the vessel limits the scene";
+    const StabilityFigures fatAlone =
+        assessStability(*probe.meshes[0], *makeConstraintModel(probe.scene.bodies[0].material, "fat"),
+                        probe.scene.bodies[0].material.density, {}, probe.scene.xpbd);
+    EXPECT_EQ(scene[0].maxStiffnessNumber, fatAlone.maxStiffnessNumber) << "nothing is tied to the fat's nodes";
+
+    // The World accepts the fewest substeps the scene rule asks for, and refuses one fewer with the
+    // one-line message that names the body.
+    const int required = std::max(scene[0].requiredSubsteps, scene[1].requiredSubsteps);
+    ASSERT_LT(required, alone.requiredSubsteps) << "the tied inertia saves substeps";
+    {
+        EmbeddedScene fewer(required - 1);
+        try {
+            World::assemble(fewer.scene, std::move(fewer.meshes), {}, requiredFeatures(fewer.scene), "case");
+            ADD_FAILURE() << "accepted at " << required - 1 << " substeps";
+        } catch (const viscera::InputError& e) {
+            EXPECT_THAT(e.what(), HasSubstr("scene cannot be simulated stably: body 'vessel': stiffness number"));
+        }
+    }
+    // At that setting the run stays finite with bounded energy, and repeats bit for bit.
+    auto run = [&] {
+        EmbeddedScene at(required);
+        auto w = World::assemble(at.scene, std::move(at.meshes), {}, requiredFeatures(at.scene), "case");
+        return w;
+    };
+    auto a = run(), b = run();
+    double mass = 0;
+    for (size_t i = 0; i < 2; ++i)
+        for (const Tet& t : a->restMesh(i).tets()) {
+            const auto& x = a->restMesh(i).positions();
+            mass += (i == 0 ? 950.0 : 1050.0) *
+                    std::abs((x[t[1]] - x[t[0]]).dot((x[t[2]] - x[t[0]]).cross(x[t[3]] - x[t[0]]))) / 6;
+        }
+    const double bound = 0.05 * mass * 9.81 * 0.06; // the stability suite's 5 % of m g L
+    for (int f = 0; f < 180; ++f) {
+        const FrameRecord ra = a->step();
+        b->step();
+        ASSERT_TRUE(ra.finite) << "frame " << f;
+        ASSERT_LE(a->invariants().maxEnergy, bound) << "frame " << f;
+        for (size_t i = 0; i < 2; ++i)
+            for (const Vec3& p : a->positions(i))
+                ASSERT_TRUE(p.allFinite());
+    }
+    EXPECT_TRUE(a->invariants().allFinite);
+    for (size_t i = 0; i < 2; ++i)
+        EXPECT_EQ(a->positions(i), b->positions(i)) << "repeat runs must be bit-identical";
+}

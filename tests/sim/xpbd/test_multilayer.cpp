@@ -1,5 +1,6 @@
 // Multi-layer tissue [A §4.2]: fascia membranes, couplings, embedded tissue, surface strain
 // limits in the UV frame, and the XpbdSystem that solves them together.
+#include "sim/diagnostics/stability_check.hpp"
 #include "sim/material/stable_neo_hookean.hpp"
 #include "sim/xpbd/coupling.hpp"
 #include "sim/xpbd/membrane.hpp"
@@ -267,6 +268,85 @@ TEST(XpbdSystem, CompliantTiesLetTheLayersSlideApartElastically) {
     EXPECT_GT(soft->maxTieGap(), 5 * hard->maxTieGap());
     EXPECT_LT(soft->maxTieGap(), 0.01);
     EXPECT_GT(soft->elasticEnergy(), 0.0);
+}
+
+TEST(XpbdSystem, TiedInertiaSharesTheCageMassAmongTheEmbeddedNodes) {
+    Layers L;
+    auto sys = XpbdSystem::create(L.desc(), XpbdSettings{});
+    const std::vector<double> vessel = sys->tiedInertia(1);
+    ASSERT_EQ(vessel.size(), L.vessel->vertexCount());
+    // Independently: lumped fat masses, the cage locations, the weight sums B_k, then
+    // 1 / Σ_k b_k B_k / m_k per vessel node.
+    std::vector<double> m(L.fat->vertexCount(), 0.0), B(m.size(), 0.0);
+    double fatMass = 0;
+    for (size_t t = 0; t < L.fat->tetCount(); ++t)
+        for (int32_t v : L.fat->tets()[t]) {
+            m[v] += 950 * L.fat->signedVolume(t) / 4;
+            fatMass += 950 * L.fat->signedVolume(t) / 4;
+        }
+    const auto loc = locateInCage(*L.fat, L.vessel->positions(), 1e-9);
+    for (const CageLocation& c : loc)
+        for (int k = 0; k < 4; ++k)
+            B[L.fat->tets()[c.tet][k]] += std::max(c.bary[k], 0.0);
+    double sum = 0;
+    for (const CageLocation& c : loc) {
+        double inv = 0;
+        for (int k = 0; k < 4; ++k) {
+            const int32_t n = L.fat->tets()[c.tet][k];
+            if (c.bary[k] > 0) inv += c.bary[k] * B[n] / m[n];
+        }
+        EXPECT_NEAR(vessel[c.point], 1 / inv, 1e-12 / inv) << "node " << c.point;
+        EXPECT_GT(vessel[c.point], 0.0);
+        sum += vessel[c.point];
+    }
+    EXPECT_LE(sum, fatMass) << "no cage mass counts twice";
+    // Nothing is tied to the fat's own nodes (the fascia's ties move fascia vertices).
+    for (double a : sys->tiedInertia(0))
+        EXPECT_EQ(a, 0.0);
+    // Compliant ties add nothing; a cage held in place makes the tied nodes immovable.
+    XpbdSystemDesc soft = L.desc();
+    soft.embeddings[0].compliance = 1e-6;
+    for (double a : XpbdSystem::create(soft, XpbdSettings{})->tiedInertia(1))
+        EXPECT_EQ(a, 0.0);
+    XpbdSystemDesc held = L.desc();
+    held.tetBodies[0].fixedNodes.resize(L.fat->vertexCount());
+    for (int32_t v = 0; v < static_cast<int32_t>(L.fat->vertexCount()); ++v)
+        held.tetBodies[0].fixedNodes[v] = v;
+    for (double a : XpbdSystem::create(held, XpbdSettings{})->tiedInertia(1))
+        EXPECT_EQ(a, kInf);
+    EXPECT_THROW(sys->tiedInertia(2), std::out_of_range);
+}
+
+TEST(StabilityCheck, TiedMassDividesTheStiffnessNumber) {
+    Layers L;
+    const auto model = snh(10000);
+    XpbdSettings s;
+    s.substeps = 20;
+    const StabilityFigures alone = assessStability(*L.vessel, *model, 1050, {}, s);
+    const StabilityFigures zero =
+        assessStability(*L.vessel, *model, 1050, {}, s, std::vector<double>(L.vessel->vertexCount(), 0.0));
+    EXPECT_EQ(zero.maxStiffnessNumber, alone.maxStiffnessNumber);
+    EXPECT_EQ(zero.worstTet, alone.worstTet);
+    // Three times each node's own lumped mass tied to it: every tet moves 4 times the inertia.
+    std::vector<double> own(L.vessel->vertexCount(), 0.0);
+    for (size_t t = 0; t < L.vessel->tetCount(); ++t)
+        for (int32_t v : L.vessel->tets()[t])
+            own[v] += 1050 * L.vessel->signedVolume(t) / 4;
+    for (double& m : own)
+        m *= 3;
+    const StabilityFigures tied = assessStability(*L.vessel, *model, 1050, {}, s, own);
+    EXPECT_NEAR(tied.maxStiffnessNumber, alone.maxStiffnessNumber / 4, 1e-12 * alone.maxStiffnessNumber);
+    // Immovable nodes (+inf) make their tets' number 0.
+    const StabilityFigures held =
+        assessStability(*L.vessel, *model, 1050, {}, s, std::vector<double>(L.vessel->vertexCount(), kInf));
+    EXPECT_EQ(held.maxStiffnessNumber, 0.0);
+    EXPECT_TRUE(held.ok());
+    try {
+        assessStability(*L.vessel, *model, 1050, {}, s, {1.0});
+        ADD_FAILURE() << "a tiedMass of the wrong size was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_THAT(e.what(), HasSubstr("sim::assessStability(): tiedMass has 1 values for"));
+    }
 }
 
 TEST(XpbdSystem, StiffnessRatioOfAMillionStaysFiniteAndBounded) {

@@ -411,36 +411,70 @@ public:
         return 3;
     }
     void solve(size_t pb, size_t pe, const SolveContext& ctx) override {
+        // The three Green-strain constraints ε00, ε11, √2 ε01 of each triangle (triGreenStrain),
+        // Gauss–Seidel one after the other; F = Ds M with Ds = [x1 − x0, x2 − x0] (3 × 2). The
+        // (up to) four triangles of a pack share no particle (one colour), so they are worked on
+        // side by side, constraint by constraint, on local copies of their vertices (written back
+        // at the end): the same arithmetic per triangle as one after the other, with four
+        // independent dependency chains in flight.
         static const double kSqrt2 = std::sqrt(2.0);
         static const int kEntry[3][2] = {{0, 0}, {1, 1}, {0, 1}};
-        for (size_t s = 4 * pb; s < 4 * pe; ++s) {
-            const int32_t u = m_slots[s];
-            if (u < 0 || !m_active[u]) continue;
-            double* lam = m_lam.data() + 3 * s;
-            if (ctx.first) std::fill_n(lam, 3, 0.0);
-            const Tri& e = m_tris[u];
-            const double t = ctx.h2inv / (m_k * m_area[u]);
-            double w[3];
-            for (int i = 0; i < 3; ++i)
-                w[i] = particleInvMass(ctx.xw, e[i]);
-            for (int c = 0; c < 3; ++c) {
-                std::array<Vec3, 3> x, g;
-                for (int i = 0; i < 3; ++i)
-                    x[i] = particlePosition(ctx.xw, e[i]);
-                double C = triGreenStrain(x, m_dmInv[u], kEntry[c][0], kEntry[c][1], &g);
-                if (c == 2) {
-                    C *= kSqrt2;
-                    for (Vec3& gi : g)
-                        gi *= kSqrt2;
+        for (size_t q = pb; q < pe; ++q) {
+            int n = 0;
+            int32_t slot[4];
+            for (size_t s = 4 * q; s < 4 * q + 4; ++s)
+                if (m_slots[s] >= 0 && m_active[m_slots[s]]) slot[n++] = static_cast<int32_t>(s);
+            double x[4][3][3], w[4][3], t[4];
+            for (int l = 0; l < n; ++l) {
+                const int32_t u = m_slots[slot[l]];
+                if (ctx.first) std::fill_n(m_lam.data() + 3 * slot[l], 3, 0.0);
+                t[l] = ctx.h2inv / (m_k * m_area[u]);
+                for (int i = 0; i < 3; ++i) {
+                    const double* p = ctx.xw + 4 * static_cast<size_t>(m_tris[u][i]);
+                    for (int r = 0; r < 3; ++r)
+                        x[l][i][r] = p[r];
+                    w[l][i] = p[3];
                 }
-                double den = t;
-                for (int i = 0; i < 3; ++i)
-                    den += w[i] * g[i].squaredNorm();
-                if (!(den > 0) || !std::isfinite(den)) continue;
-                const double d = (-C - t * lam[c]) / den;
-                lam[c] += d;
-                for (int i = 0; i < 3; ++i)
-                    moveParticle(ctx.xw, e[i], (w[i] * d) * g[i]);
+            }
+            for (int c = 0; c < 3; ++c) {
+                const int ci = kEntry[c][0], cj = kEntry[c][1];
+                const double scale = c == 2 ? kSqrt2 : 1.0;
+                for (int l = 0; l < n; ++l) {
+                    const Mat2& M = m_dmInv[m_slots[slot[l]]];
+                    double* lam = m_lam.data() + 3 * slot[l];
+                    double F[2][3]; // F[col][row]
+                    for (int r = 0; r < 3; ++r) {
+                        const double d1 = x[l][1][r] - x[l][0][r], d2 = x[l][2][r] - x[l][0][r];
+                        F[0][r] = d1 * M(0, 0) + d2 * M(1, 0);
+                        F[1][r] = d1 * M(0, 1) + d2 * M(1, 1);
+                    }
+                    const double C =
+                        scale * 0.5 *
+                        (F[ci][0] * F[cj][0] + F[ci][1] * F[cj][1] + F[ci][2] * F[cj][2] - (ci == cj ? 1.0 : 0.0));
+                    double g[3][3];
+                    for (int r = 0; r < 3; ++r) {
+                        g[1][r] = scale * 0.5 * (M(0, ci) * F[cj][r] + M(0, cj) * F[ci][r]);
+                        g[2][r] = scale * 0.5 * (M(1, ci) * F[cj][r] + M(1, cj) * F[ci][r]);
+                        g[0][r] = -(g[1][r] + g[2][r]);
+                    }
+                    double den = t[l];
+                    for (int i = 0; i < 3; ++i)
+                        den += w[l][i] * (g[i][0] * g[i][0] + g[i][1] * g[i][1] + g[i][2] * g[i][2]);
+                    if (!(den > 0) || !std::isfinite(den)) continue;
+                    const double d = (-C - t[l] * lam[c]) / den;
+                    lam[c] += d;
+                    for (int i = 0; i < 3; ++i)
+                        for (int r = 0; r < 3; ++r)
+                            x[l][i][r] += w[l][i] * d * g[i][r];
+                }
+            }
+            for (int l = 0; l < n; ++l) {
+                const int32_t u = m_slots[slot[l]];
+                for (int i = 0; i < 3; ++i) {
+                    double* p = ctx.xw + 4 * static_cast<size_t>(m_tris[u][i]);
+                    for (int r = 0; r < 3; ++r)
+                        p[r] = x[l][i][r];
+                }
             }
         }
     }
