@@ -6,8 +6,14 @@
 #include <Eigen/Cholesky>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
+#ifdef __linux__
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
 #include <thread>
 
 namespace viscera::sim {
@@ -22,6 +28,7 @@ struct Factor {
     Eigen::VectorXd f;           ///< f_R, 3#V
     Eigen::VectorXd u0;          ///< K_R⁻¹ f_R
     std::vector<Vec3> xAt;       ///< positions the rotations were taken from
+    long factorNonZeros = 0;     ///< nnz(L), for the cost model of a solve
 };
 
 struct Group {
@@ -54,6 +61,8 @@ std::string validate(const FemSettings& s) {
         return "release/activation tolerances must be >= 0";
     if (s.maxActiveSetIterations < 1) return "max_active_set_iterations must be >= 1";
     if (s.cacheEvictSteps < 1) return "cache_evict_steps must be >= 1";
+    if (s.refactorNodesPerSolve < 1) return "refactor_nodes_per_solve must be >= 1";
+    if (s.prefetchNodesPerSolve < 0) return "prefetch_nodes_per_solve must be >= 0";
     return {};
 }
 
@@ -82,18 +91,29 @@ struct CorotationalFem::Impl {
     size_t liveGroups = 0;
     int step = 0;
 
-    // background refactorization
+    // Background refactorization, in two phases. Worker: rotations, assembly, numeric factorization
+    // and u0 of the positions at the request (joined exactly `refactorLatencySteps` solves later).
+    // Main thread, amortized: the K⁻¹ columns of the nodes carried over (pinned or in recent use),
+    // `refactorNodesPerSolve` nodes per solve with the new factor while the old one keeps serving
+    // the solves; the swap happens at the first solve that finds every carried node done. All of it
+    // counts solves and nodes, never time: the swap step is the same on every run.
     struct Job {
         std::vector<Vec3> x;
-        std::vector<int> nodes;
         Factor result;
-        Eigen::MatrixXd kinv, cols;
         bool ok = false;
         std::string error;
+        std::atomic<bool> finished{false};
+        bool joined = false;
+        std::vector<int> nodes; // carried nodes, in order; columns of the first `done` are in cols
+        int done = 0;
+        Eigen::MatrixXd cols; // 3#V × 3·capacity
     };
     std::unique_ptr<Job> job;
     std::thread worker;
     int swapStep = 0;
+    std::vector<uint8_t> pinned; // per node: kept in the cache and carried by a refactorization
+    std::vector<int> prefetch;   // nodes queued for caching ahead of use (FIFO)
+    size_t prefetchHead = 0;
 
     std::vector<std::array<int32_t, 2>> edges; // unique tet edges, for the refactor test
 
@@ -152,8 +172,9 @@ struct CorotationalFem::Impl {
         out.xAt = x;
         std::vector<double> values;
         assemble(out.rotations, values, out.f);
-        if (!out.chol) out.chol = std::make_unique<SparseCholesky>(pattern);
+        if (!out.chol) out.chol = std::make_unique<SparseCholesky>(pattern, s.cholesky);
         if (!out.chol->factorize(values, error)) return false;
+        out.factorNonZeros = out.chol->factorNonZeros();
         out.u0 = out.f;
         if (!out.chol->solveInPlace(out.u0.data(), 1, error)) return false;
         return out.u0.allFinite();
@@ -239,28 +260,80 @@ struct CorotationalFem::Impl {
 
     void evict() {
         for (size_t s2 = 0; s2 < nodeOf.size(); ++s2)
-            if (nodeOf[s2] >= 0 && step - lastUsed[s2] > s.cacheEvictSteps) {
+            if (nodeOf[s2] >= 0 && !pinned[nodeOf[s2]] && step - lastUsed[s2] > s.cacheEvictSteps) {
                 slotOf[nodeOf[s2]] = -1;
                 nodeOf[s2] = -1;
                 freeSlots.push_back(static_cast<int>(s2));
             }
     }
 
-    void takeJob(FemSolveStats& st) {
-        worker.join();
-        std::unique_ptr<Job> j = std::move(job);
-        if (!j->ok) {
-            st.error = "background refactorization failed (the previous factor stays in use): " + j->error;
-            cur.xAt = j->x; // do not retry at once
+    /// Nodes cached now that a refactorization must carry: pinned or used in the last two solves.
+    void carriedNodes(std::vector<int>& out) const {
+        for (size_t s2 = 0; s2 < nodeOf.size(); ++s2) {
+            const int node = nodeOf[s2];
+            if (node >= 0 && (pinned[node] || step - lastUsed[s2] <= 1)) out.push_back(node);
+        }
+    }
+
+    /// Advances a refactorization at the start of a solve: joins the worker at its step, computes
+    /// the next chunk of carried columns, or swaps the new factor in. Deterministic (see Job).
+    void advanceJob(FemSolveStats& st) {
+        if (!job) return;
+        if (!job->joined) {
+            if (step < swapStep) return;
+            st.refactorWaited = !job->finished.load(std::memory_order_acquire);
+            worker.join();
+            job->joined = true;
+            if (!job->ok) {
+                st.error = "background refactorization failed (the previous factor stays in use): " + job->error;
+                cur.xAt = job->x; // do not retry at once
+                job.reset();
+                return;
+            }
+            carriedNodes(job->nodes);
+        }
+        Job& j = *job;
+        if (j.done == static_cast<int>(j.nodes.size())) {
+            // Nodes that came into use while the columns were computed travel too; swap when none is left.
+            std::vector<int> more;
+            carriedNodes(more);
+            for (int node : more)
+                if (std::find(j.nodes.begin(), j.nodes.end(), node) == j.nodes.end()) j.nodes.push_back(node);
+        }
+        const int k = static_cast<int>(j.nodes.size());
+        if (j.done < k) {
+            const int chunk = std::min(k - j.done, s.refactorNodesPerSolve);
+            const int n = n3();
+            if (j.cols.cols() < 3 * (j.done + chunk))
+                j.cols.conservativeResize(n, std::max<Eigen::Index>(3 * k, 2 * j.cols.cols()));
+            auto block = j.cols.middleCols(3 * j.done, 3 * chunk);
+            block.setZero();
+            for (int i = 0; i < chunk; ++i)
+                for (int c = 0; c < 3; ++c)
+                    block(3 * j.nodes[j.done + i] + c, 3 * i + c) = 1.0;
+            if (!j.result.chol->solveInPlace(block.data(), 3 * chunk, st.error)) {
+                job.reset();
+                return;
+            }
+            j.done += chunk;
+            st.substitutions += 3 * chunk;
             return;
         }
+        takeJob(st);
+    }
+
+    void takeJob(FemSolveStats& st) {
+        std::unique_ptr<Job> j = std::move(job);
         cur = std::move(j->result);
         resetCache();
         const int k = static_cast<int>(j->nodes.size());
-        kinv = Eigen::MatrixXd::Zero(std::max(96, 3 * k), std::max(96, 3 * k));
-        kinv.topLeftCorner(3 * k, 3 * k) = j->kinv;
-        cols.resize(n3(), kinv.cols());
-        cols.leftCols(3 * k) = j->cols;
+        const int cap = std::max(96, 3 * k);
+        kinv = Eigen::MatrixXd::Zero(cap, cap);
+        for (int a = 0; a < k; ++a)
+            for (int b = 0; b < k; ++b)
+                kinv.block<3, 3>(3 * a, 3 * b) = j->cols.block<3, 3>(3 * j->nodes[a], 3 * b);
+        cols.resize(n3(), cap);
+        cols.leftCols(3 * k) = j->cols.leftCols(3 * k);
         for (int i = 0; i < k; ++i) {
             nodeOf.push_back(j->nodes[i]);
             lastUsed.push_back(step);
@@ -272,21 +345,40 @@ struct CorotationalFem::Impl {
     void startJob(const std::vector<Vec3>& x) {
         job = std::make_unique<Job>();
         job->x = x;
-        // Only nodes in use now travel with the new factor; the rest are re-cached when needed.
-        for (size_t s2 = 0; s2 < nodeOf.size(); ++s2)
-            if (nodeOf[s2] >= 0 && step - lastUsed[s2] <= 1) job->nodes.push_back(nodeOf[s2]);
         swapStep = step + s.refactorLatencySteps;
         Job* jp = job.get();
-        const int n = n3();
-        worker = std::thread([this, jp, n] {
+        worker = std::thread([this, jp] {
+#ifdef __linux__
+            // Lowest priority: on a shared core the worker takes the idle time between frames and
+            // does not pre-empt the steps (the join waits for it when it is late; results never change).
+            setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
+#endif
             try {
-                jp->ok = buildFactor(jp->x, jp->result, jp->error) &&
-                         inverseBlocks(jp->result, jp->nodes, n, jp->kinv, jp->cols, jp->error);
+                jp->ok = buildFactor(jp->x, jp->result, jp->error);
             } catch (const std::exception& e) {
                 jp->ok = false;
                 jp->error = e.what();
             }
+            jp->finished.store(true, std::memory_order_release);
         });
+    }
+
+    /// Caches up to `prefetchNodesPerSolve` queued nodes that are not cached yet.
+    bool prefetchStep(FemSolveStats& st) {
+        std::vector<int> batch;
+        while (prefetchHead < prefetch.size() && static_cast<int>(batch.size()) < s.prefetchNodesPerSolve) {
+            const int node = prefetch[prefetchHead++];
+            if (slotOf[node] < 0 && !(*fixed)[node]) batch.push_back(node);
+        }
+        if (prefetchHead == prefetch.size()) {
+            prefetch.clear();
+            prefetchHead = 0;
+        }
+        if (batch.empty()) return true;
+        if (!cacheNodes(batch, st.error)) return false;
+        st.newCachedNodes += static_cast<int>(batch.size());
+        st.substitutions += 3 * static_cast<int>(batch.size());
+        return true;
     }
 };
 
@@ -377,6 +469,7 @@ std::unique_ptr<CorotationalFem> CorotationalFem::create(const TetMesh& mesh, co
             for (int c = 0; c < 3; ++c)
                 m.fixedDiag.push_back(m.pattern.find(3 * static_cast<int>(v) + c, 3 * static_cast<int>(v) + c));
     m.slotOf.assign(nv, -1);
+    m.pinned.assign(nv, 0);
     std::string error;
     if (!m.buildFactor(w->m_x0, m.cur, error)) fail(error);
     w->m_factorizations = 1;
@@ -453,6 +546,24 @@ int CorotationalFem::cachedNodes() const {
     return c;
 }
 
+void CorotationalFem::pinNodes(const std::vector<int32_t>& nodes) {
+    std::fill(m->pinned.begin(), m->pinned.end(), 0);
+    for (int32_t v : nodes)
+        if (v >= 0 && static_cast<size_t>(v) < m->pinned.size()) m->pinned[v] = 1;
+}
+
+void CorotationalFem::prefetchNodes(const std::vector<int32_t>& nodes) {
+    for (int32_t v : nodes)
+        if (v >= 0 && static_cast<size_t>(v) < m_fixed.size() && !m_fixed[v] && m->slotOf[v] < 0 &&
+            std::find(m->prefetch.begin() + static_cast<long>(m->prefetchHead), m->prefetch.end(), v) ==
+                m->prefetch.end())
+            m->prefetch.push_back(v);
+}
+
+bool CorotationalFem::refactorPending() const {
+    return m->job != nullptr;
+}
+
 bool CorotationalFem::refactorNow(std::string* error) {
     if (m->worker.joinable()) m->worker.join();
     m->job.reset();
@@ -472,11 +583,10 @@ FemSolveStats CorotationalFem::solve() {
     Impl& I = *m;
     FemSolveStats st;
     ++I.step;
-    if (I.job && I.step >= I.swapStep) {
-        I.takeJob(st);
-        if (st.refactored) ++m_factorizations;
-    }
+    I.advanceJob(st);
+    if (st.refactored) ++m_factorizations;
     I.evict();
+    if (!I.prefetch.empty()) I.prefetchStep(st); // a failure is reported in st.error; the solve goes on
     const int n = I.n3();
     const auto& X0 = m_x0;
 
@@ -536,15 +646,26 @@ FemSolveStats CorotationalFem::solve() {
     std::vector<uint8_t> rejected;
     auto solveSchur = [&]() {
         const int mrows = static_cast<int>(rows.size());
+        // W = K⁻¹Cᵀ restricted to the slots the rows use (3|U| × m): the cost does not grow with the
+        // cache size.
         const int S = static_cast<int>(I.nodeOf.size());
-        Eigen::MatrixXd W(3 * S, mrows);
+        std::vector<int> local(S, -1), used;
+        for (const SolveRow& sr : rows)
+            for (const auto& [slot, a] : sr.terms)
+                if (local[slot] < 0) {
+                    local[slot] = static_cast<int>(used.size());
+                    used.push_back(slot);
+                }
+        const int U = static_cast<int>(used.size());
+        Eigen::MatrixXd W(3 * U, mrows);
         Eigen::MatrixXd M(mrows, mrows);
         Eigen::VectorXd q(mrows);
         for (int r = 0; r < mrows; ++r) {
             auto w = W.col(r);
             w.setZero();
             for (const auto& [slot, a] : rows[r].terms)
-                w.noalias() += I.kinv.block(0, 3 * slot, 3 * S, 3) * a;
+                for (int i = 0; i < U; ++i)
+                    w.segment<3>(3 * i).noalias() += I.kinv.block<3, 3>(3 * used[i], 3 * slot) * a;
             double cu0 = 0;
             for (const auto& [node, a] : rows[r].nodeTerms)
                 cu0 += a.dot(I.cur.u0.segment<3>(3 * node));
@@ -554,7 +675,7 @@ FemSolveStats CorotationalFem::solve() {
             for (int c = 0; c <= r; ++c) {
                 double v = 0;
                 for (const auto& [slot, a] : rows[c].terms)
-                    v += a.dot(W.col(r).segment<3>(3 * slot));
+                    v += a.dot(W.col(r).segment<3>(3 * local[slot]));
                 M(r, c) = M(c, r) = v;
             }
         // Pivoted incremental Cholesky in row order; a row whose pivot is too small is rejected.
@@ -608,6 +729,7 @@ FemSolveStats CorotationalFem::solve() {
     };
 
     bool ok = true;
+    std::vector<std::pair<int, Vec3>> gsum;
     for (int outer = 0; outer < I.s.maxActiveSetIterations && ok; ++outer) {
         bool changed = false;
         for (int inner = 0; inner < I.s.maxActiveSetIterations; ++inner) {
@@ -633,23 +755,25 @@ FemSolveStats CorotationalFem::solve() {
             if (!released) break;
         }
         if (!ok) break;
-        // u = K⁻¹ (f − Cᵀλ) = u0 − Σ_nodes K⁻¹[:, node] (Cᵀλ)_node with the cached columns: no
-        // substitution, a dense product over the constrained nodes.
-        {
-            std::vector<std::pair<int, Vec3>> g; // (slot, (Cᵀλ)_node)
-            for (size_t r = 0; r < rows.size(); ++r)
-                if (lam[r] != 0)
-                    for (const auto& [slot, a] : rows[r].terms) {
-                        auto it = std::find_if(g.begin(), g.end(), [&](const auto& e) { return e.first == slot; });
-                        if (it == g.end())
-                            g.emplace_back(slot, lam[r] * a);
-                        else
-                            it->second += lam[r] * a;
-                    }
-            u = I.cur.u0;
-            for (const auto& [slot, gv] : g)
-                u.noalias() -= I.cols.middleCols(3 * slot, 3) * gv;
-        }
+        // u = K⁻¹ (f − Cᵀλ) = u0 − Σ_nodes K⁻¹[:, node] (Cᵀλ)_node. The activation test needs u only
+        // at the nodes of inactive groups: rows of the cached columns, no full product.
+        gsum.clear(); // (slot, (Cᵀλ)_node)
+        for (size_t r = 0; r < rows.size(); ++r)
+            if (lam[r] != 0)
+                for (const auto& [slot, a] : rows[r].terms) {
+                    auto it = std::find_if(gsum.begin(), gsum.end(), [&](const auto& e) { return e.first == slot; });
+                    if (it == gsum.end())
+                        gsum.emplace_back(slot, lam[r] * a);
+                    else
+                        it->second += lam[r] * a;
+                }
+        auto uAt = [&](int32_t node) -> Vec3 {
+            if (m_fixed[node]) return Vec3::Zero();
+            Vec3 v = I.cur.u0.segment<3>(3 * node);
+            for (const auto& [slot, gv] : gsum)
+                v.noalias() -= I.cols.block<3, 3>(3 * node, 3 * slot) * gv;
+            return v;
+        };
         // Activate violated unilateral groups.
         for (int g : order) {
             Group& G = I.groups[g];
@@ -658,7 +782,7 @@ FemSolveStats CorotationalFem::solve() {
             for (size_t r = 0; r < G.desc.rows.size(); ++r) {
                 double v = -G.desc.rows[r].b;
                 for (const ConstraintTerm& t : G.desc.rows[r].terms)
-                    v += t.a.dot(X0[t.node] + (m_fixed[t.node] ? Vec3::Zero() : Vec3(u.segment<3>(3 * t.node))));
+                    v += t.a.dot(X0[t.node] + uAt(t.node));
                 viol += G.desc.weights[r] * v;
             }
             if (viol < -I.s.activationTolerance && outer + 1 < I.s.maxActiveSetIterations) {
@@ -667,6 +791,22 @@ FemSolveStats CorotationalFem::solve() {
             }
         }
         if (!changed) break;
+    }
+    if (ok) {
+        // The full u once: the dense product over the constrained nodes, or one substitution of
+        // f − Cᵀλ when that is cheaper (many constrained nodes; ≈ 4 nnz(L) flops against 6 #V·|g|).
+        const double product = 6.0 * static_cast<double>(m_x.size()) * static_cast<double>(gsum.size());
+        if (product > 4.0 * static_cast<double>(I.cur.factorNonZeros)) {
+            u = I.cur.f;
+            for (const auto& [slot, gv] : gsum)
+                u.segment<3>(3 * I.nodeOf[slot]) -= gv;
+            if (!I.cur.chol->solveInPlace(u.data(), 1, st.error)) ok = false;
+            ++st.substitutions;
+        } else {
+            u = I.cur.u0;
+            for (const auto& [slot, gv] : gsum)
+                u.noalias() -= I.cols.middleCols(3 * slot, 3) * gv;
+        }
     }
     st.finite = ok && u.allFinite() && (lam.size() == 0 || lam.allFinite());
     if (!st.finite) {
@@ -724,6 +864,7 @@ FemSolveStats CorotationalFem::solve() {
                 st.error = err;
         } else {
             I.startJob(m_x);
+            st.refactorStarted = true;
         }
     }
     return st;
