@@ -4,10 +4,13 @@
 #include "sim/util/format.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #ifdef __linux__
 #include <sys/resource.h>
@@ -40,6 +43,7 @@ struct Group {
 /// A row of the current solve: free-node terms only, right-hand side in displacement form.
 struct SolveRow {
     int group = 0, row = 0;
+    int id = 0; ///< index among the rows of all live groups (key of the solve's M cache)
     std::vector<std::pair<int, Vec3>> terms;         // (cache slot, coefficient)
     std::vector<std::pair<int32_t, Vec3>> nodeTerms; // (node, coefficient), free nodes
     double bu = 0;
@@ -565,11 +569,19 @@ bool CorotationalFem::refactorPending() const {
 }
 
 bool CorotationalFem::refactorNow(std::string* error) {
+    return refactorAt(m_x, error);
+}
+
+bool CorotationalFem::refactorAt(const std::vector<Vec3>& x, std::string* error) {
+    if (x.size() != m_x.size()) {
+        if (error) *error = std::string(kWhere) + "refactorAt(): positions have the wrong size";
+        return false;
+    }
     if (m->worker.joinable()) m->worker.join();
     m->job.reset();
     Factor f;
     std::string err;
-    if (!m->buildFactor(m_x, f, err)) {
+    if (!m->buildFactor(x, f, err)) {
         if (error) *error = err;
         return false;
     }
@@ -603,6 +615,17 @@ FemSolveStats CorotationalFem::solve() {
 
     std::vector<SolveRow> rows;
     Eigen::VectorXd lam, u(n);
+    // M = C K⁻¹ Cᵀ entries are computed once per solve, when a pair of rows first meets: the rows
+    // of a group do not change within a solve, only which groups are active, so the active-set
+    // iterations reuse them.
+    std::vector<int> rowBase(I.groups.size(), 0);
+    int allRows = 0;
+    for (int g : order) {
+        rowBase[g] = allRows;
+        allRows += static_cast<int>(I.groups[g].desc.rows.size());
+    }
+    Eigen::MatrixXd mCache(allRows, allRows);
+    std::vector<uint8_t> mHave(static_cast<size_t>(allRows) * allRows, 0);
     auto buildRows = [&]() -> bool {
         rows.clear();
         std::vector<int> missing;
@@ -617,6 +640,7 @@ FemSolveStats CorotationalFem::solve() {
                 SolveRow sr;
                 sr.group = g;
                 sr.row = static_cast<int>(r);
+                sr.id = rowBase[g] + static_cast<int>(r);
                 sr.bu = G.desc.rows[r].b;
                 for (const ConstraintTerm& t : G.desc.rows[r].terms) {
                     sr.bu -= t.a.dot(X0[t.node]);
@@ -644,28 +668,14 @@ FemSolveStats CorotationalFem::solve() {
 
     // Dense Schur system on the rows: returns false on failure. Fills lam (per row; 0 if rejected).
     std::vector<uint8_t> rejected;
+    using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    RowMatrix L;
+    std::vector<int> acc, prevIds; // accepted rows and row ids of the previous active-set iteration
     auto solveSchur = [&]() {
         const int mrows = static_cast<int>(rows.size());
-        // W = K⁻¹Cᵀ restricted to the slots the rows use (3|U| × m): the cost does not grow with the
-        // cache size.
-        const int S = static_cast<int>(I.nodeOf.size());
-        std::vector<int> local(S, -1), used;
-        for (const SolveRow& sr : rows)
-            for (const auto& [slot, a] : sr.terms)
-                if (local[slot] < 0) {
-                    local[slot] = static_cast<int>(used.size());
-                    used.push_back(slot);
-                }
-        const int U = static_cast<int>(used.size());
-        Eigen::MatrixXd W(3 * U, mrows);
         Eigen::MatrixXd M(mrows, mrows);
         Eigen::VectorXd q(mrows);
         for (int r = 0; r < mrows; ++r) {
-            auto w = W.col(r);
-            w.setZero();
-            for (const auto& [slot, a] : rows[r].terms)
-                for (int i = 0; i < U; ++i)
-                    w.segment<3>(3 * i).noalias() += I.kinv.block<3, 3>(3 * used[i], 3 * slot) * a;
             double cu0 = 0;
             for (const auto& [node, a] : rows[r].nodeTerms)
                 cu0 += a.dot(I.cur.u0.segment<3>(3 * node));
@@ -673,24 +683,42 @@ FemSolveStats CorotationalFem::solve() {
         }
         for (int r = 0; r < mrows; ++r)
             for (int c = 0; c <= r; ++c) {
-                double v = 0;
-                for (const auto& [slot, a] : rows[c].terms)
-                    v += a.dot(W.col(r).segment<3>(3 * local[slot]));
-                M(r, c) = M(c, r) = v;
+                const size_t key = static_cast<size_t>(rows[r].id) * allRows + rows[c].id;
+                if (!mHave[key]) {
+                    double v = 0; // Σ_terms a_rᵀ K⁻¹[slot_r, slot_c] a_c
+                    for (const auto& [sr, ar] : rows[r].terms)
+                        for (const auto& [sc, ac] : rows[c].terms)
+                            v += ar.dot(I.kinv.block<3, 3>(3 * sr, 3 * sc) * ac);
+                    mCache(rows[r].id, rows[c].id) = mCache(rows[c].id, rows[r].id) = v;
+                    mHave[key] = mHave[static_cast<size_t>(rows[c].id) * allRows + rows[r].id] = 1;
+                }
+                M(r, c) = M(c, r) = mCache(rows[r].id, rows[c].id);
             }
-        // Pivoted incremental Cholesky in row order; a row whose pivot is too small is rejected.
-        Eigen::MatrixXd L = Eigen::MatrixXd::Zero(mrows, mrows);
-        std::vector<int> acc;
-        rejected.assign(mrows, 0);
+        // Pivoted incremental Cholesky in row order; a row whose pivot is too small is rejected. The
+        // rows that lead as in the previous active-set iteration keep their part of the factor (a
+        // released or activated group changes only what follows it).
+        int p = 0;
+        while (p < mrows && p < static_cast<int>(prevIds.size()) && prevIds[p] == rows[p].id)
+            ++p;
+        int k0 = 0;
+        while (k0 < static_cast<int>(acc.size()) && acc[k0] < p)
+            ++k0;
+        acc.resize(k0);
+        rejected.resize(mrows);
+        std::fill(rejected.begin() + p, rejected.end(), 0);
+        if (L.rows() < mrows) {
+            RowMatrix grown(mrows, mrows);
+            grown.topLeftCorner(k0, k0) = L.topLeftCorner(k0, k0);
+            L.swap(grown);
+        }
+        prevIds.resize(mrows);
+        for (int r = 0; r < mrows; ++r)
+            prevIds[r] = rows[r].id;
         Eigen::VectorXd l(mrows);
-        for (int r = 0; r < mrows; ++r) {
+        for (int r = p; r < mrows; ++r) {
             const int k = static_cast<int>(acc.size());
-            for (int i = 0; i < k; ++i) {
-                double v = M(acc[i], r);
-                for (int j = 0; j < i; ++j)
-                    v -= L(i, j) * l[j];
-                l[i] = v / L(i, i);
-            }
+            for (int i = 0; i < k; ++i)
+                l[i] = (M(acc[i], r) - L.row(i).head(i).dot(l.head(i))) / L(i, i);
             const double d = M(r, r) - l.head(k).squaredNorm();
             if (!(M(r, r) > 0) || !(d > I.s.rankTolerance * M(r, r))) {
                 rejected[r] = 1;
@@ -881,6 +909,171 @@ double CorotationalFem::elasticEnergy() const {
         e += 0.5 * d.dot(m->elems[t].stiffness * d);
     }
     return e;
+}
+
+namespace {
+
+/// Corotational element force R K (Rᵀx − x0) (12) and energy ½ dᵀKd at element positions xe.
+double elementForce(const LinearTet& e, const std::array<Vec3, 4>& xe, const std::array<Vec3, 4>& x0, Vec12* force) {
+    const Mat3 R = elementRotation(deformationGradient(e, xe));
+    Vec12 d;
+    for (int a = 0; a < 4; ++a)
+        d.segment<3>(3 * a) = R.transpose() * xe[a] - x0[a];
+    const Vec12 kd = e.stiffness * d;
+    if (force)
+        for (int a = 0; a < 4; ++a)
+            force->segment<3>(3 * a) = R * kd.segment<3>(3 * a);
+    return 0.5 * d.dot(kd);
+}
+
+} // namespace
+
+double CorotationalFem::corotationalEnergy(const std::vector<Vec3>& x) const {
+    double e = 0;
+    for (size_t t = 0; t < m->tets.size(); ++t) {
+        const Tet& T = m->tets[t];
+        e += elementForce(m->elems[t], {x[T[0]], x[T[1]], x[T[2]], x[T[3]]},
+                          {m_x0[T[0]], m_x0[T[1]], m_x0[T[2]], m_x0[T[3]]}, nullptr);
+    }
+    for (size_t v = 0; v < x.size(); ++v)
+        e -= m->fext.segment<3>(3 * v).dot(x[v] - m_x0[v]);
+    return e;
+}
+
+StaticReference CorotationalFem::convergedStatic(const StaticReferenceSettings& rs) const {
+    const auto t0 = std::chrono::steady_clock::now();
+    const Impl& I = *m;
+    StaticReference out;
+    const int n = I.n3();
+    Eigen::MatrixXd C;
+    Eigen::VectorXd bu, lam;
+    lastSystem(C, bu, lam);
+    const int mrows = static_cast<int>(C.rows());
+    std::vector<Vec3> x = m_x;
+    std::vector<double> values;
+    Eigen::VectorXd grad(n);
+    std::string error;
+    SparseCholesky chol(I.pattern, I.s.cholesky);
+    const double h = rs.fdStep * m_meanEdge;
+    Eigen::MatrixXd Z;                  // H⁻¹Cᵀ
+    Eigen::LDLT<Eigen::MatrixXd> schur; // C H⁻¹ Cᵀ
+    double r0 = -1;
+    double E = corotationalEnergy(x);
+    int hessianAge = -1; // iterations since the Hessian was assembled (-1: none yet)
+    for (int it = 0;; ++it) {
+        // Gradient every iteration; the projected Hessian at the first iteration and again every
+        // `hessianRefresh` iterations or when the line search fails with an old one (modified Newton:
+        // the FD Hessian costs 24 polar decompositions per tet, the gradient one).
+        const bool assembleHessian = hessianAge < 0 || hessianAge >= rs.hessianRefresh;
+        if (assembleHessian) {
+            values.assign(I.pattern.rowIdx.size(), 0.0);
+            for (int d : I.fixedDiag)
+                values[d] = 1.0;
+        }
+        grad = -I.fext;
+        for (size_t t = 0; t < I.tets.size(); ++t) {
+            const Tet& T = I.tets[t];
+            std::array<Vec3, 4> xe = {x[T[0]], x[T[1]], x[T[2]], x[T[3]]};
+            const std::array<Vec3, 4> x0 = {m_x0[T[0]], m_x0[T[1]], m_x0[T[2]], m_x0[T[3]]};
+            Vec12 f, fp, fm;
+            elementForce(I.elems[t], xe, x0, &f);
+            for (int a = 0; a < 4; ++a)
+                grad.segment<3>(3 * T[a]) += f.segment<3>(3 * a);
+            if (!assembleHessian) continue;
+            Mat12 H;
+            for (int j = 0; j < 12; ++j) {
+                const double keep = xe[j / 3][j % 3];
+                xe[j / 3][j % 3] = keep + h;
+                elementForce(I.elems[t], xe, x0, &fp);
+                xe[j / 3][j % 3] = keep - h;
+                elementForce(I.elems[t], xe, x0, &fm);
+                xe[j / 3][j % 3] = keep;
+                H.col(j) = (fp - fm) / (2 * h);
+            }
+            H = 0.5 * (H + H.transpose()).eval();
+            Eigen::SelfAdjointEigenSolver<Mat12> eig(H);
+            const Mat12 Hp = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
+                             eig.eigenvectors().transpose();
+            const int* map = &I.scatter[t * 144];
+            for (int i = 0; i < 144; ++i)
+                if (map[i] >= 0) values[map[i]] += Hp(i / 12, i % 12);
+        }
+        for (size_t v = 0; v < m_fixed.size(); ++v)
+            if (m_fixed[v]) grad.segment<3>(3 * v).setZero();
+        if (assembleHessian) {
+            hessianAge = 0;
+            if (!chol.factorize(values, error)) {
+                out.message = error;
+                break;
+            }
+            Z = C.transpose();
+            if (mrows > 0 && !chol.solveInPlace(Z.data(), mrows, error)) {
+                out.message = error;
+                break;
+            }
+            schur = (C * Z).ldlt();
+        }
+        ++hessianAge;
+        // KKT step: Δ = −H⁻¹(∇E + Cᵀμ) with CΔ = 0.
+        Eigen::VectorXd y = grad;
+        if (!chol.solveInPlace(y.data(), 1, error)) {
+            out.message = error;
+            break;
+        }
+        Eigen::VectorXd mu = Eigen::VectorXd::Zero(mrows);
+        if (mrows > 0) mu = schur.solve(-(C * y));
+        const Eigen::VectorXd r = grad + C.transpose() * mu;
+        out.residual = r.lpNorm<Eigen::Infinity>();
+        if (r0 < 0) r0 = std::max(out.residual, 1e-6);
+        out.iterations = it;
+        if (!std::isfinite(out.residual)) {
+            out.message = "non-finite residual";
+            break;
+        }
+        if (out.residual <= rs.tolerance * r0) {
+            out.converged = true;
+            break;
+        }
+        if (it >= rs.maxIterations) {
+            out.message = "max iterations";
+            break;
+        }
+        const Eigen::VectorXd delta = -(y + Z * mu);
+        if (delta.lpNorm<Eigen::Infinity>() <= rs.stepTolerance * m_meanEdge) { // at the rounding floor
+            out.converged = true;
+            break;
+        }
+        const double slope = grad.dot(delta);
+        double step = 1;
+        std::vector<Vec3> trial(x.size());
+        double Et = E;
+        bool accepted = false;
+        for (int b = 0; b < 40; ++b, step *= 0.5) {
+            for (size_t v = 0; v < x.size(); ++v)
+                trial[v] = x[v] + step * delta.segment<3>(3 * v);
+            Et = corotationalEnergy(trial);
+            // Armijo, with the rounding noise of E (a sum over the tets) as slack near x*.
+            if (Et <= E + 1e-4 * step * slope + 64 * std::numeric_limits<double>::epsilon() * std::abs(E)) {
+                accepted = true;
+                break;
+            }
+        }
+        if (!accepted && hessianAge > 1) { // an old Hessian: refresh it and try again
+            hessianAge = rs.hessianRefresh;
+            continue;
+        }
+        if (!accepted) { // at the rounding floor of E: the residual says how far from x* it is
+            out.converged = out.residual <= 1e3 * rs.tolerance * r0;
+            out.message = "line search stalled";
+            break;
+        }
+        x.swap(trial);
+        E = Et;
+    }
+    out.x = std::move(x);
+    out.energy = corotationalEnergy(out.x);
+    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return out;
 }
 
 Eigen::SparseMatrix<double> CorotationalFem::stiffnessMatrix() const {

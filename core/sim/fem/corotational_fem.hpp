@@ -116,6 +116,31 @@ struct FemSolveStats {
     std::string error;            ///< the last failure (empty when none)
 };
 
+/// Converged nonlinear static solution of a solve's problem (the measuring reference of the FEM's
+/// error against run time): the minimizer of the corotational energy with the rotations taken from
+/// the positions themselves, E(x) = Σ_e ½ d_eᵀ K_e d_e − f_extᵀ(x − x0), d_e = R_e(x)ᵀx_e − x0_e
+/// (R_e the polar rotation of F_e; its gradient is Σ R_e K_e d_e exactly), under the rows the
+/// solve enforced, as equalities. Newton from the solve's result: element Hessians by central
+/// differences of that gradient, projected to positive semi-definite (reassembled every
+/// `hessianRefresh` iterations), a KKT step through the Schur complement, Armijo backtracking on E. x* is the fixed point that refactorizing every solve
+/// until the rotations stop changing would reach.
+struct StaticReferenceSettings {
+    double tolerance = 1e-10; ///< converged when ‖∇E + Cᵀμ‖∞ ≤ tolerance · max(‖·‖∞ at the start, 1e-6 N) …
+    double stepTolerance = 1e-9; ///< … or the Newton step is below this many mean edge lengths
+    int maxIterations = 60;
+    double fdStep = 1e-6;   ///< central-difference step, relative to the mean edge length
+    int hessianRefresh = 8; ///< iterations between two Hessian assemblies (modified Newton in between)
+};
+struct StaticReference {
+    bool converged = false;
+    int iterations = 0;
+    std::vector<Vec3> x;         ///< x*, metres
+    double energy = 0;           ///< E(x*), J
+    double residual = 0;         ///< ‖∇E + Cᵀμ‖∞ at x*, N
+    double seconds = 0;          ///< wall time of the reference solve
+    std::string message;         ///< why it stopped when not converged
+};
+
 class CorotationalFem {
 public:
     /// Throws std::invalid_argument naming the rule: bad settings, fixed node out of range, an
@@ -145,6 +170,9 @@ public:
     FemSolveStats solve();
     /// Re-extracts the rotations from the current positions and refactorizes now (synchronous).
     bool refactorNow(std::string* error = nullptr);
+    /// The same with the rotations of positions x (nodeCount() entries), e.g. those a background
+    /// refactorization was started from. False with `error` on a size mismatch or a failed factorization.
+    bool refactorAt(const std::vector<Vec3>& x, std::string* error = nullptr);
     /// Background: a refactorization is in progress (worker or carried columns).
     bool refactorPending() const;
     /// Nodes kept in the constrained-node cache once cached (never evicted) and carried by a
@@ -161,6 +189,12 @@ public:
     bool isFixed(int32_t node) const { return m_fixed[node] != 0; }
     /// Elastic energy ½ uᵀ K_R u − (f_R − f_ext)ᵀu of the current state under the current rotations, J.
     double elasticEnergy() const;
+    /// E(x) of StaticReference (rotations from x itself), J. x has nodeCount() entries.
+    double corotationalEnergy(const std::vector<Vec3>& x) const;
+    /// The converged nonlinear static solution of the last solve's problem (its enforced rows as
+    /// equalities), from positions(). Cost: per Newton iteration 24 polar decompositions per tet, one
+    /// factorization and one substitution per enforced row. A measuring tool; never throws.
+    StaticReference convergedStatic(const StaticReferenceSettings& settings = {}) const;
     int factorizations() const { return m_factorizations; }
     int cachedNodes() const;
     double meanEdgeLength() const { return m_meanEdge; }

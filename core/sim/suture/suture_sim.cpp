@@ -58,7 +58,8 @@ std::string validate(const SutureSettings& s) {
         return "thread max_strain_per_step must be in (0, 1)";
     if (!(s.contactThickness > 0) || s.contactRounds < 0 || s.contactsPerRound < 1 || s.maxContacts < 1)
         return "contact thickness must be positive, rounds >= 0, per round >= 1, max_contacts >= 1";
-    if (s.contactLookaheadSteps < 0) return "contact_lookahead_steps must be >= 0";
+    if (s.contactLookaheadSteps < 0 || s.contactLookaheadEvery < 1 || !(s.contactLookaheadDistance >= 0))
+        return "contact_lookahead_steps and _distance must be >= 0, contact_lookahead_every >= 1";
     return {};
 }
 
@@ -396,12 +397,16 @@ void SutureSimulation::processContacts(const std::vector<Vec3>& before, SutureSt
 }
 
 void SutureSimulation::prefetchAhead(const std::vector<Vec3>& before) {
-    if (!m_detector || m_s.contactLookaheadSteps <= 0) return;
+    if (!m_detector || m_s.contactLookaheadSteps <= 0 || m_steps % m_s.contactLookaheadEvery != 0) return;
     const auto& x = m_fem->positions();
     std::vector<Vec3> ahead(x.size());
-    const double k = m_s.contactLookaheadSteps;
-    for (size_t v = 0; v < x.size(); ++v)
-        ahead[v] = x[v] + k * (x[v] - before[v]);
+    const double k = m_s.contactLookaheadSteps, cap = m_s.contactLookaheadDistance;
+    for (size_t v = 0; v < x.size(); ++v) {
+        Vec3 d = k * (x[v] - before[v]);
+        const double len = d.norm();
+        if (len > cap) d *= cap / len;
+        ahead[v] = x[v] + d;
+    }
     std::vector<Collision> hits;
     m_detector->detect(x, ahead, m_s.contactThickness, hits);
     std::vector<int32_t> nodes;
@@ -435,6 +440,7 @@ bool SutureSimulation::solve(SutureStepStats& st) {
     st.activeRows = fs.rows;
     st.rejectedRows = fs.redundant + fs.incompatible;
     st.refactored |= fs.refactored;
+    st.refactorWaited |= fs.refactorWaited;
     st.substitutions += fs.substitutions;
     st.newCachedNodes += fs.newCachedNodes;
     st.activeSetIterations += fs.activeSetIterations;
@@ -474,6 +480,7 @@ void SutureSimulation::readForces(SutureStepStats& st) {
 
 SutureStepStats SutureSimulation::step(const NeedleFrame& frame) {
     SutureStepStats st;
+    ++m_steps;
     const std::vector<Vec3> before = m_fem->positions();
     const double l = m_s.needle.length_();
     Eigen::Isometry3d next = frame.pose;

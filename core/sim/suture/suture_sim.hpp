@@ -70,7 +70,9 @@ struct SutureSettings {
     /// detector and the nodes of the predicted contacts are queued for the FEM's constrained-node
     /// cache (CorotationalFem::prefetchNodes), so a burst of contacts finds its K⁻¹ columns ready.
     /// Changes no constraint, only when the work is done. 0 disables.
-    int contactLookaheadSteps = 8;
+    int contactLookaheadSteps = 48;
+    int contactLookaheadEvery = 4; ///< steps between two predictions (the detection's cost, amortized)
+    double contactLookaheadDistance = 1e-3; ///< m, cap of a node's extrapolated motion (a playback snap is no trend)
 };
 
 /// Empty when valid, else the rule that failed.
@@ -117,6 +119,7 @@ struct SutureStepStats {
     double threadTension = 0; ///< from the pull multiplier, N
     bool threadEngaged = false;
     bool refactored = false;
+    bool refactorWaited = false; ///< a solve waited for the background factorization (timing only)
     int substitutions = 0;       ///< forward/backward substitutions (columns) of all solves this step
     int newCachedNodes = 0;      ///< constrained nodes whose K⁻¹ columns were computed this step
     int activeSetIterations = 0; ///< Schur solves of all FEM solves this step
@@ -184,6 +187,7 @@ private:
     std::vector<int> m_needleIds;
     std::vector<int> m_needleEntryOf; // history index per needle constraint
     int m_punctures = 0;
+    long m_steps = 0;
     // tip contact with a boundary facet (puncture in progress)
     struct TipContact {
         bool active = false;
