@@ -78,9 +78,8 @@ Result run(const Policy& p, int sample, std::ofstream& samples) {
         r.meanPosMm += 1e3 * pos;
         r.maxPosMm = std::max(r.maxPosMm, 1e3 * pos);
         char line[256];
-        std::snprintf(line, sizeof line, "%s,%zu,%d,%.6e,%.6e,%.6e,%d,%d,%.3e,%.1f\n", p.name.c_str(), f,
-                      st.activeRows, e, ref.energy, rel, ref.converged, ref.iterations, 1e3 * pos,
-                      1e3 * ref.seconds);
+        std::snprintf(line, sizeof line, "%s,%zu,%d,%.6e,%.6e,%.6e,%d,%d,%.3e,%.1f\n", p.name.c_str(), f, st.activeRows,
+                      e, ref.energy, rel, ref.converged, ref.iterations, 1e3 * pos, 1e3 * ref.seconds);
         samples << line;
     }
     if (r.samples > 0) {

@@ -150,13 +150,14 @@ int main(int argc, char** argv) {
         if (slowest > 0) {
             std::vector<StepRecord> bySlow = rec;
             std::sort(bySlow.begin(), bySlow.end(), [](const auto& a, const auto& b) { return a.ms > b.ms; });
-            std::printf("  slowest steps (wall): frame ms cpu_ms refactored punctured new_contacts contacts solves rows "
-                        "new_cached substitutions active_set_iterations\n");
+            std::printf(
+                "  slowest steps (wall): frame ms cpu_ms refactored punctured new_contacts contacts solves rows "
+                "new_cached substitutions active_set_iterations\n");
             for (int i = 0; i < std::min<int>(slowest, static_cast<int>(bySlow.size())); ++i) {
                 const StepRecord& r = bySlow[i];
-                std::printf("  %6d %9.3f %9.3f %d %d %4d %4d %3d %4d %4d %5d %4d\n", r.frame, r.ms, r.cpuMs, r.st.refactored,
-                            r.st.punctured, r.st.newContacts, r.st.contacts, r.st.solves, r.st.activeRows,
-                            r.st.newCachedNodes, r.st.substitutions, r.st.activeSetIterations);
+                std::printf("  %6d %9.3f %9.3f %d %d %4d %4d %3d %4d %4d %5d %4d\n", r.frame, r.ms, r.cpuMs,
+                            r.st.refactored, r.st.punctured, r.st.newContacts, r.st.contacts, r.st.solves,
+                            r.st.activeRows, r.st.newCachedNodes, r.st.substitutions, r.st.activeSetIterations);
             }
         }
     }

@@ -43,8 +43,8 @@ struct Group {
 /// A row of the current solve: free-node terms only, right-hand side in displacement form.
 struct SolveRow {
     int group = 0, row = 0;
-    int id = 0; ///< index among the rows of all live groups (key of the solve's M cache)
-    std::vector<std::pair<int, Vec3>> terms;         // (cache slot, coefficient)
+    int id = 0;                              ///< index among the rows of all live groups (key of the solve's M cache)
+    std::vector<std::pair<int, Vec3>> terms; // (cache slot, coefficient)
     std::vector<std::pair<int32_t, Vec3>> nodeTerms; // (node, coefficient), free nodes
     double bu = 0;
 };
@@ -992,8 +992,8 @@ StaticReference CorotationalFem::convergedStatic(const StaticReferenceSettings& 
             }
             H = 0.5 * (H + H.transpose()).eval();
             Eigen::SelfAdjointEigenSolver<Mat12> eig(H);
-            const Mat12 Hp = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
-                             eig.eigenvectors().transpose();
+            const Mat12 Hp =
+                eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
             const int* map = &I.scatter[t * 144];
             for (int i = 0; i < 144; ++i)
                 if (map[i] >= 0) values[map[i]] += Hp(i / 12, i % 12);

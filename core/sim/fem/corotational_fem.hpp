@@ -122,8 +122,8 @@ struct FemSolveStats {
 /// (R_e the polar rotation of F_e; its gradient is Σ R_e K_e d_e exactly), under the rows the
 /// solve enforced, as equalities. Newton from the solve's result: element Hessians by central
 /// differences of that gradient, projected to positive semi-definite (reassembled every
-/// `hessianRefresh` iterations), a KKT step through the Schur complement, Armijo backtracking on E. x* is the fixed point that refactorizing every solve
-/// until the rotations stop changing would reach.
+/// `hessianRefresh` iterations), a KKT step through the Schur complement, Armijo backtracking on E. x* is the fixed
+/// point that refactorizing every solve until the rotations stop changing would reach.
 struct StaticReferenceSettings {
     double tolerance = 1e-10; ///< converged when ‖∇E + Cᵀμ‖∞ ≤ tolerance · max(‖·‖∞ at the start, 1e-6 N) …
     double stepTolerance = 1e-9; ///< … or the Newton step is below this many mean edge lengths
@@ -134,11 +134,11 @@ struct StaticReferenceSettings {
 struct StaticReference {
     bool converged = false;
     int iterations = 0;
-    std::vector<Vec3> x;         ///< x*, metres
-    double energy = 0;           ///< E(x*), J
-    double residual = 0;         ///< ‖∇E + Cᵀμ‖∞ at x*, N
-    double seconds = 0;          ///< wall time of the reference solve
-    std::string message;         ///< why it stopped when not converged
+    std::vector<Vec3> x; ///< x*, metres
+    double energy = 0;   ///< E(x*), J
+    double residual = 0; ///< ‖∇E + Cᵀμ‖∞ at x*, N
+    double seconds = 0;  ///< wall time of the reference solve
+    std::string message; ///< why it stopped when not converged
 };
 
 class CorotationalFem {

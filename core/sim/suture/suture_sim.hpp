@@ -71,7 +71,7 @@ struct SutureSettings {
     /// cache (CorotationalFem::prefetchNodes), so a burst of contacts finds its K⁻¹ columns ready.
     /// Changes no constraint, only when the work is done. 0 disables.
     int contactLookaheadSteps = 48;
-    int contactLookaheadEvery = 4; ///< steps between two predictions (the detection's cost, amortized)
+    int contactLookaheadEvery = 4;          ///< steps between two predictions (the detection's cost, amortized)
     double contactLookaheadDistance = 1e-3; ///< m, cap of a node's extrapolated motion (a playback snap is no trend)
 };
 

@@ -484,7 +484,8 @@ TEST(CorotationalFem, ConvergedStaticReferenceIsTheFixedPointOfRefactorizing) {
     EXPECT_LT(maxDistance(early.x, ref.x), 1e-7 * span); // the same x* from an earlier state
     // The linear FEM's answer, measured against its own reference, is far off.
     const StaticReference linRef = lin->convergedStatic();
-    ASSERT_TRUE(linRef.converged) << linRef.message << " residual " << linRef.residual << " after " << linRef.iterations;
+    ASSERT_TRUE(linRef.converged) << linRef.message << " residual " << linRef.residual << " after "
+                                  << linRef.iterations;
     EXPECT_GT(maxDistance(lin->positions(), linRef.x), 1e-3 * span);
     EXPECT_GT(lin->corotationalEnergy(lin->positions()), linRef.energy);
 }
