@@ -112,8 +112,9 @@ struct CorotationalFem::Impl {
         int done = 0;
         Eigen::MatrixXd cols; // 3#V × 3·capacity
     };
-    std::unique_ptr<Job> job;
+    std::shared_ptr<Job> job;
     std::thread worker;
+    std::vector<std::pair<std::thread, std::shared_ptr<Job>>> retired; // late workers, joined when done
     int swapStep = 0;
     std::vector<uint8_t> pinned; // per node: kept in the cache and carried by a refactorization
     std::vector<int> prefetch;   // nodes queued for caching ahead of use (FIFO)
@@ -127,6 +128,8 @@ struct CorotationalFem::Impl {
 
     ~Impl() {
         if (worker.joinable()) worker.join();
+        for (auto& r : retired)
+            r.first.join();
     }
 
     int n3() const { return 3 * static_cast<int>(x0->size()); }
@@ -285,8 +288,24 @@ struct CorotationalFem::Impl {
         if (!job) return;
         if (!job->joined) {
             if (step < swapStep) return;
-            st.refactorWaited = !job->finished.load(std::memory_order_acquire);
-            worker.join();
+            if (job->finished.load(std::memory_order_acquire)) {
+                worker.join();
+            } else {
+                // The worker is late (a core busy with other work): compute the same factor here, from
+                // the same positions, instead of waiting for it without bound. Same input, same code,
+                // same bits; the late worker finishes on its own and its result is dropped.
+                st.refactorWaited = true;
+                auto mine = std::make_shared<Job>();
+                mine->x = job->x;
+                try {
+                    mine->ok = buildFactor(mine->x, mine->result, mine->error);
+                } catch (const std::exception& e) {
+                    mine->ok = false;
+                    mine->error = e.what();
+                }
+                retired.emplace_back(std::move(worker), std::move(job));
+                job = std::move(mine);
+            }
             job->joined = true;
             if (!job->ok) {
                 st.error = "background refactorization failed (the previous factor stays in use): " + job->error;
@@ -327,7 +346,7 @@ struct CorotationalFem::Impl {
     }
 
     void takeJob(FemSolveStats& st) {
-        std::unique_ptr<Job> j = std::move(job);
+        std::shared_ptr<Job> j = std::move(job);
         cur = std::move(j->result);
         resetCache();
         const int k = static_cast<int>(j->nodes.size());
@@ -347,10 +366,17 @@ struct CorotationalFem::Impl {
     }
 
     void startJob(const std::vector<Vec3>& x) {
-        job = std::make_unique<Job>();
+        for (auto it = retired.begin(); it != retired.end();)
+            if (it->second->finished.load(std::memory_order_acquire)) {
+                it->first.join();
+                it = retired.erase(it);
+            } else {
+                ++it;
+            }
+        job = std::make_shared<Job>();
         job->x = x;
         swapStep = step + s.refactorLatencySteps;
-        Job* jp = job.get();
+        std::shared_ptr<Job> jp = job;
         worker = std::thread([this, jp] {
 #ifdef __linux__
             // Lowest priority: on a shared core the worker takes the idle time between frames and
@@ -950,7 +976,7 @@ StaticReference CorotationalFem::convergedStatic(const StaticReferenceSettings& 
     lastSystem(C, bu, lam);
     const int mrows = static_cast<int>(C.rows());
     std::vector<Vec3> x = m_x;
-    std::vector<double> values;
+    std::vector<double> values, exact; // projected and exact Hessian, pattern order
     Eigen::VectorXd grad(n);
     std::string error;
     SparseCholesky chol(I.pattern, I.s.cholesky);
@@ -969,6 +995,7 @@ StaticReference CorotationalFem::convergedStatic(const StaticReferenceSettings& 
             values.assign(I.pattern.rowIdx.size(), 0.0);
             for (int d : I.fixedDiag)
                 values[d] = 1.0;
+            exact = values;
         }
         grad = -I.fext;
         for (size_t t = 0; t < I.tets.size(); ++t) {
@@ -996,13 +1023,18 @@ StaticReference CorotationalFem::convergedStatic(const StaticReferenceSettings& 
                 eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
             const int* map = &I.scatter[t * 144];
             for (int i = 0; i < 144; ++i)
-                if (map[i] >= 0) values[map[i]] += Hp(i / 12, i % 12);
+                if (map[i] >= 0) {
+                    values[map[i]] += Hp(i / 12, i % 12);
+                    exact[map[i]] += H(i / 12, i % 12);
+                }
         }
         for (size_t v = 0; v < m_fixed.size(); ++v)
             if (m_fixed[v]) grad.segment<3>(3 * v).setZero();
         if (assembleHessian) {
+            // The exact Hessian when it is positive definite (quadratic convergence), else the
+            // projected one (a descent direction; linear convergence).
             hessianAge = 0;
-            if (!chol.factorize(values, error)) {
+            if (!chol.factorize(exact, error) && !chol.factorize(values, error)) {
                 out.message = error;
                 break;
             }

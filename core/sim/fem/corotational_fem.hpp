@@ -13,11 +13,11 @@
 ///    by more than `refactorDisplacement` mean edge lengths (its change normal to itself) since the
 ///    last factorization (translation and stretch do not count); in
 ///    RefactorMode::Background the rotations, assembly and factorization run on a worker thread
-///    joined exactly `refactorLatencySteps` solves later (the solve waits only if the worker is
-///    late), then the K⁻¹ columns of the carried nodes (pinned or in use) are computed with the new
-///    factor, `refactorNodesPerSolve` nodes per solve, while the old factor keeps serving; the swap
-///    happens when all are done. Every step of it counts solves and nodes, never time, so a run is
-///    repeatable. u0 = K_R⁻¹ f_R is cached with the factor.
+///    (lowest priority) joined exactly `refactorLatencySteps` solves later (a late worker's factor is
+///    computed by that solve instead, from the same positions: same bits, bounded wait), then the K⁻¹ columns of the
+///    carried nodes (pinned or in use) are computed with the new factor, `refactorNodesPerSolve` nodes per solve, while
+///    the old factor keeps serving; the swap happens when all are done. Every step of it counts solves and nodes, never
+///    time, so a run is repeatable. u0 = K_R⁻¹ f_R is cached with the factor.
 ///  - K_R⁻¹ restricted to the constrained nodes is cached (three substitutions per node, once, when
 ///    a node first appears in a constraint; the full columns are kept too). Every constraint row's column K_R⁻¹cᵀ at
 ///    the constrained nodes is a combination of these blocks, so rows may be added, removed or change their
@@ -111,7 +111,7 @@ struct FemSolveStats {
     int newCachedNodes = 0;
     bool refactored = false;      ///< a new factor was taken into use
     bool refactorStarted = false; ///< Background: this solve found the rotations stale and started the worker
-    bool refactorWaited = false;  ///< Background: the join found the worker still busy (timing only)
+    bool refactorWaited = false;  ///< Background: the worker was late; this solve computed its factor (timing only)
     bool finite = true;           ///< false: the result was not finite and was discarded
     std::string error;            ///< the last failure (empty when none)
 };
@@ -121,11 +121,12 @@ struct FemSolveStats {
 /// the positions themselves, E(x) = Σ_e ½ d_eᵀ K_e d_e − f_extᵀ(x − x0), d_e = R_e(x)ᵀx_e − x0_e
 /// (R_e the polar rotation of F_e; its gradient is Σ R_e K_e d_e exactly), under the rows the
 /// solve enforced, as equalities. Newton from the solve's result: element Hessians by central
-/// differences of that gradient, projected to positive semi-definite (reassembled every
+/// differences of that gradient, assembled exactly when that is positive definite, else projected
+/// per element to positive semi-definite (reassembled every
 /// `hessianRefresh` iterations), a KKT step through the Schur complement, Armijo backtracking on E. x* is the fixed
 /// point that refactorizing every solve until the rotations stop changing would reach.
 struct StaticReferenceSettings {
-    double tolerance = 1e-10; ///< converged when ‖∇E + Cᵀμ‖∞ ≤ tolerance · max(‖·‖∞ at the start, 1e-6 N) …
+    double tolerance = 1e-9; ///< converged when ‖∇E + Cᵀμ‖∞ ≤ tolerance · max(‖·‖∞ at the start, 1e-6 N) …
     double stepTolerance = 1e-9; ///< … or the Newton step is below this many mean edge lengths
     int maxIterations = 60;
     double fdStep = 1e-6;   ///< central-difference step, relative to the mean edge length
