@@ -2,11 +2,11 @@
 // the running suture with 20 and with 52 punctures (5 and 13 stitches), needle driving and thread
 // pull, and what the slowest steps did (refactorization, puncture, new contacts, substitutions).
 // Run: OPENBLAS_NUM_THREADS=1 taskset -c 0 ./build/bench/bench_suture [5|13] [--refactor MODE] [--pace FPS]
-//        [--slowest N]
+//        [--slowest N] [--prefetch NODES_PER_SOLVE] [--lookahead STEPS] [--latency SOLVES]
 //   MODE: synchronous | background (default background; see FemSettings::refactorMode). With
 //   --pace 60 the steps run as in the player, one per 1/60 s frame on the same core, and the
-//   background factorization (lowest priority) takes the idle rest of the frames; without it the
-//   steps run back to back and the worker competes with them.
+//   background factorization takes the idle rest of the frames; without it the steps run back to
+//   back and the worker shares the core with them (so the default latency is 120 solves).
 // Columns: physics time of SutureSimulation::step() per frame (ms; wall clock, and the stepping thread's CPU
 // time), final closure figures (mm), factorizations, steps that waited for the background worker.
 #include "sim/suture/anastomosis.hpp"
@@ -80,7 +80,9 @@ const char* modeName(RefactorMode m) {
 
 int main(int argc, char** argv) {
     int only = 0, slowest = 0;
-    double pace = 0; // frames per second; 0 = steps back to back
+    double pace = 0;                   // frames per second; 0 = steps back to back
+    int prefetch = -1, lookahead = -1; // FemSettings::prefetchNodesPerSolve, contactLookaheadSteps (-1: default)
+    int latency = 120;                 // FemSettings::refactorLatencySteps
     RefactorMode mode = RefactorMode::Background;
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--refactor") && i + 1 < argc) {
@@ -88,6 +90,12 @@ int main(int argc, char** argv) {
                 std::fprintf(stderr, "bench_suture: --refactor %s: expected synchronous or background\n", argv[i]);
                 return 2;
             }
+        } else if (!std::strcmp(argv[i], "--prefetch") && i + 1 < argc) {
+            prefetch = std::atoi(argv[++i]);
+        } else if (!std::strcmp(argv[i], "--lookahead") && i + 1 < argc) {
+            lookahead = std::atoi(argv[++i]);
+        } else if (!std::strcmp(argv[i], "--latency") && i + 1 < argc) {
+            latency = std::max(1, std::atoi(argv[++i]));
         } else if (!std::strcmp(argv[i], "--pace") && i + 1 < argc) {
             pace = std::atof(argv[++i]);
         } else if (!std::strcmp(argv[i], "--slowest") && i + 1 < argc) {
@@ -108,7 +116,9 @@ int main(int argc, char** argv) {
         s.needle.punctureForce = 0.008;
         s.fem.youngsModulus = 60e3;
         s.fem.refactorMode = mode;
-        s.fem.refactorLatencySteps = 30; // the worker shares the core: give it 30 steps
+        s.fem.refactorLatencySteps = latency; // the worker shares the core with the steps
+        if (prefetch >= 0) s.fem.prefetchNodesPerSolve = prefetch;
+        if (lookahead >= 0) s.contactLookaheadSteps = lookahead;
         AnastomosisRun run = makeAnastomosisRun(spec, s);
         SutureSimulation* sim = run.sim.get();
         const std::vector<NeedleFrame>& frames = run.frames;

@@ -12,11 +12,6 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
-#ifdef __linux__
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
-#endif
 #include <thread>
 
 namespace viscera::sim {
@@ -378,11 +373,6 @@ struct CorotationalFem::Impl {
         swapStep = step + s.refactorLatencySteps;
         std::shared_ptr<Job> jp = job;
         worker = std::thread([this, jp] {
-#ifdef __linux__
-            // Lowest priority: on a shared core the worker takes the idle time between frames and
-            // does not pre-empt the steps (the join waits for it when it is late; results never change).
-            setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
-#endif
             try {
                 jp->ok = buildFactor(jp->x, jp->result, jp->error);
             } catch (const std::exception& e) {

@@ -13,7 +13,7 @@
 ///    by more than `refactorDisplacement` mean edge lengths (its change normal to itself) since the
 ///    last factorization (translation and stretch do not count); in
 ///    RefactorMode::Background the rotations, assembly and factorization run on a worker thread
-///    (lowest priority) joined exactly `refactorLatencySteps` solves later (a late worker's factor is
+///    joined exactly `refactorLatencySteps` solves later (a late worker's factor is
 ///    computed by that solve instead, from the same positions: same bits, bounded wait), then the K⁻¹ columns of the
 ///    carried nodes (pinned or in use) are computed with the new factor, `refactorNodesPerSolve` nodes per solve, while
 ///    the old factor keeps serving; the swap happens when all are done. Every step of it counts solves and nodes, never
@@ -63,7 +63,7 @@ struct FemSettings {
     /// Background: carried nodes whose K⁻¹ columns are computed with the new factor per solve (3
     /// substitutions each) between the worker's join and the swap.
     int refactorNodesPerSolve = 2;
-    int prefetchNodesPerSolve = 2; ///< queued nodes (prefetchNodes()) cached per solve, >= 0
+    int prefetchNodesPerSolve = 4; ///< queued nodes (prefetchNodes()) cached per solve, >= 0
     /// Simplicial: cheapest for the few-column substitutions of the constrained-node cache.
     CholeskyMethod cholesky = CholeskyMethod::Simplicial;
 };

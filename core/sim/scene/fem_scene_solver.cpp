@@ -47,11 +47,11 @@ std::unique_ptr<FemSceneSolver> FemSceneSolver::create(const SceneSolverInputs& 
     SutureSettings settings = sd.settings;
     settings.fem.youngsModulus = scene.bodies[0].material.youngsModulus;
     settings.fem.poissonRatio = scene.bodies[0].material.poissonRatio;
-    // Refactorization off the step: the worker (lowest priority, it takes the idle rest of the
-    // frames) is joined 30 solves after the request and the new factor swapped in at a solve fixed
-    // by counts alone, so a session is repeatable (CorotationalFem, RefactorMode::Background).
+    // Refactorization off the step: the worker (it takes the idle rest of the frames) is joined 60
+    // solves after the request and the new factor swapped in at a solve fixed by counts alone, so a
+    // session is repeatable (CorotationalFem, RefactorMode::Background).
     settings.fem.refactorMode = RefactorMode::Background;
-    settings.fem.refactorLatencySteps = 30;
+    settings.fem.refactorLatencySteps = 60;
     std::unique_ptr<FemSceneSolver> f(new FemSceneSolver());
     try {
         f->m_suture = SutureSimulation::create(mergeMeshes(parts, nullptr), fixed, settings, trajectory.front().pose);
