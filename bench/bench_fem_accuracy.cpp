@@ -86,7 +86,7 @@ Result run(const Policy& p, int sample, std::ofstream& samples) {
             span = std::max(span, (ref.x[v] - fem.restPositions()[v]).norm());
         }
         // A step that leaves the tissue at rest (the needle outside) measures nothing.
-        if (!(ref.energy > kEnergyFloor) || !(span > 1e-6)) continue;
+        if (!(ref.energy > kEnergyFloor) || !(span > 1e-5)) continue;
         const double rel = std::max(0.0, e - ref.energy) / ref.energy;
         const double relPos = pos / span;
         ++r.samples;
@@ -212,7 +212,7 @@ int main(int argc, char** argv) {
     if (error.empty())
         error =
             plot("fem_position_error_vs_time.png", "mean relative position error max|x - x*| / max|x* - X| (X: rest)",
-                 [](const Result& r) { return std::max(r.meanRelPos, 1e-16); });
+                 [](const Result& r) { return std::max(r.commonRelPos, 1e-16); });
     if (!error.empty()) throw std::runtime_error(error);
     if (!samples || !table) throw std::runtime_error("cannot write the CSV files in " + outDir.string());
     std::printf("\nwrote %s/{fem_policies.csv,fem_samples.csv,fem_error_vs_time.png,fem_position_error_vs_time.png}\n",

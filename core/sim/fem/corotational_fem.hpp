@@ -62,7 +62,7 @@ struct FemSettings {
     int cacheEvictSteps = 400; ///< constrained-node cache entries unused this long are freed (not pinned ones)
     /// Background: carried nodes whose K⁻¹ columns are computed with the new factor per solve (3
     /// substitutions each) between the worker's join and the swap.
-    int refactorNodesPerSolve = 2;
+    int refactorNodesPerSolve = 4;
     int prefetchNodesPerSolve = 4; ///< queued nodes (prefetchNodes()) cached per solve, >= 0
     /// Simplicial: cheapest for the few-column substitutions of the constrained-node cache.
     CholeskyMethod cholesky = CholeskyMethod::Simplicial;
