@@ -4,9 +4,13 @@
 #include "sim/util/format.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <thread>
 
@@ -22,6 +26,7 @@ struct Factor {
     Eigen::VectorXd f;           ///< f_R, 3#V
     Eigen::VectorXd u0;          ///< K_R⁻¹ f_R
     std::vector<Vec3> xAt;       ///< positions the rotations were taken from
+    long factorNonZeros = 0;     ///< nnz(L), for the cost model of a solve
 };
 
 struct Group {
@@ -33,7 +38,8 @@ struct Group {
 /// A row of the current solve: free-node terms only, right-hand side in displacement form.
 struct SolveRow {
     int group = 0, row = 0;
-    std::vector<std::pair<int, Vec3>> terms;         // (cache slot, coefficient)
+    int id = 0;                              ///< index among the rows of all live groups (key of the solve's M cache)
+    std::vector<std::pair<int, Vec3>> terms; // (cache slot, coefficient)
     std::vector<std::pair<int32_t, Vec3>> nodeTerms; // (node, coefficient), free nodes
     double bu = 0;
 };
@@ -54,6 +60,8 @@ std::string validate(const FemSettings& s) {
         return "release/activation tolerances must be >= 0";
     if (s.maxActiveSetIterations < 1) return "max_active_set_iterations must be >= 1";
     if (s.cacheEvictSteps < 1) return "cache_evict_steps must be >= 1";
+    if (s.refactorNodesPerSolve < 1) return "refactor_nodes_per_solve must be >= 1";
+    if (s.prefetchNodesPerSolve < 0) return "prefetch_nodes_per_solve must be >= 0";
     return {};
 }
 
@@ -82,18 +90,30 @@ struct CorotationalFem::Impl {
     size_t liveGroups = 0;
     int step = 0;
 
-    // background refactorization
+    // Background refactorization, in two phases. Worker: rotations, assembly, numeric factorization
+    // and u0 of the positions at the request (joined exactly `refactorLatencySteps` solves later).
+    // Main thread, amortized: the K⁻¹ columns of the nodes carried over (pinned or in recent use),
+    // `refactorNodesPerSolve` nodes per solve with the new factor while the old one keeps serving
+    // the solves; the swap happens at the first solve that finds every carried node done. All of it
+    // counts solves and nodes, never time: the swap step is the same on every run.
     struct Job {
         std::vector<Vec3> x;
-        std::vector<int> nodes;
         Factor result;
-        Eigen::MatrixXd kinv, cols;
         bool ok = false;
         std::string error;
+        std::atomic<bool> finished{false};
+        bool joined = false;
+        std::vector<int> nodes; // carried nodes, in order; columns of the first `done` are in cols
+        int done = 0;
+        Eigen::MatrixXd cols; // 3#V × 3·capacity
     };
-    std::unique_ptr<Job> job;
+    std::shared_ptr<Job> job;
     std::thread worker;
+    std::vector<std::pair<std::thread, std::shared_ptr<Job>>> retired; // late workers, joined when done
     int swapStep = 0;
+    std::vector<uint8_t> pinned; // per node: kept in the cache and carried by a refactorization
+    std::vector<int> prefetch;   // nodes queued for caching ahead of use (FIFO)
+    size_t prefetchHead = 0;
 
     std::vector<std::array<int32_t, 2>> edges; // unique tet edges, for the refactor test
 
@@ -103,6 +123,8 @@ struct CorotationalFem::Impl {
 
     ~Impl() {
         if (worker.joinable()) worker.join();
+        for (auto& r : retired)
+            r.first.join();
     }
 
     int n3() const { return 3 * static_cast<int>(x0->size()); }
@@ -152,8 +174,9 @@ struct CorotationalFem::Impl {
         out.xAt = x;
         std::vector<double> values;
         assemble(out.rotations, values, out.f);
-        if (!out.chol) out.chol = std::make_unique<SparseCholesky>(pattern);
+        if (!out.chol) out.chol = std::make_unique<SparseCholesky>(pattern, s.cholesky);
         if (!out.chol->factorize(values, error)) return false;
+        out.factorNonZeros = out.chol->factorNonZeros();
         out.u0 = out.f;
         if (!out.chol->solveInPlace(out.u0.data(), 1, error)) return false;
         return out.u0.allFinite();
@@ -239,28 +262,96 @@ struct CorotationalFem::Impl {
 
     void evict() {
         for (size_t s2 = 0; s2 < nodeOf.size(); ++s2)
-            if (nodeOf[s2] >= 0 && step - lastUsed[s2] > s.cacheEvictSteps) {
+            if (nodeOf[s2] >= 0 && !pinned[nodeOf[s2]] && step - lastUsed[s2] > s.cacheEvictSteps) {
                 slotOf[nodeOf[s2]] = -1;
                 nodeOf[s2] = -1;
                 freeSlots.push_back(static_cast<int>(s2));
             }
     }
 
-    void takeJob(FemSolveStats& st) {
-        worker.join();
-        std::unique_ptr<Job> j = std::move(job);
-        if (!j->ok) {
-            st.error = "background refactorization failed (the previous factor stays in use): " + j->error;
-            cur.xAt = j->x; // do not retry at once
+    /// Nodes cached now that a refactorization must carry: pinned or used in the last two solves.
+    void carriedNodes(std::vector<int>& out) const {
+        for (size_t s2 = 0; s2 < nodeOf.size(); ++s2) {
+            const int node = nodeOf[s2];
+            if (node >= 0 && (pinned[node] || step - lastUsed[s2] <= 1)) out.push_back(node);
+        }
+    }
+
+    /// Advances a refactorization at the start of a solve: joins the worker at its step, computes
+    /// the next chunk of carried columns, or swaps the new factor in. Deterministic (see Job).
+    void advanceJob(FemSolveStats& st) {
+        if (!job) return;
+        if (!job->joined) {
+            if (step < swapStep) return;
+            if (job->finished.load(std::memory_order_acquire)) {
+                worker.join();
+            } else {
+                // The worker is late (a core busy with other work): compute the same factor here, from
+                // the same positions, instead of waiting for it without bound. Same input, same code,
+                // same bits; the late worker finishes on its own and its result is dropped.
+                st.refactorWaited = true;
+                auto mine = std::make_shared<Job>();
+                mine->x = job->x;
+                try {
+                    mine->ok = buildFactor(mine->x, mine->result, mine->error);
+                } catch (const std::exception& e) {
+                    mine->ok = false;
+                    mine->error = e.what();
+                }
+                retired.emplace_back(std::move(worker), std::move(job));
+                job = std::move(mine);
+            }
+            job->joined = true;
+            if (!job->ok) {
+                st.error = "background refactorization failed (the previous factor stays in use): " + job->error;
+                cur.xAt = job->x; // do not retry at once
+                job.reset();
+                return;
+            }
+            carriedNodes(job->nodes);
+        }
+        Job& j = *job;
+        if (j.done == static_cast<int>(j.nodes.size())) {
+            // Nodes that came into use while the columns were computed travel too; swap when none is left.
+            std::vector<int> more;
+            carriedNodes(more);
+            for (int node : more)
+                if (std::find(j.nodes.begin(), j.nodes.end(), node) == j.nodes.end()) j.nodes.push_back(node);
+        }
+        const int k = static_cast<int>(j.nodes.size());
+        if (j.done < k) {
+            const int chunk = std::min(k - j.done, s.refactorNodesPerSolve);
+            const int n = n3();
+            if (j.cols.cols() < 3 * (j.done + chunk))
+                j.cols.conservativeResize(n, std::max<Eigen::Index>(3 * k, 2 * j.cols.cols()));
+            auto block = j.cols.middleCols(3 * j.done, 3 * chunk);
+            block.setZero();
+            for (int i = 0; i < chunk; ++i)
+                for (int c = 0; c < 3; ++c)
+                    block(3 * j.nodes[j.done + i] + c, 3 * i + c) = 1.0;
+            if (!j.result.chol->solveInPlace(block.data(), 3 * chunk, st.error)) {
+                job.reset();
+                return;
+            }
+            j.done += chunk;
+            st.substitutions += 3 * chunk;
             return;
         }
+        takeJob(st);
+    }
+
+    void takeJob(FemSolveStats& st) {
+        std::shared_ptr<Job> j = std::move(job);
         cur = std::move(j->result);
         resetCache();
         const int k = static_cast<int>(j->nodes.size());
-        kinv = Eigen::MatrixXd::Zero(std::max(96, 3 * k), std::max(96, 3 * k));
-        kinv.topLeftCorner(3 * k, 3 * k) = j->kinv;
-        cols.resize(n3(), kinv.cols());
-        cols.leftCols(3 * k) = j->cols;
+        const int cap = std::max(96, 3 * k);
+        kinv = Eigen::MatrixXd::Zero(cap, cap);
+        for (int a = 0; a < k; ++a)
+            for (int b = 0; b < k; ++b)
+                kinv.block<3, 3>(3 * a, 3 * b) = j->cols.block<3, 3>(3 * j->nodes[a], 3 * b);
+        cols.resize(n3(), cap);
+        cols.leftCols(3 * k) = j->cols.leftCols(3 * k);
         for (int i = 0; i < k; ++i) {
             nodeOf.push_back(j->nodes[i]);
             lastUsed.push_back(step);
@@ -270,23 +361,44 @@ struct CorotationalFem::Impl {
     }
 
     void startJob(const std::vector<Vec3>& x) {
-        job = std::make_unique<Job>();
+        for (auto it = retired.begin(); it != retired.end();)
+            if (it->second->finished.load(std::memory_order_acquire)) {
+                it->first.join();
+                it = retired.erase(it);
+            } else {
+                ++it;
+            }
+        job = std::make_shared<Job>();
         job->x = x;
-        // Only nodes in use now travel with the new factor; the rest are re-cached when needed.
-        for (size_t s2 = 0; s2 < nodeOf.size(); ++s2)
-            if (nodeOf[s2] >= 0 && step - lastUsed[s2] <= 1) job->nodes.push_back(nodeOf[s2]);
         swapStep = step + s.refactorLatencySteps;
-        Job* jp = job.get();
-        const int n = n3();
-        worker = std::thread([this, jp, n] {
+        std::shared_ptr<Job> jp = job;
+        worker = std::thread([this, jp] {
             try {
-                jp->ok = buildFactor(jp->x, jp->result, jp->error) &&
-                         inverseBlocks(jp->result, jp->nodes, n, jp->kinv, jp->cols, jp->error);
+                jp->ok = buildFactor(jp->x, jp->result, jp->error);
             } catch (const std::exception& e) {
                 jp->ok = false;
                 jp->error = e.what();
             }
+            jp->finished.store(true, std::memory_order_release);
         });
+    }
+
+    /// Caches up to `prefetchNodesPerSolve` queued nodes that are not cached yet.
+    bool prefetchStep(FemSolveStats& st) {
+        std::vector<int> batch;
+        while (prefetchHead < prefetch.size() && static_cast<int>(batch.size()) < s.prefetchNodesPerSolve) {
+            const int node = prefetch[prefetchHead++];
+            if (slotOf[node] < 0 && !(*fixed)[node]) batch.push_back(node);
+        }
+        if (prefetchHead == prefetch.size()) {
+            prefetch.clear();
+            prefetchHead = 0;
+        }
+        if (batch.empty()) return true;
+        if (!cacheNodes(batch, st.error)) return false;
+        st.newCachedNodes += static_cast<int>(batch.size());
+        st.substitutions += 3 * static_cast<int>(batch.size());
+        return true;
     }
 };
 
@@ -377,6 +489,7 @@ std::unique_ptr<CorotationalFem> CorotationalFem::create(const TetMesh& mesh, co
             for (int c = 0; c < 3; ++c)
                 m.fixedDiag.push_back(m.pattern.find(3 * static_cast<int>(v) + c, 3 * static_cast<int>(v) + c));
     m.slotOf.assign(nv, -1);
+    m.pinned.assign(nv, 0);
     std::string error;
     if (!m.buildFactor(w->m_x0, m.cur, error)) fail(error);
     w->m_factorizations = 1;
@@ -453,12 +566,38 @@ int CorotationalFem::cachedNodes() const {
     return c;
 }
 
+void CorotationalFem::pinNodes(const std::vector<int32_t>& nodes) {
+    std::fill(m->pinned.begin(), m->pinned.end(), 0);
+    for (int32_t v : nodes)
+        if (v >= 0 && static_cast<size_t>(v) < m->pinned.size()) m->pinned[v] = 1;
+}
+
+void CorotationalFem::prefetchNodes(const std::vector<int32_t>& nodes) {
+    for (int32_t v : nodes)
+        if (v >= 0 && static_cast<size_t>(v) < m_fixed.size() && !m_fixed[v] && m->slotOf[v] < 0 &&
+            std::find(m->prefetch.begin() + static_cast<long>(m->prefetchHead), m->prefetch.end(), v) ==
+                m->prefetch.end())
+            m->prefetch.push_back(v);
+}
+
+bool CorotationalFem::refactorPending() const {
+    return m->job != nullptr;
+}
+
 bool CorotationalFem::refactorNow(std::string* error) {
+    return refactorAt(m_x, error);
+}
+
+bool CorotationalFem::refactorAt(const std::vector<Vec3>& x, std::string* error) {
+    if (x.size() != m_x.size()) {
+        if (error) *error = std::string(kWhere) + "refactorAt(): positions have the wrong size";
+        return false;
+    }
     if (m->worker.joinable()) m->worker.join();
     m->job.reset();
     Factor f;
     std::string err;
-    if (!m->buildFactor(m_x, f, err)) {
+    if (!m->buildFactor(x, f, err)) {
         if (error) *error = err;
         return false;
     }
@@ -472,11 +611,10 @@ FemSolveStats CorotationalFem::solve() {
     Impl& I = *m;
     FemSolveStats st;
     ++I.step;
-    if (I.job && I.step >= I.swapStep) {
-        I.takeJob(st);
-        if (st.refactored) ++m_factorizations;
-    }
+    I.advanceJob(st);
+    if (st.refactored) ++m_factorizations;
     I.evict();
+    if (!I.prefetch.empty()) I.prefetchStep(st); // a failure is reported in st.error; the solve goes on
     const int n = I.n3();
     const auto& X0 = m_x0;
 
@@ -493,6 +631,17 @@ FemSolveStats CorotationalFem::solve() {
 
     std::vector<SolveRow> rows;
     Eigen::VectorXd lam, u(n);
+    // M = C K⁻¹ Cᵀ entries are computed once per solve, when a pair of rows first meets: the rows
+    // of a group do not change within a solve, only which groups are active, so the active-set
+    // iterations reuse them.
+    std::vector<int> rowBase(I.groups.size(), 0);
+    int allRows = 0;
+    for (int g : order) {
+        rowBase[g] = allRows;
+        allRows += static_cast<int>(I.groups[g].desc.rows.size());
+    }
+    Eigen::MatrixXd mCache(allRows, allRows);
+    std::vector<uint8_t> mHave(static_cast<size_t>(allRows) * allRows, 0);
     auto buildRows = [&]() -> bool {
         rows.clear();
         std::vector<int> missing;
@@ -507,6 +656,7 @@ FemSolveStats CorotationalFem::solve() {
                 SolveRow sr;
                 sr.group = g;
                 sr.row = static_cast<int>(r);
+                sr.id = rowBase[g] + static_cast<int>(r);
                 sr.bu = G.desc.rows[r].b;
                 for (const ConstraintTerm& t : G.desc.rows[r].terms) {
                     sr.bu -= t.a.dot(X0[t.node]);
@@ -534,17 +684,14 @@ FemSolveStats CorotationalFem::solve() {
 
     // Dense Schur system on the rows: returns false on failure. Fills lam (per row; 0 if rejected).
     std::vector<uint8_t> rejected;
+    using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    RowMatrix L;
+    std::vector<int> acc, prevIds; // accepted rows and row ids of the previous active-set iteration
     auto solveSchur = [&]() {
         const int mrows = static_cast<int>(rows.size());
-        const int S = static_cast<int>(I.nodeOf.size());
-        Eigen::MatrixXd W(3 * S, mrows);
         Eigen::MatrixXd M(mrows, mrows);
         Eigen::VectorXd q(mrows);
         for (int r = 0; r < mrows; ++r) {
-            auto w = W.col(r);
-            w.setZero();
-            for (const auto& [slot, a] : rows[r].terms)
-                w.noalias() += I.kinv.block(0, 3 * slot, 3 * S, 3) * a;
             double cu0 = 0;
             for (const auto& [node, a] : rows[r].nodeTerms)
                 cu0 += a.dot(I.cur.u0.segment<3>(3 * node));
@@ -552,24 +699,42 @@ FemSolveStats CorotationalFem::solve() {
         }
         for (int r = 0; r < mrows; ++r)
             for (int c = 0; c <= r; ++c) {
-                double v = 0;
-                for (const auto& [slot, a] : rows[c].terms)
-                    v += a.dot(W.col(r).segment<3>(3 * slot));
-                M(r, c) = M(c, r) = v;
+                const size_t key = static_cast<size_t>(rows[r].id) * allRows + rows[c].id;
+                if (!mHave[key]) {
+                    double v = 0; // Σ_terms a_rᵀ K⁻¹[slot_r, slot_c] a_c
+                    for (const auto& [sr, ar] : rows[r].terms)
+                        for (const auto& [sc, ac] : rows[c].terms)
+                            v += ar.dot(I.kinv.block<3, 3>(3 * sr, 3 * sc) * ac);
+                    mCache(rows[r].id, rows[c].id) = mCache(rows[c].id, rows[r].id) = v;
+                    mHave[key] = mHave[static_cast<size_t>(rows[c].id) * allRows + rows[r].id] = 1;
+                }
+                M(r, c) = M(c, r) = mCache(rows[r].id, rows[c].id);
             }
-        // Pivoted incremental Cholesky in row order; a row whose pivot is too small is rejected.
-        Eigen::MatrixXd L = Eigen::MatrixXd::Zero(mrows, mrows);
-        std::vector<int> acc;
-        rejected.assign(mrows, 0);
+        // Pivoted incremental Cholesky in row order; a row whose pivot is too small is rejected. The
+        // rows that lead as in the previous active-set iteration keep their part of the factor (a
+        // released or activated group changes only what follows it).
+        int p = 0;
+        while (p < mrows && p < static_cast<int>(prevIds.size()) && prevIds[p] == rows[p].id)
+            ++p;
+        int k0 = 0;
+        while (k0 < static_cast<int>(acc.size()) && acc[k0] < p)
+            ++k0;
+        acc.resize(k0);
+        rejected.resize(mrows);
+        std::fill(rejected.begin() + p, rejected.end(), 0);
+        if (L.rows() < mrows) {
+            RowMatrix grown(mrows, mrows);
+            grown.topLeftCorner(k0, k0) = L.topLeftCorner(k0, k0);
+            L.swap(grown);
+        }
+        prevIds.resize(mrows);
+        for (int r = 0; r < mrows; ++r)
+            prevIds[r] = rows[r].id;
         Eigen::VectorXd l(mrows);
-        for (int r = 0; r < mrows; ++r) {
+        for (int r = p; r < mrows; ++r) {
             const int k = static_cast<int>(acc.size());
-            for (int i = 0; i < k; ++i) {
-                double v = M(acc[i], r);
-                for (int j = 0; j < i; ++j)
-                    v -= L(i, j) * l[j];
-                l[i] = v / L(i, i);
-            }
+            for (int i = 0; i < k; ++i)
+                l[i] = (M(acc[i], r) - L.row(i).head(i).dot(l.head(i))) / L(i, i);
             const double d = M(r, r) - l.head(k).squaredNorm();
             if (!(M(r, r) > 0) || !(d > I.s.rankTolerance * M(r, r))) {
                 rejected[r] = 1;
@@ -608,6 +773,7 @@ FemSolveStats CorotationalFem::solve() {
     };
 
     bool ok = true;
+    std::vector<std::pair<int, Vec3>> gsum;
     for (int outer = 0; outer < I.s.maxActiveSetIterations && ok; ++outer) {
         bool changed = false;
         for (int inner = 0; inner < I.s.maxActiveSetIterations; ++inner) {
@@ -633,23 +799,25 @@ FemSolveStats CorotationalFem::solve() {
             if (!released) break;
         }
         if (!ok) break;
-        // u = K⁻¹ (f − Cᵀλ) = u0 − Σ_nodes K⁻¹[:, node] (Cᵀλ)_node with the cached columns: no
-        // substitution, a dense product over the constrained nodes.
-        {
-            std::vector<std::pair<int, Vec3>> g; // (slot, (Cᵀλ)_node)
-            for (size_t r = 0; r < rows.size(); ++r)
-                if (lam[r] != 0)
-                    for (const auto& [slot, a] : rows[r].terms) {
-                        auto it = std::find_if(g.begin(), g.end(), [&](const auto& e) { return e.first == slot; });
-                        if (it == g.end())
-                            g.emplace_back(slot, lam[r] * a);
-                        else
-                            it->second += lam[r] * a;
-                    }
-            u = I.cur.u0;
-            for (const auto& [slot, gv] : g)
-                u.noalias() -= I.cols.middleCols(3 * slot, 3) * gv;
-        }
+        // u = K⁻¹ (f − Cᵀλ) = u0 − Σ_nodes K⁻¹[:, node] (Cᵀλ)_node. The activation test needs u only
+        // at the nodes of inactive groups: rows of the cached columns, no full product.
+        gsum.clear(); // (slot, (Cᵀλ)_node)
+        for (size_t r = 0; r < rows.size(); ++r)
+            if (lam[r] != 0)
+                for (const auto& [slot, a] : rows[r].terms) {
+                    auto it = std::find_if(gsum.begin(), gsum.end(), [&](const auto& e) { return e.first == slot; });
+                    if (it == gsum.end())
+                        gsum.emplace_back(slot, lam[r] * a);
+                    else
+                        it->second += lam[r] * a;
+                }
+        auto uAt = [&](int32_t node) -> Vec3 {
+            if (m_fixed[node]) return Vec3::Zero();
+            Vec3 v = I.cur.u0.segment<3>(3 * node);
+            for (const auto& [slot, gv] : gsum)
+                v.noalias() -= I.cols.block<3, 3>(3 * node, 3 * slot) * gv;
+            return v;
+        };
         // Activate violated unilateral groups.
         for (int g : order) {
             Group& G = I.groups[g];
@@ -658,7 +826,7 @@ FemSolveStats CorotationalFem::solve() {
             for (size_t r = 0; r < G.desc.rows.size(); ++r) {
                 double v = -G.desc.rows[r].b;
                 for (const ConstraintTerm& t : G.desc.rows[r].terms)
-                    v += t.a.dot(X0[t.node] + (m_fixed[t.node] ? Vec3::Zero() : Vec3(u.segment<3>(3 * t.node))));
+                    v += t.a.dot(X0[t.node] + uAt(t.node));
                 viol += G.desc.weights[r] * v;
             }
             if (viol < -I.s.activationTolerance && outer + 1 < I.s.maxActiveSetIterations) {
@@ -667,6 +835,22 @@ FemSolveStats CorotationalFem::solve() {
             }
         }
         if (!changed) break;
+    }
+    if (ok) {
+        // The full u once: the dense product over the constrained nodes, or one substitution of
+        // f − Cᵀλ when that is cheaper (many constrained nodes; ≈ 4 nnz(L) flops against 6 #V·|g|).
+        const double product = 6.0 * static_cast<double>(m_x.size()) * static_cast<double>(gsum.size());
+        if (product > 4.0 * static_cast<double>(I.cur.factorNonZeros)) {
+            u = I.cur.f;
+            for (const auto& [slot, gv] : gsum)
+                u.segment<3>(3 * I.nodeOf[slot]) -= gv;
+            if (!I.cur.chol->solveInPlace(u.data(), 1, st.error)) ok = false;
+            ++st.substitutions;
+        } else {
+            u = I.cur.u0;
+            for (const auto& [slot, gv] : gsum)
+                u.noalias() -= I.cols.middleCols(3 * slot, 3) * gv;
+        }
     }
     st.finite = ok && u.allFinite() && (lam.size() == 0 || lam.allFinite());
     if (!st.finite) {
@@ -724,6 +908,7 @@ FemSolveStats CorotationalFem::solve() {
                 st.error = err;
         } else {
             I.startJob(m_x);
+            st.refactorStarted = true;
         }
     }
     return st;
@@ -740,6 +925,177 @@ double CorotationalFem::elasticEnergy() const {
         e += 0.5 * d.dot(m->elems[t].stiffness * d);
     }
     return e;
+}
+
+namespace {
+
+/// Corotational element force R K (Rᵀx − x0) (12) and energy ½ dᵀKd at element positions xe.
+double elementForce(const LinearTet& e, const std::array<Vec3, 4>& xe, const std::array<Vec3, 4>& x0, Vec12* force) {
+    const Mat3 R = elementRotation(deformationGradient(e, xe));
+    Vec12 d;
+    for (int a = 0; a < 4; ++a)
+        d.segment<3>(3 * a) = R.transpose() * xe[a] - x0[a];
+    const Vec12 kd = e.stiffness * d;
+    if (force)
+        for (int a = 0; a < 4; ++a)
+            force->segment<3>(3 * a) = R * kd.segment<3>(3 * a);
+    return 0.5 * d.dot(kd);
+}
+
+} // namespace
+
+double CorotationalFem::corotationalEnergy(const std::vector<Vec3>& x) const {
+    double e = 0;
+    for (size_t t = 0; t < m->tets.size(); ++t) {
+        const Tet& T = m->tets[t];
+        e += elementForce(m->elems[t], {x[T[0]], x[T[1]], x[T[2]], x[T[3]]},
+                          {m_x0[T[0]], m_x0[T[1]], m_x0[T[2]], m_x0[T[3]]}, nullptr);
+    }
+    for (size_t v = 0; v < x.size(); ++v)
+        e -= m->fext.segment<3>(3 * v).dot(x[v] - m_x0[v]);
+    return e;
+}
+
+StaticReference CorotationalFem::convergedStatic(const StaticReferenceSettings& rs) const {
+    const auto t0 = std::chrono::steady_clock::now();
+    const Impl& I = *m;
+    StaticReference out;
+    const int n = I.n3();
+    Eigen::MatrixXd C;
+    Eigen::VectorXd bu, lam;
+    lastSystem(C, bu, lam);
+    const int mrows = static_cast<int>(C.rows());
+    std::vector<Vec3> x = m_x;
+    std::vector<double> values, exact; // projected and exact Hessian, pattern order
+    Eigen::VectorXd grad(n);
+    std::string error;
+    SparseCholesky chol(I.pattern, I.s.cholesky);
+    const double h = rs.fdStep * m_meanEdge;
+    Eigen::MatrixXd Z;                  // H⁻¹Cᵀ
+    Eigen::LDLT<Eigen::MatrixXd> schur; // C H⁻¹ Cᵀ
+    double r0 = -1;
+    double E = corotationalEnergy(x);
+    int hessianAge = -1; // iterations since the Hessian was assembled (-1: none yet)
+    for (int it = 0;; ++it) {
+        // Gradient every iteration; the projected Hessian at the first iteration and again every
+        // `hessianRefresh` iterations or when the line search fails with an old one (modified Newton:
+        // the FD Hessian costs 24 polar decompositions per tet, the gradient one).
+        const bool assembleHessian = hessianAge < 0 || hessianAge >= rs.hessianRefresh;
+        if (assembleHessian) {
+            values.assign(I.pattern.rowIdx.size(), 0.0);
+            for (int d : I.fixedDiag)
+                values[d] = 1.0;
+            exact = values;
+        }
+        grad = -I.fext;
+        for (size_t t = 0; t < I.tets.size(); ++t) {
+            const Tet& T = I.tets[t];
+            std::array<Vec3, 4> xe = {x[T[0]], x[T[1]], x[T[2]], x[T[3]]};
+            const std::array<Vec3, 4> x0 = {m_x0[T[0]], m_x0[T[1]], m_x0[T[2]], m_x0[T[3]]};
+            Vec12 f, fp, fm;
+            elementForce(I.elems[t], xe, x0, &f);
+            for (int a = 0; a < 4; ++a)
+                grad.segment<3>(3 * T[a]) += f.segment<3>(3 * a);
+            if (!assembleHessian) continue;
+            Mat12 H;
+            for (int j = 0; j < 12; ++j) {
+                const double keep = xe[j / 3][j % 3];
+                xe[j / 3][j % 3] = keep + h;
+                elementForce(I.elems[t], xe, x0, &fp);
+                xe[j / 3][j % 3] = keep - h;
+                elementForce(I.elems[t], xe, x0, &fm);
+                xe[j / 3][j % 3] = keep;
+                H.col(j) = (fp - fm) / (2 * h);
+            }
+            H = 0.5 * (H + H.transpose()).eval();
+            Eigen::SelfAdjointEigenSolver<Mat12> eig(H);
+            const Mat12 Hp =
+                eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+            const int* map = &I.scatter[t * 144];
+            for (int i = 0; i < 144; ++i)
+                if (map[i] >= 0) {
+                    values[map[i]] += Hp(i / 12, i % 12);
+                    exact[map[i]] += H(i / 12, i % 12);
+                }
+        }
+        for (size_t v = 0; v < m_fixed.size(); ++v)
+            if (m_fixed[v]) grad.segment<3>(3 * v).setZero();
+        if (assembleHessian) {
+            // The exact Hessian when it is positive definite (quadratic convergence), else the
+            // projected one (a descent direction; linear convergence).
+            hessianAge = 0;
+            if (!chol.factorize(exact, error) && !chol.factorize(values, error)) {
+                out.message = error;
+                break;
+            }
+            Z = C.transpose();
+            if (mrows > 0 && !chol.solveInPlace(Z.data(), mrows, error)) {
+                out.message = error;
+                break;
+            }
+            schur = (C * Z).ldlt();
+        }
+        ++hessianAge;
+        // KKT step: Δ = −H⁻¹(∇E + Cᵀμ) with CΔ = 0.
+        Eigen::VectorXd y = grad;
+        if (!chol.solveInPlace(y.data(), 1, error)) {
+            out.message = error;
+            break;
+        }
+        Eigen::VectorXd mu = Eigen::VectorXd::Zero(mrows);
+        if (mrows > 0) mu = schur.solve(-(C * y));
+        const Eigen::VectorXd r = grad + C.transpose() * mu;
+        out.residual = r.lpNorm<Eigen::Infinity>();
+        if (r0 < 0) r0 = std::max(out.residual, 1e-6);
+        out.iterations = it;
+        if (!std::isfinite(out.residual)) {
+            out.message = "non-finite residual";
+            break;
+        }
+        if (out.residual <= rs.tolerance * r0) {
+            out.converged = true;
+            break;
+        }
+        if (it >= rs.maxIterations) {
+            out.message = "max iterations";
+            break;
+        }
+        const Eigen::VectorXd delta = -(y + Z * mu);
+        if (delta.lpNorm<Eigen::Infinity>() <= rs.stepTolerance * m_meanEdge) { // at the rounding floor
+            out.converged = true;
+            break;
+        }
+        const double slope = grad.dot(delta);
+        double step = 1;
+        std::vector<Vec3> trial(x.size());
+        double Et = E;
+        bool accepted = false;
+        for (int b = 0; b < 40; ++b, step *= 0.5) {
+            for (size_t v = 0; v < x.size(); ++v)
+                trial[v] = x[v] + step * delta.segment<3>(3 * v);
+            Et = corotationalEnergy(trial);
+            // Armijo, with the rounding noise of E (a sum over the tets) as slack near x*.
+            if (Et <= E + 1e-4 * step * slope + 64 * std::numeric_limits<double>::epsilon() * std::abs(E)) {
+                accepted = true;
+                break;
+            }
+        }
+        if (!accepted && hessianAge > 1) { // an old Hessian: refresh it and try again
+            hessianAge = rs.hessianRefresh;
+            continue;
+        }
+        if (!accepted) { // at the rounding floor of E: the residual says how far from x* it is
+            out.converged = out.residual <= 1e3 * rs.tolerance * r0;
+            out.message = "line search stalled";
+            break;
+        }
+        x.swap(trial);
+        E = Et;
+    }
+    out.x = std::move(x);
+    out.energy = corotationalEnergy(out.x);
+    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return out;
 }
 
 Eigen::SparseMatrix<double> CorotationalFem::stiffnessMatrix() const {

@@ -12,9 +12,12 @@
 ///  - K_R is factorized (CHOLMOD LLᵀ, pattern analysed once) only when some edge vector has turned
 ///    by more than `refactorDisplacement` mean edge lengths (its change normal to itself) since the
 ///    last factorization (translation and stretch do not count); in
-///    RefactorMode::Background that work runs on a worker thread and the new factor is swapped in
-///    exactly `refactorLatencySteps` solves later (deterministic; the solve waits only if the worker
-///    is late). u0 = K_R⁻¹ f_R is cached with the factor.
+///    RefactorMode::Background the rotations, assembly and factorization run on a worker thread
+///    joined exactly `refactorLatencySteps` solves later (a late worker's factor is
+///    computed by that solve instead, from the same positions: same bits, bounded wait), then the K⁻¹ columns of the
+///    carried nodes (pinned or in use) are computed with the new factor, `refactorNodesPerSolve` nodes per solve, while
+///    the old factor keeps serving; the swap happens when all are done. Every step of it counts solves and nodes, never
+///    time, so a run is repeatable. u0 = K_R⁻¹ f_R is cached with the factor.
 ///  - K_R⁻¹ restricted to the constrained nodes is cached (three substitutions per node, once, when
 ///    a node first appears in a constraint; the full columns are kept too). Every constraint row's column K_R⁻¹cᵀ at
 ///    the constrained nodes is a combination of these blocks, so rows may be added, removed or change their
@@ -29,6 +32,7 @@
 /// Sign convention: K u + Cᵀλ = f, so the constraint force on the nodes is −Cᵀλ.
 /// Nothing here throws after create(); failures are reported in FemSolveStats.
 #include "sim/fem/element.hpp"
+#include "sim/fem/sparse_cholesky.hpp"
 #include "sim/mesh/tet_mesh.hpp"
 
 #include <Eigen/SparseCore>
@@ -50,12 +54,18 @@ struct FemSettings {
     /// to the edge) since the last factorization (the rotations are then re-extracted).
     double refactorDisplacement = 0.25;
     RefactorMode refactorMode = RefactorMode::Background;
-    int refactorLatencySteps = 3;      ///< Background: solves between the request and the swap, >= 1
+    int refactorLatencySteps = 3;      ///< Background: solves between the request and the worker's join, >= 1
     double rankTolerance = 1e-9;       ///< relative pivot below which a row is rejected
     double releaseTolerance = 0;       ///< N; unilateral group released when Σ w λ exceeds it
     double activationTolerance = 1e-7; ///< m; inactive unilateral group activated when violated by more
     int maxActiveSetIterations = 6;
-    int cacheEvictSteps = 400; ///< constrained-node cache entries unused this long are freed
+    int cacheEvictSteps = 400; ///< constrained-node cache entries unused this long are freed (not pinned ones)
+    /// Background: carried nodes whose K⁻¹ columns are computed with the new factor per solve (3
+    /// substitutions each) between the worker's join and the swap.
+    int refactorNodesPerSolve = 4;
+    int prefetchNodesPerSolve = 4; ///< queued nodes (prefetchNodes()) cached per solve, >= 0
+    /// Simplicial: cheapest for the few-column substitutions of the constrained-node cache.
+    CholeskyMethod cholesky = CholeskyMethod::Simplicial;
 };
 
 /// Empty when valid, else the rule that failed ("poisson_ratio 0.5 must be in [0, 0.5)").
@@ -99,9 +109,37 @@ struct FemSolveStats {
     int activeSetIterations = 0;
     int substitutions = 0; ///< forward/backward substitutions (columns) this solve
     int newCachedNodes = 0;
-    bool refactored = false; ///< a new factor was taken into use
-    bool finite = true;      ///< false: the result was not finite and was discarded
-    std::string error;       ///< the last failure (empty when none)
+    bool refactored = false;      ///< a new factor was taken into use
+    bool refactorStarted = false; ///< Background: this solve found the rotations stale and started the worker
+    bool refactorWaited = false;  ///< Background: the worker was late; this solve computed its factor (timing only)
+    bool finite = true;           ///< false: the result was not finite and was discarded
+    std::string error;            ///< the last failure (empty when none)
+};
+
+/// Converged nonlinear static solution of a solve's problem (the measuring reference of the FEM's
+/// error against run time): the minimizer of the corotational energy with the rotations taken from
+/// the positions themselves, E(x) = Σ_e ½ d_eᵀ K_e d_e − f_extᵀ(x − x0), d_e = R_e(x)ᵀx_e − x0_e
+/// (R_e the polar rotation of F_e; its gradient is Σ R_e K_e d_e exactly), under the rows the
+/// solve enforced, as equalities. Newton from the solve's result: element Hessians by central
+/// differences of that gradient, assembled exactly when that is positive definite, else projected
+/// per element to positive semi-definite (reassembled every
+/// `hessianRefresh` iterations), a KKT step through the Schur complement, Armijo backtracking on E. x* is the fixed
+/// point that refactorizing every solve until the rotations stop changing would reach.
+struct StaticReferenceSettings {
+    double tolerance = 1e-9; ///< converged when ‖∇E + Cᵀμ‖∞ ≤ tolerance · max(‖·‖∞ at the start, 1e-6 N) …
+    double stepTolerance = 1e-9; ///< … or the Newton step is below this many mean edge lengths
+    int maxIterations = 60;
+    double fdStep = 1e-6;   ///< central-difference step, relative to the mean edge length
+    int hessianRefresh = 8; ///< iterations between two Hessian assemblies (modified Newton in between)
+};
+struct StaticReference {
+    bool converged = false;
+    int iterations = 0;
+    std::vector<Vec3> x; ///< x*, metres
+    double energy = 0;   ///< E(x*), J
+    double residual = 0; ///< ‖∇E + Cᵀμ‖∞ at x*, N
+    double seconds = 0;  ///< wall time of the reference solve
+    std::string message; ///< why it stopped when not converged
 };
 
 class CorotationalFem {
@@ -133,6 +171,18 @@ public:
     FemSolveStats solve();
     /// Re-extracts the rotations from the current positions and refactorizes now (synchronous).
     bool refactorNow(std::string* error = nullptr);
+    /// The same with the rotations of positions x (nodeCount() entries), e.g. those a background
+    /// refactorization was started from. False with `error` on a size mismatch or a failed factorization.
+    bool refactorAt(const std::vector<Vec3>& x, std::string* error = nullptr);
+    /// Background: a refactorization is in progress (worker or carried columns).
+    bool refactorPending() const;
+    /// Nodes kept in the constrained-node cache once cached (never evicted) and carried by a
+    /// refactorization: the nodes a caller knows it will constrain again (replaces the set).
+    void pinNodes(const std::vector<int32_t>& nodes);
+    /// Queues nodes to be cached ahead of use, `prefetchNodesPerSolve` per solve (spreads the
+    /// substitutions of a burst of new constraints over the steps before it). Fixed, cached or
+    /// queued nodes are skipped; out-of-range ones ignored.
+    void prefetchNodes(const std::vector<int32_t>& nodes);
 
     const std::vector<Vec3>& positions() const { return m_x; }
     const std::vector<Vec3>& restPositions() const { return m_x0; }
@@ -140,6 +190,12 @@ public:
     bool isFixed(int32_t node) const { return m_fixed[node] != 0; }
     /// Elastic energy ½ uᵀ K_R u − (f_R − f_ext)ᵀu of the current state under the current rotations, J.
     double elasticEnergy() const;
+    /// E(x) of StaticReference (rotations from x itself), J. x has nodeCount() entries.
+    double corotationalEnergy(const std::vector<Vec3>& x) const;
+    /// The converged nonlinear static solution of the last solve's problem (its enforced rows as
+    /// equalities), from positions(). Cost: per Newton iteration 24 polar decompositions per tet, one
+    /// factorization and one substitution per enforced row. A measuring tool; never throws.
+    StaticReference convergedStatic(const StaticReferenceSettings& settings = {}) const;
     int factorizations() const { return m_factorizations; }
     int cachedNodes() const;
     double meanEdgeLength() const { return m_meanEdge; }

@@ -73,21 +73,22 @@ struct SparseCholesky::Impl {
     }
 };
 
-SparseCholesky::SparseCholesky(NoAnalysis) : m(std::make_unique<Impl>()) {
+SparseCholesky::SparseCholesky(NoAnalysis, CholeskyMethod method) : m(std::make_unique<Impl>()) {
     cholmod_start(&m->common);
     m->common.print = 0;               // the library never prints
     m->common.error_handler = nullptr; // errors come back through common.status
-    m->common.supernodal = CHOLMOD_SUPERNODAL;
+    m->common.supernodal = method == CholeskyMethod::Simplicial ? CHOLMOD_SIMPLICIAL : CHOLMOD_SUPERNODAL;
     m->common.final_ll = 1;
 }
 
-SparseCholesky::SparseCholesky(const UpperPattern& p) : SparseCholesky(NoAnalysis{}) {
+SparseCholesky::SparseCholesky(const UpperPattern& p, CholeskyMethod method) : SparseCholesky(NoAnalysis{}, method) {
     std::string error;
     if (!m->analyze(p, error)) throw std::runtime_error(error);
 }
 
-std::unique_ptr<SparseCholesky> SparseCholesky::tryCreate(const UpperPattern& p, std::string& error) {
-    std::unique_ptr<SparseCholesky> chol(new SparseCholesky(NoAnalysis{}));
+std::unique_ptr<SparseCholesky> SparseCholesky::tryCreate(const UpperPattern& p, std::string& error,
+                                                          CholeskyMethod method) {
+    std::unique_ptr<SparseCholesky> chol(new SparseCholesky(NoAnalysis{}, method));
     if (!chol->m->analyze(p, error)) return nullptr;
     return chol;
 }

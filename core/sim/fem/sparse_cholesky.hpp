@@ -20,13 +20,20 @@ struct UpperPattern {
     int find(int r, int c) const;
 };
 
+/// Supernodal: dense BLAS blocks, fastest to factorize and for many right-hand sides at once.
+/// Simplicial: plain column loops; a solve with one to a few right-hand sides costs about nnz(L)
+/// flops without a BLAS call per supernode, several times cheaper on a small factor (measured on
+/// the 1,650-node anastomosis: about 0.5 against 1.5 ms for three columns).
+enum class CholeskyMethod { Supernodal, Simplicial };
+
 class SparseCholesky {
 public:
     /// Analyses the pattern. Throws std::invalid_argument on an empty or malformed pattern and
     /// std::runtime_error when CHOLMOD fails (out of memory).
-    explicit SparseCholesky(const UpperPattern& pattern);
+    explicit SparseCholesky(const UpperPattern& pattern, CholeskyMethod method = CholeskyMethod::Supernodal);
     /// As the constructor, but a CHOLMOD failure is returned: null with `error` set.
-    static std::unique_ptr<SparseCholesky> tryCreate(const UpperPattern& pattern, std::string& error);
+    static std::unique_ptr<SparseCholesky> tryCreate(const UpperPattern& pattern, std::string& error,
+                                                     CholeskyMethod method = CholeskyMethod::Supernodal);
     ~SparseCholesky();
     SparseCholesky(const SparseCholesky&) = delete;
     SparseCholesky& operator=(const SparseCholesky&) = delete;
@@ -46,7 +53,7 @@ public:
 
 private:
     struct NoAnalysis {};
-    explicit SparseCholesky(NoAnalysis);
+    SparseCholesky(NoAnalysis, CholeskyMethod method);
     struct Impl;
     std::unique_ptr<Impl> m;
 };

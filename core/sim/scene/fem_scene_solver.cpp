@@ -47,8 +47,12 @@ std::unique_ptr<FemSceneSolver> FemSceneSolver::create(const SceneSolverInputs& 
     SutureSettings settings = sd.settings;
     settings.fem.youngsModulus = scene.bodies[0].material.youngsModulus;
     settings.fem.poissonRatio = scene.bodies[0].material.poissonRatio;
-    // One core: a background refactorization would share it; results are then also repeatable.
-    settings.fem.refactorMode = RefactorMode::Synchronous;
+    // Refactorization off the step: the worker takes the idle rest of the frames (about 30 ms of
+    // work against 10 frames of 15 ms idle each) and is joined 10 solves after the request; the new
+    // factor is swapped in at a solve fixed by counts alone, so a session is repeatable
+    // (CorotationalFem, RefactorMode::Background; a late worker's factor is computed by the solve).
+    settings.fem.refactorMode = RefactorMode::Background;
+    settings.fem.refactorLatencySteps = 10;
     std::unique_ptr<FemSceneSolver> f(new FemSceneSolver());
     try {
         f->m_suture = SutureSimulation::create(mergeMeshes(parts, nullptr), fixed, settings, trajectory.front().pose);

@@ -58,6 +58,8 @@ std::string validate(const SutureSettings& s) {
         return "thread max_strain_per_step must be in (0, 1)";
     if (!(s.contactThickness > 0) || s.contactRounds < 0 || s.contactsPerRound < 1 || s.maxContacts < 1)
         return "contact thickness must be positive, rounds >= 0, per round >= 1, max_contacts >= 1";
+    if (s.contactLookaheadSteps < 0 || s.contactLookaheadEvery < 1 || !(s.contactLookaheadDistance >= 0))
+        return "contact_lookahead_steps and _distance must be >= 0, contact_lookahead_every >= 1";
     return {};
 }
 
@@ -394,6 +396,38 @@ void SutureSimulation::processContacts(const std::vector<Vec3>& before, SutureSt
     }
 }
 
+void SutureSimulation::prefetchAhead(const std::vector<Vec3>& before) {
+    if (!m_detector || m_s.contactLookaheadSteps <= 0 || m_steps % m_s.contactLookaheadEvery != 0) return;
+    const auto& x = m_fem->positions();
+    std::vector<Vec3> ahead(x.size());
+    const double k = m_s.contactLookaheadSteps, cap = m_s.contactLookaheadDistance;
+    for (size_t v = 0; v < x.size(); ++v) {
+        Vec3 d = k * (x[v] - before[v]);
+        const double len = d.norm();
+        if (len > cap) d *= cap / len;
+        ahead[v] = x[v] + d;
+    }
+    std::vector<Collision> hits;
+    m_detector->detect(x, ahead, m_s.contactThickness, hits);
+    std::vector<int32_t> nodes;
+    for (const Collision& h : hits)
+        nodes.insert(nodes.end(), h.v.begin(), h.v.end());
+    m_fem->prefetchNodes(nodes);
+}
+
+void SutureSimulation::pinHistoryNodes() {
+    // The thread's puncture points and the needle's entries will be constrained again (pull, slip):
+    // their K⁻¹ columns stay cached instead of being recomputed in one burst when the pull engages.
+    const double l = m_s.needle.length_();
+    std::vector<int32_t> nodes;
+    for (const HistoryEntry& e : m_history) {
+        if (e.face == kNone || !(e.puncture() || (e.alpha >= 0 && e.alpha <= l))) continue;
+        const auto v = m_mesh->halfFacetVertices(e.face);
+        nodes.insert(nodes.end(), v.begin(), v.end());
+    }
+    m_fem->pinNodes(nodes);
+}
+
 bool SutureSimulation::n_finite(const ConstraintRow& r) {
     for (const auto& t : r.terms)
         if (!t.a.allFinite()) return false;
@@ -406,6 +440,10 @@ bool SutureSimulation::solve(SutureStepStats& st) {
     st.activeRows = fs.rows;
     st.rejectedRows = fs.redundant + fs.incompatible;
     st.refactored |= fs.refactored;
+    st.refactorWaited |= fs.refactorWaited;
+    st.substitutions += fs.substitutions;
+    st.newCachedNodes += fs.newCachedNodes;
+    st.activeSetIterations += fs.activeSetIterations;
     if (!fs.error.empty()) st.error = fs.error;
     if (!fs.finite) st.finite = false;
     return fs.finite;
@@ -442,6 +480,7 @@ void SutureSimulation::readForces(SutureStepStats& st) {
 
 SutureStepStats SutureSimulation::step(const NeedleFrame& frame) {
     SutureStepStats st;
+    ++m_steps;
     const std::vector<Vec3> before = m_fem->positions();
     const double l = m_s.needle.length_();
     Eigen::Isometry3d next = frame.pose;
@@ -515,7 +554,11 @@ SutureStepStats SutureSimulation::step(const NeedleFrame& frame) {
         }
     }
     st.tipInContact = m_tip.active;
-    if (m_s.contact) processContacts(before, st);
+    if (m_s.contact) {
+        processContacts(before, st);
+        prefetchAhead(before);
+    }
+    pinHistoryNodes();
     readForces(st);
     for (const HistoryEntry& e : m_history) {
         if (e.alpha >= 0 && e.alpha <= l) ++st.needleEntries;

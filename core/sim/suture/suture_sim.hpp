@@ -66,6 +66,13 @@ struct SutureSettings {
     int contactsPerRound = 48;      ///< earliest collisions taken per round
     int maxContacts = 256;          ///< contact constraints held at most (bounds the dense solve)
     bool selfContact = false;       ///< also contact within one body (default: between bodies only)
+    /// Contact ahead of time: the step's motion extrapolated this many steps is run through the
+    /// detector and the nodes of the predicted contacts are queued for the FEM's constrained-node
+    /// cache (CorotationalFem::prefetchNodes), so a burst of contacts finds its K⁻¹ columns ready.
+    /// Changes no constraint, only when the work is done. 0 disables.
+    int contactLookaheadSteps = 48;
+    int contactLookaheadEvery = 4;          ///< steps between two predictions (the detection's cost, amortized)
+    double contactLookaheadDistance = 1e-3; ///< m, cap of a node's extrapolated motion (a playback snap is no trend)
 };
 
 /// Empty when valid, else the rule that failed.
@@ -112,6 +119,10 @@ struct SutureStepStats {
     double threadTension = 0; ///< from the pull multiplier, N
     bool threadEngaged = false;
     bool refactored = false;
+    bool refactorWaited = false; ///< a solve waited for the background factorization (timing only)
+    int substitutions = 0;       ///< forward/backward substitutions (columns) of all solves this step
+    int newCachedNodes = 0;      ///< constrained nodes whose K⁻¹ columns were computed this step
+    int activeSetIterations = 0; ///< Schur solves of all FEM solves this step
     std::string error;
 };
 
@@ -159,6 +170,8 @@ private:
     void updateThreadConstraint(double pull, SutureStepStats& st);
     void updateContacts();
     void processContacts(const std::vector<Vec3>& before, SutureStepStats& st);
+    void prefetchAhead(const std::vector<Vec3>& before);
+    void pinHistoryNodes();
     bool solve(SutureStepStats& st);
     void readForces(SutureStepStats& st);
     ConstraintRow pointRow(int32_t face, const Vec3& xi, const Vec3& dir, double b) const;
@@ -174,6 +187,7 @@ private:
     std::vector<int> m_needleIds;
     std::vector<int> m_needleEntryOf; // history index per needle constraint
     int m_punctures = 0;
+    long m_steps = 0;
     // tip contact with a boundary facet (puncture in progress)
     struct TipContact {
         bool active = false;

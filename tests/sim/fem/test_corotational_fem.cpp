@@ -334,3 +334,166 @@ TEST(CorotationalFem, CreateRejectsBadInputWithMessages) {
                   "fixed node 99999 is out of range");
     expectMessage([&] { CorotationalFem::create(*bar.mesh, {}, FemSettings{}); }, "not positive definite");
 }
+
+namespace {
+
+/// The bar's free end dragged by a point constraint along z by `step` per solve (large rotations).
+struct Drag {
+    Bar bar;
+    int tet = 0;
+    Vec3 rest = Vec3::Zero();
+    explicit Drag() : bar(makeBar({10, 2, 2})) {
+        tet = static_cast<int>(bar.mesh->tetCount()) - 1;
+        for (int a = 0; a < 4; ++a)
+            rest += 0.25 * bar.mesh->positions()[bar.mesh->tets()[tet][a]];
+    }
+    int constrain(CorotationalFem& fem) const {
+        return fem.addConstraint(pointConstraint(*bar.mesh, tet, Eigen::Vector4d::Constant(0.25), rest));
+    }
+    void target(CorotationalFem& fem, int id, int k, double step = 1e-3) const {
+        for (int c = 0; c < 3; ++c)
+            fem.setRhs(id, c, rest[c] + (c == 2 ? step * k : 0.0));
+    }
+};
+
+double maxDistance(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+    double d = 0;
+    for (size_t v = 0; v < a.size(); ++v)
+        d = std::max(d, (a[v] - b[v]).norm());
+    return d;
+}
+
+} // namespace
+
+TEST(CorotationalFem, BackgroundSwapEqualsASynchronousFactorizationOfTheSamePositions) {
+    // Background: the worker factorizes the positions of the request; the carried columns are then
+    // computed one node per solve; the swap comes at a fixed solve. A synchronous FEM that keeps its
+    // factor and refactorizes at exactly that solve from the same positions must give the same result.
+    const Drag d;
+    FemSettings bs;
+    bs.refactorMode = RefactorMode::Background;
+    bs.refactorDisplacement = 0.05;
+    bs.refactorLatencySteps = 4;
+    bs.refactorNodesPerSolve = 1;
+    auto a = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, bs, d.bar.gravity);
+    FemSettings ss = bs;
+    ss.refactorMode = RefactorMode::Synchronous;
+    ss.refactorDisplacement = 1e9; // refactorized by hand below
+    auto b = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, ss, d.bar.gravity);
+    const int ia = d.constrain(*a), ib = d.constrain(*b);
+    std::vector<Vec3> requestedAt;
+    int started = -1, swaps = 0;
+    for (int k = 0; k < 60; ++k) {
+        d.target(*a, ia, k);
+        d.target(*b, ib, k);
+        const FemSolveStats sa = a->solve();
+        ASSERT_TRUE(sa.finite && sa.error.empty()) << sa.error;
+        if (sa.refactored) {
+            // b had no solve with the new factor yet: refactorize from the request's positions and
+            // redo this solve's problem.
+            ASSERT_FALSE(requestedAt.empty());
+            ASSERT_GT(k - started, bs.refactorLatencySteps); // the carried column takes at least one solve more
+            std::string error;
+            ASSERT_TRUE(b->refactorAt(requestedAt, &error)) << error;
+            ++swaps;
+        }
+        const FemSolveStats sb = b->solve();
+        ASSERT_TRUE(sb.finite);
+        // Same factor on both sides at every solve: equal up to the rounding of the column batches.
+        EXPECT_LT(maxDistance(a->positions(), b->positions()), 1e-12) << "solve " << k;
+        if (sa.refactorStarted) {
+            started = k;
+            requestedAt = a->positions();
+        }
+    }
+    EXPECT_GE(swaps, 2);
+    EXPECT_EQ(a->factorizations(), b->factorizations());
+}
+
+TEST(CorotationalFem, PinnedNodesStayCachedAndPrefetchSpreadsTheSubstitutions) {
+    const Drag d;
+    FemSettings s;
+    s.refactorMode = RefactorMode::Synchronous;
+    s.refactorDisplacement = 1e9;
+    s.cacheEvictSteps = 2;
+    s.prefetchNodesPerSolve = 2;
+    auto fem = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
+    auto plain = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
+    const int id = d.constrain(*fem), ip = d.constrain(*plain);
+    ASSERT_TRUE(fem->solve().finite);
+    ASSERT_TRUE(plain->solve().finite);
+    const int constrained = fem->cachedNodes();
+    EXPECT_EQ(constrained, 4);
+    // Pin the constraint's nodes, then drop the constraint: they outlive the eviction age.
+    const auto& t = d.bar.mesh->tets()[d.tet];
+    fem->pinNodes({t[0], t[1], t[2], t[3]});
+    fem->removeConstraint(id);
+    plain->removeConstraint(ip);
+    for (int k = 0; k < 6; ++k) {
+        ASSERT_TRUE(fem->solve().finite);
+        ASSERT_TRUE(plain->solve().finite);
+    }
+    EXPECT_EQ(fem->cachedNodes(), 4);
+    EXPECT_EQ(plain->cachedNodes(), 0);
+    // Prefetch: at most two queued nodes per solve, and the results do not change.
+    const int32_t nv = static_cast<int32_t>(fem->nodeCount());
+    std::vector<int32_t> ahead;
+    for (int32_t v = nv - 1; static_cast<int>(ahead.size()) < 5; --v)
+        if (!fem->isFixed(v) && std::find(t.begin(), t.end(), v) == t.end()) ahead.push_back(v);
+    ahead.push_back(ahead[0]); // duplicates and fixed nodes are skipped
+    ahead.push_back(d.bar.fixed[0]);
+    fem->prefetchNodes(ahead);
+    const FemSolveStats st = fem->solve();
+    ASSERT_TRUE(plain->solve().finite);
+    EXPECT_EQ(st.newCachedNodes, 2);
+    EXPECT_EQ(st.substitutions, 6);
+    EXPECT_EQ(fem->cachedNodes(), 6);
+    for (int k = 0; k < 2; ++k)
+        ASSERT_TRUE(fem->solve().finite);
+    EXPECT_EQ(fem->cachedNodes(), 4 + 5); // not evicted yet (unused for two solves at most)
+    EXPECT_LT(maxDistance(fem->positions(), plain->positions()), 1e-15);
+}
+
+TEST(CorotationalFem, ConvergedStaticReferenceIsTheFixedPointOfRefactorizing) {
+    // Refactorizing at every solve with the constraint held still converges to the minimizer of the
+    // corotational energy under that constraint; the reference reaches it by Newton from anywhere on
+    // the way. The linear FEM (rotations never updated) stays far from it at this rotation.
+    const Drag d;
+    FemSettings s;
+    s.refactorMode = RefactorMode::Synchronous;
+    s.refactorDisplacement = 1e-9; // every solve
+    auto fem = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
+    auto lin = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, linearSettings(), d.bar.gravity);
+    const int id = d.constrain(*fem), il = d.constrain(*lin);
+    for (int k = 0; k <= 20; ++k) { // drag the end 24 mm down (the bar is 60 mm long)
+        d.target(*fem, id, k, 1.2e-3);
+        d.target(*lin, il, k, 1.2e-3);
+        ASSERT_TRUE(fem->solve().finite);
+        ASSERT_TRUE(lin->solve().finite);
+    }
+    const StaticReference early = fem->convergedStatic();
+    ASSERT_TRUE(early.converged) << early.message << " residual " << early.residual << " after " << early.iterations;
+    EXPECT_LE(early.energy, fem->corotationalEnergy(fem->positions()) + 1e-15);
+    for (int k = 0; k < 40; ++k)
+        ASSERT_TRUE(fem->solve().finite); // same target: the fixed-point iteration
+    const StaticReference ref = fem->convergedStatic();
+    ASSERT_TRUE(ref.converged) << ref.message;
+    const double span = maxDistance(ref.x, fem->restPositions());
+    EXPECT_GT(span, 0.02);
+    EXPECT_LT(maxDistance(fem->positions(), ref.x), 1e-7 * span);
+    EXPECT_LT(maxDistance(early.x, ref.x), 1e-7 * span); // the same x* from an earlier state
+    // The linear FEM's answer, measured against its own reference, is far off.
+    const StaticReference linRef = lin->convergedStatic();
+    ASSERT_TRUE(linRef.converged) << linRef.message << " residual " << linRef.residual << " after "
+                                  << linRef.iterations;
+    EXPECT_GT(maxDistance(lin->positions(), linRef.x), 1e-3 * span);
+    EXPECT_GT(lin->corotationalEnergy(lin->positions()), linRef.energy);
+}
+
+TEST(CorotationalFem, RefactorAtRejectsPositionsOfTheWrongSize) {
+    Bar bar = makeBar();
+    auto fem = CorotationalFem::create(*bar.mesh, bar.fixed, FemSettings{}, bar.gravity);
+    std::string error;
+    EXPECT_FALSE(fem->refactorAt({Vec3::Zero()}, &error));
+    EXPECT_NE(error.find("refactorAt(): positions have the wrong size"), std::string::npos) << error;
+}
