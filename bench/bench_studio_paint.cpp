@@ -10,6 +10,7 @@
 #include "app/stiffness_painter.hpp"
 #include "app/studio_app.hpp"
 #include "app/viewport.hpp"
+#include "studio_bench_support.hpp"
 
 #include <QAction>
 #include <QApplication>
@@ -34,21 +35,8 @@ namespace {
 
 using namespace viscera;
 
-bool waitFor(const std::function<bool()>& done, int ms) {
-    QElapsedTimer t;
-    t.start();
-    while (!done() && t.elapsed() < ms) {
-        QEventLoop loop;
-        QTimer::singleShot(20, &loop, &QEventLoop::quit);
-        loop.exec();
-    }
-    return done();
-}
-
-void send(QWidget* w, QEvent::Type type, QPointF pos, Qt::MouseButton button, Qt::MouseButtons buttons) {
-    QMouseEvent e(type, pos, w->mapToGlobal(pos), button, buttons, Qt::NoModifier);
-    QApplication::sendEvent(w, &e);
-}
+using bench::send;
+using bench::waitFor;
 
 } // namespace
 

@@ -21,6 +21,7 @@
 #include "app/plot_widget.hpp"
 #include "app/studio_app.hpp"
 #include "app/viewport.hpp"
+#include "studio_bench_support.hpp"
 
 #include <QApplication>
 #include <QDockWidget>
@@ -49,22 +50,8 @@ namespace {
 
 using namespace viscera;
 
-void send(QWidget* w, QEvent::Type type, QPointF pos, Qt::MouseButton button, Qt::MouseButtons buttons) {
-    QMouseEvent e(type, pos, w->mapToGlobal(pos), button, buttons, Qt::NoModifier);
-    QApplication::sendEvent(w, &e);
-}
-
-/// Runs the event loop (sleeping while idle, as in a session) until `done` or `ms` pass.
-bool waitFor(const std::function<bool()>& done, int ms) {
-    QElapsedTimer t;
-    t.start();
-    while (!done() && t.elapsed() < ms) {
-        QEventLoop loop;
-        QTimer::singleShot(20, &loop, &QEventLoop::quit);
-        loop.exec();
-    }
-    return done();
-}
+using bench::send;
+using bench::waitFor;
 
 double percentile(std::vector<double> v, double q) {
     if (v.empty()) return 0;
