@@ -30,6 +30,7 @@
 #include <QPlainTextEdit>
 #include <QProgressDialog>
 #include <QRegularExpression>
+#include <QScrollArea>
 #include <QSettings>
 #include <QSlider>
 #include <QStatusBar>
@@ -313,7 +314,10 @@ void MainWindow::setPainting(bool on) {
     // in paint mode F and Shift+F size the brush (the viewport's own keys); Home still frames
     m_frameAction->setShortcut(on ? QKeySequence(Qt::Key_Home) : QKeySequence(Qt::Key_F));
     if (on) {
-        if (auto* d = findChild<QDockWidget*>("paintDock")) d->show();
+        if (auto* d = findChild<QDockWidget*>("paintDock")) {
+            d->show();
+            d->raise();
+        }
         retargetPainter();
     }
     showPaintWeights();
@@ -494,8 +498,15 @@ void MainWindow::buildPaintDock() {
     form->addRow(m_paintStatus);
     auto* d = new QDockWidget(tr("Stiffness paint"), this);
     d->setObjectName("paintDock");
-    d->setWidget(host);
+    auto* scroll = new QScrollArea(d); // a short dock scrolls instead of clipping the legend
+    scroll->setWidgetResizable(true);
+    scroll->setFrameShape(QFrame::NoFrame);
+    scroll->setWidget(host);
+    d->setWidget(scroll);
     addDockWidget(Qt::LeftDockWidgetArea, d);
+    // a tab beside the properties: stacked under them it made the left column taller than a
+    // 1200-pixel screen
+    if (auto* props = findChild<QDockWidget*>("propertiesDock")) tabifyDockWidget(props, d);
     d->hide(); // shown when painting starts
     connect(&m_painter, &StiffnessPainter::statusChanged, m_paintStatus, &QLabel::setText);
     connect(&m_painter, &StiffnessPainter::weightsChanged, this, &MainWindow::showPaintWeights);
