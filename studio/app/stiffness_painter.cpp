@@ -33,14 +33,14 @@ void StiffnessPainter::setStatus(const QString& s) {
 }
 
 void StiffnessPainter::setTarget(int body, std::shared_ptr<const sim::TetMesh> mesh) {
-    if (m_stroking) cancel();
     const bool same =
         body == m_body && mesh && m_mesh && mesh->positions() == m_mesh->positions() && mesh->tets() == m_mesh->tets();
-    if (same) {
+    if (same) { // the preview built the same mesh again: a stroke in progress goes on
         m_mesh = std::move(mesh);
-        if (m_ready) recompute();
+        if (m_ready && !m_stroking) recompute();
         return;
     }
+    if (m_stroking) cancel();
     m_body = body;
     m_mesh = std::move(mesh);
     m_ready = false;

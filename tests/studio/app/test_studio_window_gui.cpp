@@ -282,7 +282,8 @@ TEST_F(WindowFixture, LivePreviewShowsAnEditTheNextFrameAndTheStabilityVerdict) 
     // the accuracy sample arrives (every 60 frames by default)
     w->preview()->setAccuracyEvery(5);
     ASSERT_EQ(w->setProperty("youngs_modulus", "20000"), "");
-    EXPECT_TRUE(test::waitFor([&] { return !w->errorPlot()->series().empty(); }, 60000));
+    // the sampler runs below every other thread: on a busy machine it may take a while
+    EXPECT_TRUE(test::waitFor([&] { return !w->errorPlot()->series().empty(); }, 180000));
     EXPECT_FALSE(w->costPlot()->series().empty());
 }
 
@@ -478,7 +479,7 @@ TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWe
     EXPECT_GT(raised, 5u);
     // the live preview takes the painted weights: the stability check sees the stiffer nodes
     // (the first stroke on an unpainted body builds once; the meshes are then kept)
-    EXPECT_TRUE(test::waitFor([&] { return w->verdictLabel()->text() != verdictBefore; }, 60000))
+    EXPECT_TRUE(test::waitFor([&] { return w->verdictLabel()->text() != verdictBefore; }, 180000))
         << w->verdictLabel()->text().toStdString();
     // the ramp is on the body: some overlay vertices are painted (alpha 0.9)
     bool ramp = false;
@@ -539,7 +540,7 @@ TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWe
         EXPECT_NEAR(painter->weights()[i], static_cast<double>(mixRef[i]), 1e-12 * static_cast<double>(mixRef[i])) << i;
     EXPECT_EQ(w->document()->undoStack()->count(), undoBefore + 2);
     const QString verdictPainted = w->verdictLabel()->text();
-    EXPECT_TRUE(test::waitFor([&] { return w->verdictLabel()->text() != verdictPainted; }, 60000))
+    EXPECT_TRUE(test::waitFor([&] { return w->verdictLabel()->text() != verdictPainted; }, 180000))
         << "the mix stroke (towards 0.4) lowers the largest stiffness number";
     QTest::qWait(300);
     EXPECT_EQ(w->log()->toPlainText().count("preview: building meshes"), buildsPainted)
