@@ -45,6 +45,7 @@ void StiffnessPainter::setTarget(int body, std::shared_ptr<const sim::TetMesh> m
     m_mesh = std::move(mesh);
     m_ready = false;
     m_committed.clear();
+    m_applied.clear();
     m_live.clear();
     m_skeleton = {};
     emit readyChanged();
@@ -105,7 +106,24 @@ void StiffnessPainter::waitUntilReady() {
 void StiffnessPainter::recompute() {
     if (!m_ready || !m_doc->hasProject() || m_body >= static_cast<int>(m_doc->project().bodies.size())) return;
     const BodyProject& b = m_doc->project().bodies[m_body];
-    m_params = b.paint ? b.paint->params : sim::PaintParams{};
+    // an edit of anything else (a material drag) leaves the weights as they are
+    const std::vector<sim::BrushStroke> strokes = b.paint ? b.paint->strokes : std::vector<sim::BrushStroke>{};
+    const sim::PaintParams params = b.paint ? b.paint->params : sim::PaintParams{};
+    auto sameStroke = [](const sim::BrushStroke& x, const sim::BrushStroke& y) {
+        return x.center == y.center && x.radius == y.radius && x.amplitude == y.amplitude && x.scale == y.scale &&
+               x.mode == y.mode && x.target == y.target;
+    };
+    if (!m_committed.empty() && m_dabs.empty() && params.baseWeight == m_params.baseWeight &&
+        params.minWeight == m_params.minWeight && params.maxWeight == m_params.maxWeight &&
+        std::equal(strokes.begin(), strokes.end(), m_applied.begin(), m_applied.end(), sameStroke)) {
+        if (m_live != m_committed) { // a refused stroke: the weights shown go back
+            m_live = m_committed;
+            emit weightsChanged();
+        }
+        return;
+    }
+    m_applied = strokes;
+    m_params = params;
     m_committed.assign(m_mesh->vertexCount(), m_params.baseWeight);
     if (b.paint)
         for (const sim::BrushStroke& s : b.paint->strokes)

@@ -83,6 +83,7 @@ private:
     sim::PaintParams m_params;
     std::vector<double> m_committed, m_live;
     std::vector<sim::BrushStroke> m_dabs;
+    std::vector<sim::BrushStroke> m_applied; ///< the project's strokes m_committed was made from
     sim::Vec3 m_lastDab = sim::Vec3::Zero();
     bool m_stroking = false;
     struct Prepared;

@@ -714,8 +714,17 @@ void Viewport::setRestPose(int body) {
 
 void Viewport::setAuthoringMeshes(std::vector<render::RenderMesh> meshes) {
     if (meshes.empty() && m_authoring.empty()) return;
+    // The same meshes with new values (a stroke recolours the section) are updated in the GPU
+    // buffers they have; other meshes need new buffers (a new renderer).
+    bool inPlace = meshes.size() == m_authoring.size();
+    for (size_t k = 0; k < meshes.size() && inPlace; ++k)
+        inPlace = meshes[k].indices == m_authoring[k].indices;
+    for (size_t k = 0; k < meshes.size() && inPlace; ++k) {
+        meshes[k].revision = m_authoring[k].revision + 1;
+        meshes[k].staticRevision = m_authoring[k].staticRevision + 1;
+    }
     m_authoring = std::move(meshes);
-    ++m_sceneSerial; // other meshes: new GPU buffers
+    if (!inPlace) ++m_sceneSerial;
     viewChanged();
 }
 

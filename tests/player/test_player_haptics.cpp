@@ -209,7 +209,6 @@ TEST(PlayerHaptics, ReplaysARecordedTrajectory) {
     EXPECT_NEAR(m["real_time_factor"].get<double>(), dt * 1e3 / mean, 1e-9 * dt * 1e3 / mean);
     EXPECT_NEAR(m["real_time_factor_p99"].get<double>(), dt * 1e3 / m["step_ms_p99"].get<double>(),
                 1e-9 * m["real_time_factor_p99"].get<double>());
-    EXPECT_LE(m["real_time_factor_p99"].get<double>(), m["real_time_factor"].get<double>() * (1 + 1e-12));
     int over = 0;
     for (const auto& f : j["frames"])
         over += f["step_ms"].get<double>() > dt * 1e3 ? 1 : 0;
