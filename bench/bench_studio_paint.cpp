@@ -51,21 +51,8 @@ int main(int argc, char** argv) {
     QCoreApplication::setOrganizationName("VisceraBench");
     QCoreApplication::setApplicationName("StudioPaint");
     studio::MainWindow w;
-    w.setConfirmDiscard(false);
-    w.resize(1600, 1000);
-    w.show();
-    if (!w.openProject(QString::fromStdString(std::string(VISCERA_SOURCE_DIR) + "/projects/" + projectName))) return 1;
-    int body = -1;
-    for (size_t i = 0; i < w.document()->project().bodies.size(); ++i)
-        if (w.document()->project().bodies[i].scene.name == bodyName) body = static_cast<int>(i);
-    if (body < 0) {
-        std::fprintf(stderr, "no body '%s' in %s\n", bodyName.c_str(), projectName.c_str());
-        return 2;
-    }
-    std::printf("waiting for the preview (meshing %s)...\n", projectName.c_str());
-    if (!waitFor([&] { return w.preview()->bodyMesh(body) != nullptr && w.viewport()->meshCount() > 0; }, 600000))
-        return 1;
-    w.selectBody(body);
+    const int body = bench::openSampleBody(w, projectName, bodyName);
+    if (body < 0) return 1;
     QElapsedTimer prep;
     prep.start();
     w.findChild<QAction*>("actionPaintStiffness")->trigger();

@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
             loaded = player::loadCase(input);
             for (int f = 0; f < frames; ++f)
                 loaded.world->step();
-            view = render::SceneView::fromWorld(*loaded.world);
+            view = player::caseView(loaded);
         }
         if (heat && !view.meshes().empty()) {
             // A dissection line across the first mesh: heat falls off with distance from the x = 0 plane.

@@ -194,7 +194,7 @@ int cmdRun(const std::vector<std::string>& args) {
     if (headless && screenshot) {
         // The rendered view of the last frame (EGL; Mesa llvmpipe where there is no GPU).
         try {
-            const render::SceneView view = render::SceneView::fromWorld(*loaded.world);
+            const render::SceneView view = player::caseView(loaded);
             render::RenderSettings rs = render::defaultSettingsFor(view);
             render::applyCaseRender(rs, loaded.scene.render, *casePath);
             std::string why;

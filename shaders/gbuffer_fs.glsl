@@ -34,8 +34,10 @@ uniform float uReflection;
 uniform float uFlags;
 uniform float uThicknessRange;
 uniform int uDoubleSided;
+uniform int uScreenDoor; // 1: drawn in every other pixel (authoring translucency)
 
 void main() {
+    if (uScreenDoor != 0 && ((int(gl_FragCoord.x) + int(gl_FragCoord.y)) & 1) == 0) discard;
     vec3 n = normalize(vNormal);
     if (uDoubleSided != 0 && !gl_FrontFacing) n = -n;
 

@@ -76,6 +76,20 @@ std::vector<Tri3> trianglesOf(const sim::TriMesh& mesh) {
 
 } // namespace
 
+RenderMesh bodySurfaceMesh(const sim::TetMesh& rest, const std::string& name, size_t body) {
+    auto mesh = rest.clone();
+    mesh->requireLevel(3);
+    const std::vector<int32_t>& map = mesh->boundaryVertexMap();
+    std::vector<Eigen::Vector3f> pos(map.size());
+    for (size_t i = 0; i < map.size(); ++i)
+        pos[i] = mesh->positions()[map[i]].cast<float>();
+    RenderMesh m = makeMesh(name, pos, trianglesOf(mesh->boundary()));
+    m.source = RenderMesh::Source::Body;
+    m.sourceIndex = body;
+    m.sourceVertex = map;
+    return m;
+}
+
 uint32_t SceneView::addMaterial(const TissueMaterial& material) {
     m_materials.push_back(material);
     return uint32_t(m_materials.size() - 1);
@@ -102,19 +116,12 @@ SceneView SceneView::fromWorld(const sim::World& world, const ThicknessBakeSetti
     std::vector<Eigen::Vector3f> allPos;
     std::vector<Tri3> allTris;
     for (size_t b = 0; b < world.bodyCount(); ++b) {
-        auto mesh = world.restMesh(b).clone();
-        mesh->requireLevel(3);
-        const sim::TriMesh& boundary = mesh->boundary();
-        const std::vector<int32_t>& map = mesh->boundaryVertexMap();
-        std::vector<Eigen::Vector3f> pos(map.size());
-        for (size_t i = 0; i < map.size(); ++i)
-            pos[i] = mesh->positions()[map[i]].cast<float>();
-        const auto tris = trianglesOf(boundary);
-        RenderMesh m = makeMesh(world.bodyName(b), pos, tris);
+        RenderMesh m = bodySurfaceMesh(world.restMesh(b), world.bodyName(b), b);
+        const std::vector<Eigen::Vector3f> pos = asVectors(m.rest);
+        std::vector<Tri3> tris(m.triangleCount());
+        for (size_t t = 0; t < tris.size(); ++t)
+            tris[t] = {m.indices[3 * t], m.indices[3 * t + 1], m.indices[3 * t + 2]};
         m.material = view.addMaterial(defaultMaterialFor(world.bodyName(b)));
-        m.source = RenderMesh::Source::Body;
-        m.sourceIndex = b;
-        m.sourceVertex = map;
         m.thickness = bakeThickness(pos, asVectors(m.normals), TriangleBvh(pos, tris), bake);
         const uint32_t base = uint32_t(allPos.size());
         allPos.insert(allPos.end(), pos.begin(), pos.end());
@@ -125,12 +132,9 @@ SceneView SceneView::fromWorld(const sim::World& world, const ThicknessBakeSetti
     std::unique_ptr<TriangleBvh> bodies;
     if (!allTris.empty()) bodies = std::make_unique<TriangleBvh>(allPos, allTris);
     for (size_t s = 0; s < world.surfaceCount(); ++s) {
-        const auto& sp = world.surfacePositions(s);
-        std::vector<Tri3> tris;
-        // The world keeps the rest surfaces private; the current positions at assembly are the rest state.
-        // Topology comes from the surface mesh the world was assembled with.
-        tris = trianglesOf(world.surfaceMesh(s));
-        const auto pos = toFloat(sp);
+        // The surface mesh the world was assembled with is the layer at rest (also once it has moved).
+        const std::vector<Tri3> tris = trianglesOf(world.surfaceMesh(s));
+        const auto pos = toFloat(world.surfaceMesh(s).positions());
         const std::string name = world.surfaceName(s);
         RenderMesh m = makeMesh(name, pos, tris);
         m.material = view.addMaterial(defaultMaterialFor(name));

@@ -16,6 +16,7 @@
 namespace viscera::sim {
 class World;
 class TriMesh;
+class TetMesh;
 } // namespace viscera::sim
 
 namespace viscera::render {
@@ -26,6 +27,9 @@ struct RenderMesh {
     bool doubleSided = false; ///< open surfaces (fascia): no culling, normal faces the viewer
     bool drawOnTop = false;   ///< polygon offset towards the camera (a layer lying on a body)
     bool visible = true;
+    /// Authoring (the studio's paint tools): drawn through a 50 % screen door, every other pixel,
+    /// so what lies inside the mesh (a curve skeleton) shows through it.
+    bool translucent = false;
     // ---- fixed at creation ----------------------------------------------------------------
     std::vector<uint32_t> indices; ///< #F × 3, counter-clockwise from outside
     std::vector<float> rest;       ///< #V × 3, m: rest positions (procedural pattern space)
@@ -58,6 +62,11 @@ struct RenderMesh {
     /// The indices of the drawn faces, in face order, into out (resized; #drawn × 3). O(#F).
     void drawnIndicesInto(std::vector<uint32_t>& out) const;
 };
+
+/// The boundary of a tet body at rest as a render mesh: positions and rest from `rest`'s nodes,
+/// Source::Body with sourceIndex `body` and sourceVertex the boundary's node map; material 0, no
+/// thickness baked. What SceneView::fromWorld draws for a body, and what the studio paints on.
+RenderMesh bodySurfaceMesh(const sim::TetMesh& rest, const std::string& name, size_t body = 0);
 
 class SceneView {
 public:

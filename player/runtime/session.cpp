@@ -3,10 +3,12 @@
 #include "sim/skeleton/node_weights_io.hpp"
 
 #include "render/case_settings.hpp"
+#include "render/sample_map.hpp"
 
 #include "sim/mesh/tet_io.hpp"
 #include "sim/util/error.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 namespace viscera::player {
@@ -19,10 +21,8 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
     if (!pkg.contains(sceneName))
         throw InputError(pkg.name() + ": " + sceneName + ": required file is missing from the package");
     out.scene = sim::parseScene(pkg.read(sceneName), pkg.name() + ":" + sceneName);
-    {
-        render::RenderSettings check; // the look the case asks for is checked at load, not at the first frame
-        render::applyCaseRender(check, out.scene.render, pkg.name() + ":" + sceneName);
-    }
+    render::RenderSettings look; // the look the case asks for is checked at load, not at the first frame
+    render::applyCaseRender(look, out.scene.render, pkg.name() + ":" + sceneName);
     std::vector<std::unique_ptr<sim::TetMesh>> meshes;
     for (const sim::BodyDesc& b : out.scene.bodies) {
         if (!pkg.contains(b.meshPath))
@@ -38,6 +38,18 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
                              b.nodeWeightsPath + "', which are not in the package");
         b.nodeWeights = sim::parseNodeWeights(pkg.read(b.nodeWeightsPath), pkg.name() + ":" + b.nodeWeightsPath,
                                               meshes[i]->vertexCount());
+    }
+    out.sampleMaps.resize(out.scene.bodies.size());
+    for (size_t i = 0; i < out.scene.bodies.size(); ++i) { // painted light samples, only where they are used
+        const sim::BodyDesc& b = out.scene.bodies[i];
+        if (b.sampleMapPath.empty()) continue;
+        const std::string field =
+            pkg.name() + ": " + sceneName + ": bodies[" + std::to_string(i) + "].sample_map_file: ";
+        if (look.sampling.mode != render::SampleMode::Painted)
+            throw InputError(field + "the case's render.sampling is not 'painted', so the map would not be used");
+        if (!pkg.contains(b.sampleMapPath)) throw InputError(field + "'" + b.sampleMapPath + "' is not in the package");
+        out.sampleMaps[i] = render::parseSampleMap(pkg.read(b.sampleMapPath), pkg.name() + ":" + b.sampleMapPath,
+                                                   meshes[i]->vertexCount());
     }
     std::vector<sim::TriMesh> surfaces;
     for (const sim::SurfaceDesc& sd : out.scene.surfaces) {
@@ -64,6 +76,22 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
     out.world = sim::World::assemble(out.scene, std::move(meshes), std::move(surfaces), pkg.manifest().features,
                                      pkg.name() + ": manifest.json");
     return out;
+}
+
+render::SceneView caseView(const LoadedCase& loaded) {
+    render::SceneView view = render::SceneView::fromWorld(*loaded.world);
+    for (size_t b = 0; b < loaded.sampleMaps.size(); ++b) {
+        if (loaded.sampleMaps[b].empty()) continue;
+        std::vector<size_t> layers; // fascia cut from this body's boundary show its map too
+        double tolerance = 1e-6;
+        for (size_t s = 0; s < loaded.scene.surfaces.size(); ++s)
+            if (loaded.scene.surfaces[s].attachTo == loaded.scene.bodies[b].name) {
+                layers.push_back(s);
+                tolerance = std::max(tolerance, loaded.scene.surfaces[s].attachDistance);
+            }
+        render::applyNodeSampleClasses(view, b, loaded.sampleMaps[b], layers, static_cast<float>(tolerance));
+    }
+    return view;
 }
 
 SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {

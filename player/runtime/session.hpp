@@ -2,6 +2,7 @@
 /// Loading a verified case into a World and running a session on it.
 #include "case/case_package.hpp"
 #include "haptics/device.hpp"
+#include "render/scene_view.hpp"
 #include "runtime/haptic_rig.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/world.hpp"
@@ -21,11 +22,20 @@ struct LoadedCase {
     std::unique_ptr<vcase::CasePackage> package;
     sim::SceneDesc scene;
     std::unique_ptr<sim::World> world;
+    /// Per body: its painted light-sample classes per node (sample_map_file), empty when it has
+    /// none. Loaded only when the case renders with painted sampling.
+    std::vector<std::vector<uint8_t>> sampleMaps;
 };
 
 /// Verifies the package, parses its scene and assembles a World with only the subsystems the
-/// manifest declares. Throws viscera::InputError naming the file, the field and the rule.
+/// manifest declares. Throws viscera::InputError naming the file, the field and the rule (also for
+/// a body's sample map when the case does not render with painted sampling: it would not be used).
 LoadedCase loadCase(const std::filesystem::path& casePath);
+
+/// What the trainee sees of a loaded case: the world's bodies and surfaces
+/// (render::SceneView::fromWorld) with the case's painted sample maps on the bodies and on the
+/// fascia attached to them.
+render::SceneView caseView(const LoadedCase& loaded);
 
 /// What the trainee window draws; the physics thread writes it after every frame.
 struct LiveView {

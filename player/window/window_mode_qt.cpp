@@ -34,9 +34,10 @@ using haptics::KeyboardDevice;
 /// QImage for the window's paint events. GUI thread only.
 class Viewport3D {
 public:
-    Viewport3D(const sim::World& world, const std::string& caseRender, LiveView& live, int width, int height)
-        : m_live(live) {
-        m_view = render::SceneView::fromWorld(world);
+    Viewport3D(const LoadedCase& loaded, LiveView& live, int width, int height) : m_live(live) {
+        const sim::World& world = *loaded.world;
+        const std::string& caseRender = loaded.scene.render;
+        m_view = caseView(loaded);
         for (size_t b = 0; b < world.bodyCount(); ++b) {
             m_bodyOffset.push_back(m_offset);
             m_offset += world.restMesh(b).vertexCount();
@@ -314,7 +315,7 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
     options.live = &live;
     options.stop = &stop;
     const std::string title = loaded.package->manifest().title.value_or(loaded.package->manifest().caseId);
-    Viewport3D viewport(*loaded.world, loaded.scene.render, live, 640, 480);
+    Viewport3D viewport(loaded, live, 640, 480);
     if (!viewport.available()) log::warn("3D view off (side view instead): " + viewport.whyNot());
     TraineeWindow window(live, title, loaded.scene.instructions, dynamic_cast<KeyboardDevice*>(options.device), stop,
                          &viewport);

@@ -8,6 +8,7 @@
 #include "app/paint_overlays.hpp"
 #include "app/plot_widget.hpp"
 #include "app/viewport.hpp"
+#include "render/case_settings.hpp"
 #include "sim/material/material.hpp"
 
 #include <QAction>
@@ -29,6 +30,7 @@
 #include <QMessageBox>
 #include <QPlainTextEdit>
 #include <QProgressDialog>
+#include <QPushButton>
 #include <QRegularExpression>
 #include <QScrollArea>
 #include <QSettings>
@@ -248,9 +250,19 @@ void MainWindow::buildActions() {
                                  "(left drag paints, Esc cancels a stroke, Alt + left drag orbits)"));
     connect(m_paintAction, &QAction::toggled, this, [this](bool on) { setPainting(on); });
     view->addAction(m_paintAction);
+    m_samplesAction = new QAction(tr("Paint &light samples"), this);
+    m_samplesAction->setObjectName("actionPaintSamples");
+    m_samplesAction->setCheckable(true);
+    m_samplesAction->setShortcut(QKeySequence(Qt::Key_L));
+    m_samplesAction->setToolTip(tr("Paint the selected body's area-light sample classes 1×, 4×, 8× (left drag "
+                                   "paints or fills, Ctrl erases, Esc cancels, Alt + left drag orbits)"));
+    connect(m_samplesAction, &QAction::toggled, this, [this](bool on) { setPaintingSamples(on); });
+    view->addAction(m_samplesAction);
     toolbar->addSeparator();
     toolbar->addAction(m_paintAction);
+    toolbar->addAction(m_samplesAction);
     buildPaintDock();
+    buildSampleDock();
     m_widgetHostAction = view->addAction(tr("Compatibility viewport (QOpenGLWidget, slower)"));
     m_widgetHostAction->setObjectName("actionWidgetViewport");
     m_widgetHostAction->setCheckable(true);
@@ -306,15 +318,30 @@ bool MainWindow::painting() const {
 }
 
 void MainWindow::setPainting(bool on) {
-    if (m_paintAction && m_paintAction->isChecked() != on) {
-        m_paintAction->setChecked(on); // toggled() comes back here
+    setPaintTool(m_paintAction, on);
+}
+
+bool MainWindow::paintingSamples() const {
+    return m_samplesAction && m_samplesAction->isChecked();
+}
+
+void MainWindow::setPaintingSamples(bool on) {
+    setPaintTool(m_samplesAction, on);
+}
+
+void MainWindow::setPaintTool(QAction* action, bool on) {
+    if (action && action->isChecked() != on) {
+        action->setChecked(on); // toggled() comes back here
         return;
     }
-    m_viewport->setPaintMode(on);
+    QAction* other = action == m_paintAction ? m_samplesAction : m_paintAction;
+    if (on && other && other->isChecked()) other->setChecked(false); // one paint tool at a time
+    const bool any = painting() || paintingSamples();
+    m_viewport->setPaintMode(any);
     // in paint mode F and Shift+F size the brush (the viewport's own keys); Home still frames
-    m_frameAction->setShortcut(on ? QKeySequence(Qt::Key_Home) : QKeySequence(Qt::Key_F));
+    m_frameAction->setShortcut(any ? QKeySequence(Qt::Key_Home) : QKeySequence(Qt::Key_F));
     if (on) {
-        if (auto* d = findChild<QDockWidget*>("paintDock")) {
+        if (auto* d = findChild<QDockWidget*>(action == m_paintAction ? "paintDock" : "sampleDock")) {
             d->show();
             d->raise();
         }
@@ -324,40 +351,56 @@ void MainWindow::setPainting(bool on) {
 }
 
 void MainWindow::retargetPainter() {
-    if (!painting()) return;
-    m_painter.setTarget(m_body, m_body >= 0 ? m_preview.bodyMesh(m_body) : nullptr);
+    const auto mesh = m_body >= 0 && (painting() || paintingSamples()) ? m_preview.bodyMesh(m_body) : nullptr;
+    if (painting()) m_painter.setTarget(m_body, mesh);
+    if (paintingSamples()) m_samplePainter.setTarget(m_body, mesh);
 }
 
 void MainWindow::connectPainting(Viewport* v) {
     // a dab only on the painted body's own surface
     auto onBody = [this](const Viewport::SurfaceHit& hit) {
         const auto& meshes = m_viewport->view().meshes();
+        const int body = paintingSamples() ? m_samplePainter.body() : m_painter.body();
         return hit.mesh >= 0 && hit.mesh < static_cast<int>(meshes.size()) &&
                meshes[hit.mesh].source == render::RenderMesh::Source::Body &&
-               static_cast<int>(meshes[hit.mesh].sourceIndex) == m_painter.body();
+               static_cast<int>(meshes[hit.mesh].sourceIndex) == body;
     };
     connect(v, &Viewport::paintPressed, this, [this, onBody](const Viewport::SurfaceHit& hit) {
-        if (onBody(hit)) m_painter.begin(hit.rest.cast<double>());
+        if (!onBody(hit)) return;
+        if (paintingSamples())
+            m_samplePainter.begin(hit.rest.cast<double>(), hit.invert);
+        else
+            m_painter.begin(hit.rest.cast<double>(), hit.invert);
     });
     connect(v, &Viewport::paintMoved, this, [this, onBody](const Viewport::SurfaceHit& hit) {
-        if (onBody(hit)) m_painter.move(hit.rest.cast<double>());
+        if (!onBody(hit)) return;
+        if (paintingSamples())
+            m_samplePainter.move(hit.rest.cast<double>());
+        else
+            m_painter.move(hit.rest.cast<double>());
     });
     connect(v, &Viewport::paintReleased, this, [this] {
-        const QString why = m_painter.end();
+        const QString why = paintingSamples() ? m_samplePainter.end() : m_painter.end();
         if (!why.isEmpty()) logLine(why);
     });
-    connect(v, &Viewport::paintCancelled, this, [this] { m_painter.cancel(); });
+    connect(v, &Viewport::paintCancelled, this, [this] {
+        m_painter.cancel();
+        m_samplePainter.cancel();
+    });
     connect(v, &Viewport::brushAdjusted, this, [this](bool strength, double dx, bool done) {
         // a drag to the right grows the brush: ×2 per 200 px for the radius, +1 (or +0.2 for a
         // blend) per 100 px for the strength; Esc restores (done with dx 0)
-        auto* radius = findChild<QDoubleSpinBox*>("paintRadius");
-        auto* amount = findChild<QDoubleSpinBox*>("paintStrength");
+        const bool samples = paintingSamples(); // its Shift+F sets the fill's edge angle
+        auto* radius = findChild<QDoubleSpinBox*>(samples ? "sampleRadius" : "paintRadius");
+        auto* amount = findChild<QDoubleSpinBox*>(samples ? "sampleAngle" : "paintStrength");
         if (!m_adjustStarted) {
             m_adjustRadius = radius->value();
             m_adjustStrength = amount->value();
             m_adjustStarted = true;
         }
-        if (strength) {
+        if (strength && samples) {
+            amount->setValue(m_adjustStrength + dx / 100.0 * 15.0); // 15° per 100 px
+        } else if (strength) {
             const bool blend =
                 m_painter.brush.mode == sim::BrushMode::Mix || m_painter.brush.mode == sim::BrushMode::Smooth;
             amount->setValue(m_adjustStrength + dx / 100.0 * (blend ? 0.2 : 1.0));
@@ -368,14 +411,43 @@ void MainWindow::connectPainting(Viewport* v) {
     });
 }
 
+void MainWindow::showPaintedBody(int body, const std::function<Eigen::Vector4f(int32_t node)>& rgbaOfNode,
+                                 const std::optional<CutPlane>& cut, bool translucent) {
+    const bool show = body >= 0 && rgbaOfNode;
+    // the painted body at rest: the brush, the skeleton and the section share its frame
+    m_viewport->setRestPose(show ? body : -1);
+    const auto& meshes = m_viewport->view().meshes();
+    for (size_t k = 0; k < meshes.size(); ++k) {
+        const render::RenderMesh& m = meshes[k];
+        const bool painted =
+            show && m.source == render::RenderMesh::Source::Body && static_cast<int>(m.sourceIndex) == body;
+        // while painting, the painted body alone is drawn (a fascia on it or a neighbour would
+        // hide its colours and take the brush's hits)
+        m_viewport->setMeshVisible(static_cast<int>(k), painted || !show);
+        m_viewport->setMeshTranslucent(static_cast<int>(k), painted && translucent);
+        m_viewport->setFaceMask(static_cast<int>(k), painted && cut ? cutAwayMask(m, *cut) : std::vector<uint8_t>{});
+        if (!painted) {
+            if (!m.overlay.empty()) m_viewport->setOverlay(static_cast<int>(k), {});
+            continue;
+        }
+        std::vector<float> rgba(4 * m.vertexCount());
+        for (size_t v = 0; v < m.vertexCount(); ++v) {
+            const Eigen::Vector4f c = rgbaOfNode(m.sourceVertex[v]);
+            std::copy(c.data(), c.data() + 4, rgba.begin() + 4 * v);
+        }
+        m_viewport->setOverlay(static_cast<int>(k), rgba);
+    }
+}
+
 void MainWindow::showPaintWeights() {
     if (!m_viewport) return;
-    const auto& meshes = m_viewport->view().meshes();
+    if (paintingSamples()) {
+        showSampleClasses();
+        return;
+    }
     const std::vector<double>& w = m_painter.weights();
     const bool show = painting() && m_painter.ready() && !w.empty();
     const double base = m_painter.params().baseWeight;
-    // the painted body at rest: the brush, the skeleton and the section share its frame
-    m_viewport->setRestPose(show ? m_painter.body() : -1);
     std::optional<CutPlane> cut;
     const auto mesh = show ? m_preview.bodyMesh(m_painter.body()) : nullptr;
     if (show && mesh && m_paintCut && m_paintCut->isChecked()) {
@@ -391,41 +463,53 @@ void MainWindow::showPaintWeights() {
         }
         cut = CutPlane{n, lo + (hi - lo) * m_paintCutAt->value() / 100.0};
     }
-    for (size_t k = 0; k < meshes.size(); ++k) {
-        const render::RenderMesh& m = meshes[k];
-        const bool painted =
-            show && m.source == render::RenderMesh::Source::Body && static_cast<int>(m.sourceIndex) == m_painter.body();
-        // while painting, the painted body alone is drawn (a fascia on it or a neighbour would
-        // hide its ramp and take the brush's hits)
-        m_viewport->setMeshVisible(static_cast<int>(k), painted || !show);
-        m_viewport->setFaceMask(static_cast<int>(k), painted && cut ? cutAwayMask(m, *cut) : std::vector<uint8_t>{});
-        if (!painted) {
-            if (!m.overlay.empty()) m_viewport->setOverlay(static_cast<int>(k), {});
-            continue;
-        }
-        std::vector<float> rgba(4 * m.vertexCount());
-        for (size_t v = 0; v < m.vertexCount(); ++v) {
-            const int32_t node = m.sourceVertex[v];
-            const Eigen::Vector4f c =
-                weightColour(node >= 0 && static_cast<size_t>(node) < w.size() ? w[node] : base, base);
-            std::copy(c.data(), c.data() + 4, rgba.begin() + 4 * v);
-        }
-        m_viewport->setOverlay(static_cast<int>(k), rgba);
-    }
+    auto colour = [&w, base](int32_t node) {
+        return weightColour(node >= 0 && static_cast<size_t>(node) < w.size() ? w[node] : base, base);
+    };
+    // with the skeleton shown and no section, the body is drawn translucent around it
+    const bool skeleton =
+        show && m_paintSkeleton && m_paintSkeleton->isChecked() && !m_painter.skeleton().nodes.empty();
+    showPaintedBody(show ? m_painter.body() : -1, show ? std::function<Eigen::Vector4f(int32_t)>(colour) : nullptr, cut,
+                    skeleton && !cut);
     std::vector<render::RenderMesh> extra;
-    if (show && m_paintSkeleton && m_paintSkeleton->isChecked() && !m_painter.skeleton().nodes.empty())
-        extra.push_back(skeletonMesh(m_painter.skeleton(), 0.0006f, 0));
+    if (skeleton) extra.push_back(skeletonMesh(m_painter.skeleton(), 0.0006f, 0));
     if (cut && mesh) extra.push_back(sliceMesh(*mesh, w, base, *cut, 0));
     m_viewport->setAuthoringMeshes(std::move(extra));
 }
 
-void MainWindow::buildPaintDock() {
-    auto* host = new QWidget(this);
+namespace {
+
+/// The form of a paint tool's dock, starting with the tool's own button.
+QFormLayout* toolForm(QWidget* host, QAction* action) {
     auto* form = new QFormLayout(host);
     auto* tool = new QToolButton(host);
-    tool->setDefaultAction(m_paintAction);
+    tool->setDefaultAction(action);
     tool->setToolButtonStyle(Qt::ToolButtonTextOnly);
     form->addRow(tool);
+    return form;
+}
+
+} // namespace
+
+QDockWidget* MainWindow::addToolDock(QWidget* host, const QString& title, const char* name) {
+    auto* d = new QDockWidget(title, this);
+    d->setObjectName(name);
+    auto* scroll = new QScrollArea(d); // a short dock scrolls instead of clipping the legend
+    scroll->setWidgetResizable(true);
+    scroll->setFrameShape(QFrame::NoFrame);
+    scroll->setWidget(host);
+    d->setWidget(scroll);
+    addDockWidget(Qt::LeftDockWidgetArea, d);
+    // a tab beside the properties: stacked under them it made the left column taller than a
+    // 1200-pixel screen
+    if (auto* props = findChild<QDockWidget*>("propertiesDock")) tabifyDockWidget(props, d);
+    d->hide(); // shown when the tool starts
+    return d;
+}
+
+void MainWindow::buildPaintDock() {
+    auto* host = new QWidget(this);
+    QFormLayout* form = toolForm(host, m_paintAction);
     auto* mode = new QComboBox(host);
     mode->setObjectName("paintMode");
     mode->addItems({tr("Add"), tr("Subtract"), tr("Mix (towards target)"), tr("Smooth")});
@@ -496,21 +580,151 @@ void MainWindow::buildPaintDock() {
     m_paintStatus->setObjectName("paintStatus");
     m_paintStatus->setWordWrap(true);
     form->addRow(m_paintStatus);
-    auto* d = new QDockWidget(tr("Stiffness paint"), this);
-    d->setObjectName("paintDock");
-    auto* scroll = new QScrollArea(d); // a short dock scrolls instead of clipping the legend
-    scroll->setWidgetResizable(true);
-    scroll->setFrameShape(QFrame::NoFrame);
-    scroll->setWidget(host);
-    d->setWidget(scroll);
-    addDockWidget(Qt::LeftDockWidgetArea, d);
-    // a tab beside the properties: stacked under them it made the left column taller than a
-    // 1200-pixel screen
-    if (auto* props = findChild<QDockWidget*>("propertiesDock")) tabifyDockWidget(props, d);
-    d->hide(); // shown when painting starts
+    addToolDock(host, tr("Stiffness paint"), "paintDock");
     connect(&m_painter, &StiffnessPainter::statusChanged, m_paintStatus, &QLabel::setText);
     connect(&m_painter, &StiffnessPainter::weightsChanged, this, &MainWindow::showPaintWeights);
     connect(&m_painter, &StiffnessPainter::readyChanged, this, &MainWindow::showPaintWeights);
+}
+
+void MainWindow::showSampleClasses() {
+    const std::vector<uint8_t>& classes = m_samplePainter.nodeClasses();
+    const bool show = paintingSamples() && m_samplePainter.ready() && !classes.empty();
+    auto colour = [&classes](int32_t node) {
+        const std::array<float, 4> c =
+            sampleClassColour(node >= 0 && static_cast<size_t>(node) < classes.size() ? classes[node] : 0);
+        return Eigen::Vector4f(c[0], c[1], c[2], c[3]);
+    };
+    showPaintedBody(show ? m_samplePainter.body() : -1,
+                    show ? std::function<Eigen::Vector4f(int32_t)>(colour) : nullptr, std::nullopt);
+    m_viewport->setAuthoringMeshes({});
+    if (!m_sampleLegend) return;
+    // the legend: the three classes' colours and their share of the body's surface
+    const std::array<double, 4> a = show ? m_samplePainter.areas() : std::array<double, 4>{0, 0, 0, 0};
+    const double all = a[0] + a[1] + a[2] + a[3];
+    auto share = [&](int i) { return all > 0 ? 100.0 * a[i] / all : 0.0; };
+    auto swatch = [](int samples) {
+        const std::array<float, 4> c = sampleClassColour(samples);
+        return QColor::fromRgbF(c[0], c[1], c[2]).name();
+    };
+    QString text;
+    const int classesShown[] = {1, 4, 8};
+    for (int i = 0; i < 3; ++i)
+        text += tr("<span style='color:%1'>■</span> %2×: %3 %<br>")
+                    .arg(swatch(classesShown[i]))
+                    .arg(classesShown[i])
+                    .arg(share(i + 1), 0, 'f', 1);
+    text += tr("<span style='color:#8c8c8c'>■</span> unpainted (the case's uniform count): %1 %<br>"
+               "surface %2 cm²")
+                .arg(share(0), 0, 'f', 1)
+                .arg(all * 1e4, 0, 'f', 1);
+    m_sampleLegend->setText(text);
+}
+
+void MainWindow::buildSampleDock() {
+    auto* host = new QWidget(this);
+    QFormLayout* form = toolForm(host, m_samplesAction);
+    auto* kind = new QComboBox(host);
+    kind->setObjectName("sampleTool");
+    kind->addItems({tr("Brush"), tr("Fill (up to sharp edges)")});
+    form->addRow(tr("Tool"), kind);
+    auto* cls = new QComboBox(host);
+    cls->setObjectName("sampleClass");
+    cls->addItems({tr("8× samples"), tr("4× samples"), tr("1× sample"), tr("Erase (unpainted)")});
+    form->addRow(tr("Class"), cls);
+    auto* radius = new QDoubleSpinBox(host);
+    radius->setObjectName("sampleRadius");
+    radius->setRange(0.5, 200);
+    radius->setDecimals(1);
+    radius->setSuffix(tr(" mm"));
+    radius->setValue(m_samplePainter.brush.radius * 1000);
+    auto* angle = new QDoubleSpinBox(host);
+    angle->setObjectName("sampleAngle");
+    angle->setRange(0, 180);
+    angle->setDecimals(1);
+    angle->setSuffix(tr("°"));
+    angle->setValue(m_samplePainter.brush.maxAngleDeg);
+    angle->setToolTip(tr("Fill: an edge whose two faces turn by more than this stops it"));
+    form->addRow(tr("Radius (F)"), radius);
+    form->addRow(tr("Edge angle (Shift+F)"), angle);
+    auto sync = [this, kind, cls, radius, angle] {
+        static const int kClasses[] = {8, 4, 1, 0};
+        m_samplePainter.brush.tool =
+            kind->currentIndex() == 1 ? render::SamplePaintOp::Tool::Fill : render::SamplePaintOp::Tool::Brush;
+        m_samplePainter.brush.samples = kClasses[std::clamp(cls->currentIndex(), 0, 3)];
+        m_samplePainter.brush.radius = radius->value() / 1000.0;
+        m_samplePainter.brush.maxAngleDeg = angle->value();
+        radius->setEnabled(kind->currentIndex() == 0);
+        angle->setEnabled(kind->currentIndex() == 1);
+    };
+    connect(kind, &QComboBox::currentIndexChanged, this, sync);
+    connect(cls, &QComboBox::currentIndexChanged, this, sync);
+    for (QDoubleSpinBox* sp : {radius, angle})
+        connect(sp, &QDoubleSpinBox::valueChanged, this, sync);
+    sync();
+    m_sampleLegend = new QLabel(host);
+    m_sampleLegend->setObjectName("sampleLegend");
+    m_sampleLegend->setTextFormat(Qt::RichText);
+    form->addRow(m_sampleLegend);
+    auto* compare = new QPushButton(tr("Compare uniform 1× | painted…"), host);
+    compare->setObjectName("sampleCompare");
+    compare->setToolTip(tr("Render the scene as the player would, uniform 1× beside the painted map, with the "
+                           "error against the many-sample reference near the light and the frame time"));
+    connect(compare, &QPushButton::clicked, this, [this] { openSampleCompare(); });
+    form->addRow(compare);
+    m_sampleStatus = new QLabel(tr("Select a tet body to paint its light samples."), host);
+    m_sampleStatus->setObjectName("sampleStatus");
+    m_sampleStatus->setWordWrap(true);
+    form->addRow(m_sampleStatus);
+    addToolDock(host, tr("Light samples"), "sampleDock");
+    connect(&m_samplePainter, &SamplePainter::statusChanged, m_sampleStatus, &QLabel::setText);
+    connect(&m_samplePainter, &SamplePainter::classesChanged, this, &MainWindow::showPaintWeights);
+    showSampleClasses();
+}
+
+SampleCompareDialog* MainWindow::openSampleCompare() {
+    if (!m_doc.hasProject()) return nullptr;
+    auto source = m_preview.sceneView();
+    if (!source) {
+        logLine(tr("Light samples: the preview has not built the scene yet"));
+        return nullptr;
+    }
+    // the scene at rest with the painted classes, as the exported case would show it
+    render::SceneView view = *source;
+    const auto& bodies = m_doc.project().bodies;
+    for (size_t b = 0; b < bodies.size(); ++b) {
+        const auto mesh = m_preview.bodyMesh(static_cast<int>(b));
+        if (!mesh) continue;
+        render::RenderMesh surface = render::bodySurfaceMesh(*mesh, bodies[b].scene.name, b);
+        render::applySamplePaint(surface, bodies[b].lightSamples);
+        std::vector<size_t> layers;
+        double tolerance = 1e-6;
+        for (size_t s = 0; s < m_doc.project().surfaces.size(); ++s)
+            if (m_doc.project().surfaces[s].scene.attachTo == bodies[b].scene.name) {
+                layers.push_back(s);
+                tolerance = std::max(tolerance, m_doc.project().surfaces[s].scene.attachDistance);
+            }
+        render::applyNodeSampleClasses(view, b, render::nodeSampleClasses(surface, mesh->vertexCount()), layers,
+                                       static_cast<float>(tolerance));
+    }
+    for (render::RenderMesh& m : view.meshes()) { // at rest, every face, no authoring colours
+        m.positions = m.rest;
+        m.faceMask.clear();
+        m.overlay.clear();
+        m.visible = true;
+    }
+    for (size_t k = 0; k < view.meshes().size(); ++k)
+        view.recomputeNormals(k);
+    render::RenderSettings settings = render::defaultSettingsFor(view, 480, 360);
+    try {
+        render::applyCaseRender(settings, m_doc.project().scene.render, "project.json");
+    } catch (const std::exception& e) {
+        logLine(QString::fromStdString(e.what()));
+    }
+    if (!m_compare) m_compare = new SampleCompareDialog(this);
+    m_compare->show();
+    m_compare->raise();
+    m_compare->start(view, settings);
+    return m_compare;
 }
 
 QStringList MainWindow::recentProjects() const {

@@ -6,17 +6,23 @@
 /// a project folder (atomic writes); the title marks unsaved changes from the undo stack's clean
 /// state; File → Export case… runs the export with progress and Cancel.
 #include "app/document.hpp"
+#include "app/paint_overlays.hpp"
 #include "app/preview.hpp"
+#include "app/sample_compare.hpp"
+#include "app/sample_painter.hpp"
 #include "app/stiffness_painter.hpp"
 #include "app/viewport.hpp"
 
 #include <QMainWindow>
 #include <QStringList>
 
+#include <functional>
 #include <memory>
+#include <optional>
 
 class QCheckBox;
 class QComboBox;
+class QDockWidget;
 class QSlider;
 class QLabel;
 class QLineEdit;
@@ -70,6 +76,13 @@ public:
     /// selected body's node weights, shown as a colour ramp.
     void setPainting(bool on);
     bool painting() const;
+    SamplePainter* samplePainter() { return &m_samplePainter; }
+    /// Light samples mode (the toolbar's Light samples action, L): the viewport's left drag paints
+    /// the selected body's light-sample classes (or fills a region), shown in the class colours.
+    void setPaintingSamples(bool on);
+    bool paintingSamples() const;
+    /// Opens the side-by-side render of uniform 1× and the painted map for the current scene.
+    SampleCompareDialog* openSampleCompare();
     QTreeWidget* tree() { return m_tree; }
     PlotWidget* errorPlot() { return m_errorPlot; }
     PlotWidget* costPlot() { return m_costPlot; }
@@ -127,6 +140,21 @@ private:
     /// The painter's weights as an overlay on the painted body's render meshes (none when off).
     void showPaintWeights();
     void retargetPainter();
+    SamplePainter m_samplePainter{&m_doc};
+    QAction* m_samplesAction = nullptr;
+    QLabel *m_sampleStatus = nullptr, *m_sampleLegend = nullptr;
+    SampleCompareDialog* m_compare = nullptr;
+    void buildSampleDock();
+    /// `host` in a scrolling dock tabbed beside the properties, hidden until its tool starts.
+    QDockWidget* addToolDock(QWidget* host, const QString& title, const char* name);
+    /// Turns the paint tool of `action` (stiffness or light samples) on or off; the other goes off.
+    void setPaintTool(QAction* action, bool on);
+    /// The sample painter's classes as an overlay on the painted body (none when off).
+    void showSampleClasses();
+    /// The painted body at rest, alone, with `rgbaOfNode` colouring its render meshes (null: the
+    /// paint view is off and every mesh is shown as it is).
+    void showPaintedBody(int body, const std::function<Eigen::Vector4f(int32_t node)>& rgbaOfNode,
+                         const std::optional<CutPlane>& cut, bool translucent = false);
     MaterialPanel* m_material = nullptr;
     QTreeWidget* m_tree = nullptr;
     QWidget* m_propertiesHost = nullptr;

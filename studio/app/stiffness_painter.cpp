@@ -142,6 +142,14 @@ sim::BrushStroke StiffnessPainter::dabAt(const sim::Vec3& center) const {
     s.mode = brush.mode;
     s.amplitude = brush.strength;
     s.target = brush.target;
+    if (m_invert && m_stroking) { // Ctrl: the inverse of the brush
+        if (s.mode == sim::BrushMode::Add)
+            s.mode = sim::BrushMode::Subtract;
+        else if (s.mode == sim::BrushMode::Subtract)
+            s.mode = sim::BrushMode::Add;
+        else if (s.mode == sim::BrushMode::Mix)
+            s.target = m_params.baseWeight;
+    }
     s.scale = sim::BrushScale::Peak;
     return s;
 }
@@ -159,11 +167,12 @@ void StiffnessPainter::addDab(const sim::Vec3& center) {
     emit weightsChanged();
 }
 
-void StiffnessPainter::begin(const sim::Vec3& restPoint) {
+void StiffnessPainter::begin(const sim::Vec3& restPoint, bool invert) {
     if (!m_ready || !restPoint.allFinite()) return;
     m_dabs.clear();
     m_live = m_committed;
     m_stroking = true;
+    m_invert = invert;
     addDab(restPoint);
 }
 

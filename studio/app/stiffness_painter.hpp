@@ -48,7 +48,9 @@ public:
     /// The dab the brush would make at `center` (validated by the project's stroke rule).
     sim::BrushStroke dabAt(const sim::Vec3& center) const;
 
-    void begin(const sim::Vec3& restPoint);
+    /// Starts a stroke; `invert` (Ctrl held) paints the brush's inverse: Add subtracts, Subtract
+    /// adds, Mix moves towards the base weight; Smooth is its own inverse.
+    void begin(const sim::Vec3& restPoint, bool invert = false);
     void move(const sim::Vec3& restPoint);
     /// Commits the stroke in progress as one undo step; returns the document's error (empty: ok).
     QString end();
@@ -85,7 +87,7 @@ private:
     std::vector<sim::BrushStroke> m_dabs;
     std::vector<sim::BrushStroke> m_applied; ///< the project's strokes m_committed was made from
     sim::Vec3 m_lastDab = sim::Vec3::Zero();
-    bool m_stroking = false;
+    bool m_stroking = false, m_invert = false;
     struct Prepared;
     QFutureWatcher<std::shared_ptr<Prepared>>* m_watcher = nullptr;
     uint64_t m_generation = 0;

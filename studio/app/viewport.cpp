@@ -688,6 +688,13 @@ void Viewport::setMeshVisible(int mesh, bool visible) {
     viewChanged();
 }
 
+void Viewport::setMeshTranslucent(int mesh, bool translucent) {
+    if (mesh < 0 || mesh >= static_cast<int>(m_view.meshes().size())) return;
+    if (m_view.meshes()[mesh].translucent == translucent) return;
+    m_view.meshes()[mesh].translucent = translucent;
+    viewChanged();
+}
+
 void Viewport::setFaceMask(int mesh, const std::vector<uint8_t>& mask) {
     if (mesh < 0 || mesh >= static_cast<int>(m_view.meshes().size())) return;
     if (m_view.meshes()[mesh].faceMask == mask) return;
@@ -752,8 +759,9 @@ void Viewport::mousePressEvent(QMouseEvent* e) {
     m_button = e->button();
     m_dragged = false;
     if (m_paintMode && m_button == Qt::LeftButton && !(e->modifiers() & Qt::AltModifier)) {
-        if (const auto hit = hitAt(m_pressPos)) {
+        if (auto hit = hitAt(m_pressPos)) {
             m_painting = true;
+            hit->invert = (e->modifiers() & Qt::ControlModifier) != 0;
             emit paintPressed(*hit);
         }
         return;

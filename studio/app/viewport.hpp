@@ -83,6 +83,7 @@ public:
         QString name;                                    ///< the mesh's name
         Eigen::Vector3f world = Eigen::Vector3f::Zero(); ///< on the drawn (deformed) surface
         Eigen::Vector3f rest = Eigen::Vector3f::Zero();  ///< the same surface point at rest
+        bool invert = false; ///< paintPressed: Ctrl was held (the stroke does the brush's inverse)
     };
     std::optional<SurfaceHit> hitAt(QPoint pos) const;
     /// The meshes drawn (the UI thread's copy).
@@ -91,6 +92,8 @@ public:
     void setOverlay(int mesh, const std::vector<float>& rgba);
     /// Shows or hides mesh `mesh` (a hidden mesh is neither drawn nor hit).
     void setMeshVisible(int mesh, bool visible);
+    /// Draws mesh `mesh` translucent (a 50 % screen door, render::RenderMesh::translucent).
+    void setMeshTranslucent(int mesh, bool translucent);
     /// Face mask of mesh `mesh` (empty: every face), as render::SceneView::setFaceMask.
     void setFaceMask(int mesh, const std::vector<uint8_t>& mask);
     /// Draws body `body` at its rest positions (the preview's positions are not applied to it);

@@ -341,6 +341,55 @@ json paintJson(const StiffnessPaintProject& p) {
             {"strokes", strokes}};
 }
 
+/// "light_samples": the body's light-sample painting [A §6.3.2], operations replayed in order on
+/// its surface at rest (render::applySamplePaint).
+std::vector<render::SamplePaintOp> readLightSamples(const JsonField& j) {
+    std::vector<render::SamplePaintOp> ops;
+    for (const JsonField& o : j.items()) {
+        render::SamplePaintOp op;
+        const std::string tool = o["tool"].choice({"brush", "fill"}, "a light-sample tool");
+        op.samples = o["samples"].integer(0, 8);
+        if (!render::isSampleClass(op.samples)) o.failAt("samples", "must be 0 (erase), 1, 4 or 8");
+        if (tool == "brush") {
+            o.object({"tool", "samples", "radius", "points"});
+            op.tool = render::SamplePaintOp::Tool::Brush;
+            op.radius = o["radius"].number(NumberRule::closed(1e-4, 10.0));
+            for (const JsonField& pt : o["points"].items(1))
+                op.points.push_back(pt.vec3());
+        } else {
+            o.object({"tool", "samples", "seed", "max_angle_deg"});
+            op.tool = render::SamplePaintOp::Tool::Fill;
+            op.points.push_back(o["seed"].vec3());
+            op.maxAngleDeg = o.number("max_angle_deg", op.maxAngleDeg, NumberRule::closed(0.0, 180.0));
+        }
+        try {
+            render::validateSamplePaintOp(op, o.origin() + ": " + o.path());
+        } catch (const std::invalid_argument& e) {
+            throw InputError(e.what());
+        }
+        ops.push_back(std::move(op));
+    }
+    return ops;
+}
+
+json lightSamplesJson(const std::vector<render::SamplePaintOp>& ops) {
+    json out = json::array();
+    for (const render::SamplePaintOp& op : ops) {
+        if (op.tool == render::SamplePaintOp::Tool::Fill) {
+            out.push_back({{"tool", "fill"},
+                           {"samples", op.samples},
+                           {"seed", vec3Json(op.points.front())},
+                           {"max_angle_deg", op.maxAngleDeg}});
+            continue;
+        }
+        json pts = json::array();
+        for (const Eigen::Vector3d& pt : op.points)
+            pts.push_back(vec3Json(pt));
+        out.push_back({{"tool", "brush"}, {"samples", op.samples}, {"radius", op.radius}, {"points", pts}});
+    }
+    return out;
+}
+
 /// The interaction section (sim::readInteractionSection): every instrument's track is read from
 /// a project file (kept in `trackFiles`), checked, and exported as tools/<instrument>.track.
 sim::InteractionDesc readInteractionProject(const JsonField& section, const std::filesystem::path& dir,
@@ -403,7 +452,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     std::set<std::string> names;
     for (const JsonField& b : root["bodies"].items(1)) {
         b.object({"name", "mesh", "material", "strain_limits", "embedded_in", "embedding_compliance", "fixed",
-                  "stiffness_regions", "stiffness_paint"});
+                  "stiffness_regions", "stiffness_paint", "light_samples"});
         BodyProject body;
         sim::readBodyCommon(b, body.scene, names);
         body.mesh = readMeshSource(b["mesh"], dir);
@@ -414,6 +463,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
                     {r["min"].vec3(), r["max"].vec3(), r["weight"].number(NumberRule::positive())});
             }
         if (auto sp = b.find("stiffness_paint")) body.paint = readPaint(*sp);
+        if (auto ls = b.find("light_samples")) body.lightSamples = readLightSamples(*ls);
         if (auto fx = b.find("fixed")) body.fixedBox = readBox(*fx);
         p.bodies.push_back(std::move(body));
     }
@@ -470,6 +520,7 @@ std::string projectJsonText(const Project& p) {
             j["stiffness_regions"] = regions;
         }
         if (b.paint) j["stiffness_paint"] = paintJson(*b.paint);
+        if (!b.lightSamples.empty()) j["light_samples"] = lightSamplesJson(b.lightSamples);
         doc["bodies"].push_back(j);
     }
     if (!p.surfaces.empty()) {
@@ -600,6 +651,12 @@ struct StageCounter {
 
 } // namespace
 
+bool usesPaintedSampling(const sim::SceneDesc& scene) {
+    render::RenderSettings look;
+    render::applyCaseRender(look, scene.render, "project.json"); // checked when the project was read
+    return look.sampling.mode == render::SampleMode::Painted;
+}
+
 std::vector<double> bodyNodeWeights(const BodyProject& b, sim::TetMesh& mesh, std::optional<sim::Skeleton>& skeleton,
                                     const std::string& origin, const std::string& field) {
     const auto& pos = mesh.positions();
@@ -639,6 +696,7 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
     auto& files = built.files;
     auto& meshes = built.meshes;
     auto& surfaces = built.surfaces;
+    const bool paintedSampling = usesPaintedSampling(project.scene);
     for (size_t i = 0; i < project.bodies.size(); ++i) {
         const BodyProject& b = project.bodies[i];
         const std::string& name = b.scene.name;
@@ -676,6 +734,17 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
         if (b.paint) {
             desc.nodeWeightsPath = "meshes/" + name + ".vweights";
             files.emplace_back(desc.nodeWeightsPath, sim::formatNodeWeights(desc.nodeWeights));
+        }
+        if (paintedSampling && !b.lightSamples.empty()) { // packaged only where the look uses it
+            render::RenderMesh surface = render::bodySurfaceMesh(*mesh, name, i);
+            try {
+                render::applySamplePaint(surface, b.lightSamples);
+            } catch (const std::invalid_argument& e) {
+                throw InputError(origin + ": " + field + ".light_samples: " + e.what());
+            }
+            desc.sampleMapPath = "maps/" + name + ".vsamples";
+            files.emplace_back(desc.sampleMapPath,
+                               render::formatSampleMap(render::nodeSampleClasses(surface, mesh->vertexCount())));
         }
         built.skeletons.push_back(std::move(skeleton));
         be.fixedNodes = desc.fixedNodes.size();

@@ -27,6 +27,10 @@
 ///                                      "scale": "peak" | "kernel",
 ///                                      "mode": "add" | "subtract" | "mix" | "smooth",
 ///                                      "target": 3 (mix only)}]},   weights × region weights
+///     "light_samples": [{"tool": "brush", "samples": 8, "radius": 0.01, "points": [[..], ..]},
+///                       {"tool": "fill", "samples": 4, "seed": [..], "max_angle_deg": 30}],
+///                       painted light samples, replayed in order on the body's surface at rest;
+///                       exported as maps/<body>.vsamples when "render" asks for painted sampling
 ///     "embedded_in": "organ", "embedding_compliance": 0
 ///   }],
 ///   "surfaces": [{"name": "fascia", "from_boundary_of": "organ", "region": {"min": .., "max": ..},
@@ -46,6 +50,7 @@
 /// cell_radius_edge_ratio, cell_size, seed.
 #include "bake/skeleton.hpp"
 #include "bake/tetrahedralize.hpp"
+#include "render/sample_map.hpp"
 #include "sim/material/material.hpp"
 #include "sim/mesh/generators.hpp"
 #include "sim/mesh/tet_mesh.hpp"
@@ -105,6 +110,9 @@ struct BodyProject {
     std::optional<std::array<sim::Vec3, 2>> fixedBox; ///< {min, max}, metres
     std::vector<StiffnessRegion> stiffnessRegions;
     std::optional<StiffnessPaintProject> paint; ///< exported as meshes/<body>.vweights
+    /// Light-sample painting [A §6.3.2], by position; exported as maps/<body>.vsamples only when
+    /// the scene renders with painted sampling (usesPaintedSampling).
+    std::vector<render::SamplePaintOp> lightSamples;
 };
 
 /// A fascia layer cut from the boundary of a tet body (scene.attachTo, "from_boundary_of" in
@@ -216,6 +224,10 @@ struct BuiltScene {
 /// `origin`, `field` and the rule.
 std::vector<double> bodyNodeWeights(const BodyProject& b, sim::TetMesh& mesh, std::optional<sim::Skeleton>& skeleton,
                                     const std::string& origin, const std::string& field);
+
+/// True when the scene's "render" block asks for painted light sampling (the sample maps are
+/// then packaged and used).
+bool usesPaintedSampling(const sim::SceneDesc& scene);
 
 /// Stages exportCase reports: meshing per body, stiffness paint per painted body, cutting per
 /// surface, checking the scene, packaging.

@@ -228,6 +228,33 @@ TEST_F(RenderGl, OverlayTintsTheSurfaceByItsAlphaAndNoneLeavesItAsItWas) {
     EXPECT_EQ(compareImages(plain, render(settings)).differing, 0u);
 }
 
+TEST_F(RenderGl, TranslucentMeshIsDrawnInEveryOtherPixel) {
+    // the studio's paint tools draw a body translucent (a screen door) so its skeleton shows
+    auto drawnPixels = [&](int parity[2]) {
+        render(settings);
+        const std::vector<float> d = renderer->renderer().distanceMap(Eigen::Vector3f::Zero());
+        size_t n = 0;
+        parity[0] = parity[1] = 0;
+        for (int y = 0; y < kH; ++y)
+            for (int x = 0; x < kW; ++x)
+                if (d[size_t(y) * kW + x] >= 0) {
+                    ++n;
+                    ++parity[(x + y) & 1];
+                }
+        return n;
+    };
+    int p[2];
+    const size_t opaque = drawnPixels(p);
+    ASSERT_GT(opaque, size_t(kW * kH / 10));
+    EXPECT_GT(std::min(p[0], p[1]), int(opaque / 3)) << "both parities drawn when opaque";
+    view.meshes()[0].translucent = true;
+    const size_t door = drawnPixels(p);
+    EXPECT_NEAR(double(door) / opaque, 0.5, 0.02);
+    EXPECT_EQ(std::min(p[0], p[1]), 0) << "every other pixel: one parity only";
+    view.meshes()[0].translucent = false;
+    EXPECT_EQ(drawnPixels(p), opaque);
+}
+
 TEST_F(RenderGl, DeformingMeshesUpdateInPlace) {
     const Image first = render(settings);
     const BackendStats before = renderer->renderer().backend().stats();

@@ -463,6 +463,7 @@ void GlBackend::gbufferPass(const PassDesc& pass, const PassContext& ctx) {
         p.set("uReflection", mat.reflection);
         p.set("uFlags", float(mat.flags));
         p.set("uDoubleSided", m.doubleSided ? 1 : 0);
+        p.set("uScreenDoor", m.translucent ? 1 : 0);
         if (m.doubleSided)
             m_gl.Disable(GL_CULL_FACE);
         else {

@@ -198,8 +198,8 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
 
     std::set<std::string> names;
     for (const JsonField& b : root["bodies"].items(1)) {
-        b.object({"name", "mesh", "material", "fixed_nodes", "node_weights", "node_weights_file", "strain_limits",
-                  "embedded_in", "embedding_compliance"});
+        b.object({"name", "mesh", "material", "fixed_nodes", "node_weights", "node_weights_file", "sample_map_file",
+                  "strain_limits", "embedded_in", "embedding_compliance"});
         BodyDesc body;
         readBodyCommon(b, body, names);
         body.meshPath = b["mesh"].entryPath();
@@ -211,6 +211,7 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
             if (b.has("node_weights")) f->fail("give node_weights or node_weights_file, not both");
             body.nodeWeightsPath = f->entryPath();
         }
+        if (auto f = b.find("sample_map_file")) body.sampleMapPath = f->entryPath();
         scene.bodies.push_back(std::move(body));
     }
     if (auto surfaces = root.find("surfaces"))
@@ -258,6 +259,7 @@ json sceneJson(const SceneDesc& scene) {
             j["node_weights_file"] = b.nodeWeightsPath;
         else if (!b.nodeWeights.empty())
             j["node_weights"] = b.nodeWeights;
+        if (!b.sampleMapPath.empty()) j["sample_map_file"] = b.sampleMapPath;
         doc["bodies"].push_back(j);
     }
     if (!scene.surfaces.empty()) {

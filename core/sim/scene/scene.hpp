@@ -14,6 +14,8 @@
 ///               "fixed_nodes": [0, 1, 2],
 ///               "node_weights": [1.0, ...],                            optional, one per node
 ///               "node_weights_file": "meshes/organ.vweights",         optional, instead
+///               "sample_map_file": "maps/organ.vsamples",            optional: painted light
+///                                  samples, only with "render": {"sampling": "painted"}
 ///               "strain_limits": {"axes": [[1,0,0],[0,1,0],[0,0,1]],   optional
 ///                                 "limits": [{"i": 0, "j": 0, "upper": 0.2, "compliance": 0}]},
 ///               "embedded_in": "fat", "embedding_compliance": 0}],   optional
@@ -51,6 +53,10 @@ struct BodyDesc {
     /// "node_weights_file": a .vweights file inside the case (skeleton stiffness painting,
     /// sim/skeleton/node_weights_io.hpp); whoever reads the case fills nodeWeights from it.
     std::string nodeWeightsPath;
+    /// "sample_map_file": a .vsamples file inside the case, the painted light-sample class of
+    /// every node (render/sample_map.hpp) [A §6.3.2]. The simulation does not read it; the
+    /// player loads it when the render block asks for painted sampling and refuses it otherwise.
+    std::string sampleMapPath;
     std::optional<TetStrainLimits> strainLimits;
     std::string embeddedIn; ///< name of the cage body; empty = free-standing
     double embeddingCompliance = 0;

@@ -1,10 +1,13 @@
 #pragma once
-/// Line-oriented tokenizer for the project's small text formats (.vtet, .vtri, .vweights): skips
+/// Line-oriented tokenizer for the project's small text formats (.vtet, .vtri, .vweights,
+/// .vsamples): skips
 /// blank lines and '#' comments, knows its line number, and fails with
 /// "<origin>: line <n>: <rule>" (viscera::InputError).
 #include "sim/util/error.hpp"
 
 #include <charconv>
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -64,5 +67,39 @@ private:
     size_t m_pos = 0;
     size_t m_line = 0;
 };
+
+/// The per-node formats (.vweights, .vsamples):
+///
+///   <magic> 1
+///   nodes <N>
+///   <value>            N lines, one per node in node order
+///
+/// Reads the header (version 1 only, 1 ≤ N ≤ 2^28, N equal to `expectedNodes` when given), then
+/// calls `each(token, i, what)` for node i's value token (`what` is "<valueName> of node <i>",
+/// for the caller's messages) and refuses anything after the last node.
+template <class Each>
+void readNodeValues(LineReader& in, std::string_view magic, std::optional<size_t> expectedNodes,
+                    const std::string& valueName, Each&& each) {
+    std::vector<std::string_view> tok;
+    const std::string header = std::string(magic) + " 1";
+    if (!in.next(tok)) in.failEof("header '" + header + "'");
+    if (tok.size() != 2 || tok[0] != magic) in.fail("header must be '" + std::string(magic) + " <version>'");
+    if (in.number<int>(tok[1], "version") != 1)
+        in.fail("unsupported " + std::string(magic) + " version " + std::string(tok[1]) + " (supported: 1)");
+    if (!in.next(tok)) in.failEof("'nodes <count>'");
+    if (tok.size() != 2 || tok[0] != "nodes") in.fail("expected 'nodes <count>'");
+    const int64_t n = in.number<int64_t>(tok[1], "node count");
+    if (n < 1 || n > (int64_t{1} << 28)) in.fail("node count " + std::to_string(n) + " is out of range [1, 2^28]");
+    if (expectedNodes && static_cast<size_t>(n) != *expectedNodes)
+        in.fail("file has " + std::to_string(n) + " nodes, the mesh has " + std::to_string(*expectedNodes));
+    for (int64_t i = 0; i < n; ++i) {
+        const std::string what = valueName + " of node " + std::to_string(i);
+        if (!in.next(tok)) in.failEof(what + " (file declares " + std::to_string(n) + " nodes)");
+        if (tok.size() != 1) in.fail(what + ": expected one value per line, found " + std::to_string(tok.size()));
+        each(tok[0], static_cast<size_t>(i), what);
+    }
+    if (in.next(tok))
+        in.fail("unexpected content after the last " + valueName + " (file declares " + std::to_string(n) + " nodes)");
+}
 
 } // namespace viscera::sim::detail

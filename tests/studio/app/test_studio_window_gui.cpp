@@ -8,10 +8,13 @@
 #include "app/main_window.hpp"
 #include "app/material_panel.hpp"
 #include "app/plot_widget.hpp"
+#include "app/sample_compare.hpp"
+#include "app/sample_painter.hpp"
 #include "app/stiffness_painter.hpp"
 #include "app/viewport.hpp"
 #include "case/case_package.hpp"
 #include "gui_test_support.hpp"
+#include "render/sample_map.hpp"
 #include "sim/material/laws.hpp"
 #include "sim/material/material_response.hpp"
 #include "sim/skeleton/skeleton.hpp"
@@ -550,4 +553,221 @@ TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWe
     w->document()->undoStack()->undo();
     EXPECT_EQ(studio::projectJsonText(w->document()->project()), textBefore);
     EXPECT_EQ(painter->weights(), before);
+
+    // Ctrl inverts the brush: an Add stroke with Ctrl held subtracts (lowers weights), one step
+    w->findChild<QComboBox*>("paintMode")->setCurrentIndex(0);
+    w->findChild<QDoubleSpinBox*>("paintStrength")->setValue(0.5);
+    if (QWindow* win = v->canvasWindow()) {
+        QTest::mousePress(win, Qt::LeftButton, Qt::ControlModifier, centre - QPoint(40, 0));
+        for (int i = 1; i <= 8; ++i)
+            QTest::mouseMove(win, centre - QPoint(40, 0) + QPoint(10 * i, 0));
+        QTest::mouseRelease(win, Qt::LeftButton, Qt::ControlModifier, centre + QPoint(40, 0));
+    } else {
+        test::drag(v->canvasWidget(), centre - QPoint(40, 0), centre + QPoint(40, 0), 8, Qt::LeftButton,
+                   Qt::ControlModifier);
+    }
+    ASSERT_EQ(w->document()->undoStack()->count(), undoBefore + 1);
+    const auto& inverted = w->document()->project().bodies[0].paint->strokes;
+    ASSERT_FALSE(inverted.empty());
+    size_t lowered = 0;
+    for (const sim::BrushStroke& s : inverted)
+        EXPECT_EQ(s.mode, sim::BrushMode::Subtract);
+    for (size_t i = 0; i < before.size(); ++i) {
+        EXPECT_LE(painter->weights()[i], before[i]) << i;
+        lowered += painter->weights()[i] < before[i];
+    }
+    EXPECT_GT(lowered, 5u);
+    w->document()->undoStack()->undo();
+    EXPECT_EQ(painter->weights(), before);
+}
+
+TEST_F(WindowFixture, LightSamplePaintingIsExactOneUndoStepAndEscLeavesTheMap) {
+    open("tissue-slab");
+    ASSERT_TRUE(waitForPreview()) << w->verdictLabel()->text().toStdString();
+    w->selectBody(0);
+    studio::SamplePainter* painter = w->samplePainter();
+    auto* action = w->findChild<QAction*>("actionPaintSamples");
+    ASSERT_NE(action, nullptr);
+    action->trigger();
+    ASSERT_TRUE(w->paintingSamples());
+    ASSERT_FALSE(w->painting()) << "one paint tool at a time";
+    ASSERT_TRUE(test::waitFor([&] { return painter->ready(); }, 60000)) << painter->status().toStdString();
+    const auto mesh = w->preview()->bodyMesh(0);
+    ASSERT_NE(mesh, nullptr);
+    const render::RenderMesh surface = render::bodySurfaceMesh(*mesh, "slab");
+    const std::string textBefore = studio::projectJsonText(w->document()->project());
+    const int undoBefore = w->document()->undoStack()->count();
+    ASSERT_EQ(painter->nodeClasses(), std::vector<uint8_t>(mesh->vertexCount(), 0));
+    studio::Viewport* v = w->viewport();
+    v->frameAll();
+    QTest::qWait(50);
+    const QPoint centre(v->width() / 2, v->height() / 2);
+    ASSERT_TRUE(v->hitAt(centre).has_value());
+
+    // an 8× brush stroke: exactly the surface nodes within the radius of a dab, one undo step
+    w->findChild<QComboBox*>("sampleTool")->setCurrentIndex(0);
+    w->findChild<QComboBox*>("sampleClass")->setCurrentIndex(0);
+    w->findChild<QDoubleSpinBox*>("sampleRadius")->setValue(6.0);
+    hostDrag(v, centre - QPoint(80, 0), centre + QPoint(80, 0));
+    ASSERT_EQ(w->document()->undoStack()->count(), undoBefore + 1) << "one stroke, one undo step";
+    const auto& ops = w->document()->project().bodies[0].lightSamples;
+    ASSERT_EQ(ops.size(), 1u);
+    EXPECT_EQ(ops[0].tool, render::SamplePaintOp::Tool::Brush);
+    EXPECT_EQ(ops[0].samples, 8);
+    EXPECT_DOUBLE_EQ(ops[0].radius, 0.006);
+    ASSERT_GT(ops[0].points.size(), 2u) << "dabs along the drag";
+    // what the export writes: the operations replayed on the body's surface (studio == case)
+    auto replayed = [&] {
+        render::RenderMesh m = surface;
+        render::applySamplePaint(m, w->document()->project().bodies[0].lightSamples);
+        return render::nodeSampleClasses(m, mesh->vertexCount());
+    };
+    // independently of the painter: nodes a cell or more inside every dab's sphere are 8×, nodes
+    // a cell or more outside all of them are untouched, and the class's area is the area of the
+    // surface within the dabs (dense sampling of every boundary face) to within a cell
+    const double h = 0.1 / 20; // the slab's cell
+    auto dist = [](const sim::Vec3& x, const render::SamplePaintOp& op) {
+        double d = INFINITY;
+        for (const Eigen::Vector3d& c : op.points)
+            d = std::min(d, (x - c).norm());
+        return d;
+    };
+    auto paintedArea = [&](const render::SamplePaintOp& op) {
+        double a = 0;
+        for (size_t f = 0; f < surface.triangleCount(); ++f) {
+            sim::Vec3 p[3];
+            for (int k = 0; k < 3; ++k)
+                p[k] = mesh->positions()[surface.sourceVertex[surface.indices[3 * f + k]]];
+            const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+            constexpr int n = 20;
+            for (int i = 0; i < n; ++i)
+                for (int j = 0; i + j < n; ++j) {
+                    const double u = (i + 1.0 / 3) / n, v = (j + 1.0 / 3) / n;
+                    a += dist((1 - u - v) * p[0] + u * p[1] + v * p[2], op) <= op.radius ? area / (n * n) : 0.0;
+                    if (i + j < n - 1) {
+                        const double u2 = (i + 2.0 / 3) / n, v2 = (j + 2.0 / 3) / n;
+                        a += dist((1 - u2 - v2) * p[0] + u2 * p[1] + v2 * p[2], op) <= op.radius ? area / (n * n) : 0.0;
+                    }
+                }
+        }
+        return a;
+    };
+    const std::vector<uint8_t> stroke1 = painter->nodeClasses();
+    EXPECT_EQ(stroke1, replayed());
+    for (size_t k = 0; k < surface.vertexCount(); ++k) {
+        const int32_t n = surface.sourceVertex[k];
+        const double d = dist(mesh->positions()[n], ops[0]);
+        if (d <= ops[0].radius - h) EXPECT_EQ(stroke1[n], 8) << "node " << n << " inside the stroke";
+        if (d >= ops[0].radius + h) EXPECT_EQ(stroke1[n], 0) << "node " << n << " outside the stroke";
+    }
+    EXPECT_GT(std::count(stroke1.begin(), stroke1.end(), 8), 5);
+    EXPECT_NEAR(painter->areas()[3], paintedArea(ops[0]), 0.6 * h * h);
+    // the classes show on the body, and the legend gives their share of the surface
+    bool shown = false;
+    for (const render::RenderMesh& m : v->view().meshes())
+        for (size_t k = 3; k < m.overlay.size(); k += 4)
+            shown = shown || m.overlay[k] > 0.5f;
+    EXPECT_TRUE(shown);
+    const auto areas = painter->areas();
+    const double share8 = 100.0 * areas[3] / (areas[0] + areas[1] + areas[2] + areas[3]);
+    EXPECT_GT(share8, 0.0);
+    EXPECT_TRUE(w->findChild<QLabel*>("sampleLegend")->text().contains(QString("8×: %1 %").arg(share8, 0, 'f', 1)))
+        << w->findChild<QLabel*>("sampleLegend")->text().toStdString();
+
+    // Esc during a stroke: nothing changes
+    const std::string textPainted = studio::projectJsonText(w->document()->project());
+    if (QWindow* win = v->canvasWindow()) {
+        QTest::mousePress(win, Qt::LeftButton, Qt::NoModifier, centre + QPoint(0, 30));
+        QTest::mouseMove(win, centre + QPoint(30, 30));
+        EXPECT_TRUE(painter->stroking());
+        QTest::keyClick(win, Qt::Key_Escape);
+        QTest::mouseRelease(win, Qt::LeftButton, Qt::NoModifier, centre + QPoint(30, 30));
+    }
+    EXPECT_FALSE(painter->stroking());
+    EXPECT_EQ(painter->nodeClasses(), stroke1);
+    EXPECT_EQ(studio::projectJsonText(w->document()->project()), textPainted);
+    EXPECT_EQ(w->document()->undoStack()->count(), undoBefore + 1);
+
+    // a 4× fill under the cursor: the whole side of the slab it starts on, stopped by the 90° edges
+    w->findChild<QComboBox*>("sampleTool")->setCurrentIndex(1);
+    w->findChild<QComboBox*>("sampleClass")->setCurrentIndex(1);
+    w->findChild<QDoubleSpinBox*>("sampleAngle")->setValue(30.0);
+    const QPoint fillAt = centre + QPoint(0, 40);
+    const auto hit = v->hitAt(fillAt);
+    ASSERT_TRUE(hit.has_value());
+    hostClick(v, fillAt);
+    ASSERT_EQ(w->document()->undoStack()->count(), undoBefore + 2);
+    ASSERT_EQ(ops.size(), 2u);
+    EXPECT_EQ(ops[1].tool, render::SamplePaintOp::Tool::Fill);
+    // the side: the box face whose plane the hit lies on
+    const auto [lo, hi] = [&] {
+        sim::Vec3 a = mesh->positions()[0], b = a;
+        for (const sim::Vec3& x : mesh->positions())
+            a = a.cwiseMin(x), b = b.cwiseMax(x);
+        return std::pair{a, b};
+    }();
+    int axis = -1;
+    double plane = 0;
+    for (int d = 0; d < 3; ++d)
+        for (double at : {lo[d], hi[d]})
+            if (std::abs(hit->rest[d] - at) < 1e-5) axis = d, plane = at;
+    ASSERT_GE(axis, 0) << "the hit lies on a side of the slab";
+    const std::vector<uint8_t> want = painter->nodeClasses();
+    EXPECT_EQ(want, replayed());
+    // the side's nodes off its border are 4×, the rest keep the stroke's classes
+    size_t onSide = 0;
+    for (size_t n = 0; n < want.size(); ++n) {
+        const sim::Vec3& x = mesh->positions()[n];
+        bool border = false;
+        for (int d = 0; d < 3; ++d)
+            border |= d != axis && (std::abs(x[d] - lo[d]) < 1e-9 || std::abs(x[d] - hi[d]) < 1e-9);
+        if (std::abs(x[axis] - plane) < 1e-9 && !border) {
+            EXPECT_EQ(want[n], 4) << "node " << n;
+            ++onSide;
+        } else if (std::abs(x[axis] - plane) > h + 1e-9) {
+            EXPECT_EQ(want[n], stroke1[n]) << "node " << n;
+        }
+    }
+    EXPECT_GT(onSide, 10u);
+
+    // Ctrl erases: a brush stroke with Ctrl held sets class 0
+    w->findChild<QComboBox*>("sampleTool")->setCurrentIndex(0);
+    w->findChild<QComboBox*>("sampleClass")->setCurrentIndex(0);
+    if (QWindow* win = v->canvasWindow()) {
+        QTest::mousePress(win, Qt::LeftButton, Qt::ControlModifier, centre - QPoint(20, 0));
+        for (int i = 1; i <= 4; ++i)
+            QTest::mouseMove(win, centre - QPoint(20, 0) + QPoint(10 * i, 0));
+        QTest::mouseRelease(win, Qt::LeftButton, Qt::ControlModifier, centre + QPoint(20, 0));
+        ASSERT_EQ(ops.size(), 3u);
+        EXPECT_EQ(ops[2].samples, 0);
+        EXPECT_EQ(painter->nodeClasses(), replayed());
+        for (size_t k = 0; k < surface.vertexCount(); ++k) {
+            const int32_t n = surface.sourceVertex[k];
+            if (dist(mesh->positions()[n], ops[2]) <= ops[2].radius - h)
+                EXPECT_EQ(painter->nodeClasses()[n], 0) << "node " << n << " erased";
+        }
+        w->document()->undoStack()->undo();
+    }
+    EXPECT_EQ(painter->nodeClasses(), want);
+
+    // the side-by-side render: uniform 1× and the painted map, with figures
+    studio::SampleCompareDialog* cmp = w->openSampleCompare();
+    ASSERT_NE(cmp, nullptr);
+    cmp->waitForFinished();
+    ASSERT_TRUE(cmp->result().has_value()) << cmp->error().toStdString();
+    const render::SamplingComparison& c = *cmp->result();
+    EXPECT_GT(c.nearPixels, 0u);
+    EXPECT_TRUE(std::isfinite(c.rmseNearUniform) && std::isfinite(c.rmseNearPainted));
+    EXPECT_GT(c.msUniform, 0.0);
+    EXPECT_FALSE(c.painted.empty());
+    EXPECT_NE(c.painted.rgba, c.uniform.rgba) << "the painted classes take more light samples";
+    EXPECT_FALSE(cmp->findChild<QLabel*>("comparePainted")->pixmap().isNull());
+    cmp->close();
+
+    // undo twice: the model and the classes are as before, exactly
+    w->document()->undoStack()->undo();
+    EXPECT_EQ(painter->nodeClasses(), stroke1);
+    w->document()->undoStack()->undo();
+    EXPECT_EQ(studio::projectJsonText(w->document()->project()), textBefore);
+    EXPECT_EQ(painter->nodeClasses(), std::vector<uint8_t>(mesh->vertexCount(), 0));
 }

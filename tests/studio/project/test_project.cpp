@@ -1,5 +1,8 @@
 #include "case/case_package.hpp"
 #include "project/project.hpp"
+#include "render/sample_map.hpp"
+#include "sim/mesh/tet_io.hpp"
+#include "sim/scene/scene.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
 
@@ -180,4 +183,98 @@ TEST_F(ProjectTest, RemeshingABodyKeepsItsPaintedWeightMass) {
         EXPECT_GE(mb / ma, 0.99);
         EXPECT_LE(mb / ma, 1.05);
     }
+}
+
+TEST_F(ProjectTest, SampleMapIsPackagedOnlyWhenTheSceneUsesPaintedSampling) {
+    const std::string painted =
+        replaced(replaced(kGood, "\"gravity\"", "\"render\": {\"sampling\": \"painted\"}, \"gravity\""), "\"fixed\":",
+                 "\"light_samples\": [{\"tool\": \"fill\", \"samples\": 4, \"seed\": [0.02, 0.005, 0.0101]},"
+                 " {\"tool\": \"brush\", \"samples\": 8, \"radius\": 0.006, \"points\": [[0.0, 0.0, 0.0]]}],"
+                 " \"fixed\":");
+    write(painted);
+    const studio::Project p = studio::loadProject(m_dir);
+    ASSERT_EQ(p.bodies[0].lightSamples.size(), 2u);
+    EXPECT_TRUE(studio::usesPaintedSampling(p.scene));
+    // the text round-trips
+    EXPECT_EQ(studio::projectJsonText(studio::loadProjectText(studio::projectJsonText(p), m_dir, "again")),
+              studio::projectJsonText(p));
+    const auto out = m_dir / "mini.vcase";
+    studio::exportCase(p, out);
+    auto pkg = vcase::CasePackage::open(out);
+    ASSERT_TRUE(pkg->contains("maps/slab.vsamples"));
+    const sim::SceneDesc scene = sim::parseScene(pkg->read("scene.json"), "scene.json");
+    EXPECT_EQ(scene.bodies[0].sampleMapPath, "maps/slab.vsamples");
+    const auto mesh = sim::parseVtet(pkg->read("meshes/slab.vtet"), "slab.vtet");
+    const std::vector<uint8_t> nodes =
+        render::parseSampleMap(pkg->read("maps/slab.vsamples"), "slab.vsamples", mesh->vertexCount());
+    // the classes are the operations replayed on the body's surface at rest
+    render::RenderMesh surface = render::bodySurfaceMesh(*mesh, "slab");
+    render::applySamplePaint(surface, p.bodies[0].lightSamples);
+    EXPECT_EQ(nodes, render::nodeSampleClasses(surface, mesh->vertexCount()));
+    // the fill's top side (z = 0.01) is 4×, the other sides are not painted by it
+    size_t four = 0;
+    for (size_t v = 0; v < mesh->vertexCount(); ++v) {
+        const sim::Vec3& x = mesh->positions()[v];
+        four += nodes[v] == 4;
+        if (x.z() < 0.01 - 1e-9 && x.norm() > 0.006 + 0.01) EXPECT_EQ(nodes[v], 0) << "node " << v;
+    }
+    EXPECT_GT(four, 2u);
+    // another sampling mode: the map stays in the project but is not packaged
+    write(replaced(painted, "\"painted\"", "\"distance\""));
+    studio::exportCase(studio::loadProject(m_dir), out);
+    auto plain = vcase::CasePackage::open(out);
+    EXPECT_FALSE(plain->contains("maps/slab.vsamples"));
+    EXPECT_TRUE(sim::parseScene(plain->read("scene.json"), "scene.json").bodies[0].sampleMapPath.empty());
+    // bad operations are refused naming the field and the rule
+    write(replaced(painted, "\"samples\": 4", "\"samples\": 3"));
+    EXPECT_THAT(loadError(), HasSubstr("bodies[0].light_samples[0].samples: must be 0 (erase), 1, 4 or 8"));
+    write(replaced(painted, "\"radius\": 0.006", "\"radius\": -1"));
+    EXPECT_THAT(loadError(), HasSubstr("bodies[0].light_samples[1].radius: "));
+    write(replaced(painted, "\"points\": [[0.0, 0.0, 0.0]]", "\"points\": []"));
+    EXPECT_THAT(loadError(), HasSubstr("bodies[0].light_samples[1].points"));
+    write(replaced(painted, "\"tool\": \"fill\"", "\"tool\": \"spray\""));
+    EXPECT_THAT(loadError(), HasSubstr("bodies[0].light_samples[0].tool"));
+    write(replaced(painted, "\"seed\"", "\"radius\": 0.01, \"seed\""));
+    EXPECT_THAT(loadError(), HasSubstr("bodies[0].light_samples[0].radius: unknown field"));
+}
+
+TEST_F(ProjectTest, RemeshingABodyKeepsItsSampleClassArea) {
+    // Light-sample operations are stored by position: the liver's organ meshed again with other
+    // CGAL parameters is painted by the same operations. Each painted class keeps at least 99 %
+    // of its area and grows by at most 1 % (the replay keeps the painted area to within a vertex
+    // cell on any mesh).
+    studio::Project p = studio::loadProject(std::filesystem::path(VISCERA_SOURCE_DIR) / "projects/liver");
+    p.dir = m_dir;
+    ASSERT_FALSE(p.bodies[0].lightSamples.empty()) << "the liver sample has painted light samples";
+    ASSERT_TRUE(studio::usesPaintedSampling(p.scene));
+    studio::Project q = p;
+    q.bodies[0].mesh.meshing.facetSize *= 0.75;
+    q.bodies[0].mesh.meshing.cellSize *= 0.75;
+    q.bodies[0].mesh.meshing.seed += 1;
+    const studio::BuiltScene A = studio::buildScene(p), B = studio::buildScene(q);
+    auto classAreas = [](const studio::BuiltScene& built) {
+        std::string map;
+        for (const auto& [path, bytes] : built.files)
+            if (path == "maps/organ.vsamples") map = bytes;
+        const sim::TetMesh& mesh = *built.meshes[0];
+        const std::vector<uint8_t> nodes = render::parseSampleMap(map, "organ.vsamples", mesh.vertexCount());
+        render::RenderMesh surface = render::bodySurfaceMesh(mesh, "organ");
+        for (size_t v = 0; v < surface.vertexCount(); ++v)
+            surface.sampleMap[v] = nodes[surface.sourceVertex[v]];
+        return render::sampleClassAreas(surface);
+    };
+    ASSERT_NE(A.meshes[0]->vertexCount(), B.meshes[0]->vertexCount()) << "meshed again, differently";
+    const auto a = classAreas(A), b = classAreas(B);
+    const char* names[] = {"unpainted", "1x", "4x", "8x"};
+    int painted = 0;
+    for (int c = 1; c < 4; ++c) {
+        if (a[c] == 0) continue;
+        ++painted;
+        std::printf("organ %s: %zu -> %zu nodes, area %.4g -> %.4g cm^2 (%.2f %%)\n", names[c],
+                    A.meshes[0]->vertexCount(), B.meshes[0]->vertexCount(), a[c] * 1e4, b[c] * 1e4,
+                    100.0 * b[c] / a[c]);
+        EXPECT_GE(b[c] / a[c], 0.99) << names[c];
+        EXPECT_LE(b[c] / a[c], 1.01) << names[c];
+    }
+    EXPECT_GE(painted, 2);
 }
