@@ -631,6 +631,10 @@ void MainWindow::buildSampleDock() {
     cls->setObjectName("sampleClass");
     cls->addItems({tr("8× samples"), tr("4× samples"), tr("1× sample"), tr("Erase (unpainted)")});
     form->addRow(tr("Class"), cls);
+    m_sampleLegend = new QLabel(host); // near the top: a short dock still shows it
+    m_sampleLegend->setObjectName("sampleLegend");
+    m_sampleLegend->setTextFormat(Qt::RichText);
+    form->addRow(m_sampleLegend);
     auto* radius = new QDoubleSpinBox(host);
     radius->setObjectName("sampleRadius");
     radius->setRange(0.5, 200);
@@ -661,10 +665,6 @@ void MainWindow::buildSampleDock() {
     for (QDoubleSpinBox* sp : {radius, angle})
         connect(sp, &QDoubleSpinBox::valueChanged, this, sync);
     sync();
-    m_sampleLegend = new QLabel(host);
-    m_sampleLegend->setObjectName("sampleLegend");
-    m_sampleLegend->setTextFormat(Qt::RichText);
-    form->addRow(m_sampleLegend);
     auto* compare = new QPushButton(tr("Compare uniform 1× | painted…"), host);
     compare->setObjectName("sampleCompare");
     compare->setToolTip(tr("Render the scene as the player would, uniform 1× beside the painted map, with the "

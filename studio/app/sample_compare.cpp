@@ -11,8 +11,22 @@
 #include <QPushButton>
 #include <QtConcurrent/QtConcurrent>
 
+#include <algorithm>
+#include <cstdlib>
+
 namespace viscera::studio {
 namespace {
+
+/// |reference − image| per channel, ×16 (an 8-bit error of 16 shows white), opaque.
+render::Image errorImage(const render::Image& reference, const render::Image& img) {
+    render::Image e = img;
+    if (reference.rgba.size() != img.rgba.size()) return e;
+    for (size_t i = 0; i < e.rgba.size(); ++i)
+        e.rgba[i] = i % 4 == 3
+                        ? 255
+                        : static_cast<uint8_t>(std::min(255, 16 * std::abs(int(reference.rgba[i]) - int(img.rgba[i]))));
+    return e;
+}
 
 QPixmap pixmapOf(const render::Image& img) {
     if (img.width <= 0 || img.height <= 0) return {};
@@ -30,9 +44,11 @@ SampleCompareDialog::SampleCompareDialog(QWidget* parent) : QDialog(parent) {
     m_painted = new QLabel(this);
     m_uniformText = new QLabel(tr("Uniform 1×"), this);
     m_paintedText = new QLabel(tr("Painted map"), this);
+    m_uniformError = new QLabel(this);
+    m_paintedError = new QLabel(this);
     m_uniform->setObjectName("compareUniform");
     m_painted->setObjectName("comparePainted");
-    for (QLabel* l : {m_uniform, m_painted}) {
+    for (QLabel* l : {m_uniform, m_painted, m_uniformError, m_paintedError}) {
         l->setMinimumSize(320, 240);
         l->setAlignment(Qt::AlignCenter);
         l->setStyleSheet("background:#202020");
@@ -47,13 +63,19 @@ SampleCompareDialog::SampleCompareDialog(QWidget* parent) : QDialog(parent) {
     grid->addWidget(m_paintedText, 0, 1);
     grid->addWidget(m_uniform, 1, 0);
     grid->addWidget(m_painted, 1, 1);
-    grid->addWidget(m_summary, 2, 0, 1, 2);
-    grid->addWidget(m_bar, 3, 0);
+    auto* errorText = new QLabel(tr("Error against the reference, ×16 (white: 16 or more of 255)"), this);
+    grid->addWidget(errorText, 2, 0, 1, 2);
+    grid->addWidget(m_uniformError, 3, 0);
+    grid->addWidget(m_paintedError, 3, 1);
+    grid->addWidget(m_summary, 4, 0, 1, 2);
+    grid->addWidget(m_bar, 5, 0);
+    grid->setRowStretch(1, 1); // the pictures take the room
+    grid->setRowStretch(3, 1);
     auto* buttons = new QHBoxLayout;
     buttons->addStretch(1);
     buttons->addWidget(m_cancel);
     buttons->addWidget(close);
-    grid->addLayout(buttons, 3, 1);
+    grid->addLayout(buttons, 5, 1);
     connect(m_cancel, &QPushButton::clicked, this, &SampleCompareDialog::cancel);
     connect(close, &QPushButton::clicked, this, &QDialog::close);
 }
@@ -136,6 +158,10 @@ void SampleCompareDialog::present(const Outcome& o) {
     const QSize box = m_uniform->size();
     m_uniform->setPixmap(pixmapOf(c.uniform).scaled(box, Qt::KeepAspectRatio, Qt::SmoothTransformation));
     m_painted->setPixmap(pixmapOf(c.painted).scaled(box, Qt::KeepAspectRatio, Qt::SmoothTransformation));
+    m_uniformError->setPixmap(
+        pixmapOf(errorImage(c.reference, c.uniform)).scaled(box, Qt::KeepAspectRatio, Qt::SmoothTransformation));
+    m_paintedError->setPixmap(
+        pixmapOf(errorImage(c.reference, c.painted)).scaled(box, Qt::KeepAspectRatio, Qt::SmoothTransformation));
     m_uniformText->setText(tr("Uniform 1×: RMSE near the light %1, frame %2 ms")
                                .arg(c.rmseNearUniform, 0, 'f', 2)
                                .arg(c.msUniform, 0, 'f', 2));

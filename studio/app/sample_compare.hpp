@@ -46,7 +46,8 @@ private:
     };
     void present(const Outcome& o);
 
-    QLabel *m_uniform = nullptr, *m_painted = nullptr, *m_uniformText = nullptr, *m_paintedText = nullptr;
+    QLabel *m_uniform = nullptr, *m_painted = nullptr, *m_uniformError = nullptr, *m_paintedError = nullptr,
+           *m_uniformText = nullptr, *m_paintedText = nullptr;
     QLabel* m_summary = nullptr;
     QProgressBar* m_bar = nullptr;
     QPushButton* m_cancel = nullptr;
