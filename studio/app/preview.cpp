@@ -4,6 +4,7 @@
 #include "sim/material/material.hpp"
 #include "sim/scene/features.hpp"
 #include "sim/scene/world.hpp"
+#include "sim/scene/xpbd_scene_solver.hpp"
 #include "sim/util/format.hpp"
 
 #include <chrono>
@@ -42,11 +43,13 @@ QString stabilityVerdict(const BuiltScene& built, bool& ok) {
     if (built.scene.solverType != "xpbd")
         return QObject::tr("solver %1: no XPBD stability rule").arg(QString::fromStdString(built.scene.solverType));
     QStringList lines;
-    for (size_t i = 0; i < built.scene.bodies.size(); ++i) {
+    // the player's load rule: the scene as one system (embedded bodies count their ties' inertia)
+    const std::string origin = "project.json";
+    const std::vector<sim::StabilityFigures> figures =
+        sim::assessSceneStability({built.scene, built.meshes, built.surfaces, origin});
+    for (size_t i = 0; i < built.scene.bodies.size() && i < figures.size(); ++i) {
         const sim::BodyDesc& b = built.scene.bodies[i];
-        const auto model = sim::makeConstraintModel(b.material, b.name);
-        const sim::StabilityFigures f =
-            sim::assessStability(*built.meshes[i], *model, b.material.density, b.nodeWeights, built.scene.xpbd);
+        const sim::StabilityFigures& f = figures[i];
         const QString head =
             QObject::tr("body '%1': stiffness number %2 (limit %3)")
                 .arg(QString::fromStdString(b.name), QString::fromStdString(sim::formatNumber(f.maxStiffnessNumber, 3)),
