@@ -278,7 +278,7 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
         sys->m_surf.push_back(std::move(r));
         eng.addParticles(x, mass, fixed);
         if (d.stretchStiffness > 0)
-            eng.blocks.push_back(detail::makeMembraneBlock(tris, restInv, area, d.stretchStiffness));
+            eng.blocks.push_back(detail::makeMembraneBlock(tris, restInv, area, d.stretchStiffness, settings.simd));
         if (d.strainLimits) {
             const TriStrainLimits& sl = *d.strainLimits;
             if (d.uv.empty()) fail(label, "strain limits need per-vertex uv coordinates");
