@@ -529,6 +529,66 @@ TEST(XpbdSystem, MembraneSimdAndScalarKernelsAgree) {
     EXPECT_EQ(run(true).first, simd) << "repeat runs must be bit-identical";
 }
 
+TEST(XpbdSystem, AddedInertiaKeepsTheWeightAndSlowsTheFall) {
+    // A free block with every node's inertia tripled falls at g / 3 (its weight m g moves 3 m),
+    // the kinetic energy counts the scaled inertia; zeros restore the plain fall bit for bit.
+    auto block = makeBoxTetMesh({Vec3::Zero(), Vec3(0.02, 0.02, 0.02), {2, 2, 2}});
+    XpbdSystemDesc d;
+    d.tetBodies.push_back({"block", block.get(), snh(3000), 1000, {}, {}, {}});
+    XpbdSettings s;
+    s.substeps = 4;
+    s.damping = 0;
+    auto plain = XpbdSystem::create(d, s), scaled = XpbdSystem::create(d, s), restored = XpbdSystem::create(d, s);
+    std::vector<double> own(block->vertexCount(), 0.0);
+    for (const Tet& t : block->tets())
+        for (int32_t v : t)
+            own[v] += 1000 * std::abs(block->signedVolume(&t - block->tets().data())) / 4;
+    std::vector<double> twice = own;
+    for (double& m : twice)
+        m *= 2;
+    scaled->setAddedInertia(0, twice);
+    EXPECT_EQ(scaled->addedInertia(0), twice);
+    restored->setAddedInertia(0, twice);
+    restored->setAddedInertia(0, std::vector<double>(own.size(), 0.0));
+    for (int f = 0; f < 3; ++f) {
+        plain->step();
+        scaled->step();
+        restored->step();
+    }
+    const double vp = plain->tetVelocities(0)[0].z(), vs = scaled->tetVelocities(0)[0].z();
+    EXPECT_NEAR(vp, -9.81 * 3 * s.dt, 1e-9);
+    EXPECT_NEAR(vs, vp / 3, 1e-9);
+    EXPECT_NEAR(scaled->kineticEnergy(), plain->kineticEnergy() / 3, 1e-9 * plain->kineticEnergy());
+    EXPECT_EQ(restored->tetPositions(0), plain->tetPositions(0));
+    try {
+        scaled->setAddedInertia(0, {1.0});
+        ADD_FAILURE() << "accepted a short vector";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_THAT(e.what(), HasSubstr("sim::XpbdSystem::setAddedInertia(): expected"));
+    }
+    twice[3] = -1;
+    EXPECT_THROW(scaled->setAddedInertia(0, twice), std::invalid_argument);
+}
+
+TEST(StabilityCheck, StabilizingInertiaBringsEveryTetUnderTheLimitWithinItsCap) {
+    auto block = makeBoxTetMesh({Vec3::Zero(), Vec3(0.04, 0.01, 0.01), {8, 2, 2}});
+    const auto model = snh(200000);
+    XpbdSettings s;
+    s.substeps = 2;
+    const StabilityFigures before = assessStability(*block, *model, 1000, {}, s);
+    ASSERT_FALSE(before.ok());
+    const auto none = stabilizingInertia(*block, *model, 1000, {}, s, {}, 1.0);
+    EXPECT_EQ(*std::max_element(none.begin(), none.end()), 0.0) << "a cap of 1 adds nothing";
+    const double need = before.maxStiffnessNumber;
+    const auto extra = stabilizingInertia(*block, *model, 1000, {}, s, {}, need * 1.01);
+    EXPECT_TRUE(assessStability(*block, *model, 1000, {}, s, extra).ok());
+    const auto capped = stabilizingInertia(*block, *model, 1000, {}, s, {}, 0.5 * need);
+    EXPECT_FALSE(assessStability(*block, *model, 1000, {}, s, capped).ok());
+    s.substeps = before.requiredSubsteps;
+    const auto at = stabilizingInertia(*block, *model, 1000, {}, s, {}, 4);
+    EXPECT_EQ(*std::max_element(at.begin(), at.end()), 0.0) << "nothing over the limit, nothing added";
+}
+
 TEST(XpbdSystem, RejectsInvalidCouplings) {
     Layers L;
     XpbdSettings s;
