@@ -1,49 +1,14 @@
 // AVX2/FMA membrane kernel: four triangles per pack, one per lane. Compiled with -mavx2 -mfma
 // (see sim/xpbd/CMakeLists.txt); selected at run time by membraneAvx2Available(). Like
-// snh_avx2.cpp it includes only its plain-data header and <immintrin.h>, with internal linkage
-// helpers, so no AVX2 code leaks into the rest of the library.
+// snh_avx2.cpp it includes only its plain-data header and the internal-linkage helpers of
+// avx2_ops.hpp, so no AVX2 code leaks into the rest of the library.
 #include "sim/xpbd/detail/membrane_kernel.hpp"
 
 #if defined(__AVX2__) && defined(__FMA__)
-#include <immintrin.h>
+#include "sim/xpbd/detail/avx2_ops.hpp"
 
 namespace viscera::sim::detail {
 namespace {
-
-using V = __m256d;
-
-inline V add(V a, V b) {
-    return _mm256_add_pd(a, b);
-}
-inline V sub(V a, V b) {
-    return _mm256_sub_pd(a, b);
-}
-inline V mul(V a, V b) {
-    return _mm256_mul_pd(a, b);
-}
-inline V madd(V a, V b, V c) {
-    return _mm256_fmadd_pd(a, b, c);
-} // a·b + c
-
-inline void toColumns(V r0, V r1, V r2, V r3, V& X, V& Y, V& Z, V& W) {
-    const V t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
-    const V t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
-    X = _mm256_permute2f128_pd(t0, t2, 0x20);
-    Y = _mm256_permute2f128_pd(t1, t3, 0x20);
-    Z = _mm256_permute2f128_pd(t0, t2, 0x31);
-    W = _mm256_permute2f128_pd(t1, t3, 0x31);
-}
-
-/// Stored in lane order 3, 2, 1, 0: a padding lane repeats lane 0's particle with its old value,
-/// and lane 0's store comes last.
-inline void storeRows(double* xw, const int32_t* idx, V X, V Y, V Z, V W) {
-    const V t0 = _mm256_unpacklo_pd(X, Y), t1 = _mm256_unpackhi_pd(X, Y);
-    const V t2 = _mm256_unpacklo_pd(Z, W), t3 = _mm256_unpackhi_pd(Z, W);
-    _mm256_store_pd(xw + 4 * static_cast<size_t>(idx[3]), _mm256_permute2f128_pd(t1, t3, 0x31));
-    _mm256_store_pd(xw + 4 * static_cast<size_t>(idx[2]), _mm256_permute2f128_pd(t0, t2, 0x31));
-    _mm256_store_pd(xw + 4 * static_cast<size_t>(idx[1]), _mm256_permute2f128_pd(t1, t3, 0x20));
-    _mm256_store_pd(xw + 4 * static_cast<size_t>(idx[0]), _mm256_permute2f128_pd(t0, t2, 0x20));
-}
 
 void solvePack(MembranePack& P, double* xw, V h2inv, bool first) {
     const V zero = _mm256_setzero_pd(), half = _mm256_set1_pd(0.5), huge = _mm256_set1_pd(__builtin_huge_val());
