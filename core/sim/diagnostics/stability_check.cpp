@@ -40,23 +40,30 @@ StabilityFigures assessStability(const TetMesh& mesh, const TetConstraintModel& 
     return assessStability(mesh, model, density, nodeWeights, settings, {});
 }
 
-StabilityFigures assessStability(const TetMesh& mesh, const TetConstraintModel& model, double density,
-                                 const std::vector<double>& nodeWeights, const XpbdSettings& settings,
-                                 const std::vector<double>& tiedMass) {
-    StabilityFigures f;
+namespace {
+
+/// Per tet of the body: the stiffness number without tie inertia (k w h² / (ρ L²); 0 for a
+/// degenerate tet) and the present ratio r = min over its nodes of (m_i + tied_i) / m_i; and the
+/// nodes' own lumped masses.
+struct TetNumbers {
+    std::vector<double> raw, ratio, own;
+};
+
+TetNumbers tetNumbers(const TetMesh& mesh, const TetConstraintModel& model, double density,
+                      const std::vector<double>& nodeWeights, const XpbdSettings& settings,
+                      const std::vector<double>& tiedMass, const char* where) {
     const double h = settings.dt / settings.substeps;
     const double k = probedStiffness(model);
-    // Lumped own masses (without the density, which cancels) for the tied-inertia ratio.
     if (!tiedMass.empty() && tiedMass.size() != mesh.vertexCount())
-        throw std::invalid_argument("sim::assessStability(): tiedMass has " + std::to_string(tiedMass.size()) +
+        throw std::invalid_argument(std::string(where) + "tiedMass has " + std::to_string(tiedMass.size()) +
                                     " values for " + std::to_string(mesh.vertexCount()) + " nodes");
-    std::vector<double> own;
-    if (!tiedMass.empty()) {
-        own.assign(mesh.vertexCount(), 0.0);
-        for (int32_t t = 0; t < static_cast<int32_t>(mesh.tetCount()); ++t)
-            for (int32_t v : mesh.tets()[t])
-                own[v] += std::abs(mesh.signedVolume(t)) / 4.0;
-    }
+    TetNumbers n;
+    n.own.assign(mesh.vertexCount(), 0.0); // kg
+    for (int32_t t = 0; t < static_cast<int32_t>(mesh.tetCount()); ++t)
+        for (int32_t v : mesh.tets()[t])
+            n.own[v] += density * std::abs(mesh.signedVolume(t)) / 4.0;
+    n.raw.assign(mesh.tetCount(), 0.0);
+    n.ratio.assign(mesh.tetCount(), 1.0);
     for (int32_t t = 0; t < static_cast<int32_t>(mesh.tetCount()); ++t) {
         const double vol = std::abs(mesh.signedVolume(t));
         if (!(vol > 0)) continue;
@@ -67,16 +74,29 @@ StabilityFigures assessStability(const TetMesh& mesh, const TetConstraintModel& 
                 w += nodeWeights[v] / 4.0;
         }
         const double L = std::cbrt(6.0 * vol);
-        double inertia = 1.0; // smallest (m_i + tied_i) / m_i over the tet's nodes
+        n.raw[t] = k * w * h * h / (density * L * L);
         if (!tiedMass.empty()) {
-            inertia = std::numeric_limits<double>::infinity();
+            double r = std::numeric_limits<double>::infinity();
             for (int32_t v : mesh.tets()[t])
-                inertia = std::min(inertia, 1.0 + tiedMass[v] / (density * own[v]));
+                r = std::min(r, 1.0 + tiedMass[v] / n.own[v]);
+            n.ratio[t] = r;
         }
-        const double s = k * w * h * h / (density * L * L) / inertia;
+    }
+    return n;
+}
+
+} // namespace
+
+StabilityFigures assessStability(const TetMesh& mesh, const TetConstraintModel& model, double density,
+                                 const std::vector<double>& nodeWeights, const XpbdSettings& settings,
+                                 const std::vector<double>& tiedMass) {
+    StabilityFigures f;
+    const TetNumbers n = tetNumbers(mesh, model, density, nodeWeights, settings, tiedMass, "sim::assessStability(): ");
+    for (size_t t = 0; t < n.raw.size(); ++t) {
+        const double s = n.raw[t] / n.ratio[t];
         if (s > f.maxStiffnessNumber) {
             f.maxStiffnessNumber = s;
-            f.worstTet = t;
+            f.worstTet = static_cast<int>(t);
         }
     }
     // s scales with h², so the substep count that brings it under the limit scales with sqrt(s).
@@ -86,6 +106,28 @@ StabilityFigures assessStability(const TetMesh& mesh, const TetConstraintModel& 
     f.requiredSubsteps = std::max(
         1, static_cast<int>(std::ceil(settings.substeps * std::sqrt(f.maxStiffnessNumber / kMaxStiffnessNumber))));
     return f;
+}
+
+std::vector<double> stabilizingInertia(const TetMesh& mesh, const TetConstraintModel& model, double density,
+                                       const std::vector<double>& nodeWeights, const XpbdSettings& settings,
+                                       const std::vector<double>& tiedMass, double maxScale) {
+    const TetNumbers n =
+        tetNumbers(mesh, model, density, nodeWeights, settings, tiedMass, "sim::stabilizingInertia(): ");
+    std::vector<double> extra(mesh.vertexCount(), 0.0);
+    // A hair above the limit's ratio, so that the rounding of s = raw / ratio lands below it.
+    constexpr double kMargin = 1 + 1e-9;
+    for (size_t t = 0; t < n.raw.size(); ++t) {
+        if (!(n.raw[t] / n.ratio[t] > kMaxStiffnessNumber)) continue;
+        const double need = kMargin * n.raw[t] / kMaxStiffnessNumber; // ratio every node must reach
+        for (int32_t v : mesh.tets()[t]) {
+            const double tied = tiedMass.empty() ? 0.0 : tiedMass[v];
+            if (!std::isfinite(tied)) continue;
+            extra[v] = std::max(extra[v], (need - 1) * n.own[v] - tied);
+        }
+    }
+    for (size_t v = 0; v < extra.size(); ++v)
+        extra[v] = std::clamp(extra[v], 0.0, std::max(0.0, maxScale - 1) * n.own[v]);
+    return extra;
 }
 
 std::string stabilityProblem(const std::string& body, const StabilityFigures& f, const XpbdSettings& settings) {

@@ -48,6 +48,18 @@ StabilityFigures assessStability(const TetMesh& mesh, const TetConstraintModel& 
                                  const std::vector<double>& nodeWeights, const XpbdSettings& settings,
                                  const std::vector<double>& tiedMass);
 
+/// Selective inertia scaling: the extra inertia per node (kg, #V, ≥ 0) that brings every tet of
+/// the body under the limit at settings.substeps, given the inertia ties already add (tiedMass as
+/// above; empty: none). A tet with stiffness number s > 1 needs (m_i + tied_i + extra_i) / m_i ≥
+/// s · r at each of its nodes (r: its present ratio), so extra_i is the largest such need over the
+/// node's tets, capped at (maxScale − 1) m_i (m_i: the node's own lumped mass). All zero when no
+/// tet is over the limit. The cap may leave some tets over it: assessStability with tiedMass +
+/// extra tells. Extra inertia slows only the dynamics of those nodes (XpbdSystem::setAddedInertia
+/// keeps their weight). O(#tets).
+std::vector<double> stabilizingInertia(const TetMesh& mesh, const TetConstraintModel& model, double density,
+                                       const std::vector<double>& nodeWeights, const XpbdSettings& settings,
+                                       const std::vector<double>& tiedMass, double maxScale);
+
 /// Empty when stable, else one line: "body 'slab': stiffness number 22 at tet 17 exceeds 1
 /// (substep 0.83 ms); use at least 95 substeps per frame or a softer material".
 std::string stabilityProblem(const std::string& body, const StabilityFigures& f, const XpbdSettings& settings);

@@ -78,7 +78,8 @@ std::vector<ToolDesc> readTools(const JsonField& tools, std::set<std::string>& n
 void readSolver(const JsonField& doc, SceneDesc& scene) {
     using L = XpbdLimits;
     const JsonField solver = doc["solver"];
-    solver.object({"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads", "primal_correction"});
+    solver.object({"type", "dt", "substeps", "iterations", "damping", "max_speed", "threads", "primal_correction",
+                   "inertia_scaling"});
     scene.solverType = solver["type"].choice({"xpbd", "fem"}, "a supported solver");
     XpbdSettings& s = scene.xpbd;
     if (scene.solverType == "fem") solver.object({"type", "dt"}); // quasi-static suturing FEM [B §2.2]
@@ -92,6 +93,7 @@ void readSolver(const JsonField& doc, SceneDesc& scene) {
     s.damping = solver.number("damping", s.damping, NumberRule::closed(0, L::maxDamping));
     s.maxSpeed = solver.number("max_speed", s.maxSpeed, NumberRule::positive());
     s.primalCorrection = solver.boolean("primal_correction", s.primalCorrection);
+    s.inertiaScaling = solver.number("inertia_scaling", s.inertiaScaling, NumberRule::closed(1, L::maxInertiaScaling));
     s.gravity = Vec3::Zero();
     if (auto g = doc.find("gravity")) {
         s.gravity = g->vec3();
@@ -105,6 +107,7 @@ void writeSolver(const SceneDesc& scene, json& doc) {
                      {"iterations", s.iterations}, {"damping", s.damping}, {"max_speed", s.maxSpeed},
                      {"threads", s.threads}};
     if (s.primalCorrection) doc["solver"]["primal_correction"] = true;
+    if (s.inertiaScaling > 1) doc["solver"]["inertia_scaling"] = s.inertiaScaling;
     if (scene.solverType == "fem") doc["solver"] = {{"type", "fem"}, {"dt", s.dt}};
     doc["gravity"] = {s.gravity.x(), s.gravity.y(), s.gravity.z()};
 }

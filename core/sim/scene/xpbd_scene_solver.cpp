@@ -5,6 +5,7 @@
 #include "sim/scene/features.hpp"
 #include "sim/scene/interaction_runtime.hpp"
 #include "sim/util/error.hpp"
+#include "sim/util/format.hpp"
 
 namespace viscera::sim {
 
@@ -76,16 +77,45 @@ template <class Build> auto buildOrRefuse(const std::string& origin, const Build
     }
 }
 
-/// The load-time rule per tet body, with the inertia that hard ties of `system` (null: none) add.
+/// The inertia that hard ties of `system` (null: none) and selective inertia scaling add to the
+/// nodes of tet body b, kg per node (empty: none).
+std::vector<double> inertiaAddedTo(const XpbdSystem* system, size_t b) {
+    if (!system) return {};
+    std::vector<double> m = system->tiedInertia(b);
+    const std::vector<double> extra = system->addedInertia(b);
+    for (size_t i = 0; i < m.size(); ++i)
+        m[i] += extra[i];
+    return m;
+}
+
+/// The load-time rule per tet body, with the inertia that ties and scaling of `system` add.
 std::vector<StabilityFigures> figuresOf(const SceneSolverInputs& in, const XpbdSystemDesc& desc,
                                         const XpbdSystem* system) {
     std::vector<StabilityFigures> out;
     for (size_t i = 0; i < desc.tetBodies.size(); ++i) {
         const TetBodyDesc& tb = desc.tetBodies[i];
         out.push_back(assessStability(*in.meshes[i], *tb.model, tb.density, tb.nodeWeights, in.scene.xpbd,
-                                      system ? system->tiedInertia(i) : std::vector<double>{}));
+                                      inertiaAddedTo(system, i)));
     }
     return out;
+}
+
+/// The load-time rule, after selective inertia scaling (settings.inertiaScaling > 1) of the bodies
+/// over the limit: their nodes get the extra inertia stabilizingInertia asks for (capped).
+std::vector<StabilityFigures> scaleAndAssess(const SceneSolverInputs& in, const XpbdSystemDesc& desc,
+                                             XpbdSystem& system) {
+    std::vector<StabilityFigures> figures = figuresOf(in, desc, &system);
+    const double scaling = in.scene.xpbd.inertiaScaling;
+    if (!(scaling > 1)) return figures;
+    bool scaled = false;
+    for (size_t i = 0; i < figures.size(); ++i) {
+        if (figures[i].ok()) continue;
+        const TetBodyDesc& tb = desc.tetBodies[i];
+        system.setAddedInertia(i, stabilizingInertia(*in.meshes[i], *tb.model, tb.density, tb.nodeWeights,
+                                                     in.scene.xpbd, inertiaAddedTo(&system, i), scaling));
+        scaled = true;
+    }
+    return scaled ? figuresOf(in, desc, &system) : figures;
 }
 
 } // namespace
@@ -94,9 +124,10 @@ std::vector<StabilityFigures> assessSceneStability(const SceneSolverInputs& in) 
     if (auto why = validate(in.scene.xpbd); !why.empty())
         throw InputError(in.origin + ": scene cannot be simulated stably: solver: " + why);
     const XpbdSystemDesc desc = describe(in);
-    if (desc.embeddings.empty() && desc.attachments.empty()) return figuresOf(in, desc, nullptr);
+    if (desc.embeddings.empty() && desc.attachments.empty() && !(in.scene.xpbd.inertiaScaling > 1))
+        return figuresOf(in, desc, nullptr);
     const auto system = buildOrRefuse(in.origin, [&] { return XpbdSystem::create(desc, in.scene.xpbd); });
-    return figuresOf(in, desc, system.get());
+    return scaleAndAssess(in, desc, *system);
 }
 
 std::unique_ptr<XpbdSceneSolver> XpbdSceneSolver::create(const SceneSolverInputs& in) {
@@ -123,11 +154,21 @@ std::unique_ptr<XpbdSceneSolver> XpbdSceneSolver::create(const SceneSolverInputs
         return 0;
     });
     // Load-time stability rule, per body, with the inertia that hard ties add to its nodes (an
-    // embedded body moves with its cage).
-    const std::vector<StabilityFigures> figures = figuresOf(in, desc, x->m_layered.get());
+    // embedded body moves with its cage) and, when the scene allows it, selective inertia scaling
+    // of the nodes of the tets over the limit.
+    const std::vector<StabilityFigures> figures = scaleAndAssess(in, desc, *x->m_sys);
     for (size_t i = 0; i < figures.size(); ++i)
-        if (auto why = stabilityProblem(scene.bodies[i].name, figures[i], scene.xpbd); !why.empty())
+        if (auto why = stabilityProblem(scene.bodies[i].name, figures[i], scene.xpbd); !why.empty()) {
+            if (scene.xpbd.inertiaScaling > 1)
+                why += " (after inertia scaling up to " + formatNumber(scene.xpbd.inertiaScaling, 3) + "x)";
             throw InputError(origin + ": scene cannot be simulated stably: " + why);
+        }
+    for (size_t i = 0; i < figures.size(); ++i) {
+        double kg = 0;
+        for (double m : x->m_sys->addedInertia(i))
+            kg += m;
+        x->m_addedInertia.push_back(kg);
+    }
     if (scene.interaction) {
         std::vector<const TetMesh*> bodies;
         for (const auto& m : in.meshes)

@@ -28,6 +28,8 @@ std::string validate(const XpbdSettings& s) {
         return "gravity must be finite and at most 1000 m/s^2";
     if (!std::isfinite(s.maxSpeed) || s.maxSpeed <= 0) return "max_speed must be positive";
     if (s.threads < 1 || s.threads > L::maxThreads) return "threads must be in [1, 64]";
+    if (!(s.inertiaScaling >= 1 && s.inertiaScaling <= L::maxInertiaScaling))
+        return "inertia_scaling must be in [1, 100]";
     return {};
 }
 

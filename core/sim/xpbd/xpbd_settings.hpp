@@ -32,17 +32,25 @@ struct XpbdSettings {
     /// or ties); converges while the stiffness number h² k w/(ρ L²) is small, which the load-time stability check
     /// enforces.
     bool primalCorrection = false;
+    /// Selective inertia scaling, applied by the scene solver at load (XpbdSceneSolver::create):
+    /// a node of a tet over the stability limit at these substeps gets extra inertia, at most
+    /// (inertiaScaling − 1) times its own lumped mass, so that the tet passes
+    /// (stabilizingInertia, stability_check.hpp). Gravity on that node is scaled down by the same
+    /// factor, so its weight and hence every static equilibrium stay as they were; only the
+    /// dynamics of those nodes are slower. 1 = off.
+    double inertiaScaling = 1.0;
 };
 
 /// Admissible ranges of XpbdSettings: validate() and the scene readers (scene_json.hpp) use
 /// these, so scene.json and project.json get one rule.
 struct XpbdLimits {
-    static constexpr double maxDt = 0.1;       ///< s; dt in (0, maxDt]
-    static constexpr int maxSubsteps = 1000;   ///< substeps in [1, maxSubsteps]
-    static constexpr int maxIterations = 1000; ///< iterations in [1, maxIterations]
-    static constexpr double maxDamping = 1000; ///< 1/s; damping in [0, maxDamping]
-    static constexpr double maxGravity = 1000; ///< m/s^2, |gravity|
-    static constexpr int maxThreads = 64;      ///< threads in [1, maxThreads]
+    static constexpr double maxDt = 0.1;             ///< s; dt in (0, maxDt]
+    static constexpr int maxSubsteps = 1000;         ///< substeps in [1, maxSubsteps]
+    static constexpr int maxIterations = 1000;       ///< iterations in [1, maxIterations]
+    static constexpr double maxDamping = 1000;       ///< 1/s; damping in [0, maxDamping]
+    static constexpr double maxGravity = 1000;       ///< m/s^2, |gravity|
+    static constexpr int maxThreads = 64;            ///< threads in [1, maxThreads]
+    static constexpr double maxInertiaScaling = 100; ///< inertiaScaling in [1, maxInertiaScaling]
 };
 
 /// Checks settings; empty string when valid, otherwise the rule that failed.

@@ -278,7 +278,7 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
         sys->m_surf.push_back(std::move(r));
         eng.addParticles(x, mass, fixed);
         if (d.stretchStiffness > 0)
-            eng.blocks.push_back(detail::makeMembraneBlock(tris, restInv, area, d.stretchStiffness));
+            eng.blocks.push_back(detail::makeMembraneBlock(tris, restInv, area, d.stretchStiffness, settings.simd));
         if (d.strainLimits) {
             const TriStrainLimits& sl = *d.strainLimits;
             if (d.uv.empty()) fail(label, "strain limits need per-vertex uv coordinates");
@@ -403,6 +403,34 @@ void XpbdSystem::setState(Range& r, const std::vector<Vec3>& x, const std::vecto
     refreshMirrors();
 }
 
+void XpbdSystem::setAddedInertia(size_t b, const std::vector<double>& extra) {
+    const Range& r = m_tet.at(b);
+    const std::string where = "sim::XpbdSystem::setAddedInertia(): ";
+    if (extra.size() != r.x.size())
+        throw PreconditionError(where, "expected " + std::to_string(r.x.size()) + " values, got " +
+                                           std::to_string(extra.size()));
+    for (size_t i = 0; i < extra.size(); ++i)
+        if (!std::isfinite(extra[i]) || extra[i] < 0)
+            throw PreconditionError(where, "node " + std::to_string(i) + ": extra inertia must be finite and >= 0");
+    detail::Engine& eng = *m_engine;
+    if (m_added.empty()) m_added.assign(eng.particleCount(), 0.0);
+    if (eng.gravityScale.empty()) eng.gravityScale.assign(eng.particleCount(), 1.0);
+    for (size_t i = 0; i < extra.size(); ++i) {
+        const size_t p = r.first + i;
+        double& w = eng.xw[4 * p + 3];
+        m_added[p] = extra[i]; // a fixed node records it (its inertia is infinite anyway) but stays
+        if (w == 0) continue;
+        w = 1.0 / (eng.mass[p] + extra[i]);
+        eng.gravityScale[p] = eng.mass[p] / (eng.mass[p] + extra[i]);
+    }
+}
+
+std::vector<double> XpbdSystem::addedInertia(size_t b) const {
+    const Range& r = m_tet.at(b);
+    if (m_added.empty()) return std::vector<double>(r.x.size(), 0.0);
+    return {m_added.begin() + r.first, m_added.begin() + r.first + static_cast<long>(r.x.size())};
+}
+
 void XpbdSystem::setTetState(size_t b, const std::vector<Vec3>& x, const std::vector<Vec3>& v) {
     setState(m_tet.at(b), x, v, "setTetState");
 }
@@ -492,6 +520,7 @@ double XpbdSystem::maxTieGap() const {
 
 std::vector<double> XpbdSystem::tiedInertia(size_t b) const {
     const Range& r = m_tet.at(b);
+    auto inertiaOf = [&](int32_t i) { return m_engine->mass[i] + (m_added.empty() ? 0.0 : m_added[i]); };
     std::vector<double> added(r.x.size(), 0.0);
     const double* xw = m_engine->xw.data();
     std::vector<double> share(m_engine->particleCount(), 0.0); // B_k
@@ -504,7 +533,7 @@ std::vector<double> XpbdSystem::tiedInertia(size_t b) const {
         double inv = 0; // Σ b_k B_k / m_k; fixed nodes (inverse mass 0) add nothing
         for (int k = 0; k < t.n; ++k)
             if (detail::particleInvMass(xw, t.t[k]) > 0 && t.b[k] > 0)
-                inv += t.b[k] * share[t.t[k]] / m_engine->mass[t.t[k]];
+                inv += t.b[k] * share[t.t[k]] / inertiaOf(t.t[k]);
         added[t.p - r.first] += inv > 0 ? 1.0 / inv : std::numeric_limits<double>::infinity();
     }
     return added;
@@ -520,7 +549,7 @@ double XpbdSystem::elasticEnergy() const {
 double XpbdSystem::kineticEnergy() const {
     double e = 0;
     for (size_t i = 0; i < m_engine->particleCount(); ++i)
-        e += 0.5 * m_engine->mass[i] * m_engine->v[i].squaredNorm();
+        e += 0.5 * (m_engine->mass[i] + (m_added.empty() ? 0.0 : m_added[i])) * m_engine->v[i].squaredNorm();
     return e;
 }
 

@@ -160,6 +160,18 @@ public:
     /// twice. The load-time stability check (stability_check.hpp) divides by it. O(ties).
     std::vector<double> tiedInertia(size_t b) const;
 
+    /// Selective inertia scaling (XpbdSettings::inertiaScaling): node i of tet body b moves with
+    /// inertia m_i + extra[i] instead of its lumped mass m_i, and feels the fraction
+    /// m_i / (m_i + extra[i]) of gravity, so that its weight m_i g (and every static equilibrium)
+    /// is unchanged; only its dynamics slow down. extra: #V values, finite and ≥ 0 (a fixed node
+    /// keeps inverse mass 0 and only records its value, which addedInertia returns); all zero
+    /// restores the plain masses. Between frames. The kinetic energy counts the scaled inertia,
+    /// the potential energy the weight. Throws viscera::PreconditionError on a size mismatch or a
+    /// bad value. O(#V).
+    void setAddedInertia(size_t b, const std::vector<double>& extra);
+    /// The extra inertia of tet body b's nodes, kg (#V; zeros unless set).
+    std::vector<double> addedInertia(size_t b) const;
+
     double elasticEnergy() const;   ///< J: elasticity, membranes, compliant ties and strain limits, relative to rest
     double kineticEnergy() const;   ///< J
     double potentialEnergy() const; ///< J, gravity relative to the rest configuration
@@ -214,6 +226,7 @@ private:
     std::vector<Range> m_tet, m_surf;
     std::vector<Vec3> m_rest; ///< all particles, rest positions
     std::vector<TieRecord> m_ties;
+    std::vector<double> m_added; ///< empty, or one per particle: extra inertia, kg
     bool m_simd = false;
 };
 

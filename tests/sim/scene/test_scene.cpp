@@ -60,6 +60,8 @@ TEST(Scene, RenderBlockAndPrimalCorrectionRoundTrip) {
                 HasSubstr("scene.json: render: must be an object"));
     EXPECT_THAT(parseError(R"({"solver": {"type": "xpbd", "primal_correction": 1}, "bodies": []})"),
                 HasSubstr("solver.primal_correction: must be true or false"));
+    EXPECT_THAT(parseError(R"({"solver": {"type": "xpbd", "inertia_scaling": 0.5}, "bodies": []})"),
+                HasSubstr("solver.inertia_scaling"));
 }
 
 TEST(Scene, ErrorsNameTheField) {

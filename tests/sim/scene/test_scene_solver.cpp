@@ -355,3 +355,64 @@ TEST(SceneSolver, EmbeddedBodiesCountTheInertiaOfTheirCage) {
     for (size_t i = 0; i < 2; ++i)
         EXPECT_EQ(a->positions(i), b->positions(i)) << "repeat runs must be bit-identical";
 }
+
+TEST(SceneSolver, InertiaScalingStabilizesTheLimitingNodesOnly) {
+    // Selective inertia scaling (solver.inertia_scaling): below the substeps the vessel needs, its
+    // limiting nodes get extra inertia (their weight kept) and the World accepts the scene; the
+    // fat, under the limit, keeps its masses. The run stays finite with bounded energy, repeats
+    // bit for bit, and settles where the unscaled scene at the rule's substeps settles.
+    const auto figures = EmbeddedScene(20).figures();
+    const int required = std::max(figures[0].requiredSubsteps, figures[1].requiredSubsteps);
+    const int fewer = figures[0].requiredSubsteps; // the fat's own limit
+    ASSERT_LT(fewer, required) << "the vessel limits the scene";
+    auto assemble = [&](int substeps, double scaling) {
+        EmbeddedScene at(substeps);
+        at.scene.xpbd.inertiaScaling = scaling;
+        return World::assemble(at.scene, std::move(at.meshes), {}, requiredFeatures(at.scene), "case");
+    };
+    EXPECT_THROW(assemble(fewer, 1.0), viscera::InputError);
+    {
+        EmbeddedScene probe(fewer);
+        probe.scene.xpbd.inertiaScaling = 4;
+        for (const StabilityFigures& f : probe.figures())
+            EXPECT_TRUE(f.ok()) << f.maxStiffnessNumber;
+        const std::vector<TriMesh> none;
+        const auto solver = XpbdSceneSolver::create({probe.scene, probe.meshes, none, "case"});
+        ASSERT_EQ(solver->addedInertia().size(), 2u);
+        EXPECT_EQ(solver->addedInertia()[0], 0.0) << "the fat is under the limit";
+        EXPECT_GT(solver->addedInertia()[1], 0.0);
+        // Less than the vessel's own mass (0.04 × 0.008² m³ × 1050 kg/m³ = 2.7 g) times the cap.
+        EXPECT_LT(solver->addedInertia()[1], 3 * 0.04 * 0.008 * 0.008 * 1050);
+    }
+    auto a = assemble(fewer, 4), b = assemble(fewer, 4), plain = assemble(required, 1);
+    const double mass = (0.06 * 0.02 * 0.02 * 950 + 0.04 * 0.008 * 0.008 * 1050);
+    for (int f = 0; f < 300; ++f) {
+        ASSERT_TRUE(a->step().finite) << "frame " << f;
+        b->step();
+        plain->step();
+        ASSERT_LE(a->invariants().maxEnergy, 0.05 * mass * 9.81 * 0.06) << "frame " << f;
+    }
+    for (size_t i = 0; i < 2; ++i)
+        EXPECT_EQ(a->positions(i), b->positions(i)) << "repeat runs must be bit-identical";
+    // Settled after 5 s: the sag of the scaled scene matches the plain one (weights unchanged).
+    double sagA = 0, sagPlain = 0;
+    for (size_t v = 0; v < a->positions(0).size(); ++v) {
+        sagA = std::max(sagA, a->restMesh(0).positions()[v].z() - a->positions(0)[v].z());
+        sagPlain = std::max(sagPlain, plain->restMesh(0).positions()[v].z() - plain->positions(0)[v].z());
+    }
+    RecordProperty("sag_scaled_um", static_cast<int>(1e6 * sagA));
+    RecordProperty("sag_plain_um", static_cast<int>(1e6 * sagPlain));
+    EXPECT_NEAR(sagA, sagPlain, 0.02 * sagPlain);
+}
+
+TEST(SceneSolver, InertiaScalingThatCannotSufficeIsRefusedWithTheCap) {
+    EmbeddedScene at(2);
+    at.scene.xpbd.inertiaScaling = 4;
+    try {
+        World::assemble(at.scene, std::move(at.meshes), {}, requiredFeatures(at.scene), "case");
+        ADD_FAILURE() << "accepted at 2 substeps";
+    } catch (const viscera::InputError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("scene cannot be simulated stably: body '"));
+        EXPECT_THAT(e.what(), HasSubstr("(after inertia scaling up to 4x)"));
+    }
+}

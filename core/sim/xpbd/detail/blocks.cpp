@@ -2,6 +2,7 @@
 
 #include "sim/material/stable_neo_hookean.hpp"
 #include "sim/xpbd/coupling.hpp"
+#include "sim/xpbd/detail/membrane_kernel.hpp"
 #include "sim/xpbd/detail/snh_kernel.hpp"
 #include "sim/xpbd/membrane.hpp"
 
@@ -393,15 +394,19 @@ private:
 
 class MembraneBlock final : public Block {
 public:
-    MembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area, double k)
+    MembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area, double k, bool simd)
         : m_tris(std::move(tris)), m_dmInv(std::move(dmInv)), m_area(std::move(area)), m_k(k),
-          m_active(m_tris.size(), 1) {}
+          m_active(m_tris.size(), 1), m_simd(simd) {}
     bool setUnitActive(size_t u, bool active) override {
         m_active.at(u) = active ? 1 : 0;
+        if (m_simd) m_packs[m_slotOf[u] / 4].active[m_slotOf[u] % 4] = active ? 1.0 : 0.0;
         return true;
     }
     bool setUnitRestInverse(size_t u, const double* m) override {
         m_dmInv.at(u) << m[0], m[1], m[2], m[3];
+        if (m_simd)
+            for (int e = 0; e < 4; ++e)
+                m_packs[m_slotOf[u] / 4].m[e][m_slotOf[u] % 4] = m[e];
         return true;
     }
 
@@ -411,6 +416,10 @@ public:
         return 3;
     }
     void solve(size_t pb, size_t pe, const SolveContext& ctx) override {
+        if (m_simd) {
+            if (pe > pb) membraneSolveAvx2(m_packs.data() + pb, pe - pb, {ctx.xw, ctx.h2inv, ctx.first ? 1 : 0});
+            return;
+        }
         // The three Green-strain constraints ε00, ε11, √2 ε01 of each triangle (triGreenStrain),
         // Gauss–Seidel one after the other; F = Ds M with Ds = [x1 − x0, x2 − x0] (3 × 2). The
         // (up to) four triangles of a pack share no particle (one colour), so they are worked on
@@ -495,6 +504,27 @@ protected:
     void build(const std::vector<int32_t>& slots) override {
         m_slots = slots;
         m_lam.assign(3 * slots.size(), 0.0);
+        if (!m_simd) return;
+        m_packs.assign(slots.size() / 4, MembranePack{});
+        m_slotOf.assign(m_tris.size(), 0);
+        for (size_t q = 0; q < m_packs.size(); ++q) {
+            MembranePack& P = m_packs[q];
+            const int32_t lane0 = slots[4 * q];
+            for (int l = 0; l < 4; ++l) {
+                const int32_t u = slots[4 * q + l];
+                const int32_t src = u >= 0 ? u : lane0; // padding repeats lane 0 and moves nothing
+                if (u >= 0) m_slotOf[u] = static_cast<int32_t>(4 * q + l);
+                for (int i = 0; i < 3; ++i)
+                    P.idx[i][l] = m_tris[src][i];
+                const Mat2& M = m_dmInv[src];
+                P.m[0][l] = M(0, 0);
+                P.m[1][l] = M(0, 1);
+                P.m[2][l] = M(1, 0);
+                P.m[3][l] = M(1, 1);
+                P.invKA[l] = 1.0 / (m_k * m_area[src]);
+                P.active[l] = u >= 0 && m_active[u] ? 1.0 : 0.0;
+            }
+        }
     }
 
 private:
@@ -505,6 +535,10 @@ private:
     std::vector<uint8_t> m_active; ///< per unit
     std::vector<int32_t> m_slots;
     std::vector<double> m_lam;
+    // AVX2 path: the units in packs of four (slot order), and each unit's slot.
+    bool m_simd = false;
+    std::vector<MembranePack, AlignedAllocator<MembranePack, 64>> m_packs;
+    std::vector<int32_t> m_slotOf;
 };
 
 // ---- coupling ties ------------------------------------------------------------------------------
@@ -612,8 +646,9 @@ std::unique_ptr<Block> makeTriStrainBlock(std::vector<Tri> tris, std::vector<Mat
 }
 
 std::unique_ptr<Block> makeMembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area,
-                                         double stiffness) {
-    return std::make_unique<MembraneBlock>(std::move(tris), std::move(dmInv), std::move(area), stiffness);
+                                         double stiffness, bool simd) {
+    return std::make_unique<MembraneBlock>(std::move(tris), std::move(dmInv), std::move(area), stiffness,
+                                           simd && membraneAvx2Available());
 }
 
 std::unique_ptr<Block> makeCouplingBlock(std::vector<Tie> ties) {

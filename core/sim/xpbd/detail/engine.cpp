@@ -279,10 +279,14 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
     buildSchedule(Schedule::Frame, &s, threads);
     double* const x = xw.data();
     // Start of a substep for particle i: remember x, predict x̃ = x + h (v + h g).
+    const bool scaledGravity = !gravityScale.empty();
     auto predict = [&](size_t i, double* p, Vec3& vi) {
         m_prev[i] = Vec3(p[0], p[1], p[2]);
         if (p[3] == 0) return;
-        vi += hg;
+        if (scaledGravity)
+            vi += gravityScale[i] * hg;
+        else
+            vi += hg;
         p[0] += h * vi.x();
         p[1] += h * vi.y();
         p[2] += h * vi.z();

@@ -106,6 +106,9 @@ public:
     ParticleArray xw;         ///< 4 per particle: x, y, z (m), inverse mass (1/kg, 0 = fixed)
     std::vector<Vec3> v;      ///< velocities, m/s
     std::vector<double> mass; ///< kg (fixed particles keep theirs)
+    /// Empty, or one per particle: the fraction of gravity it feels (m / (m + added inertia) for
+    /// a node with selective inertia scaling, so that its weight stays m g).
+    std::vector<double> gravityScale;
     std::vector<std::unique_ptr<Block>> blocks;
     /// Optional: called by frame() after every sweep (see XpbdIterationHook). Empty: frame()
     /// runs exactly the schedule it runs without hooks.
