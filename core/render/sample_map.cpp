@@ -315,6 +315,18 @@ void applyNodeSampleClasses(SceneView& view, size_t body, const std::vector<uint
     }
 }
 
+void applyBodySampleMap(SceneView& view, size_t body, const std::string& bodyName,
+                        const std::vector<uint8_t>& nodeClasses, const std::vector<sim::SurfaceDesc>& surfaces) {
+    std::vector<size_t> layers;
+    double tolerance = 1e-6;
+    for (size_t s = 0; s < surfaces.size(); ++s)
+        if (surfaces[s].attachTo == bodyName) {
+            layers.push_back(s);
+            tolerance = std::max(tolerance, surfaces[s].attachDistance);
+        }
+    applyNodeSampleClasses(view, body, nodeClasses, layers, static_cast<float>(tolerance));
+}
+
 std::vector<uint8_t> parseSampleMap(std::string_view text, const std::string& origin,
                                     std::optional<size_t> expectedNodes) {
     sim::detail::LineReader in(text, origin);

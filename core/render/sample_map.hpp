@@ -3,6 +3,7 @@
 /// 8×) a RenderMesh carries in sampleMap, filled over connected regions and measured by area.
 /// Everything works on the rest positions, so a map does not change as the tissue deforms.
 #include "render/scene_view.hpp"
+#include "sim/scene/scene.hpp"
 
 #include <Eigen/Core>
 
@@ -72,6 +73,13 @@ std::vector<uint8_t> nodeSampleClasses(const RenderMesh& bodySurface, size_t nod
 /// Throws std::invalid_argument when the classes do not match the body's nodes.
 void applyNodeSampleClasses(SceneView& view, size_t body, const std::vector<uint8_t>& nodeClasses,
                             const std::vector<size_t>& surfacesOnBody, float tolerance);
+
+/// applyNodeSampleClasses for body `body` named `bodyName` of a scene whose fascia are
+/// `surfaces` (scene order): the layers attached to the body take its map, matched within the
+/// largest of their attach distances (at least 1 µm). What the player and the studio's
+/// comparison both do with a body's map.
+void applyBodySampleMap(SceneView& view, size_t body, const std::string& bodyName,
+                        const std::vector<uint8_t>& nodeClasses, const std::vector<sim::SurfaceDesc>& surfaces);
 
 /// The .vsamples text format: the painted light-sample class of every node of a tet body (case
 /// packages; packaging/vcase-spec.md):

@@ -8,7 +8,6 @@
 #include "sim/mesh/tet_io.hpp"
 #include "sim/util/error.hpp"
 
-#include <algorithm>
 #include <chrono>
 
 namespace viscera::player {
@@ -80,17 +79,10 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
 
 render::SceneView caseView(const LoadedCase& loaded) {
     render::SceneView view = render::SceneView::fromWorld(*loaded.world);
-    for (size_t b = 0; b < loaded.sampleMaps.size(); ++b) {
-        if (loaded.sampleMaps[b].empty()) continue;
-        std::vector<size_t> layers; // fascia cut from this body's boundary show its map too
-        double tolerance = 1e-6;
-        for (size_t s = 0; s < loaded.scene.surfaces.size(); ++s)
-            if (loaded.scene.surfaces[s].attachTo == loaded.scene.bodies[b].name) {
-                layers.push_back(s);
-                tolerance = std::max(tolerance, loaded.scene.surfaces[s].attachDistance);
-            }
-        render::applyNodeSampleClasses(view, b, loaded.sampleMaps[b], layers, static_cast<float>(tolerance));
-    }
+    for (size_t b = 0; b < loaded.sampleMaps.size(); ++b) // fascia cut from a body show its map too
+        if (!loaded.sampleMaps[b].empty())
+            render::applyBodySampleMap(view, b, loaded.scene.bodies[b].name, loaded.sampleMaps[b],
+                                       loaded.scene.surfaces);
     return view;
 }
 

@@ -242,22 +242,23 @@ void MainWindow::buildActions() {
 
     QMenu* view = menuBar()->addMenu(tr("&View"));
     m_frameAction = add(view, tr("&Frame all"), QKeySequence(Qt::Key_F), [this] { m_viewport->frameAll(); });
-    m_paintAction = new QAction(tr("&Paint stiffness"), this);
-    m_paintAction->setObjectName("actionPaintStiffness");
-    m_paintAction->setCheckable(true);
-    m_paintAction->setShortcut(QKeySequence(Qt::Key_P));
-    m_paintAction->setToolTip(tr("Paint the selected body's stiffness weights through its curve skeleton "
-                                 "(left drag paints, Esc cancels a stroke, Alt + left drag orbits)"));
-    connect(m_paintAction, &QAction::toggled, this, [this](bool on) { setPainting(on); });
-    view->addAction(m_paintAction);
-    m_samplesAction = new QAction(tr("Paint &light samples"), this);
-    m_samplesAction->setObjectName("actionPaintSamples");
-    m_samplesAction->setCheckable(true);
-    m_samplesAction->setShortcut(QKeySequence(Qt::Key_L));
-    m_samplesAction->setToolTip(tr("Paint the selected body's area-light sample classes 1×, 4×, 8× (left drag "
-                                   "paints or fills, Ctrl erases, Esc cancels, Alt + left drag orbits)"));
-    connect(m_samplesAction, &QAction::toggled, this, [this](bool on) { setPaintingSamples(on); });
-    view->addAction(m_samplesAction);
+    // the paint tools: checkable, one at a time (setPaintTool)
+    auto tool = [this, view](const QString& text, const char* name, Qt::Key key, const QString& tip) {
+        auto* a = new QAction(text, this);
+        a->setObjectName(name);
+        a->setCheckable(true);
+        a->setShortcut(QKeySequence(key));
+        a->setToolTip(tip);
+        connect(a, &QAction::toggled, this, [this, a](bool on) { setPaintTool(a, on); });
+        view->addAction(a);
+        return a;
+    };
+    m_paintAction = tool(tr("&Paint stiffness"), "actionPaintStiffness", Qt::Key_P,
+                         tr("Paint the selected body's stiffness weights through its curve skeleton "
+                            "(left drag paints, Ctrl inverts, Esc cancels a stroke, Alt + left drag orbits)"));
+    m_samplesAction = tool(tr("Paint &light samples"), "actionPaintSamples", Qt::Key_L,
+                           tr("Paint the selected body's area-light sample classes 1×, 4×, 8× (left drag "
+                              "paints or fills, Ctrl erases, Esc cancels, Alt + left drag orbits)"));
     toolbar->addSeparator();
     toolbar->addAction(m_paintAction);
     toolbar->addAction(m_samplesAction);
@@ -691,20 +692,16 @@ SampleCompareDialog* MainWindow::openSampleCompare() {
     // the scene at rest with the painted classes, as the exported case would show it
     render::SceneView view = *source;
     const auto& bodies = m_doc.project().bodies;
+    std::vector<sim::SurfaceDesc> layers;
+    for (const SurfaceProject& sp : m_doc.project().surfaces)
+        layers.push_back(sp.scene);
     for (size_t b = 0; b < bodies.size(); ++b) {
         const auto mesh = m_preview.bodyMesh(static_cast<int>(b));
         if (!mesh) continue;
         render::RenderMesh surface = render::bodySurfaceMesh(*mesh, bodies[b].scene.name, b);
         render::applySamplePaint(surface, bodies[b].lightSamples);
-        std::vector<size_t> layers;
-        double tolerance = 1e-6;
-        for (size_t s = 0; s < m_doc.project().surfaces.size(); ++s)
-            if (m_doc.project().surfaces[s].scene.attachTo == bodies[b].scene.name) {
-                layers.push_back(s);
-                tolerance = std::max(tolerance, m_doc.project().surfaces[s].scene.attachDistance);
-            }
-        render::applyNodeSampleClasses(view, b, render::nodeSampleClasses(surface, mesh->vertexCount()), layers,
-                                       static_cast<float>(tolerance));
+        render::applyBodySampleMap(view, b, bodies[b].scene.name,
+                                   render::nodeSampleClasses(surface, mesh->vertexCount()), layers);
     }
     for (render::RenderMesh& m : view.meshes()) { // at rest, every face, no authoring colours
         m.positions = m.rest;
