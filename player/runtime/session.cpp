@@ -57,6 +57,15 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
                              "', which is not in the package");
         surfaces.push_back(sim::parseVtri(pkg.read(sd.meshPath), pkg.name() + ":" + sd.meshPath));
     }
+    for (size_t s = 0; s < out.scene.surfaces.size(); ++s) { // so do those painted on a fascia
+        sim::SurfaceDesc& sd = out.scene.surfaces[s];
+        if (sd.nodeWeightsPath.empty()) continue;
+        if (!pkg.contains(sd.nodeWeightsPath))
+            throw InputError(pkg.name() + ": " + sceneName + ": surfaces[" + std::to_string(s) +
+                             "].node_weights_file: '" + sd.nodeWeightsPath + "' is not in the package");
+        sd.nodeWeights = sim::parseNodeWeights(pkg.read(sd.nodeWeightsPath), pkg.name() + ":" + sd.nodeWeightsPath,
+                                               surfaces[s].vertexCount());
+    }
     if (out.scene.suture) { // the recorded needle trajectory travels with the case
         const std::string& path = out.scene.suture->trajectoryPath;
         if (!pkg.contains(path))

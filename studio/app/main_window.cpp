@@ -119,11 +119,16 @@ void MainWindow::buildDocks() {
             selectBody(index);
             return;
         }
+        if (kind == kSurface) {
+            selectSurface(index);
+            return;
+        }
         m_body = -1;
         m_selKind = kind;
         m_selIndex = index;
         m_material->setBody(-1);
-        m_viewport->setSelectedName(kind == kSurface ? item->text(0) : QString());
+        m_viewport->setSelectedName(QString());
+        retargetPainter();
         scheduleRefresh(false);
     });
     dock("projectDock", tr("Project"), m_tree, Qt::LeftDockWidgetArea);
@@ -353,7 +358,10 @@ void MainWindow::setPaintTool(QAction* action, bool on) {
 
 void MainWindow::retargetPainter() {
     const auto mesh = m_body >= 0 && (painting() || paintingSamples()) ? m_preview.bodyMesh(m_body) : nullptr;
-    if (painting()) m_painter.setTarget(m_body, mesh);
+    if (painting() && m_selKind == kSurface)
+        m_painter.setSurfaceTarget(m_selIndex, m_preview.surfaceMesh(m_selIndex)); // polygon paint
+    else if (painting())
+        m_painter.setTarget(m_body, mesh);
     if (paintingSamples()) m_samplePainter.setTarget(m_body, mesh);
 }
 
@@ -361,10 +369,12 @@ void MainWindow::connectPainting(Viewport* v) {
     // a dab only on the painted body's own surface
     auto onBody = [this](const Viewport::SurfaceHit& hit) {
         const auto& meshes = m_viewport->view().meshes();
-        const int body = paintingSamples() ? m_samplePainter.body() : m_painter.body();
+        const bool surface = !paintingSamples() && m_painter.surface() >= 0;
+        const int index = paintingSamples() ? m_samplePainter.body() : surface ? m_painter.surface() : m_painter.body();
         return hit.mesh >= 0 && hit.mesh < static_cast<int>(meshes.size()) &&
-               meshes[hit.mesh].source == render::RenderMesh::Source::Body &&
-               static_cast<int>(meshes[hit.mesh].sourceIndex) == body;
+               meshes[hit.mesh].source ==
+                   (surface ? render::RenderMesh::Source::Surface : render::RenderMesh::Source::Body) &&
+               static_cast<int>(meshes[hit.mesh].sourceIndex) == index;
     };
     connect(v, &Viewport::paintPressed, this, [this, onBody](const Viewport::SurfaceHit& hit) {
         if (!onBody(hit)) return;
@@ -412,16 +422,16 @@ void MainWindow::connectPainting(Viewport* v) {
     });
 }
 
-void MainWindow::showPaintedBody(int body, const std::function<Eigen::Vector4f(int32_t node)>& rgbaOfNode,
+void MainWindow::showPaintedBody(render::RenderMesh::Source source, int index,
+                                 const std::function<Eigen::Vector4f(int32_t node)>& rgbaOfNode,
                                  const std::optional<CutPlane>& cut, bool translucent) {
-    const bool show = body >= 0 && rgbaOfNode;
-    // the painted body at rest: the brush, the skeleton and the section share its frame
-    m_viewport->setRestPose(show ? body : -1);
+    const bool show = index >= 0 && rgbaOfNode;
+    // the painted mesh at rest: the brush, the skeleton and the section share its frame
+    m_viewport->setRestPose(show ? index : -1, source);
     const auto& meshes = m_viewport->view().meshes();
     for (size_t k = 0; k < meshes.size(); ++k) {
         const render::RenderMesh& m = meshes[k];
-        const bool painted =
-            show && m.source == render::RenderMesh::Source::Body && static_cast<int>(m.sourceIndex) == body;
+        const bool painted = show && m.source == source && static_cast<int>(m.sourceIndex) == index;
         // while painting, the painted body alone is drawn (a fascia on it or a neighbour would
         // hide its colours and take the brush's hits)
         m_viewport->setMeshVisible(static_cast<int>(k), painted || !show);
@@ -450,7 +460,8 @@ void MainWindow::showPaintWeights() {
     const bool show = painting() && m_painter.ready() && !w.empty();
     const double base = m_painter.params().baseWeight;
     std::optional<CutPlane> cut;
-    const auto mesh = show ? m_preview.bodyMesh(m_painter.body()) : nullptr;
+    const bool surface = m_painter.surface() >= 0; // a fascia: its vertices alone, nothing inside
+    const auto mesh = show && !surface ? m_preview.bodyMesh(m_painter.body()) : nullptr;
     if (show && mesh && m_paintCut && m_paintCut->isChecked()) {
         // the normal: towards the camera (the section faces the viewer), or an axis
         const int axis = m_paintCutAxis->currentIndex() - 1;
@@ -470,8 +481,9 @@ void MainWindow::showPaintWeights() {
     // with the skeleton shown and no section, the body is drawn translucent around it
     const bool skeleton =
         show && m_paintSkeleton && m_paintSkeleton->isChecked() && !m_painter.skeleton().nodes.empty();
-    showPaintedBody(show ? m_painter.body() : -1, show ? std::function<Eigen::Vector4f(int32_t)>(colour) : nullptr, cut,
-                    skeleton && !cut);
+    showPaintedBody(surface ? render::RenderMesh::Source::Surface : render::RenderMesh::Source::Body,
+                    show ? (surface ? m_painter.surface() : m_painter.body()) : -1,
+                    show ? std::function<Eigen::Vector4f(int32_t)>(colour) : nullptr, cut, skeleton && !cut);
     std::vector<render::RenderMesh> extra;
     if (skeleton) extra.push_back(skeletonMesh(m_painter.skeleton(), 0.0006f, 0));
     if (cut && mesh) extra.push_back(sliceMesh(*mesh, w, base, *cut, 0));
@@ -595,7 +607,7 @@ void MainWindow::showSampleClasses() {
             sampleClassColour(node >= 0 && static_cast<size_t>(node) < classes.size() ? classes[node] : 0);
         return Eigen::Vector4f(c[0], c[1], c[2], c[3]);
     };
-    showPaintedBody(show ? m_samplePainter.body() : -1,
+    showPaintedBody(render::RenderMesh::Source::Body, show ? m_samplePainter.body() : -1,
                     show ? std::function<Eigen::Vector4f(int32_t)>(colour) : nullptr, std::nullopt);
     m_viewport->setAuthoringMeshes({});
     if (!m_sampleLegend) return;
@@ -909,16 +921,31 @@ void MainWindow::selectBody(int index) {
     retargetPainter();
     const bool ok = m_doc.hasProject() && index >= 0 && index < static_cast<int>(m_doc.project().bodies.size());
     m_viewport->setSelectedName(ok ? QString::fromStdString(m_doc.project().bodies[index].scene.name) : QString());
-    // the tree follows
-    m_rebuilding = true;
+    followInTree(kBody, index);
+    scheduleRefresh(false);
+    if (m_previewMode->currentIndex() == 1) submitPreview();
+}
+
+void MainWindow::followInTree(int kind, int index) {
+    m_rebuilding = true; // the tree follows without selecting again
     for (QTreeWidgetItemIterator it(m_tree); *it; ++it)
-        if ((*it)->data(0, kKindRole).toInt() == kBody && (*it)->data(0, kIndexRole).toInt() == index) {
+        if ((*it)->data(0, kKindRole).toInt() == kind && (*it)->data(0, kIndexRole).toInt() == index) {
             m_tree->setCurrentItem(*it);
             break;
         }
     m_rebuilding = false;
+}
+
+void MainWindow::selectSurface(int index) {
+    const bool ok = m_doc.hasProject() && index >= 0 && index < static_cast<int>(m_doc.project().surfaces.size());
+    m_body = -1;
+    m_selKind = ok ? kSurface : kGroup;
+    m_selIndex = ok ? index : -1;
+    m_material->setBody(-1);
+    retargetPainter();
+    m_viewport->setSelectedName(ok ? QString::fromStdString(m_doc.project().surfaces[index].scene.name) : QString());
+    followInTree(kSurface, index);
     scheduleRefresh(false);
-    if (m_previewMode->currentIndex() == 1) submitPreview();
 }
 
 QString MainWindow::treeKey() const {

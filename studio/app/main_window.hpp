@@ -59,6 +59,9 @@ public:
 
     /// Selects the body (tree, material editor, viewport highlight). -1: none.
     void selectBody(int index);
+    /// Selects fascia surface `index` (-1: none), as a click on it in the project tree; the
+    /// stiffness paint tool then paints its vertices.
+    void selectSurface(int index);
     int selectedBody() const { return m_body; }
     /// Sets a property field of the selection as if typed (name as the field's object name,
     /// e.g. "youngs_modulus"). Returns the error shown, empty when accepted.
@@ -140,6 +143,8 @@ private:
     /// The painter's weights as an overlay on the painted body's render meshes (none when off).
     void showPaintWeights();
     void retargetPainter();
+    /// Makes tree item (kind, index) current without acting on the change.
+    void followInTree(int kind, int index);
     SamplePainter m_samplePainter{&m_doc};
     QAction* m_samplesAction = nullptr;
     QLabel *m_sampleStatus = nullptr, *m_sampleLegend = nullptr;
@@ -153,7 +158,8 @@ private:
     void showSampleClasses();
     /// The painted body at rest, alone, with `rgbaOfNode` colouring its render meshes (null: the
     /// paint view is off and every mesh is shown as it is).
-    void showPaintedBody(int body, const std::function<Eigen::Vector4f(int32_t node)>& rgbaOfNode,
+    void showPaintedBody(render::RenderMesh::Source source, int index,
+                         const std::function<Eigen::Vector4f(int32_t node)>& rgbaOfNode,
                          const std::optional<CutPlane>& cut, bool translucent = false);
     MaterialPanel* m_material = nullptr;
     QTreeWidget* m_tree = nullptr;

@@ -27,6 +27,8 @@ std::string structureKey(const Project& p, Preview::Mode mode, int body) {
         b.scene.material = sim::Material{};
         if (b.paint) b.paint->strokes.clear();
     }
+    for (SurfaceProject& sp : q.surfaces)
+        if (sp.paint) sp.paint->strokes.clear();
     return projectJsonText(q) + (mode == Preview::Mode::Specimen ? "#specimen" : "#scene");
 }
 
@@ -167,6 +169,11 @@ std::shared_ptr<const sim::TetMesh> Preview::bodyMesh(int i) const {
     return i >= 0 && i < static_cast<int>(m_bodyMeshes.size()) ? m_bodyMeshes[i] : nullptr;
 }
 
+std::shared_ptr<const sim::TriMesh> Preview::surfaceMesh(int s) const {
+    std::lock_guard lock(m_mutex);
+    return s >= 0 && s < static_cast<int>(m_surfaceMeshes.size()) ? m_surfaceMeshes[s] : nullptr;
+}
+
 std::shared_ptr<const render::SceneView> Preview::sceneView() const {
     std::lock_guard lock(m_mutex);
     return m_view;
@@ -243,15 +250,20 @@ void Preview::run() {
                     next = assembleWorld(b, origin);
                     auto view = std::make_shared<render::SceneView>(render::SceneView::fromWorld(*next));
                     std::vector<std::shared_ptr<const sim::TetMesh>> meshes;
-                    if (job->mode == Mode::Scene)
+                    std::vector<std::shared_ptr<const sim::TriMesh>> surfaceMeshes;
+                    if (job->mode == Mode::Scene) {
                         for (const auto& m : b.meshes)
                             meshes.push_back(std::shared_ptr<const sim::TetMesh>(m->clone()));
+                        for (const sim::TriMesh& m : b.surfaces)
+                            surfaceMeshes.push_back(std::make_shared<const sim::TriMesh>(m));
+                    }
                     built = std::move(b);
                     builtKey = key;
                     {
                         std::lock_guard lock(m_mutex);
                         m_view = std::move(view);
                         m_bodyMeshes = std::move(meshes);
+                        m_surfaceMeshes = std::move(surfaceMeshes);
                         m_snapshot.scene = ++sceneRevision;
                         ++m_revision;
                     }
@@ -261,12 +273,14 @@ void Preview::run() {
                 } else {
                     BuiltScene& b = *built;
                     std::vector<sim::Material> old;
-                    std::vector<std::vector<double>> oldWeights;
+                    std::vector<std::vector<double>> oldWeights, oldSurfaceWeights;
                     auto restore = [&] {
                         for (size_t i = 0; i < old.size(); ++i) {
                             b.scene.bodies[i].material = old[i];
                             b.scene.bodies[i].nodeWeights = oldWeights[i];
                         }
+                        for (size_t s = 0; s < oldSurfaceWeights.size(); ++s)
+                            b.scene.surfaces[s].nodeWeights = oldSurfaceWeights[s];
                     };
                     bool ok = true;
                     QString verdict;
@@ -280,6 +294,12 @@ void Preview::run() {
                                 b.scene.bodies[i].nodeWeights =
                                     bodyNodeWeights(project.bodies[i], *b.meshes[i], b.skeletons[i], origin,
                                                     "bodies[" + std::to_string(i) + "]");
+                        }
+                        for (size_t s = 0; s < b.scene.surfaces.size() && s < project.surfaces.size(); ++s) {
+                            oldSurfaceWeights.push_back(b.scene.surfaces[s].nodeWeights);
+                            if (project.surfaces[s].paint) // painted fascia: its strokes again
+                                b.scene.surfaces[s].nodeWeights = surfaceNodeWeights(
+                                    project.surfaces[s], b.surfaces[s], origin, "surfaces[" + std::to_string(s) + "]");
                         }
                         verdict = stabilityVerdict(b, ok);
                         if (ok) next = assembleWorld(b, origin);

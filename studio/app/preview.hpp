@@ -89,6 +89,9 @@ public:
     /// The built tet mesh of body `i` of the scene shown (rest state; null: none yet). What the
     /// stiffness painter maps its strokes through.
     std::shared_ptr<const sim::TetMesh> bodyMesh(int i) const;
+    /// The cut surface of fascia `s` of the scene shown (rest state; null: none yet). What the
+    /// stiffness painter paints a fascia's vertices on.
+    std::shared_ptr<const sim::TriMesh> surfaceMesh(int s) const;
 
     /// A project holding the specimen of `material` (exposed for tests).
     static Project specimenProject(const Project& source, const sim::Material& material);
@@ -121,7 +124,8 @@ private:
     std::optional<Pending> m_pending;
     Snapshot m_snapshot;
     std::shared_ptr<const render::SceneView> m_view;
-    std::vector<std::shared_ptr<const sim::TetMesh>> m_bodyMeshes; ///< of the scene shown
+    std::vector<std::shared_ptr<const sim::TetMesh>> m_bodyMeshes;    ///< of the scene shown
+    std::vector<std::shared_ptr<const sim::TriMesh>> m_surfaceMeshes; ///< of the scene shown
     std::thread m_thread;
     std::thread m_sampler; ///< error sampling, at a lower priority than the preview
     std::mutex m_sampleMutex;

@@ -40,14 +40,9 @@ void StiffnessPainter::setTarget(int body, std::shared_ptr<const sim::TetMesh> m
         if (m_ready && !m_stroking) recompute();
         return;
     }
-    if (m_stroking) cancel();
+    clearTarget();
     m_body = body;
     m_mesh = std::move(mesh);
-    m_ready = false;
-    m_committed.clear();
-    m_applied.clear();
-    m_live.clear();
-    m_skeleton = {};
     emit readyChanged();
     emit weightsChanged();
     if (body < 0 || !m_mesh || !m_doc->hasProject() || body >= static_cast<int>(m_doc->project().bodies.size())) {
@@ -98,17 +93,81 @@ void StiffnessPainter::setTarget(int body, std::shared_ptr<const sim::TetMesh> m
     }));
 }
 
+void StiffnessPainter::clearTarget() {
+    if (m_stroking) cancel();
+    ++m_generation; // a skeleton still on its way is for another target
+    m_body = m_surface = -1;
+    m_mesh.reset();
+    m_triMesh.reset();
+    m_ready = false;
+    m_committed.clear();
+    m_applied.clear();
+    m_live.clear();
+    m_skeleton = {};
+    m_neighbours = {};
+}
+
+void StiffnessPainter::setSurfaceTarget(int surface, std::shared_ptr<const sim::TriMesh> mesh) {
+    const bool same = surface == m_surface && mesh && m_triMesh && mesh->positions() == m_triMesh->positions() &&
+                      mesh->triangles() == m_triMesh->triangles();
+    if (same) {
+        m_triMesh = std::move(mesh);
+        if (m_ready && !m_stroking) recompute();
+        return;
+    }
+    clearTarget();
+    if (surface < 0 || !mesh || !m_doc->hasProject() || surface >= static_cast<int>(m_doc->project().surfaces.size())) {
+        emit readyChanged();
+        emit weightsChanged();
+        setStatus(surface < 0 ? tr("Select a tet body or a fascia to paint its stiffness.")
+                              : tr("Waiting for the preview to cut the fascia's surface."));
+        return;
+    }
+    m_surface = surface;
+    m_triMesh = std::move(mesh);
+    m_neighbours = sim::nodeNeighbours(*m_triMesh);
+    m_ready = true; // polygon paint: no skeleton to wait for
+    recompute();
+    setStatus(
+        tr("Painting fascia '%1' on its %2 vertices (polygon paint)").arg(targetName()).arg(m_triMesh->vertexCount()));
+    emit readyChanged();
+}
+
+const std::optional<StiffnessPaintProject>* StiffnessPainter::paintOf(const Project& p) const {
+    if (m_surface >= 0 && m_surface < static_cast<int>(p.surfaces.size())) return &p.surfaces[m_surface].paint;
+    if (m_body >= 0 && m_body < static_cast<int>(p.bodies.size())) return &p.bodies[m_body].paint;
+    return nullptr;
+}
+
+QString StiffnessPainter::targetName() const {
+    if (!m_doc->hasProject()) return {};
+    const Project& p = m_doc->project();
+    if (m_surface >= 0 && m_surface < static_cast<int>(p.surfaces.size()))
+        return QString::fromStdString(p.surfaces[m_surface].scene.name);
+    if (m_body >= 0 && m_body < static_cast<int>(p.bodies.size()))
+        return QString::fromStdString(p.bodies[m_body].scene.name);
+    return {};
+}
+
+void StiffnessPainter::applyStroke(const sim::BrushStroke& s, std::vector<double>& w) const {
+    if (m_triMesh)
+        sim::applySurfaceBrushStroke(m_triMesh->positions(), s, m_params, w, nullptr, &m_neighbours);
+    else
+        sim::applyBrushStroke(m_mesh->positions(), m_skeleton, m_map, s, m_params, w, nullptr, &m_neighbours);
+}
+
 void StiffnessPainter::waitUntilReady() {
     if (m_watcher) m_watcher->waitForFinished();
     QCoreApplication::processEvents(); // delivers finished()
 }
 
 void StiffnessPainter::recompute() {
-    if (!m_ready || !m_doc->hasProject() || m_body >= static_cast<int>(m_doc->project().bodies.size())) return;
-    const BodyProject& b = m_doc->project().bodies[m_body];
+    if (!m_ready || !m_doc->hasProject()) return;
+    const std::optional<StiffnessPaintProject>* paint = paintOf(m_doc->project());
+    if (!paint) return;
     // an edit of anything else (a material drag) leaves the weights as they are
-    const std::vector<sim::BrushStroke> strokes = b.paint ? b.paint->strokes : std::vector<sim::BrushStroke>{};
-    const sim::PaintParams params = b.paint ? b.paint->params : sim::PaintParams{};
+    const std::vector<sim::BrushStroke> strokes = *paint ? (*paint)->strokes : std::vector<sim::BrushStroke>{};
+    const sim::PaintParams params = *paint ? (*paint)->params : sim::PaintParams{};
     auto sameStroke = [](const sim::BrushStroke& x, const sim::BrushStroke& y) {
         return x.center == y.center && x.radius == y.radius && x.amplitude == y.amplitude && x.scale == y.scale &&
                x.mode == y.mode && x.target == y.target;
@@ -124,14 +183,12 @@ void StiffnessPainter::recompute() {
     }
     m_applied = strokes;
     m_params = params;
-    m_committed.assign(m_mesh->vertexCount(), m_params.baseWeight);
-    if (b.paint)
-        for (const sim::BrushStroke& s : b.paint->strokes)
-            sim::applyBrushStroke(m_mesh->positions(), m_skeleton, m_map, s, m_params, m_committed, nullptr,
-                                  &m_neighbours);
+    m_committed.assign(m_triMesh ? m_triMesh->vertexCount() : m_mesh->vertexCount(), m_params.baseWeight);
+    for (const sim::BrushStroke& s : strokes)
+        applyStroke(s, m_committed);
     m_live = m_committed;
     for (const sim::BrushStroke& s : m_dabs)
-        sim::applyBrushStroke(m_mesh->positions(), m_skeleton, m_map, s, m_params, m_live, nullptr, &m_neighbours);
+        applyStroke(s, m_live);
     emit weightsChanged();
 }
 
@@ -157,7 +214,7 @@ sim::BrushStroke StiffnessPainter::dabAt(const sim::Vec3& center) const {
 void StiffnessPainter::addDab(const sim::Vec3& center) {
     const sim::BrushStroke s = dabAt(center);
     try {
-        sim::applyBrushStroke(m_mesh->positions(), m_skeleton, m_map, s, m_params, m_live, nullptr, &m_neighbours);
+        applyStroke(s, m_live);
     } catch (const std::exception& e) {
         setStatus(QString::fromStdString(e.what()));
         return;
@@ -194,14 +251,14 @@ QString StiffnessPainter::end() {
     m_dabs.clear();
     if (dabs.empty()) return {};
     static const char* const kModes[] = {"add", "subtract", "mix", "smooth"};
-    const QString name = QString::fromStdString(m_doc->project().bodies[m_body].scene.name);
-    const int body = m_body;
-    const QString why = m_doc->edit(
-        tr("Paint stiffness (%1) on '%2'").arg(kModes[static_cast<int>(dabs.front().mode)], name), [&](Project& p) {
-            BodyProject& b = p.bodies[body];
-            if (!b.paint) b.paint = StiffnessPaintProject{};
-            b.paint->strokes.insert(b.paint->strokes.end(), dabs.begin(), dabs.end());
-        });
+    const QString why =
+        m_doc->edit(tr("Paint stiffness (%1) on '%2'").arg(kModes[static_cast<int>(dabs.front().mode)], targetName()),
+                    [&](Project& p) {
+                        std::optional<StiffnessPaintProject>& paint =
+                            m_surface >= 0 ? p.surfaces[m_surface].paint : p.bodies[m_body].paint;
+                        if (!paint) paint = StiffnessPaintProject{};
+                        paint->strokes.insert(paint->strokes.end(), dabs.begin(), dabs.end());
+                    });
     if (!why.isEmpty()) setStatus(why);
     recompute(); // the committed strokes (or, refused, the weights as they were)
     return why;

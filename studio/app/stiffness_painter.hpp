@@ -9,6 +9,9 @@
 ///     weights for display; end() commits every dab as one undo step, cancel() drops them.
 /// Dab centres are in the mesh (rest) frame, so strokes are carried over by position when the
 /// body is meshed again.
+/// A fascia surface is painted on its vertices directly (polygon paint, [A Fig. 4.11]): no
+/// skeleton, the same strokes through sim::applySurfaceBrushStroke, stored in the surface's
+/// stiffness_paint.
 #include "app/document.hpp"
 #include "sim/skeleton/stiffness_paint.hpp"
 
@@ -37,7 +40,12 @@ public:
     /// Paints body `body` of the document on `mesh` (its built rest mesh). Extracts the skeleton
     /// in the background; ready() once done (readyChanged). Null mesh or -1: no target.
     void setTarget(int body, std::shared_ptr<const sim::TetMesh> mesh);
+    /// Paints fascia `surface` of the document on `mesh` (its cut rest surface); ready at once.
+    void setSurfaceTarget(int surface, std::shared_ptr<const sim::TriMesh> mesh);
+    /// The painted body, or -1 (none, or a surface is painted).
     int body() const { return m_body; }
+    /// The painted fascia surface, or -1.
+    int surface() const { return m_surface; }
     bool ready() const { return m_ready; }
     /// One line: what the painter is doing or why it cannot paint.
     const QString& status() const { return m_status; }
@@ -72,11 +80,18 @@ signals:
 private:
     void recompute();
     void addDab(const sim::Vec3& center);
+    void clearTarget();
+    /// The stroke on `w` through the skeleton (a body) or on the vertices (a surface).
+    void applyStroke(const sim::BrushStroke& s, std::vector<double>& w) const;
+    /// The target's paint in the document (null: none yet).
+    const std::optional<StiffnessPaintProject>* paintOf(const Project& p) const;
+    QString targetName() const;
     void setStatus(const QString& s);
 
     Document* m_doc;
-    int m_body = -1;
+    int m_body = -1, m_surface = -1;
     std::shared_ptr<const sim::TetMesh> m_mesh;
+    std::shared_ptr<const sim::TriMesh> m_triMesh;
     bool m_ready = false;
     QString m_status;
     sim::Skeleton m_skeleton;

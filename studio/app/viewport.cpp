@@ -564,7 +564,7 @@ void Viewport::setPositions(const std::vector<std::vector<Eigen::Vector3d>>& bod
         if (m.source == render::RenderMesh::Source::Surface && m.sourceIndex < surfaces.size())
             src = &surfaces[m.sourceIndex];
         if (!src) continue;
-        if (m.source == render::RenderMesh::Source::Body && static_cast<int>(m.sourceIndex) == m_restBody) continue;
+        if (m.source == m_restSource && static_cast<int>(m.sourceIndex) == m_restBody) continue;
         bool ok = true;
         for (size_t v = 0; v < m.sourceVertex.size() && ok; ++v)
             ok = m.sourceVertex[v] >= 0 && static_cast<size_t>(m.sourceVertex[v]) < src->size() &&
@@ -706,15 +706,16 @@ void Viewport::applyRestPose() {
     auto& meshes = m_view.meshes();
     for (size_t i = 0; i < meshes.size(); ++i) {
         render::RenderMesh& m = meshes[i];
-        if (m.source != render::RenderMesh::Source::Body || static_cast<int>(m.sourceIndex) != m_restBody) continue;
+        if (m.source != m_restSource || static_cast<int>(m.sourceIndex) != m_restBody) continue;
         m.positions = m.rest;
         m_view.recomputeNormals(i);
     }
 }
 
-void Viewport::setRestPose(int body) {
-    if (body == m_restBody) return;
-    m_restBody = body;
+void Viewport::setRestPose(int index, render::RenderMesh::Source source) {
+    if (index == m_restBody && source == m_restSource) return;
+    m_restBody = index;
+    m_restSource = source;
     applyRestPose(); // back to simulated positions with the preview's next frame
     viewChanged();
 }

@@ -96,9 +96,9 @@ public:
     void setMeshTranslucent(int mesh, bool translucent);
     /// Face mask of mesh `mesh` (empty: every face), as render::SceneView::setFaceMask.
     void setFaceMask(int mesh, const std::vector<uint8_t>& mask);
-    /// Draws body `body` at its rest positions (the preview's positions are not applied to it);
-    /// -1: every body as simulated.
-    void setRestPose(int body);
+    /// Draws body (or, `source` Surface, fascia) `index` at its rest positions (the preview's
+    /// positions are not applied to it); -1: everything as simulated.
+    void setRestPose(int index, render::RenderMesh::Source source = render::RenderMesh::Source::Body);
     /// Static meshes drawn after the scene's (the paint tool's skeleton and section); not hit.
     void setAuthoringMeshes(std::vector<render::RenderMesh> meshes);
     size_t authoringMeshCount() const { return m_authoring.size(); }
@@ -172,7 +172,8 @@ private:
     bool m_dragged = false;
     bool m_framed = false;
     bool m_paintMode = false, m_painting = false;
-    int m_restBody = -1;
+    int m_restBody = -1; ///< the mesh drawn at rest: its source index and kind
+    render::RenderMesh::Source m_restSource = render::RenderMesh::Source::Body;
     enum class Adjust { None, Radius, Strength } m_adjust = Adjust::None;
     QPoint m_adjustFrom;
     std::vector<render::RenderMesh> m_authoring;

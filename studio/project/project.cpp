@@ -266,8 +266,12 @@ json sutureProjectJson(const sim::SutureSceneDesc& d, const TrajectorySource& so
     return j;
 }
 
-StiffnessPaintProject readPaint(const JsonField& j) {
-    j.object({"skeleton", "base_weight", "min_weight", "max_weight", "strokes"});
+/// "stiffness_paint" of a body (skeleton: true) or of a fascia surface (polygon paint, no skeleton).
+StiffnessPaintProject readPaint(const JsonField& j, bool skeleton) {
+    if (skeleton)
+        j.object({"skeleton", "base_weight", "min_weight", "max_weight", "strokes"});
+    else
+        j.object({"base_weight", "min_weight", "max_weight", "strokes"});
     StiffnessPaintProject p;
     if (auto sk = j.find("skeleton")) {
         sk->object({"min_edge_length_rel", "medially_centered", "max_iterations"});
@@ -317,7 +321,7 @@ StiffnessPaintProject readPaint(const JsonField& j) {
     return p;
 }
 
-json paintJson(const StiffnessPaintProject& p) {
+json paintJson(const StiffnessPaintProject& p, bool skeleton) {
     json strokes = json::array();
     for (const sim::BrushStroke& s : p.strokes) {
         json j = {{"center", vec3Json(s.center)},
@@ -331,14 +335,15 @@ json paintJson(const StiffnessPaintProject& p) {
         if (s.mode == sim::BrushMode::Mix) j["target"] = s.target;
         strokes.push_back(std::move(j));
     }
-    return {{"skeleton",
-             {{"min_edge_length_rel", p.skeleton.minEdgeLengthRel},
-              {"medially_centered", p.skeleton.mediallyCentered},
-              {"max_iterations", p.skeleton.maxIterations}}},
-            {"base_weight", p.params.baseWeight},
-            {"min_weight", p.params.minWeight},
-            {"max_weight", p.params.maxWeight},
-            {"strokes", strokes}};
+    json out = {{"base_weight", p.params.baseWeight},
+                {"min_weight", p.params.minWeight},
+                {"max_weight", p.params.maxWeight},
+                {"strokes", strokes}};
+    if (skeleton)
+        out["skeleton"] = {{"min_edge_length_rel", p.skeleton.minEdgeLengthRel},
+                           {"medially_centered", p.skeleton.mediallyCentered},
+                           {"max_iterations", p.skeleton.maxIterations}};
+    return out;
 }
 
 /// "light_samples": the body's light-sample painting [A §6.3.2], operations replayed in order on
@@ -462,7 +467,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
                 body.stiffnessRegions.push_back(
                     {r["min"].vec3(), r["max"].vec3(), r["weight"].number(NumberRule::positive())});
             }
-        if (auto sp = b.find("stiffness_paint")) body.paint = readPaint(*sp);
+        if (auto sp = b.find("stiffness_paint")) body.paint = readPaint(*sp, true);
         if (auto ls = b.find("light_samples")) body.lightSamples = readLightSamples(*ls);
         if (auto fx = b.find("fixed")) body.fixedBox = readBox(*fx);
         p.bodies.push_back(std::move(body));
@@ -470,7 +475,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     if (auto surfaces = root.find("surfaces"))
         for (const JsonField& sj : surfaces->items()) {
             sj.object({"name", "areal_density", "stretch_stiffness", "attach_distance", "attach_compliance",
-                       "from_boundary_of", "region"});
+                       "from_boundary_of", "region", "stiffness_paint"});
             SurfaceProject sp;
             sim::readSurfaceCommon(sj, sp.scene, names);
             const JsonField from = sj["from_boundary_of"];
@@ -480,6 +485,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
                 found |= b.scene.name == sp.scene.attachTo;
             if (!found) from.fail("'" + sp.scene.attachTo + "' is not a body");
             if (auto r = sj.find("region")) sp.region = readBox(*r);
+            if (auto pt = sj.find("stiffness_paint")) sp.paint = readPaint(*pt, false);
             p.surfaces.push_back(std::move(sp));
         }
     if (auto in = root.find("interaction")) scene.interaction = readInteractionProject(*in, dir, p.trackFiles);
@@ -519,7 +525,7 @@ std::string projectJsonText(const Project& p) {
                 regions.push_back({{"min", vec3Json(r.min)}, {"max", vec3Json(r.max)}, {"weight", r.weight}});
             j["stiffness_regions"] = regions;
         }
-        if (b.paint) j["stiffness_paint"] = paintJson(*b.paint);
+        if (b.paint) j["stiffness_paint"] = paintJson(*b.paint, true);
         if (!b.lightSamples.empty()) j["light_samples"] = lightSamplesJson(b.lightSamples);
         doc["bodies"].push_back(j);
     }
@@ -529,6 +535,7 @@ std::string projectJsonText(const Project& p) {
             json j = {{"from_boundary_of", s.scene.attachTo}};
             sim::writeSurfaceCommon(s.scene, j);
             if (s.region) j["region"] = boxJson(*s.region);
+            if (s.paint) j["stiffness_paint"] = paintJson(*s.paint, false);
             doc["surfaces"].push_back(j);
         }
     }
@@ -685,6 +692,16 @@ std::vector<double> bodyNodeWeights(const BodyProject& b, sim::TetMesh& mesh, st
     return w;
 }
 
+std::vector<double> surfaceNodeWeights(const SurfaceProject& s, const sim::TriMesh& mesh, const std::string& origin,
+                                       const std::string& field) {
+    if (!s.paint) return {};
+    try {
+        return sim::bakeSurfacePaint(mesh, s.paint->strokes, s.paint->params);
+    } catch (const std::invalid_argument& e) {
+        throw InputError(origin + ": " + field + ".stiffness_paint: " + e.what());
+    }
+}
+
 namespace {
 
 BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
@@ -770,6 +787,11 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
         sim::SurfaceDesc sd = sp.scene;
         sd.meshPath = "meshes/" + sd.name + ".vtri";
         files.emplace_back(sd.meshPath, sim::formatVtri(tri));
+        if (sp.paint) {
+            sd.nodeWeights = surfaceNodeWeights(sp, tri, origin, "surfaces[" + std::to_string(s) + "]");
+            sd.nodeWeightsPath = "meshes/" + sd.name + ".vweights";
+            files.emplace_back(sd.nodeWeightsPath, sim::formatNodeWeights(sd.nodeWeights));
+        }
         scene.surfaces.push_back(std::move(sd));
         surfaces.push_back(std::move(tri));
     }

@@ -34,7 +34,9 @@
 ///     "embedded_in": "organ", "embedding_compliance": 0
 ///   }],
 ///   "surfaces": [{"name": "fascia", "from_boundary_of": "organ", "region": {"min": .., "max": ..},
-///                 "areal_density": 0.1, "stretch_stiffness": 50, "attach_distance": 0.001}],
+///                 "areal_density": 0.1, "stretch_stiffness": 50, "attach_distance": 0.001,
+///                 "stiffness_paint": {"base_weight": 1, ..., "strokes": [..]}}],   optional: polygon
+///                 paint on the fascia's vertices (no skeleton), exported as meshes/<surface>.vweights
 ///   "accuracy": {"every_frames": 60, "max_iterations": 100},
 ///   "suture": {...the scene's suture section (core/sim/suture/suture_scene.hpp), with
 ///              "trajectory": {"generator": "anastomosis", "stitches": 5, ...AnastomosisSpec fields}
@@ -94,7 +96,9 @@ struct StiffnessRegion {
 };
 
 /// Skeleton stiffness painting [A §4.3.5]: the body's curve skeleton (mean curvature flow) maps
-/// every node to skeleton nodes; poly6 brush strokes on the skeleton set per-node weights.
+/// every node to skeleton nodes; poly6 brush strokes on the skeleton set per-node weights. On a
+/// fascia surface the same strokes select its vertices directly (polygon paint, Fig. 4.11) and
+/// `skeleton` is not used.
 struct StiffnessPaintProject {
     bake::SkeletonParams skeleton;
     sim::PaintParams params;
@@ -121,6 +125,9 @@ struct BodyProject {
 struct SurfaceProject {
     sim::SurfaceDesc scene;
     std::optional<std::array<sim::Vec3, 2>> region;
+    /// Polygon stiffness paint on the layer's vertices at rest (sim::bakeSurfacePaint); exported as
+    /// meshes/<surface>.vweights. By position, so it survives the body being meshed again.
+    std::optional<StiffnessPaintProject> paint;
 };
 
 /// Where the suture's needle trajectory comes from ("suture.trajectory" of project.json): the
@@ -224,6 +231,11 @@ struct BuiltScene {
 /// `origin`, `field` and the rule.
 std::vector<double> bodyNodeWeights(const BodyProject& b, sim::TetMesh& mesh, std::optional<sim::Skeleton>& skeleton,
                                     const std::string& origin, const std::string& field);
+
+/// The vertex weights of fascia `s` on its cut surface `mesh` (polygon paint; empty: no paint).
+/// Throws viscera::InputError naming `origin`, `field` and the rule.
+std::vector<double> surfaceNodeWeights(const SurfaceProject& s, const sim::TriMesh& mesh, const std::string& origin,
+                                       const std::string& field);
 
 /// True when the scene's "render" block asks for painted light sampling (the sample maps are
 /// then packaged and used).

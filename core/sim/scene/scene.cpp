@@ -187,6 +187,29 @@ void checkSceneReferences(const std::vector<const BodyDesc*>& bodies, const std:
     if (interaction) checkInteractionNames(*interaction, bodyNames, surfaceNames, origin);
 }
 
+namespace {
+
+/// "node_weights" (inline, one positive number per node) or "node_weights_file" (a .vweights
+/// entry of the case), for bodies and surfaces alike.
+void readNodeWeightFields(const JsonField& j, std::vector<double>& weights, std::string& path) {
+    if (auto w = j.find("node_weights"))
+        for (const JsonField& x : w->items())
+            weights.push_back(x.number(NumberRule::positive()));
+    if (auto f = j.find("node_weights_file")) {
+        if (j.has("node_weights")) f->fail("give node_weights or node_weights_file, not both");
+        path = f->entryPath();
+    }
+}
+
+void writeNodeWeightFields(const std::vector<double>& weights, const std::string& path, json& j) {
+    if (!path.empty())
+        j["node_weights_file"] = path;
+    else if (!weights.empty())
+        j["node_weights"] = weights;
+}
+
+} // namespace
+
 SceneDesc parseScene(std::string_view text, const std::string& origin) {
     const json doc = parseJsonText(text, origin);
     const JsonField root(doc, "", origin);
@@ -207,20 +230,14 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
         readBodyCommon(b, body, names);
         body.meshPath = b["mesh"].entryPath();
         if (auto f = b.find("fixed_nodes")) body.fixedNodes = f->indices();
-        if (auto w = b.find("node_weights"))
-            for (const JsonField& x : w->items())
-                body.nodeWeights.push_back(x.number(NumberRule::positive()));
-        if (auto f = b.find("node_weights_file")) {
-            if (b.has("node_weights")) f->fail("give node_weights or node_weights_file, not both");
-            body.nodeWeightsPath = f->entryPath();
-        }
+        readNodeWeightFields(b, body.nodeWeights, body.nodeWeightsPath);
         if (auto f = b.find("sample_map_file")) body.sampleMapPath = f->entryPath();
         scene.bodies.push_back(std::move(body));
     }
     if (auto surfaces = root.find("surfaces"))
         for (const JsonField& sj : surfaces->items()) {
             sj.object({"name", "mesh", "areal_density", "stretch_stiffness", "attach_to", "attach_distance",
-                       "attach_compliance", "fixed_nodes"});
+                       "attach_compliance", "fixed_nodes", "node_weights", "node_weights_file"});
             SurfaceDesc sd;
             readSurfaceCommon(sj, sd, names);
             sd.meshPath = sj["mesh"].entryPath();
@@ -232,6 +249,7 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
                 if (!found) a->fail("'" + sd.attachTo + "' is not a body of the scene");
             }
             if (auto f = sj.find("fixed_nodes")) sd.fixedNodes = f->indices();
+            readNodeWeightFields(sj, sd.nodeWeights, sd.nodeWeightsPath);
             scene.surfaces.push_back(std::move(sd));
         }
     if (auto t = root.find("tools")) scene.tools = readTools(*t, names);
@@ -258,10 +276,7 @@ json sceneJson(const SceneDesc& scene) {
     for (const BodyDesc& b : scene.bodies) {
         json j = {{"mesh", b.meshPath}, {"fixed_nodes", b.fixedNodes}};
         writeBodyCommon(b, j);
-        if (!b.nodeWeightsPath.empty())
-            j["node_weights_file"] = b.nodeWeightsPath;
-        else if (!b.nodeWeights.empty())
-            j["node_weights"] = b.nodeWeights;
+        writeNodeWeightFields(b.nodeWeights, b.nodeWeightsPath, j);
         if (!b.sampleMapPath.empty()) j["sample_map_file"] = b.sampleMapPath;
         doc["bodies"].push_back(j);
     }
@@ -271,6 +286,7 @@ json sceneJson(const SceneDesc& scene) {
             json j = {{"mesh", sd.meshPath}, {"fixed_nodes", sd.fixedNodes}};
             writeSurfaceCommon(sd, j);
             if (!sd.attachTo.empty()) j["attach_to"] = sd.attachTo;
+            writeNodeWeightFields(sd.nodeWeights, sd.nodeWeightsPath, j);
             doc["surfaces"].push_back(j);
         }
     }

@@ -21,7 +21,9 @@
 ///               "embedded_in": "fat", "embedding_compliance": 0}],   optional
 ///   "surfaces": [{"name": "fascia", "mesh": "meshes/fascia.vtri", "areal_density": 0.1,
 ///                 "stretch_stiffness": 50, "attach_to": "organ", "attach_distance": 0.001,
-///                 "attach_compliance": 0, "fixed_nodes": []}],
+///                 "attach_compliance": 0, "fixed_nodes": [],
+///                 "node_weights_file": "meshes/fascia.vweights"}],   optional (or "node_weights"):
+///                                  painted stiffness, one weight per vertex
 ///   "tools": [{"name": "probe", "shape": "sphere", ...see tool_probe.hpp...}]   optional
 ///   "interaction": {...see scene/interaction.hpp...}   optional, xpbd: instruments on recorded
 ///              tracks (grasper, energy hook, clip applier) and the tissues the hook can cut
@@ -71,6 +73,12 @@ struct SurfaceDesc {
     double attachDistance = 1e-3;   ///< m
     double attachCompliance = 0;    ///< m/N
     std::vector<int32_t> fixedNodes;
+    /// Stiffness painted on the layer's triangles (polygon paint [A §4.3.5, Fig. 4.11]): empty
+    /// (all 1) or one weight per vertex, "node_weights"; or "node_weights_file", a .vweights entry
+    /// of the case that whoever reads the case loads into nodeWeights. A triangle's stiffness is
+    /// stretchStiffness × the mean of its vertices' weights.
+    std::vector<double> nodeWeights;
+    std::string nodeWeightsPath;
 };
 
 struct AccuracySampling {

@@ -51,6 +51,7 @@ XpbdSystemDesc describe(const SceneSolverInputs& in) {
         sb.mesh = &in.surfaces[s];
         sb.arealDensity = sd.arealDensity;
         sb.stretchStiffness = sd.stretchStiffness;
+        sb.nodeWeights = sd.nodeWeights;
         sb.fixedNodes = sd.fixedNodes;
         desc.surfaces.push_back(std::move(sb));
         if (!sd.attachTo.empty()) {

@@ -75,31 +75,13 @@ void validateStroke(const BrushStroke& s, size_t index, const std::string& origi
         throw std::invalid_argument(p + "amplitude × kernel at the centre is not finite");
 }
 
-void applyBrushStroke(const std::vector<Vec3>& positions, const Skeleton& skeleton, const SkeletonNodeMap& map,
+namespace {
+
+/// The stroke on the nodes of `selected` (sorted, unique): the mode's change, then the clamp.
+/// Commits only when every value is finite.
+void applyToSelection(const std::vector<Vec3>& positions, const std::vector<int32_t>& selected,
                       const BrushStroke& stroke, const PaintParams& params, std::vector<double>& weights,
-                      StiffnessPaintReport* report, const NodeNeighbours* neighbours) {
-    validateParams(params);
-    const size_t index = report ? report->strokeSelected.size() : 0;
-    validateStroke(stroke, index, params.origin);
-    const size_t n = positions.size();
-    if (weights.size() != n || map.meshNodeCount != n || map.skeletonNodeCount() != skeleton.nodes.size())
-        throw std::invalid_argument(params.origin + ": stroke " + std::to_string(index) + ": " +
-                                    std::to_string(weights.size()) + " weights, " + std::to_string(n) +
-                                    " positions, a map of " + std::to_string(map.meshNodeCount) +
-                                    " nodes: sizes must agree (and the map must come from this skeleton)");
-    if (stroke.mode == BrushMode::Smooth && (!neighbours || neighbours->nodeCount() != n))
-        throw std::invalid_argument(params.origin + ": stroke " + std::to_string(index) +
-                                    ": smoothing needs the neighbours of the mesh's " + std::to_string(n) + " nodes");
-
-    // Selection through the skeleton: skeleton nodes strictly inside the brush select their Π_j.
-    std::vector<int32_t> selected;
-    for (size_t j = 0; j < skeleton.nodes.size(); ++j)
-        if ((skeleton.nodes[j] - stroke.center).norm() < stroke.radius)
-            selected.insert(selected.end(), map.members.begin() + map.start[j], map.members.begin() + map.start[j + 1]);
-    std::sort(selected.begin(), selected.end());
-    selected.erase(std::unique(selected.begin(), selected.end()), selected.end());
-
-    // Compute first, commit only when every value is finite.
+                      StiffnessPaintReport* report, const NodeNeighbours* neighbours, size_t index) {
     std::vector<double> next(selected.size());
     size_t changed = 0, low = 0, high = 0;
     for (size_t k = 0; k < selected.size(); ++k) {
@@ -143,17 +125,31 @@ void applyBrushStroke(const std::vector<Vec3>& positions, const Skeleton& skelet
     }
 }
 
-NodeNeighbours nodeNeighbours(const TetMesh& mesh) {
-    // the six edges of every tet, each pair once
+/// The checks both kinds of stroke share; returns the stroke's index for messages.
+size_t checkStroke(size_t n, const BrushStroke& stroke, const PaintParams& params, const std::vector<double>& weights,
+                   const StiffnessPaintReport* report, const NodeNeighbours* neighbours) {
+    validateParams(params);
+    const size_t index = report ? report->strokeSelected.size() : 0;
+    validateStroke(stroke, index, params.origin);
+    if (weights.size() != n)
+        throw std::invalid_argument(params.origin + ": stroke " + std::to_string(index) + ": " +
+                                    std::to_string(weights.size()) + " weights for " + std::to_string(n) +
+                                    " positions: sizes must agree");
+    if (stroke.mode == BrushMode::Smooth && (!neighbours || neighbours->nodeCount() != n))
+        throw std::invalid_argument(params.origin + ": stroke " + std::to_string(index) +
+                                    ": smoothing needs the neighbours of the mesh's " + std::to_string(n) + " nodes");
+    return index;
+}
+
+/// Neighbours from elements of N nodes each: every pair of nodes of an element.
+template <class Elements> NodeNeighbours neighboursOf(const Elements& elements, size_t n) {
     std::vector<std::pair<int32_t, int32_t>> pairs;
-    pairs.reserve(mesh.tetCount() * 12);
-    for (const Tet& t : mesh.tets())
-        for (int a = 0; a < 4; ++a)
-            for (int b = 0; b < 4; ++b)
+    for (const auto& t : elements)
+        for (size_t a = 0; a < t.size(); ++a)
+            for (size_t b = 0; b < t.size(); ++b)
                 if (a != b) pairs.emplace_back(t[a], t[b]);
     std::sort(pairs.begin(), pairs.end());
     pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-    const size_t n = mesh.vertexCount();
     NodeNeighbours nb;
     nb.start.assign(n + 1, 0);
     for (const auto& [a, b] : pairs)
@@ -164,6 +160,66 @@ NodeNeighbours nodeNeighbours(const TetMesh& mesh) {
     for (const auto& pr : pairs)
         nb.members.push_back(pr.second); // sorted by first: node order
     return nb;
+}
+
+} // namespace
+
+void applyBrushStroke(const std::vector<Vec3>& positions, const Skeleton& skeleton, const SkeletonNodeMap& map,
+                      const BrushStroke& stroke, const PaintParams& params, std::vector<double>& weights,
+                      StiffnessPaintReport* report, const NodeNeighbours* neighbours) {
+    const size_t index = checkStroke(positions.size(), stroke, params, weights, report, neighbours);
+    if (map.meshNodeCount != positions.size() || map.skeletonNodeCount() != skeleton.nodes.size())
+        throw std::invalid_argument(params.origin + ": stroke " + std::to_string(index) + ": a map of " +
+                                    std::to_string(map.meshNodeCount) + " nodes for " +
+                                    std::to_string(positions.size()) +
+                                    " positions: sizes must agree (and the map must come from this skeleton)");
+    // Selection through the skeleton: skeleton nodes strictly inside the brush select their Π_j.
+    std::vector<int32_t> selected;
+    for (size_t j = 0; j < skeleton.nodes.size(); ++j)
+        if ((skeleton.nodes[j] - stroke.center).norm() < stroke.radius)
+            selected.insert(selected.end(), map.members.begin() + map.start[j], map.members.begin() + map.start[j + 1]);
+    std::sort(selected.begin(), selected.end());
+    selected.erase(std::unique(selected.begin(), selected.end()), selected.end());
+    applyToSelection(positions, selected, stroke, params, weights, report, neighbours, index);
+}
+
+void applySurfaceBrushStroke(const std::vector<Vec3>& positions, const BrushStroke& stroke, const PaintParams& params,
+                             std::vector<double>& weights, StiffnessPaintReport* report,
+                             const NodeNeighbours* neighbours) {
+    const size_t index = checkStroke(positions.size(), stroke, params, weights, report, neighbours);
+    std::vector<int32_t> selected; // polygon paint: the vertices strictly inside the brush
+    for (size_t i = 0; i < positions.size(); ++i)
+        if ((positions[i] - stroke.center).norm() < stroke.radius) selected.push_back(static_cast<int32_t>(i));
+    applyToSelection(positions, selected, stroke, params, weights, report, neighbours, index);
+}
+
+NodeNeighbours nodeNeighbours(const TriMesh& mesh) {
+    return neighboursOf(mesh.triangles(), mesh.vertexCount());
+}
+
+std::vector<double> bakeSurfacePaint(const TriMesh& mesh, const std::vector<BrushStroke>& strokes,
+                                     const PaintParams& params, StiffnessPaintReport* report) {
+    validateParams(params);
+    for (size_t k = 0; k < strokes.size(); ++k)
+        validateStroke(strokes[k], k, params.origin);
+    std::vector<double> w(mesh.vertexCount(), params.baseWeight);
+    const bool smooth =
+        std::any_of(strokes.begin(), strokes.end(), [](const BrushStroke& s) { return s.mode == BrushMode::Smooth; });
+    const NodeNeighbours nb = smooth ? nodeNeighbours(mesh) : NodeNeighbours{};
+    StiffnessPaintReport local;
+    StiffnessPaintReport& r = report ? *report : local;
+    for (const BrushStroke& s : strokes)
+        applySurfaceBrushStroke(mesh.positions(), s, params, w, &r, smooth ? &nb : nullptr);
+    if (!w.empty()) {
+        const auto [lo, hi] = std::minmax_element(w.begin(), w.end());
+        r.minWeight = *lo;
+        r.maxWeight = *hi;
+    }
+    return w;
+}
+
+NodeNeighbours nodeNeighbours(const TetMesh& mesh) {
+    return neighboursOf(mesh.tets(), mesh.vertexCount());
 }
 
 StiffnessPaintResult bakeStiffnessPaint(const TetMesh& mesh, const Skeleton& skeleton,

@@ -10,6 +10,7 @@
 ///     W_poly6(v, h) = 315/(64π h⁹)·(h² − v²)³  for 0 <= v < h,   0 for v >= h,
 /// which is >= 0, maximal at v = 0 (315/(64π h³)) and integrates to 1 over the ball of radius h.
 /// Softening is expressed by a negative stroke amplitude instead.
+#include "sim/mesh/tri_mesh.hpp"
 #include "sim/skeleton/skeleton.hpp"
 
 #include <string>
@@ -62,6 +63,8 @@ struct NodeNeighbours {
 };
 /// From the tets' edges. O(#T log #T).
 NodeNeighbours nodeNeighbours(const TetMesh& mesh);
+/// From the triangles' edges (a fascia's polygon paint).
+NodeNeighbours nodeNeighbours(const TriMesh& mesh);
 
 struct PaintParams {
     double baseWeight = 1.0; ///< W before the first stroke, > 0
@@ -102,6 +105,20 @@ void validateStroke(const BrushStroke& stroke, size_t index, const std::string& 
 void applyBrushStroke(const std::vector<Vec3>& positions, const Skeleton& skeleton, const SkeletonNodeMap& map,
                       const BrushStroke& stroke, const PaintParams& params, std::vector<double>& weights,
                       StiffnessPaintReport* report = nullptr, const NodeNeighbours* neighbours = nullptr);
+
+/// Polygon paint of a triangle surface (fascia) [A §4.3.5, Fig. 4.11]: the same stroke on the
+/// vertices directly, no skeleton. The selected vertices are those strictly inside the brush
+/// sphere (|x_i − c| < h); each changes by the stroke's mode with k = kernel(|x_i − c|, h), then is
+/// clamped. `positions` are the surface's rest positions, `neighbours` (nodeNeighbours of the
+/// triangles) is needed by Smooth only. Throws as applyBrushStroke.
+void applySurfaceBrushStroke(const std::vector<Vec3>& positions, const BrushStroke& stroke, const PaintParams& params,
+                             std::vector<double>& weights, StiffnessPaintReport* report = nullptr,
+                             const NodeNeighbours* neighbours = nullptr);
+
+/// `strokes` in order on W = baseWeight, one weight per vertex of `mesh` (SurfaceDesc::nodeWeights).
+/// Throws std::invalid_argument naming the stroke/field on bad input.
+std::vector<double> bakeSurfacePaint(const TriMesh& mesh, const std::vector<BrushStroke>& strokes,
+                                     const PaintParams& params = {}, StiffnessPaintReport* report = nullptr);
 
 /// Maps every node of `mesh` to the skeleton (mapNodesToSkeleton) and applies `strokes` in order to
 /// W = baseWeight. Throws std::invalid_argument naming the stroke/field on bad input.

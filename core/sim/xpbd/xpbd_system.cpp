@@ -32,6 +32,17 @@ void checkFixed(const std::vector<int32_t>& fixed, size_t nv, const std::string&
                  "fixed node " + std::to_string(f) + " is out of range (mesh has " + std::to_string(nv) + " vertices)");
 }
 
+/// Empty (all 1) or one weight per vertex, each positive and finite (it divides compliances).
+void checkNodeWeights(const std::vector<double>& w, size_t nv, const std::string& label, const Failer& fail) {
+    if (w.empty()) return;
+    if (w.size() != nv)
+        fail(label, "node weights: " + std::to_string(w.size()) + " given for " + std::to_string(nv) + " vertices");
+    for (size_t i = 0; i < nv; ++i)
+        if (!std::isfinite(w[i]) || w[i] <= 0)
+            fail(label,
+                 "node weight " + std::to_string(i) + " is " + formatNumber(w[i]) + " (must be positive and finite)");
+}
+
 void checkLimits(const std::vector<StrainLimit>& limits, int dim, const std::vector<int32_t>& elems, size_t count,
                  const char* elemName, const std::string& label, const Failer& fail) {
     if (limits.empty()) fail(label, "strain limits: no limit given");
@@ -110,15 +121,7 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
                                 " (must be finite and >= 0)");
         if (!std::isfinite(d.density) || d.density <= 0) fail(label, "density must be positive and finite");
         const size_t nv = mesh.vertexCount();
-        if (!d.nodeWeights.empty()) {
-            if (d.nodeWeights.size() != nv)
-                fail(label, "node weights: " + std::to_string(d.nodeWeights.size()) + " given for " +
-                                std::to_string(nv) + " vertices");
-            for (size_t i = 0; i < nv; ++i)
-                if (!std::isfinite(d.nodeWeights[i]) || d.nodeWeights[i] <= 0)
-                    fail(label, "node weight " + std::to_string(i) + " is " + formatNumber(d.nodeWeights[i]) +
-                                    " (must be positive and finite)");
-        }
+        checkNodeWeights(d.nodeWeights, nv, label, fail);
         const auto& x = mesh.positions();
         detail::ElasticTets et;
         et.model = d.model;
@@ -241,8 +244,9 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
         for (size_t i = 0; i < d.uv.size(); ++i)
             if (!d.uv[i].allFinite()) fail(label, "uv " + std::to_string(i) + " is not finite");
         checkFixed(d.fixedNodes, nv, label, fail);
+        checkNodeWeights(d.nodeWeights, nv, label, fail);
         const int32_t off = surfFirst[s];
-        std::vector<double> mass(nv, 0.0), area(mesh.triangleCount());
+        std::vector<double> mass(nv, 0.0), area(mesh.triangleCount()), stiffness(mesh.triangleCount());
         std::vector<Tri> tris;
         std::vector<Mat2> restInv;
         for (size_t t = 0; t < mesh.triangleCount(); ++t) {
@@ -254,6 +258,10 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
                      "triangle " + std::to_string(t) + " is degenerate (area " + formatNumber(area[t]) + " m^2)");
             tris.push_back({e[0] + off, e[1] + off, e[2] + off});
             restInv.push_back(M);
+            // painted fascia: a triangle's stiffness is k times the mean of its vertices' weights
+            stiffness[t] =
+                d.stretchStiffness *
+                (d.nodeWeights.empty() ? 1.0 : (d.nodeWeights[e[0]] + d.nodeWeights[e[1]] + d.nodeWeights[e[2]]) / 3.0);
             for (int k = 0; k < 3; ++k)
                 mass[e[k]] += d.arealDensity * area[t] / 3.0;
         }
@@ -278,7 +286,7 @@ std::unique_ptr<XpbdSystem> XpbdSystem::build(const XpbdSystemDesc& desc, const 
         sys->m_surf.push_back(std::move(r));
         eng.addParticles(x, mass, fixed);
         if (d.stretchStiffness > 0)
-            eng.blocks.push_back(detail::makeMembraneBlock(tris, restInv, area, d.stretchStiffness, settings.simd));
+            eng.blocks.push_back(detail::makeMembraneBlock(tris, restInv, area, stiffness, settings.simd));
         if (d.strainLimits) {
             const TriStrainLimits& sl = *d.strainLimits;
             if (d.uv.empty()) fail(label, "strain limits need per-vertex uv coordinates");

@@ -64,6 +64,9 @@ struct SurfaceBodyDesc {
     double arealDensity = 0.1;      ///< kg/m^2 (e.g. 1000 kg/m^3 × 0.1 mm)
     double stretchStiffness = 50.0; ///< membrane k, N/m (≈ Young's modulus × thickness); 0 = none
     std::vector<int32_t> fixedNodes;
+    /// Empty (all 1) or one stiffness weight per vertex (> 0), painted on the layer's triangles
+    /// [A §4.3.5, Fig. 4.11]; a triangle's k is stretchStiffness × the mean of its three weights.
+    std::vector<double> nodeWeights;
     std::optional<TriStrainLimits> strainLimits;
 };
 

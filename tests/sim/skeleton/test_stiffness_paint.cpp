@@ -403,3 +403,72 @@ TEST(StiffnessPaint, BadMixAndSmoothStrokesAreRefusedAndChangeNothing) {
     }
     EXPECT_EQ(w, w0);
 }
+
+// Polygon paint of a fascia [A Fig. 4.11]: strokes on the surface's vertices directly.
+TEST(SurfacePaint, StrokesChangeTheVerticesInsideTheBrushByEq428AndItsModes) {
+    const TriMesh tube = makeTubeSurface(Vec3(0, 0, 0), Vec3(0.1, 0, 0), 0.012, 24, 30);
+    const auto& x = tube.positions();
+    const BrushStroke add{Vec3(0.03, 0.012, 0.0), 0.02, 2.0, BrushScale::Peak};
+    const BrushStroke soften{Vec3(0.07, -0.012, 0.0), 0.015, 0.5, BrushScale::Peak, BrushMode::Subtract};
+    const BrushStroke mix{Vec3(0.05, 0.0, 0.012), 0.025, 0.7, BrushScale::Peak, BrushMode::Mix, 3.0};
+    const BrushStroke smooth{Vec3(0.04, 0.0, 0.0), 0.03, 0.5, BrushScale::Peak, BrushMode::Smooth};
+    StiffnessPaintReport report;
+    const std::vector<double> w = bakeSurfacePaint(tube, {add, soften, mix, smooth}, {}, &report);
+    ASSERT_EQ(w.size(), x.size());
+
+    // independent evaluation in long double, stroke after stroke
+    std::vector<std::set<int32_t>> nb(x.size());
+    for (const Tri& t : tube.triangles())
+        for (int a = 0; a < 3; ++a)
+            for (int c = 0; c < 3; ++c)
+                if (a != c) nb[t[a]].insert(t[c]);
+    std::vector<long double> ref(x.size(), 1.0L);
+    size_t k = 0;
+    for (const BrushStroke& s : {add, soften, mix, smooth}) {
+        const std::vector<long double> before = ref;
+        size_t selected = 0;
+        for (size_t i = 0; i < x.size(); ++i) {
+            const long double v = (x[i] - s.center).norm();
+            if (v >= s.radius) continue;
+            ++selected;
+            const long double f = peakFactor(v, s.radius);
+            if (s.mode == BrushMode::Add) ref[i] += s.amplitude * f;
+            if (s.mode == BrushMode::Subtract) ref[i] -= s.amplitude * f;
+            if (s.mode == BrushMode::Mix) ref[i] += std::min(1.0L, s.amplitude * f) * (s.target - before[i]);
+            if (s.mode == BrushMode::Smooth) {
+                long double mean = 0;
+                for (int32_t q : nb[i])
+                    mean += before[q];
+                mean /= nb[i].size();
+                ref[i] += std::min(1.0L, s.amplitude * f) * (mean - before[i]);
+            }
+        }
+        EXPECT_GT(selected, 5u) << "stroke " << k;
+        EXPECT_EQ(report.strokeSelected[k], selected) << "stroke " << k;
+        ++k;
+    }
+    size_t changed = 0;
+    for (size_t i = 0; i < x.size(); ++i) {
+        EXPECT_NEAR(w[i], static_cast<double>(ref[i]), 1e-12 * static_cast<double>(ref[i])) << "vertex " << i;
+        changed += w[i] != 1.0;
+    }
+    EXPECT_GT(changed, 50u);
+    EXPECT_EQ(bakeSurfacePaint(tube, {add, soften, mix, smooth}), w) << "repeatable";
+}
+
+TEST(SurfacePaint, BadStrokesAreRefusedAndChangeNothing) {
+    const TriMesh tube = makeTubeSurface(Vec3(0, 0, 0), Vec3(0.1, 0, 0), 0.012, 12, 10);
+    std::vector<double> w(tube.vertexCount(), 1.0);
+    const auto w0 = w;
+    BrushStroke s{Vec3(0.05, 0, 0), 0.02, 1.0, BrushScale::Peak, BrushMode::Smooth};
+    EXPECT_THROW(applySurfaceBrushStroke(tube.positions(), s, {}, w), std::invalid_argument) << "no neighbours";
+    s.mode = BrushMode::Add;
+    s.radius = NAN;
+    EXPECT_THROW(applySurfaceBrushStroke(tube.positions(), s, {}, w), std::invalid_argument);
+    s.radius = 0.02;
+    std::vector<double> shorter(3, 1.0);
+    EXPECT_THROW(applySurfaceBrushStroke(tube.positions(), s, {}, shorter), std::invalid_argument);
+    EXPECT_EQ(w, w0);
+    s.center = Vec3(NAN, 0, 0);
+    EXPECT_THROW(bakeSurfacePaint(tube, {s}), std::invalid_argument);
+}

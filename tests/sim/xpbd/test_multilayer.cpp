@@ -446,6 +446,100 @@ TEST(XpbdSystem, SurfaceStrainLimitsInTheUvFrame) {
     EXPECT_LE(across.second, 0.01 + 2e-3);
 }
 
+TEST(XpbdSystem, PaintedFasciaWeightsScaleEachTrianglesStiffness) {
+    // [A Fig. 4.11] polygon paint: a triangle's k is stretchStiffness × the mean of its vertices'
+    // weights. Checked on the stored energy of one stretched state (exact per triangle), then on
+    // the settled stretch of a hanging sheet painted stiff on one half.
+    std::vector<Vec2> uv;
+    TriMesh mesh = sheet(Vec3(0, 0, 0.04), Vec3(0, 0, -0.04), Vec3(0.04, 0, 0), 8, 8, &uv);
+    const size_t nv = mesh.vertexCount();
+    SurfaceBodyDesc s;
+    s.name = "membrane";
+    s.mesh = &mesh;
+    s.uv = uv;
+    s.stretchStiffness = 0.5;
+    s.arealDensity = 0.2;
+    for (int32_t v = 0; v < static_cast<int32_t>(nv); ++v)
+        if (mesh.positions()[v].z() > 0.04 - 1e-9) s.fixedNodes.push_back(v);
+    auto energyOf = [&](const std::vector<double>& w, size_t onlyTri = SIZE_MAX) {
+        XpbdSystemDesc d;
+        SurfaceBodyDesc body = s;
+        body.nodeWeights = w;
+        TriMesh one;
+        if (onlyTri != SIZE_MAX) { // the triangle alone, unweighted
+            const Tri& t = mesh.triangles()[onlyTri];
+            one = TriMesh::fromArrays({mesh.positions()[t[0]], mesh.positions()[t[1]], mesh.positions()[t[2]]},
+                                      {Tri{0, 1, 2}});
+            body.mesh = &one;
+            body.uv = {uv[t[0]], uv[t[1]], uv[t[2]]};
+            body.fixedNodes.clear();
+        }
+        d.surfaces = {body};
+        auto sys = XpbdSystem::create(d, XpbdSettings{});
+        std::vector<Vec3> x = body.mesh->positions();
+        for (Vec3& p : x)
+            p = Vec3(1.3 * p.x(), p.y() + 0.2 * p.x(), 0.9 * p.z() + 0.1 * p.x() * p.x() / 0.04);
+        sys->setSurfaceState(0, x, std::vector<Vec3>(x.size(), Vec3::Zero()));
+        return sys->elasticEnergy();
+    };
+    std::vector<double> w(nv);
+    for (size_t i = 0; i < nv; ++i)
+        w[i] = 0.5 + 3.0 * std::abs(std::sin(1.3 * double(i)));
+    const double painted = energyOf(w);
+    long double expected = 0;
+    for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+        const Tri& tri = mesh.triangles()[t];
+        expected += (w[tri[0]] + w[tri[1]] + w[tri[2]]) / 3.0L * energyOf({}, t);
+    }
+    EXPECT_GT(painted, 0.0);
+    EXPECT_NEAR(painted, static_cast<double>(expected), 1e-12 * painted) << "sum of k_t · E_t";
+    EXPECT_NEAR(energyOf(std::vector<double>(nv, 4.0)), 4.0 * energyOf({}), 1e-12 * energyOf({}));
+
+    // hanging: the half at x > 2 cm painted 5× stretches less than the other half
+    auto hang = [&](const std::vector<double>& weights) {
+        XpbdSystemDesc d;
+        SurfaceBodyDesc body = s;
+        body.nodeWeights = weights;
+        d.surfaces = {body};
+        XpbdSettings set;
+        set.substeps = 20;
+        set.iterations = 10;
+        set.damping = 5;
+        auto sys = XpbdSystem::create(d, set);
+        for (int f = 0; f < 120; ++f)
+            EXPECT_TRUE(sys->step().finite);
+        return sys->surfacePositions(0);
+    };
+    std::vector<double> half(nv, 1.0);
+    for (size_t i = 0; i < nv; ++i)
+        if (mesh.positions()[i].x() > 0.02 + 1e-9) half[i] = 5.0;
+    const auto plain = hang({}), stiff = hang(half);
+    auto drop = [&](const std::vector<Vec3>& x, bool right) { // mean fall of a half's vertices
+        double sum = 0;
+        int n = 0;
+        for (size_t i = 0; i < nv; ++i)
+            if ((mesh.positions()[i].x() > 0.02 + 1e-9) == right && mesh.positions()[i].x() != 0.02) {
+                sum += mesh.positions()[i].z() - x[i].z();
+                ++n;
+            }
+        return sum / n;
+    };
+    EXPECT_GT(drop(plain, true), 1e-3) << "m: the soft sheet stretches under its weight";
+    EXPECT_LT(drop(stiff, true), 0.6 * drop(plain, true)) << "the painted half stretches less";
+    EXPECT_LT(drop(stiff, true) / drop(stiff, false), 0.8 * drop(plain, true) / drop(plain, false));
+    // bad weights are refused with the layer named
+    try {
+        std::vector<double> bad(nv, 1.0);
+        bad[5] = -1.0;
+        energyOf(bad);
+        ADD_FAILURE() << "a negative weight was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_THAT(e.what(), HasSubstr("membrane"));
+        EXPECT_THAT(e.what(), HasSubstr("node weight 5 is -1"));
+    }
+    EXPECT_THROW(energyOf(std::vector<double>(3, 1.0)), std::invalid_argument);
+}
+
 TEST(XpbdSystem, BitIdenticalAcrossThreadCounts) {
     // Large enough that colours are split between threads.
     auto fat = makeBoxTetMesh({Vec3::Zero(), Vec3(0.2, 0.1, 0.1), {20, 10, 10}});
@@ -491,7 +585,12 @@ TEST(XpbdSystem, MembraneSimdAndScalarKernelsAgree) {
         XpbdSettings s;
         s.substeps = 10;
         s.simd = simd;
-        auto sys = XpbdSystem::create(L.desc(), s);
+        XpbdSystemDesc d = L.desc();
+        // painted: every triangle its own k, so the packs' per-lane stiffness is checked too
+        d.surfaces[0].nodeWeights.resize(L.fascia.vertexCount());
+        for (size_t i = 0; i < L.fascia.vertexCount(); ++i)
+            d.surfaces[0].nodeWeights[i] = 1.0 + std::abs(std::cos(0.7 * double(i)));
+        auto sys = XpbdSystem::create(d, s);
         std::vector<Vec3> v(L.fascia.vertexCount(), Vec3::Zero());
         for (size_t i = 0; i < v.size(); ++i)
             v[i] = Vec3(0.3 * std::sin(1.7 * double(i)), 0.3 * std::cos(2.3 * double(i)), 0.5);

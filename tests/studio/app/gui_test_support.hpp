@@ -9,10 +9,12 @@
 #include <QCoreApplication>
 #include <QElapsedTimer>
 #include <QMouseEvent>
+#include <QScreen>
 #include <QStandardPaths>
 #include <QTest>
 #include <QWidget>
 
+#include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -44,6 +46,16 @@ inline bool waitFor(const std::function<bool()>& done, int ms) {
         QTest::qWait(5);
     }
     return true;
+}
+
+/// With VISCERA_GUI_SHOTS set to a folder: the whole screen (the GL viewport included) saved there
+/// as <name>.png, for looking at what a test drove. Otherwise nothing.
+inline void saveShot(const char* name) {
+    const char* dir = std::getenv("VISCERA_GUI_SHOTS");
+    if (!dir || !*dir) return;
+    QTest::qWait(200); // the viewport's next frame
+    if (QScreen* s = QGuiApplication::primaryScreen())
+        s->grabWindow(0).save(QString::fromStdString((std::filesystem::path(dir) / name).string() + ".png"));
 }
 
 inline void sendMouse(QWidget* w, QEvent::Type type, QPointF pos, Qt::MouseButton button, Qt::MouseButtons buttons,

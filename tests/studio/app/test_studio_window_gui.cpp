@@ -424,6 +424,32 @@ std::vector<long double> referenceWeights(const sim::TetMesh& mesh, const sim::S
 
 } // namespace
 
+namespace {
+
+/// A press at `at`, a short move, Esc, a release: a cancelled stroke. The painter must be in the
+/// stroke before Esc and out of it after.
+void cancelledStroke(studio::Viewport* v, const studio::StiffnessPainter* painter, QPoint at, QPoint move) {
+    if (QWindow* win = v->canvasWindow()) {
+        QTest::mousePress(win, Qt::LeftButton, Qt::NoModifier, at);
+        QTest::mouseMove(win, at + move);
+        EXPECT_TRUE(painter->stroking());
+        QTest::keyClick(win, Qt::Key_Escape);
+        QTest::mouseRelease(win, Qt::LeftButton, Qt::NoModifier, at + move);
+    }
+    EXPECT_FALSE(painter->stroking());
+}
+
+/// True when some overlay vertex of a mesh from `source` is painted (the ramp's alpha 0.9).
+bool rampShown(const studio::Viewport* v, render::RenderMesh::Source source) {
+    for (const render::RenderMesh& m : v->view().meshes())
+        if (m.source == source)
+            for (size_t k = 3; k < m.overlay.size(); k += 4)
+                if (m.overlay[k] > 0.5f) return true;
+    return false;
+}
+
+} // namespace
+
 TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWeights) {
     open("tissue-slab");
     // substeps to spare: the strokes below stiffen nodes up to 2.5×, which the sample's own count
@@ -485,23 +511,12 @@ TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWe
     EXPECT_TRUE(test::waitFor([&] { return w->verdictLabel()->text() != verdictBefore; }, 180000))
         << w->verdictLabel()->text().toStdString();
     // the ramp is on the body: some overlay vertices are painted (alpha 0.9)
-    bool ramp = false;
-    for (const render::RenderMesh& m : v->view().meshes())
-        for (size_t k = 3; k < m.overlay.size(); k += 4)
-            ramp = ramp || m.overlay[k] > 0.5f;
-    EXPECT_TRUE(ramp);
+    EXPECT_TRUE(rampShown(v, render::RenderMesh::Source::Body));
 
     // Esc during a stroke: nothing changes
     const std::vector<double> painted = painter->weights();
     const std::string textPainted = studio::projectJsonText(w->document()->project());
-    if (QWindow* win = v->canvasWindow()) {
-        QTest::mousePress(win, Qt::LeftButton, Qt::NoModifier, centre);
-        QTest::mouseMove(win, centre + QPoint(10, 5));
-        EXPECT_TRUE(painter->stroking());
-        QTest::keyClick(win, Qt::Key_Escape);
-        QTest::mouseRelease(win, Qt::LeftButton, Qt::NoModifier, centre + QPoint(10, 5));
-    }
-    EXPECT_FALSE(painter->stroking());
+    cancelledStroke(v, painter, centre, QPoint(10, 5));
     EXPECT_EQ(painter->weights(), painted);
     EXPECT_EQ(studio::projectJsonText(w->document()->project()), textPainted);
     EXPECT_EQ(w->document()->undoStack()->count(), undoBefore + 1);
@@ -579,6 +594,111 @@ TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWe
     EXPECT_GT(lowered, 5u);
     w->document()->undoStack()->undo();
     EXPECT_EQ(painter->weights(), before);
+}
+
+TEST_F(WindowFixture, FasciaPolygonPaintIsEq428OnItsVerticesAndOneUndoStep) {
+    // [A Fig. 4.11]: a fascia is painted on its own vertices, no skeleton
+    open("liver");
+    ASSERT_TRUE(waitForPreview()) << w->verdictLabel()->text().toStdString();
+    w->selectSurface(0);
+    studio::StiffnessPainter* painter = w->painter();
+    w->findChild<QAction*>("actionPaintStiffness")->trigger();
+    ASSERT_TRUE(w->painting());
+    ASSERT_TRUE(test::waitFor([&] { return painter->ready(); }, 60000)) << painter->status().toStdString();
+    EXPECT_EQ(painter->surface(), 0);
+    EXPECT_EQ(painter->body(), -1);
+    EXPECT_TRUE(painter->status().contains("polygon paint")) << painter->status().toStdString();
+    const auto mesh = w->preview()->surfaceMesh(0);
+    ASSERT_NE(mesh, nullptr);
+    const std::vector<double> before = painter->weights();
+    ASSERT_EQ(before, std::vector<double>(mesh->vertexCount(), 1.0));
+    const std::string textBefore = studio::projectJsonText(w->document()->project());
+    const int undoBefore = w->document()->undoStack()->count();
+    studio::Viewport* v = w->viewport();
+    v->frameAll();
+    // Alt + drag orbits in paint mode: look down on the organ's upper face, where the fascia lies
+    if (QWindow* win = v->canvasWindow()) {
+        const QPoint c(v->width() / 2, v->height() / 2);
+        QTest::mousePress(win, Qt::LeftButton, Qt::AltModifier, c);
+        for (int i = 1; i <= 9; ++i)
+            QTest::mouseMove(win, c + QPoint(0, 10 * i));
+        QTest::mouseRelease(win, Qt::LeftButton, Qt::AltModifier, c + QPoint(0, 90));
+    } else {
+        test::drag(v->canvasWidget(), QPoint(v->width() / 2, v->height() / 2),
+                   QPoint(v->width() / 2, v->height() / 2 + 90), 9, Qt::LeftButton, Qt::AltModifier);
+    }
+    EXPECT_EQ(w->document()->undoStack()->count(), undoBefore) << "an orbit paints nothing";
+    QTest::qWait(50);
+    // only the fascia is drawn while it is painted: find a row of points on it
+    auto onFascia = [&](QPoint p) {
+        const auto hit = v->hitAt(p);
+        return hit && v->view().meshes()[hit->mesh].source == render::RenderMesh::Source::Surface;
+    };
+    QPoint start(-1, -1);
+    for (int y = v->height() / 4; y < 3 * v->height() / 4 && start.x() < 0; y += 10)
+        for (int x = v->width() / 4; x < v->width() / 2 && start.x() < 0; x += 10)
+            if (onFascia(QPoint(x, y)) && onFascia(QPoint(x + 120, y))) start = QPoint(x, y + 30);
+    ASSERT_GE(start.x(), 0) << "no 120 px run of the fascia in view";
+    ASSERT_TRUE(onFascia(start) && onFascia(start + QPoint(120, 0)));
+    for (size_t k = 0; k < v->view().meshes().size(); ++k)
+        if (v->view().meshes()[k].source != render::RenderMesh::Source::Surface)
+            EXPECT_FALSE(v->view().meshes()[k].visible) << "mesh " << k << " hidden while the fascia is painted";
+
+    w->findChild<QComboBox*>("paintMode")->setCurrentIndex(0);
+    w->findChild<QDoubleSpinBox*>("paintRadius")->setValue(15.0);
+    w->findChild<QDoubleSpinBox*>("paintStrength")->setValue(2.0);
+    hostDrag(v, start, start + QPoint(120, 0));
+    ASSERT_EQ(w->document()->undoStack()->count(), undoBefore + 1) << "one stroke, one undo step";
+    ASSERT_TRUE(w->document()->project().surfaces[0].paint.has_value());
+    const auto& strokes = w->document()->project().surfaces[0].paint->strokes;
+    ASSERT_GT(strokes.size(), 2u) << "dabs along the drag";
+    EXPECT_FALSE(w->document()->project().bodies[0].paint.has_value()) << "the body is not painted";
+    // independent evaluation: every vertex inside a dab's sphere, in order, peak-normalised 4.28
+    const sim::PaintParams params = w->document()->project().surfaces[0].paint->params;
+    std::vector<long double> ref(mesh->vertexCount(), params.baseWeight);
+    for (const sim::BrushStroke& s : strokes) {
+        EXPECT_EQ(s.mode, sim::BrushMode::Add);
+        EXPECT_DOUBLE_EQ(s.radius, 0.015);
+        for (size_t i = 0; i < ref.size(); ++i) {
+            const long double d = (mesh->positions()[i] - s.center).norm();
+            if (d < s.radius)
+                ref[i] = std::clamp<long double>(ref[i] + s.amplitude * peakKernel(d, s.radius), params.minWeight,
+                                                 params.maxWeight);
+        }
+    }
+    size_t raised = 0;
+    for (size_t i = 0; i < ref.size(); ++i) {
+        EXPECT_NEAR(painter->weights()[i], static_cast<double>(ref[i]), 1e-12 * static_cast<double>(ref[i])) << i;
+        raised += painter->weights()[i] > 1.0;
+    }
+    EXPECT_GT(raised, 5u);
+    // the ramp is drawn on the fascia
+    EXPECT_TRUE(rampShown(v, render::RenderMesh::Source::Surface));
+    test::saveShot("fascia_paint");
+
+    // Esc during a stroke: nothing changes
+    const std::vector<double> painted = painter->weights();
+    const std::string textPainted = studio::projectJsonText(w->document()->project());
+    cancelledStroke(v, painter, start, QPoint(10, 0));
+    EXPECT_EQ(painter->weights(), painted);
+    EXPECT_EQ(studio::projectJsonText(w->document()->project()), textPainted);
+
+    // saved and read back the same; undo restores the model and the weights exactly
+    const studio::Project again = studio::loadProjectText(textPainted, w->document()->project().dir, "again");
+    EXPECT_EQ(studio::projectJsonText(again), textPainted);
+    w->document()->undoStack()->undo();
+    EXPECT_EQ(studio::projectJsonText(w->document()->project()), textBefore);
+    EXPECT_EQ(painter->weights(), before);
+    w->document()->undoStack()->redo();
+    EXPECT_EQ(painter->weights(), painted);
+    // the preview keeps running with the painted layer
+    const uint64_t frames = w->preview()->snapshot().frames;
+    EXPECT_TRUE(test::waitFor([&] { return w->preview()->snapshot().frames > frames + 3; }, 60000));
+    const studio::Preview::Snapshot snap = w->preview()->snapshot();
+    ASSERT_FALSE(snap.surfaces.empty());
+    ASSERT_EQ(snap.surfaces[0].size(), mesh->vertexCount());
+    for (const auto& x : snap.surfaces[0])
+        ASSERT_TRUE(x.allFinite());
 }
 
 TEST_F(WindowFixture, LightSamplePaintingIsExactOneUndoStepAndEscLeavesTheMap) {

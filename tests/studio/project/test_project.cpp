@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 #include <unistd.h>
 
@@ -182,6 +183,60 @@ TEST_F(ProjectTest, RemeshingABodyKeepsItsPaintedWeightMass) {
         ASSERT_GT(ma, 0.0);
         EXPECT_GE(mb / ma, 0.99);
         EXPECT_LE(mb / ma, 1.05);
+    }
+}
+
+TEST_F(ProjectTest, RemeshingKeepsAFasciasPaintedWeightMass) {
+    // Polygon paint on the liver's fascia is stored by position: the organ meshed again (another
+    // cell size, so another cut surface) gets the same strokes; >= 99 % of the painted area mass
+    // ∫ (w − base) dA is kept.
+    studio::Project p = studio::loadProject(std::filesystem::path(VISCERA_SOURCE_DIR) / "projects/liver");
+    p.dir = m_dir;
+    ASSERT_FALSE(p.surfaces.empty());
+    studio::StiffnessPaintProject paint;
+    paint.params.maxWeight = 50;
+    paint.strokes.push_back({sim::Vec3(0.0, -0.02, 0.04), 0.05, 8.0});
+    paint.strokes.push_back({sim::Vec3(0.05, 0.01, 0.02), 0.03, 0.6});
+    sim::BrushStroke smooth{sim::Vec3(0.02, 0.0, 0.04), 0.04, 0.5};
+    smooth.mode = sim::BrushMode::Smooth;
+    paint.strokes.push_back(smooth);
+    p.surfaces[0].paint = paint;
+    studio::Project q = p;
+    q.bodies[0].mesh.meshing.cellSize *= 0.8;
+    q.bodies[0].mesh.meshing.facetSize *= 0.8;
+    const studio::BuiltScene A = studio::buildScene(p), B = studio::buildScene(q);
+    auto mass = [](const sim::TriMesh& m, const std::vector<double>& w) {
+        double sum = 0;
+        for (size_t t = 0; t < m.triangleCount(); ++t) {
+            const sim::Tri& f = m.triangles()[t];
+            const sim::Vec3 &a = m.positions()[f[0]], &b = m.positions()[f[1]], &c = m.positions()[f[2]];
+            sum += 0.5 * (b - a).cross(c - a).norm() * ((w[f[0]] + w[f[1]] + w[f[2]]) / 3 - 1.0);
+        }
+        return sum;
+    };
+    ASSERT_EQ(A.scene.surfaces[0].nodeWeights.size(), A.surfaces[0].vertexCount());
+    ASSERT_EQ(B.scene.surfaces[0].nodeWeights.size(), B.surfaces[0].vertexCount());
+    ASSERT_NE(A.surfaces[0].vertexCount(), B.surfaces[0].vertexCount()) << "cut again, differently";
+    EXPECT_EQ(A.scene.surfaces[0].nodeWeightsPath, "meshes/fascia.vweights");
+    const double ma = mass(A.surfaces[0], A.scene.surfaces[0].nodeWeights);
+    const double mb = mass(B.surfaces[0], B.scene.surfaces[0].nodeWeights);
+    std::printf("fascia: %zu -> %zu vertices, painted area mass %.6g -> %.6g m^2 (%.2f %%)\n",
+                A.surfaces[0].vertexCount(), B.surfaces[0].vertexCount(), ma, mb, 100.0 * mb / ma);
+    ASSERT_GT(ma, 0.0);
+    EXPECT_GE(mb / ma, 0.99);
+    EXPECT_LE(mb / ma, 1.05);
+    // the project text round-trips the surface's paint (no skeleton block on a fascia)
+    const std::string text = studio::projectJsonText(p);
+    EXPECT_EQ(studio::projectJsonText(studio::loadProjectText(text, m_dir, "again")), text);
+    EXPECT_EQ(nlohmann::json::parse(text)["surfaces"][0]["stiffness_paint"].count("skeleton"), 0u);
+    nlohmann::json bad = nlohmann::json::parse(text);
+    bad["surfaces"][0]["stiffness_paint"]["skeleton"] = nlohmann::json::object();
+    try {
+        studio::loadProjectText(bad.dump(), m_dir, "p.json");
+        ADD_FAILURE() << "a skeleton on a fascia was accepted";
+    } catch (const InputError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("p.json: surfaces[0].stiffness_paint"));
+        EXPECT_THAT(e.what(), HasSubstr("skeleton"));
     }
 }
 

@@ -394,8 +394,9 @@ private:
 
 class MembraneBlock final : public Block {
 public:
-    MembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area, double k, bool simd)
-        : m_tris(std::move(tris)), m_dmInv(std::move(dmInv)), m_area(std::move(area)), m_k(k),
+    MembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area, std::vector<double> k,
+                  bool simd)
+        : m_tris(std::move(tris)), m_dmInv(std::move(dmInv)), m_area(std::move(area)), m_k(std::move(k)),
           m_active(m_tris.size(), 1), m_simd(simd) {}
     bool setUnitActive(size_t u, bool active) override {
         m_active.at(u) = active ? 1 : 0;
@@ -437,7 +438,7 @@ public:
             for (int l = 0; l < n; ++l) {
                 const int32_t u = m_slots[slot[l]];
                 if (ctx.first) std::fill_n(m_lam.data() + 3 * slot[l], 3, 0.0);
-                t[l] = ctx.h2inv / (m_k * m_area[u]);
+                t[l] = ctx.h2inv / (m_k[u] * m_area[u]);
                 for (int i = 0; i < 3; ++i) {
                     const double* p = ctx.xw + 4 * static_cast<size_t>(m_tris[u][i]);
                     for (int r = 0; r < 3; ++r)
@@ -495,7 +496,7 @@ public:
             for (int i = 0; i < 3; ++i)
                 x[i] = particlePosition(xw, m_tris[u][i]);
             const auto C = membraneConstraints(x, m_dmInv[u]);
-            sum += 0.5 * m_k * m_area[u] * (C[0] * C[0] + C[1] * C[1] + C[2] * C[2]);
+            sum += 0.5 * m_k[u] * m_area[u] * (C[0] * C[0] + C[1] * C[1] + C[2] * C[2]);
         }
         return sum;
     }
@@ -521,7 +522,7 @@ protected:
                 P.m[1][l] = M(0, 1);
                 P.m[2][l] = M(1, 0);
                 P.m[3][l] = M(1, 1);
-                P.invKA[l] = 1.0 / (m_k * m_area[src]);
+                P.invKA[l] = 1.0 / (m_k[src] * m_area[src]);
                 P.active[l] = u >= 0 && m_active[u] ? 1.0 : 0.0;
             }
         }
@@ -531,7 +532,7 @@ private:
     std::vector<Tri> m_tris;
     std::vector<Mat2> m_dmInv;
     std::vector<double> m_area;
-    double m_k;
+    std::vector<double> m_k;       ///< per unit, N/m
     std::vector<uint8_t> m_active; ///< per unit
     std::vector<int32_t> m_slots;
     std::vector<double> m_lam;
@@ -646,8 +647,8 @@ std::unique_ptr<Block> makeTriStrainBlock(std::vector<Tri> tris, std::vector<Mat
 }
 
 std::unique_ptr<Block> makeMembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area,
-                                         double stiffness, bool simd) {
-    return std::make_unique<MembraneBlock>(std::move(tris), std::move(dmInv), std::move(area), stiffness,
+                                         std::vector<double> stiffness, bool simd) {
+    return std::make_unique<MembraneBlock>(std::move(tris), std::move(dmInv), std::move(area), std::move(stiffness),
                                            simd && membraneAvx2Available());
 }
 

@@ -43,10 +43,11 @@ std::unique_ptr<Block> makeTetStrainBlock(std::vector<Tet> tets, std::vector<Mat
 /// Strain limits on triangles; dmInv of the UV frame (triangleUvDmInv).
 std::unique_ptr<Block> makeTriStrainBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area,
                                           std::vector<ScalarStrainLimit> limits);
-/// Membrane constraints (membrane.hpp), α = 1/(k A). simd: the AVX2 kernel when the CPU has it
+/// Membrane constraints (membrane.hpp), α = 1/(k A) with k the triangle's own stiffness (N/m,
+/// one per triangle: painted fascia). simd: the AVX2 kernel when the CPU has it
 /// (membrane_kernel.hpp), else the scalar path.
 std::unique_ptr<Block> makeMembraneBlock(std::vector<Tri> tris, std::vector<Mat2> dmInv, std::vector<double> area,
-                                         double stiffness, bool simd);
+                                         std::vector<double> stiffness, bool simd);
 
 /// C = x_p − Σ_{k<n} b_k x_k, n = 3 or 4.
 struct Tie {
