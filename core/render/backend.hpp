@@ -33,6 +33,8 @@ struct BackendStats {
     uint64_t targetAllocations = 0; ///< render-target (re)allocations
     uint64_t drawCalls = 0;
     uint64_t passesRun = 0;
+    uint64_t textureUploads = 0; ///< material map images sent to the GPU (once per map and material)
+    uint64_t mappedDraws = 0;    ///< G-buffer draws that sampled material maps
 };
 
 enum class ImageStage : uint8_t {

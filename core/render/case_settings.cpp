@@ -1,15 +1,101 @@
 #include "render/case_settings.hpp"
 
+#include "render/scene_view.hpp"
+
 #include "sim/util/error.hpp"
 #include "sim/util/json_reader.hpp"
 
+#include <optional>
+
 namespace viscera::render {
+
+namespace {
+
+std::vector<CaseMaterialMaps> readMaterials(const sim::JsonField& root) {
+    std::vector<CaseMaterialMaps> out;
+    auto materials = root.find("materials");
+    if (!materials) return out;
+    for (const auto& [name, m] : materials->anyObject().members()) {
+        m.object({"diffuse", "roughness", "metallic", "normal", "tiles_per_metre", "normal_strength"});
+        CaseMaterialMaps c;
+        c.target = name;
+        const std::pair<const char*, std::string*> maps[] = {
+            {"diffuse", &c.diffuse}, {"roughness", &c.roughness}, {"metallic", &c.metallic}, {"normal", &c.normal}};
+        for (const auto& [key, path] : maps)
+            if (auto f = m.find(key)) *path = f->entryPath();
+        if (c.files().empty()) m.fail("names no map (give at least one of diffuse, roughness, metallic, normal)");
+        c.tilesPerMetre = float(m.number("tiles_per_metre", c.tilesPerMetre, sim::NumberRule::aboveUpTo(0, 1e4)));
+        c.normalStrength = float(m.number("normal_strength", c.normalStrength, sim::NumberRule::closed(0, 4)));
+        out.push_back(std::move(c));
+    }
+    return out;
+}
+
+} // namespace
+
+std::vector<std::string> CaseMaterialMaps::files() const {
+    std::vector<std::string> f;
+    for (const std::string* p : {&diffuse, &roughness, &metallic, &normal})
+        if (!p->empty()) f.push_back(*p);
+    return f;
+}
+
+std::vector<CaseMaterialMaps> caseMaterialMaps(std::string_view text, const std::string& origin) {
+    if (text.empty()) return {};
+    const nlohmann::json doc = sim::parseJsonText(text, origin);
+    return readMaterials(sim::JsonField(doc, "render", origin).anyObject());
+}
+
+std::shared_ptr<const MaterialMaps> loadMaterialMaps(const CaseMaterialMaps& entry,
+                                                     const std::function<std::string_view(const std::string&)>& read,
+                                                     const std::string& origin) {
+    auto maps = std::make_shared<MaterialMaps>();
+    maps->tilesPerMetre = entry.tilesPerMetre;
+    maps->normalStrength = entry.normalStrength;
+    const std::pair<const std::string*, Image*> slots[] = {{&entry.diffuse, &maps->diffuse},
+                                                           {&entry.roughness, &maps->roughness},
+                                                           {&entry.metallic, &maps->metallic},
+                                                           {&entry.normal, &maps->normal}};
+    const Image* first = nullptr;
+    const std::string* firstPath = nullptr;
+    for (const auto& [path, image] : slots) {
+        if (path->empty()) continue;
+        *image = decodePng(read(*path), origin + ":" + *path, 4096);
+        if (first && (image->width != first->width || image->height != first->height))
+            throw InputError(origin + ": render.materials." + entry.target + ": '" + *path + "' is " +
+                             std::to_string(image->width) + " x " + std::to_string(image->height) + ", '" + *firstPath +
+                             "' is " + std::to_string(first->width) + " x " + std::to_string(first->height) +
+                             " (a material's maps must have one size)");
+        if (!first) {
+            first = image;
+            firstPath = path;
+        }
+    }
+    return maps;
+}
+
+size_t applyMaterialMaps(SceneView& view, const std::string& target, std::shared_ptr<const MaterialMaps> maps) {
+    size_t changed = 0;
+    std::optional<uint32_t> material; // one new material for all of the target's meshes
+    for (RenderMesh& m : view.meshes()) {
+        if (m.name != target) continue;
+        if (!material) {
+            TissueMaterial mat = view.materials().at(m.material);
+            mat.maps = maps;
+            material = view.addMaterial(mat);
+        }
+        m.material = *material;
+        ++changed;
+    }
+    return changed;
+}
 
 void applyCaseRender(RenderSettings& settings, std::string_view text, const std::string& origin) {
     if (text.empty()) return;
     const nlohmann::json doc = sim::parseJsonText(text, origin);
     const sim::JsonField root(doc, "render", origin);
-    root.object({"sss", "sampling", "stereo", "post"});
+    root.object({"sss", "sampling", "stereo", "post", "materials"});
+    readMaterials(root); // checked with the rest of the block (the maps are read by the loader)
     RenderSettings s = settings;
     s.subsurface = root.boolean("sss", s.subsurface);
     if (auto v = root.find("sampling")) {

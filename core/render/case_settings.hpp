@@ -7,15 +7,26 @@
 ///     "sampling": "distance",                       uniform | distance | painted [A eq. 6.15–6.16]
 ///     "stereo": "off",                              off | side_by_side | anaglyph [B ch. 4]
 ///     "post": {"tone_mapping": true, "colour_curve": false, "chromatic_aberration": false,
-///              "depth_of_field": false, "noise": false, "sharpen": false, "radial_mask": false}
+///              "depth_of_field": false, "noise": false, "sharpen": false, "radial_mask": false},
+///     "materials": {                                material maps per body or surface [A §6.2.2]
+///       "organ": {"diffuse": "textures/organ_diffuse.png", "roughness": "textures/organ_roughness.png",
+///                 "metallic": "...", "normal": "...",   package entries (PNG); at least one map
+///                 "tiles_per_metre": 20,               triplanar repeats per metre, (0, 10000]
+///                 "normal_strength": 1}                [0, 4]
+///     }
 ///   }
 ///
 /// Every key is optional; a post effect not named keeps the renderer's default (off, except
 /// tone mapping). Parsing is strict: unknown keys and wrong types are errors.
+#include "render/material.hpp"
 #include "render/settings.hpp"
+
+#include <functional>
+#include <memory>
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace viscera::render {
 
@@ -23,5 +34,33 @@ namespace viscera::render {
 /// Throws viscera::InputError "<origin>: render.<field>: <rule>" on malformed input; `settings`
 /// is then unchanged.
 void applyCaseRender(RenderSettings& settings, std::string_view json, const std::string& origin);
+
+/// One entry of "render.materials": the maps body or surface `target` is drawn with.
+struct CaseMaterialMaps {
+    std::string target;
+    std::string diffuse, roughness, metallic, normal; ///< package entries; empty: that map is not used
+    float tilesPerMetre = 20.0f;
+    float normalStrength = 1.0f;
+    /// The entries named, in the order diffuse, roughness, metallic, normal.
+    std::vector<std::string> files() const;
+};
+
+/// The "materials" of the "render" object `json` (empty text or no "materials": none), sorted
+/// by name (deterministic). Throws viscera::InputError "<origin>: render.materials.<name>.<field>:
+/// <rule>" (unknown field, bad entry name, no map, number out of range). Whether each target is
+/// a body or surface of the scene is the caller's check (it knows the scene).
+std::vector<CaseMaterialMaps> caseMaterialMaps(std::string_view json, const std::string& origin);
+
+/// Decodes the maps of `entry`: `read(path)` gives an entry's bytes (the case package's), each a
+/// PNG of at most 4096 pixels a side, all of one size. Throws viscera::InputError naming `origin`,
+/// the entry and the rule.
+std::shared_ptr<const MaterialMaps> loadMaterialMaps(const CaseMaterialMaps& entry,
+                                                     const std::function<std::string_view(const std::string&)>& read,
+                                                     const std::string& origin);
+
+class SceneView;
+/// Draws every mesh of `view` named `target` with a copy of its material that carries `maps`.
+/// Returns the number of meshes changed.
+size_t applyMaterialMaps(SceneView& view, const std::string& target, std::shared_ptr<const MaterialMaps> maps);
 
 } // namespace viscera::render

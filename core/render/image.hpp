@@ -2,6 +2,8 @@
 /// 8-bit RGBA images (rows top to bottom) and the comparisons golden-image tests use.
 #include <cstdint>
 #include <filesystem>
+#include <string>
+#include <string_view>
 #include <vector>
 
 namespace viscera::render {
@@ -28,5 +30,11 @@ ImageDifference compareImages(const Image& a, const Image& b, const std::vector<
 void writePng(const std::filesystem::path& path, const Image& image);
 /// Reads any PNG as 8-bit RGBA. Throws std::runtime_error naming the path.
 Image readPng(const std::filesystem::path& path);
+/// An 8-bit RGBA PNG in memory. Throws std::invalid_argument for an empty or inconsistent image.
+std::string encodePng(const Image& image);
+/// Decodes PNG bytes (a case's texture entry) as 8-bit RGBA (16-bit samples are rounded). The
+/// size is checked against `maxSide` before anything is allocated. Throws viscera::InputError
+/// "<origin>: <rule>" for data that is not a PNG, is truncated or is too large.
+Image decodePng(std::string_view bytes, const std::string& origin, int maxSide = 8192);
 
 } // namespace viscera::render

@@ -5,9 +5,12 @@
 /// `fibreAxis`) and submucosa (vessel pattern, shown more where the tissue is thin). Shading
 /// parameters feed the G-buffer (roughness, metallic, reflection) and the SSS term [A eq. 6.8]:
 /// f_sub = C·exp(−σ·T) with C = sssColour, σ = sigma (1/m per channel), T = baked thickness.
+#include "render/image.hpp"
+
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 namespace viscera::render {
@@ -20,6 +23,17 @@ struct TissueLayer {
 
 /// Bits of the G-buffer flag channel (RT3.a).
 enum MaterialFlags : uint8_t { kFlagNone = 0, kFlagMembrane = 1, kFlagTool = 2 };
+
+/// Material maps of a layer [A §6.2.2, Fig. 6.8–6.9], sampled in the G-buffer pass in place of
+/// the procedural layers. Each map may be empty (that channel stays procedural or uniform); the
+/// maps given have one size. diffuse: sRGB colour; roughness and metallic: the red channel, linear;
+/// normal: tangent-space, RGB = (n + 1)/2. Coordinates: the mesh's UVs when it has them, else a
+/// triplanar projection of the rest position with `tilesPerMetre` texture repeats per metre.
+struct MaterialMaps {
+    Image diffuse, roughness, metallic, normal;
+    float tilesPerMetre = 20.0f;
+    float normalStrength = 1.0f; ///< scales the map's tangent-plane tilt, [0, 4]
+};
 
 struct TissueMaterial {
     std::string name = "tissue";
@@ -37,6 +51,7 @@ struct TissueMaterial {
     Eigen::Vector3f sssColour{1.0f, 0.35f, 0.25f}; ///< C [A eq. 6.8]
     Eigen::Vector3f sigma{60.0f, 180.0f, 220.0f};  ///< absorption σ, 1/m, per channel
     uint8_t flags = kFlagNone;
+    std::shared_ptr<const MaterialMaps> maps; ///< null: the procedural layers above
 };
 
 /// A material for a body or surface name ("liver", "organ", "vessel", "fascia", "fat", …); a

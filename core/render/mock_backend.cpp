@@ -36,8 +36,15 @@ void MockBackend::runPass(const PassDesc& pass, const PassContext& ctx) {
     m_passes.push_back(pass);
     ++m_stats.passesRun;
     if (pass.kind == PassKind::GBuffer)
-        for (const RenderMesh& m : ctx.view.meshes())
-            m_stats.drawCalls += m.visible ? 1 : 0;
+        for (const RenderMesh& m : ctx.view.meshes()) {
+            if (!m.visible) continue;
+            ++m_stats.drawCalls;
+            const MaterialMaps* maps =
+                m.material < ctx.view.materials().size() ? ctx.view.materials()[m.material].maps.get() : nullptr;
+            const bool mapped = maps && (!maps->diffuse.empty() || !maps->roughness.empty() ||
+                                         !maps->metallic.empty() || !maps->normal.empty());
+            m_stats.mappedDraws += mapped ? 1 : 0;
+        }
     if (pass.kind == PassKind::Lighting) {
         m_samples.assign(ctx.view.meshes().size(), {});
         for (size_t i = 0; i < ctx.view.meshes().size(); ++i) {

@@ -1,5 +1,6 @@
 // PNG through libpng's simplified API (zlib compression and CRCs are libpng's).
 #include "render/image.hpp"
+#include "sim/util/error.hpp"
 
 #include <png.h>
 
@@ -40,6 +41,49 @@ Image readPng(const std::filesystem::path& path) {
         const std::string why = png.message;
         png_image_free(&png);
         throw std::runtime_error(path.string() + ": cannot decode PNG: " + why);
+    }
+    return image;
+}
+
+std::string encodePng(const Image& image) {
+    if (image.width <= 0 || image.height <= 0 || image.rgba.size() != size_t(image.width) * image.height * 4)
+        throw std::invalid_argument("render::encodePng(): image is empty or its size is inconsistent");
+    png_image png;
+    std::memset(&png, 0, sizeof png);
+    png.version = PNG_IMAGE_VERSION;
+    png.width = png_uint_32(image.width);
+    png.height = png_uint_32(image.height);
+    png.format = PNG_FORMAT_RGBA;
+    png_alloc_size_t size = 0;
+    if (!png_image_write_to_memory(&png, nullptr, &size, 0, image.rgba.data(), 0, nullptr))
+        throw std::runtime_error(std::string("render::encodePng(): ") + png.message);
+    std::string out(size, '\0');
+    if (!png_image_write_to_memory(&png, out.data(), &size, 0, image.rgba.data(), 0, nullptr))
+        throw std::runtime_error(std::string("render::encodePng(): ") + png.message);
+    out.resize(size);
+    return out;
+}
+
+Image decodePng(std::string_view bytes, const std::string& origin, int maxSide) {
+    png_image png;
+    std::memset(&png, 0, sizeof png);
+    png.version = PNG_IMAGE_VERSION;
+    if (bytes.empty() || !png_image_begin_read_from_memory(&png, bytes.data(), bytes.size()))
+        throw InputError(origin + ": not a PNG image (" + std::string(bytes.empty() ? "empty" : png.message) + ")");
+    if (png.width == 0 || png.height == 0 || png.width > png_uint_32(maxSide) || png.height > png_uint_32(maxSide)) {
+        png_image_free(&png);
+        throw InputError(origin + ": PNG is " + std::to_string(png.width) + " x " + std::to_string(png.height) +
+                         " pixels (each side must be 1 to " + std::to_string(maxSide) + ")");
+    }
+    png.format = PNG_FORMAT_RGBA;
+    Image image;
+    image.width = int(png.width);
+    image.height = int(png.height);
+    image.rgba.resize(PNG_IMAGE_SIZE(png));
+    if (!png_image_finish_read(&png, nullptr, image.rgba.data(), 0, nullptr)) {
+        const std::string why = png.message;
+        png_image_free(&png);
+        throw InputError(origin + ": cannot decode PNG (" + why + ")");
     }
     return image;
 }

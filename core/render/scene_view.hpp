@@ -35,6 +35,8 @@ struct RenderMesh {
     std::vector<float> rest;       ///< #V × 3, m: rest positions (procedural pattern space)
     std::vector<float> thickness;  ///< #V, m: baked thickness [A §6.3.1]
     std::vector<float> sampleMap;  ///< #V: painted light samples (0 unpainted, else 1, 4 or 8)
+    /// #V × 2 or empty: texture coordinates for the material's maps (none: triplanar on `rest`)
+    std::vector<float> uv;
     /// #V × 4 (RGBA) or empty: an authoring overlay (the studio's weight ramp) blended over the
     /// diffuse colour by its alpha. Set with SceneView::setOverlay.
     std::vector<float> overlay;

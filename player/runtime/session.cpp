@@ -66,6 +66,20 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
         sd.nodeWeights = sim::parseNodeWeights(pkg.read(sd.nodeWeightsPath), pkg.name() + ":" + sd.nodeWeightsPath,
                                                surfaces[s].vertexCount());
     }
+    for (const render::CaseMaterialMaps& m : render::caseMaterialMaps(out.scene.render, pkg.name() + ":" + sceneName)) {
+        const std::string field = pkg.name() + ": " + sceneName + ": render.materials." + m.target + ": ";
+        bool named = false;
+        for (const sim::BodyDesc& b : out.scene.bodies)
+            named |= b.name == m.target;
+        for (const sim::SurfaceDesc& sd : out.scene.surfaces)
+            named |= sd.name == m.target;
+        if (!named) throw InputError(field + "'" + m.target + "' is not a body or surface of the scene");
+        for (const std::string& f : m.files())
+            if (!pkg.contains(f)) throw InputError(field + "'" + f + "' is not in the package");
+        out.materialMaps.emplace_back(m.target,
+                                      render::loadMaterialMaps(
+                                          m, [&pkg](const std::string& path) { return pkg.read(path); }, pkg.name()));
+    }
     if (out.scene.suture) { // the recorded needle trajectory travels with the case
         const std::string& path = out.scene.suture->trajectoryPath;
         if (!pkg.contains(path))
@@ -92,6 +106,8 @@ render::SceneView caseView(const LoadedCase& loaded) {
         if (!loaded.sampleMaps[b].empty())
             render::applyBodySampleMap(view, b, loaded.scene.bodies[b].name, loaded.sampleMaps[b],
                                        loaded.scene.surfaces);
+    for (const auto& [target, maps] : loaded.materialMaps)
+        render::applyMaterialMaps(view, target, maps);
     return view;
 }
 

@@ -25,6 +25,8 @@ struct LoadedCase {
     /// Per body: its painted light-sample classes per node (sample_map_file), empty when it has
     /// none. Loaded only when the case renders with painted sampling.
     std::vector<std::vector<uint8_t>> sampleMaps;
+    /// The material maps of render.materials, decoded: (body or surface name, maps).
+    std::vector<std::pair<std::string, std::shared_ptr<const render::MaterialMaps>>> materialMaps;
 };
 
 /// Verifies the package, parses its scene and assembles a World with only the subsystems the
@@ -34,7 +36,7 @@ LoadedCase loadCase(const std::filesystem::path& casePath);
 
 /// What the trainee sees of a loaded case: the world's bodies and surfaces
 /// (render::SceneView::fromWorld) with the case's painted sample maps on the bodies and on the
-/// fascia attached to them.
+/// fascia attached to them, and the case's material maps on the meshes they name.
 render::SceneView caseView(const LoadedCase& loaded);
 
 /// What the trainee window draws; the physics thread writes it after every frame.

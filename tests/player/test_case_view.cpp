@@ -2,6 +2,8 @@
 // renders with painted sampling, put on the body and on the fascia over it (player::caseView),
 // refused when the case would not use them or when the file is malformed.
 #include "case/case_writer.hpp"
+#include "render/case_settings.hpp"
+#include "render/image.hpp"
 #include "render/sample_map.hpp"
 #include "runtime/session.hpp"
 #include "sim/mesh/generators.hpp"
@@ -55,6 +57,53 @@ std::filesystem::path writeCase(const std::string& name, const std::string& samp
     return path;
 }
 
+/// A one-body case whose render block is `render` and which packages `files` (entry, bytes).
+std::filesystem::path writeMappedCase(const std::string& name, const nlohmann::json& render,
+                                      const std::vector<std::pair<std::string, std::string>>& files) {
+    const auto path = std::filesystem::temp_directory_path() /
+                      ("viscera_case_view_" + std::to_string(::getpid()) + "_" + name + ".vcase");
+    auto mesh = slab();
+    nlohmann::json scene = {
+        {"solver", {{"type", "xpbd"}, {"dt", 1.0 / 60}, {"substeps", 20}, {"iterations", 1}}},
+        {"render", render},
+        {"bodies",
+         {{{"name", "slab"},
+           {"mesh", "meshes/slab.vtet"},
+           {"material",
+            {{"model", "stable_neo_hookean"}, {"youngs_modulus", 5000}, {"poisson_ratio", 0.4}, {"density", 1000}}},
+           {"fixed_nodes", {0, 1, 2}}}}}};
+    vcase::Manifest m;
+    m.caseId = "view";
+    m.caseVersion = "1.0.0";
+    m.minPlayerVersion = "0.1.0";
+    m.features = {"xpbd"};
+    vcase::CaseWriter w(m);
+    w.addFile("scene.json", scene.dump());
+    w.addFile("meshes/slab.vtet", sim::formatVtet(*mesh));
+    for (const auto& [entry, bytes] : files)
+        w.addFile(entry, bytes);
+    w.write(path);
+    return path;
+}
+
+/// A w × h checker of two colours, 8 × 8 pixel squares.
+render::Image checker(int w, int h, uint8_t a, uint8_t b) {
+    render::Image img;
+    img.width = w;
+    img.height = h;
+    img.rgba.resize(size_t(w) * h * 4);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const uint8_t v = ((x / 8 + y / 8) & 1) ? a : b;
+            uint8_t* p = &img.rgba[(size_t(y) * w + x) * 4];
+            p[0] = v;
+            p[1] = uint8_t(255 - v);
+            p[2] = 40;
+            p[3] = 255;
+        }
+    return img;
+}
+
 std::string loadError(const std::filesystem::path& p) {
     try {
         player::loadCase(p);
@@ -106,4 +155,81 @@ TEST(CaseView, AMapTheCaseWouldNotUseOrAMalformedOneIsRefusedAtLoad) {
         EXPECT_EQ(c, 0.0f);
     for (const auto& p : {unused, malformed, shortMap, none})
         std::filesystem::remove(p);
+}
+
+TEST(CaseView, MaterialMapsOfTheCaseAreDecodedAndPutOnTheNamedMesh) {
+    const render::Image diffuse = checker(32, 32, 200, 30), rough = checker(32, 32, 90, 160);
+    const nlohmann::json render = {{"materials",
+                                    {{"slab",
+                                      {{"diffuse", "textures/slab_diffuse.png"},
+                                       {"roughness", "textures/slab_roughness.png"},
+                                       {"tiles_per_metre", 40}}}}}};
+    const auto path = writeMappedCase("maps", render,
+                                      {{"textures/slab_diffuse.png", render::encodePng(diffuse)},
+                                       {"textures/slab_roughness.png", render::encodePng(rough)}});
+    const player::LoadedCase c = player::loadCase(path);
+    ASSERT_EQ(c.materialMaps.size(), 1u);
+    EXPECT_EQ(c.materialMaps[0].first, "slab");
+    const render::MaterialMaps& maps = *c.materialMaps[0].second;
+    EXPECT_EQ(maps.diffuse.rgba, diffuse.rgba) << "decoded exactly";
+    EXPECT_EQ(maps.roughness.rgba, rough.rgba);
+    EXPECT_TRUE(maps.metallic.empty());
+    EXPECT_TRUE(maps.normal.empty());
+    EXPECT_FLOAT_EQ(maps.tilesPerMetre, 40.0f);
+    const render::SceneView view = player::caseView(c);
+    ASSERT_EQ(view.meshes().size(), 1u);
+    EXPECT_EQ(view.materials().at(view.meshes()[0].material).maps.get(), &maps) << "the body draws with them";
+    std::filesystem::remove(path);
+}
+
+TEST(CaseView, BadMaterialMapsAreRefusedAtLoadNamingTheFieldAndTheRule) {
+    const std::string png = render::encodePng(checker(16, 16, 10, 250));
+    const std::string big = render::encodePng(checker(32, 16, 10, 250));
+    auto error = [&](const std::string& name, const nlohmann::json& materials,
+                     const std::vector<std::pair<std::string, std::string>>& files) {
+        const auto path = writeMappedCase(name, {{"materials", materials}}, files);
+        const std::string e = loadError(path);
+        std::filesystem::remove(path);
+        return e;
+    };
+    const std::string where = ".vcase: scene.json: render.materials.";
+    EXPECT_NE(error("missing", {{"slab", {{"diffuse", "textures/d.png"}}}}, {})
+                  .find(where + "slab: 'textures/d.png' is not in the package"),
+              std::string::npos);
+    EXPECT_NE(error("target", {{"liver", {{"diffuse", "textures/d.png"}}}}, {{"textures/d.png", png}})
+                  .find(where + "liver: 'liver' is not a body or surface of the scene"),
+              std::string::npos);
+    EXPECT_NE(error("none", {{"slab", {{"tiles_per_metre", 10}}}}, {}).find("render.materials.slab: names no map"),
+              std::string::npos);
+    EXPECT_NE(error("key", {{"slab", {{"diffuse", "textures/d.png"}, {"albedo", "x.png"}}}}, {{"textures/d.png", png}})
+                  .find("render.materials.slab.albedo: unknown field"),
+              std::string::npos);
+    EXPECT_NE(error("escape", {{"slab", {{"diffuse", "../d.png"}}}}, {}).find("render.materials.slab.diffuse"),
+              std::string::npos);
+    EXPECT_NE(
+        error("tiles", {{"slab", {{"diffuse", "textures/d.png"}, {"tiles_per_metre", 0}}}}, {{"textures/d.png", png}})
+            .find("render.materials.slab.tiles_per_metre: must be in (0, 10000]"),
+        std::string::npos);
+    EXPECT_NE(error("notpng", {{"slab", {{"diffuse", "textures/d.png"}}}}, {{"textures/d.png", "not a png at all"}})
+                  .find("textures/d.png: not a PNG image"),
+              std::string::npos);
+    const std::string sizes = error("sizes", {{"slab", {{"diffuse", "textures/d.png"}, {"normal", "textures/n.png"}}}},
+                                    {{"textures/d.png", png}, {"textures/n.png", big}});
+    EXPECT_NE(
+        sizes.find("'textures/n.png' is 32 x 16, 'textures/d.png' is 16 x 16 (a material's maps must have one size)"),
+        std::string::npos)
+        << sizes;
+}
+
+TEST(CaseView, MaterialEntriesComeSortedByNameWithTheirFiles) {
+    // entries sorted by name, each with its files in the order diffuse, roughness, metallic, normal
+    const auto entries = render::caseMaterialMaps(
+        R"({"materials": {"b": {"normal": "t/b_n.png"}, "a": {"diffuse": "t/a.png", "metallic": "t/a_m.png"}}})",
+        "scene.json");
+    ASSERT_EQ(entries.size(), 2u);
+    EXPECT_EQ(entries[0].target, "a");
+    EXPECT_EQ(entries[0].files(), (std::vector<std::string>{"t/a.png", "t/a_m.png"}));
+    EXPECT_EQ(entries[1].files(), (std::vector<std::string>{"t/b_n.png"}));
+    EXPECT_TRUE(render::caseMaterialMaps("", "scene.json").empty());
+    EXPECT_TRUE(render::caseMaterialMaps(R"({"sss": true})", "scene.json").empty());
 }

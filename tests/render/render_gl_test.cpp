@@ -12,9 +12,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 
 using namespace viscera::render;
 namespace fs = std::filesystem;
@@ -307,4 +311,104 @@ TEST_F(RenderGl, AdaptiveSamplingBeatsUniformNearTheLight) {
     const double painted = compareImages(reference, render(s), nearMask).rmse;
     RecordProperty("rmse_painted_near", std::to_string(painted));
     EXPECT_LT(painted, 0.5 * uniform);
+}
+
+namespace {
+
+/// w × h, every pixel `rgba` except the bottom-left quadrant, which is `corner`.
+Image quadrantImage(int w, int h, std::array<uint8_t, 4> rgba, std::array<uint8_t, 4> corner) {
+    Image img;
+    img.width = w;
+    img.height = h;
+    img.rgba.resize(size_t(w) * h * 4);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            std::copy_n((x < w / 2 && y >= h / 2 ? corner : rgba).data(), 4, &img.rgba[(size_t(y) * w + x) * 4]);
+    return img;
+}
+
+/// Mean of red minus green over the pixels where `drawn` (the renderer's distance map) is >= 0.
+double redOverGreen(const Image& img, const std::vector<float>& drawn, size_t* count = nullptr) {
+    double sum = 0;
+    size_t n = 0;
+    for (size_t i = 0; i < drawn.size() && 4 * i + 3 < img.rgba.size(); ++i)
+        if (drawn[i] >= 0) {
+            sum += double(img.rgba[4 * i]) - img.rgba[4 * i + 1];
+            ++n;
+        }
+    if (count) *count = n;
+    return n ? sum / double(n) : 0.0;
+}
+
+} // namespace
+
+TEST_F(RenderGl, MaterialMapsReplaceTheProceduralLayersAndUploadOnce) {
+    // [A §6.2.2]: a diffuse map on the organ (triplanar on the rest position: it has no UVs)
+    const Image plain = render(settings, ImageStage::Unprocessed);
+    SceneView empty;
+    empty.addMaterial(defaultMaterialFor("liver"));
+    auto maps = std::make_shared<MaterialMaps>();
+    maps->diffuse = quadrantImage(64, 64, {20, 230, 20, 255}, {20, 230, 20, 255}); // all green
+    maps->tilesPerMetre = 30;
+    TissueMaterial mat = view.materials()[view.meshes()[0].material];
+    mat.maps = maps;
+    view.meshes()[0].material = view.addMaterial(mat);
+    const BackendStats before = renderer->renderer().backend().stats();
+    const Image mapped = render(settings, ImageStage::Unprocessed);
+    if (const char* d = std::getenv("VISCERA_GL_SHOTS")) {
+        writePng(fs::path(d) / "maps_plain.png", plain);
+        writePng(fs::path(d) / "maps_mapped.png", mapped);
+    }
+    const BackendStats after = renderer->renderer().backend().stats();
+    EXPECT_EQ(after.textureUploads - before.textureUploads, 1u) << "one map, uploaded on first use";
+    EXPECT_EQ(after.mappedDraws - before.mappedDraws, 1u);
+    render(settings, ImageStage::Unprocessed);
+    EXPECT_EQ(renderer->renderer().backend().stats().textureUploads, after.textureUploads) << "not again";
+    ASSERT_GT(compareImages(plain, mapped).differing, size_t(kW * kH / 10));
+    // the tissue's red turns green where the map is sampled
+    const std::vector<float> drawn = renderer->renderer().distanceMap(Eigen::Vector3f::Zero());
+    size_t pixels = 0;
+    EXPECT_GT(redOverGreen(plain, drawn, &pixels), 10.0);
+    EXPECT_GT(pixels, size_t(kW * kH / 10));
+    EXPECT_LT(redOverGreen(mapped, drawn), -10.0);
+    // a flat normal map (0, 0, 1) leaves the shading as it was; a tilted one changes it
+    maps->normal = quadrantImage(64, 64, {128, 128, 255, 255}, {128, 128, 255, 255});
+    mat.maps = std::make_shared<MaterialMaps>(*maps);
+    view.materials()[view.meshes()[0].material] = mat;
+    const ImageDifference flat = compareImages(mapped, render(settings, ImageStage::Unprocessed));
+    EXPECT_LE(flat.rmse, 1.0) << "flat normal map";
+    auto tilted = std::make_shared<MaterialMaps>(*maps);
+    tilted->normal = quadrantImage(64, 64, {230, 128, 180, 255}, {40, 200, 180, 255});
+    mat.maps = tilted;
+    view.materials()[view.meshes()[0].material] = mat;
+    const ImageDifference bumped = compareImages(mapped, render(settings, ImageStage::Unprocessed));
+    EXPECT_GT(bumped.rmse, 2.0) << "tilted normals change the lighting";
+    std::printf("material maps: flat normal map RMSE %.3f, tilted %.3f (8-bit) against the diffuse-only frame\n",
+                flat.rmse, bumped.rmse);
+    // no maps: the procedural frame exactly
+    view.meshes()[0].material = 0;
+    EXPECT_EQ(compareImages(plain, render(settings, ImageStage::Unprocessed)).differing, 0u);
+}
+
+TEST_F(RenderGl, MeshUvsSelectTheTexelsWithVZeroAtTheImageBottom) {
+    // every vertex at one UV: the whole organ shows that texel's colour
+    auto maps = std::make_shared<MaterialMaps>();
+    maps->diffuse = quadrantImage(64, 64, {230, 20, 20, 255}, {20, 230, 20, 255}); // green bottom-left
+    TissueMaterial mat = view.materials()[view.meshes()[0].material];
+    mat.maps = maps;
+    view.meshes()[0].material = view.addMaterial(mat);
+    RenderMesh& m = view.meshes()[0];
+    auto at = [&](float u, float v) {
+        m.uv.assign(2 * m.vertexCount(), 0.0f);
+        for (size_t i = 0; i < m.vertexCount(); ++i) {
+            m.uv[2 * i] = u;
+            m.uv[2 * i + 1] = v;
+        }
+        ++m.staticRevision;
+        const Image img = render(settings, ImageStage::Unprocessed);
+        return redOverGreen(img, renderer->renderer().distanceMap(Eigen::Vector3f::Zero()));
+    };
+    EXPECT_LT(at(0.25f, 0.25f), -10.0) << "v = 0.25: the bottom half of the image, left: green";
+    EXPECT_GT(at(0.25f, 0.75f), 10.0) << "v = 0.75: the top half: red";
+    EXPECT_GT(at(0.75f, 0.25f), 10.0) << "u = 0.75: the right half: red";
 }

@@ -33,6 +33,7 @@ namespace viscera::render::gl {
     X(PFNGLTEXIMAGE2DPROC, TexImage2D)                                                                                 \
     X(PFNGLTEXPARAMETERIPROC, TexParameteri)                                                                           \
     X(PFNGLACTIVETEXTUREPROC, ActiveTexture)                                                                           \
+    X(PFNGLGENERATEMIPMAPPROC, GenerateMipmap)                                                                         \
     X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers)                                                                       \
     X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers)                                                                 \
     X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer)                                                                       \

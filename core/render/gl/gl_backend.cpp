@@ -19,6 +19,8 @@ namespace {
 
 constexpr float kThicknessRange = 0.05f; ///< m: G-buffer thickness 1.0 (matches the bake's default maximum)
 constexpr int kMaxMaterials = 16;
+constexpr int kAttributeFloats = 11; ///< static attributes per vertex: rest xyz, thickness, samples, overlay rgba, uv
+constexpr GLsizei kAttributeBytes = kAttributeFloats * 4;
 
 std::string expandIncludes(std::string_view source, std::string* error) {
     std::string out;
@@ -124,6 +126,14 @@ struct GpuMesh {
     size_t drawIndices = 0; ///< leading indices drawn (face mask, [A §5.3.1])
 };
 
+/// The GPU copies of one material's maps (MaterialMaps), made the first time the material is drawn
+/// with them and again only when the material's maps object changes.
+struct MaterialTextures {
+    std::shared_ptr<const MaterialMaps> source;
+    GLuint texture[4] = {0, 0, 0, 0}; ///< diffuse, roughness, metallic, normal (0: none)
+    int mask = 0;                     ///< bit i: texture[i] present (the shader's uMapMask)
+};
+
 class GlBackend final : public Backend {
 public:
     explicit GlBackend(const gl::Api& api) : m_gl(api) {}
@@ -152,6 +162,9 @@ private:
     void bindTexture(Program& p, const char* uniform, int unit, GLuint texture);
     void beginFullscreen(Program& p, const PassDesc& pass);
     void gbufferPass(const PassDesc& pass, const PassContext& ctx);
+    /// The textures of material `index`, uploaded when its maps changed.
+    const MaterialTextures& texturesOf(size_t index, const TissueMaterial& material);
+    void freeTextures(MaterialTextures& t);
     void lightingPass(const PassDesc& pass, const PassContext& ctx);
     void postPass(const PassDesc& pass, const PassContext& ctx);
     void outputPass(const PassDesc& pass);
@@ -166,7 +179,8 @@ private:
     GLuint m_emptyVao = 0;
     RenderTarget m_gbufferTarget, m_lit, m_postA, m_postB, m_eyeLeft, m_eyeRight, m_final, m_scratch;
     std::vector<GpuMesh> m_meshes;
-    std::vector<uint32_t> m_maskScratch; ///< compacted indices of a face mask
+    std::vector<MaterialTextures> m_materialTextures; ///< by material index
+    std::vector<uint32_t> m_maskScratch;              ///< compacted indices of a face mask
     Target m_lastLitSource = Target::Lit;
 };
 
@@ -180,6 +194,56 @@ GlBackend::~GlBackend() {
          {&m_gbufferTarget, &m_lit, &m_postA, &m_postB, &m_eyeLeft, &m_eyeRight, &m_final, &m_scratch})
         freeTarget(*t);
     if (m_emptyVao) m_gl.DeleteVertexArrays(1, &m_emptyVao);
+    for (MaterialTextures& t : m_materialTextures)
+        freeTextures(t);
+}
+
+void GlBackend::freeTextures(MaterialTextures& t) {
+    for (GLuint& tex : t.texture)
+        if (tex) {
+            m_gl.DeleteTextures(1, &tex);
+            tex = 0;
+        }
+    t.mask = 0;
+    t.source.reset();
+}
+
+const MaterialTextures& GlBackend::texturesOf(size_t index, const TissueMaterial& material) {
+    if (m_materialTextures.size() <= index) m_materialTextures.resize(index + 1);
+    MaterialTextures& t = m_materialTextures[index];
+    if (t.source == material.maps) return t;
+    freeTextures(t);
+    t.source = material.maps;
+    if (!material.maps) return t;
+    const Image* images[4] = {&material.maps->diffuse, &material.maps->roughness, &material.maps->metallic,
+                              &material.maps->normal};
+    std::vector<uint8_t> flipped;
+    for (int k = 0; k < 4; ++k) {
+        const Image& img = *images[k];
+        if (img.empty() || img.width <= 0 || img.height <= 0 ||
+            img.rgba.size() != size_t(img.width) * size_t(img.height) * 4)
+            continue;
+        // texture row 0 is the image's bottom row: v = 0 at the bottom, as UVs are given
+        flipped.resize(img.rgba.size());
+        const size_t row = size_t(img.width) * 4;
+        for (int y = 0; y < img.height; ++y)
+            std::copy_n(img.rgba.begin() + ptrdiff_t(row * (img.height - 1 - y)), row,
+                        flipped.begin() + ptrdiff_t(row * y));
+        m_gl.GenTextures(1, &t.texture[k]);
+        m_gl.BindTexture(GL_TEXTURE_2D, t.texture[k]);
+        m_gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        m_gl.TexImage2D(GL_TEXTURE_2D, 0, k == 0 ? GL_SRGB8_ALPHA8 : GL_RGBA8, img.width, img.height, 0, GL_RGBA,
+                        GL_UNSIGNED_BYTE, flipped.data());
+        m_gl.GenerateMipmap(GL_TEXTURE_2D);
+        m_gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+        m_gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        m_gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+        m_gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+        t.mask |= 1 << k;
+        ++m_stats.textureUploads;
+    }
+    m_gl.BindTexture(GL_TEXTURE_2D, 0);
+    return t;
 }
 
 bool GlBackend::init(std::string* whyNot) {
@@ -322,11 +386,12 @@ void GlBackend::createMesh(size_t index, const RenderMesh& mesh) {
     m_gl.VertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
     buffer(g.heat, v * 4, GL_DYNAMIC_DRAW);
     m_gl.VertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, 0, nullptr);
-    buffer(g.attributes, v * 36, GL_STATIC_DRAW); // rest xyz, thickness, samples, overlay rgba
-    m_gl.VertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, 36, nullptr);
-    m_gl.VertexAttribPointer(5, 1, GL_FLOAT, GL_FALSE, 36, reinterpret_cast<const void*>(16));
-    m_gl.VertexAttribPointer(6, 4, GL_FLOAT, GL_FALSE, 36, reinterpret_cast<const void*>(20));
-    for (GLuint a = 0; a < 7; ++a)
+    buffer(g.attributes, v * kAttributeBytes, GL_STATIC_DRAW); // rest xyz, thickness, samples, overlay rgba, uv
+    m_gl.VertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, kAttributeBytes, nullptr);
+    m_gl.VertexAttribPointer(5, 1, GL_FLOAT, GL_FALSE, kAttributeBytes, reinterpret_cast<const void*>(16));
+    m_gl.VertexAttribPointer(6, 4, GL_FLOAT, GL_FALSE, kAttributeBytes, reinterpret_cast<const void*>(20));
+    m_gl.VertexAttribPointer(7, 2, GL_FLOAT, GL_FALSE, kAttributeBytes, reinterpret_cast<const void*>(36));
+    for (GLuint a = 0; a < 8; ++a)
         m_gl.EnableVertexAttribArray(a);
     m_gl.GenBuffers(1, &g.index);
     m_gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.index);
@@ -368,9 +433,10 @@ void GlBackend::updateMesh(size_t index, const RenderMesh& mesh, bool staticChan
     write(g.heat, mesh.heat.data(), v * 4);
     if (staticChanged) {
         const bool overlay = mesh.overlay.size() == 4 * v;
-        std::vector<float> attr(v * 9, 0.0f);
+        const bool uv = mesh.uv.size() == 2 * v;
+        std::vector<float> attr(v * kAttributeFloats, 0.0f);
         for (size_t i = 0; i < v; ++i) {
-            float* a = &attr[9 * i];
+            float* a = &attr[kAttributeFloats * i];
             a[0] = mesh.rest[3 * i + 0];
             a[1] = mesh.rest[3 * i + 1];
             a[2] = mesh.rest[3 * i + 2];
@@ -379,6 +445,10 @@ void GlBackend::updateMesh(size_t index, const RenderMesh& mesh, bool staticChan
             if (overlay)
                 for (int c = 0; c < 4; ++c)
                     a[5 + c] = mesh.overlay[4 * i + c];
+            if (uv) {
+                a[9] = mesh.uv[2 * i];
+                a[10] = mesh.uv[2 * i + 1];
+            }
         }
         write(g.attributes, attr.data(), attr.size() * 4);
     }
@@ -464,6 +534,17 @@ void GlBackend::gbufferPass(const PassDesc& pass, const PassContext& ctx) {
         p.set("uFlags", float(mat.flags));
         p.set("uDoubleSided", m.doubleSided ? 1 : 0);
         p.set("uScreenDoor", m.translucent ? 1 : 0);
+        const MaterialTextures& tex = texturesOf(m.material, mat);
+        p.set("uMapMask", tex.mask);
+        if (tex.mask) {
+            static const char* const kSamplers[4] = {"uDiffuseMap", "uRoughnessMap", "uMetallicMap", "uNormalMap"};
+            for (int k = 0; k < 4; ++k)
+                if (tex.texture[k]) bindTexture(p, kSamplers[k], k, tex.texture[k]);
+            p.set("uHasUv", m.uv.size() == 2 * m.vertexCount() && !m.uv.empty() ? 1 : 0);
+            p.set("uTilesPerMetre", mat.maps->tilesPerMetre);
+            p.set("uNormalStrength", mat.maps->normalStrength);
+            ++m_stats.mappedDraws;
+        }
         if (m.doubleSided)
             m_gl.Disable(GL_CULL_FACE);
         else {
