@@ -5,6 +5,11 @@
 //   viscera-studio export <project-dir> -o <case.vcase> [--project-file <json>]
 //   viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M] [--facet-size M]
 //                         [-o out.vtet]
+//   viscera-studio texture <spec.json> -o <dir>
+//
+// texture generates the quadtree pattern mask and the material maps of one layer from a texture
+// spec (bake/texture.hpp, README "Texture spec") and writes <dir>/<name>_<map>.png; stdout lists
+// the palette, the files written and the time of each phase.
 //
 // export --project-file reads the project text from <json> instead of <project-dir>/project.json
 // (its file references still resolve against <project-dir>): the authoring window exports its
@@ -18,10 +23,11 @@
 // failure is one line "viscera-studio: <message>" (no "stage"), exit code 1. The summary goes to
 // stdout.
 //
-// Exit codes: 0 success, 1 bad input (project, mesh), 2 usage.
+// Exit codes: 0 success, 1 bad input (project, mesh, texture spec), 2 usage.
 #include "app/studio_app.hpp"
 #include "bake/import.hpp"
 #include "bake/tetrahedralize.hpp"
+#include "bake/texture.hpp"
 #include "project/project.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/util/atomic_file.hpp"
@@ -32,8 +38,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <initializer_list>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace {
@@ -45,6 +53,7 @@ void usage(std::FILE* out) {
                "       viscera-studio export <project-dir> -o <case.vcase> [--project-file <json>]\n"
                "       viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M]\n"
                "                             [--facet-size M] [-o out.vtet]\n"
+               "       viscera-studio texture <spec.json> -o <dir>\n"
                "       viscera-studio --version\n",
                out);
 }
@@ -64,21 +73,39 @@ void printQuality(const sim::QualityReport& q) {
                 q.degenerate.size(), q.slivers.size(), q.totalVolume);
 }
 
-int cmdExport(const std::vector<std::string>& args) {
-    std::optional<std::string> dir, out, projectFile;
+/// The arguments of a command taking one operand, -o/--output <value> and the value options
+/// `extra` names ("--project-file"): throws std::invalid_argument for an unknown option, a missing
+/// value or a second operand.
+struct OperandArgs {
+    std::optional<std::string> operand, out;
+    std::vector<std::optional<std::string>> extra; ///< one per name in `extra`, in that order
+};
+OperandArgs parseOperandArgs(const std::vector<std::string>& args, std::initializer_list<std::string_view> extra = {}) {
+    OperandArgs r;
+    r.extra.resize(extra.size());
     for (size_t i = 0; i < args.size(); ++i) {
-        if (args[i] == "-o" || args[i] == "--output" || args[i] == "--project-file") {
+        std::optional<std::string>* value = args[i] == "-o" || args[i] == "--output" ? &r.out : nullptr;
+        for (size_t k = 0; k < extra.size(); ++k)
+            if (args[i] == extra.begin()[k]) value = &r.extra[k];
+        if (value) {
             if (i + 1 >= args.size()) throw std::invalid_argument(args[i] + " needs a value");
-            std::optional<std::string>& value = args[i] == "--project-file" ? projectFile : out;
-            value = args[++i];
+            *value = args[++i];
         } else if (!args[i].empty() && args[i][0] == '-') {
             throw std::invalid_argument("unknown option '" + args[i] + "'");
-        } else if (!dir) {
-            dir = args[i];
+        } else if (!r.operand) {
+            r.operand = args[i];
         } else {
             throw std::invalid_argument("unexpected argument '" + args[i] + "'");
         }
     }
+    return r;
+}
+
+int cmdExport(const std::vector<std::string>& args) {
+    const OperandArgs parsed = parseOperandArgs(args, {"--project-file"});
+    const std::optional<std::string>& dir = parsed.operand;
+    const std::optional<std::string>& out = parsed.out;
+    const std::optional<std::string>& projectFile = parsed.extra[0];
     if (!dir || !out) throw std::invalid_argument("export needs <project-dir> and -o <case.vcase>");
     const auto t0 = std::chrono::steady_clock::now();
     studio::Project project =
@@ -150,6 +177,41 @@ int cmdImport(const std::vector<std::string>& args) {
     return 0;
 }
 
+void printColors(const char* what, const std::vector<bake::PaletteColor>& colors) {
+    std::printf("  %s:", what);
+    for (const bake::PaletteColor& c : colors)
+        std::printf(" %s %.1f%%", bake::hexColor(c.color).c_str(), 100.0 * c.share);
+    std::printf("\n");
+}
+
+int cmdTexture(const std::vector<std::string>& args) {
+    const OperandArgs parsed = parseOperandArgs(args);
+    const std::optional<std::string>& specFile = parsed.operand;
+    const std::optional<std::string>& out = parsed.out;
+    if (!specFile || !out) throw std::invalid_argument("texture needs <spec.json> and -o <dir>");
+    const auto t0 = std::chrono::steady_clock::now();
+    const bake::TextureSpec spec = bake::loadTextureSpec(*specFile);
+    const double loadSecs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const bake::BakeTextureResult r = bake::bakeTexture(spec, *out);
+    const auto& q = spec.quadtree;
+    std::printf("texture %s: %dx%d, %d levels, %zu patterns, seed %llu%s\n", spec.name.c_str(), q.size, q.size,
+                q.levels, q.patterns.size(), static_cast<unsigned long long>(q.seed), q.tileable ? ", tileable" : "");
+    if (spec.palette && !spec.palette->imageFile.empty()) {
+        printColors(("palette of " + spec.palette->imageFile).c_str(), r.set.palette);
+        if (!r.set.prominent.empty()) printColors("prominent colours", r.set.prominent);
+    } else if (spec.palette) {
+        std::printf("  palette:");
+        for (const bake::Rgb8& c : r.set.colors)
+            std::printf(" %s", bake::hexColor(c).c_str());
+        std::printf("\n");
+    }
+    for (const bake::WrittenFile& f : r.files)
+        std::printf("  wrote %s (%llu bytes)\n", f.path.string().c_str(), static_cast<unsigned long long>(f.bytes));
+    std::printf("  time: load %.3f s, generate %.3f s, encode %.3f s, write %.3f s\n", loadSecs, r.generateSeconds,
+                r.encodeSeconds, r.writeSeconds);
+    return 0;
+}
+
 int g_argc = 0;
 char** g_argv = nullptr;
 
@@ -167,7 +229,7 @@ int main(int argc, char** argv) {
     program.name = "viscera-studio";
     program.version = VISCERA_VERSION;
     program.usage = usage;
-    program.subcommands = {{"export", cmdExport}, {"import", cmdImport}, {"open", cmdOpen}};
+    program.subcommands = {{"export", cmdExport}, {"import", cmdImport}, {"open", cmdOpen}, {"texture", cmdTexture}};
     program.noArguments = [] { return studio::runStudio(g_argc, g_argv, {}); };
     return sim::runCli(program, argc, argv);
 }

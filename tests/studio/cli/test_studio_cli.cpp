@@ -1,5 +1,6 @@
 // viscera-studio export --project-file: the project text comes from another file, its file
 // references resolve against <project-dir>; the progress lines on stderr are numbered stages.
+// viscera-studio texture <spec.json> -o <dir>: the files it writes and lists, one-line refusals.
 #include "case/case_package.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "support/run_process.hpp"
@@ -118,4 +119,50 @@ TEST(StudioCli, TheWindowWithoutADisplayIsRefusedWithOneLine) {
     const auto help = studio({"--help"});
     EXPECT_EQ(help.exitCode, 0);
     EXPECT_THAT(help.out, HasSubstr("open <project-dir>"));
+}
+
+namespace {
+
+/// A texture spec: one patterned level, an explicit palette, four maps.
+const char* kSpec = R"({
+  "size": 64, "seed": 3, "levels": 5,
+  "patterns": [{"level": 3, "tile": {"shape": "gaussian"}, "offset": {"radius": [0, 0.5]},
+                "scale": {"uniform": [0.8, 1.5]}, "opacity": [0.5, 1]}],
+  "palette": {"colors": ["#7a1f24", "#efc1a8"]},
+  "maps": {"diffuse": {}, "roughness": {"values": [0.6, 0.3]}, "height": {}, "normal": {"bit_depth": 16}}
+})";
+
+} // namespace
+
+TEST(StudioCli, TextureWritesTheMapsOfASpecAndListsThem) {
+    test::Scratch scratch("viscera-studio-texture");
+    const fs::path spec = scratch.dir / "mucosa.json";
+    writeFileAtomic(spec, kSpec);
+    const fs::path out = scratch.dir / "maps";
+    const auto r = studio({"texture", spec.string(), "-o", out.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_THAT(r.out, HasSubstr("texture mucosa: 64x64, 5 levels, 1 patterns, seed 3, tileable"));
+    EXPECT_THAT(r.out, HasSubstr("palette: #7a1f24 #efc1a8"));
+    for (const char* map : {"diffuse", "roughness", "height", "normal"}) {
+        const fs::path file = out / (std::string("mucosa_") + map + ".png");
+        ASSERT_TRUE(fs::is_regular_file(file)) << file;
+        EXPECT_THAT(r.out,
+                    HasSubstr("wrote " + file.string() + " (" + std::to_string(fs::file_size(file)) + " bytes)"));
+    }
+    EXPECT_FALSE(fs::exists(out / "mucosa_mask.png"));
+    EXPECT_THAT(r.out, HasSubstr("time: load "));
+    EXPECT_TRUE(r.err.empty()) << r.err;
+
+    // A bad spec: exit 1 and one line naming the file, the field and the rule.
+    std::string bad = kSpec;
+    bad.replace(bad.find("\"levels\": 5"), 11, "\"levels\": 5, \"colour\": 1");
+    writeFileAtomic(spec, bad);
+    const auto refused = studio({"texture", spec.string(), "-o", out.string()});
+    EXPECT_EQ(refused.exitCode, 1);
+    EXPECT_EQ(refused.err, "viscera-studio: " + spec.string() + ": colour: unknown field\n");
+    // Usage errors: exit 2; the usage text lists the command.
+    const auto usage = studio({"texture", spec.string()});
+    EXPECT_EQ(usage.exitCode, 2);
+    EXPECT_THAT(usage.err, HasSubstr("texture needs <spec.json> and -o <dir>"));
+    EXPECT_THAT(studio({"--help"}).out, HasSubstr("viscera-studio texture <spec.json> -o <dir>"));
 }

@@ -1,0 +1,557 @@
+// Procedural tissue textures [A §6.2]: the quadtree mask (determinism, seamless tiling, blend
+// modes, tile placement), the palette (threshold grouping and k-means), the material maps (normal
+// length after quantization) and the texture spec's refusals. Fixtures are written at run time.
+#include "bake/texture.hpp"
+
+#include "sim/util/atomic_file.hpp"
+#include "sim/util/error.hpp"
+#include "support/scratch_dir.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace viscera;
+using namespace viscera::bake;
+
+namespace {
+
+/// A 7-level quadtree with tiles on two levels (after [A Fig. 6.4]) and every map; `extra`
+/// members are spliced into the root object.
+std::string specText(int seed, const std::string& extra = "") {
+    return R"({
+  "name": "layer", "size": 128, "seed": )" +
+           std::to_string(seed) + R"(, "levels": 6, "bit_depth": 8,
+  "patterns": [
+    {"level": 3, "tile": {"shape": "gaussian", "sigma": 0.45}, "rotation_deg": [0, 360],
+     "offset": {"radius": [0, 0.5], "angle_deg": [0, 360]}, "scale": {"width": [0.8, 1.8], "height": [0.6, 1.4]},
+     "opacity": [0.5, 1], "blend": "add"},
+    {"level": 5, "tile": {"shape": "bell"}, "offset": {"radius": [0, 0.6]}, "scale": {"uniform": [0.6, 1.6]},
+     "opacity": [0.2, 0.6], "probability": 0.7, "blend": "max"}
+  ],
+  "palette": {"colors": ["#7a1f24", "#c65a4f", "#efc1a8"]},
+  "maps": {"mask": {"bit_depth": 16}, "diffuse": {}, "roughness": {"values": [0.6, 0.3]}, "metallic": {"values": [0, 0.1]},
+           "height": {"blur_px": 1}, "normal": {"depth": 0.02}, "palette": {"swatch_px": 8}})" +
+           extra + "}";
+}
+
+TextureSpec parse(const std::string& text, const fs::path& folder = ".") {
+    return parseTextureSpec(text, "spec.json", folder);
+}
+
+/// Largest |difference| across the wrap seam (column N-1 to 0, row N-1 to 0) and between
+/// neighbouring pixels inside the image.
+struct SeamFigures {
+    double seam = 0, interior = 0;
+};
+SeamFigures seamFigures(const GrayImage& m) {
+    SeamFigures f;
+    const int n = m.width;
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            if (x + 1 < n) f.interior = std::max(f.interior, double(std::abs(m.at(x + 1, y) - m.at(x, y))));
+            if (y + 1 < n) f.interior = std::max(f.interior, double(std::abs(m.at(x, y + 1) - m.at(x, y))));
+        }
+    for (int i = 0; i < n; ++i) {
+        f.seam = std::max(f.seam, double(std::abs(m.at(n - 1, i) - m.at(0, i))));
+        f.seam = std::max(f.seam, double(std::abs(m.at(i, n - 1) - m.at(i, 0))));
+    }
+    return f;
+}
+
+// CIE L*a*b* (D65) of an 8-bit sRGB colour, and ΔE*ab (CIE 1976).
+std::array<double, 3> lab(Rgb8 c) {
+    auto linear = [](uint8_t v) {
+        const double s = v / 255.0;
+        return s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
+    };
+    const double r = linear(c.r), g = linear(c.g), b = linear(c.b);
+    const double x = (0.4124564 * r + 0.3575761 * g + 0.1804375 * b) / 0.95047;
+    const double y = 0.2126729 * r + 0.7151522 * g + 0.0721750 * b;
+    const double z = (0.0193339 * r + 0.1191920 * g + 0.9503041 * b) / 1.08883;
+    auto f = [](double t) { return t > 216.0 / 24389.0 ? std::cbrt(t) : (24389.0 / 27.0 * t + 16) / 116; };
+    return {116 * f(y) - 16, 500 * (f(x) - f(y)), 200 * (f(y) - f(z))};
+}
+double deltaE(Rgb8 a, Rgb8 b) {
+    const auto p = lab(a), q = lab(b);
+    return std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
+}
+
+/// Angle between two vectors in degrees (atan2 of |a × b| and a · b: accurate near 0).
+double angleDeg(const double a[3], const double b[3]) {
+    const double cx = a[1] * b[2] - a[2] * b[1], cy = a[2] * b[0] - a[0] * b[2], cz = a[0] * b[1] - a[1] * b[0];
+    const double dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    return std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), dot) * 180 / std::numbers::pi;
+}
+
+/// 100 × 60 pixels: three flat colours on 50 %, 30 % and 20 % of the image (columns 0-49, 50-79,
+/// 80-99), each pixel's channels moved by a deterministic -3..+4.
+const Rgb8 kFlat[3] = {{180, 60, 70}, {230, 190, 160}, {90, 20, 30}};
+Rgb8Image threeColours() {
+    Rgb8Image im{100, 60, {}};
+    uint32_t state = 12345;
+    for (int y = 0; y < im.height; ++y)
+        for (int x = 0; x < im.width; ++x) {
+            const Rgb8 c = kFlat[x < 50 ? 0 : x < 80 ? 1 : 2];
+            for (uint8_t v : {c.r, c.g, c.b}) {
+                state = state * 1664525u + 1013904223u;
+                im.pixels.push_back(static_cast<uint8_t>(v + static_cast<int>(state >> 29) - 3));
+            }
+        }
+    return im;
+}
+
+/// A smooth two-dimensional colour field with noise: many distinct colours for k-means.
+Rgb8Image gradientImage() {
+    Rgb8Image im{80, 80, {}};
+    uint32_t state = 99;
+    for (int y = 0; y < im.height; ++y)
+        for (int x = 0; x < im.width; ++x) {
+            state = state * 1664525u + 1013904223u;
+            const int noise = static_cast<int>(state >> 28) - 8;
+            im.pixels.push_back(static_cast<uint8_t>(std::clamp(40 + 2 * x + noise, 0, 255)));
+            im.pixels.push_back(static_cast<uint8_t>(std::clamp(30 + y + noise, 0, 255)));
+            im.pixels.push_back(static_cast<uint8_t>(std::clamp(200 - x - y / 2, 0, 255)));
+        }
+    return im;
+}
+
+/// One pattern covering the whole image with a constant `value`: discs 4 × their node, whose
+/// borders lie outside the image (level 0) or beyond the next node's centre (level 1).
+LevelPattern flatLevel(int level, double value, BlendMode blend) {
+    LevelPattern p;
+    p.level = level;
+    p.tile.shape = TileShape::Disc;
+    p.width = p.height = {4, 4};
+    p.opacity = {value, value};
+    p.blend = blend;
+    return p;
+}
+
+} // namespace
+
+// ---- quadtree mask ----------------------------------------------------------------------------
+
+TEST(TextureMask, SameSpecAndSeedGiveIdenticalPngBytesAndAnotherSeedDiffers) {
+    const TextureSpec a = parse(specText(7));
+    const std::vector<EncodedFile> first = encodeTextureSet(a, generateTextureSet(a));
+    const std::vector<EncodedFile> second = encodeTextureSet(a, generateTextureSet(parse(specText(7))));
+    ASSERT_EQ(first.size(), 8u); // mask, diffuse, roughness, metallic, height, normal, palette png + json
+    ASSERT_EQ(first.size(), second.size());
+    for (size_t i = 0; i < first.size(); ++i) {
+        EXPECT_EQ(first[i].fileName, second[i].fileName);
+        EXPECT_TRUE(first[i].bytes == second[i].bytes) << first[i].fileName;
+    }
+    EXPECT_EQ(first[0].fileName, "layer_mask.png");
+    const TextureSpec b = parse(specText(8));
+    const std::vector<EncodedFile> other = encodeTextureSet(b, generateTextureSet(b));
+    for (size_t i = 0; i < 6; ++i) // every map depends on the mask
+        EXPECT_FALSE(first[i].bytes == other[i].bytes) << first[i].fileName;
+    // The mask itself, not only its encoding: equal floats for a seed, different for another.
+    EXPECT_EQ(generateMask(a.quadtree).pixels, generateMask(a.quadtree).pixels);
+    EXPECT_NE(generateMask(a.quadtree).pixels, generateMask(b.quadtree).pixels);
+}
+
+TEST(TextureMask, TileableMaskHasNoSeamAndAClippedOneHas) {
+    // Tiles larger than their nodes with polar offsets: many cross the borders.
+    QuadtreeParams q = parse(specText(3)).quadtree;
+    q.size = 256;
+    const GrayImage wrapped = generateMask(q);
+    const SeamFigures t = seamFigures(wrapped);
+    RecordProperty("tileable_seam_max_diff", std::to_string(t.seam));
+    RecordProperty("tileable_interior_max_diff", std::to_string(t.interior));
+    EXPECT_GT(t.interior, 0.01); // the mask is not flat
+    EXPECT_LE(t.seam, t.interior) << "seam " << t.seam << ", interior " << t.interior;
+
+    q.tileable = false;
+    const SeamFigures c = seamFigures(generateMask(q));
+    RecordProperty("clipped_seam_max_diff", std::to_string(c.seam));
+    RecordProperty("clipped_interior_max_diff", std::to_string(c.interior));
+    EXPECT_GT(c.seam, c.interior) << "seam " << c.seam << ", interior " << c.interior;
+}
+
+TEST(TextureMask, BlendModesCombineLevelsAndClamp) {
+    QuadtreeParams q;
+    q.size = 16;
+    q.levels = 2;
+    q.base = 0.2;
+    const struct {
+        BlendMode mode;
+        float expected; // canvas 0.2 + 0.6 = 0.8, then the mode with 0.5
+    } cases[] = {{BlendMode::Add, 1.0f},
+                 {BlendMode::Subtract, 0.3f},
+                 {BlendMode::Max, 0.8f},
+                 {BlendMode::Min, 0.5f},
+                 {BlendMode::Multiply, 0.4f}};
+    for (const auto& c : cases) {
+        q.patterns = {flatLevel(1, 0.5, c.mode), flatLevel(0, 0.6, BlendMode::Add)}; // applied coarse to fine
+        for (float v : generateMask(q).pixels)
+            ASSERT_NEAR(v, c.expected, 1e-6) << static_cast<int>(c.mode);
+    }
+    q.patterns = {flatLevel(0, 0.6, BlendMode::Add)};
+    q.patterns[0].probability = 0;
+    for (float v : generateMask(q).pixels)
+        ASSERT_FLOAT_EQ(v, 0.2f);
+    q.patterns = {flatLevel(0, 0.6, BlendMode::Add), flatLevel(1, 0.5, BlendMode::Add)};
+    q.patterns[1].level = 0;
+    EXPECT_THAT([&] { generateMask(q); }, testing::ThrowsMessage<std::invalid_argument>(testing::StrEq(
+                                              "bake::generateMask(): patterns[1].level 0 already has a pattern")));
+}
+
+TEST(TextureMask, PolarOffsetMovesTheTileAndWrapsAroundTheBorder) {
+    QuadtreeParams q;
+    q.size = 64;
+    q.levels = 1;
+    LevelPattern p;
+    p.tile.shape = TileShape::Disc;
+    p.width = p.height = {0.25, 0.25}; // radius 8 px
+    p.offsetRadius = {0.25, 0.25};
+    p.offsetAngleDeg = {90, 90}; // counter-clockwise from +x as displayed: up
+    q.patterns = {p};
+    const GrayImage up = generateMask(q);
+    double sx = 0, sy = 0, sum = 0;
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) {
+            sum += up.at(x, y);
+            sx += up.at(x, y) * (x + 0.5);
+            sy += up.at(x, y) * (y + 0.5);
+        }
+    EXPECT_NEAR(sx / sum, 32.0, 0.05);
+    EXPECT_NEAR(sy / sum, 16.0, 0.05);          // 0.25 × 64 above the centre
+    EXPECT_NEAR(sum, std::numbers::pi * 64, 2); // the disc's area
+
+    q.patterns[0].offsetRadius = {0.5, 0.5};
+    q.patterns[0].offsetAngleDeg = {0, 0}; // centre on the right border: half on each side
+    const GrayImage split = generateMask(q);
+    EXPECT_FLOAT_EQ(split.at(0, 32), 1.0f);
+    EXPECT_FLOAT_EQ(split.at(63, 32), 1.0f);
+    EXPECT_FLOAT_EQ(split.at(32, 32), 0.0f);
+    for (int y = 0; y < 64; ++y)
+        for (int d = 0; d < 10; ++d)
+            EXPECT_FLOAT_EQ(split.at(d, y), split.at(63 - d, y)) << d << ", " << y;
+}
+
+TEST(TextureMask, ImageTileIsStretchedOverTheTileAndRotated) {
+    GrayImage ramp{32, 32, {}};
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x)
+            ramp.pixels.push_back((x + 0.5f) / 32.0f);
+    QuadtreeParams q;
+    q.size = 64;
+    q.levels = 1;
+    LevelPattern p;
+    p.tile.shape = TileShape::Image;
+    p.tile.image = ramp;
+    q.patterns = {p};
+    const GrayImage flat = generateMask(q); // the ramp at twice its size
+    for (int x = 2; x < 62; ++x)
+        EXPECT_NEAR(flat.at(x, 30), (x + 0.5) / 64.0, 0.02) << x;
+    q.patterns[0].rotationDeg = {90, 90}; // image x now points up the screen
+    const GrayImage turned = generateMask(q);
+    for (int y = 2; y < 62; ++y)
+        EXPECT_NEAR(turned.at(30, y), 1.0 - (y + 0.5) / 64.0, 0.02) << y;
+}
+
+// ---- palette ----------------------------------------------------------------------------------
+
+TEST(TexturePalette, ThreeFlatColoursAreFoundSortedByShare) {
+    const Rgb8Image im = threeColours();
+    PaletteParams threshold;
+    threshold.threshold = 24;
+    PaletteParams kmeans;
+    kmeans.method = PaletteMethod::KMeans;
+    kmeans.k = 3;
+    kmeans.seed = 5;
+    for (const PaletteParams& params : {threshold, kmeans}) {
+        const std::vector<PaletteColor> p = extractPalette(im, params);
+        ASSERT_EQ(p.size(), 3u);
+        const double shares[3] = {0.5, 0.3, 0.2};
+        double worst = 0;
+        for (size_t i = 0; i < 3; ++i) {
+            worst = std::max(worst, deltaE(p[i].color, kFlat[i]));
+            EXPECT_LT(deltaE(p[i].color, kFlat[i]), 2.0) << hexColor(p[i].color) << " vs " << hexColor(kFlat[i]);
+            EXPECT_DOUBLE_EQ(p[i].share, shares[i]);
+        }
+        RecordProperty(params.method == PaletteMethod::Threshold ? "threshold_max_delta_e" : "kmeans_max_delta_e",
+                       std::to_string(worst));
+    }
+    // A threshold larger than the colours' distances merges them; the proportional map's bars
+    // follow the shares.
+    threshold.threshold = 256;
+    const std::vector<PaletteColor> one = extractPalette(im, threshold);
+    ASSERT_EQ(one.size(), 1u);
+    EXPECT_DOUBLE_EQ(one[0].share, 1.0);
+    const Rgb8Image bars = proportionalMap(extractPalette(im, PaletteParams{}), 100, 4);
+    EXPECT_EQ(bars.width, 100);
+    auto at = [&](int x) {
+        return Rgb8{bars.pixels[3 * size_t(x)], bars.pixels[3 * size_t(x) + 1], bars.pixels[3 * size_t(x) + 2]};
+    };
+    EXPECT_LT(deltaE(at(49), kFlat[0]), 2.0);
+    EXPECT_LT(deltaE(at(50), kFlat[1]), 2.0);
+    EXPECT_LT(deltaE(at(79), kFlat[1]), 2.0);
+    EXPECT_LT(deltaE(at(80), kFlat[2]), 2.0);
+    EXPECT_EQ(hexColor({0x7a, 0x1f, 0x24}), "#7a1f24");
+    EXPECT_EQ(parseHexColor("#7A1F24"), (Rgb8{0x7a, 0x1f, 0x24}));
+    EXPECT_FALSE(parseHexColor("#7a1f2"));
+    EXPECT_FALSE(parseHexColor("7a1f24x"));
+}
+
+TEST(TexturePalette, KMeansWithAFixedSeedIsReproducible) {
+    const Rgb8Image im = gradientImage();
+    PaletteParams p;
+    p.method = PaletteMethod::KMeans;
+    p.k = 5;
+    p.seed = 42;
+    const std::vector<PaletteColor> a = extractPalette(im, p), b = extractPalette(im, p);
+    ASSERT_EQ(a.size(), 5u);
+    double shares = 0;
+    for (size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(a[i].color, b[i].color);
+        EXPECT_EQ(a[i].pixels, b[i].pixels);
+        if (i > 0) {
+            EXPECT_GE(a[i - 1].pixels, a[i].pixels);
+        }
+        shares += a[i].share;
+    }
+    EXPECT_NEAR(shares, 1.0, 1e-12);
+    // The threshold grouping of the same image: every pixel in exactly one group.
+    PaletteParams t;
+    t.maxColors = 256;
+    uint64_t pixels = 0;
+    for (const PaletteColor& c : extractPalette(im, t))
+        pixels += c.pixels;
+    EXPECT_EQ(pixels, 80u * 80u);
+}
+
+// ---- material maps ----------------------------------------------------------------------------
+
+TEST(TextureMaps, NormalsFollowTheHeightByCentralDifferences) {
+    // h = 0.5 + 0.25 sin(2πx/N): n_x = -s (h(x+1) - h(x-1)) / 2 / |(...)|, n_y = 0; wrap at x = 0.
+    const int n = 32;
+    GrayImage h{n, n, {}};
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+            h.pixels.push_back(static_cast<float>(0.5 + 0.25 * std::sin(2 * std::numbers::pi * x / n)));
+    const double depth = 0.05, s = depth * n;
+    const RgbImage normals = normalsFromHeight(h, depth, true);
+    for (int x = 0; x < n; ++x) {
+        const double g = (h.at((x + 1) % n, 3) - h.at((x + n - 1) % n, 3)) / 2.0;
+        const double len = std::sqrt(s * s * g * g + 1);
+        const float* v = &normals.pixels[3 * (size_t(3) * n + x)];
+        EXPECT_NEAR(v[0], -s * g / len, 1e-6) << x;
+        EXPECT_NEAR(v[1], 0.0, 1e-6);
+        EXPECT_NEAR(v[2], 1.0 / len, 1e-6);
+    }
+    // Height rising down the rows tilts the normal up the image (+y, OpenGL convention).
+    GrayImage rows{4, 4, {}};
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x)
+            rows.pixels.push_back(y / 3.0f);
+    EXPECT_GT(normalsFromHeight(rows, 0.1, false).pixels[3 * 5 + 1], 0.1f);
+}
+
+TEST(TextureMaps, NormalMapsAreUnitLengthAfter8And16BitDecoding) {
+    const TextureSpec spec = parse(specText(11));
+    const TextureSet set = generateTextureSet(spec);
+    const RgbImage& normals = set.maps.normal;
+    ASSERT_EQ(normals.width, 128);
+    for (int bits : {8, 16}) {
+        const DecodedImage d = decodeImage(encodeNormalPng(normals, bits), "normal.png");
+        ASSERT_EQ(d.bits, bits);
+        ASSERT_EQ(d.channels, 3);
+        const double maxCode = bits == 8 ? 255.0 : 65535.0;
+        double lengthError = 0, angle = 0, tilt = 0;
+        for (size_t i = 0; i < d.samples.size(); i += 3) {
+            double v[3], n[3], len = 0;
+            for (int c = 0; c < 3; ++c) {
+                v[c] = 2.0 * d.samples[i + size_t(c)] / maxCode - 1.0;
+                n[c] = normals.pixels[i + size_t(c)];
+                len += v[c] * v[c];
+            }
+            lengthError = std::max(lengthError, std::abs(std::sqrt(len) - 1.0));
+            angle = std::max(angle, angleDeg(v, n));
+            tilt = std::max(tilt, std::acos(double(normals.pixels[i + 2])) * 180 / std::numbers::pi);
+        }
+        RecordProperty("normal" + std::to_string(bits) + "_max_length_error", std::to_string(lengthError));
+        RecordProperty("normal" + std::to_string(bits) + "_max_angle_error_deg", std::to_string(angle));
+        EXPECT_LE(lengthError, kNormalLengthTolerance) << bits << " bits";
+        EXPECT_GT(tilt, 10.0); // the map has real slopes
+        EXPECT_LT(angle, bits == 8 ? 3.5 : 0.01) << bits << " bits";
+    }
+}
+
+TEST(TextureMaps, EightBitNormalCodesStayUnitLengthOverAllDirections) {
+    // Directions over the upper hemisphere, dense near the pole where the codes are coarsest in
+    // length, and the plain nearest code's error for comparison.
+    double worstLength = 0, worstAngle = 0, nearestLength = 0;
+    for (int i = 0; i < 200; ++i)
+        for (int j = 0; j < 90; ++j) {
+            const double theta = std::pow(i / 199.0, 2) * 1.45, phi = j * 2 * std::numbers::pi / 90;
+            const double n[3] = {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
+            const std::array<uint8_t, 3> c = encodeUnitNormal8(n[0], n[1], n[2]);
+            double v[3], len = 0, lenNearest = 0;
+            for (int k = 0; k < 3; ++k) {
+                v[k] = c[size_t(k)] / 127.5 - 1;
+                const double r = std::round((n[k] + 1) * 127.5) / 127.5 - 1;
+                len += v[k] * v[k];
+                lenNearest += r * r;
+            }
+            worstLength = std::max(worstLength, std::abs(std::sqrt(len) - 1));
+            worstAngle = std::max(worstAngle, angleDeg(v, n));
+            nearestLength = std::max(nearestLength, std::abs(std::sqrt(lenNearest) - 1));
+        }
+    RecordProperty("unit8_max_length_error", std::to_string(worstLength));
+    RecordProperty("unit8_max_angle_error_deg", std::to_string(worstAngle));
+    RecordProperty("nearest8_max_length_error", std::to_string(nearestLength));
+    EXPECT_LE(worstLength, kNormalLengthTolerance);
+    EXPECT_GT(nearestLength, kNormalLengthTolerance); // why the search is needed
+    EXPECT_LT(worstAngle, 3.5); // the price of unit length in 8 bits (nearest codes: under 0.4 degrees)
+}
+
+TEST(TextureMaps, MapsFollowTheMaskAndThePaletteGradient) {
+    GrayImage mask{4, 2, {0.0f, 0.25f, 0.5f, 1.0f, 0.75f, 0.1f, 0.9f, 0.6f}};
+    MaterialParams p;
+    p.diffuseColors = {{0, 0, 0}, {255, 128, 0}, {255, 255, 255}};
+    p.roughness = {0.8, 0.2};
+    p.metallic = {0, 0};
+    const MaterialMaps m = generateMaps(mask, p);
+    ASSERT_EQ(m.diffuse.width, 4);
+    const float at25[3] = {0.5f, 128.0f / 255 / 2, 0.0f};
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(m.diffuse.pixels[3 + size_t(c)], at25[c], 1e-6);
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(m.diffuse.pixels[9 + size_t(c)], 1.0f, 1e-6);
+    EXPECT_NEAR(m.roughness.pixels[2], 0.5f, 1e-6);
+    EXPECT_NEAR(m.roughness.pixels[3], 0.2f, 1e-6);
+    EXPECT_EQ(m.metallic.pixels, std::vector<float>(8, 0.0f));
+    EXPECT_EQ(m.height.pixels, mask.pixels);
+    EXPECT_EQ(m.normal.pixels.size(), 8u * 3u);
+    p.diffuseStops = {0.0, 0.9, 1.0};
+    EXPECT_NEAR(generateMaps(mask, p).diffuse.pixels[3 * 6], 1.0f, 1e-6); // mask 0.9 → the middle colour's red
+}
+
+// ---- spec -------------------------------------------------------------------------------------
+
+namespace {
+
+std::string refusal(const std::string& text, const fs::path& folder = ".") {
+    try {
+        parse(text, folder);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(accepted)";
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
+} // namespace
+
+TEST(TextureSpec, BadSpecsAreRefusedWithOneLineNamingTheField) {
+    const std::string good = specText(1);
+    EXPECT_EQ(refusal(good), "(accepted)");
+    EXPECT_EQ(refusal(specText(1, R"(, "colour": 3)")), "spec.json: colour: unknown field");
+    // Each case: a piece of the good spec, what replaces it, the message.
+    const struct {
+        const char *from, *to, *message;
+    } cases[] = {
+        {R"("shape": "bell")", R"("shape": "bell", "sigma": 0.3)", "patterns[1].tile.sigma: unknown field"},
+        {R"("opacity": [0.5, 1])", R"("opacity": [0.5, 1.5])", "patterns[0].opacity[1]: must be in [0, 1]"},
+        {R"("opacity": [0.5, 1])", R"("opacity": [0.9, 0.5])",
+         "patterns[0].opacity: [0.9, 0.5] is not an interval (lower bound above upper)"},
+        {R"("size": 128)", R"("size": 1000)", "size: must be a power of two (1000 is not)"},
+        {R"("size": 128)", R"("size": 8192)", "size: must be an integer in [8, 4096]"},
+        {R"("levels": 6)", R"("levels": 9)", "levels: must be an integer in [1, 8]"},
+        {R"("level": 5)", R"("level": 3)", "patterns[1].level: level 3 already has a pattern (patterns[0])"},
+        {R"("blend": "max")", R"("blend": "screen")",
+         "patterns[1].blend: 'screen' is not a blend mode (add, subtract, max, min, multiply)"},
+        {R"("bit_depth": 8)", R"("bit_depth": 12)", "bit_depth: must be 8 or 16"},
+        {R"("#c65a4f")", R"("#c65a4")", "palette.colors[1]: '#c65a4' is not a colour (#rrggbb)"},
+        {R"("diffuse": {})", R"("diffuse": {"colors": [0, 3]})",
+         "maps.diffuse.colors[1]: palette index 3 is out of range (the palette has 3 colours)"},
+        {R"("normal": {"depth": 0.02})", R"("normal": {"depth": 0})", "maps.normal.depth: must be in (0, 1]"},
+        {R"("scale": {"uniform": [0.6, 1.6]})", R"("scale": {"uniform": [0.6, 5]})",
+         "patterns[1].scale.uniform[1]: must be in (0, 4]"},
+        {R"("seed": 1)", R"("seed": -1)", "seed: must not be negative"},
+        {R"("palette": {"colors": ["#7a1f24", "#c65a4f", "#efc1a8"]},)", "",
+         "palette: required field is missing (maps.diffuse uses it)"},
+    };
+    for (const auto& c : cases)
+        EXPECT_EQ(refusal(replaced(good, c.from, c.to)), std::string("spec.json: ") + c.message);
+    EXPECT_EQ(refusal("{\"size\": 64, \"size\": 32}"), "spec.json: invalid JSON (duplicate object key \"size\")");
+}
+
+TEST(TextureSpec, FilesMustStayInsideTheSpecsFolder) {
+    test::Scratch scratch("viscera-texture");
+    const fs::path folder = scratch.dir / "spec";
+    writeFileAtomic(folder / "refs" / "liver.png", encodePng(threeColours()));
+    writeFileAtomic(scratch.dir / "outside.png", encodePng(threeColours()));
+    auto withImage = [](const std::string& path, const std::string& extra = "") {
+        return replaced(specText(1), R"("colors": ["#7a1f24", "#c65a4f", "#efc1a8"])",
+                        "\"image\": \"" + path + "\"" + extra);
+    };
+    EXPECT_EQ(refusal(withImage("../outside.png"), folder),
+              "spec.json: palette.image: '../outside.png' escapes the spec's folder ('..' component)");
+    EXPECT_EQ(refusal(withImage("refs/../../outside.png"), folder),
+              "spec.json: palette.image: 'refs/../../outside.png' escapes the spec's folder ('..' component)");
+    EXPECT_EQ(refusal(withImage((scratch.dir / "outside.png").string()), folder),
+              "spec.json: palette.image: '" + (scratch.dir / "outside.png").string() +
+                  "' is an absolute path (files are named relative to the spec's folder)");
+    fs::create_symlink(scratch.dir / "outside.png", folder / "link.png");
+    EXPECT_EQ(refusal(withImage("link.png"), folder),
+              "spec.json: palette.image: 'link.png' resolves outside the spec's folder (symbolic link)");
+    EXPECT_EQ(refusal(withImage("refs/missing.png"), folder),
+              "spec.json: palette.image: " + (folder / "refs/missing.png").string() +
+                  ": cannot open for reading (file not found)");
+    EXPECT_EQ(refusal(withImage("refs/liver.png", R"(, "threshold": 40, "prominent_threshold": 30)"), folder),
+              "spec.json: palette.prominent_threshold: must be at least the threshold (40)");
+    EXPECT_EQ(refusal(withImage("refs/liver.png", R"(, "k": 4)"), folder), "spec.json: palette.k: unknown field");
+
+    // Accepted: the palette of the reference image, the prominent-colour map, all written.
+    const TextureSpec spec =
+        parse(replaced(withImage("refs/liver.png", R"(, "method": "kmeans", "k": 3)"), R"("palette": {"swatch_px": 8})",
+                       R"("palette": {"swatch_px": 8}, "prominent": {"width": 100, "height": 10})"),
+              folder);
+    const fs::path out = scratch.dir / "out";
+    const BakeTextureResult r = bakeTexture(spec, out);
+    ASSERT_EQ(r.files.size(), 9u);
+    for (const WrittenFile& f : r.files) {
+        EXPECT_EQ(fs::file_size(f.path), f.bytes) << f.path;
+        if (f.path.extension() != ".png") continue;
+        const DecodedImage d = decodeImage(readFile(f.path), f.path.string());
+        const std::string stem = f.path.stem().string();
+        if (stem == "layer_palette") {
+            EXPECT_EQ(d.width, 3 * 8);
+        } else if (stem == "layer_prominent") {
+            EXPECT_EQ(d.width, 100);
+        } else {
+            EXPECT_EQ(d.width, 128) << stem;
+            EXPECT_EQ(d.bits, stem == "layer_mask" ? 16 : 8) << stem;
+        }
+    }
+    const nlohmann::json j = nlohmann::json::parse(readFile(out / "layer_palette.json"));
+    ASSERT_EQ(j["palette"].size(), 3u);
+    for (size_t i = 0; i < 3; ++i)
+        EXPECT_LT(deltaE(*parseHexColor(j["palette"][i]["color"].get<std::string>()), kFlat[i]), 2.0);
+    EXPECT_DOUBLE_EQ(j["palette"][0]["share"].get<double>(), 0.5);
+    EXPECT_EQ(j["source"], "refs/liver.png");
+    EXPECT_EQ(r.set.prominent.size(), 3u); // threshold 64 keeps the three colours apart
+
+    // The output folder is checked before any work.
+    EXPECT_THAT([&] { bakeTexture(spec, out / "layer_mask.png"); },
+                testing::ThrowsMessage<InputError>(
+                    testing::StrEq((out / "layer_mask.png").string() + ": the output folder is a file, not a folder")));
+}
