@@ -24,14 +24,18 @@ std::vector<CaseMaterialMaps> readMaterials(const sim::JsonField& root) {
         for (const auto& [key, path] : maps)
             if (auto f = m.find(key)) *path = f->entryPath();
         if (c.files().empty()) m.fail("names no map (give at least one of diffuse, roughness, metallic, normal)");
-        c.tilesPerMetre = float(m.number("tiles_per_metre", c.tilesPerMetre, sim::NumberRule::aboveUpTo(0, 1e4)));
-        c.normalStrength = float(m.number("normal_strength", c.normalStrength, sim::NumberRule::closed(0, 4)));
+        readMapLayout(m, c.tilesPerMetre, c.normalStrength);
         out.push_back(std::move(c));
     }
     return out;
 }
 
 } // namespace
+
+void readMapLayout(const sim::JsonField& j, float& tilesPerMetre, float& normalStrength) {
+    tilesPerMetre = float(j.number("tiles_per_metre", tilesPerMetre, sim::NumberRule::aboveUpTo(0, 1e4)));
+    normalStrength = float(j.number("normal_strength", normalStrength, sim::NumberRule::closed(0, 4)));
+}
 
 std::vector<std::string> CaseMaterialMaps::files() const {
     std::vector<std::string> f;

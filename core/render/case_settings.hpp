@@ -28,6 +28,10 @@
 #include <string_view>
 #include <vector>
 
+namespace viscera::sim {
+class JsonField;
+}
+
 namespace viscera::render {
 
 /// Applies `json` (the text of the "render" object; empty: nothing to apply) to `settings`.
@@ -50,6 +54,10 @@ struct CaseMaterialMaps {
 /// <rule>" (unknown field, bad entry name, no map, number out of range). Whether each target is
 /// a body or surface of the scene is the caller's check (it knows the scene).
 std::vector<CaseMaterialMaps> caseMaterialMaps(std::string_view json, const std::string& origin);
+
+/// The optional "tiles_per_metre" (0, 10000] and "normal_strength" [0, 4] of object `j` (a
+/// render.materials entry or a project's texture block: one rule for both).
+void readMapLayout(const sim::JsonField& j, float& tilesPerMetre, float& normalStrength);
 
 /// Decodes the maps of `entry`: `read(path)` gives an entry's bytes (the case package's), each a
 /// PNG of at most 4096 pixels a side, all of one size. Throws viscera::InputError naming `origin`,

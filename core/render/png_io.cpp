@@ -75,10 +75,25 @@ Image decodePng(std::string_view bytes, const std::string& origin, int maxSide) 
         throw InputError(origin + ": PNG is " + std::to_string(png.width) + " x " + std::to_string(png.height) +
                          " pixels (each side must be 1 to " + std::to_string(maxSide) + ")");
     }
-    png.format = PNG_FORMAT_RGBA;
     Image image;
     image.width = int(png.width);
     image.height = int(png.height);
+    if (png.format & PNG_FORMAT_FLAG_LINEAR) {
+        // 16-bit samples: read them as stored (libpng's 8-bit output would treat them as linear
+        // light and re-encode them to sRGB, which a normal or roughness map must not be) and round
+        png.format = PNG_FORMAT_LINEAR_RGB_ALPHA;
+        std::vector<uint16_t> wide(PNG_IMAGE_SIZE(png) / 2);
+        if (!png_image_finish_read(&png, nullptr, wide.data(), 0, nullptr)) {
+            const std::string why = png.message;
+            png_image_free(&png);
+            throw InputError(origin + ": cannot decode PNG (" + why + ")");
+        }
+        image.rgba.resize(wide.size());
+        for (size_t i = 0; i < wide.size(); ++i)
+            image.rgba[i] = uint8_t((uint32_t(wide[i]) * 255u + 32767u) / 65535u);
+        return image;
+    }
+    png.format = PNG_FORMAT_RGBA;
     image.rgba.resize(PNG_IMAGE_SIZE(png));
     if (!png_image_finish_read(&png, nullptr, image.rgba.data(), 0, nullptr)) {
         const std::string why = png.message;

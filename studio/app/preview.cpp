@@ -32,6 +32,19 @@ std::string structureKey(const Project& p, Preview::Mode mode, int body) {
     return projectJsonText(q) + (mode == Preview::Mode::Specimen ? "#specimen" : "#scene");
 }
 
+/// The project's generated material maps on the view's meshes, as the exported case will show
+/// them; a spec that cannot be read is reported and leaves the procedural look.
+void applyTextures(const Project& project, render::SceneView& view) {
+    const ProjectTextures t = bakeProjectTextures(project);
+    auto read = [&t](const std::string& f) -> std::string_view {
+        for (const auto& [path, bytes] : t.files)
+            if (path == f) return bytes;
+        return {};
+    };
+    for (const render::CaseMaterialMaps& m : t.materials)
+        render::applyMaterialMaps(view, m.target, render::loadMaterialMaps(m, read, "the studio's texture bake"));
+}
+
 bool allFinite(const std::vector<sim::Vec3>& x) {
     for (const sim::Vec3& p : x)
         if (!p.allFinite()) return false;
@@ -249,6 +262,13 @@ void Preview::run() {
                     if (!ok) throw std::runtime_error(tr("the preview keeps the last stable model").toStdString());
                     next = assembleWorld(b, origin);
                     auto view = std::make_shared<render::SceneView>(render::SceneView::fromWorld(*next));
+                    if (job->mode == Mode::Scene && hasTextures(project)) {
+                        try {
+                            applyTextures(project, *view);
+                        } catch (const std::exception& e) { // the scene is still shown, procedural
+                            emit logMessage(tr("preview: %1 (drawn without its material maps)").arg(e.what()));
+                        }
+                    }
                     std::vector<std::shared_ptr<const sim::TetMesh>> meshes;
                     std::vector<std::shared_ptr<const sim::TriMesh>> surfaceMeshes;
                     if (job->mode == Mode::Scene) {

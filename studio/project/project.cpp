@@ -1,5 +1,6 @@
 #include "project/project.hpp"
 
+#include "bake/texture.hpp"
 #include "render/case_settings.hpp"
 
 #include "bake/import.hpp"
@@ -346,6 +347,19 @@ json paintJson(const StiffnessPaintProject& p, bool skeleton) {
     return out;
 }
 
+/// "texture": a body's or surface's generated material maps (TextureProject).
+TextureProject readTexture(const JsonField& j) {
+    j.object({"spec", "tiles_per_metre", "normal_strength"});
+    TextureProject t;
+    t.spec = j["spec"].entryPath(); // inside the project folder
+    render::readMapLayout(j, t.tilesPerMetre, t.normalStrength);
+    return t;
+}
+
+json textureJson(const TextureProject& t) {
+    return {{"spec", t.spec}, {"tiles_per_metre", t.tilesPerMetre}, {"normal_strength", t.normalStrength}};
+}
+
 /// "light_samples": the body's light-sample painting [A §6.3.2], operations replayed in order on
 /// its surface at rest (render::applySamplePaint).
 std::vector<render::SamplePaintOp> readLightSamples(const JsonField& j) {
@@ -451,13 +465,16 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
         scene.render = v->anyObject().value().dump();
         render::RenderSettings check;
         render::applyCaseRender(check, scene.render, origin); // the player's rule for the block
+        if (v->has("materials"))
+            v->failAt("materials", "is written by export from the bodies' and surfaces' \"texture\" blocks; "
+                                   "describe a material there");
     }
     scene.accuracy = sim::readAccuracy(root);
 
     std::set<std::string> names;
     for (const JsonField& b : root["bodies"].items(1)) {
         b.object({"name", "mesh", "material", "strain_limits", "embedded_in", "embedding_compliance", "fixed",
-                  "stiffness_regions", "stiffness_paint", "light_samples"});
+                  "stiffness_regions", "stiffness_paint", "light_samples", "texture"});
         BodyProject body;
         sim::readBodyCommon(b, body.scene, names);
         body.mesh = readMeshSource(b["mesh"], dir);
@@ -469,13 +486,14 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
             }
         if (auto sp = b.find("stiffness_paint")) body.paint = readPaint(*sp, true);
         if (auto ls = b.find("light_samples")) body.lightSamples = readLightSamples(*ls);
+        if (auto t = b.find("texture")) body.texture = readTexture(*t);
         if (auto fx = b.find("fixed")) body.fixedBox = readBox(*fx);
         p.bodies.push_back(std::move(body));
     }
     if (auto surfaces = root.find("surfaces"))
         for (const JsonField& sj : surfaces->items()) {
             sj.object({"name", "areal_density", "stretch_stiffness", "attach_distance", "attach_compliance",
-                       "from_boundary_of", "region", "stiffness_paint"});
+                       "from_boundary_of", "region", "stiffness_paint", "texture"});
             SurfaceProject sp;
             sim::readSurfaceCommon(sj, sp.scene, names);
             const JsonField from = sj["from_boundary_of"];
@@ -486,6 +504,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
             if (!found) from.fail("'" + sp.scene.attachTo + "' is not a body");
             if (auto r = sj.find("region")) sp.region = readBox(*r);
             if (auto pt = sj.find("stiffness_paint")) sp.paint = readPaint(*pt, false);
+            if (auto t = sj.find("texture")) sp.texture = readTexture(*t);
             p.surfaces.push_back(std::move(sp));
         }
     if (auto in = root.find("interaction")) scene.interaction = readInteractionProject(*in, dir, p.trackFiles);
@@ -527,6 +546,7 @@ std::string projectJsonText(const Project& p) {
         }
         if (b.paint) j["stiffness_paint"] = paintJson(*b.paint, true);
         if (!b.lightSamples.empty()) j["light_samples"] = lightSamplesJson(b.lightSamples);
+        if (b.texture) j["texture"] = textureJson(*b.texture);
         doc["bodies"].push_back(j);
     }
     if (!p.surfaces.empty()) {
@@ -536,6 +556,7 @@ std::string projectJsonText(const Project& p) {
             sim::writeSurfaceCommon(s.scene, j);
             if (s.region) j["region"] = boxJson(*s.region);
             if (s.paint) j["stiffness_paint"] = paintJson(*s.paint, false);
+            if (s.texture) j["texture"] = textureJson(*s.texture);
             doc["surfaces"].push_back(j);
         }
     }
@@ -702,6 +723,55 @@ std::vector<double> surfaceNodeWeights(const SurfaceProject& s, const sim::TriMe
     }
 }
 
+ProjectTextures bakeProjectTextures(const Project& project) {
+    ProjectTextures out;
+    auto bake = [&](const std::string& name, const TextureProject& t) {
+        const std::filesystem::path file = project.dir / t.spec;
+        const bake::TextureSpec spec = bake::loadTextureSpec(file);
+        const bake::TextureSet set = bake::generateTextureSet(spec);
+        render::CaseMaterialMaps entry;
+        entry.target = name;
+        entry.tilesPerMetre = t.tilesPerMetre;
+        entry.normalStrength = t.normalStrength;
+        for (const bake::EncodedFile& f : bake::encodeTextureSet(spec, set)) {
+            // only what the renderer samples is packaged
+            for (const auto& [kind, slot] : {std::pair{bake::MapKind::Diffuse, &entry.diffuse},
+                                             std::pair{bake::MapKind::Roughness, &entry.roughness},
+                                             std::pair{bake::MapKind::Metallic, &entry.metallic},
+                                             std::pair{bake::MapKind::Normal, &entry.normal}}) {
+                const std::string suffix = "_" + std::string(bake::mapName(kind)) + ".png";
+                if (f.fileName == spec.name + suffix) {
+                    *slot = "textures/" + name + suffix;
+                    out.files.emplace_back(*slot, f.bytes);
+                }
+            }
+        }
+        if (entry.files().empty())
+            throw InputError(file.string() + ": maps: writes none of diffuse, roughness, metallic, normal (nothing "
+                                             "the renderer would sample)");
+        out.materials.push_back(std::move(entry));
+    };
+    for (const BodyProject& b : project.bodies)
+        if (b.texture) bake(b.scene.name, *b.texture);
+    for (const SurfaceProject& s : project.surfaces)
+        if (s.texture) bake(s.scene.name, *s.texture);
+    return out;
+}
+
+std::string renderWithMaterials(const std::string& render, const std::vector<render::CaseMaterialMaps>& materials) {
+    if (materials.empty()) return render;
+    json doc = render.empty() ? json::object() : json::parse(render);
+    json& m = doc["materials"] = json::object();
+    for (const render::CaseMaterialMaps& e : materials) {
+        json j = {{"tiles_per_metre", e.tilesPerMetre}, {"normal_strength", e.normalStrength}};
+        for (const auto& [key, path] : {std::pair{"diffuse", &e.diffuse}, std::pair{"roughness", &e.roughness},
+                                        std::pair{"metallic", &e.metallic}, std::pair{"normal", &e.normal}})
+            if (!path->empty()) j[key] = *path;
+        m[e.target] = std::move(j);
+    }
+    return doc.dump();
+}
+
 namespace {
 
 BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
@@ -801,15 +871,23 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
 
 } // namespace
 
+bool hasTextures(const Project& project) {
+    for (const BodyProject& b : project.bodies)
+        if (b.texture) return true;
+    for (const SurfaceProject& s : project.surfaces)
+        if (s.texture) return true;
+    return false;
+}
+
 size_t exportStageCount(const Project& project) {
     size_t n = project.bodies.size() + project.surfaces.size() + 2; // + checking the scene, packaging
     for (const BodyProject& b : project.bodies)
         n += b.paint ? 1 : 0;
-    return n;
+    return n + (hasTextures(project) ? 1 : 0);
 }
 
 BuiltScene buildScene(const Project& project, const ExportProgress& progress) {
-    StageCounter stage{progress, exportStageCount(project) - 2};
+    StageCounter stage{progress, exportStageCount(project) - 2 - (hasTextures(project) ? 1 : 0)};
     return buildSceneCounted(project, stage);
 }
 
@@ -823,6 +901,11 @@ std::unique_ptr<sim::World> assembleWorld(const BuiltScene& built, const std::st
 ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress) {
     StageCounter stage{progress, exportStageCount(project)};
     const std::string origin = (project.dir / "project.json").string();
+    ProjectTextures textures; // first: a broken spec is reported before the meshing
+    if (hasTextures(project)) {
+        stage("generating material maps");
+        textures = bakeProjectTextures(project);
+    }
     BuiltScene built = buildSceneCounted(project, stage);
     // The player runs what it loads, so assemble the world here exactly as the player will and
     // refuse a case that cannot be simulated stably.
@@ -841,16 +924,20 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     if (!project.title.empty()) header.title = project.title;
     header.features = features;
     vcase::CaseWriter writer(header);
-    writer.addFile("scene.json", sim::formatScene(scene));
+    sim::SceneDesc written = scene;
+    written.render = renderWithMaterials(scene.render, textures.materials);
+    writer.addFile("scene.json", sim::formatScene(written));
     for (auto& [path, bytes] : files)
+        writer.addFile(path, std::move(bytes));
+    for (auto& [path, bytes] : textures.files)
         writer.addFile(path, std::move(bytes));
     if (scene.suture) writer.addFile(scene.suture->trajectoryPath, scene.suture->trajectoryText);
     if (scene.interaction)
         for (const sim::InstrumentDesc& in : scene.interaction->instruments)
             writer.addFile(in.trackPath, in.trackText);
-    vcase::Manifest written = writer.write(out);
+    const vcase::Manifest manifest = writer.write(out);
     result.casePath = out;
-    result.features = written.features;
+    result.features = manifest.features;
     result.bytes = std::filesystem::file_size(out);
     return result;
 }

@@ -52,6 +52,7 @@
 /// cell_radius_edge_ratio, cell_size, seed.
 #include "bake/skeleton.hpp"
 #include "bake/tetrahedralize.hpp"
+#include "render/case_settings.hpp"
 #include "render/sample_map.hpp"
 #include "sim/material/material.hpp"
 #include "sim/mesh/generators.hpp"
@@ -108,6 +109,17 @@ struct StiffnessPaintProject {
 /// A tet body: its scene description (what the case's scene.json carries: name, material,
 /// strain limits, embedding; read by the same code as the player's scene) plus what only
 /// authoring needs. meshPath, fixedNodes and nodeWeights of `scene` are filled at export.
+/// Generated material maps of a body or surface [A §6.2, issue 17]: a texture spec file of the
+/// project (bake::parseTextureSpec, `viscera-studio texture`) and how the renderer lays the maps
+/// on the mesh. Export packages the diffuse, roughness, metallic and normal maps the spec writes
+/// as textures/<name>_<map>.png and names them in the scene's render.materials; nothing else.
+///   "texture": {"spec": "textures/liver.json", "tiles_per_metre": 20, "normal_strength": 1}
+struct TextureProject {
+    std::string spec; ///< path relative to the project folder
+    float tilesPerMetre = 20.0f;
+    float normalStrength = 1.0f;
+};
+
 struct BodyProject {
     sim::BodyDesc scene;
     MeshSource mesh;
@@ -117,6 +129,7 @@ struct BodyProject {
     /// Light-sample painting [A §6.3.2], by position; exported as maps/<body>.vsamples only when
     /// the scene renders with painted sampling (usesPaintedSampling).
     std::vector<render::SamplePaintOp> lightSamples;
+    std::optional<TextureProject> texture;
 };
 
 /// A fascia layer cut from the boundary of a tet body (scene.attachTo, "from_boundary_of" in
@@ -128,6 +141,7 @@ struct SurfaceProject {
     /// Polygon stiffness paint on the layer's vertices at rest (sim::bakeSurfacePaint); exported as
     /// meshes/<surface>.vweights. By position, so it survives the body being meshed again.
     std::optional<StiffnessPaintProject> paint;
+    std::optional<TextureProject> texture;
 };
 
 /// Where the suture's needle trajectory comes from ("suture.trajectory" of project.json): the
@@ -236,6 +250,21 @@ std::vector<double> bodyNodeWeights(const BodyProject& b, sim::TetMesh& mesh, st
 /// Throws viscera::InputError naming `origin`, `field` and the rule.
 std::vector<double> surfaceNodeWeights(const SurfaceProject& s, const sim::TriMesh& mesh, const std::string& origin,
                                        const std::string& field);
+
+/// The material maps of the project's textured bodies and surfaces, generated from their specs:
+/// the package files (textures/<name>_<map>.png, only the maps the renderer samples) and the
+/// render.materials entries naming them. Throws viscera::InputError naming the spec, the field
+/// and the rule. Cost: one texture generation per textured body or surface.
+struct ProjectTextures {
+    std::vector<std::pair<std::string, std::string>> files; ///< case path, PNG bytes
+    std::vector<render::CaseMaterialMaps> materials;
+};
+ProjectTextures bakeProjectTextures(const Project& project);
+/// True when a body or surface of the project has a texture block.
+bool hasTextures(const Project& project);
+
+/// `scene.render` (JSON text, may be empty) with "materials" set to `materials`.
+std::string renderWithMaterials(const std::string& render, const std::vector<render::CaseMaterialMaps>& materials);
 
 /// True when the scene's "render" block asks for painted light sampling (the sample maps are
 /// then packaged and used).

@@ -28,14 +28,16 @@ nlohmann::json readJson(const std::filesystem::path& p) {
     return nlohmann::json::parse(in);
 }
 
-/// The liver sample's project with `edit` applied, written under `dir`.
+/// A copy of the liver sample (its texture specs included) under `dir` with `edit` applied to
+/// its project.json.
 std::filesystem::path projectWith(const std::filesystem::path& dir, const std::string& name,
                                   const std::function<void(nlohmann::json&)>& edit) {
-    nlohmann::json p = readJson(std::filesystem::path(VISCERA_SOURCE_DIR) / "projects/liver/project.json");
+    const auto sample = std::filesystem::path(VISCERA_SOURCE_DIR) / "projects/liver";
+    nlohmann::json p = readJson(sample / "project.json");
     edit(p);
     const auto pdir = dir / name;
-    std::filesystem::create_directories(pdir);
-    std::ofstream(pdir / "project.json") << p.dump(1);
+    std::filesystem::copy(sample, pdir, std::filesystem::copy_options::recursive);
+    std::ofstream(pdir / "project.json", std::ios::trunc) << p.dump(1);
     return pdir;
 }
 

@@ -333,3 +333,119 @@ TEST_F(ProjectTest, RemeshingABodyKeepsItsSampleClassArea) {
     }
     EXPECT_GE(painted, 2);
 }
+
+namespace {
+
+/// A small texture spec writing `maps` (the "maps" object's text).
+std::string textureSpec(const std::string& maps) {
+    return R"({"name": "t", "size": 32, "seed": 4, "levels": 4,
+  "patterns": [{"level": 2, "tile": {"shape": "bell"}, "opacity": [0.5, 1]}],
+  "palette": {"colors": ["#802020", "#e0a090"]},
+  "maps": )" +
+           maps + "}";
+}
+
+} // namespace
+
+TEST_F(ProjectTest, TexturedBodiesPackageExactlyTheMapsTheRendererSamples) {
+    // [A §6.2.2] a body's texture spec makes its maps at export: diffuse, roughness and normal are
+    // packaged and named in render.materials; the mask and height the spec also writes are not
+    std::filesystem::create_directories(m_dir / "textures");
+    writeFileAtomic(m_dir / "textures/slab.json",
+                    textureSpec(R"({"mask": {}, "diffuse": {"colors": [0, 1]}, "roughness": {"values": [0.5, 0.2]},
+                        "height": {}, "normal": {"depth": 0.01}})"));
+    write(replaced(
+        kGood, "\"fixed\":", "\"texture\": {\"spec\": \"textures/slab.json\", \"tiles_per_metre\": 50}, \"fixed\":"));
+    const studio::Project p = studio::loadProject(m_dir);
+    ASSERT_TRUE(p.bodies[0].texture.has_value());
+    EXPECT_EQ(studio::projectJsonText(studio::loadProjectText(studio::projectJsonText(p), m_dir, "again")),
+              studio::projectJsonText(p));
+    const auto out = m_dir / "t.vcase";
+    studio::exportCase(p, out);
+    std::vector<std::string> maps;
+    for (const vcase::FileEntry& f : vcase::verify(out).files)
+        if (f.path.rfind("textures/", 0) == 0) maps.push_back(f.path);
+    EXPECT_EQ(maps, (std::vector<std::string>{"textures/slab_diffuse.png", "textures/slab_normal.png",
+                                              "textures/slab_roughness.png"}));
+    const auto pkg = vcase::CasePackage::open(out);
+    const auto entries =
+        render::caseMaterialMaps(nlohmann::json::parse(pkg->read("scene.json"))["render"].dump(), "scene.json");
+    ASSERT_EQ(entries.size(), 1u);
+    EXPECT_EQ(entries[0].target, "slab");
+    EXPECT_EQ(entries[0].diffuse, "textures/slab_diffuse.png");
+    EXPECT_TRUE(entries[0].metallic.empty()) << "the spec writes no metallic map";
+    EXPECT_FLOAT_EQ(entries[0].tilesPerMetre, 50.0f);
+    // the packaged maps decode and have one size
+    const auto decoded = render::loadMaterialMaps(
+        entries[0], [&](const std::string& f) { return pkg->read(f); }, "t.vcase");
+    EXPECT_EQ(decoded->diffuse.width, 32);
+    EXPECT_EQ(decoded->normal.height, 32);
+    // without the texture block: no texture in the case
+    write(kGood);
+    studio::exportCase(studio::loadProject(m_dir), out);
+    for (const vcase::FileEntry& f : vcase::verify(out).files)
+        EXPECT_NE(f.path.rfind("textures/", 0), 0u) << f.path;
+}
+
+TEST_F(ProjectTest, BadTextureBlocksAreRefusedNamingTheFieldAndTheRule) {
+    std::filesystem::create_directories(m_dir / "textures");
+    const std::string where = (m_dir / "project.json").string() + ": ";
+    auto with = [&](const std::string& texture) {
+        write(replaced(kGood, "\"fixed\":", "\"texture\": " + texture + ", \"fixed\":"));
+        return loadError();
+    };
+    EXPECT_EQ(with(R"({"spec": "../outside.json"})").rfind(where + "bodies[0].texture.spec: ", 0), 0u);
+    EXPECT_EQ(with(R"({"spec": "t.json", "tiles_per_metre": -1})"),
+              where + "bodies[0].texture.tiles_per_metre: must be in (0, 10000]");
+    EXPECT_EQ(with(R"({"spec": "t.json", "normal_strength": 9})"),
+              where + "bodies[0].texture.normal_strength: must be in [0, 4]");
+    EXPECT_EQ(with(R"({"spec": "t.json", "colour": 1})"), where + "bodies[0].texture.colour: unknown field");
+    // render.materials is the export's to write
+    write(replaced(kGood, "\"gravity\"", "\"render\": {\"materials\": {}}, \"gravity\""));
+    EXPECT_EQ(loadError().rfind(where + "render.materials: is written by export", 0), 0u) << loadError();
+    // at export: a missing spec, and a spec that writes nothing the renderer samples
+    auto exportError = [&](const std::string& spec) {
+        write(replaced(kGood, "\"fixed\":", "\"texture\": {\"spec\": \"" + spec + "\"}, \"fixed\":"));
+        try {
+            studio::exportCase(studio::loadProject(m_dir), m_dir / "x.vcase");
+        } catch (const InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string("exported");
+    };
+    EXPECT_THAT(exportError("textures/none.json"), HasSubstr("none.json"));
+    writeFileAtomic(m_dir / "textures/h.json", textureSpec(R"({"mask": {}, "height": {}})"));
+    EXPECT_THAT(exportError("textures/h.json"),
+                HasSubstr("h.json: maps: writes none of diffuse, roughness, metallic, normal"));
+    EXPECT_FALSE(std::filesystem::exists(m_dir / "x.vcase")) << "nothing written by a failed export";
+}
+
+TEST_F(ProjectTest, SixteenBitMapsDecodeToTheSameCodesAsEightBitOnes) {
+    // a 16-bit normal or roughness map is data, not light: the player's decoder rounds the
+    // samples (no sRGB re-encoding), so it matches the 8-bit map of the same spec to one code
+    std::filesystem::create_directories(m_dir / "textures");
+    auto decodeWith = [&](int bits) {
+        writeFileAtomic(m_dir / "textures/slab.json",
+                        textureSpec(R"({"diffuse": {"colors": [0, 1], "bit_depth": )" + std::to_string(bits) +
+                                    R"(}, "roughness": {"values": [0.9, 0.1], "bit_depth": )" + std::to_string(bits) +
+                                    "}}"));
+        write(replaced(kGood, "\"fixed\":", "\"texture\": {\"spec\": \"textures/slab.json\"}, \"fixed\":"));
+        const studio::ProjectTextures t = studio::bakeProjectTextures(studio::loadProject(m_dir));
+        return render::loadMaterialMaps(
+            t.materials.at(0),
+            [&](const std::string& f) -> std::string_view {
+                for (const auto& [path, bytes] : t.files)
+                    if (path == f) return bytes;
+                return {};
+            },
+            "t");
+    };
+    const auto m8 = decodeWith(8), m16 = decodeWith(16);
+    ASSERT_EQ(m8->roughness.rgba.size(), m16->roughness.rgba.size());
+    int worst = 0;
+    for (size_t i = 0; i < m8->roughness.rgba.size(); ++i) {
+        worst = std::max(worst, std::abs(int(m8->roughness.rgba[i]) - int(m16->roughness.rgba[i])));
+        worst = std::max(worst, std::abs(int(m8->diffuse.rgba[i]) - int(m16->diffuse.rgba[i])));
+    }
+    EXPECT_LE(worst, 1) << "codes";
+}
