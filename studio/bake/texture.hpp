@@ -1,8 +1,8 @@
 #pragma once
 /// Procedural tissue materials [A §6.2]: the quadtree pattern mask [A §6.2.1], the colour palette
-/// and prominent-colour proportional map of a reference image, and the PBR maps of one material
-/// layer made from the mask [A §6.2.2]; the JSON texture spec that drives them
-/// (`viscera-studio texture <spec.json> -o <dir>`).
+/// and prominent-colour proportional map of a reference image (a file, or a synthetic photograph
+/// made by code), and the PBR maps of one material layer made from the mask [A §6.2.2]; the JSON
+/// texture spec that drives them (`viscera-studio texture <spec.json> -o <dir>`).
 ///
 /// Images are plain row-major float or byte buffers: OpenCV (PNG coding, colour conversion,
 /// resampling) is private to viscera::bake. Everything is deterministic: the same parameters and
@@ -158,6 +158,36 @@ Rgb8Image proportionalMap(const std::vector<PaletteColor>& colors, int width, in
 /// The palette as a row of square swatches of `swatch` pixels.
 Rgb8Image paletteSwatches(const std::vector<Rgb8>& colors, int swatch);
 
+// ---- synthetic reference photograph ---------------------------------------------------------
+
+/// A reference photograph for palette extraction made by code instead of read from a file
+/// (reference images are generated in the repository, never downloaded or committed).
+struct ReferenceSpec {
+    int size = 256;             ///< width = height in pixels, a power of two in [16, 4096]
+    uint64_t seed = 0;          ///< the regions' layout and the noise
+    std::vector<Rgb8> colors;   ///< region colours, 1 to 16
+    std::vector<double> shares; ///< area share of each colour: one per colour, each > 0, sum 1 (within 1e-6)
+    double noise = 6;           ///< per-pixel noise amplitude, 8-bit units, [0, 64]
+    double blurPx = 1.5;        ///< Gaussian blur across the region borders, σ in pixels, [0, 16]
+};
+
+/// A blotchy, tileable tissue-like photograph, size × size, of `colors` covering `shares` of the
+/// area. A noise field Σ_l 0.6^(l-1) · generateMask(one level-l pattern of rotated, offset Gaussian
+/// blobs), l = 1 .. min(5, log2(min(size, 256)) - 2) (made at most 256 px wide, then bilinearly
+/// upsampled with wrap-around) is ranked pixel by pixel (ties by pixel index) and colour i takes
+/// the ranks in [N·S(i-1), N·S(i)), S the cumulative shares, N = size²: colours[0] fills the low
+/// ground, the last colour the blobs' cores, and each colour borders mostly the ones before and
+/// after it in the list. The label image is blurred (σ = blurPx, wrapping); since blurring moves
+/// pixels of thin regions towards their neighbours' colours, the rank bounds are then corrected (at
+/// most 3 rounds) until the share of pixels nearest (RGB) each colour is within 1e-3 of its share.
+/// Last, every channel moves by noise · (a + b_c) / 2, with a (shared by the channels) and b_c
+/// triangular on [-1, 1] (at most ±noise, standard deviation ≈ 0.29 · noise), rounded and clamped
+/// to [0, 255]. blurPx = 0 and noise = 0: the shares to the pixel. Deterministic: the same spec
+/// gives the same bytes on every run and thread count. Throws std::invalid_argument
+/// "bake::generateReferenceImage(): <field> ..." when a field breaks its rule. Cost: about 0.05 s
+/// at 256², 0.4 s at 1024², 8 s at 4096² (two cores): a sort and up to four blurs of N pixels.
+Rgb8Image generateReferenceImage(const ReferenceSpec& spec);
+
 // ---- material maps of one layer [A §6.2.2, Fig. 6.8-6.9] ------------------------------------
 
 /// A map made from the mask: value(m) = atZero + (atOne - atZero) · m.
@@ -240,23 +270,27 @@ GrayImage readGrayImage(const std::filesystem::path& file, int maxSide = 4096);
 
 // ---- texture spec and bake ------------------------------------------------------------------
 
-enum class MapKind { Mask, Diffuse, Roughness, Metallic, Height, Normal, Palette, Prominent };
+/// Reference: the synthetic reference photograph of palette.reference (a look at what the
+/// palette was extracted from; an authoring aid, never packaged into a case).
+enum class MapKind { Mask, Diffuse, Roughness, Metallic, Height, Normal, Palette, Prominent, Reference };
 
-/// "mask", "diffuse", ..., "prominent": the spec's key and the file name's suffix.
+/// "mask", "diffuse", ..., "prominent", "reference": the spec's key and the file name's suffix.
 std::string_view mapName(MapKind kind);
 
 struct MapRequest {
     MapKind kind = MapKind::Mask;
-    int bits = 8; ///< 8 or 16 (unused by palette and prominent: 8-bit colour images)
+    int bits = 8; ///< 8 or 16 (unused by palette, prominent and reference: 8-bit colour images)
 };
 
-/// Where the palette comes from: explicit colours, or a reference image.
+/// Where the palette comes from: explicit colours, a reference image file, or a synthetic
+/// reference photograph (exactly one of the three).
 struct PaletteSpec {
-    std::vector<Rgb8> colors;       ///< explicit colours (empty when from an image)
-    Rgb8Image image;                ///< the reference image (empty when explicit)
-    std::string imageFile;          ///< the image's path as written in the spec
-    PaletteParams params;           ///< extraction (method, threshold or k, ...)
-    double prominentThreshold = 64; ///< threshold grouping for the proportional map, >= threshold
+    std::vector<Rgb8> colors;               ///< explicit colours (empty otherwise)
+    Rgb8Image image;                        ///< the reference image file's pixels (empty otherwise)
+    std::string imageFile;                  ///< the image's path as written in the spec (empty otherwise)
+    std::optional<ReferenceSpec> reference; ///< the synthetic reference (generated by generateTextureSet)
+    PaletteParams params;                   ///< extraction (method, threshold or k, ...)
+    double prominentThreshold = 64;         ///< threshold grouping for the proportional map, >= threshold
 };
 
 /// One layer's texture job, as read from a spec file (see README "Texture spec").
@@ -276,7 +310,8 @@ struct TextureSpec {
 /// palette's reference image, image tiles). Throws viscera::InputError, one line
 /// "<origin>: <JSON path>: <rule>": invalid JSON, unknown field, missing field, wrong type,
 /// number out of its range, size not a power of two, a path that is absolute or leaves the
-/// folder ('..'), an unreadable image.
+/// folder ('..'), an unreadable image, a palette.reference breaking a rule of ReferenceSpec
+/// (checked here in full, so generateReferenceImage() cannot refuse it; generated later).
 TextureSpec parseTextureSpec(std::string_view text, const std::string& origin, const std::filesystem::path& folder);
 /// Reads and parses a spec file; origin is the path as given, files resolve against its folder.
 TextureSpec loadTextureSpec(const std::filesystem::path& file);
@@ -288,9 +323,11 @@ struct TextureSet {
     std::vector<Rgb8> colors;            ///< the palette used (explicit or extracted)
     std::vector<PaletteColor> palette;   ///< extracted palette (empty when explicit)
     std::vector<PaletteColor> prominent; ///< prominent colours (empty when explicit)
+    Rgb8Image reference;                 ///< the synthetic reference photograph (empty unless palette.reference)
 };
 
-/// Generates the mask, extracts the palettes and makes the requested maps. Throws InputError
+/// Generates the mask and the synthetic reference (palette.reference), extracts the palettes and
+/// makes the requested maps. Throws InputError
 /// "<origin>: maps.diffuse.colors[i]: ..." when a diffuse colour index exceeds an extracted palette.
 TextureSet generateTextureSet(const TextureSpec& spec);
 
@@ -299,7 +336,7 @@ struct EncodedFile {
     std::string bytes;
 };
 /// The files of a spec's maps: one PNG per request, plus <name>_palette.json (colours as hex and
-/// share) with the palette map.
+/// share) with the palette map; <name>_reference.png is the synthetic reference photograph.
 std::vector<EncodedFile> encodeTextureSet(const TextureSpec& spec, const TextureSet& set);
 
 /// Creates `dir` if needed and checks that a file can be written in it (a probe file is written

@@ -15,6 +15,7 @@
 #include <bit>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <future>
 
@@ -143,26 +144,63 @@ LevelPattern readPattern(const JsonField& f, int levels, const fs::path& folder)
     return p;
 }
 
+/// A colour "#rrggbb".
+Rgb8 readColor(const JsonField& c) {
+    const std::optional<Rgb8> rgb = parseHexColor(c.string());
+    if (!rgb) c.fail("'" + sim::displayName(c.string()) + "' is not a colour (#rrggbb)");
+    return *rgb;
+}
+
+/// palette.reference: every rule of ReferenceSpec, so that generateReferenceImage() accepts it.
+ReferenceSpec readReference(const JsonField& f) {
+    f.object({"size", "seed", "colors", "shares", "noise", "blur_px"});
+    ReferenceSpec r;
+    if (auto size = f.find("size")) {
+        r.size = size->integer(16, 4096);
+        if (!std::has_single_bit(static_cast<unsigned>(r.size)))
+            size->fail("must be a power of two (" + std::to_string(r.size) + " is not)");
+    }
+    r.seed = static_cast<uint64_t>(f.integer("seed", 0, 0, INT32_MAX));
+    for (const JsonField& c : f["colors"].items(1, 16))
+        r.colors.push_back(readColor(c));
+    const JsonField shares = f["shares"];
+    const std::vector<JsonField> items = shares.items();
+    if (items.size() != r.colors.size())
+        shares.fail("must have one share per colour (" + std::to_string(r.colors.size()) + " colours, " +
+                    std::to_string(items.size()) + " shares)");
+    double sum = 0;
+    for (const JsonField& share : items)
+        sum += r.shares.emplace_back(share.number(NumberRule::aboveUpTo(0, 1)));
+    if (!(std::abs(sum - 1) <= 1e-6)) shares.fail("must sum to 1 within 1e-6 (sum " + formatNumber(sum, 9) + ")");
+    r.noise = f.number("noise", r.noise, NumberRule::closed(0, 64));
+    r.blurPx = f.number("blur_px", r.blurPx, NumberRule::closed(0, 16));
+    return r;
+}
+
 PaletteSpec readPalette(const JsonField& f, const fs::path& folder, uint64_t seed) {
     f.anyObject();
     PaletteSpec p;
-    if (f.has("colors") && f.has("image")) f.fail("takes 'colors' or 'image', not both");
+    std::vector<std::string> sources;
+    for (const char* key : {"colors", "image", "reference"})
+        if (f.has(key)) sources.push_back(std::string(1, '\'') + key + "'");
+    if (sources.size() > 1)
+        f.fail("takes one of 'colors', 'image' and 'reference' (found " + sources[0] + " and " + sources[1] + ")");
     if (f.has("colors")) {
         f.object({"colors"});
-        for (const JsonField& c : f["colors"].items(1, 256)) {
-            const std::optional<Rgb8> rgb = parseHexColor(c.string());
-            if (!rgb) c.fail("'" + sim::displayName(c.string()) + "' is not a colour (#rrggbb)");
-            p.colors.push_back(*rgb);
-        }
+        for (const JsonField& c : f["colors"].items(1, 256))
+            p.colors.push_back(readColor(c));
         return p;
     }
-    if (!f.has("image")) f.fail("needs 'colors' (a list of #rrggbb) or 'image' (a reference image)");
+    if (sources.empty())
+        f.fail("needs 'colors' (a list of #rrggbb), 'image' (a reference image) or 'reference' (a synthetic "
+               "reference photograph)");
+    const char* source = f.has("image") ? "image" : "reference";
     const std::string method =
         f.has("method") ? f["method"].choice({"threshold", "kmeans"}, "a palette method") : "threshold";
     if (method == "threshold")
-        f.object({"image", "method", "threshold", "prominent_threshold", "max_colors"});
+        f.object({source, "method", "threshold", "prominent_threshold", "max_colors"});
     else
-        f.object({"image", "method", "k", "iterations", "prominent_threshold", "max_colors"});
+        f.object({source, "method", "k", "iterations", "prominent_threshold", "max_colors"});
     // Every number is checked before the image is read.
     const NumberRule threshold = NumberRule::aboveUpTo(0, 256);
     p.params.method = method == "threshold" ? PaletteMethod::Threshold : PaletteMethod::KMeans;
@@ -176,6 +214,10 @@ PaletteSpec readPalette(const JsonField& f, const fs::path& folder, uint64_t see
         f.number("prominent_threshold", byThreshold ? std::max(64.0, p.params.threshold) : 64.0, threshold);
     if (byThreshold && p.prominentThreshold < p.params.threshold)
         f.failAt("prominent_threshold", "must be at least the threshold (" + formatNumber(p.params.threshold) + ")");
+    if (f.has("reference")) {
+        p.reference = readReference(f["reference"]);
+        return p;
+    }
     p.imageFile = f["image"].string();
     p.image = readImageField(f["image"], folder, [](const fs::path& file) { return readRgb8Image(file); });
     return p;
@@ -189,11 +231,11 @@ MaskMapping readValues(const JsonField& map, MaskMapping fallback) {
 }
 
 void readMaps(const JsonField& m, int bits, TextureSpec& spec) {
-    m.object({"mask", "diffuse", "roughness", "metallic", "height", "normal", "palette", "prominent"});
+    m.object({"mask", "diffuse", "roughness", "metallic", "height", "normal", "palette", "prominent", "reference"});
     if (m.value().empty()) m.fail("must name at least one map");
     MaterialParams& mat = spec.material;
     for (MapKind kind : {MapKind::Mask, MapKind::Diffuse, MapKind::Roughness, MapKind::Metallic, MapKind::Height,
-                         MapKind::Normal, MapKind::Palette, MapKind::Prominent}) {
+                         MapKind::Normal, MapKind::Palette, MapKind::Prominent, MapKind::Reference}) {
         auto f = m.find(mapName(kind));
         if (!f) continue;
         switch (kind) {
@@ -240,6 +282,9 @@ void readMaps(const JsonField& m, int bits, TextureSpec& spec) {
             spec.prominentWidth = f->integer("width", spec.prominentWidth, 1, 4096);
             spec.prominentHeight = f->integer("height", spec.prominentHeight, 1, 4096);
             break;
+        case MapKind::Reference:
+            f->object({});
+            break;
         }
         spec.maps.push_back({kind, readBits(*f, bits)});
     }
@@ -266,8 +311,8 @@ nlohmann::json colorList(const std::vector<PaletteColor>& colors) {
 } // namespace
 
 std::string_view mapName(MapKind kind) {
-    static constexpr std::string_view kNames[] = {"mask",   "diffuse", "roughness", "metallic",
-                                                  "height", "normal",  "palette",   "prominent"};
+    static constexpr std::string_view kNames[] = {"mask",   "diffuse", "roughness", "metallic", "height",
+                                                  "normal", "palette", "prominent", "reference"};
     return kNames[static_cast<size_t>(kind)];
 }
 
@@ -308,8 +353,10 @@ TextureSpec parseTextureSpec(std::string_view text, const std::string& origin, c
     for (MapKind kind : {MapKind::Diffuse, MapKind::Palette})
         if (wants(spec, kind) && !spec.palette)
             root.failAt("palette", "required field is missing (maps." + std::string(mapName(kind)) + " uses it)");
-    if (wants(spec, MapKind::Prominent) && (!spec.palette || spec.palette->image.pixels.empty()))
-        root.failAt("maps.prominent", "needs a reference image (palette.image)");
+    if (wants(spec, MapKind::Prominent) && (!spec.palette || !spec.palette->colors.empty()))
+        root.failAt("maps.prominent", "needs a reference image (palette.image or palette.reference)");
+    if (wants(spec, MapKind::Reference) && (!spec.palette || !spec.palette->reference))
+        root.failAt("maps.reference", "needs a synthetic reference photograph (palette.reference)");
     if (spec.palette && !spec.palette->colors.empty() && !spec.diffuseIndices.empty()) {
         const std::vector<JsonField> indices = root["maps"]["diffuse"]["colors"].items();
         const size_t n = spec.palette->colors.size();
@@ -330,8 +377,10 @@ TextureSet generateTextureSet(const TextureSpec& spec) {
     set.mask = generateMask(spec.quadtree);
     if (spec.palette) {
         const PaletteSpec& p = *spec.palette;
+        if (p.reference) set.reference = generateReferenceImage(*p.reference);
+        const Rgb8Image& image = p.reference ? set.reference : p.image;
         if (p.colors.empty()) {
-            set.palette = extractPalette(p.image, p.params);
+            set.palette = extractPalette(image, p.params);
             for (const PaletteColor& c : set.palette)
                 set.colors.push_back(c.color);
             if (wants(spec, MapKind::Prominent) || wants(spec, MapKind::Palette)) {
@@ -339,7 +388,7 @@ TextureSet generateTextureSet(const TextureSpec& spec) {
                 prominent.method = PaletteMethod::Threshold;
                 prominent.threshold = p.prominentThreshold;
                 prominent.maxColors = 256;
-                set.prominent = extractPalette(p.image, prominent);
+                set.prominent = extractPalette(image, prominent);
             }
         } else {
             set.colors = p.colors;
@@ -354,9 +403,10 @@ TextureSet generateTextureSet(const TextureSpec& spec) {
             const int index = spec.diffuseIndices[i];
             if (index >= static_cast<int>(set.colors.size()))
                 throw InputError(spec.origin + ": maps.diffuse.colors[" + std::to_string(i) + "]: palette index " +
-                                 std::to_string(index) + " is out of range (the palette of '" +
-                                 sim::displayName(spec.palette->imageFile) + "' has " +
-                                 std::to_string(set.colors.size()) + " colours)");
+                                 std::to_string(index) + " is out of range (the palette of " +
+                                 (spec.palette->reference ? std::string("the synthetic reference")
+                                                          : "'" + sim::displayName(spec.palette->imageFile) + "'") +
+                                 " has " + std::to_string(set.colors.size()) + " colours)");
             material.diffuseColors.push_back(set.colors[static_cast<size_t>(index)]);
         }
     }
@@ -395,8 +445,18 @@ std::vector<EncodedFile> encodeMap(const TextureSpec& spec, const TextureSet& se
     case MapKind::Palette: {
         add(png, encodePng(paletteSwatches(set.colors, spec.swatchPx)));
         nlohmann::json j;
-        j["source"] =
-            spec.palette->image.pixels.empty() ? nlohmann::json("colors") : nlohmann::json(spec.palette->imageFile);
+        const PaletteSpec& p = *spec.palette;
+        j["source"] = p.reference           ? nlohmann::json("reference")
+                      : p.imageFile.empty() ? nlohmann::json("colors")
+                                            : nlohmann::json(p.imageFile);
+        if (p.reference) {
+            nlohmann::json colors = nlohmann::json::array();
+            for (Rgb8 c : p.reference->colors)
+                colors.push_back(hexColor(c));
+            j["reference"] = {
+                {"size", p.reference->size},     {"seed", p.reference->seed},   {"colors", colors},
+                {"shares", p.reference->shares}, {"noise", p.reference->noise}, {"blur_px", p.reference->blurPx}};
+        }
         nlohmann::json colors = nlohmann::json::array();
         for (Rgb8 c : set.colors)
             colors.push_back(hexColor(c));
@@ -408,6 +468,9 @@ std::vector<EncodedFile> encodeMap(const TextureSpec& spec, const TextureSet& se
     }
     case MapKind::Prominent:
         add(png, encodePng(proportionalMap(set.prominent, spec.prominentWidth, spec.prominentHeight)));
+        break;
+    case MapKind::Reference:
+        add(png, encodePng(set.reference));
         break;
     }
     return files;

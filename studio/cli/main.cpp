@@ -196,8 +196,9 @@ int cmdTexture(const std::vector<std::string>& args) {
     const auto& q = spec.quadtree;
     std::printf("texture %s: %dx%d, %d levels, %zu patterns, seed %llu%s\n", spec.name.c_str(), q.size, q.size,
                 q.levels, q.patterns.size(), static_cast<unsigned long long>(q.seed), q.tileable ? ", tileable" : "");
-    if (spec.palette && !spec.palette->imageFile.empty()) {
-        printColors(("palette of " + spec.palette->imageFile).c_str(), r.set.palette);
+    if (spec.palette && spec.palette->colors.empty()) {
+        const std::string source = spec.palette->reference ? "the synthetic reference" : spec.palette->imageFile;
+        printColors(("palette of " + source).c_str(), r.set.palette);
         if (!r.set.prominent.empty()) printColors("prominent colours", r.set.prominent);
     } else if (spec.palette) {
         std::printf("  palette:");

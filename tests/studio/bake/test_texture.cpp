@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <numbers>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -554,4 +555,234 @@ TEST(TextureSpec, FilesMustStayInsideTheSpecsFolder) {
     EXPECT_THAT([&] { bakeTexture(spec, out / "layer_mask.png"); },
                 testing::ThrowsMessage<InputError>(
                     testing::StrEq((out / "layer_mask.png").string() + ": the output folder is a file, not a folder")));
+}
+
+// ---- synthetic reference photograph -------------------------------------------------------------
+
+namespace {
+
+const Rgb8 kTissue[3] = {{0x8a, 0x2b, 0x24}, {0xc9, 0x64, 0x5a}, {0xf0, 0xd2, 0xc4}};
+const double kTissueShares[3] = {0.6, 0.3, 0.1};
+
+/// The spec's example reference: 256 px, seed 3, three tissue colours on 60 / 30 / 10 %.
+const char* kReference =
+    R"({"size": 256, "seed": 3, "colors": ["#8a2b24", "#c9645a", "#f0d2c4"], "shares": [0.6, 0.3, 0.1],)"
+    R"( "noise": 6, "blur_px": 1.5})";
+
+/// specText() with the palette taken from the synthetic reference (`extra` members added to the
+/// palette) and maps.reference requested.
+std::string referenceSpecText(int seed, const std::string& reference = kReference, const std::string& extra = "") {
+    std::string text = replaced(specText(seed), R"({"colors": ["#7a1f24", "#c65a4f", "#efc1a8"]})",
+                                R"({"reference": )" + reference + extra + "}");
+    return replaced(text, R"("palette": {"swatch_px": 8})", R"("palette": {"swatch_px": 8}, "reference": {})");
+}
+
+Rgb8 pixel(const Rgb8Image& im, size_t i) {
+    return {im.pixels[3 * i], im.pixels[3 * i + 1], im.pixels[3 * i + 2]};
+}
+
+/// Share of the pixels nearest (RGB) to each of `colors`.
+std::vector<double> nearestShares(const Rgb8Image& im, const std::vector<Rgb8>& colors) {
+    std::vector<double> shares(colors.size(), 0.0);
+    const size_t n = static_cast<size_t>(im.width) * im.height;
+    for (size_t i = 0; i < n; ++i) {
+        const Rgb8 p = pixel(im, i);
+        size_t best = 0;
+        int bestD = INT32_MAX;
+        for (size_t c = 0; c < colors.size(); ++c) {
+            const int dr = p.r - colors[c].r, dg = p.g - colors[c].g, db = p.b - colors[c].b;
+            if (dr * dr + dg * dg + db * db < bestD) {
+                bestD = dr * dr + dg * dg + db * db;
+                best = c;
+            }
+        }
+        shares[best] += 1.0 / double(n);
+    }
+    return shares;
+}
+
+} // namespace
+
+TEST(TextureReference, SameSpecGivesIdenticalPngBytesAndAnotherSeedDiffers) {
+    const TextureSpec a = parse(referenceSpecText(1));
+    ASSERT_TRUE(a.palette && a.palette->reference);
+    EXPECT_TRUE(a.palette->imageFile.empty());
+    EXPECT_TRUE(a.palette->image.pixels.empty());
+    const std::vector<EncodedFile> first = encodeTextureSet(a, generateTextureSet(a));
+    const std::vector<EncodedFile> second = encodeTextureSet(a, generateTextureSet(parse(referenceSpecText(1))));
+    ASSERT_EQ(first.size(), 9u); // mask, diffuse, roughness, metallic, height, normal, palette png + json, reference
+    ASSERT_EQ(first.back().fileName, "layer_reference.png");
+    for (size_t i = 0; i < first.size(); ++i)
+        EXPECT_TRUE(first[i].bytes == second[i].bytes) << first[i].fileName;
+    const DecodedImage d = decodeImage(first.back().bytes, "layer_reference.png");
+    EXPECT_EQ(d.width, 256);
+    EXPECT_EQ(d.channels, 3);
+    EXPECT_EQ(d.bits, 8);
+    const nlohmann::json j = nlohmann::json::parse(first[7].bytes);
+    EXPECT_EQ(j["source"], "reference");
+    EXPECT_EQ(j["reference"]["colors"][2], "#f0d2c4");
+
+    // The reference's own seed, not the mask's, moves it; equal bytes from the API directly.
+    ReferenceSpec r = *a.palette->reference;
+    EXPECT_EQ(encodePng(generateReferenceImage(r)), first.back().bytes);
+    r.seed = 4;
+    EXPECT_NE(generateReferenceImage(r).pixels, generateReferenceImage(*a.palette->reference).pixels);
+    const TextureSpec otherMask = parse(referenceSpecText(2));
+    EXPECT_EQ(encodeTextureSet(otherMask, generateTextureSet(otherMask)).back().bytes, first.back().bytes);
+
+    // Not flat: noise inside the regions, many distinct colours, and blur: colours between regions.
+    const Rgb8Image im = generateReferenceImage(*a.palette->reference);
+    PaletteParams all;
+    all.threshold = 1;
+    all.maxColors = 256;
+    double within = 0; // mean |Δ| of the pixels nearest colour 0 from it, 8-bit units
+    size_t count = 0, between = 0;
+    for (size_t i = 0; i < 256u * 256u; ++i) {
+        const Rgb8 p = pixel(im, i);
+        const double d0 = deltaE(p, kTissue[0]), d1 = deltaE(p, kTissue[1]);
+        if (d0 < 6) {
+            within +=
+                (std::abs(p.r - kTissue[0].r) + std::abs(p.g - kTissue[0].g) + std::abs(p.b - kTissue[0].b)) / 3.0;
+            ++count;
+        } else if (d0 > 12 && d1 > 12 && deltaE(p, kTissue[2]) > 12) {
+            ++between;
+        }
+    }
+    within /= double(count);
+    RecordProperty("reference_mean_abs_noise", std::to_string(within));
+    RecordProperty("reference_between_share", std::to_string(double(between) / (256.0 * 256.0)));
+    EXPECT_GT(within, 1.0);
+    EXPECT_LT(within, 6.0);
+    EXPECT_GT(between, 100u);
+    EXPECT_EQ(extractPalette(im, all).size(), 256u); // at least 256 distinct colours
+}
+
+TEST(TextureReference, RegionSharesFollowTheRequestedShares) {
+    const ReferenceSpec example = *parse(referenceSpecText(1)).palette->reference;
+    ReferenceSpec five;
+    five.size = 128;
+    five.seed = 11;
+    five.colors = {{0x5c, 0x14, 0x1c}, {0x9e, 0x3a, 0x3a}, {0xc8, 0x78, 0x6e}, {0xe6, 0xb4, 0xa0}, {0xf8, 0xe8, 0xe0}};
+    five.shares = {0.35, 0.25, 0.2, 0.15, 0.05};
+    five.noise = 10;
+    five.blurPx = 3;
+    // five: at 128 px, σ = 3 px shrinks the thin and small regions by up to 0.07 of the area
+    // before the bound correction. large: 512 px, the noise field upsampled from 256 px.
+    ReferenceSpec large = example;
+    large.size = 512;
+    ReferenceSpec sharp = example; // no blur, no noise: the label image itself meets the shares to the pixel
+    sharp.noise = 0;
+    sharp.blurPx = 0;
+    for (const auto& [name, spec, tolerance] :
+         {std::tuple{"example", example, 0.02}, std::tuple{"five", five, 0.02}, std::tuple{"large", large, 0.02},
+          std::tuple{"sharp", sharp, 1.0 / (256.0 * 256.0)}}) {
+        const std::vector<double> shares = nearestShares(generateReferenceImage(spec), spec.colors);
+        double worst = 0;
+        std::string figures;
+        for (size_t i = 0; i < shares.size(); ++i) {
+            worst = std::max(worst, std::abs(shares[i] - spec.shares[i]));
+            figures += std::string(i ? " " : "") + std::to_string(shares[i]);
+            EXPECT_NEAR(shares[i], spec.shares[i], tolerance) << name << " colour " << i;
+        }
+        RecordProperty(std::string("shares_") + name, figures);
+        RecordProperty(std::string("shares_") + name + "_max_error", std::to_string(worst));
+    }
+}
+
+TEST(TextureReference, ThresholdAndKMeansPalettesRecoverTheRequestedColours) {
+    const std::string kmeans = R"(, "method": "kmeans", "k": 3)";
+    for (const std::string& extra : {std::string(R"(, "threshold": 24)"), kmeans}) {
+        const TextureSpec spec = parse(referenceSpecText(1, kReference, extra));
+        const TextureSet set = generateTextureSet(spec);
+        ASSERT_GE(set.palette.size(), 3u);
+        const std::string method = extra == kmeans ? "kmeans" : "threshold";
+        double worst = 0, worstShare = 0;
+        std::string figures;
+        for (size_t i = 0; i < 3; ++i) {
+            const double e = deltaE(set.palette[i].color, kTissue[i]);
+            worst = std::max(worst, e);
+            worstShare = std::max(worstShare, std::abs(set.palette[i].share - kTissueShares[i]));
+            figures += std::string(i ? ", " : "") + hexColor(set.palette[i].color) + " " +
+                       std::to_string(set.palette[i].share) + " dE " + std::to_string(e);
+            EXPECT_LT(e, 6.0) << method << ": " << hexColor(set.palette[i].color) << " vs " << hexColor(kTissue[i]);
+        }
+        RecordProperty(method + "_palette", figures);
+        RecordProperty(method + "_max_delta_e", std::to_string(worst));
+        RecordProperty(method + "_max_share_error", std::to_string(worstShare));
+        // The diffuse gradient and the proportional map use the extracted colours.
+        EXPECT_EQ(set.colors[0], set.palette[0].color);
+        EXPECT_FALSE(set.maps.diffuse.pixels.empty());
+    }
+}
+
+TEST(TextureReference, BadReferenceSpecsAreRefusedWithOneLineNamingTheField) {
+    EXPECT_EQ(refusal(referenceSpecText(1)), "(accepted)");
+    const std::string good = kReference;
+    const struct {
+        const char *from, *to, *message;
+    } cases[] = {
+        {R"("size": 256)", R"("size": 8)", "palette.reference.size: must be an integer in [16, 4096]"},
+        {R"("size": 256)", R"("size": 8192)", "palette.reference.size: must be an integer in [16, 4096]"},
+        {R"("size": 256)", R"("size": 100)", "palette.reference.size: must be a power of two (100 is not)"},
+        {R"("size": 256)", R"("size": 256.5)", "palette.reference.size: must be an integer (found number)"},
+        {R"("seed": 3)", R"("seed": -3)", "palette.reference.seed: must not be negative"},
+        {R"("seed": 3)", R"("seed": 1.5)", "palette.reference.seed: must be an integer (found number)"},
+        {R"("colors": ["#8a2b24", "#c9645a", "#f0d2c4"])", R"("colors": [])",
+         "palette.reference.colors: must have 1 to 16 elements"},
+        {R"("colors": ["#8a2b24", "#c9645a", "#f0d2c4"])",
+         R"("colors": ["#8a2b24", "#c9645a", "#f0d2c4", "#000000", "#000000", "#000000", "#000000", "#000000",
+                      "#000000", "#000000", "#000000", "#000000", "#000000", "#000000", "#000000", "#000000", "#000000"])",
+         "palette.reference.colors: must have 1 to 16 elements"},
+        {R"("#c9645a")", R"("#c9645g")", "palette.reference.colors[1]: '#c9645g' is not a colour (#rrggbb)"},
+        {R"("shares": [0.6, 0.3, 0.1])", R"("shares": [0.6, 0.4])",
+         "palette.reference.shares: must have one share per colour (3 colours, 2 shares)"},
+        {R"("shares": [0.6, 0.3, 0.1])", R"("shares": [0.7, 0.3, 0])",
+         "palette.reference.shares[2]: must be in (0, 1]"},
+        {R"("shares": [0.6, 0.3, 0.1])", R"("shares": [0.6, 0.5, -0.1])",
+         "palette.reference.shares[2]: must be in (0, 1]"},
+        {R"("shares": [0.6, 0.3, 0.1])", R"("shares": [0.6, 0.3, 0.2])",
+         "palette.reference.shares: must sum to 1 within 1e-6 (sum 1.1)"},
+        {R"("shares": [0.6, 0.3, 0.1])", R"("shares": [0.6, 0.3, 0.100002])",
+         "palette.reference.shares: must sum to 1 within 1e-6 (sum 1.000002)"},
+        {R"("noise": 6)", R"("noise": 65)", "palette.reference.noise: must be in [0, 64]"},
+        {R"("noise": 6)", R"("noise": -1)", "palette.reference.noise: must be in [0, 64]"},
+        {R"("blur_px": 1.5)", R"("blur_px": 16.5)", "palette.reference.blur_px: must be in [0, 16]"},
+        {R"("blur_px": 1.5)", R"("blur_px": 1.5, "file": "x.png")", "palette.reference.file: unknown field"},
+        {R"("colors": ["#8a2b24", "#c9645a", "#f0d2c4"], )", "", "palette.reference.colors: required field is missing"},
+    };
+    for (const auto& c : cases)
+        EXPECT_EQ(refusal(referenceSpecText(1, replaced(good, c.from, c.to))), std::string("spec.json: ") + c.message)
+            << c.to;
+    // Sums within 1e-6 of 1 are accepted.
+    EXPECT_EQ(refusal(referenceSpecText(1, replaced(good, "0.1]", "0.1000009]"))), "(accepted)");
+
+    // Exactly one palette source; the palette's extraction fields follow the method.
+    EXPECT_EQ(refusal(referenceSpecText(1, good, R"(, "image": "refs/liver.png")")),
+              "spec.json: palette: takes one of 'colors', 'image' and 'reference' (found 'image' and 'reference')");
+    EXPECT_EQ(refusal(referenceSpecText(1, good, R"(, "colors": ["#000000"])")),
+              "spec.json: palette: takes one of 'colors', 'image' and 'reference' (found 'colors' and 'reference')");
+    EXPECT_EQ(refusal(referenceSpecText(1, good, R"(, "k": 4)")), "spec.json: palette.k: unknown field");
+    EXPECT_EQ(
+        refusal(replaced(specText(1), R"({"colors": ["#7a1f24", "#c65a4f", "#efc1a8"]})", R"({"method": "kmeans"})")),
+        "spec.json: palette: needs 'colors' (a list of #rrggbb), 'image' (a reference image) or 'reference' (a "
+        "synthetic reference photograph)");
+    // maps.reference needs palette.reference and takes no fields.
+    EXPECT_EQ(refusal(replaced(specText(1), R"("palette": {"swatch_px": 8})",
+                               R"("palette": {"swatch_px": 8}, "reference": {})")),
+              "spec.json: maps.reference: needs a synthetic reference photograph (palette.reference)");
+    EXPECT_EQ(refusal(replaced(referenceSpecText(1), R"("reference": {})", R"("reference": {"bit_depth": 16})")),
+              "spec.json: maps.reference.bit_depth: unknown field");
+
+    // The API checks the same rules.
+    ReferenceSpec r;
+    r.colors = {kTissue[0], kTissue[1]};
+    r.shares = {0.5, 0.4};
+    EXPECT_THAT([&] { generateReferenceImage(r); },
+                testing::ThrowsMessage<std::invalid_argument>(
+                    testing::StrEq("bake::generateReferenceImage(): shares must sum to 1 within 1e-6 (sum 0.9)")));
+    r.shares = {0.5, 0.5};
+    r.size = 100;
+    EXPECT_THAT([&] { generateReferenceImage(r); },
+                testing::ThrowsMessage<std::invalid_argument>(
+                    testing::StrEq("bake::generateReferenceImage(): size 100 must be a power of two in [16, 4096]")));
 }
