@@ -46,6 +46,8 @@ uniform sampler2D uDiffuseMap;   // sRGB texture: sampled linear
 uniform sampler2D uRoughnessMap; // red channel
 uniform sampler2D uMetallicMap;  // red channel
 uniform sampler2D uNormalMap;    // tangent space, (n + 1) / 2
+uniform int uHasThicknessMap;    // 1: the mesh's baked thickness per texel [A §6.3.1] (needs UVs)
+uniform sampler2D uThicknessMap; // red = thickness / uThicknessRange
 
 // Triplanar weights from the rest surface's normal (screen derivatives of the rest position, so
 // the projection stays with the tissue as it deforms).
@@ -97,7 +99,8 @@ void main() {
     q += uFibreAxis * (dot(q, uFibreAxis) * -0.85); // stretch cells along the fibre axis
     float fibre = pow(1.0 - abs(2.0 * valueNoise(q) - 1.0), 6.0);
     float ridge = 1.0 - abs(2.0 * fbm2(vRest * uLayerFrequency.w) - 1.0);
-    float thin = 1.0 - clamp(vThickness / (0.5 * uThicknessRange), 0.0, 1.0);
+    float thickness = uHasThicknessMap != 0 ? texture(uThicknessMap, vUv).r * uThicknessRange : vThickness;
+    float thin = 1.0 - clamp(thickness / (0.5 * uThicknessRange), 0.0, 1.0);
     float vessel = smoothstep(0.9, 0.975, ridge) * mix(0.45, 1.0, thin);
 
     vec3 diffuse = uSurfaceColour * uLayerWeights.x;
@@ -119,7 +122,7 @@ void main() {
     vec2 velocity = clamp(0.5 + 4.0 * 0.5 * (ndc - prevNdc), 0.0, 1.0);
 
     oG0 = vec4(encodeNormal(n), vViewDepth, uMaterialId);
-    oG1 = vec4(roughness, metallic, clamp(vThickness / uThicknessRange, 0.0, 1.0), uReflection);
+    oG1 = vec4(roughness, metallic, clamp(thickness / uThicknessRange, 0.0, 1.0), uReflection);
     oG2 = vec4(clamp(diffuse, 0.0, 1.0), clamp(vHeat, 0.0, 1.0));
     oG3 = vec4(velocity, vSamples / 255.0, uFlags / 255.0);
 }

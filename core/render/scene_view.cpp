@@ -111,6 +111,25 @@ size_t SceneView::addMesh(const std::string& name, const sim::TriMesh& mesh, uin
     return m_meshes.size() - 1;
 }
 
+size_t SceneView::bakeThicknessMap(size_t i, int size, const ThicknessBakeSettings& bake) {
+    RenderMesh& m = m_meshes.at(i);
+    if (m.uv.size() != 2 * m.vertexCount() || m.uv.empty())
+        throw std::invalid_argument("render::SceneView::bakeThicknessMap(): mesh '" + m.name + "' has no UVs");
+    const std::vector<Eigen::Vector3f> pos = asVectors(m.rest);
+    std::vector<Tri3> tris(m.triangleCount());
+    for (size_t t = 0; t < tris.size(); ++t)
+        tris[t] = {m.indices[3 * t], m.indices[3 * t + 1], m.indices[3 * t + 2]};
+    std::vector<Eigen::Vector2f> uv(m.vertexCount());
+    for (size_t v = 0; v < uv.size(); ++v)
+        uv[v] = Eigen::Vector2f(m.uv[2 * v], m.uv[2 * v + 1]);
+    std::vector<Eigen::Vector3f> normals = asVectors(m.normals); // at rest when baked before a frame
+    size_t covered = 0;
+    m.thicknessMap =
+        bakeThicknessTexture(pos, normals, tris, uv, TriangleBvh(pos, tris), size, kThicknessMapRange, bake, &covered);
+    ++m.staticRevision;
+    return covered;
+}
+
 SceneView SceneView::fromWorld(const sim::World& world, const ThicknessBakeSettings& bake) {
     SceneView view;
     std::vector<Eigen::Vector3f> allPos;

@@ -21,6 +21,9 @@ class TetMesh;
 
 namespace viscera::render {
 
+/// The thickness a thickness map's code 255 stands for (m), the G-buffer's thickness range.
+inline constexpr float kThicknessMapRange = 0.05f;
+
 struct RenderMesh {
     std::string name;
     uint32_t material = 0;    ///< index into SceneView::materials()
@@ -37,6 +40,9 @@ struct RenderMesh {
     std::vector<float> sampleMap;  ///< #V: painted light samples (0 unpainted, else 1, 4 or 8)
     /// #V × 2 or empty: texture coordinates for the material's maps (none: triplanar on `rest`)
     std::vector<float> uv;
+    /// Empty, or with `uv`: the thickness baked per texel (bakeThicknessTexture, R = thickness /
+    /// 0.05 m), sampled by the G-buffer pass instead of the per-vertex `thickness`.
+    Image thicknessMap;
     /// #V × 4 (RGBA) or empty: an authoring overlay (the studio's weight ramp) blended over the
     /// diffuse colour by its alpha. Set with SceneView::setOverlay.
     std::vector<float> overlay;
@@ -103,6 +109,12 @@ public:
     /// Paints `samples` (1, 4 or 8; 0 erases) into the sample map of every vertex of every mesh
     /// within `radius` (m) of `centre` in the current positions.
     void paintSampleMap(const Eigen::Vector3f& centre, float radius, int samples);
+
+    /// Bakes mesh i's thickness into a `size` × `size` texture in its UV space against the mesh
+    /// itself at rest (bakeThicknessTexture, range kThicknessMapRange) and bumps its
+    /// staticRevision. Throws std::invalid_argument when the mesh has no UVs. Returns the texels
+    /// covered by a triangle.
+    size_t bakeThicknessMap(size_t i, int size, const ThicknessBakeSettings& bake = {});
 
     /// Recomputes the normals of mesh i from its positions (allocation-free); bumps its revision.
     void recomputeNormals(size_t i);

@@ -8,6 +8,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace viscera::render {
 
@@ -143,6 +144,80 @@ std::vector<float> bakeThickness(const std::vector<Eigen::Vector3f>& positions,
         out[i] = float(sum / rays);
     }
     return out;
+}
+
+Image bakeThicknessTexture(const std::vector<Eigen::Vector3f>& positions, const std::vector<Eigen::Vector3f>& normals,
+                           const std::vector<std::array<uint32_t, 3>>& triangles,
+                           const std::vector<Eigen::Vector2f>& uv, const TriangleBvh& target, int size, float range,
+                           const ThicknessBakeSettings& settings, size_t* covered) {
+    const std::string fn = "render::bakeThicknessTexture(): ";
+    if (uv.size() != positions.size() || normals.size() != positions.size())
+        throw std::invalid_argument(fn + std::to_string(uv.size()) + " uv and " + std::to_string(normals.size()) +
+                                    " normals for " + std::to_string(positions.size()) + " positions");
+    if (size < 1 || size > 4096) throw std::invalid_argument(fn + "size " + std::to_string(size) + " not in [1, 4096]");
+    if (!(range > 0)) throw std::invalid_argument(fn + "range must be positive");
+    // texel (x, y) ↔ uv ((x + 0.5) / size, 1 − (y + 0.5) / size)
+    std::vector<int32_t> owner(size_t(size) * size, -1);
+    std::vector<Eigen::Vector3f> points, pointNormals;
+    for (const auto& t : triangles) {
+        for (uint32_t v : t)
+            if (v >= positions.size()) throw std::invalid_argument(fn + "index " + std::to_string(v) + " out of range");
+        Eigen::Vector2f a = uv[t[0]] * float(size), b = uv[t[1]] * float(size), c = uv[t[2]] * float(size);
+        for (Eigen::Vector2f* q : {&a, &b, &c})
+            q->y() = float(size) - q->y(); // rows from the top
+        const Eigen::Vector2f lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
+        if ((hi - lo).maxCoeff() > 0.5f * float(size) || !lo.allFinite() || !hi.allFinite()) continue;
+        const float area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+        if (std::abs(area) < 1e-12f) continue;
+        const int x0 = std::max(0, int(std::floor(lo.x()))), x1 = std::min(size - 1, int(std::ceil(hi.x())));
+        const int y0 = std::max(0, int(std::floor(lo.y()))), y1 = std::min(size - 1, int(std::ceil(hi.y())));
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) {
+                const Eigen::Vector2f p(float(x) + 0.5f, float(y) + 0.5f);
+                const float w1 = ((p - a).x() * (c - a).y() - (p - a).y() * (c - a).x()) / area;
+                const float w2 = ((b - a).x() * (p - a).y() - (b - a).y() * (p - a).x()) / area;
+                const float w0 = 1.0f - w1 - w2;
+                constexpr float eps = -1e-5f;
+                if (w0 < eps || w1 < eps || w2 < eps) continue;
+                int32_t& o = owner[size_t(y) * size + x];
+                if (o >= 0) continue; // the first triangle over a texel keeps it
+                o = int32_t(points.size());
+                points.push_back(w0 * positions[t[0]] + w1 * positions[t[1]] + w2 * positions[t[2]]);
+                const Eigen::Vector3f n = w0 * normals[t[0]] + w1 * normals[t[1]] + w2 * normals[t[2]];
+                pointNormals.push_back(n.squaredNorm() > 0 ? Eigen::Vector3f(n.normalized()) : n);
+            }
+    }
+    if (covered) *covered = points.size();
+    const std::vector<float> thick = bakeThickness(points, pointNormals, target, settings);
+    std::vector<float> value(owner.size(), -1.0f);
+    for (size_t i = 0; i < owner.size(); ++i)
+        if (owner[i] >= 0) value[i] = thick[size_t(owner[i])];
+    for (int pass = 0; pass < 4; ++pass) { // grow the covered texels by one ring per pass
+        std::vector<float> next = value;
+        for (int y = 0; y < size; ++y)
+            for (int x = 0; x < size; ++x) {
+                if (value[size_t(y) * size + x] >= 0) continue;
+                for (const auto& [dx, dy] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+                    const int nx = x + dx, ny = y + dy;
+                    if (nx < 0 || ny < 0 || nx >= size || ny >= size) continue;
+                    const float v = value[size_t(ny) * size + nx];
+                    if (v >= 0) {
+                        next[size_t(y) * size + x] = v;
+                        break;
+                    }
+                }
+            }
+        value = std::move(next);
+    }
+    Image img;
+    img.width = img.height = size;
+    img.rgba.assign(size_t(size) * size * 4, 0);
+    for (size_t i = 0; i < value.size(); ++i) {
+        const uint8_t code = uint8_t(std::lround(std::clamp(std::max(value[i], 0.0f) / range, 0.0f, 1.0f) * 255.0f));
+        img.rgba[4 * i] = img.rgba[4 * i + 1] = img.rgba[4 * i + 2] = code;
+        img.rgba[4 * i + 3] = 255;
+    }
+    return img;
 }
 
 } // namespace viscera::render

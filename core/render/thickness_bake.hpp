@@ -3,6 +3,8 @@
 /// cone of 37° around the inward normal (−n) against a triangle mesh; the thickness is the mean
 /// distance to the first hit (rays that escape count as `maxThickness`). Done once, in the rest
 /// configuration, like the thesis's pre-computed thickness map (here stored per vertex).
+#include "render/image.hpp"
+
 #include <Eigen/Core>
 
 #include <array>
@@ -45,5 +47,18 @@ struct ThicknessBakeSettings {
 std::vector<float> bakeThickness(const std::vector<Eigen::Vector3f>& positions,
                                  const std::vector<Eigen::Vector3f>& normals, const TriangleBvh& target,
                                  const ThicknessBakeSettings& settings = {});
+
+/// The thickness map of a textured mesh [A §6.3.1]: a `size` × `size` texture in its UV space
+/// (v = 0 at the image's bottom row), each texel covered by a triangle holding the thickness of
+/// the surface point under it (barycentric position and normal, the same cone of rays as
+/// bakeThickness), encoded as thickness / `range` in R = G = B (8-bit; A = 255). Texels no
+/// triangle covers take their nearest covered neighbour's value within 4 texels (no dark seams
+/// under filtering), else 0. Triangles spanning more than half the texture (a wrapped seam) are
+/// skipped. Throws std::invalid_argument for #uv != #positions, an index out of range, size not
+/// in [1, 4096] or range <= 0. `covered`, when given, receives the texels covered by a triangle.
+Image bakeThicknessTexture(const std::vector<Eigen::Vector3f>& positions, const std::vector<Eigen::Vector3f>& normals,
+                           const std::vector<std::array<uint32_t, 3>>& triangles,
+                           const std::vector<Eigen::Vector2f>& uv, const TriangleBvh& target, int size, float range,
+                           const ThicknessBakeSettings& settings = {}, size_t* covered = nullptr);
 
 } // namespace viscera::render

@@ -10,6 +10,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 using namespace viscera::render;
@@ -84,6 +87,57 @@ TEST(ThicknessBake, SphereAndEllipsoidByRayCasting) {
     view.addMesh("sheet", sim::makeBoxSurface(sim::Vec3(0, 0, 0), sim::Vec3(0.01, 0.01, 0.01)), 0);
     EXPECT_FALSE(view.meshes()[1].doubleSided);
     EXPECT_THROW(TriangleBvh(pos, {{0, 1, 99999}}), std::invalid_argument);
+}
+
+TEST(ThicknessBake, TextureOfASphereMatchesTheChordsOfItsRayCone) {
+    // [A §6.3.1] baked per texel: every texel of a UV sphere of radius R holds the mean chord
+    // 2R cos θ over the bake's cone of rays, whatever point of the surface it lies on
+    const float R = 0.02f;
+    SceneView view;
+    view.addMesh("ball", sim::makeEllipsoidSurface(sim::Vec3::Zero(), sim::Vec3(R, R, R), 64, 32),
+                 view.addMaterial(TissueMaterial{}));
+    RenderMesh& m = view.meshes()[0];
+    EXPECT_THROW(view.bakeThicknessMap(0, 64), std::invalid_argument) << "no UVs yet";
+    m.uv.resize(2 * m.vertexCount());
+    for (size_t v = 0; v < m.vertexCount(); ++v) { // longitude, latitude
+        const float x = m.rest[3 * v], y = m.rest[3 * v + 1], z = m.rest[3 * v + 2];
+        m.uv[2 * v] = 0.5f + std::atan2(y, x) / (2.0f * float(M_PI));
+        m.uv[2 * v + 1] = 1.0f - std::acos(std::clamp(z / R, -1.0f, 1.0f)) / float(M_PI);
+    }
+    const uint64_t revision = m.staticRevision;
+    const int size = 128;
+    const size_t covered = view.bakeThicknessMap(0, size);
+    EXPECT_GT(m.staticRevision, revision);
+    ASSERT_EQ(m.thicknessMap.width, size);
+    EXPECT_GT(covered, size_t(size * size * 0.85)) << "all but the seam column";
+    const ThicknessBakeSettings bake;
+    double coneMean = 0; // the bake's ray pattern: cos θ = sqrt(1 − 0.36 u)
+    for (int r = 0; r < bake.rays; ++r)
+        coneMean += std::sqrt(1.0 - 0.36 * (r + 0.5) / bake.rays) / bake.rays;
+    const double expected = 2.0 * R * coneMean;
+    double sumErr = 0, maxErr = 0;
+    size_t n = 0;
+    for (size_t i = 0; i < size_t(size) * size; ++i) {
+        const double t = m.thicknessMap.rgba[4 * i] / 255.0 * kThicknessMapRange;
+        if (t == 0) continue; // not covered
+        sumErr += std::abs(t - expected);
+        maxErr = std::max(maxErr, std::abs(t - expected));
+        ++n;
+    }
+    ASSERT_GT(n, size_t(size * size * 0.9));
+    std::printf("thickness map of a sphere (R %.0f mm, %d^2 texels): expected %.3f mm, mean |error| %.3f mm, max "
+                "%.3f mm (8-bit step %.3f mm)\n",
+                1e3 * R, size, 1e3 * expected, 1e3 * sumErr / n, 1e3 * maxErr, 1e3 * kThicknessMapRange / 255);
+    EXPECT_LT(sumErr / n, 0.02 * expected);
+    EXPECT_LT(maxErr, 0.08 * expected);
+    // bad input
+    std::vector<Eigen::Vector3f> p(3, Eigen::Vector3f::Zero());
+    const TriangleBvh bvh({Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(1, 0, 0), Eigen::Vector3f(0, 1, 0)}, {{0, 1, 2}});
+    EXPECT_THROW(bakeThicknessTexture(p, p, {{0, 1, 2}}, {}, bvh, 8, 0.05f), std::invalid_argument);
+    const std::vector<Eigen::Vector2f> uv(3, Eigen::Vector2f::Zero());
+    EXPECT_THROW(bakeThicknessTexture(p, p, {{0, 1, 3}}, uv, bvh, 8, 0.05f), std::invalid_argument);
+    EXPECT_THROW(bakeThicknessTexture(p, p, {{0, 1, 2}}, uv, bvh, 0, 0.05f), std::invalid_argument);
+    EXPECT_THROW(bakeThicknessTexture(p, p, {{0, 1, 2}}, uv, bvh, 8, 0.0f), std::invalid_argument);
 }
 
 TEST(SceneView, FollowsTheWorldWithoutReallocating) {

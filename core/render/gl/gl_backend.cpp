@@ -17,7 +17,7 @@ namespace viscera::render {
 
 namespace {
 
-constexpr float kThicknessRange = 0.05f; ///< m: G-buffer thickness 1.0 (matches the bake's default maximum)
+constexpr float kThicknessRange = kThicknessMapRange; ///< m: G-buffer thickness 1.0 (the bake's default maximum)
 constexpr int kMaxMaterials = 16;
 constexpr int kAttributeFloats = 11; ///< static attributes per vertex: rest xyz, thickness, samples, overlay rgba, uv
 constexpr GLsizei kAttributeBytes = kAttributeFloats * 4;
@@ -123,7 +123,8 @@ struct GpuMesh {
     GLuint vao = 0;
     GLuint position = 0, previous = 0, normal = 0, heat = 0, attributes = 0, index = 0;
     size_t vertices = 0, indices = 0;
-    size_t drawIndices = 0; ///< leading indices drawn (face mask, [A §5.3.1])
+    size_t drawIndices = 0;  ///< leading indices drawn (face mask, [A §5.3.1])
+    GLuint thicknessMap = 0; ///< the mesh's baked thickness texture (0: none)
 };
 
 /// The GPU copies of one material's maps (MaterialMaps), made the first time the material is drawn
@@ -165,6 +166,8 @@ private:
     /// The textures of material `index`, uploaded when its maps changed.
     const MaterialTextures& texturesOf(size_t index, const TissueMaterial& material);
     void freeTextures(MaterialTextures& t);
+    /// A mip-mapped, repeating 2D texture of `img` (rows flipped into `scratch`).
+    GLuint uploadTexture(const Image& img, bool srgb, std::vector<uint8_t>& scratch);
     void lightingPass(const PassDesc& pass, const PassContext& ctx);
     void postPass(const PassDesc& pass, const PassContext& ctx);
     void outputPass(const PassDesc& pass);
@@ -189,6 +192,7 @@ GlBackend::~GlBackend() {
         GLuint buffers[] = {m.position, m.previous, m.normal, m.heat, m.attributes, m.index};
         m_gl.DeleteBuffers(6, buffers);
         m_gl.DeleteVertexArrays(1, &m.vao);
+        if (m.thicknessMap) m_gl.DeleteTextures(1, &m.thicknessMap);
     }
     for (RenderTarget* t :
          {&m_gbufferTarget, &m_lit, &m_postA, &m_postB, &m_eyeLeft, &m_eyeRight, &m_final, &m_scratch})
@@ -223,27 +227,33 @@ const MaterialTextures& GlBackend::texturesOf(size_t index, const TissueMaterial
         if (img.empty() || img.width <= 0 || img.height <= 0 ||
             img.rgba.size() != size_t(img.width) * size_t(img.height) * 4)
             continue;
-        // texture row 0 is the image's bottom row: v = 0 at the bottom, as UVs are given
-        flipped.resize(img.rgba.size());
-        const size_t row = size_t(img.width) * 4;
-        for (int y = 0; y < img.height; ++y)
-            std::copy_n(img.rgba.begin() + ptrdiff_t(row * (img.height - 1 - y)), row,
-                        flipped.begin() + ptrdiff_t(row * y));
-        m_gl.GenTextures(1, &t.texture[k]);
-        m_gl.BindTexture(GL_TEXTURE_2D, t.texture[k]);
-        m_gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-        m_gl.TexImage2D(GL_TEXTURE_2D, 0, k == 0 ? GL_SRGB8_ALPHA8 : GL_RGBA8, img.width, img.height, 0, GL_RGBA,
-                        GL_UNSIGNED_BYTE, flipped.data());
-        m_gl.GenerateMipmap(GL_TEXTURE_2D);
-        m_gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-        m_gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        m_gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-        m_gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+        t.texture[k] = uploadTexture(img, k == 0, flipped);
         t.mask |= 1 << k;
-        ++m_stats.textureUploads;
     }
-    m_gl.BindTexture(GL_TEXTURE_2D, 0);
     return t;
+}
+
+GLuint GlBackend::uploadTexture(const Image& img, bool srgb, std::vector<uint8_t>& flipped) {
+    // texture row 0 is the image's bottom row: v = 0 at the bottom, as UVs are given
+    flipped.resize(img.rgba.size());
+    const size_t row = size_t(img.width) * 4;
+    for (int y = 0; y < img.height; ++y)
+        std::copy_n(img.rgba.begin() + ptrdiff_t(row * (img.height - 1 - y)), row,
+                    flipped.begin() + ptrdiff_t(row * y));
+    GLuint tex = 0;
+    m_gl.GenTextures(1, &tex);
+    m_gl.BindTexture(GL_TEXTURE_2D, tex);
+    m_gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    m_gl.TexImage2D(GL_TEXTURE_2D, 0, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, img.width, img.height, 0, GL_RGBA,
+                    GL_UNSIGNED_BYTE, flipped.data());
+    m_gl.GenerateMipmap(GL_TEXTURE_2D);
+    m_gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    m_gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    m_gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    m_gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    m_gl.BindTexture(GL_TEXTURE_2D, 0);
+    ++m_stats.textureUploads;
+    return tex;
 }
 
 bool GlBackend::init(std::string* whyNot) {
@@ -451,6 +461,15 @@ void GlBackend::updateMesh(size_t index, const RenderMesh& mesh, bool staticChan
             }
         }
         write(g.attributes, attr.data(), attr.size() * 4);
+        if (g.thicknessMap) {
+            m_gl.DeleteTextures(1, &g.thicknessMap);
+            g.thicknessMap = 0;
+        }
+        const Image& tm = mesh.thicknessMap;
+        if (uv && !tm.empty() && tm.rgba.size() == size_t(tm.width) * size_t(tm.height) * 4) {
+            std::vector<uint8_t> scratch;
+            g.thicknessMap = uploadTexture(tm, false, scratch);
+        }
     }
 }
 
@@ -536,6 +555,9 @@ void GlBackend::gbufferPass(const PassDesc& pass, const PassContext& ctx) {
         p.set("uScreenDoor", m.translucent ? 1 : 0);
         const MaterialTextures& tex = texturesOf(m.material, mat);
         p.set("uMapMask", tex.mask);
+        p.set("uHasThicknessMap", g.thicknessMap ? 1 : 0);
+        if (g.thicknessMap) bindTexture(p, "uThicknessMap", 4, g.thicknessMap);
+        if (g.thicknessMap && !tex.mask) p.set("uHasUv", 1);
         if (tex.mask) {
             static const char* const kSamplers[4] = {"uDiffuseMap", "uRoughnessMap", "uMetallicMap", "uNormalMap"};
             for (int k = 0; k < 4; ++k)
