@@ -1,5 +1,7 @@
 #include "app/document.hpp"
 
+#include "bake/texture.hpp"
+
 #include "sim/material/material.hpp"
 #include "sim/util/error.hpp"
 
@@ -80,7 +82,7 @@ void Document::saveAs(const QString& folder) {
     const QString abs = QDir(folder).absolutePath();
     if (abs == m_folder) return save();
     if (!QDir().mkpath(abs)) throw InputError(abs.toStdString() + ": the folder cannot be created");
-    // The project's files (imported meshes, trajectory, instrument tracks) go along, in the same
+    // The project's files (imported meshes, trajectory, instrument tracks, texture specs) go along, in the same
     // layout, so that the saved project is complete; then project.json, atomically.
     Project p = *m_project;
     p.dir = abs.toStdString();
@@ -99,6 +101,24 @@ void Document::saveAs(const QString& folder) {
     if (p.scene.suture && !p.trajectory.generator) relocate(p.trajectory.file);
     for (fs::path& t : p.trackFiles)
         relocate(t);
+    // texture specs (relative to the project folder) and the files they read travel too
+    auto specOf = [&](const std::optional<TextureProject>& t) {
+        if (!t) return;
+        const fs::path spec = m_project->dir / t->spec;
+        if (!fs::exists(spec)) return; // nothing to carry; export names the missing spec
+        copies.emplace_back(spec, p.dir / t->spec);
+        std::vector<std::string> inputs;
+        try {
+            inputs = bake::specInputFiles(bake::loadTextureSpec(spec));
+        } catch (const InputError&) { // a broken spec is copied as it is, to be fixed there
+        }
+        for (const std::string& f : inputs)
+            copies.emplace_back(spec.parent_path() / f, (p.dir / t->spec).parent_path() / f);
+    };
+    for (const BodyProject& b : p.bodies)
+        specOf(b.texture);
+    for (const SurfaceProject& sp : p.surfaces)
+        specOf(sp.texture);
     for (const auto& [from, to] : copies) {
         std::error_code ec;
         fs::create_directories(to.parent_path(), ec);

@@ -7,6 +7,7 @@
 #include "app/material_panel.hpp"
 #include "app/paint_overlays.hpp"
 #include "app/plot_widget.hpp"
+#include "app/texture_panel.hpp"
 #include "app/viewport.hpp"
 #include "render/case_settings.hpp"
 #include "sim/material/material.hpp"
@@ -127,6 +128,7 @@ void MainWindow::buildDocks() {
         m_selKind = kind;
         m_selIndex = index;
         m_material->setBody(-1);
+        m_texture->setTarget(TexturePanel::Target::None, -1);
         m_viewport->setSelectedName(QString());
         retargetPainter();
         scheduleRefresh(false);
@@ -148,6 +150,12 @@ void MainWindow::buildDocks() {
     m_material = new MaterialPanel(&m_doc, this);
     m_material->setObjectName("materialPanel");
     dock("materialDock", tr("Material curves"), m_material, Qt::BottomDockWidgetArea);
+
+    m_texture = new TexturePanel(&m_doc, this);
+    m_texture->setObjectName("texturePanel");
+    auto* textureScroll = new QScrollArea(this); // a short dock scrolls instead of clipping the swatches
+    textureScroll->setWidget(m_texture);
+    textureScroll->setWidgetResizable(true);
 
     m_log = new QPlainTextEdit(this);
     m_log->setObjectName("log");
@@ -184,7 +192,10 @@ void MainWindow::buildDocks() {
     m_costPlot->setTitle(tr("Physics cost per frame"));
     m_costPlot->setAxes(tr("frame"), tr("ms"));
     pl->addWidget(m_costPlot, 1);
-    dock("plotsDock", tr("Preview and plots"), plots, Qt::RightDockWidgetArea);
+    QDockWidget* plotsDock = dock("plotsDock", tr("Preview and plots"), plots, Qt::RightDockWidgetArea);
+    // a tab beside the plots, which stay in front: the panel needs the column's height
+    tabifyDockWidget(plotsDock, dock("textureDock", tr("Material maps"), textureScroll, Qt::RightDockWidgetArea));
+    plotsDock->raise();
 }
 
 void MainWindow::buildActions() {
@@ -918,6 +929,7 @@ void MainWindow::selectBody(int index) {
     m_selKind = index >= 0 ? kBody : kGroup;
     m_selIndex = index;
     m_material->setBody(index);
+    m_texture->setTarget(TexturePanel::Target::Body, index);
     retargetPainter();
     const bool ok = m_doc.hasProject() && index >= 0 && index < static_cast<int>(m_doc.project().bodies.size());
     m_viewport->setSelectedName(ok ? QString::fromStdString(m_doc.project().bodies[index].scene.name) : QString());
@@ -942,6 +954,7 @@ void MainWindow::selectSurface(int index) {
     m_selKind = ok ? kSurface : kGroup;
     m_selIndex = ok ? index : -1;
     m_material->setBody(-1);
+    m_texture->setTarget(ok ? TexturePanel::Target::Surface : TexturePanel::Target::None, ok ? index : -1);
     retargetPainter();
     m_viewport->setSelectedName(ok ? QString::fromStdString(m_doc.project().surfaces[index].scene.name) : QString());
     followInTree(kSurface, index);

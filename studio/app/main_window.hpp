@@ -39,6 +39,7 @@ namespace viscera::studio {
 class ExportRunner;
 class MaterialPanel;
 class PlotWidget;
+class TexturePanel;
 
 class MainWindow : public QMainWindow {
     Q_OBJECT
@@ -74,6 +75,8 @@ public:
     /// menu; saved in the settings as "viewport/host").
     void setViewportHost(ViewportHost host);
     MaterialPanel* materialPanel() { return m_material; }
+    /// The "Material maps" dock's panel: the selection's texture block, thumbnails, palette picker.
+    TexturePanel* texturePanel() { return m_texture; }
     StiffnessPainter* painter() { return &m_painter; }
     /// Paint stiffness mode (the toolbar's Paint action): the viewport's left drag paints the
     /// selected body's node weights, shown as a colour ramp.
@@ -162,6 +165,7 @@ private:
                          const std::function<Eigen::Vector4f(int32_t node)>& rgbaOfNode,
                          const std::optional<CutPlane>& cut, bool translucent = false);
     MaterialPanel* m_material = nullptr;
+    TexturePanel* m_texture = nullptr;
     QTreeWidget* m_tree = nullptr;
     QWidget* m_propertiesHost = nullptr;
     QFormLayout* m_properties = nullptr;

@@ -79,6 +79,7 @@ struct Tile {
     TileShape shape = TileShape::Gaussian;
     double sigma = 0.4; ///< Gaussian: standard deviation in units of the tile's half-size, (0, 4]
     GrayImage image;    ///< Image: the pattern, values in [0, 1], at most 4096 × 4096
+    std::string file;   ///< Image: the file as written in the spec (relative to its folder)
 };
 
 /// The pattern of one quadtree level and its per-node randomness [A Fig. 6.4]. Every node of the
@@ -315,6 +316,9 @@ struct TextureSpec {
 TextureSpec parseTextureSpec(std::string_view text, const std::string& origin, const std::filesystem::path& folder);
 /// Reads and parses a spec file; origin is the path as given, files resolve against its folder.
 TextureSpec loadTextureSpec(const std::filesystem::path& file);
+/// The files a spec reads besides itself (the palette's image, image tiles), as written in it
+/// (relative to the spec's folder), each once: what must travel with the spec.
+std::vector<std::string> specInputFiles(const TextureSpec& spec);
 
 /// Everything a spec makes, in memory.
 struct TextureSet {

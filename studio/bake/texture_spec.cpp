@@ -1,6 +1,8 @@
 // The texture spec (JSON, read through sim::JsonField) and the bake of its files.
 #include "bake/texture.hpp"
 
+#include <algorithm>
+
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/entry_name.hpp"
 #include "sim/util/error.hpp"
@@ -101,6 +103,7 @@ Tile readTile(const JsonField& f, const fs::path& folder) {
         f.object({"shape", "file"});
         t.shape = TileShape::Image;
         t.image = readImageField(f["file"], folder, [](const fs::path& p) { return readGrayImage(p); });
+        t.file = f["file"].string();
     } else {
         f.object({"shape"});
         t.shape = shape == "disc" ? TileShape::Disc : TileShape::Bell;
@@ -366,6 +369,17 @@ TextureSpec parseTextureSpec(std::string_view text, const std::string& origin, c
                                 " is out of range (the palette has " + std::to_string(n) + " colours)");
     }
     return spec;
+}
+
+std::vector<std::string> specInputFiles(const TextureSpec& spec) {
+    std::vector<std::string> files;
+    auto add = [&files](const std::string& f) {
+        if (!f.empty() && std::find(files.begin(), files.end(), f) == files.end()) files.push_back(f);
+    };
+    if (spec.palette) add(spec.palette->imageFile);
+    for (const LevelPattern& lp : spec.quadtree.patterns)
+        if (lp.tile.shape == TileShape::Image) add(lp.tile.file);
+    return files;
 }
 
 TextureSpec loadTextureSpec(const fs::path& file) {

@@ -14,11 +14,13 @@
 #include "app/viewport.hpp"
 #include "case/case_package.hpp"
 #include "gui_test_support.hpp"
+#include "render/image.hpp"
 #include "render/sample_map.hpp"
 #include "sim/material/laws.hpp"
 #include "sim/material/material_response.hpp"
 #include "sim/skeleton/skeleton.hpp"
 #include "sim/util/atomic_file.hpp"
+#include "window_fixture.hpp"
 
 #include <QAction>
 #include <QComboBox>
@@ -34,6 +36,7 @@
 #include <QTreeWidget>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <fstream>
 #include <set>
@@ -43,28 +46,11 @@ namespace {
 using namespace viscera;
 namespace fs = std::filesystem;
 
-struct WindowFixture : ::testing::Test {
-    test::Scratch scratch{"viscera-gui-window"};
-    std::unique_ptr<studio::MainWindow> w;
-
+struct WindowFixture : test::MainWindowFixture {
+    WindowFixture() : MainWindowFixture("viscera-gui-window") {}
     void SetUp() override {
-        test::guiApp();
-        QSettings().clear();
-        w = std::make_unique<studio::MainWindow>();
-        w->setConfirmDiscard(false);
+        MainWindowFixture::SetUp();
         w->exportRunner()->setProgram(VISCERA_STUDIO_EXE);
-        w->resize(1500, 950);
-        w->show();
-        ASSERT_TRUE(QTest::qWaitForWindowExposed(w.get()));
-    }
-    void TearDown() override {
-        w->preview()->stop();
-        w.reset();
-    }
-    fs::path open(const std::string& sample) {
-        const fs::path dir = test::copySample(scratch, sample);
-        EXPECT_TRUE(w->openProject(QString::fromStdString(dir.string())));
-        return dir;
     }
     bool waitForPreview(int ms = 120000) {
         return test::waitFor([&] { return w->viewport()->meshCount() > 0 && w->preview()->snapshot().frames > 3; }, ms);
@@ -149,6 +135,29 @@ TEST_F(WindowFixture, SaveAsWritesTheProjectAndRecentKeepsFive) {
     std::ofstream(bad / "project.json") << "{\"schemaVersion\": 1, \"caseId\": \"x\"";
     EXPECT_FALSE(w->openProject(QString::fromStdString(bad.string())));
     EXPECT_TRUE(w->windowTitle().contains("r5"));
+}
+
+TEST_F(WindowFixture, SaveAsCarriesTheTextureSpecsSoTheCopyExports) {
+    const fs::path dir = open("liver");
+    // an image tile the organ's spec reads travels with it too
+    {
+        nlohmann::json spec = nlohmann::json::parse(viscera::readFile(dir / "textures/organ.json"));
+        spec["patterns"][0]["tile"] = {{"shape", "image"}, {"file", "tiles/blob.png"}};
+        fs::create_directories(dir / "textures/tiles");
+        render::Image tile;
+        tile.width = tile.height = 8;
+        tile.rgba.assign(8 * 8 * 4, 255);
+        for (size_t i = 0; i < tile.rgba.size(); i += 4)
+            tile.rgba[i] = tile.rgba[i + 1] = tile.rgba[i + 2] = uint8_t(i % 251);
+        render::writePng(dir / "textures/tiles/blob.png", tile);
+        viscera::writeFileAtomic(dir / "textures/organ.json", spec.dump(1));
+    }
+    const fs::path copy = scratch.dir / "liver-copy";
+    ASSERT_TRUE(w->saveProjectAs(QString::fromStdString(copy.string())));
+    for (const char* f : {"textures/organ.json", "textures/fascia.json", "textures/tiles/blob.png"})
+        EXPECT_EQ(viscera::readFile(copy / f), viscera::readFile(dir / f)) << f;
+    const studio::ProjectTextures t = studio::bakeProjectTextures(studio::loadProject(copy));
+    EXPECT_EQ(t.materials.size(), 2u) << "organ and fascia bake from the copy";
 }
 
 TEST_F(WindowFixture, NewProjectIsWrittenAndAnExistingOneIsNotOverwritten) {
