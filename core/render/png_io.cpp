@@ -10,15 +10,27 @@
 
 namespace viscera::render {
 
-void writePng(const std::filesystem::path& path, const Image& image) {
+namespace {
+
+/// libpng's description of `image` for writing, into `png`; false when the image is empty or its
+/// size is inconsistent (each caller throws its own error).
+bool writeHeader(const Image& image, png_image& png) {
     if (image.width <= 0 || image.height <= 0 || image.rgba.size() != size_t(image.width) * image.height * 4)
-        throw std::runtime_error(path.string() + ": render::writePng(): image is empty or its size is inconsistent");
-    png_image png;
+        return false;
     std::memset(&png, 0, sizeof png);
     png.version = PNG_IMAGE_VERSION;
     png.width = png_uint_32(image.width);
     png.height = png_uint_32(image.height);
     png.format = PNG_FORMAT_RGBA;
+    return true;
+}
+
+} // namespace
+
+void writePng(const std::filesystem::path& path, const Image& image) {
+    png_image png;
+    if (!writeHeader(image, png))
+        throw std::runtime_error(path.string() + ": render::writePng(): image is empty or its size is inconsistent");
     if (!png_image_write_to_file(&png, path.string().c_str(), 0, image.rgba.data(), 0, nullptr)) {
         const std::string why = png.message;
         png_image_free(&png);
@@ -46,14 +58,9 @@ Image readPng(const std::filesystem::path& path) {
 }
 
 std::string encodePng(const Image& image) {
-    if (image.width <= 0 || image.height <= 0 || image.rgba.size() != size_t(image.width) * image.height * 4)
-        throw std::invalid_argument("render::encodePng(): image is empty or its size is inconsistent");
     png_image png;
-    std::memset(&png, 0, sizeof png);
-    png.version = PNG_IMAGE_VERSION;
-    png.width = png_uint_32(image.width);
-    png.height = png_uint_32(image.height);
-    png.format = PNG_FORMAT_RGBA;
+    if (!writeHeader(image, png))
+        throw std::invalid_argument("render::encodePng(): image is empty or its size is inconsistent");
     png_alloc_size_t size = 0;
     if (!png_image_write_to_memory(&png, nullptr, &size, 0, image.rgba.data(), 0, nullptr))
         throw std::runtime_error(std::string("render::encodePng(): ") + png.message);

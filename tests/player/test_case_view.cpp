@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
 
 #include <unistd.h>
 
@@ -29,37 +30,11 @@ std::unique_ptr<sim::TetMesh> slab() {
     return sim::makeBoxTetMesh(spec);
 }
 
-/// A one-body case; `map` is the .vsamples text (empty: none), `sampling` the render mode.
-std::filesystem::path writeCase(const std::string& name, const std::string& sampling, const std::string& map) {
-    const auto path = std::filesystem::temp_directory_path() /
-                      ("viscera_case_view_" + std::to_string(::getpid()) + "_" + name + ".vcase");
-    auto mesh = slab();
-    nlohmann::json scene = {
-        {"solver", {{"type", "xpbd"}, {"dt", 1.0 / 60}, {"substeps", 20}, {"iterations", 1}}},
-        {"render", {{"sampling", sampling}}},
-        {"bodies",
-         {{{"name", "slab"},
-           {"mesh", "meshes/slab.vtet"},
-           {"material",
-            {{"model", "stable_neo_hookean"}, {"youngs_modulus", 5000}, {"poisson_ratio", 0.4}, {"density", 1000}}},
-           {"fixed_nodes", {0, 1, 2}}}}}};
-    if (!map.empty()) scene["bodies"][0]["sample_map_file"] = "maps/slab.vsamples";
-    vcase::Manifest m;
-    m.caseId = "view";
-    m.caseVersion = "1.0.0";
-    m.minPlayerVersion = "0.1.0";
-    m.features = {"xpbd"};
-    vcase::CaseWriter w(m);
-    w.addFile("scene.json", scene.dump());
-    w.addFile("meshes/slab.vtet", sim::formatVtet(*mesh));
-    if (!map.empty()) w.addFile("maps/slab.vsamples", map);
-    w.write(path);
-    return path;
-}
-
-/// A one-body case whose render block is `render` and which packages `files` (entry, bytes).
+/// A one-body case whose render block is `render`, with `edit` applied to the body's scene entry,
+/// packaging `files` (entry, bytes) besides its scene and mesh.
 std::filesystem::path writeMappedCase(const std::string& name, const nlohmann::json& render,
-                                      const std::vector<std::pair<std::string, std::string>>& files) {
+                                      const std::vector<std::pair<std::string, std::string>>& files,
+                                      const std::function<void(nlohmann::json&)>& edit = {}) {
     const auto path = std::filesystem::temp_directory_path() /
                       ("viscera_case_view_" + std::to_string(::getpid()) + "_" + name + ".vcase");
     auto mesh = slab();
@@ -72,6 +47,7 @@ std::filesystem::path writeMappedCase(const std::string& name, const nlohmann::j
            {"material",
             {{"model", "stable_neo_hookean"}, {"youngs_modulus", 5000}, {"poisson_ratio", 0.4}, {"density", 1000}}},
            {"fixed_nodes", {0, 1, 2}}}}}};
+    if (edit) edit(scene["bodies"][0]);
     vcase::Manifest m;
     m.caseId = "view";
     m.caseVersion = "1.0.0";
@@ -84,6 +60,13 @@ std::filesystem::path writeMappedCase(const std::string& name, const nlohmann::j
         w.addFile(entry, bytes);
     w.write(path);
     return path;
+}
+
+/// A one-body case; `map` is the .vsamples text (empty: none), `sampling` the render mode.
+std::filesystem::path writeCase(const std::string& name, const std::string& sampling, const std::string& map) {
+    if (map.empty()) return writeMappedCase(name, {{"sampling", sampling}}, {});
+    return writeMappedCase(name, {{"sampling", sampling}}, {{"maps/slab.vsamples", map}},
+                           [](nlohmann::json& body) { body["sample_map_file"] = "maps/slab.vsamples"; });
 }
 
 /// A w × h checker of two colours, 8 × 8 pixel squares.
