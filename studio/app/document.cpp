@@ -104,6 +104,16 @@ void Document::saveAs(const QString& folder) {
     // texture specs (relative to the project folder) and the files they read travel too
     auto specOf = [&](const std::optional<TextureProject>& t) {
         if (!t) return;
+        if (!t->generator.empty()) { // kept in project.json: only the files it reads
+            std::vector<std::string> inputs;
+            try {
+                inputs = bake::specInputFiles(loadTextureBlock(*t, m_project->dir, "the texture generator"));
+            } catch (const InputError&) { // the model's rules admitted it; a file may have gone since
+            }
+            for (const std::string& f : inputs)
+                copies.emplace_back(m_project->dir / f, p.dir / f);
+            return;
+        }
         const fs::path spec = m_project->dir / t->spec;
         if (!fs::exists(spec)) return; // nothing to carry; export names the missing spec
         copies.emplace_back(spec, p.dir / t->spec);

@@ -27,9 +27,46 @@ std::string structureKey(const Project& p, Preview::Mode mode, int body) {
         b.scene.material = sim::Material{};
         if (b.paint) b.paint->strokes.clear();
     }
-    for (SurfaceProject& sp : q.surfaces)
+    for (SurfaceProject& sp : q.surfaces) {
         if (sp.paint) sp.paint->strokes.clear();
+        sp.texture.reset();
+    }
+    for (BodyProject& b : q.bodies)
+        b.texture.reset(); // material maps go onto the meshes already built (texturesKey)
     return projectJsonText(q) + (mode == Preview::Mode::Specimen ? "#specimen" : "#scene");
+}
+
+/// Everything but the material maps: when only those changed, the running world stays and only
+/// the view is made again.
+std::string allButTexturesKey(const Project& p, Preview::Mode mode) {
+    Project q = p;
+    for (BodyProject& b : q.bodies)
+        b.texture.reset();
+    for (SurfaceProject& sp : q.surfaces)
+        sp.texture.reset();
+    return projectJsonText(q) + (mode == Preview::Mode::Specimen ? "#specimen" : "#scene");
+}
+
+/// What the view's material maps are made from: every texture block with its spec's text (a
+/// spec file edited elsewhere shows on the next change here).
+std::string texturesKey(const Project& p) {
+    std::string key;
+    auto add = [&](const std::string& name, const std::optional<TextureProject>& t) {
+        if (!t) return;
+        key += name + "|" + sim::formatNumber(t->tilesPerMetre) + "|" + sim::formatNumber(t->normalStrength) + "|" +
+               t->spec + "|";
+        try {
+            key += textureSpecText(*t, p.dir);
+        } catch (const std::exception& e) {
+            key += e.what();
+        }
+        key += '\n';
+    };
+    for (const BodyProject& b : p.bodies)
+        add(b.scene.name, b.texture);
+    for (const SurfaceProject& s : p.surfaces)
+        add(s.scene.name, s.texture);
+    return key;
 }
 
 /// The project's generated material maps on the view's meshes, as the exported case will show
@@ -216,13 +253,29 @@ void Preview::run() {
     // The preview yields to the UI thread (nice 5): an editor stays responsive when the machine
     // is busy; the preview's frame rate gives way instead.
     ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 5);
-    std::string builtKey;
+    std::string builtKey, builtTextures, builtRest;
     std::optional<BuiltScene> built;
     std::unique_ptr<sim::World> world;
     std::shared_ptr<sim::World> probe; ///< the selected body alone, for error sampling
     int probeBody = -1;
     uint64_t sceneRevision = 0, frames = 0;
     std::deque<double> history;
+    // When the project's material maps changed: a new view of `w` with them (no meshing again).
+    auto showMaps = [&](const Project& project, const sim::World& w) {
+        std::string textures = texturesKey(project);
+        if (textures == builtTextures) return;
+        auto view = std::make_shared<render::SceneView>(render::SceneView::fromWorld(w));
+        try {
+            applyTextures(project, *view);
+        } catch (const std::exception& e) {
+            emit logMessage(tr("preview: %1 (drawn without its material maps)").arg(e.what()));
+        }
+        builtTextures = std::move(textures);
+        std::lock_guard lock(m_mutex);
+        m_view = std::move(view);
+        m_snapshot.scene = ++sceneRevision;
+        ++m_revision;
+    };
     auto publishStatus = [&](auto&& fn) {
         std::lock_guard lock(m_mutex);
         fn(m_snapshot);
@@ -247,8 +300,13 @@ void Preview::run() {
             const std::string origin = (project.dir / "project.json").string();
             try {
                 const std::string key = structureKey(project, job->mode, job->body);
+                const std::string rest = allButTexturesKey(project, job->mode);
                 std::unique_ptr<sim::World> next;
-                if (!built || key != builtKey) {
+                const bool mapsOnly = built && world && key == builtKey && rest == builtRest;
+                if (mapsOnly) {
+                    // only material maps changed: the running world goes on, the view is new
+                    showMaps(project, *world);
+                } else if (!built || key != builtKey) {
                     emit logMessage(tr("preview: building meshes"));
                     BuiltScene b = buildScene(project);
                     // one solver thread: the other core stays with the UI and the viewport's renderer
@@ -279,6 +337,8 @@ void Preview::run() {
                     }
                     built = std::move(b);
                     builtKey = key;
+                    builtRest = rest;
+                    builtTextures = texturesKey(project);
                     {
                         std::lock_guard lock(m_mutex);
                         m_view = std::move(view);
@@ -343,11 +403,18 @@ void Preview::run() {
                         for (size_t i = 0; i < next->surfaceCount(); ++i)
                             next->setSurfaceState(i, world->surfacePositions(i), world->surfaceVelocities(i));
                     }
+                    builtRest = rest;
+                    if (job->mode == Mode::Scene) {
+                        // new material maps on the same meshes: a new view, without meshing again
+                        showMaps(project, *next);
+                    }
                 }
-                world = std::move(next);
-                probeBody = -1;
-                probe.reset();
-                if (built->scene.solverType == "xpbd" && !built->scene.bodies.empty()) {
+                if (!mapsOnly) {
+                    world = std::move(next);
+                    probeBody = -1;
+                    probe.reset();
+                }
+                if (!mapsOnly && built->scene.solverType == "xpbd" && !built->scene.bodies.empty()) {
                     probeBody = std::clamp(job->mode == Mode::Specimen ? 0 : job->body, 0,
                                            static_cast<int>(built->scene.bodies.size()) - 1);
                     try {

@@ -471,6 +471,25 @@ MaterialMaps generateMaps(const GrayImage& mask, const MaterialParams& params, c
     return maps;
 }
 
+void compositeLayer(MaterialMaps& below, const MaterialMaps& layer, const GrayImage& alpha, const MapSelection& which) {
+    const size_t n = static_cast<size_t>(alpha.width) * alpha.height;
+    auto blend = [&](std::vector<float>& c, const std::vector<float>& l, size_t channels, const char* name) {
+        if (c.size() != n * channels || l.size() != n * channels)
+            throw std::invalid_argument(std::string("bake::compositeLayer(): the ") + name +
+                                        " maps must both have the coverage's size");
+        for (size_t i = 0; i < c.size(); ++i) {
+            const float a = alpha.pixels[i / channels];
+            c[i] += a * (l[i] - c[i]);
+        }
+    };
+    if (alpha.pixels.size() != n)
+        throw std::invalid_argument("bake::compositeLayer(): coverage has a wrong pixel count");
+    if (which.diffuse) blend(below.diffuse.pixels, layer.diffuse.pixels, 3, "diffuse");
+    if (which.roughness) blend(below.roughness.pixels, layer.roughness.pixels, 1, "roughness");
+    if (which.metallic) blend(below.metallic.pixels, layer.metallic.pixels, 1, "metallic");
+    if (which.height) blend(below.height.pixels, layer.height.pixels, 1, "height");
+}
+
 std::string encodePng(const GrayImage& image, int bits) {
     checkBits("bake::encodePng(): ", bits);
     return encodeFloats(image.pixels, image.width, image.height, 1, bits);

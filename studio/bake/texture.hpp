@@ -1,8 +1,9 @@
 #pragma once
 /// Procedural tissue materials [A §6.2]: the quadtree pattern mask [A §6.2.1], the colour palette
 /// and prominent-colour proportional map of a reference image (a file, or a synthetic photograph
-/// made by code), and the PBR maps of one material layer made from the mask [A §6.2.2]; the JSON
-/// texture spec that drives them (`viscera-studio texture <spec.json> -o <dir>`).
+/// made by code), and the PBR maps of a material made from the mask, with sub-layers composited
+/// over it by their own masks [A §6.2.2, Fig. 6.8]; the JSON texture spec that drives them (`viscera-studio texture
+/// <spec.json> -o <dir>`).
 ///
 /// Images are plain row-major float or byte buffers: OpenCV (PNG coding, colour conversion,
 /// resampling) is private to viscera::bake. Everything is deterministic: the same parameters and
@@ -294,7 +295,24 @@ struct PaletteSpec {
     double prominentThreshold = 64;         ///< threshold grouping for the proportional map, >= threshold
 };
 
-/// One layer's texture job, as read from a spec file (see README "Texture spec").
+/// A sub-layer composited over the base material [A §6.2.2, Fig. 6.8: surface, granular,
+/// connective, submucosa]: its own quadtree mask m (same size and tiling as the base), coverage
+/// α = opacity · m, and the channels it paints. Each channel it names blends over the material
+/// below, C = C + α (L - C), with L the layer's own map of m; the others show through. Layers
+/// composite in order, before the height blur and the normals, so the normal map is the composite
+/// height's.
+struct LayerSpec {
+    std::string name;                                       ///< files <spec name>_<layer name>_<map>.png
+    QuadtreeParams quadtree;                                ///< size and tileable are the base's
+    std::optional<PaletteSpec> palette;                     ///< empty: the base's palette
+    double opacity = 1;                                     ///< [0, 1]
+    MaterialParams material;                                ///< diffuseColors stays empty: it comes from diffuseIndices
+    std::vector<int> diffuseIndices;                        ///< colours of the layer's palette (empty: all of them)
+    MapSelection paints{false, false, false, false, false}; ///< channels composited (normal unused)
+    std::vector<MapRequest> files;                          ///< the layer's own maps written (mask = the coverage α)
+};
+
+/// One material's texture job, as read from a spec file (see README "Texture spec").
 struct TextureSpec {
     std::string origin; ///< the spec's name in messages
     std::string name;   ///< output files are <name>_<map>.png
@@ -305,6 +323,7 @@ struct TextureSpec {
     std::vector<MapRequest> maps;    ///< what to write, in MapKind order
     int swatchPx = 64;               ///< palette swatch size
     int prominentWidth = 512, prominentHeight = 64;
+    std::vector<LayerSpec> layers; ///< composited over the base, in order
 };
 
 /// Parses a texture spec; files it names resolve against `folder` and are read here (the
@@ -320,6 +339,13 @@ TextureSpec loadTextureSpec(const std::filesystem::path& file);
 /// (relative to the spec's folder), each once: what must travel with the spec.
 std::vector<std::string> specInputFiles(const TextureSpec& spec);
 
+/// What one layer makes: its coverage and its own maps (before compositing).
+struct LayerSet {
+    GrayImage coverage; ///< α = opacity · mask
+    MaterialMaps maps;  ///< the channels the layer paints or writes; height unblurred
+    std::vector<Rgb8> colors;
+};
+
 /// Everything a spec makes, in memory.
 struct TextureSet {
     GrayImage mask;
@@ -328,7 +354,13 @@ struct TextureSet {
     std::vector<PaletteColor> palette;   ///< extracted palette (empty when explicit)
     std::vector<PaletteColor> prominent; ///< prominent colours (empty when explicit)
     Rgb8Image reference;                 ///< the synthetic reference photograph (empty unless palette.reference)
+    std::vector<LayerSet> layers;        ///< one per spec layer
 };
+
+/// Blends `layer` over `below` in place with coverage α: for each channel `which` names (height:
+/// into below.height), C = C + α (L - C). Every image has α's size. Throws std::invalid_argument
+/// "bake::compositeLayer(): ..." when a named channel is missing or of another size.
+void compositeLayer(MaterialMaps& below, const MaterialMaps& layer, const GrayImage& alpha, const MapSelection& which);
 
 /// Generates the mask and the synthetic reference (palette.reference), extracts the palettes and
 /// makes the requested maps. Throws InputError

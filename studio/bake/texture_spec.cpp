@@ -233,6 +233,34 @@ MaskMapping readValues(const JsonField& map, MaskMapping fallback) {
     return {e[0].number(NumberRule::closed(0, 1)), e[1].number(NumberRule::closed(0, 1))};
 }
 
+/// maps.diffuse's gradient: palette indices and optional stops (one per index, non-decreasing).
+void readDiffuse(const JsonField& f, std::vector<int>& indices, std::vector<double>& stops) {
+    if (auto c = f.find("colors"))
+        for (const JsonField& i : c->items(1, 256))
+            indices.push_back(i.integer(0, 255));
+    if (auto s = f.find("stops")) {
+        if (indices.empty()) s->fail("needs 'colors' (one stop per colour)");
+        const std::vector<JsonField> items = s->items(indices.size(), indices.size());
+        for (size_t i = 0; i < items.size(); ++i) {
+            stops.push_back(items[i].number(NumberRule::closed(0, 1)));
+            if (i > 0 && stops[i] < stops[i - 1])
+                items[i].fail("must not be below the stop before it (" + formatNumber(stops[i - 1]) + ")");
+        }
+    }
+}
+
+/// Explicit palette colours must cover the diffuse indices.
+void checkIndices(const JsonField& diffuse, const std::optional<PaletteSpec>& palette,
+                  const std::vector<int>& indices) {
+    if (!palette || palette->colors.empty() || indices.empty()) return;
+    const std::vector<JsonField> items = diffuse["colors"].items();
+    const size_t n = palette->colors.size();
+    for (size_t i = 0; i < items.size(); ++i)
+        if (indices[i] >= static_cast<int>(n))
+            items[i].fail("palette index " + std::to_string(indices[i]) + " is out of range (the palette has " +
+                          std::to_string(n) + " colours)");
+}
+
 void readMaps(const JsonField& m, int bits, TextureSpec& spec) {
     m.object({"mask", "diffuse", "roughness", "metallic", "height", "normal", "palette", "prominent", "reference"});
     if (m.value().empty()) m.fail("must name at least one map");
@@ -247,19 +275,7 @@ void readMaps(const JsonField& m, int bits, TextureSpec& spec) {
             break;
         case MapKind::Diffuse:
             f->object({"colors", "stops", "bit_depth"});
-            if (auto c = f->find("colors"))
-                for (const JsonField& i : c->items(1, 256))
-                    spec.diffuseIndices.push_back(i.integer(0, 255));
-            if (auto s = f->find("stops")) {
-                if (spec.diffuseIndices.empty()) s->fail("needs 'colors' (one stop per colour)");
-                const std::vector<JsonField> stops = s->items(spec.diffuseIndices.size(), spec.diffuseIndices.size());
-                for (size_t i = 0; i < stops.size(); ++i) {
-                    mat.diffuseStops.push_back(stops[i].number(NumberRule::closed(0, 1)));
-                    if (i > 0 && mat.diffuseStops[i] < mat.diffuseStops[i - 1])
-                        stops[i].fail("must not be below the stop before it (" + formatNumber(mat.diffuseStops[i - 1]) +
-                                      ")");
-                }
-            }
+            readDiffuse(*f, spec.diffuseIndices, mat.diffuseStops);
             break;
         case MapKind::Roughness:
         case MapKind::Metallic:
@@ -293,10 +309,89 @@ void readMaps(const JsonField& m, int bits, TextureSpec& spec) {
     }
 }
 
-bool wants(const TextureSpec& spec, MapKind kind) {
-    for (const MapRequest& r : spec.maps)
+bool wants(const std::vector<MapRequest>& maps, MapKind kind) {
+    for (const MapRequest& r : maps)
         if (r.kind == kind) return true;
     return false;
+}
+bool wants(const TextureSpec& spec, MapKind kind) {
+    return wants(spec.maps, kind);
+}
+
+/// The quadtree fields shared by the spec's root and its layers: levels, base, patterns.
+void readQuadtree(const JsonField& f, QuadtreeParams& q, const fs::path& dir) {
+    q.levels = f["levels"].integer(1, std::countr_zero(static_cast<unsigned>(q.size)) + 1);
+    q.base = f.number("base", 0.0, NumberRule::closed(0, 1));
+    const std::vector<JsonField> patterns = f["patterns"].items(1, static_cast<size_t>(q.levels));
+    for (size_t i = 0; i < patterns.size(); ++i) {
+        q.patterns.push_back(readPattern(patterns[i], q.levels, dir));
+        for (size_t j = 0; j < i; ++j)
+            if (q.patterns[j].level == q.patterns[i].level)
+                patterns[i]["level"].fail("level " + std::to_string(q.patterns[i].level) + " already has a pattern (" +
+                                          patterns[j].path() + ")");
+    }
+}
+
+/// A file-name part: "A-Z a-z 0-9 . _ -", no '/'.
+std::string readFileName(const JsonField& n) {
+    std::string name = n.nonEmptyString();
+    if (name.find('/') != std::string::npos || sim::entryNameProblem(name))
+        n.fail("'" + sim::displayName(name) + "' is not a file name (A-Z a-z 0-9 . _ -)");
+    return name;
+}
+
+/// layers[i]: see LayerSpec. A layer paints only channels the base makes (height: when the base
+/// makes a height or normal map), with its own palette or the base's.
+LayerSpec readLayer(const JsonField& f, const TextureSpec& spec, size_t index, int bits, const fs::path& dir) {
+    f.object({"name", "seed", "levels", "base", "patterns", "palette", "opacity", "maps"});
+    LayerSpec layer;
+    layer.name = readFileName(f["name"]);
+    layer.quadtree.size = spec.quadtree.size;
+    layer.quadtree.tileable = spec.quadtree.tileable;
+    layer.quadtree.seed =
+        f.has("seed") ? static_cast<uint64_t>(f["seed"].integer(0, INT32_MAX)) : spec.quadtree.seed + 1 + index;
+    readQuadtree(f, layer.quadtree, dir);
+    layer.opacity = f.number("opacity", 1.0, NumberRule::closed(0, 1));
+    layer.material.tileable = spec.quadtree.tileable; // the composite height is blurred once, not per layer
+    const JsonField m = f["maps"];
+    m.object({"mask", "diffuse", "roughness", "metallic", "height"});
+    if (m.value().empty()) m.fail("must name at least one map");
+    const bool baseHeight = wants(spec, MapKind::Height) || wants(spec, MapKind::Normal);
+    for (MapKind kind : {MapKind::Mask, MapKind::Diffuse, MapKind::Roughness, MapKind::Metallic, MapKind::Height}) {
+        auto c = m.find(mapName(kind));
+        if (!c) continue;
+        const std::string name(mapName(kind));
+        if (kind == MapKind::Mask) {
+            c->object({"bit_depth"});
+            layer.files.push_back({kind, readBits(*c, bits)});
+            continue;
+        }
+        if (kind == MapKind::Diffuse) {
+            c->object({"colors", "stops", "write", "bit_depth"});
+            readDiffuse(*c, layer.diffuseIndices, layer.material.diffuseStops);
+        } else {
+            c->object({"values", "write", "bit_depth"});
+            MaskMapping& v = kind == MapKind::Roughness  ? layer.material.roughness
+                             : kind == MapKind::Metallic ? layer.material.metallic
+                                                         : layer.material.height;
+            v = readValues(*c, v);
+        }
+        if (kind == MapKind::Height ? !baseHeight : !wants(spec, kind))
+            c->fail("the base material makes no " + name + " map to composite over (add maps." +
+                    (kind == MapKind::Height ? std::string("height or maps.normal") : name) + ")");
+        (kind == MapKind::Diffuse     ? layer.paints.diffuse
+         : kind == MapKind::Roughness ? layer.paints.roughness
+         : kind == MapKind::Metallic  ? layer.paints.metallic
+                                      : layer.paints.height) = true;
+        if (c->boolean("write", false)) layer.files.push_back({kind, readBits(*c, bits)});
+    }
+    if (auto p = f.find("palette")) layer.palette = readPalette(*p, dir, layer.quadtree.seed);
+    if (layer.paints.diffuse) {
+        if (!layer.palette && !spec.palette)
+            m.failAt("diffuse", "needs a palette (layers[" + std::to_string(index) + "].palette or the base's)");
+        checkIndices(m["diffuse"], layer.palette ? layer.palette : spec.palette, layer.diffuseIndices);
+    }
+    return layer;
 }
 
 std::string defaultName(const std::string& origin) {
@@ -322,34 +417,22 @@ std::string_view mapName(MapKind kind) {
 TextureSpec parseTextureSpec(std::string_view text, const std::string& origin, const fs::path& folder) {
     const nlohmann::json doc = sim::parseJsonText(text, origin);
     const JsonField root(doc, "", origin);
-    root.object({"name", "size", "seed", "levels", "tileable", "base", "patterns", "palette", "maps", "bit_depth"});
+    root.object(
+        {"name", "size", "seed", "levels", "tileable", "base", "patterns", "palette", "maps", "bit_depth", "layers"});
     TextureSpec spec;
     spec.origin = origin;
     spec.name = defaultName(origin);
-    if (auto n = root.find("name")) {
-        spec.name = n->nonEmptyString();
-        if (spec.name.find('/') != std::string::npos || sim::entryNameProblem(spec.name))
-            n->fail("'" + sim::displayName(spec.name) + "' is not a file name (A-Z a-z 0-9 . _ -)");
-    }
+    if (auto n = root.find("name")) spec.name = readFileName(*n);
     QuadtreeParams& q = spec.quadtree;
     const JsonField size = root["size"];
     q.size = size.integer(8, 4096);
     if (!std::has_single_bit(static_cast<unsigned>(q.size)))
         size.fail("must be a power of two (" + std::to_string(q.size) + " is not)");
     q.seed = static_cast<uint64_t>(root["seed"].integer(0, INT32_MAX));
-    q.levels = root["levels"].integer(1, std::countr_zero(static_cast<unsigned>(q.size)) + 1);
     q.tileable = root.boolean("tileable", true);
-    q.base = root.number("base", 0.0, NumberRule::closed(0, 1));
     const int bits = readBits(root, 8);
     const fs::path dir = folder.empty() ? fs::path(".") : folder;
-    const std::vector<JsonField> patterns = root["patterns"].items(1, static_cast<size_t>(q.levels));
-    for (size_t i = 0; i < patterns.size(); ++i) {
-        q.patterns.push_back(readPattern(patterns[i], q.levels, dir));
-        for (size_t j = 0; j < i; ++j)
-            if (q.patterns[j].level == q.patterns[i].level)
-                patterns[i]["level"].fail("level " + std::to_string(q.patterns[i].level) + " already has a pattern (" +
-                                          patterns[j].path() + ")");
-    }
+    readQuadtree(root, q, dir);
     spec.material.tileable = q.tileable;
     readMaps(root["maps"], bits, spec);
     if (auto p = root.find("palette")) spec.palette = readPalette(*p, dir, q.seed);
@@ -360,13 +443,15 @@ TextureSpec parseTextureSpec(std::string_view text, const std::string& origin, c
         root.failAt("maps.prominent", "needs a reference image (palette.image or palette.reference)");
     if (wants(spec, MapKind::Reference) && (!spec.palette || !spec.palette->reference))
         root.failAt("maps.reference", "needs a synthetic reference photograph (palette.reference)");
-    if (spec.palette && !spec.palette->colors.empty() && !spec.diffuseIndices.empty()) {
-        const std::vector<JsonField> indices = root["maps"]["diffuse"]["colors"].items();
-        const size_t n = spec.palette->colors.size();
-        for (size_t i = 0; i < indices.size(); ++i)
-            if (spec.diffuseIndices[i] >= static_cast<int>(n))
-                indices[i].fail("palette index " + std::to_string(spec.diffuseIndices[i]) +
-                                " is out of range (the palette has " + std::to_string(n) + " colours)");
+    if (wants(spec, MapKind::Diffuse)) checkIndices(root["maps"]["diffuse"], spec.palette, spec.diffuseIndices);
+    if (auto l = root.find("layers")) {
+        const std::vector<JsonField> layers = l->items(1, 8);
+        for (size_t i = 0; i < layers.size(); ++i) {
+            spec.layers.push_back(readLayer(layers[i], spec, i, bits, dir));
+            for (size_t j = 0; j < i; ++j)
+                if (spec.layers[j].name == spec.layers[i].name)
+                    layers[i]["name"].fail("'" + spec.layers[i].name + "' already names " + layers[j].path());
+        }
     }
     return spec;
 }
@@ -376,9 +461,14 @@ std::vector<std::string> specInputFiles(const TextureSpec& spec) {
     auto add = [&files](const std::string& f) {
         if (!f.empty() && std::find(files.begin(), files.end(), f) == files.end()) files.push_back(f);
     };
-    if (spec.palette) add(spec.palette->imageFile);
-    for (const LevelPattern& lp : spec.quadtree.patterns)
-        if (lp.tile.shape == TileShape::Image) add(lp.tile.file);
+    auto addLayer = [&add](const std::optional<PaletteSpec>& palette, const QuadtreeParams& q) {
+        if (palette) add(palette->imageFile);
+        for (const LevelPattern& lp : q.patterns)
+            if (lp.tile.shape == TileShape::Image) add(lp.tile.file);
+    };
+    addLayer(spec.palette, spec.quadtree);
+    for (const LayerSpec& l : spec.layers)
+        addLayer(l.palette, l.quadtree);
     return files;
 }
 
@@ -386,46 +476,106 @@ TextureSpec loadTextureSpec(const fs::path& file) {
     return parseTextureSpec(readFile(file, std::uintmax_t{1} << 20), file.string(), file.parent_path());
 }
 
+namespace {
+
+/// The palette's colours: explicit, or extracted from its image or synthetic reference (made into
+/// `reference`); `extracted` and `prominent` receive the extraction's groups when given.
+std::vector<Rgb8> paletteColors(const PaletteSpec& p, Rgb8Image& reference, std::vector<PaletteColor>* extracted,
+                                std::vector<PaletteColor>* prominent) {
+    if (!p.colors.empty()) return p.colors;
+    if (p.reference) reference = generateReferenceImage(*p.reference);
+    const Rgb8Image& image = p.reference ? reference : p.image;
+    std::vector<PaletteColor> groups = extractPalette(image, p.params);
+    std::vector<Rgb8> colors;
+    for (const PaletteColor& c : groups)
+        colors.push_back(c.color);
+    if (prominent) {
+        PaletteParams params = p.params;
+        params.method = PaletteMethod::Threshold;
+        params.threshold = p.prominentThreshold;
+        params.maxColors = 256;
+        *prominent = extractPalette(image, params);
+    }
+    if (extracted) *extracted = std::move(groups);
+    return colors;
+}
+
+/// The diffuse gradient's colours: the palette's at `indices` (all of them when empty).
+std::vector<Rgb8> gradientColors(const std::vector<Rgb8>& palette, const std::vector<int>& indices,
+                                 const PaletteSpec& source, const std::string& where) {
+    if (indices.empty()) return palette;
+    std::vector<Rgb8> colors;
+    for (size_t i = 0; i < indices.size(); ++i) {
+        const int index = indices[i];
+        if (index >= static_cast<int>(palette.size()))
+            throw InputError(where + ".colors[" + std::to_string(i) + "]: palette index " + std::to_string(index) +
+                             " is out of range (the palette of " +
+                             (source.reference ? std::string("the synthetic reference")
+                                               : "'" + sim::displayName(source.imageFile) + "'") +
+                             " has " + std::to_string(palette.size()) + " colours)");
+        colors.push_back(palette[static_cast<size_t>(index)]);
+    }
+    return colors;
+}
+
+} // namespace
+
 TextureSet generateTextureSet(const TextureSpec& spec) {
     TextureSet set;
     set.mask = generateMask(spec.quadtree);
-    if (spec.palette) {
-        const PaletteSpec& p = *spec.palette;
-        if (p.reference) set.reference = generateReferenceImage(*p.reference);
-        const Rgb8Image& image = p.reference ? set.reference : p.image;
-        if (p.colors.empty()) {
-            set.palette = extractPalette(image, p.params);
-            for (const PaletteColor& c : set.palette)
-                set.colors.push_back(c.color);
-            if (wants(spec, MapKind::Prominent) || wants(spec, MapKind::Palette)) {
-                PaletteParams prominent = p.params;
-                prominent.method = PaletteMethod::Threshold;
-                prominent.threshold = p.prominentThreshold;
-                prominent.maxColors = 256;
-                set.prominent = extractPalette(image, prominent);
-            }
-        } else {
-            set.colors = p.colors;
-        }
-    }
+    if (spec.palette)
+        set.colors =
+            paletteColors(*spec.palette, set.reference, &set.palette,
+                          wants(spec, MapKind::Prominent) || wants(spec, MapKind::Palette) ? &set.prominent : nullptr);
     MaterialParams material = spec.material;
-    MapSelection which{wants(spec, MapKind::Diffuse), wants(spec, MapKind::Roughness), wants(spec, MapKind::Metallic),
-                       wants(spec, MapKind::Height), wants(spec, MapKind::Normal)};
-    if (which.diffuse) {
-        if (spec.diffuseIndices.empty()) material.diffuseColors = set.colors;
-        for (size_t i = 0; i < spec.diffuseIndices.size(); ++i) {
-            const int index = spec.diffuseIndices[i];
-            if (index >= static_cast<int>(set.colors.size()))
-                throw InputError(spec.origin + ": maps.diffuse.colors[" + std::to_string(i) + "]: palette index " +
-                                 std::to_string(index) + " is out of range (the palette of " +
-                                 (spec.palette->reference ? std::string("the synthetic reference")
-                                                          : "'" + sim::displayName(spec.palette->imageFile) + "'") +
-                                 " has " + std::to_string(set.colors.size()) + " colours)");
-            material.diffuseColors.push_back(set.colors[static_cast<size_t>(index)]);
-        }
+    const MapSelection which{wants(spec, MapKind::Diffuse), wants(spec, MapKind::Roughness),
+                             wants(spec, MapKind::Metallic), wants(spec, MapKind::Height),
+                             wants(spec, MapKind::Normal)};
+    if (which.diffuse)
+        material.diffuseColors =
+            gradientColors(set.colors, spec.diffuseIndices, *spec.palette, spec.origin + ": maps.diffuse");
+    if (spec.layers.empty()) {
+        if (which.diffuse || which.roughness || which.metallic || which.height || which.normal)
+            set.maps = generateMaps(set.mask, material, which);
+        return set;
     }
-    if (which.diffuse || which.roughness || which.metallic || which.height || which.normal)
-        set.maps = generateMaps(set.mask, material, which);
+    // Layers composite over the unblurred base height; the blur and the normals come last.
+    MapSelection base = which;
+    base.height = which.height || which.normal;
+    base.normal = false;
+    material.heightBlurPx = 0;
+    set.maps = generateMaps(set.mask, material, base);
+    for (size_t i = 0; i < spec.layers.size(); ++i) {
+        const LayerSpec& l = spec.layers[i];
+        LayerSet& out = set.layers.emplace_back();
+        const GrayImage mask = generateMask(l.quadtree);
+        out.coverage = mask;
+        for (float& a : out.coverage.pixels)
+            a = static_cast<float>(l.opacity * a);
+        MapSelection own = l.paints;
+        for (const MapRequest& r : l.files)
+            (r.kind == MapKind::Diffuse     ? own.diffuse
+             : r.kind == MapKind::Roughness ? own.roughness
+             : r.kind == MapKind::Metallic  ? own.metallic
+             : r.kind == MapKind::Height    ? own.height
+                                            : own.normal) = true;
+        own.normal = false;
+        MaterialParams lm = l.material;
+        if (own.diffuse) {
+            Rgb8Image reference;
+            out.colors = l.palette ? paletteColors(*l.palette, reference, nullptr, nullptr) : set.colors;
+            lm.diffuseColors = gradientColors(out.colors, l.diffuseIndices, l.palette ? *l.palette : *spec.palette,
+                                              spec.origin + ": layers[" + std::to_string(i) + "].maps.diffuse");
+        }
+        if (own.diffuse || own.roughness || own.metallic || own.height) out.maps = generateMaps(mask, lm, own);
+        compositeLayer(set.maps, out.maps, out.coverage, l.paints);
+    }
+    if (base.height) {
+        GrayImage height = blurGaussian(set.maps.height, spec.material.heightBlurPx, spec.material.tileable);
+        if (which.normal)
+            set.maps.normal = normalsFromHeight(height, spec.material.normalDepth, spec.material.tileable);
+        set.maps.height = which.height ? std::move(height) : GrayImage{};
+    }
     return set;
 }
 
@@ -490,13 +640,32 @@ std::vector<EncodedFile> encodeMap(const TextureSpec& spec, const TextureSet& se
     return files;
 }
 
+/// A layer's own map: <name>_<layer>_<map>.png.
+EncodedFile encodeLayerMap(const TextureSpec& spec, const TextureSet& set, size_t layer, const MapRequest& r) {
+    const LayerSet& l = set.layers[layer];
+    EncodedFile f{spec.name + "_" + spec.layers[layer].name + "_" + std::string(mapName(r.kind)) + ".png", {}};
+    f.bytes = r.kind == MapKind::Diffuse ? encodePng(l.maps.diffuse, r.bits)
+                                         : encodePng(r.kind == MapKind::Mask        ? l.coverage
+                                                     : r.kind == MapKind::Roughness ? l.maps.roughness
+                                                     : r.kind == MapKind::Metallic  ? l.maps.metallic
+                                                                                    : l.maps.height,
+                                                     r.bits);
+    return f;
+}
+
 } // namespace
 
 std::vector<EncodedFile> encodeTextureSet(const TextureSpec& spec, const TextureSet& set) {
-    // The maps encode concurrently (zlib dominates); the files keep the order of spec.maps.
+    // The maps encode concurrently (zlib dominates); the files keep the order of spec.maps, then
+    // each layer's in its order.
     std::vector<std::future<std::vector<EncodedFile>>> jobs;
     for (const MapRequest& r : spec.maps)
         jobs.push_back(std::async(std::launch::async, [&spec, &set, r] { return encodeMap(spec, set, r); }));
+    for (size_t i = 0; i < spec.layers.size() && i < set.layers.size(); ++i)
+        for (const MapRequest& r : spec.layers[i].files)
+            jobs.push_back(std::async(std::launch::async, [&spec, &set, i, r] {
+                return std::vector<EncodedFile>{encodeLayerMap(spec, set, i, r)};
+            }));
     std::vector<EncodedFile> files;
     for (auto& job : jobs)
         for (EncodedFile& f : job.get())

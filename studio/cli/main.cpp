@@ -33,6 +33,7 @@
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/cli_main.hpp"
 #include "sim/util/error.hpp"
+#include "sim/util/format.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -196,6 +197,19 @@ int cmdTexture(const std::vector<std::string>& args) {
     const auto& q = spec.quadtree;
     std::printf("texture %s: %dx%d, %d levels, %zu patterns, seed %llu%s\n", spec.name.c_str(), q.size, q.size,
                 q.levels, q.patterns.size(), static_cast<unsigned long long>(q.seed), q.tileable ? ", tileable" : "");
+    for (size_t i = 0; i < spec.layers.size(); ++i) {
+        const bake::LayerSpec& l = spec.layers[i];
+        const bake::GrayImage& a = r.set.layers[i].coverage;
+        double mean = 0;
+        for (float v : a.pixels)
+            mean += v;
+        std::printf("  layer %s: %d levels, %zu patterns, seed %llu, opacity %s, mean coverage %.3f, paints%s%s%s%s\n",
+                    l.name.c_str(), l.quadtree.levels, l.quadtree.patterns.size(),
+                    static_cast<unsigned long long>(l.quadtree.seed), sim::formatNumber(l.opacity).c_str(),
+                    a.pixels.empty() ? 0.0 : mean / static_cast<double>(a.pixels.size()),
+                    l.paints.diffuse ? " diffuse" : "", l.paints.roughness ? " roughness" : "",
+                    l.paints.metallic ? " metallic" : "", l.paints.height ? " height" : "");
+    }
     if (spec.palette && spec.palette->colors.empty()) {
         const std::string source = spec.palette->reference ? "the synthetic reference" : spec.palette->imageFile;
         printColors(("palette of " + source).c_str(), r.set.palette);

@@ -347,17 +347,33 @@ json paintJson(const StiffnessPaintProject& p, bool skeleton) {
     return out;
 }
 
-/// "texture": a body's or surface's generated material maps (TextureProject).
-TextureProject readTexture(const JsonField& j) {
-    j.object({"spec", "tiles_per_metre", "normal_strength"});
+/// "texture": a body's or surface's generated material maps (TextureProject). A generator is
+/// read in full here (bake::parseTextureSpec), so a spec the export cannot bake never loads.
+TextureProject readTexture(const JsonField& j, const std::filesystem::path& dir) {
+    j.object({"spec", "generator", "tiles_per_metre", "normal_strength"});
+    if (j.has("spec") == j.has("generator"))
+        j.fail(j.has("spec") ? "takes 'spec' (a file) or 'generator' (the spec itself), not both"
+                             : "needs 'spec' (a texture spec file) or 'generator' (the spec itself)");
     TextureProject t;
-    t.spec = j["spec"].entryPath(); // inside the project folder
+    if (j.has("spec")) {
+        t.spec = j["spec"].entryPath(); // inside the project folder
+    } else {
+        const JsonField g = j["generator"];
+        g.anyObject();
+        t.generator = g.value().dump();
+        bake::parseTextureSpec(t.generator, j.origin() + ": " + g.path(), dir);
+    }
     render::readMapLayout(j, t.tilesPerMetre, t.normalStrength);
     return t;
 }
 
 json textureJson(const TextureProject& t) {
-    return {{"spec", t.spec}, {"tiles_per_metre", t.tilesPerMetre}, {"normal_strength", t.normalStrength}};
+    json j = {{"tiles_per_metre", t.tilesPerMetre}, {"normal_strength", t.normalStrength}};
+    if (t.generator.empty())
+        j["spec"] = t.spec;
+    else
+        j["generator"] = json::parse(t.generator);
+    return j;
 }
 
 /// "light_samples": the body's light-sample painting [A §6.3.2], operations replayed in order on
@@ -486,7 +502,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
             }
         if (auto sp = b.find("stiffness_paint")) body.paint = readPaint(*sp, true);
         if (auto ls = b.find("light_samples")) body.lightSamples = readLightSamples(*ls);
-        if (auto t = b.find("texture")) body.texture = readTexture(*t);
+        if (auto t = b.find("texture")) body.texture = readTexture(*t, dir);
         if (auto fx = b.find("fixed")) body.fixedBox = readBox(*fx);
         p.bodies.push_back(std::move(body));
     }
@@ -504,7 +520,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
             if (!found) from.fail("'" + sp.scene.attachTo + "' is not a body");
             if (auto r = sj.find("region")) sp.region = readBox(*r);
             if (auto pt = sj.find("stiffness_paint")) sp.paint = readPaint(*pt, false);
-            if (auto t = sj.find("texture")) sp.texture = readTexture(*t);
+            if (auto t = sj.find("texture")) sp.texture = readTexture(*t, dir);
             p.surfaces.push_back(std::move(sp));
         }
     if (auto in = root.find("interaction")) scene.interaction = readInteractionProject(*in, dir, p.trackFiles);
@@ -723,11 +739,54 @@ std::vector<double> surfaceNodeWeights(const SurfaceProject& s, const sim::TriMe
     }
 }
 
+std::string textureSpecText(const TextureProject& t, const std::filesystem::path& projectDir) {
+    return t.generator.empty() ? readFile(projectDir / t.spec, std::uintmax_t{1} << 20) : t.generator;
+}
+
+bake::TextureSpec loadTextureBlock(const TextureProject& t, const std::filesystem::path& projectDir,
+                                   const std::string& origin) {
+    if (t.generator.empty()) return bake::loadTextureSpec(projectDir / t.spec);
+    return bake::parseTextureSpec(t.generator, origin, projectDir);
+}
+
+TextureProject embedTextureSpec(const TextureProject& t, const std::filesystem::path& projectDir) {
+    if (!t.generator.empty()) return t;
+    const std::filesystem::path file = projectDir / t.spec;
+    const std::string text = textureSpecText(t, projectDir);
+    json doc = json::parse(text, nullptr, false);
+    if (doc.is_discarded() || !doc.is_object()) throw InputError(file.string() + ": is not a JSON object");
+    // The spec's file references are relative to its folder; in project.json they are relative
+    // to the project folder.
+    const std::filesystem::path folder = std::filesystem::path(t.spec).parent_path();
+    auto rebase = [&](json& holder, const char* key) {
+        if (holder.is_object() && holder.contains(key) && holder[key].is_string())
+            holder[key] = (folder / holder[key].get<std::string>()).lexically_normal().generic_string();
+    };
+    auto rebaseSpec = [&](json& spec) {
+        if (!spec.is_object()) return;
+        if (spec.contains("patterns") && spec["patterns"].is_array())
+            for (json& p : spec["patterns"])
+                if (p.is_object() && p.contains("tile")) rebase(p["tile"], "file");
+        if (spec.contains("palette")) rebase(spec["palette"], "image");
+    };
+    rebaseSpec(doc);
+    if (doc.contains("layers") && doc["layers"].is_array())
+        for (json& layer : doc["layers"])
+            rebaseSpec(layer);
+    if (const std::string stem = file.stem().string();
+        !doc.contains("name") && !stem.empty() && !sim::entryNameProblem(stem))
+        doc["name"] = stem; // the map files keep their names
+    TextureProject out = t;
+    out.spec.clear();
+    out.generator = doc.dump();
+    return out;
+}
+
 ProjectTextures bakeProjectTextures(const Project& project) {
     ProjectTextures out;
-    auto bake = [&](const std::string& name, const TextureProject& t) {
-        const std::filesystem::path file = project.dir / t.spec;
-        const bake::TextureSpec spec = bake::loadTextureSpec(file);
+    const std::string origin = (project.dir / "project.json").string();
+    auto bake = [&](const std::string& name, const TextureProject& t, const std::string& field) {
+        const bake::TextureSpec spec = loadTextureBlock(t, project.dir, origin + ": " + field + ".texture.generator");
         const bake::TextureSet set = bake::generateTextureSet(spec);
         render::CaseMaterialMaps entry;
         entry.target = name;
@@ -747,14 +806,16 @@ ProjectTextures bakeProjectTextures(const Project& project) {
             }
         }
         if (entry.files().empty())
-            throw InputError(file.string() + ": maps: writes none of diffuse, roughness, metallic, normal (nothing "
-                                             "the renderer would sample)");
+            throw InputError(spec.origin + ": maps: writes none of diffuse, roughness, metallic, normal (nothing "
+                                           "the renderer would sample)");
         out.materials.push_back(std::move(entry));
     };
-    for (const BodyProject& b : project.bodies)
-        if (b.texture) bake(b.scene.name, *b.texture);
-    for (const SurfaceProject& s : project.surfaces)
-        if (s.texture) bake(s.scene.name, *s.texture);
+    for (size_t i = 0; i < project.bodies.size(); ++i)
+        if (const BodyProject& b = project.bodies[i]; b.texture)
+            bake(b.scene.name, *b.texture, "bodies[" + std::to_string(i) + "]");
+    for (size_t i = 0; i < project.surfaces.size(); ++i)
+        if (const SurfaceProject& s = project.surfaces[i]; s.texture)
+            bake(s.scene.name, *s.texture, "surfaces[" + std::to_string(i) + "]");
     return out;
 }
 

@@ -52,6 +52,7 @@
 /// cell_radius_edge_ratio, cell_size, seed.
 #include "bake/skeleton.hpp"
 #include "bake/tetrahedralize.hpp"
+#include "bake/texture.hpp"
 #include "render/case_settings.hpp"
 #include "render/sample_map.hpp"
 #include "sim/material/material.hpp"
@@ -106,20 +107,41 @@ struct StiffnessPaintProject {
     std::vector<sim::BrushStroke> strokes;
 };
 
+/// Generated material maps of a body or surface [A §6.2, issue 17]: a texture spec
+/// (bake::parseTextureSpec, `viscera-studio texture`) and how the renderer lays the maps on the
+/// mesh. The spec is either a file of the project or kept in project.json itself ("generator",
+/// the same JSON object, its files named relative to the project folder): the studio's
+/// generator editor keeps the spec it edits in the model, so that every change is one undo step.
+/// Export packages the diffuse, roughness, metallic and normal maps the spec writes as
+/// textures/<name>_<map>.png and names them in the scene's render.materials; nothing else.
+///   "texture": {"spec": "textures/liver.json", "tiles_per_metre": 20, "normal_strength": 1}
+///   "texture": {"generator": {"size": 512, "seed": 3, ...}, "tiles_per_metre": 20}
+struct TextureProject {
+    std::string spec;      ///< a spec file relative to the project folder; empty when `generator` holds it
+    std::string generator; ///< the spec as compact JSON text (files relative to the project folder), or empty
+    float tilesPerMetre = 20.0f;
+    float normalStrength = 1.0f;
+
+    bool operator==(const TextureProject&) const = default;
+};
+
+/// The JSON text of a texture block's spec: the generator, or the spec file's contents (at most
+/// 1 MiB). Throws viscera::InputError naming the file when it cannot be read.
+std::string textureSpecText(const TextureProject& t, const std::filesystem::path& projectDir);
+/// The block's spec, read by bake::parseTextureSpec: a file spec's files resolve against its
+/// folder, a generator's against the project folder; `origin` names a generator in messages.
+/// Throws viscera::InputError "<origin or file>: <JSON path>: <rule>".
+bake::TextureSpec loadTextureBlock(const TextureProject& t, const std::filesystem::path& projectDir,
+                                   const std::string& origin);
+/// The block with its spec kept in project.json: a file spec's JSON, its file references (image
+/// tiles, palette images, also of layers) rebased from the spec's folder onto the project
+/// folder; a generator block as it is. Throws viscera::InputError when the file cannot be read
+/// or is not JSON.
+TextureProject embedTextureSpec(const TextureProject& t, const std::filesystem::path& projectDir);
+
 /// A tet body: its scene description (what the case's scene.json carries: name, material,
 /// strain limits, embedding; read by the same code as the player's scene) plus what only
 /// authoring needs. meshPath, fixedNodes and nodeWeights of `scene` are filled at export.
-/// Generated material maps of a body or surface [A §6.2, issue 17]: a texture spec file of the
-/// project (bake::parseTextureSpec, `viscera-studio texture`) and how the renderer lays the maps
-/// on the mesh. Export packages the diffuse, roughness, metallic and normal maps the spec writes
-/// as textures/<name>_<map>.png and names them in the scene's render.materials; nothing else.
-///   "texture": {"spec": "textures/liver.json", "tiles_per_metre": 20, "normal_strength": 1}
-struct TextureProject {
-    std::string spec; ///< path relative to the project folder
-    float tilesPerMetre = 20.0f;
-    float normalStrength = 1.0f;
-};
-
 struct BodyProject {
     sim::BodyDesc scene;
     MeshSource mesh;

@@ -786,3 +786,151 @@ TEST(TextureReference, BadReferenceSpecsAreRefusedWithOneLineNamingTheField) {
                 testing::ThrowsMessage<std::invalid_argument>(
                     testing::StrEq("bake::generateReferenceImage(): size 100 must be a power of two in [16, 4096]")));
 }
+
+// ---- layers [A §6.2.2, Fig. 6.8] --------------------------------------------------------------
+
+namespace {
+
+/// specText() with one layer; `layer` members are spliced into the layer object.
+std::string layeredSpec(int seed, const std::string& layer = "") {
+    return specText(seed, R"(, "layers": [
+    {"name": "granular", "levels": 6, "opacity": 0.8,
+     "patterns": [{"level": 4, "tile": {"shape": "disc"}, "scale": {"uniform": [0.3, 0.7]},
+                   "offset": {"radius": [0, 0.4]}, "probability": 0.6, "blend": "max"}],
+     "palette": {"colors": ["#302010", "#f0f0f0"]},
+     "maps": {"mask": {}, "diffuse": {"colors": [1], "write": true}, "roughness": {"values": [0.9, 0.9]},
+              "height": {"values": [0, 1]}})" +
+                              layer + "}]");
+}
+
+double maxAbsDiff(const std::vector<float>& a, const std::vector<float>& b) {
+    double d = 0;
+    for (size_t i = 0; i < a.size() && i < b.size(); ++i)
+        d = std::max(d, static_cast<double>(std::abs(a[i] - b[i])));
+    return a.size() == b.size() ? d : 1e9;
+}
+
+} // namespace
+
+TEST(TextureLayers, ALayerBlendsItsChannelsOverTheBaseByItsCoverage) {
+    const TextureSpec plain = parse(specText(4));
+    const TextureSpec layered = parse(layeredSpec(4));
+    ASSERT_EQ(layered.layers.size(), 1u);
+    EXPECT_EQ(layered.layers[0].quadtree.seed, 5u); // spec seed + 1 + index
+    const TextureSet base = generateTextureSet(plain);
+    const TextureSet set = generateTextureSet(layered);
+    ASSERT_EQ(set.layers.size(), 1u);
+    const LayerSet& l = set.layers[0];
+    // The layer's own diffuse is its palette's colour 1, flat.
+    ASSERT_EQ(l.maps.diffuse.pixels.size(), base.maps.diffuse.pixels.size());
+    EXPECT_NEAR(l.maps.diffuse.pixels[0], 240.0 / 255, 1e-6);
+    // Coverage is opacity × mask: at most 0.8, and the disc pattern covers part of the image.
+    double covered = 0, maxAlpha = 0;
+    for (float a : l.coverage.pixels) {
+        maxAlpha = std::max(maxAlpha, static_cast<double>(a));
+        covered += a > 0.5;
+    }
+    EXPECT_NEAR(maxAlpha, 0.8, 1e-6);
+    const double share = covered / static_cast<double>(l.coverage.pixels.size());
+    EXPECT_GT(share, 0.05);
+    EXPECT_LT(share, 0.8);
+    // Diffuse and roughness: C = base + α (L - base) at every pixel; metallic untouched.
+    double diffuseErr = 0, roughErr = 0;
+    for (size_t i = 0; i < l.coverage.pixels.size(); ++i) {
+        const double a = l.coverage.pixels[i];
+        for (int c = 0; c < 3; ++c) {
+            const double b = base.maps.diffuse.pixels[3 * i + c], L = l.maps.diffuse.pixels[3 * i + c];
+            diffuseErr = std::max(diffuseErr, std::abs(set.maps.diffuse.pixels[3 * i + c] - (b + a * (L - b))));
+        }
+        const double b = base.maps.roughness.pixels[i];
+        roughErr = std::max(roughErr, std::abs(set.maps.roughness.pixels[i] - (b + a * (0.9 - b))));
+    }
+    EXPECT_LT(diffuseErr, 1e-6);
+    EXPECT_LT(roughErr, 1e-6);
+    EXPECT_EQ(maxAbsDiff(set.maps.metallic.pixels, base.maps.metallic.pixels), 0.0);
+    // The height and the normals are the composite's: they differ from the base where the layer is.
+    EXPECT_GT(maxAbsDiff(set.maps.height.pixels, base.maps.height.pixels), 0.1);
+    EXPECT_GT(maxAbsDiff(set.maps.normal.pixels, base.maps.normal.pixels), 0.05);
+    for (size_t i = 0; i < set.maps.normal.pixels.size(); i += 3) {
+        const float* n = &set.maps.normal.pixels[i];
+        ASSERT_NEAR(std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), 1.0, 1e-5);
+    }
+    // Tileable: the composite tiles too.
+    const SeamFigures f = seamFigures(set.maps.roughness);
+    EXPECT_LE(f.seam, f.interior + 1e-6) << f.seam << " vs " << f.interior;
+
+    // Opacity 0: the composite is the base material, byte for byte.
+    const TextureSpec off = parse(replaced(layeredSpec(4), R"("opacity": 0.8)", R"("opacity": 0)"));
+    const TextureSet none = generateTextureSet(off);
+    const std::vector<EncodedFile> a = encodeTextureSet(plain, base), b = encodeTextureSet(off, none);
+    ASSERT_EQ(b.size(), a.size() + 2); // + the layer's mask and diffuse
+    for (size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(b[i].fileName, a[i].fileName);
+        EXPECT_TRUE(b[i].bytes == a[i].bytes) << a[i].fileName;
+    }
+    EXPECT_EQ(b[a.size()].fileName, "layer_granular_mask.png");
+    EXPECT_EQ(b[a.size() + 1].fileName, "layer_granular_diffuse.png");
+}
+
+TEST(TextureLayers, LayeredSpecsAreDeterministicAndTwoLayersCompositeInOrder) {
+    const std::string two = layeredSpec(9, R"(}, {"name": "surface", "seed": 77, "levels": 5,
+     "patterns": [{"level": 2, "tile": {"shape": "gaussian"}, "scale": {"uniform": 1.5}, "blend": "add"}],
+     "maps": {"roughness": {"values": [0.1, 0.1], "write": true}})");
+    const TextureSpec spec = parse(two);
+    ASSERT_EQ(spec.layers.size(), 2u);
+    EXPECT_EQ(spec.layers[1].quadtree.seed, 77u);
+    const std::vector<EncodedFile> a = encodeTextureSet(spec, generateTextureSet(spec));
+    const std::vector<EncodedFile> b = encodeTextureSet(spec, generateTextureSet(parse(two)));
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t i = 0; i < a.size(); ++i)
+        EXPECT_TRUE(a[i].bytes == b[i].bytes) << a[i].fileName;
+    EXPECT_EQ(a.back().fileName, "layer_surface_roughness.png");
+    // The second layer blends over the first's composite.
+    const TextureSet set = generateTextureSet(spec);
+    const TextureSet one = generateTextureSet(parse(layeredSpec(9)));
+    double err = 0;
+    for (size_t i = 0; i < set.maps.roughness.pixels.size(); ++i) {
+        const double a2 = set.layers[1].coverage.pixels[i], below = one.maps.roughness.pixels[i];
+        err = std::max(err, std::abs(set.maps.roughness.pixels[i] - (below + a2 * (0.1 - below))));
+    }
+    EXPECT_LT(err, 1e-6);
+    EXPECT_GT(maxAbsDiff(set.maps.roughness.pixels, one.maps.roughness.pixels), 0.1);
+}
+
+TEST(TextureLayers, BadLayersAreRefusedWithOneLineNamingTheField) {
+    EXPECT_EQ(refusal(layeredSpec(1)), "(accepted)");
+    const std::string good = layeredSpec(1);
+    const struct {
+        std::string from, to, message;
+    } cases[] = {
+        {R"("name": "granular")", R"("name": "a/b")", "layers[0].name: 'a/b' is not a file name (A-Z a-z 0-9 . _ -)"},
+        {R"("opacity": 0.8)", R"("opacity": 1.2)", "layers[0].opacity: must be in [0, 1]"},
+        {R"("opacity": 0.8)", R"("opacity": 0.8, "tileable": false)", "layers[0].tileable: unknown field"},
+        {R"("levels": 6, "opacity")", R"("levels": 9, "opacity")", "layers[0].levels: must be an integer in [1, 8]"},
+        {R"("diffuse": {"colors": [1], "write": true})", R"("diffuse": {"colors": [2]})",
+         "layers[0].maps.diffuse.colors[0]: palette index 2 is out of range (the palette has 2 colours)"},
+        {R"("roughness": {"values": [0.9, 0.9]})", R"("normal": {})", "layers[0].maps.normal: unknown field"},
+        {R"("maps": {"mask": {}, "diffuse")", R"("maps": {"mask": {"write": true}, "diffuse")",
+         "layers[0].maps.mask.write: unknown field"},
+        {R"("scale": {"uniform": [0.3, 0.7]})", R"("scale": {"uniform": [0.3, 7]})",
+         "layers[0].patterns[0].scale.uniform[1]: must be in (0, 4]"},
+    };
+    for (const auto& c : cases)
+        EXPECT_EQ(refusal(replaced(good, c.from, c.to)), "spec.json: " + c.message);
+    // A channel the base does not make cannot be composited.
+    EXPECT_EQ(refusal(replaced(good, R"("metallic": {"values": [0, 0.1]},)", "")), "(accepted)");
+    EXPECT_EQ(refusal(replaced(replaced(good, R"("metallic": {"values": [0, 0.1]},)", ""),
+                               R"("height": {"values": [0, 1]})", R"("metallic": {})")),
+              "spec.json: layers[0].maps.metallic: the base material makes no metallic map to composite over (add "
+              "maps.metallic)");
+    // Without its own palette the layer uses the base's (3 colours).
+    EXPECT_EQ(refusal(replaced(replaced(good, R"("palette": {"colors": ["#302010", "#f0f0f0"]},)", ""),
+                               R"("colors": [1], "write")", R"("colors": [3], "write")")),
+              "spec.json: layers[0].maps.diffuse.colors[0]: palette index 3 is out of range (the palette has 3 "
+              "colours)");
+    // Names are unique.
+    EXPECT_EQ(refusal(layeredSpec(1, R"(}, {"name": "granular", "levels": 2,
+     "patterns": [{"level": 1, "tile": {"shape": "disc"}}], "maps": {"mask": {}})")),
+              "spec.json: layers[1].name: 'granular' already names layers[0]");
+    EXPECT_EQ(refusal(specText(1, R"(, "layers": [])")), "spec.json: layers: must have 1 to 8 elements");
+}

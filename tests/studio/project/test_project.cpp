@@ -420,6 +420,67 @@ TEST_F(ProjectTest, BadTextureBlocksAreRefusedNamingTheFieldAndTheRule) {
     EXPECT_FALSE(std::filesystem::exists(m_dir / "x.vcase")) << "nothing written by a failed export";
 }
 
+TEST_F(ProjectTest, AGeneratorKeptInTheProjectIsReadByTheSpecReaderAndBakesLikeItsFile) {
+    // the same spec as a file and as "generator" gives the same packaged bytes
+    std::filesystem::create_directories(m_dir / "textures" / "tiles");
+    const std::string maps = R"({"diffuse": {"colors": [0, 1]}, "roughness": {"values": [0.5, 0.2]}})";
+    writeFileAtomic(m_dir / "textures/slab.json", textureSpec(maps));
+    write(replaced(kGood, "\"fixed\":", "\"texture\": {\"spec\": \"textures/slab.json\"}, \"fixed\":"));
+    const studio::Project fromFile = studio::loadProject(m_dir);
+    const studio::ProjectTextures a = studio::bakeProjectTextures(fromFile);
+    write(replaced(kGood, "\"fixed\":", "\"texture\": {\"generator\": " + textureSpec(maps) + "}, \"fixed\":"));
+    const studio::Project inlined = studio::loadProject(m_dir);
+    ASSERT_TRUE(inlined.bodies[0].texture);
+    EXPECT_TRUE(inlined.bodies[0].texture->spec.empty());
+    EXPECT_EQ(studio::projectJsonText(studio::loadProjectText(studio::projectJsonText(inlined), m_dir, "again")),
+              studio::projectJsonText(inlined));
+    const studio::ProjectTextures b = studio::bakeProjectTextures(inlined);
+    ASSERT_EQ(a.files.size(), 2u);
+    EXPECT_EQ(a.files, b.files);
+
+    // embedding a file spec: its file references move from the spec's folder onto the project's
+    bake::GrayImage tile;
+    tile.width = tile.height = 8;
+    tile.pixels.assign(64, 0.5f);
+    writeFileAtomic(m_dir / "textures/tiles/dot.png", bake::encodePng(tile, 8));
+    const std::string withImage = R"({"size": 32, "seed": 4, "levels": 4,
+      "patterns": [{"level": 2, "tile": {"shape": "image", "file": "tiles/dot.png"}}],
+      "palette": {"colors": ["#802020", "#e0a090"]}, "maps": )" +
+                                  maps + "}";
+    writeFileAtomic(m_dir / "textures/img.json", withImage);
+    studio::TextureProject file;
+    file.spec = "textures/img.json";
+    file.tilesPerMetre = 33;
+    const studio::TextureProject embedded = studio::embedTextureSpec(file, m_dir);
+    EXPECT_TRUE(embedded.spec.empty());
+    EXPECT_EQ(embedded.tilesPerMetre, 33.0f);
+    const nlohmann::json g = nlohmann::json::parse(embedded.generator);
+    EXPECT_EQ(g["patterns"][0]["tile"]["file"], "textures/tiles/dot.png");
+    EXPECT_EQ(g["name"], "img"); // the map files keep the file's name
+    const bake::TextureSpec spec = studio::loadTextureBlock(embedded, m_dir, "inline");
+    EXPECT_EQ(bake::specInputFiles(spec), std::vector<std::string>{"textures/tiles/dot.png"});
+    EXPECT_EQ(studio::embedTextureSpec(embedded, m_dir), embedded); // already embedded
+
+    // refusals name the project, the field inside the generator and the rule
+    const std::string where = (m_dir / "project.json").string() + ": ";
+    auto with = [&](const std::string& texture) {
+        write(replaced(kGood, "\"fixed\":", "\"texture\": " + texture + ", \"fixed\":"));
+        return loadError();
+    };
+    EXPECT_EQ(with(R"({"spec": "textures/slab.json", "generator": {}})"),
+              where + "bodies[0].texture: takes 'spec' (a file) or 'generator' (the spec itself), not both");
+    EXPECT_EQ(with(R"({"tiles_per_metre": 5})"),
+              where + "bodies[0].texture: needs 'spec' (a texture spec file) or 'generator' (the spec itself)");
+    nlohmann::json bad = nlohmann::json::parse(textureSpec(maps));
+    bad["patterns"][0]["opacity"] = {0.5, 2};
+    EXPECT_EQ(with("{\"generator\": " + bad.dump() + "}"),
+              where + "bodies[0].texture.generator: patterns[0].opacity[1]: must be in [0, 1]");
+    bad = nlohmann::json::parse(textureSpec(maps));
+    bad["patterns"][0]["tile"] = {{"shape", "image"}, {"file", "../../etc/passwd"}};
+    EXPECT_THAT(with("{\"generator\": " + bad.dump() + "}"),
+                HasSubstr("bodies[0].texture.generator: patterns[0].tile.file: '../../etc/passwd' escapes"));
+}
+
 TEST_F(ProjectTest, SixteenBitMapsDecodeToTheSameCodesAsEightBitOnes) {
     // a 16-bit normal or roughness map is data, not light: the player's decoder rounds the
     // samples (no sRGB re-encoding), so it matches the 8-bit map of the same spec to one code
