@@ -155,6 +155,11 @@ int cmdRun(const std::vector<std::string>& args) {
     }
     if (tracePath && !device) return fail(kExitUsage, "--trace records the device forces and poses; it needs --device");
 
+    // Outputs are checked before the run, so that results are never lost at its end.
+    if (reportPath) requireWritableFile(*reportPath, "the report");
+    if (tracePath) requireWritableFile(*tracePath, "the trace");
+    if (screenshot) requireWritableFile(*screenshot, "the screenshot");
+
     std::unique_ptr<haptics::Device> dev;
     if (spec) dev = haptics::openDevice(*spec);
     const bool rt = realtime || (dev && dev->capabilities().realtime) || !headless;
@@ -191,6 +196,7 @@ int cmdRun(const std::vector<std::string>& args) {
         if (!framesGiven) opts.frames = 0; // until the trainee closes the window
         result = player::runWindow(loaded, opts, screenshot.value_or(""));
     }
+    std::string screenshotError; // bad output, not a failed session: exit 1 once the rest is written
     if (headless && screenshot) {
         // The rendered view of the last frame (EGL; Mesa llvmpipe where there is no GPU).
         try {
@@ -214,7 +220,7 @@ int cmdRun(const std::vector<std::string>& args) {
                 fig.passes.push_back({p.name, p.eye, p.ms});
             result.render = std::move(fig);
         } catch (const std::exception& e) {
-            result.errors.push_back(std::string("--screenshot ") + *screenshot + ": " + e.what());
+            screenshotError = *screenshot + ": cannot write the screenshot (" + e.what() + ")";
         }
     }
     if (reportPath) writeFileAtomic(*reportPath, player::reportJson(result).dump(2) + "\n");
@@ -222,7 +228,9 @@ int cmdRun(const std::vector<std::string>& args) {
     std::fputs(player::summaryText(result).c_str(), stdout);
     if (reportPath) std::printf("report        %s\n", std::filesystem::absolute(*reportPath).c_str());
     if (tracePath) std::printf("trace         %s\n", std::filesystem::absolute(*tracePath).c_str());
-    return result.ok() ? 0 : kExitInvariant;
+    if (!result.ok()) return kExitInvariant;
+    if (!screenshotError.empty()) return fail(kExitInput, screenshotError);
+    return 0;
 }
 
 } // namespace

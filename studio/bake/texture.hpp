@@ -13,6 +13,8 @@
 ///
 /// Coordinates: pixel (x, y) has its centre at (x + 0.5, y + 0.5), x to the right, y down (row
 /// 0 is the top row of the PNG). Angles are degrees, counter-clockwise as displayed.
+#include "sim/util/atomic_file.hpp"
+
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -377,7 +379,7 @@ std::vector<EncodedFile> encodeTextureSet(const TextureSpec& spec, const Texture
 
 /// Creates `dir` if needed and checks that a file can be written in it (a probe file is written
 /// and removed). Throws InputError "<dir>: ..." naming the reason.
-void requireWritableFolder(const std::filesystem::path& dir);
+using viscera::requireWritableFolder;
 
 struct WrittenFile {
     std::filesystem::path path;

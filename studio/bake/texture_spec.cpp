@@ -11,14 +11,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <bit>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <future>
 
 namespace viscera::bake {
@@ -671,19 +666,6 @@ std::vector<EncodedFile> encodeTextureSet(const TextureSpec& spec, const Texture
         for (EncodedFile& f : job.get())
             files.push_back(std::move(f));
     return files;
-}
-
-void requireWritableFolder(const fs::path& dir) {
-    std::error_code ec;
-    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-        throw InputError(dir.string() + ": the output folder is a file, not a folder");
-    fs::create_directories(dir, ec);
-    if (ec) throw InputError(dir.string() + ": cannot create the output folder (" + ec.message() + ")");
-    const fs::path probe = dir / (".viscera-write-probe-" + std::to_string(::getpid()));
-    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
-    if (fd < 0) throw InputError(dir.string() + ": the output folder is not writable (" + std::strerror(errno) + ")");
-    ::close(fd);
-    ::unlink(probe.c_str());
 }
 
 BakeTextureResult bakeTexture(const TextureSpec& spec, const fs::path& outDir) {

@@ -6,18 +6,24 @@
 #include "sim/mesh/generators.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/scene/scene.hpp"
+#include "sim/util/atomic_file.hpp"
 #include "support/run_process.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <set>
 
 using namespace viscera;
 using ::testing::HasSubstr;
+using ::testing::Not;
+namespace fs = std::filesystem;
 using vcase::test::RawEntry;
 using vcase::test::ScratchDir;
 
@@ -160,6 +166,51 @@ TEST(PlayerCli, RunWritesTheSessionReport) {
     EXPECT_GT(sag, 1e-4);
     EXPECT_LT(sag, 0.05);
     EXPECT_TRUE(j["errors"].empty());
+}
+
+TEST(PlayerCli, UnwritableOutputsAreRefusedBeforeTheFirstFrame) {
+    ScratchDir dir;
+    const auto path = writeSlabCase(dir, "slab.vcase", {"gravity", "xpbd"});
+    const fs::path file = dir.path() / "a-file";
+    writeFileAtomic(file, "x");
+    const fs::path folder = dir.path() / "reports";
+    fs::create_directories(folder);
+    const struct {
+        std::vector<std::string> args;
+        std::string message;
+    } cases[] = {
+        {{"--report", (file / "r.json").string()},
+         (file / "r.json").string() + ": cannot write the report ('" + file.string() + "' is a file, not a folder)"},
+        {{"--report", folder.string()}, folder.string() + ": cannot write the report (it is a folder)"},
+        {{"--screenshot", (file / "s.png").string()},
+         (file / "s.png").string() + ": cannot write the screenshot ('" + file.string() + "' is a file, not a folder)"},
+        {{"--device", "scripted:press", "--trace", folder.string()},
+         folder.string() + ": cannot write the trace (it is a folder)"},
+    };
+    for (const auto& c : cases) {
+        std::vector<std::string> args = {"run", path, "--headless", "--frames", "600"};
+        args.insert(args.end(), c.args.begin(), c.args.end());
+        const test::ProcessResult r = player(args);
+        EXPECT_EQ(r.exitCode, 1) << r.err;
+        EXPECT_EQ(r.err, "viscera-player: " + c.message + "\n");
+        EXPECT_THAT(r.err, Not(HasSubstr("frame"))); // no frame ran
+        EXPECT_TRUE(r.out.empty()) << r.out;
+    }
+    // A folder that does not exist yet is made, as writing the report would.
+    const fs::path fresh = dir.path() / "new" / "r.json";
+    const test::ProcessResult ok = player({"run", path, "--headless", "--frames", "2", "--report", fresh.string()});
+    EXPECT_EQ(ok.exitCode, 0) << ok.err;
+    EXPECT_TRUE(fs::exists(fresh));
+    // As root, permissions do not stop a write: the unwritable folder is checked only as a user.
+    if (::geteuid() != 0) {
+        const fs::path locked = dir.path() / "locked";
+        fs::create_directories(locked);
+        fs::permissions(locked, fs::perms::owner_read | fs::perms::owner_exec);
+        const test::ProcessResult r = player({"run", path, "--headless", "--report", (locked / "r.json").string()});
+        EXPECT_EQ(r.exitCode, 1);
+        EXPECT_THAT(r.err, HasSubstr("takes no new file"));
+        fs::permissions(locked, fs::perms::owner_all);
+    }
 }
 
 TEST(PlayerCli, OnlyDeclaredSubsystemsRun) {

@@ -29,7 +29,44 @@ void writeAll(int fd, std::string_view bytes, const std::filesystem::path& tmp) 
     }
 }
 
+/// Creates and removes a temporary file in `dir`; the errno text when it cannot.
+std::string probeFolder(const std::filesystem::path& dir) {
+    std::string tmpl = (dir / ".viscera-write-probe-XXXXXX").string();
+    const int fd = ::mkstemp(tmpl.data());
+    if (fd < 0) return errnoText();
+    ::close(fd);
+    ::unlink(tmpl.c_str());
+    return {};
+}
+
 } // namespace
+
+void requireWritableFile(const std::filesystem::path& path, std::string_view what) {
+    namespace fs = std::filesystem;
+    const std::string head = path.string() + ": cannot write " + std::string(what) + " (";
+    std::error_code ec;
+    if (path.empty() || path.filename().empty()) throw InputError(head + "the path names no file)");
+    if (fs::is_directory(path, ec)) throw InputError(head + "it is a folder)");
+    fs::path dir = path.parent_path();
+    if (dir.empty()) dir = ".";
+    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+        throw InputError(head + "'" + dir.string() + "' is a file, not a folder)");
+    fs::create_directories(dir, ec);
+    if (ec) throw InputError(head + "cannot create the folder '" + dir.string() + "': " + ec.message() + ")");
+    if (const std::string why = probeFolder(dir); !why.empty())
+        throw InputError(head + "the folder '" + dir.string() + "' takes no new file: " + why + ")");
+}
+
+void requireWritableFolder(const std::filesystem::path& dir) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+        throw InputError(dir.string() + ": the output folder is a file, not a folder");
+    fs::create_directories(dir, ec);
+    if (ec) throw InputError(dir.string() + ": cannot create the output folder (" + ec.message() + ")");
+    if (const std::string why = probeFolder(dir); !why.empty())
+        throw InputError(dir.string() + ": the output folder is not writable (" + why + ")");
+}
 
 void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes) {
     namespace fs = std::filesystem;

@@ -13,6 +13,16 @@ namespace viscera {
 
 void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes);
 
+/// Checks, before long work, that writeFileAtomic(path, ...) will be able to write `path`: the
+/// path is not a folder, its folder exists or can be created, and a file can be made there (a
+/// probe file is created and removed). Throws viscera::InputError, one line "<path>: cannot
+/// write <what> (<reason>)", e.g. "out/r.json: cannot write the report (Permission denied)".
+void requireWritableFile(const std::filesystem::path& path, std::string_view what);
+
+/// The same for a folder that will receive files: it is created if needed and must take a new
+/// file. Throws viscera::InputError "<dir>: ..." naming the reason.
+void requireWritableFolder(const std::filesystem::path& dir);
+
 /// Default size cap of readFile(): 256 MiB.
 inline constexpr std::uintmax_t kReadFileMaxBytes = std::uintmax_t{256} << 20;
 
