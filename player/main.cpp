@@ -48,6 +48,33 @@ void usage(std::FILE* out) {
                out);
 }
 
+constexpr const char* kVerifyHelp =
+    "usage: viscera-player verify <case.vcase>\n"
+    "\n"
+    "Checks a case package without running it: the manifest, every file's size and checksum, the\n"
+    "features against those this player supports. Prints the case id, version, file count and\n"
+    "features. Exit 0 valid, 1 a broken package (one line naming the file and the rule), 2 usage.\n";
+
+constexpr const char* kRunHelp =
+    "usage: viscera-player run <case.vcase> [options]\n"
+    "\n"
+    "Runs a case: the trainee window (default) or headless. Only the subsystems the case's\n"
+    "manifest declares are built.\n"
+    "\n"
+    "  --headless            no window; runs --frames frames as fast as the physics goes\n"
+    "  --frames N            frames to run (headless default 300; window: until closed)\n"
+    "  --device SPEC         drive the case's tools: replay:<file.csv> | scripted:<name>\n"
+    "                        (idle, press, circle, bimanual, clutch, roll) | console:<host:port>\n"
+    "                        | keyboard (window only). A device that drives no tool is warned about.\n"
+    "  --realtime            pace headless physics to the wall clock (console and window always are)\n"
+    "  --servo MODE          real-time servo wait: sleep | sleep:CPU | spin:US | busy | busy:CPU\n"
+    "  --report FILE.json    session report (schemaVersion, frames, metrics, haptics, errors)\n"
+    "  --trace FILE.csv      per-tick device force and pose trace (needs --device)\n"
+    "  --screenshot FILE.png the rendered last frame (headless: EGL, window: the window)\n"
+    "\n"
+    "Output paths are checked before the first frame. Exit 0 ok, 1 bad input or an output that\n"
+    "cannot be written, 2 usage, 3 the session broke an invariant (non-finite state, energy).\n";
+
 int fail(int code, const std::string& message) {
     return sim::cliFail("viscera-player", code, message);
 }
@@ -243,6 +270,6 @@ int main(int argc, char** argv) {
     program.name = "viscera-player";
     program.version = VISCERA_VERSION;
     program.usage = usage;
-    program.subcommands = {{"verify", cmdVerify}, {"run", cmdRun}};
+    program.subcommands = {{"verify", cmdVerify, kVerifyHelp}, {"run", cmdRun, kRunHelp}};
     return sim::runCli(program, argc, argv);
 }

@@ -22,7 +22,7 @@ double pressHeight(double t, double depth, bool* rising) {
 } // namespace
 
 const std::vector<std::string>& ScriptedDevice::scripts() {
-    static const std::vector<std::string> s = {"idle", "press", "circle", "bimanual", "clutch"};
+    static const std::vector<std::string> s = {"idle", "press", "circle", "bimanual", "clutch", "roll"};
     return s;
 }
 
@@ -37,6 +37,8 @@ ScriptedDevice::ScriptedDevice(const std::string& script, double maxForce) {
         m_script = Script::Bimanual;
     else if (script == "clutch")
         m_script = Script::Clutch;
+    else if (script == "roll")
+        m_script = Script::Roll;
     else {
         std::string known;
         for (const auto& s : scripts())
@@ -75,17 +77,30 @@ void ScriptedDevice::poll(int64_t now_ns, DeviceState& out) {
         }
         case Script::Bimanual:
             return Vec3(0, 0, pressHeight(std::max(0.0, s - (arm == 1 ? 2.5 : 0.0)), 0.09, rising));
+        case Script::Roll:
+            return Vec3::Zero();
         }
         return Vec3::Zero();
+    };
+    // Roll: arm 0 turns its wrist about its own z axis, 0 → 150° over 3 s, holds 1 s, back over 3 s.
+    auto roll = [&](double s) {
+        if (m_script != Script::Roll) return 0.0;
+        const double u = std::fmod(s, 8.0), full = 150.0 * M_PI / 180.0;
+        auto smooth = [](double x) { return x * x * (3 - 2 * x); };
+        if (u < 3.0) return full * smooth(u / 3.0);
+        if (u < 4.0) return full;
+        if (u < 7.0) return full * (1.0 - smooth((u - 4.0) / 3.0));
+        return 0.0;
     };
     for (int a = 0; a < kMaxArms; ++a) {
         bool rising = false;
         ArmState& st = out.arms[a];
         st.measured_cp.position = position(a, t, &rising);
-        st.measured_cp.orientation = Quat::Identity();
+        st.measured_cp.orientation = a == 0 ? Quat(Eigen::AngleAxisd(roll(t), Vec3::UnitZ())) : Quat::Identity();
         st.measured_cv.linear =
             (position(a, t + h, nullptr) - position(a, std::max(0.0, t - h), nullptr)) / (t >= h ? 2 * h : h);
-        st.measured_cv.angular.setZero();
+        st.measured_cv.angular =
+            Vec3(0, 0, a == 0 ? (roll(t + h) - roll(std::max(0.0, t - h))) / (t >= h ? 2 * h : h) : 0.0);
         st.jaw_measured_js = 0.3;
         st.buttons = 0;
         if (a == 0 && m_script == Script::Clutch && rising) out.pedals |= kPedalClutch;

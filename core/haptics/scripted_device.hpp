@@ -7,6 +7,8 @@
 ///   circle     arm 0 circles (radius 4 cm, period 4 s) 7 cm below the centre
 ///   bimanual   both arms press alternately (arm 1 starts half a period, 2.5 s, after arm 0)
 ///   clutch     like press, with the clutch pedal held during the rise
+///   roll       arm 0 stays at the centre and turns its wrist about its own z axis, 0 → 150° over
+///              3 s, holds 1 s, back over 3 s; period 8 s (drives a needle along its curve)
 #include "haptics/device.hpp"
 
 #include <atomic>
@@ -25,7 +27,7 @@ public:
     const char* backend() const override { return "scripted"; }
 
 private:
-    enum class Script { Idle, Press, Circle, Bimanual, Clutch };
+    enum class Script { Idle, Press, Circle, Bimanual, Clutch, Roll };
     Script m_script;
     DeviceCapabilities m_caps;
     bool m_started = false;

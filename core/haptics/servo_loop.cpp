@@ -185,6 +185,7 @@ void ServoLoop::tick(int64_t now) {
         poses.target[a] = x;
         poses.orientation[a] = arm.measured_cp.orientation;
         poses.grip[a] = arm.jaw_measured_js;
+        poses.buttons[a] = arm.buttons;
     }
     SafetyInput in;
     in.now_ns = now;

@@ -19,35 +19,106 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
     const haptics::DeviceCapabilities& caps = device.capabilities();
     const int arms = std::clamp(caps.arms, 1, kMaxArms);
     haptics::ServoConfig cfg;
-    std::array<bool, kMaxArms> used{false, false};
     m_caseMaxForce = 15.0;
-    for (size_t t = 0; t < world.toolCount(); ++t) {
-        const sim::ToolDesc& d = world.toolDesc(t);
-        int arm = -1;
-        if (arms == 2 && d.hand == "left")
-            arm = 0;
-        else if (arms == 2 && d.hand == "right")
-            arm = 1;
-        else
-            for (int a = 0; a < arms; ++a)
-                if (!used[a]) {
-                    arm = a;
-                    break;
-                }
-        if (arm >= 0 && used[arm]) arm = -1;
-        m_tools.push_back({d.name, d.hand, arm});
-        m_caseMaxForce = std::min(m_caseMaxForce, d.maxForceN);
-        if (arm < 0) continue;
-        used[arm] = true;
-        m_toolOfArm[arm] = static_cast<int>(t);
+    // The arm a hand asks for: left → 0 and right → 1 on a bimanual device; "any" (or a one-arm
+    // device) → the first arm nothing is on yet, else arm 0.
+    auto armFor = [&](const std::string& hand, bool exclusive) {
+        if (arms == 2 && hand == "left") return 0;
+        if (arms == 2 && hand == "right") return 1;
+        for (int a = 0; a < arms; ++a)
+            if (m_armTools[a].empty()) return a;
+        return exclusive ? -1 : 0;
+    };
+    auto mapArm = [&](int arm, const sim::Vec3& start, double motion, double force) {
         haptics::ToolMapping& m = cfg.tools[arm];
         m.enabled = true;
-        m.sceneStart = d.start;
-        m.motionScale = d.motionScale;
-        m.forceScale = d.forceScale;
+        m.sceneStart = start;
+        m.motionScale = motion;
+        m.forceScale = force;
+    };
+    for (size_t t = 0; t < world.toolCount(); ++t) { // probes: one arm each
+        const sim::ToolDesc& d = world.toolDesc(t);
+        int arm = armFor(d.hand, true);
+        if (arm >= 0 && !m_armTools[arm].empty()) arm = -1;
+        m_tools.push_back({d.name, d.hand, arm, "probe", 0});
+        RigTool rt;
+        rt.kind = RigTool::Kind::Probe;
+        rt.index = t;
+        rt.arm = arm;
+        m_rig.push_back(rt);
+        m_caseMaxForce = std::min(m_caseMaxForce, d.maxForceN);
+        if (arm < 0) continue;
+        m_armTools[arm].push_back(static_cast<int>(m_rig.size() - 1));
+        m_toolOfArm[arm] = static_cast<int>(t);
+        mapArm(arm, d.start, d.motionScale, d.forceScale);
     }
+    if (sim::InteractionRuntime* in = world.interaction()) // instruments: arms may be shared
+        for (size_t i = 0; i < in->instrumentCount(); ++i) {
+            const sim::InstrumentDesc& d = in->instrumentDesc(i);
+            if (!d.device.declared) continue;
+            int arm = armFor(d.device.hand, false);
+            // An arm a probe holds is not shared.
+            if (arm >= 0 && m_toolOfArm[arm] >= 0) arm = -1;
+            m_tools.push_back({d.name, d.device.hand, arm, sim::kindName(d.kind), 0});
+            RigTool rt;
+            rt.kind = RigTool::Kind::Instrument;
+            rt.index = i;
+            rt.arm = arm;
+            rt.gripOpen = d.device.gripOpenRad;
+            rt.rest = in->restKey(i);
+            m_rig.push_back(rt);
+            m_caseMaxForce = std::min(m_caseMaxForce, d.device.maxForceN);
+            if (arm < 0) continue;
+            // The arm's first instrument sets its mapping: workspace centre at its rest tip.
+            if (m_armTools[arm].empty()) mapArm(arm, rt.rest.position, d.device.motionScale, d.device.forceScale);
+            m_armTools[arm].push_back(static_cast<int>(m_rig.size() - 1));
+        }
+    if (sim::NeedleDrive* nd = world.needleDrive();
+        nd && world.scene().suture && world.scene().suture->device.declared) {
+        // The needle holder on its hand; the thread on the other arm (its lift pulls).
+        const sim::NeedleDeviceDesc& d = world.scene().suture->device;
+        int arm = armFor(d.hand, true);
+        if (arm >= 0 && !m_armTools[arm].empty()) arm = -1;
+        const sim::NeedleFrame rest = nd->restFrame();
+        m_tools.push_back({"needle", d.hand, arm, "needle", 0});
+        RigTool rt;
+        rt.kind = RigTool::Kind::Needle;
+        rt.arm = arm;
+        rt.needleRest = rest.pose;
+        m_rig.push_back(rt);
+        m_caseMaxForce = std::min(m_caseMaxForce, d.maxForceN);
+        if (arm >= 0) {
+            m_armTools[arm].push_back(static_cast<int>(m_rig.size() - 1));
+            mapArm(arm, rest.pose.translation(), d.motionScale, d.forceScale);
+        }
+        int other = -1;
+        for (int a = 0; a < arms; ++a)
+            if (a != arm && m_armTools[a].empty()) other = a;
+        const std::string otherHand = d.hand == "left" ? "right" : d.hand == "right" ? "left" : "any";
+        m_tools.push_back({"thread", otherHand, other, "thread", 0});
+        RigTool th;
+        th.kind = RigTool::Kind::Thread;
+        th.arm = other;
+        th.pullScale = d.pullScale;
+        m_rig.push_back(th);
+        if (other >= 0) {
+            m_armTools[other].push_back(static_cast<int>(m_rig.size() - 1));
+            mapArm(other, sim::Vec3::Zero(), 1.0, d.forceScale); // device metres: the lift itself
+        }
+    }
+    for (int a = 0; a < kMaxArms; ++a)
+        if (!m_armTools[a].empty()) {
+            RigTool& first = m_rig[static_cast<size_t>(m_armTools[a][0])];
+            if (first.kind == RigTool::Kind::Instrument) first.offset = first.rest.position - cfg.tools[a].sceneStart;
+        }
     m_aboveDamage.assign(world.toolCount(), false);
-    m_metrics.toolPathLengthPerTool_m.assign(world.toolCount(), 0.0);
+    for (size_t t = 0; t < m_rig.size(); ++t) // instruments are measured by the session, scripted or driven
+        if (m_rig[t].kind != RigTool::Kind::Instrument) {
+            m_rig[t].slot = static_cast<int>(m_metrics.toolNames.size());
+            m_metrics.toolNames.push_back(m_tools[t].name);
+            m_metrics.toolPathLengthPerTool_m.push_back(0.0);
+            m_metrics.maxForcePerTool_n.push_back(0.0);
+        }
     cfg.safety.maxForce = m_caseMaxForce;
     if (m_realtime) {
         m_clock = std::make_unique<haptics::SteadyClock>();
@@ -57,6 +128,24 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
         m_clock = std::move(c);
     }
     m_servoConfig = cfg;
+}
+
+int HapticRig::activeTool(int arm) const {
+    if (arm < 0 || arm >= kMaxArms || m_armTools[arm].empty()) return -1;
+    return m_armTools[arm][static_cast<size_t>(m_selected[arm]) % m_armTools[arm].size()];
+}
+
+std::vector<std::string> HapticRig::undrivenTools() const {
+    std::vector<std::string> out;
+    for (const auto& t : m_tools)
+        if (t.arm < 0) out.push_back(t.name);
+    return out;
+}
+
+bool HapticRig::drivesAnyTool() const {
+    for (const auto& t : m_tools)
+        if (t.arm >= 0) return true;
+    return false;
 }
 
 HapticRig::~HapticRig() {
@@ -92,17 +181,43 @@ haptics::LocalContactModel HapticRig::contactModel(int64_t now) const {
     m.timestamp_ns = now;
     m.frame = m_frame;
     m.physicsPeriod_s = m_dt;
+    const sim::InteractionRuntime* interaction = m_world.interaction();
     for (int a = 0; a < kMaxArms; ++a) {
-        const int t = m_toolOfArm[a];
+        const int t = activeTool(a);
         if (t < 0) continue;
-        const sim::ToolContact& c = m_world.toolContact(static_cast<size_t>(t));
+        const RigTool& rt = m_rig[static_cast<size_t>(t)];
         haptics::ToolContactModel& tm = m.tools[a];
         tm.active = true;
-        tm.p0 = c.centre;
-        tm.n = c.normal;
-        tm.f0 = c.force.norm();
-        tm.gap = c.gap;
-        tm.k = c.stiffness;
+        if (rt.kind == RigTool::Kind::Needle || rt.kind == RigTool::Kind::Thread) {
+            // Quasi-static FEM: the last step's force is held until the next one (k = 0).
+            const sim::NeedleDrive* nd = m_world.needleDrive();
+            sim::Vec3 f = sim::Vec3::Zero();
+            if (nd) f = rt.kind == RigTool::Kind::Needle ? nd->needleForce() : sim::Vec3(0, 0, -nd->threadTension());
+            const double fn = f.allFinite() ? f.norm() : 0.0;
+            tm.p0 = m_armProxy[a];
+            tm.f0 = fn;
+            tm.n = fn > 0 ? sim::Vec3(f / fn) : sim::Vec3::UnitZ();
+            tm.gap = fn > 0 ? 0.0 : 1e9;
+            tm.k = 0;
+        } else if (rt.kind == RigTool::Kind::Probe) {
+            const sim::ToolContact& c = m_world.toolContact(rt.index);
+            tm.p0 = c.centre;
+            tm.n = c.normal;
+            tm.f0 = c.force.norm();
+            tm.gap = c.gap;
+            tm.k = c.stiffness;
+        } else if (interaction) {
+            // An instrument pushes the tissue kinematically inside the XPBD iterations; its force
+            // (contact pushes and grasp hold, InteractionRuntime::instrumentForce) is held until
+            // the next physics frame (k = 0), at the servo proxy the step used.
+            const sim::Vec3 f = interaction->instrumentForce(rt.index);
+            const double fn = f.norm();
+            tm.p0 = m_armProxy[a];
+            tm.f0 = std::isfinite(fn) ? fn : 0.0;
+            tm.n = tm.f0 > 0 ? sim::Vec3(f / fn) : sim::Vec3::UnitZ();
+            tm.gap = tm.f0 > 0 ? 0.0 : 1e9;
+            tm.k = 0;
+        }
     }
     return m;
 }
@@ -136,18 +251,92 @@ void HapticRig::beforeStep() {
     }
     m_servo->notifyStepStart();
     const haptics::ToolPoseState poses = m_servo->toolPoses();
-    if (poses.tick == 0) return;
-    for (int a = 0; a < kMaxArms; ++a)
-        if (m_toolOfArm[a] >= 0) m_world.setToolPosition(static_cast<size_t>(m_toolOfArm[a]), poses.proxy[a]);
+    sim::InteractionRuntime* interaction = m_world.interaction();
+    std::array<int, kMaxArms> active{-1, -1};
+    if (poses.tick != 0)
+        for (int a = 0; a < kMaxArms; ++a) {
+            if (m_armTools[a].empty()) continue;
+            // The arm's first button hands it to its next instrument, which starts from where it waits.
+            const bool down = (poses.buttons[a] & 1u) != 0;
+            if (down && !m_buttonDown[a] && m_armTools[a].size() > 1) {
+                m_selected[a] = (m_selected[a] + 1) % static_cast<int>(m_armTools[a].size());
+                RigTool& next = m_rig[static_cast<size_t>(activeTool(a))];
+                next.offset = next.rest.position - poses.proxy[a];
+            }
+            m_buttonDown[a] = down;
+            active[a] = activeTool(a);
+            m_armProxy[a] = poses.proxy[a];
+        }
+    for (size_t t = 0; t < m_rig.size(); ++t) {
+        RigTool& rt = m_rig[t];
+        const int a = rt.arm;
+        const bool driven = a >= 0 && active[a] == static_cast<int>(t);
+        if (rt.kind == RigTool::Kind::Probe) {
+            if (driven) m_world.setToolPosition(rt.index, poses.proxy[a]);
+            continue;
+        }
+        if (rt.kind == RigTool::Kind::Thread) {
+            if (driven) rt.pull = std::max(rt.pull, rt.pullScale * std::max(0.0, poses.target[a].z()));
+            continue;
+        }
+        if (rt.kind == RigTool::Kind::Needle) {
+            sim::NeedleDrive* nd = m_world.needleDrive();
+            if (!nd || !driven) continue;
+            sim::NeedleFrame f;
+            // The master's orientation turns the needle in its own frame: a roll about the master's
+            // z is a turn about the needle's axis, which drives it along its curve.
+            f.pose.linear() = rt.needleRest.linear() * poses.orientation[a].toRotationMatrix();
+            f.pose.translation() = poses.proxy[a];
+            for (const RigTool& th : m_rig)
+                if (th.kind == RigTool::Kind::Thread) f.pull = th.pull;
+            nd->drive(f);
+            m_tools[t].drivenTime_s += m_dt;
+            continue;
+        }
+        if (!interaction) continue;
+        if (!driven) { // waits at its track's first key while the device is on
+            interaction->drive(rt.index, rt.rest);
+            continue;
+        }
+        sim::InstrumentKey k;
+        k.position = poses.proxy[a] + rt.offset;
+        k.direction = poses.orientation[a] * rt.rest.direction;
+        const bool grip = m_device.capabilities().arm[a].grip;
+        k.jaw = grip ? std::clamp(poses.grip[a] / rt.gripOpen, 0.0, 1.0) : rt.rest.jaw;
+        switch (interaction->instrumentDesc(rt.index).kind) {
+        case sim::InstrumentDesc::Kind::EnergyHook:
+            k.act = (poses.pedals & (haptics::kPedalEnergyCut | haptics::kPedalEnergyCoag)) != 0;
+            break;
+        case sim::InstrumentDesc::Kind::ClipApplier:
+            k.act = k.jaw < 0.2; // the grip squeezed shut fires the clip
+            break;
+        case sim::InstrumentDesc::Kind::Grasper:
+            k.act = false;
+            break;
+        }
+        interaction->drive(rt.index, k);
+        m_tools[t].drivenTime_s += m_dt;
+    }
 }
 
 void HapticRig::afterStep() {
     ++m_frame;
     publish();
+    if (const sim::NeedleDrive* nd = m_world.needleDrive())
+        for (const RigTool& rt : m_rig)
+            if (rt.slot >= 0 && (rt.kind == RigTool::Kind::Needle || rt.kind == RigTool::Kind::Thread)) {
+                const double f = rt.kind == RigTool::Kind::Needle ? nd->needleForce().norm() : nd->threadTension();
+                if (!std::isfinite(f)) continue;
+                double& m = m_metrics.maxForcePerTool_n[static_cast<size_t>(rt.slot)];
+                m = std::max(m, f);
+                m_metrics.maxContactForce_n = std::max(m_metrics.maxContactForce_n, f);
+            }
     for (size_t t = 0; t < m_world.toolCount(); ++t) {
         const double f = m_world.toolContact(t).force.norm();
         const double thr = m_world.toolDesc(t).damageForceN;
         m_metrics.maxContactForce_n = std::max(m_metrics.maxContactForce_n, f);
+        m_metrics.maxForcePerTool_n[static_cast<size_t>(m_rig[t].slot)] =
+            std::max(m_metrics.maxForcePerTool_n[static_cast<size_t>(m_rig[t].slot)], f);
         if (f > thr) {
             m_metrics.tissueDamage_ns += (f - thr) * m_dt;
             if (!m_aboveDamage[t]) ++m_metrics.damageEvents;
@@ -171,10 +360,11 @@ void HapticRig::drain() {
         m_forceSum += f;
         ++m_forceCount;
         if (f > 0) m_contactSum += f, ++m_contactCount;
-        if (m_haveLast[a] && m_toolOfArm[a] >= 0) {
+        const int t = activeTool(a);
+        if (m_haveLast[a] && t >= 0 && m_rig[static_cast<size_t>(t)].slot >= 0) {
             const double d = (s.tool - m_last[a]).norm();
             m_metrics.toolPathLength_m += d;
-            m_metrics.toolPathLengthPerTool_m[static_cast<size_t>(m_toolOfArm[a])] += d;
+            m_metrics.toolPathLengthPerTool_m[static_cast<size_t>(m_rig[static_cast<size_t>(t)].slot)] += d;
         }
         m_last[a] = s.tool;
         m_haveLast[a] = true;
@@ -230,11 +420,20 @@ LiveState HapticRig::live() const {
     s.pedals = p.pedals;
     s.safetyRules = p.safetyRules;
     s.maxForce_n = m_caseMaxForce;
+    const sim::InteractionRuntime* interaction = m_world.interaction();
     for (int a = 0; a < kMaxArms; ++a) {
         s.force[a] = p.force[a];
-        s.toolActive[a] = m_toolOfArm[a] >= 0;
-        s.tool[a] =
-            m_toolOfArm[a] >= 0 ? m_world.toolContact(static_cast<size_t>(m_toolOfArm[a])).centre : sim::Vec3::Zero();
+        const int t = activeTool(a);
+        s.toolActive[a] = t >= 0;
+        if (t < 0) continue;
+        const RigTool& rt = m_rig[static_cast<size_t>(t)];
+        if (rt.kind == RigTool::Kind::Probe)
+            s.tool[a] = m_world.toolContact(rt.index).centre;
+        else if (rt.kind == RigTool::Kind::Needle || rt.kind == RigTool::Kind::Thread)
+            s.tool[a] = m_armProxy[a];
+        else if (interaction && rt.index < interaction->summary().instruments.size())
+            s.tool[a] = interaction->summary().instruments[rt.index].tip;
+        s.toolName[a] = m_tools[static_cast<size_t>(t)].name;
     }
     return s;
 }

@@ -22,20 +22,23 @@
 
 namespace viscera::player {
 
-/// Task metrics of a session (report "metrics").
+/// Task metrics of a session (report "metrics"). Tools: the scene's probes, then the
+/// interaction's instruments (scripted on their tracks or driven by the device).
 struct TaskMetrics {
     double time_s = 0;           ///< simulated session time
     double toolPathLength_m = 0; ///< sum over tools, scene frame
+    std::vector<std::string> toolNames;
     std::vector<double> toolPathLengthPerTool_m;
-    double maxForce_n = 0;         ///< device force after the safety filter
-    double meanForce_n = 0;        ///< over all servo ticks of driven arms
-    double meanContactForce_n = 0; ///< over ticks with a non-zero force
-    double tissueDamage_ns = 0;    ///< ∫ max(0, contact force − damage threshold) dt, N·s
-    int damageEvents = 0;          ///< times the contact force rose above the threshold
-    double maxContactForce_n = 0;  ///< N, tissue on tool, from the physics
-    int punctures = 0;             ///< needle punctures (suturing cases)
-    int clips = 0;                 ///< clips applied (cases with a clip applier)
-    int cutEdges = 0;              ///< edges dissected by energy (cases with an energy hook)
+    std::vector<double> maxForcePerTool_n; ///< tissue on tool, from the physics
+    double maxForce_n = 0;                 ///< device force after the safety filter
+    double meanForce_n = 0;                ///< over all servo ticks of driven arms
+    double meanContactForce_n = 0;         ///< over ticks with a non-zero force
+    double tissueDamage_ns = 0;            ///< ∫ max(0, contact force − damage threshold) dt, N·s
+    int damageEvents = 0;                  ///< times the contact force rose above the threshold
+    double maxContactForce_n = 0;          ///< N, tissue on tool, from the physics
+    int punctures = 0;                     ///< needle punctures (suturing cases)
+    int clips = 0;                         ///< clips applied (cases with a clip applier)
+    int cutEdges = 0;                      ///< edges dissected by energy (cases with an energy hook)
 };
 
 struct HapticsResult {
@@ -44,7 +47,9 @@ struct HapticsResult {
     double deviceMaxForce_n = 0, caseMaxForce_n = 0;
     struct Tool {
         std::string name, hand;
-        int arm = -1; ///< -1: no arm of this device drives it
+        int arm = -1;            ///< -1: no arm of this device drives it
+        std::string kind;        ///< "probe" or the instrument kind (grasper, energy_hook, ...)
+        double drivenTime_s = 0; ///< time its arm drove it (instruments sharing an arm take turns)
     };
     std::vector<Tool> tools;
     haptics::ServoStats servo;
@@ -70,6 +75,7 @@ struct LiveState {
     std::array<double, haptics::kMaxArms> force{0, 0};
     std::array<sim::Vec3, haptics::kMaxArms> tool{sim::Vec3::Zero(), sim::Vec3::Zero()};
     std::array<bool, haptics::kMaxArms> toolActive{false, false};
+    std::array<std::string, haptics::kMaxArms> toolName{}; ///< the tool each arm drives now
     double maxForce_n = 15;
     /// Physics speed over the last frames (session.cpp): mean step wall time, ms, and the
     /// real-time factor, simulated time per physics wall time (≥ 1: keeps up with real time).
@@ -103,6 +109,10 @@ public:
     std::vector<TraceRow>& trace() { return m_trace; }
     LiveState live() const;
     bool realtime() const { return m_realtime; }
+    /// Tools of the scene that no arm of the device drives (the player warns about them), and
+    /// whether any tool is driven at all.
+    std::vector<std::string> undrivenTools() const;
+    bool drivesAnyTool() const;
 
 private:
     void drain();
@@ -117,7 +127,27 @@ private:
     haptics::ManualClock* m_manual = nullptr;
     haptics::ServoConfig m_servoConfig;
     std::unique_ptr<haptics::ServoLoop> m_servo;
-    std::array<int, haptics::kMaxArms> m_toolOfArm{-1, -1};
+    /// Tools: probes [0, toolCount), then the instruments that declare a device, then the needle
+    /// and the thread of a suturing scene with a suture "device".
+    struct RigTool {
+        enum class Kind { Probe, Instrument, Needle, Thread };
+        Kind kind = Kind::Probe;
+        size_t index = 0; ///< probe or instrument index in the World
+        int arm = -1;
+        sim::Vec3 offset = sim::Vec3::Zero(); ///< instrument: tip − servo proxy while its arm drives it
+        double gripOpen = 1.0;
+        sim::InstrumentKey rest;
+        Eigen::Isometry3d needleRest = Eigen::Isometry3d::Identity();
+        double pullScale = 0, pull = 0; ///< thread: scale and the pull so far (m)
+        int slot = -1;                  ///< its entry in the task metrics' per-tool lists (instruments: the session's)
+    };
+    std::vector<RigTool> m_rig;
+    std::array<std::vector<int>, haptics::kMaxArms> m_armTools; ///< rig tools per arm, in scene order
+    std::array<int, haptics::kMaxArms> m_selected{0, 0};        ///< index into m_armTools[a]
+    std::array<bool, haptics::kMaxArms> m_buttonDown{false, false};
+    /// Rig tool the arm drives now (-1: none).
+    int activeTool(int arm) const;
+    std::array<int, haptics::kMaxArms> m_toolOfArm{-1, -1}; ///< probe index per arm (-1: none / an instrument)
     std::vector<HapticsResult::Tool> m_tools;
     double m_dt = 0, m_caseMaxForce = 15;
     int64_t m_frame = 0, m_t0 = 0, m_tick = 0;
@@ -126,6 +156,7 @@ private:
     TaskMetrics m_metrics;
     std::array<bool, haptics::kMaxArms> m_haveLast{false, false};
     std::array<sim::Vec3, haptics::kMaxArms> m_last{sim::Vec3::Zero(), sim::Vec3::Zero()};
+    std::array<sim::Vec3, haptics::kMaxArms> m_armProxy{sim::Vec3::Zero(), sim::Vec3::Zero()};
     std::vector<bool> m_aboveDamage;
     double m_forceSum = 0, m_contactSum = 0;
     uint64_t m_forceCount = 0, m_contactCount = 0;

@@ -49,7 +49,8 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
     using nlohmann::json;
     json tools = json::array();
     for (const auto& t : h.tools)
-        tools.push_back({{"name", t.name}, {"hand", t.hand}, {"arm", t.arm}});
+        tools.push_back(
+            {{"name", t.name}, {"hand", t.hand}, {"arm", t.arm}, {"kind", t.kind}, {"driven_time_s", t.drivenTime_s}});
     const haptics::ServoStats& s = h.servo;
     json servo = {{"rate_hz", 1000.0}, {"ticks", s.ticks}, {"tick_cost_us", distribution(s.tickCost)}};
     if (h.mode == "realtime") {
@@ -218,6 +219,7 @@ static nlohmann::json sutureJson(const SessionResult& r) {
 nlohmann::json reportJson(const SessionResult& r) {
     using nlohmann::json;
     json doc;
+    doc["schemaVersion"] = kReportSchemaVersion;
     doc["case"] = {{"id", r.caseId}, {"version", r.caseVersion}, {"title", r.title}};
     doc["active_subsystems"] = r.activeSubsystems;
     json frames = json::array();
@@ -252,7 +254,8 @@ nlohmann::json reportJson(const SessionResult& r) {
                       {"step_ms_max", st.max},
                       {"nodes", r.nodes},
                       {"tets", r.tets},
-                      {"max_node_displacement_m", r.maxNodeDisplacement}};
+                      {"max_node_displacement_m", r.maxNodeDisplacement},
+                      {"final_node_displacement_m", r.finalNodeDisplacement}};
     const RealTimeFigures rt = realTimeFigures(r);
     doc["metrics"]["frame_dt_s"] = r.frameDt;
     doc["metrics"]["real_time_factor"] = rt.factorMean;
@@ -264,6 +267,8 @@ nlohmann::json reportJson(const SessionResult& r) {
     doc["metrics"]["time_s"] = tm.time_s;
     doc["metrics"]["tool_path_length_m"] = tm.toolPathLength_m;
     doc["metrics"]["tool_path_length_per_tool_m"] = tm.toolPathLengthPerTool_m;
+    doc["metrics"]["tool_names"] = tm.toolNames;
+    doc["metrics"]["max_contact_force_per_tool_n"] = tm.maxForcePerTool_n;
     doc["metrics"]["max_force_n"] = tm.maxForce_n;
     doc["metrics"]["mean_force_n"] = tm.meanForce_n;
     doc["metrics"]["mean_contact_force_n"] = tm.meanContactForce_n;
@@ -289,6 +294,7 @@ nlohmann::json reportJson(const SessionResult& r) {
                          {"passes", passes}};
     }
     doc["errors"] = r.errors;
+    doc["warnings"] = r.warnings;
     return doc;
 }
 
@@ -297,20 +303,23 @@ std::string summaryText(const SessionResult& r) {
     std::string subs;
     for (const auto& s : r.activeSubsystems)
         subs += (subs.empty() ? "" : ", ") + s;
-    char buf[1024];
+    char buf[1400];
     std::snprintf(buf, sizeof buf,
                   "case          %s %s%s%s\n"
                   "subsystems    %s\n"
                   "mesh          %zu nodes, %zu tets\n"
                   "frames        %zu (%.3f s simulated in %.3f s wall)\n"
                   "step time     mean %.3f ms, p50 %.3f ms, p99 %.3f ms, max %.3f ms\n"
-                  "displacement  max node %.3f mm from rest; max per frame %.3f mm\n"
-                  "invariants    all finite: %s, max energy %.4g J, max device force %.3g N\n"
+                  "displacement  largest node distance from rest %.3f mm over the run (%.3f mm at the end); "
+                  "largest node move in one frame %.3f mm\n"
+                  "energy        largest total %.4g J (elastic + kinetic + gravitational, measured from the rest "
+                  "pose)\n"
+                  "invariants    all finite: %s\n"
                   "status        %s\n",
                   r.caseId.c_str(), r.caseVersion.c_str(), r.title.empty() ? "" : " — ", r.title.c_str(),
                   subs.empty() ? "(none)" : subs.c_str(), r.nodes, r.tets, r.frames.size(), r.simTime, r.wallTime,
-                  st.mean, st.p50, st.p99, st.max, r.maxNodeDisplacement * 1e3, r.invariants.maxStepDisplacement * 1e3,
-                  r.invariants.allFinite ? "yes" : "NO", r.invariants.maxEnergy, r.invariants.maxForce,
+                  st.mean, st.p50, st.p99, st.max, r.maxNodeDisplacement * 1e3, r.finalNodeDisplacement * 1e3,
+                  r.invariants.maxStepDisplacement * 1e3, r.invariants.maxEnergy, r.invariants.allFinite ? "yes" : "NO",
                   r.ok() ? "ok"
                          : ("FAILED: " + (r.errors.empty() ? std::string("invariants") : r.errors.front())).c_str());
     std::string out = buf;
@@ -321,6 +330,22 @@ std::string summaryText(const SessionResult& r) {
                       rt.factorP99, rt.framesOver, r.frames.size(), r.frameDt * 1e3,
                       rt.slower() ? " — PHYSICS SLOWER THAN REAL TIME" : "");
         out += line;
+    }
+    for (const std::string& w : r.warnings)
+        out += "warning       " + w + "\n";
+    if (!r.metrics.toolNames.empty()) { // scripted and device-driven tools alike
+        std::string per;
+        for (size_t t = 0; t < r.metrics.toolNames.size(); ++t) {
+            char item[160];
+            std::snprintf(item, sizeof item, "%s%s %.1f mm, %.2f N", per.empty() ? "" : "; ",
+                          r.metrics.toolNames[t].c_str(), r.metrics.toolPathLengthPerTool_m[t] * 1e3,
+                          r.metrics.maxForcePerTool_n[t]);
+            per += item;
+        }
+        char line[160];
+        std::snprintf(line, sizeof line, "tools         path %.1f mm, largest force from the tissue %.2f N (",
+                      r.metrics.toolPathLength_m * 1e3, r.metrics.maxContactForce_n);
+        out += line + per + ")\n";
     }
     if (r.haptics) {
         const HapticsResult& h = *r.haptics;
@@ -338,9 +363,9 @@ std::string summaryText(const SessionResult& r) {
         out += line;
         std::snprintf(
             line, sizeof line,
-            "task          path %.1f mm, force max %.2f N mean %.2f N, contact model age max %.2f ms (%.2f periods)\n",
-            r.metrics.toolPathLength_m * 1e3, r.metrics.maxForce_n, r.metrics.meanForce_n,
-            h.servo.contactAge.max_us * 1e-3, h.maxContactAgeSteps);
+            "device force  max %.2f N, mean %.2f N (after the safety filter), contact model age max %.2f ms (%.2f "
+            "periods)\n",
+            r.metrics.maxForce_n, r.metrics.meanForce_n, h.servo.contactAge.max_us * 1e-3, h.maxContactAgeSteps);
         out += line;
         const haptics::HandoverFigures& ho = h.handover;
         std::snprintf(

@@ -7,10 +7,76 @@
 
 #include "sim/mesh/tet_io.hpp"
 #include "sim/util/error.hpp"
+#include "sim/util/log.hpp"
 
 #include <chrono>
+#include <cmath>
 
 namespace viscera::player {
+namespace {
+
+/// Task figures of the interaction's instruments, scripted or driven: tip path, force from the
+/// tissue, damage above the threshold (the instrument's device damage_force_n, else 4 N).
+class InstrumentMeter {
+public:
+    void record(const sim::InteractionRuntime& in, double dt) {
+        const auto& now = in.summary().instruments;
+        if (m_path.empty()) {
+            m_path.assign(now.size(), 0.0);
+            m_maxForce.assign(now.size(), 0.0);
+            m_above.assign(now.size(), false);
+        }
+        for (size_t i = 0; i < now.size() && i < m_path.size(); ++i) {
+            if (m_haveLast) m_path[i] += (now[i].tip - m_last[i]).norm();
+            const double f = now[i].force.norm();
+            m_maxForce[i] = std::max(m_maxForce[i], f);
+            const sim::InstrumentDesc& d = in.instrumentDesc(i);
+            const double thr = d.device.declared ? d.device.damageForceN : sim::InstrumentDeviceDesc{}.damageForceN;
+            if (f > thr) {
+                m_damage += (f - thr) * dt;
+                if (!m_above[i]) ++m_events;
+            }
+            m_above[i] = f > thr;
+        }
+        m_last.resize(now.size());
+        for (size_t i = 0; i < now.size(); ++i)
+            m_last[i] = now[i].tip;
+        m_haveLast = true;
+    }
+    void addTo(TaskMetrics& m, const sim::InteractionRuntime& in) const {
+        for (size_t i = 0; i < m_path.size(); ++i) {
+            m.toolNames.push_back(in.instrumentDesc(i).name);
+            m.toolPathLengthPerTool_m.push_back(m_path[i]);
+            m.maxForcePerTool_n.push_back(m_maxForce[i]);
+            m.toolPathLength_m += m_path[i];
+            m.maxContactForce_n = std::max(m.maxContactForce_n, m_maxForce[i]);
+        }
+        m.tissueDamage_ns += m_damage;
+        m.damageEvents += m_events;
+    }
+
+private:
+    std::vector<double> m_path, m_maxForce;
+    std::vector<bool> m_above;
+    std::vector<sim::Vec3> m_last;
+    bool m_haveLast = false;
+    double m_damage = 0;
+    int m_events = 0;
+};
+
+/// m: the largest distance of a node from its rest position now (every body).
+double nodeDisplacement(const sim::World& world) {
+    double d2 = 0;
+    for (size_t b = 0; b < world.bodyCount(); ++b) {
+        const auto& rest = world.restMesh(b).positions();
+        const auto& x = world.positions(b);
+        for (size_t v = 0; v < x.size(); ++v)
+            d2 = std::max(d2, (x[v] - rest[v]).squaredNorm());
+    }
+    return std::sqrt(d2);
+}
+
+} // namespace
 
 LoadedCase loadCase(const std::filesystem::path& casePath) {
     LoadedCase out;
@@ -131,7 +197,17 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         rig->setServoWait(options.servoWait, options.servoCpu, options.servoSpinNs);
         rig->configure(loaded.scene.xpbd.dt);
         r.activeSubsystems.push_back("haptics");
+        if (!rig->drivesAnyTool())
+            r.warnings.push_back("--device " + options.deviceSpec +
+                                 ": the case declares no tool a device can drive (no 'tools', no instrument "
+                                 "with a 'device'); the session runs as without it");
+        for (const std::string& t : rig->undrivenTools())
+            r.warnings.push_back("--device " + options.deviceSpec + ": tool '" + t +
+                                 "' has no arm of this device to drive it");
+        for (const std::string& w : r.warnings)
+            log::warn(w);
     }
+    InstrumentMeter meter;
     if (options.live) {
         std::lock_guard<std::mutex> lock(options.live->mutex);
         for (size_t t = 0; t < world.toolCount(); ++t)
@@ -147,6 +223,8 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         if (rig) rig->beforeStep();
         sim::FrameRecord rec = world.step();
         if (rig) rig->afterStep();
+        if (const sim::InteractionRuntime* in = world.interaction()) meter.record(*in, frameDt);
+        r.maxNodeDisplacement = std::max(r.maxNodeDisplacement, nodeDisplacement(world));
         if (options.live) {
             std::lock_guard<std::mutex> lock(options.live->mutex);
             LiveView& lv = *options.live;
@@ -207,13 +285,9 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         r.interaction = in->summary();
         r.metrics.clips = static_cast<int>(r.interaction->clips.size());
         r.metrics.cutEdges = r.interaction->fasciaEdgesCut + r.interaction->fatEdgesCut;
+        meter.addTo(r.metrics, *in);
     }
-    for (size_t b = 0; b < world.bodyCount(); ++b) {
-        const auto& rest = world.restMesh(b).positions();
-        const auto& x = world.positions(b);
-        for (size_t v = 0; v < x.size(); ++v)
-            r.maxNodeDisplacement = std::max(r.maxNodeDisplacement, (x[v] - rest[v]).norm());
-    }
+    r.finalNodeDisplacement = nodeDisplacement(world);
     return r;
 }
 

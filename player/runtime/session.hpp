@@ -85,12 +85,14 @@ struct SessionResult {
     std::vector<sim::FrameRecord> frames;
     std::vector<sim::AccuracyRecord> accuracy;
     sim::Invariants invariants;
-    double simTime = 0;             ///< s
-    double wallTime = 0;            ///< s
-    double frameDt = 0;             ///< s, the scene's frame time step (real time: one frame per dt)
-    double maxNodeDisplacement = 0; ///< m, from the rest configuration, at the end
+    double simTime = 0;               ///< s
+    double wallTime = 0;              ///< s
+    double frameDt = 0;               ///< s, the scene's frame time step (real time: one frame per dt)
+    double maxNodeDisplacement = 0;   ///< m, largest node distance from the rest configuration over the run
+    double finalNodeDisplacement = 0; ///< m, the same at the end
     size_t nodes = 0, tets = 0;
     std::vector<std::string> errors;
+    std::vector<std::string> warnings;    ///< e.g. a device that drives no tool (also logged when given)
     std::optional<HapticsResult> haptics; ///< present when the session ran a device
     TaskMetrics metrics;
     std::vector<TraceRow> trace;                        ///< when RunOptions::keepTrace

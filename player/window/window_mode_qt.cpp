@@ -203,7 +203,9 @@ public:
             if (!s.toolActive[a]) continue;
             const double frac = std::clamp(s.force[a] / std::max(1e-9, s.maxForce_n), 0.0, 1.0);
             p.setPen(QColor(235, 235, 235));
-            p.drawText(px, y, QString::asprintf("%s force %.2f N", a == 0 ? "Left/1" : "Right/2", s.force[a]));
+            p.drawText(px, y,
+                       QString::asprintf("%s %s: force %.2f N", a == 0 ? "Left/1" : "Right/2", s.toolName[a].c_str(),
+                                         s.force[a]));
             y += 8;
             p.setPen(QColor(120, 120, 120));
             p.setBrush(QColor(50, 54, 60));

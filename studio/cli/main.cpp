@@ -28,8 +28,10 @@
 #include "bake/import.hpp"
 #include "bake/tetrahedralize.hpp"
 #include "bake/texture.hpp"
+#include "haptics/trajectory.hpp"
 #include "project/project.hpp"
 #include "sim/mesh/tet_io.hpp"
+#include "sim/suture/anastomosis.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/cli_main.hpp"
 #include "sim/util/error.hpp"
@@ -55,9 +57,41 @@ void usage(std::FILE* out) {
                "       viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M]\n"
                "                             [--facet-size M] [-o out.vtet]\n"
                "       viscera-studio texture <spec.json> -o <dir>\n"
+               "       viscera-studio replay <project-dir> -o <replay.csv> [--frames N]\n"
                "       viscera-studio --version\n",
                out);
 }
+
+constexpr const char* kExportHelp =
+    "usage: viscera-studio export <project-dir> -o <case.vcase> [--project-file <json>]\n"
+    "\n"
+    "Builds a case package from a project: meshes the bodies, cuts the fascia, bakes paint and\n"
+    "textures, writes scene.json and the manifest with only the features the scene needs. The\n"
+    "output is written atomically; its folder is checked before the work starts.\n"
+    "  --project-file <json>  read the project from this file instead of <project-dir>/project.json\n";
+constexpr const char* kImportHelp =
+    "usage: viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M]\n"
+    "                             [--facet-size M] [-o out.vtet]\n"
+    "\n"
+    "Reads a surface mesh (OBJ, STL, PLY, glTF/GLB through assimp), checks it, prints its size,\n"
+    "closedness and bounds; with --tetrahedralize meshes its volume (CGAL) and prints the quality.\n"
+    "  --scale S        metres per file unit (default 1)\n"
+    "  --cell-size M    largest tetrahedron size, m;  --facet-size M  largest surface facet, m\n"
+    "  -o out.vtet      write the tet mesh (needs --tetrahedralize)\n";
+constexpr const char* kOpenHelp = "usage: viscera-studio open <project-dir>\n"
+                                  "\n"
+                                  "Opens the desktop studio on a project (without a folder: an empty studio).\n";
+constexpr const char* kTextureHelp =
+    "usage: viscera-studio texture <spec.json> -o <dir>\n"
+    "\n"
+    "Generates a procedural tissue material from its spec (quadtree patterns, palette, layers):\n"
+    "diffuse, normal, roughness, height, metallic as the spec asks, PNG, into <dir>.\n";
+constexpr const char* kReplayHelp =
+    "usage: viscera-studio replay <project-dir> -o <replay.csv> [--frames N]\n"
+    "\n"
+    "Writes a console replay of a suturing project's recorded needle motion, through the\n"
+    "project's suture.device mapping, for viscera-player run --device replay:<replay.csv>.\n"
+    "  --frames N   only the first N frames (default: the whole trajectory)\n";
 
 double parsePositive(const std::string& flag, const std::string& v) {
     char* end = nullptr;
@@ -227,6 +261,62 @@ int cmdTexture(const std::vector<std::string>& args) {
     return 0;
 }
 
+/// A console replay (haptics trajectory) of a suturing project's recorded needle motion, through
+/// the inverse of the suture "device" mapping: the needle hand's master at (centre − start) /
+/// motion_scale with the needle's turn as its orientation, the other master lifted by pull /
+/// pull_scale. What `viscera-player run --device replay:<file>` plays back on the exported case.
+int cmdReplay(const std::vector<std::string>& args) {
+    const OperandArgs parsed = parseOperandArgs(args, {"--frames"});
+    const std::optional<std::string>& dir = parsed.operand;
+    const std::optional<std::string>& out = parsed.out;
+    if (!dir || !out) throw std::invalid_argument("replay needs <project-dir> and -o <replay.csv>");
+    long frames = 0;
+    if (const auto& v = parsed.extra[0]) {
+        char* end = nullptr;
+        frames = std::strtol(v->c_str(), &end, 10);
+        if (*end != '\0' || frames < 2 || frames > 100000)
+            throw std::invalid_argument("--frames '" + *v + "' must be an integer in [2, 100000]");
+    }
+    requireWritableFile(*out, "the replay");
+    const studio::Project project = studio::loadProject(*dir);
+    const std::string origin = (std::filesystem::path(*dir) / "project.json").string();
+    const auto& su = project.scene.suture;
+    if (!su) throw InputError(origin + ": suture: the project has no suture section to make a replay of");
+    if (!su->device.declared)
+        throw InputError(origin + ": suture.device: missing; the replay follows the device mapping it declares");
+    const std::vector<sim::NeedleFrame> traj = sim::parseTrajectory(su->trajectoryText, origin + ": suture.trajectory");
+    const size_t n = frames > 0 ? std::min<size_t>(static_cast<size_t>(frames), traj.size()) : traj.size();
+    const sim::NeedleDeviceDesc& d = su->device;
+    const int needleArm = d.hand == "left" ? 0 : 1, pullArm = 1 - needleArm;
+    const Eigen::Isometry3d& rest = traj.front().pose;
+    haptics::Trajectory replay;
+    const double dt = project.scene.xpbd.dt;
+    for (size_t f = 0; f < n; ++f) {
+        const sim::NeedleFrame& fr = traj[f];
+        haptics::TrajectorySample s;
+        s.t = double(f) * dt;
+        s.pose.position = (fr.pose.translation() - rest.translation()) / d.motionScale;
+        s.pose.orientation = Eigen::Quaterniond(rest.linear().transpose() * fr.pose.linear()).normalized();
+        s.grip = 0.3;
+        s.pedals = haptics::kPedalDeadman;
+        replay.add(needleArm, s);
+        haptics::TrajectorySample p;
+        p.t = s.t;
+        p.pose.position = sim::Vec3(0, 0, fr.pull / d.pullScale);
+        p.grip = 0.3;
+        p.pedals = haptics::kPedalDeadman;
+        replay.add(pullArm, p);
+    }
+    std::string text = replay.format();
+    text.insert(text.find('\n') + 1, "# " + project.caseId + ": the recorded needle trajectory, " + std::to_string(n) +
+                                         " frames at " + sim::formatNumber(dt) +
+                                         " s, through the case's suture.device mapping (viscera-studio replay)\n");
+    writeFileAtomic(*out, text);
+    std::printf("replay %s: %zu frames (%.2f s), needle on arm %d, thread pull on arm %d\n", out->c_str(), n,
+                double(n) * dt, needleArm, pullArm);
+    return 0;
+}
+
 int g_argc = 0;
 char** g_argv = nullptr;
 
@@ -244,7 +334,11 @@ int main(int argc, char** argv) {
     program.name = "viscera-studio";
     program.version = VISCERA_VERSION;
     program.usage = usage;
-    program.subcommands = {{"export", cmdExport}, {"import", cmdImport}, {"open", cmdOpen}, {"texture", cmdTexture}};
+    program.subcommands = {{"export", cmdExport, kExportHelp},
+                           {"import", cmdImport, kImportHelp},
+                           {"open", cmdOpen, kOpenHelp},
+                           {"texture", cmdTexture, kTextureHelp},
+                           {"replay", cmdReplay, kReplayHelp}};
     program.noArguments = [] { return studio::runStudio(g_argc, g_argv, {}); };
     return sim::runCli(program, argc, argv);
 }

@@ -464,7 +464,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     const json doc = sim::parseJsonText(text, origin);
     const JsonField root(doc, "", origin);
     root.object({"schemaVersion", "caseId", "caseVersion", "title", "instructions", "solver", "gravity", "bodies",
-                 "surfaces", "accuracy", "render", "suture", "interaction"});
+                 "surfaces", "accuracy", "render", "suture", "interaction", "tools"});
     Project p;
     p.dir = dir;
     p.schemaVersion = root["schemaVersion"].integer(1, 1);
@@ -523,6 +523,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
             if (auto t = sj.find("texture")) sp.texture = readTexture(*t, dir);
             p.surfaces.push_back(std::move(sp));
         }
+    if (auto t = root.find("tools")) scene.tools = sim::readTools(*t, names);
     if (auto in = root.find("interaction")) scene.interaction = readInteractionProject(*in, dir, p.trackFiles);
     // Cross-references (embedding cages, interaction names) are checked now, before any meshing.
     std::vector<const sim::BodyDesc*> bodies;
@@ -547,6 +548,7 @@ std::string projectJsonText(const Project& p) {
     sim::writeAccuracy(scene.accuracy, doc);
     if (scene.suture) doc["suture"] = sutureProjectJson(*scene.suture, p.trajectory, w);
     if (scene.interaction) doc["interaction"] = interactionProjectJson(*scene.interaction, p.trackFiles, w);
+    sim::writeTools(scene.tools, doc);
 
     doc["bodies"] = json::array();
     for (size_t i = 0; i < p.bodies.size(); ++i) {

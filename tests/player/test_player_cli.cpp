@@ -162,10 +162,15 @@ TEST(PlayerCli, RunWritesTheSessionReport) {
     EXPECT_GT(j["invariants"]["max_step_displacement_m"].get<double>(), 0.0);
     EXPECT_EQ(j["invariants"]["max_force_n"].get<double>(), 0.0);
     // The free end sags under gravity by a plausible amount (millimetres, not metres).
-    const double sag = j["metrics"]["max_node_displacement_m"].get<double>();
+    const double sag = j["metrics"]["final_node_displacement_m"].get<double>();
     EXPECT_GT(sag, 1e-4);
     EXPECT_LT(sag, 0.05);
+    EXPECT_GE(j["metrics"]["max_node_displacement_m"].get<double>(), sag) << "the largest is over the run";
+    EXPECT_EQ(j["schemaVersion"].get<int>(), 2);
     EXPECT_TRUE(j["errors"].empty());
+    EXPECT_TRUE(j["warnings"].empty());
+    EXPECT_THAT(r.out, HasSubstr("displacement  largest node distance from rest"));
+    EXPECT_THAT(r.out, HasSubstr("(elastic + kinetic + gravitational, measured from the rest pose)"));
 }
 
 TEST(PlayerCli, UnwritableOutputsAreRefusedBeforeTheFirstFrame) {
@@ -263,6 +268,41 @@ TEST(PlayerCli, UsageErrorsAreClear) {
     auto m = player({"verify", "/nonexistent/case.vcase"});
     EXPECT_EQ(m.exitCode, 1);
     EXPECT_THAT(m.err, HasSubstr("/nonexistent/case.vcase"));
+    // --help on every subcommand, anywhere after it: its own usage on stdout, exit 0, nothing run.
+    for (const auto& [args, line] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+             {{"run", "--help"}, "usage: viscera-player run <case.vcase> [options]"},
+             {{"run", "/nonexistent.vcase", "--headless", "-h"}, "--screenshot FILE.png"},
+             {{"verify", "--help"}, "usage: viscera-player verify <case.vcase>"}}) {
+        auto h = player(args);
+        EXPECT_EQ(h.exitCode, 0) << args[0];
+        EXPECT_THAT(h.out, HasSubstr(line));
+        EXPECT_TRUE(h.err.empty()) << h.err;
+    }
+    for (const auto& [sub, line] :
+         std::vector<std::pair<std::string, std::string>>{{"export", "usage: viscera-studio export"},
+                                                          {"import", "usage: viscera-studio import"},
+                                                          {"open", "usage: viscera-studio open"},
+                                                          {"texture", "usage: viscera-studio texture"},
+                                                          {"replay", "usage: viscera-studio replay"}}) {
+        auto h = test::runProcess(VISCERA_STUDIO_EXE, {sub, "--help"});
+        EXPECT_EQ(h.exitCode, 0) << sub;
+        EXPECT_THAT(h.out, HasSubstr(line));
+    }
+}
+
+TEST(PlayerCli, ADeviceThatDrivesNoToolIsWarnedAbout) {
+    ScratchDir dir;
+    const auto path = writeSlabCase(dir, "slab.vcase", {"gravity", "xpbd"});
+    const auto report = dir.path() / "report.json";
+    auto r = player(
+        {"run", path, "--headless", "--frames", "20", "--device", "scripted:press", "--report", report.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
+    EXPECT_THAT(r.err, HasSubstr("--device scripted:press: the case declares no tool a device can drive"));
+    EXPECT_THAT(r.out, HasSubstr("warning       --device scripted:press: the case declares no tool"));
+    const nlohmann::json j = readJson(report);
+    ASSERT_EQ(j["warnings"].size(), 1u);
+    EXPECT_TRUE(j["haptics"]["tools"].empty());
+    EXPECT_EQ(j["metrics"]["max_force_n"].get<double>(), 0.0);
 }
 
 TEST(StudioCli, ExportsAndThePlayerRunsTheSampleProject) {

@@ -63,6 +63,42 @@ TEST(RectumCase, ExportsRunsGraspsCutsAndClips) {
     EXPECT_LT(in["clips"][0]["max_contact_drift_m"].get<double>(), 5e-4);
     EXPECT_EQ(doc["metrics"]["clips"].get<int>(), 1);
     EXPECT_EQ(doc["metrics"]["cut_edges"].get<int>(), d["fascia_edges_cut"].get<int>());
+    // Scripted instruments count in the task metrics: each moved, the grasper felt the fascia.
+    const nlohmann::json& m = doc["metrics"];
+    EXPECT_EQ(m["tool_names"], nlohmann::json({"grasper", "hook", "clipper"}));
+    ASSERT_EQ(m["tool_path_length_per_tool_m"].size(), 3u);
+    for (size_t t = 0; t < 3; ++t)
+        EXPECT_GT(m["tool_path_length_per_tool_m"][t].get<double>(), 0.01) << t;
+    EXPECT_GT(m["max_contact_force_per_tool_n"][0].get<double>(), 0.0);
+    EXPECT_GT(m["tool_path_length_m"].get<double>(), 0.05);
+    EXPECT_EQ(doc["schemaVersion"].get<int>(), 2);
+
+    // The committed console replay drives the three instruments from two masters: the left
+    // grasps and lifts, the right cuts with the pedal held, hands its arm to the clip applier
+    // with its button and fires a clip with the grip; forces go back through the safety filter.
+    const auto replayReport = dir.path() / "replay.json";
+    auto rr = player({"run", out.string(), "--headless", "--frames", "290", "--device",
+                      "replay:" + std::string(VISCERA_SOURCE_DIR) + "/projects/rectum/replays/dissection.csv",
+                      "--report", replayReport.string()});
+    ASSERT_EQ(rr.exitCode, 0) << rr.err << rr.out;
+    const nlohmann::json rd = readJson(replayReport);
+    EXPECT_TRUE(rd["invariants"]["all_finite"].get<bool>());
+    EXPECT_TRUE(rd["warnings"].empty()) << rd["warnings"].dump();
+    const nlohmann::json& tools = rd["haptics"]["tools"];
+    ASSERT_EQ(tools.size(), 3u);
+    EXPECT_EQ(tools[0]["name"], "grasper");
+    EXPECT_EQ(tools[0]["arm"].get<int>(), 0);
+    EXPECT_EQ(tools[1]["arm"].get<int>(), 1);
+    EXPECT_EQ(tools[2]["arm"].get<int>(), 1) << "hook and clip applier share the right master";
+    EXPECT_GT(tools[2]["driven_time_s"].get<double>(), 1.0) << "the button handed the arm to the clip applier";
+    EXPECT_LT(tools[1]["driven_time_s"].get<double>(), 4.0);
+    EXPECT_EQ(rd["interaction"]["grasps"].get<int>(), 1);
+    EXPECT_GT(rd["interaction"]["dissection"]["fascia_edges_cut"].get<int>(), 20) << "the pedal energized the hook";
+    ASSERT_EQ(rd["interaction"]["clips"].size(), 1u) << "the squeezed grip fired the clip";
+    for (size_t t = 0; t < 3; ++t)
+        EXPECT_GT(rd["metrics"]["tool_path_length_per_tool_m"][t].get<double>(), 0.01) << t;
+    EXPECT_GT(rd["metrics"]["max_force_n"].get<double>(), 0.0) << "force reached the device";
+    EXPECT_LE(rd["metrics"]["max_force_n"].get<double>(), rd["haptics"]["case_max_force_n"].get<double>() + 1e-9);
 }
 
 TEST(RectumCase, BrokenTracksAndSectionsAreRejectedAtExport) {

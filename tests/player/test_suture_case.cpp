@@ -106,3 +106,51 @@ TEST(SutureCase, BrokenSutureSectionsAreRejectedAtExport) {
     EXPECT_EQ(d.exitCode, 1);
     EXPECT_THAT(d.err, HasSubstr("solver 'fem' needs a 'suture' section"));
 }
+
+// A device drives the needle (suture "device"): the replay made by `viscera-studio replay` from
+// the recorded trajectory punctures as the trajectory does; a scripted wrist roll drives the
+// needle along its curve into the wall; the tissue's force reaches the device.
+TEST(SutureCase, ADeviceDrivesTheNeedle) {
+    ScratchDir dir;
+    const std::string project = std::string(VISCERA_SOURCE_DIR) + "/projects/anastomosis";
+    const auto out = dir.path() / "anastomosis.vcase";
+    ASSERT_EQ(studio({"export", project, "-o", out.string()}).exitCode, 0);
+    const auto made = dir.path() / "made.csv";
+    auto m = studio({"replay", project, "-o", made.string(), "--frames", "160"});
+    ASSERT_EQ(m.exitCode, 0) << m.err;
+    EXPECT_THAT(m.out, HasSubstr("160 frames"));
+    std::ifstream a(made), b(project + "/replays/two-stitches.csv");
+    const std::string madeText((std::istreambuf_iterator<char>(a)), {}), kept((std::istreambuf_iterator<char>(b)), {});
+    EXPECT_EQ(madeText, kept) << "the committed replay is what `viscera-studio replay` makes";
+
+    const auto scripted = dir.path() / "s.json";
+    ASSERT_EQ(player({"run", out.string(), "--headless", "--frames", "160", "--report", scripted.string()}).exitCode,
+              0);
+    const int trackPunctures = readJson(scripted)["suture"]["punctures"].get<int>();
+    const auto replayed = dir.path() / "r.json";
+    auto r = player({"run", out.string(), "--headless", "--frames", "160", "--device", "replay:" + made.string(),
+                     "--report", replayed.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
+    const nlohmann::json rd = readJson(replayed);
+    EXPECT_EQ(rd["suture"]["punctures"].get<int>(), trackPunctures);
+    EXPECT_GT(trackPunctures, 0);
+    EXPECT_GT(rd["metrics"]["max_force_n"].get<double>(), 0.0);
+    EXPECT_EQ(rd["haptics"]["tools"][0]["name"], "needle");
+    EXPECT_EQ(rd["haptics"]["tools"][1]["name"], "thread");
+
+    const auto rolled = dir.path() / "roll.json";
+    auto rl = player({"run", out.string(), "--headless", "--frames", "120", "--device", "scripted:roll", "--report",
+                      rolled.string()});
+    ASSERT_EQ(rl.exitCode, 0) << rl.err << rl.out;
+    EXPECT_THAT(rl.err, HasSubstr("tool 'thread' has no arm of this device")) << "one-arm script: warned";
+    const nlohmann::json ro = readJson(rolled);
+    EXPECT_GT(ro["suture"]["punctures"].get<int>(), 0) << "the roll drove the needle into the wall";
+    EXPECT_GT(ro["metrics"]["max_force_n"].get<double>(), 0.0);
+    EXPECT_TRUE(ro["invariants"]["all_finite"].get<bool>());
+    EXPECT_EQ(ro["warnings"].size(), 1u);
+
+    auto bad = studio(
+        {"replay", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab", "-o", (dir.path() / "x.csv").string()});
+    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_THAT(bad.err, HasSubstr("suture: the project has no suture section"));
+}

@@ -148,6 +148,7 @@ void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& too
     m_contactDirty = true;
     if (x.size() != m_rest.size() || !(h > 0)) return;
     m_alphaTilde = m_settings.compliance / (h * h);
+    m_h = h;
     m_start = x;
     const bool polygon =
         m_settings.method == CollisionMethod::Polygon || m_settings.method == CollisionMethod::PolygonFeatures;
@@ -428,6 +429,21 @@ int CollisionSolver::iterate(XpbdParticles& particles, size_t offset, const Tool
         for (int32_t v : m_candVerts)
             if (particles.inverseMass(offset + v) != 0) particles.setPosition(offset + v, m_x[v]);
     return contacts;
+}
+
+Vec3 CollisionSolver::contactForce() const {
+    Vec3 f = Vec3::Zero();
+    if (!(m_h > 0) || m_push.size() != m_w.size() || m_touched.size() != m_w.size()) return f;
+    auto add = [&](size_t v) {
+        if (m_touched[v] && m_w[v] > 0) f += m_push[v] / m_w[v];
+    };
+    if (m_viewValid) // particle-view step: only the candidates' vertices can have moved
+        for (int32_t v : m_candVerts)
+            add(static_cast<size_t>(v));
+    else
+        for (size_t v = 0; v < m_push.size(); ++v)
+            add(v);
+    return f / (m_h * m_h);
 }
 
 int CollisionSolver::endStep(XpbdParticles& particles, size_t offset) {

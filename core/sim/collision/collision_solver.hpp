@@ -143,6 +143,10 @@ public:
     int endStep(XpbdParticles& particles, size_t offset);
 
     const CollisionStats& stats() const { return m_stats; }
+    /// N: the force the contacts of the current step put on the tissue, Σ_v m_v Δx_v / h² over
+    /// the vertices they moved (Δx_v: the vertex's total contact push of the step, m_v = 1/w_v;
+    /// fixed vertices excluded). The tool feels its negative. Zero before the first step.
+    Vec3 contactForce() const;
     /// Vertices of the triangles in contact during the current step (any sweep), ascending.
     const std::vector<int32_t>& contactVertices() const;
     const CollisionSettings& settings() const { return m_settings; }
@@ -197,6 +201,7 @@ private:
     mutable std::vector<int32_t> m_contactVerts;
     mutable bool m_contactDirty = false;
     double m_alphaTilde = 0;
+    double m_h = 0; ///< s, length of the current step
     CollisionStats m_stats;
 };
 

@@ -90,7 +90,20 @@ std::vector<Vec3> FemSceneSolver::gaugePositions() const {
 }
 
 StepStats FemSceneSolver::step(const FrameClock& clock) {
-    NeedleFrame frame = m_trajectory[std::min<size_t>(static_cast<size_t>(clock.frame), m_trajectory.size() - 1)];
+    NeedleFrame frame;
+    if (m_drive) {
+        frame = *m_drive;
+        const Eigen::Isometry3d& now = m_suture->needlePose();
+        if (frame.pose.matrix().allFinite()) {
+            Vec3 move = frame.pose.translation() - now.translation();
+            if (move.norm() > kMaxDrivenMove) move *= kMaxDrivenMove / move.norm();
+            Eigen::AngleAxisd turn(frame.pose.linear() * now.linear().transpose());
+            turn.angle() = std::min(turn.angle(), kMaxDrivenTurnDeg * M_PI / 180.0);
+            frame.pose.linear() = turn.toRotationMatrix() * now.linear();
+            frame.pose.translation() = now.translation() + move;
+        }
+    } else
+        frame = m_trajectory[std::min<size_t>(static_cast<size_t>(clock.frame), m_trajectory.size() - 1)];
     if (!m_thread) frame.pull = 0;
     m_last = m_suture->step(frame);
     StepStats rec;

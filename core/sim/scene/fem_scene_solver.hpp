@@ -9,10 +9,11 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 
 namespace viscera::sim {
 
-class FemSceneSolver final : public SceneSolver, public SutureReport {
+class FemSceneSolver final : public SceneSolver, public SutureReport, public NeedleDrive {
 public:
     /// Throws viscera::InputError naming in.origin ("<origin>: scene: solver 'fem': <rule>", or
     /// "... cannot be simulated stably: ..." for a mesh the FEM refuses).
@@ -33,6 +34,16 @@ public:
     const std::vector<Vec3>& surfaceVelocities(size_t s) const override;
     void setSurfaceState(size_t s, const std::vector<Vec3>& x, const std::vector<Vec3>& v) override;
     const SutureReport* suture() const override { return this; }
+    NeedleDrive* needleDrive() override { return this; }
+    const NeedleDrive* needleDrive() const override { return this; }
+    NeedleFrame restFrame() const override { return m_trajectory.front(); }
+    /// The step moves the needle at most kMaxDrivenMove and kMaxDrivenTurnDeg per frame towards
+    /// the frame's pose (a jump of the master drags the tissue over several frames, not one).
+    void drive(const NeedleFrame& frame) override { m_drive = frame; }
+    static constexpr double kMaxDrivenMove = 0.0005; ///< m per frame
+    static constexpr double kMaxDrivenTurnDeg = 4.0; ///< degrees per frame
+    Vec3 needleForce() const override { return m_last.needleForceVector; }
+    double threadTension() const override { return m_last.threadTension; }
 
     const std::vector<SutureFrameRecord>& frames() const override { return m_frames; }
     SutureSummary summary() const override;
@@ -50,7 +61,8 @@ private:
     std::unique_ptr<TetMesh> m_gaugeMesh;   ///< the two gauged bodies, merged
     std::unique_ptr<ClosureGauge> m_gauge;
     std::array<size_t, 2> m_gaugeBodies{};
-    SutureStepStats m_last; ///< of the last step()
+    SutureStepStats m_last;             ///< of the last step()
+    std::optional<NeedleFrame> m_drive; ///< a device's frame, instead of the trajectory's
     std::vector<SutureFrameRecord> m_frames;
     double m_initialGap = 0, m_sampledPenetration = 0;
 };

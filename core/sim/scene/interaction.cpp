@@ -41,7 +41,7 @@ InteractionDesc readInteractionSection(const JsonField& doc) {
     }
     std::set<std::string> names;
     for (const JsonField& j : doc["instruments"].items(1, 8)) {
-        j.object({"name", "kind", "track", "radius", "jaw_length", "temperature_c", "target"});
+        j.object({"name", "kind", "track", "radius", "jaw_length", "temperature_c", "target", "device"});
         InstrumentDesc in;
         in.name = readName(j["name"], names); // it names the track file of the case
         const std::string kind = j["kind"].choice({"grasper", "energy_hook", "clip_applier"}, "an instrument");
@@ -61,6 +61,13 @@ InteractionDesc readInteractionSection(const JsonField& doc) {
             in.target = j["target"].nonEmptyString();
         else if (j.has("target"))
             j.failAt("target", "only a clip_applier has a target");
+        if (auto dev = j.find("device")) {
+            dev->object({"hand", "motion_scale", "force_scale", "max_force_n", "damage_force_n", "grip_open_rad"});
+            InstrumentDeviceDesc& dd = in.device;
+            readDeviceMapping(*dev, dd);
+            dd.damageForceN = dev->number("damage_force_n", dd.damageForceN, NumberRule::aboveUpTo(0, 1000.0));
+            dd.gripOpenRad = dev->number("grip_open_rad", dd.gripOpenRad, NumberRule::closed(0.05, M_PI));
+        }
         d.instruments.push_back(std::move(in));
     }
     if (auto t = doc.find("tissues")) {
@@ -117,6 +124,12 @@ json interactionJson(const InteractionDesc& d) {
                   {"jaw_length", in.jawLength}};
         if (in.kind == InstrumentDesc::Kind::EnergyHook) j["temperature_c"] = in.temperatureC;
         if (in.kind == InstrumentDesc::Kind::ClipApplier) j["target"] = in.target;
+        if (in.device.declared) {
+            const InstrumentDeviceDesc& dd = in.device;
+            writeDeviceMapping(dd, j["device"]);
+            j["device"]["damage_force_n"] = dd.damageForceN;
+            j["device"]["grip_open_rad"] = dd.gripOpenRad;
+        }
         doc["instruments"].push_back(j);
     }
     if (!d.tissues.empty()) {

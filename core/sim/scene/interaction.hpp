@@ -15,12 +15,22 @@
 ///   "tissues": [{"layer": "fascia", "ignition_c": 160, "conductivity": 0.4,
 ///                "shrink": [0.1, 0.3, 1.0]}]                         what the energy hook can cut
 /// }
+/// An instrument may also name the master that drives it when the player runs with a device:
+///   "device": {"hand": "left", "motion_scale": 0.25, "force_scale": 1.0, "max_force_n": 15,
+///              "damage_force_n": 4, "grip_open_rad": 1.0}                 all optional
+/// With a device the master places the tip (its workspace centre at the track's first key, its
+/// orientation turning the track's first direction), the grip sets the jaws (jaw = grip /
+/// grip_open_rad), the energy pedals (cut or coag) energize a hook and a fully closed grip
+/// (jaw < 0.2) fires a clip; the contact force goes back to the master. Several instruments on
+/// one hand: the arm's first button hands the arm to the next one (the others wait at their
+/// track's first key). Without a device every instrument follows its track.
 /// Tracks are files inside the case (instrument_track.hpp). An instrument's tip is the track's
 /// position; its shaft points along the track's direction. Grasper: jaws (two capsules) that
 /// hold the surface vertices between them while closed (jaw < 0.5). Energy hook: a capsule whose
 /// tip sphere is the heat source while act = 1. Clip applier: fires a clip onto `target` at the
 /// first key with act = 1; the clip then follows the vessel [A §5.4].
 /// Units SI; temperatures °C. Parsing is strict; errors name the origin, the field and the rule.
+#include "sim/scene/device_mapping.hpp"
 #include "sim/scene/instrument_track.hpp"
 
 #include <string>
@@ -28,6 +38,12 @@
 #include <vector>
 
 namespace viscera::sim {
+
+/// How a haptic master drives an instrument (scene "device" of an instrument; see above).
+struct InstrumentDeviceDesc : DeviceMapping {
+    double damageForceN = 4.0; ///< N, contact force above which tissue is damaged (session metric)
+    double gripOpenRad = 1.0;  ///< rad: the grip angle at which the jaws are fully open
+};
 
 struct InstrumentDesc {
     enum class Kind { Grasper, EnergyHook, ClipApplier };
@@ -39,6 +55,7 @@ struct InstrumentDesc {
     double jawLength = 0.012;  ///< m: grasper and clip jaws
     double temperatureC = 170; ///< energy hook
     std::string target;        ///< clip applier: the tet body (vessel) it clips
+    InstrumentDeviceDesc device;
 };
 
 struct DissectionTissueDesc {

@@ -63,6 +63,13 @@ struct InteractionRuntime::Instrument {
     size_t target = 0; ///< tet body it clips
     bool fired = false;
     int contacts = 0;
+    // device drive
+    bool driven = false;
+    InstrumentKey drive;
+    Vec3 holdImpulse = Vec3::Zero(); ///< kg·m: Σ m Δx of the grasp hold in the current substep
+    Vec3 forceSum = Vec3::Zero();    ///< N, on the tissue, summed over the frame's substeps
+    int forceSubsteps = 0;
+    Vec3 force = Vec3::Zero(); ///< N, on the instrument, last frame
 };
 
 struct InteractionRuntime::Clip {
@@ -201,7 +208,19 @@ void InteractionRuntime::beforeStep(double t, double dt) {
     hi.array() += grow;
     for (auto& inp : m_instruments) {
         Instrument& in = *inp;
-        in.key = in.track.sample(t);
+        if (in.driven) {
+            // The master's pose, the tip's move capped per frame.
+            InstrumentKey k = in.drive;
+            const Vec3 step = k.position - in.key.position;
+            if (step.norm() > kMaxDrivenMovePerFrame)
+                k.position = in.key.position + kMaxDrivenMovePerFrame * step.normalized();
+            k.t = t;
+            in.key = k;
+        } else
+            in.key = in.track.sample(t);
+        in.forceSum = Vec3::Zero();
+        in.forceSubsteps = 0;
+        in.holdImpulse = Vec3::Zero();
         const Vec3 dir = in.key.direction;
         if (in.shape) {
             // Jaws and the hook's shaft end at the track's tip: the frame origin sits one jaw
@@ -315,11 +334,23 @@ void InteractionRuntime::runHook(XpbdParticles& particles, const XpbdIterationIn
     for (auto& inp : m_instruments) {
         Instrument& in = *inp;
         if (in.collision && in.colliding) in.hook(particles, info);
+        if (info.velocityPass) { // the substep's force on the tissue: contacts and grasp hold
+            Vec3 f = in.collision && in.colliding ? in.collision->contactForce() : Vec3::Zero();
+            if (info.h > 0) f += in.holdImpulse / (info.h * info.h);
+            in.holdImpulse = Vec3::Zero();
+            in.forceSum += f;
+            ++in.forceSubsteps;
+            continue;
+        }
         if (in.holding)
             for (size_t k = 0; k < in.held.size(); ++k) {
                 const size_t p = m_particleOffset + static_cast<size_t>(in.held[k]);
-                if (p < particles.size() && particles.inverseMass(p) > 0)
-                    particles.setPosition(p, in.pose * in.heldLocal[k]);
+                if (p >= particles.size()) continue;
+                const double w = particles.inverseMass(p);
+                if (!(w > 0)) continue;
+                const Vec3 target = in.pose * in.heldLocal[k];
+                in.holdImpulse += (target - particles.position(p)) / w;
+                particles.setPosition(p, target);
             }
     }
 }
@@ -329,7 +360,9 @@ void InteractionRuntime::afterStep() {
     m_summary.instruments.clear();
     int contacts = 0;
     for (auto& inp : m_instruments) {
-        const Instrument& in = *inp;
+        Instrument& in = *inp;
+        in.force = in.forceSubsteps > 0 ? Vec3(-in.forceSum / in.forceSubsteps) : Vec3::Zero();
+        if (!in.force.allFinite()) in.force = Vec3::Zero();
         InstrumentState s;
         s.name = in.desc.name;
         s.kind = kindName(in.desc.kind);
@@ -339,6 +372,8 @@ void InteractionRuntime::afterStep() {
         s.act = in.key.act;
         s.contacts = in.collision && in.colliding ? in.collision->stats().contacts : 0;
         s.grasped = static_cast<int>(in.held.size());
+        s.force = in.force;
+        s.driven = in.driven;
         contacts += s.contacts;
         m_summary.instruments.push_back(s);
     }
@@ -357,6 +392,35 @@ void InteractionRuntime::afterStep() {
         m_summary.clips.push_back(c->state);
     }
     m_summary.clipMs += msSince(t0);
+}
+
+const InstrumentDesc& InteractionRuntime::instrumentDesc(size_t i) const {
+    return m_instruments.at(i)->desc;
+}
+
+InstrumentKey InteractionRuntime::restKey(size_t i) const {
+    const InstrumentTrack& tr = m_instruments.at(i)->track;
+    return tr.keys().empty() ? InstrumentKey{} : tr.keys().front();
+}
+
+void InteractionRuntime::drive(size_t i, const InstrumentKey& key) {
+    if (i >= m_instruments.size()) return;
+    if (!key.position.allFinite() || !key.direction.allFinite() || !(key.direction.norm() > 1e-9) ||
+        !std::isfinite(key.jaw))
+        return;
+    Instrument& in = *m_instruments[i];
+    in.driven = true;
+    in.drive = key;
+    in.drive.direction.normalize();
+    in.drive.jaw = std::clamp(key.jaw, 0.0, 1.0);
+}
+
+void InteractionRuntime::release(size_t i) {
+    if (i < m_instruments.size()) m_instruments[i]->driven = false;
+}
+
+Vec3 InteractionRuntime::instrumentForce(size_t i) const {
+    return i < m_instruments.size() ? m_instruments[i]->force : Vec3::Zero();
 }
 
 void InteractionRuntime::surfaceFaceMaskInto(size_t s, std::vector<uint8_t>& out) const {

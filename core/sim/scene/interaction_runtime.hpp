@@ -36,8 +36,10 @@ struct InstrumentState {
     Vec3 direction = -Vec3::UnitZ();
     double jaw = 1;
     bool act = false;
-    int contacts = 0; ///< collision projections in the last sweep of the frame
-    int grasped = 0;  ///< vertices held
+    int contacts = 0;          ///< collision projections in the last sweep of the frame
+    int grasped = 0;           ///< vertices held
+    Vec3 force = Vec3::Zero(); ///< N, on the instrument from the tissue, mean over the frame's substeps
+    bool driven = false;       ///< a device drove it this frame (else its track)
 };
 
 struct ClipState {
@@ -84,6 +86,23 @@ public:
     void afterStep();
 
     const InteractionSummary& summary() const { return m_summary; }
+
+    // ---- instruments driven by a device (InstrumentDesc::device) --------------------------------
+    size_t instrumentCount() const { return m_instruments.size(); }
+    const InstrumentDesc& instrumentDesc(size_t i) const;
+    /// The first key of instrument i's track: where a driven instrument's master has its
+    /// workspace centre, and where an instrument waits while no arm drives it.
+    InstrumentKey restKey(size_t i) const;
+    /// From the next beforeStep on, instrument i takes `key` (position, direction, jaw, act; t is
+    /// ignored) instead of its track, until release(i). A key with a non-finite value is
+    /// ignored; the tip moves at most kMaxDrivenMovePerFrame per frame towards it (no tunnelling
+    /// through the fascia on a jump of the master).
+    void drive(size_t i, const InstrumentKey& key);
+    void release(size_t i);
+    /// N: force on instrument i from the tissue over the last frame (mean over its substeps of the
+    /// contact pushes and the grasp hold, InstrumentState::force).
+    Vec3 instrumentForce(size_t i) const;
+    static constexpr double kMaxDrivenMovePerFrame = 0.003; ///< m
     /// Render mask of surface s: 1 per intact triangle (empty: no dissection on that surface).
     void surfaceFaceMaskInto(size_t s, std::vector<uint8_t>& out) const;
     bool dissects() const { return m_dissection != nullptr; }

@@ -50,6 +50,8 @@ json strainLimitsJson(const TetStrainLimits& s) {
             {"limits", lim}};
 }
 
+} // namespace
+
 std::vector<ToolDesc> readTools(const JsonField& tools, std::set<std::string>& names) {
     std::vector<ToolDesc> out;
     const std::vector<JsonField> list = tools.items();
@@ -73,7 +75,34 @@ std::vector<ToolDesc> readTools(const JsonField& tools, std::set<std::string>& n
     return out;
 }
 
-} // namespace
+void readDeviceMapping(const JsonField& dev, DeviceMapping& out) {
+    out.declared = true;
+    if (auto hand = dev.find("hand")) out.hand = hand->choice({"left", "right", "any"}, "a hand");
+    out.motionScale = dev.number("motion_scale", out.motionScale, NumberRule::aboveUpTo(0, 10.0));
+    out.forceScale = dev.number("force_scale", out.forceScale, NumberRule::aboveUpTo(0, 100.0));
+    out.maxForceN = dev.number("max_force_n", out.maxForceN, NumberRule::aboveUpTo(0, 50.0));
+}
+
+void writeDeviceMapping(const DeviceMapping& m, json& device) {
+    device["hand"] = m.hand;
+    device["motion_scale"] = m.motionScale;
+    device["force_scale"] = m.forceScale;
+    device["max_force_n"] = m.maxForceN;
+}
+
+void writeTools(const std::vector<ToolDesc>& tools, json& doc) {
+    for (const ToolDesc& t : tools)
+        doc["tools"].push_back({{"name", t.name},
+                                {"shape", "sphere"},
+                                {"radius", t.radius},
+                                {"hand", t.hand},
+                                {"start", {t.start.x(), t.start.y(), t.start.z()}},
+                                {"motion_scale", t.motionScale},
+                                {"force_scale", t.forceScale},
+                                {"stiffness", t.stiffness},
+                                {"max_force_n", t.maxForceN},
+                                {"damage_force_n", t.damageForceN}});
+}
 
 void readSolver(const JsonField& doc, SceneDesc& scene) {
     using L = XpbdLimits;
@@ -290,17 +319,7 @@ json sceneJson(const SceneDesc& scene) {
             doc["surfaces"].push_back(j);
         }
     }
-    for (const ToolDesc& t : scene.tools)
-        doc["tools"].push_back({{"name", t.name},
-                                {"shape", "sphere"},
-                                {"radius", t.radius},
-                                {"hand", t.hand},
-                                {"start", {t.start.x(), t.start.y(), t.start.z()}},
-                                {"motion_scale", t.motionScale},
-                                {"force_scale", t.forceScale},
-                                {"stiffness", t.stiffness},
-                                {"max_force_n", t.maxForceN},
-                                {"damage_force_n", t.damageForceN}});
+    writeTools(scene.tools, doc);
     return doc;
 }
 

@@ -27,6 +27,15 @@ void writeAccuracy(const std::optional<AccuracySampling>& accuracy, nlohmann::js
 /// The name rule of bodies, surfaces and tools: 1–64 characters of [A-Za-z0-9_-] (it names the
 /// files of the case), unique among all of them (`names`).
 std::string readName(const JsonField& name, std::set<std::string>& names);
+/// The common fields of a "device" block (hand, motion_scale, force_scale, max_force_n); marks it
+/// declared. The caller checks the block's key set.
+void readDeviceMapping(const JsonField& device, DeviceMapping& out);
+/// Writes those fields into the block `device`.
+void writeDeviceMapping(const DeviceMapping& mapping, nlohmann::json& device);
+/// "tools" (haptic sphere probes, tool_probe.hpp; at most 2), names unique with the others.
+std::vector<ToolDesc> readTools(const JsonField& tools, std::set<std::string>& names);
+/// Writes "tools" into `doc` when there are any.
+void writeTools(const std::vector<ToolDesc>& tools, nlohmann::json& doc);
 /// The body fields both files carry: name, material, strain_limits, embedded_in,
 /// embedding_compliance (the caller checks the object's key set).
 void readBodyCommon(const JsonField& body, BodyDesc& out, std::set<std::string>& names);

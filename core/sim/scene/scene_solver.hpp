@@ -65,6 +65,23 @@ protected:
     ~SutureReport() = default;
 };
 
+/// A suturing solver's needle as a device drives it (suture "device").
+class NeedleDrive {
+public:
+    /// The first frame of the recorded trajectory: where the needle starts.
+    virtual NeedleFrame restFrame() const = 0;
+    /// From the next step on the needle takes `frame` instead of the recorded trajectory (a
+    /// non-finite pose or pull is ignored by the step).
+    virtual void drive(const NeedleFrame& frame) = 0;
+    /// N: the tissue's force on the needle after the last step.
+    virtual Vec3 needleForce() const = 0;
+    /// N: the thread tension after the last step.
+    virtual double threadTension() const = 0;
+
+protected:
+    ~NeedleDrive() = default;
+};
+
 /// Where a step stands in time.
 struct FrameClock {
     int frame = 0;   ///< index of the frame being stepped, from 0
@@ -116,8 +133,13 @@ public:
 
     /// The scripted instruments (scene "interaction"), null when the scene has none.
     virtual const InteractionRuntime* interaction() const { return nullptr; }
+    /// The same, to drive instruments between frames (a device).
+    virtual InteractionRuntime* mutableInteraction() { return nullptr; }
     /// Suturing figures, null unless the back-end sutures.
     virtual const SutureReport* suture() const { return nullptr; }
+    /// The needle of a suturing solver, to drive it from a device; null otherwise.
+    virtual NeedleDrive* needleDrive() { return nullptr; }
+    virtual const NeedleDrive* needleDrive() const { return nullptr; }
 };
 
 /// The back-end of scene.solverType ("fem": FemSceneSolver, otherwise XpbdSceneSolver). Throws

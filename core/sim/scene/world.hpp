@@ -84,11 +84,18 @@ public:
     // ---- scripted instruments (scene "interaction"; features collision, dissection, clip) --------
     /// Null unless the scene has an interaction section.
     const InteractionRuntime* interaction() const { return m_solver->interaction(); }
+    /// The same, to drive instruments between frames (InteractionRuntime::drive).
+    InteractionRuntime* interaction() { return m_solver->mutableInteraction(); }
 
     // ---- suturing (solver "fem"; features fem, needle, thread, contact) ---------------------------
     /// Only a "fem" scene creates the suturing simulation; the needle follows the case's recorded
     /// trajectory, one frame per step (the last frame is held after the end).
     bool hasSuture() const { return m_solver->suture() != nullptr; }
+    /// The needle of a suturing scene, for a device to drive (suture "device"); null otherwise.
+    NeedleDrive* needleDrive() { return m_solver->needleDrive(); }
+    const NeedleDrive* needleDrive() const { return m_solver->needleDrive(); }
+    /// The scene the world was assembled from.
+    const SceneDesc& scene() const { return m_scene; }
     /// One record per step of a "fem" scene; empty otherwise.
     const std::vector<SutureFrameRecord>& sutureFrames() const;
     /// Figures so far; the closure gauge is evaluated on the current state (O(facing × tets)).

@@ -42,6 +42,7 @@ public:
     const std::vector<Vec3>& surfaceVelocities(size_t s) const override;
     void setSurfaceState(size_t s, const std::vector<Vec3>& x, const std::vector<Vec3>& v) override;
     const InteractionRuntime* interaction() const override { return m_interaction.get(); }
+    InteractionRuntime* mutableInteraction() override { return m_interaction.get(); }
     /// Per tet body: the extra inertia selective inertia scaling gave its nodes at load, kg (0 when
     /// none; XpbdSettings::inertiaScaling).
     const std::vector<double>& addedInertia() const { return m_addedInertia; }

@@ -10,7 +10,7 @@ namespace viscera::sim {
 using nlohmann::json;
 
 SutureSceneDesc readSutureSection(const JsonField& doc, bool readTrajectory) {
-    doc.object({"needle", "thread", "contact", "trajectory", "gauge"});
+    doc.object({"needle", "thread", "contact", "trajectory", "gauge", "device"});
     SutureSceneDesc d;
     SutureSettings& s = d.settings;
     const JsonField n = doc["needle"];
@@ -48,6 +48,12 @@ SutureSceneDesc readSutureSection(const JsonField& doc, bool readTrajectory) {
         d.gauge = {pair[0].nonEmptyString(), pair[1].nonEmptyString()};
         if (d.gauge[0] == d.gauge[1]) g->fail("must name two different bodies");
     }
+    if (auto dev = doc.find("device")) {
+        dev->object({"hand", "motion_scale", "force_scale", "max_force_n", "pull_scale"});
+        NeedleDeviceDesc& nd = d.device;
+        readDeviceMapping(*dev, nd);
+        nd.pullScale = dev->number("pull_scale", nd.pullScale, NumberRule::aboveUpTo(0, 10.0));
+    }
     if (auto why = validate(s); !why.empty()) n.fail(why);
     return d;
 }
@@ -72,6 +78,10 @@ json sutureJson(const SutureSceneDesc& d) {
                           {"max", s.maxContacts}};
     doc["trajectory"] = d.trajectoryPath;
     if (!d.gauge[0].empty()) doc["gauge"] = {d.gauge[0], d.gauge[1]};
+    if (d.device.declared) {
+        writeDeviceMapping(d.device, doc["device"]);
+        doc["device"]["pull_scale"] = d.device.pullScale;
+    }
     return doc;
 }
 

@@ -12,6 +12,7 @@
 ///   "gauge": ["wide", "narrow"]            optional: closure gap/penetration between two bodies
 /// }
 /// Units SI (metres, newtons). Parsing is strict; errors name the origin, the field and the rule.
+#include "sim/scene/device_mapping.hpp"
 #include "sim/suture/suture_sim.hpp"
 
 #include <array>
@@ -20,6 +21,20 @@
 
 namespace viscera::sim {
 
+/// suture "device" (optional): a haptic master drives the needle holder when the player runs with
+/// a device. {"hand": "right", "motion_scale": 0.25, "force_scale": 1.0, "max_force_n": 15,
+/// "pull_scale": 0.1}: the master moves the needle's centre from where the recorded trajectory
+/// starts (motion_scale scene metres per device metre) and turns it about that centre by the
+/// master's orientation taken in the needle's own frame (a roll about the master's z turns the
+/// needle about its axis and so drives it along its curve); the other
+/// master's lift above its workspace centre pulls the thread (pull = pull_scale × lift, never
+/// given back). The tissue's force on the needle goes back to the needle hand, the thread
+/// tension to the other.
+struct NeedleDeviceDesc : DeviceMapping {
+    NeedleDeviceDesc() { hand = "right"; }
+    double pullScale = 0.1; ///< thread metres per device metre of lift
+};
+
 struct SutureSceneDesc {
     SutureSettings settings;          ///< fem.youngsModulus / poissonRatio come from the bodies' material
     bool thread = false;              ///< "thread" present: pulls in the trajectory are applied
@@ -27,6 +42,7 @@ struct SutureSceneDesc {
     std::string trajectoryPath;       ///< file inside the case
     std::string trajectoryText;       ///< its contents, filled by whoever reads the case (not serialized)
     std::array<std::string, 2> gauge; ///< body names; empty = no closure figures
+    NeedleDeviceDesc device;
 };
 
 /// Read and written by readSutureSection / sutureJson (sim/scene/scene_json.hpp).

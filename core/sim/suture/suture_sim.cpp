@@ -471,6 +471,7 @@ void SutureSimulation::readForces(SutureStepStats& st) {
         st.tipAxialForce = f.dot(curve().tangent(m_s.needle.length_()));
     }
     st.needleForce = total.norm();
+    st.needleForceVector = -total;
     double tension = 0;
     for (int id : m_pullIds)
         if (m_fem->hasConstraint(id) && m_fem->state(id).active && !m_fem->state(id).lambda.empty())

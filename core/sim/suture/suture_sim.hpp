@@ -112,11 +112,12 @@ struct SutureStepStats {
     int contacts = 0;  ///< contact constraints in force
     int newContacts = 0;
     bool tipInContact = false;
-    bool punctured = false;   ///< a puncture happened this step
-    double sigma = 0;         ///< sliding amount, m
-    double needleForce = 0;   ///< resultant force of the tissue on the needle, N
-    double tipAxialForce = 0; ///< axial force at a boundary contact, N
-    double threadTension = 0; ///< from the pull multiplier, N
+    bool punctured = false;                ///< a puncture happened this step
+    double sigma = 0;                      ///< sliding amount, m
+    double needleForce = 0;                ///< resultant force of the tissue on the needle, N
+    Vec3 needleForceVector = Vec3::Zero(); ///< N: that force as a vector (tissue on needle)
+    double tipAxialForce = 0;              ///< axial force at a boundary contact, N
+    double threadTension = 0;              ///< from the pull multiplier, N
     bool threadEngaged = false;
     bool refactored = false;
     bool refactorWaited = false; ///< a solve waited for the background factorization (timing only)

@@ -17,7 +17,17 @@ int dispatch(const CliProgram& program, const CliArgs& args) {
     if (args.empty()) return program.noArguments ? program.noArguments() : usageError(program);
     const std::string& cmd = args[0];
     for (const CliSubcommand& sub : program.subcommands)
-        if (cmd == sub.name) return sub.run(CliArgs(args.begin() + 1, args.end()));
+        if (cmd == sub.name) {
+            for (size_t i = 1; i < args.size(); ++i)
+                if (args[i] == "--help" || args[i] == "-h") {
+                    if (!sub.help.empty())
+                        std::fwrite(sub.help.data(), 1, sub.help.size(), stdout);
+                    else if (program.usage)
+                        program.usage(stdout);
+                    return kExitOk;
+                }
+            return sub.run(CliArgs(args.begin() + 1, args.end()));
+        }
     if (program.version && cmd == "--version") {
         std::printf("%s %s\n", program.name, program.version);
         return kExitOk;

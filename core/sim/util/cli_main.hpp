@@ -20,10 +20,12 @@ inline constexpr int kExitInvariant = 3; ///< the run broke an invariant
 using CliArgs = std::vector<std::string>;
 using CliAction = std::function<int(const CliArgs& args)>;
 
-/// `program <name> args...`; `run` gets the arguments after the name.
+/// `program <name> args...`; `run` gets the arguments after the name. `program <name> ... --help`
+/// (or -h anywhere after the name) prints `help` to stdout and exits 0 without running it.
 struct CliSubcommand {
     std::string_view name;
     CliAction run;
+    std::string_view help; ///< the subcommand's usage and options; empty: the program's usage
 };
 
 struct CliProgram {

@@ -394,3 +394,39 @@ TEST(CollisionSolver, BroadPhaseFindsEveryTriangleWhoseSphereBoxMeetsTheTool) {
     EXPECT_GT(found, 0);
     EXPECT_GT(missed, 0);
 }
+
+// The contact force of a step is Σ m Δx / h² over the vertices the contacts moved: a sphere
+// pressed into a fixed-mass patch gives the momentum its pushes put in, along the push, and no
+// force from a fixed vertex or from a step without contact.
+TEST(CollisionSolver, ContactForceIsTheMassWeightedPushOverHSquared) {
+    const double h = 1e-3;
+    for (const double w3 : {1.0, 0.0}) { // vertex 3 free, then fixed
+        CollisionSettings s;
+        s.method = CollisionMethod::Polygon;
+        auto solver = CollisionSolver::create(square(0.01, {1, 1, 1, w3}), s);
+        std::vector<Vec3> x = {Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.01, 0.01, 0), Vec3(0, 0.01, 0)};
+        const std::vector<Vec3> start = x;
+        const ToolShape tool = sphereAt(0.004, Vec3(0.004, 0.005, 0.003)); // reaches 1 mm (+ margin) below z = 0
+        solver->beginStep(x, tool, h);
+        EXPECT_EQ(solver->contactForce(), Vec3::Zero()) << "nothing pushed yet";
+        for (int it = 0; it < 4; ++it)
+            solver->iterate(x, tool);
+        Vec3 expected = Vec3::Zero();
+        const std::vector<double> w = {1, 1, 1, w3};
+        for (size_t v = 0; v < x.size(); ++v)
+            if (w[v] > 0) expected += (x[v] - start[v]) / w[v];
+        expected /= h * h;
+        const Vec3 f = solver->contactForce();
+        ASSERT_GT(expected.norm(), 0) << "the sphere pushed the patch";
+        EXPECT_LT((f - expected).norm(), 1e-9 * expected.norm()) << f.transpose() << " vs " << expected.transpose();
+        EXPECT_LT(f.z(), 0) << "the tissue is pushed down, away from the tool above it";
+        EXPECT_TRUE(f.allFinite());
+    }
+    CollisionSettings s;
+    auto solver = CollisionSolver::create(square(), s);
+    std::vector<Vec3> x = {Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.01, 0.01, 0), Vec3(0, 0.01, 0)};
+    const ToolShape far = sphereAt(0.002, Vec3(0.005, 0.005, 0.05));
+    solver->beginStep(x, far, h);
+    solver->iterate(x, far);
+    EXPECT_EQ(solver->contactForce(), Vec3::Zero()) << "no contact, no force";
+}

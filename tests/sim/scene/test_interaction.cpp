@@ -70,6 +70,27 @@ TEST(Interaction, RejectsBadSectionsNamingTheField) {
         sectionError(
             R"({"collision": {"method": "sdf"}, "instruments": [{"name": "g", "kind": "grasper", "track": "t"}]})"),
         HasSubstr("collision.method: 'sdf' is not a method"));
+    // A device block: read strictly, written back with its defaults.
+    const std::string driven = R"({"instruments": [{"name": "g", "kind": "grasper", "track": "t",
+                                   "device": {"hand": "left", "force_scale": 8}}]})";
+    EXPECT_EQ(sectionError(driven), "accepted");
+    const InteractionDesc d = parseInteractionSection(driven, "scene.json");
+    EXPECT_TRUE(d.instruments[0].device.declared);
+    EXPECT_EQ(d.instruments[0].device.hand, "left");
+    EXPECT_DOUBLE_EQ(d.instruments[0].device.forceScale, 8);
+    EXPECT_DOUBLE_EQ(d.instruments[0].device.gripOpenRad, 1.0);
+    EXPECT_EQ(formatInteractionSection(parseInteractionSection(formatInteractionSection(d), "x")),
+              formatInteractionSection(d));
+    EXPECT_FALSE(parseInteractionSection(ok, "scene.json").instruments[0].device.declared);
+    EXPECT_THAT(sectionError(R"({"instruments": [{"name": "g", "kind": "grasper", "track": "t",
+                                                  "device": {"hand": "middle"}}]})"),
+                HasSubstr("instruments[0].device.hand: 'middle' is not a hand (left, right, any)"));
+    EXPECT_THAT(sectionError(R"({"instruments": [{"name": "g", "kind": "grasper", "track": "t",
+                                                  "device": {"grip_open_rad": 0}}]})"),
+                HasSubstr("instruments[0].device.grip_open_rad: must be in [0.05, 3.14159"));
+    EXPECT_THAT(sectionError(R"({"instruments": [{"name": "g", "kind": "grasper", "track": "t",
+                                                  "device": {"arm": 1}}]})"),
+                HasSubstr("instruments[0].device.arm: unknown field"));
     EXPECT_THAT(sectionError(R"({"instruments": [{"name": "g", "kind": "grasper", "track": "t"},
                                                  {"name": "g", "kind": "grasper", "track": "u"}]})"),
                 HasSubstr("instruments[1].name: 'g' is used twice"));

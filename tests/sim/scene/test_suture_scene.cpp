@@ -61,6 +61,23 @@ TEST(SutureScene, RejectsBadSectionsNamingTheField) {
                     j["suture"]["contact"] = {{"rounds", 99}};
                 })),
                 HasSubstr("suture.contact.rounds: must be an integer in [0, 16]"));
+    EXPECT_THAT(parseError(withChange([](auto& j) {
+                    j["suture"]["device"] = {{"pull_scale", 0}};
+                })),
+                HasSubstr("suture.device.pull_scale: must be in (0, 10]"));
+    EXPECT_THAT(parseError(withChange([](auto& j) {
+                    j["suture"]["device"] = {{"hand", 2}};
+                })),
+                HasSubstr("suture.device.hand: "));
+    {
+        const SceneDesc s = parseScene(withChange([](auto& j) {
+                                           j["suture"]["device"] = {{"hand", "left"}};
+                                       }),
+                                       "d.json");
+        EXPECT_TRUE(s.suture->device.declared);
+        EXPECT_EQ(s.suture->device.hand, "left");
+        EXPECT_EQ(formatScene(parseScene(formatScene(s), "again.json")), formatScene(s));
+    }
     EXPECT_THAT(parseError(withChange([](auto& j) { j["suture"]["knot"] = 1; })),
                 HasSubstr("suture.knot: unknown field"));
     EXPECT_THAT(parseError(withChange([](auto& j) { j.erase("suture"); })),
