@@ -16,6 +16,7 @@
 #include "render/case_settings.hpp"
 #include "render/headless.hpp"
 #include "render/scene_view.hpp"
+#include "render/tool_meshes.hpp"
 #include "runtime/report.hpp"
 #include "runtime/session.hpp"
 #include "sim/util/atomic_file.hpp"
@@ -227,9 +228,11 @@ int cmdRun(const std::vector<std::string>& args) {
     if (headless && screenshot) {
         // The rendered view of the last frame (EGL; Mesa llvmpipe where there is no GPU).
         try {
-            const render::SceneView view = player::caseView(loaded);
-            render::RenderSettings rs = render::defaultSettingsFor(view);
+            render::SceneView view = player::caseView(loaded);
+            render::RenderSettings rs = render::defaultSettingsFor(view); // framed on the tissue
             render::applyCaseRender(rs, loaded.scene.render, *casePath);
+            // Instruments, probes, clips, needle and thread at the last frame.
+            const render::ToolMeshes tools(view, render::toolPoses(*loaded.world));
             std::string why;
             auto renderer = render::HeadlessRenderer::create(rs, &why);
             if (!renderer) throw std::runtime_error("no OpenGL context: " + why);

@@ -197,6 +197,15 @@ void SceneView::updateFromWorld(const sim::World& world) {
         if (m.source == RenderMesh::Source::Surface && world.interaction() && world.interaction()->dissects()) {
             world.interaction()->surfaceFaceMaskInto(m.sourceIndex, m_maskScratch);
             if (m_maskScratch.size() == m.triangleCount()) setFaceMask(i, m_maskScratch);
+            // The heat channel of the G-buffer: coagulated and charred tissue along the cut.
+            world.interaction()->surfaceHeatInto(m.sourceIndex, m_heatScratch);
+            if (!m_heatScratch.empty() && m.heat.size() == n) {
+                for (size_t v = 0; v < n; ++v) {
+                    const int32_t s = m.sourceVertex[v];
+                    m.heat[v] = s >= 0 && size_t(s) < m_heatScratch.size() ? m_heatScratch[size_t(s)] : 0.0f;
+                }
+                ++m.revision;
+            }
         }
     }
 }

@@ -130,6 +130,7 @@ private:
     std::vector<RenderMesh> m_meshes;
     std::vector<TissueMaterial> m_materials;
     std::vector<uint8_t> m_maskScratch; ///< updateFromWorld: the dissection mask of a surface
+    std::vector<float> m_heatScratch;   ///< updateFromWorld: the heat of a dissected surface
 };
 
 } // namespace viscera::render

@@ -241,8 +241,16 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
             for (size_t b = 0; b < world.bodyCount(); ++b)
                 lv.nodes.insert(lv.nodes.end(), world.positions(b).begin(), world.positions(b).end());
             lv.surfaces.resize(world.surfaceCount());
-            for (size_t k = 0; k < world.surfaceCount(); ++k)
+            lv.surfaceMasks.resize(world.surfaceCount());
+            lv.surfaceHeat.resize(world.surfaceCount());
+            for (size_t k = 0; k < world.surfaceCount(); ++k) {
                 lv.surfaces[k].assign(world.surfacePositions(k).begin(), world.surfacePositions(k).end());
+                if (const sim::InteractionRuntime* in = world.interaction(); in && in->dissects()) {
+                    in->surfaceFaceMaskInto(k, lv.surfaceMasks[k]);
+                    in->surfaceHeatInto(k, lv.surfaceHeat[k]);
+                }
+            }
+            lv.tools = render::toolPoses(world);
         }
         if (!rec.finite)
             r.errors.push_back("frame " + std::to_string(rec.index) +

@@ -3,6 +3,7 @@
 #include "case/case_package.hpp"
 #include "haptics/device.hpp"
 #include "render/scene_view.hpp"
+#include "render/tool_meshes.hpp"
 #include "runtime/haptic_rig.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/world.hpp"
@@ -43,8 +44,11 @@ render::SceneView caseView(const LoadedCase& loaded);
 struct LiveView {
     std::mutex mutex;
     LiveState state;
-    std::vector<sim::Vec3> nodes;                 ///< nodes of every body, m, scene
-    std::vector<std::vector<sim::Vec3>> surfaces; ///< nodes of every fascia surface, m, scene
+    std::vector<sim::Vec3> nodes;                   ///< nodes of every body, m, scene
+    std::vector<std::vector<sim::Vec3>> surfaces;   ///< nodes of every fascia surface, m, scene
+    std::vector<std::vector<uint8_t>> surfaceMasks; ///< per surface: intact triangles (empty: no cut)
+    std::vector<std::vector<float>> surfaceHeat;    ///< per surface: vertex heat in [0, 1] (empty: none)
+    render::ToolPoses tools;                        ///< instruments, probes, clips, needle, thread
     std::vector<double> toolRadius;
     bool finished = false;
 };

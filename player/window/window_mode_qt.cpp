@@ -43,7 +43,8 @@ public:
             m_offset += world.restMesh(b).vertexCount();
         }
         render::RenderSettings settings = render::defaultSettingsFor(m_view, width, height);
-        render::applyCaseRender(settings, caseRender, "scene.json"); // checked at load already
+        render::applyCaseRender(settings, caseRender, "scene.json");    // checked at load already
+        m_tools = render::ToolMeshes(m_view, render::toolPoses(world)); // after the framing: tissue only
         m_renderer = render::HeadlessRenderer::create(settings, &m_whyNot);
         if (m_renderer) refresh(); // the rest state, until the first frame arrives
     }
@@ -77,7 +78,22 @@ public:
                             m.positions[3 * v + r] = static_cast<float>((*src)[k][r]);
                     }
                     m_view.recomputeNormals(i);
+                    if (m.source != render::RenderMesh::Source::Surface) continue;
+                    // The cut [A §5.3.1]: dropped faces and the heat tint along it.
+                    const size_t s = m.sourceIndex;
+                    if (s < m_live.surfaceMasks.size() && m_live.surfaceMasks[s].size() == m.triangleCount())
+                        m_view.setFaceMask(i, m_live.surfaceMasks[s]);
+                    if (s < m_live.surfaceHeat.size() && !m_live.surfaceHeat[s].empty() &&
+                        m.heat.size() == m.sourceVertex.size()) {
+                        const std::vector<float>& heat = m_live.surfaceHeat[s];
+                        for (size_t v = 0; v < m.sourceVertex.size(); ++v) {
+                            const auto k = static_cast<size_t>(m.sourceVertex[v]);
+                            m.heat[v] = k < heat.size() ? heat[k] : 0.0f;
+                        }
+                        ++m.revision;
+                    }
                 }
+                m_tools.update(m_view, m_live.tools);
             }
         }
         m_frameMs = m_renderer->renderFrame(m_view).totalMs;
@@ -89,6 +105,7 @@ public:
 private:
     LiveView& m_live;
     render::SceneView m_view;
+    render::ToolMeshes m_tools;
     std::unique_ptr<render::HeadlessRenderer> m_renderer;
     std::vector<size_t> m_bodyOffset;
     size_t m_offset = 0;
@@ -111,11 +128,13 @@ public:
         LiveState s;
         std::vector<sim::Vec3> nodes;
         std::vector<double> radius;
+        std::vector<render::ToolPoses::Instrument> instruments;
         {
             std::lock_guard<std::mutex> lock(m_live.mutex);
             s = m_live.state;
             nodes = m_live.nodes;
             radius = m_live.toolRadius;
+            instruments = m_live.tools.instruments;
         }
         const int w = size.width(), h = size.height();
         p.fillRect(0, 0, w, h, QColor(24, 26, 30));
@@ -141,6 +160,7 @@ public:
         const QRect view(16, 88, w - 280, h - 104);
         p.setPen(QColor(60, 64, 70));
         p.drawRect(view);
+        bool sideView = true;
         if (m_viewport && m_viewport->available() && !m_viewport->image().isNull()) {
             const QImage& img = m_viewport->image();
             const QSize fit = img.size().scaled(view.size(), Qt::KeepAspectRatio);
@@ -150,7 +170,7 @@ public:
             p.setPen(QColor(140, 140, 140));
             p.drawText(view.adjusted(6, 0, 0, -4), Qt::AlignLeft | Qt::AlignBottom,
                        QString::asprintf("render %.0f ms", m_viewport->lastFrameMs()));
-            nodes.clear(); // no side view
+            sideView = false; // the instruments are in the rendered view
         }
         double x0 = 1e9, x1 = -1e9, z0 = 1e9, z1 = -1e9;
         for (const auto& n : nodes)
@@ -159,7 +179,7 @@ public:
             if (s.toolActive[a])
                 x0 = std::min(x0, s.tool[a].x()), x1 = std::max(x1, s.tool[a].x()), z0 = std::min(z0, s.tool[a].z()),
                 z1 = std::max(z1, s.tool[a].z());
-        if (x1 > x0 && z1 >= z0) {
+        if (sideView && x1 > x0 && z1 >= z0) {
             const double span = std::max(x1 - x0, z1 - z0) * 1.3 + 1e-3;
             const double scale = std::min(view.width(), view.height()) / span;
             const double cx = 0.5 * (x0 + x1), cz = 0.5 * (z0 + z1);
@@ -214,6 +234,23 @@ public:
             p.drawRect(px, y, static_cast<int>(230 * frac), 14);
             y += 34;
         }
+        // Instrument states: jaws, grasp, energy.
+        for (const auto& in : instruments) {
+            QString state;
+            if (in.kind == "energy_hook")
+                state = in.act ? "ENERGIZED" : "energy off";
+            else if (in.kind == "clip_applier")
+                state = in.jaw < 0.2 ? "firing" : in.jaw < 0.5 ? "closing" : "open";
+            else
+                state = in.grasped > 0 ? QString::asprintf("closed, holding %d", in.grasped)
+                        : in.jaw < 0.5 ? "closed"
+                                       : "open";
+            const bool hot = in.kind == "energy_hook" && in.act;
+            p.setPen(hot ? QColor(250, 150, 60) : QColor(200, 200, 200));
+            p.drawText(px, y, QString::fromStdString(in.name) + ": " + state);
+            y += 20;
+        }
+        if (!instruments.empty()) y += 8;
         p.setPen(QColor(230, 120, 100));
         if (s.safetyRules & haptics::kRuleSimStale) p.drawText(px, y, "Forces off: simulation stale"), y += 20;
         if (s.safetyRules & haptics::kRuleDisconnected) p.drawText(px, y, "Forces off: device not answering"), y += 20;
@@ -223,8 +260,7 @@ public:
             const bool slow = s.realTimeFactor < 1;
             p.setPen(slow ? QColor(230, 80, 60) : QColor(140, 140, 140));
             p.drawText(px, h - 36,
-                       slow ? QString::asprintf("Physics %.1f ms/frame: %.2fx real time (SLOWER)", s.physicsMs,
-                                                s.realTimeFactor)
+                       slow ? QString::asprintf("Physics %.1f ms: %.2fx real time", s.physicsMs, s.realTimeFactor)
                             : QString::asprintf("Physics %.1f ms/frame: real time", s.physicsMs));
         }
         p.setPen(QColor(140, 140, 140));

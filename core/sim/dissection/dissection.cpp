@@ -271,6 +271,18 @@ void Dissection::fasciaFaceMaskInto(std::vector<uint8_t>& out) const {
     fasciaEdges().intactMaskInto(out);
 }
 
+void Dissection::fasciaVertexHeatInto(std::vector<float>& out) const {
+    const EdgeStructure& E = fasciaEdges();
+    out.assign(E.vertexCount(), 0.0f);
+    const double ignition = m_fascia->tissue.ignition;
+    for (size_t e = 0; e < E.edgeCount(); ++e) {
+        const double h = E.isDissected(e) ? 1.0 : std::clamp(m_fascia->heat[e] / ignition, 0.0, 1.0);
+        if (!(h > 0)) continue;
+        for (int32_t v : E.edge(e))
+            out[static_cast<size_t>(v)] = std::max(out[static_cast<size_t>(v)], static_cast<float>(h));
+    }
+}
+
 void Dissection::fatTetMaskInto(std::vector<uint8_t>& out) const {
     fatEdges().intactMaskInto(out);
 }

@@ -126,6 +126,9 @@ public:
     const std::vector<double>& fatEdgeHeat() const;
     /// Render masks [A §5.3.1]: 1 for every intact triangle (fascia) / tet (fat), in mesh order.
     void fasciaFaceMaskInto(std::vector<uint8_t>& out) const;
+    /// Heat of every fascia vertex for the renderer's heat channel, in [0, 1]: the largest τ_e of
+    /// its edges over the ignition temperature (1 where an edge burnt through: charred).
+    void fasciaVertexHeatInto(std::vector<float>& out) const;
     void fatTetMaskInto(std::vector<uint8_t>& out) const;
     /// Mask of the fat mesh's boundary triangles (TetMesh::boundary() order, which is the order of
     /// the render mesh SceneView makes for a tet body): 1 while the tet behind the face is intact.

@@ -74,6 +74,7 @@ std::unique_ptr<FemSceneSolver> FemSceneSolver::create(const SceneSolverInputs& 
     }
     f->m_trajectory = std::move(trajectory);
     f->m_thread = sd.thread;
+    f->m_needle = settings.needle;
     f->m_offsets = std::move(offsets);
     for (const auto& m : meshes) {
         f->m_bodyX.push_back(m->positions());
@@ -122,6 +123,16 @@ StepStats FemSceneSolver::step(const FrameClock& clock) {
     rec.maxDisplacement = maxMove;
     rec.finite = finite;
     return rec;
+}
+
+double FemSceneSolver::needleLength() const {
+    return m_needle.length_();
+}
+
+std::vector<Vec3> FemSceneSolver::threadPath() const {
+    std::vector<Vec3> path = m_thread ? m_suture->puncturePoints() : std::vector<Vec3>{};
+    path.push_back(m_suture->curve().point(0.0));
+    return path;
 }
 
 bool FemSceneSolver::recordFrame(const FrameClock& clock) {

@@ -47,6 +47,9 @@ public:
 
     const std::vector<SutureFrameRecord>& frames() const override { return m_frames; }
     SutureSummary summary() const override;
+    NeedleCurve needleCurve() const override { return m_suture->curve(); }
+    double needleLength() const override;
+    std::vector<Vec3> threadPath() const override;
 
 private:
     FemSceneSolver();
@@ -54,7 +57,8 @@ private:
 
     std::unique_ptr<SutureSimulation> m_suture;
     std::vector<NeedleFrame> m_trajectory;
-    bool m_thread = false;                  ///< pulls of the trajectory are applied
+    bool m_thread = false; ///< pulls of the trajectory are applied
+    NeedleSpec m_needle;
     std::vector<int32_t> m_offsets;         ///< first merged node of each body
     std::vector<std::vector<Vec3>> m_bodyX; ///< per-body positions
     std::vector<std::vector<Vec3>> m_zeroV; ///< per-body zero velocities

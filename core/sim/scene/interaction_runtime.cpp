@@ -389,6 +389,9 @@ void InteractionRuntime::afterStep() {
         const auto& cp = c->attachment->contactPoints();
         for (size_t k = 0; k < cp.size() && k < c->contactVertices.size(); ++k)
             c->state.maxContactDrift = std::max(c->state.maxContactDrift, (cp[k] - x[c->contactVertices[k]]).norm());
+        const auto& cv = c->attachment->vertices();
+        for (size_t k = 0; k < 4 && k < cv.size(); ++k)
+            c->state.legs[k] = cv[k];
         m_summary.clips.push_back(c->state);
     }
     m_summary.clipMs += msSince(t0);
@@ -421,6 +424,11 @@ void InteractionRuntime::release(size_t i) {
 
 Vec3 InteractionRuntime::instrumentForce(size_t i) const {
     return i < m_instruments.size() ? m_instruments[i]->force : Vec3::Zero();
+}
+
+void InteractionRuntime::surfaceHeatInto(size_t s, std::vector<float>& out) const {
+    out.clear();
+    if (m_dissection && m_dissection->hasFascia() && s == m_dissectSurface) m_dissection->fasciaVertexHeatInto(out);
 }
 
 void InteractionRuntime::surfaceFaceMaskInto(size_t s, std::vector<uint8_t>& out) const {

@@ -52,6 +52,8 @@ struct ClipState {
     /// was on at application (how well the clip follows the vessel material).
     double maxContactDrift = 0;
     int regionVertices = 0, auxiliaryNodes = 0;
+    /// m, current: the end points of the clip's two legs (leg 0: [0]–[1], leg 1: [2]–[3]).
+    std::array<Vec3, 4> legs{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
 };
 
 struct InteractionSummary {
@@ -105,6 +107,9 @@ public:
     static constexpr double kMaxDrivenMovePerFrame = 0.003; ///< m
     /// Render mask of surface s: 1 per intact triangle (empty: no dissection on that surface).
     void surfaceFaceMaskInto(size_t s, std::vector<uint8_t>& out) const;
+    /// Heat of surface s per vertex in [0, 1] (Dissection::fasciaVertexHeatInto; empty: no
+    /// dissection on that surface).
+    void surfaceHeatInto(size_t s, std::vector<float>& out) const;
     bool dissects() const { return m_dissection != nullptr; }
 
 private:

@@ -60,6 +60,11 @@ public:
     virtual const std::vector<SutureFrameRecord>& frames() const = 0;
     /// Figures so far; the closure gauge is evaluated on the current state (O(facing × tets)).
     virtual SutureSummary summary() const = 0;
+    /// What the renderer draws: the needle's curve and length now, and the thread's path (the
+    /// puncture points in thread order, then the needle's end).
+    virtual NeedleCurve needleCurve() const = 0;
+    virtual double needleLength() const = 0;
+    virtual std::vector<Vec3> threadPath() const = 0;
 
 protected:
     ~SutureReport() = default;

@@ -91,6 +91,8 @@ public:
     /// Only a "fem" scene creates the suturing simulation; the needle follows the case's recorded
     /// trajectory, one frame per step (the last frame is held after the end).
     bool hasSuture() const { return m_solver->suture() != nullptr; }
+    /// The suturing figures and geometry (needle, thread) of a "fem" scene; null otherwise.
+    const SutureReport* sutureReport() const { return m_solver->suture(); }
     /// The needle of a suturing scene, for a device to drive (suture "device"); null otherwise.
     NeedleDrive* needleDrive() { return m_solver->needleDrive(); }
     const NeedleDrive* needleDrive() const { return m_solver->needleDrive(); }
