@@ -227,6 +227,46 @@ ToolPoses toolPoses(const sim::World& world) {
     return p;
 }
 
+template <class B>
+bool ToolMeshes::build(B& b, const Part& part, const ToolPoses& poses, RenderMesh& m, std::vector<Vec3>& pts) const {
+    switch (part.kind) {
+    case Part::Kind::Instrument: {
+        if (part.index >= poses.instruments.size()) return false;
+        const ToolPoses::Instrument& in = poses.instruments[part.index];
+        buildInstrument(b, in);
+        m.material = in.kind == "energy_hook" && in.act ? m_active : m_steel;
+        return true;
+    }
+    case Part::Kind::Probe:
+        if (part.index >= poses.probes.size()) return false;
+        b.sphere(poses.probes[part.index].centre, poses.probes[part.index].radius);
+        return true;
+    case Part::Kind::Clip: {
+        m.visible = part.index < poses.clips.size();
+        if (!m.visible) { // not fired yet: a hidden placeholder of the same shape
+            for (int k = 0; k < 3; ++k)
+                b.plate(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 1e-4, 1e-4);
+            return true;
+        }
+        const auto& q = poses.clips[part.index];
+        const Vec3 across = q[2] - q[0];
+        b.plate(q[0], q[1], across.cross(q[1] - q[0]), 3.5e-4, 2.0e-4);
+        b.plate(q[2], q[3], across.cross(q[3] - q[2]), 3.5e-4, 2.0e-4);
+        b.plate(q[1], q[3], q[1] - q[0], 2.0e-4, 2.0e-4); // the hinge joining the legs
+        return true;
+    }
+    case Part::Kind::Needle:
+        if (poses.needle.size() < 2) return false;
+        b.tube(poses.needle.data(), poses.needle.size(), 3.0e-4, 8);
+        return true;
+    case Part::Kind::Thread:
+        m.visible = resample(poses.thread, kThreadPoints, pts);
+        b.tube(pts.data(), pts.size(), 2.4e-4, 6);
+        return true;
+    }
+    return false;
+}
+
 ToolMeshes::ToolMeshes(SceneView& view, const ToolPoses& first) {
     if (first.empty()) return;
     m_steel = view.addMaterial(toolMaterial("instrument steel", {0.78f, 0.79f, 0.81f}, 0.32f, 0.55f));
@@ -251,32 +291,12 @@ ToolMeshes::ToolMeshes(SceneView& view, const ToolPoses& first) {
         add("needle", Part::Kind::Needle, 0, m_steel);
         add("thread", Part::Kind::Thread, 0, m_thread);
     }
-    // Topology from the first snapshot (hidden clips get a placeholder pose of the same shape).
+    // Topology from the first snapshot; update() rewrites the same vertices in the same order.
+    std::vector<Vec3> pts;
     for (const Part& part : m_meshes) {
         RenderMesh& m = view.meshes()[part.mesh];
         Builder b(m.positions, &m.indices);
-        std::vector<Vec3> pts;
-        switch (part.kind) {
-        case Part::Kind::Instrument:
-            buildInstrument(b, first.instruments[part.index]);
-            break;
-        case Part::Kind::Probe:
-            b.sphere(first.probes[part.index].centre, first.probes[part.index].radius);
-            break;
-        case Part::Kind::Clip:
-            b.plate(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 1e-4, 1e-4);
-            b.plate(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 1e-4, 1e-4);
-            b.plate(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 1e-4, 1e-4);
-            m.visible = false;
-            break;
-        case Part::Kind::Needle:
-            b.tube(first.needle.data(), first.needle.size(), 3.0e-4, 8);
-            break;
-        case Part::Kind::Thread:
-            m.visible = resample(first.thread, kThreadPoints, pts);
-            b.tube(pts.data(), pts.size(), 2.4e-4, 6);
-            break;
-        }
+        build(b, part, first, m, pts);
         const size_t nv = m.positions.size() / 3;
         m.rest = m.positions;
         m.normals.assign(m.positions.size(), 0.0f);
@@ -294,40 +314,7 @@ void ToolMeshes::update(SceneView& view, const ToolPoses& poses) {
         RenderMesh& m = view.meshes()[part.mesh];
         const size_t before = m.positions.size();
         Builder b(m_scratch, nullptr);
-        switch (part.kind) {
-        case Part::Kind::Instrument: {
-            if (part.index >= poses.instruments.size()) continue;
-            const ToolPoses::Instrument& in = poses.instruments[part.index];
-            buildInstrument(b, in);
-            m.material = in.kind == "energy_hook" && in.act ? m_active : m_steel;
-            break;
-        }
-        case Part::Kind::Probe:
-            if (part.index >= poses.probes.size()) continue;
-            b.sphere(poses.probes[part.index].centre, poses.probes[part.index].radius);
-            break;
-        case Part::Kind::Clip: {
-            if (part.index >= poses.clips.size()) { // not fired yet
-                m.visible = false;
-                continue;
-            }
-            const auto& q = poses.clips[part.index];
-            const Vec3 across = q[2] - q[0];
-            b.plate(q[0], q[1], across.cross(q[1] - q[0]), 3.5e-4, 2.0e-4);
-            b.plate(q[2], q[3], across.cross(q[3] - q[2]), 3.5e-4, 2.0e-4);
-            b.plate(q[1], q[3], q[1] - q[0], 2.0e-4, 2.0e-4); // the hinge joining the legs
-            m.visible = true;
-            break;
-        }
-        case Part::Kind::Needle:
-            if (poses.needle.size() < 2) continue;
-            b.tube(poses.needle.data(), poses.needle.size(), 3.0e-4, 8);
-            break;
-        case Part::Kind::Thread:
-            m.visible = resample(poses.thread, kThreadPoints, pts);
-            b.tube(pts.data(), pts.size(), 2.4e-4, 6);
-            break;
-        }
+        if (!build(b, part, poses, m, pts) || !m.visible) continue;
         if (m_scratch.size() != before) continue; // another topology: keep the last pose
         bool finite = true;
         for (float v : m_scratch)

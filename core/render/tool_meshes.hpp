@@ -71,6 +71,12 @@ private:
         size_t index = 0; ///< instrument, probe or clip index
         size_t mesh = 0;  ///< in the view
     };
+    /// Appends part's primitives for `poses` to the builder (the same calls for every snapshot,
+    /// so the counts never change), sets its material and visibility; false when the snapshot
+    /// does not have the part. Defined in the .cpp, with its builder.
+    template <class Builder>
+    bool build(Builder& b, const Part& part, const ToolPoses& poses, RenderMesh& m,
+               std::vector<Eigen::Vector3d>& pts) const;
     std::vector<Part> m_meshes;
     uint32_t m_steel = 0, m_active = 0, m_clip = 0, m_thread = 0, m_probe = 0;
     std::vector<float> m_scratch;

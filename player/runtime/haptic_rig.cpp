@@ -49,7 +49,6 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
         m_caseMaxForce = std::min(m_caseMaxForce, d.maxForceN);
         if (arm < 0) continue;
         m_armTools[arm].push_back(static_cast<int>(m_rig.size() - 1));
-        m_toolOfArm[arm] = static_cast<int>(t);
         mapArm(arm, d.start, d.motionScale, d.forceScale);
     }
     if (sim::InteractionRuntime* in = world.interaction()) // instruments: arms may be shared
@@ -58,7 +57,10 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
             if (!d.device.declared) continue;
             int arm = armFor(d.device.hand, false);
             // An arm a probe holds is not shared.
-            if (arm >= 0 && m_toolOfArm[arm] >= 0) arm = -1;
+            if (arm >= 0 && std::any_of(m_armTools[arm].begin(), m_armTools[arm].end(), [&](int k) {
+                    return m_rig[static_cast<size_t>(k)].kind == RigTool::Kind::Probe;
+                }))
+                arm = -1;
             m_tools.push_back({d.name, d.device.hand, arm, sim::kindName(d.kind), 0});
             RigTool rt;
             rt.kind = RigTool::Kind::Instrument;

@@ -147,7 +147,6 @@ private:
     std::array<bool, haptics::kMaxArms> m_buttonDown{false, false};
     /// Rig tool the arm drives now (-1: none).
     int activeTool(int arm) const;
-    std::array<int, haptics::kMaxArms> m_toolOfArm{-1, -1}; ///< probe index per arm (-1: none / an instrument)
     std::vector<HapticsResult::Tool> m_tools;
     double m_dt = 0, m_caseMaxForce = 15;
     int64_t m_frame = 0, m_t0 = 0, m_tick = 0;
