@@ -3,6 +3,8 @@
 //   viscera-player verify <case.vcase>
 //   viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]
 //                  [--report report.json] [--screenshot out.png] [--trace trace.csv] [--realtime]
+//                  [--plots DIR]
+//   viscera-player plot <report.json> -o DIR
 //
 // --device: replay:<file>, scripted:<name>, console:<host:port>, keyboard (window mode only).
 // Without --headless the trainee window opens (case title, instructions, timer, pedals and
@@ -24,6 +26,9 @@
 #include "sim/util/error.hpp"
 #include "sim/util/log.hpp"
 #include "window/window_mode.hpp"
+#if VISCERA_HAVE_PLOTS
+#include "plots/session_plots.hpp"
+#endif
 
 #include <algorithm>
 #include <cstdio>
@@ -43,7 +48,8 @@ void usage(std::FILE* out) {
     std::fputs("usage: viscera-player verify <case.vcase>\n"
                "       viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]\n"
                "                      [--report report.json] [--screenshot out.png] [--trace trace.csv]\n"
-               "                      [--realtime] [--servo sleep|sleep:CPU|spin:US|busy|busy:CPU]\n"
+               "                      [--realtime] [--servo sleep|sleep:CPU|spin:US|busy|busy:CPU] [--plots DIR]\n"
+               "       viscera-player plot <report.json> -o DIR\n"
                "       SPEC: replay:<file> | scripted:<name> | console:<host:port> | keyboard\n"
                "       viscera-player --version\n",
                out);
@@ -72,9 +78,22 @@ constexpr const char* kRunHelp =
     "  --report FILE.json    session report (schemaVersion, frames, metrics, haptics, errors)\n"
     "  --trace FILE.csv      per-tick device force and pose trace (needs --device)\n"
     "  --screenshot FILE.png the rendered last frame (headless: EGL, window: the window)\n"
+    "  --plots DIR           session plots (PNG) and session.html, as 'viscera-player plot' makes\n"
     "\n"
     "Output paths are checked before the first frame. Exit 0 ok, 1 bad input or an output that\n"
     "cannot be written, 2 usage, 3 the session broke an invariant (non-finite state, energy).\n";
+
+constexpr const char* kPlotHelp =
+    "usage: viscera-player plot <report.json> -o DIR\n"
+    "\n"
+    "Draws a session report (viscera-player run --report) as charts: physics step time per frame\n"
+    "against the real-time budget, the force on each tool, the tool paths, the task events\n"
+    "(grasps, cuts, clips, punctures), energy and largest node move, and solver error against run\n"
+    "time where the session sampled it. Writes step_time.png, forces.png, tool_paths.png,\n"
+    "events.png, stability.png, accuracy.png (when sampled) and session.html (the figures and the\n"
+    "charts in one self-contained page) into DIR, created when missing.\n"
+    "Exit 0 ok, 1 a malformed report (one line naming the file, the field and the rule) or a folder\n"
+    "that cannot be written, 2 usage.\n";
 
 int fail(int code, const std::string& message) {
     return sim::cliFail("viscera-player", code, message);
@@ -95,7 +114,7 @@ int cmdVerify(const std::vector<std::string>& args) {
 }
 
 int cmdRun(const std::vector<std::string>& args) {
-    std::optional<std::string> casePath, reportPath, screenshot, device, tracePath;
+    std::optional<std::string> casePath, reportPath, screenshot, device, tracePath, plotsDir;
     bool headless = false, realtime = false, framesGiven = false;
     haptics::ServoWait servoWait = haptics::ServoWait::SleepSpin;
     int servoCpu = -1;
@@ -121,6 +140,8 @@ int cmdRun(const std::vector<std::string>& args) {
             reportPath = value("--report");
         else if (a == "--trace")
             tracePath = value("--trace");
+        else if (a == "--plots")
+            plotsDir = value("--plots");
         else if (a == "--realtime")
             realtime = true;
         else if (a == "--screenshot")
@@ -187,6 +208,13 @@ int cmdRun(const std::vector<std::string>& args) {
     if (reportPath) requireWritableFile(*reportPath, "the report");
     if (tracePath) requireWritableFile(*tracePath, "the trace");
     if (screenshot) requireWritableFile(*screenshot, "the screenshot");
+    if (plotsDir) {
+#if VISCERA_HAVE_PLOTS
+        requireWritableFolder(*plotsDir);
+#else
+        return fail(kExitUsage, "--plots: this viscera-player was built without Qt6 Gui, which draws the plots");
+#endif
+    }
 
     std::unique_ptr<haptics::Device> dev;
     if (spec) dev = haptics::openDevice(*spec);
@@ -255,12 +283,57 @@ int cmdRun(const std::vector<std::string>& args) {
     }
     if (reportPath) writeFileAtomic(*reportPath, player::reportJson(result).dump(2) + "\n");
     if (tracePath) writeFileAtomic(*tracePath, player::traceCsv(result));
+    std::string plotsError;
+#if VISCERA_HAVE_PLOTS
+    std::optional<player::PlotFiles> plotFiles;
+    if (plotsDir) { // from the report's JSON, as 'plot' reads it afterwards
+        try {
+            plotFiles = player::writeSessionPlots(
+                player::readPlotInput(player::reportJson(result), reportPath.value_or("(this session)")), *plotsDir);
+        } catch (const std::exception& e) {
+            plotsError = e.what();
+        }
+    }
+#endif
     std::fputs(player::summaryText(result).c_str(), stdout);
     if (reportPath) std::printf("report        %s\n", std::filesystem::absolute(*reportPath).c_str());
+#if VISCERA_HAVE_PLOTS
+    if (plotFiles)
+        std::printf("plots         %zu charts and %s\n", plotFiles->images.size(),
+                    std::filesystem::absolute(plotFiles->page).c_str());
+#endif
     if (tracePath) std::printf("trace         %s\n", std::filesystem::absolute(*tracePath).c_str());
     if (!result.ok()) return kExitInvariant;
     if (!screenshotError.empty()) return fail(kExitInput, screenshotError);
+    if (!plotsError.empty()) return fail(kExitInput, plotsError);
     return 0;
+}
+
+int cmdPlot(const std::vector<std::string>& args) {
+    std::optional<std::string> report, dir;
+    for (size_t i = 0; i < args.size(); ++i) {
+        if (args[i] == "-o" || args[i] == "--output") {
+            if (i + 1 >= args.size()) throw std::invalid_argument(args[i] + " needs a folder");
+            dir = args[++i];
+        } else if (!args[i].empty() && args[i][0] == '-')
+            throw std::invalid_argument("unknown option '" + args[i] + "'");
+        else if (!report)
+            report = args[i];
+        else
+            throw std::invalid_argument("unexpected argument '" + args[i] + "'");
+    }
+    if (!report) throw std::invalid_argument("plot needs a report file");
+    if (!dir) throw std::invalid_argument("plot needs an output folder: -o DIR");
+#if VISCERA_HAVE_PLOTS
+    const player::PlotInput input = player::readPlotInputFile(*report); // a bad report creates no folder
+    const player::PlotFiles files = player::writeSessionPlots(input, *dir);
+    for (const auto& p : files.images)
+        std::printf("%s\n", p.c_str());
+    std::printf("%s\n", files.page.c_str());
+    return 0;
+#else
+    return fail(kExitUsage, "plot: this viscera-player was built without Qt6 Gui, which draws the plots");
+#endif
 }
 
 } // namespace
@@ -273,6 +346,6 @@ int main(int argc, char** argv) {
     program.name = "viscera-player";
     program.version = VISCERA_VERSION;
     program.usage = usage;
-    program.subcommands = {{"verify", cmdVerify, kVerifyHelp}, {"run", cmdRun, kRunHelp}};
+    program.subcommands = {{"verify", cmdVerify, kVerifyHelp}, {"run", cmdRun, kRunHelp}, {"plot", cmdPlot, kPlotHelp}};
     return sim::runCli(program, argc, argv);
 }

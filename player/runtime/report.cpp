@@ -216,6 +216,30 @@ static nlohmann::json sutureJson(const SessionResult& r) {
     return doc;
 }
 
+/// The session's timeline (tool tips, forces, task events): what `viscera-player plot` draws.
+/// Positions rounded to 1 µm, forces to 0.1 mN, times to 1 µs.
+static nlohmann::json timelineJson(const SessionTimeline& tl) {
+    using nlohmann::json;
+    auto round = [](double v, double q) { return std::isfinite(v) ? std::round(v / q) * q : 0.0; };
+    json t = json::array();
+    for (double v : tl.t_s)
+        t.push_back(round(v, 1e-6));
+    json tools = json::array();
+    for (const SessionTimeline::Tool& tool : tl.tools) {
+        json tip = json::array(), force = json::array();
+        for (const Eigen::Vector3d& p : tool.tip)
+            tip.push_back({round(p.x(), 1e-6), round(p.y(), 1e-6), round(p.z(), 1e-6)});
+        for (double f : tool.force_n)
+            force.push_back(round(f, 1e-4));
+        tools.push_back({{"name", tool.name}, {"kind", tool.kind}, {"tip_m", tip}, {"force_n", force}});
+    }
+    json events = json::array();
+    for (const SessionTimeline::Event& e : tl.events)
+        events.push_back(
+            {{"t_s", round(e.t_s, 1e-6)}, {"frame", e.frame}, {"kind", e.kind}, {"tool", e.tool}, {"count", e.count}});
+    return {{"stride_frames", tl.stride}, {"t_s", t}, {"tools", tools}, {"events", events}};
+}
+
 nlohmann::json reportJson(const SessionResult& r) {
     using nlohmann::json;
     json doc;
@@ -293,6 +317,7 @@ nlohmann::json reportJson(const SessionResult& r) {
                          {"upload_ms", r.render->uploadMs},
                          {"passes", passes}};
     }
+    doc["timeline"] = timelineJson(r.timeline);
     doc["errors"] = r.errors;
     doc["warnings"] = r.warnings;
     return doc;

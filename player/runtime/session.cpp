@@ -208,6 +208,7 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
             log::warn(w);
     }
     InstrumentMeter meter;
+    TimelineRecorder timeline(world);
     if (options.live) {
         std::lock_guard<std::mutex> lock(options.live->mutex);
         for (size_t t = 0; t < world.toolCount(); ++t)
@@ -224,6 +225,7 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         sim::FrameRecord rec = world.step();
         if (rig) rig->afterStep();
         if (const sim::InteractionRuntime* in = world.interaction()) meter.record(*in, frameDt);
+        timeline.record(world);
         r.maxNodeDisplacement = std::max(r.maxNodeDisplacement, nodeDisplacement(world));
         if (options.live) {
             std::lock_guard<std::mutex> lock(options.live->mutex);
@@ -296,6 +298,7 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         meter.addTo(r.metrics, *in);
     }
     r.finalNodeDisplacement = nodeDisplacement(world);
+    r.timeline = timeline.take();
     return r;
 }
 

@@ -5,6 +5,7 @@
 #include "render/scene_view.hpp"
 #include "render/tool_meshes.hpp"
 #include "runtime/haptic_rig.hpp"
+#include "runtime/timeline.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/world.hpp"
 
@@ -104,6 +105,7 @@ struct SessionResult {
     std::optional<sim::SutureSummary> suture;           ///< solver "fem" cases (needle and thread)
     std::vector<sim::SutureFrameRecord> sutureFrames;   ///< one per frame of a "fem" case
     std::optional<sim::InteractionSummary> interaction; ///< cases with scripted instruments
+    SessionTimeline timeline; ///< tool tips, forces and task events over the run (plots, report)
     bool ok() const { return errors.empty() && invariants.allFinite; }
 };
 

@@ -14,6 +14,7 @@ set(rules
   "studio/app/=viscera::studio"
   "player/runtime/=viscera::player"
   "player/window/=viscera::player"
+  "player/plots/=viscera::player"
   "studio/cli/="
   "player/console_sim/="
   "player/main.cpp=")

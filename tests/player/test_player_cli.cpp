@@ -191,6 +191,7 @@ TEST(PlayerCli, UnwritableOutputsAreRefusedBeforeTheFirstFrame) {
          (file / "s.png").string() + ": cannot write the screenshot ('" + file.string() + "' is a file, not a folder)"},
         {{"--device", "scripted:press", "--trace", folder.string()},
          folder.string() + ": cannot write the trace (it is a folder)"},
+        {{"--plots", file.string()}, file.string() + ": the output folder is a file, not a folder"},
     };
     for (const auto& c : cases) {
         std::vector<std::string> args = {"run", path, "--headless", "--frames", "600"};
@@ -272,7 +273,8 @@ TEST(PlayerCli, UsageErrorsAreClear) {
     for (const auto& [args, line] : std::vector<std::pair<std::vector<std::string>, std::string>>{
              {{"run", "--help"}, "usage: viscera-player run <case.vcase> [options]"},
              {{"run", "/nonexistent.vcase", "--headless", "-h"}, "--screenshot FILE.png"},
-             {{"verify", "--help"}, "usage: viscera-player verify <case.vcase>"}}) {
+             {{"verify", "--help"}, "usage: viscera-player verify <case.vcase>"},
+             {{"plot", "--help"}, "usage: viscera-player plot <report.json> -o DIR"}}) {
         auto h = player(args);
         EXPECT_EQ(h.exitCode, 0) << args[0];
         EXPECT_THAT(h.out, HasSubstr(line));
@@ -357,4 +359,34 @@ TEST(StudioCli, ImportRejectsBadMeshesWithOneLineErrors) {
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_THAT(r.err, HasSubstr("project.json: bodies[0].mesh.size: every edge length must be positive"));
     EXPECT_FALSE(std::filesystem::exists(dir.path() / "x.vcase"));
+}
+
+TEST(PlayerCli, PlotDrawsAReportAndRefusesABrokenOne) {
+    ScratchDir dir;
+    const auto path = writeSlabCase(dir, "slab.vcase", {"gravity", "xpbd"});
+    const auto report = dir.path() / "r.json";
+    ASSERT_EQ(player({"run", path, "--headless", "--frames", "30", "--report", report.string()}).exitCode, 0);
+    const fs::path out = dir.path() / "plots";
+    const test::ProcessResult r = player({"plot", report.string(), "-o", out.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    for (const char* f :
+         {"step_time.png", "forces.png", "tool_paths.png", "events.png", "stability.png", "session.html"}) {
+        EXPECT_TRUE(fs::exists(out / f)) << f;
+        EXPECT_THAT(r.out, HasSubstr((out / f).string()));
+    }
+    EXPECT_TRUE(r.err.empty()) << r.err;
+    // A broken report: one line naming the file and the field; no folder made.
+    nlohmann::json j = readJson(report);
+    j["frames"][2]["step_ms"] = "slow";
+    const fs::path bad = dir.path() / "bad.json";
+    writeFileAtomic(bad, j.dump());
+    const fs::path none = dir.path() / "none";
+    const test::ProcessResult b = player({"plot", bad.string(), "-o", none.string()});
+    EXPECT_EQ(b.exitCode, 1);
+    EXPECT_EQ(b.err, "viscera-player: " + bad.string() + ": frames[2].step_ms: must be a number\n");
+    EXPECT_FALSE(fs::exists(none));
+    const test::ProcessResult m = player({"plot", (dir.path() / "missing.json").string(), "-o", none.string()});
+    EXPECT_EQ(m.exitCode, 1);
+    EXPECT_THAT(m.err, HasSubstr("missing.json: cannot open for reading"));
+    EXPECT_EQ(player({"plot", report.string()}).exitCode, 2) << "no -o";
 }

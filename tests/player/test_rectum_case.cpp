@@ -79,7 +79,7 @@ TEST(RectumCase, ExportsRunsGraspsCutsAndClips) {
     const auto replayReport = dir.path() / "replay.json";
     auto rr = player({"run", out.string(), "--headless", "--frames", "290", "--device",
                       "replay:" + std::string(VISCERA_SOURCE_DIR) + "/projects/rectum/replays/dissection.csv",
-                      "--report", replayReport.string()});
+                      "--report", replayReport.string(), "--plots", (dir.path() / "plots").string()});
     ASSERT_EQ(rr.exitCode, 0) << rr.err << rr.out;
     const nlohmann::json rd = readJson(replayReport);
     EXPECT_TRUE(rd["invariants"]["all_finite"].get<bool>());
@@ -99,6 +99,32 @@ TEST(RectumCase, ExportsRunsGraspsCutsAndClips) {
         EXPECT_GT(rd["metrics"]["tool_path_length_per_tool_m"][t].get<double>(), 0.01) << t;
     EXPECT_GT(rd["metrics"]["max_force_n"].get<double>(), 0.0) << "force reached the device";
     EXPECT_LE(rd["metrics"]["max_force_n"].get<double>(), rd["haptics"]["case_max_force_n"].get<double>() + 1e-9);
+
+    // The timeline has the task in order: the grasp, then the hook's cuts, then the clip; the
+    // plots were drawn from it.
+    const nlohmann::json& tl = rd["timeline"];
+    ASSERT_EQ(tl["tools"].size(), 3u);
+    EXPECT_EQ(tl["t_s"].size(), 290u);
+    double grasp = -1, firstCut = -1, clip = -1;
+    int cutEdges = 0;
+    for (const auto& e : tl["events"]) {
+        const std::string k = e["kind"];
+        if (k == "grasp" && grasp < 0) grasp = e["t_s"];
+        if (k == "cut") {
+            if (firstCut < 0) firstCut = e["t_s"];
+            EXPECT_EQ(e["tool"], "hook");
+            cutEdges += e["count"].get<int>();
+        }
+        if (k == "clip") clip = e["t_s"];
+    }
+    EXPECT_EQ(cutEdges, rd["metrics"]["cut_edges"].get<int>());
+    EXPECT_GT(grasp, 0);
+    EXPECT_GT(firstCut, grasp);
+    EXPECT_GT(clip, firstCut);
+    for (const char* f :
+         {"step_time.png", "forces.png", "tool_paths.png", "events.png", "stability.png", "session.html"})
+        EXPECT_GT(std::filesystem::file_size(dir.path() / "plots" / f), 1000u) << f;
+    EXPECT_THAT(rr.out, HasSubstr("plots         5 charts and"));
 }
 
 TEST(RectumCase, BrokenTracksAndSectionsAreRejectedAtExport) {

@@ -137,6 +137,14 @@ TEST(SutureCase, ADeviceDrivesTheNeedle) {
     EXPECT_GT(rd["metrics"]["max_force_n"].get<double>(), 0.0);
     EXPECT_EQ(rd["haptics"]["tools"][0]["name"], "needle");
     EXPECT_EQ(rd["haptics"]["tools"][1]["name"], "thread");
+    int timelinePunctures = 0; // the report's timeline has each puncture, by the needle
+    for (const auto& e : rd["timeline"]["events"])
+        if (e["kind"] == "puncture") {
+            EXPECT_EQ(e["tool"], "needle");
+            timelinePunctures += e["count"].get<int>();
+        }
+    EXPECT_EQ(timelinePunctures, trackPunctures);
+    EXPECT_EQ(rd["timeline"]["tools"].back()["kind"], "needle");
 
     const auto rolled = dir.path() / "roll.json";
     auto rl = player({"run", out.string(), "--headless", "--frames", "120", "--device", "scripted:roll", "--report",

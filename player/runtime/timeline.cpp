@@ -1,0 +1,102 @@
+#include "runtime/timeline.hpp"
+
+#include "sim/scene/world.hpp"
+
+#include <algorithm>
+#include <string_view>
+
+namespace viscera::player {
+
+TimelineRecorder::TimelineRecorder(const sim::World& world, size_t maxSamples)
+    : m_maxSamples(std::max<size_t>(maxSamples, 2)) {
+    if (const sim::InteractionRuntime* in = world.interaction()) {
+        for (size_t i = 0; i < in->instrumentCount(); ++i) {
+            const sim::InstrumentDesc& d = in->instrumentDesc(i);
+            m_tl.tools.push_back({d.name, sim::kindName(d.kind), {}, {}});
+        }
+        m_grasped.assign(in->instrumentCount(), 0);
+        m_cut = in->summary().fasciaEdgesCut + in->summary().fatEdgesCut;
+        m_clips = static_cast<int>(in->summary().clips.size());
+    }
+    for (size_t t = 0; t < world.toolCount(); ++t)
+        m_tl.tools.push_back({world.toolDesc(t).name, "probe", {}, {}});
+    if (world.sutureReport()) m_tl.tools.push_back({"needle", "needle", {}, {}});
+}
+
+void TimelineRecorder::sample(const sim::World& world) {
+    m_tl.t_s.push_back(world.time());
+    size_t k = 0;
+    if (const sim::InteractionRuntime* in = world.interaction())
+        for (const sim::InstrumentState& s : in->summary().instruments) {
+            if (k >= m_tl.tools.size()) break;
+            m_tl.tools[k].tip.push_back(s.tip);
+            m_tl.tools[k].force_n.push_back(s.force.norm());
+            ++k;
+        }
+    for (size_t t = 0; t < world.toolCount() && k < m_tl.tools.size(); ++t, ++k) {
+        const sim::ToolContact& c = world.toolContact(t);
+        m_tl.tools[k].tip.push_back(c.centre);
+        m_tl.tools[k].force_n.push_back(c.force.norm());
+    }
+    if (const sim::SutureReport* su = world.sutureReport(); su && k < m_tl.tools.size()) {
+        // The tip: the far end of the curve (the curve is parameterized by length from its end).
+        const Eigen::Vector3d tip = su->needleCurve().point(su->needleLength());
+        m_tl.tools[k].tip.push_back(tip);
+        const std::vector<sim::SutureFrameRecord>& fr = su->frames();
+        m_tl.tools[k].force_n.push_back(fr.empty() ? 0.0 : fr.back().needleForce);
+        ++k;
+    }
+    // Every tool has one entry per sample (a tool the world no longer reports holds its last).
+    for (SessionTimeline::Tool& tool : m_tl.tools)
+        while (tool.tip.size() < m_tl.t_s.size()) {
+            tool.tip.push_back(tool.tip.empty() ? Eigen::Vector3d::Zero() : tool.tip.back());
+            tool.force_n.push_back(0.0);
+        }
+}
+
+void TimelineRecorder::record(const sim::World& world) {
+    const double t = world.time();
+    const int frame = world.frameCount();
+    if (const sim::InteractionRuntime* in = world.interaction()) {
+        const sim::InteractionSummary& s = in->summary();
+        for (size_t i = 0; i < s.instruments.size() && i < m_grasped.size(); ++i) {
+            const int g = s.instruments[i].grasped;
+            if (g > 0 && m_grasped[i] == 0) m_tl.events.push_back({t, frame, "grasp", s.instruments[i].name, g});
+            if (g == 0 && m_grasped[i] > 0) m_tl.events.push_back({t, frame, "release", s.instruments[i].name, 1});
+            m_grasped[i] = g;
+        }
+        const int cut = s.fasciaEdgesCut + s.fatEdgesCut;
+        if (cut > m_cut) {
+            std::string by; // the energized hook, else the first hook
+            for (const sim::InstrumentState& st : s.instruments)
+                if (std::string_view(st.kind) == "energy_hook" && (by.empty() || st.act)) by = st.name;
+            m_tl.events.push_back({t, frame, "cut", by, cut - m_cut});
+        }
+        m_cut = cut;
+        for (size_t c = static_cast<size_t>(m_clips); c < s.clips.size(); ++c)
+            m_tl.events.push_back({s.clips[c].firedAt, frame, "clip", s.clips[c].instrument, 1});
+        m_clips = static_cast<int>(s.clips.size());
+    }
+    if (const sim::SutureReport* su = world.sutureReport(); su && !su->frames().empty()) {
+        const int p = su->frames().back().punctures;
+        if (p > m_punctures) m_tl.events.push_back({t, frame, "puncture", "needle", p - m_punctures});
+        m_punctures = p;
+    }
+    if (m_frames++ % m_tl.stride == 0) sample(world);
+    if (m_tl.t_s.size() > m_maxSamples) { // keep every other sample, double the stride
+        auto halve = [](auto& v) {
+            size_t w = 0;
+            for (size_t r = 0; r < v.size(); r += 2)
+                v[w++] = v[r];
+            v.resize(w);
+        };
+        halve(m_tl.t_s);
+        for (SessionTimeline::Tool& tool : m_tl.tools) {
+            halve(tool.tip);
+            halve(tool.force_n);
+        }
+        m_tl.stride *= 2;
+    }
+}
+
+} // namespace viscera::player

@@ -1,0 +1,61 @@
+#pragma once
+/// What happened over a session, frame by frame, for the session plots and the report's
+/// "timeline": each tool's position and the tissue's force on it, and the task events (grasps,
+/// cuts, clips, punctures) with their time. Recorded on the physics thread after every step.
+///
+/// The samples stay bounded on a long session: past kMaxSamples the recorder keeps every other
+/// sample and doubles its stride (a window session left open for an hour keeps ≤ kMaxSamples
+/// samples per tool). Events are never dropped.
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace viscera::sim {
+class World;
+}
+
+namespace viscera::player {
+
+struct SessionTimeline {
+    struct Tool {
+        std::string name;
+        std::string kind;                 ///< grasper, energy_hook, clip_applier, probe, needle
+        std::vector<Eigen::Vector3d> tip; ///< m, scene frame, one per sample
+        std::vector<double> force_n;      ///< N, the tissue on the tool, one per sample
+    };
+    struct Event {
+        double t_s = 0;
+        int frame = 0;
+        std::string kind; ///< grasp, release, cut, clip, puncture
+        std::string tool;
+        int count = 1; ///< cut: edges cut that frame; puncture: punctures that frame
+    };
+    std::vector<double> t_s; ///< s, the end of each sampled frame
+    int stride = 1;          ///< frames per sample
+    std::vector<Tool> tools;
+    std::vector<Event> events;
+    bool empty() const { return tools.empty() && events.empty(); }
+};
+
+class TimelineRecorder {
+public:
+    static constexpr size_t kMaxSamples = 4096;
+    /// Names the tools `world` has (instruments of its interaction, probes, the needle).
+    /// maxSamples (≥ 2): the bound past which the samples are halved.
+    explicit TimelineRecorder(const sim::World& world, size_t maxSamples = kMaxSamples);
+    /// After each step.
+    void record(const sim::World& world);
+    const SessionTimeline& timeline() const { return m_tl; }
+    SessionTimeline take() { return std::move(m_tl); }
+
+private:
+    void sample(const sim::World& world);
+    SessionTimeline m_tl;
+    size_t m_maxSamples = kMaxSamples;
+    int m_frames = 0;
+    std::vector<int> m_grasped; ///< per instrument: vertices held last frame
+    int m_cut = 0, m_clips = 0, m_punctures = 0;
+};
+
+} // namespace viscera::player
