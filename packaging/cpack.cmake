@@ -1,10 +1,116 @@
-# Debian packages for the studio and the player: `cpack -G DEB` in the build folder.
+# Debian packages: viscera-player (the lean runtime and the console simulator), viscera-studio
+# (authoring) and viscera-samples (the sample projects exported as cases). Made by
+# scripts/package.sh: it builds the target viscera_samples (the exports), then runs
+# `cpack -G DEB` in the build folder and checks what it made.
+#
+# Every package carries /usr/share/doc/<package>/ (copyright, changelog.gz, README.md, the case
+# package and console protocol specs) and the man pages of its programs.
+
+set(VISCERA_PACKAGES player studio samples)
+set(VISCERA_PKG_OUT ${CMAKE_BINARY_DIR}/packaging)
+
+# Man pages (version filled in) and the changelog, compressed without a timestamp (gzip -n).
+set(VISCERA_MAN_PAGES viscera-player viscera-console-sim viscera-studio)
+set(VISCERA_PKG_GZ)
+foreach(page IN LISTS VISCERA_MAN_PAGES)
+  set(VERSION ${PROJECT_VERSION})
+  configure_file(${CMAKE_CURRENT_LIST_DIR}/man/${page}.1 ${VISCERA_PKG_OUT}/${page}.1 @ONLY)
+  list(APPEND VISCERA_PKG_GZ ${VISCERA_PKG_OUT}/${page}.1.gz)
+  add_custom_command(OUTPUT ${VISCERA_PKG_OUT}/${page}.1.gz
+    COMMAND gzip -9nf -k ${VISCERA_PKG_OUT}/${page}.1
+    DEPENDS ${VISCERA_PKG_OUT}/${page}.1 VERBATIM)
+endforeach()
+configure_file(${CMAKE_CURRENT_LIST_DIR}/doc/changelog.in ${VISCERA_PKG_OUT}/changelog @ONLY)
+add_custom_command(OUTPUT ${VISCERA_PKG_OUT}/changelog.gz
+  COMMAND gzip -9nf -k ${VISCERA_PKG_OUT}/changelog
+  DEPENDS ${VISCERA_PKG_OUT}/changelog VERBATIM)
+list(APPEND VISCERA_PKG_GZ ${VISCERA_PKG_OUT}/changelog.gz)
+add_custom_target(viscera_package_docs ALL DEPENDS ${VISCERA_PKG_GZ})
+
+foreach(comp IN LISTS VISCERA_PACKAGES)
+  install(FILES ${CMAKE_CURRENT_LIST_DIR}/doc/copyright ${VISCERA_PKG_OUT}/changelog.gz
+                ${CMAKE_SOURCE_DIR}/README.md ${CMAKE_CURRENT_LIST_DIR}/vcase-spec.md
+                ${CMAKE_CURRENT_LIST_DIR}/console-protocol.md
+          DESTINATION share/doc/viscera-${comp} COMPONENT ${comp})
+endforeach()
+install(FILES ${VISCERA_PKG_OUT}/viscera-player.1.gz ${VISCERA_PKG_OUT}/viscera-console-sim.1.gz
+        DESTINATION share/man/man1 COMPONENT player)
+install(FILES ${VISCERA_PKG_OUT}/viscera-studio.1.gz DESTINATION share/man/man1 COMPONENT studio)
+
+# The sample cases: every project in projects/ exported by the studio just built. Not part of
+# `all` (a minute of meshing); scripts/package.sh builds it before cpack.
+file(GLOB VISCERA_SAMPLE_PROJECTS LIST_DIRECTORIES true CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/projects/*)
+set(VISCERA_SAMPLE_CASES)
+foreach(dir IN LISTS VISCERA_SAMPLE_PROJECTS)
+  if(NOT EXISTS ${dir}/project.json)
+    continue()
+  endif()
+  get_filename_component(name ${dir} NAME)
+  file(GLOB_RECURSE inputs CONFIGURE_DEPENDS ${dir}/*)
+  set(out ${CMAKE_BINARY_DIR}/samples/${name}.vcase)
+  add_custom_command(OUTPUT ${out}
+    COMMAND $<TARGET_FILE:viscera-studio> export ${dir} -o ${out}
+    DEPENDS viscera-studio ${inputs}
+    COMMENT "Exporting the sample ${name}" VERBATIM)
+  list(APPEND VISCERA_SAMPLE_CASES ${out})
+endforeach()
+add_custom_target(viscera_samples DEPENDS ${VISCERA_SAMPLE_CASES})
+install(FILES ${VISCERA_SAMPLE_CASES} DESTINATION share/viscera/samples COMPONENT samples OPTIONAL)
+
 set(CPACK_PACKAGE_NAME "viscera")
 set(CPACK_PACKAGE_VENDOR "Viscera")
-set(CPACK_PACKAGE_CONTACT "Viscera engineering")
-set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Surgical simulation: studio (authoring) and player (runtime)")
+set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
+set(CPACK_PACKAGE_CONTACT "Viscera engineering <engineering@viscera.dev>")
+set(CPACK_PACKAGING_INSTALL_PREFIX "/usr")
 set(CPACK_GENERATOR "DEB")
+set(CPACK_STRIP_FILES ON)
+set(CPACK_COMPONENTS_ALL ${VISCERA_PACKAGES})
 set(CPACK_DEB_COMPONENT_INSTALL ON)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_PACKAGE_SECTION "science")
+set(CPACK_DEBIAN_PACKAGE_PRIORITY "optional")
+set(CPACK_DEBIAN_PACKAGE_HOMEPAGE "https://viscera.dev/")
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
+set(CPACK_DEBIAN_COMPRESSION_TYPE "xz")
+
+set(CPACK_DEBIAN_PLAYER_PACKAGE_NAME "viscera-player")
+# Mesa's DRI drivers (llvmpipe) for headless rendering where no GPU vendor supplies its own.
+set(CPACK_DEBIAN_PLAYER_PACKAGE_RECOMMENDS "libgl1-mesa-dri")
+set(CPACK_DEBIAN_PLAYER_DESCRIPTION
+"surgical training simulator, trainee runtime
+Viscera Player runs packaged surgical training cases (.vcase): soft
+tissue simulated with XPBD and corotational FEM, grasping, energy
+dissection, clips and suturing, driven by a two-master haptic console
+with force feedback, a recorded replay, a script or the keyboard.
+.
+It builds only the subsystems a case declares, writes a session report
+and plots, and renders headless through EGL (Mesa without a GPU). It
+links no authoring library. Includes viscera-console-sim, a console
+simulator speaking the console's UDP protocol.")
+
+set(CPACK_DEBIAN_STUDIO_PACKAGE_NAME "viscera-studio")
+set(CPACK_DEBIAN_STUDIO_PACKAGE_SUGGESTS "viscera-player")
+set(CPACK_DEBIAN_STUDIO_DESCRIPTION
+"surgical training simulator, case authoring studio
+Viscera Studio is where medical and technical artists build training
+cases for Viscera Player: tissue materials edited as stress-strain
+curves, skeleton stiffness painting, procedural textures, light-sample
+painting, instruments and their device mapping, meshing (CGAL) and
+import of artists' meshes (assimp).
+.
+A Qt desktop application and a command line (export, import, texture,
+replay) that produce the case packages the player runs.")
+
+set(CPACK_DEBIAN_SAMPLES_PACKAGE_NAME "viscera-samples")
+set(CPACK_DEBIAN_SAMPLES_PACKAGE_ARCHITECTURE "all")
+set(CPACK_DEBIAN_SAMPLES_PACKAGE_SHLIBDEPS OFF)
+set(CPACK_DEBIAN_SAMPLES_PACKAGE_DEPENDS "viscera-player (>= ${PROJECT_VERSION})")
+set(CPACK_DEBIAN_SAMPLES_DESCRIPTION
+"surgical training simulator, sample cases
+Training cases for Viscera Player, in /usr/share/viscera/samples: a
+tissue slab and an organ under gravity, a liver to palpate with a
+probe, a rectal dissection (grasper, energy hook, clip applier) and an
+intestinal anastomosis with a running suture.")
+
 include(CPack)

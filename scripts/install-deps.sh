@@ -20,6 +20,8 @@ PKGS=(
   qt6-base-dev libqt6opengl6-dev xvfb xauth
   # tests and benchmarks; clang-format for the formatting check (tests/lint)
   libgtest-dev libgmock-dev googletest libbenchmark-dev clang-format
+  # packages: cpack (dpkg-deb, fakeroot), checked with lintian
+  dpkg-dev fakeroot lintian
   # peer solver for error-time comparisons
   libbullet-dev
 )

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds everything and runs the whole test suite with CTest, in four
-# steps: lint (label "lint": clang-format --dry-run -Werror over the sources, the namespace rule),
+# steps, then checks the Debian packages (scripts/package.sh): lint (label "lint": clang-format --dry-run -Werror over the sources, the namespace rule),
 # everything that needs no OpenGL context or display, the GL tests (label "gl": headless EGL,
 # Mesa llvmpipe without a GPU), then the studio's GUI tests (label "gui": real widgets under
 # Xvfb with Mesa). The GL step fails when no context can be created
@@ -25,4 +25,6 @@ echo "== GUI tests (Xvfb + Mesa) =="
 env -u QT_QPA_PLATFORM LIBGL_ALWAYS_SOFTWARE=1 \
   xvfb-run -a -s "-screen 0 1920x1200x24 -nolisten tcp" \
   ctest --test-dir "$BUILD_DIR" --output-on-failure -j1 -L '^gui$' || status=1
+echo "== packages (cpack, lintian, the extracted player) =="
+bash scripts/package.sh || status=1
 exit $status

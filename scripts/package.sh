@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# Builds the Debian packages (viscera-player, viscera-studio, viscera-samples) with CPack and
+# checks them: each one's Section, Depends and files (docs, copyright, changelog, a man page per
+# program), that the player depends on no authoring library, lintian with 0 errors; then the
+# player and samples packages are extracted into a temporary root and the extracted player
+# verifies every sample and runs two of them headless from there.
+# Usage: scripts/package.sh   (after scripts/configure.sh; VISCERA_BUILD_DIR as there)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BUILD_DIR=${VISCERA_BUILD_DIR:-build}
+JOBS=${VISCERA_JOBS:-$(nproc)}
+fail() { echo "package: FAILED: $*" >&2; exit 1; }
+
+cmake --build "$BUILD_DIR" -j"$JOBS" --target all viscera_samples
+out="$(cd "$BUILD_DIR" && pwd)/packages"
+rm -rf "$out"
+mkdir -p "$out"
+(cd "$BUILD_DIR" && cpack -G DEB -B "$out" >"$out/cpack.log" 2>&1) || { cat "$out/cpack.log"; fail "cpack"; }
+rm -rf "$out/_CPack_Packages"
+
+declare -A deb
+for p in viscera-player viscera-studio viscera-samples; do
+  f=$(ls "$out"/${p}_*.deb 2>/dev/null | head -1)
+  [[ -n "$f" ]] || fail "cpack made no $p package"
+  deb[$p]=$f
+done
+
+summaries=()
+for p in viscera-player viscera-studio viscera-samples; do
+  f=${deb[$p]}
+  section=$(dpkg-deb -f "$f" Section)
+  [[ "$section" == science ]] || fail "$p: Section is '$section', not science"
+  summary=$(dpkg-deb -f "$f" Description | head -1)
+  for s in "${summaries[@]}"; do [[ "$s" != "$summary" ]] || fail "$p: its description is another package's"; done
+  summaries+=("$summary")
+  files=$(dpkg-deb -c "$f" | awk '{print $6}')
+  for d in copyright changelog.gz README.md vcase-spec.md console-protocol.md; do
+    grep -qx "./usr/share/doc/$p/$d" <<<"$files" || fail "$p: no /usr/share/doc/$p/$d"
+  done
+  for b in $(grep '^\./usr/bin/' <<<"$files" | sed 's|^\./usr/bin/||'); do
+    grep -qx "./usr/share/man/man1/$b.1.gz" <<<"$files" || fail "$p: /usr/bin/$b has no man page"
+  done
+  printf '%-16s %8s KiB installed, %8s bytes .deb\n  Depends: %s\n' "$p" "$(dpkg-deb -f "$f" Installed-Size)" \
+    "$(stat -c %s "$f")" "$(dpkg-deb -f "$f" Depends)"
+done
+
+# The lean player: nothing of the authoring stack in its Depends or in its programs' NEEDED.
+authoring='cgal|openvdb|opencv|assimp|qt6widgets|qt6openglwidgets|qt6concurrent|libtbb'
+if dpkg-deb -f "${deb[viscera-player]}" Depends | grep -Eiq "$authoring"; then
+  fail "viscera-player depends on an authoring library: $(dpkg-deb -f "${deb[viscera-player]}" Depends)"
+fi
+root=$(mktemp -d)
+trap 'rm -rf "$root"' EXIT
+dpkg-deb -x "${deb[viscera-player]}" "$root"
+dpkg-deb -x "${deb[viscera-samples]}" "$root"
+for b in "$root"/usr/bin/*; do
+  if readelf -d "$b" | grep NEEDED | grep -Eiq "$authoring"; then fail "$(basename "$b") links an authoring library"; fi
+done
+[[ -z $(dpkg-deb -c "${deb[viscera-studio]}" | awk '{print $6}' | grep '^\./usr/bin/viscera-player') ]] ||
+  fail "viscera-studio ships the player"
+samples=("$root"/usr/share/viscera/samples/*.vcase)
+((${#samples[@]} >= 5)) || fail "viscera-samples has ${#samples[@]} cases, expected the 5 sample projects"
+
+# The extracted player, from the temporary root: verify every sample, run two headless.
+player="$root/usr/bin/viscera-player"
+"$player" --version
+for c in "${samples[@]}"; do "$player" verify "$c"; done
+"$player" run "$root/usr/share/viscera/samples/tissue-slab.vcase" --headless --frames 60 --report "$root/slab.json" |
+  grep -E '^(case|status)'
+"$player" run "$root/usr/share/viscera/samples/liver.vcase" --headless --frames 120 --device scripted:press \
+  --report "$root/liver.json" --plots "$root/plots" | grep -E '^(case|status|tools|plots)'
+[[ -s "$root/plots/session.html" ]] || fail "the extracted player wrote no plots"
+
+# lintian: 0 errors (warnings are listed).
+lint="$out/lintian.txt"
+lintian --tag-display-limit 0 "${deb[@]}" >"$lint" 2>&1 || true
+cat "$lint"
+errors=$(grep -c '^E: ' "$lint" || true)
+warnings=$(grep -c '^W: ' "$lint" || true)
+echo "package: lintian: $errors errors, $warnings warnings"
+((errors == 0)) || fail "lintian reported $errors errors"
+echo "package: ok — $(ls "$out"/*.deb | xargs -n1 basename | tr '\n' ' ')"
