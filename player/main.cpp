@@ -48,7 +48,8 @@ void usage(std::FILE* out) {
     std::fputs("usage: viscera-player verify <case.vcase>\n"
                "       viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]\n"
                "                      [--report report.json] [--screenshot out.png] [--trace trace.csv]\n"
-               "                      [--realtime] [--servo sleep|sleep:CPU|spin:US|busy|busy:CPU] [--plots DIR]\n"
+               "                      [--realtime | --lockstep] [--servo sleep|sleep:CPU|spin:US|busy|busy:CPU]\n"
+               "                      [--plots DIR]\n"
                "       viscera-player plot <report.json> -o DIR\n"
                "       SPEC: replay:<file> | scripted:<name> | console:<host:port> | keyboard\n"
                "       viscera-player --version\n",
@@ -74,6 +75,8 @@ constexpr const char* kRunHelp =
     "                        (idle, press, circle, bimanual, clutch, roll) | console:<host:port>\n"
     "                        | keyboard (window only). A device that drives no tool is warned about.\n"
     "  --realtime            pace headless physics to the wall clock (console and window always are)\n"
+    "  --lockstep            window: step a replay or scripted device with the physics instead of\n"
+    "                        the wall clock (what happens is what the headless run shows)\n"
     "  --servo MODE          real-time servo wait: sleep | sleep:CPU | spin:US | busy | busy:CPU\n"
     "  --report FILE.json    session report (schemaVersion, frames, metrics, haptics, errors)\n"
     "  --trace FILE.csv      per-tick device force and pose trace (needs --device)\n"
@@ -115,7 +118,7 @@ int cmdVerify(const std::vector<std::string>& args) {
 
 int cmdRun(const std::vector<std::string>& args) {
     std::optional<std::string> casePath, reportPath, screenshot, device, tracePath, plotsDir;
-    bool headless = false, realtime = false, framesGiven = false;
+    bool headless = false, realtime = false, lockstep = false, framesGiven = false;
     haptics::ServoWait servoWait = haptics::ServoWait::SleepSpin;
     int servoCpu = -1;
     int64_t servoSpinNs = -1;
@@ -144,6 +147,8 @@ int cmdRun(const std::vector<std::string>& args) {
             plotsDir = value("--plots");
         else if (a == "--realtime")
             realtime = true;
+        else if (a == "--lockstep")
+            lockstep = true;
         else if (a == "--screenshot")
             screenshot = value("--screenshot");
         else if (a == "--device")
@@ -216,9 +221,15 @@ int cmdRun(const std::vector<std::string>& args) {
 #endif
     }
 
+    if (lockstep && realtime) return fail(kExitUsage, "--lockstep and --realtime exclude each other");
+    if (lockstep && spec &&
+        (spec->kind == haptics::DeviceSpec::Kind::Console || spec->kind == haptics::DeviceSpec::Kind::Keyboard))
+        return fail(kExitUsage, "--lockstep: --device " + *device + " runs on the wall clock; drop --lockstep");
     std::unique_ptr<haptics::Device> dev;
     if (spec) dev = haptics::openDevice(*spec);
-    const bool rt = realtime || (dev && dev->capabilities().realtime) || !headless;
+    // The window paces to the wall clock unless --lockstep asks for a replay or script stepped
+    // with the physics (shown at physics speed where that is slower than real time).
+    const bool rt = !lockstep && (realtime || (dev && dev->capabilities().realtime) || !headless);
     if (dev && rt) {
         // The servo gets a CPU of its own (the highest allowed, where two or more are): this thread
         // and every thread started from here on (physics, solver workers, window) stay off it, so

@@ -148,6 +148,9 @@ SceneView SceneView::fromWorld(const sim::World& world, const ThicknessBakeSetti
             allTris.push_back({t[0] + base, t[1] + base, t[2] + base});
         view.m_meshes.push_back(std::move(m));
     }
+    if (const sim::InteractionRuntime* in = world.interaction(); in && in->dissects())
+        for (size_t b = 0; b < world.bodyCount(); ++b) // the fat's cut surface, shown as it opens
+            if (in->dissectsBody(b)) view.addBodyCut(b, world.restMesh(b));
     std::unique_ptr<TriangleBvh> bodies;
     if (!allTris.empty()) bodies = std::make_unique<TriangleBvh>(allPos, allTris);
     for (size_t s = 0; s < world.surfaceCount(); ++s) {
@@ -175,6 +178,13 @@ SceneView SceneView::fromWorld(const sim::World& world, const ThicknessBakeSetti
 }
 
 void SceneView::updateFromWorld(const sim::World& world) {
+    const sim::InteractionRuntime* cut =
+        world.interaction() && world.interaction()->dissects() ? world.interaction() : nullptr;
+    if (cut) // before the positions are copied: the cut mesh's slots name the nodes to copy
+        for (const BodyCut& c : m_cuts) {
+            cut->bodyTetMaskInto(c.body, m_maskScratch);
+            setBodyCut(c.body, m_maskScratch);
+        }
     for (size_t i = 0; i < m_meshes.size(); ++i) {
         RenderMesh& m = m_meshes[i];
         const std::vector<sim::Vec3>* src = nullptr;
@@ -193,21 +203,133 @@ void SceneView::updateFromWorld(const sim::World& world) {
             m.positions[3 * v + 2] = float(p.z());
         }
         recomputeNormals(i);
-        // Energized dissection [A §5.3.1]: cut faces are dropped from the same buffers.
-        if (m.source == RenderMesh::Source::Surface && world.interaction() && world.interaction()->dissects()) {
-            world.interaction()->surfaceFaceMaskInto(m.sourceIndex, m_maskScratch);
+        if (!cut) continue;
+        // Energized dissection [A §5.3.1]: cut faces are dropped from the same buffers, and the
+        // heat channel of the G-buffer tints coagulated and charred tissue along the cut.
+        if (m.source == RenderMesh::Source::Surface) {
+            cut->surfaceFaceMaskInto(m.sourceIndex, m_maskScratch);
             if (m_maskScratch.size() == m.triangleCount()) setFaceMask(i, m_maskScratch);
-            // The heat channel of the G-buffer: coagulated and charred tissue along the cut.
-            world.interaction()->surfaceHeatInto(m.sourceIndex, m_heatScratch);
-            if (!m_heatScratch.empty() && m.heat.size() == n) {
-                for (size_t v = 0; v < n; ++v) {
-                    const int32_t s = m.sourceVertex[v];
-                    m.heat[v] = s >= 0 && size_t(s) < m_heatScratch.size() ? m_heatScratch[size_t(s)] : 0.0f;
+            cut->surfaceHeatInto(m.sourceIndex, m_heatScratch);
+        } else {
+            cut->bodyHeatInto(m.sourceIndex, m_heatScratch);
+        }
+        if (!m_heatScratch.empty()) setSourceHeat(i, m_heatScratch);
+    }
+}
+
+void SceneView::setSourceHeat(size_t i, const std::vector<float>& nodeHeat) {
+    RenderMesh& m = m_meshes.at(i);
+    if (m.source == RenderMesh::Source::Static || m.heat.size() != m.vertexCount() ||
+        m.sourceVertex.size() != m.vertexCount())
+        return;
+    for (size_t v = 0; v < m.heat.size(); ++v) {
+        const int32_t s = m.sourceVertex[v];
+        const float h = s >= 0 && size_t(s) < nodeHeat.size() ? nodeHeat[size_t(s)] : 0.0f;
+        m.heat[v] = std::isfinite(h) ? std::clamp(h, 0.0f, 1.0f) : 0.0f;
+    }
+    ++m.revision;
+}
+
+size_t SceneView::addBodyCut(size_t bodyMesh, const sim::TetMesh& rest, size_t capacity) {
+    const RenderMesh& body = m_meshes.at(bodyMesh);
+    if (body.source != RenderMesh::Source::Body)
+        throw std::invalid_argument("render::SceneView::addBodyCut(): mesh " + body.name + " is not a body's boundary");
+    if (rest.tetCount() == 0 || capacity == 0)
+        throw std::invalid_argument("render::SceneView::addBodyCut(): " + body.name + ": no tets or no capacity");
+    auto mesh = std::shared_ptr<sim::TetMesh>(rest.clone());
+    mesh->requireLevel(3);
+    if (mesh->boundaryHalfFacets().size() != body.triangleCount())
+        throw std::invalid_argument("render::SceneView::addBodyCut(): mesh " + body.name +
+                                    " is not the boundary of the given tet mesh");
+    RenderMesh m;
+    m.name = body.name + " cut surface";
+    m.material = body.material;
+    m.source = RenderMesh::Source::Body;
+    m.sourceIndex = body.sourceIndex;
+    m.visible = false; // nothing cut yet
+    const size_t nv = 3 * capacity;
+    const int32_t anyNode = mesh->tets()[0][0]; // unused slots sit on the body (bounds stay true)
+    m.sourceVertex.assign(nv, anyNode);
+    m.indices.resize(nv);
+    for (size_t k = 0; k < nv; ++k)
+        m.indices[k] = uint32_t(k);
+    m.positions.resize(3 * nv);
+    const sim::Vec3& p0 = mesh->positions()[size_t(anyNode)];
+    for (size_t v = 0; v < nv; ++v)
+        for (int c = 0; c < 3; ++c)
+            m.positions[3 * v + c] = float(p0[c]);
+    m.rest = m.positions;
+    m.normals.assign(3 * nv, 0.0f);
+    m.thickness.assign(nv, 0.0f);
+    m.sampleMap.assign(nv, 0.0f);
+    m.heat.assign(nv, 0.0f);
+    m.faceMask.assign(capacity, 0);
+    m_meshes.push_back(std::move(m));
+    BodyCut c;
+    c.body = body.sourceIndex;
+    c.bodyMesh = bodyMesh;
+    c.cutMesh = m_meshes.size() - 1;
+    c.capacity = capacity;
+    c.rest = std::move(mesh);
+    c.lastMask.assign(c.rest->tetCount(), 1);
+    m_cuts.push_back(std::move(c));
+    return m_meshes.size() - 1;
+}
+
+void SceneView::setBodyCut(size_t body, const std::vector<uint8_t>& tetMask) {
+    for (BodyCut& c : m_cuts) {
+        if (c.body != body || tetMask.size() != c.lastMask.size()) continue;
+        bool same = true;
+        for (size_t t = 0; t < tetMask.size() && same; ++t)
+            same = (tetMask[t] != 0) == (c.lastMask[t] != 0);
+        if (same) continue;
+        for (size_t t = 0; t < tetMask.size(); ++t)
+            c.lastMask[t] = tetMask[t] ? 1 : 0;
+        const sim::TetMesh& T = *c.rest;
+        // The body's own boundary: a face goes with its tet.
+        const std::vector<int32_t>& bhf = T.boundaryHalfFacets();
+        m_maskScratch.resize(bhf.size());
+        for (size_t f = 0; f < bhf.size(); ++f)
+            m_maskScratch[f] = c.lastMask[size_t(sim::TetMesh::cellOf(bhf[f]))];
+        setFaceMask(c.bodyMesh, m_maskScratch);
+        // The cavity: faces of intact tets across from a cut one, oriented out of the intact tet.
+        RenderMesh& m = m_meshes[c.cutMesh];
+        const int32_t anyNode = T.tets()[0][0];
+        size_t k = 0;
+        c.exposed = 0;
+        for (size_t t = 0; t < T.tetCount(); ++t) {
+            if (!c.lastMask[t]) continue;
+            for (int i = 0; i < 4; ++i) {
+                const int32_t hf = int32_t(4 * t + i);
+                const int32_t o = T.opp(hf);
+                if (o == sim::kNone || c.lastMask[size_t(sim::TetMesh::cellOf(o))]) continue;
+                ++c.exposed;
+                if (k >= c.capacity) continue;
+                const std::array<int32_t, 3> v = T.halfFacetVertices(hf);
+                for (int j = 0; j < 3; ++j) {
+                    m.sourceVertex[3 * k + j] = v[j];
+                    const sim::Vec3& r = T.positions()[size_t(v[j])];
+                    for (int a = 0; a < 3; ++a)
+                        m.rest[3 * (3 * k + j) + a] = float(r[a]);
                 }
-                ++m.revision;
+                ++k;
             }
         }
+        for (size_t s = k; s < c.capacity; ++s)
+            for (int j = 0; j < 3; ++j)
+                m.sourceVertex[3 * s + j] = anyNode;
+        m_maskScratch.assign(c.capacity, 0);
+        std::fill(m_maskScratch.begin(), m_maskScratch.begin() + long(k), 1);
+        setFaceMask(c.cutMesh, m_maskScratch);
+        m.visible = k > 0;
+        ++m.staticRevision; // rest positions (the pattern space) of the refilled slots
     }
+}
+
+size_t SceneView::exposedCutFaces(size_t body) const {
+    for (const BodyCut& c : m_cuts)
+        if (c.body == body) return c.exposed;
+    return 0;
 }
 
 void SceneView::recomputeNormals(size_t i) {

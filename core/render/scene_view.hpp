@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -119,6 +120,26 @@ public:
     /// Recomputes the normals of mesh i from its positions (allocation-free); bumps its revision.
     void recomputeNormals(size_t i);
 
+    /// The cut surface of a dissected tet body [A §5.3.1]: adds a mesh of `capacity` face slots
+    /// (Source::Body, same body and material as mesh `bodyMesh`, which must be the body's
+    /// boundary as bodySurfaceMesh makes it) that setBodyCut fills with the faces a cut exposes.
+    /// The topology never changes (each slot has its own three vertices, flat shaded); unused
+    /// slots are masked out. Returns the new mesh's index. fromWorld adds one for every body the
+    /// world's interaction dissects.
+    static constexpr size_t kCutFaceCapacity = 16384;
+    size_t addBodyCut(size_t bodyMesh, const sim::TetMesh& rest, size_t capacity = kCutFaceCapacity);
+    /// Applies body `body`'s tet mask (1 intact, 0 cut; #T entries): the body's boundary faces
+    /// whose tet is cut are dropped, and every face of an intact tet whose neighbour is cut is
+    /// shown in the cut mesh, facing into the cavity (the first `capacity` of them, in tet
+    /// order). The same mask as last time changes nothing; a body without addBodyCut or a mask
+    /// of the wrong size is ignored. Positions follow with the next copy from the source.
+    void setBodyCut(size_t body, const std::vector<uint8_t>& tetMask);
+    /// Faces the last setBodyCut exposed for `body` (all of them, also past the capacity).
+    size_t exposedCutFaces(size_t body) const;
+    /// Sets the heat of mesh i from per-node heat of its source (through sourceVertex; a node
+    /// out of range gets 0). Ignored unless the mesh has a source and heat per vertex.
+    void setSourceHeat(size_t i, const std::vector<float>& nodeHeat);
+
     std::vector<RenderMesh>& meshes() { return m_meshes; }
     const std::vector<RenderMesh>& meshes() const { return m_meshes; }
     std::vector<TissueMaterial>& materials() { return m_materials; }
@@ -131,6 +152,12 @@ private:
     std::vector<TissueMaterial> m_materials;
     std::vector<uint8_t> m_maskScratch; ///< updateFromWorld: the dissection mask of a surface
     std::vector<float> m_heatScratch;   ///< updateFromWorld: the heat of a dissected surface
+    struct BodyCut {
+        size_t body = 0, bodyMesh = 0, cutMesh = 0, capacity = 0, exposed = 0;
+        std::shared_ptr<const sim::TetMesh> rest; ///< level 3: opp() and the boundary's half-facets
+        std::vector<uint8_t> lastMask;
+    };
+    std::vector<BodyCut> m_cuts;
 };
 
 } // namespace viscera::render

@@ -252,6 +252,13 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
                     in->surfaceHeatInto(k, lv.surfaceHeat[k]);
                 }
             }
+            lv.bodyTetMasks.resize(world.bodyCount());
+            lv.bodyHeat.resize(world.bodyCount());
+            for (size_t b = 0; b < world.bodyCount(); ++b)
+                if (const sim::InteractionRuntime* in = world.interaction(); in && in->dissectsBody(b)) {
+                    in->bodyTetMaskInto(b, lv.bodyTetMasks[b]);
+                    in->bodyHeatInto(b, lv.bodyHeat[b]);
+                }
             lv.tools = render::toolPoses(world);
         }
         if (!rec.finite)

@@ -49,6 +49,8 @@ struct LiveView {
     std::vector<std::vector<sim::Vec3>> surfaces;   ///< nodes of every fascia surface, m, scene
     std::vector<std::vector<uint8_t>> surfaceMasks; ///< per surface: intact triangles (empty: no cut)
     std::vector<std::vector<float>> surfaceHeat;    ///< per surface: vertex heat in [0, 1] (empty: none)
+    std::vector<std::vector<uint8_t>> bodyTetMasks; ///< per body: intact tets (empty: not dissected)
+    std::vector<std::vector<float>> bodyHeat;       ///< per body: node heat in [0, 1] (empty: none)
     render::ToolPoses tools;                        ///< instruments, probes, clips, needle, thread
     std::vector<double> toolRadius;
     bool finished = false;

@@ -59,6 +59,9 @@ public:
         {
             std::lock_guard<std::mutex> lock(m_live.mutex);
             if (m_live.nodes.size() == m_offset) {
+                // The fat's cut first: its cut mesh's slots name the nodes the copy below reads.
+                for (size_t b = 0; b < m_live.bodyTetMasks.size(); ++b)
+                    if (!m_live.bodyTetMasks[b].empty()) m_view.setBodyCut(b, m_live.bodyTetMasks[b]);
                 for (size_t i = 0; i < m_view.meshes().size(); ++i) {
                     render::RenderMesh& m = m_view.meshes()[i];
                     const std::vector<sim::Vec3>* src = nullptr;
@@ -78,20 +81,17 @@ public:
                             m.positions[3 * v + r] = static_cast<float>((*src)[k][r]);
                     }
                     m_view.recomputeNormals(i);
-                    if (m.source != render::RenderMesh::Source::Surface) continue;
                     // The cut [A §5.3.1]: dropped faces and the heat tint along it.
                     const size_t s = m.sourceIndex;
-                    if (s < m_live.surfaceMasks.size() && m_live.surfaceMasks[s].size() == m.triangleCount())
-                        m_view.setFaceMask(i, m_live.surfaceMasks[s]);
-                    if (s < m_live.surfaceHeat.size() && !m_live.surfaceHeat[s].empty() &&
-                        m.heat.size() == m.sourceVertex.size()) {
-                        const std::vector<float>& heat = m_live.surfaceHeat[s];
-                        for (size_t v = 0; v < m.sourceVertex.size(); ++v) {
-                            const auto k = static_cast<size_t>(m.sourceVertex[v]);
-                            m.heat[v] = k < heat.size() ? heat[k] : 0.0f;
-                        }
-                        ++m.revision;
+                    const std::vector<float>* heat = nullptr;
+                    if (m.source == render::RenderMesh::Source::Surface) {
+                        if (s < m_live.surfaceMasks.size() && m_live.surfaceMasks[s].size() == m.triangleCount())
+                            m_view.setFaceMask(i, m_live.surfaceMasks[s]);
+                        if (s < m_live.surfaceHeat.size()) heat = &m_live.surfaceHeat[s];
+                    } else if (s < m_live.bodyHeat.size()) {
+                        heat = &m_live.bodyHeat[s];
                     }
+                    if (heat && !heat->empty()) m_view.setSourceHeat(i, *heat);
                 }
                 m_tools.update(m_view, m_live.tools);
             }

@@ -269,6 +269,10 @@ TEST(PlayerCli, UsageErrorsAreClear) {
     auto m = player({"verify", "/nonexistent/case.vcase"});
     EXPECT_EQ(m.exitCode, 1);
     EXPECT_THAT(m.err, HasSubstr("/nonexistent/case.vcase"));
+    auto ls = player({"run", "x.vcase", "--headless", "--lockstep", "--device", "console:127.0.0.1:7400"});
+    EXPECT_EQ(ls.exitCode, 2);
+    EXPECT_THAT(ls.err, HasSubstr("--lockstep: --device console:127.0.0.1:7400 runs on the wall clock"));
+    EXPECT_EQ(player({"run", "x.vcase", "--headless", "--lockstep", "--realtime"}).exitCode, 2);
     // --help on every subcommand, anywhere after it: its own usage on stdout, exit 0, nothing run.
     for (const auto& [args, line] : std::vector<std::pair<std::vector<std::string>, std::string>>{
              {{"run", "--help"}, "usage: viscera-player run <case.vcase> [options]"},

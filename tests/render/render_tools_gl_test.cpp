@@ -121,3 +121,42 @@ TEST(RenderGlTools, StereoDrawsTheInstrumentsInBothEyes) {
     EXPECT_GT(compareImages(half(with, 0), half(with, 1)).differing, 50u);
     writePng(std::string(VISCERA_TEST_OUTPUT_DIR) + "/tools_stereo.png", with);
 }
+
+// The fat's cut surface is drawn: with the tets of a corner cut away, hiding the cut mesh changes
+// the image (what shows through the opening is the cavity's faces, not the background).
+TEST(RenderGlTools, TheFatsCutSurfaceIsDrawnInTheOpening) {
+    using namespace viscera::sim;
+    BoxSpec spec;
+    spec.size = Vec3(0.04, 0.03, 0.02);
+    spec.cells = {8, 6, 4};
+    const std::unique_ptr<TetMesh> rest = makeBoxTetMesh(spec);
+    rest->requireLevel(3);
+    SceneView view;
+    view.addMaterial(defaultMaterialFor("fat"));
+    view.meshes().push_back(bodySurfaceMesh(*rest, "fat", 0));
+    const size_t cut = view.addBodyCut(0, *rest);
+    Rig r(view);
+    if (!r.r) GTEST_SKIP() << "no headless OpenGL context: " << r.why;
+    // Cut every tet whose centroid lies in the upper front quarter (a notch open to the camera).
+    std::vector<uint8_t> mask(rest->tetCount(), 1);
+    for (size_t t = 0; t < rest->tetCount(); ++t) {
+        Vec3 c = Vec3::Zero();
+        for (int32_t v : rest->tets()[t])
+            c += rest->positions()[size_t(v)] / 4;
+        if (c.z() > 0.01 && c.x() > 0.02) mask[t] = 0;
+    }
+    view.setBodyCut(0, mask);
+    ASSERT_GT(view.exposedCutFaces(0), 0u);
+    for (size_t i = 0; i < view.meshes().size(); ++i) { // the copy from the source, as updateFromWorld does
+        RenderMesh& m = view.meshes()[i];
+        for (size_t v = 0; v < m.vertexCount(); ++v)
+            for (int a = 0; a < 3; ++a)
+                m.positions[3 * v + a] = float(rest->positions()[size_t(m.sourceVertex[v])][a]);
+        view.recomputeNormals(i);
+    }
+    const Image with = r.draw(view);
+    view.meshes()[cut].visible = false;
+    const Image without = r.draw(view);
+    EXPECT_GT(compareImages(with, without).differing, 300u) << "the cavity's faces are drawn";
+    writePng(std::string(VISCERA_TEST_OUTPUT_DIR) + "/fat_cut.png", with);
+}

@@ -271,16 +271,25 @@ void Dissection::fasciaFaceMaskInto(std::vector<uint8_t>& out) const {
     fasciaEdges().intactMaskInto(out);
 }
 
-void Dissection::fasciaVertexHeatInto(std::vector<float>& out) const {
-    const EdgeStructure& E = fasciaEdges();
+namespace {
+/// Per vertex: the largest τ_e of its edges over the ignition temperature, 1 on a dissected edge.
+void vertexHeatInto(const EdgeStructure& E, const std::vector<double>& heat, double ignition, std::vector<float>& out) {
     out.assign(E.vertexCount(), 0.0f);
-    const double ignition = m_fascia->tissue.ignition;
     for (size_t e = 0; e < E.edgeCount(); ++e) {
-        const double h = E.isDissected(e) ? 1.0 : std::clamp(m_fascia->heat[e] / ignition, 0.0, 1.0);
+        const double h = E.isDissected(e) ? 1.0 : std::clamp(heat[e] / ignition, 0.0, 1.0);
         if (!(h > 0)) continue;
         for (int32_t v : E.edge(e))
             out[static_cast<size_t>(v)] = std::max(out[static_cast<size_t>(v)], static_cast<float>(h));
     }
+}
+} // namespace
+
+void Dissection::fasciaVertexHeatInto(std::vector<float>& out) const {
+    vertexHeatInto(fasciaEdges(), m_fascia->heat, m_fascia->tissue.ignition, out);
+}
+
+void Dissection::fatVertexHeatInto(std::vector<float>& out) const {
+    vertexHeatInto(fatEdges(), m_fat->heat, m_fat->tissue.ignition, out);
 }
 
 void Dissection::fatTetMaskInto(std::vector<uint8_t>& out) const {

@@ -129,6 +129,8 @@ public:
     /// Heat of every fascia vertex for the renderer's heat channel, in [0, 1]: the largest τ_e of
     /// its edges over the ignition temperature (1 where an edge burnt through: charred).
     void fasciaVertexHeatInto(std::vector<float>& out) const;
+    /// The same for the fat's nodes (its cut surface shows the heat).
+    void fatVertexHeatInto(std::vector<float>& out) const;
     void fatTetMaskInto(std::vector<uint8_t>& out) const;
     /// Mask of the fat mesh's boundary triangles (TetMesh::boundary() order, which is the order of
     /// the render mesh SceneView makes for a tet body): 1 while the tet behind the face is intact.

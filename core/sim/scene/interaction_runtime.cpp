@@ -179,6 +179,7 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
                     dd.fat = bodies[b];
                     dd.tetBody = b;
                     dd.fatTissue = p;
+                    r->m_dissectBody = b;
                     found = true;
                 }
             if (!found) fail("tissues", "'" + t.layer + "' is not a body or surface of the scene");
@@ -434,6 +435,20 @@ void InteractionRuntime::surfaceHeatInto(size_t s, std::vector<float>& out) cons
 void InteractionRuntime::surfaceFaceMaskInto(size_t s, std::vector<uint8_t>& out) const {
     out.clear();
     if (m_dissection && m_dissection->hasFascia() && s == m_dissectSurface) m_dissection->fasciaFaceMaskInto(out);
+}
+
+bool InteractionRuntime::dissectsBody(size_t b) const {
+    return m_dissection && m_dissection->hasFat() && b == m_dissectBody;
+}
+
+void InteractionRuntime::bodyTetMaskInto(size_t b, std::vector<uint8_t>& out) const {
+    out.clear();
+    if (dissectsBody(b)) m_dissection->fatTetMaskInto(out);
+}
+
+void InteractionRuntime::bodyHeatInto(size_t b, std::vector<float>& out) const {
+    out.clear();
+    if (dissectsBody(b)) m_dissection->fatVertexHeatInto(out);
 }
 
 } // namespace viscera::sim

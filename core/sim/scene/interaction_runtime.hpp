@@ -111,6 +111,12 @@ public:
     /// dissection on that surface).
     void surfaceHeatInto(size_t s, std::vector<float>& out) const;
     bool dissects() const { return m_dissection != nullptr; }
+    /// Body b is the tet layer the energy hook cuts (its render shows the cut surface).
+    bool dissectsBody(size_t b) const;
+    /// Body b's tets: 1 intact, 0 cut (empty: b is not dissected).
+    void bodyTetMaskInto(size_t b, std::vector<uint8_t>& out) const;
+    /// Heat of body b per node in [0, 1] (Dissection::fatVertexHeatInto; empty: not dissected).
+    void bodyHeatInto(size_t b, std::vector<float>& out) const;
 
 private:
     struct Instrument;
@@ -124,6 +130,7 @@ private:
     std::vector<std::unique_ptr<Clip>> m_clips;
     std::unique_ptr<Dissection> m_dissection;
     size_t m_dissectSurface = SIZE_MAX;
+    size_t m_dissectBody = SIZE_MAX;
     // collision surface
     bool m_surfaceIsLayer = false;
     size_t m_surfaceIndex = 0;
