@@ -220,11 +220,39 @@ ToolPoses toolPoses(const sim::World& world) {
         const double len = s->needleLength();
         for (int k = 0; k <= 24; ++k)
             p.needle.push_back(curve.point(len * k / 24.0));
+        p.instruments.push_back(needleHolderPose(p.needle));
         p.thread = s->threadPath();
         if (p.thread.size() < 2) // not through the tissue yet: a tail behind the needle's end
             p.thread.insert(p.thread.begin(), curve.point(0.0) - 0.012 * curve.tangent(0.0));
     }
     return p;
+}
+
+ToolPoses::Instrument needleHolderPose(const std::vector<Eigen::Vector3d>& points) {
+    ToolPoses::Instrument h;
+    h.name = "needle holder";
+    h.kind = "needle_holder";
+    h.jaw = 0;           // closed on the needle
+    h.jawLength = 0.005; // a fine holder, to the scale of the needle (0.3 mm wire)
+    h.radius = 0.0008;
+    if (points.size() < 2) return h;
+    const size_t k = std::min(points.size() - 1, std::max<size_t>(1, points.size() / 3));
+    h.tip = points[k];
+    Vec3 tangent = points[std::min(k + 1, points.size() - 1)] - points[k - 1];
+    if (tangent.norm() < 1e-12) tangent = Vec3::UnitX();
+    tangent.normalize();
+    // The arc's plane, from its ends and its middle.
+    const Vec3 chord = points.back() - points.front();
+    const Vec3 bow = points[points.size() / 2] - 0.5 * (points.front() + points.back());
+    Vec3 normal = chord.cross(bow);
+    if (normal.norm() < 1e-12) normal = tangent.unitOrthogonal();
+    normal.normalize();
+    // In the plane, across the needle; the arc's middle bows away from its centre.
+    Vec3 outward = normal.cross(tangent);
+    if (outward.dot(bow) < 0) outward = -outward;
+    // Shaft along −direction: away from the centre and out of the plane.
+    h.direction = -(0.7 * outward + 0.7 * normal).normalized();
+    return h;
 }
 
 template <class B>

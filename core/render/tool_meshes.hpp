@@ -49,8 +49,15 @@ struct ToolPoses {
     bool empty() const { return instruments.empty() && probes.empty() && needle.empty(); }
 };
 
-/// The snapshot of `world` now (instruments of the interaction, probes, clips, needle, thread).
+/// The snapshot of `world` now (instruments of the interaction, probes, clips, needle, thread;
+/// with the needle, the needle holder that carries it).
 ToolPoses toolPoses(const sim::World& world);
+
+/// The needle holder of a suturing needle (`points`: the needle end to tip, at least two): closed
+/// jaws on the needle a third of its length from the end (where a surgeon grips it), the shaft
+/// leaving away from the arc's centre and out of its plane so that it does not lie along the
+/// needle. Kind "needle_holder".
+ToolPoses::Instrument needleHolderPose(const std::vector<Eigen::Vector3d>& points);
 
 class ToolMeshes {
 public:

@@ -122,3 +122,26 @@ TEST(ToolMeshes, AnEmptySnapshotAddsNothing) {
     EXPECT_TRUE(view.meshes().empty());
     EXPECT_TRUE(view.materials().empty());
 }
+
+TEST(ToolMeshes, TheNeedleHolderGripsTheNeedleAwayFromItsCentre) {
+    // A semicircular needle of radius 8 mm around the origin in the z = 0 plane, end to tip.
+    std::vector<Vector3d> needle;
+    for (int k = 0; k <= 24; ++k) {
+        const double a = M_PI * k / 24.0;
+        needle.push_back(Vector3d(0.008 * std::cos(a), 0.008 * std::sin(a), 0.0));
+    }
+    const ToolPoses::Instrument h = needleHolderPose(needle);
+    EXPECT_EQ(h.kind, "needle_holder");
+    EXPECT_EQ(h.jaw, 0.0) << "closed on the needle";
+    EXPECT_NEAR(h.tip.norm(), 0.008, 1e-12) << "the jaws are on the needle";
+    EXPECT_NEAR(h.direction.norm(), 1.0, 1e-12);
+    const Vector3d shaft = -h.direction; // from the tip up the shaft
+    EXPECT_GT(shaft.dot(h.tip.normalized()), 0.5) << "away from the arc's centre";
+    EXPECT_GT(std::abs(shaft.z()), 0.5) << "out of the needle's plane";
+    const Vector3d tangent = (needle[9] - needle[7]).normalized();
+    EXPECT_LT(std::abs(shaft.dot(tangent)), 0.1) << "across the needle, not along it";
+    // Degenerate input: a pose, no NaN.
+    const ToolPoses::Instrument d = needleHolderPose({Vector3d::Zero(), Vector3d::Zero()});
+    EXPECT_TRUE(d.direction.allFinite());
+    EXPECT_TRUE(needleHolderPose({}).tip.allFinite());
+}
