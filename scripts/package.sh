@@ -54,7 +54,9 @@ trap 'rm -rf "$root"' EXIT
 dpkg-deb -x "${deb[viscera-player]}" "$root"
 dpkg-deb -x "${deb[viscera-samples]}" "$root"
 for b in "$root"/usr/bin/*; do
-  if readelf -d "$b" | grep NEEDED | grep -Eiq "$authoring"; then fail "$(basename "$b") links an authoring library"; fi
+  needed=$(readelf -d "$b") || fail "$(basename "$b"): readelf cannot read it"
+  grep -q NEEDED <<<"$needed" || fail "$(basename "$b"): no NEEDED entries (not a dynamic program?)"
+  if grep NEEDED <<<"$needed" | grep -Eiq "$authoring"; then fail "$(basename "$b") links an authoring library"; fi
 done
 [[ -z $(dpkg-deb -c "${deb[viscera-studio]}" | awk '{print $6}' | grep '^\./usr/bin/viscera-player') ]] ||
   fail "viscera-studio ships the player"
@@ -73,7 +75,10 @@ for c in "${samples[@]}"; do "$player" verify "$c"; done
 
 # lintian: 0 errors (warnings are listed).
 lint="$out/lintian.txt"
-lintian --tag-display-limit 0 "${deb[@]}" >"$lint" 2>&1 || true
+command -v lintian >/dev/null || fail "lintian is not installed (scripts/install-deps.sh installs it)"
+rc=0
+lintian --tag-display-limit 0 "${deb[@]}" >"$lint" 2>&1 || rc=$?
+((rc <= 1)) || { cat "$lint"; fail "lintian did not run (exit $rc)"; }  # 1: it found errors, counted below
 cat "$lint"
 errors=$(grep -c '^E: ' "$lint" || true)
 warnings=$(grep -c '^W: ' "$lint" || true)

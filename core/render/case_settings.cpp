@@ -82,7 +82,7 @@ size_t applyMaterialMaps(SceneView& view, const std::string& target, std::shared
     size_t changed = 0;
     std::optional<uint32_t> material; // one new material for all of the target's meshes
     for (RenderMesh& m : view.meshes()) {
-        if (m.name != target) continue;
+        if (m.name != target && !(m.cutSurface && m.name == target + " cut surface")) continue;
         if (!material) {
             TissueMaterial mat = view.materials().at(m.material);
             mat.maps = maps;

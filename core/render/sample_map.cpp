@@ -280,7 +280,8 @@ void applyNodeSampleClasses(SceneView& view, size_t body, const std::vector<uint
     std::vector<RenderMesh>& meshes = view.meshes();
     const RenderMesh* bodyMesh = nullptr;
     for (RenderMesh& m : meshes) {
-        if (m.source != RenderMesh::Source::Body || m.sourceIndex != body) continue;
+        // The cut surface's slots change with the cut: it keeps the default sampling.
+        if (m.source != RenderMesh::Source::Body || m.sourceIndex != body || m.cutSurface) continue;
         m.sampleMap.assign(m.vertexCount(), 0.0f);
         for (size_t v = 0; v < m.vertexCount(); ++v) {
             const int32_t n = v < m.sourceVertex.size() ? m.sourceVertex[v] : -1;

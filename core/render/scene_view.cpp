@@ -182,8 +182,8 @@ void SceneView::updateFromWorld(const sim::World& world) {
         world.interaction() && world.interaction()->dissects() ? world.interaction() : nullptr;
     if (cut) // before the positions are copied: the cut mesh's slots name the nodes to copy
         for (const BodyCut& c : m_cuts) {
-            cut->bodyTetMaskInto(c.body, m_maskScratch);
-            setBodyCut(c.body, m_maskScratch);
+            cut->bodyTetMaskInto(c.body, m_tetMaskScratch); // setBodyCut uses m_maskScratch itself
+            setBodyCut(c.body, m_tetMaskScratch);
         }
     for (size_t i = 0; i < m_meshes.size(); ++i) {
         RenderMesh& m = m_meshes[i];
@@ -247,6 +247,7 @@ size_t SceneView::addBodyCut(size_t bodyMesh, const sim::TetMesh& rest, size_t c
     m.source = RenderMesh::Source::Body;
     m.sourceIndex = body.sourceIndex;
     m.visible = false; // nothing cut yet
+    m.cutSurface = true;
     const size_t nv = 3 * capacity;
     const int32_t anyNode = mesh->tets()[0][0]; // unused slots sit on the body (bounds stay true)
     m.sourceVertex.assign(nv, anyNode);

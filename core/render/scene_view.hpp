@@ -34,6 +34,9 @@ struct RenderMesh {
     /// Authoring (the studio's paint tools): drawn through a 50 % screen door, every other pixel,
     /// so what lies inside the mesh (a curve skeleton) shows through it.
     bool translucent = false;
+    /// The cavity mesh SceneView::addBodyCut made (its slots change with the cut; sample maps
+    /// skip it, material maps of its body reach it).
+    bool cutSurface = false;
     // ---- fixed at creation ----------------------------------------------------------------
     std::vector<uint32_t> indices; ///< #F × 3, counter-clockwise from outside
     std::vector<float> rest;       ///< #V × 3, m: rest positions (procedural pattern space)
@@ -150,8 +153,9 @@ public:
 private:
     std::vector<RenderMesh> m_meshes;
     std::vector<TissueMaterial> m_materials;
-    std::vector<uint8_t> m_maskScratch; ///< updateFromWorld: the dissection mask of a surface
-    std::vector<float> m_heatScratch;   ///< updateFromWorld: the heat of a dissected surface
+    std::vector<uint8_t> m_maskScratch;    ///< updateFromWorld: the dissection mask of a surface
+    std::vector<float> m_heatScratch;      ///< updateFromWorld: the heat of a dissected surface
+    std::vector<uint8_t> m_tetMaskScratch; ///< updateFromWorld: a dissected body's tet mask
     struct BodyCut {
         size_t body = 0, bodyMesh = 0, cutMesh = 0, capacity = 0, exposed = 0;
         std::shared_ptr<const sim::TetMesh> rest; ///< level 3: opp() and the boundary's half-facets

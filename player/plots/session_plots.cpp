@@ -62,6 +62,10 @@ struct Reader {
     }
     int integer(const json& v, const std::string& field) const {
         if (!v.is_number_integer()) fail(field, "must be an integer");
+        if (v.is_number_unsigned() ? v.get<uint64_t>() > uint64_t(std::numeric_limits<int>::max())
+                                   : (v.get<int64_t>() > std::numeric_limits<int>::max() ||
+                                      v.get<int64_t>() < std::numeric_limits<int>::min()))
+            fail(field, "is out of range");
         return v.get<int>();
     }
     std::string string(const json& v, const std::string& field) const {
@@ -302,6 +306,11 @@ struct Range {
     }
 };
 
+/// The time axis [0, end], never empty (end non-finite or ≤ 1 ms: 1 ms).
+Range timeAxis(double end) {
+    return {0.0, std::fmax(end, 1e-3)};
+}
+
 class Chart {
 public:
     Chart(QPainter& p, const QRectF& box, const QString& title, const QString& xLabel, const QString& yLabel)
@@ -516,10 +525,22 @@ std::vector<double> frameTimes(const PlotInput& in) {
     return t;
 }
 
+/// printf of one double; a non-finite value prints as "—" in its place (never "nan").
+std::string formatted(const char* f, double v) {
+    if (!std::isfinite(v)) {
+        std::string out = f;
+        const size_t a = out.find('%');
+        const size_t b = a == std::string::npos ? a : out.find_first_of("fge", a);
+        if (b != std::string::npos) out.replace(a, b - a + 1, "—");
+        return out;
+    }
+    char buf[96];
+    std::snprintf(buf, sizeof buf, f, v);
+    return buf;
+}
+
 QString fmt(const char* f, double v) {
-    char b[64];
-    std::snprintf(b, sizeof b, f, v);
-    return QString::fromUtf8(b);
+    return QString::fromStdString(formatted(f, v));
 }
 
 QByteArray stepTimePlot(const PlotInput& in) {
@@ -539,9 +560,7 @@ QByteArray stepTimePlot(const PlotInput& in) {
                                                         (in.realTimeFactor < 1 ? " (slower than real time)" : "")
                                                   : QString()),
              "session time (s)", "step time (ms)");
-    Range x;
-    x.add(0);
-    x.add(t.empty() ? 1 : t.back());
+    const Range x = timeAxis(t.empty() ? 1 : t.back());
     ch.setRange(x, y.padded(true));
     ch.axes();
     if (in.frames.empty()) {
@@ -557,9 +576,8 @@ QByteArray stepTimePlot(const PlotInput& in) {
 QByteArray forcePlot(const PlotInput& in) {
     Canvas c(1100, 440);
     Chart ch(*c.p, QRectF(0, 0, 1100, 440), "Force from the tissue on each tool", "session time (s)", "force (N)");
-    Range x, y;
-    x.add(0);
-    x.add(in.t_s.empty() ? std::max(in.simTime_s, 1e-3) : in.t_s.back());
+    const Range x = timeAxis(in.t_s.empty() ? in.simTime_s : in.t_s.back());
+    Range y;
     for (const auto& tool : in.tools)
         for (double f : tool.forceN)
             y.add(f);
@@ -614,9 +632,8 @@ QByteArray pathPlot(const PlotInput& in) {
     // Path length over time.
     Chart ch(*c.p, QRectF(740, 26, 360, 444), "Path length", "session time (s)", "path (mm)");
     std::vector<std::vector<double>> len(in.tools.size());
-    Range x, y;
-    x.add(0);
-    x.add(in.t_s.empty() ? 1 : in.t_s.back());
+    const Range x = timeAxis(in.t_s.empty() ? 1 : in.t_s.back());
+    Range y;
     for (size_t k = 0; k < in.tools.size(); ++k) {
         double s = 0;
         for (size_t i = 0; i < in.tools[k].tip.size(); ++i) {
@@ -648,9 +665,8 @@ QByteArray eventPlot(const PlotInput& in) {
     static const char* kLabels[] = {"grasps", "releases", "cuts", "clips", "punctures"};
     Canvas c(1100, 360);
     Chart ch(*c.p, QRectF(110, 0, 990, 360), "Task events", "session time (s)", "");
-    Range x, y{0.5, 5.5};
-    x.add(0);
-    x.add(std::max({in.simTime_s, in.t_s.empty() ? 0.0 : in.t_s.back(), 1e-3}));
+    const Range x = timeAxis(std::fmax(in.simTime_s, in.t_s.empty() ? 0.0 : in.t_s.back()));
+    const Range y{0.5, 5.5};
     ch.setRange(x, y);
     ch.hideYTicks(); // the rows are labelled on the left
     ch.axes();
@@ -660,7 +676,7 @@ QByteArray eventPlot(const PlotInput& in) {
     QPainter& p = *c.p;
     const QFontMetricsF fm(p.font());
     for (int row = 0; row < 5; ++row) {
-        int n = 0, total = 0;
+        int64_t n = 0, total = 0;
         for (const auto& e : in.events)
             if (e.kind == kKinds[row]) {
                 ++n;
@@ -696,9 +712,8 @@ QByteArray stabilityPlot(const PlotInput& in) {
     Canvas c(1100, 440);
     const std::vector<double> t = frameTimes(in);
     std::vector<double> e, d;
-    Range ye, yd, x;
-    x.add(0);
-    x.add(t.empty() ? 1 : t.back());
+    Range ye, yd;
+    const Range x = timeAxis(t.empty() ? 1 : t.back());
     for (const auto& f : in.frames) {
         e.push_back(f.energyJ);
         d.push_back(f.maxDisplacementM * 1e3);
@@ -776,9 +791,7 @@ std::string html(const std::string& s) {
 }
 
 std::string num(const char* f, double v) {
-    char b[64];
-    std::snprintf(b, sizeof b, f, v);
-    return b;
+    return formatted(f, v);
 }
 
 } // namespace
@@ -852,7 +865,7 @@ PlotFiles writeSessionPlots(const PlotInput& in, const std::filesystem::path& di
     if (!in.device.empty())
         row("device force", num("max %.2f N", in.maxDeviceForceN) +
                                 (in.caseMaxForceN > 0 ? num(" (case limit %.1f N)", in.caseMaxForceN) : ""));
-    std::map<std::string, int> counts;
+    std::map<std::string, int64_t> counts;
     for (const auto& e : in.events)
         counts[e.kind] += e.kind == "cut" || e.kind == "puncture" ? e.count : 1;
     if (in.grasps || counts["grasp"]) row("grasps", std::to_string(counts["grasp"]));

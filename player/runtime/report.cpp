@@ -220,7 +220,8 @@ static nlohmann::json sutureJson(const SessionResult& r) {
 /// Positions rounded to 1 µm, forces to 0.1 mN, times to 1 µs.
 static nlohmann::json timelineJson(const SessionTimeline& tl) {
     using nlohmann::json;
-    auto round = [](double v, double q) { return std::isfinite(v) ? std::round(v / q) * q : 0.0; };
+    // A non-finite value stays so (written as null: a gap in the plots, never a number).
+    auto round = [](double v, double q) { return std::isfinite(v) ? std::round(v / q) * q : v; };
     json t = json::array();
     for (double v : tl.t_s)
         t.push_back(round(v, 1e-6));

@@ -3,6 +3,7 @@
 #include "sim/scene/world.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <string_view>
 
 namespace viscera::player {
@@ -49,8 +50,8 @@ void TimelineRecorder::sample(const sim::World& world) {
     // Every tool has one entry per sample (a tool the world no longer reports holds its last).
     for (SessionTimeline::Tool& tool : m_tl.tools)
         while (tool.tip.size() < m_tl.t_s.size()) {
-            tool.tip.push_back(tool.tip.empty() ? Eigen::Vector3d::Zero() : tool.tip.back());
-            tool.force_n.push_back(0.0);
+            tool.tip.push_back(Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN())); // a gap
+            tool.force_n.push_back(std::numeric_limits<double>::quiet_NaN());
         }
 }
 

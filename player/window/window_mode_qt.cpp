@@ -74,9 +74,14 @@ public:
                         src = &m_live.surfaces[m.sourceIndex];
                     }
                     if (!src) continue;
+                    const size_t end =
+                        m.source == render::RenderMesh::Source::Body && m.sourceIndex + 1 < m_bodyOffset.size()
+                            ? m_bodyOffset[m.sourceIndex + 1]
+                            : src->size();
                     for (size_t v = 0; v < m.sourceVertex.size(); ++v) {
+                        if (m.sourceVertex[v] < 0) continue;
                         const size_t k = base + static_cast<size_t>(m.sourceVertex[v]);
-                        if (k >= src->size()) continue;
+                        if (k >= end || k >= src->size()) continue;
                         for (int r = 0; r < 3; ++r)
                             m.positions[3 * v + r] = static_cast<float>((*src)[k][r]);
                     }

@@ -168,13 +168,34 @@ TEST(SessionPlots, ChartsDrawTheDataAndThePageEmbedsThem) {
 TEST(SessionPlots, AFigureTheSessionCouldNotComputeIsAGapNotANumber) {
     json doc = pressed().report;
     doc["frames"][3]["energy_j"] = nullptr; // how nlohmann writes NaN
+    doc["metrics"]["step_ms_mean"] = nullptr;
+    doc["metrics"]["sim_time_s"] = nullptr;
+    doc["timeline"]["tools"][0]["tip_m"][4] = json::array({nullptr, nullptr, nullptr});
     const player::PlotInput in = player::readPlotInput(doc, "r.json");
     EXPECT_TRUE(std::isnan(in.frames[3].energyJ));
+    EXPECT_TRUE(std::isnan(in.stepMsMean));
+    EXPECT_TRUE(std::isnan(in.tools[0].tip[4][0]));
     test::Scratch out("viscera-plots-nan");
     const auto files = player::writeSessionPlots(in, out.dir);
-    const std::string page = readFile(files.page);
+    std::string page = readFile(files.page);
+    for (size_t a = page.find("data:image/png;base64,"); a != std::string::npos;
+         a = page.find("data:image/png;base64,", a)) // the text only, not the images' base64
+        page.erase(a, page.find('"', a) - a);
+    EXPECT_NE(page.find("mean — ms"), std::string::npos) << "the missing figure is shown as missing";
     EXPECT_EQ(page.find("nan"), std::string::npos);
-    EXPECT_EQ(page.find("inf "), std::string::npos);
+    EXPECT_EQ(page.find("inf"), std::string::npos);
+}
+
+TEST(SessionPlots, ANonFiniteValueInTheSessionIsWrittenAsNullAndReadAsAGap) {
+    player::SessionResult r = pressed().result;
+    r.timeline.tools[0].tip[2] = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    r.timeline.tools[0].force_n[2] = std::numeric_limits<double>::infinity();
+    const json doc = json::parse(player::reportJson(r).dump()); // as a saved report
+    EXPECT_TRUE(doc["timeline"]["tools"][0]["tip_m"][2][0].is_null());
+    EXPECT_TRUE(doc["timeline"]["tools"][0]["force_n"][2].is_null());
+    const player::PlotInput in = player::readPlotInput(doc, "r.json");
+    EXPECT_TRUE(std::isnan(in.tools[0].tip[2][1]));
+    EXPECT_TRUE(std::isnan(in.tools[0].forceN[2]));
 }
 
 TEST(SessionPlots, MalformedReportsAreRefusedNamingTheField) {
@@ -208,6 +229,13 @@ TEST(SessionPlots, MalformedReportsAreRefusedNamingTheField) {
     d["timeline"]["events"] = json::array({{{"t_s", 0.1}, {"kind", "cut"}, {"tool", "hook"}, {"count", 0}}});
     EXPECT_EQ(refusal(d), "r.json: timeline.events[0].count: must be at least 1");
     EXPECT_EQ(refusal(json::array()), "r.json: (document): a session report must be a JSON object");
+    d = ok;
+    d["schemaVersion"] = 4294967298ull; // would wrap to 2 as an int
+    EXPECT_EQ(refusal(d), "r.json: schemaVersion: is out of range");
+    d = ok;
+    d["timeline"]["events"] =
+        json::array({{{"t_s", 0.1}, {"kind", "cut"}, {"tool", "hook"}, {"count", -4294967295ll}}});
+    EXPECT_EQ(refusal(d), "r.json: timeline.events[0].count: is out of range");
 
     test::Scratch dir("viscera-plots-bad");
     writeFileAtomic(dir / "broken.json", "{\"schemaVersion\": 2,");

@@ -174,10 +174,11 @@ TEST(BodyCut, ACutTetShowsItsNeighboursFacesTowardsTheCavity) {
         EXPECT_GT(n.dot(c - (p[0] + p[1] + p[2]) / 3), 0.0) << "face " << f;
     }
     // The same mask again changes nothing; a mask of the wrong size is ignored.
-    const uint64_t rev = cutMesh.faceMaskRevision;
+    const uint64_t rev = cutMesh.faceMaskRevision, staticRev = cutMesh.staticRevision;
     b.view.setBodyCut(0, mask);
     b.view.setBodyCut(0, std::vector<uint8_t>(3, 0));
     EXPECT_EQ(cutMesh.faceMaskRevision, rev);
+    EXPECT_EQ(cutMesh.staticRevision, staticRev) << "the slots were not refilled";
     EXPECT_EQ(b.view.exposedCutFaces(0), 4u);
     // Healed (a reset): nothing exposed, the cut mesh hidden again.
     b.view.setBodyCut(0, std::vector<uint8_t>(b.rest->tetCount(), 1));
