@@ -21,6 +21,7 @@
 #include "render/tool_meshes.hpp"
 #include "runtime/report.hpp"
 #include "runtime/session.hpp"
+#include "runtime/soak.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/cli_main.hpp"
 #include "sim/util/error.hpp"
@@ -31,6 +32,7 @@
 #endif
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -51,6 +53,7 @@ void usage(std::FILE* out) {
                "                      [--realtime | --lockstep] [--servo sleep|sleep:CPU|spin:US|busy|busy:CPU]\n"
                "                      [--plots DIR]\n"
                "       viscera-player plot <report.json> -o DIR\n"
+               "       viscera-player soak <case.vcase[@SPEC]>... [--minutes M] [--frames N] [--report soak.json]\n"
                "       SPEC: replay:<file> | scripted:<name> | console:<host:port> | keyboard\n"
                "       viscera-player --version\n",
                out);
@@ -97,6 +100,23 @@ constexpr const char* kPlotHelp =
     "charts in one self-contained page) into DIR, created when missing.\n"
     "Exit 0 ok, 1 a malformed report (one line naming the file, the field and the rule) or a folder\n"
     "that cannot be written, 2 usage.\n";
+
+constexpr const char* kSoakHelp =
+    "usage: viscera-player soak <case.vcase[@SPEC]>... [options]\n"
+    "\n"
+    "Runs the cases back to back in this one process, headless and stepped with the physics (no\n"
+    "wall-clock pacing), each pass loaded afresh from its package, until the time is up. SPEC after\n"
+    "'@' drives the case's tools (replay:<file.csv> or scripted:<name>). Prints a line per interval:\n"
+    "frames, passes, all finite, the largest energy and whether it stays within the tolerance of\n"
+    "the case's first pass, resident memory; at the end the memory growth from the 5th line.\n"
+    "\n"
+    "  --minutes M           wall time (default 60; decimals allowed)\n"
+    "  --line-seconds S      one line per S seconds (default 60)\n"
+    "  --frames N            frames per pass (default 300)\n"
+    "  --energy-tolerance X  a pass's largest energy may exceed the first pass's by X (default 0.1)\n"
+    "  --report FILE.json    the lines, the cases and the errors\n"
+    "\n"
+    "Exit 0 ok, 1 bad input, 2 usage, 3 a non-finite state or an energy above the bound.\n";
 
 int fail(int code, const std::string& message) {
     return sim::cliFail("viscera-player", code, message);
@@ -324,6 +344,74 @@ int cmdRun(const std::vector<std::string>& args) {
     return 0;
 }
 
+double numberArg(const std::string& flag, const std::string& v, double lo, double hi) {
+    char* end = nullptr;
+    const double d = std::strtod(v.c_str(), &end);
+    if (v.empty() || *end != '\0' || !std::isfinite(d) || d < lo || d > hi)
+        throw std::invalid_argument(flag + " '" + v + "' must be a number in [" + std::to_string(lo).substr(0, 6) +
+                                    ", " + std::to_string(hi).substr(0, 8) + "]");
+    return d;
+}
+
+int cmdSoak(const std::vector<std::string>& args) {
+    std::vector<player::SoakCase> cases;
+    player::SoakOptions opt;
+    opt.seconds = 3600;
+    int frames = 300;
+    std::optional<std::string> reportPath;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
+            return args[++i];
+        };
+        if (a == "--minutes")
+            opt.seconds = 60 * numberArg(a, value(), 0.001, 10000);
+        else if (a == "--line-seconds")
+            opt.lineSeconds = numberArg(a, value(), 0.1, 3600);
+        else if (a == "--frames")
+            frames = static_cast<int>(numberArg(a, value(), 1, 1e7));
+        else if (a == "--energy-tolerance")
+            opt.energyTolerance = numberArg(a, value(), 0, 100);
+        else if (a == "--report")
+            reportPath = value();
+        else if (!a.empty() && a[0] == '-')
+            throw std::invalid_argument("unknown option '" + a + "'");
+        else {
+            player::SoakCase c;
+            const size_t at = a.find('@');
+            c.path = a.substr(0, at);
+            if (at != std::string::npos) c.device = a.substr(at + 1);
+            if (!c.device.empty()) {
+                const haptics::DeviceSpec spec = haptics::parseDeviceSpec(c.device);
+                if (spec.kind == haptics::DeviceSpec::Kind::Console || spec.kind == haptics::DeviceSpec::Kind::Keyboard)
+                    throw InputError(a + ": the soak steps devices with the physics; use replay: or scripted:");
+            }
+            cases.push_back(std::move(c));
+        }
+    }
+    if (cases.empty()) throw std::invalid_argument("soak needs at least one case");
+    for (player::SoakCase& c : cases)
+        c.frames = frames;
+    if (reportPath) requireWritableFile(*reportPath, "the soak report");
+    std::fprintf(stderr, "viscera-player: soaking %zu case(s) for %.1f min, a line every %.0f s\n", cases.size(),
+                 opt.seconds / 60, opt.lineSeconds);
+    const player::SoakResult r = player::runSoak(cases, opt, [](const player::SoakLine& l) {
+        std::printf("line %3d  %7.1f s  frames %6lld  passes %3d  finite %s  energy max %.4g J%s  rss %.1f MiB\n",
+                    l.index, l.wall_s, static_cast<long long>(l.frames), l.passes, l.allFinite ? "yes" : "NO",
+                    l.maxEnergyJ, l.energyBounded ? "" : " ABOVE THE BOUND", l.rssMiB);
+        std::fflush(stdout);
+    });
+    if (reportPath) writeFileAtomic(*reportPath, player::soakJson(r, cases).dump(2) + "\n");
+    std::printf("soak          %d passes, %lld frames; resident memory %+.2f%% from line 5 (or the first) to the "
+                "last; %s\n",
+                r.passes, static_cast<long long>(r.frames), 100 * r.rssGrowth(5),
+                r.ok() ? "ok" : ("FAILED: " + r.errors.front()).c_str());
+    for (size_t e = 1; e < r.errors.size() && e < 10; ++e)
+        std::printf("              %s\n", r.errors[e].c_str());
+    return r.ok() ? 0 : kExitInvariant;
+}
+
 int cmdPlot(const std::vector<std::string>& args) {
     std::optional<std::string> report, dir;
     for (size_t i = 0; i < args.size(); ++i) {
@@ -361,6 +449,9 @@ int main(int argc, char** argv) {
     program.name = "viscera-player";
     program.version = VISCERA_VERSION;
     program.usage = usage;
-    program.subcommands = {{"verify", cmdVerify, kVerifyHelp}, {"run", cmdRun, kRunHelp}, {"plot", cmdPlot, kPlotHelp}};
+    program.subcommands = {{"verify", cmdVerify, kVerifyHelp},
+                           {"run", cmdRun, kRunHelp},
+                           {"plot", cmdPlot, kPlotHelp},
+                           {"soak", cmdSoak, kSoakHelp}};
     return sim::runCli(program, argc, argv);
 }

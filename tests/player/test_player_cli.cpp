@@ -394,3 +394,36 @@ TEST(PlayerCli, PlotDrawsAReportAndRefusesABrokenOne) {
     EXPECT_THAT(m.err, HasSubstr("missing.json: cannot open for reading"));
     EXPECT_EQ(player({"plot", report.string()}).exitCode, 2) << "no -o";
 }
+
+TEST(PlayerCli, SoakRunsCasesBackToBackAndReportsEachInterval) {
+    ScratchDir dir;
+    const auto path = writeSlabCase(dir, "slab.vcase", {"gravity", "xpbd"});
+    const auto report = dir.path() / "soak.json";
+    const test::ProcessResult r = player({"soak", path, path, "--minutes", "0.05", "--line-seconds", "1", "--frames",
+                                          "20", "--report", report.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
+    EXPECT_THAT(r.out, HasSubstr("line   1"));
+    EXPECT_THAT(r.out, HasSubstr("finite yes"));
+    EXPECT_THAT(r.out, HasSubstr("; ok"));
+    const nlohmann::json j = readJson(report);
+    ASSERT_GE(j["lines"].size(), 2u) << "3 s at a line a second";
+    int64_t frames = 0;
+    for (const auto& l : j["lines"]) {
+        EXPECT_TRUE(l["all_finite"].get<bool>());
+        EXPECT_TRUE(l["energy_bounded"].get<bool>());
+        EXPECT_GT(l["rss_mib"].get<double>(), 1.0);
+        frames += l["frames"].get<int64_t>();
+    }
+    EXPECT_EQ(frames, j["frames"].get<int64_t>());
+    EXPECT_GE(j["passes"].get<int>(), 2) << "both cases ran";
+    EXPECT_TRUE(j["errors"].empty());
+    // Refused before any time is spent: a missing case, a wall-clock device, a bad number.
+    const test::ProcessResult m = player({"soak", path, (dir.path() / "missing.vcase").string(), "--minutes", "1"});
+    EXPECT_EQ(m.exitCode, 1);
+    EXPECT_THAT(m.err, HasSubstr("missing.vcase"));
+    EXPECT_THAT(m.out, Not(HasSubstr("line")));
+    const test::ProcessResult c = player({"soak", path + "@console:127.0.0.1:7400", "--minutes", "1"});
+    EXPECT_EQ(c.exitCode, 1);
+    EXPECT_THAT(c.err, HasSubstr("the soak steps devices with the physics"));
+    EXPECT_EQ(player({"soak", path, "--minutes", "abc"}).exitCode, 2);
+}
