@@ -804,8 +804,10 @@ FemSolveStats CorotationalFem::solve() {
         gsum.clear(); // (slot, (Cᵀλ)_node)
         for (size_t r = 0; r < rows.size(); ++r)
             if (lam[r] != 0)
-                for (const auto& [slot, a] : rows[r].terms) {
-                    auto it = std::find_if(gsum.begin(), gsum.end(), [&](const auto& e) { return e.first == slot; });
+                for (const auto& term : rows[r].terms) {
+                    const auto& [slot, a] = term;
+                    const auto key = term.first; // a lambda cannot capture a binding before clang 16
+                    auto it = std::find_if(gsum.begin(), gsum.end(), [&](const auto& e) { return e.first == key; });
                     if (it == gsum.end())
                         gsum.emplace_back(slot, lam[r] * a);
                     else

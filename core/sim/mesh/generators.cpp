@@ -7,7 +7,9 @@
 namespace viscera::sim {
 
 std::unique_ptr<TetMesh> makeBoxTetMesh(const BoxSpec& spec) {
-    const auto [nx, ny, nz] = spec.cells;
+    // Plain ints, not a structured binding: the lambda below captures them (clang 14 cannot
+    // capture bindings).
+    const int nx = spec.cells[0], ny = spec.cells[1], nz = spec.cells[2];
     if (nx <= 0 || ny <= 0 || nz <= 0)
         throw std::invalid_argument("sim::makeBoxTetMesh(): cell counts must be positive");
     if (!(spec.size.array() > 0).all() || !spec.size.allFinite() || !spec.origin.allFinite())
