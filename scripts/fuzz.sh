@@ -5,14 +5,23 @@
 # given seconds, then prints per target: executions, coverage (cov), corpus size and findings
 # (crash-*, leak-*, timeout-*, oom-* files in out/fuzz/<target>/).
 #
-#   scripts/fuzz.sh [seconds-per-target=60] [build-dir=build]
+#   scripts/fuzz.sh [seconds-per-target=60] [build-dir=build] [target...]   (no target: all)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 secs="${1:-60}"
 build="${2:-${VISCERA_BUILD_DIR:-build}}"
+shift $(( $# > 2 ? 2 : $# ))
+targets=("$@")
+((${#targets[@]})) || targets=(case_package manifest scene vtet vweights console_protocol instrument_track device_trajectory needle_trajectory)
 fz=build-fuzz
 out=out/fuzz
-command -v clang++-14 >/dev/null || { echo "fuzz: clang++-14 is missing (apt install clang-14 libfuzzer-14-dev)" >&2; exit 1; }
+# clang-14 and its libFuzzer, from Debian, where missing.
+if ! command -v clang++-14 >/dev/null || [[ ! -d /usr/lib/llvm-14/lib/clang/14.0.6/lib/linux ]] ||
+   ! ls /usr/lib/llvm-14/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
+  echo "fuzz: installing clang-14 libfuzzer-14-dev"
+  SUDO=""; [[ $(id -u) -ne 0 ]] && SUDO=sudo
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends clang-14 libfuzzer-14-dev
+fi
 if [[ ! -f "$fz/build.ninja" ]]; then
   cmake -S . -B "$fz" -G Ninja -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVISCERA_BUILD_FUZZ=ON -DVISCERA_BUILD_TESTS=OFF \
@@ -47,7 +56,7 @@ cp projects/*/replays/*.csv "$seeds/device_trajectory/"
 
 status=0
 printf '%-24s %12s %8s %8s %s\n' target executions cov corpus findings
-for t in case_package manifest scene vtet vweights console_protocol instrument_track device_trajectory needle_trajectory; do
+for t in "${targets[@]}"; do
   dir="$out/$t"
   mkdir -p "$dir/corpus" "$dir/findings"
   dict=()
