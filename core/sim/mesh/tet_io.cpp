@@ -4,6 +4,7 @@
 #include "sim/util/error.hpp"
 #include "sim/util/line_reader.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -37,8 +38,11 @@ void parseElements(LineReader& in, const char* magic, const char* elemKeyword, c
             in.fail(std::string(keyword) + " count " + std::to_string(n) + " is out of range [0, 2^28]");
         return n;
     };
+    // A count only reserves what a few lines would need: the lines themselves grow the arrays, so
+    // a header claiming 2^28 elements over a short file costs no more memory than the file.
+    constexpr int64_t kReserveAtMost = 1 << 16;
     const int64_t nv = readCount("vertices");
-    pos.reserve(static_cast<size_t>(nv));
+    pos.reserve(static_cast<size_t>(std::min(nv, kReserveAtMost)));
     for (int64_t v = 0; v < nv; ++v) {
         if (!in.next(tok)) in.failEof("vertex " + std::to_string(v));
         if (tok.size() != 3) in.fail("vertex " + std::to_string(v) + " must have 3 coordinates");
@@ -49,7 +53,7 @@ void parseElements(LineReader& in, const char* magic, const char* elemKeyword, c
     }
     const int64_t ne = readCount(elemKeyword);
     if (ne == 0) in.fail(std::string("mesh has no ") + elemKeyword);
-    elems.reserve(static_cast<size_t>(ne));
+    elems.reserve(static_cast<size_t>(std::min(ne, kReserveAtMost)));
     for (int64_t t = 0; t < ne; ++t) {
         const std::string what = std::string(elemName) + " " + std::to_string(t);
         if (!in.next(tok)) in.failEof(what);

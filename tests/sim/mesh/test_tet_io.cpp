@@ -7,6 +7,8 @@
 
 #include <filesystem>
 
+#include <sys/resource.h>
+
 using namespace viscera::sim;
 using ::testing::HasSubstr;
 
@@ -62,4 +64,36 @@ TEST(TetIo, ErrorsNameFileLineAndRule) {
     EXPECT_THAT(errorOf(std::string(kHeader) + "tets 1\n0 1 1 3\n"), HasSubstr("tet 0 repeats vertex 1"));
     EXPECT_THAT(errorOf("vtet 1\nvertices -3\n"), HasSubstr("vertices count -3 is out of range"));
     EXPECT_EQ(errorOf(std::string(kHeader) + "# comment\n\ntets 1\n0 1 2 3\n"), "no error");
+}
+
+// Found by fuzz_vtet (out-of-memory): a header claiming 94,967,295 vertices over a few bytes made
+// the reader reserve 2.3 GB before reading a line. Under an address-space limit of 1 GiB above
+// what the process uses now, such a file (and one at the 2^28 maximum) is refused cleanly.
+TEST(TetIo, AHugeCountInTheHeaderCostsNoMoreMemoryThanTheFile) {
+    rlimit old{};
+    ASSERT_EQ(getrlimit(RLIMIT_AS, &old), 0);
+    long pages = 0;
+    if (FILE* f = std::fopen("/proc/self/statm", "r")) {
+        if (std::fscanf(f, "%ld", &pages) != 1) pages = 0;
+        std::fclose(f);
+    }
+    ASSERT_GT(pages, 0);
+    rlimit lim = old;
+    lim.rlim_cur = rlim_t(pages) * rlim_t(sysconf(_SC_PAGESIZE)) + (rlim_t(1) << 30);
+    if (old.rlim_max != RLIM_INFINITY && lim.rlim_cur > old.rlim_max) lim.rlim_cur = old.rlim_max;
+    ASSERT_EQ(setrlimit(RLIMIT_AS, &lim), 0);
+    std::string what;
+    for (const char* text : {"vtet 1\nvertices 94967295\n0 0 0\n1 0 0\n", "vtet 1\nvertices 268435456\n0 0 0\n",
+                             "vtet 1\nvertices 1\n0 0 0\ntets 268435456\n0 0 0 0\n"}) {
+        try {
+            (void)parseVtet(text, "huge.vtet");
+            what += "(accepted) ";
+        } catch (const viscera::InputError&) {
+            what += "refused ";
+        } catch (const std::bad_alloc&) {
+            what += "bad_alloc ";
+        }
+    }
+    setrlimit(RLIMIT_AS, &old);
+    EXPECT_EQ(what, "refused refused refused ");
 }
