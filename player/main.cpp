@@ -312,7 +312,9 @@ int cmdRun(const std::vector<std::string>& args) {
             screenshotError = *screenshot + ": cannot write the screenshot (" + e.what() + ")";
         }
     }
-    if (reportPath) writeFileAtomic(*reportPath, player::reportJson(result).dump(2) + "\n");
+    // The report's text, made once: written with --report and read back by --plots.
+    const std::string reportText = reportPath || plotsDir ? player::reportJson(result).dump(2) + "\n" : std::string();
+    if (reportPath) writeFileAtomic(*reportPath, reportText);
     if (tracePath) writeFileAtomic(*tracePath, player::traceCsv(result));
     std::string plotsError;
 #if VISCERA_HAVE_PLOTS
@@ -321,8 +323,7 @@ int cmdRun(const std::vector<std::string>& args) {
         try {
             // Through the report's text, as 'plot' reads a saved one (a non-finite figure is null).
             plotFiles = player::writeSessionPlots(
-                player::readPlotInput(nlohmann::json::parse(player::reportJson(result).dump()),
-                                      reportPath.value_or("(this session)")),
+                player::readPlotInput(nlohmann::json::parse(reportText), reportPath.value_or("(this session)")),
                 *plotsDir);
         } catch (const std::exception& e) {
             plotsError = e.what();

@@ -271,7 +271,7 @@ bool ToolMeshes::build(B& b, const Part& part, const ToolPoses& poses, RenderMes
         return true;
     case Part::Kind::Clip: {
         m.visible = part.index < poses.clips.size();
-        if (!m.visible) { // not fired yet: a hidden placeholder of the same shape
+        if (!m.visible) { // not fired yet: hidden, with the fired clip's three plates so the topology is fixed
             for (int k = 0; k < 3; ++k)
                 b.plate(Vec3::Zero(), Vec3::UnitX(), Vec3::UnitY(), 1e-4, 1e-4);
             return true;
