@@ -12,7 +12,7 @@ secs="${1:-60}"
 build="${2:-${VISCERA_BUILD_DIR:-build}}"
 shift $(( $# > 2 ? 2 : $# ))
 targets=("$@")
-((${#targets[@]})) || targets=(case_package manifest scene vtet vweights console_protocol instrument_track device_trajectory needle_trajectory)
+((${#targets[@]})) || targets=(case_package manifest scene vtet vweights console_protocol instrument_track device_trajectory needle_trajectory mesh_format)
 fz=build-fuzz
 out=out/fuzz
 # clang-14 and its libFuzzer, from Debian, where missing.
@@ -52,7 +52,7 @@ for p in tissue-slab organ-blob anastomosis rectum liver; do
   for t in $(find "$x" -name '*.csv'); do cp "$t" "$seeds/needle_trajectory/$p-$(basename "$t")"; done
 done
 cp projects/*/replays/*.csv "$seeds/device_trajectory/"
-"$fz/fuzz/fuzz_make_seeds" "$seeds/console_protocol" >/dev/null
+"$fz/fuzz/fuzz_make_seeds" "$seeds" >/dev/null # console_protocol/, mesh_format/
 
 status=0
 printf '%-24s %12s %8s %8s %s\n' target executions cov corpus findings
@@ -64,6 +64,7 @@ for t in "${targets[@]}"; do
   [[ $t == vtet ]] && maxlen=8192 # mesh seeds are large; short inputs reach the rules far faster
   case $t in
     manifest|scene|case_package) dict=(-dict=fuzz/dict/json.dict) ;;
+    mesh_format) dict=(-dict=fuzz/dict/mesh.dict) ;;
     vtet|vweights|instrument_track|device_trajectory|needle_trajectory) dict=(-dict=fuzz/dict/text.dict) ;;
   esac
   log="$dir/run.log"
