@@ -692,6 +692,10 @@ void checkGlb(const std::string& label, std::string_view b) {
 
 } // namespace
 
+std::vector<std::string_view> blankSeparatedTokens(std::string_view s) {
+    return tokens(s);
+}
+
 std::string lowerExtension(const std::filesystem::path& file) {
     std::string ext = file.extension().string();
     for (char& c : ext)

@@ -9,8 +9,12 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace viscera::bake::detail {
+
+/// Splits a line on blanks (space, tab, CR, LF, FF, VT); the tokens are views into s.
+std::vector<std::string_view> blankSeparatedTokens(std::string_view s);
 
 /// The file's extension, lower case with the dot ("" when it has none).
 std::string lowerExtension(const std::filesystem::path& file);

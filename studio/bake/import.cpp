@@ -1,11 +1,14 @@
 #include "bake/import.hpp"
 
 #include "bake/format_check.hpp"
+#include "bake/references.hpp"
 #include "sim/util/atomic_file.hpp"
+#include "sim/util/entry_name.hpp"
 #include "sim/util/error.hpp"
 #include "sim/util/format.hpp"
 #include "sim/util/log.hpp"
 
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
@@ -18,6 +21,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -45,6 +49,34 @@ std::string readMeshBytes(const std::filesystem::path& file, std::uintmax_t maxB
         fail(file.string(), "is not a regular file");
     return readFile(file, maxBytes, kMaxFileBytesName); // missing, directory, size: its messages
 }
+
+/// The importer's file system: opens the mesh file and files inside its folder (symbolic links
+/// resolved), for reading only. The references were checked before parsing
+/// (detail::checkReferences); this refuses what a parser would still reach another way (a link
+/// out of the folder, a path it builds itself) and remembers the first refusal for the message.
+class FolderIOSystem : public Assimp::DefaultIOSystem {
+public:
+    explicit FolderIOSystem(const std::filesystem::path& file) : m_folder(file.parent_path()) {}
+    bool Exists(const char* path) const override { return path && allowed(path) && DefaultIOSystem::Exists(path); }
+    Assimp::IOStream* Open(const char* path, const char* mode = "rb") override {
+        if (path == nullptr) return nullptr;
+        const std::string_view m = mode ? mode : "rb";
+        if (m.find_first_of("wa+") != std::string_view::npos) {
+            if (!refused) refused = std::string(path) + "' for writing";
+            return nullptr;
+        }
+        if (!allowed(path)) {
+            if (!refused) refused = std::string(path) + "', outside the file's folder";
+            return nullptr;
+        }
+        return DefaultIOSystem::Open(path, "rb");
+    }
+    std::optional<std::string> refused; ///< "<path>', outside the file's folder"
+
+private:
+    bool allowed(const char* path) const { return detail::insideFolder(m_folder, path); }
+    std::filesystem::path m_folder;
+};
 
 std::string meshName(const aiMesh* mesh, unsigned index) {
     std::string s = "mesh " + std::to_string(index);
@@ -131,7 +163,8 @@ struct Merged {
 
 /// Walks the node tree (iteratively, depth-limited), applies the accumulated transforms and the
 /// unit scale, joins identical positions across meshes and collects the triangles.
-Merged mergeScene(const std::string& label, const aiScene* scene, double scale) {
+Merged mergeScene(const std::string& label, const aiScene* scene, const ImportOptions& options) {
+    const double scale = options.scale;
     if (scene->mRootNode == nullptr) fail(label, "empty scene: the file has no root node");
     Merged out;
     std::unordered_map<PosKey, int32_t, PosKeyHash> index;
@@ -161,6 +194,17 @@ Merged mergeScene(const std::string& label, const aiScene* scene, double scale) 
                                 std::to_string(scene->mNumMeshes) + ")");
             const aiMesh* mesh = scene->mMeshes[mi];
             ++out.instances;
+            // Instancing multiplies a mesh: the caps are checked before each instance is added.
+            if (out.positions.size() + mesh->mNumVertices > options.maxVertices)
+                fail(label, "more than " + std::to_string(options.maxVertices) + " vertices (" + nodeName + " adds " +
+                                meshName(mesh, mi) + " of " + std::to_string(mesh->mNumVertices) + " to the " +
+                                std::to_string(out.positions.size()) +
+                                " so far): over the import cap ImportOptions::maxVertices");
+            if (out.triangles.size() + mesh->mNumFaces > options.maxTriangles)
+                fail(label, "more than " + std::to_string(options.maxTriangles) + " triangles (" + nodeName + " adds " +
+                                meshName(mesh, mi) + " of " + std::to_string(mesh->mNumFaces) + " faces to the " +
+                                std::to_string(out.triangles.size()) +
+                                " so far): over the import cap ImportOptions::maxTriangles");
             remap.assign(mesh->mNumVertices, 0);
             for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
                 const aiVector3D& a = mesh->mVertices[v];
@@ -233,9 +277,13 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file, const Im
         const std::string bytes = readMeshBytes(file, options.maxFileBytes);
         report.format = detail::sniffFormat(label, ext, bytes);
         detail::checkStructure(label, report.format, bytes);
+        // Before any parser runs: a reference out of the folder refuses the file unread.
+        detail::checkReferences(label, report.format, bytes, file.parent_path());
     }
 
     Assimp::Importer importer;
+    auto* io = new FolderIOSystem(file); // owned by the importer
+    importer.SetIOHandler(io);
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                                             aiComponent_COLORS | aiComponent_TEXCOORDS |
@@ -251,6 +299,9 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file, const Im
     } catch (const std::exception& e) {
         fail(label, "cannot be parsed as " + std::string(formatName(report.format)) + ": " + e.what());
     }
+    if (io->refused)
+        fail(label, "the importer asked for '" + sim::displayName(*io->refused) +
+                        " (refused; references must be relative paths inside the file's folder)");
     if (scene == nullptr) {
         std::string why = importer.GetErrorString();
         if (why.rfind("No suitable reader found", 0) == 0)
@@ -268,7 +319,7 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file, const Im
     }
     if (scene == nullptr) fail(label, std::string("invalid scene structure: ") + importer.GetErrorString());
 
-    Merged merged = mergeScene(label, scene, options.scale);
+    Merged merged = mergeScene(label, scene, options);
     report.meshInstances = merged.instances;
     report.sourceTriangles = merged.triangles.size();
     if (merged.triangles.empty()) fail(label, "no faces: no mesh instance in the scene graph holds triangles");

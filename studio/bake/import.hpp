@@ -39,6 +39,10 @@ struct ImportOptions {
     double scale = 1.0;
     /// Files larger than this are rejected before parsing (bytes).
     std::uintmax_t maxFileBytes = std::uintmax_t{1} << 30;
+    /// Caps on the merged surface (after node instancing, before joining): a file over them is
+    /// refused naming the cap, before the vertices are copied.
+    size_t maxVertices = 10'000'000;
+    size_t maxTriangles = 20'000'000;
 };
 
 struct ImportReport {
@@ -63,7 +67,10 @@ SurfaceFormat detectSurfaceFormat(const std::filesystem::path& file);
 /// Throws viscera::InputError, naming the file, the element and the rule, when: the format is not
 /// accepted or the content does not match the extension; the file is empty, truncated or
 /// malformed; the scene has no triangles; a coordinate is not finite (names the vertex); a face
-/// references a vertex that does not exist (names the face and the index).
+/// references a vertex that does not exist (names the face and the index); the file refers to
+/// another file (material library, texture, buffer, image) by a path that is not a relative path
+/// inside its folder (bake/references.hpp: before any parser runs, so nothing outside is opened;
+/// names the reference and the rule); the merged surface exceeds maxVertices or maxTriangles.
 /// Throws std::invalid_argument when `options.scale` is not finite and > 0.
 /// Cost: linear in the file size; the whole file is read into memory once for the checks.
 sim::TriMesh importSurface(const std::filesystem::path& file, const ImportOptions& options = {});

@@ -193,6 +193,7 @@ int cmdImport(const std::vector<std::string>& args) {
     }
     if (!in) throw std::invalid_argument("import needs a mesh file");
     if (out && !tetra) throw std::invalid_argument("-o writes a tet mesh; add --tetrahedralize");
+    if (out) requireWritableFile(*out, "the tet mesh"); // before meshing, which can take minutes
     sim::TriMesh surface = bake::importSurface(*in, opt);
     auto [lo, hi] = surface.bounds();
     std::printf("%s: %zu vertices, %zu triangles, closed: %s, bounds [%g %g %g] - [%g %g %g] m\n", in->c_str(),
@@ -201,7 +202,11 @@ int cmdImport(const std::vector<std::string>& args) {
     if (!tetra) return 0;
     const auto t0 = std::chrono::steady_clock::now();
     meshing.label = std::filesystem::path(*in).filename().string();
-    bake::TetrahedralizeResult r = bake::tetrahedralize(surface, meshing);
+    // Progress on stderr, a line per stage: "viscera-studio: meshing: refine (10%)".
+    bake::TetrahedralizeResult r = bake::tetrahedralize(surface, meshing, [](bake::MeshingStage stage, double f) {
+        std::fprintf(stderr, "viscera-studio: meshing: %s (%.0f%%)\n", std::string(bake::stageName(stage)).c_str(),
+                     100.0 * f);
+    });
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("tetrahedralized: %zu nodes, %zu tets in %.2f s\n", r.mesh->vertexCount(), r.mesh->tetCount(), secs);
     printQuality(r.mesh->quality());

@@ -1,6 +1,7 @@
 // Surface import: accepted formats, the extension/content whitelist and the input rules.
 // Every fixture is written to a temporary folder at run time (no binary files in the tree).
 #include "bake/import.hpp"
+#include "bake/references.hpp"
 
 #include "sim/mesh/generators.hpp"
 #include "sim/util/error.hpp"
@@ -15,9 +16,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <random>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -563,4 +566,139 @@ TEST_F(bake_import, TruncatedAndCorruptedFilesNeverCrash) {
     }
     EXPECT_GT(rejected, 0);
     EXPECT_GT(imported, 0);
+}
+
+// ---- references to other files [issue 16 item 3] -----------------------------------------------
+// Each refused reference points at a file that exists and would import: were it followed, the
+// import would succeed, so the refusal shows it was not.
+
+namespace {
+
+/// A folder layout: <dir>/outside/cube.bin (a valid buffer of the unit cube), <dir>/a/b/ for the
+/// file under test.
+struct Layout {
+    fs::path outsideBin, inner;
+};
+
+Layout makeLayout(const fs::path& dir) {
+    fs::create_directories(dir / "outside");
+    fs::create_directories(dir / "a" / "b");
+    const fs::path bin = dir / "outside" / "cube.bin";
+    std::FILE* f = std::fopen(bin.c_str(), "wb");
+    const std::string b = gltfBuffer(unitCube());
+    std::fwrite(b.data(), 1, b.size(), f);
+    std::fclose(f);
+    return {bin, dir / "a" / "b"};
+}
+
+std::string glbWithJson(std::string json) {
+    while (json.size() % 4)
+        json.push_back(' ');
+    std::string s = "glTF";
+    putU32(s, 2);
+    putU32(s, static_cast<uint32_t>(12 + 8 + json.size()));
+    putU32(s, static_cast<uint32_t>(json.size()));
+    return s + "JSON" + json;
+}
+
+} // namespace
+
+TEST(bake_references, TheRuleAdmitsRelativePathsInsideTheFolderOnly) {
+    using bake::detail::referenceProblem;
+    for (const char* ok : {"cube.bin", "tex/skin diffuse.png", "x..y.png", "./a/b.mtl", "a/..b/c"})
+        EXPECT_EQ(referenceProblem(ok), std::nullopt) << ok;
+    const std::pair<const char*, const char*> refused[] = {
+        {"", "empty reference"},
+        {"../x", "'..' component"},
+        {"a/../../x", "'..' component"},
+        {"a\\..\\x", "'..' component"},
+        {"..", "'..' component"},
+        {"/etc/passwd", "absolute path"},
+        {"\\\\server\\share\\x", "absolute path"},
+        {"C:x.png", "drive letter"},
+        {"c:\\x.png", "drive letter"},
+        {"file:///etc/passwd", "URI scheme ('file:')"},
+        {"http://example.com/x.bin", "URI scheme ('http:')"},
+        {"x\x01.png", "control character"},
+    };
+    for (const auto& [path, rule] : refused) {
+        const auto problem = referenceProblem(path);
+        ASSERT_TRUE(problem.has_value()) << path;
+        EXPECT_THAT(*problem, HasSubstr(rule)) << path;
+    }
+}
+
+TEST_F(bake_import, AGltfBufferInItsFolderIsRead) {
+    const Layout l = makeLayout(m_dir);
+    fs::copy_file(l.outsideBin, l.inner / "cube.bin");
+    expectUnitCube(bake::importSurface(write("a/b/cube.gltf", gltfJson(unitCube(), "cube.bin"))));
+}
+
+TEST_F(bake_import, GltfReferencesOutOfTheFolderAreRefusedUnread) {
+    const Layout l = makeLayout(m_dir);
+    const std::pair<std::string, std::string> cases[] = {
+        {"../../outside/cube.bin",
+         "buffers[0].uri '../../outside/cube.bin': leaves the file's folder ('..' component)"},
+        {l.outsideBin.string(), "buffers[0].uri '" + l.outsideBin.string() + "': absolute path"},
+        {"file://" + l.outsideBin.string(), "a URI scheme ('file:') is refused"},
+        {"%2E%2E/%2e%2e/outside/cube.bin", "buffers[0].uri '../../outside/cube.bin': leaves the file's folder"},
+    };
+    int k = 0;
+    for (const auto& [uri, message] : cases) {
+        const fs::path p = write("a/b/cube" + std::to_string(k++) + ".gltf", gltfJson(unitCube(), uri));
+        const std::string e = importError(p);
+        EXPECT_THAT(e, AllOf(HasSubstr(p.string() + ": "), HasSubstr(message),
+                             HasSubstr("references must be relative paths inside the file's folder")))
+            << uri;
+        EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+    }
+}
+
+TEST_F(bake_import, GlbAndGltfImageReferencesAreCheckedToo) {
+    const std::string json = R"({"asset":{"version":"2.0"},"images":[{"uri":"data:image/png;base64,AAAA"},)"
+                             R"({"uri":"../secret.png"}],"buffers":[{"byteLength":4}]})";
+    EXPECT_THAT(importError(write("img.glb", glbWithJson(json))),
+                HasSubstr("images[1].uri '../secret.png': leaves the file's folder"));
+    EXPECT_THAT(importError(write("img.gltf", json)), HasSubstr("images[1].uri '../secret.png'"));
+    // A glTF 1.0 shader (or any extension) naming a file is a reference as well.
+    EXPECT_THAT(importError(write("v1.gltf", R"({"asset":{"version":"1.0"},"shaders":{"vs":{"uri":"/etc/x"}}})")),
+                HasSubstr("shaders.vs.uri '/etc/x': absolute path"));
+}
+
+TEST_F(bake_import, ObjMaterialLibrariesAndTheirTexturesMustStayInTheFolder) {
+    makeLayout(m_dir);
+    write("a/x.mtl", "newmtl skin\nKd 1 0 0\n");
+    const fs::path obj = write("a/b/cube.obj", "mtllib ../x.mtl\n" + cubeObj());
+    EXPECT_THAT(importError(obj), HasSubstr(obj.string() + ": line 1: mtllib '../x.mtl': leaves the file's folder"));
+    // Two names on one line: each is checked.
+    EXPECT_THAT(importError(write("a/b/two.obj", "mtllib ok.mtl /etc/x.mtl\n" + cubeObj())),
+                HasSubstr("mtllib '/etc/x.mtl': absolute path"));
+    // A library inside the folder is read, and its textures are checked (options before the name).
+    write("a/b/cube.mtl", "newmtl skin\nKd 1 0 0\nmap_Kd -bm 1.0 ../../outside/skin.png\n");
+    const fs::path inner = write("a/b/inner.obj", "mtllib cube.mtl\n" + cubeObj());
+    EXPECT_THAT(importError(inner),
+                HasSubstr("cube.mtl line 3: map_Kd '../../outside/skin.png': leaves the file's folder"));
+    write("a/b/cube.mtl", "newmtl skin\nKd 1 0 0\nmap_Kd textures/skin.png\n");
+    expectUnitCube(bake::importSurface(inner));
+}
+
+TEST_F(bake_import, ALinkOutOfTheFolderIsNotFollowed) {
+    const Layout l = makeLayout(m_dir);
+    fs::create_symlink(l.outsideBin, l.inner / "link.bin");
+    const fs::path p = write("a/b/linked.gltf", gltfJson(unitCube(), "link.bin"));
+    EXPECT_THAT(importError(p), AllOf(HasSubstr(p.string() + ": the importer asked for '"),
+                                      HasSubstr("link.bin', outside the file's folder (refused")));
+}
+
+TEST_F(bake_import, TheVertexAndTriangleCapsNameThemselves) {
+    const fs::path p = write("cube.stl", stlBinary(unitCube()));
+    bake::ImportOptions few;
+    few.maxTriangles = 11;
+    EXPECT_THAT(importError(p, few), AllOf(HasSubstr(p.string() + ": more than 11 triangles"),
+                                           HasSubstr("over the import cap ImportOptions::maxTriangles")));
+    few = {};
+    few.maxVertices = 7;
+    EXPECT_THAT(importError(p, few), HasSubstr("more than 7 vertices"));
+    few.maxVertices = 8;
+    expectUnitCube(bake::importSurface(p, few));
 }

@@ -166,3 +166,32 @@ TEST(StudioCli, TextureWritesTheMapsOfASpecAndListsThem) {
     EXPECT_THAT(usage.err, HasSubstr("texture needs <spec.json> and -o <dir>"));
     EXPECT_THAT(studio({"--help"}).out, HasSubstr("viscera-studio texture <spec.json> -o <dir>"));
 }
+
+// import --tetrahedralize: an output it cannot write is refused before meshing (no stage line),
+// meshing reports its stages on stderr, a reference out of the folder is refused in one line.
+TEST(StudioCli, ImportChecksItsOutputFirstAndReportsMeshingStages) {
+    test::Scratch s("viscera-studio-cli");
+    const std::string obj = s / "cube.obj";
+    writeFileAtomic(obj, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                         "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
+    writeFileAtomic(s / "file", "x");
+    const auto refused =
+        studio({"import", obj, "--tetrahedralize", "-o", (fs::path(s / "file") / "cube.vtet").string()});
+    EXPECT_EQ(refused.exitCode, 1);
+    EXPECT_THAT(refused.err, HasSubstr("cube.vtet: cannot write the tet mesh"));
+    EXPECT_THAT(refused.err, ::testing::Not(HasSubstr("meshing:")));
+    EXPECT_EQ(lines(refused.err).size(), 1u) << refused.err;
+
+    const auto r = studio({"import", obj, "--tetrahedralize", "-o", s / "cube.vtet"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_THAT(r.err, HasSubstr("viscera-studio: meshing: check surface (0%)"));
+    EXPECT_THAT(r.err, HasSubstr("viscera-studio: meshing: refine ("));
+    EXPECT_THAT(r.err, HasSubstr("viscera-studio: meshing: export (100%)"));
+    EXPECT_TRUE(fs::exists(s / "cube.vtet"));
+
+    writeFileAtomic(s / "up.obj", "mtllib ../outside.mtl\n" + readFile(obj));
+    const auto up = studio({"import", s / "up.obj"});
+    EXPECT_EQ(up.exitCode, 1);
+    EXPECT_THAT(up.err, HasSubstr("up.obj: line 1: mtllib '../outside.mtl': leaves the file's folder"));
+    EXPECT_EQ(lines(up.err).size(), 1u) << up.err;
+}
