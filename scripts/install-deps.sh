@@ -12,7 +12,7 @@ PKGS=(
   libzip-dev zipcmp zipmerge ziptool libssl-dev nlohmann-json3-dev
   # authoring (studio/bake only; never linked by the player)
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev
-  libassimp-dev libopenvdb-dev libtbb-dev
+  libassimp-dev libopenvdb-dev libtbb-dev libboost-iostreams-dev libblosc-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
   # rendering, headless EGL on Mesa (llvmpipe)
   libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri mesa-utils libpng-dev

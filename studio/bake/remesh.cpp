@@ -1,0 +1,214 @@
+// The CGAL half of the voxel remesh (bake/remesh.hpp, stages 5–6): parameter rules, isotropic
+// remeshing with hard edges, the checks and figures of the result, and the OBJ writer.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized" // Boost.Graph in CGAL's feature detection
+#endif
+
+#include "bake/remesh.hpp"
+#include "bake/surface_check.hpp"
+
+#include "sim/util/atomic_file.hpp"
+#include "sim/util/error.hpp"
+#include "sim/util/format.hpp"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/detect_features.h>
+#include <CGAL/Polygon_mesh_processing/remesh.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Surface_mesh.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iterator>
+#include <string>
+#include <vector>
+
+namespace viscera::bake {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using SurfaceMesh = CGAL::Surface_mesh<K::Point_3>;
+namespace PMP = CGAL::Polygon_mesh_processing;
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+void require(bool ok, const std::string& field, const std::string& rule) {
+    if (!ok) throw std::invalid_argument("bake::voxelRemesh(): RemeshParams::" + field + " " + rule);
+}
+
+void validate(const RemeshParams& p) {
+    require(std::isfinite(p.voxelSize) && p.voxelSize >= 0, "voxelSize", "must be finite and >= 0");
+    require(p.maxVoxelsPerAxis >= 8 && p.maxVoxelsPerAxis <= 65536, "maxVoxelsPerAxis", "must be in [8, 65536]");
+    require(p.voxelCount >= 8 && p.voxelCount <= p.maxVoxelsPerAxis, "voxelCount", "must be in [8, maxVoxelsPerAxis]");
+    require(std::isfinite(p.bandVoxels) && p.bandVoxels >= 3 && p.bandVoxels <= 16, "bandVoxels", "must be in [3, 16]");
+    require(p.smoothingIterations >= 0 && p.smoothingIterations <= 100, "smoothingIterations", "must be in [0, 100]");
+    require(std::isfinite(p.targetEdgeLength) && p.targetEdgeLength >= 0, "targetEdgeLength",
+            "must be finite and >= 0");
+    require(p.remeshIterations >= 0 && p.remeshIterations <= 20, "remeshIterations", "must be in [0, 20]");
+    require(std::isfinite(p.featureAngleDeg) && p.featureAngleDeg > 0 && p.featureAngleDeg <= 180, "featureAngleDeg",
+            "must be in (0, 180]");
+    require(p.maxTriangles >= 4, "maxTriangles", "must be at least 4");
+}
+
+SurfaceMesh toSurfaceMesh(const sim::TriMesh& m) {
+    SurfaceMesh sm;
+    std::vector<SurfaceMesh::Vertex_index> v;
+    v.reserve(m.vertexCount());
+    for (const sim::Vec3& p : m.positions())
+        v.push_back(sm.add_vertex(K::Point_3(p.x(), p.y(), p.z())));
+    for (size_t t = 0; t < m.triangleCount(); ++t) {
+        const sim::Tri& tri = m.triangles()[t];
+        if (sm.add_face(v[tri[0]], v[tri[1]], v[tri[2]]) == SurfaceMesh::null_face())
+            throw InputError("remesh: the isosurface is not manifold at triangle " + std::to_string(t));
+    }
+    return sm;
+}
+
+sim::TriMesh toTriMesh(SurfaceMesh& sm) {
+    sm.collect_garbage();
+    std::vector<sim::Vec3> positions;
+    positions.reserve(sm.number_of_vertices());
+    for (auto v : sm.vertices()) {
+        const K::Point_3& p = sm.point(v);
+        positions.emplace_back(p.x(), p.y(), p.z());
+    }
+    std::vector<sim::Tri> tris;
+    tris.reserve(sm.number_of_faces());
+    for (auto f : sm.faces()) {
+        sim::Tri t{};
+        int k = 0;
+        for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm))
+            if (k < 3) t[k++] = int32_t(v.idx());
+        tris.push_back(t);
+    }
+    return sim::TriMesh::fromArrays(std::move(positions), std::move(tris), "remesh result");
+}
+
+} // namespace
+
+std::string_view csgOpName(CsgOp op) {
+    switch (op) {
+    case CsgOp::Union:
+        return "union";
+    case CsgOp::Difference:
+        return "difference";
+    case CsgOp::Intersection:
+        return "intersection";
+    }
+    return "union";
+}
+
+RemeshResult voxelRemesh(const std::vector<RemeshPart>& parts, const RemeshParams& params,
+                         const RemeshProgress& progress, const std::atomic<bool>* cancel) {
+    validate(params);
+    if (parts.empty()) throw std::invalid_argument("bake::voxelRemesh(): no parts");
+    for (const RemeshPart& part : parts)
+        if (part.surface.triangleCount() == 0) throw InputError(part.name + ": the part has no triangles");
+    auto stage = [&](const std::string& name, double fraction) {
+        if (cancel && cancel->load()) throw RemeshCancelled();
+        if (progress && !progress(name, fraction)) throw RemeshCancelled();
+    };
+    RemeshReport report;
+    const sim::TriMesh iso = detail::combinedIsosurface(parts, params, progress, cancel, report);
+    report.isoVolume = iso.signedVolume();
+    for (const RemeshPart& part : parts)
+        if (part.surface.isClosedOriented()) report.sourceVolume += std::abs(part.surface.signedVolume());
+
+    const double vs = report.voxelSize;
+    report.targetEdgeLength = params.targetEdgeLength > 0 ? std::max(params.targetEdgeLength, 0.5 * vs) : 1.5 * vs;
+    const auto t0 = Clock::now();
+    SurfaceMesh sm = toSurfaceMesh(iso);
+    if (params.remeshIterations > 0) {
+        auto ecm = sm.add_property_map<SurfaceMesh::Edge_index, bool>("e:hard", false).first;
+        PMP::detect_sharp_edges(sm, params.featureAngleDeg, ecm);
+        for (auto e : sm.edges())
+            report.featureEdges += ecm[e] ? 1 : 0;
+        for (int it = 0; it < params.remeshIterations; ++it) {
+            stage("remeshing " + std::to_string(it + 1) + "/" + std::to_string(params.remeshIterations),
+                  0.72 + 0.2 * double(it) / params.remeshIterations);
+            PMP::isotropic_remeshing(faces(sm), report.targetEdgeLength, sm,
+                                     PMP::parameters::number_of_iterations(1).edge_is_constrained_map(ecm));
+            if (sm.number_of_faces() > params.maxTriangles)
+                throw InputError("remesh: remeshing gives " + std::to_string(sm.number_of_faces()) +
+                                 " triangles (cap RemeshParams::maxTriangles = " + std::to_string(params.maxTriangles) +
+                                 "); use a longer target edge length");
+        }
+    }
+    sim::TriMesh result = toTriMesh(sm);
+    report.remeshSeconds = secondsSince(t0);
+
+    stage("checks", 0.93);
+    const auto t1 = Clock::now();
+    report.vertices = result.vertexCount();
+    report.triangles = result.triangleCount();
+    std::string topology;
+    try {
+        detail::checkInputSurface("remesh result", result);
+        report.closed = report.manifold = true;
+    } catch (const InputError& e) {
+        topology = e.what();
+    }
+    std::vector<std::pair<SurfaceMesh::Face_index, SurfaceMesh::Face_index>> pairs;
+    PMP::self_intersections(sm, std::back_inserter(pairs));
+    report.selfIntersections = pairs.size();
+    // Distance from the result to the source surfaces, at its vertices and face centroids.
+    std::vector<K::Triangle_3> source;
+    for (const RemeshPart& part : parts)
+        for (const sim::Tri& t : part.surface.triangles()) {
+            const auto& p = part.surface.positions();
+            auto pt = [&](int32_t i) { return K::Point_3(p[i].x(), p[i].y(), p[i].z()); };
+            const K::Triangle_3 tri(pt(t[0]), pt(t[1]), pt(t[2]));
+            if (!tri.is_degenerate()) source.push_back(tri);
+        }
+    using Primitive = CGAL::AABB_triangle_primitive<K, std::vector<K::Triangle_3>::const_iterator>;
+    CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>> tree(source.cbegin(), source.cend());
+    tree.accelerate_distance_queries();
+    double sum = 0, most = 0;
+    size_t samples = 0;
+    auto sample = [&](const sim::Vec3& q) {
+        const double d = std::sqrt(tree.squared_distance(K::Point_3(q.x(), q.y(), q.z())));
+        sum += d;
+        most = std::max(most, d);
+        ++samples;
+    };
+    for (const sim::Vec3& q : result.positions())
+        sample(q);
+    for (const sim::Tri& t : result.triangles())
+        sample((result.positions()[t[0]] + result.positions()[t[1]] + result.positions()[t[2]]) / 3.0);
+    report.distanceMeanMm = samples ? 1e3 * sum / double(samples) : 0;
+    report.distanceMaxMm = 1e3 * most;
+    report.volume = result.signedVolume();
+    report.volumeChangeFromIso = report.isoVolume != 0 ? (report.volume - report.isoVolume) / report.isoVolume : 0;
+    report.checkSeconds = secondsSince(t1);
+    if (!topology.empty()) throw InputError(topology + " (try more smoothing or a shorter target edge length)");
+    if (report.selfIntersections > 0)
+        throw InputError("remesh result: " + std::to_string(report.selfIntersections) +
+                         " pair(s) of triangles intersect (try a shorter target edge length or more smoothing)");
+    stage("done", 1.0);
+    return {std::move(result), report};
+}
+
+void writeObj(const std::string& path, const sim::TriMesh& mesh) {
+    std::string text = "# viscera-studio remesh: " + std::to_string(mesh.vertexCount()) + " vertices, " +
+                       std::to_string(mesh.triangleCount()) + " triangles, metres\n";
+    char line[128];
+    for (const sim::Vec3& p : mesh.positions()) {
+        std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", p.x(), p.y(), p.z());
+        text += line;
+    }
+    for (const sim::Tri& t : mesh.triangles()) {
+        std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
+        text += line;
+    }
+    writeFileAtomic(path, text);
+}
+
+} // namespace viscera::bake

@@ -1,0 +1,116 @@
+#pragma once
+/// Voxel remesh [A §3.2]: anatomy modelled for rendering (open, self-intersecting, overlapping
+/// parts) made into one closed, manifold, self-intersection-free surface that the tetrahedralizer
+/// accepts.
+///
+///   1. a narrow-band signed distance field per part (OpenVDB meshToLevelSet) at one voxel size;
+///      an open part (a hole, a boundary edge) has no inside, so it is thickened instead: its
+///      unsigned distance field is meshed at half a voxel and that closed shell is converted;
+///   2. the parts combined in order with union / difference / intersection (OpenVDB CSG);
+///   3. optional smoothing of the combined level set (mean-curvature flow, a pass per iteration);
+///   4. the zero isosurface (OpenVDB volumeToMesh, quads split along their shorter diagonal);
+///   5. isotropic remeshing to a target edge length (CGAL Polygon_mesh_processing), edges whose
+///      dihedral angle exceeds the feature angle held as constraints (hard edges stay);
+///   6. checks and figures: closed, manifold, self-intersecting triangle pairs (CGAL), the
+///      distance from the result to the source surfaces (mean and max, sampled at the result's
+///      vertices and face centroids), the enclosed volume of source, isosurface and result.
+///
+/// The work runs on the calling thread (OpenVDB's parallel loops use TBB's threads). Caps refuse
+/// a grid or a result that would not fit: the voxel count along the longest axis and the
+/// triangles of the result.
+#include "sim/mesh/tri_mesh.hpp"
+
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace viscera::bake {
+
+enum class CsgOp { Union, Difference, Intersection };
+
+/// "union", "difference", "intersection".
+std::string_view csgOpName(CsgOp op);
+
+struct RemeshPart {
+    std::string name; ///< for messages ("kidney.obj")
+    sim::TriMesh surface;
+    CsgOp op = CsgOp::Union; ///< how the part combines with the parts before it (ignored for the first)
+};
+
+struct RemeshParams {
+    /// Voxel edge, m; 0: the longest axis of the parts' bounds divided by voxelCount.
+    double voxelSize = 0;
+    int voxelCount = 128;        ///< voxels along the longest axis when voxelSize is 0, in [8, maxVoxelsPerAxis]
+    double bandVoxels = 3;       ///< narrow band half width, voxels, in [3, 16]
+    int smoothingIterations = 0; ///< mean-curvature passes on the combined level set, in [0, 100]
+    /// Target edge length of the result, m; 0: 1.5 voxels. Not below half a voxel.
+    double targetEdgeLength = 0;
+    int remeshIterations = 3;        ///< CGAL isotropic remeshing iterations, in [0, 20] (0: the isosurface)
+    double featureAngleDeg = 60;     ///< dihedral angle that makes an edge hard, degrees, in (0, 180]
+    int maxVoxelsPerAxis = 2048;     ///< refuses finer grids
+    size_t maxTriangles = 2'000'000; ///< refuses larger results (isosurface or remeshed)
+};
+
+struct RemeshReport {
+    double voxelSize = 0;        ///< m, as used
+    double targetEdgeLength = 0; ///< m, as used
+    std::array<int, 3> voxels{}; ///< grid extent of the parts' bounds, voxels per axis
+    size_t activeVoxels = 0;     ///< narrow-band voxels of the combined level set
+    size_t openParts = 0;        ///< parts meshed through the unsigned-distance fallback
+    size_t isoTriangles = 0;     ///< triangles of the isosurface
+    size_t featureEdges = 0;     ///< edges held as hard edges while remeshing
+    size_t vertices = 0, triangles = 0;
+    bool closed = false;                          ///< every edge in exactly two triangles, consistently oriented
+    bool manifold = false;                        ///< every vertex a single fan
+    size_t selfIntersections = 0;                 ///< intersecting triangle pairs (CGAL)
+    double distanceMeanMm = 0, distanceMaxMm = 0; ///< result → source surfaces, mm
+    double sourceVolume = 0;        ///< m³, Σ |enclosed volume| of the closed parts (overlaps counted twice)
+    double isoVolume = 0;           ///< m³, enclosed by the isosurface
+    double volume = 0;              ///< m³, enclosed by the result
+    double volumeChangeFromIso = 0; ///< (volume − isoVolume) / isoVolume: what remeshing changed
+    double levelSetSeconds = 0, isosurfaceSeconds = 0, remeshSeconds = 0, checkSeconds = 0;
+};
+
+struct RemeshResult {
+    sim::TriMesh mesh;
+    RemeshReport report;
+};
+
+/// Progress: called on the calling thread at each stage with its name ("level set 2/3: ureter.obj", "union",
+/// "smoothing", "isosurface", "remeshing", "checks") and the estimated overall fraction in [0, 1].
+/// Returning false cancels: the call throws RemeshCancelled at the next check. `cancel`, when
+/// given, is also polled inside OpenVDB's parallel loops (set it from another thread to stop a
+/// long level-set conversion within a fraction of a second).
+using RemeshProgress = std::function<bool(std::string_view stage, double fraction)>;
+
+struct RemeshCancelled : std::runtime_error {
+    RemeshCancelled() : std::runtime_error("remesh cancelled") {}
+};
+
+/// Throws std::invalid_argument naming the field when a parameter is out of range, InputError
+/// naming the part when a part is empty or not finite, or naming the cap when the grid or the
+/// result exceeds it ("voxel size 0.1 mm gives 4000 voxels along the longest axis (cap
+/// RemeshParams::maxVoxelsPerAxis = 2048)"), and when the result is not closed, not manifold or
+/// self-intersects (with the count).
+RemeshResult voxelRemesh(const std::vector<RemeshPart>& parts, const RemeshParams& params,
+                         const RemeshProgress& progress = {}, const std::atomic<bool>* cancel = nullptr);
+
+/// Writes a surface as Wavefront OBJ (vertices in metres, faces 1-based), atomically.
+void writeObj(const std::string& path, const sim::TriMesh& mesh);
+
+namespace detail {
+
+/// Stage 1–4 (OpenVDB, remesh_vdb.cpp): the isosurface of the combined level set. Fills
+/// voxelSize, voxels, activeVoxels, openParts, isoTriangles, levelSetSeconds, isosurfaceSeconds.
+/// Throws RemeshCancelled when progress returns false or *cancel becomes true.
+sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const RemeshParams& params,
+                                const RemeshProgress& progress, const std::atomic<bool>* cancel, RemeshReport& report);
+
+} // namespace detail
+
+} // namespace viscera::bake

@@ -1,0 +1,211 @@
+// The OpenVDB half of the voxel remesh (bake/remesh.hpp, stages 1–4): level sets per part, the
+// CSG combination, smoothing and the isosurface. The only translation unit that includes
+// OpenVDB (it compiles slowly).
+#include "bake/remesh.hpp"
+
+#include "sim/util/error.hpp"
+#include "sim/util/format.hpp"
+
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Composite.h>
+#include <openvdb/tools/LevelSetFilter.h>
+#include <openvdb/tools/MeshToVolume.h>
+#include <openvdb/tools/VolumeToMesh.h>
+#include <openvdb/util/NullInterrupter.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace viscera::bake::detail {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// OpenVDB's cancellation hook: polled from its worker threads, so it only reads an atomic.
+struct CancelInterrupter : openvdb::util::NullInterrupter {
+    explicit CancelInterrupter(const std::atomic<bool>* flag) : cancel(flag) {}
+    bool wasInterrupted(int = -1) override { return cancel && cancel->load(std::memory_order_relaxed); }
+    const std::atomic<bool>* cancel;
+};
+
+struct Stager {
+    const RemeshProgress& progress;
+    const std::atomic<bool>* cancel;
+    void operator()(const std::string& stage, double fraction) const {
+        if (cancel && cancel->load()) throw RemeshCancelled();
+        if (progress && !progress(stage, fraction)) throw RemeshCancelled();
+    }
+    void check() const {
+        if (cancel && cancel->load()) throw RemeshCancelled();
+    }
+};
+
+void toVdb(const sim::TriMesh& m, std::vector<openvdb::Vec3s>& points, std::vector<openvdb::Vec3I>& tris) {
+    points.clear();
+    tris.clear();
+    points.reserve(m.vertexCount());
+    for (const sim::Vec3& p : m.positions())
+        points.emplace_back(float(p.x()), float(p.y()), float(p.z()));
+    tris.reserve(m.triangleCount());
+    for (const sim::Tri& t : m.triangles())
+        tris.emplace_back(openvdb::Index32(t[0]), openvdb::Index32(t[1]), openvdb::Index32(t[2]));
+}
+
+/// Triangles and quads of volumeToMesh as a surface: quads split along the shorter diagonal,
+/// unreferenced points dropped, oriented so that the enclosed volume is positive.
+sim::TriMesh fromVdb(const std::vector<openvdb::Vec3s>& points, const std::vector<openvdb::Vec3I>& tris,
+                     const std::vector<openvdb::Vec4I>& quads, const std::string& label) {
+    std::vector<sim::Tri> out;
+    out.reserve(tris.size() + 2 * quads.size());
+    auto add = [&](openvdb::Index32 a, openvdb::Index32 b, openvdb::Index32 c) {
+        if (a != b && b != c && a != c) out.push_back({int32_t(a), int32_t(b), int32_t(c)});
+    };
+    for (const auto& t : tris)
+        add(t[0], t[1], t[2]);
+    for (const auto& q : quads) {
+        const double d02 = (points[q[0]] - points[q[2]]).lengthSqr(), d13 = (points[q[1]] - points[q[3]]).lengthSqr();
+        if (d02 <= d13) {
+            add(q[0], q[1], q[2]);
+            add(q[0], q[2], q[3]);
+        } else {
+            add(q[0], q[1], q[3]);
+            add(q[1], q[2], q[3]);
+        }
+    }
+    std::vector<int32_t> compact(points.size(), -1);
+    std::vector<sim::Vec3> positions;
+    for (sim::Tri& t : out)
+        for (int32_t& v : t) {
+            if (compact[v] < 0) {
+                compact[v] = int32_t(positions.size());
+                const auto& p = points[v];
+                positions.emplace_back(p.x(), p.y(), p.z());
+            }
+            v = compact[v];
+        }
+    sim::TriMesh mesh = sim::TriMesh::fromArrays(std::move(positions), std::move(out), label);
+    if (mesh.signedVolume() < 0) {
+        std::vector<sim::Tri> flipped = mesh.triangles();
+        for (sim::Tri& t : flipped)
+            std::swap(t[1], t[2]);
+        mesh = sim::TriMesh::fromArrays(mesh.positions(), std::move(flipped), label);
+    }
+    return mesh;
+}
+
+} // namespace
+
+sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const RemeshParams& params,
+                                const RemeshProgress& progress, const std::atomic<bool>* cancel, RemeshReport& report) {
+    openvdb::initialize();
+    const Stager stage{progress, cancel};
+    // The grid: one voxel size for every part, from the bounds of them all.
+    sim::Vec3 lo = sim::Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const RemeshPart& part : parts) {
+        const auto [a, b] = part.surface.bounds();
+        lo = lo.cwiseMin(a);
+        hi = hi.cwiseMax(b);
+    }
+    const sim::Vec3 extent = hi - lo;
+    const double longest = extent.maxCoeff();
+    if (!(longest > 0)) throw InputError(parts.front().name + ": the parts have no extent (all points coincide)");
+    const double vs = params.voxelSize > 0 ? params.voxelSize : longest / params.voxelCount;
+    for (int k = 0; k < 3; ++k) {
+        const double n = std::ceil(extent[k] / vs) + 2 * std::ceil(params.bandVoxels);
+        if (!(n <= params.maxVoxelsPerAxis))
+            throw InputError("remesh: voxel size " + sim::formatNumber(vs * 1e3) + " mm gives " +
+                             sim::formatNumber(std::ceil(n)) + " voxels along axis " + "xyz"[k] +
+                             " of the parts' bounds (cap RemeshParams::maxVoxelsPerAxis = " +
+                             std::to_string(params.maxVoxelsPerAxis) + ")");
+        report.voxels[k] = int(n);
+    }
+    report.voxelSize = vs;
+    const auto xform = openvdb::math::Transform::createLinearTransform(vs);
+    const float band = float(params.bandVoxels);
+    CancelInterrupter interrupter(cancel);
+
+    const auto t0 = Clock::now();
+    openvdb::FloatGrid::Ptr combined;
+    std::vector<openvdb::Vec3s> points;
+    std::vector<openvdb::Vec3I> tris;
+    const std::vector<openvdb::Vec4I> noQuads;
+    const double levelSetShare = 0.6;
+    for (size_t i = 0; i < parts.size(); ++i) {
+        const RemeshPart& part = parts[i];
+        stage("level set " + std::to_string(i + 1) + "/" + std::to_string(parts.size()) + ": " + part.name,
+              levelSetShare * double(i) / double(parts.size()));
+        toVdb(part.surface, points, tris);
+        openvdb::FloatGrid::Ptr grid;
+        if (part.surface.isClosedOriented()) {
+            grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(interrupter, *xform, points, tris, band);
+        } else {
+            // No inside: thicken the open surface into a closed shell 1.5 voxels thick (the
+            // unsigned distance at 0.75 voxels), then take the shell's level set.
+            ++report.openParts;
+            auto udf = openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(interrupter, *xform, points,
+                                                                                       tris, noQuads, band);
+            stage.check();
+            std::vector<openvdb::Vec3s> shellPoints;
+            std::vector<openvdb::Vec3I> shellTris;
+            std::vector<openvdb::Vec4I> shellQuads;
+            openvdb::tools::volumeToMesh(*udf, shellPoints, shellTris, shellQuads, 0.75 * vs, 0.0);
+            if (shellTris.empty() && shellQuads.empty())
+                throw InputError(part.name + ": the open part is thinner than the voxel grid resolves (voxel size " +
+                                 sim::formatNumber(vs * 1e3) + " mm)");
+            grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(interrupter, *xform, shellPoints, shellTris,
+                                                                      shellQuads, band);
+        }
+        stage.check();
+        if (!combined) {
+            combined = grid;
+            continue;
+        }
+        switch (part.op) {
+        case CsgOp::Union:
+            openvdb::tools::csgUnion(*combined, *grid);
+            break;
+        case CsgOp::Difference:
+            openvdb::tools::csgDifference(*combined, *grid);
+            break;
+        case CsgOp::Intersection:
+            openvdb::tools::csgIntersection(*combined, *grid);
+            break;
+        }
+    }
+    if (params.smoothingIterations > 0) {
+        openvdb::tools::LevelSetFilter<openvdb::FloatGrid> filter(*combined);
+        for (int i = 0; i < params.smoothingIterations; ++i) {
+            stage("smoothing", levelSetShare + 0.1 * double(i) / params.smoothingIterations);
+            filter.meanCurvature();
+        }
+    }
+    report.activeVoxels = size_t(combined->activeVoxelCount());
+    report.levelSetSeconds = secondsSince(t0);
+
+    stage("isosurface", levelSetShare + 0.1);
+    const auto t1 = Clock::now();
+    std::vector<openvdb::Vec3s> isoPoints;
+    std::vector<openvdb::Vec3I> isoTris;
+    std::vector<openvdb::Vec4I> isoQuads;
+    openvdb::tools::volumeToMesh(*combined, isoPoints, isoTris, isoQuads, 0.0, 0.0);
+    const size_t triangles = isoTris.size() + 2 * isoQuads.size();
+    if (triangles == 0)
+        throw InputError("remesh: the combined volume is empty (the operations leave nothing inside at voxel size " +
+                         sim::formatNumber(vs * 1e3) + " mm)");
+    if (triangles > params.maxTriangles)
+        throw InputError("remesh: the isosurface has " + std::to_string(triangles) +
+                         " triangles (cap RemeshParams::maxTriangles = " + std::to_string(params.maxTriangles) +
+                         "); use a larger voxel size");
+    sim::TriMesh iso = fromVdb(isoPoints, isoTris, isoQuads, "remesh isosurface");
+    report.isoTriangles = iso.triangleCount();
+    report.isosurfaceSeconds = secondsSince(t1);
+    return iso;
+}
+
+} // namespace viscera::bake::detail

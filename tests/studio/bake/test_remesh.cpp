@@ -1,0 +1,190 @@
+// Voxel remesh (bake/remesh.hpp): CSG of overlapping, open parts into one closed, manifold,
+// self-intersection-free surface; its figures against the analytic volumes of boxes; caps,
+// parameter rules, cancellation; the result tetrahedralizes.
+#include "bake/import.hpp"
+#include "bake/remesh.hpp"
+#include "bake/tetrahedralize.hpp"
+
+#include "sim/mesh/generators.hpp"
+#include "sim/util/error.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+using namespace viscera;
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+namespace {
+
+sim::TriMesh box(double x0, double y0, double z0, double size) {
+    return sim::makeBoxSurface(sim::Vec3(x0, y0, z0), sim::Vec3(x0 + size, y0 + size, z0 + size));
+}
+
+/// A box with the two triangles of one face removed: open, no inside.
+sim::TriMesh openBox(double x0, double y0, double z0, double size) {
+    const sim::TriMesh b = box(x0, y0, z0, size);
+    std::vector<sim::Tri> tris;
+    for (const sim::Tri& t : b.triangles()) {
+        bool top = true;
+        for (int32_t v : t)
+            top = top && b.positions()[v].z() > z0 + 0.5 * size;
+        if (!top) tris.push_back(t);
+    }
+    return sim::TriMesh::fromArrays(b.positions(), tris);
+}
+
+bake::RemeshParams params(int voxels = 64) {
+    bake::RemeshParams p;
+    p.voxelCount = voxels;
+    return p;
+}
+
+// Two 2 cm cubes overlapping in a 1 cm cube.
+std::vector<bake::RemeshPart> twoCubes(bake::CsgOp op) {
+    return {{"a", box(0, 0, 0, 0.02), bake::CsgOp::Union}, {"b", box(0.01, 0.01, 0.01, 0.02), op}};
+}
+
+void expectSound(const bake::RemeshResult& r) {
+    EXPECT_TRUE(r.report.closed);
+    EXPECT_TRUE(r.report.manifold);
+    EXPECT_EQ(r.report.selfIntersections, 0u);
+    EXPECT_TRUE(r.mesh.isClosedOriented());
+    EXPECT_GT(r.mesh.signedVolume(), 0);
+}
+
+} // namespace
+
+TEST(bake_remesh, UnionOfOverlappingCubesIsOneClosedSurfaceOfTheirVolume) {
+    const bake::RemeshResult r = bake::voxelRemesh(twoCubes(bake::CsgOp::Union), params());
+    expectSound(r);
+    const double exact = 2 * 8e-6 - 1e-6; // overlap counted once
+    EXPECT_NEAR(r.report.volume, exact, 0.02 * exact);
+    EXPECT_NEAR(r.report.sourceVolume, 16e-6, 1e-12); // the parts, overlap twice
+    const double voxelMm = r.report.voxelSize * 1e3;
+    EXPECT_NEAR(voxelMm, 30.0 / 64, 1e-9); // 3 cm longest axis / 64
+    EXPECT_LT(r.report.distanceMeanMm, 0.25 * voxelMm);
+    EXPECT_LT(r.report.distanceMaxMm, 1.5 * voxelMm);
+    EXPECT_GT(r.report.featureEdges, 0u); // the cube edges are held while remeshing
+    EXPECT_LT(std::abs(r.report.volumeChangeFromIso), 0.01);
+    EXPECT_EQ(r.report.triangles, r.mesh.triangleCount());
+}
+
+TEST(bake_remesh, DifferenceAndIntersectionGiveTheirVolumes) {
+    const bake::RemeshResult d = bake::voxelRemesh(twoCubes(bake::CsgOp::Difference), params());
+    expectSound(d);
+    EXPECT_NEAR(d.report.volume, 7e-6, 0.03 * 7e-6);
+    const bake::RemeshResult i = bake::voxelRemesh(twoCubes(bake::CsgOp::Intersection), params());
+    expectSound(i);
+    EXPECT_NEAR(i.report.volume, 1e-6, 0.05 * 1e-6);
+}
+
+TEST(bake_remesh, AnOpenPartIsThickenedIntoAClosedShell) {
+    std::vector<bake::RemeshPart> parts{{"open", openBox(0, 0, 0, 0.02), bake::CsgOp::Union}};
+    ASSERT_FALSE(parts[0].surface.isClosedOriented());
+    const bake::RemeshResult r = bake::voxelRemesh(parts, params());
+    expectSound(r);
+    EXPECT_EQ(r.report.openParts, 1u);
+    // A shell 1.5 voxels thick over the five faces (5 × 4 cm²), far less than the box's 8 cm³.
+    const double shell = 5 * 4e-4 * 1.5 * r.report.voxelSize;
+    EXPECT_NEAR(r.report.volume, shell, 0.35 * shell);
+    EXPECT_LT(r.report.distanceMaxMm, 2.0 * r.report.voxelSize * 1e3);
+}
+
+TEST(bake_remesh, TheResultTetrahedralizes) {
+    const bake::RemeshResult r = bake::voxelRemesh(twoCubes(bake::CsgOp::Union), params(48));
+    bake::MeshingParams m;
+    m.cellSize = 0.003;
+    m.facetSize = 0.002;
+    const bake::TetrahedralizeResult t = bake::tetrahedralize(r.mesh, m);
+    EXPECT_GT(t.mesh->tetCount(), 100u);
+    EXPECT_TRUE(t.report.quality.inverted.empty());
+    EXPECT_NEAR(t.report.tetVolume, r.report.volume, 0.03 * r.report.volume);
+}
+
+TEST(bake_remesh, RunsAreRepeatable) {
+    const bake::RemeshResult a = bake::voxelRemesh(twoCubes(bake::CsgOp::Union), params(40));
+    const bake::RemeshResult b = bake::voxelRemesh(twoCubes(bake::CsgOp::Union), params(40));
+    ASSERT_EQ(a.mesh.vertexCount(), b.mesh.vertexCount());
+    ASSERT_EQ(a.mesh.triangleCount(), b.mesh.triangleCount());
+    EXPECT_EQ(a.mesh.positions(), b.mesh.positions());
+    EXPECT_EQ(a.mesh.triangles(), b.mesh.triangles());
+}
+
+TEST(bake_remesh, CapsAndParameterRulesNameThemselves) {
+    bake::RemeshParams p = params();
+    p.voxelSize = 1e-5; // 3 cm / 10 µm = 3000 voxels
+    try {
+        bake::voxelRemesh(twoCubes(bake::CsgOp::Union), p);
+        ADD_FAILURE() << "a 3000-voxel grid was accepted";
+    } catch (const InputError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("cap RemeshParams::maxVoxelsPerAxis = 2048"));
+    }
+    p = params();
+    p.maxTriangles = 100;
+    try {
+        bake::voxelRemesh(twoCubes(bake::CsgOp::Union), p);
+        ADD_FAILURE() << "the triangle cap was not applied";
+    } catch (const InputError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("cap RemeshParams::maxTriangles = 100"));
+    }
+    p = params(4);
+    EXPECT_THROW(bake::voxelRemesh(twoCubes(bake::CsgOp::Union), p), std::invalid_argument);
+    p = params();
+    p.bandVoxels = 2;
+    try {
+        bake::voxelRemesh(twoCubes(bake::CsgOp::Union), p);
+        ADD_FAILURE();
+    } catch (const std::invalid_argument& e) {
+        EXPECT_THAT(e.what(), HasSubstr("RemeshParams::bandVoxels must be in [3, 16]"));
+    }
+    // Disjoint parts intersect in nothing.
+    std::vector<bake::RemeshPart> apart{{"a", box(0, 0, 0, 0.01), bake::CsgOp::Union},
+                                        {"b", box(0.02, 0, 0, 0.01), bake::CsgOp::Intersection}};
+    try {
+        bake::voxelRemesh(apart, params(32));
+        ADD_FAILURE();
+    } catch (const InputError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("the combined volume is empty"));
+    }
+}
+
+TEST(bake_remesh, ProgressCanCancelAndReportsEveryStage) {
+    std::vector<std::string> stages;
+    double last = -1;
+    bool rising = true;
+    bake::voxelRemesh(twoCubes(bake::CsgOp::Union), params(32), [&](std::string_view s, double f) {
+        stages.emplace_back(s);
+        rising = rising && f >= last && f <= 1.0;
+        last = f;
+        return true;
+    });
+    EXPECT_TRUE(rising);
+    ASSERT_GE(stages.size(), 6u);
+    EXPECT_EQ(stages.front(), "level set 1/2: a");
+    EXPECT_EQ(stages.back(), "done");
+    EXPECT_THAT(stages, ::testing::Contains("isosurface"));
+    EXPECT_THROW(bake::voxelRemesh(twoCubes(bake::CsgOp::Union), params(32),
+                                   [](std::string_view s, double) { return s != "isosurface"; }),
+                 bake::RemeshCancelled);
+    std::atomic<bool> cancel{true};
+    EXPECT_THROW(bake::voxelRemesh(twoCubes(bake::CsgOp::Union), params(32), {}, &cancel), bake::RemeshCancelled);
+}
+
+TEST(bake_remesh, TheObjWriterRoundTrips) {
+    const bake::RemeshResult r = bake::voxelRemesh(twoCubes(bake::CsgOp::Union), params(24));
+    const fs::path file = fs::path(::testing::TempDir()) / ("viscera_remesh_" + std::to_string(::getpid()) + ".obj");
+    bake::writeObj(file.string(), r.mesh);
+    const sim::TriMesh back = bake::importSurface(file);
+    fs::remove(file);
+    EXPECT_EQ(back.vertexCount(), r.mesh.vertexCount());
+    EXPECT_EQ(back.triangleCount(), r.mesh.triangleCount());
+    EXPECT_NEAR(back.signedVolume(), r.mesh.signedVolume(), 1e-6 * r.mesh.signedVolume());
+}
