@@ -119,8 +119,10 @@ RemeshResult voxelRemesh(const std::vector<RemeshPart>& parts, const RemeshParam
     RemeshReport report;
     const sim::TriMesh iso = detail::combinedIsosurface(parts, params, progress, cancel, report);
     report.isoVolume = iso.signedVolume();
-    for (const RemeshPart& part : parts)
-        if (part.surface.isClosedOriented()) report.sourceVolume += std::abs(part.surface.signedVolume());
+    for (const RemeshPart& part : parts) // closed, or closed up to holes the band closes over
+        if (part.surface.isClosedOriented() ||
+            detail::largestHoleDiameter(part.surface) < params.bandVoxels * report.voxelSize)
+            report.sourceVolume += std::abs(part.surface.signedVolume());
 
     const double vs = report.voxelSize;
     report.targetEdgeLength = params.targetEdgeLength > 0 ? std::max(params.targetEdgeLength, 0.5 * vs) : 1.5 * vs;

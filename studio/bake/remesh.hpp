@@ -4,8 +4,9 @@
 /// accepts.
 ///
 ///   1. a narrow-band signed distance field per part (OpenVDB meshToLevelSet) at one voxel size;
-///      an open part (a hole, a boundary edge) has no inside, so it is thickened instead: its
-///      unsigned distance field is meshed at half a voxel and that closed shell is converted;
+///      a part whose holes are narrower than the band is closed over them by the band; an open
+///      part with a wider hole has no inside, so it is thickened instead: its unsigned distance
+///      field is meshed at 0.75 voxels and that closed shell (1.5 voxels thick) is converted;
 ///   2. the parts combined in order with union / difference / intersection (OpenVDB CSG);
 ///   3. optional smoothing of the combined level set (mean-curvature flow, a pass per iteration);
 ///   4. the zero isosurface (OpenVDB volumeToMesh, quads split along their shorter diagonal);
@@ -62,6 +63,7 @@ struct RemeshReport {
     std::array<int, 3> voxels{}; ///< grid extent of the parts' bounds, voxels per axis
     size_t activeVoxels = 0;     ///< narrow-band voxels of the combined level set
     size_t openParts = 0;        ///< parts meshed through the unsigned-distance fallback
+    size_t closedHoles = 0;      ///< parts with holes narrower than the band, closed over them
     size_t isoTriangles = 0;     ///< triangles of the isosurface
     size_t featureEdges = 0;     ///< edges held as hard edges while remeshing
     size_t vertices = 0, triangles = 0;
@@ -69,7 +71,8 @@ struct RemeshReport {
     bool manifold = false;                        ///< every vertex a single fan
     size_t selfIntersections = 0;                 ///< intersecting triangle pairs (CGAL)
     double distanceMeanMm = 0, distanceMaxMm = 0; ///< result → source surfaces, mm
-    double sourceVolume = 0;        ///< m³, Σ |enclosed volume| of the closed parts (overlaps counted twice)
+    double sourceVolume = 0; ///< m³, Σ |enclosed volume| of the parts with an inside (closed, or holes under the band;
+                             ///< overlaps counted twice, a self-intersecting part's folds subtracted)
     double isoVolume = 0;           ///< m³, enclosed by the isosurface
     double volume = 0;              ///< m³, enclosed by the result
     double volumeChangeFromIso = 0; ///< (volume − isoVolume) / isoVolume: what remeshing changed
@@ -106,7 +109,11 @@ void writeObj(const std::string& path, const sim::TriMesh& mesh);
 namespace detail {
 
 /// Stage 1–4 (OpenVDB, remesh_vdb.cpp): the isosurface of the combined level set. Fills
-/// voxelSize, voxels, activeVoxels, openParts, isoTriangles, levelSetSeconds, isosurfaceSeconds.
+/// voxelSize, voxels, activeVoxels, openParts, closedHoles, isoTriangles, levelSetSeconds, isosurfaceSeconds.
+/// The largest extent (bounding-box diagonal, m) of a hole of `mesh`: a loop of edges that belong
+/// to one triangle only; 0 when there is none. O(triangles).
+double largestHoleDiameter(const sim::TriMesh& mesh);
+
 /// Throws RemeshCancelled when progress returns false or *cancel becomes true.
 sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const RemeshParams& params,
                                 const RemeshProgress& progress, const std::atomic<bool>* cancel, RemeshReport& report);

@@ -16,7 +16,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <unordered_map>
+#include <utility>
 
 namespace viscera::bake::detail {
 namespace {
@@ -101,6 +104,46 @@ sim::TriMesh fromVdb(const std::vector<openvdb::Vec3s>& points, const std::vecto
 
 } // namespace
 
+double largestHoleDiameter(const sim::TriMesh& mesh) {
+    // Undirected edges used by one triangle only; a face orientation that flips between
+    // neighbours is no hole (the level set does not depend on orientation).
+    std::unordered_map<uint64_t, int> uses;
+    auto key = [](int32_t a, int32_t b) {
+        if (a > b) std::swap(a, b);
+        return (uint64_t(uint32_t(a)) << 32) | uint32_t(b);
+    };
+    for (const sim::Tri& t : mesh.triangles())
+        for (int k = 0; k < 3; ++k)
+            ++uses[key(t[k], t[(k + 1) % 3])];
+    // Boundary vertices grouped into loops by union-find over the boundary edges.
+    std::unordered_map<int32_t, int32_t> parent;
+    std::function<int32_t(int32_t)> root = [&](int32_t v) {
+        while (parent[v] != v)
+            v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    for (const auto& [k, n] : uses) {
+        if (n != 1) continue;
+        const auto a = int32_t(k >> 32), b = int32_t(k & 0xffffffffu);
+        parent.try_emplace(a, a);
+        parent.try_emplace(b, b);
+        parent[root(a)] = root(b);
+    }
+    std::unordered_map<int32_t, std::pair<sim::Vec3, sim::Vec3>> box;
+    for (const auto& [v, p] : parent) {
+        const sim::Vec3& x = mesh.positions()[v];
+        auto [it, fresh] = box.try_emplace(root(v), x, x);
+        if (!fresh) {
+            it->second.first = it->second.first.cwiseMin(x);
+            it->second.second = it->second.second.cwiseMax(x);
+        }
+    }
+    double most = 0;
+    for (const auto& [r, b] : box)
+        most = std::max(most, (b.second - b.first).norm());
+    return most;
+}
+
 sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const RemeshParams& params,
                                 const RemeshProgress& progress, const std::atomic<bool>* cancel, RemeshReport& report) {
     openvdb::initialize();
@@ -142,7 +185,11 @@ sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const Reme
               levelSetShare * double(i) / double(parts.size()));
         toVdb(part.surface, points, tris);
         openvdb::FloatGrid::Ptr grid;
-        if (part.surface.isClosedOriented()) {
+        const double hole = part.surface.isClosedOriented() ? 0.0 : largestHoleDiameter(part.surface);
+        if (hole < params.bandVoxels * vs) {
+            // Closed, or its holes narrower than the band: the band closes over them and the
+            // inside is found as for a closed part.
+            if (hole > 0) ++report.closedHoles;
             grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(interrupter, *xform, points, tris, band);
         } else {
             // No inside: thicken the open surface into a closed shell 1.5 voxels thick (the

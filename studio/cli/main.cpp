@@ -30,6 +30,7 @@
 #include "app/studio_app.hpp"
 #include "bake/import.hpp"
 #include "bake/remesh.hpp"
+#include "bake/sample_anatomy.hpp"
 #include "bake/tetrahedralize.hpp"
 #include "bake/texture.hpp"
 #include "haptics/trajectory.hpp"
@@ -60,7 +61,8 @@ void usage(std::FILE* out) {
                "       viscera-studio export <project-dir> -o <case.vcase> [--project-file <json>]\n"
                "       viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M]\n"
                "                             [--facet-size M] [-o out.vtet]\n"
-               "       viscera-studio remesh <mesh>... [--subtract M] [--intersect M] [options] -o out.obj\n"
+               "       viscera-studio remesh [<mesh>...] [--sample kidney] [--subtract M] [--intersect M] [options] -o "
+               "out.obj\n"
                "       viscera-studio texture <spec.json> -o <dir>\n"
                "       viscera-studio replay <project-dir> -o <replay.csv> [--frames N]\n"
                "       viscera-studio --version\n",
@@ -91,6 +93,8 @@ constexpr const char* kRemeshHelp =
     "its figures: closedness, intersecting pairs, distance to the source (mean, max), volumes.\n"
     "The parts combine in the order given: each <mesh> by union, --subtract by difference,\n"
     "--intersect by intersection. Progress goes to stderr.\n"
+    "  --sample kidney     add the built-in kidney-like anatomy (four overlapping parts: a\n"
+    "                      self-intersecting cortex with a hole, pelvis, open ureter, artery)\n"
     "  --scale S           metres per file unit of every part (default 1)\n"
     "  --voxel-size M      voxel edge, m (default: the longest axis / --voxels)\n"
     "  --voxels N          voxels along the longest axis (default 128)\n"
@@ -359,6 +363,7 @@ int cmdRemesh(const std::vector<std::string>& args) {
     };
     std::vector<Input> inputs;
     std::optional<std::string> out;
+    bool sample = false;
     bake::ImportOptions opt;
     bake::RemeshParams params;
     for (size_t i = 0; i < args.size(); ++i) {
@@ -367,7 +372,10 @@ int cmdRemesh(const std::vector<std::string>& args) {
             if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
             return args[++i];
         };
-        if (a == "--subtract")
+        if (a == "--sample") {
+            if (value() != "kidney") throw std::invalid_argument("--sample: the built-in sample is 'kidney'");
+            sample = true;
+        } else if (a == "--subtract")
             inputs.push_back({value(), bake::CsgOp::Difference});
         else if (a == "--intersect")
             inputs.push_back({value(), bake::CsgOp::Intersection});
@@ -395,11 +403,19 @@ int cmdRemesh(const std::vector<std::string>& args) {
         else
             inputs.push_back({a, bake::CsgOp::Union});
     }
-    if (inputs.empty() || !out) throw std::invalid_argument("remesh needs at least one <mesh> and -o out.obj");
+    if ((inputs.empty() && !sample) || !out)
+        throw std::invalid_argument("remesh needs at least one <mesh> (or --sample kidney) and -o out.obj");
     if (std::filesystem::path(*out).extension() != ".obj")
         throw std::invalid_argument("-o '" + *out + "': the result is written as OBJ (.obj)");
     requireWritableFile(*out, "the remeshed surface"); // before the work, which can take minutes
     std::vector<bake::RemeshPart> parts;
+    if (sample)
+        for (bake::RemeshPart& part : bake::kidneyAnatomy()) {
+            std::printf("part %s (sample, union): %zu vertices, %zu triangles, closed: %s\n", part.name.c_str(),
+                        part.surface.vertexCount(), part.surface.triangleCount(),
+                        part.surface.isClosedOriented() ? "yes" : "no");
+            parts.push_back(std::move(part));
+        }
     for (const Input& in : inputs) {
         sim::TriMesh m = bake::importSurface(in.file, opt);
         std::printf("part %s (%s): %zu vertices, %zu triangles, closed: %s\n", in.file.c_str(),
@@ -415,8 +431,9 @@ int cmdRemesh(const std::vector<std::string>& args) {
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const bake::RemeshReport& q = r.report;
     bake::writeObj(*out, r.mesh);
-    std::printf("grid: voxel %.4g mm, %d x %d x %d voxels, %zu active; %zu open part(s) thickened\n", q.voxelSize * 1e3,
-                q.voxels[0], q.voxels[1], q.voxels[2], q.activeVoxels, q.openParts);
+    std::printf("grid: voxel %.4g mm, %d x %d x %d voxels, %zu active; %zu open part(s) thickened, %zu closed over "
+                "holes narrower than the band\n",
+                q.voxelSize * 1e3, q.voxels[0], q.voxels[1], q.voxels[2], q.activeVoxels, q.openParts, q.closedHoles);
     std::printf("isosurface: %zu triangles, volume %.6g m^3\n", q.isoTriangles, q.isoVolume);
     std::printf("result: %zu vertices, %zu triangles, target edge %.4g mm, %zu hard edges\n", q.vertices, q.triangles,
                 q.targetEdgeLength * 1e3, q.featureEdges);

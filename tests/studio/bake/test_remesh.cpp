@@ -3,6 +3,7 @@
 // parameter rules, cancellation; the result tetrahedralizes.
 #include "bake/import.hpp"
 #include "bake/remesh.hpp"
+#include "bake/sample_anatomy.hpp"
 #include "bake/tetrahedralize.hpp"
 
 #include "sim/mesh/generators.hpp"
@@ -13,7 +14,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -187,4 +190,52 @@ TEST(bake_remesh, TheObjWriterRoundTrips) {
     EXPECT_EQ(back.vertexCount(), r.mesh.vertexCount());
     EXPECT_EQ(back.triangleCount(), r.mesh.triangleCount());
     EXPECT_NEAR(back.signedVolume(), r.mesh.signedVolume(), 1e-6 * r.mesh.signedVolume());
+}
+
+TEST(bake_remesh, HolesNarrowerThanTheBandAreClosedWiderOnesThickened) {
+    const sim::TriMesh closed = box(0, 0, 0, 0.02);
+    EXPECT_EQ(bake::detail::largestHoleDiameter(closed), 0.0);
+    EXPECT_NEAR(bake::detail::largestHoleDiameter(openBox(0, 0, 0, 0.02)), 0.02 * std::sqrt(2.0), 1e-12);
+    // A fine ellipsoid (triangles of about 1.5 mm) with one triangle missing: a 2 mm hole under a
+    // band of 3 voxels of 0.8 mm, so the part keeps its inside.
+    const sim::TriMesh e = sim::makeEllipsoidSurface(sim::Vec3::Zero(), sim::Vec3(0.03, 0.02, 0.015), 128, 64);
+    std::vector<sim::Tri> tris = e.triangles();
+    tris.erase(tris.begin() + long(tris.size() / 3));
+    std::vector<bake::RemeshPart> parts{{"e", sim::TriMesh::fromArrays(e.positions(), tris), bake::CsgOp::Union}};
+    const double hole = bake::detail::largestHoleDiameter(parts[0].surface);
+    EXPECT_GT(hole, 0.0005);
+    EXPECT_LT(hole, 0.0024);
+    const bake::RemeshResult r = bake::voxelRemesh(parts, params(75));
+    expectSound(r);
+    EXPECT_EQ(r.report.closedHoles, 1u);
+    EXPECT_EQ(r.report.openParts, 0u);
+    const double exact = 4.0 / 3.0 * M_PI * 0.03 * 0.02 * 0.015;
+    EXPECT_NEAR(r.report.volume, exact, 0.03 * exact);
+}
+
+TEST(bake_remesh, TheKidneySampleBecomesOneSoundBodyThatTetrahedralizes) {
+    const std::vector<bake::RemeshPart> parts = bake::kidneyAnatomy();
+    ASSERT_EQ(parts.size(), 4u);
+    const sim::TriMesh& cortex = parts[0].surface;
+    // The dent passes through the far side: some medial vertex lies beyond it (self-intersection).
+    double leftmost = 0;
+    for (const sim::Vec3& x : cortex.positions())
+        leftmost = std::min(leftmost, x.x());
+    EXPECT_LT(leftmost, -0.031);
+    EXPECT_FALSE(cortex.isClosedOriented()); // the hole
+    EXPECT_GT(bake::detail::largestHoleDiameter(cortex), 0);
+    EXPECT_FALSE(parts[2].surface.isClosedOriented()); // the open ureter
+    EXPECT_TRUE(parts[1].surface.isClosedOriented());
+    EXPECT_TRUE(parts[3].surface.isClosedOriented());
+    const bake::RemeshResult r = bake::voxelRemesh(parts, params(96));
+    expectSound(r);
+    EXPECT_EQ(r.report.closedHoles, 1u);
+    EXPECT_EQ(r.report.openParts, 1u);
+    EXPECT_LT(r.report.distanceMaxMm, 3.0 * r.report.voxelSize * 1e3);
+    bake::MeshingParams m;
+    m.cellSize = 0.004;
+    m.facetSize = 0.003;
+    const bake::TetrahedralizeResult t = bake::tetrahedralize(r.mesh, m);
+    EXPECT_GT(t.mesh->tetCount(), 1000u);
+    EXPECT_TRUE(t.report.quality.inverted.empty());
 }
