@@ -56,26 +56,46 @@ std::string readMeshBytes(const std::filesystem::path& file, std::uintmax_t maxB
 /// out of the folder, a path it builds itself) and remembers the first refusal for the message.
 class FolderIOSystem : public Assimp::DefaultIOSystem {
 public:
-    explicit FolderIOSystem(const std::filesystem::path& file) : m_folder(file.parent_path()) {}
+    explicit FolderIOSystem(const std::filesystem::path& file)
+        : m_folder(file.parent_path()), m_main(std::filesystem::weakly_canonical(file, m_ec)) {}
     bool Exists(const char* path) const override { return path && allowed(path) && DefaultIOSystem::Exists(path); }
     Assimp::IOStream* Open(const char* path, const char* mode = "rb") override {
         if (path == nullptr) return nullptr;
         const std::string_view m = mode ? mode : "rb";
         if (m.find_first_of("wa+") != std::string_view::npos) {
-            if (!refused) refused = std::string(path) + "' for writing";
+            refuse(path, "for writing (the importer only reads)");
             return nullptr;
         }
-        if (!allowed(path)) {
-            if (!refused) refused = std::string(path) + "', outside the file's folder";
-            return nullptr;
-        }
+        if (!allowed(path)) return nullptr;
         return DefaultIOSystem::Open(path, "rb");
     }
-    std::optional<std::string> refused; ///< "<path>', outside the file's folder"
+    /// The first refusal: the path and why.
+    mutable std::optional<std::pair<std::string, std::string>> refused;
 
 private:
-    bool allowed(const char* path) const { return detail::insideFolder(m_folder, path); }
+    void refuse(const char* path, const char* why) const {
+        if (!refused) refused.emplace(path, why);
+    }
+    /// The mesh file itself (also through a link to it), or a regular file inside its folder; not
+    /// a FIFO or device, which would block or never end.
+    bool allowed(const char* path) const {
+        std::error_code ec;
+        const std::filesystem::path p(path);
+        if (!std::filesystem::exists(p, ec)) return false; // nothing to open; assimp reports it
+        if (!m_ec && std::filesystem::weakly_canonical(p, ec) == m_main && !ec) return true;
+        if (!detail::insideFolder(m_folder, p)) {
+            refuse(path, "outside the file's folder (references must be relative paths inside it)");
+            return false;
+        }
+        if (!std::filesystem::is_regular_file(p, ec)) {
+            refuse(path, "not a regular file");
+            return false;
+        }
+        return true;
+    }
     std::filesystem::path m_folder;
+    std::error_code m_ec;
+    std::filesystem::path m_main;
 };
 
 std::string meshName(const aiMesh* mesh, unsigned index) {
@@ -300,8 +320,8 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file, const Im
         fail(label, "cannot be parsed as " + std::string(formatName(report.format)) + ": " + e.what());
     }
     if (io->refused)
-        fail(label, "the importer asked for '" + sim::displayName(*io->refused) +
-                        " (refused; references must be relative paths inside the file's folder)");
+        fail(label,
+             "the importer asked for '" + sim::displayName(io->refused->first) + "', refused: " + io->refused->second);
     if (scene == nullptr) {
         std::string why = importer.GetErrorString();
         if (why.rfind("No suitable reader found", 0) == 0)

@@ -8,6 +8,7 @@
 #include "sim/util/json_reader.hpp"
 
 #include <cstdint>
+#include <set>
 #include <system_error>
 #include <utility>
 
@@ -81,26 +82,45 @@ void addStatement(std::vector<MeshReference>& out, const std::string& where, std
     if (tok.size() > 1) out.push_back({where, std::string(trim(rest))});
 }
 
-/// Line-based statements (OBJ, MTL): `keyword(first token)` picks the statements to collect.
+/// Line-based statements (OBJ, MTL) as assimp reads them: a line ends at LF, CR, FF or NUL; a
+/// backslash at the end of a line joins the next one; '#' starts a comment only at the start of a
+/// line (a statement takes the rest of its line, '#' included). `pick(first token)` selects the
+/// statements to collect; more than kMaxStatements of them refuse the file.
+constexpr size_t kMaxStatements = 10000;
+
 template <class Pick>
-std::vector<MeshReference> lineStatements(std::string_view b, const std::string& prefix, const Pick& pick) {
+std::vector<MeshReference> lineStatements(std::string_view b, const std::string& label, const std::string& prefix,
+                                          const Pick& pick) {
     std::vector<MeshReference> out;
-    size_t pos = 0, lineNo = 0;
+    auto isEnd = [](char c) { return c == '\n' || c == '\r' || c == '\f' || c == '\0'; };
+    size_t pos = 0, lineNo = 1;
+    std::string joined;
     while (pos < b.size()) {
-        size_t end = b.find('\n', pos);
-        if (end == std::string_view::npos) end = b.size();
-        ++lineNo;
-        std::string_view line = b.substr(pos, end - pos);
-        pos = end + 1;
-        const size_t hash = line.find('#');
-        if (hash != std::string_view::npos) line = line.substr(0, hash);
-        line = trim(line);
+        const size_t first = lineNo;
+        joined.clear();
+        for (;;) {
+            size_t end = pos;
+            while (end < b.size() && !isEnd(b[end]))
+                ++end;
+            std::string_view piece = b.substr(pos, end - pos);
+            if (end < b.size() && b[end] == '\n') ++lineNo;
+            pos = end + 1;
+            const bool continued = !piece.empty() && piece.back() == '\\' && end < b.size();
+            if (continued) piece.remove_suffix(1);
+            joined.append(piece);
+            if (!continued) break;
+        }
+        std::string_view line = trim(joined);
+        if (line.empty() || line.front() == '#') continue;
         size_t k = 0;
         while (k < line.size() && !isBlank(line[k]))
             ++k;
         const std::string_view keyword = line.substr(0, k);
-        if (keyword.empty() || !pick(keyword)) continue;
-        addStatement(out, prefix + "line " + std::to_string(lineNo) + ": " + std::string(keyword), line.substr(k));
+        if (!pick(keyword)) continue;
+        if (out.size() >= 2 * kMaxStatements)
+            throw InputError(label + ": " + prefix + "more than " + std::to_string(kMaxStatements) + " " +
+                             sim::displayName(keyword) + " statements (the limit of a mesh file's references)");
+        addStatement(out, prefix + "line " + std::to_string(first) + ": " + sim::displayName(keyword), line.substr(k));
     }
     return out;
 }
@@ -117,7 +137,9 @@ void collectUris(const nlohmann::json& doc, std::vector<MeshReference>& out) {
                 const std::string sub = path.empty() ? it.key() : path + "." + it.key();
                 if (it.key() == "uri" && it->is_string()) {
                     const std::string& uri = it->get_ref<const std::string&>();
-                    if (!startsWithNoCase(uri, "data:")) out.push_back({sub, uri});
+                    // Embedded data, exactly as assimp recognises it (case-sensitive); "DATA:" is a
+                    // file name to assimp, and a scheme to the rule.
+                    if (uri.rfind("data:", 0) != 0) out.push_back({sim::displayName(sub), uri});
                 } else if (it->is_structured()) {
                     stack.emplace_back(&*it, sub);
                 }
@@ -125,6 +147,32 @@ void collectUris(const nlohmann::json& doc, std::vector<MeshReference>& out) {
         } else if (node->is_array()) {
             for (size_t i = 0; i < node->size(); ++i)
                 if ((*node)[i].is_structured()) stack.emplace_back(&(*node)[i], path + "[" + std::to_string(i) + "]");
+        }
+    }
+}
+
+/// Refuses JSON nested deeper than kMaxJsonDepth before any parser sees it: assimp's glTF parser
+/// (rapidjson) recurses per level, so a deep document would overflow its stack.
+constexpr int kMaxJsonDepth = 64;
+
+void checkJsonDepth(const std::string& label, std::string_view json) {
+    int depth = 0;
+    bool inString = false;
+    for (size_t i = 0; i < json.size(); ++i) {
+        const char c = json[i];
+        if (inString) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonDepth)
+                throw InputError(label + ": JSON nested more than " + std::to_string(kMaxJsonDepth) +
+                                 " levels deep at byte " + std::to_string(i) + " (the limit of a glTF document)");
+        } else if (c == ']' || c == '}') {
+            --depth;
         }
     }
 }
@@ -140,6 +188,8 @@ uint32_t readU32le(std::string_view b, size_t at) {
 
 std::optional<std::string> referenceProblem(std::string_view path) {
     if (path.empty()) return "empty reference";
+    if (isBlank(path.front()) || isBlank(path.back()))
+        return std::string("begins or ends with a blank (importers strip them differently)");
     for (char c : path)
         if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return std::string("contains a control character");
     const size_t colon = path.find(':');
@@ -163,8 +213,8 @@ std::optional<std::string> referenceProblem(std::string_view path) {
     return std::nullopt;
 }
 
-std::vector<MeshReference> materialReferences(std::string_view bytes) {
-    return lineStatements(bytes, "", [](std::string_view k) {
+std::vector<MeshReference> materialReferences(const std::string& label, std::string_view bytes) {
+    return lineStatements(bytes, label, "", [](std::string_view k) {
         return startsWithNoCase(k, "map_") || startsWithNoCase(k, "bump") || startsWithNoCase(k, "disp") ||
                startsWithNoCase(k, "decal") || startsWithNoCase(k, "refl") || startsWithNoCase(k, "norm");
     });
@@ -174,14 +224,16 @@ std::vector<MeshReference> meshReferences(const std::string& label, SurfaceForma
     std::vector<MeshReference> out;
     switch (format) {
     case SurfaceFormat::Obj:
-        return lineStatements(bytes, "", [](std::string_view k) { return k == "mtllib"; });
+        return lineStatements(bytes, label, "", [](std::string_view k) { return k == "mtllib"; });
     case SurfaceFormat::Gltf:
+        checkJsonDepth(label, bytes);
         collectUris(sim::parseJsonText(bytes, label), out);
         break;
     case SurfaceFormat::Glb: {
         if (bytes.size() < 20) break; // checkStructure refuses it
         const uint64_t length = readU32le(bytes, 12);
         if (20 + length > bytes.size()) break;
+        checkJsonDepth(label + " (JSON chunk)", bytes.substr(20, length));
         collectUris(sim::parseJsonText(bytes.substr(20, length), label + " (JSON chunk)"), out);
         break;
     }
@@ -225,12 +277,19 @@ void checkReferences(const std::string& label, SurfaceFormat format, std::string
     const std::vector<MeshReference> refs = meshReferences(label, format, bytes);
     check("", refs);
     if (format != SurfaceFormat::Obj) return;
+    std::set<std::filesystem::path> read; // each library once, whatever the statements repeat
     for (const MeshReference& r : refs) {
         const std::filesystem::path lib = folder / r.path;
         std::error_code ec;
         if (!std::filesystem::is_regular_file(lib, ec) || !insideFolder(folder, lib)) continue;
-        const std::string text = readFile(lib, kMaxMaterialLibraryBytes, "the material library limit of 64 MiB");
-        check(sim::displayName(r.path) + " ", materialReferences(text));
+        if (!read.insert(std::filesystem::weakly_canonical(lib, ec)).second) continue;
+        std::string text;
+        try {
+            text = readFile(lib, kMaxMaterialLibraryBytes, "the material library limit of 64 MiB");
+        } catch (const InputError& e) {
+            throw InputError(label + ": " + r.where + ": " + e.what());
+        }
+        check(sim::displayName(r.path) + " ", materialReferences(label, text));
     }
 }
 

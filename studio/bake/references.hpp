@@ -30,15 +30,17 @@ struct MeshReference {
 /// or nullopt when it is a relative path inside the folder. O(length).
 std::optional<std::string> referenceProblem(std::string_view path);
 
-/// The references the bytes of a file in `format` make: OBJ mtllib statements, glTF/GLB buffer
-/// and image URIs that are not data: URIs (the JSON is read with the one strict parser,
-/// sim::parseJsonText; a GLB's from its first chunk). STL, PLY and FBX (assimp reads no file
-/// beside an FBX) make none. Throws InputError naming the file on JSON it cannot read.
+/// The references the bytes of a file in `format` make (lines as assimp reads them: LF, CR, FF
+/// and NUL end a line, a final backslash joins the next, at most 10,000 statements): OBJ mtllib statements, glTF/GLB
+/// buffer and image URIs that are not data: URIs (the JSON is read with the one strict parser, sim::parseJsonText; a
+/// GLB's from its first chunk). STL, PLY and FBX (assimp reads no file beside an FBX) make none. Throws InputError
+/// naming the file on JSON it cannot read.
 std::vector<MeshReference> meshReferences(const std::string& label, SurfaceFormat format, std::string_view bytes);
 
 /// The texture references of a material library (.mtl): every map_*, bump, disp, decal, refl
-/// and norm statement's file name (its options before it are not references).
-std::vector<MeshReference> materialReferences(std::string_view bytes);
+/// and norm statement's file name (its options before it are not references). Each material
+/// library is read once, however many statements name it.
+std::vector<MeshReference> materialReferences(const std::string& label, std::string_view bytes);
 
 /// True when `file` (symbolic links resolved, as far as it exists) lies in `folder` or below it.
 bool insideFolder(const std::filesystem::path& folder, const std::filesystem::path& file);

@@ -47,7 +47,8 @@ void require(bool ok, const std::string& field, const std::string& rule) {
 void validate(const RemeshParams& p) {
     require(std::isfinite(p.voxelSize) && p.voxelSize >= 0, "voxelSize", "must be finite and >= 0");
     require(p.maxVoxelsPerAxis >= 8 && p.maxVoxelsPerAxis <= 65536, "maxVoxelsPerAxis", "must be in [8, 65536]");
-    require(p.voxelCount >= 8 && p.voxelCount <= p.maxVoxelsPerAxis, "voxelCount", "must be in [8, maxVoxelsPerAxis]");
+    require(p.voxelCount >= 8 && p.voxelCount + 2 * std::ceil(p.bandVoxels) <= p.maxVoxelsPerAxis, "voxelCount",
+            "must be in [8, maxVoxelsPerAxis - 2 bandVoxels] (the band pads the grid on each side)");
     require(std::isfinite(p.bandVoxels) && p.bandVoxels >= 3 && p.bandVoxels <= 16, "bandVoxels", "must be in [3, 16]");
     require(p.smoothingIterations >= 0 && p.smoothingIterations <= 100, "smoothingIterations", "must be in [0, 100]");
     require(std::isfinite(p.targetEdgeLength) && p.targetEdgeLength >= 0, "targetEdgeLength",
@@ -119,10 +120,6 @@ RemeshResult voxelRemesh(const std::vector<RemeshPart>& parts, const RemeshParam
     RemeshReport report;
     const sim::TriMesh iso = detail::combinedIsosurface(parts, params, progress, cancel, report);
     report.isoVolume = iso.signedVolume();
-    for (const RemeshPart& part : parts) // closed, or closed up to holes the band closes over
-        if (part.surface.isClosedOriented() ||
-            detail::largestHoleDiameter(part.surface) < params.bandVoxels * report.voxelSize)
-            report.sourceVolume += std::abs(part.surface.signedVolume());
 
     const double vs = report.voxelSize;
     report.targetEdgeLength = params.targetEdgeLength > 0 ? std::max(params.targetEdgeLength, 0.5 * vs) : 1.5 * vs;
@@ -133,16 +130,16 @@ RemeshResult voxelRemesh(const std::vector<RemeshPart>& parts, const RemeshParam
         PMP::detect_sharp_edges(sm, params.featureAngleDeg, ecm);
         for (auto e : sm.edges())
             report.featureEdges += ecm[e] ? 1 : 0;
-        for (int it = 0; it < params.remeshIterations; ++it) {
-            stage("remeshing " + std::to_string(it + 1) + "/" + std::to_string(params.remeshIterations),
-                  0.72 + 0.2 * double(it) / params.remeshIterations);
-            PMP::isotropic_remeshing(faces(sm), report.targetEdgeLength, sm,
-                                     PMP::parameters::number_of_iterations(1).edge_is_constrained_map(ecm));
-            if (sm.number_of_faces() > params.maxTriangles)
-                throw InputError("remesh: remeshing gives " + std::to_string(sm.number_of_faces()) +
-                                 " triangles (cap RemeshParams::maxTriangles = " + std::to_string(params.maxTriangles) +
-                                 "); use a longer target edge length");
-        }
+        // One call for all iterations: each call would rebuild its projection tree from the
+        // current mesh, so iterations would project onto the previous output and drift.
+        stage("remeshing (" + std::to_string(params.remeshIterations) + " iterations)", 0.72);
+        PMP::isotropic_remeshing(
+            faces(sm), report.targetEdgeLength, sm,
+            PMP::parameters::number_of_iterations(unsigned(params.remeshIterations)).edge_is_constrained_map(ecm));
+        if (sm.number_of_faces() > params.maxTriangles)
+            throw InputError("remesh: remeshing gives " + std::to_string(sm.number_of_faces()) +
+                             " triangles (cap RemeshParams::maxTriangles = " + std::to_string(params.maxTriangles) +
+                             "); use a longer target edge length");
     }
     sim::TriMesh result = toTriMesh(sm);
     report.remeshSeconds = secondsSince(t0);
@@ -170,6 +167,7 @@ RemeshResult voxelRemesh(const std::vector<RemeshPart>& parts, const RemeshParam
             const K::Triangle_3 tri(pt(t[0]), pt(t[1]), pt(t[2]));
             if (!tri.is_degenerate()) source.push_back(tri);
         }
+    if (source.empty()) throw InputError(parts.front().name + ": every triangle of the parts is degenerate");
     using Primitive = CGAL::AABB_triangle_primitive<K, std::vector<K::Triangle_3>::const_iterator>;
     CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>> tree(source.cbegin(), source.cend());
     tree.accelerate_distance_queries();

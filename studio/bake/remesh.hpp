@@ -4,9 +4,11 @@
 /// accepts.
 ///
 ///   1. a narrow-band signed distance field per part (OpenVDB meshToLevelSet) at one voxel size;
-///      a part whose holes are narrower than the band is closed over them by the band; an open
-///      part with a wider hole has no inside, so it is thickened instead: its unsigned distance
-///      field is meshed at 0.75 voxels and that closed shell (1.5 voxels thick) is converted;
+///      a part whose holes are at most two voxels across is usually closed over by the sign flood
+///      (checked: its level set must hold half its enclosed volume); an open part with wider
+///      holes, or one that leaked, has no inside, so it is thickened instead: its unsigned distance
+///      field is meshed at 0.75 voxels and that closed shell (1.5 voxels thick) is converted
+///      (a shell that closes over its holes encloses its cavity as well);
 ///   2. the parts combined in order with union / difference / intersection (OpenVDB CSG);
 ///   3. optional smoothing of the combined level set (mean-curvature flow, a pass per iteration);
 ///   4. the zero isosurface (OpenVDB volumeToMesh, quads split along their shorter diagonal);
@@ -64,6 +66,7 @@ struct RemeshReport {
     size_t activeVoxels = 0;     ///< narrow-band voxels of the combined level set
     size_t openParts = 0;        ///< parts meshed through the unsigned-distance fallback
     size_t closedHoles = 0;      ///< parts with holes narrower than the band, closed over them
+    size_t leakedParts = 0;      ///< parts with small holes whose inside leaked out, thickened instead
     size_t isoTriangles = 0;     ///< triangles of the isosurface
     size_t featureEdges = 0;     ///< edges held as hard edges while remeshing
     size_t vertices = 0, triangles = 0;

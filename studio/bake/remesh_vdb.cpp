@@ -9,6 +9,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Composite.h>
 #include <openvdb/tools/LevelSetFilter.h>
+#include <openvdb/tools/LevelSetMeasure.h>
 #include <openvdb/tools/MeshToVolume.h>
 #include <openvdb/tools/VolumeToMesh.h>
 #include <openvdb/util/NullInterrupter.h>
@@ -144,6 +145,9 @@ double largestHoleDiameter(const sim::TriMesh& mesh) {
     return most;
 }
 
+/// Holes up to this many voxels across may be closed over by the level set (then checked).
+constexpr double kMaxClosedHoleVoxels = 2.0;
+
 sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const RemeshParams& params,
                                 const RemeshProgress& progress, const std::atomic<bool>* cancel, RemeshReport& report) {
     openvdb::initialize();
@@ -186,12 +190,24 @@ sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const Reme
         toVdb(part.surface, points, tris);
         openvdb::FloatGrid::Ptr grid;
         const double hole = part.surface.isClosedOriented() ? 0.0 : largestHoleDiameter(part.surface);
-        if (hole < params.bandVoxels * vs) {
-            // Closed, or its holes narrower than the band: the band closes over them and the
-            // inside is found as for a closed part.
-            if (hole > 0) ++report.closedHoles;
+        bool thicken = hole >= kMaxClosedHoleVoxels * vs;
+        if (!thicken) {
+            // Closed, or with holes of at most two voxels, which OpenVDB's sign flood usually
+            // closes over; whether it did is checked: the level set must hold at least half the
+            // part's enclosed volume, else the part is thickened like an open one.
             grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(interrupter, *xform, points, tris, band);
-        } else {
+            stage.check();
+            const double inside = openvdb::tools::levelSetVolume(*grid);
+            const double enclosed = std::abs(part.surface.signedVolume());
+            if (!(inside >= 0.5 * enclosed)) {
+                thicken = true;
+                ++report.leakedParts;
+            } else {
+                report.sourceVolume += enclosed;
+                if (hole > 0) ++report.closedHoles;
+            }
+        }
+        if (thicken) {
             // No inside: thicken the open surface into a closed shell 1.5 voxels thick (the
             // unsigned distance at 0.75 voxels), then take the shell's level set.
             ++report.openParts;

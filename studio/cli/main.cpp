@@ -433,7 +433,8 @@ int cmdRemesh(const std::vector<std::string>& args) {
     bake::writeObj(*out, r.mesh);
     std::printf("grid: voxel %.4g mm, %d x %d x %d voxels, %zu active; %zu open part(s) thickened, %zu closed over "
                 "holes narrower than the band\n",
-                q.voxelSize * 1e3, q.voxels[0], q.voxels[1], q.voxels[2], q.activeVoxels, q.openParts, q.closedHoles);
+                q.voxelSize * 1e3, q.voxels[0], q.voxels[1], q.voxels[2], q.activeVoxels, q.openParts, q.leakedParts,
+                q.closedHoles);
     std::printf("isosurface: %zu triangles, volume %.6g m^3\n", q.isoTriangles, q.isoVolume);
     std::printf("result: %zu vertices, %zu triangles, target edge %.4g mm, %zu hard edges\n", q.vertices, q.triangles,
                 q.targetEdgeLength * 1e3, q.featureEdges);
