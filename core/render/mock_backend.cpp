@@ -51,7 +51,8 @@ void MockBackend::runPass(const PassDesc& pass, const PassContext& ctx) {
             const RenderMesh& m = ctx.view.meshes()[i];
             for (size_t v = 0; v < m.vertexCount(); ++v) {
                 const float d = (Eigen::Map<const Eigen::Vector3f>(&m.positions[3 * v]) - ctx.light.center).norm();
-                m_samples[i].push_back(samplesFor(ctx.settings.sampling, d, int(m.sampleMap[v] + 0.5f)));
+                const float painted = v < m.sampleMap.size() ? m.sampleMap[v] : 0.0f; // the map may be absent
+                m_samples[i].push_back(samplesFor(ctx.settings.sampling, d, int(painted + 0.5f)));
             }
         }
     }

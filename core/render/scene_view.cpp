@@ -231,7 +231,8 @@ void SceneView::setSourceHeat(size_t i, const std::vector<float>& nodeHeat) {
 }
 
 size_t SceneView::addBodyCut(size_t bodyMesh, const sim::TetMesh& rest, size_t capacity) {
-    const RenderMesh& body = m_meshes.at(bodyMesh);
+    const RenderMesh& body = m_meshes.at(bodyMesh); // a reference only until m_meshes grows below
+    const size_t bodySource = body.sourceIndex;
     if (body.source != RenderMesh::Source::Body)
         throw std::invalid_argument("render::SceneView::addBodyCut(): mesh " + body.name + " is not a body's boundary");
     if (rest.tetCount() == 0 || capacity == 0)
@@ -267,7 +268,7 @@ size_t SceneView::addBodyCut(size_t bodyMesh, const sim::TetMesh& rest, size_t c
     m.faceMask.assign(capacity, 0);
     m_meshes.push_back(std::move(m));
     BodyCut c;
-    c.body = body.sourceIndex;
+    c.body = bodySource;
     c.bodyMesh = bodyMesh;
     c.cutMesh = m_meshes.size() - 1;
     c.capacity = capacity;

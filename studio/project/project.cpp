@@ -262,8 +262,15 @@ sim::SutureSceneDesc readSutureProject(const JsonField& su, const std::filesyste
 /// The scene's suture section (sim::sutureJson) with the project's "trajectory".
 json sutureProjectJson(const sim::SutureSceneDesc& d, const TrajectorySource& source, const WriteContext& w) {
     json j = sim::sutureJson(d);
-    j["trajectory"] = source.generator ? anastomosisTrajectoryJson(*source.generator)
-                                       : json{{"file", projectFileJson(source.file, w, "suture.trajectory.file")}};
+    // Not a conditional expression with a braced json{...}: its initializer list's temporaries end
+    // before the conditional's result is copied (AddressSanitizer: stack-use-after-scope).
+    if (source.generator) {
+        j["trajectory"] = anastomosisTrajectoryJson(*source.generator);
+    } else {
+        json file = json::object();
+        file["file"] = projectFileJson(source.file, w, "suture.trajectory.file");
+        j["trajectory"] = std::move(file);
+    }
     return j;
 }
 

@@ -402,7 +402,11 @@ struct CorotationalFem::Impl {
     }
 };
 
-CorotationalFem::~CorotationalFem() = default;
+// The Impl first: its destructor joins the background workers, which read m_x0 (a member destroyed
+// before m if the defaults ran in reverse declaration order; AddressSanitizer: heap-use-after-free).
+CorotationalFem::~CorotationalFem() {
+    m.reset();
+}
 
 std::unique_ptr<CorotationalFem> CorotationalFem::create(const TetMesh& mesh, const std::vector<int32_t>& fixedNodes,
                                                          const FemSettings& settings,
