@@ -4,7 +4,7 @@
 /// accepts.
 ///
 ///   1. a narrow-band signed distance field per part (OpenVDB meshToLevelSet) at one voxel size;
-///      a part whose holes are at most two voxels across is usually closed over by the sign flood
+///      a part whose holes are at most three voxels across is usually closed over by the sign flood
 ///      (checked: its level set must hold half its enclosed volume); an open part with wider
 ///      holes, or one that leaked, has no inside, so it is thickened instead: its unsigned distance
 ///      field is meshed at 0.75 voxels and that closed shell (1.5 voxels thick) is converted

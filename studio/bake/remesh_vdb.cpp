@@ -146,7 +146,7 @@ double largestHoleDiameter(const sim::TriMesh& mesh) {
 }
 
 /// Holes up to this many voxels across may be closed over by the level set (then checked).
-constexpr double kMaxClosedHoleVoxels = 2.0;
+constexpr double kMaxClosedHoleVoxels = 3.0;
 
 sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const RemeshParams& params,
                                 const RemeshProgress& progress, const std::atomic<bool>* cancel, RemeshReport& report) {
@@ -192,7 +192,7 @@ sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const Reme
         const double hole = part.surface.isClosedOriented() ? 0.0 : largestHoleDiameter(part.surface);
         bool thicken = hole >= kMaxClosedHoleVoxels * vs;
         if (!thicken) {
-            // Closed, or with holes of at most two voxels, which OpenVDB's sign flood usually
+            // Closed, or with holes of at most three voxels, which OpenVDB's sign flood often
             // closes over; whether it did is checked: the level set must hold at least half the
             // part's enclosed volume, else the part is thickened like an open one.
             grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(interrupter, *xform, points, tris, band);

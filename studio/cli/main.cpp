@@ -431,8 +431,8 @@ int cmdRemesh(const std::vector<std::string>& args) {
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const bake::RemeshReport& q = r.report;
     bake::writeObj(*out, r.mesh);
-    std::printf("grid: voxel %.4g mm, %d x %d x %d voxels, %zu active; %zu open part(s) thickened, %zu closed over "
-                "holes narrower than the band\n",
+    std::printf("grid: voxel %.4g mm, %d x %d x %d voxels, %zu active; %zu open part(s) thickened (%zu of them "
+                "leaked), %zu closed over small holes\n",
                 q.voxelSize * 1e3, q.voxels[0], q.voxels[1], q.voxels[2], q.activeVoxels, q.openParts, q.leakedParts,
                 q.closedHoles);
     std::printf("isosurface: %zu triangles, volume %.6g m^3\n", q.isoTriangles, q.isoVolume);
