@@ -20,7 +20,7 @@ rm -rf "$out/_CPack_Packages"
 
 declare -A deb
 for p in viscera-player viscera-studio viscera-samples; do
-  f=$(ls "$out"/${p}_*.deb 2>/dev/null | head -1)
+  f=$(ls "$out"/${p}_*.deb 2>/dev/null | sed -n 1p)
   [[ -n "$f" ]] || fail "cpack made no $p package"
   deb[$p]=$f
 done
@@ -30,7 +30,7 @@ for p in viscera-player viscera-studio viscera-samples; do
   f=${deb[$p]}
   section=$(dpkg-deb -f "$f" Section)
   [[ "$section" == science ]] || fail "$p: Section is '$section', not science"
-  summary=$(dpkg-deb -f "$f" Description | head -1)
+  summary=$(dpkg-deb -f "$f" Description | sed -n 1p) # sed reads it all: head could SIGPIPE dpkg-deb under pipefail
   for s in "${summaries[@]}"; do [[ "$s" != "$summary" ]] || fail "$p: its description is another package's"; done
   summaries+=("$summary")
   files=$(dpkg-deb -c "$f" | awk '{print $6}')
