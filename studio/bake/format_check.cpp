@@ -14,13 +14,14 @@
 #include <vector>
 
 namespace viscera::bake::detail {
-namespace {
 
-[[noreturn]] void fail(const std::string& label, const std::string& message) {
-    throw InputError(label + ": " + message);
+// ---- text and byte helpers, shared with references.cpp (format_check.hpp) ----------------
+
+std::string_view trimLeft(std::string_view s) {
+    while (!s.empty() && isSpace(s.front()))
+        s.remove_prefix(1);
+    return s;
 }
-
-// ---- small text helpers --------------------------------------------------------------------
 
 bool isSpace(char c) {
     return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v';
@@ -28,17 +29,6 @@ bool isSpace(char c) {
 
 char lower(char c) {
     return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c;
-}
-
-std::string_view skipBom(std::string_view s) {
-    if (s.size() >= 3 && s.substr(0, 3) == "\xEF\xBB\xBF") s.remove_prefix(3);
-    return s;
-}
-
-std::string_view trimLeft(std::string_view s) {
-    while (!s.empty() && isSpace(s.front()))
-        s.remove_prefix(1);
-    return s;
 }
 
 std::string_view trim(std::string_view s) {
@@ -53,6 +43,26 @@ bool startsWithNoCase(std::string_view s, std::string_view prefix) {
     for (size_t i = 0; i < prefix.size(); ++i)
         if (lower(s[i]) != lower(prefix[i])) return false;
     return true;
+}
+
+uint32_t readU32le(std::string_view b, size_t at) {
+    uint32_t v = 0;
+    for (int i = 3; i >= 0; --i)
+        v = (v << 8) | static_cast<unsigned char>(b[at + i]);
+    return v;
+}
+
+namespace {
+
+[[noreturn]] void fail(const std::string& label, const std::string& message) {
+    throw InputError(label + ": " + message);
+}
+
+// ---- small text helpers --------------------------------------------------------------------
+
+std::string_view skipBom(std::string_view s) {
+    if (s.size() >= 3 && s.substr(0, 3) == "\xEF\xBB\xBF") s.remove_prefix(3);
+    return s;
 }
 
 /// Splits on blanks; returns the tokens (views into s).
@@ -103,13 +113,6 @@ std::optional<int64_t> parseInt(std::string_view tok) {
     int64_t v = 0;
     auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
     if (ec != std::errc() || ptr != tok.data() + tok.size()) return std::nullopt;
-    return v;
-}
-
-uint32_t readU32le(std::string_view b, size_t at) {
-    uint32_t v = 0;
-    for (int i = 3; i >= 0; --i)
-        v = (v << 8) | static_cast<unsigned char>(b[at + i]);
     return v;
 }
 

@@ -13,6 +13,16 @@
 
 namespace viscera::bake::detail {
 
+/// Small text and byte helpers of the format checks (ASCII only): blanks are space, tab, CR, LF,
+/// FF and VT.
+bool isSpace(char c);
+char lower(char c);
+std::string_view trimLeft(std::string_view s);
+std::string_view trim(std::string_view s);
+bool startsWithNoCase(std::string_view s, std::string_view prefix);
+/// The little-endian uint32 at byte `at` (the caller checks that 4 bytes are there).
+uint32_t readU32le(std::string_view b, size_t at);
+
 /// Splits a line on blanks (space, tab, CR, LF, FF, VT); the tokens are views into s.
 std::vector<std::string_view> blankSeparatedTokens(std::string_view s);
 

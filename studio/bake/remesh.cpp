@@ -35,10 +35,7 @@ using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using SurfaceMesh = CGAL::Surface_mesh<K::Point_3>;
 namespace PMP = CGAL::Polygon_mesh_processing;
 using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point t0) {
-    return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+using detail::secondsSince;
 
 void require(bool ok, const std::string& field, const std::string& rule) {
     if (!ok) throw std::invalid_argument("bake::voxelRemesh(): RemeshParams::" + field + " " + rule);
@@ -114,8 +111,7 @@ RemeshResult voxelRemesh(const std::vector<RemeshPart>& parts, const RemeshParam
     for (const RemeshPart& part : parts)
         if (part.surface.triangleCount() == 0) throw InputError(part.name + ": the part has no triangles");
     auto stage = [&](const std::string& name, double fraction) {
-        if (cancel && cancel->load()) throw RemeshCancelled();
-        if (progress && !progress(name, fraction)) throw RemeshCancelled();
+        detail::reportStage(progress, cancel, name, fraction);
     };
     RemeshReport report;
     const sim::TriMesh iso = detail::combinedIsosurface(parts, params, progress, cancel, report);
@@ -195,6 +191,24 @@ RemeshResult voxelRemesh(const std::vector<RemeshPart>& parts, const RemeshParam
     stage("done", 1.0);
     return {std::move(result), report};
 }
+
+namespace detail {
+
+void reportStage(const RemeshProgress& progress, const std::atomic<bool>* cancel, const std::string& stage,
+                 double fraction) {
+    checkCancel(cancel);
+    if (progress && !progress(stage, fraction)) throw RemeshCancelled();
+}
+
+void checkCancel(const std::atomic<bool>* cancel) {
+    if (cancel && cancel->load()) throw RemeshCancelled();
+}
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+} // namespace detail
 
 void writeObj(const std::string& path, const sim::TriMesh& mesh) {
     std::string text = "# viscera-studio remesh: " + std::to_string(mesh.vertexCount()) + " vertices, " +

@@ -25,6 +25,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <functional>
 #include <stdexcept>
@@ -113,6 +114,14 @@ namespace detail {
 
 /// Stage 1–4 (OpenVDB, remesh_vdb.cpp): the isosurface of the combined level set. Fills
 /// voxelSize, voxels, activeVoxels, openParts, closedHoles, isoTriangles, levelSetSeconds, isosurfaceSeconds.
+/// Reports a stage to `progress`; throws RemeshCancelled when it returns false or *cancel is set.
+void reportStage(const RemeshProgress& progress, const std::atomic<bool>* cancel, const std::string& stage,
+                 double fraction);
+/// Throws RemeshCancelled when *cancel is set (between OpenVDB calls).
+void checkCancel(const std::atomic<bool>* cancel);
+/// Seconds since t0 (steady clock).
+double secondsSince(std::chrono::steady_clock::time_point t0);
+
 /// The largest extent (bounding-box diagonal, m) of a hole of `mesh`: a loop of edges that belong
 /// to one triangle only; 0 when there is none. O(triangles).
 double largestHoleDiameter(const sim::TriMesh& mesh);

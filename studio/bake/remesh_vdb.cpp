@@ -27,27 +27,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double secondsSince(Clock::time_point t0) {
-    return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
 /// OpenVDB's cancellation hook: polled from its worker threads, so it only reads an atomic.
 struct CancelInterrupter : openvdb::util::NullInterrupter {
     explicit CancelInterrupter(const std::atomic<bool>* flag) : cancel(flag) {}
     bool wasInterrupted(int = -1) override { return cancel && cancel->load(std::memory_order_relaxed); }
     const std::atomic<bool>* cancel;
-};
-
-struct Stager {
-    const RemeshProgress& progress;
-    const std::atomic<bool>* cancel;
-    void operator()(const std::string& stage, double fraction) const {
-        if (cancel && cancel->load()) throw RemeshCancelled();
-        if (progress && !progress(stage, fraction)) throw RemeshCancelled();
-    }
-    void check() const {
-        if (cancel && cancel->load()) throw RemeshCancelled();
-    }
 };
 
 void toVdb(const sim::TriMesh& m, std::vector<openvdb::Vec3s>& points, std::vector<openvdb::Vec3I>& tris) {
@@ -151,7 +135,7 @@ constexpr double kMaxClosedHoleVoxels = 3.0;
 sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const RemeshParams& params,
                                 const RemeshProgress& progress, const std::atomic<bool>* cancel, RemeshReport& report) {
     openvdb::initialize();
-    const Stager stage{progress, cancel};
+    auto stage = [&](const std::string& name, double fraction) { reportStage(progress, cancel, name, fraction); };
     // The grid: one voxel size for every part, from the bounds of them all.
     sim::Vec3 lo = sim::Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     for (const RemeshPart& part : parts) {
@@ -196,7 +180,7 @@ sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const Reme
             // closes over; whether it did is checked: the level set must hold at least half the
             // part's enclosed volume, else the part is thickened like an open one.
             grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(interrupter, *xform, points, tris, band);
-            stage.check();
+            checkCancel(cancel);
             const double inside = openvdb::tools::levelSetVolume(*grid);
             const double enclosed = std::abs(part.surface.signedVolume());
             if (!(inside >= 0.5 * enclosed)) {
@@ -213,7 +197,7 @@ sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const Reme
             ++report.openParts;
             auto udf = openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(interrupter, *xform, points,
                                                                                        tris, noQuads, band);
-            stage.check();
+            checkCancel(cancel);
             std::vector<openvdb::Vec3s> shellPoints;
             std::vector<openvdb::Vec3I> shellTris;
             std::vector<openvdb::Vec4I> shellQuads;
@@ -224,7 +208,7 @@ sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const Reme
             grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(interrupter, *xform, shellPoints, shellTris,
                                                                       shellQuads, band);
         }
-        stage.check();
+        checkCancel(cancel);
         if (!combined) {
             combined = grid;
             continue;
