@@ -50,7 +50,8 @@ void usage(std::FILE* out) {
     std::fputs("usage: viscera-player verify <case.vcase>\n"
                "       viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]\n"
                "                      [--report report.json] [--screenshot out.png] [--trace trace.csv]\n"
-               "                      [--realtime | --lockstep] [--servo sleep|sleep:CPU|spin:US|busy|busy:CPU]\n"
+               "                      [--realtime | --lockstep] [--servo "
+               "shared|shared:US|sleep|sleep:CPU|spin:US|busy|busy:CPU]\n"
                "                      [--plots DIR]\n"
                "       viscera-player plot <report.json> -o DIR\n"
                "       viscera-player soak <case.vcase[@SPEC]>... [--minutes M] [--frames N] [--report soak.json]\n"
@@ -80,7 +81,9 @@ constexpr const char* kRunHelp =
     "  --realtime            pace headless physics to the wall clock (console and window always are)\n"
     "  --lockstep            window: step a replay or scripted device with the physics instead of\n"
     "                        the wall clock (what happens is what the headless run shows)\n"
-    "  --servo MODE          real-time servo wait: sleep | sleep:CPU | spin:US | busy | busy:CPU\n"
+    "  --servo MODE          real-time servo wait: shared (default: sleeps at real-time priority on the\n"
+    "                        CPUs the physics uses, spins the last 100 us) | shared:US | sleep | sleep:CPU |\n"
+    "                        spin:US (a CPU of its own, the physics off it) | busy | busy:CPU\n"
     "  --report FILE.json    session report (schemaVersion, frames, metrics, haptics, errors)\n"
     "  --trace FILE.csv      per-tick device force and pose trace (needs --device)\n"
     "  --screenshot FILE.png the rendered last frame (headless: EGL, window: the window)\n"
@@ -136,12 +139,66 @@ int cmdVerify(const std::vector<std::string>& args) {
     return 0;
 }
 
+/// The servo's wait (--servo): shared (default), shared:US, sleep, sleep:CPU, spin:US, busy, busy:CPU.
+struct ServoChoice {
+    haptics::ServoWait wait = haptics::ServoWait::SleepSpin;
+    int cpu = -1;
+    int64_t spinNs = haptics::kSharedSpinNs;
+    bool reserveCpu = false; ///< the servo owns a CPU that the physics stays off
+};
+
+ServoChoice parseServoMode(const std::string& v) {
+    auto cpuOf = [&](size_t at) { // "…:CPU", one this process may run on
+        const std::vector<int> allowed = haptics::allowedCpus();
+        char* end = nullptr;
+        const long c = std::strtol(v.c_str() + at, &end, 10);
+        if (v.size() == at || *end != '\0' || std::find(allowed.begin(), allowed.end(), c) == allowed.end()) {
+            std::string list;
+            for (int a : allowed)
+                list += (list.empty() ? "" : ", ") + std::to_string(a);
+            throw std::invalid_argument("--servo '" + v + "': the CPU must be one this process may run on (" + list +
+                                        ")");
+        }
+        return static_cast<int>(c);
+    };
+    auto spinOf = [&](size_t at) { // "…:US", microseconds
+        char* end = nullptr;
+        const long us = std::strtol(v.c_str() + at, &end, 10);
+        if (v.size() == at || *end != '\0' || us < 0 || us > 1000)
+            throw std::invalid_argument("--servo '" + v + "': the spin must be an integer in [0, 1000] microseconds");
+        return int64_t(us) * 1000;
+    };
+    ServoChoice c;
+    if (v == "shared") return c;
+    if (v.rfind("shared:", 0) == 0) { // sleep, spin the last US microseconds, no CPU of its own
+        c.spinNs = spinOf(7);
+        return c;
+    }
+    c.reserveCpu = true;
+    c.spinNs = -1; // the reserved-CPU default (ServoConfig::spin_ns)
+    if (v == "sleep") return c;
+    if (v.rfind("sleep:", 0) == 0) { // sleep + spin, pinned to a CPU the physics thread stays off
+        c.cpu = cpuOf(6);
+        return c;
+    }
+    if (v.rfind("spin:", 0) == 0) { // sleep, then spin the last US microseconds, on its own CPU
+        c.spinNs = spinOf(5);
+        return c;
+    }
+    c.wait = haptics::ServoWait::Busy;
+    if (v == "busy") return c;
+    if (v.rfind("busy:", 0) == 0) {
+        c.cpu = cpuOf(5);
+        return c;
+    }
+    throw std::invalid_argument("--servo '" + v +
+                                "': expected shared, shared:US, sleep, sleep:CPU, spin:US, busy or busy:CPU");
+}
+
 int cmdRun(const std::vector<std::string>& args) {
     std::optional<std::string> casePath, reportPath, screenshot, device, tracePath, plotsDir;
     bool headless = false, realtime = false, lockstep = false, framesGiven = false;
-    haptics::ServoWait servoWait = haptics::ServoWait::SleepSpin;
-    int servoCpu = -1;
-    int64_t servoSpinNs = -1;
+    ServoChoice servo;
     int frames = 300;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
@@ -173,43 +230,9 @@ int cmdRun(const std::vector<std::string>& args) {
             screenshot = value("--screenshot");
         else if (a == "--device")
             device = value("--device");
-        else if (a == "--servo") {
-            const std::string v = value("--servo");
-            auto cpuOf = [&](size_t at) { // "…:CPU", one this process may run on
-                const std::vector<int> allowed = haptics::allowedCpus();
-                char* end = nullptr;
-                const long c = std::strtol(v.c_str() + at, &end, 10);
-                if (v.size() == at || *end != '\0' || std::find(allowed.begin(), allowed.end(), c) == allowed.end()) {
-                    std::string list;
-                    for (int a : allowed)
-                        list += (list.empty() ? "" : ", ") + std::to_string(a);
-                    throw std::invalid_argument("--servo '" + v + "': the CPU must be one this process may run on (" +
-                                                list + ")");
-                }
-                return static_cast<int>(c);
-            };
-            if (v == "sleep")
-                servoWait = haptics::ServoWait::SleepSpin;
-            else if (v.rfind("sleep:", 0) == 0) { // sleep + spin, pinned to a CPU the physics thread stays off
-                servoWait = haptics::ServoWait::SleepSpin;
-                servoCpu = cpuOf(6);
-            } else if (v.rfind("spin:", 0) == 0) { // sleep, then spin the last US microseconds
-                char* end = nullptr;
-                const long us = std::strtol(v.c_str() + 5, &end, 10);
-                if (v.size() == 5 || *end != '\0' || us < 0 || us > 1000)
-                    throw std::invalid_argument("--servo '" + v +
-                                                "': the spin must be an integer in [0, 1000] microseconds");
-                servoWait = haptics::ServoWait::SleepSpin;
-                servoSpinNs = int64_t(us) * 1000;
-            } else if (v == "busy")
-                servoWait = haptics::ServoWait::Busy;
-            else if (v.rfind("busy:", 0) == 0) {
-                servoWait = haptics::ServoWait::Busy;
-                servoCpu = cpuOf(5);
-            } else
-                throw std::invalid_argument("--servo '" + v +
-                                            "': expected sleep, sleep:CPU, spin:US, busy or busy:CPU");
-        } else if (!a.empty() && a[0] == '-')
+        else if (a == "--servo")
+            servo = parseServoMode(value("--servo"));
+        else if (!a.empty() && a[0] == '-')
             throw std::invalid_argument("unknown option '" + a + "'");
         else if (!casePath)
             casePath = a;
@@ -250,13 +273,13 @@ int cmdRun(const std::vector<std::string>& args) {
     // The window paces to the wall clock unless --lockstep asks for a replay or script stepped
     // with the physics (shown at physics speed where that is slower than real time).
     const bool rt = !lockstep && (realtime || (dev && dev->capabilities().realtime) || !headless);
-    if (dev && rt) {
+    if (dev && rt && servo.reserveCpu) {
         // The servo gets a CPU of its own (the highest allowed, where two or more are): this thread
         // and every thread started from here on (physics, solver workers, window) stay off it, so
-        // nothing of ours waits behind the servo's spin and the kernel never has to preempt the
-        // servo to serve a starved task on its CPU.
-        if (servoCpu < 0) servoCpu = haptics::defaultServoCpu();
-        if (servoCpu >= 0) haptics::pinCurrentThreadExcept(servoCpu);
+        // nothing of ours waits behind the servo's spin. Not in the default shared mode, where the
+        // servo preempts the physics at real-time priority for its short spin and tick.
+        if (servo.cpu < 0) servo.cpu = haptics::defaultServoCpu();
+        if (servo.cpu >= 0) haptics::pinCurrentThreadExcept(servo.cpu);
     }
     player::LoadedCase loaded = player::loadCase(*casePath);
     player::RunOptions opts;
@@ -265,9 +288,9 @@ int cmdRun(const std::vector<std::string>& args) {
     opts.deviceSpec = device.value_or("");
     opts.realtime = rt;
     opts.keepTrace = tracePath.has_value();
-    opts.servoWait = servoWait;
-    opts.servoCpu = servoCpu;
-    opts.servoSpinNs = servoSpinNs;
+    opts.servoWait = servo.wait;
+    opts.servoCpu = servo.cpu;
+    opts.servoSpinNs = servo.spinNs;
     player::SessionResult result;
     if (headless) {
         std::fprintf(stderr, "viscera-player: running %s for %d frames%s\n", casePath->c_str(), frames,

@@ -3,16 +3,17 @@
 # viscera-player (headless, real time, on the haptic sample case) and records the forces it gets
 # back. Prints the servo period/jitter, the contact-model age and the console-side figures.
 #
-#   scripts/haptics-loopback.sh [seconds=60] [build-dir=build] [out-dir=out/haptics-loopback] [servo=sleep]
+#   scripts/haptics-loopback.sh [seconds=60] [build-dir=build] [out-dir=out/haptics-loopback] [servo=shared]
 #
-# servo: "sleep" (sleep, then spin the last 0.94 ms; the last CPU), "sleep:CPU" (on that CPU), "spin:US" (the same with a
+# servo: "shared" (the player's default: SCHED_FIFO on the physics' CPUs, spins the last 100 us; "shared:US"
+# another spin), "sleep" (sleep, then spin the last 0.94 ms; the last CPU), "sleep:CPU" (on that CPU), "spin:US" (the same with a
 # spin of US microseconds) or "busy[:CPU]" (spin the whole period on a CPU of its own; for a
 # console PC with a core set aside).
 set -euo pipefail
 secs="${1:-60}"
 build="${2:-${VISCERA_BUILD_DIR:-build}}"
 out="${3:-out/haptics-loopback}"
-servo="${4:-sleep}"
+servo="${4:-shared}"
 mkdir -p "$out"
 # The console is a machine of its own; here its simulator runs beside the player, so keep it off
 # the CPU the player's servo thread owns (the highest allowed one, or the one the servo mode names).
@@ -20,6 +21,7 @@ mkdir -p "$out"
 cpus="$(awk '/^Cpus_allowed_list/ {print $2}' /proc/self/status | tr ',' '\n' |
         awk -F- '{ if (NF == 2) for (i = $1; i <= $2; i++) print i; else print $1 }')"
 case "$servo" in
+  shared|shared:*) servo_cpu=-1 ;;
   sleep:*|busy:*) servo_cpu="${servo#*:}" ;;
   *) if [ "$(echo "$cpus" | wc -l)" -ge 2 ]; then servo_cpu="$(echo "$cpus" | tail -n 1)"; else servo_cpu=-1; fi ;;
 esac

@@ -47,6 +47,11 @@ enum class ServoWait {
     Busy,
 };
 
+/// The spin of the player's default "shared" real-time mode: the servo thread (SCHED_FIFO) sleeps
+/// on the CPUs the physics runs on, wakes this early and spins to the deadline, so it takes about
+/// a tenth of one CPU instead of a whole one (measured choices in the README's session plan).
+inline constexpr int64_t kSharedSpinNs = 100'000;
+
 struct ServoConfig {
     double rateHz = 1000.0;
     ServoWait wait = ServoWait::SleepSpin;

@@ -251,6 +251,13 @@ void HapticRig::beforeStep() {
         }
         m_manual->set(end);
     }
+    if (m_realtime) { // how late this frame starts against the wall-clock time it simulates
+        const int64_t due = m_t0 + int64_t(std::llround(double(m_frame) * m_dt * 1e9));
+        m_lagMs = std::max(0.0, 1e-6 * double(m_clock->now_ns() - due));
+        m_lagSumMs += m_lagMs;
+        m_lagMaxMs = std::max(m_lagMaxMs, m_lagMs);
+        if (m_lagMs > m_dt * 1e3) ++m_framesLate;
+    }
     m_servo->notifyStepStart();
     const haptics::ToolPoseState poses = m_servo->toolPoses();
     sim::InteractionRuntime* interaction = m_world.interaction();
@@ -409,6 +416,9 @@ HapticsResult HapticRig::result() const {
     r.handover = m_audit.figures();
     r.physicsRealtimePriority = m_physicsRt || m_hadPhysicsRt;
     r.physicsCpus = m_physicsCpus;
+    r.lagMeanMs = m_frame > 0 ? m_lagSumMs / double(m_frame) : 0.0;
+    r.lagMaxMs = m_lagMaxMs;
+    r.framesLate = m_framesLate;
     r.traceSamples = m_samples;
     return r;
 }
@@ -422,6 +432,7 @@ LiveState HapticRig::live() const {
     s.pedals = p.pedals;
     s.safetyRules = p.safetyRules;
     s.maxForce_n = m_caseMaxForce;
+    s.lagMs = m_lagMs;
     const sim::InteractionRuntime* interaction = m_world.interaction();
     for (int a = 0; a < kMaxArms; ++a) {
         s.force[a] = p.force[a];

@@ -60,6 +60,13 @@ struct HapticsResult {
     bool physicsRealtimePriority = false;
     std::vector<int> physicsCpus; ///< real time: the CPUs the physics thread may run on
     uint64_t traceSamples = 0;
+    /// Real time: how late each physics frame started against the wall-clock time it simulates
+    /// (frame k simulates the device from k·dt after the start on), ms; frames late by more than
+    /// one frame time. A device replayed in real time is sampled that much later than in
+    /// lockstep, so these say how far the session's input differs from the lockstep run's.
+    /// Lockstep: 0.
+    double lagMeanMs = 0, lagMaxMs = 0;
+    int64_t framesLate = 0;
 };
 
 /// One row of the force/pose trace (--trace CSV).
@@ -81,6 +88,10 @@ struct LiveState {
     /// real-time factor, simulated time per physics wall time (≥ 1: keeps up with real time).
     double physicsMs = 0;
     double realTimeFactor = 0;
+    /// Real time: how late the frame started against the wall clock, ms (HapticsResult::lagMaxMs).
+    double lagMs = 0;
+    /// Set by the session once it estimated that this machine cannot keep real time (shown in red).
+    std::string realTimeWarning;
 };
 
 class HapticRig {
@@ -150,6 +161,8 @@ private:
     std::vector<HapticsResult::Tool> m_tools;
     double m_dt = 0, m_caseMaxForce = 15;
     int64_t m_frame = 0, m_t0 = 0, m_tick = 0;
+    double m_lagMs = 0, m_lagSumMs = 0, m_lagMaxMs = 0; ///< real time: frame start against the wall clock
+    int64_t m_framesLate = 0;
     std::vector<TraceRow> m_trace;
     uint64_t m_samples = 0;
     TaskMetrics m_metrics;

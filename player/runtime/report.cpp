@@ -65,6 +65,9 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
         servo["wake_latency_us"] = distribution(s.wakeLatency);
         servo["physics_realtime_priority"] = h.physicsRealtimePriority;
         servo["physics_cpus"] = h.physicsCpus;
+        // How far the session's device input differs from a lockstep run's (HapticsResult).
+        servo["frame_lag_ms"] = {{"mean", h.lagMeanMs}, {"max", h.lagMaxMs}};
+        servo["frames_late"] = h.framesLate;
     }
     const auto& a = s.contactAge;
     json contact = {
@@ -287,6 +290,9 @@ nlohmann::json reportJson(const SessionResult& r) {
     doc["metrics"]["real_time_factor_p99"] = rt.factorP99;
     doc["metrics"]["frames_slower_than_real_time"] = rt.framesOver;
     doc["metrics"]["slower_than_real_time"] = rt.slower();
+    if (r.realTimeEstimate > 0) doc["metrics"]["real_time_estimate"] = r.realTimeEstimate;
+    for (const SessionResult::BodyInertia& b : r.inertia) // selective inertia scaling, per body
+        doc["metrics"]["added_inertia"][b.name] = {{"mass_kg", b.massKg}, {"added_kg", b.addedKg}};
     // Task metrics [issue 7]: time, tool path, forces, tissue damage, punctures, clips.
     const TaskMetrics& tm = r.metrics;
     doc["metrics"]["time_s"] = tm.time_s;
@@ -357,6 +363,13 @@ std::string summaryText(const SessionResult& r) {
                       rt.slower() ? " — PHYSICS SLOWER THAN REAL TIME" : "");
         out += line;
     }
+    for (const SessionResult::BodyInertia& b : r.inertia)
+        if (b.addedKg > 0) {
+            char line[256];
+            std::snprintf(line, sizeof line, "inertia       '%s' +%.2f g on %.1f g (%.1f %%, selective inertia scaling)\n",
+                          b.name.c_str(), b.addedKg * 1e3, b.massKg * 1e3, b.massKg > 0 ? 100 * b.addedKg / b.massKg : 0.0);
+            out += line;
+        }
     for (const std::string& w : r.warnings)
         out += "warning       " + w + "\n";
     if (!r.metrics.toolNames.empty()) { // scripted and device-driven tools alike
@@ -378,12 +391,20 @@ std::string summaryText(const SessionResult& r) {
         const auto& p = h.servo.period;
         const auto& j = h.servo.jitter;
         char line[512];
-        if (h.mode == "realtime")
+        if (h.mode == "realtime") {
             std::snprintf(line, sizeof line,
                           "haptics       %s (%s), %llu ticks, period mean %.1f us, jitter p99 %.1f us, max %.1f us\n",
                           h.spec.c_str(), h.mode.c_str(), (unsigned long long)h.servo.ticks, p.mean_us, j.p99_us,
                           j.max_us);
-        else
+            out += line;
+            std::snprintf(line, sizeof line,
+                          "pacing        frames started late against the wall clock: mean %.1f ms, max %.1f ms, %lld "
+                          "over one frame; servo %s, %s\n",
+                          h.lagMeanMs, h.lagMaxMs, (long long)h.framesLate,
+                          h.servo.wait == haptics::ServoWait::Busy ? "busy" : "sleep + spin",
+                          h.servo.cpu >= 0 ? ("on CPU " + std::to_string(h.servo.cpu) + ", the physics off it").c_str()
+                                           : "sharing the physics' CPUs");
+        } else
             std::snprintf(line, sizeof line, "haptics       %s (%s), %llu ticks\n", h.spec.c_str(), h.mode.c_str(),
                           (unsigned long long)h.servo.ticks);
         out += line;

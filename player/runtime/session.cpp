@@ -1,5 +1,7 @@
 #include "runtime/session.hpp"
 
+#include "runtime/realtime_watch.hpp"
+
 #include "sim/skeleton/node_weights_io.hpp"
 
 #include "render/case_settings.hpp"
@@ -177,6 +179,90 @@ render::SceneView caseView(const LoadedCase& loaded) {
     return view;
 }
 
+namespace {
+
+constexpr size_t kRateWindow = 60; // frames the live real-time factor averages over
+
+/// m³, the sum of the tets' volumes.
+double restVolume(const sim::TetMesh& mesh) {
+    double v = 0;
+    const auto& x = mesh.positions();
+    for (const sim::Tet& t : mesh.tets())
+        v += (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).dot(x[t[3]] - x[t[0]]) / 6.0;
+    return v;
+} // frames the live real-time factor averages over
+
+/// The trainee window's copy of the session after a frame (under the view's lock).
+void publishLive(const sim::World& world, const HapticRig* rig, const std::vector<sim::FrameRecord>& frames,
+                 const sim::FrameRecord& rec, double frameDt, const std::string& realTimeWarning, LiveView& lv) {
+    std::lock_guard<std::mutex> lock(lv.mutex);
+    if (rig) lv.state = rig->live();
+    lv.state.time_s = world.time();
+    lv.state.frame = world.frameCount();
+    lv.state.realTimeWarning = realTimeWarning;
+    double ms = rec.stepMs;
+    size_t n = 1;
+    for (size_t k = frames.size(); k > 0 && n < kRateWindow; --k, ++n)
+        ms += frames[k - 1].stepMs;
+    lv.state.physicsMs = ms / static_cast<double>(n);
+    lv.state.realTimeFactor = realTimeFactor(frameDt, lv.state.physicsMs);
+    lv.nodes.clear();
+    for (size_t b = 0; b < world.bodyCount(); ++b)
+        lv.nodes.insert(lv.nodes.end(), world.positions(b).begin(), world.positions(b).end());
+    lv.surfaces.resize(world.surfaceCount());
+    lv.surfaceMasks.resize(world.surfaceCount());
+    lv.surfaceHeat.resize(world.surfaceCount());
+    for (size_t k = 0; k < world.surfaceCount(); ++k) {
+        lv.surfaces[k].assign(world.surfacePositions(k).begin(), world.surfacePositions(k).end());
+        if (const sim::InteractionRuntime* in = world.interaction(); in && in->dissects()) {
+            in->surfaceFaceMaskInto(k, lv.surfaceMasks[k]);
+            in->surfaceHeatInto(k, lv.surfaceHeat[k]);
+        }
+    }
+    lv.bodyTetMasks.resize(world.bodyCount());
+    lv.bodyHeat.resize(world.bodyCount());
+    for (size_t b = 0; b < world.bodyCount(); ++b)
+        if (const sim::InteractionRuntime* in = world.interaction(); in && in->dissectsBody(b)) {
+            in->bodyTetMaskInto(b, lv.bodyTetMasks[b]);
+            in->bodyHeatInto(b, lv.bodyHeat[b]);
+        }
+    lv.tools = render::toolPoses(world);
+}
+
+/// The device's figures at the end of a session with a rig.
+void collectHaptics(HapticRig& rig, SessionResult& r) {
+    rig.finish();
+    r.haptics = rig.result();
+    r.metrics = rig.metrics();
+    r.trace = std::move(rig.trace());
+    r.invariants.maxForce = r.metrics.maxForce_n;
+    const haptics::HandoverFigures& ho = r.haptics->handover;
+    if (ho.ticksOnOlderModel)
+        r.errors.push_back("haptics: " + std::to_string(ho.ticksOnOlderModel) +
+                           " servo ticks used an older contact model than the newest the physics had published");
+    if (ho.logErrors)
+        r.errors.push_back("haptics: the hand-over log has " + std::to_string(ho.logErrors) +
+                           " publishes out of order");
+}
+
+/// The world's figures at the end of a session.
+void collectWorld(const sim::World& world, SessionResult& r) {
+    r.simTime = world.time();
+    const double deviceMax = r.invariants.maxForce;
+    r.invariants = world.invariants();
+    r.invariants.maxForce = std::max(r.invariants.maxForce, deviceMax);
+    r.accuracy = world.accuracy();
+    if (world.hasSuture()) {
+        r.suture = world.sutureSummary();
+        r.sutureFrames = world.sutureFrames();
+        r.metrics.punctures = r.suture->punctures;
+        if (!r.suture->finite) r.errors.push_back("suture: the closure gauge or the thread tension was not finite");
+    }
+    r.finalNodeDisplacement = nodeDisplacement(world);
+}
+
+} // namespace
+
 SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     SessionResult r;
     const vcase::Manifest& m = loaded.package->manifest();
@@ -185,9 +271,13 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     r.title = m.title.value_or("");
     sim::World& world = *loaded.world;
     r.activeSubsystems = world.activeSubsystems();
+    const std::vector<double> added = world.addedInertiaKg();
     for (size_t b = 0; b < world.bodyCount(); ++b) {
         r.nodes += world.restMesh(b).vertexCount();
         r.tets += world.restMesh(b).tetCount();
+        if (b < added.size())
+            r.inertia.push_back({world.bodyName(b), restVolume(world.restMesh(b)) * loaded.scene.bodies[b].material.density,
+                                 added[b]});
     }
     r.frames.reserve(static_cast<size_t>(std::max(options.frames, 0)));
     std::unique_ptr<HapticRig> rig;
@@ -218,7 +308,10 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     if (rig) rig->start();
     const double frameDt = world.dt();
     r.frameDt = frameDt;
-    constexpr size_t kRateWindow = 60; // frames the live real-time factor averages over
+    // Only a paced session (a device on the wall clock) can fall behind real time.
+    const bool paced = rig && options.realtime;
+    RealTimeWatch watch(frameDt);
+    std::string realTimeWarning;
     for (int f = 0; options.frames == 0 || f < options.frames; ++f) {
         if (options.stop && options.stop->load()) break;
         if (rig) rig->beforeStep();
@@ -227,84 +320,36 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         if (const sim::InteractionRuntime* in = world.interaction()) meter.record(*in, frameDt);
         timeline.record(world);
         r.maxNodeDisplacement = std::max(r.maxNodeDisplacement, nodeDisplacement(world));
-        if (options.live) {
-            std::lock_guard<std::mutex> lock(options.live->mutex);
-            LiveView& lv = *options.live;
-            if (rig) lv.state = rig->live();
-            lv.state.time_s = world.time();
-            lv.state.frame = world.frameCount();
-            double ms = rec.stepMs;
-            size_t n = 1;
-            for (size_t k = r.frames.size(); k > 0 && n < kRateWindow; --k, ++n)
-                ms += r.frames[k - 1].stepMs;
-            lv.state.physicsMs = ms / static_cast<double>(n);
-            lv.state.realTimeFactor = realTimeFactor(frameDt, lv.state.physicsMs);
-            lv.nodes.clear();
-            for (size_t b = 0; b < world.bodyCount(); ++b)
-                lv.nodes.insert(lv.nodes.end(), world.positions(b).begin(), world.positions(b).end());
-            lv.surfaces.resize(world.surfaceCount());
-            lv.surfaceMasks.resize(world.surfaceCount());
-            lv.surfaceHeat.resize(world.surfaceCount());
-            for (size_t k = 0; k < world.surfaceCount(); ++k) {
-                lv.surfaces[k].assign(world.surfacePositions(k).begin(), world.surfacePositions(k).end());
-                if (const sim::InteractionRuntime* in = world.interaction(); in && in->dissects()) {
-                    in->surfaceFaceMaskInto(k, lv.surfaceMasks[k]);
-                    in->surfaceHeatInto(k, lv.surfaceHeat[k]);
-                }
-            }
-            lv.bodyTetMasks.resize(world.bodyCount());
-            lv.bodyHeat.resize(world.bodyCount());
-            for (size_t b = 0; b < world.bodyCount(); ++b)
-                if (const sim::InteractionRuntime* in = world.interaction(); in && in->dissectsBody(b)) {
-                    in->bodyTetMaskInto(b, lv.bodyTetMasks[b]);
-                    in->bodyHeatInto(b, lv.bodyHeat[b]);
-                }
-            lv.tools = render::toolPoses(world);
-        }
+        if (options.live) publishLive(world, rig.get(), r.frames, rec, frameDt, realTimeWarning, *options.live);
         if (!rec.finite)
             r.errors.push_back("frame " + std::to_string(rec.index) +
                                ": the step produced a non-finite value and was rolled back");
         r.frames.push_back(rec);
+        if (paced)
+            if (auto w = watch.afterFrame(r.frames)) {
+                realTimeWarning = *w;
+                r.warnings.push_back(*w);
+                log::warn(*w);
+            }
         if (options.progress) options.progress(f + 1, options.frames);
     }
-    if (rig) {
-        rig->finish();
-        r.haptics = rig->result();
-        r.metrics = rig->metrics();
-        r.trace = std::move(rig->trace());
-        r.invariants.maxForce = r.metrics.maxForce_n;
-        const haptics::HandoverFigures& ho = r.haptics->handover;
-        if (ho.ticksOnOlderModel)
-            r.errors.push_back("haptics: " + std::to_string(ho.ticksOnOlderModel) +
-                               " servo ticks used an older contact model than the newest the physics had published");
-        if (ho.logErrors)
-            r.errors.push_back("haptics: the hand-over log has " + std::to_string(ho.logErrors) +
-                               " publishes out of order");
-    }
+    if (rig) collectHaptics(*rig, r);
+    r.realTimeEstimate = watch.estimate();
+    if (paced)
+        if (std::string e = watch.verdict(r.frames, r.haptics->lagMaxMs); !e.empty()) r.errors.push_back(e);
     r.metrics.time_s = world.time();
     if (options.live) {
         std::lock_guard<std::mutex> lock(options.live->mutex);
         options.live->finished = true;
     }
     r.wallTime = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    r.simTime = world.time();
-    const double deviceMax = r.invariants.maxForce;
-    r.invariants = world.invariants();
-    r.invariants.maxForce = std::max(r.invariants.maxForce, deviceMax);
-    r.accuracy = world.accuracy();
-    if (world.hasSuture()) {
-        r.suture = world.sutureSummary();
-        r.sutureFrames = world.sutureFrames();
-        r.metrics.punctures = r.suture->punctures;
-        if (!r.suture->finite) r.errors.push_back("suture: the closure gauge or the thread tension was not finite");
-    }
+    collectWorld(world, r);
     if (const sim::InteractionRuntime* in = world.interaction()) {
         r.interaction = in->summary();
         r.metrics.clips = static_cast<int>(r.interaction->clips.size());
         r.metrics.cutEdges = r.interaction->fasciaEdgesCut + r.interaction->fatEdgesCut;
         meter.addTo(r.metrics, *in);
     }
-    r.finalNodeDisplacement = nodeDisplacement(world);
     r.timeline = timeline.take();
     return r;
 }

@@ -98,6 +98,13 @@ struct SessionResult {
     double maxNodeDisplacement = 0;   ///< m, largest node distance from the rest configuration over the run
     double finalNodeDisplacement = 0; ///< m, the same at the end
     size_t nodes = 0, tets = 0;
+    /// Per body: its name, lumped mass and the extra inertia selective inertia scaling gave its
+    /// nodes at load (World::addedInertiaKg), kg.
+    struct BodyInertia {
+        std::string name;
+        double massKg = 0, addedKg = 0;
+    };
+    std::vector<BodyInertia> inertia;
     std::vector<std::string> errors;
     std::vector<std::string> warnings;    ///< e.g. a device that drives no tool (also logged when given)
     std::optional<HapticsResult> haptics; ///< present when the session ran a device
@@ -108,6 +115,9 @@ struct SessionResult {
     std::vector<sim::SutureFrameRecord> sutureFrames;   ///< one per frame of a "fem" case
     std::optional<sim::InteractionSummary> interaction; ///< cases with scripted instruments
     SessionTimeline timeline; ///< tool tips, forces and task events over the run (plots, report)
+    /// Paced sessions (a device on the wall clock): the physics' real-time factor estimated from
+    /// the first frames (RealTimeWatch); 0 when not estimated.
+    double realTimeEstimate = 0;
     bool ok() const { return errors.empty() && invariants.allFinite; }
 };
 

@@ -260,6 +260,10 @@ public:
         if (s.safetyRules & haptics::kRuleSimStale) p.drawText(px, y, "Forces off: simulation stale"), y += 20;
         if (s.safetyRules & haptics::kRuleDisconnected) p.drawText(px, y, "Forces off: device not answering"), y += 20;
         if (s.safetyRules & haptics::kRuleDeadman) p.drawText(px, y, "Forces off: hold the deadman pedal"), y += 20;
+        if (!s.realTimeWarning.empty()) { // estimated from the first frames: this machine cannot keep up
+            p.setPen(QColor(230, 80, 60));
+            p.drawText(px, h - 56, "Not real time on this machine: the session differs from the authored one");
+        }
         if (s.realTimeFactor > 0) {
             // Physics slower than real time: the tissue moves in slow motion; say so in red.
             const bool slow = s.realTimeFactor < 1;

@@ -265,16 +265,15 @@ TEST(PlayerHaptics, ConsoleLoopbackWithADisconnectMidSession) {
     EXPECT_EQ(ho["ticks_on_older_model"].get<int>(), 0);
     EXPECT_LE(ho["max_age_over_step"].get<double>(), 1.0);
     EXPECT_EQ(ho["models_published"].get<int>(), 181);
-    // The servo owns the highest CPU the player may run on (where there are two or more); the
-    // physics thread stays off it and keeps the others.
+    // The default servo wait shares the CPUs with the physics (--servo shared): not pinned, the
+    // physics keeps every CPU, the servo sleeps and spins the last 100 us.
     const std::vector<int> allowed = haptics::allowedCpus();
     const auto& servo = h["servo"];
-    if (allowed.size() >= 2) {
-        EXPECT_EQ(servo["cpu"].get<int>(), allowed.back());
-        EXPECT_EQ(servo["physics_cpus"].get<std::vector<int>>(), std::vector<int>(allowed.begin(), allowed.end() - 1));
-    } else {
-        EXPECT_EQ(servo["cpu"].get<int>(), -1) << "one CPU: shared, not pinned";
-    }
+    EXPECT_EQ(servo["cpu"].get<int>(), -1);
+    EXPECT_EQ(servo["physics_cpus"].get<std::vector<int>>(), allowed);
+    EXPECT_EQ(servo["spin_us"].get<int>(), 100);
+    EXPECT_TRUE(servo.contains("frame_lag_ms"));
+    EXPECT_TRUE(servo.contains("frames_late"));
     EXPECT_TRUE(j["invariants"]["all_finite"].get<bool>());
     // The player kept running through the gap and forces came back to the console afterwards.
     const auto sum = readJson(s / "sum.json");
@@ -386,10 +385,27 @@ TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
                          "--realtime", "--report", s / "r2.json"});
     ASSERT_EQ(sleep.exitCode, 0) << sleep.err;
     EXPECT_EQ(readJson(s / "r2.json")["haptics"]["servo"]["wait"], "sleep");
+    EXPECT_EQ(readJson(s / "r2.json")["haptics"]["servo"]["cpu"], -1) << "shared by default";
     auto spin = player({"run", s / "slab.vcase", "--headless", "--frames", "10", "--device", "scripted:press",
                         "--realtime", "--servo", "spin:900", "--report", s / "r3.json"});
     ASSERT_EQ(spin.exitCode, 0) << spin.err;
     EXPECT_EQ(readJson(s / "r3.json")["haptics"]["servo"]["spin_us"], 900);
+    auto shared = player({"run", s / "slab.vcase", "--headless", "--frames", "10", "--device", "scripted:press",
+                          "--realtime", "--servo", "shared:30", "--report", s / "r5.json"});
+    ASSERT_EQ(shared.exitCode, 0) << shared.err;
+    EXPECT_EQ(readJson(s / "r5.json")["haptics"]["servo"]["spin_us"], 30);
+    EXPECT_EQ(readJson(s / "r5.json")["haptics"]["servo"]["cpu"], -1);
+    // "sleep" reserves the highest CPU for the servo; the physics keeps the others.
+    auto reserved = player({"run", s / "slab.vcase", "--headless", "--frames", "10", "--device", "scripted:press",
+                            "--realtime", "--servo", "sleep", "--report", s / "r6.json"});
+    ASSERT_EQ(reserved.exitCode, 0) << reserved.err;
+    const auto rs = readJson(s / "r6.json")["haptics"]["servo"];
+    const std::vector<int> cpus = haptics::allowedCpus();
+    if (cpus.size() >= 2) {
+        EXPECT_EQ(rs["cpu"].get<int>(), cpus.back());
+        EXPECT_EQ(rs["physics_cpus"].get<std::vector<int>>(), std::vector<int>(cpus.begin(), cpus.end() - 1));
+        EXPECT_EQ(rs["spin_us"].get<int>(), 940);
+    }
     // A mask set from outside (taskset, cpusets) is respected: started on one CPU, the player
     // shares it with the servo instead of pinning anything elsewhere.
     const std::vector<int> allowed = haptics::allowedCpus();
@@ -410,8 +426,8 @@ TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
     EXPECT_EQ(outside.exitCode, 2);
     EXPECT_THAT(outside.err,
                 HasSubstr("the CPU must be one this process may run on (" + std::to_string(allowed.front()) + ")"));
-    for (const char* bad :
-         {"busy:", "busy:x", "busy:-1", "busy:4096", "sleep:", "sleep:4096", "spin", "spin:", "spin:2000", "spin:-5"}) {
+    for (const char* bad : {"busy:", "busy:x", "busy:-1", "busy:4096", "sleep:", "sleep:4096", "spin",
+                            "spin:", "spin:2000", "spin:-5", "shared:", "shared:x", "shared:2000", "sharedx"}) {
         auto b = player({"run", s / "slab.vcase", "--headless", "--frames", "1", "--servo", bad});
         EXPECT_EQ(b.exitCode, 2) << bad;
         EXPECT_THAT(b.err, HasSubstr("--servo")) << bad;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace viscera::sim {
@@ -38,6 +39,10 @@ std::string validate(const CollisionSettings& s) {
     if (!(s.polygonMargin >= 0) || !std::isfinite(s.polygonMargin)) return "polygon margin must be finite and >= 0";
     if (!(s.compliance >= 0) || !std::isfinite(s.compliance)) return "compliance must be finite and >= 0";
     if (!(s.maxCorrectionPerStep > 0)) return "max correction per step must be > 0";
+    if (!(s.reachListMargin >= 0) || !std::isfinite(s.reachListMargin))
+        return "reach list margin must be finite and >= 0";
+    if (!(s.reachListToolMargin >= 0) || !std::isfinite(s.reachListToolMargin))
+        return "reach list tool margin must be finite and >= 0";
     return {};
 }
 
@@ -112,6 +117,17 @@ std::unique_ptr<CollisionSolver> CollisionSolver::create(CollisionSurfaceDesc de
     s->m_energy.assign(nt, 0.0);
     s->m_refArea.assign(nt, -1.0);
     s->m_touched.assign(nv, 0);
+    s->m_vertexTriStart.assign(nv + 1, 0);
+    for (const Tri& f : s->m_tris)
+        for (int32_t v : f)
+            ++s->m_vertexTriStart[v + 1];
+    for (size_t v = 0; v < nv; ++v)
+        s->m_vertexTriStart[v + 1] += s->m_vertexTriStart[v];
+    s->m_vertexTris.resize(s->m_vertexTriStart.back());
+    std::vector<uint32_t> fill(s->m_vertexTriStart.begin(), s->m_vertexTriStart.end() - 1);
+    for (size_t t = 0; t < nt; ++t)
+        for (int32_t v : s->m_tris[t])
+            s->m_vertexTris[fill[v]++] = static_cast<int32_t>(t);
     s->refreshAllFactors(s->m_rest);
     return s;
 }
@@ -125,6 +141,7 @@ void CollisionSolver::refreshFactors(int32_t t, const std::vector<Vec3>& x, doub
 
 void CollisionSolver::refreshAllFactors(const std::vector<Vec3>& x) {
     if (x.size() != m_rest.size()) return;
+    m_reachValid = false; // the list was made with the old factors
     for (size_t t = 0; t < m_tris.size(); ++t) {
         const Tri& f = m_tris[t];
         const double area = 0.5 * (x[f[1]] - x[f[0]]).cross(x[f[2]] - x[f[0]]).norm();
@@ -140,67 +157,206 @@ Sphere CollisionSolver::triangleSphere(int32_t t, const std::vector<Vec3>& x) co
                                                m_settings.circumsphere.energyScale));
 }
 
-void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& tool, double h) {
-    m_stats = CollisionStats{};
-    m_candidates.clear();
-    std::fill(m_touched.begin(), m_touched.end(), 0);
-    m_push.assign(m_rest.size(), Vec3::Zero());
-    m_contactDirty = true;
-    if (x.size() != m_rest.size() || !(h > 0)) return;
-    m_alphaTilde = m_settings.compliance / (h * h);
-    m_h = h;
-    m_start = x;
+// Broad phase: one query (the tool's box) per step, so each triangle's box is tested directly,
+// in triangle order (a spatial hash rebuilt every substep for a single query cost more than the
+// test). Circumsphere: a triangle whose vertex box, grown by a bound on how far its sphere can
+// reach beyond it, misses the tool is no candidate, and its sphere is not computed. The bound:
+// the circumradius r is at most 4 × the longest edge ℓ (else the bounding sphere, radius ≤ ℓ, is
+// used), ℓ ≤ the box diagonal d, the circumcentre is within r of every vertex, and the sphere (or
+// its safe-cone part) lies within r + 2|offset| of the circumcentre, with
+// |offset| ≤ φ cot θ · r · |H3| + energyScale · |ε| (circumsphere.hpp) from the cached factors.
+bool CollisionSolver::broadPhaseHit(int32_t t, const std::vector<Vec3>& x, const Aabb& toolBox) const {
     const bool polygon =
         m_settings.method == CollisionMethod::Polygon || m_settings.method == CollisionMethod::PolygonFeatures;
-    const bool circum = m_settings.method == CollisionMethod::Circumsphere;
-    // Broad phase: one query (the tool's box) per step, so each triangle's box is tested directly,
-    // in triangle order (a spatial hash rebuilt every substep for a single query cost more than
-    // the test). Circumsphere: a triangle whose vertex box, grown by a bound on how far its sphere
-    // can reach beyond it, misses the tool is no candidate, and its sphere is not computed. The
-    // bound: the circumradius r is at most 4 × the longest edge ℓ (else the bounding sphere,
-    // radius ≤ ℓ, is used), ℓ ≤ the box diagonal d, the circumcentre is within r of every vertex,
-    // and the sphere (or its safe-cone part) lies within r + 2|offset| of the circumcentre, with
-    // |offset| ≤ φ cot θ · r · |H3| + energyScale · |ε| (circumsphere.hpp) from the cached factors.
+    const Tri& f = m_tris[t];
+    Aabb b;
+    const Vec3 lo = x[f[0]].cwiseMin(x[f[1]]).cwiseMin(x[f[2]]);
+    const Vec3 hi = x[f[0]].cwiseMax(x[f[1]]).cwiseMax(x[f[2]]);
+    if (polygon) {
+        const Vec3 m = Vec3::Constant(m_settings.polygonMargin);
+        b.lo = lo - m;
+        b.hi = hi + m;
+    } else {
+        if (m_settings.method == CollisionMethod::Circumsphere) {
+            const Vec3 reach = Vec3::Constant(circumsphereReach(t, x, 0));
+            if (!Aabb{lo - reach, hi + reach}.overlaps(toolBox)) return false; // also skips non-finite vertices
+        }
+        const Sphere s = triangleSphere(t, x);
+        if (m_settings.safeConeOnly && s.coneCos > -1) {
+            // Only the safe cone inside the sphere can hold a contact: the cap lies within the
+            // circumcircle's radius of the circumcentre, and the cone narrows from there to the
+            // sphere centre. Box of that ball and the centre (exact for the contacts at x; about
+            // a sixth of the sphere's box for a flat surface).
+            const double c = std::clamp(s.coneCos, 0.0, 1.0);
+            const Vec3 rim = s.centre + s.radius * c * s.coneAxis; // circumcentre
+            const Vec3 R = Vec3::Constant(s.radius * std::sqrt(1 - c * c));
+            b.lo = (rim - R).cwiseMin(s.centre);
+            b.hi = (rim + R).cwiseMax(s.centre);
+        } else {
+            b.lo = s.centre - Vec3::Constant(s.radius);
+            b.hi = s.centre + Vec3::Constant(s.radius);
+        }
+    }
+    return b.lo.allFinite() && b.hi.allFinite() && b.overlaps(toolBox);
+}
+
+// Within the margin μ (each vertex moved at most μ along each axis, so at most √3 μ) the vertex
+// box grows by at most μ per side, every edge vector changes by at most δ = 2√3 μ, and twice the
+// area |e₁ × e₂| by at most δ(|e₁| + |e₂|) + δ². The radius the sphere methods use is at most
+// min(R, 4ℓ) (circumcircle.cpp: a circumradius R over 4 × the longest edge ℓ falls back to the
+// bounding sphere, radius ≤ ℓ), with R = abc / (2 |e₁ × e₂|) bounded from the grown edges and the
+// shrunk area while that stays positive, else 4(ℓ + δ). The reach of broadPhaseHit then follows
+// with that radius (see the safe cone below). The factors cannot change meanwhile: only candidates are refreshed, and a
+// triangle off the list is no candidate while the list holds (by induction over the steps).
+// Polygon: the margin; bounding sphere: centroid inside the box, radius ≤ ℓ.
+double CollisionSolver::circumsphereReach(int32_t t, const std::vector<Vec3>& x, double margin) const {
+    const Tri& f = m_tris[t];
+    const double delta = 2 * std::sqrt(3.0) * margin;
+    const Vec3 e1 = x[f[1]] - x[f[0]], e2 = x[f[2]] - x[f[0]];
+    const double a = (x[f[2]] - x[f[1]]).norm() + delta, b = e1.norm() + delta, c = e2.norm() + delta;
+    double r = 4 * std::max({a, b, c});
+    const double twiceArea = e1.cross(e2).norm() - delta * (b + c) - delta * delta;
+    if (twiceArea > 0) r = std::min(r, a * b * c / (2 * twiceArea));
+    const double offset =
+        m_offsetPerRadius * r * std::abs(m_h3[t]) + m_settings.circumsphere.energyScale * std::abs(m_energy[t]);
+    // The safe-cone part of the sphere (offset ≥ 0: H3, ε and the scales are) lies within
+    // max(r, offset) of the circumcentre: the circumcircle's ball and the sphere's centre.
+    return m_settings.safeConeOnly ? r + std::max(r, offset) : 2 * r + 2 * offset;
+}
+
+bool CollisionSolver::mayReach(int32_t t, const std::vector<Vec3>& x0, double margin, const Aabb& grownTool) const {
+    const Tri& f = m_tris[t];
+    const Vec3 lo = x0[f[0]].cwiseMin(x0[f[1]]).cwiseMin(x0[f[2]]);
+    const Vec3 hi = x0[f[0]].cwiseMax(x0[f[1]]).cwiseMax(x0[f[2]]);
+    double reach = 0;
+    switch (m_settings.method) {
+    case CollisionMethod::Polygon:
+    case CollisionMethod::PolygonFeatures:
+        reach = m_settings.polygonMargin;
+        break;
+    case CollisionMethod::Circumsphere:
+        reach = circumsphereReach(t, x0, margin);
+        break;
+    case CollisionMethod::BoundingSphere:
+        reach = (hi - lo).norm() + 2 * std::sqrt(3.0) * margin;
+        break;
+    }
+    const Vec3 grow = Vec3::Constant(margin + reach);
+    return Aabb{lo - grow, hi + grow}.overlaps(grownTool); // false for non-finite vertices
+}
+
+// The list holds the triangles that may reach the tool while their vertices stay within the margin
+// μ. Every other triangle t gets the largest of μ, 4μ, 16μ within which it still cannot reach the
+// tool, and each vertex the smallest such allowance of its unlisted triangles (listed triangles
+// are tested exactly every step, so their vertices may move freely). A vertex that leaves its
+// allowance brings its unlisted triangles onto the list (then tested exactly too); the list is
+// made anew when the tool's box leaves the tool margin or the list has grown to twice its size.
+const std::vector<int32_t>* CollisionSolver::reachList(const std::vector<Vec3>& x, const Aabb& toolBox) {
+    const double margin = m_settings.reachListMargin;
+    if (!(margin > 0)) return nullptr;
+    const bool valid = m_reachValid && m_reachX.size() == x.size() &&
+                       (toolBox.lo.array() >= m_reachTool.lo.array()).all() &&
+                       (toolBox.hi.array() <= m_reachTool.hi.array()).all();
+    // Grown to twice its size since it was made: made anew, tight around the tool again.
+    if (valid) {
+        growReachList(x);
+        if (m_reach.size() <= 2 * m_reachMadeSize + 64) return &m_reach;
+    }
+    m_stats.reachListMade = true;
+    m_stats.trianglesTested += static_cast<int>(m_tris.size());
+    m_reachX = x;
+    const Vec3 toolMargin = Vec3::Constant(m_settings.reachListToolMargin);
+    m_reachTool = Aabb{toolBox.lo - toolMargin, toolBox.hi + toolMargin};
+    m_reach.clear();
+    m_inReach.assign(m_tris.size(), 0);
+    m_reachAllow.assign(x.size(), std::numeric_limits<double>::infinity());
+    for (int32_t t = 0; t < static_cast<int32_t>(m_tris.size()); ++t) {
+        double allow = 0; // widest first: most triangles are far from the tool
+        for (double tier : {16 * margin, 4 * margin, margin})
+            if (!mayReach(t, x, tier, m_reachTool)) {
+                allow = tier;
+                break;
+            }
+        if (allow == 0) {
+            m_reach.push_back(t);
+            m_inReach[t] = 1;
+            continue;
+        }
+        for (int32_t v : m_tris[t])
+            m_reachAllow[v] = std::min(m_reachAllow[v], allow);
+    }
+    m_reachValid = true;
+    m_reachMadeSize = m_reach.size();
+    return &m_reach;
+}
+
+void CollisionSolver::growReachList(const std::vector<Vec3>& x) {
+    const size_t before = m_reach.size();
+    for (size_t v = 0; v < x.size(); ++v) {
+        if ((x[v] - m_reachX[v]).cwiseAbs().maxCoeff() <= m_reachAllow[v]) continue; // NaN: grows
+        for (uint32_t k = m_vertexTriStart[v]; k < m_vertexTriStart[v + 1]; ++k) {
+            const int32_t t = m_vertexTris[k];
+            if (m_inReach[t]) continue;
+            m_inReach[t] = 1;
+            m_reach.push_back(t);
+        }
+        m_reachAllow[v] = std::numeric_limits<double>::infinity();
+    }
+    if (m_reach.size() == before) return;
+    m_stats.reachListGrown = static_cast<int>(m_reach.size() - before);
+    const auto mid = m_reach.begin() + static_cast<std::ptrdiff_t>(before);
+    std::sort(mid, m_reach.end());
+    std::inplace_merge(m_reach.begin(), mid, m_reach.end()); // ascending: the candidates' order
+}
+
+void CollisionSolver::beginStep(const std::vector<Vec3>& x, const ToolShape& tool, double h) {
+    m_stats = CollisionStats{};
+    const size_t nv = m_rest.size();
+    // Only the vertices of the last step's candidates can have been pushed or touched.
+    if (m_push.size() != nv) {
+        m_push.assign(nv, Vec3::Zero());
+        std::fill(m_touched.begin(), m_touched.end(), 0);
+    } else {
+        for (int32_t v : m_candVerts) {
+            m_push[v].setZero();
+            m_touched[v] = 0;
+        }
+    }
+    m_candidates.clear();
+    m_candVerts.clear();
+    m_contactDirty = true;
+    if (x.size() != nv || !(h > 0)) return;
+    m_alphaTilde = m_settings.compliance / (h * h);
+    m_h = h;
     const auto tb = tool.bounds();
     const Aabb toolBox{tb[0], tb[1]};
-    const bool toolFinite = toolBox.lo.allFinite() && toolBox.hi.allFinite();
-    for (size_t t = 0; t < m_tris.size() && toolFinite; ++t) {
-        const Tri& f = m_tris[t];
-        Aabb b;
-        const Vec3 lo = x[f[0]].cwiseMin(x[f[1]]).cwiseMin(x[f[2]]);
-        const Vec3 hi = x[f[0]].cwiseMax(x[f[1]]).cwiseMax(x[f[2]]);
-        if (polygon) {
-            const Vec3 m = Vec3::Constant(m_settings.polygonMargin);
-            b.lo = lo - m;
-            b.hi = hi + m;
+    if (toolBox.lo.allFinite() && toolBox.hi.allFinite()) {
+        if (const std::vector<int32_t>* list = reachList(x, toolBox)) {
+            m_stats.trianglesTested += static_cast<int>(list->size());
+            for (int32_t t : *list)
+                if (broadPhaseHit(t, x, toolBox)) m_candidates.push_back(t);
         } else {
-            if (circum) {
-                const double r = 4 * (hi - lo).norm();
-                const double offset = m_offsetPerRadius * r * std::abs(m_h3[t]) +
-                                      m_settings.circumsphere.energyScale * std::abs(m_energy[t]);
-                const Vec3 reach = Vec3::Constant(2 * r + 2 * offset);
-                if (!Aabb{lo - reach, hi + reach}.overlaps(toolBox)) continue; // also skips non-finite vertices
-            }
-            const Sphere s = triangleSphere(static_cast<int32_t>(t), x);
-            if (m_settings.safeConeOnly && s.coneCos > -1) {
-                // Only the safe cone inside the sphere can hold a contact: the cap lies within
-                // the circumcircle's radius of the circumcentre, and the cone narrows from
-                // there to the sphere centre. Box of that ball and the centre (exact for the
-                // contacts at x; about a sixth of the sphere's box for a flat surface).
-                const double c = std::clamp(s.coneCos, 0.0, 1.0);
-                const Vec3 rim = s.centre + s.radius * c * s.coneAxis; // circumcentre
-                const Vec3 R = Vec3::Constant(s.radius * std::sqrt(1 - c * c));
-                b.lo = (rim - R).cwiseMin(s.centre);
-                b.hi = (rim + R).cwiseMax(s.centre);
-            } else {
-                b.lo = s.centre - Vec3::Constant(s.radius);
-                b.hi = s.centre + Vec3::Constant(s.radius);
-            }
+            m_stats.trianglesTested = static_cast<int>(m_tris.size());
+            for (int32_t t = 0; t < static_cast<int32_t>(m_tris.size()); ++t)
+                if (broadPhaseHit(t, x, toolBox)) m_candidates.push_back(t);
         }
-        if (b.lo.allFinite() && b.hi.allFinite() && b.overlaps(toolBox))
-            m_candidates.push_back(static_cast<int32_t>(t));
     }
     m_stats.candidates = static_cast<int>(m_candidates.size());
+    // The candidates' vertices, ascending; their positions at the start of the step (the cap of
+    // capCorrection: no other vertex is moved in this step).
+    m_mark.resize(nv, 0);
+    for (int32_t t : m_candidates)
+        for (int32_t v : m_tris[t])
+            if (!m_mark[v]) {
+                m_mark[v] = 1;
+                m_candVerts.push_back(v);
+            }
+    std::sort(m_candVerts.begin(), m_candVerts.end());
+    m_start.resize(nv);
+    for (int32_t v : m_candVerts) {
+        m_mark[v] = 0;
+        m_start[v] = x[v];
+    }
     if (m_settings.method == CollisionMethod::Circumsphere) {
         const double delta = m_settings.circumsphere.updateThreshold;
         for (int32_t t : m_candidates) {
@@ -400,7 +556,6 @@ int CollisionSolver::iterate(std::vector<Vec3>& x, const ToolShape& tool) {
 void CollisionSolver::beginStep(const XpbdParticles& particles, size_t offset, const ToolShape& tool, double h) {
     const size_t nv = m_rest.size();
     m_viewValid = offset <= particles.size() && nv <= particles.size() - offset;
-    m_candVerts.clear();
     if (!m_viewValid) {
         beginStep(std::vector<Vec3>{}, tool, h); // size mismatch: an empty step
         return;
@@ -409,14 +564,6 @@ void CollisionSolver::beginStep(const XpbdParticles& particles, size_t offset, c
     for (size_t v = 0; v < nv; ++v)
         m_x[v] = particles.position(offset + v);
     beginStep(m_x, tool, h);
-    m_mark.assign(nv, 0);
-    for (int32_t t : m_candidates)
-        for (int32_t v : m_tris[t])
-            if (!m_mark[v]) {
-                m_mark[v] = 1;
-                m_candVerts.push_back(v);
-            }
-    std::sort(m_candVerts.begin(), m_candVerts.end());
 }
 
 int CollisionSolver::iterate(XpbdParticles& particles, size_t offset, const ToolShape& tool) {

@@ -5,7 +5,9 @@
 /// iterations (after every elastic sweep, multipliers per substep, inelastic velocity pass);
 /// stepWithCollision is the older after-the-substep coupling.
 ///
-/// Pipeline per substep (beginStep): the surface triangles' boxes (sphere methods: the sphere's;
+/// Pipeline per substep (beginStep): the triangles that can reach the tool (the reach list, kept
+/// over the steps of a frame and beyond while surface and tool stay within its margins; see
+/// CollisionSettings::reachListMargin), then the surface triangles' boxes (sphere methods: the sphere's;
 /// circumsphere with the safe cone: the part of the sphere inside the cone) are tested against
 /// the tool's box (Aabb of spatial_hash.hpp; one query per step, so no hash is built), which selects
 /// the candidates in triangle order; for the circumsphere method the
@@ -78,6 +80,19 @@ struct CollisionSettings {
     /// m: no vertex is moved farther than this by the sweeps of one step (a tool that starts
     /// deep inside the tissue pushes it out over several substeps instead of in one jump).
     double maxCorrectionPerStep = 0.002;
+    /// m: the broad phase keeps a list of the triangles that could reach the tool as long as the
+    /// vertices of the others move no more than this along any axis (far triangles: up to 16 ×
+    /// this, see reachList) and the tool's box stays within reachListToolMargin of where it was
+    /// when the list was made; while both hold, a step tests only the listed triangles, otherwise
+    /// it tests every triangle and makes the list anew. The candidates (and
+    /// so every result) are the same as without the list; 0 tests every triangle every step.
+    /// The bound on a sphere's reach widens fast with the margin once it nears the triangles'
+    /// size, so keep it well below their edges (0.1 mm for 2 mm triangles: the list is made
+    /// about once per frame and per tool in the rectum case).
+    double reachListMargin = 1e-4;
+    /// m: how far the tool's box may move before the reach list is made anew (the tool is
+    /// kinematic, one pose per frame; a wider margin lists a few more triangles).
+    double reachListToolMargin = 0.002;
 };
 
 /// Empty when valid, otherwise the rule that failed.
@@ -94,10 +109,13 @@ struct CollisionSurfaceDesc {
 };
 
 struct CollisionStats {
-    int candidates = 0;       ///< broad-phase candidate triangles of the step
-    int contacts = 0;         ///< constraint projections in the last sweep
-    int factorUpdates = 0;    ///< triangles whose curvature/energy factors were refreshed (δ test)
-    double maxCorrection = 0; ///< m, largest vertex move of the last sweep
+    int candidates = 0;         ///< broad-phase candidate triangles of the step
+    int contacts = 0;           ///< constraint projections in the last sweep
+    int factorUpdates = 0;      ///< triangles whose curvature/energy factors were refreshed (δ test)
+    double maxCorrection = 0;   ///< m, largest vertex move of the last sweep
+    int trianglesTested = 0;    ///< broad-phase tests of the step (making the reach list: one per triangle)
+    bool reachListMade = false; ///< the step made the reach list anew (tested every triangle)
+    int reachListGrown = 0;     ///< triangles the step added to the list (their vertices moved on)
 };
 
 /// The unified triangle constraint of [A eq. 5.8] for vertices x and targets x' (fixed):
@@ -165,6 +183,20 @@ public:
 private:
     CollisionSolver() = default;
     void refreshFactors(int32_t t, const std::vector<Vec3>& x, double area);
+    /// Broad phase of one triangle at x against the tool's box (the candidate test).
+    bool broadPhaseHit(int32_t t, const std::vector<Vec3>& x, const Aabb& toolBox) const;
+    /// How far beyond its vertex box the circumsphere method's sphere of triangle t (its safe-cone
+    /// part where safeConeOnly) can reach at x, or at any x' within `margin` of x along each axis,
+    /// with the cached factors. m.
+    double circumsphereReach(int32_t t, const std::vector<Vec3>& x, double margin) const;
+    /// Whether triangle t at m_reachX, its vertices moved by at most `margin` along each axis and
+    /// its factors as cached, could pass broadPhaseHit against a tool box inside `grownTool`.
+    bool mayReach(int32_t t, const std::vector<Vec3>& x0, double margin, const Aabb& grownTool) const;
+    /// The triangles to test this step at x (ascending): the reach list, made anew when x or the
+    /// tool left its margin; nullptr when every triangle must be tested (margin 0).
+    const std::vector<int32_t>* reachList(const std::vector<Vec3>& x, const Aabb& toolBox);
+    /// Lists the unlisted triangles of every vertex that left its allowance (kept ascending).
+    void growReachList(const std::vector<Vec3>& x);
     bool projectSphere(int32_t t, const Sphere& s, const Capsule& c, double& lambda, std::vector<Vec3>& x);
     bool projectPolygon(int32_t t, const Capsule& c, double& lambda, std::vector<Vec3>& x);
     /// Distance constraint C = |Σ b_k x_{v_k} − q| − reach on n (1–3) vertices; false when not
@@ -188,6 +220,19 @@ private:
     double m_offsetPerRadius = 0;                  ///< φ cot θ
     std::vector<double> m_h3, m_energy, m_refArea; ///< per triangle; m_refArea < 0: never set
     std::vector<int32_t> m_candidates;
+    // Reach list (CollisionSettings::reachListMargin): triangles that could reach the tool while
+    // the surface stays within the margin of m_reachX and the tool's box inside m_reachTool.
+    // Triangles off the list are never candidates meanwhile, so their cached factors stay as the
+    // list was made with them; refreshAllFactors drops the list.
+    std::vector<int32_t> m_reach;
+    std::vector<Vec3> m_reachX;
+    std::vector<double> m_reachAllow;       ///< per vertex: how far it may move, per axis, while the list holds
+    std::vector<uint8_t> m_inReach;         ///< per triangle: on the list
+    size_t m_reachMadeSize = 0;             ///< the list's length when it was made
+    std::vector<uint32_t> m_vertexTriStart; ///< #V + 1: triangles of each vertex in m_vertexTris
+    std::vector<int32_t> m_vertexTris;
+    Aabb m_reachTool;
+    bool m_reachValid = false;
     std::vector<double> m_lambda; ///< #candidates × #parts (PolygonFeatures: faces, edges, vertices)
     std::vector<std::array<int32_t, 2>> m_candEdges; ///< PolygonFeatures: edges of the candidates
     std::vector<int32_t> m_featVerts;                ///< PolygonFeatures: vertices of the candidates
@@ -195,7 +240,7 @@ private:
     std::vector<Vec3> m_start;                       ///< positions at beginStep
     std::vector<Vec3> m_push;                        ///< per vertex, sum of the contact moves of this step
     std::vector<Vec3> m_x;                           ///< particle-view steps: the surface's positions
-    std::vector<int32_t> m_candVerts;                ///< particle-view steps: vertices of the candidates
+    std::vector<int32_t> m_candVerts;                ///< vertices of the candidates of the step, ascending
     std::vector<char> m_mark;                        ///< per vertex, scratch
     bool m_viewValid = false;                        ///< particle-view step begun with a large enough view
     mutable std::vector<int32_t> m_contactVerts;

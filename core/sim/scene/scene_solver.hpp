@@ -136,6 +136,9 @@ public:
     virtual const std::vector<Vec3>& surfaceVelocities(size_t s) const = 0; ///< #V of surface s, m/s
     virtual void setSurfaceState(size_t s, const std::vector<Vec3>& x, const std::vector<Vec3>& v) = 0;
 
+    /// Selective inertia scaling (solver.inertia_scaling): the extra inertia given to each body's
+    /// nodes at assembly, kg per body (empty: a back-end without it).
+    virtual std::vector<double> addedInertiaKg() const { return {}; }
     /// The scripted instruments (scene "interaction"), null when the scene has none.
     virtual const InteractionRuntime* interaction() const { return nullptr; }
     /// The same, to drive instruments between frames (a device).

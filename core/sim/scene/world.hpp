@@ -71,6 +71,9 @@ public:
     const TriMesh& surfaceMesh(size_t s) const { return m_surfaces[s]; }
     const std::string& surfaceName(size_t s) const { return m_scene.surfaces[s].name; }
     double totalEnergy() const { return m_solver->totalEnergy(); }
+    /// Extra inertia selective inertia scaling gave each body's nodes at assembly, kg per body
+    /// (empty when the back-end has none; SceneSolver::addedInertiaKg).
+    std::vector<double> addedInertiaKg() const { return m_solver->addedInertiaKg(); }
 
     // ---- haptic probes (feature "probe": only scenes with tools create them) --------------------
     size_t toolCount() const { return m_probes ? m_probes->size() : 0; }

@@ -46,6 +46,7 @@ public:
     /// Per tet body: the extra inertia selective inertia scaling gave its nodes at load, kg (0 when
     /// none; XpbdSettings::inertiaScaling).
     const std::vector<double>& addedInertia() const { return m_addedInertia; }
+    std::vector<double> addedInertiaKg() const override { return m_addedInertia; }
 
 private:
     XpbdSceneSolver();

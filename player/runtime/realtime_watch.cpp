@@ -1,0 +1,53 @@
+#include "runtime/realtime_watch.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+namespace viscera::player {
+namespace {
+
+std::string fixed(double v, int decimals) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+    return buf;
+}
+
+} // namespace
+
+double RealTimeWatch::meanStepMs(const std::vector<sim::FrameRecord>& frames, size_t begin, size_t end) {
+    end = std::min(end, frames.size());
+    if (begin >= end) return 0;
+    double sum = 0;
+    for (size_t f = begin; f < end; ++f)
+        sum += frames[f].stepMs;
+    return sum / double(end - begin);
+}
+
+std::optional<std::string> RealTimeWatch::afterFrame(const std::vector<sim::FrameRecord>& frames) {
+    if (frames.size() != kWarmupFrames + kEstimateFrames || !(m_dt > 0)) return std::nullopt;
+    const double ms = meanStepMs(frames, kWarmupFrames, frames.size());
+    if (!(ms > 0)) return std::nullopt;
+    m_estimate = m_dt * 1e3 / ms;
+    if (m_estimate >= 1) return std::nullopt;
+    return "real time: this machine runs the case at " + fixed(m_estimate, 2) + " of real time (physics " +
+           fixed(ms, 1) + " ms per frame against the case's " + fixed(m_dt * 1e3, 1) + " ms, frames " +
+           std::to_string(kWarmupFrames + 1) + "-" + std::to_string(frames.size()) +
+           "): the device is sampled later and later in simulated time, so the session will differ from the "
+           "authored one";
+}
+
+std::string RealTimeWatch::verdict(const std::vector<sim::FrameRecord>& frames, double lagMaxMs) const {
+    if (!(m_dt > 0) || frames.size() <= kWarmupFrames) return {};
+    const double ms = meanStepMs(frames, kWarmupFrames, frames.size());
+    const double frameMs = m_dt * 1e3;
+    const bool slow = ms > frameMs;
+    const bool late = lagMaxMs > kMaxLagFrames * frameMs;
+    if (!slow && !late) return {};
+    return "real time: the physics fell behind the wall clock (mean step " + fixed(ms, 1) + " ms against the " +
+           fixed(frameMs, 1) + " ms frame, a frame started up to " + fixed(lagMaxMs, 0) + " ms late; allowed " +
+           fixed(kMaxLagFrames * frameMs, 0) +
+           " ms): the device was sampled later than the time it simulates, so this session differs from the "
+           "authored one";
+}
+
+} // namespace viscera::player
