@@ -366,8 +366,9 @@ std::string summaryText(const SessionResult& r) {
     for (const SessionResult::BodyInertia& b : r.inertia)
         if (b.addedKg > 0) {
             char line[256];
-            std::snprintf(line, sizeof line, "inertia       '%s' +%.2f g on %.1f g (%.1f %%, selective inertia scaling)\n",
-                          b.name.c_str(), b.addedKg * 1e3, b.massKg * 1e3, b.massKg > 0 ? 100 * b.addedKg / b.massKg : 0.0);
+            std::snprintf(line, sizeof line,
+                          "inertia       '%s' +%.2f g on %.1f g (%.1f %%, selective inertia scaling)\n", b.name.c_str(),
+                          b.addedKg * 1e3, b.massKg * 1e3, b.massKg > 0 ? 100 * b.addedKg / b.massKg : 0.0);
             out += line;
         }
     for (const std::string& w : r.warnings)

@@ -276,8 +276,8 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         r.nodes += world.restMesh(b).vertexCount();
         r.tets += world.restMesh(b).tetCount();
         if (b < added.size())
-            r.inertia.push_back({world.bodyName(b), restVolume(world.restMesh(b)) * loaded.scene.bodies[b].material.density,
-                                 added[b]});
+            r.inertia.push_back(
+                {world.bodyName(b), restVolume(world.restMesh(b)) * loaded.scene.bodies[b].material.density, added[b]});
     }
     r.frames.reserve(static_cast<size_t>(std::max(options.frames, 0)));
     std::unique_ptr<HapticRig> rig;

@@ -15,6 +15,10 @@ namespace {
 constexpr size_t kMinChunkPacks = 4;
 constexpr size_t kChunksPerThread = 16;
 constexpr size_t kChunkParticles = 1024;
+/// A colour with fewer packs than this (a few µs of work) is swept by one thread together with
+/// the small colours next to it, in colour order: the same result as a phase per colour, minus
+/// the barriers between them (the greedy colouring leaves a tail of such colours in every stage).
+constexpr size_t kSerialColourPacks = 48;
 } // namespace
 
 void Block::arrange(const std::vector<int32_t>& colourOfUnit, int colours) {
@@ -159,13 +163,17 @@ void Engine::correctParticles(uint32_t chunk) {
 
 void Engine::appendCorrectionPhases(int threads) {
     for (int c = 0; c < m_colours; ++c) {
-        Phase ph{c, false, false, false,
-                 static_cast<uint32_t>(
-                     std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1, kChunksPerThread * threads))};
+        Phase ph{
+            c,
+            c,
+            false,
+            false,
+            false,
+            static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1, kChunksPerThread * threads))};
         ph.forces = true;
         m_phases.push_back(ph);
     }
-    m_phases.push_back({kCorrect, false, false, false,
+    m_phases.push_back({kCorrect, -1, false, false, false,
                         static_cast<uint32_t>((particleCount() + kChunkParticles - 1) / kChunkParticles)});
 }
 
@@ -173,24 +181,36 @@ void Engine::buildSchedule(Schedule kind, const XpbdSettings* s, int threads) {
     m_phases.clear();
     const auto particleChunks = static_cast<uint32_t>((particleCount() + kChunkParticles - 1) / kChunkParticles);
     auto colourPhases = [&](bool first, bool last) {
-        for (int c = 0; c < m_colours; ++c)
-            m_phases.push_back({c, first, last, false,
-                                static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1,
-                                                                         kChunksPerThread * threads))});
+        for (int c = 0; c < m_colours; ++c) {
+            Phase ph{
+                c,
+                c,
+                first,
+                last,
+                false,
+                static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1, kChunksPerThread * threads))};
+            if (m_colourPacks[c] < kSerialColourPacks) {
+                ph.chunks = 1;
+                while (ph.lastColour + 1 < m_colours && m_colourPacks[ph.lastColour + 1] < kSerialColourPacks)
+                    ++ph.lastColour;
+                c = ph.lastColour;
+            }
+            m_phases.push_back(ph);
+        }
     };
     if (kind == Schedule::Sweep) {
         colourPhases(false, false);
     } else if (kind == Schedule::Correction) {
         appendCorrectionPhases(threads);
     } else {
-        m_phases.push_back({kPredictOnly, false, false, true, particleChunks});
+        m_phases.push_back({kPredictOnly, -1, false, false, true, particleChunks});
         for (int sub = 0; sub < s->substeps; ++sub) {
             for (int it = 0; it < s->iterations; ++it) {
                 // The correction reads the multipliers, so they are kept after the last sweep too.
                 colourPhases(it == 0, it + 1 == s->iterations && !s->primalCorrection);
                 if (s->primalCorrection) appendCorrectionPhases(threads);
                 if (iterationHook) {
-                    Phase ph{kHook, false, false, false, 1};
+                    Phase ph{kHook, -1, false, false, false, 1};
                     ph.substep = sub;
                     ph.iteration = it;
                     m_phases.push_back(ph);
@@ -198,14 +218,14 @@ void Engine::buildSchedule(Schedule kind, const XpbdSettings* s, int threads) {
             }
             if (iterationHook) {
                 // End of substep split in two around the velocity pass of the hook.
-                m_phases.push_back({-1, false, false, false, particleChunks});
-                Phase ph{kHook, false, false, false, 1};
+                m_phases.push_back({-1, -1, false, false, false, particleChunks});
+                Phase ph{kHook, -1, false, false, false, 1};
                 ph.substep = sub;
                 ph.iteration = s->iterations;
                 m_phases.push_back(ph);
-                if (sub + 1 < s->substeps) m_phases.push_back({kPredictOnly, false, false, true, particleChunks});
+                if (sub + 1 < s->substeps) m_phases.push_back({kPredictOnly, -1, false, false, true, particleChunks});
             } else {
-                m_phases.push_back({-1, false, false, sub + 1 < s->substeps, particleChunks});
+                m_phases.push_back({-1, -1, false, false, sub + 1 < s->substeps, particleChunks});
             }
         }
     }
@@ -318,7 +338,8 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
             if (ph.forces)
                 forceColourChunk(ph.colour, chunk, ph.chunks);
             else
-                solveColourChunk(ph.colour, chunk, ph.chunks, SolveContext{x, h2inv, ph.first, ph.last});
+                for (int c = ph.colour; c <= ph.lastColour; ++c)
+                    solveColourChunk(c, chunk, ph.chunks, SolveContext{x, h2inv, ph.first, ph.last});
             return;
         }
         if (ph.colour == kCorrect) {
@@ -394,7 +415,8 @@ double Engine::sweep(bool first, double h2inv, int threads, WorkerPool* pool) {
     double* const x = xw.data();
     const auto t0 = std::chrono::steady_clock::now();
     execute(t, pool, [&](const Phase& ph, uint32_t chunk, int) {
-        solveColourChunk(ph.colour, chunk, ph.chunks, SolveContext{x, h2inv, first, false});
+        for (int c = ph.colour; c <= ph.lastColour; ++c)
+            solveColourChunk(c, chunk, ph.chunks, SolveContext{x, h2inv, first, false});
     });
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

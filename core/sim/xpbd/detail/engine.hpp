@@ -150,6 +150,9 @@ private:
     /// not depend on how the chunks are cut.
     struct Phase {
         int colour = 0;
+        /// Colour sweep: the last colour of the phase (> colour: a run of small colours that one
+        /// thread sweeps in order in one chunk, sparing the barriers between them).
+        int lastColour = -1;
         bool first = false;       ///< colour sweep: first iteration of the substep
         bool last = false;        ///< colour sweep: last iteration of the substep
         bool predictNext = false; ///< particle pass: also start the next substep
