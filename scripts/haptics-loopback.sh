@@ -5,8 +5,8 @@
 #
 #   scripts/haptics-loopback.sh [seconds=60] [build-dir=build] [out-dir=out/haptics-loopback] [servo=shared]
 #
-# servo: "shared" (the player's default: SCHED_FIFO on the physics' CPUs, spins the last 100 us; "shared:US"
-# another spin), "sleep" (sleep, then spin the last 0.94 ms; the last CPU), "sleep:CPU" (on that CPU), "spin:US" (the same with a
+# servo: "shared" (the player's default: SCHED_FIFO on the physics' CPUs, sleeps to each deadline; "shared:US"
+# spins the last US microseconds), "sleep" (sleep, then spin the last 0.94 ms; the last CPU), "sleep:CPU" (on that CPU), "spin:US" (the same with a
 # spin of US microseconds) or "busy[:CPU]" (spin the whole period on a CPU of its own; for a
 # console PC with a core set aside).
 set -euo pipefail

@@ -48,9 +48,10 @@ enum class ServoWait {
 };
 
 /// The spin of the player's default "shared" real-time mode: the servo thread (SCHED_FIFO) sleeps
-/// on the CPUs the physics runs on, wakes this early and spins to the deadline, so it takes about
-/// a tenth of one CPU instead of a whole one (measured choices in the README's session plan).
-inline constexpr int64_t kSharedSpinNs = 100'000;
+/// on the CPUs the physics runs on to its absolute deadline and does not spin: its wake-up on a
+/// busy CPU is late by tens of µs (jitter p99 23-49 µs in the rectum), and every µs of spin is
+/// taken from the physics (a 100 µs spin cost it about a tenth of one CPU).
+inline constexpr int64_t kSharedSpinNs = 0;
 
 struct ServoConfig {
     double rateHz = 1000.0;

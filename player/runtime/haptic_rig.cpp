@@ -228,12 +228,18 @@ void HapticRig::start() {
     m_t0 = m_clock->now_ns();
     publish();
     if (m_realtime) {
-        // The physics thread gets a real-time priority below the servo thread's, so other
-        // processes do not delay its publishes (ignored when the system refuses).
-        sched_param sp{};
-        sp.sched_priority = 40;
-        m_physicsRt = pthread_getschedparam(pthread_self(), &m_oldPolicy, &m_oldParam) == 0 &&
-                      pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0;
+        // With a CPU of its own for the servo, the physics thread gets a real-time priority below
+        // the servo thread's, so other processes do not delay its publishes (ignored when the
+        // system refuses). Sharing the CPUs, it stays SCHED_OTHER: a real-time physics thread
+        // that runs behind real time would use up the kernel's real-time budget on the servo's
+        // CPU (sched_rt_runtime_us), and the servo would be stopped with it for the rest of
+        // each second (5-25 ms servo stalls measured so).
+        if (m_servoConfig.cpu >= 0) {
+            sched_param sp{};
+            sp.sched_priority = 40;
+            m_physicsRt = pthread_getschedparam(pthread_self(), &m_oldPolicy, &m_oldParam) == 0 &&
+                          pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0;
+        }
         m_servo->start();
         // The caller has kept this thread off the servo's CPU before the world was built, so the
         // solver's workers are off it too (player main); recorded for the report.

@@ -266,12 +266,13 @@ TEST(PlayerHaptics, ConsoleLoopbackWithADisconnectMidSession) {
     EXPECT_LE(ho["max_age_over_step"].get<double>(), 1.0);
     EXPECT_EQ(ho["models_published"].get<int>(), 181);
     // The default servo wait shares the CPUs with the physics (--servo shared): not pinned, the
-    // physics keeps every CPU, the servo sleeps and spins the last 100 us.
+    // physics keeps every CPU, the servo sleeps to each deadline without spinning.
     const std::vector<int> allowed = haptics::allowedCpus();
     const auto& servo = h["servo"];
     EXPECT_EQ(servo["cpu"].get<int>(), -1);
     EXPECT_EQ(servo["physics_cpus"].get<std::vector<int>>(), allowed);
-    EXPECT_EQ(servo["spin_us"].get<int>(), 100);
+    EXPECT_EQ(servo["spin_us"].get<int>(), 0);
+    EXPECT_FALSE(servo["physics_realtime_priority"].get<bool>()) << "sharing: the physics stays SCHED_OTHER";
     EXPECT_TRUE(servo.contains("frame_lag_ms"));
     EXPECT_TRUE(servo.contains("frames_late"));
     EXPECT_TRUE(j["invariants"]["all_finite"].get<bool>());
