@@ -34,6 +34,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -346,9 +347,12 @@ int run(const std::filesystem::path& outDir) {
 namespace {
 
 /// --variants: the sample bodies (and the 30,000-tet block) at the substep counts of the
-/// load-time rule, old and new, and at 20 substeps: error of plain and primal-corrected XPBD
-/// against the Newton reference of the same substep, against the frame time (s × substep time).
-int runVariants(const std::filesystem::path& outDir, const std::vector<std::string>& vtets) {
+/// load-time rule, old and new, at 20 substeps and at the counts --substeps adds: error of plain
+/// and primal-corrected XPBD against the Newton reference of the same substep, against the frame
+/// time (s × substep time). The masses are the lumped ones (a case's selective inertia scaling
+/// changes the dynamics, not this per-step error of the solver).
+int runVariants(const std::filesystem::path& outDir, const std::vector<std::string>& vtets,
+                const std::vector<int>& extraSubsteps) {
     std::filesystem::create_directories(outDir);
     std::vector<SampleBody> bodies = sampleBoxBodies();
     for (const std::string& v : vtets)
@@ -377,6 +381,7 @@ int runVariants(const std::filesystem::path& outDir, const std::vector<std::stri
             motion->step();
         std::vector<PlotSeries> plot;
         std::vector<int> counts = {20, now, old};
+        counts.insert(counts.end(), extraSubsteps.begin(), extraSubsteps.end()); // e.g. the samples' shipped counts
         std::sort(counts.begin(), counts.end());
         counts.erase(std::unique(counts.begin(), counts.end()), counts.end());
         for (int sub : counts) {
@@ -437,16 +442,33 @@ int main(int argc, char** argv) {
     std::vector<std::string> args(argv + 1, argv + argc);
     if (!args.empty() && (args[0] == "-h" || args[0] == "--help")) {
         std::fprintf(stderr, "usage: bench_accuracy [output-dir]   (default ./accuracy_out)\n"
-                             "       bench_accuracy --variants output-dir [--vtet name:E:nu:density:path ...]\n");
+                             "       bench_accuracy --variants output-dir [--vtet name:E:nu:density:path ...]\n"
+                             "                      [--substeps N,M,...]   (extra substep counts for every body)\n");
         return 0;
     }
     try {
         if (!args.empty() && args[0] == "--variants") {
             if (args.size() < 2) throw std::runtime_error("--variants needs an output directory");
             std::vector<std::string> vtets;
-            for (size_t i = 2; i + 1 < args.size(); i += 2)
-                if (args[i] == "--vtet") vtets.push_back(args[i + 1]);
-            return runVariants(args[1], vtets);
+            std::vector<int> substeps;
+            for (size_t i = 2; i + 1 < args.size(); i += 2) {
+                if (args[i] == "--vtet") {
+                    vtets.push_back(args[i + 1]);
+                } else if (args[i] == "--substeps") {
+                    std::stringstream list(args[i + 1]);
+                    for (std::string n; std::getline(list, n, ',');) {
+                        char* end = nullptr;
+                        const long v = std::strtol(n.c_str(), &end, 10);
+                        if (n.empty() || *end != '\0' || v < 1 || v > 1000)
+                            throw std::runtime_error("--substeps '" + args[i + 1] +
+                                                     "': expected a comma-separated list of integers in [1, 1000]");
+                        substeps.push_back(static_cast<int>(v));
+                    }
+                } else {
+                    throw std::runtime_error("--variants: unknown option '" + args[i] + "'");
+                }
+            }
+            return runVariants(args[1], vtets, substeps);
         }
         if (args.size() > 1) {
             std::fprintf(stderr, "usage: bench_accuracy [output-dir]   (see --help)\n");

@@ -9,6 +9,9 @@
 # spins the last US microseconds), "sleep" (sleep, then spin the last 0.94 ms; the last CPU), "sleep:CPU" (on that CPU), "spin:US" (the same with a
 # spin of US microseconds) or "busy[:CPU]" (spin the whole period on a CPU of its own; for a
 # console PC with a core set aside).
+# Environment: LOOPBACK_CASE=path.vcase runs that case instead of the haptic sample slab (e.g. the
+# rectum, out/rectum.vcase); LOOPBACK_WINDOW=1 runs the trainee window under Xvfb (Mesa) instead of
+# headless, with a screenshot of its last frame in out-dir/window.png.
 set -euo pipefail
 secs="${1:-60}"
 build="${2:-${VISCERA_BUILD_DIR:-build}}"
@@ -29,7 +32,8 @@ sim_cpus=""
 if [ "$servo_cpu" -ge 0 ] && command -v taskset >/dev/null; then
   sim_cpus="$(echo "$cpus" | grep -vx "$servo_cpu" | paste -sd, -)"
 fi
-"$build/tests/player/make_haptic_case" "$out/haptic-slab.vcase" 2 >/dev/null
+case_file="${LOOPBACK_CASE:-$out/haptic-slab.vcase}"
+[ -n "${LOOPBACK_CASE:-}" ] || "$build/tests/player/make_haptic_case" "$out/haptic-slab.vcase" 2 >/dev/null
 rm -f "$out/port"
 ${sim_cpus:+taskset -c "$sim_cpus"} "$build/player/viscera-console-sim" --listen 127.0.0.1:0 --port-file "$out/port" --script bimanual --loop \
   --duration "$(( secs + 1 ))" --record "$out/console-forces.csv" --summary "$out/console-summary.json" \
@@ -38,8 +42,17 @@ sim=$!
 for _ in $(seq 100); do [ -s "$out/port" ] && break; sleep 0.05; done
 port="$(cat "$out/port")"
 frames=$(( secs * 60 ))
-"$build/player/viscera-player" run "$out/haptic-slab.vcase" --headless --frames "$frames" \
-  --device "console:127.0.0.1:$port" --servo "$servo" --report "$out/report.json" --trace "$out/trace.csv" 2>/dev/null
+player_rc=0 # the figures are printed either way; the script exits with the player's status
+if [ "${LOOPBACK_WINDOW:-0}" = 1 ]; then
+  env -u QT_QPA_PLATFORM LIBGL_ALWAYS_SOFTWARE=1 xvfb-run -a -s "-screen 0 1920x1200x24 -nolisten tcp" \
+    "$build/player/viscera-player" run "$case_file" --frames "$frames" --screenshot "$out/window.png" \
+    --device "console:127.0.0.1:$port" --servo "$servo" --report "$out/report.json" --trace "$out/trace.csv" \
+    2>/dev/null || player_rc=$?
+else
+  "$build/player/viscera-player" run "$case_file" --headless --frames "$frames" \
+    --device "console:127.0.0.1:$port" --servo "$servo" --report "$out/report.json" --trace "$out/trace.csv" \
+    2>/dev/null || player_rc=$?
+fi
 wait "$sim"
 cat "$out/console-sim.log" | grep -v '^viscera-console-sim:'
 python3 - "$out/report.json" <<'PY'
@@ -63,3 +76,4 @@ print(f"safety        {h['safety']}")
 print(f"link          {h['link']}")
 PY
 echo "files         $out/{report.json,trace.csv,console-forces.csv,console-summary.json}"
+exit "$player_rc"

@@ -262,7 +262,8 @@ public:
         if (s.safetyRules & haptics::kRuleDeadman) p.drawText(px, y, "Forces off: hold the deadman pedal"), y += 20;
         if (!s.realTimeWarning.empty()) { // estimated from the first frames: this machine cannot keep up
             p.setPen(QColor(230, 80, 60));
-            p.drawText(px, h - 56, "Not real time on this machine: the session differs from the authored one");
+            p.drawText(px, h - 76, "Not real time on this machine:");
+            p.drawText(px, h - 56, "the session differs from the case");
         }
         if (s.realTimeFactor > 0) {
             // Physics slower than real time: the tissue moves in slow motion; say so in red.
