@@ -7,10 +7,12 @@
 #include "render/case_settings.hpp"
 #include "render/headless.hpp"
 #include "render/scene_view.hpp"
+#include "runtime/realtime_watch.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/log.hpp"
 
 #include <QBuffer>
+#include <QElapsedTimer>
 #include <QGuiApplication>
 #include <QImage>
 #include <QKeyEvent>
@@ -264,6 +266,11 @@ public:
             p.setPen(QColor(230, 80, 60));
             p.drawText(px, h - 76, "Not real time on this machine:");
             p.drawText(px, h - 56, "the session differs from the case");
+        } else if (s.frame > 0 &&
+                   s.lagMs > RealTimeWatch::kMaxLagFrames * 1e3 * s.time_s / s.frame) { // fell behind later
+            p.setPen(QColor(230, 80, 60));
+            p.drawText(px, h - 76, QString::asprintf("Behind real time by %.1f s:", 1e-3 * s.lagMs));
+            p.drawText(px, h - 56, "the session differs from the case");
         }
         if (s.realTimeFactor > 0) {
             // Physics slower than real time: the tissue moves in slow motion; say so in red.
@@ -372,13 +379,21 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
     std::thread physics([&] { result = runSession(loaded, options); });
     bool failed = false;
     QTimer timer;
+    // The 3D view takes at most a quarter of the time: after a render of R ms the next waits at
+    // least 4 R (a software renderer without a GPU spends tens of ms per frame of the cores the
+    // physics needs; with a GPU, R ~ 1 ms, the view follows the timer's 30 Hz). The HUD repaints
+    // at every tick.
+    QElapsedTimer sinceRender;
     QObject::connect(&timer, &QTimer::timeout, [&] {
         bool finished;
         {
             std::lock_guard<std::mutex> lock(live.mutex);
             finished = live.finished;
         }
-        viewport.refresh();
+        if (finished || !sinceRender.isValid() || sinceRender.elapsed() >= 4 * viewport.lastFrameMs()) {
+            sinceRender.start();
+            viewport.refresh();
+        }
         window.requestUpdate();
         window.update();
         if (!finished) return;
