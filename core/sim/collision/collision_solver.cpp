@@ -157,14 +157,11 @@ Sphere CollisionSolver::triangleSphere(int32_t t, const std::vector<Vec3>& x) co
                                                m_settings.circumsphere.energyScale));
 }
 
-// Broad phase: one query (the tool's box) per step, so each triangle's box is tested directly,
-// in triangle order (a spatial hash rebuilt every substep for a single query cost more than the
-// test). Circumsphere: a triangle whose vertex box, grown by a bound on how far its sphere can
-// reach beyond it, misses the tool is no candidate, and its sphere is not computed. The bound:
-// the circumradius r is at most 4 × the longest edge ℓ (else the bounding sphere, radius ≤ ℓ, is
-// used), ℓ ≤ the box diagonal d, the circumcentre is within r of every vertex, and the sphere (or
-// its safe-cone part) lies within r + 2|offset| of the circumcentre, with
-// |offset| ≤ φ cot θ · r · |H3| + energyScale · |ε| (circumsphere.hpp) from the cached factors.
+// Broad phase: one query (the tool's box) per step, so each listed triangle's box is tested
+// directly, in triangle order (a spatial hash rebuilt every substep for a single query cost more
+// than the test). Circumsphere: a triangle whose vertex box, grown by circumsphereReach (a bound
+// on how far its sphere, or the sphere's safe-cone part, can reach beyond it), misses the tool is
+// no candidate, and its sphere is not computed.
 bool CollisionSolver::broadPhaseHit(int32_t t, const std::vector<Vec3>& x, const Aabb& toolBox) const {
     const bool polygon =
         m_settings.method == CollisionMethod::Polygon || m_settings.method == CollisionMethod::PolygonFeatures;
@@ -205,10 +202,12 @@ bool CollisionSolver::broadPhaseHit(int32_t t, const std::vector<Vec3>& x, const
 // area |e₁ × e₂| by at most δ(|e₁| + |e₂|) + δ². The radius the sphere methods use is at most
 // min(R, 4ℓ) (circumcircle.cpp: a circumradius R over 4 × the longest edge ℓ falls back to the
 // bounding sphere, radius ≤ ℓ), with R = abc / (2 |e₁ × e₂|) bounded from the grown edges and the
-// shrunk area while that stays positive, else 4(ℓ + δ). The reach of broadPhaseHit then follows
-// with that radius (see the safe cone below). The factors cannot change meanwhile: only candidates are refreshed, and a
-// triangle off the list is no candidate while the list holds (by induction over the steps).
-// Polygon: the margin; bounding sphere: centroid inside the box, radius ≤ ℓ.
+// shrunk area while that stays positive, else 4(ℓ + δ); the circumcentre is within that radius
+// of every vertex, and the sphere (or its safe-cone part) within r + 2|offset| (max(r, offset))
+// of the circumcentre, |offset| ≤ φ cot θ · r · |H3| + energyScale · |ε| from the cached factors.
+// The factors cannot change meanwhile: only candidates are refreshed, and a triangle off the list
+// is no candidate while the list holds (by induction over the steps). mayReach: polygon, the
+// margin; bounding sphere, the centroid inside the box and a radius ≤ ℓ.
 double CollisionSolver::circumsphereReach(int32_t t, const std::vector<Vec3>& x, double margin) const {
     const Tri& f = m_tris[t];
     const double delta = 2 * std::sqrt(3.0) * margin;
