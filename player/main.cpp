@@ -278,7 +278,7 @@ int cmdRun(const std::vector<std::string>& args) {
         // The servo gets a CPU of its own (the highest allowed, where two or more are): this thread
         // and every thread started from here on (physics, solver workers, window) stay off it, so
         // nothing of ours waits behind the servo's spin. Not in the default shared mode, where the
-        // servo preempts the physics at real-time priority for its short spin and tick.
+        // servo preempts the physics at real-time priority for its tick.
         if (servo.cpu < 0) servo.cpu = haptics::defaultServoCpu();
         if (servo.cpu >= 0) haptics::pinCurrentThreadExcept(servo.cpu);
     }

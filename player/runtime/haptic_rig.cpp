@@ -1,5 +1,7 @@
 #include "runtime/haptic_rig.hpp"
 
+#include "runtime/realtime_watch.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -263,6 +265,9 @@ void HapticRig::beforeStep() {
         m_lagSumMs += m_lagMs;
         m_lagMaxMs = std::max(m_lagMaxMs, m_lagMs);
         if (m_lagMs > m_dt * 1e3) ++m_framesLate;
+        if (m_frame == static_cast<int64_t>(RealTimeWatch::kWarmupFrames)) m_lagAtWarmupMs = m_lagMs;
+        if (m_frame >= static_cast<int64_t>(RealTimeWatch::kWarmupFrames))
+            m_lagGrowthMaxMs = std::max(m_lagGrowthMaxMs, m_lagMs - m_lagAtWarmupMs);
     }
     m_servo->notifyStepStart();
     const haptics::ToolPoseState poses = m_servo->toolPoses();
@@ -425,6 +430,7 @@ HapticsResult HapticRig::result() const {
     r.lagMeanMs = m_frame > 0 ? m_lagSumMs / double(m_frame) : 0.0;
     r.lagMaxMs = m_lagMaxMs;
     r.framesLate = m_framesLate;
+    r.lagGrowthMaxMs = m_lagGrowthMaxMs;
     r.traceSamples = m_samples;
     return r;
 }

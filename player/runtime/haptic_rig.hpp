@@ -67,6 +67,9 @@ struct HapticsResult {
     /// Lockstep: 0.
     double lagMeanMs = 0, lagMaxMs = 0;
     int64_t framesLate = 0;
+    /// Real time: the largest growth of that lag after the warm-up frames (RealTimeWatch), ms: how
+    /// far the session fell behind once running (a slow start shifts the whole session instead).
+    double lagGrowthMaxMs = 0;
 };
 
 /// One row of the force/pose trace (--trace CSV).
@@ -162,6 +165,7 @@ private:
     double m_dt = 0, m_caseMaxForce = 15;
     int64_t m_frame = 0, m_t0 = 0, m_tick = 0;
     double m_lagMs = 0, m_lagSumMs = 0, m_lagMaxMs = 0; ///< real time: frame start against the wall clock
+    double m_lagAtWarmupMs = 0, m_lagGrowthMaxMs = 0;   ///< the lag after the warm-up, and its growth since
     int64_t m_framesLate = 0;
     std::vector<TraceRow> m_trace;
     uint64_t m_samples = 0;

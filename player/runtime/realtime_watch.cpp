@@ -36,15 +36,16 @@ std::optional<std::string> RealTimeWatch::afterFrame(const std::vector<sim::Fram
            "authored one";
 }
 
-std::string RealTimeWatch::verdict(const std::vector<sim::FrameRecord>& frames, double lagMaxMs) const {
+std::string RealTimeWatch::verdict(const std::vector<sim::FrameRecord>& frames, double lagGrowthMs) const {
     if (!(m_dt > 0) || frames.size() <= kWarmupFrames) return {};
     const double ms = meanStepMs(frames, kWarmupFrames, frames.size());
     const double frameMs = m_dt * 1e3;
     const bool slow = ms > frameMs;
-    const bool late = lagMaxMs > kMaxLagFrames * frameMs;
+    const bool late = lagGrowthMs > kMaxLagFrames * frameMs;
     if (!slow && !late) return {};
     return "real time: the physics fell behind the wall clock (mean step " + fixed(ms, 1) + " ms against the " +
-           fixed(frameMs, 1) + " ms frame, a frame started up to " + fixed(lagMaxMs, 0) + " ms late; allowed " +
+           fixed(frameMs, 1) + " ms frame; after the first " + std::to_string(kWarmupFrames) +
+           " frames they fell up to " + fixed(lagGrowthMs, 0) + " ms further behind, allowed " +
            fixed(kMaxLagFrames * frameMs, 0) +
            " ms): the device was sampled later than the time it simulates, so this session differs from the "
            "authored one";

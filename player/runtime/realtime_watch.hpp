@@ -7,8 +7,9 @@
 /// first frames fill caches and start the workers), the mean physics step against the frame time
 /// step; below real time, a warning once (log, report, the trainee window in red).
 /// Verdict at the end: the session fell behind when the mean step over the frames past the
-/// warm-up exceeded the frame time step or a frame started more than kMaxLagFrames frame times
-/// late against the wall clock (HapticsResult::lagMaxMs); then an error (status FAILED, exit 3).
+/// warm-up exceeded the frame time step or the frames fell more than kMaxLagFrames frame times
+/// further behind the wall clock after the warm-up (HapticsResult::lagGrowthMaxMs: a slow start
+/// shifts the whole session and is not counted); then an error (status FAILED, exit 3).
 #include "sim/scene/world.hpp"
 
 #include <optional>
@@ -31,9 +32,9 @@ public:
     std::optional<std::string> afterFrame(const std::vector<sim::FrameRecord>& frames);
     /// Real-time factor estimated from the first frames (0 before the estimate).
     double estimate() const { return m_estimate; }
-    /// The error for a session that fell behind (empty when it kept real time). lagMaxMs: the
-    /// largest frame start lag against the wall clock, ms.
-    std::string verdict(const std::vector<sim::FrameRecord>& frames, double lagMaxMs) const;
+    /// The error for a session that fell behind (empty when it kept real time). lagGrowthMs: how
+    /// much later than at the end of the warm-up a frame started at most, ms.
+    std::string verdict(const std::vector<sim::FrameRecord>& frames, double lagGrowthMs) const;
 
 private:
     /// Mean step, ms, over frames [begin, end) (0 when empty).

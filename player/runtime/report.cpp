@@ -66,7 +66,8 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
         servo["physics_realtime_priority"] = h.physicsRealtimePriority;
         servo["physics_cpus"] = h.physicsCpus;
         // How far the session's device input differs from a lockstep run's (HapticsResult).
-        servo["frame_lag_ms"] = {{"mean", h.lagMeanMs}, {"max", h.lagMaxMs}};
+        servo["frame_lag_ms"] = {
+            {"mean", h.lagMeanMs}, {"max", h.lagMaxMs}, {"max_growth_after_warmup", h.lagGrowthMaxMs}};
         servo["frames_late"] = h.framesLate;
     }
     const auto& a = s.contactAge;

@@ -190,7 +190,7 @@ double restVolume(const sim::TetMesh& mesh) {
     for (const sim::Tet& t : mesh.tets())
         v += (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).dot(x[t[3]] - x[t[0]]) / 6.0;
     return v;
-} // frames the live real-time factor averages over
+}
 
 /// The trainee window's copy of the session after a frame (under the view's lock).
 void publishLive(const sim::World& world, const HapticRig* rig, const std::vector<sim::FrameRecord>& frames,
@@ -336,7 +336,7 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     if (rig) collectHaptics(*rig, r);
     r.realTimeEstimate = watch.estimate();
     if (paced)
-        if (std::string e = watch.verdict(r.frames, r.haptics->lagMaxMs); !e.empty()) r.errors.push_back(e);
+        if (std::string e = watch.verdict(r.frames, r.haptics->lagGrowthMaxMs); !e.empty()) r.errors.push_back(e);
     r.metrics.time_s = world.time();
     if (options.live) {
         std::lock_guard<std::mutex> lock(options.live->mutex);

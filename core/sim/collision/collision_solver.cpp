@@ -200,7 +200,7 @@ bool CollisionSolver::broadPhaseHit(int32_t t, const std::vector<Vec3>& x, const
 // Within the margin μ (each vertex moved at most μ along each axis, so at most √3 μ) the vertex
 // box grows by at most μ per side, every edge vector changes by at most δ = 2√3 μ, and twice the
 // area |e₁ × e₂| by at most δ(|e₁| + |e₂|) + δ². The radius the sphere methods use is at most
-// min(R, 4ℓ) (circumcircle.cpp: a circumradius R over 4 × the longest edge ℓ falls back to the
+// min(R, 4ℓ) (circumsphere.cpp, circumcircle(): a circumradius R over 4 × the longest edge ℓ falls back to the
 // bounding sphere, radius ≤ ℓ), with R = abc / (2 |e₁ × e₂|) bounded from the grown edges and the
 // shrunk area while that stays positive, else 4(ℓ + δ); the circumcentre is within that radius
 // of every vertex, and the sphere (or its safe-cone part) within r + 2|offset| (max(r, offset))
@@ -225,6 +225,8 @@ double CollisionSolver::circumsphereReach(int32_t t, const std::vector<Vec3>& x,
 
 bool CollisionSolver::mayReach(int32_t t, const std::vector<Vec3>& x0, double margin, const Aabb& grownTool) const {
     const Tri& f = m_tris[t];
+    // A non-finite vertex: listed, so the exact test of every step decides, as without the list.
+    if (!(x0[f[0]].allFinite() && x0[f[1]].allFinite() && x0[f[2]].allFinite())) return true;
     const Vec3 lo = x0[f[0]].cwiseMin(x0[f[1]]).cwiseMin(x0[f[2]]);
     const Vec3 hi = x0[f[0]].cwiseMax(x0[f[1]]).cwiseMax(x0[f[2]]);
     double reach = 0;
@@ -241,7 +243,7 @@ bool CollisionSolver::mayReach(int32_t t, const std::vector<Vec3>& x0, double ma
         break;
     }
     const Vec3 grow = Vec3::Constant(margin + reach);
-    return Aabb{lo - grow, hi + grow}.overlaps(grownTool); // false for non-finite vertices
+    return Aabb{lo - grow, hi + grow}.overlaps(grownTool);
 }
 
 // The list holds the triangles that may reach the tool while their vertices stay within the margin
@@ -292,7 +294,8 @@ const std::vector<int32_t>* CollisionSolver::reachList(const std::vector<Vec3>& 
 void CollisionSolver::growReachList(const std::vector<Vec3>& x) {
     const size_t before = m_reach.size();
     for (size_t v = 0; v < x.size(); ++v) {
-        if ((x[v] - m_reachX[v]).cwiseAbs().maxCoeff() <= m_reachAllow[v]) continue; // NaN: grows
+        // Every component within the allowance; a NaN on either side fails the test (grows).
+        if (((x[v] - m_reachX[v]).array().abs() <= m_reachAllow[v]).all()) continue;
         for (uint32_t k = m_vertexTriStart[v]; k < m_vertexTriStart[v + 1]; ++k) {
             const int32_t t = m_vertexTris[k];
             if (m_inReach[t]) continue;

@@ -109,11 +109,12 @@ struct CollisionSurfaceDesc {
 };
 
 struct CollisionStats {
-    int candidates = 0;         ///< broad-phase candidate triangles of the step
-    int contacts = 0;           ///< constraint projections in the last sweep
-    int factorUpdates = 0;      ///< triangles whose curvature/energy factors were refreshed (δ test)
-    double maxCorrection = 0;   ///< m, largest vertex move of the last sweep
-    int trianglesTested = 0;    ///< broad-phase tests of the step (making the reach list: one per triangle)
+    int candidates = 0;       ///< broad-phase candidate triangles of the step
+    int contacts = 0;         ///< constraint projections in the last sweep
+    int factorUpdates = 0;    ///< triangles whose curvature/energy factors were refreshed (δ test)
+    double maxCorrection = 0; ///< m, largest vertex move of the last sweep
+    int trianglesTested =
+        0; ///< broad-phase tests of the step (a step that makes the reach list: #triangles + its length)
     bool reachListMade = false; ///< the step made the reach list anew (tested every triangle)
     int reachListGrown = 0;     ///< triangles the step added to the list (their vertices moved on)
 };

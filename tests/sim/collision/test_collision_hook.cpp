@@ -337,3 +337,41 @@ TEST(CollisionHook, ReachListMarginIsValidated) {
     cs.reachListMargin = 0;
     EXPECT_TRUE(validate(cs).empty());
 }
+
+// A list made while a vertex was not finite (a step the solver then rolls back) still gives the
+// candidates of testing every triangle once the positions are finite again: the triangles of a
+// non-finite vertex go onto the list, and a NaN never passes the allowance test.
+TEST(CollisionHook, ReachListMadeOverANonFiniteVertexMissesNothing) {
+    const Slab s = slab(Vec3(0.06, 0.04, 0.012), {20, 12, 4});
+    CollisionSettings every, listed;
+    every.reachListMargin = 0;
+    for (CollisionMethod method : {CollisionMethod::Circumsphere, CollisionMethod::Polygon}) {
+        SCOPED_TRACE(toString(method));
+        every.method = listed.method = method;
+        auto a = CollisionSolver::create(CollisionSurfaceDesc::fromTetMesh(*s.mesh, s.invMass), every);
+        auto b = CollisionSolver::create(CollisionSurfaceDesc::fromTetMesh(*s.mesh, s.invMass), listed);
+        const std::vector<Vec3> x = s.mesh->positions();
+        // A top vertex 15 mm (along y) from where the tool waits, just above the top.
+        int32_t v = 0;
+        const Vec3 from(0.03, 0.01, 0.012);
+        for (int32_t k = 0; k < static_cast<int32_t>(x.size()); ++k)
+            if ((x[k] - from).norm() < (x[v] - from).norm()) v = k;
+        const Vec3 under = x[v] + Vec3(0, 0.015, 0);
+        ToolShape tool = ToolShape::sphere(0.003);
+        tool.setPose(translation(under + Vec3(0, 0, 0.0028)));
+        std::vector<Vec3> broken = x;
+        broken[v].y() = std::nan(""); // the list is made over it (a step the solver rolls back)
+        b->beginStep(broken, tool, 1e-3);
+        ASSERT_TRUE(b->stats().reachListMade);
+        // Then, finite again, the vertex slides along y (the NaN's axis only) under the tool.
+        for (double u : {0.0, 0.5, 1.0}) {
+            std::vector<Vec3> moved = x;
+            moved[v] = x[v] + u * (under - x[v]);
+            a->beginStep(moved, tool, 1e-3);
+            b->beginStep(moved, tool, 1e-3);
+            EXPECT_FALSE(b->stats().reachListMade) << "the tool did not move";
+            EXPECT_EQ(a->stats().candidates, b->stats().candidates) << u;
+            if (u == 1.0) EXPECT_GT(a->stats().candidates, 0);
+        }
+    }
+}
