@@ -403,7 +403,9 @@ std::string summaryText(const SessionResult& r) {
                           "pacing        frames started late against the wall clock: mean %.1f ms, max %.1f ms, %lld "
                           "over one frame; servo %s, %s\n",
                           h.lagMeanMs, h.lagMaxMs, (long long)h.framesLate,
-                          h.servo.wait == haptics::ServoWait::Busy ? "busy" : "sleep + spin",
+                          h.servo.wait == haptics::ServoWait::Busy
+                              ? "busy"
+                              : ("sleep, spin " + std::to_string(h.servo.spinNs / 1000) + " us").c_str(),
                           h.servo.cpu >= 0 ? ("on CPU " + std::to_string(h.servo.cpu) + ", the physics off it").c_str()
                                            : "sharing the physics' CPUs");
         } else

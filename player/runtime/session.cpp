@@ -183,12 +183,11 @@ namespace {
 
 constexpr size_t kRateWindow = 60; // frames the live real-time factor averages over
 
-/// m³, the sum of the tets' volumes.
+/// m³, the sum of the tets' volumes (TetMesh::signedVolume).
 double restVolume(const sim::TetMesh& mesh) {
     double v = 0;
-    const auto& x = mesh.positions();
-    for (const sim::Tet& t : mesh.tets())
-        v += (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).dot(x[t[3]] - x[t[0]]) / 6.0;
+    for (size_t t = 0; t < mesh.tetCount(); ++t)
+        v += mesh.signedVolume(static_cast<int32_t>(t));
     return v;
 }
 

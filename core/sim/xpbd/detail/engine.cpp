@@ -161,15 +161,13 @@ void Engine::correctParticles(uint32_t chunk) {
     }
 }
 
+uint32_t Engine::colourChunks(int c, int threads) const {
+    return static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1, kChunksPerThread * threads));
+}
+
 void Engine::appendCorrectionPhases(int threads) {
     for (int c = 0; c < m_colours; ++c) {
-        Phase ph{
-            c,
-            c,
-            false,
-            false,
-            false,
-            static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1, kChunksPerThread * threads))};
+        Phase ph{c, c, false, false, false, colourChunks(c, threads)};
         ph.forces = true;
         m_phases.push_back(ph);
     }
@@ -182,13 +180,7 @@ void Engine::buildSchedule(Schedule kind, const XpbdSettings* s, int threads) {
     const auto particleChunks = static_cast<uint32_t>((particleCount() + kChunkParticles - 1) / kChunkParticles);
     auto colourPhases = [&](bool first, bool last) {
         for (int c = 0; c < m_colours; ++c) {
-            Phase ph{
-                c,
-                c,
-                first,
-                last,
-                false,
-                static_cast<uint32_t>(std::clamp<size_t>(m_colourPacks[c] / kMinChunkPacks, 1, kChunksPerThread * threads))};
+            Phase ph{c, c, first, last, false, colourChunks(c, threads)};
             if (m_colourPacks[c] < kSerialColourPacks) {
                 ph.chunks = 1;
                 while (ph.lastColour + 1 < m_colours && m_colourPacks[ph.lastColour + 1] < kSerialColourPacks)

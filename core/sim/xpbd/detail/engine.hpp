@@ -169,6 +169,8 @@ private:
     /// s: needed for Schedule::Frame only.
     void buildSchedule(Schedule kind, const XpbdSettings* s, int threads);
     void appendCorrectionPhases(int threads);
+    /// Chunks of a phase of colour c: a few per thread, each at least kMinChunkPacks packs.
+    uint32_t colourChunks(int c, int threads) const;
     void forceColourChunk(int c, uint32_t chunk, uint32_t chunks);
     void correctParticles(uint32_t chunk);
     template <class Fn> void forColourChunk(int c, uint32_t chunk, uint32_t chunks, const Fn& fn);
