@@ -40,7 +40,7 @@ struct LocalContactModel {
 
 /// What the servo loop hands the physics thread: where each tool (proxy) is.
 struct ToolPoseState {
-    int64_t timestamp_ns = 0;
+    int64_t timestamp_ns = 0; ///< servo clock: the deadline of the tick that wrote them
     uint64_t tick = 0;
     bool connected = false;
     uint32_t pedals = 0;

@@ -106,7 +106,7 @@ Distribution ServoLoop::Histogram::summary() const {
 
 ServoLoop::ServoLoop(Device& device, const Clock& clock, const ServoConfig& config)
     : m_device(device), m_clock(clock), m_config(config), m_safety(device.capabilities(), config.safety),
-      m_trace(config.traceCapacity) {
+      m_history(std::make_unique<SeqLock<ToolPoseState>[]>(kPoseHistory)), m_trace(config.traceCapacity) {
     if (m_config.wait == ServoWait::Busy && m_config.cpu < 0) {
         const std::vector<int> cpus = allowedCpus();
         m_config.cpu = cpus.empty() ? -1 : cpus.back();
@@ -117,9 +117,9 @@ ServoLoop::~ServoLoop() {
     stop();
 }
 
-void ServoLoop::tick(int64_t now) {
+void ServoLoop::tick(int64_t now, int64_t due) {
     const int64_t t0 = monotonicNs();
-    m_device.poll(now, m_state);
+    m_device.poll(due, m_state);
     const int64_t started = m_stepsStarted.load(std::memory_order_acquire);
     const LocalContactModel contact = m_contact.read();
     double age_s = -1;
@@ -140,7 +140,7 @@ void ServoLoop::tick(int64_t now) {
     m_desired.sequence = ++m_seq;
     m_desired.flags = clutch ? uint32_t(kFlagClutch) : 0u;
     ToolPoseState poses;
-    poses.timestamp_ns = now;
+    poses.timestamp_ns = due;
     poses.tick = m_seq;
     poses.connected = m_state.connected;
     poses.pedals = m_state.pedals;
@@ -198,6 +198,7 @@ void ServoLoop::tick(int64_t now) {
     for (int a = 0; a < arms; ++a)
         poses.force[a] = m_out.arms[a].servo_cf.force.norm();
     m_poses.write(poses);
+    m_history[poses.tick % kPoseHistory].write(poses);
     for (int a = 0; a < arms; ++a) {
         if (!m_config.tools[a].enabled) continue;
         TraceSample s;
@@ -217,6 +218,37 @@ void ServoLoop::tick(int64_t now) {
     }
     m_ticks.fetch_add(1, std::memory_order_relaxed);
     m_cost.add(monotonicNs() - t0);
+}
+
+bool ServoLoop::poseAt(uint64_t tick, ToolPoseState& out) const {
+    if (tick == 0) return false;
+    const ToolPoseState p = m_history[tick % kPoseHistory].read();
+    if (p.tick != tick) return false;
+    out = p;
+    return true;
+}
+
+PoseLookup ServoLoop::poseBefore(int64_t t_ns, ToolPoseState& out) const {
+    const ToolPoseState latest = m_poses.read();
+    if (latest.tick == 0 || latest.timestamp_ns < t_ns) return PoseLookup::NotYet;
+    // Binary search over tick numbers (timestamps grow with them): hi's tick is at or after t_ns,
+    // lo's before it. The oldest slots are left alone: the servo may be overwriting them.
+    constexpr uint64_t kMargin = 64;
+    uint64_t hi = latest.tick;
+    uint64_t lo = hi > kPoseHistory - kMargin ? hi - (kPoseHistory - kMargin) : 1;
+    ToolPoseState p;
+    if (!poseAt(lo, p)) return PoseLookup::Dropped;
+    if (p.timestamp_ns >= t_ns) { // before the first tick the first one's poses stand
+        if (lo != 1) return PoseLookup::Dropped;
+        out = p;
+        return PoseLookup::Found;
+    }
+    while (hi - lo > 1) {
+        const uint64_t mid = lo + (hi - lo) / 2;
+        if (!poseAt(mid, p)) return PoseLookup::Dropped;
+        (p.timestamp_ns < t_ns ? lo : hi) = mid;
+    }
+    return poseAt(lo, out) ? PoseLookup::Found : PoseLookup::Dropped;
 }
 
 void ServoLoop::start() {
@@ -251,6 +283,7 @@ void ServoLoop::run() {
         }
     }
     const int64_t period = static_cast<int64_t>(std::llround(1e9 / m_config.rateHz));
+    const int64_t clockOffset = m_clock.now_ns() - monotonicNs(); // deadlines on the servo clock
     int64_t next = monotonicNs() + period;
     int64_t prev = -1;
     while (m_running.load(std::memory_order_acquire)) {
@@ -273,7 +306,7 @@ void ServoLoop::run() {
             m_jitter.add(std::llabs(now - prev - period));
         }
         prev = now;
-        tick(m_clock.now_ns());
+        tick(m_clock.now_ns(), next + clockOffset);
         next += period;
         const int64_t after = monotonicNs();
         if (after > next) { // overran a whole period: skip to the next deadline in the future

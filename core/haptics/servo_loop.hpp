@@ -80,6 +80,13 @@ struct TraceSample {
     int64_t contactFrame = -1;  ///< physics frame of that model (-1: none yet)
 };
 
+/// ServoLoop::poseBefore's answer.
+enum class PoseLookup {
+    Found,   ///< the last tick before the time; a later tick has run, so it is final
+    NotYet,  ///< no tick at or after the time has run yet
+    Dropped, ///< every kept tick is at or after the time: the reader is too far behind
+};
+
 /// Percentiles from a 1 µs histogram.
 struct Distribution {
     uint64_t count = 0;
@@ -118,6 +125,9 @@ bool pinCurrentThreadExcept(int cpu);
 
 class ServoLoop {
 public:
+    /// Ticks whose tool poses poseAt() keeps: 8.192 s at 1 kHz (2 MB).
+    static constexpr size_t kPoseHistory = 8192;
+
     /// `device` and `clock` must outlive the loop. Allocates the trace ring and histograms.
     ServoLoop(Device& device, const Clock& clock, const ServoConfig& config);
     ~ServoLoop();
@@ -130,10 +140,19 @@ public:
     /// (ServoStats::maxStepsBehind: 1 while the step after the model's is running).
     void notifyStepStart() { m_stepsStarted.fetch_add(1, std::memory_order_release); }
     ToolPoseState toolPoses() const { return m_poses.read(); }
+    /// The tool poses of the last tick that ran before t_ns (ToolPoseState::timestamp_ns, the
+    /// servo clock), from the last kPoseHistory ticks. The physics reads a frame's input at the
+    /// frame's own instant with it, however late the frame starts (HapticRig), so a real-time
+    /// session sees the input a lockstep session does.
+    PoseLookup poseBefore(int64_t t_ns, ToolPoseState& out) const;
 
     // ---- servo ----------------------------------------------------------------------------------
     /// One tick at time now_ns (the servo thread calls it; lockstep callers too).
-    void tick(int64_t now_ns);
+    void tick(int64_t now_ns) { tick(now_ns, now_ns); }
+    /// One tick at now_ns for its deadline due_ns (<= now_ns): the device is polled and the tool
+    /// poses stamped at the deadline, so that the input of tick n is the input lockstep gives it
+    /// whatever the wake-up latency; the contact model's age and the safety filter use now_ns.
+    void tick(int64_t now_ns, int64_t due_ns);
     /// Runs ticks on a thread at config.rateHz until stop().
     void start();
     void stop();
@@ -157,6 +176,8 @@ private:
         Distribution summary() const;
     };
     void run();
+    /// The poses of tick `tick` (from 1) when it is still kept.
+    bool poseAt(uint64_t tick, ToolPoseState& out) const;
 
     Device& m_device;
     const Clock& m_clock;
@@ -164,6 +185,7 @@ private:
     SafetyFilter m_safety;
     SeqLock<LocalContactModel> m_contact;
     SeqLock<ToolPoseState> m_poses;
+    std::unique_ptr<SeqLock<ToolPoseState>[]> m_history; ///< kPoseHistory slots, tick % kPoseHistory
     SpscRing<TraceSample> m_trace;
     Histogram m_period{20001}, m_jitter{20001}, m_wake{20001}, m_cost{20001}, m_age{200001};
     std::atomic<uint64_t> m_ticks{0}, m_overruns{0};

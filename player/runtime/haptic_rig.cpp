@@ -243,6 +243,16 @@ void HapticRig::start() {
                           pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0;
         }
         m_servo->start();
+        // The session's time zero is the servo's first tick, as in lockstep (where the first tick
+        // runs at 0 and a replay starts at its first poll): frame k is due when the ticks before
+        // (k+1)·dt from it have run.
+        const int64_t waitUntil = m_clock->now_ns() + 100'000'000;
+        haptics::ToolPoseState first = m_servo->toolPoses();
+        while (first.tick == 0 && m_clock->now_ns() < waitUntil) {
+            haptics::sleepUntilNs(m_clock->now_ns() + 100'000);
+            first = m_servo->toolPoses();
+        }
+        if (first.tick != 0) m_t0 = first.timestamp_ns;
         // The caller has kept this thread off the servo's CPU before the world was built, so the
         // solver's workers are off it too (player main); recorded for the report.
         m_physicsCpus = haptics::allowedCpus();
@@ -250,8 +260,10 @@ void HapticRig::start() {
 }
 
 void HapticRig::beforeStep() {
+    // Frame k simulates [k dt, (k+1) dt) and takes the tool poses of the last servo tick before
+    // (k+1) dt, in lockstep and in real time alike.
+    const int64_t end = int64_t(std::llround(double(m_frame + 1) * m_dt * 1e9));
     if (m_manual) {
-        const int64_t end = int64_t(std::llround(double(m_frame + 1) * m_dt * 1e9));
         while (m_tick * 1'000'000 < end) {
             m_manual->set(m_tick * 1'000'000);
             m_servo->tick(m_manual->now_ns());
@@ -259,18 +271,9 @@ void HapticRig::beforeStep() {
         }
         m_manual->set(end);
     }
-    if (m_realtime) { // how late this frame starts against the wall-clock time it simulates
-        const int64_t due = m_t0 + int64_t(std::llround(double(m_frame) * m_dt * 1e9));
-        m_lagMs = std::max(0.0, 1e-6 * double(m_clock->now_ns() - due));
-        m_lagSumMs += m_lagMs;
-        m_lagMaxMs = std::max(m_lagMaxMs, m_lagMs);
-        if (m_lagMs > m_dt * 1e3) ++m_framesLate;
-        if (m_frame == static_cast<int64_t>(RealTimeWatch::kWarmupFrames)) m_lagAtWarmupMs = m_lagMs;
-        if (m_frame >= static_cast<int64_t>(RealTimeWatch::kWarmupFrames))
-            m_lagGrowthMaxMs = std::max(m_lagGrowthMaxMs, m_lagMs - m_lagAtWarmupMs);
-    }
+    if (m_realtime) measureLag(m_t0 + end);
     m_servo->notifyStepStart();
-    const haptics::ToolPoseState poses = m_servo->toolPoses();
+    const haptics::ToolPoseState poses = m_realtime ? framePoses(m_t0 + end) : m_servo->toolPoses();
     sim::InteractionRuntime* interaction = m_world.interaction();
     std::array<int, kMaxArms> active{-1, -1};
     if (poses.tick != 0)
@@ -339,6 +342,34 @@ void HapticRig::beforeStep() {
     }
 }
 
+void HapticRig::measureLag(int64_t due) {
+    m_lagMs = std::max(0.0, 1e-6 * double(m_clock->now_ns() - due));
+    m_lagSumMs += m_lagMs;
+    m_lagMaxMs = std::max(m_lagMaxMs, m_lagMs);
+    if (m_lagMs > m_dt * 1e3) ++m_framesLate;
+    if (m_frame == static_cast<int64_t>(RealTimeWatch::kWarmupFrames)) m_lagAtWarmupMs = m_lagMs;
+    if (m_frame >= static_cast<int64_t>(RealTimeWatch::kWarmupFrames))
+        m_lagGrowthMaxMs = std::max(m_lagGrowthMaxMs, m_lagMs - m_lagAtWarmupMs);
+}
+
+haptics::ToolPoseState HapticRig::framePoses(int64_t due) {
+    if (m_clock->now_ns() < due) haptics::sleepUntilNs(due);
+    // Wait for the tick after `due` (at most a period away); a servo stalled for longer than
+    // kMaxInputWaitNs, or input no longer kept (the physics over 8 s behind), gives the latest.
+    constexpr int64_t kPollNs = 100'000, kMaxInputWaitNs = 50'000'000;
+    const int64_t giveUp = m_clock->now_ns() + kMaxInputWaitNs;
+    haptics::ToolPoseState p;
+    while (true) {
+        const haptics::PoseLookup found = m_servo->poseBefore(due, p);
+        if (found == haptics::PoseLookup::Found) return p;
+        if (found == haptics::PoseLookup::Dropped || m_clock->now_ns() > giveUp) {
+            ++m_inputMissed;
+            return m_servo->toolPoses();
+        }
+        haptics::sleepUntilNs(m_clock->now_ns() + kPollNs);
+    }
+}
+
 void HapticRig::afterStep() {
     ++m_frame;
     publish();
@@ -364,10 +395,6 @@ void HapticRig::afterStep() {
         m_aboveDamage[t] = f > thr;
     }
     drain();
-    if (m_realtime) {
-        const int64_t deadline = m_t0 + int64_t(std::llround(double(m_frame) * m_dt * 1e9));
-        if (deadline > m_clock->now_ns()) haptics::sleepUntilNs(deadline);
-    }
 }
 
 void HapticRig::drain() {
@@ -430,6 +457,7 @@ HapticsResult HapticRig::result() const {
     r.lagMeanMs = m_frame > 0 ? m_lagSumMs / double(m_frame) : 0.0;
     r.lagMaxMs = m_lagMaxMs;
     r.framesLate = m_framesLate;
+    r.inputMissed = m_inputMissed;
     r.lagGrowthMaxMs = m_lagGrowthMaxMs;
     r.traceSamples = m_samples;
     return r;

@@ -60,13 +60,17 @@ struct HapticsResult {
     bool physicsRealtimePriority = false;
     std::vector<int> physicsCpus; ///< real time: the CPUs the physics thread may run on
     uint64_t traceSamples = 0;
-    /// Real time: how late each physics frame started against the wall-clock time it simulates
-    /// (frame k simulates the device from k·dt after the start on), ms; frames late by more than
-    /// one frame time. A device replayed in real time is sampled that much later than in
-    /// lockstep, so these say how far the session's input differs from the lockstep run's.
+    /// Real time: how late each physics frame started against the wall-clock time its input was
+    /// complete (frame k takes the device at the last servo tick before (k+1)·dt after the first
+    /// tick, as in lockstep, from the servo's pose history), ms; frames late by more than one frame time. A late frame
+    /// still gets its own instant's input; the lag is how far the picture trails the hands.
     /// Lockstep: 0.
     double lagMeanMs = 0, lagMaxMs = 0;
     int64_t framesLate = 0;
+    /// Real time: frames whose servo tick was no longer kept (the physics over
+    /// ServoLoop::kPoseHistory ticks behind) or did not come (a servo stalled over 50 ms); they
+    /// took the latest tick's poses instead, so the input differs from the lockstep run's.
+    int64_t inputMissed = 0;
     /// Real time: the largest growth of that lag after the warm-up frames (RealTimeWatch), ms: how
     /// far the session fell behind once running (a slow start shifts the whole session instead).
     double lagGrowthMaxMs = 0;
@@ -130,6 +134,11 @@ public:
 
 private:
     void drain();
+    /// Real time: how late the frame that is due at `due` (wall clock) starts (m_lag*).
+    void measureLag(int64_t due);
+    /// Real time: waits until the frame's input is in (`due`: the frame's end on the servo clock)
+    /// and returns the poses of the last servo tick before it (the lockstep run's input).
+    haptics::ToolPoseState framePoses(int64_t due);
     haptics::LocalContactModel contactModel(int64_t now) const;
     /// Publishes the contact model of m_frame and logs it for the hand-over audit.
     void publish();
@@ -167,6 +176,7 @@ private:
     double m_lagMs = 0, m_lagSumMs = 0, m_lagMaxMs = 0; ///< real time: frame start against the wall clock
     double m_lagAtWarmupMs = 0, m_lagGrowthMaxMs = 0;   ///< the lag after the warm-up, and its growth since
     int64_t m_framesLate = 0;
+    int64_t m_inputMissed = 0;
     std::vector<TraceRow> m_trace;
     uint64_t m_samples = 0;
     TaskMetrics m_metrics;

@@ -32,23 +32,24 @@ std::optional<std::string> RealTimeWatch::afterFrame(const std::vector<sim::Fram
     return "real time: this machine runs the case at " + fixed(m_estimate, 2) + " of real time (physics " +
            fixed(ms, 1) + " ms per frame against the case's " + fixed(m_dt * 1e3, 1) + " ms, frames " +
            std::to_string(kWarmupFrames + 1) + "-" + std::to_string(frames.size()) +
-           "): the device is sampled later and later in simulated time, so the session will differ from the "
-           "authored one";
+           "): the picture will trail the hands further and further and the forces go stale, so the session "
+           "will not be the authored one";
 }
 
-std::string RealTimeWatch::verdict(const std::vector<sim::FrameRecord>& frames, double lagGrowthMs) const {
+std::string RealTimeWatch::verdict(const std::vector<sim::FrameRecord>& frames, double lagGrowthMs,
+                                   int64_t inputMissed) const {
     if (!(m_dt > 0) || frames.size() <= kWarmupFrames) return {};
     const double ms = meanStepMs(frames, kWarmupFrames, frames.size());
     const double frameMs = m_dt * 1e3;
     const bool slow = ms > frameMs;
-    const bool late = lagGrowthMs > kMaxLagFrames * frameMs;
-    if (!slow && !late) return {};
-    return "real time: the physics fell behind the wall clock (mean step " + fixed(ms, 1) + " ms against the " +
-           fixed(frameMs, 1) + " ms frame; after the first " + std::to_string(kWarmupFrames) +
-           " frames they fell up to " + fixed(lagGrowthMs, 0) + " ms further behind, allowed " +
-           fixed(kMaxLagFrames * frameMs, 0) +
-           " ms): the device was sampled later than the time it simulates, so this session differs from the "
-           "authored one";
+    const bool late = lagGrowthMs > kMaxLagMs;
+    if (!slow && !late && inputMissed == 0) return {};
+    std::string e = "real time: the physics fell behind the wall clock (mean step " + fixed(ms, 1) +
+                    " ms against the " + fixed(frameMs, 1) + " ms frame; after the first " +
+                    std::to_string(kWarmupFrames) + " frames they fell up to " + fixed(lagGrowthMs, 0) +
+                    " ms further behind, allowed " + fixed(kMaxLagMs, 0) + " ms";
+    if (inputMissed > 0) e += "; " + std::to_string(inputMissed) + " frames lost their own input";
+    return e + "): the picture trailed the hands and the forces went stale, so this session was not the authored one";
 }
 
 } // namespace viscera::player

@@ -1,15 +1,19 @@
 #pragma once
 /// Whether a real-time session keeps real time, said at load and at the end instead of silently
-/// diverging from the authored session (a device replayed on the wall clock is sampled later and
-/// later in simulated time when the physics falls behind).
+/// diverging from the authored session: a frame that starts late still takes its own instant's
+/// input (HapticRig), but the picture trails the hands by the lag, the servo renders forces from
+/// an ever older contact model (zeroed once stale), and past ServoLoop::kPoseHistory ticks the
+/// input itself is lost.
 ///
 /// Estimate: after kEstimateFrames frames past the first kWarmupFrames (shader-free, but the
 /// first frames fill caches and start the workers), the mean physics step against the frame time
 /// step; below real time, a warning once (log, report, the trainee window in red).
 /// Verdict at the end: the session fell behind when the mean step over the frames past the
-/// warm-up exceeded the frame time step or the frames fell more than kMaxLagFrames frame times
-/// further behind the wall clock after the warm-up (HapticsResult::lagGrowthMaxMs: a slow start
-/// shifts the whole session and is not counted); then an error (status FAILED, exit 3).
+/// warm-up exceeded the frame time step, the frames fell more than kMaxLagMs further behind the
+/// wall clock after the warm-up (HapticsResult::lagGrowthMaxMs: a slow start shifts the whole
+/// session and is not counted), or frames lost their own input (HapticsResult::inputMissed);
+/// then an error (status FAILED, exit 3). A shorter delay that the physics makes up changes no
+/// outcome (every frame takes its own instant's input), only how late the picture is then.
 #include "sim/scene/world.hpp"
 
 #include <optional>
@@ -22,7 +26,9 @@ class RealTimeWatch {
 public:
     static constexpr size_t kWarmupFrames = 5;
     static constexpr size_t kEstimateFrames = 30;
-    static constexpr double kMaxLagFrames = 4.0;
+    /// The largest delay of the picture behind the hands a session may build up and still count
+    /// as real time: 200 ms, where delays begin to cost teleoperated task performance.
+    static constexpr double kMaxLagMs = 200.0;
 
     /// frameDt: the case's frame time step, s (> 0).
     explicit RealTimeWatch(double frameDt) : m_dt(frameDt) {}
@@ -33,8 +39,9 @@ public:
     /// Real-time factor estimated from the first frames (0 before the estimate).
     double estimate() const { return m_estimate; }
     /// The error for a session that fell behind (empty when it kept real time). lagGrowthMs: how
-    /// much later than at the end of the warm-up a frame started at most, ms.
-    std::string verdict(const std::vector<sim::FrameRecord>& frames, double lagGrowthMs) const;
+    /// much later than at the end of the warm-up a frame started at most, ms; inputMissed: frames
+    /// that took the latest input instead of their own instant's.
+    std::string verdict(const std::vector<sim::FrameRecord>& frames, double lagGrowthMs, int64_t inputMissed = 0) const;
 
 private:
     /// Mean step, ms, over frames [begin, end) (0 when empty).

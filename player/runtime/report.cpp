@@ -65,10 +65,12 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
         servo["wake_latency_us"] = distribution(s.wakeLatency);
         servo["physics_realtime_priority"] = h.physicsRealtimePriority;
         servo["physics_cpus"] = h.physicsCpus;
-        // How far the session's device input differs from a lockstep run's (HapticsResult).
+        // How far the frames trailed the wall clock, and how many lacked their own instant's input
+        // (HapticsResult): with none missed, the device input is the lockstep run's.
         servo["frame_lag_ms"] = {
             {"mean", h.lagMeanMs}, {"max", h.lagMaxMs}, {"max_growth_after_warmup", h.lagGrowthMaxMs}};
         servo["frames_late"] = h.framesLate;
+        servo["frames_input_missed"] = h.inputMissed;
     }
     const auto& a = s.contactAge;
     json contact = {
@@ -401,8 +403,8 @@ std::string summaryText(const SessionResult& r) {
             out += line;
             std::snprintf(line, sizeof line,
                           "pacing        frames started late against the wall clock: mean %.1f ms, max %.1f ms, %lld "
-                          "over one frame; servo %s, %s\n",
-                          h.lagMeanMs, h.lagMaxMs, (long long)h.framesLate,
+                          "over one frame, %lld without their own input; servo %s, %s\n",
+                          h.lagMeanMs, h.lagMaxMs, (long long)h.framesLate, (long long)h.inputMissed,
                           h.servo.wait == haptics::ServoWait::Busy
                               ? "busy"
                               : ("sleep, spin " + std::to_string(h.servo.spinNs / 1000) + " us").c_str(),

@@ -335,7 +335,8 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     if (rig) collectHaptics(*rig, r);
     r.realTimeEstimate = watch.estimate();
     if (paced)
-        if (std::string e = watch.verdict(r.frames, r.haptics->lagGrowthMaxMs); !e.empty()) r.errors.push_back(e);
+        if (std::string e = watch.verdict(r.frames, r.haptics->lagGrowthMaxMs, r.haptics->inputMissed); !e.empty())
+            r.errors.push_back(e);
     r.metrics.time_s = world.time();
     if (options.live) {
         std::lock_guard<std::mutex> lock(options.live->mutex);

@@ -265,12 +265,11 @@ public:
         if (!s.realTimeWarning.empty()) { // estimated from the first frames: this machine cannot keep up
             p.setPen(QColor(230, 80, 60));
             p.drawText(px, h - 76, "Not real time on this machine:");
-            p.drawText(px, h - 56, "the session differs from the case");
-        } else if (s.frame > 0 &&
-                   s.lagMs > RealTimeWatch::kMaxLagFrames * 1e3 * s.time_s / s.frame) { // fell behind later
+            p.drawText(px, h - 56, "the picture trails your hands");
+        } else if (s.frame > 0 && s.lagMs > RealTimeWatch::kMaxLagMs) { // fell behind later
             p.setPen(QColor(230, 80, 60));
             p.drawText(px, h - 76, QString::asprintf("Behind real time by %.1f s:", 1e-3 * s.lagMs));
-            p.drawText(px, h - 56, "the session differs from the case");
+            p.drawText(px, h - 56, "the picture trails your hands");
         }
         if (s.realTimeFactor > 0) {
             // Physics slower than real time: the tissue moves in slow motion; say so in red.

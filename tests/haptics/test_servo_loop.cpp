@@ -236,3 +236,36 @@ TEST(ServoLoop, RunsOnItsOwnThreadAgainstTheWallClock) {
     EXPECT_GT(st.contactModelsSeen, 1);
     EXPECT_GT(dev.linkStats().sent, 10u);
 }
+
+TEST(ServoLoop, PoseHistoryGivesTheLastTickBeforeAnInstant) {
+    Rig r;
+    // Woken late by 0.3 ms each tick: the poses are stamped at the deadline, the device polled there.
+    for (int n = 0; n < 10'000; ++n) {
+        r.dev.state.arms[0].measured_cp.position = Vec3(0, 0, 1e-6 * n);
+        r.servo->tick(n * kMs + 300'000, n * kMs);
+    }
+    ToolPoseState p;
+    EXPECT_EQ(r.servo->poseBefore(9'999 * kMs + 1, p), PoseLookup::NotYet) << "no tick after the instant yet";
+    ASSERT_EQ(r.servo->poseBefore(9'999 * kMs, p), PoseLookup::Found);
+    EXPECT_EQ(p.tick, 9'999u);
+    EXPECT_EQ(p.timestamp_ns, 9'998 * kMs);
+    ASSERT_EQ(r.servo->poseBefore(5'000 * kMs + 1, p), PoseLookup::Found);
+    EXPECT_EQ(p.timestamp_ns, 5'000 * kMs);
+    EXPECT_DOUBLE_EQ(p.target[0].z(), 1e-6 * 5'000) << "the input of that tick, not the latest";
+    // Beyond the history: the oldest ticks are gone.
+    const int64_t kept = static_cast<int64_t>(ServoLoop::kPoseHistory);
+    EXPECT_EQ(r.servo->poseBefore((10'000 - kept) * kMs, p), PoseLookup::Dropped);
+    ASSERT_EQ(r.servo->poseBefore((10'000 - kept + 100) * kMs, p), PoseLookup::Found);
+    EXPECT_EQ(p.timestamp_ns, (10'000 - kept + 99) * kMs);
+
+    // Before the first tick the first tick's poses stand; a skipped tick (an overrun) is passed over.
+    Rig q;
+    q.servo->tick(0, 0);
+    q.servo->tick(kMs, kMs);
+    q.servo->tick(5 * kMs, 4 * kMs); // ticks at 2 and 3 ms skipped
+    ASSERT_EQ(q.servo->poseBefore(-kMs, p), PoseLookup::Found);
+    EXPECT_EQ(p.tick, 1u);
+    ASSERT_EQ(q.servo->poseBefore(3 * kMs + 500'000, p), PoseLookup::Found);
+    EXPECT_EQ(p.timestamp_ns, kMs);
+    EXPECT_EQ(q.servo->poseBefore(4 * kMs + 1, p), PoseLookup::NotYet);
+}

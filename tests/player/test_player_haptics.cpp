@@ -12,10 +12,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -216,6 +218,54 @@ TEST(PlayerHaptics, ReplaysARecordedTrajectory) {
     EXPECT_EQ(m["slower_than_real_time"].get<bool>(), m["real_time_factor"].get<double>() < 1);
     EXPECT_NE(r.out.find("real time     factor"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("PHYSICS SLOWER THAN REAL TIME") != std::string::npos, m["slower_than_real_time"].get<bool>());
+}
+
+/// The device positions of a --trace CSV, one per row, in metres rounded to 1 nm.
+static std::vector<std::array<long long, 3>> tracedDevicePositions(const std::string& csv) {
+    std::vector<std::array<long long, 3>> out;
+    std::istringstream lines(csv);
+    std::string line;
+    std::getline(lines, line);
+    while (std::getline(lines, line)) {
+        double t, x, y, z;
+        int arm;
+        if (std::sscanf(line.c_str(), "%lf,%d,%lf,%lf,%lf", &t, &arm, &x, &y, &z) == 5)
+            out.push_back({std::llround(x * 1e9), std::llround(y * 1e9), std::llround(z * 1e9)});
+    }
+    return out;
+}
+
+TEST(PlayerHaptics, RealTimeReplayTakesTheLockstepRunsInput) {
+    Scratch s;
+    test::writeHapticCase(s / "slab.vcase");
+    auto w = test::runProcess(VISCERA_CONSOLE_SIM_EXE,
+                              {"--write-trajectory", s / "press.csv", "--script", "press", "--duration", "3"});
+    ASSERT_EQ(w.exitCode, 0) << w.err;
+    auto run = [&](const std::string& mode, const std::string& frames, const std::string& tag) {
+        auto r =
+            player({"run", s / "slab.vcase", "--headless", "--frames", frames, mode, "--device",
+                    "replay:" + (s / "press.csv"), "--report", s / (tag + ".json"), "--trace", s / (tag + ".csv")});
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        return readJson(s / (tag + ".json"));
+    };
+    // Lockstep runs on for 30 more frames: the real-time servo ticks on until the session stops it.
+    run("--lockstep", "120", "lock");
+    const auto rt = run("--realtime", "90", "rt");
+    EXPECT_EQ(rt["haptics"]["mode"], "realtime");
+    EXPECT_EQ(rt["haptics"]["servo"]["frames_input_missed"].get<int>(), 0);
+    // Every tick of the real-time run polled the replay at a servo deadline, the instants lockstep
+    // polls it at (whatever its wake-up latency), so each device position it saw is one the
+    // lockstep run saw; a replay sampled at the wake-up time gives positions in between.
+    const auto lock = tracedDevicePositions(readText(s / "lock.csv"));
+    auto realtime = tracedDevicePositions(readText(s / "rt.csv"));
+    ASSERT_GT(lock.size(), 1000u);
+    ASSERT_GT(realtime.size(), 1000u);
+    const std::set<std::array<long long, 3>> seen(lock.begin(), lock.end());
+    ASSERT_GT(seen.size(), 500u) << "the replay moves";
+    size_t outside = 0;
+    for (const auto& p : realtime)
+        outside += seen.count(p) == 0 ? 1 : 0;
+    EXPECT_EQ(outside, 0u) << "of " << realtime.size() << " ticks";
 }
 
 TEST(PlayerHaptics, BadDeviceSpecsAndTrajectoriesGiveOneLineErrors) {
