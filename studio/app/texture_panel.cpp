@@ -332,7 +332,12 @@ TexturePanel::TexturePanel(Document* doc, QWidget* parent) : QWidget(parent), m_
     refresh();
 }
 
-TexturePanel::~TexturePanel() = default;
+TexturePanel::~TexturePanel() {
+    // A thumbnail or palette job still running would outlive the panel (at exit, the application
+    // whose image types it builds): wait for it, as the other panels with background jobs do.
+    for (QFutureWatcherBase* w : findChildren<QFutureWatcherBase*>())
+        w->waitForFinished();
+}
 
 void TexturePanel::buildGeneratorBox(QVBoxLayout* root) {
     m_genBox = new QGroupBox(tr("Generator"), this);
