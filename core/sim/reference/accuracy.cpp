@@ -62,17 +62,20 @@ void AccuracyRecorder::observe(int k, const std::vector<Vec3>& xk, double second
 }
 
 AccuracyTrace measureXpbd(const XpbdSolver& solver, int maxIterations, const NewtonSettings& settings,
-                          XpbdIteration mode) {
+                          XpbdIteration mode, double chebyshevRho) {
     if (maxIterations < 1)
         throw std::invalid_argument("sim::measureXpbd(): max_iterations " + std::to_string(maxIterations) +
                                     " must be >= 1");
     const StepProblem problem = solver.nextSubstepProblem();
     const NewtonResult reference = solveNewton(problem, problem.xTilde, settings);
-    AccuracyRecorder recorder(mode == XpbdIteration::Standard ? "xpbd" : "xpbd-primal", problem, reference,
-                              problem.xTilde);
+    const char* name = mode == XpbdIteration::Standard          ? "xpbd"
+                       : mode == XpbdIteration::PrimalCorrected ? "xpbd-primal"
+                                                                : "xpbd-chebyshev";
+    AccuracyRecorder recorder(name, problem, reference, problem.xTilde);
     solver.iterateOn(
         problem, maxIterations,
-        [&](int k, const std::vector<Vec3>& xk, double seconds) { recorder.observe(k, xk, seconds); }, mode);
+        [&](int k, const std::vector<Vec3>& xk, double seconds) { recorder.observe(k, xk, seconds); }, mode,
+        chebyshevRho);
     return recorder.take();
 }
 

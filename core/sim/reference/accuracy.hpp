@@ -70,8 +70,9 @@ private:
 /// 0.17 ms on a 4,944-tet body, bench/bench_accuracy.cpp). The solver's state is untouched. Throws
 /// std::invalid_argument when maxIterations < 1 or the settings are invalid. Cost: one Newton solve plus the sweeps
 /// plus one f evaluation per sweep.
+/// chebyshevRho: XpbdIteration::Chebyshev's rho (the trace is then named "xpbd-chebyshev").
 AccuracyTrace measureXpbd(const XpbdSolver& solver, int maxIterations, const NewtonSettings& settings = {},
-                          XpbdIteration mode = XpbdIteration::Standard);
+                          XpbdIteration mode = XpbdIteration::Standard, double chebyshevRho = 0.0);
 
 /// Newton's own iterates on `problem` from x_0 = x̃, measured against its final iterate
 /// (Fig. 4.12 "newton direct"); the last entry is 0 when the solve converged. Entries stop where

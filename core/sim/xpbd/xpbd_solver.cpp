@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -115,8 +116,30 @@ StepProblem XpbdSolver::nextSubstepProblem() const {
     return p;
 }
 
-void XpbdSolver::iterateOn(const StepProblem& p, int iterations, const IterateObserver& observe,
-                           XpbdIteration mode) const {
+namespace {
+
+/// XpbdIteration::Chebyshev after sweep k on the packed positions xw (x, y, z, w per particle):
+/// extrapolates from x_{k-2} (before2) and shifts the history. Returns its wall time, s.
+double chebyshevStep(detail::ParticleArray& xw, detail::ParticleArray& before2, detail::ParticleArray& before1, int k,
+                     double rho, double& omega) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (k >= 2) {
+        omega = k == 2 ? 2.0 / (2.0 - rho * rho) : 4.0 / (4.0 - rho * rho * omega);
+        for (size_t i = 0; i + 3 < xw.size(); i += 4) {
+            if (xw[i + 3] == 0) continue; // fixed
+            for (size_t r = 0; r < 3; ++r)
+                xw[i + r] = omega * (xw[i + r] - before2[i + r]) + before2[i + r];
+        }
+    }
+    before2.swap(before1);
+    before1 = xw;
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+} // namespace
+
+void XpbdSolver::iterateOn(const StepProblem& p, int iterations, const IterateObserver& observe, XpbdIteration mode,
+                           double chebyshevRho) const {
     const std::string where = "sim::XpbdSolver::iterateOn(): ";
     if (iterations < 1) throw std::invalid_argument(where + "iterations must be >= 1");
     if (!(p.h > 0) || !std::isfinite(p.h)) throw std::invalid_argument(where + "h must be positive and finite");
@@ -126,6 +149,8 @@ void XpbdSolver::iterateOn(const StepProblem& p, int iterations, const IterateOb
     if (p.dmInv.size() != nt || p.volume.size() != nt || p.weight.size() != nt)
         throw std::invalid_argument(where + "dmInv, volume and weight must have one entry per tet");
     if (!p.model) throw std::invalid_argument(where + "model is null");
+    if (mode == XpbdIteration::Chebyshev && !(chebyshevRho >= 0 && chebyshevRho < 1))
+        throw std::invalid_argument(where + "chebyshev rho must be in [0, 1)");
     if (p.model->count() < 1 || p.model->count() > kMaxTetConstraints)
         throw std::invalid_argument(where + "model must have 1 or 2 constraints per tet");
     for (size_t t = 0; t < nt; ++t) {
@@ -143,10 +168,14 @@ void XpbdSolver::iterateOn(const StepProblem& p, int iterations, const IterateOb
     const double h2inv = 1.0 / (p.h * p.h);
     double seconds = 0;
     std::vector<Vec3> xk(nv);
+    detail::ParticleArray before2, before1 = eng.xw; // Chebyshev: x_{k-2}, x_{k-1}
+    double omega = 1;
     for (int k = 1; k <= iterations; ++k) {
         seconds += eng.sweep(k == 1, h2inv, settings().threads, m_sys->m_pool.get());
         if (mode == XpbdIteration::PrimalCorrected)
             seconds += eng.primalCorrection(p.xTilde, settings().threads, m_sys->m_pool.get());
+        if (mode == XpbdIteration::Chebyshev)
+            seconds += chebyshevStep(eng.xw, before2, before1, k, chebyshevRho, omega);
         for (size_t i = 0; i < nv; ++i)
             xk[i] = detail::particlePosition(eng.xw.data(), static_cast<int32_t>(i));
         if (observe) observe(k, xk, seconds);

@@ -55,6 +55,13 @@ enum class XpbdIteration {
     /// point satisfies both rows of [A eq. 4.41], so the iterates converge to x* itself. Costs
     /// one gradient evaluation per tet per iteration (serial) on top of the sweep.
     PrimalCorrected,
+    /// Chebyshev semi-iterative acceleration of the sweeps (Wang 2015, "A Chebyshev semi-iterative
+    /// approach for accelerating projective and position-based dynamics"): after sweep k >= 2,
+    /// x_k <- w_k (x_k - x_{k-2}) + x_{k-2}, w_2 = 2 / (2 - rho^2), w_k = 4 / (4 - rho^2 w_{k-1}),
+    /// rho the spectral radius estimated from the plain sweeps; the multipliers are left as the
+    /// sweeps made them. One pass over the positions per sweep; with one sweep per substep (the
+    /// production setting) it changes nothing. Measured by bench_accuracy --variants only.
+    Chebyshev,
 };
 
 class XpbdSolver {
@@ -123,8 +130,9 @@ public:
     /// solver's state is untouched; it shares the worker threads, so it must not run
     /// concurrently with step(). Throws std::invalid_argument on an inconsistent problem or
     /// iterations < 1.
+    /// chebyshevRho: XpbdIteration::Chebyshev's rho in [0, 1).
     void iterateOn(const StepProblem& problem, int iterations, const IterateObserver& observe,
-                   XpbdIteration mode = XpbdIteration::Standard) const;
+                   XpbdIteration mode = XpbdIteration::Standard, double chebyshevRho = 0.0) const;
 
     /// The one-body system this solver wraps (its tet body 0 is this body): stepping or setting
     /// state through it is stepping or setting state here (XpbdSystem::setTetState(0, ...) is

@@ -300,3 +300,43 @@ TEST_F(XpbdAccuracy, AtTheFewestSubstepsTheRuleAcceptsTheIterationsApproachTheRe
     RecordProperty("plain_rel_error_plateau", std::to_string(plateau(plain)));
     RecordProperty("primal_rel_error_k30", std::to_string(plateau(primal)));
 }
+
+// Chebyshev acceleration (bench_accuracy --variants): with rho = 0 every weight is 1 and the
+// iterates are the plain sweeps' (to rounding); with rho = 0.6 it extrapolates from the second
+// sweep on, stays finite and deterministic; a rho outside [0, 1) is refused.
+TEST_F(XpbdAccuracy, ChebyshevWithRhoZeroIsThePlainIterationAndExtrapolatesOtherwise) {
+    auto s = solver(20);
+    const StepProblem p = s->nextSubstepProblem();
+    std::vector<std::vector<Vec3>> plain, flat, fast, again;
+    auto keep = [](std::vector<std::vector<Vec3>>& into) {
+        return [&into](int, const std::vector<Vec3>& x, double) { into.push_back(x); };
+    };
+    s->iterateOn(p, 6, keep(plain), XpbdIteration::Standard);
+    s->iterateOn(p, 6, keep(flat), XpbdIteration::Chebyshev, 0.0);
+    s->iterateOn(p, 6, keep(fast), XpbdIteration::Chebyshev, 0.6);
+    s->iterateOn(p, 6, keep(again), XpbdIteration::Chebyshev, 0.6);
+    ASSERT_EQ(plain.size(), 6u);
+    ASSERT_EQ(flat.size(), 6u);
+    ASSERT_EQ(fast.size(), 6u);
+    double flatGap = 0, firstGap = 0, laterGap = 0;
+    for (size_t i = 0; i < plain[0].size(); ++i) {
+        firstGap = std::max(firstGap, (fast[0][i] - plain[0][i]).norm());
+        for (int k = 0; k < 6; ++k) {
+            flatGap = std::max(flatGap, (flat[k][i] - plain[k][i]).norm());
+            ASSERT_TRUE(fast[k][i].allFinite());
+            ASSERT_EQ(fast[k][i], again[k][i]) << "node " << i << ", sweep " << k + 1;
+        }
+        laterGap = std::max(laterGap, (fast[1][i] - plain[1][i]).norm());
+    }
+    EXPECT_LT(flatGap, 1e-12) << "m";
+    EXPECT_EQ(firstGap, 0.0) << "the first sweep is not extrapolated";
+    EXPECT_GT(laterGap, 1e-9) << "the second is";
+    const AccuracyTrace t = measureXpbd(*s, 4, {}, XpbdIteration::Chebyshev, 0.6);
+    EXPECT_EQ(t.solver, "xpbd-chebyshev");
+    try {
+        s->iterateOn(p, 2, {}, XpbdIteration::Chebyshev, 1.0);
+        FAIL() << "no exception";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_THAT(e.what(), HasSubstr("chebyshev rho must be in [0, 1)"));
+    }
+}
