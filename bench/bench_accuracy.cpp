@@ -25,6 +25,7 @@
 #include "sim/material/stable_neo_hookean.hpp"
 #include "sim/mesh/generators.hpp"
 #include "sim/reference/accuracy.hpp"
+#include "sim/reference/vbd.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
 
 #include <nlohmann/json.hpp>
@@ -350,6 +351,14 @@ namespace {
 /// per scene; 0.9 is the scale of the plain sweeps' early error ratios here).
 constexpr double kChebyshevRhos[] = {0.6, 0.9};
 
+/// The plot legend's name of a --variants trace.
+std::string variantLabel(const std::string& variant) {
+    if (variant == "xpbd") return "XPBD, ";
+    if (variant == "xpbd-primal") return "XPBD + primal correction, ";
+    if (variant == "vbd") return "VBD (serial, FD blocks), ";
+    return "XPBD + Chebyshev rho " + variant.substr(std::string("xpbd-chebyshev-").size()) + ", ";
+}
+
 /// --variants: the sample bodies (and the 30,000-tet block) at the substep counts of the
 /// load-time rule, old and new, at 20 substeps and at the counts --substeps adds: error of plain
 /// and primal-corrected XPBD against the Newton reference of the same substep, against the frame
@@ -406,6 +415,9 @@ int runVariants(const std::filesystem::path& outDir, const std::vector<std::stri
                 traces.emplace_back(name, measureXpbd(*solver, 10, reference, XpbdIteration::Chebyshev, rho));
                 keepFastestSweeps(*solver, XpbdIteration::Chebyshev, traces.back().second, rho);
             }
+            // Vertex Block Descent on the same substep (serial, finite-difference blocks: its time
+            // is this measuring implementation's, an upper bound on a production kernel's).
+            traces.emplace_back("vbd", measureVbd(solver->nextSubstepProblem(), 10, reference));
             if (fig.maxStiffnessNumber <= 1.0) { // the primal correction diverges above (see run())
                 traces.emplace_back("xpbd-primal", measureXpbd(*solver, 10, reference, XpbdIteration::PrimalCorrected));
                 keepFastestSweeps(*solver, XpbdIteration::PrimalCorrected, traces.back().second);
@@ -427,10 +439,7 @@ int runVariants(const std::filesystem::path& outDir, const std::vector<std::stri
                 std::printf("%-12s %-11s %3d substeps (s = %6.3f): 1 iteration rel error %.3e, %.2f ms per frame\n",
                             b.name.c_str(), variant.c_str(), sub, fig.maxStiffnessNumber, t.relError.at(1),
                             sub * t.timeMs.at(1));
-                const std::string label = variant == "xpbd" ? "XPBD, "
-                                          : variant == "xpbd-primal"
-                                              ? "XPBD + primal correction, "
-                                              : "XPBD + Chebyshev rho " + variant.substr(15) + ", ";
+                const std::string label = variantLabel(variant);
                 plot.push_back(series(label + tag, t, true, sub));
             }
         }

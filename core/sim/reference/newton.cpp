@@ -14,6 +14,14 @@
 #include <stdexcept>
 
 namespace viscera::sim {
+Mat3 tetTermGradientColumns(const StepProblem& p, size_t t, const std::array<Vec3, 4>& xe, double scale) {
+    Mat3 ds;
+    for (int k = 0; k < 3; ++k)
+        ds.col(k) = xe[k + 1] - xe[0];
+    const Mat3& dmInv = p.dmInv[t];
+    return scale * p.model->energyDensityGradient(ds * dmInv) * dmInv.transpose();
+}
+
 namespace {
 
 using Vec12 = Eigen::Matrix<double, 12, 1>;
@@ -85,11 +93,7 @@ bool factorizeHessian(SparseCholesky& llt, const std::vector<double>& values, st
 
 /// Gradient (12) of the tet term h² V w Ψ(F) with respect to its four node positions.
 Vec12 elementGradient(const StepProblem& p, size_t t, const std::array<Vec3, 4>& xe, double scale) {
-    Mat3 ds;
-    for (int k = 0; k < 3; ++k)
-        ds.col(k) = xe[k + 1] - xe[0];
-    const Mat3& dmInv = p.dmInv[t];
-    const Mat3 G = scale * p.model->energyDensityGradient(ds * dmInv) * dmInv.transpose();
+    const Mat3 G = tetTermGradientColumns(p, t, xe, scale);
     Vec12 g;
     g.segment<3>(0) = -(G.col(0) + G.col(1) + G.col(2));
     for (int k = 0; k < 3; ++k)

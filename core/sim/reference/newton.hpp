@@ -26,6 +26,7 @@
 /// numerical sparse factorization of a 3#V × 3#V matrix. The library never prints.
 #include "sim/xpbd/step_problem.hpp"
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,10 @@ struct NewtonSettings {
     /// The solve stops (see above) when ‖α d‖∞ ≤ stepTolerance · max(‖x‖∞, mean tet size).
     double stepTolerance = 1e-15;
 };
+
+/// scale ∂Ψ/∂F(F) Dm⁻ᵀ of tet t at its node positions xe (scale = h² V w for the step's term):
+/// column k is the gradient of the term with respect to node k + 1, node 0's is minus their sum.
+Mat3 tetTermGradientColumns(const StepProblem& p, size_t t, const std::array<Vec3, 4>& xe, double scale);
 
 /// Throws std::invalid_argument naming the rule that failed, e.g.
 /// "sim::solveNewton(): armijo 2 must be in (0, 1)".

@@ -5,6 +5,7 @@
 #include "sim/material/stable_neo_hookean.hpp"
 #include "sim/mesh/generators.hpp"
 #include "sim/reference/accuracy.hpp"
+#include "sim/reference/vbd.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
 
 #include <gmock/gmock.h>
@@ -339,4 +340,26 @@ TEST_F(XpbdAccuracy, ChebyshevWithRhoZeroIsThePlainIterationAndExtrapolatesOther
     } catch (const std::invalid_argument& e) {
         EXPECT_THAT(e.what(), HasSubstr("chebyshev rho must be in [0, 1)"));
     }
+}
+
+// Vertex Block Descent (bench_accuracy --variants) minimizes f itself: its error falls with every
+// sweep and, unlike XPBD's, does not level off above x* (XPBD at 20 substeps: 1.2e-2); at 5
+// substeps, where XPBD's stiffness number is far over 1, it still falls; repeatable.
+TEST_F(XpbdAccuracy, VertexBlockDescentApproachesTheImplicitStepSolution) {
+    const StepProblem p = solver(20)->nextSubstepProblem();
+    const AccuracyTrace t = measureVbd(p, 30);
+    EXPECT_EQ(t.solver, "vbd");
+    ASSERT_EQ(t.referenceStatus, "converged");
+    ASSERT_EQ(t.relError.size(), 31u);
+    for (int k = 1; k <= 30; ++k)
+        EXPECT_LE(t.relError[k], t.relError[k - 1] + 10 * std::abs(t.relErrorFloor)) << "k = " << k; // f's rounding
+    EXPECT_LT(t.relError[30], 0.1 * plateau(s_traces.at(20)));
+    RecordProperty("vbd_substeps20_rel_error_k30", std::to_string(t.relError[30]));
+    const AccuracyTrace big = measureVbd(solver(5)->nextSubstepProblem(), 30);
+    EXPECT_LT(big.relError[30], 0.1 * big.relError[1]);
+    std::vector<Vec3> a, b;
+    iterateVbd(p, 3, [&](int, const std::vector<Vec3>& x, double) { a = x; });
+    iterateVbd(p, 3, [&](int, const std::vector<Vec3>& x, double) { b = x; });
+    EXPECT_EQ(a, b);
+    EXPECT_THROW(iterateVbd(p, 0, {}), std::invalid_argument);
 }
