@@ -140,8 +140,8 @@ struct CorotationalFem::Impl {
     int swapStep = 0;
     std::vector<uint8_t> pinned; // per node: kept in the cache and carried by a refactorization
     std::vector<int> prefetch;   // nodes queued for caching ahead of use (FIFO)
-    bool stepMode = false;       // beginStep() was called: prefetching is budgeted per step
-    bool stepWorkDone = false;   // this step's prefetching has run
+    bool stepMode = false;       // beginStep() was called: the amortized work is budgeted per step
+    bool stepWorkDone = false;   // this step's first solve has run
     size_t prefetchHead = 0;
 
     std::vector<std::array<int32_t, 2>> edges; // unique tet edges, for the refactor test
@@ -308,7 +308,7 @@ struct CorotationalFem::Impl {
 
     /// Advances a refactorization at the start of a solve: joins the worker at its step, computes
     /// the next chunk of carried columns, or swaps the new factor in. Deterministic (see Job).
-    void advanceJob(FemSolveStats& st) {
+    void advanceJob(FemSolveStats& st, bool firstOfStep) {
         if (!job) return;
         if (!job->joined) {
             if (step < swapStep) return;
@@ -349,7 +349,9 @@ struct CorotationalFem::Impl {
         }
         const int k = static_cast<int>(j.nodes.size());
         if (j.done < k) {
-            const int chunk = std::min(k - j.done, s.refactorNodesPerSolve);
+            // A step's first solve computes `refactorNodesPerSolve` nodes, its further solves (contact
+            // rounds) one each: a step of several solves costs little more than a step of one.
+            const int chunk = std::min(k - j.done, firstOfStep ? s.refactorNodesPerSolve : 1);
             const int n = n3();
             if (j.cols.cols() < 3 * (j.done + chunk))
                 j.cols.conservativeResize(n, std::max<Eigen::Index>(3 * k, 2 * j.cols.cols()));
@@ -649,14 +651,14 @@ FemSolveStats CorotationalFem::solve() {
     Impl& I = *m;
     FemSolveStats st;
     ++I.step;
-    // Prefetching runs in the first solve of a step when the caller marks steps (beginStep()), else
-    // in every solve.
-    const bool prefetchNow = !I.stepMode || !I.stepWorkDone;
+    // The amortized work runs in the first solve of a step when the caller marks steps (beginStep()),
+    // else in every solve.
+    const bool firstOfStep = !I.stepMode || !I.stepWorkDone;
     I.stepWorkDone = true;
-    I.advanceJob(st);
+    I.advanceJob(st, firstOfStep);
     if (st.refactored) ++m_factorizations;
     I.evict();
-    if (prefetchNow && !I.prefetch.empty()) I.prefetchStep(st); // a failure is reported in st.error; the solve goes on
+    if (firstOfStep && !I.prefetch.empty()) I.prefetchStep(st); // a failure is reported in st.error; the solve goes on
     const int n = I.n3();
     const auto& X0 = m_x0;
 

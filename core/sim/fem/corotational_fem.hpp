@@ -67,7 +67,7 @@ struct FemSettings {
     bool incrementalSchur = true;
     int cacheEvictSteps = 400; ///< constrained-node cache entries unused this long are freed (not pinned ones)
     /// Background: carried nodes whose K⁻¹ columns are computed with the new factor per solve (3
-    /// substitutions each) between the worker's join and the swap.
+    /// substitutions each) between the worker's join and the swap (see beginStep()).
     int refactorNodesPerSolve = 4;
     int prefetchNodesPerSolve = 4; ///< queued nodes (prefetchNodes()) cached per solve, >= 0
     /// Simplicial: cheapest for the few-column substitutions of the constrained-node cache.
@@ -175,11 +175,13 @@ public:
     // ---- solve ------------------------------------------------------------------------------
     /// One quasi-static solve with the current constraints. Never throws.
     FemSolveStats solve();
-    /// Marks the start of a step (a frame) of one or more solves. Once called, the prefetched nodes
-    /// (`prefetchNodesPerSolve`) are cached in the first solve of each step only, so a step of several
-    /// solves (contact rounds) does no more of that work than a step of one. (A refactorization's
-    /// carried columns stay per solve: they decide when the new rotations take effect.) Never called:
-    /// every solve prefetches. Counts only, never time: a run stays repeatable.
+    /// Marks the start of a step (a frame) of one or more solves. Once called, the amortized work is
+    /// budgeted per step: the prefetched nodes (`prefetchNodesPerSolve`) are cached in the first solve
+    /// of a step only, and a refactorization's carried columns take `refactorNodesPerSolve` nodes in
+    /// the first solve and one node in each further solve (contact rounds) — at least one per solve,
+    /// so the new rotations still take effect within a bounded number of solves. A step of several
+    /// solves then costs little more of this work than a step of one. Never called: every solve does
+    /// its full share. Counts only, never time: a run stays repeatable.
     void beginStep();
     /// Re-extracts the rotations from the current positions and refactorizes now (synchronous).
     bool refactorNow(std::string* error = nullptr);

@@ -602,3 +602,58 @@ TEST(CorotationalFem, AStepOfSeveralSolvesDoesItsAmortizedWorkOnce) {
     EXPECT_EQ(plain->cachedNodes(), 8);
     EXPECT_LT(maxDistance(stepped->positions(), plain->positions()), 1e-15) << "work moved, results unchanged";
 }
+
+TEST(CorotationalFem, AStepOfSeveralSolvesCarriesOneNodePerFurtherSolve) {
+    // Background refactorization with 4 carried nodes per solve (28 carried: 24 pinned, 4 constrained)
+    // and steps of three solves: a step's first solve computes 4
+    // nodes' columns (12 substitutions), its further solves one node (3); the swap still comes.
+    const Drag d;
+    FemSettings s;
+    s.refactorMode = RefactorMode::Background;
+    s.refactorDisplacement = 0.05;
+    s.refactorLatencySteps = 1;
+    s.refactorNodesPerSolve = 4;
+    auto plain = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
+    auto stepped = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
+    std::vector<int32_t> pins;
+    for (int32_t v = 0; pins.size() < 24; ++v)
+        if (!plain->isFixed(v)) pins.push_back(v);
+    for (auto* fem : {plain.get(), stepped.get()}) { // pinned and cached: carried by every refactorization
+        fem->pinNodes(pins);
+        fem->prefetchNodes(pins);
+    }
+    const int ip = d.constrain(*plain), is = d.constrain(*stepped);
+    auto solvesToSwap = [](std::vector<int>& started, std::vector<int>& swapped) {
+        std::vector<int> out;
+        for (size_t i = 0; i < std::min(started.size(), swapped.size()); ++i)
+            out.push_back(swapped[i] - started[i]);
+        return out;
+    };
+    std::vector<int> startedP, swappedP, startedS, swappedS;
+    int carriedFirst = 0, carriedFurther = 0;
+    for (int k = 0; k < 90; ++k) {
+        if (k % 3 == 0) stepped->beginStep();
+        d.target(*plain, ip, k / 3);
+        d.target(*stepped, is, k / 3);
+        const bool pending = stepped->refactorPending();
+        const FemSolveStats a = plain->solve(), b = stepped->solve();
+        ASSERT_TRUE(a.finite && b.finite) << a.error << b.error;
+        if (a.refactorStarted) startedP.push_back(k);
+        if (a.refactored) swappedP.push_back(k);
+        if (b.refactorStarted) startedS.push_back(k);
+        if (b.refactored) swappedS.push_back(k);
+        if (pending && !b.refactored && b.newCachedNodes == 0 && b.substitutions > 1) {
+            const int carried = b.substitutions - b.substitutions % 3; // less the substitution of u
+            EXPECT_LE(carried, k % 3 == 0 ? 12 : 3) << "solve " << k;  // less when the last nodes are done
+            carriedFirst += k % 3 == 0 && carried == 12;
+            carriedFurther += k % 3 != 0 && carried == 3;
+        }
+    }
+    EXPECT_GT(carriedFirst, 0);
+    EXPECT_GT(carriedFurther, 0);
+    ASSERT_GE(swappedS.size(), 1u) << "the new factor still takes effect";
+    const std::vector<int> p = solvesToSwap(startedP, swappedP), q = solvesToSwap(startedS, swappedS);
+    ASSERT_FALSE(p.empty());
+    EXPECT_GT(q[0], p[0]) << "fewer substitutions per solve, more solves to the swap";
+    EXPECT_LE(q[0], 1 + 24 + 4 + 1) << "at least one node per solve";
+}
