@@ -3,6 +3,9 @@
 // pull, and what the slowest steps did (refactorization, puncture, new contacts, substitutions).
 // Run: OPENBLAS_NUM_THREADS=1 taskset -c 0 ./build/bench/bench_suture [5|13] [--refactor MODE] [--pace FPS]
 //        [--slowest N] [--prefetch NODES_PER_SOLVE] [--lookahead STEPS] [--latency SOLVES]
+//        [--carry NODES_PER_SOLVE] [--hold FRAMES]
+//   --hold appends FRAMES copies of the last frame (the closed suture held at full pull, as the player
+//   does past the trajectory's end; up to 256 contacts); --carry sets FemSettings::refactorNodesPerSolve.
 //   MODE: synchronous | background (default background; see FemSettings::refactorMode). With
 //   --pace 60 the steps run as in the player, one per 1/60 s frame on the same core, and the
 //   background factorization takes the idle rest of the frames; without it the steps run back to

@@ -376,13 +376,18 @@ struct CorotationalFem::Impl {
         cur = std::move(j->result);
         resetCache();
         const int k = static_cast<int>(j->nodes.size());
-        const int cap = std::max(96, 3 * k);
-        kinv = Eigen::MatrixXd::Zero(cap, cap);
+        // The job's columns are laid out as the cache's (node i in slot i): taken over, not copied (a
+        // copy of #V × 3k doubles and the page faults of a new buffer made the swap step a spike:
+        // tens of ms with a few hundred carried nodes).
+        cols = std::move(j->cols);
+        if (cols.cols() < 96) cols.conservativeResize(n3(), 96);
+        const Eigen::Index cap = cols.cols();
+        // The same buffer when the size repeats (entries past the carried slots are rewritten when
+        // their slots are allocated, and never read before).
+        if (kinv.rows() != cap) kinv = Eigen::MatrixXd::Zero(cap, cap);
         for (int a = 0; a < k; ++a)
             for (int b = 0; b < k; ++b)
-                kinv.block<3, 3>(3 * a, 3 * b) = j->cols.block<3, 3>(3 * j->nodes[a], 3 * b);
-        cols.resize(n3(), cap);
-        cols.leftCols(3 * k) = j->cols.leftCols(3 * k);
+                kinv.block<3, 3>(3 * a, 3 * b) = cols.block<3, 3>(3 * j->nodes[a], 3 * b);
         for (int i = 0; i < k; ++i) {
             nodeOf.push_back(j->nodes[i]);
             lastUsed.push_back(step);
