@@ -112,6 +112,10 @@ struct CorotationalFem::Impl {
     // substitution of a solve (a dense product over the constrained nodes only).
     Eigen::MatrixXd cols;
     std::vector<double> rhsWork;
+    // u at single nodes in the activation test, memoized per active-set iteration (uEpoch)
+    std::vector<int64_t> uStamp;
+    std::vector<Vec3> uMemo;
+    int64_t uEpoch = 0;
 
     std::vector<Group> groups;
     size_t liveGroups = 0;
@@ -529,6 +533,8 @@ std::unique_ptr<CorotationalFem> CorotationalFem::create(const TetMesh& mesh, co
             for (int c = 0; c < 3; ++c)
                 m.fixedDiag.push_back(m.pattern.find(3 * static_cast<int>(v) + c, 3 * static_cast<int>(v) + c));
     m.slotOf.assign(nv, -1);
+    m.uStamp.assign(nv, 0);
+    m.uMemo.assign(nv, Vec3::Zero());
     m.pinned.assign(nv, 0);
     std::string error;
     if (!m.buildFactor(w->m_x0, m.cur, error)) fail(error);
@@ -875,6 +881,7 @@ FemSolveStats CorotationalFem::solve() {
 
     bool ok = true;
     std::vector<std::pair<int, Vec3>> gsum;
+    Eigen::VectorXd gDense; // (Cᵀλ) per cached slot (3·slots), for the activation test
     for (int outer = 0; outer < I.s.maxActiveSetIterations && ok; ++outer) {
         bool changed = false;
         for (int inner = 0; inner < I.s.maxActiveSetIterations; ++inner) {
@@ -914,11 +921,31 @@ FemSolveStats CorotationalFem::solve() {
                     else
                         it->second += lam[r] * a;
                 }
+        // At a cached node, K⁻¹[node, ·] (Cᵀλ) is the node's three columns of the cached blocks (K⁻¹ is
+        // symmetric) against (Cᵀλ) over the slots: one contiguous product, instead of a 3 × 3 block
+        // per slot gathered from rows far apart in the full columns. Each node once per iteration.
+        const Eigen::Index slots3 = 3 * static_cast<Eigen::Index>(I.nodeOf.size());
+        bool haveDense = false;
+        ++I.uEpoch;
         auto uAt = [&](int32_t node) -> Vec3 {
             if (m_fixed[node]) return Vec3::Zero();
+            if (I.uStamp[node] == I.uEpoch) return I.uMemo[node];
             Vec3 v = I.cur.u0.segment<3>(3 * node);
-            for (const auto& [slot, gv] : gsum)
-                v.noalias() -= I.cols.block<3, 3>(3 * node, 3 * slot) * gv;
+            const int own = I.slotOf[node];
+            if (own >= 0) {
+                if (!haveDense) {
+                    gDense.setZero(slots3);
+                    for (const auto& [slot, gv] : gsum)
+                        gDense.segment<3>(3 * slot) = gv;
+                    haveDense = true;
+                }
+                v.noalias() -= I.kinv.block(0, 3 * own, slots3, 3).transpose() * gDense;
+            } else {
+                for (const auto& [slot, gv] : gsum)
+                    v.noalias() -= I.cols.block<3, 3>(3 * node, 3 * slot) * gv;
+            }
+            I.uStamp[node] = I.uEpoch;
+            I.uMemo[node] = v;
             return v;
         };
         // Activate violated unilateral groups.
