@@ -3,6 +3,9 @@
 // pull, and what the slowest steps did (refactorization, puncture, new contacts, substitutions).
 // Run: OPENBLAS_NUM_THREADS=1 taskset -c 0 ./build/bench/bench_suture [5|13] [--refactor MODE] [--pace FPS]
 //        [--slowest N] [--prefetch NODES_PER_SOLVE] [--lookahead STEPS] [--latency SOLVES]
+//        [--carry NODES_PER_SOLVE] [--hold FRAMES]
+//   --hold appends FRAMES copies of the last frame (the closed suture held at full pull, as the player
+//   does past the trajectory's end; up to 256 contacts); --carry sets FemSettings::refactorNodesPerSolve.
 //   MODE: synchronous | background (default background; see FemSettings::refactorMode). With
 //   --pace 60 the steps run as in the player, one per 1/60 s frame on the same core, and the
 //   background factorization takes the idle rest of the frames; without it the steps run back to
@@ -83,6 +86,8 @@ int main(int argc, char** argv) {
     double pace = 0;                   // frames per second; 0 = steps back to back
     int prefetch = -1, lookahead = -1; // FemSettings::prefetchNodesPerSolve, contactLookaheadSteps (-1: default)
     int latency = 120;                 // FemSettings::refactorLatencySteps
+    int carry = -1;                    // FemSettings::refactorNodesPerSolve (-1: default)
+    int hold = 0;                      // frames of the last pose (full pull) appended: the closed suture held
     RefactorMode mode = RefactorMode::Background;
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--refactor") && i + 1 < argc) {
@@ -96,6 +101,10 @@ int main(int argc, char** argv) {
             lookahead = std::atoi(argv[++i]);
         } else if (!std::strcmp(argv[i], "--latency") && i + 1 < argc) {
             latency = std::max(1, std::atoi(argv[++i]));
+        } else if (!std::strcmp(argv[i], "--carry") && i + 1 < argc) {
+            carry = std::max(1, std::atoi(argv[++i]));
+        } else if (!std::strcmp(argv[i], "--hold") && i + 1 < argc) {
+            hold = std::max(0, std::atoi(argv[++i]));
         } else if (!std::strcmp(argv[i], "--pace") && i + 1 < argc) {
             pace = std::atof(argv[++i]);
         } else if (!std::strcmp(argv[i], "--slowest") && i + 1 < argc) {
@@ -118,10 +127,12 @@ int main(int argc, char** argv) {
         s.fem.refactorMode = mode;
         s.fem.refactorLatencySteps = latency; // the worker shares the core with the steps
         if (prefetch >= 0) s.fem.prefetchNodesPerSolve = prefetch;
+        if (carry > 0) s.fem.refactorNodesPerSolve = carry;
         if (lookahead >= 0) s.contactLookaheadSteps = lookahead;
         AnastomosisRun run = makeAnastomosisRun(spec, s);
         SutureSimulation* sim = run.sim.get();
-        const std::vector<NeedleFrame>& frames = run.frames;
+        std::vector<NeedleFrame>& frames = run.frames;
+        frames.insert(frames.end(), static_cast<size_t>(hold), frames.back());
         ClosureGauge gauge(sim->mesh(), run.narrowOffset);
         std::vector<StepRecord> rec;
         int punctures = 0;

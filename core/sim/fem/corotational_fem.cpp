@@ -44,6 +44,33 @@ struct SolveRow {
     double bu = 0;
 };
 
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+/// Removes row and column j from the k × k lower factor L (L Lᵀ = A → L' L'ᵀ = A without row and
+/// column j): the rows below j take the rank-one update L₂₂L₂₂ᵀ + x xᵀ, x = L[j+1:k, j], by Givens
+/// rotations, then move up one place. O((k − j)²) instead of the O((k − j)³) of factoring them again.
+void deleteFactorRow(RowMatrix& L, int k, int j, Eigen::VectorXd& x) {
+    const int n = k - j - 1;
+    x.resize(n);
+    for (int t = 0; t < n; ++t)
+        x[t] = L(j + 1 + t, j);
+    for (int i = 0; i < n; ++i) {
+        const int ri = j + 1 + i;
+        const double lii = L(ri, ri), r = std::hypot(lii, x[i]);
+        const double c = r / lii, sn = x[i] / lii;
+        L(ri, ri) = r;
+        for (int t = i + 1; t < n; ++t) {
+            const int rt = j + 1 + t;
+            L(rt, ri) = (L(rt, ri) + sn * x[t]) / c;
+            x[t] = c * x[t] - sn * L(rt, ri);
+        }
+    }
+    for (int r = j; r + 1 < k; ++r) { // close the gap: row r ← row r + 1 without its column j
+        L.row(r).head(j) = L.row(r + 1).head(j);
+        L.row(r).segment(j, r - j + 1) = L.row(r + 1).segment(j + 1, r - j + 1);
+    }
+}
+
 } // namespace
 
 std::string validate(const FemSettings& s) {
@@ -85,6 +112,10 @@ struct CorotationalFem::Impl {
     // substitution of a solve (a dense product over the constrained nodes only).
     Eigen::MatrixXd cols;
     std::vector<double> rhsWork;
+    // u at single nodes in the activation test, memoized per active-set iteration (uEpoch)
+    std::vector<int64_t> uStamp;
+    std::vector<Vec3> uMemo;
+    int64_t uEpoch = 0;
 
     std::vector<Group> groups;
     size_t liveGroups = 0;
@@ -113,6 +144,8 @@ struct CorotationalFem::Impl {
     int swapStep = 0;
     std::vector<uint8_t> pinned; // per node: kept in the cache and carried by a refactorization
     std::vector<int> prefetch;   // nodes queued for caching ahead of use (FIFO)
+    bool stepMode = false;       // beginStep() was called: the amortized work is budgeted per step
+    bool stepWorkDone = false;   // this step's first solve has run
     size_t prefetchHead = 0;
 
     std::vector<std::array<int32_t, 2>> edges; // unique tet edges, for the refactor test
@@ -279,7 +312,7 @@ struct CorotationalFem::Impl {
 
     /// Advances a refactorization at the start of a solve: joins the worker at its step, computes
     /// the next chunk of carried columns, or swaps the new factor in. Deterministic (see Job).
-    void advanceJob(FemSolveStats& st) {
+    void advanceJob(FemSolveStats& st, bool firstOfStep) {
         if (!job) return;
         if (!job->joined) {
             if (step < swapStep) return;
@@ -320,7 +353,9 @@ struct CorotationalFem::Impl {
         }
         const int k = static_cast<int>(j.nodes.size());
         if (j.done < k) {
-            const int chunk = std::min(k - j.done, s.refactorNodesPerSolve);
+            // A step's first solve computes `refactorNodesPerSolve` nodes, its further solves (contact
+            // rounds) one each: a step of several solves costs little more than a step of one.
+            const int chunk = std::min(k - j.done, firstOfStep ? s.refactorNodesPerSolve : 1);
             const int n = n3();
             if (j.cols.cols() < 3 * (j.done + chunk))
                 j.cols.conservativeResize(n, std::max<Eigen::Index>(3 * k, 2 * j.cols.cols()));
@@ -345,13 +380,18 @@ struct CorotationalFem::Impl {
         cur = std::move(j->result);
         resetCache();
         const int k = static_cast<int>(j->nodes.size());
-        const int cap = std::max(96, 3 * k);
-        kinv = Eigen::MatrixXd::Zero(cap, cap);
+        // The job's columns are laid out as the cache's (node i in slot i): taken over, not copied (a
+        // copy of #V × 3k doubles and the page faults of a new buffer made the swap step a spike:
+        // tens of ms with a few hundred carried nodes).
+        cols = std::move(j->cols);
+        if (cols.cols() < 96) cols.conservativeResize(n3(), 96);
+        const Eigen::Index cap = cols.cols();
+        // The same buffer when the size repeats (entries past the carried slots are rewritten when
+        // their slots are allocated, and never read before).
+        if (kinv.rows() != cap) kinv = Eigen::MatrixXd::Zero(cap, cap);
         for (int a = 0; a < k; ++a)
             for (int b = 0; b < k; ++b)
-                kinv.block<3, 3>(3 * a, 3 * b) = j->cols.block<3, 3>(3 * j->nodes[a], 3 * b);
-        cols.resize(n3(), cap);
-        cols.leftCols(3 * k) = j->cols.leftCols(3 * k);
+                kinv.block<3, 3>(3 * a, 3 * b) = cols.block<3, 3>(3 * j->nodes[a], 3 * b);
         for (int i = 0; i < k; ++i) {
             nodeOf.push_back(j->nodes[i]);
             lastUsed.push_back(step);
@@ -493,6 +533,8 @@ std::unique_ptr<CorotationalFem> CorotationalFem::create(const TetMesh& mesh, co
             for (int c = 0; c < 3; ++c)
                 m.fixedDiag.push_back(m.pattern.find(3 * static_cast<int>(v) + c, 3 * static_cast<int>(v) + c));
     m.slotOf.assign(nv, -1);
+    m.uStamp.assign(nv, 0);
+    m.uMemo.assign(nv, Vec3::Zero());
     m.pinned.assign(nv, 0);
     std::string error;
     if (!m.buildFactor(w->m_x0, m.cur, error)) fail(error);
@@ -584,6 +626,11 @@ void CorotationalFem::prefetchNodes(const std::vector<int32_t>& nodes) {
             m->prefetch.push_back(v);
 }
 
+void CorotationalFem::beginStep() {
+    m->stepMode = true;
+    m->stepWorkDone = false;
+}
+
 bool CorotationalFem::refactorPending() const {
     return m->job != nullptr;
 }
@@ -615,10 +662,14 @@ FemSolveStats CorotationalFem::solve() {
     Impl& I = *m;
     FemSolveStats st;
     ++I.step;
-    I.advanceJob(st);
+    // The amortized work runs in the first solve of a step when the caller marks steps (beginStep()),
+    // else in every solve.
+    const bool firstOfStep = !I.stepMode || !I.stepWorkDone;
+    I.stepWorkDone = true;
+    I.advanceJob(st, firstOfStep);
     if (st.refactored) ++m_factorizations;
     I.evict();
-    if (!I.prefetch.empty()) I.prefetchStep(st); // a failure is reported in st.error; the solve goes on
+    if (firstOfStep && !I.prefetch.empty()) I.prefetchStep(st); // a failure is reported in st.error; the solve goes on
     const int n = I.n3();
     const auto& X0 = m_x0;
 
@@ -645,7 +696,10 @@ FemSolveStats CorotationalFem::solve() {
         allRows += static_cast<int>(I.groups[g].desc.rows.size());
     }
     Eigen::MatrixXd mCache(allRows, allRows);
-    std::vector<uint8_t> mHave(static_cast<size_t>(allRows) * allRows, 0);
+    std::vector<int> mIds; // row ids whose M entries with each other are in mCache
+    std::vector<uint8_t> mKnown(static_cast<size_t>(allRows), 0);                        // per row id: in mIds
+    std::vector<std::vector<std::pair<int, Vec3>>> mTerms(static_cast<size_t>(allRows)); // (slot, a) per known id
+    Eigen::VectorXd w; // K⁻¹c_rᵀ at the cached slots of the row being added
     auto buildRows = [&]() -> bool {
         rows.clear();
         std::vector<int> missing;
@@ -688,12 +742,52 @@ FemSolveStats CorotationalFem::solve() {
 
     // Dense Schur system on the rows: returns false on failure. Fills lam (per row; 0 if rejected).
     std::vector<uint8_t> rejected;
-    using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
     RowMatrix L;
     std::vector<int> acc, prevIds; // accepted rows and row ids of the previous active-set iteration
+    // Rows only removed since the previous active-set iteration (groups released): the factor loses
+    // their rows by rank-one updates instead of being computed again from the first of them. The
+    // rows kept stay enforced (a row's pivot only grows when rows before it leave); a rejected row
+    // that now passes the pivot test is where the factorization resumes. Returns the first row the
+    // factorization must still compute (acc, rejected and L describe the rows before it).
+    Eigen::VectorXd dropWork;
+    auto dropReleasedRows = [&](int p) -> int {
+        const int mrows = static_cast<int>(rows.size()), old = static_cast<int>(prevIds.size());
+        std::vector<int> newPos(old, -1); // per previous row: its position now (-1: removed)
+        for (int r = 0, o = 0; r < mrows; ++r, ++o) {
+            while (o < old && prevIds[o] != rows[r].id)
+                ++o;
+            if (o == old) return p; // a row came in: factor from p as usual
+            newPos[o] = r;
+        }
+        const auto Mv = [&](int r, int c) { return mCache(rows[r].id, rows[c].id); };
+        int k = static_cast<int>(acc.size());
+        for (int i = k - 1; i >= 0; --i)
+            if (newPos[acc[i]] < 0) {
+                deleteFactorRow(L, k, i, dropWork);
+                acc.erase(acc.begin() + i);
+                --k;
+            }
+        std::vector<uint8_t> wasRejected(mrows, 0);
+        for (int o = 0; o < old; ++o)
+            if (newPos[o] >= 0) wasRejected[newPos[o]] = rejected[o];
+        for (int& a : acc)
+            a = newPos[a];
+        rejected.assign(wasRejected.begin(), wasRejected.end());
+        for (int r = p, before = 0; r < mrows; ++r) {
+            while (before < k && acc[before] < r)
+                ++before;
+            if (!rejected[r]) continue;
+            Eigen::VectorXd col(before);
+            for (int i = 0; i < before; ++i)
+                col[i] = Mv(acc[i], r);
+            L.topLeftCorner(before, before).triangularView<Eigen::Lower>().solveInPlace(col);
+            const double d = Mv(r, r) - col.squaredNorm();
+            if (Mv(r, r) > 0 && d > I.s.rankTolerance * Mv(r, r)) return r; // resume here
+        }
+        return mrows;
+    };
     auto solveSchur = [&]() {
         const int mrows = static_cast<int>(rows.size());
-        Eigen::MatrixXd M(mrows, mrows);
         Eigen::VectorXd q(mrows);
         for (int r = 0; r < mrows; ++r) {
             double cu0 = 0;
@@ -701,25 +795,34 @@ FemSolveStats CorotationalFem::solve() {
                 cu0 += a.dot(I.cur.u0.segment<3>(3 * node));
             q[r] = cu0 - rows[r].bu;
         }
-        for (int r = 0; r < mrows; ++r)
-            for (int c = 0; c <= r; ++c) {
-                const size_t key = static_cast<size_t>(rows[r].id) * allRows + rows[c].id;
-                if (!mHave[key]) {
-                    double v = 0; // Σ_terms a_rᵀ K⁻¹[slot_r, slot_c] a_c
-                    for (const auto& [sr, ar] : rows[r].terms)
-                        for (const auto& [sc, ac] : rows[c].terms)
-                            v += ar.dot(I.kinv.block<3, 3>(3 * sr, 3 * sc) * ac);
-                    mCache(rows[r].id, rows[c].id) = mCache(rows[c].id, rows[r].id) = v;
-                    mHave[key] = mHave[static_cast<size_t>(rows[c].id) * allRows + rows[r].id] = 1;
-                }
-                M(r, c) = M(c, r) = mCache(rows[r].id, rows[c].id);
+        // A row id met for the first time in this solve gets its M entries with every known id (the
+        // rows of a group do not change within a solve; an inactive group's entries wait for its return).
+        for (int r = 0; r < mrows; ++r) {
+            const int id = rows[r].id;
+            if (mKnown[id]) continue;
+            mKnown[id] = 1;
+            mIds.push_back(id);
+            mTerms[id] = rows[r].terms;
+            // K⁻¹c_rᵀ at the cached slots: one product per term over contiguous columns of the blocks.
+            const Eigen::Index slots3 = 3 * static_cast<Eigen::Index>(I.nodeOf.size());
+            w.setZero(slots3);
+            for (const auto& [slot, a] : rows[r].terms)
+                w.noalias() += I.kinv.block(0, 3 * slot, slots3, 3) * a;
+            for (int c : mIds) {
+                double v = 0; // Σ_terms a_cᵀ (K⁻¹ c_rᵀ)[slot_c] = Σ_terms a_rᵀ K⁻¹[slot_r, slot_c] a_c
+                for (const auto& [sc, ac] : mTerms[c])
+                    v += ac.dot(w.segment<3>(3 * sc));
+                mCache(id, c) = mCache(c, id) = v;
             }
+        }
+        auto M = [&](int r, int c) { return mCache(rows[r].id, rows[c].id); };
         // Pivoted incremental Cholesky in row order; a row whose pivot is too small is rejected. The
         // rows that lead as in the previous active-set iteration keep their part of the factor (a
         // released or activated group changes only what follows it).
         int p = 0;
         while (p < mrows && p < static_cast<int>(prevIds.size()) && prevIds[p] == rows[p].id)
             ++p;
+        if (I.s.incrementalSchur && (p < mrows || p < static_cast<int>(prevIds.size()))) p = dropReleasedRows(p);
         int k0 = 0;
         while (k0 < static_cast<int>(acc.size()) && acc[k0] < p)
             ++k0;
@@ -778,6 +881,7 @@ FemSolveStats CorotationalFem::solve() {
 
     bool ok = true;
     std::vector<std::pair<int, Vec3>> gsum;
+    Eigen::VectorXd gDense; // (Cᵀλ) per cached slot (3·slots), for the activation test
     for (int outer = 0; outer < I.s.maxActiveSetIterations && ok; ++outer) {
         bool changed = false;
         for (int inner = 0; inner < I.s.maxActiveSetIterations; ++inner) {
@@ -817,11 +921,31 @@ FemSolveStats CorotationalFem::solve() {
                     else
                         it->second += lam[r] * a;
                 }
+        // At a cached node, K⁻¹[node, ·] (Cᵀλ) is the node's three columns of the cached blocks (K⁻¹ is
+        // symmetric) against (Cᵀλ) over the slots: one contiguous product, instead of a 3 × 3 block
+        // per slot gathered from rows far apart in the full columns. Each node once per iteration.
+        const Eigen::Index slots3 = 3 * static_cast<Eigen::Index>(I.nodeOf.size());
+        bool haveDense = false;
+        ++I.uEpoch;
         auto uAt = [&](int32_t node) -> Vec3 {
             if (m_fixed[node]) return Vec3::Zero();
+            if (I.uStamp[node] == I.uEpoch) return I.uMemo[node];
             Vec3 v = I.cur.u0.segment<3>(3 * node);
-            for (const auto& [slot, gv] : gsum)
-                v.noalias() -= I.cols.block<3, 3>(3 * node, 3 * slot) * gv;
+            const int own = I.slotOf[node];
+            if (own >= 0) {
+                if (!haveDense) {
+                    gDense.setZero(slots3);
+                    for (const auto& [slot, gv] : gsum)
+                        gDense.segment<3>(3 * slot) = gv;
+                    haveDense = true;
+                }
+                v.noalias() -= I.kinv.block(0, 3 * own, slots3, 3).transpose() * gDense;
+            } else {
+                for (const auto& [slot, gv] : gsum)
+                    v.noalias() -= I.cols.block<3, 3>(3 * node, 3 * slot) * gv;
+            }
+            I.uStamp[node] = I.uEpoch;
+            I.uMemo[node] = v;
             return v;
         };
         // Activate violated unilateral groups.

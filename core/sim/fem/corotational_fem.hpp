@@ -26,6 +26,8 @@
 ///    falls below `rankTolerance` (redundant or incompatible rows, [B §2.2.6]) instead of producing a
 ///    singular system, the multipliers λ, and u = u0 − Σ_nodes K_R⁻¹[:, node](Cᵀλ)_node from the
 ///    cached columns (a dense product over the constrained nodes; no substitution).
+///  - M's entries are computed once per solve, when a row first takes part (K⁻¹cᵀ at the cached
+///    nodes by one product per term); a released group leaves the factor of M by rank-one updates.
 /// Unilateral groups (contact, thread pull) are released when their weighted multiplier shows that
 /// they pull (Σ w_r λ_r > releaseTolerance) and re-activated when violated; the active set is
 /// iterated at most `maxActiveSetIterations` times.
@@ -59,9 +61,13 @@ struct FemSettings {
     double releaseTolerance = 0;       ///< N; unilateral group released when Σ w λ exceeds it
     double activationTolerance = 1e-7; ///< m; inactive unilateral group activated when violated by more
     int maxActiveSetIterations = 6;
+    /// Groups released in an active-set iteration leave the Schur factor by rank-one updates
+    /// (O(rows²) each) instead of a factorization of every row after the first of them (O(rows³)).
+    /// false: the reference path (same system, results equal to rounding).
+    bool incrementalSchur = true;
     int cacheEvictSteps = 400; ///< constrained-node cache entries unused this long are freed (not pinned ones)
     /// Background: carried nodes whose K⁻¹ columns are computed with the new factor per solve (3
-    /// substitutions each) between the worker's join and the swap.
+    /// substitutions each) between the worker's join and the swap (see beginStep()).
     int refactorNodesPerSolve = 4;
     int prefetchNodesPerSolve = 4; ///< queued nodes (prefetchNodes()) cached per solve, >= 0
     /// Simplicial: cheapest for the few-column substitutions of the constrained-node cache.
@@ -169,6 +175,14 @@ public:
     // ---- solve ------------------------------------------------------------------------------
     /// One quasi-static solve with the current constraints. Never throws.
     FemSolveStats solve();
+    /// Marks the start of a step (a frame) of one or more solves. Once called, the amortized work is
+    /// budgeted per step: the prefetched nodes (`prefetchNodesPerSolve`) are cached in the first solve
+    /// of a step only, and a refactorization's carried columns take `refactorNodesPerSolve` nodes in
+    /// the first solve and one node in each further solve (contact rounds) — at least one per solve,
+    /// so the new rotations still take effect within a bounded number of solves. A step of several
+    /// solves then costs little more of this work than a step of one. Never called: every solve does
+    /// its full share. Counts only, never time: a run stays repeatable.
+    void beginStep();
     /// Re-extracts the rotations from the current positions and refactorizes now (synchronous).
     bool refactorNow(std::string* error = nullptr);
     /// The same with the rotations of positions x (nodeCount() entries), e.g. those a background

@@ -482,6 +482,7 @@ void SutureSimulation::readForces(SutureStepStats& st) {
 SutureStepStats SutureSimulation::step(const NeedleFrame& frame) {
     SutureStepStats st;
     ++m_steps;
+    m_fem->beginStep();
     const std::vector<Vec3> before = m_fem->positions();
     const double l = m_s.needle.length_();
     Eigen::Isometry3d next = frame.pose;

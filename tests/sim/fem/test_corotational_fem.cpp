@@ -497,3 +497,163 @@ TEST(CorotationalFem, RefactorAtRejectsPositionsOfTheWrongSize) {
     EXPECT_FALSE(fem->refactorAt({Vec3::Zero()}, &error));
     EXPECT_NE(error.find("refactorAt(): positions have the wrong size"), std::string::npos) << error;
 }
+
+namespace {
+
+/// Floors under the bottom nodes of a sagging bar, one unilateral group each, started active: the
+/// ones far below pull and are released, in cascades over several active-set iterations. Two groups
+/// share the tip's row: the later one is rejected while the earlier (a pulling floor) holds it, and
+/// enforced once that one is released.
+struct Floors {
+    Bar bar = makeBar({10, 2, 3});
+    std::vector<int> ids;
+    void addTo(CorotationalFem& fem, const std::vector<Vec3>& sagged) {
+        const auto& p = bar.mesh->positions();
+        int tip = -1, k = 0;
+        for (int v = 0; v < static_cast<int>(p.size()); ++v)
+            if (!fem.isFixed(v) && p[v].z() < 1e-9 && (tip < 0 || p[v].x() > p[tip].x())) tip = v;
+        for (int v = 0; v < static_cast<int>(p.size()); ++v) {
+            if (fem.isFixed(v) || p[v].z() > 1e-9 || v == tip) continue;
+            const double sag = p[v].z() - sagged[v].z();
+            ConstraintDesc d;
+            d.kind = ConstraintKind::Unilateral;
+            d.priority = 3;
+            // alternately held half-way up and far below (pulling, released)
+            d.rows.push_back({{{v, Vec3(0, 0, 1)}}, p[v].z() - (k++ % 3 == 0 ? 0.5 : 4.0) * sag});
+            ids.push_back(fem.addConstraint(d));
+        }
+        const double sag = p[tip].z() - sagged[tip].z();
+        for (double depth : {4.0, 0.5}) {
+            ConstraintDesc d;
+            d.kind = ConstraintKind::Unilateral;
+            d.priority = 3;
+            d.rows.push_back({{{tip, Vec3(0, 0, 1)}}, p[tip].z() - depth * sag});
+            ids.push_back(fem.addConstraint(d));
+        }
+    }
+};
+
+} // namespace
+
+TEST(CorotationalFem, ReleasedGroupsLeaveTheSchurFactorAsAFactorizationWouldDo) {
+    Floors floors;
+    FemSettings s = linearSettings();
+    FemSettings ref = s;
+    ref.incrementalSchur = false;
+    auto fem = CorotationalFem::create(*floors.bar.mesh, floors.bar.fixed, s, floors.bar.gravity);
+    auto plain = CorotationalFem::create(*floors.bar.mesh, floors.bar.fixed, ref, floors.bar.gravity);
+    const std::vector<Vec3> sagged = fem->positions();
+    floors.addTo(*fem, sagged);
+    floors.addTo(*plain, sagged);
+    ASSERT_GT(floors.ids.size(), 20u);
+    const FemSolveStats a = fem->solve(), b = plain->solve();
+    ASSERT_TRUE(a.finite && b.finite) << a.error << b.error;
+    EXPECT_GE(a.activeSetIterations, 2) << "a release, then the factor without the released rows";
+    EXPECT_EQ(a.activeSetIterations, b.activeSetIterations);
+    EXPECT_EQ(a.rows, b.rows);
+    EXPECT_EQ(a.redundant + a.incompatible, b.redundant + b.incompatible);
+    int held = 0, released = 0;
+    const size_t half = floors.ids.size() / 2;
+    for (size_t i = 0; i < half; ++i) {
+        const int id = floors.ids[i];
+        ASSERT_EQ(fem->state(id).active, plain->state(id).active) << "group " << id;
+        held += fem->state(id).active;
+        released += !fem->state(id).active;
+        EXPECT_NEAR(fem->state(id).lambda[0], plain->state(id).lambda[0],
+                    1e-10 * (1 + std::abs(plain->state(id).lambda[0])));
+    }
+    EXPECT_GT(held, 0);
+    EXPECT_GT(released, 0);
+    // The tip's second floor (half-way up) is enforced once the first (far below, pulling) is released.
+    const int first = floors.ids[floors.ids.size() - 2], second = floors.ids.back();
+    EXPECT_FALSE(fem->state(first).active);
+    EXPECT_TRUE(fem->state(second).active);
+    EXPECT_EQ(fem->state(second).status[0], RowStatus::Enforced);
+    EXPECT_EQ(plain->state(second).status[0], RowStatus::Enforced);
+    const double scale = maxDistance(sagged, fem->restPositions());
+    EXPECT_LT(maxDistance(fem->positions(), plain->positions()), 1e-10 * scale);
+}
+
+TEST(CorotationalFem, AStepOfSeveralSolvesDoesItsAmortizedWorkOnce) {
+    const Drag d;
+    FemSettings s;
+    s.refactorMode = RefactorMode::Synchronous;
+    s.refactorDisplacement = 1e9;
+    s.prefetchNodesPerSolve = 2;
+    auto stepped = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
+    auto plain = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
+    std::vector<int32_t> ahead;
+    for (int32_t v = static_cast<int32_t>(plain->nodeCount()) - 1; ahead.size() < 8; --v)
+        if (!plain->isFixed(v)) ahead.push_back(v);
+    stepped->prefetchNodes(ahead);
+    plain->prefetchNodes(ahead);
+    for (int step = 0; step < 2; ++step) {
+        stepped->beginStep();
+        for (int solve = 0; solve < 3; ++solve) {
+            const FemSolveStats a = stepped->solve(), b = plain->solve();
+            ASSERT_TRUE(a.finite && b.finite);
+            EXPECT_EQ(a.newCachedNodes, solve == 0 ? 2 : 0) << "step " << step << ", solve " << solve;
+            EXPECT_EQ(a.substitutions, solve == 0 ? 6 : 0);
+            EXPECT_EQ(b.newCachedNodes, std::max(0, std::min(2, 8 - 2 * (3 * step + solve))))
+                << "no steps: every solve";
+        }
+    }
+    EXPECT_EQ(stepped->cachedNodes(), 4);
+    EXPECT_EQ(plain->cachedNodes(), 8);
+    EXPECT_LT(maxDistance(stepped->positions(), plain->positions()), 1e-15) << "work moved, results unchanged";
+}
+
+TEST(CorotationalFem, AStepOfSeveralSolvesCarriesOneNodePerFurtherSolve) {
+    // Background refactorization with 4 carried nodes per solve (28 carried: 24 pinned, 4 constrained)
+    // and steps of three solves: a step's first solve computes 4
+    // nodes' columns (12 substitutions), its further solves one node (3); the swap still comes.
+    const Drag d;
+    FemSettings s;
+    s.refactorMode = RefactorMode::Background;
+    s.refactorDisplacement = 0.05;
+    s.refactorLatencySteps = 1;
+    s.refactorNodesPerSolve = 4;
+    auto plain = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
+    auto stepped = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
+    std::vector<int32_t> pins;
+    for (int32_t v = 0; pins.size() < 24; ++v)
+        if (!plain->isFixed(v)) pins.push_back(v);
+    for (auto* fem : {plain.get(), stepped.get()}) { // pinned and cached: carried by every refactorization
+        fem->pinNodes(pins);
+        fem->prefetchNodes(pins);
+    }
+    const int ip = d.constrain(*plain), is = d.constrain(*stepped);
+    auto solvesToSwap = [](std::vector<int>& started, std::vector<int>& swapped) {
+        std::vector<int> out;
+        for (size_t i = 0; i < std::min(started.size(), swapped.size()); ++i)
+            out.push_back(swapped[i] - started[i]);
+        return out;
+    };
+    std::vector<int> startedP, swappedP, startedS, swappedS;
+    int carriedFirst = 0, carriedFurther = 0;
+    for (int k = 0; k < 90; ++k) {
+        if (k % 3 == 0) stepped->beginStep();
+        d.target(*plain, ip, k / 3);
+        d.target(*stepped, is, k / 3);
+        const bool pending = stepped->refactorPending();
+        const FemSolveStats a = plain->solve(), b = stepped->solve();
+        ASSERT_TRUE(a.finite && b.finite) << a.error << b.error;
+        if (a.refactorStarted) startedP.push_back(k);
+        if (a.refactored) swappedP.push_back(k);
+        if (b.refactorStarted) startedS.push_back(k);
+        if (b.refactored) swappedS.push_back(k);
+        if (pending && !b.refactored && b.newCachedNodes == 0 && b.substitutions > 1) {
+            const int carried = b.substitutions - b.substitutions % 3; // less the substitution of u
+            EXPECT_LE(carried, k % 3 == 0 ? 12 : 3) << "solve " << k;  // less when the last nodes are done
+            carriedFirst += k % 3 == 0 && carried == 12;
+            carriedFurther += k % 3 != 0 && carried == 3;
+        }
+    }
+    EXPECT_GT(carriedFirst, 0);
+    EXPECT_GT(carriedFurther, 0);
+    ASSERT_GE(swappedS.size(), 1u) << "the new factor still takes effect";
+    const std::vector<int> p = solvesToSwap(startedP, swappedP), q = solvesToSwap(startedS, swappedS);
+    ASSERT_FALSE(p.empty());
+    EXPECT_GT(q[0], p[0]) << "fewer substitutions per solve, more solves to the swap";
+    EXPECT_LE(q[0], 1 + 24 + 4 + 1) << "at least one node per solve";
+}
