@@ -8,6 +8,7 @@
 #include "render/headless.hpp"
 #include "render/scene_view.hpp"
 #include "runtime/realtime_watch.hpp"
+#include "runtime/render_pacer.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/log.hpp"
 
@@ -67,54 +68,71 @@ public:
     void refresh() {
         if (!m_renderer) return;
         {
+            // Only the copy holds the view's lock (the physics thread publishes under it every
+            // frame); the cut, normals and heat are worked out after.
             std::lock_guard<std::mutex> lock(m_live.mutex);
-            if (m_live.nodes.size() == m_offset) {
-                // The fat's cut first: its cut mesh's slots name the nodes the copy below reads.
-                for (size_t b = 0; b < m_live.bodyTetMasks.size(); ++b)
-                    if (!m_live.bodyTetMasks[b].empty()) m_view.setBodyCut(b, m_live.bodyTetMasks[b]);
-                for (size_t i = 0; i < m_view.meshes().size(); ++i) {
-                    render::RenderMesh& m = m_view.meshes()[i];
-                    const std::vector<sim::Vec3>* src = nullptr;
-                    size_t base = 0;
-                    if (m.source == render::RenderMesh::Source::Body && m.sourceIndex < m_bodyOffset.size()) {
-                        src = &m_live.nodes;
-                        base = m_bodyOffset[m.sourceIndex];
-                    } else if (m.source == render::RenderMesh::Source::Surface &&
-                               m.sourceIndex < m_live.surfaces.size()) {
-                        src = &m_live.surfaces[m.sourceIndex];
-                    }
-                    if (!src) continue;
-                    const size_t end =
-                        m.source == render::RenderMesh::Source::Body && m.sourceIndex + 1 < m_bodyOffset.size()
-                            ? m_bodyOffset[m.sourceIndex + 1]
-                            : src->size();
-                    for (size_t v = 0; v < m.sourceVertex.size(); ++v) {
-                        if (m.sourceVertex[v] < 0) continue;
-                        const size_t k = base + static_cast<size_t>(m.sourceVertex[v]);
-                        if (k >= end || k >= src->size()) continue;
-                        for (int r = 0; r < 3; ++r)
-                            m.positions[3 * v + r] = static_cast<float>((*src)[k][r]);
-                    }
-                    m_view.recomputeNormals(i);
-                    // The cut [A §5.3.1]: dropped faces and the heat tint along it.
-                    const size_t s = m.sourceIndex;
-                    const std::vector<float>* heat = nullptr;
-                    if (m.source == render::RenderMesh::Source::Surface) {
-                        if (s < m_live.surfaceMasks.size() && m_live.surfaceMasks[s].size() == m.triangleCount())
-                            m_view.setFaceMask(i, m_live.surfaceMasks[s]);
-                        if (s < m_live.surfaceHeat.size()) heat = &m_live.surfaceHeat[s];
-                    } else if (s < m_live.bodyHeat.size()) {
-                        heat = &m_live.bodyHeat[s];
-                    }
-                    if (heat && !heat->empty()) m_view.setSourceHeat(i, *heat);
-                }
-                m_tools.update(m_view, m_live.tools);
-            }
+            m_snap.nodes = m_live.nodes;
+            m_snap.surfaces = m_live.surfaces;
+            m_snap.surfaceMasks = m_live.surfaceMasks;
+            m_snap.surfaceHeat = m_live.surfaceHeat;
+            m_snap.bodyTetMasks = m_live.bodyTetMasks;
+            m_snap.bodyHeat = m_live.bodyHeat;
+            m_snap.tools = m_live.tools;
         }
+        if (m_snap.nodes.size() == m_offset) apply(m_snap);
         m_frameMs = m_renderer->renderFrame(m_view).totalMs;
         const render::Image img = m_renderer->readPixels();
         QImage q(img.rgba.data(), img.width, img.height, img.width * 4, QImage::Format_RGBA8888);
         m_image = q.copy(); // own the pixels
+    }
+
+    /// The copied geometry into the render meshes.
+    struct Geometry {
+        std::vector<sim::Vec3> nodes;
+        std::vector<std::vector<sim::Vec3>> surfaces;
+        std::vector<std::vector<uint8_t>> surfaceMasks, bodyTetMasks;
+        std::vector<std::vector<float>> surfaceHeat, bodyHeat;
+        render::ToolPoses tools;
+    };
+    void apply(const Geometry& g) {
+        // The fat's cut first: its cut mesh's slots name the nodes the copy below reads.
+        for (size_t b = 0; b < g.bodyTetMasks.size(); ++b)
+            if (!g.bodyTetMasks[b].empty()) m_view.setBodyCut(b, g.bodyTetMasks[b]);
+        for (size_t i = 0; i < m_view.meshes().size(); ++i) {
+            render::RenderMesh& m = m_view.meshes()[i];
+            const std::vector<sim::Vec3>* src = nullptr;
+            size_t base = 0;
+            if (m.source == render::RenderMesh::Source::Body && m.sourceIndex < m_bodyOffset.size()) {
+                src = &g.nodes;
+                base = m_bodyOffset[m.sourceIndex];
+            } else if (m.source == render::RenderMesh::Source::Surface && m.sourceIndex < g.surfaces.size()) {
+                src = &g.surfaces[m.sourceIndex];
+            }
+            if (!src) continue;
+            const size_t end = m.source == render::RenderMesh::Source::Body && m.sourceIndex + 1 < m_bodyOffset.size()
+                                   ? m_bodyOffset[m.sourceIndex + 1]
+                                   : src->size();
+            for (size_t v = 0; v < m.sourceVertex.size(); ++v) {
+                if (m.sourceVertex[v] < 0) continue;
+                const size_t k = base + static_cast<size_t>(m.sourceVertex[v]);
+                if (k >= end || k >= src->size()) continue;
+                for (int r = 0; r < 3; ++r)
+                    m.positions[3 * v + r] = static_cast<float>((*src)[k][r]);
+            }
+            m_view.recomputeNormals(i);
+            // The cut [A §5.3.1]: dropped faces and the heat tint along it.
+            const size_t s = m.sourceIndex;
+            const std::vector<float>* heat = nullptr;
+            if (m.source == render::RenderMesh::Source::Surface) {
+                if (s < g.surfaceMasks.size() && g.surfaceMasks[s].size() == m.triangleCount())
+                    m_view.setFaceMask(i, g.surfaceMasks[s]);
+                if (s < g.surfaceHeat.size()) heat = &g.surfaceHeat[s];
+            } else if (s < g.bodyHeat.size()) {
+                heat = &g.bodyHeat[s];
+            }
+            if (heat && !heat->empty()) m_view.setSourceHeat(i, *heat);
+        }
+        m_tools.update(m_view, g.tools);
     }
 
 private:
@@ -124,6 +142,7 @@ private:
         return false;
     }
     LiveView& m_live;
+    Geometry m_snap; ///< the last copy of the session's geometry (GUI thread)
     render::SceneView m_view;
     render::ToolMeshes m_tools;
     std::unique_ptr<render::HeadlessRenderer> m_renderer;
@@ -152,7 +171,7 @@ public:
         {
             std::lock_guard<std::mutex> lock(m_live.mutex);
             s = m_live.state;
-            nodes = m_live.nodes;
+            if (!m_viewport || !m_viewport->available()) nodes = m_live.nodes; // the side view only
             radius = m_live.toolRadius;
             instruments = m_live.tools.instruments;
         }
@@ -382,6 +401,10 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
     options.live = &live;
     options.stop = &stop;
     const std::string title = loaded.package->manifest().title.value_or(loaded.package->manifest().caseId);
+    // Mesa's software rasterizer (no GPU) renders with one thread, so that a render takes one
+    // core and the physics keeps the other instead of both stopping for it; set before the first
+    // GL context, before any other thread starts; a GPU driver ignores it; the user's value stands.
+    setenv("LP_NUM_THREADS", "1", 0);
     Viewport3D viewport(loaded, live, 640, 480);
     if (!viewport.available()) log::warn("3D view off (side view instead): " + viewport.whyNot());
     TraineeWindow window(live, title, loaded.scene.instructions, dynamic_cast<KeyboardDevice*>(options.device), stop,
@@ -391,28 +414,19 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
     std::thread physics([&] { result = runSession(loaded, options); });
     bool failed = false;
     QTimer timer;
-    // The 3D view never takes time the physics needs: it renders when the physics has kept up
-    // (its frames no later than the least they have been since the warm-up, plus one frame) and
-    // at most a quarter of the time (after a render of R ms the next waits at least 4 R: a
-    // software renderer without a GPU spends tens of ms per frame of the cores the physics
-    // needs; with a GPU, R ~ 1 ms, the view follows the timer's 30 Hz), and at least once a
-    // second. The HUD repaints at every tick.
+    // The 3D view never takes time the physics needs (RenderPacer); the HUD repaints at every tick.
     QElapsedTimer sinceRender;
-    double leastLagMs = -1;
+    RenderPacer pacer;
     QObject::connect(&timer, &QTimer::timeout, [&] {
         bool finished;
-        double lagMs = 0, frameMs = 0;
+        LiveState state;
         {
             std::lock_guard<std::mutex> lock(live.mutex);
             finished = live.finished;
-            lagMs = live.state.lagMs;
-            if (live.state.frame > 0) frameMs = 1e3 * live.state.time_s / live.state.frame;
-            if (live.state.frame > static_cast<int>(RealTimeWatch::kWarmupFrames))
-                leastLagMs = leastLagMs < 0 ? lagMs : std::min(leastLagMs, lagMs);
+            state = live.state;
         }
-        const bool keptUp = leastLagMs < 0 || lagMs <= leastLagMs + frameMs;
-        const qint64 since = sinceRender.isValid() ? sinceRender.elapsed() : 0;
-        if (finished || !sinceRender.isValid() || (keptUp && since >= 4 * viewport.lastFrameMs()) || since >= 1000) {
+        const double since = sinceRender.isValid() ? double(sinceRender.elapsed()) : -1.0;
+        if (pacer.due(state, finished, since, viewport.lastFrameMs())) {
             sinceRender.start();
             viewport.refresh();
         }
