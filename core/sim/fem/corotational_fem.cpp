@@ -133,6 +133,8 @@ struct CorotationalFem::Impl {
         bool ok = false;
         std::string error;
         std::atomic<bool> finished{false};
+        std::chrono::steady_clock::time_point started{}; // when the worker began
+        double seconds = 0;                              // the build's wall time (worker or here)
         bool joined = false;
         std::vector<int> nodes; // carried nodes, in order; columns of the first `done` are in cols
         int done = 0;
@@ -141,6 +143,7 @@ struct CorotationalFem::Impl {
     std::shared_ptr<Job> job;
     std::thread worker;
     std::vector<std::pair<std::thread, std::shared_ptr<Job>>> retired; // late workers, joined when done
+    double lastBuildSeconds = 0; // wall time of the last factor built (0: none yet)
     int swapStep = 0;
     std::vector<uint8_t> pinned; // per node: kept in the cache and carried by a refactorization
     std::vector<int> prefetch;   // nodes queued for caching ahead of use (FIFO)
@@ -316,24 +319,28 @@ struct CorotationalFem::Impl {
         if (!job) return;
         if (!job->joined) {
             if (step < swapStep) return;
-            if (job->finished.load(std::memory_order_acquire)) {
+            if (awaitWorker()) {
                 worker.join();
             } else {
-                // The worker is late (a core busy with other work): compute the same factor here, from
-                // the same positions, instead of waiting for it without bound. Same input, same code,
-                // same bits; the late worker finishes on its own and its result is dropped.
+                // The worker is late past the time a build took last (a core busy with other work):
+                // compute the same factor here, from the same positions, instead of waiting for it
+                // without bound. Same input, same code, same bits; the late worker finishes on its
+                // own and its result is dropped.
                 st.refactorWaited = true;
                 auto mine = std::make_shared<Job>();
                 mine->x = job->x;
+                const auto t0 = std::chrono::steady_clock::now();
                 try {
                     mine->ok = buildFactor(mine->x, mine->result, mine->error);
                 } catch (const std::exception& e) {
                     mine->ok = false;
                     mine->error = e.what();
                 }
+                mine->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
                 retired.emplace_back(std::move(worker), std::move(job));
                 job = std::move(mine);
             }
+            if (job->ok) lastBuildSeconds = job->seconds;
             job->joined = true;
             if (!job->ok) {
                 st.error = "background refactorization failed (the previous factor stays in use): " + job->error;
@@ -400,6 +407,21 @@ struct CorotationalFem::Impl {
         st.refactored = true;
     }
 
+    /// True once the worker has finished: at once, or after waiting until the worker has run as
+    /// long as the last build took (it is then at most that far from done, where a build here
+    /// would take all of it and share the cores with the worker). False: still running then.
+    bool awaitWorker() const {
+        if (job->finished.load(std::memory_order_acquire)) return true;
+        if (!(lastBuildSeconds > 0)) return false;
+        const auto until = job->started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                              std::chrono::duration<double>(lastBuildSeconds));
+        while (std::chrono::steady_clock::now() < until) {
+            if (job->finished.load(std::memory_order_acquire)) return true;
+            std::this_thread::sleep_for(std::chrono::microseconds(200));
+        }
+        return job->finished.load(std::memory_order_acquire);
+    }
+
     void startJob(const std::vector<Vec3>& x) {
         for (auto it = retired.begin(); it != retired.end();)
             if (it->second->finished.load(std::memory_order_acquire)) {
@@ -412,6 +434,7 @@ struct CorotationalFem::Impl {
         job->x = x;
         swapStep = step + s.refactorLatencySteps;
         std::shared_ptr<Job> jp = job;
+        jp->started = std::chrono::steady_clock::now();
         worker = std::thread([this, jp] {
             try {
                 jp->ok = buildFactor(jp->x, jp->result, jp->error);
@@ -419,6 +442,7 @@ struct CorotationalFem::Impl {
                 jp->ok = false;
                 jp->error = e.what();
             }
+            jp->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - jp->started).count();
             jp->finished.store(true, std::memory_order_release);
         });
     }
@@ -537,7 +561,9 @@ std::unique_ptr<CorotationalFem> CorotationalFem::create(const TetMesh& mesh, co
     m.uMemo.assign(nv, Vec3::Zero());
     m.pinned.assign(nv, 0);
     std::string error;
+    const auto t0 = std::chrono::steady_clock::now();
     if (!m.buildFactor(w->m_x0, m.cur, error)) fail(error);
+    m.lastBuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     w->m_factorizations = 1;
     for (size_t v = 0; v < nv; ++v)
         w->m_x[v] = w->m_x0[v] + m.cur.u0.segment<3>(3 * v);
