@@ -189,12 +189,17 @@ TEST(PlayerHaptics, ScriptedSessionIsRepeatableAndReportsTaskMetrics) {
     EXPECT_EQ(csv.find("nan"), std::string::npos);
 }
 
-TEST(PlayerHaptics, ReplaysARecordedTrajectory) {
-    Scratch s;
+/// The haptic slab case and a 3 s "press" trajectory recorded by the console simulator.
+static void writeSlabAndPress(const Scratch& s) {
     test::writeHapticCase(s / "slab.vcase");
     auto w = test::runProcess(VISCERA_CONSOLE_SIM_EXE,
                               {"--write-trajectory", s / "press.csv", "--script", "press", "--duration", "3"});
     ASSERT_EQ(w.exitCode, 0) << w.err;
+}
+
+TEST(PlayerHaptics, ReplaysARecordedTrajectory) {
+    Scratch s;
+    ASSERT_NO_FATAL_FAILURE(writeSlabAndPress(s));
     EXPECT_NO_THROW(haptics::Trajectory::load(s / "press.csv"));
     auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "120", "--device",
                      "replay:" + (s / "press.csv"), "--report", s / "r.json"});
@@ -237,10 +242,7 @@ static std::vector<std::array<long long, 3>> tracedDevicePositions(const std::st
 
 TEST(PlayerHaptics, RealTimeReplayTakesTheLockstepRunsInput) {
     Scratch s;
-    test::writeHapticCase(s / "slab.vcase");
-    auto w = test::runProcess(VISCERA_CONSOLE_SIM_EXE,
-                              {"--write-trajectory", s / "press.csv", "--script", "press", "--duration", "3"});
-    ASSERT_EQ(w.exitCode, 0) << w.err;
+    ASSERT_NO_FATAL_FAILURE(writeSlabAndPress(s));
     auto run = [&](const std::string& mode, const std::string& frames, const std::string& tag) {
         auto r =
             player({"run", s / "slab.vcase", "--headless", "--frames", frames, mode, "--device",
