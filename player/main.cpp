@@ -244,6 +244,10 @@ int cmdRun(const std::vector<std::string>& args) {
     // Refused up front, before any work.
     if (!headless) {
         if (auto why = player::windowModeUnavailable(); !why.empty()) return fail(kExitUsage, why);
+        // Mesa's software rasterizer (no GPU) renders the window's view with one thread, so that
+        // a render takes one core and the physics keeps the other instead of both stopping for
+        // it; a GPU driver ignores it; the user's value stands. Set here, before any thread.
+        setenv("LP_NUM_THREADS", "1", 0);
     }
     std::optional<haptics::DeviceSpec> spec;
     if (device) {

@@ -119,7 +119,7 @@ ServoLoop::~ServoLoop() {
 
 void ServoLoop::tick(int64_t now, int64_t due) {
     const int64_t t0 = monotonicNs();
-    m_device.poll(due, m_state);
+    m_device.poll(m_device.capabilities().realtime ? now : due, m_state);
     const int64_t started = m_stepsStarted.load(std::memory_order_acquire);
     const LocalContactModel contact = m_contact.read();
     double age_s = -1;
@@ -197,8 +197,9 @@ void ServoLoop::tick(int64_t now, int64_t due) {
     poses.safetyRules = rules;
     for (int a = 0; a < arms; ++a)
         poses.force[a] = m_out.arms[a].servo_cf.force.norm();
+    m_history[poses.tick % kPoseHistory].write(poses); // before the latest: poseBefore reads it so
     m_poses.write(poses);
-    m_history[poses.tick % kPoseHistory].write(poses);
+    if (poses.tick == 1) m_firstDue.store(due, std::memory_order_release);
     for (int a = 0; a < arms; ++a) {
         if (!m_config.tools[a].enabled) continue;
         TraceSample s;

@@ -84,7 +84,7 @@ struct TraceSample {
 enum class PoseLookup {
     Found,   ///< the last tick before the time; a later tick has run, so it is final
     NotYet,  ///< no tick at or after the time has run yet
-    Dropped, ///< every kept tick is at or after the time: the reader is too far behind
+    Dropped, ///< the ticks before the time are no longer kept (or were overwritten while searched)
 };
 
 /// Percentiles from a 1 µs histogram.
@@ -147,12 +147,16 @@ public:
     PoseLookup poseBefore(int64_t t_ns, ToolPoseState& out) const;
 
     // ---- servo ----------------------------------------------------------------------------------
-    /// One tick at time now_ns (the servo thread calls it; lockstep callers too).
+    /// One tick at time now_ns (lockstep callers: a ManualClock's time is its deadline).
     void tick(int64_t now_ns) { tick(now_ns, now_ns); }
-    /// One tick at now_ns for its deadline due_ns (<= now_ns): the device is polled and the tool
-    /// poses stamped at the deadline, so that the input of tick n is the input lockstep gives it
-    /// whatever the wake-up latency; the contact model's age and the safety filter use now_ns.
+    /// One tick at now_ns for its deadline due_ns (<= now_ns; the servo thread): the tool poses
+    /// are stamped at the deadline and a device on recorded time (replay, scripted: not
+    /// DeviceCapabilities::realtime) is polled there, so that the input of tick n is the input
+    /// lockstep gives it whatever the wake-up latency; a live device is polled at now_ns, and the
+    /// contact model's age and the safety filter use now_ns.
     void tick(int64_t now_ns, int64_t due_ns);
+    /// The first tick's deadline (its poses' timestamp); INT64_MIN before it ran.
+    int64_t firstTickNs() const { return m_firstDue.load(std::memory_order_acquire); }
     /// Runs ticks on a thread at config.rateHz until stop().
     void start();
     void stop();
@@ -192,6 +196,7 @@ private:
     std::atomic<int64_t> m_modelsSeen{0}, m_stepsStarted{0}, m_maxBehind{0};
     std::atomic<bool> m_running{false}, m_rt{false};
     std::atomic<int> m_cpu{-1};
+    std::atomic<int64_t> m_firstDue{INT64_MIN};
     std::string m_priorityNote; ///< written by the servo thread before its first tick
     std::thread m_thread;
     // tick state (servo thread only)

@@ -245,14 +245,12 @@ void HapticRig::start() {
         m_servo->start();
         // The session's time zero is the servo's first tick, as in lockstep (where the first tick
         // runs at 0 and a replay starts at its first poll): frame k is due when the ticks before
-        // (k+1)·dt from it have run.
-        const int64_t waitUntil = m_clock->now_ns() + 100'000'000;
-        haptics::ToolPoseState first = m_servo->toolPoses();
-        while (first.tick == 0 && m_clock->now_ns() < waitUntil) {
+        // (k+1)·dt from it have run. A servo that has not ticked within a second leaves the start
+        // time (its frames then count as without input).
+        const int64_t waitUntil = m_clock->now_ns() + 1'000'000'000;
+        while (m_servo->firstTickNs() == INT64_MIN && m_clock->now_ns() < waitUntil)
             haptics::sleepUntilNs(m_clock->now_ns() + 100'000);
-            first = m_servo->toolPoses();
-        }
-        if (first.tick != 0) m_t0 = first.timestamp_ns;
+        if (m_servo->firstTickNs() != INT64_MIN) m_t0 = m_servo->firstTickNs();
         // The caller has kept this thread off the servo's CPU before the world was built, so the
         // solver's workers are off it too (player main); recorded for the report.
         m_physicsCpus = haptics::allowedCpus();
@@ -272,8 +270,8 @@ void HapticRig::beforeStep() {
         m_manual->set(end);
     }
     if (m_realtime) measureLag(m_t0 + end);
-    m_servo->notifyStepStart();
     const haptics::ToolPoseState poses = m_realtime ? framePoses(m_t0 + end) : m_servo->toolPoses();
+    m_servo->notifyStepStart();
     sim::InteractionRuntime* interaction = m_world.interaction();
     std::array<int, kMaxArms> active{-1, -1};
     if (poses.tick != 0)
@@ -361,7 +359,12 @@ haptics::ToolPoseState HapticRig::framePoses(int64_t due) {
     haptics::ToolPoseState p;
     while (true) {
         const haptics::PoseLookup found = m_servo->poseBefore(due, p);
-        if (found == haptics::PoseLookup::Found) return p;
+        if (found == haptics::PoseLookup::Found) {
+            // A servo that overran skipped the ticks just before `due`: the input is an earlier one.
+            const int64_t period = std::llround(1e9 / m_servoConfig.rateHz);
+            if (p.timestamp_ns < due - period) ++m_inputEarlier;
+            return p;
+        }
         if (found == haptics::PoseLookup::Dropped || m_clock->now_ns() > giveUp) {
             ++m_inputMissed;
             return m_servo->toolPoses();
@@ -458,6 +461,7 @@ HapticsResult HapticRig::result() const {
     r.lagMaxMs = m_lagMaxMs;
     r.framesLate = m_framesLate;
     r.inputMissed = m_inputMissed;
+    r.inputEarlier = m_inputEarlier;
     r.lagGrowthMaxMs = m_lagGrowthMaxMs;
     r.traceSamples = m_samples;
     return r;
@@ -473,6 +477,8 @@ LiveState HapticRig::live() const {
     s.safetyRules = p.safetyRules;
     s.maxForce_n = m_caseMaxForce;
     s.lagMs = m_lagMs;
+    if (m_frame > static_cast<int64_t>(RealTimeWatch::kWarmupFrames))
+        s.lagGrowthMs = std::max(0.0, m_lagMs - m_lagAtWarmupMs);
     const sim::InteractionRuntime* interaction = m_world.interaction();
     for (int a = 0; a < kMaxArms; ++a) {
         s.force[a] = p.force[a];

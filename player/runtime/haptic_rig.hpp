@@ -71,6 +71,9 @@ struct HapticsResult {
     /// ServoLoop::kPoseHistory ticks behind) or did not come (a servo stalled over 50 ms); they
     /// took the latest tick's poses instead, so the input differs from the lockstep run's.
     int64_t inputMissed = 0;
+    /// Real time: frames whose input came from a tick before the frame's last one because the
+    /// servo overran and skipped ticks (a VM stall): their input is up to the stall earlier.
+    int64_t inputEarlier = 0;
     /// Real time: the largest growth of that lag after the warm-up frames (RealTimeWatch), ms: how
     /// far the session fell behind once running (a slow start shifts the whole session instead).
     double lagGrowthMaxMs = 0;
@@ -97,6 +100,8 @@ struct LiveState {
     double realTimeFactor = 0;
     /// Real time: how late the frame started against the wall clock, ms (HapticsResult::lagMaxMs).
     double lagMs = 0;
+    /// Real time: how much further behind than after the warm-up (HapticsResult::lagGrowthMaxMs).
+    double lagGrowthMs = 0;
     /// Set by the session once it estimated that this machine cannot keep real time (shown in red).
     std::string realTimeWarning;
 };
@@ -176,7 +181,7 @@ private:
     double m_lagMs = 0, m_lagSumMs = 0, m_lagMaxMs = 0; ///< real time: frame start against the wall clock
     double m_lagAtWarmupMs = 0, m_lagGrowthMaxMs = 0;   ///< the lag after the warm-up, and its growth since
     int64_t m_framesLate = 0;
-    int64_t m_inputMissed = 0;
+    int64_t m_inputMissed = 0, m_inputEarlier = 0;
     std::vector<TraceRow> m_trace;
     uint64_t m_samples = 0;
     TaskMetrics m_metrics;

@@ -44,10 +44,11 @@ std::string RealTimeWatch::verdict(const std::vector<sim::FrameRecord>& frames, 
     const bool slow = ms > frameMs;
     const bool late = lagGrowthMs > kMaxLagMs;
     if (!slow && !late && inputMissed == 0) return {};
-    std::string e = "real time: the physics fell behind the wall clock (mean step " + fixed(ms, 1) +
-                    " ms against the " + fixed(frameMs, 1) + " ms frame; after the first " +
-                    std::to_string(kWarmupFrames) + " frames they fell up to " + fixed(lagGrowthMs, 0) +
-                    " ms further behind, allowed " + fixed(kMaxLagMs, 0) + " ms";
+    std::string e = std::string(slow || late ? "real time: the physics fell behind the wall clock"
+                                             : "real time: frames lost their input") +
+                    " (mean step " + fixed(ms, 1) + " ms against the " + fixed(frameMs, 1) +
+                    " ms frame; after the first " + std::to_string(kWarmupFrames) + " frames they fell up to " +
+                    fixed(lagGrowthMs, 0) + " ms further behind, allowed " + fixed(kMaxLagMs, 0) + " ms";
     if (inputMissed > 0) e += "; " + std::to_string(inputMissed) + " frames lost their own input";
     return e + "): the picture trailed the hands and the forces went stale, so this session was not the authored one";
 }

@@ -66,11 +66,13 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
         servo["physics_realtime_priority"] = h.physicsRealtimePriority;
         servo["physics_cpus"] = h.physicsCpus;
         // How far the frames trailed the wall clock, and how many lacked their own instant's input
-        // (HapticsResult): with none missed, the device input is the lockstep run's.
+        // (HapticsResult): with none missed or earlier, the device's poses, buttons and pedals are
+        // the lockstep run's (the proxies also depend on the contact model each tick saw).
         servo["frame_lag_ms"] = {
             {"mean", h.lagMeanMs}, {"max", h.lagMaxMs}, {"max_growth_after_warmup", h.lagGrowthMaxMs}};
         servo["frames_late"] = h.framesLate;
         servo["frames_input_missed"] = h.inputMissed;
+        servo["frames_input_from_an_earlier_tick"] = h.inputEarlier;
     }
     const auto& a = s.contactAge;
     json contact = {
@@ -403,8 +405,9 @@ std::string summaryText(const SessionResult& r) {
             out += line;
             std::snprintf(line, sizeof line,
                           "pacing        frames started late against the wall clock: mean %.1f ms, max %.1f ms, %lld "
-                          "over one frame, %lld without their own input; servo %s, %s\n",
+                          "over one frame, %lld without their own input, %lld from an earlier tick; servo %s, %s\n",
                           h.lagMeanMs, h.lagMaxMs, (long long)h.framesLate, (long long)h.inputMissed,
+                          (long long)h.inputEarlier,
                           h.servo.wait == haptics::ServoWait::Busy
                               ? "busy"
                               : ("sleep, spin " + std::to_string(h.servo.spinNs / 1000) + " us").c_str(),

@@ -298,7 +298,7 @@ public:
             p.setPen(QColor(230, 80, 60));
             p.drawText(px, h - 76, "Not real time on this machine:");
             p.drawText(px, h - 56, "the picture trails your hands");
-        } else if (s.frame > 0 && s.lagMs > RealTimeWatch::kMaxLagMs) { // fell behind later
+        } else if (s.frame > 0 && s.lagGrowthMs > RealTimeWatch::kMaxLagMs) { // fell behind later (not a slow start)
             p.setPen(QColor(230, 80, 60));
             p.drawText(px, h - 76, QString::asprintf("Behind real time by %.1f s:", 1e-3 * s.lagMs));
             p.drawText(px, h - 56, "the picture trails your hands");
@@ -401,10 +401,6 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
     options.live = &live;
     options.stop = &stop;
     const std::string title = loaded.package->manifest().title.value_or(loaded.package->manifest().caseId);
-    // Mesa's software rasterizer (no GPU) renders with one thread, so that a render takes one
-    // core and the physics keeps the other instead of both stopping for it; set before the first
-    // GL context, before any other thread starts; a GPU driver ignores it; the user's value stands.
-    setenv("LP_NUM_THREADS", "1", 0);
     Viewport3D viewport(loaded, live, 640, 480);
     if (!viewport.available()) log::warn("3D view off (side view instead): " + viewport.whyNot());
     TraineeWindow window(live, title, loaded.scene.instructions, dynamic_cast<KeyboardDevice*>(options.device), stop,

@@ -259,7 +259,9 @@ TEST(ServoLoop, PoseHistoryGivesTheLastTickBeforeAnInstant) {
     EXPECT_EQ(p.timestamp_ns, (10'000 - kept + 99) * kMs);
 
     // Before the first tick the first tick's poses stand; a skipped tick (an overrun) is passed over.
+    EXPECT_EQ(r.servo->firstTickNs(), 0) << "the first tick's deadline: the session's time zero";
     Rig q;
+    EXPECT_EQ(q.servo->firstTickNs(), INT64_MIN) << "no tick yet";
     q.servo->tick(0, 0);
     q.servo->tick(kMs, kMs);
     q.servo->tick(5 * kMs, 4 * kMs); // ticks at 2 and 3 ms skipped

@@ -319,8 +319,11 @@ struct CorotationalFem::Impl {
         if (!job) return;
         if (!job->joined) {
             if (step < swapStep) return;
-            if (awaitWorker()) {
+            const bool onTime = job->finished.load(std::memory_order_acquire);
+            if (onTime || awaitWorker()) {
                 worker.join();
+                // The wait's bound: a build that finished before its join, undisturbed by one here.
+                if (onTime && job->ok) lastBuildSeconds = job->seconds;
             } else {
                 // The worker is late past the time a build took last (a core busy with other work):
                 // compute the same factor here, from the same positions, instead of waiting for it
@@ -340,7 +343,6 @@ struct CorotationalFem::Impl {
                 retired.emplace_back(std::move(worker), std::move(job));
                 job = std::move(mine);
             }
-            if (job->ok) lastBuildSeconds = job->seconds;
             job->joined = true;
             if (!job->ok) {
                 st.error = "background refactorization failed (the previous factor stays in use): " + job->error;
