@@ -283,7 +283,7 @@ void ServoLoop::run() {
             if (!ok) m_priorityNote = "SCHED_FIFO refused by the system (needs CAP_SYS_NICE or an rtprio limit)";
         }
     }
-    const int64_t period = static_cast<int64_t>(std::llround(1e9 / m_config.rateHz));
+    const int64_t period = periodNs();
     const int64_t clockOffset = m_clock.now_ns() - monotonicNs(); // deadlines on the servo clock
     int64_t next = monotonicNs() + period;
     int64_t prev = -1;

@@ -19,6 +19,7 @@
 #include "haptics/safety_filter.hpp"
 
 #include <atomic>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <thread>
@@ -169,6 +170,8 @@ public:
     uint64_t ticks() const { return m_ticks.load(std::memory_order_relaxed); }
     const SafetyFilter& safety() const { return m_safety; }
     const ServoConfig& config() const { return m_config; }
+    /// The tick period, ns (config().rateHz): ticks are due at whole periods from the first.
+    int64_t periodNs() const { return static_cast<int64_t>(std::llround(1e9 / m_config.rateHz)); }
 
 private:
     struct Histogram {

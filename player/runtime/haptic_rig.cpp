@@ -262,8 +262,9 @@ void HapticRig::beforeStep() {
     // (k+1) dt, in lockstep and in real time alike.
     const int64_t end = int64_t(std::llround(double(m_frame + 1) * m_dt * 1e9));
     if (m_manual) {
-        while (m_tick * 1'000'000 < end) {
-            m_manual->set(m_tick * 1'000'000);
+        const int64_t period = m_servo->periodNs();
+        while (m_tick * period < end) {
+            m_manual->set(m_tick * period);
             m_servo->tick(m_manual->now_ns());
             ++m_tick;
         }
@@ -346,8 +347,10 @@ void HapticRig::measureLag(int64_t due) {
     m_lagMaxMs = std::max(m_lagMaxMs, m_lagMs);
     if (m_lagMs > m_dt * 1e3) ++m_framesLate;
     if (m_frame == static_cast<int64_t>(RealTimeWatch::kWarmupFrames)) m_lagAtWarmupMs = m_lagMs;
-    if (m_frame >= static_cast<int64_t>(RealTimeWatch::kWarmupFrames))
-        m_lagGrowthMaxMs = std::max(m_lagGrowthMaxMs, m_lagMs - m_lagAtWarmupMs);
+    if (m_frame >= static_cast<int64_t>(RealTimeWatch::kWarmupFrames)) {
+        m_lagGrowthMs = m_lagMs - m_lagAtWarmupMs;
+        m_lagGrowthMaxMs = std::max(m_lagGrowthMaxMs, m_lagGrowthMs);
+    }
 }
 
 haptics::ToolPoseState HapticRig::framePoses(int64_t due) {
@@ -361,8 +364,7 @@ haptics::ToolPoseState HapticRig::framePoses(int64_t due) {
         const haptics::PoseLookup found = m_servo->poseBefore(due, p);
         if (found == haptics::PoseLookup::Found) {
             // A servo that overran skipped the ticks just before `due`: the input is an earlier one.
-            const int64_t period = std::llround(1e9 / m_servoConfig.rateHz);
-            if (p.timestamp_ns < due - period) ++m_inputEarlier;
+            if (p.timestamp_ns < due - m_servo->periodNs()) ++m_inputEarlier;
             return p;
         }
         if (found == haptics::PoseLookup::Dropped || m_clock->now_ns() > giveUp) {
@@ -477,8 +479,7 @@ LiveState HapticRig::live() const {
     s.safetyRules = p.safetyRules;
     s.maxForce_n = m_caseMaxForce;
     s.lagMs = m_lagMs;
-    if (m_frame > static_cast<int64_t>(RealTimeWatch::kWarmupFrames))
-        s.lagGrowthMs = std::max(0.0, m_lagMs - m_lagAtWarmupMs);
+    s.lagGrowthMs = std::max(0.0, m_lagGrowthMs);
     const sim::InteractionRuntime* interaction = m_world.interaction();
     for (int a = 0; a < kMaxArms; ++a) {
         s.force[a] = p.force[a];

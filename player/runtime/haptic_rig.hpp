@@ -179,7 +179,8 @@ private:
     double m_dt = 0, m_caseMaxForce = 15;
     int64_t m_frame = 0, m_t0 = 0, m_tick = 0;
     double m_lagMs = 0, m_lagSumMs = 0, m_lagMaxMs = 0; ///< real time: frame start against the wall clock
-    double m_lagAtWarmupMs = 0, m_lagGrowthMaxMs = 0;   ///< the lag after the warm-up, and its growth since
+    double m_lagAtWarmupMs = 0, m_lagGrowthMs = 0,
+           m_lagGrowthMaxMs = 0; ///< the lag after the warm-up, and its growth since
     int64_t m_framesLate = 0;
     int64_t m_inputMissed = 0, m_inputEarlier = 0;
     std::vector<TraceRow> m_trace;

@@ -205,27 +205,28 @@ void publishLive(const sim::World& world, const HapticRig* rig, const std::vecto
         ms += frames[k - 1].stepMs;
     lv.state.physicsMs = ms / static_cast<double>(n);
     lv.state.realTimeFactor = realTimeFactor(frameDt, lv.state.physicsMs);
-    lv.nodes.clear();
+    LiveGeometry& g = lv.geometry;
+    g.nodes.clear();
     for (size_t b = 0; b < world.bodyCount(); ++b)
-        lv.nodes.insert(lv.nodes.end(), world.positions(b).begin(), world.positions(b).end());
-    lv.surfaces.resize(world.surfaceCount());
-    lv.surfaceMasks.resize(world.surfaceCount());
-    lv.surfaceHeat.resize(world.surfaceCount());
+        g.nodes.insert(g.nodes.end(), world.positions(b).begin(), world.positions(b).end());
+    g.surfaces.resize(world.surfaceCount());
+    g.surfaceMasks.resize(world.surfaceCount());
+    g.surfaceHeat.resize(world.surfaceCount());
     for (size_t k = 0; k < world.surfaceCount(); ++k) {
-        lv.surfaces[k].assign(world.surfacePositions(k).begin(), world.surfacePositions(k).end());
+        g.surfaces[k].assign(world.surfacePositions(k).begin(), world.surfacePositions(k).end());
         if (const sim::InteractionRuntime* in = world.interaction(); in && in->dissects()) {
-            in->surfaceFaceMaskInto(k, lv.surfaceMasks[k]);
-            in->surfaceHeatInto(k, lv.surfaceHeat[k]);
+            in->surfaceFaceMaskInto(k, g.surfaceMasks[k]);
+            in->surfaceHeatInto(k, g.surfaceHeat[k]);
         }
     }
-    lv.bodyTetMasks.resize(world.bodyCount());
-    lv.bodyHeat.resize(world.bodyCount());
+    g.bodyTetMasks.resize(world.bodyCount());
+    g.bodyHeat.resize(world.bodyCount());
     for (size_t b = 0; b < world.bodyCount(); ++b)
         if (const sim::InteractionRuntime* in = world.interaction(); in && in->dissectsBody(b)) {
-            in->bodyTetMaskInto(b, lv.bodyTetMasks[b]);
-            in->bodyHeatInto(b, lv.bodyHeat[b]);
+            in->bodyTetMaskInto(b, g.bodyTetMasks[b]);
+            in->bodyHeatInto(b, g.bodyHeat[b]);
         }
-    lv.tools = render::toolPoses(world);
+    g.tools = render::toolPoses(world);
 }
 
 /// The device's figures at the end of a session with a rig.

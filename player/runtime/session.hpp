@@ -41,10 +41,8 @@ LoadedCase loadCase(const std::filesystem::path& casePath);
 /// fascia attached to them, and the case's material maps on the meshes they name.
 render::SceneView caseView(const LoadedCase& loaded);
 
-/// What the trainee window draws; the physics thread writes it after every frame.
-struct LiveView {
-    std::mutex mutex;
-    LiveState state;
+/// The session's geometry after a frame, as the trainee window's 3D view draws it.
+struct LiveGeometry {
     std::vector<sim::Vec3> nodes;                   ///< nodes of every body, m, scene
     std::vector<std::vector<sim::Vec3>> surfaces;   ///< nodes of every fascia surface, m, scene
     std::vector<std::vector<uint8_t>> surfaceMasks; ///< per surface: intact triangles (empty: no cut)
@@ -52,6 +50,13 @@ struct LiveView {
     std::vector<std::vector<uint8_t>> bodyTetMasks; ///< per body: intact tets (empty: not dissected)
     std::vector<std::vector<float>> bodyHeat;       ///< per body: node heat in [0, 1] (empty: none)
     render::ToolPoses tools;                        ///< instruments, probes, clips, needle, thread
+};
+
+/// What the trainee window draws; the physics thread writes it after every frame.
+struct LiveView {
+    std::mutex mutex;
+    LiveState state;
+    LiveGeometry geometry;
     std::vector<double> toolRadius;
     bool finished = false;
 };

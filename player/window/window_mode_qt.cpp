@@ -71,13 +71,7 @@ public:
             // Only the copy holds the view's lock (the physics thread publishes under it every
             // frame); the cut, normals and heat are worked out after.
             std::lock_guard<std::mutex> lock(m_live.mutex);
-            m_snap.nodes = m_live.nodes;
-            m_snap.surfaces = m_live.surfaces;
-            m_snap.surfaceMasks = m_live.surfaceMasks;
-            m_snap.surfaceHeat = m_live.surfaceHeat;
-            m_snap.bodyTetMasks = m_live.bodyTetMasks;
-            m_snap.bodyHeat = m_live.bodyHeat;
-            m_snap.tools = m_live.tools;
+            m_snap = m_live.geometry;
         }
         if (m_snap.nodes.size() == m_offset) apply(m_snap);
         m_frameMs = m_renderer->renderFrame(m_view).totalMs;
@@ -86,15 +80,9 @@ public:
         m_image = q.copy(); // own the pixels
     }
 
+private:
     /// The copied geometry into the render meshes.
-    struct Geometry {
-        std::vector<sim::Vec3> nodes;
-        std::vector<std::vector<sim::Vec3>> surfaces;
-        std::vector<std::vector<uint8_t>> surfaceMasks, bodyTetMasks;
-        std::vector<std::vector<float>> surfaceHeat, bodyHeat;
-        render::ToolPoses tools;
-    };
-    void apply(const Geometry& g) {
+    void apply(const LiveGeometry& g) {
         // The fat's cut first: its cut mesh's slots name the nodes the copy below reads.
         for (size_t b = 0; b < g.bodyTetMasks.size(); ++b)
             if (!g.bodyTetMasks[b].empty()) m_view.setBodyCut(b, g.bodyTetMasks[b]);
@@ -135,14 +123,13 @@ public:
         m_tools.update(m_view, g.tools);
     }
 
-private:
     static bool softwareGl(const std::string& device) {
         for (const char* name : {"llvmpipe", "softpipe", "swrast", "SwiftShader"})
             if (device.find(name) != std::string::npos) return true;
         return false;
     }
     LiveView& m_live;
-    Geometry m_snap; ///< the last copy of the session's geometry (GUI thread)
+    LiveGeometry m_snap; ///< the last copy of the session's geometry (GUI thread)
     render::SceneView m_view;
     render::ToolMeshes m_tools;
     std::unique_ptr<render::HeadlessRenderer> m_renderer;
@@ -171,9 +158,9 @@ public:
         {
             std::lock_guard<std::mutex> lock(m_live.mutex);
             s = m_live.state;
-            if (!m_viewport || !m_viewport->available()) nodes = m_live.nodes; // the side view only
+            if (!m_viewport || !m_viewport->available()) nodes = m_live.geometry.nodes; // the side view only
             radius = m_live.toolRadius;
-            instruments = m_live.tools.instruments;
+            instruments = m_live.geometry.tools.instruments;
         }
         const int w = size.width(), h = size.height();
         p.fillRect(0, 0, w, h, QColor(24, 26, 30));

@@ -133,7 +133,7 @@ struct CorotationalFem::Impl {
         bool ok = false;
         std::string error;
         std::atomic<bool> finished{false};
-        std::chrono::steady_clock::time_point started{}; // when the worker began
+        std::chrono::steady_clock::time_point started{}; // when the worker was started
         double seconds = 0;                              // the build's wall time (worker or here)
         bool joined = false;
         std::vector<int> nodes; // carried nodes, in order; columns of the first `done` are in cols
@@ -332,14 +332,7 @@ struct CorotationalFem::Impl {
                 st.refactorWaited = true;
                 auto mine = std::make_shared<Job>();
                 mine->x = job->x;
-                const auto t0 = std::chrono::steady_clock::now();
-                try {
-                    mine->ok = buildFactor(mine->x, mine->result, mine->error);
-                } catch (const std::exception& e) {
-                    mine->ok = false;
-                    mine->error = e.what();
-                }
-                mine->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+                runJob(*mine);
                 retired.emplace_back(std::move(worker), std::move(job));
                 job = std::move(mine);
             }
@@ -409,6 +402,18 @@ struct CorotationalFem::Impl {
         st.refactored = true;
     }
 
+    /// Builds the job's factor from its positions (on the worker, or here for a late one), timed.
+    void runJob(Job& j) const {
+        const auto t0 = std::chrono::steady_clock::now();
+        try {
+            j.ok = buildFactor(j.x, j.result, j.error);
+        } catch (const std::exception& e) {
+            j.ok = false;
+            j.error = e.what();
+        }
+        j.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+
     /// True once the worker has finished: at once, or after waiting until the worker has run as
     /// long as the last build took (it is then at most that far from done, where a build here
     /// would take all of it and share the cores with the worker). False: still running then.
@@ -436,15 +441,9 @@ struct CorotationalFem::Impl {
         job->x = x;
         swapStep = step + s.refactorLatencySteps;
         std::shared_ptr<Job> jp = job;
-        jp->started = std::chrono::steady_clock::now();
+        jp->started = std::chrono::steady_clock::now(); // read by awaitWorker: set before the thread
         worker = std::thread([this, jp] {
-            try {
-                jp->ok = buildFactor(jp->x, jp->result, jp->error);
-            } catch (const std::exception& e) {
-                jp->ok = false;
-                jp->error = e.what();
-            }
-            jp->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - jp->started).count();
+            runJob(*jp);
             jp->finished.store(true, std::memory_order_release);
         });
     }
