@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
+#include <thread>
 
 namespace viscera::sim {
 
@@ -15,14 +16,46 @@ int UpperPattern::find(int r, int c) const {
     return (it != last && *it == r) ? static_cast<int>(it - rowIdx.begin()) : -1;
 }
 
+namespace {
+
+/// Reused right-hand side and workspaces of cholmod_solve2 for one thread, with the Common they
+/// were allocated from.
+struct SolveSpace {
+    cholmod_dense* rhs = nullptr;
+    cholmod_dense* sol = nullptr;
+    cholmod_dense* y = nullptr;
+    cholmod_dense* e = nullptr;
+
+    void release(cholmod_common& c) {
+        for (cholmod_dense** d : {&rhs, &sol, &y, &e})
+            if (*d) cholmod_free_dense(d, &c);
+    }
+    /// Solves A X = B for the `columns` column-major right-hand sides at b (n rows), in place.
+    bool solve(cholmod_factor* factor, size_t n, double* b, int columns, cholmod_common& c) {
+        if (!rhs || rhs->ncol != static_cast<size_t>(columns)) {
+            if (rhs) cholmod_free_dense(&rhs, &c);
+            rhs = cholmod_allocate_dense(n, columns, n, CHOLMOD_REAL, &c);
+            if (!rhs) return false;
+        }
+        std::memcpy(rhs->x, b, sizeof(double) * n * columns);
+        if (!cholmod_solve2(CHOLMOD_A, factor, rhs, nullptr, &sol, nullptr, &y, &e, &c)) return false;
+        std::memcpy(b, sol->x, sizeof(double) * n * columns);
+        return true;
+    }
+};
+
+} // namespace
+
 struct SparseCholesky::Impl {
     cholmod_common common{};
     cholmod_sparse* matrix = nullptr;
     cholmod_factor* factor = nullptr;
-    cholmod_dense* rhs = nullptr; // reused workspaces of cholmod_solve2
-    cholmod_dense* sol = nullptr;
-    cholmod_dense* y = nullptr;
-    cholmod_dense* e = nullptr;
+    SolveSpace space; // this thread's solves (allocated from `common`)
+    // A second thread's solves with the same factor (read only by cholmod_solve2): its own Common
+    // and workspaces, started on first use.
+    cholmod_common helperCommon{};
+    bool helperStarted = false;
+    SolveSpace helperSpace;
     bool ok = false;
     int n = 0;
 
@@ -94,8 +127,11 @@ std::unique_ptr<SparseCholesky> SparseCholesky::tryCreate(const UpperPattern& p,
 }
 
 SparseCholesky::~SparseCholesky() {
-    for (cholmod_dense** d : {&m->rhs, &m->sol, &m->y, &m->e})
-        if (*d) cholmod_free_dense(d, &m->common);
+    m->space.release(m->common);
+    if (m->helperStarted) {
+        m->helperSpace.release(m->helperCommon);
+        cholmod_finish(&m->helperCommon);
+    }
     if (m->factor) cholmod_free_factor(&m->factor, &m->common);
     if (m->matrix) cholmod_free_sparse(&m->matrix, &m->common);
     cholmod_finish(&m->common);
@@ -157,20 +193,33 @@ bool SparseCholesky::solveInPlace(double* b, int columns, std::string& error) {
     }
     if (columns <= 0) return true;
     const size_t n = static_cast<size_t>(m->n);
-    if (!m->rhs || m->rhs->ncol != static_cast<size_t>(columns)) {
-        if (m->rhs) cholmod_free_dense(&m->rhs, &m->common);
-        m->rhs = cholmod_allocate_dense(n, columns, n, CHOLMOD_REAL, &m->common);
-        if (!m->rhs) {
-            error = m->why("cholmod_allocate_dense");
-            return false;
+    // Columns are independent: from kSplitColumns on, a second thread solves the first half with
+    // the same factor. The split depends on the count only: a run stays repeatable.
+    const int mine = columns >= kSplitColumns ? columns / 2 : columns, theirs = columns - mine;
+    bool helperOk = true;
+    std::thread helper;
+    if (theirs > 0) {
+        if (!m->helperStarted) {
+            cholmod_start(&m->helperCommon);
+            m->helperCommon.print = 0;
+            m->helperCommon.error_handler = nullptr;
+            m->helperStarted = true;
         }
+        helper = std::thread([this, n, b, theirs, &helperOk] {
+            helperOk = m->helperSpace.solve(m->factor, n, b, theirs, m->helperCommon);
+        });
     }
-    std::memcpy(m->rhs->x, b, sizeof(double) * n * columns);
-    if (!cholmod_solve2(CHOLMOD_A, m->factor, m->rhs, nullptr, &m->sol, nullptr, &m->y, &m->e, &m->common)) {
+    const bool ok = m->space.solve(m->factor, n, b + n * static_cast<size_t>(theirs), mine, m->common);
+    if (helper.joinable()) helper.join();
+    if (!ok) {
         error = m->why("cholmod_solve2");
         return false;
     }
-    std::memcpy(b, m->sol->x, sizeof(double) * n * columns);
+    if (!helperOk) {
+        error = std::string("CHOLMOD: cholmod_solve2 failed on the second thread (status ") +
+                std::to_string(m->helperCommon.status) + ")";
+        return false;
+    }
     return true;
 }
 
