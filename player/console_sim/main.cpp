@@ -6,8 +6,12 @@
 //   viscera-console-sim --listen HOST:PORT (--trajectory FILE | --script NAME) [--duration S]
 //                       [--rate HZ] [--loop] [--record forces.csv] [--summary summary.json]
 //                       [--port-file FILE] [--pause-at S --pause-for S] [--wait-player S]
+//                       [--until-player-stops]
 //   viscera-console-sim --write-trajectory OUT.csv --script NAME --duration S [--rate HZ]
 //
+// --until-player-stops streams like the real console until the player has sent nothing for 1 s
+// (its session ended), --duration bounding the whole run: a player that falls behind the wall
+// clock gets its input to the end instead of a disconnection the console made.
 // --pause-at/--pause-for simulate a disconnection: no state is sent during the pause (commands
 // are still recorded, dated by their arrival in the kernel queue; a command with force more than
 // 250 ms after the last state actually sent counts as paused_nonzero_after_timeout). Exit codes: 0 done, 1 bad input, 2
@@ -43,6 +47,7 @@ struct Options {
     std::optional<std::string> trajectory, script, record, summary, portFile, writeTrajectory;
     double duration = -1, rate = 1000, pauseAt = -1, pauseFor = 0, waitPlayer = 30;
     bool loop = false;
+    bool untilPlayerStops = false;
 };
 
 struct Received {
@@ -94,6 +99,8 @@ Options parse(const std::vector<std::string>& args) {
             o.waitPlayer = number(a, value(), 0.1, 3600);
         else if (a == "--loop")
             o.loop = true;
+        else if (a == "--until-player-stops")
+            o.untilPlayerStops = true;
         else
             throw std::invalid_argument("unknown option '" + a + "'");
     }
@@ -176,7 +183,7 @@ int run(const Options& o) {
     Endpoint player;
     bool havePlayer = false;
     const int64_t waitEnd = monotonicNs() + int64_t(o.waitPlayer * 1e9);
-    int64_t t0 = 0;
+    int64_t t0 = 0, lastHeard = 0;
     auto drain = [&]() {
         while (true) {
             Endpoint from;
@@ -197,6 +204,7 @@ int run(const Options& o) {
                 std::fprintf(stderr, "viscera-console-sim: player at %s\n", player.text().c_str());
             }
             if (!(from == player)) continue;
+            lastHeard = arrived;
             // Time the command arrived, not when this loop got to it (the figures judge the
             // player's forces by when it sent them, whatever the load on this process).
             const double t = 1e-9 * double(arrived - t0);
@@ -220,11 +228,15 @@ int run(const Options& o) {
     int64_t next = t0;
     DeviceState s;
     double lastStateBeforeResume = 0; // s after t0
+    double streamed = 0; // s from the player's first command to the last state
+    constexpr int64_t kPlayerSilentNs = 1'000'000'000;
     while (true) {
         const int64_t now = monotonicNs();
         const double t = 1e-9 * double(now - t0);
         if (t > duration) break;
         drain();
+        if (o.untilPlayerStops && now - lastHeard > kPlayerSilentNs) break;
+        streamed = t;
         const bool paused = o.pauseAt >= 0 && t >= o.pauseAt && t < o.pauseAt + o.pauseFor;
         if (!paused) {
             src.sample(t, s);
@@ -299,7 +311,7 @@ int run(const Options& o) {
         }
         writeFileAtomic(*o.record, csv);
     }
-    nlohmann::json sum = {{"duration_s", duration},
+    nlohmann::json sum = {{"duration_s", streamed},
                           {"states_sent", sent},
                           {"send_errors", sendErrors},
                           {"commands_received", received.size()},
@@ -330,7 +342,7 @@ int run(const Options& o) {
 void usage(std::FILE* out) {
     std::fputs("usage: viscera-console-sim --listen HOST:PORT (--trajectory FILE | --script NAME) [--duration S]\n"
                "           [--rate HZ] [--loop] [--record forces.csv] [--summary summary.json] [--port-file FILE]\n"
-               "           [--pause-at S --pause-for S] [--wait-player S]\n"
+               "           [--pause-at S --pause-for S] [--wait-player S] [--until-player-stops]\n"
                "       viscera-console-sim --write-trajectory OUT.csv --script NAME --duration S [--rate HZ]\n",
                out);
 }

@@ -355,6 +355,20 @@ TEST(PlayerHaptics, ConsoleLoopbackWithADisconnectMidSession) {
                        << "\nmetrics: " << j["metrics"].dump();
 }
 
+TEST(PlayerHaptics, ConsoleStreamsUntilThePlayerStops) {
+    // --until-player-stops: the console streams as long as the player talks to it (a player behind
+    // the wall clock gets its input to its last frame), bounded by --duration, and then stops.
+    Scratch s;
+    ASSERT_NO_FATAL_FAILURE(runLoopback(s, 90, {"--loop", "--duration", "60", "--until-player-stops"}));
+    const auto j = readJson(s / "r.json");
+    EXPECT_EQ(j["haptics"]["link"]["disconnects"].get<int>(), 0) << "the console streamed to the last frame";
+    const auto sum = readJson(s / "sum.json");
+    const double streamed = sum["duration_s"].get<double>();
+    EXPECT_GE(streamed, 90.0 / 60 - 0.05) << "it streamed through the whole session";
+    EXPECT_LT(streamed, 59.0) << "it stopped with the player, not at the --duration bound";
+    EXPECT_GT(sum["commands_received"].get<int>(), 1000);
+}
+
 TEST(PlayerHaptics, SixtySecondConsoleLoopback) {
     // The acceptance loopback over 60 s (scripts/haptics-loopback.sh runs the same and prints a
     // summary). Checked: every servo tick used the newest contact model the physics had published,
