@@ -25,7 +25,11 @@
 
 #include <atomic>
 #include <cstdlib>
+#include <future>
 #include <thread>
+
+#include <pthread.h>
+#include <sched.h>
 
 namespace viscera::player {
 namespace {
@@ -379,22 +383,53 @@ std::string windowModeUnavailable() {
 }
 
 SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::string& screenshot) {
-    static int argc = 1;
-    static char arg0[] = "viscera-player";
-    static char* argv[] = {arg0, nullptr};
-    QGuiApplication app(argc, argv);
     LiveView live;
     std::atomic<bool> stop{false};
     options.live = &live;
     options.stop = &stop;
+    // The physics thread is made first, at normal priority, and starts when the window is up. The
+    // window's thread then drops to SCHED_IDLE, and with it every thread it makes (Qt's, the
+    // software rasterizer's): the picture runs on what the physics leaves of the CPUs and never
+    // preempts the physics or its constraint workers (on 2 cores a render of tens of ms took the
+    // core a worker needed, and the whole step waited for it). The servo thread has its own
+    // real-time priority.
+    SessionResult result;
+    std::promise<void> windowUp;
+    std::thread physics([&, up = windowUp.get_future()]() mutable {
+        up.wait();
+        result = runSession(loaded, options);
+    });
+    struct PhysicsGuard { // on a way out before the window is up: the session stops at once, is joined
+        std::promise<void>& up;
+        std::thread& t;
+        std::atomic<bool>& stop;
+        bool started = false;
+        void start() {
+            started = true;
+            up.set_value();
+        }
+        ~PhysicsGuard() {
+            if (!started) {
+                stop = true;
+                up.set_value();
+            }
+            if (t.joinable()) t.join();
+        }
+    } guard{windowUp, physics, stop};
+    const sched_param idle{};
+    if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle) != 0)
+        log::warn("the window could not lower its priority (SCHED_IDLE); its renders share the CPUs with the physics");
+    static int argc = 1;
+    static char arg0[] = "viscera-player";
+    static char* argv[] = {arg0, nullptr};
+    QGuiApplication app(argc, argv);
     const std::string title = loaded.package->manifest().title.value_or(loaded.package->manifest().caseId);
     Viewport3D viewport(loaded, live, 640, 480);
     if (!viewport.available()) log::warn("3D view off (side view instead): " + viewport.whyNot());
     TraineeWindow window(live, title, loaded.scene.instructions, dynamic_cast<KeyboardDevice*>(options.device), stop,
                          &viewport);
     window.show();
-    SessionResult result;
-    std::thread physics([&] { result = runSession(loaded, options); });
+    guard.start();
     bool failed = false;
     QTimer timer;
     // The 3D view never takes time the physics needs (RenderPacer); the HUD repaints at every tick.
@@ -435,6 +470,9 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
     app.exec();
     stop = true;
     physics.join();
+    const sched_param normal{};
+    // Back for the summary and report (refused without CAP_SYS_NICE: they then run at idle priority).
+    pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal);
     if (failed) result.errors.push_back("screenshot " + screenshot + " could not be written");
     return result;
 }
