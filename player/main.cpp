@@ -196,11 +196,15 @@ ServoChoice parseServoMode(const std::string& v) {
                                 "': expected shared, shared:US, sleep, sleep:CPU, spin:US, busy or busy:CPU");
 }
 
-int cmdRun(const std::vector<std::string>& args) {
+struct RunArgs {
     std::optional<std::string> casePath, reportPath, screenshot, device, tracePath, plotsDir;
     bool headless = false, realtime = false, lockstep = false, framesGiven = false;
     ServoChoice servo;
     int frames = 300;
+};
+
+RunArgs parseRunArgs(const std::vector<std::string>& args) {
+    RunArgs r;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         auto value = [&](const char* flag) -> std::string {
@@ -208,76 +212,191 @@ int cmdRun(const std::vector<std::string>& args) {
             return args[++i];
         };
         if (a == "--headless")
-            headless = true;
+            r.headless = true;
         else if (a == "--frames") {
             const std::string v = value("--frames");
             char* end = nullptr;
             long n = std::strtol(v.c_str(), &end, 10);
             if (*end != '\0' || n < 1 || n > 10'000'000)
                 throw std::invalid_argument("--frames '" + v + "' must be an integer in [1, 10000000]");
-            frames = static_cast<int>(n);
-            framesGiven = true;
+            r.frames = static_cast<int>(n);
+            r.framesGiven = true;
         } else if (a == "--report")
-            reportPath = value("--report");
+            r.reportPath = value("--report");
         else if (a == "--trace")
-            tracePath = value("--trace");
+            r.tracePath = value("--trace");
         else if (a == "--plots")
-            plotsDir = value("--plots");
+            r.plotsDir = value("--plots");
         else if (a == "--realtime")
-            realtime = true;
+            r.realtime = true;
         else if (a == "--lockstep")
-            lockstep = true;
+            r.lockstep = true;
         else if (a == "--screenshot")
-            screenshot = value("--screenshot");
+            r.screenshot = value("--screenshot");
         else if (a == "--device")
-            device = value("--device");
+            r.device = value("--device");
         else if (a == "--servo")
-            servo = parseServoMode(value("--servo"));
+            r.servo = parseServoMode(value("--servo"));
         else if (!a.empty() && a[0] == '-')
             throw std::invalid_argument("unknown option '" + a + "'");
-        else if (!casePath)
-            casePath = a;
+        else if (!r.casePath)
+            r.casePath = a;
         else
             throw std::invalid_argument("unexpected argument '" + a + "'");
     }
-    if (!casePath) throw std::invalid_argument("run needs a case file");
-    // Refused up front, before any work.
-    if (!headless) {
+    if (!r.casePath) throw std::invalid_argument("run needs a case file");
+    return r;
+}
+
+/// What run refuses before any work (an exit code), else nullopt with `spec` parsed: the window
+/// without a display, a bad device, options that exclude each other, and outputs that cannot be
+/// written or would overwrite an input (the case, the replayed trajectory).
+std::optional<int> refuseRun(const RunArgs& r, std::optional<haptics::DeviceSpec>& spec) {
+    if (!r.headless) {
         if (auto why = player::windowModeUnavailable(); !why.empty()) return fail(kExitUsage, why);
         // Mesa's software rasterizer (no GPU) renders the window's view with one thread, so that
         // a render takes one core and the physics keeps the other instead of both stopping for
         // it; a GPU driver ignores it; the user's value stands. Set here, before any thread.
         setenv("LP_NUM_THREADS", "1", 0);
     }
-    std::optional<haptics::DeviceSpec> spec;
-    if (device) {
-        spec = haptics::parseDeviceSpec(*device); // InputError names the spec and the rule
-        if (spec->kind == haptics::DeviceSpec::Kind::Keyboard && headless)
+    if (r.device) {
+        spec = haptics::parseDeviceSpec(*r.device); // InputError names the spec and the rule
+        if (spec->kind == haptics::DeviceSpec::Kind::Keyboard && r.headless)
             throw InputError("--device 'keyboard': the keyboard device needs the trainee window; drop --headless");
     }
-    if (tracePath && !device) return fail(kExitUsage, "--trace records the device forces and poses; it needs --device");
-
-    // Outputs are checked before the run, so that results are never lost at its end.
-    if (reportPath) requireWritableFile(*reportPath, "the report");
-    if (tracePath) requireWritableFile(*tracePath, "the trace");
-    if (screenshot) requireWritableFile(*screenshot, "the screenshot");
-    if (plotsDir) {
+    if (r.tracePath && !r.device)
+        return fail(kExitUsage, "--trace records the device forces and poses; it needs --device");
+    // Outputs are checked before the run, so that results are never lost at its end, and never
+    // written over what the run reads.
+    std::vector<std::filesystem::path> inputs{*r.casePath};
+    if (spec && spec->kind == haptics::DeviceSpec::Kind::Replay) inputs.emplace_back(spec->argument);
+    for (const auto& [path, what] : {std::pair{r.reportPath, "the report"}, std::pair{r.tracePath, "the trace"},
+                                     std::pair{r.screenshot, "the screenshot"}})
+        if (path) {
+            requireWritableFile(*path, what);
+            requireNotAnInput(*path, what, inputs);
+        }
+    if (r.plotsDir) {
 #if VISCERA_HAVE_PLOTS
-        requireWritableFolder(*plotsDir);
+        requireWritableFolder(*r.plotsDir);
 #else
         return fail(kExitUsage, "--plots: this viscera-player was built without Qt6 Gui, which draws the plots");
 #endif
     }
-
-    if (lockstep && realtime) return fail(kExitUsage, "--lockstep and --realtime exclude each other");
-    if (lockstep && spec &&
+    if (r.lockstep && r.realtime) return fail(kExitUsage, "--lockstep and --realtime exclude each other");
+    if (r.lockstep && spec &&
         (spec->kind == haptics::DeviceSpec::Kind::Console || spec->kind == haptics::DeviceSpec::Kind::Keyboard))
-        return fail(kExitUsage, "--lockstep: --device " + *device + " runs on the wall clock; drop --lockstep");
+        return fail(kExitUsage, "--lockstep: --device " + *r.device + " runs on the wall clock; drop --lockstep");
+    return std::nullopt;
+}
+
+/// Renders the last frame headless (EGL; Mesa llvmpipe where there is no GPU) to `path`, with its
+/// figures in result.render. The error text when it could not (a bad output, not a failed session).
+std::string headlessScreenshot(player::LoadedCase& loaded, player::SessionResult& result, const std::string& path,
+                               const std::string& casePath) {
+    try {
+        render::SceneView view = player::caseView(loaded);
+        render::RenderSettings rs = render::defaultSettingsFor(view); // framed on the tissue
+        render::applyCaseRender(rs, loaded.scene.render, casePath);
+        // Instruments, probes, clips, needle and thread at the last frame.
+        const render::ToolMeshes tools(view, render::toolPoses(*loaded.world));
+        std::string why;
+        auto renderer = render::HeadlessRenderer::create(rs, &why);
+        if (!renderer) throw std::runtime_error("no OpenGL context: " + why);
+        renderer->renderFrame(view); // first frame: shader compilation and first upload
+        const render::FrameStats st = renderer->renderFrame(view);
+        renderer->writePng(path);
+        player::RenderFigures fig;
+        fig.image = std::filesystem::absolute(path).string();
+        fig.device = renderer->description();
+        fig.width = rs.width;
+        fig.height = rs.height;
+        fig.totalMs = st.totalMs;
+        fig.uploadMs = st.uploadMs;
+        for (const auto& p : st.passes)
+            fig.passes.push_back({p.name, p.eye, p.ms});
+        result.render = std::move(fig);
+        return {};
+    } catch (const std::exception& e) {
+        return path + ": cannot write the screenshot (" + e.what() + ")";
+    }
+}
+
+/// Writes the report; when that fails at the end (a full disk), saves it under the temporary
+/// folder instead. Returns where it went (empty: nowhere) and sets `error` when not at `path`.
+std::string writeReport(const std::string& path, const std::string& text, std::string& error) {
+    try {
+        writeFileAtomic(path, text);
+        return std::filesystem::absolute(path).string();
+    } catch (const std::exception& e) {
+        error = e.what();
+    }
+    std::error_code ec;
+    const std::filesystem::path fallback =
+        std::filesystem::temp_directory_path(ec) / ("viscera-report-" + std::to_string(::getpid()) + ".json");
+    try {
+        writeFileAtomic(fallback, text);
+        error += "; the report was saved to " + fallback.string() + " instead";
+        return fallback.string();
+    } catch (const std::exception& e) {
+        error += std::string("; nor could it be saved to the temporary folder (") + e.what() + ")";
+        return {};
+    }
+}
+
+/// The end of a run: the summary first (whatever happens to the files), then the report, trace
+/// and plots, and the exit status.
+int finishRun(const RunArgs& r, const player::SessionResult& result, const std::string& screenshotError) {
+    std::fputs(player::summaryText(result).c_str(), stdout);
+    std::fflush(stdout);
+    std::vector<std::string> errors;
+    if (!screenshotError.empty()) errors.push_back(screenshotError);
+    // The report's text, made once: written with --report and read back by --plots.
+    const std::string reportText = r.reportPath || r.plotsDir ? player::reportJson(result).dump(2) + "\n" : "";
+    if (r.reportPath) {
+        std::string error;
+        const std::string at = writeReport(*r.reportPath, reportText, error);
+        if (!at.empty()) std::printf("report        %s\n", at.c_str());
+        if (!error.empty()) errors.push_back(error);
+    }
+    if (r.tracePath) {
+        try {
+            writeFileAtomic(*r.tracePath, player::traceCsv(result));
+            std::printf("trace         %s\n", std::filesystem::absolute(*r.tracePath).c_str());
+        } catch (const std::exception& e) {
+            errors.push_back(e.what());
+        }
+    }
+#if VISCERA_HAVE_PLOTS
+    if (r.plotsDir) { // from the report's JSON, as 'plot' reads it afterwards (a non-finite figure is null)
+        try {
+            const player::PlotFiles files = player::writeSessionPlots(
+                player::readPlotInput(nlohmann::json::parse(reportText), r.reportPath.value_or("(this session)")),
+                *r.plotsDir);
+            std::printf("plots         %zu charts and %s\n", files.images.size(),
+                        std::filesystem::absolute(files.page).c_str());
+        } catch (const std::exception& e) {
+            errors.push_back(e.what());
+        }
+    }
+#endif
+    std::fflush(stdout);
+    for (const std::string& e : errors)
+        std::fprintf(stderr, "viscera-player: %s\n", e.c_str());
+    if (!result.ok()) return kExitInvariant;
+    return errors.empty() ? 0 : kExitInput;
+}
+
+int cmdRun(const std::vector<std::string>& args) {
+    RunArgs r = parseRunArgs(args);
+    std::optional<haptics::DeviceSpec> spec;
+    if (auto refused = refuseRun(r, spec)) return *refused;
     std::unique_ptr<haptics::Device> dev;
     if (spec) dev = haptics::openDevice(*spec);
     // The window paces to the wall clock unless --lockstep asks for a replay or script stepped
     // with the physics (shown at physics speed where that is slower than real time).
-    const bool rt = !lockstep && (realtime || (dev && dev->capabilities().realtime) || !headless);
+    const bool rt = !r.lockstep && (r.realtime || (dev && dev->capabilities().realtime) || !r.headless);
+    ServoChoice& servo = r.servo;
     if (dev && rt && servo.reserveCpu) {
         // The servo gets a CPU of its own (the highest allowed, where two or more are): this thread
         // and every thread started from here on (physics, solver workers, window) stay off it, so
@@ -286,91 +405,34 @@ int cmdRun(const std::vector<std::string>& args) {
         if (servo.cpu < 0) servo.cpu = haptics::defaultServoCpu();
         if (servo.cpu >= 0) haptics::pinCurrentThreadExcept(servo.cpu);
     }
-    player::LoadedCase loaded = player::loadCase(*casePath);
+    player::LoadedCase loaded = player::loadCase(*r.casePath);
     player::RunOptions opts;
-    opts.frames = frames;
+    opts.frames = r.frames;
     opts.device = dev.get();
-    opts.deviceSpec = device.value_or("");
+    opts.deviceSpec = r.device.value_or("");
     opts.realtime = rt;
-    opts.keepTrace = tracePath.has_value();
+    opts.keepTrace = r.tracePath.has_value();
     opts.servoWait = servo.wait;
     opts.servoCpu = servo.cpu;
     opts.servoSpinNs = servo.spinNs;
     player::SessionResult result;
-    if (headless) {
-        std::fprintf(stderr, "viscera-player: running %s for %d frames%s\n", casePath->c_str(), frames,
-                     dev ? (std::string(" with ") + *device + (opts.realtime ? " (real time)" : " (lockstep)")).c_str()
-                         : "");
-        const int every = std::max(1, frames / 10);
+    if (r.headless) {
+        std::fprintf(
+            stderr, "viscera-player: running %s for %d frames%s\n", r.casePath->c_str(), r.frames,
+            dev ? (std::string(" with ") + *r.device + (opts.realtime ? " (real time)" : " (lockstep)")).c_str() : "");
+        const int every = std::max(1, r.frames / 10);
         opts.progress = [every](int done, int total) {
             if (done % every == 0 || done == total)
                 std::fprintf(stderr, "  frame %d/%d (%d%%)\n", done, total, 100 * done / total);
         };
         result = player::runSession(loaded, opts);
     } else {
-        if (!framesGiven) opts.frames = 0; // until the trainee closes the window
-        result = player::runWindow(loaded, opts, screenshot.value_or(""));
+        if (!r.framesGiven) opts.frames = 0; // until the trainee closes the window
+        result = player::runWindow(loaded, opts, r.screenshot.value_or(""));
     }
-    std::string screenshotError; // bad output, not a failed session: exit 1 once the rest is written
-    if (headless && screenshot) {
-        // The rendered view of the last frame (EGL; Mesa llvmpipe where there is no GPU).
-        try {
-            render::SceneView view = player::caseView(loaded);
-            render::RenderSettings rs = render::defaultSettingsFor(view); // framed on the tissue
-            render::applyCaseRender(rs, loaded.scene.render, *casePath);
-            // Instruments, probes, clips, needle and thread at the last frame.
-            const render::ToolMeshes tools(view, render::toolPoses(*loaded.world));
-            std::string why;
-            auto renderer = render::HeadlessRenderer::create(rs, &why);
-            if (!renderer) throw std::runtime_error("no OpenGL context: " + why);
-            renderer->renderFrame(view); // first frame: shader compilation and first upload
-            const render::FrameStats st = renderer->renderFrame(view);
-            renderer->writePng(*screenshot);
-            player::RenderFigures fig;
-            fig.image = std::filesystem::absolute(*screenshot).string();
-            fig.device = renderer->description();
-            fig.width = rs.width;
-            fig.height = rs.height;
-            fig.totalMs = st.totalMs;
-            fig.uploadMs = st.uploadMs;
-            for (const auto& p : st.passes)
-                fig.passes.push_back({p.name, p.eye, p.ms});
-            result.render = std::move(fig);
-        } catch (const std::exception& e) {
-            screenshotError = *screenshot + ": cannot write the screenshot (" + e.what() + ")";
-        }
-    }
-    // The report's text, made once: written with --report and read back by --plots.
-    const std::string reportText = reportPath || plotsDir ? player::reportJson(result).dump(2) + "\n" : std::string();
-    if (reportPath) writeFileAtomic(*reportPath, reportText);
-    if (tracePath) writeFileAtomic(*tracePath, player::traceCsv(result));
-    std::string plotsError;
-#if VISCERA_HAVE_PLOTS
-    std::optional<player::PlotFiles> plotFiles;
-    if (plotsDir) { // from the report's JSON, as 'plot' reads it afterwards
-        try {
-            // Through the report's text, as 'plot' reads a saved one (a non-finite figure is null).
-            plotFiles = player::writeSessionPlots(
-                player::readPlotInput(nlohmann::json::parse(reportText), reportPath.value_or("(this session)")),
-                *plotsDir);
-        } catch (const std::exception& e) {
-            plotsError = e.what();
-        }
-    }
-#endif
-    std::fputs(player::summaryText(result).c_str(), stdout);
-    if (reportPath) std::printf("report        %s\n", std::filesystem::absolute(*reportPath).c_str());
-#if VISCERA_HAVE_PLOTS
-    if (plotFiles)
-        std::printf("plots         %zu charts and %s\n", plotFiles->images.size(),
-                    std::filesystem::absolute(plotFiles->page).c_str());
-#endif
-    if (tracePath) std::printf("trace         %s\n", std::filesystem::absolute(*tracePath).c_str());
-    if (!plotsError.empty()) std::fprintf(stderr, "viscera-player: %s\n", plotsError.c_str());
-    if (!result.ok()) return kExitInvariant;
-    if (!screenshotError.empty()) return fail(kExitInput, screenshotError);
-    if (!plotsError.empty()) return kExitInput;
-    return 0;
+    std::string screenshotError;
+    if (r.headless && r.screenshot) screenshotError = headlessScreenshot(loaded, result, *r.screenshot, *r.casePath);
+    return finishRun(r, result, screenshotError);
 }
 
 double numberArg(const std::string& flag, const std::string& v, double lo, double hi) {

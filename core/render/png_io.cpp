@@ -1,5 +1,6 @@
 // PNG through libpng's simplified API (zlib compression and CRCs are libpng's).
 #include "render/image.hpp"
+#include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
 
 #include <png.h>
@@ -31,11 +32,8 @@ void writePng(const std::filesystem::path& path, const Image& image) {
     png_image png;
     if (!writeHeader(image, png))
         throw std::runtime_error(path.string() + ": render::writePng(): image is empty or its size is inconsistent");
-    if (!png_image_write_to_file(&png, path.string().c_str(), 0, image.rgba.data(), 0, nullptr)) {
-        const std::string why = png.message;
-        png_image_free(&png);
-        throw std::runtime_error(path.string() + ": cannot write PNG: " + why);
-    }
+    // Encoded in memory, then written atomically: a failed or killed write leaves the old file.
+    writeFileAtomic(path, encodePng(image));
 }
 
 Image readPng(const std::filesystem::path& path) {

@@ -228,7 +228,7 @@ int run(const Options& o) {
     int64_t next = t0;
     DeviceState s;
     double lastStateBeforeResume = 0; // s after t0
-    double streamed = 0; // s from the player's first command to the last state
+    double streamed = 0;              // s from the player's first command to the last state
     constexpr int64_t kPlayerSilentNs = 1'000'000'000;
     while (true) {
         const int64_t now = monotonicNs();

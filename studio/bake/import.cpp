@@ -83,7 +83,7 @@ private:
         const std::filesystem::path p(path);
         if (!std::filesystem::exists(p, ec)) return false; // nothing to open; assimp reports it
         if (!m_ec && std::filesystem::weakly_canonical(p, ec) == m_main && !ec) return true;
-        if (!detail::insideFolder(m_folder, p)) {
+        if (!sim::insideFolder(m_folder, p)) {
             refuse(path, "outside the file's folder (references must be relative paths inside it)");
             return false;
         }

@@ -228,18 +228,6 @@ std::vector<MeshReference> meshReferences(const std::string& label, SurfaceForma
     return out;
 }
 
-bool insideFolder(const std::filesystem::path& folder, const std::filesystem::path& file) {
-    std::error_code ec;
-    const std::filesystem::path base = std::filesystem::weakly_canonical(folder.empty() ? "." : folder, ec);
-    if (ec) return false;
-    const std::filesystem::path target = std::filesystem::weakly_canonical(file, ec);
-    if (ec) return false;
-    auto b = base.begin(), t = target.begin();
-    for (; b != base.end(); ++b, ++t)
-        if (t == target.end() || *b != *t) return false;
-    return true;
-}
-
 void checkReferences(const std::string& label, SurfaceFormat format, std::string_view bytes,
                      const std::filesystem::path& folder) {
     auto check = [&](const std::string& prefix, const std::vector<MeshReference>& refs) {
@@ -255,7 +243,7 @@ void checkReferences(const std::string& label, SurfaceFormat format, std::string
     for (const MeshReference& r : refs) {
         const std::filesystem::path lib = folder / r.path;
         std::error_code ec;
-        if (!std::filesystem::is_regular_file(lib, ec) || !insideFolder(folder, lib)) continue;
+        if (!std::filesystem::is_regular_file(lib, ec) || !sim::insideFolder(folder, lib)) continue;
         if (!read.insert(std::filesystem::weakly_canonical(lib, ec)).second) continue;
         std::string text;
         try {

@@ -42,9 +42,6 @@ std::vector<MeshReference> meshReferences(const std::string& label, SurfaceForma
 /// library is read once, however many statements name it.
 std::vector<MeshReference> materialReferences(const std::string& label, std::string_view bytes);
 
-/// True when `file` (symbolic links resolved, as far as it exists) lies in `folder` or below it.
-bool insideFolder(const std::filesystem::path& folder, const std::filesystem::path& file);
-
 /// Throws InputError "<label>: <where> '<path>': <rule>; references must be relative paths inside
 /// the file's folder" for the first reference that breaks the rule. For an OBJ, each material
 /// library that exists in `folder` as a regular file (at most 64 MiB) is read and its texture

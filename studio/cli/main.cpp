@@ -168,8 +168,10 @@ int cmdExport(const std::vector<std::string>& args) {
     const std::optional<std::string>& projectFile = parsed.extra[0];
     if (!dir || !out) throw std::invalid_argument("export needs <project-dir> and -o <case.vcase>");
     const auto t0 = std::chrono::steady_clock::now();
+    requireWritableFile(*out, "the case"); // before the work, which can take minutes
     studio::Project project =
         projectFile ? studio::loadProjectText(readFile(*projectFile), *dir, *projectFile) : studio::loadProject(*dir);
+    if (projectFile) requireNotAnInput(*out, "the case", {*projectFile}); // the project's own files: exportCase
     studio::ExportResult r =
         studio::exportCase(project, *out, [](size_t index, size_t total, const std::string& stage) {
             std::fprintf(stderr, "viscera-studio: stage %zu/%zu: %s\n", index, total, stage.c_str());
@@ -218,7 +220,10 @@ int cmdImport(const std::vector<std::string>& args) {
     }
     if (!in) throw std::invalid_argument("import needs a mesh file");
     if (out && !tetra) throw std::invalid_argument("-o writes a tet mesh; add --tetrahedralize");
-    if (out) requireWritableFile(*out, "the tet mesh"); // before meshing, which can take minutes
+    if (out) { // before meshing, which can take minutes
+        requireWritableFile(*out, "the tet mesh");
+        requireNotAnInput(*out, "the tet mesh", {*in});
+    }
     sim::TriMesh surface = bake::importSurface(*in, opt);
     auto [lo, hi] = surface.bounds();
     std::printf("%s: %zu vertices, %zu triangles, closed: %s, bounds [%g %g %g] - [%g %g %g] m\n", in->c_str(),
@@ -408,6 +413,10 @@ int cmdRemesh(const std::vector<std::string>& args) {
     if (std::filesystem::path(*out).extension() != ".obj")
         throw std::invalid_argument("-o '" + *out + "': the result is written as OBJ (.obj)");
     requireWritableFile(*out, "the remeshed surface"); // before the work, which can take minutes
+    std::vector<std::filesystem::path> inputPaths;
+    for (const auto& part : inputs)
+        inputPaths.emplace_back(part.file);
+    requireNotAnInput(*out, "the remeshed surface", inputPaths);
     std::vector<bake::RemeshPart> parts;
     if (sample)
         for (bake::RemeshPart& part : bake::kidneyAnatomy()) {

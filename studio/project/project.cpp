@@ -49,10 +49,24 @@ json boxJson(const std::array<sim::Vec3, 2>& box) {
     return {{"min", vec3Json(box[0])}, {"max", vec3Json(box[1])}};
 }
 
+/// The rule every file reference of a project keeps: `file` (dir / a relative path by the
+/// entry-name rule) still lies in the project folder once symbolic links are resolved. The rule
+/// it breaks, for a message, or empty.
+std::string outsideProjectProblem(const std::filesystem::path& dir, const std::filesystem::path& file) {
+    if (sim::insideFolder(dir, file)) return {};
+    std::error_code ec;
+    const std::filesystem::path target = std::filesystem::weakly_canonical(file, ec);
+    return "'" + file.string() + "' leads outside the project folder" +
+           (ec ? std::string() : " (to '" + target.string() + "')") + "; project files must lie inside it";
+}
+
 /// A file of the project folder: a relative path by the entry-name rule (no '..', not
-/// absolute), so that nothing outside the folder the user gave is read.
+/// absolute) that stays inside the folder through links, so that nothing outside the folder the
+/// user gave is read.
 std::filesystem::path projectFile(const JsonField& f, const std::filesystem::path& dir) {
-    return dir / f.entryPath();
+    std::filesystem::path file = dir / f.entryPath();
+    if (const std::string why = outsideProjectProblem(dir, file); !why.empty()) f.fail(why);
+    return file;
 }
 
 /// Where the writers of project.json report to: the file and the project folder.
@@ -363,7 +377,10 @@ TextureProject readTexture(const JsonField& j, const std::filesystem::path& dir)
                              : "needs 'spec' (a texture spec file) or 'generator' (the spec itself)");
     TextureProject t;
     if (j.has("spec")) {
-        t.spec = j["spec"].entryPath(); // inside the project folder
+        // Inside the project folder, through links too (kept relative: it is written back as given).
+        const JsonField spec = j["spec"];
+        t.spec = spec.entryPath();
+        if (const std::string why = outsideProjectProblem(dir, dir / t.spec); !why.empty()) spec.fail(why);
     } else {
         const JsonField g = j["generator"];
         g.anyObject();
@@ -438,8 +455,11 @@ sim::InteractionDesc readInteractionProject(const JsonField& section, const std:
                                             std::vector<std::filesystem::path>& trackFiles) {
     sim::InteractionDesc d = sim::readInteractionSection(section);
     trackFiles.clear();
-    for (sim::InstrumentDesc& in : d.instruments) {
+    for (size_t i = 0; i < d.instruments.size(); ++i) {
+        sim::InstrumentDesc& in = d.instruments[i];
         const std::filesystem::path file = dir / in.trackPath;
+        if (const std::string why = outsideProjectProblem(dir, file); !why.empty())
+            section.failAt("instruments[" + std::to_string(i) + "].track", why);
         in.trackText = readFile(file);
         sim::InstrumentTrack::parse(in.trackText, file.string()); // checked now, not in the player
         in.trackPath = "tools/" + in.name + ".track";
@@ -465,6 +485,22 @@ json interactionProjectJson(sim::InteractionDesc d, const std::vector<std::files
 Project loadProject(const std::filesystem::path& dir) {
     const std::filesystem::path file = dir / "project.json";
     return loadProjectText(readFile(file), dir, file.string());
+}
+
+std::vector<std::filesystem::path> projectInputFiles(const Project& p) {
+    std::vector<std::filesystem::path> files{p.dir / "project.json"};
+    auto texture = [&](const std::optional<TextureProject>& t) {
+        if (t && t->generator.empty()) files.push_back(p.dir / t->spec);
+    };
+    for (const BodyProject& b : p.bodies) {
+        if (b.mesh.kind == MeshSource::Kind::File) files.push_back(b.mesh.file);
+        texture(b.texture);
+    }
+    for (const SurfaceProject& s : p.surfaces)
+        texture(s.texture);
+    if (!p.trajectory.file.empty()) files.push_back(p.trajectory.file);
+    files.insert(files.end(), p.trackFiles.begin(), p.trackFiles.end());
+    return files;
 }
 
 Project loadProjectText(const std::string& text, const std::filesystem::path& dir, const std::string& origin) {
@@ -969,6 +1005,9 @@ std::unique_ptr<sim::World> assembleWorld(const BuiltScene& built, const std::st
 }
 
 ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress) {
+    // Before the work: the case can be written, and over none of the files it is made from.
+    requireWritableFile(out, "the case");
+    requireNotAnInput(out, "the case", projectInputFiles(project));
     StageCounter stage{progress, exportStageCount(project)};
     const std::string origin = (project.dir / "project.json").string();
     ProjectTextures textures; // first: a broken spec is reported before the meshing

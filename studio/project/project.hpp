@@ -203,6 +203,11 @@ struct Project {
 /// Reads <dir>/project.json: loadProjectText of the file's text. Throws viscera::InputError.
 Project loadProject(const std::filesystem::path& dir);
 
+/// Every file of the project folder an export of `project` reads: <dir>/project.json, the
+/// bodies' mesh files, the trajectory file, the tracks and the texture spec files (an output
+/// must be none of them).
+std::vector<std::filesystem::path> projectInputFiles(const Project& project);
+
 /// The project reader on text: `text` is a project.json whose file references resolve against
 /// `dir` (the files are read and checked now); `origin` names the text in every message
 /// ("<origin>: bodies[0].fixed.min: must be an array of 3 numbers"). Throws viscera::InputError.
@@ -307,7 +312,8 @@ std::unique_ptr<sim::World> assembleWorld(const BuiltScene& built, const std::st
 /// Builds every body mesh (generator or import + tetrahedralization), checks its quality (an
 /// inverted or degenerate element is an error naming the body and element), resolves fixed
 /// regions to node lists, and writes the case package atomically. Only what the scene uses is
-/// packaged, and the manifest's features list only the subsystems the scene needs.
+/// packaged, and the manifest's features list only the subsystems the scene needs. Before any of
+/// it, `out` must be writable and none of projectInputFiles (InputError naming `out`).
 ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress = {});
 
 /// Builds one body's tet mesh from its source (exposed for the import command and tests).

@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <thread>
 
 using namespace viscera;
 using ::testing::HasSubstr;
@@ -217,6 +218,78 @@ TEST(PlayerCli, UnwritableOutputsAreRefusedBeforeTheFirstFrame) {
         EXPECT_THAT(r.err, HasSubstr("takes no new file"));
         fs::permissions(locked, fs::perms::owner_all);
     }
+}
+
+TEST(PlayerCli, OutputsOverAnInputAreRefusedBeforeTheFirstFrame) {
+    ScratchDir dir;
+    const auto path = writeSlabCase(dir, "slab.vcase", {"gravity", "xpbd"});
+    const std::string before = readFile(path);
+    const fs::path alias = dir.path() / "alias.vcase", replay = dir.path() / "press.csv";
+    fs::create_symlink(path, alias);
+    writeFileAtomic(replay, "not read: refused before the device opens");
+    const struct {
+        std::vector<std::string> args;
+        std::string message;
+    } cases[] = {
+        {{"--report", path}, path + ": cannot write the report over the input '" + path + "'"},
+        {{"--screenshot", alias.string()},
+         alias.string() + ": cannot write the screenshot over the input '" + path + "'"},
+        {{"--device", "replay:" + replay.string(), "--trace", replay.string()},
+         replay.string() + ": cannot write the trace over the input '" + replay.string() + "'"},
+    };
+    for (const auto& c : cases) {
+        std::vector<std::string> args = {"run", path, "--headless", "--frames", "60"};
+        args.insert(args.end(), c.args.begin(), c.args.end());
+        const test::ProcessResult r = player(args);
+        EXPECT_EQ(r.exitCode, 1) << r.err;
+        EXPECT_EQ(r.err, "viscera-player: " + c.message + "\n");
+        EXPECT_TRUE(r.out.empty()) << r.out;
+    }
+    EXPECT_EQ(readFile(path), before) << "the case is intact";
+}
+
+TEST(PlayerCli, AReportThatCannotBeWrittenAtTheEndKeepsTheSummaryAndIsSavedElsewhere) {
+    // The report's folder takes files when the run starts; at the end its name has become a folder
+    // (as a full disk, the write fails). The summary is printed, the report saved in TMPDIR.
+    ScratchDir dir;
+    const auto path = writeSlabCase(dir, "slab.vcase", {"gravity", "xpbd"});
+    const fs::path out = dir.path() / "out" / "r.json", tmp = dir.path() / "tmp", log = dir.path() / "player";
+    fs::create_directories(out.parent_path());
+    fs::create_directories(tmp);
+    const char* oldTmp = std::getenv("TMPDIR");
+    const std::string savedTmp = oldTmp ? oldTmp : "";
+    ::setenv("TMPDIR", tmp.c_str(), 1);
+    // Real time with a device: the 240 frames take 4 s of wall clock whatever this machine's speed.
+    test::Background run(VISCERA_PLAYER_EXE,
+                         {"run", path, "--headless", "--realtime", "--device", "scripted:press", "--frames", "240",
+                          "--report", out.string()},
+                         log.string());
+    if (oldTmp)
+        ::setenv("TMPDIR", savedTmp.c_str(), 1);
+    else
+        ::unsetenv("TMPDIR");
+    ASSERT_GT(run.pid, 0);
+    // Past the checks: the first progress line (frame 24 of 240) is on stderr.
+    bool running = false;
+    for (int k = 0; k < 600 && !running; ++k) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        running = fs::exists(log.string() + ".err") &&
+                  readFile(log.string() + ".err").find("frame 24/240") != std::string::npos;
+    }
+    ASSERT_TRUE(running) << readFile(log.string() + ".err");
+    fs::create_directories(out / "in-the-way");
+    EXPECT_EQ(run.waitFor(), 1);
+    const std::string stdoutText = readFile(log.string() + ".out"), err = readFile(log.string() + ".err");
+    EXPECT_THAT(stdoutText, HasSubstr("status        ok"));
+    EXPECT_THAT(err, HasSubstr(out.string() + ": rename from temporary file failed: "));
+    EXPECT_THAT(err, HasSubstr("; the report was saved to " + tmp.string() + "/viscera-report-"));
+    std::vector<fs::path> saved;
+    for (const auto& e : fs::directory_iterator(tmp))
+        saved.push_back(e.path());
+    ASSERT_EQ(saved.size(), 1u) << "the report, and no temporary left behind";
+    EXPECT_THAT(stdoutText, HasSubstr("report        " + saved[0].string()));
+    const auto report = nlohmann::json::parse(readFile(saved[0]));
+    EXPECT_EQ(report["frames"].size(), 240u);
 }
 
 TEST(PlayerCli, OnlyDeclaredSubsystemsRun) {

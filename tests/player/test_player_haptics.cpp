@@ -35,6 +35,7 @@ using ::testing::HasSubstr;
 
 namespace {
 
+using test::Background;
 using test::Scratch;
 
 test::ProcessResult player(const std::vector<std::string>& args) {
@@ -52,38 +53,6 @@ std::string readText(const std::string& p) {
     s << in.rdbuf();
     return s.str();
 }
-
-/// Starts a process in the background (stdout/stderr to files); waitFor() reaps it.
-struct Background {
-    pid_t pid = -1;
-    Background(const std::string& exe, const std::vector<std::string>& args, const std::string& logPrefix) {
-        std::vector<char*> argv;
-        argv.push_back(const_cast<char*>(exe.c_str()));
-        for (const auto& a : args)
-            argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-        posix_spawn_file_actions_t fa;
-        posix_spawn_file_actions_init(&fa);
-        posix_spawn_file_actions_addopen(&fa, 1, (logPrefix + ".out").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        posix_spawn_file_actions_addopen(&fa, 2, (logPrefix + ".err").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (posix_spawn(&pid, exe.c_str(), &fa, nullptr, argv.data(), environ) != 0) pid = -1;
-        posix_spawn_file_actions_destroy(&fa);
-    }
-    int waitFor() {
-        int status = 0;
-        if (pid > 0 && ::waitpid(pid, &status, 0) == pid) {
-            pid = -1;
-            return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        }
-        return -1;
-    }
-    ~Background() {
-        if (pid > 0) {
-            ::kill(pid, SIGTERM);
-            ::waitpid(pid, nullptr, 0);
-        }
-    }
-};
 
 std::string waitForPort(const std::string& file) {
     for (int k = 0; k < 200; ++k) {

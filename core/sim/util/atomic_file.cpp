@@ -3,6 +3,7 @@
 #include "sim/util/error.hpp"
 
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
@@ -37,6 +38,33 @@ std::string probeFolder(const std::filesystem::path& dir) {
     ::close(fd);
     ::unlink(tmpl.c_str());
     return {};
+}
+
+const char* fileKind(mode_t mode) {
+    if (S_ISFIFO(mode)) return "a FIFO";
+    if (S_ISSOCK(mode)) return "a socket";
+    if (S_ISCHR(mode)) return "a character device";
+    if (S_ISBLK(mode)) return "a block device";
+    return "not a file";
+}
+
+/// Removes ".<name>.<pid>.tmpXXXXXX" files of `dir` whose writer process no longer runs.
+void sweepStaleTemporaries(const std::filesystem::path& dir, const std::string& name) {
+    namespace fs = std::filesystem;
+    const std::string head = "." + name + ".";
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string file = it->path().filename().string();
+        if (file.size() <= head.size() || file.compare(0, head.size(), head) != 0) continue;
+        const size_t tmp = file.find(".tmp", head.size());
+        if (tmp == std::string::npos || tmp + 10 != file.size()) continue; // ".tmp" + mkstemp's 6
+        const std::string pid = file.substr(head.size(), tmp - head.size());
+        if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos || pid.size() > 9) continue;
+        if (::kill(static_cast<pid_t>(std::stol(pid)), 0) != 0 && errno == ESRCH) {
+            std::error_code rm;
+            fs::remove(it->path(), rm);
+        }
+    }
 }
 
 } // namespace
@@ -74,8 +102,11 @@ void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes) 
     if (dir.empty()) dir = ".";
     std::error_code ec;
     fs::create_directories(dir, ec);
+    sweepStaleTemporaries(dir, path.filename().string());
     std::string name = ".";
     name += path.filename().string();
+    name += '.';
+    name += std::to_string(::getpid());
     name += ".tmpXXXXXX";
     std::string tmpl = (dir / name).string();
     int fd = ::mkstemp(tmpl.data());
@@ -104,36 +135,60 @@ void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes) 
 }
 
 std::string readFile(const std::filesystem::path& path, std::uintmax_t maxBytes, std::string_view limitName) {
-    namespace fs = std::filesystem;
     auto fail = [&](const std::string& rule) { throw InputError(path.string() + ": " + rule); };
     auto tooLarge = [&](const std::string& size) { // size: "300000000 bytes, " or ""
         fail("file is " + size + "larger than the limit of " + std::to_string(maxBytes) + " bytes" +
              (limitName.empty() ? std::string() : " (" + std::string(limitName) + ")"));
     };
-    std::error_code ec;
-    const fs::file_status status = fs::status(path, ec);
-    if (status.type() == fs::file_type::not_found) fail("cannot open for reading (file not found)");
-    if (ec) fail("cannot open for reading (" + ec.message() + ")");
-    if (fs::is_directory(status)) fail("cannot open for reading (is a directory, not a file)");
-    std::uintmax_t size = 0; // known for a regular file; a FIFO or device is read to its end
-    if (fs::is_regular_file(status)) {
-        size = fs::file_size(path, ec);
-        if (ec) fail("cannot read the file size (" + ec.message() + ")");
-        if (size > maxBytes) tooLarge(std::to_string(size) + " bytes, ");
+    // O_NONBLOCK: opening a FIFO without a writer returns at once (and is refused below).
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) {
+        if (errno == ENOENT) fail("cannot open for reading (file not found)");
+        if (errno == EISDIR) fail("cannot open for reading (is a directory, not a file)");
+        fail("cannot open for reading (" + errnoText() + ")");
     }
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
-    if (!f) fail("cannot open for reading (" + errnoText() + ")");
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(::fdopen(fd, "rb"), &std::fclose);
+    if (!f) {
+        ::close(fd);
+        fail("cannot open for reading (" + errnoText() + ")");
+    }
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) fail("cannot read the file status (" + errnoText() + ")");
+    if (S_ISDIR(st.st_mode)) fail("cannot open for reading (is a directory, not a file)");
+    if (!S_ISREG(st.st_mode)) fail(std::string("is not a regular file (") + fileKind(st.st_mode) + ")");
+    const auto size = static_cast<std::uintmax_t>(st.st_size);
+    if (size > maxBytes) tooLarge(std::to_string(size) + " bytes, ");
+    ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
     std::string bytes;
     bytes.reserve(static_cast<size_t>(size));
     char chunk[1 << 16];
     while (true) {
         const size_t got = std::fread(chunk, 1, sizeof chunk, f.get());
-        if (bytes.size() + got > maxBytes) tooLarge("");
+        if (bytes.size() + got > maxBytes) tooLarge(""); // grown since the fstat
         bytes.append(chunk, got);
         if (got < sizeof chunk) break;
     }
     if (std::ferror(f.get())) fail("read failed (" + errnoText() + ")");
     return bytes;
+}
+
+void requireNotAnInput(const std::filesystem::path& output, std::string_view what,
+                       const std::vector<std::filesystem::path>& inputs) {
+    namespace fs = std::filesystem;
+    auto resolved = [](const fs::path& p) {
+        std::error_code ec;
+        fs::path r = fs::weakly_canonical(fs::absolute(p, ec), ec);
+        return ec ? fs::absolute(p).lexically_normal() : r;
+    };
+    const fs::path out = resolved(output);
+    for (const fs::path& in : inputs) {
+        std::error_code ec;
+        const bool same =
+            fs::exists(output, ec) && fs::exists(in, ec) ? fs::equivalent(output, in, ec) : resolved(in) == out;
+        if (same && !ec)
+            throw InputError(output.string() + ": cannot write " + std::string(what) + " over the input '" +
+                             in.string() + "'");
+    }
 }
 
 } // namespace viscera

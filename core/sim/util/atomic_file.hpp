@@ -8,10 +8,19 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace viscera {
 
+/// The temporary file is "<folder>/.<name>.<pid>.tmpXXXXXX"; temporaries of the same destination
+/// left by a writer that no longer runs (killed mid-write) are removed first.
 void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes);
+
+/// Refuses, before any work, an output that is one of the inputs (the same file, through links
+/// or not): throws viscera::InputError "<output>: cannot write <what> over the input '<input>'".
+/// Paths that do not exist yet are compared after resolving the links of their folders.
+void requireNotAnInput(const std::filesystem::path& output, std::string_view what,
+                       const std::vector<std::filesystem::path>& inputs);
 
 /// Checks, before long work, that writeFileAtomic(path, ...) will be able to write `path`: the
 /// path is not a folder, its folder exists or can be created, and a file can be made there (a
@@ -26,12 +35,12 @@ void requireWritableFolder(const std::filesystem::path& dir);
 /// Default size cap of readFile(): 256 MiB.
 inline constexpr std::uintmax_t kReadFileMaxBytes = std::uintmax_t{256} << 20;
 
-/// Reads a whole file of at most `maxBytes` bytes (the one whole-file reader of the tree). Throws
-/// viscera::InputError, one line naming the path and the rule: "<path>: cannot open for reading
-/// (file not found)" (or "(is a directory, not a file)", "(Permission denied)", ...),
-/// "<path>: file is 300000000 bytes, larger than the limit of 268435456 bytes" followed by
-/// " (<limitName>)" when `limitName` names the setting behind maxBytes, "<path>: read failed
-/// (...)". A FIFO or device is read to its end, up to the same cap.
+/// Reads a whole regular file of at most `maxBytes` bytes (the one whole-file reader of the tree).
+/// Throws viscera::InputError, one line naming the path and the rule: "<path>: cannot open for
+/// reading (file not found)" (or "(is a directory, not a file)", "(Permission denied)", ...),
+/// "<path>: is not a regular file (a FIFO)" (or a socket, a device: never opened in a way that
+/// blocks), "<path>: file is 300000000 bytes, larger than the limit of 268435456 bytes" followed
+/// by " (<limitName>)" when `limitName` names the setting behind maxBytes, "<path>: read failed (...)".
 std::string readFile(const std::filesystem::path& path, std::uintmax_t maxBytes = kReadFileMaxBytes,
                      std::string_view limitName = {});
 

@@ -54,4 +54,17 @@ std::string displayName(std::string_view name) {
     return out;
 }
 
+bool insideFolder(const std::filesystem::path& folder, const std::filesystem::path& file) {
+    std::error_code ec;
+    std::filesystem::path base = std::filesystem::weakly_canonical(folder.empty() ? "." : folder, ec);
+    if (ec) return false;
+    if (base.filename().empty()) base = base.parent_path(); // "dir/": no empty last component
+    const std::filesystem::path target = std::filesystem::weakly_canonical(file, ec);
+    if (ec) return false;
+    auto b = base.begin(), t = target.begin();
+    for (; b != base.end(); ++b, ++t)
+        if (t == target.end() || *b != *t) return false;
+    return true;
+}
+
 } // namespace viscera::sim

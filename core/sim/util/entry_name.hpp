@@ -6,6 +6,7 @@
 /// only the portable characters A-Z a-z 0-9 '.' '_' '-'. It must not be absolute (leading '/',
 /// a drive letter "C:"), contain a backslash, or have an empty, "." or ".." component. The rules
 /// are checked in that order so that each name gets the most specific message.
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -21,5 +22,9 @@ std::optional<std::string> entryNameProblem(std::string_view path);
 /// `name` made safe for a one-line message: bytes outside printable ASCII become \xNN and the
 /// result is cut after kMaxEntryNameBytes bytes. Names from a hostile archive go through this.
 std::string displayName(std::string_view name);
+
+/// True when `file` (symbolic links resolved, as far as it exists) lies in `folder` or below it:
+/// the rule that keeps a project's references, and an import's, inside the folder the user gave.
+bool insideFolder(const std::filesystem::path& folder, const std::filesystem::path& file);
 
 } // namespace viscera::sim

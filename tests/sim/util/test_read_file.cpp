@@ -8,6 +8,10 @@
 
 #include <string>
 
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 using namespace viscera;
 using ::testing::AllOf;
 using ::testing::HasSubstr;
@@ -56,9 +60,64 @@ TEST(ReadFile, MissingOrDirectoryIsOneLineNamingThePath) {
     EXPECT_EQ(readError(scratch.dir), scratch.dir.string() + ": cannot open for reading (is a directory, not a file)");
 }
 
-TEST(ReadFile, StreamWithoutASizeIsCappedToo) {
-    // /dev/zero has no size and no end: the cap alone stops the read.
-    EXPECT_THAT(
-        readError("/dev/zero", 100000),
-        AllOf(HasSubstr("/dev/zero: file is larger than the limit of 100000 bytes"), ::testing::Not(HasSubstr("\n"))));
+TEST(ReadFile, OnlyRegularFilesAreOpenedAndAFifoDoesNotBlock) {
+    // A device has no end (/dev/zero) and a FIFO without a writer blocks an open: neither is a file
+    // a user gives as input, and neither is read.
+    EXPECT_EQ(readError("/dev/zero", 100000), "/dev/zero: is not a regular file (a character device)");
+    test::Scratch scratch("viscera-read-file");
+    const std::string fifo = scratch / "track.csv";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    EXPECT_EQ(readError(fifo), fifo + ": is not a regular file (a FIFO)"); // returns at once, no writer needed
+    // Through a link the same.
+    const std::string link = scratch / "link.csv";
+    ASSERT_EQ(::symlink(fifo.c_str(), link.c_str()), 0);
+    EXPECT_EQ(readError(link), link + ": is not a regular file (a FIFO)");
+}
+
+TEST(WriteFileAtomic, SweepsTheTemporariesOfAWriterThatNoLongerRuns) {
+    test::Scratch scratch("viscera-write-file");
+    const pid_t child = ::fork();
+    if (child == 0) ::_exit(0);
+    ASSERT_GT(child, 0);
+    ASSERT_EQ(::waitpid(child, nullptr, 0), child); // a pid that no longer runs
+    const std::filesystem::path d = scratch.dir;
+    const auto dead = d / (".r.json." + std::to_string(child) + ".tmpAbC123");
+    const auto live = d / (".r.json." + std::to_string(::getpid()) + ".tmpXyZ789");
+    const auto other = d / (".other.json." + std::to_string(child) + ".tmpAbC123");
+    for (const auto& f : {dead, live, other})
+        writeFileAtomic(f, "partial");
+    writeFileAtomic(scratch / "r.json", "{}\n");
+    EXPECT_FALSE(std::filesystem::exists(dead)) << "killed writer's temporary swept";
+    EXPECT_TRUE(std::filesystem::exists(live)) << "a running writer's temporary is left alone";
+    EXPECT_TRUE(std::filesystem::exists(other)) << "another destination's temporary is left alone";
+    EXPECT_EQ(readFile(scratch / "r.json"), "{}\n");
+    for (const auto& e : std::filesystem::directory_iterator(scratch.dir)) // no temporary of this write left
+        EXPECT_EQ(e.path().filename().string().find(".r.json." + std::to_string(::getpid()) + ".tmp") == 0,
+                  e.path() == live)
+            << e.path();
+}
+
+TEST(RequireNotAnInput, RefusesTheSameFileByAnyNameAndAcceptsAnother) {
+    test::Scratch scratch("viscera-not-input");
+    const std::filesystem::path d = scratch.dir, input = d / "case.vcase";
+    writeFileAtomic(input, "zip");
+    std::filesystem::create_directory(d / "sub");
+    std::filesystem::create_directory_symlink(d, d / "sub" / "up");
+    std::filesystem::create_symlink(input, d / "alias.vcase");
+    std::filesystem::create_hard_link(input, d / "hard.vcase");
+    auto error = [&](const std::filesystem::path& out) -> std::string {
+        try {
+            requireNotAnInput(out, "the report", {d / "other.csv", input});
+        } catch (const InputError& e) {
+            return e.what();
+        }
+        return "no error";
+    };
+    for (const auto& same :
+         {input, d / "sub" / ".." / "case.vcase", d / "sub" / "up" / "case.vcase", d / "alias.vcase", d / "hard.vcase"})
+        EXPECT_EQ(error(same), same.string() + ": cannot write the report over the input '" + input.string() + "'");
+    EXPECT_EQ(error(d / "report.json"), "no error");
+    EXPECT_EQ(error(d / "sub" / "up" / "report.json"), "no error");
+    // Neither exists yet: compared by their resolved paths.
+    EXPECT_THAT(error(d / "sub" / "up" / "other.csv"), HasSubstr("over the input '"));
 }

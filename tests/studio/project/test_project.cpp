@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 using namespace viscera;
@@ -509,4 +510,67 @@ TEST_F(ProjectTest, SixteenBitMapsDecodeToTheSameCodesAsEightBitOnes) {
         worst = std::max(worst, std::abs(int(m8->diffuse.rgba[i]) - int(m16->diffuse.rgba[i])));
     }
     EXPECT_LE(worst, 1) << "codes";
+}
+
+TEST_F(ProjectTest, FileReferencesStayInsideTheProjectFolderThroughLinks) {
+    namespace fs = std::filesystem;
+    const fs::path outside = m_dir.string() + "_outside";
+    fs::create_directories(outside);
+    struct Cleanup {
+        fs::path dir;
+        ~Cleanup() { fs::remove_all(dir); }
+    } cleanup{outside};
+    const std::string where = (m_dir / "project.json").string() + ": ";
+    // A mesh file and a texture spec that are links to files outside the folder are refused at load.
+    writeFileAtomic(outside / "cube.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    fs::create_symlink(outside / "cube.obj", m_dir / "cube.obj");
+    write(replaced(kGood, R"("mesh": {"generator": "box", "size": [0.04, 0.01, 0.01], "cells": [4, 1, 1]})",
+                   R"("mesh": {"file": "cube.obj"})"));
+    EXPECT_EQ(loadError(), where + "bodies[0].mesh.file: '" + (m_dir / "cube.obj").string() +
+                               "' leads outside the project folder (to '" +
+                               fs::canonical(outside / "cube.obj").string() + "'); project files must lie inside it");
+    fs::create_directories(outside / "textures");
+    writeFileAtomic(outside / "textures" / "t.json", "{}");
+    fs::create_directory_symlink(outside / "textures", m_dir / "textures"); // a linked folder, too
+    write(replaced(kGood, "\"fixed\":", R"("texture": {"spec": "textures/t.json"}, "fixed":)"));
+    EXPECT_THAT(loadError(), HasSubstr(where + "bodies[0].texture.spec: '" + (m_dir / "textures/t.json").string() +
+                                       "' leads outside the project folder"));
+}
+
+TEST_F(ProjectTest, ATrackThatLeadsOutsideOrIsAFifoIsRefusedAtLoad) {
+    namespace fs = std::filesystem;
+    const fs::path sample = fs::path(VISCERA_SOURCE_DIR) / "projects" / "rectum";
+    fs::copy(sample / "project.json", m_dir / "project.json");
+    fs::copy(sample / "tools", m_dir / "tools");
+    ASSERT_EQ(loadError(), "accepted");
+    const std::string where = (m_dir / "project.json").string() + ": ";
+    const fs::path track = m_dir / "tools" / "hook.track", outside = m_dir.string() + "_hook.track";
+    fs::rename(track, outside);
+    struct Cleanup {
+        fs::path file;
+        ~Cleanup() { fs::remove(file); }
+    } cleanup{outside};
+    fs::create_symlink(outside, track);
+    EXPECT_EQ(loadError(), where + "interaction.instruments[1].track: '" + track.string() +
+                               "' leads outside the project folder (to '" + outside.string() +
+                               "'); project files must lie inside it");
+    fs::remove(track);
+    ASSERT_EQ(::mkfifo(track.c_str(), 0600), 0);
+    EXPECT_EQ(loadError(), track.string() + ": is not a regular file (a FIFO)"); // at once: nothing writes to it
+}
+
+TEST_F(ProjectTest, ExportOverAnInputIsRefusedBeforeTheWork) {
+    write(kGood);
+    const std::string before = readFile(m_dir / "project.json");
+    const studio::Project p = studio::loadProject(m_dir);
+    try {
+        studio::exportCase(p, m_dir / "project.json");
+        FAIL() << "exported over project.json";
+    } catch (const InputError& e) {
+        EXPECT_EQ(std::string(e.what()), (m_dir / "project.json").string() +
+                                             ": cannot write the case over the input '" +
+                                             (m_dir / "project.json").string() + "'");
+    }
+    EXPECT_EQ(readFile(m_dir / "project.json"), before) << "the input is intact";
+    EXPECT_EQ(studio::projectInputFiles(p), std::vector<std::filesystem::path>{m_dir / "project.json"});
 }
