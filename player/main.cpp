@@ -63,9 +63,11 @@ void usage(std::FILE* out) {
 constexpr const char* kVerifyHelp =
     "usage: viscera-player verify <case.vcase>\n"
     "\n"
-    "Checks a case package without running it: the manifest, every file's size and checksum, the\n"
-    "features against those this player supports. Prints the case id, version, file count and\n"
-    "features. Exit 0 valid, 1 a broken package (one line naming the file and the rule), 2 usage.\n";
+    "Checks a case package without running it, with every check 'run' makes before its first\n"
+    "frame: the manifest, every file's size and checksum, the features against those this player\n"
+    "supports, the scene, the meshes, the work budget of a frame and the assembled world's\n"
+    "stability. Prints the case id, version, file count and features. Exit 0 valid, 1 a broken\n"
+    "case (one line naming the file and the rule), 2 usage.\n";
 
 constexpr const char* kRunHelp =
     "usage: viscera-player run <case.vcase> [options]\n"
@@ -131,7 +133,10 @@ int cmdVerify(const std::vector<std::string>& args) {
         usage(stderr);
         return kExitUsage;
     }
-    vcase::Manifest m = vcase::verify(args[0]);
+    // Every check a run makes before its first frame: the package, the scene, the meshes, the
+    // work budget and the assembled world (stability), so that a case verify accepts also loads.
+    const player::LoadedCase loaded = player::loadCase(args[0]);
+    const vcase::Manifest& m = loaded.package->manifest();
     std::printf("%s: ok (case %s %s, %zu files, features:", args[0].c_str(), m.caseId.c_str(), m.caseVersion.c_str(),
                 m.files.size());
     for (const auto& f : m.features)

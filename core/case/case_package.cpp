@@ -106,8 +106,10 @@ void checkNames(const Failure& fail, const std::vector<Entry>& entries) {
     }
 }
 
-/// (d) compression method, encryption, uncompressed sizes and compression ratio.
-void checkSizes(const Failure& fail, const std::vector<Entry>& entries, const Limits& limits) {
+/// (d) compression method, encryption, uncompressed sizes and compression ratio, per entry and
+/// for the whole package of `packageBytes` (many small entries that each pass the per-entry rule
+/// can still expand a small package a thousandfold).
+void checkSizes(const Failure& fail, const std::vector<Entry>& entries, const Limits& limits, uint64_t packageBytes) {
     uint64_t total = 0;
     for (const Entry& e : entries) {
         const detail::ZipEntryInfo& info = e.info;
@@ -128,6 +130,11 @@ void checkSizes(const Failure& fail, const std::vector<Entry>& entries, const Li
             fail.package("total uncompressed size exceeds the limit of " + bytesText(limits.maxTotalBytes) +
                          " (reached at entry '" + displayName(info.name) + "')");
     }
+    const double expansion = double(total) / double(std::max<uint64_t>(packageBytes, 1));
+    if (total >= limits.ratioMinBytes && expansion > limits.maxCompressionRatio)
+        fail.package("the entries expand to " + bytesText(total) + ", " + std::to_string(std::llround(expansion)) +
+                     " times the package's " + bytesText(packageBytes) + ", more than the limit of " +
+                     std::to_string(std::llround(limits.maxCompressionRatio)) + ":1 (possible zip bomb)");
 }
 
 std::string readEntry(const Failure& fail, const detail::ZipReader& zip, const Entry& e) {
@@ -183,7 +190,7 @@ Verified verifyBytes(std::string_view bytes, const std::string& name, const Limi
 
     // (c) names; (d) sizes.
     checkNames(fail, entries);
-    checkSizes(fail, entries, limits);
+    checkSizes(fail, entries, limits, bytes.size());
 
     // (e) manifest.
     std::map<std::string_view, const Entry*> files; // file entries by name (names are unique)

@@ -11,9 +11,10 @@ struct Limits {
     uint64_t maxEntryBytes = 256ull << 20;   ///< uncompressed, per entry (256 MiB)
     uint64_t maxTotalBytes = 1ull << 30;     ///< uncompressed, all entries (1 GiB)
     uint64_t maxManifestBytes = 1ull << 20;  ///< uncompressed manifest.json (1 MiB)
-    double maxCompressionRatio = 200.0;      ///< uncompressed : compressed, per entry
-    /// Entries smaller than this (uncompressed) skip the ratio rule: tiny files compress
-    /// extremely well and cannot expand into anything large.
+    /// Uncompressed : compressed, per entry, and all entries' uncompressed size : the package's size.
+    double maxCompressionRatio = 200.0;
+    /// Entries smaller than this (uncompressed) skip the per-entry ratio rule: tiny files compress
+    /// extremely well; the whole-package rule applies once all entries together reach this size.
     uint64_t ratioMinBytes = 1ull << 20;
 };
 

@@ -163,6 +163,7 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
                                  "].track: '" + in.trackPath + "' is not in the package");
             in.trackText = pkg.read(in.trackPath);
         }
+    sim::checkWorkBudget(out.scene, meshes, surfaces, pkg.name() + ": " + sceneName); // names the scene's field
     out.world = sim::World::assemble(out.scene, std::move(meshes), std::move(surfaces), pkg.manifest().features,
                                      pkg.name() + ": manifest.json");
     return out;

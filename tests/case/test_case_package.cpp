@@ -176,6 +176,28 @@ TEST_F(VcasePackage, CompressionRatioBombIsRejected) {
     EXPECT_THAT(message, HasSubstr(":1 exceeds the limit of 200:1 (possible zip bomb)"));
 }
 
+TEST_F(VcasePackage, ManySmallEntriesThatExpandTheWholePackageAreRejected) {
+    // 300 entries of 512 KiB of zeros: each under the per-entry rule's 1 MiB, 150 MiB together
+    // from a package of about 150 KiB. Refused from the central directory, before any inflate.
+    std::vector<RawEntry> files;
+    for (int i = 0; i < 300; ++i)
+        files.push_back({"textures/t" + std::to_string(i) + ".raw", std::string(512u << 10, '\0')});
+    const std::string bytes = craftPackage(manifestFor(files), files);
+    const std::string message = rejection(bytes);
+    EXPECT_THAT(message, HasSubstr(pkg() + "the entries expand to "));
+    EXPECT_THAT(message, HasSubstr(" times the package's " + std::to_string(bytes.size()) +
+                                   " bytes, more than the limit of 200:1 (possible zip bomb)"));
+    // The shipped kind of package passes: text that compresses a few times.
+    std::string digits(3u << 20, ' ');
+    uint32_t state = 12345;
+    for (char& c : digits) {
+        state = state * 1664525u + 1013904223u;
+        c = "0123456789 .\n-"[(state >> 24) % 15];
+    }
+    std::vector<RawEntry> text{{"textures/noise.raw", digits}};
+    EXPECT_NO_THROW(CasePackage::open(dir.write("text.vcase", craftPackage(manifestFor(text), text))));
+}
+
 TEST_F(VcasePackage, EntryAndTotalSizeLimits) {
     std::vector<RawEntry> files{{"a.bin", std::string(2000, 'a')}, {"b.bin", std::string(2000, 'b')}};
     const std::string bytes = craftPackage(manifestFor(files), files);

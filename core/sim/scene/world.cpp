@@ -1,7 +1,10 @@
 #include "sim/scene/world.hpp"
 
+#include "sim/util/error.hpp"
+
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace viscera::sim {
@@ -19,6 +22,25 @@ void World::setSurfaceState(size_t s, const std::vector<Vec3>& x, const std::vec
     m_solver->setSurfaceState(s, x, v);
 }
 
+void checkWorkBudget(const SceneDesc& scene, const std::vector<std::unique_ptr<TetMesh>>& meshes,
+                     const std::vector<TriMesh>& surfaces, const std::string& origin) {
+    if (scene.solverType != "xpbd") return;
+    double elements = 0;
+    for (const auto& m : meshes)
+        elements += static_cast<double>(m->tetCount());
+    for (const TriMesh& t : surfaces)
+        elements += static_cast<double>(t.triangleCount());
+    const double solves = double(scene.xpbd.substeps) * double(scene.xpbd.iterations) * elements;
+    if (solves <= XpbdLimits::maxConstraintSolvesPerFrame) return;
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  ": solver: substeps %d x iterations %d x %.0f elements = %.3g constraint solves per frame, more "
+                  "than the work limit of %.0e (about a second per frame); lower substeps or iterations",
+                  scene.xpbd.substeps, scene.xpbd.iterations, elements, solves,
+                  XpbdLimits::maxConstraintSolvesPerFrame);
+    throw InputError(origin + text);
+}
+
 std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::unique_ptr<TetMesh>> meshes,
                                        std::vector<TriMesh> surfaces, const std::vector<std::string>& features,
                                        const std::string& origin) {
@@ -26,6 +48,7 @@ std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::
     if (meshes.size() != scene.bodies.size() || surfaces.size() != scene.surfaces.size())
         throw std::invalid_argument("sim::World::assemble(): one mesh per body and per surface is required");
     std::vector<std::string> needed = checkDeclaredFeatures(scene, features, origin);
+    checkWorkBudget(scene, meshes, surfaces, origin);
 
     std::unique_ptr<World> w(new World());
     w->m_scene = scene;

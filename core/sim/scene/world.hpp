@@ -28,13 +28,23 @@ struct FrameRecord {
 /// The bodies run through one SceneSolver (scene_solver.hpp: XPBD or the suturing FEM, chosen by
 /// the scene's solver type); the World adds what is common to every back-end: feature checks,
 /// haptic probes, invariants, accuracy sampling frames, time.
+class World;
+
+/// Refuses an XPBD scene whose frame would take more than XpbdLimits::maxConstraintSolvesPerFrame
+/// constraint solves (substeps × iterations × tets and surface triangles): InputError
+/// "<origin>: solver: substeps 1000 x iterations 1000 x 4608 elements = 4.61e+09 constraint solves
+/// per frame, more than the work limit of 1e+08 ...". World::assemble checks it first; a loader
+/// may check it earlier with the scene's own name as `origin`.
+void checkWorkBudget(const SceneDesc& scene, const std::vector<std::unique_ptr<TetMesh>>& meshes,
+                     const std::vector<TriMesh>& surfaces, const std::string& origin);
+
 class World {
 public:
     /// meshes[i] belongs to scene.bodies[i], surfaces[s] to scene.surfaces[s]. Throws
     /// viscera::InputError naming `origin`, the field and the rule: unsupported feature, a feature
     /// the scene needs but the manifest does not declare, a body or layer that cannot be simulated
     /// stably (bad material or curves, fixed node out of range, inverted rest element, embedded
-    /// node outside its cage, nothing free to move).
+    /// node outside its cage, nothing free to move), a frame over the work budget (checkWorkBudget).
     static std::unique_ptr<World> assemble(const SceneDesc& scene, std::vector<std::unique_ptr<TetMesh>> meshes,
                                            std::vector<TriMesh> surfaces, const std::vector<std::string>& features,
                                            const std::string& origin);

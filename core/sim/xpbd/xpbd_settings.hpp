@@ -51,6 +51,11 @@ struct XpbdLimits {
     static constexpr double maxGravity = 1000;       ///< m/s^2, |gravity|
     static constexpr int maxThreads = 64;            ///< threads in [1, maxThreads]
     static constexpr double maxInertiaScaling = 100; ///< inertiaScaling in [1, maxInertiaScaling]
+    /// Work budget of a frame, checked when a world is assembled (player load, studio export):
+    /// substeps × iterations × elements (tets and surface triangles) at most this many constraint
+    /// solves, about a second per frame on a 2-core machine. Each limit above can hold alone while
+    /// their product asks for hours per frame and gigabytes before the first one.
+    static constexpr double maxConstraintSolvesPerFrame = 1e8;
 };
 
 /// Checks settings; empty string when valid, otherwise the rule that failed.

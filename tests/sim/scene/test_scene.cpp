@@ -116,3 +116,31 @@ TEST(World, RefusesWhatItCannotRun) {
     EXPECT_THAT(bad, HasSubstr("cannot be simulated stably"));
     EXPECT_THAT(bad, HasSubstr("fixed node 100000"));
 }
+
+TEST(World, RefusesAFrameOverTheWorkBudgetBeforeAllocatingIt) {
+    // 1,000 substeps x 1,000 iterations, each within its own limit, on a 1,000-tet box: 1e9 constraint
+    // solves per frame (hours per second of simulation, gigabytes before the first frame).
+    SceneDesc s = slabScene();
+    s.xpbd.substeps = XpbdLimits::maxSubsteps;
+    s.xpbd.iterations = XpbdLimits::maxIterations;
+    auto meshes = oneMesh();
+    const size_t tets = meshes[0]->tetCount();
+    try {
+        World::assemble(s, std::move(meshes), {}, {"gravity", "xpbd"}, "c.vcase: scene.json");
+        FAIL() << "assembled";
+    } catch (const viscera::InputError& e) {
+        EXPECT_EQ(
+            std::string(e.what()), "c.vcase: scene.json: solver: substeps 1000 x iterations 1000 x " +
+                                       std::to_string(tets) + " elements = " +
+                                       [&] {
+                                           char t[32];
+                                           std::snprintf(t, sizeof t, "%.3g", 1e6 * double(tets));
+                                           return std::string(t);
+                                       }() +
+                                       " constraint solves per frame, more than the work limit of "
+                                       "1e+08 (about a second per frame); lower substeps or iterations");
+    }
+    // The budget is a product: the same substeps with one iteration fits.
+    s.xpbd.iterations = 1;
+    EXPECT_NO_THROW(World::assemble(s, oneMesh(), {}, {"gravity", "xpbd"}, "c.vcase: scene.json"));
+}
