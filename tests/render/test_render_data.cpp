@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 using namespace viscera::render;
 namespace sim = viscera::sim;
@@ -33,7 +34,11 @@ TEST(Png, RoundTripIsExact) {
     EXPECT_EQ(back.rgba, img.rgba);
     std::filesystem::remove(path);
     EXPECT_THROW(readPng(path), std::runtime_error);
-    EXPECT_THROW(writePng("/nonexistent-dir/x.png", img), std::runtime_error);
+    // A folder that cannot exist (its parent is a file): refused, and nothing is left behind.
+    const auto file = std::filesystem::path(VISCERA_BINARY_DIR) / "test_render_not_a_folder";
+    std::ofstream(file) << "x";
+    EXPECT_THROW(writePng(file / "x.png", img), std::runtime_error);
+    std::filesystem::remove(file);
 }
 
 TEST(Image, CompareReportsRmseMaxAndMask) {
