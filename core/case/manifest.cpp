@@ -102,7 +102,7 @@ Manifest Manifest::fromJson(const nlohmann::json& j, std::string_view origin) {
 
     m.caseVersion = readSemVer(root["caseVersion"]);
     m.minPlayerVersion = readSemVer(root["minPlayerVersion"]);
-    if (auto t = root.find("title")) m.title = t->string();
+    if (auto t = root.find("title")) m.title = t->displayText(kMaxTitleBytes);
 
     std::set<std::string> seenFeatures;
     for (const sim::JsonField& f : root["features"].items()) {

@@ -48,6 +48,10 @@ struct FileEntry {
     friend bool operator==(const FileEntry&, const FileEntry&) = default;
 };
 
+/// A case title: printable UTF-8 text of at most this many bytes (JsonField::displayText), so that
+/// a summary line it is printed on cannot be broken or pushed off screen.
+inline constexpr size_t kMaxTitleBytes = 200;
+
 struct Manifest {
     int schemaVersion = kSchemaVersion;
     std::string caseId;

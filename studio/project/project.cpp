@@ -513,13 +513,13 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     p.schemaVersion = root["schemaVersion"].integer(1, 1);
     p.caseId = vcase::readCaseId(root["caseId"]);
     p.caseVersion = vcase::readSemVer(root["caseVersion"]);
-    if (auto v = root.find("title")) p.title = v->string();
+    if (auto v = root.find("title")) p.title = v->displayText(vcase::kMaxTitleBytes);
 
     // The scene part: the same readers as the player's scene.json.
     sim::SceneDesc& scene = p.scene;
     sim::readSolver(root, scene);
     if (auto su = root.find("suture")) scene.suture = readSutureProject(*su, dir, p.trajectory);
-    if (auto v = root.find("instructions")) scene.instructions = v->string();
+    if (auto v = root.find("instructions")) scene.instructions = v->displayText(sim::kMaxInstructionsBytes);
     if (auto v = root.find("render")) {
         scene.render = v->anyObject().value().dump();
         render::RenderSettings check;

@@ -292,6 +292,37 @@ TEST(PlayerCli, AReportThatCannotBeWrittenAtTheEndKeepsTheSummaryAndIsSavedElsew
     EXPECT_EQ(report["frames"].size(), 240u);
 }
 
+TEST(PlayerCli, ATitleThatCouldRewriteTheSummaryIsRefused) {
+    // A title with a newline and an erase-line escape would print a fake "status ok" over a failed
+    // session's summary: the case writer refuses it, and a crafted package is refused by verify and
+    // run, one line naming the field.
+    ScratchDir dir;
+    auto mesh = sim::makeBoxTetMesh({sim::Vec3::Zero(), sim::Vec3(0.08, 0.02, 0.02), {8, 2, 2}});
+    sim::SceneDesc scene;
+    scene.xpbd.substeps = 50;
+    sim::BodyDesc body;
+    body.name = "slab";
+    body.meshPath = "meshes/slab.vtet";
+    body.fixedNodes = {0, 1, 2};
+    scene.bodies.push_back(body);
+    const std::vector<RawEntry> files{{"scene.json", sim::formatScene(scene)},
+                                      {"meshes/slab.vtet", sim::formatVtet(*mesh)}};
+    vcase::Manifest header = vcase::test::manifestFor(files);
+    header.features = {"gravity", "xpbd"};
+    header.title = "Slab\n\x1b[2Kstatus        ok";
+    EXPECT_THROW(vcase::CaseWriter{header}, std::exception) << "the writer takes the reader's rule";
+    const std::string path = dir.write("title.vcase", vcase::test::craftPackage(header, files)).string();
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"verify", path},
+          std::vector<std::string>{"run", path, "--headless", "--frames", "2"}}) {
+        const test::ProcessResult r = player(args);
+        EXPECT_EQ(r.exitCode, 1) << r.err;
+        EXPECT_EQ(r.err, "viscera-player: " + path +
+                             ": manifest.json: title: must be printable text: control character U+000A at byte 4\n");
+        EXPECT_TRUE(r.out.empty()) << r.out;
+    }
+}
+
 TEST(PlayerCli, OnlyDeclaredSubsystemsRun) {
     ScratchDir dir;
     // Without gravity the world creates no gravity subsystem and nothing moves.

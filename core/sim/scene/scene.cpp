@@ -247,7 +247,7 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     SceneDesc scene;
     readSolver(root, scene);
     if (auto su = root.find("suture")) scene.suture = readSutureSection(*su);
-    if (auto v = root.find("instructions")) scene.instructions = v->string();
+    if (auto v = root.find("instructions")) scene.instructions = v->displayText(kMaxInstructionsBytes);
     if (auto v = root.find("render")) scene.render = v->anyObject().value().dump();
     scene.accuracy = readAccuracy(root);
 

@@ -86,6 +86,10 @@ struct AccuracySampling {
     int maxIterations = 100; ///< XPBD iterations recorded per sampled frame
 };
 
+/// The scene's instructions to the trainee: printable UTF-8 text of at most this many bytes
+/// (JsonField::displayText), one rule for scene.json and project.json.
+inline constexpr size_t kMaxInstructionsBytes = 2000;
+
 struct SceneDesc {
     std::string instructions; ///< shown to the trainee; may be empty
     /// The "render" object as JSON text (empty: renderer defaults). The simulation does not read

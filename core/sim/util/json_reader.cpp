@@ -5,6 +5,7 @@
 #include "sim/util/format.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <set>
 
 namespace viscera::sim {
@@ -133,6 +134,33 @@ bool JsonField::boolean() const {
 std::string JsonField::string() const {
     if (!m_value->is_string()) typeError("a string");
     return m_value->get<std::string>();
+}
+
+std::string JsonField::displayText(size_t maxBytes) const {
+    std::string s = string();
+    if (s.size() > maxBytes)
+        fail("must be at most " + std::to_string(maxBytes) + " bytes of text (it is " + std::to_string(s.size()) + ")");
+    for (size_t i = 0; i < s.size();) {
+        const auto c = static_cast<unsigned char>(s[i]);
+        const int len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+        if (len == 0 || i + len > s.size()) fail("must be valid UTF-8 (byte " + std::to_string(i) + ")");
+        uint32_t cp = len == 1 ? c : c & (0x7F >> len);
+        for (int k = 1; k < len; ++k) {
+            const auto t = static_cast<unsigned char>(s[i + k]);
+            if ((t >> 6) != 0x2) fail("must be valid UTF-8 (byte " + std::to_string(i + k) + ")");
+            cp = (cp << 6) | (t & 0x3F);
+        }
+        const bool overlong = (len == 2 && cp < 0x80) || (len == 3 && cp < 0x800) || (len == 4 && cp < 0x10000);
+        if (overlong || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
+            fail("must be valid UTF-8 (byte " + std::to_string(i) + ")");
+        if (cp < 0x20 || cp == 0x7F || (cp >= 0x80 && cp < 0xA0)) {
+            char code[16];
+            std::snprintf(code, sizeof code, "U+%04X", static_cast<unsigned>(cp));
+            fail(std::string("must be printable text: control character ") + code + " at byte " + std::to_string(i));
+        }
+        i += static_cast<size_t>(len);
+    }
+    return s;
 }
 
 std::string JsonField::nonEmptyString() const {

@@ -79,6 +79,11 @@ public:
     bool boolean() const;
     std::string string() const;
     std::string nonEmptyString() const;
+    /// Text shown to people (a title, instructions): valid UTF-8 of at most `maxBytes` bytes
+    /// without control characters (no newline, tab or escape code: it cannot break or recolour
+    /// the line it is printed on). "must be at most 200 bytes of text (it is 5000)", "must be
+    /// printable text: control character U+001B at byte 12", "must be valid UTF-8 (byte 3)".
+    std::string displayText(size_t maxBytes) const;
     /// One of `options`: "'x' is not one of (a, b, c)", or with `what` = "a generator":
     /// "'x' is not a generator (a, b, c)".
     std::string choice(std::initializer_list<std::string_view> options, std::string_view what = {}) const;

@@ -88,6 +88,22 @@ TEST(JsonReader, IntegersVectorsIndicesChoicesAndPaths) {
     EXPECT_EQ(got, 12.0);
 }
 
+TEST(JsonReader, DisplayTextIsBoundedPrintableUtf8) {
+    auto title = [](const std::string& t) {
+        return errorOf(json({{"title", t}}).dump(), [](const JsonField& f) { f["title"].displayText(40); });
+    };
+    EXPECT_EQ(title("Mesorectal dissection \u2014 fascia"), "accepted"); // UTF-8 (an em dash) is text
+    EXPECT_EQ(title("two\nlines"), "scene.json: title: must be printable text: control character U+000A at byte 3");
+    EXPECT_EQ(title("\x1b[2Kstatus ok"),
+              "scene.json: title: must be printable text: control character U+001B at byte 0");
+    EXPECT_EQ(title("tab\there"), "scene.json: title: must be printable text: control character U+0009 at byte 3");
+    EXPECT_EQ(title("c1 \xc2\x9b"), "scene.json: title: must be printable text: control character U+009B at byte 3");
+    EXPECT_EQ(title(std::string(41, 'x')), "scene.json: title: must be at most 40 bytes of text (it is 41)");
+    // Bytes that are not UTF-8 (an overlong '/', an encoded UTF-16 surrogate) never reach a title.
+    for (const std::string text : {"{\"title\": \"over\xc0\xaflong\"}", "{\"title\": \"a\xed\xa0\x80\"}"})
+        EXPECT_NE(errorOf(text, [](const JsonField& f) { f["title"].displayText(40); }), "accepted") << text;
+}
+
 TEST(JsonReader, NonFiniteNumbersAndBrokenDocumentsAreRefused) {
     // 1e999 overflows the parser: refused as a document, never read as infinity.
     EXPECT_THAT(errorOf(R"({"x": 1e999})", [](const JsonField& r) { r["x"].number(); }),
