@@ -337,8 +337,9 @@ std::string writeReport(const std::string& path, const std::string& text, std::s
         error = e.what();
     }
     std::error_code ec;
-    const std::filesystem::path fallback =
-        std::filesystem::temp_directory_path(ec) / ("viscera-report-" + std::to_string(::getpid()) + ".json");
+    std::filesystem::path tmp = std::filesystem::temp_directory_path(ec);
+    if (ec || tmp.empty()) tmp = "/tmp"; // TMPDIR names no folder
+    const std::filesystem::path fallback = tmp / ("viscera-report-" + std::to_string(::getpid()) + ".json");
     try {
         writeFileAtomic(fallback, text);
         error += "; the report was saved to " + fallback.string() + " instead";

@@ -194,8 +194,15 @@ double restVolume(const sim::TetMesh& mesh) {
 
 /// The trainee window's copy of the session after a frame (under the view's lock).
 void publishLive(const sim::World& world, const HapticRig* rig, const std::vector<sim::FrameRecord>& frames,
-                 const sim::FrameRecord& rec, double frameDt, const std::string& realTimeWarning, LiveView& lv) {
-    std::lock_guard<std::mutex> lock(lv.mutex);
+                 const sim::FrameRecord& rec, double frameDt, const std::string& realTimeWarning, LiveView& lv,
+                 bool last) {
+    // The physics never waits for the window (whose thread runs at idle priority): while the
+    // window holds the view, this frame is not shown; the last frame always is.
+    std::unique_lock<std::mutex> lock(lv.mutex, std::defer_lock);
+    if (last)
+        lock.lock();
+    else if (!lock.try_lock())
+        return;
     if (rig) lv.state = rig->live();
     lv.state.time_s = world.time();
     lv.state.frame = world.frameCount();
@@ -321,7 +328,9 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         if (const sim::InteractionRuntime* in = world.interaction()) meter.record(*in, frameDt);
         timeline.record(world);
         r.maxNodeDisplacement = std::max(r.maxNodeDisplacement, nodeDisplacement(world));
-        if (options.live) publishLive(world, rig.get(), r.frames, rec, frameDt, realTimeWarning, *options.live);
+        if (options.live)
+            publishLive(world, rig.get(), r.frames, rec, frameDt, realTimeWarning, *options.live,
+                        options.frames > 0 && f + 1 == options.frames);
         if (!rec.finite)
             r.errors.push_back("frame " + std::to_string(rec.index) +
                                ": the step produced a non-finite value and was rolled back");

@@ -397,9 +397,9 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
     std::promise<void> windowUp;
     std::thread physics([&, up = windowUp.get_future()]() mutable {
         up.wait();
-        result = runSession(loaded, options);
+        if (!stop) result = runSession(loaded, options); // not when the window never came up
     });
-    struct PhysicsGuard { // on a way out before the window is up: the session stops at once, is joined
+    struct PhysicsGuard { // on every way out: the session is stopped and joined
         std::promise<void>& up;
         std::thread& t;
         std::atomic<bool>& stop;
@@ -408,11 +408,9 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
             started = true;
             up.set_value();
         }
-        ~PhysicsGuard() {
-            if (!started) {
-                stop = true;
-                up.set_value();
-            }
+        ~PhysicsGuard() { // the session stops whenever this function is left, normally or not
+            stop = true;
+            if (!started) up.set_value();
             if (t.joinable()) t.join();
         }
     } guard{windowUp, physics, stop};

@@ -314,6 +314,7 @@ int cmdReplay(const std::vector<std::string>& args) {
     }
     requireWritableFile(*out, "the replay");
     const studio::Project project = studio::loadProject(*dir);
+    requireNotAnInput(*out, "the replay", studio::projectInputFiles(project));
     const std::string origin = (std::filesystem::path(*dir) / "project.json").string();
     const auto& su = project.scene.suture;
     if (!su) throw InputError(origin + ": suture: the project has no suture section to make a replay of");

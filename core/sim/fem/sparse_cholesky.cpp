@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
+#include <system_error>
 #include <thread>
 
 namespace viscera::sim {
@@ -205,9 +206,13 @@ bool SparseCholesky::solveInPlace(double* b, int columns, std::string& error) {
             m->helperCommon.error_handler = nullptr;
             m->helperStarted = true;
         }
-        helper = std::thread([this, n, b, theirs, &helperOk] {
-            helperOk = m->helperSpace.solve(m->factor, n, b, theirs, m->helperCommon);
-        });
+        try {
+            helper = std::thread([this, n, b, theirs, &helperOk] {
+                helperOk = m->helperSpace.solve(m->factor, n, b, theirs, m->helperCommon);
+            });
+        } catch (const std::system_error&) { // no thread to be had: all columns here
+            return m->space.solve(m->factor, n, b, columns, m->common) || (error = m->why("cholmod_solve2"), false);
+        }
     }
     const bool ok = m->space.solve(m->factor, n, b + n * static_cast<size_t>(theirs), mine, m->common);
     if (helper.joinable()) helper.join();

@@ -3,6 +3,7 @@
 #include "sim/util/error.hpp"
 
 #include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -48,10 +49,19 @@ const char* fileKind(mode_t mode) {
     return "not a file";
 }
 
-/// Removes ".<name>.<pid>.tmpXXXXXX" files of `dir` whose writer process no longer runs.
+/// The part of a destination's file name its temporaries carry: at most 200 bytes, so that
+/// ".<part>.<pid>.tmpXXXXXX" stays within the 255 bytes of a file name.
+std::string temporaryStem(const std::string& name) {
+    return name.substr(0, 200);
+}
+
+/// Removes ".<name>.<pid>.tmpXXXXXX" files of `dir` whose writer process no longer runs and that
+/// are over an hour old (a pid of another machine or container sharing the folder may look dead).
 void sweepStaleTemporaries(const std::filesystem::path& dir, const std::string& name) {
     namespace fs = std::filesystem;
-    const std::string head = "." + name + ".";
+    std::string head = ".";
+    head += temporaryStem(name);
+    head += '.';
     std::error_code ec;
     for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
         const std::string file = it->path().filename().string();
@@ -62,7 +72,8 @@ void sweepStaleTemporaries(const std::filesystem::path& dir, const std::string& 
         if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos || pid.size() > 9) continue;
         if (::kill(static_cast<pid_t>(std::stol(pid)), 0) != 0 && errno == ESRCH) {
             std::error_code rm;
-            fs::remove(it->path(), rm);
+            const auto written = fs::last_write_time(it->path(), rm);
+            if (!rm && fs::file_time_type::clock::now() - written > std::chrono::hours(1)) fs::remove(it->path(), rm);
         }
     }
 }
@@ -104,7 +115,7 @@ void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes) 
     fs::create_directories(dir, ec);
     sweepStaleTemporaries(dir, path.filename().string());
     std::string name = ".";
-    name += path.filename().string();
+    name += temporaryStem(path.filename().string());
     name += '.';
     name += std::to_string(::getpid());
     name += ".tmpXXXXXX";
@@ -140,8 +151,13 @@ std::string readFile(const std::filesystem::path& path, std::uintmax_t maxBytes,
         fail("file is " + size + "larger than the limit of " + std::to_string(maxBytes) + " bytes" +
              (limitName.empty() ? std::string() : " (" + std::string(limitName) + ")"));
     };
-    // O_NONBLOCK: opening a FIFO without a writer returns at once (and is refused below).
-    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    // Not opened unless a regular file now (opening a device can act, e.g. arm a watchdog), and
+    // checked again on the open descriptor (it may have been replaced in between); O_NONBLOCK:
+    // a FIFO put there meanwhile opens at once and is refused below.
+    struct stat before {};
+    if (::stat(path.c_str(), &before) == 0 && !S_ISREG(before.st_mode) && !S_ISDIR(before.st_mode))
+        fail(std::string("is not a regular file (") + fileKind(before.st_mode) + ")");
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
     if (fd < 0) {
         if (errno == ENOENT) fail("cannot open for reading (file not found)");
         if (errno == EISDIR) fail("cannot open for reading (is a directory, not a file)");

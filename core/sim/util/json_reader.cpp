@@ -153,7 +153,11 @@ std::string JsonField::displayText(size_t maxBytes) const {
         const bool overlong = (len == 2 && cp < 0x80) || (len == 3 && cp < 0x800) || (len == 4 && cp < 0x10000);
         if (overlong || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
             fail("must be valid UTF-8 (byte " + std::to_string(i) + ")");
-        if (cp < 0x20 || cp == 0x7F || (cp >= 0x80 && cp < 0xA0)) {
+        // Control characters, and the format characters that break a line (U+2028, U+2029) or
+        // reorder it (bidirectional marks, embeddings, overrides and isolates).
+        const bool format =
+            cp == 0x200E || cp == 0x200F || (cp >= 0x2028 && cp <= 0x202E) || (cp >= 0x2066 && cp <= 0x2069);
+        if (cp < 0x20 || cp == 0x7F || (cp >= 0x80 && cp < 0xA0) || format) {
             char code[16];
             std::snprintf(code, sizeof code, "U+%04X", static_cast<unsigned>(cp));
             fail(std::string("must be printable text: control character ") + code + " at byte " + std::to_string(i));

@@ -80,8 +80,9 @@ public:
     std::string string() const;
     std::string nonEmptyString() const;
     /// Text shown to people (a title, instructions): valid UTF-8 of at most `maxBytes` bytes
-    /// without control characters (no newline, tab or escape code: it cannot break or recolour
-    /// the line it is printed on). "must be at most 200 bytes of text (it is 5000)", "must be
+    /// without control characters (no newline, tab or escape code) or line-breaking and
+    /// bidirectional format characters (U+2028, U+2029, U+200E/F, U+202A–E, U+2066–9): it cannot
+    /// break, recolour or reorder the line it is printed on. "must be at most 200 bytes of text (it is 5000)", "must be
     /// printable text: control character U+001B at byte 12", "must be valid UTF-8 (byte 3)".
     std::string displayText(size_t maxBytes) const;
     /// One of `options`: "'x' is not one of (a, b, c)", or with `what` = "a generator":

@@ -99,6 +99,8 @@ TEST(JsonReader, DisplayTextIsBoundedPrintableUtf8) {
     EXPECT_EQ(title("tab\there"), "scene.json: title: must be printable text: control character U+0009 at byte 3");
     EXPECT_EQ(title("c1 \xc2\x9b"), "scene.json: title: must be printable text: control character U+009B at byte 3");
     EXPECT_EQ(title(std::string(41, 'x')), "scene.json: title: must be at most 40 bytes of text (it is 41)");
+    EXPECT_EQ(title("ok \u202e"), "scene.json: title: must be printable text: control character U+202E at byte 3");
+    EXPECT_EQ(title("ok \u2028"), "scene.json: title: must be printable text: control character U+2028 at byte 3");
     // Bytes that are not UTF-8 (an overlong '/', an encoded UTF-16 surrogate) never reach a title.
     for (const std::string text : {"{\"title\": \"over\xc0\xaflong\"}", "{\"title\": \"a\xed\xa0\x80\"}"})
         EXPECT_NE(errorOf(text, [](const JsonField& f) { f["title"].displayText(40); }), "accepted") << text;

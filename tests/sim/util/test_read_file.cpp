@@ -84,12 +84,18 @@ TEST(WriteFileAtomic, SweepsTheTemporariesOfAWriterThatNoLongerRuns) {
     const auto dead = d / (".r.json." + std::to_string(child) + ".tmpAbC123");
     const auto live = d / (".r.json." + std::to_string(::getpid()) + ".tmpXyZ789");
     const auto other = d / (".other.json." + std::to_string(child) + ".tmpAbC123");
-    for (const auto& f : {dead, live, other})
+    const auto young = d / (".r.json." + std::to_string(child) + ".tmpNeW456"); // a minute old: kept
+    for (const auto& f : {dead, live, other, young})
         writeFileAtomic(f, "partial");
+    const auto now = std::filesystem::file_time_type::clock::now();
+    for (const auto& f : {dead, live, other})
+        std::filesystem::last_write_time(f, now - std::chrono::hours(2));
+    std::filesystem::last_write_time(young, now - std::chrono::minutes(1));
     writeFileAtomic(scratch / "r.json", "{}\n");
     EXPECT_FALSE(std::filesystem::exists(dead)) << "killed writer's temporary swept";
     EXPECT_TRUE(std::filesystem::exists(live)) << "a running writer's temporary is left alone";
     EXPECT_TRUE(std::filesystem::exists(other)) << "another destination's temporary is left alone";
+    EXPECT_TRUE(std::filesystem::exists(young)) << "under an hour old: perhaps a writer of another machine";
     EXPECT_EQ(readFile(scratch / "r.json"), "{}\n");
     for (const auto& e : std::filesystem::directory_iterator(scratch.dir)) // no temporary of this write left
         EXPECT_EQ(e.path().filename().string().find(".r.json." + std::to_string(::getpid()) + ".tmp") == 0,
