@@ -490,7 +490,15 @@ int cmdSoak(const std::vector<std::string>& args) {
     if (cases.empty()) throw std::invalid_argument("soak needs at least one case");
     for (player::SoakCase& c : cases)
         c.frames = frames;
-    if (reportPath) requireWritableFile(*reportPath, "the soak report");
+    if (reportPath) { // before the soak, which runs for minutes or hours
+        requireWritableFile(*reportPath, "the soak report");
+        std::vector<std::filesystem::path> inputs;
+        for (const player::SoakCase& c : cases) {
+            inputs.emplace_back(c.path);
+            if (c.device.rfind("replay:", 0) == 0) inputs.emplace_back(c.device.substr(7));
+        }
+        requireNotAnInput(*reportPath, "the soak report", inputs);
+    }
     std::fprintf(stderr, "viscera-player: soaking %zu case(s) for %.1f min, a line every %.0f s\n", cases.size(),
                  opt.seconds / 60, opt.lineSeconds);
     const player::SoakResult r = player::runSoak(cases, opt, [](const player::SoakLine& l) {

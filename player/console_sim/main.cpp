@@ -31,6 +31,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -167,6 +168,13 @@ int writeTrajectory(const Options& o) {
 }
 
 int run(const Options& o) {
+    std::vector<std::filesystem::path> inputs;
+    if (o.trajectory) inputs.emplace_back(*o.trajectory);
+    for (const auto& [file, what] : {std::pair{o.record, "the force record"}, std::pair{o.summary, "the summary"}})
+        if (file) { // before the session, whose record would be lost at its end
+            requireWritableFile(*file, what);
+            requireNotAnInput(*file, what, inputs);
+        }
     Source src(o);
     const double duration = o.duration > 0 ? o.duration : src.duration();
     if (!(duration > 0))

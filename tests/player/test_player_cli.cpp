@@ -530,4 +530,7 @@ TEST(PlayerCli, SoakRunsCasesBackToBackAndReportsEachInterval) {
     EXPECT_EQ(c.exitCode, 1);
     EXPECT_THAT(c.err, HasSubstr("the soak steps devices with the physics"));
     EXPECT_EQ(player({"soak", path, "--minutes", "abc"}).exitCode, 2);
+    const test::ProcessResult over = player({"soak", path, "--minutes", "1", "--report", path});
+    EXPECT_EQ(over.exitCode, 1);
+    EXPECT_EQ(over.err, "viscera-player: " + path + ": cannot write the soak report over the input '" + path + "'\n");
 }

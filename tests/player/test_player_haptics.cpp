@@ -166,6 +166,17 @@ static void writeSlabAndPress(const Scratch& s) {
     ASSERT_EQ(w.exitCode, 0) << w.err;
 }
 
+TEST(PlayerHaptics, TheConsoleSimulatorRefusesToRecordOverItsTrajectory) {
+    Scratch s;
+    ASSERT_NO_FATAL_FAILURE(writeSlabAndPress(s));
+    const std::string before = readText(s / "press.csv");
+    auto r = test::runProcess(VISCERA_CONSOLE_SIM_EXE, {"--listen", "127.0.0.1:0", "--trajectory", s / "press.csv",
+                                                        "--record", s / "press.csv", "--wait-player", "0.1"});
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_THAT(r.err, HasSubstr((s / "press.csv") + ": cannot write the force record over the input '"));
+    EXPECT_EQ(readText(s / "press.csv"), before);
+}
+
 TEST(PlayerHaptics, ReplaysARecordedTrajectory) {
     Scratch s;
     ASSERT_NO_FATAL_FAILURE(writeSlabAndPress(s));
