@@ -408,11 +408,13 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
             started = true;
             up.set_value();
         }
-        ~PhysicsGuard() { // the session stops whenever this function is left, normally or not
+        void end() { // stops the session and joins it (once; again on every way out)
             stop = true;
             if (!started) up.set_value();
+            started = true;
             if (t.joinable()) t.join();
         }
+        ~PhysicsGuard() { end(); }
     } guard{windowUp, physics, stop};
     const sched_param idle{};
     if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle) != 0)
@@ -466,8 +468,7 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
     });
     timer.start(33);
     app.exec();
-    stop = true;
-    physics.join();
+    guard.end();
     const sched_param normal{};
     // Back for the summary and report (refused without CAP_SYS_NICE: they then run at idle priority).
     pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal);

@@ -168,7 +168,6 @@ int cmdExport(const std::vector<std::string>& args) {
     const std::optional<std::string>& projectFile = parsed.extra[0];
     if (!dir || !out) throw std::invalid_argument("export needs <project-dir> and -o <case.vcase>");
     const auto t0 = std::chrono::steady_clock::now();
-    requireWritableFile(*out, "the case"); // before the work, which can take minutes
     studio::Project project =
         projectFile ? studio::loadProjectText(readFile(*projectFile), *dir, *projectFile) : studio::loadProject(*dir);
     if (projectFile) requireNotAnInput(*out, "the case", {*projectFile}); // the project's own files: exportCase
