@@ -193,6 +193,11 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
     }
     InteractionRuntime* self = r.get();
     system.setIterationHook([self](XpbdParticles& p, const XpbdIterationInfo& info) { self->runHook(p, info); });
+    // The hook touches the collision surface's particles only (contacts, grasped vertices), and
+    // cuts never add particles.
+    const size_t surfaceParticles =
+        r->m_surfaceIsLayer ? system.surfacePositions(r->m_surfaceIndex).size() : system.tetPositions(0).size();
+    system.setIterationHookParticles(r->m_particleOffset, surfaceParticles);
     return r;
 }
 
@@ -306,6 +311,12 @@ void InteractionRuntime::beforeStep(double t, double dt) {
         }
     }
     m_summary.clipMs += msSince(t0);
+    // A frame with no tool near the tissue and nothing held has no hook work: it runs the
+    // schedule without hooks (the force on every tool is then zero, as the hook would sum).
+    bool hooks = false;
+    for (const auto& inp : m_instruments)
+        hooks = hooks || (inp->collision && inp->colliding) || (inp->holding && !inp->held.empty());
+    m_sys->setIterationHookActive(hooks);
     if (m_dissection) {
         t0 = std::chrono::steady_clock::now();
         for (auto& inp : m_instruments) {

@@ -384,6 +384,18 @@ void XpbdSystem::refreshMirrors() {
 
 void XpbdSystem::setIterationHook(XpbdIterationHook hook) {
     m_engine->iterationHook = std::move(hook);
+    m_engine->iterationHookActive = true;
+    m_engine->hookFirst = 0;
+    m_engine->hookEnd = SIZE_MAX;
+}
+
+void XpbdSystem::setIterationHookParticles(size_t first, size_t count) {
+    m_engine->hookFirst = first;
+    m_engine->hookEnd = first + count;
+}
+
+void XpbdSystem::setIterationHookActive(bool active) {
+    m_engine->iterationHookActive = active;
 }
 
 StepStats XpbdSystem::step() {
@@ -548,10 +560,7 @@ std::vector<double> XpbdSystem::tiedInertia(size_t b) const {
 }
 
 double XpbdSystem::elasticEnergy() const {
-    double e = 0;
-    for (const auto& b : m_engine->blocks)
-        e += b->energy(m_engine->xw.data());
-    return e;
+    return m_engine->energy(m_settings.threads, m_pool.get());
 }
 
 double XpbdSystem::kineticEnergy() const {

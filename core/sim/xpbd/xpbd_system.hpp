@@ -189,6 +189,15 @@ public:
     /// from sim/collision, makeCollisionHook). Between frames only. Without a hook step() runs
     /// exactly as before (bit-identical, same schedule).
     void setIterationHook(XpbdIterationHook hook);
+    /// Whether the next frames call the hook (true after setIterationHook). A frame without the
+    /// hook runs the schedule of a system without one (the end and start of each substep in one
+    /// pass, no hook phases): for frames in which the hook has nothing to do.
+    void setIterationHookActive(bool active);
+    /// The particles the hook reads and writes: [first, first + count) of its XpbdParticles
+    /// (setIterationHook resets it to all). A hook that touches only part of the particles lets
+    /// the rest end each substep beside it instead of after it; touching any other particle is
+    /// then a data race.
+    void setIterationHookParticles(size_t first, size_t count);
     /// First particle index of tet body b / surface s in the XpbdParticles of a hook.
     int32_t tetParticleOffset(size_t b) const { return m_tet.at(b).first; }
     int32_t surfaceParticleOffset(size_t s) const { return m_surf.at(s).first; }

@@ -540,40 +540,127 @@ TEST(XpbdSystem, PaintedFasciaWeightsScaleEachTrianglesStiffness) {
     EXPECT_THROW(energyOf(std::vector<double>(3, 1.0)), std::invalid_argument);
 }
 
-TEST(XpbdSystem, BitIdenticalAcrossThreadCounts) {
-    // Large enough that colours are split between threads.
-    auto fat = makeBoxTetMesh({Vec3::Zero(), Vec3(0.2, 0.1, 0.1), {20, 10, 10}});
-    auto vessel = makeBoxTetMesh({Vec3(0.02, 0.04, 0.04), Vec3(0.16, 0.02, 0.02), {16, 2, 2}});
+namespace {
+
+/// Fat 20 × 10 × 10 cm fixed at x = 0, a strain-limited vessel embedded in it, fascia tied on
+/// top: large enough that colours and particle passes are split between threads.
+struct BigLayers {
+    std::unique_ptr<TetMesh> fat = makeBoxTetMesh({Vec3::Zero(), Vec3(0.2, 0.1, 0.1), {20, 10, 10}});
+    std::unique_ptr<TetMesh> vessel = makeBoxTetMesh({Vec3(0.02, 0.04, 0.04), Vec3(0.16, 0.02, 0.02), {16, 2, 2}});
     TriMesh fascia = sheet(Vec3(0, 0, 0.1), Vec3(0.2, 0, 0), Vec3(0, 0.1, 0), 40, 20);
-    std::vector<int32_t> fixed;
-    for (int32_t v = 0; v < static_cast<int32_t>(fat->vertexCount()); ++v)
-        if (fat->positions()[v].x() < 1e-9) fixed.push_back(v);
-    XpbdSystemDesc d;
-    d.tetBodies.push_back({"fat", fat.get(), snh(3000), 950, fixed, {}, {}});
-    TetStrainLimits limits;
-    limits.limits.push_back({0, 0, -kInf, 0.05, 0.0});
-    d.tetBodies.push_back({"vessel", vessel.get(), snh(30000), 100, {}, {}, limits});
-    SurfaceBodyDesc s;
-    s.name = "fascia";
-    s.mesh = &fascia;
-    d.surfaces.push_back(s);
-    d.attachments.push_back({0, 0, 1e-4, 0.0, true});
-    d.embeddings.push_back({1, 0, 0.0, 1e-9});
+    XpbdSystemDesc desc;
+
+    BigLayers() {
+        std::vector<int32_t> fixed;
+        for (int32_t v = 0; v < static_cast<int32_t>(fat->vertexCount()); ++v)
+            if (fat->positions()[v].x() < 1e-9) fixed.push_back(v);
+        desc.tetBodies.push_back({"fat", fat.get(), snh(3000), 950, fixed, {}, {}});
+        TetStrainLimits limits;
+        limits.limits.push_back({0, 0, -kInf, 0.05, 0.0});
+        desc.tetBodies.push_back({"vessel", vessel.get(), snh(30000), 100, {}, {}, limits});
+        SurfaceBodyDesc s;
+        s.name = "fascia";
+        s.mesh = &fascia;
+        desc.surfaces.push_back(s);
+        desc.attachments.push_back({0, 0, 1e-4, 0.0, true});
+        desc.embeddings.push_back({1, 0, 0.0, 1e-9});
+    }
+};
+
+std::vector<Vec3> allPositions(const XpbdSystem& sys) {
+    std::vector<Vec3> all = sys.tetPositions(0);
+    all.insert(all.end(), sys.tetPositions(1).begin(), sys.tetPositions(1).end());
+    all.insert(all.end(), sys.surfacePositions(0).begin(), sys.surfacePositions(0).end());
+    return all;
+}
+
+} // namespace
+
+// Frames and the stored energy (summed in parallel parts) are the same to the bit for any number
+// of threads.
+TEST(XpbdSystem, BitIdenticalAcrossThreadCounts) {
+    const BigLayers L;
     std::vector<std::vector<Vec3>> results;
+    std::vector<double> energies;
     for (int threads : {1, 2, 3}) {
         XpbdSettings set;
         set.substeps = 5;
         set.threads = threads;
-        auto sys = XpbdSystem::create(d, set);
+        auto sys = XpbdSystem::create(L.desc, set);
         for (int f = 0; f < 3; ++f)
             ASSERT_TRUE(sys->step().finite);
-        std::vector<Vec3> all = sys->tetPositions(0);
-        all.insert(all.end(), sys->tetPositions(1).begin(), sys->tetPositions(1).end());
-        all.insert(all.end(), sys->surfacePositions(0).begin(), sys->surfacePositions(0).end());
-        results.push_back(all);
+        results.push_back(allPositions(*sys));
+        energies.push_back(sys->elasticEnergy()); // summed in parallel parts
     }
     EXPECT_EQ(results[1], results[0]);
     EXPECT_EQ(results[2], results[0]);
+    EXPECT_GT(energies[0], 0);
+    EXPECT_EQ(energies[1], energies[0]);
+    EXPECT_EQ(energies[2], energies[0]);
+}
+
+// A hook that declares the particles it touches (the fascia: a tool pressing on it during the
+// sweeps and damping its contact velocities in the velocity pass) ends each substep beside the other
+// particles' pass instead of after it: the frames are bit-identical to the same hook without the
+// declaration, for one to three threads and one or two iterations. A hook switched off for a
+// frame is not called and the frame is the one without a hook.
+TEST(XpbdSystem, HookOnItsOwnParticlesGivesTheFramesOfTheHookOnAll) {
+    const BigLayers L;
+    for (int iterations : {1, 2}) {
+        std::vector<std::vector<Vec3>> results;
+        std::vector<long> calls;
+        for (int threads : {1, 2, 3})
+            for (bool declared : {false, true}) {
+                SCOPED_TRACE(::testing::Message() << iterations << " iterations, " << threads << " threads, "
+                                                  << (declared ? "declared" : "all particles"));
+                XpbdSettings set;
+                set.substeps = 5;
+                set.iterations = iterations;
+                set.threads = threads;
+                auto sys = XpbdSystem::create(L.desc, set);
+                const size_t first = sys->surfaceParticleOffset(0), count = sys->surfacePositions(0).size();
+                long n = 0;
+                sys->setIterationHook([&, first, count](XpbdParticles& p, const XpbdIterationInfo& info) {
+                    ++n;
+                    for (size_t i = first; i < first + count; ++i) {
+                        Vec3 x = p.position(i);
+                        if (info.velocityPass) {
+                            if (x.x() > 0.15) p.setVelocity(i, 0.5 * p.velocity(i)); // contact friction
+                        } else if (x.x() > 0.15 && x.z() > 0.0995) {
+                            x.z() = 0.0995; // a flat tool 0.5 mm into the fascia's free end
+                            p.setPosition(i, x);
+                        }
+                    }
+                });
+                if (declared) sys->setIterationHookParticles(first, count);
+                for (int f = 0; f < 4; ++f)
+                    ASSERT_TRUE(sys->step().finite);
+                results.push_back(allPositions(*sys));
+                calls.push_back(n);
+            }
+        for (size_t k = 1; k < results.size(); ++k) {
+            EXPECT_EQ(results[k], results[0]) << "run " << k;
+            EXPECT_EQ(calls[k], calls[0]);
+        }
+        EXPECT_EQ(calls[0], 4 * 5 * (iterations + 1)); // every sweep and every velocity pass
+    }
+    XpbdSettings set;
+    set.substeps = 5;
+    set.threads = 2;
+    auto plain = XpbdSystem::create(L.desc, set);
+    auto off = XpbdSystem::create(L.desc, set);
+    long n = 0;
+    off->setIterationHook([&](XpbdParticles&, const XpbdIterationInfo&) { ++n; });
+    off->setIterationHookActive(false);
+    for (int f = 0; f < 3; ++f) {
+        ASSERT_TRUE(plain->step().finite);
+        ASSERT_TRUE(off->step().finite);
+    }
+    EXPECT_EQ(n, 0);
+    EXPECT_EQ(allPositions(*off), allPositions(*plain));
+    off->setIterationHookActive(true);
+    ASSERT_TRUE(off->step().finite);
+    EXPECT_EQ(n, 5 * 2);
 }
 
 TEST(XpbdSystem, MembraneSimdAndScalarKernelsAgree) {

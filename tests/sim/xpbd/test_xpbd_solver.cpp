@@ -376,3 +376,27 @@ TEST(XpbdSolver, RejectsUnsupportedModelsAndSettings) {
     body.mesh = nullptr;
     EXPECT_THAT(msg(body, s), HasSubstr("mesh is null"));
 }
+
+// The stored energy of a body large enough to be summed in several parts (12,000 tets, threads
+// 1 and 2) under a uniform deformation F is V Ψ(F), Ψ the stable Neo-Hookean density relative
+// to rest: μ/2 (|F|² − 3) + λ/2 ((J − γ)² − (1 − γ)²), γ = 1 + μ/λ.
+TEST(XpbdSolver, EnergyOfAUniformDeformationIsVolumeTimesDensity) {
+    auto mesh = makeBoxTetMesh({Vec3::Zero(), Vec3(0.2, 0.1, 0.1), {20, 10, 10}});
+    const Material m = tissue(5000, 0.45);
+    Mat3 F;
+    F << 1.10, 0.05, 0.00, //
+        0.02, 0.95, 0.03,  //
+        0.00, -0.04, 1.02;
+    const double mu = m.mu(), la = m.lambda(), g = 1 + mu / la, J = F.determinant();
+    const double psi = 0.5 * mu * (F.squaredNorm() - 3) + 0.5 * la * ((J - g) * (J - g) - (1 - g) * (1 - g));
+    std::vector<Vec3> x;
+    for (const Vec3& p : mesh->positions())
+        x.push_back(F * p);
+    for (int threads : {1, 2}) {
+        XpbdSettings s;
+        s.threads = threads;
+        auto solver = XpbdSolver::create(*mesh, m, {}, s);
+        solver->setState(x, std::vector<Vec3>(x.size(), Vec3::Zero()));
+        EXPECT_NEAR(solver->elasticEnergy(), 0.2 * 0.1 * 0.1 * psi, 1e-9 * std::abs(psi)) << threads << " threads";
+    }
+}

@@ -75,10 +75,10 @@ public:
         }
         return true;
     }
-    double energy(const double* xw) const override {
+    double energy(const double* xw, size_t unitBegin, size_t unitEnd) const override {
         // Ψ relative to rest: μ/2 (|F|² − 3) + λ/2 ((J − γ)² − (1 − γ)²).
         double sum = 0;
-        for (size_t u = 0; u < m_t.tets.size(); ++u) {
+        for (size_t u = unitBegin; u < unitEnd; ++u) {
             if (!m_active[u]) continue;
             const Tet& e = m_t.tets[u];
             const Mat3 ds = edgeMatrix(xw, e);
@@ -251,9 +251,9 @@ public:
         }
         return true;
     }
-    double energy(const double* xw) const override {
+    double energy(const double* xw, size_t unitBegin, size_t unitEnd) const override {
         double sum = 0;
-        for (size_t u = 0; u < m_t.tets.size(); ++u) {
+        for (size_t u = unitBegin; u < unitEnd; ++u) {
             if (!m_active[u]) continue;
             const Tet& e = m_t.tets[u];
             const Mat3 ds = edgeMatrix(xw, e);
@@ -355,9 +355,9 @@ public:
             }
         }
     }
-    double energy(const double* xw) const override {
+    double energy(const double* xw, size_t unitBegin, size_t unitEnd) const override {
         double sum = 0;
-        for (size_t u = 0; u < m_elems.size(); ++u) {
+        for (size_t u = unitBegin; u < unitEnd; ++u) {
             if (!m_active[u]) continue;
             std::array<Vec3, N> x;
             for (int i = 0; i < N; ++i)
@@ -488,9 +488,9 @@ public:
             }
         }
     }
-    double energy(const double* xw) const override {
+    double energy(const double* xw, size_t unitBegin, size_t unitEnd) const override {
         double sum = 0;
-        for (size_t u = 0; u < m_tris.size(); ++u) {
+        for (size_t u = unitBegin; u < unitEnd; ++u) {
             if (!m_active[u]) continue;
             std::array<Vec3, 3> x;
             for (int i = 0; i < 3; ++i)
@@ -584,9 +584,10 @@ public:
                 moveParticle(ctx.xw, t.t[k], (-w[k] * t.b[k]) * d);
         }
     }
-    double energy(const double* xw) const override {
+    double energy(const double* xw, size_t unitBegin, size_t unitEnd) const override {
         double sum = 0;
-        for (const Tie& t : m_ties) {
+        for (size_t u = unitBegin; u < unitEnd; ++u) {
+            const Tie& t = m_ties[u];
             if (t.compliance == 0) continue;
             Vec3 target[4];
             for (int k = 0; k < t.n; ++k)

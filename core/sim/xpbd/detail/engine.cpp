@@ -175,6 +175,16 @@ void Engine::appendCorrectionPhases(int threads) {
                         static_cast<uint32_t>((particleCount() + kChunkParticles - 1) / kChunkParticles)});
 }
 
+bool Engine::cutOutsideHookRange() {
+    m_outside.clear();
+    const size_t n = particleCount(), e = std::min(hookEnd, n), b = std::min(hookFirst, e);
+    if (b == 0 && e == n) return false;
+    for (auto [lo, hi] : {std::pair{size_t(0), b}, std::pair{e, n}})
+        for (size_t i = lo; i < hi; i += kChunkParticles)
+            m_outside.push_back({i, std::min(hi, i + kChunkParticles)});
+    return true;
+}
+
 void Engine::buildSchedule(Schedule kind, const XpbdSettings* s, int threads) {
     m_phases.clear();
     const auto particleChunks = static_cast<uint32_t>((particleCount() + kChunkParticles - 1) / kChunkParticles);
@@ -195,20 +205,28 @@ void Engine::buildSchedule(Schedule kind, const XpbdSettings* s, int threads) {
     } else if (kind == Schedule::Correction) {
         appendCorrectionPhases(threads);
     } else {
+        const bool hooks = iterationHook && iterationHookActive;
+        const bool tail = hooks && cutOutsideHookRange();
         m_phases.push_back({kPredictOnly, -1, false, false, true, particleChunks});
         for (int sub = 0; sub < s->substeps; ++sub) {
             for (int it = 0; it < s->iterations; ++it) {
                 // The correction reads the multipliers, so they are kept after the last sweep too.
                 colourPhases(it == 0, it + 1 == s->iterations && !s->primalCorrection);
                 if (s->primalCorrection) appendCorrectionPhases(threads);
-                if (iterationHook) {
+                if (hooks && !(tail && it + 1 == s->iterations)) {
                     Phase ph{kHook, -1, false, false, false, 1};
                     ph.substep = sub;
                     ph.iteration = it;
                     m_phases.push_back(ph);
                 }
             }
-            if (iterationHook) {
+            if (tail) {
+                Phase ph{
+                    kHookTail, -1, false, false, sub + 1 < s->substeps, static_cast<uint32_t>(1 + m_outside.size())};
+                ph.substep = sub;
+                ph.iteration = s->iterations - 1;
+                m_phases.push_back(ph);
+            } else if (hooks) {
                 // End of substep split in two around the velocity pass of the hook.
                 m_phases.push_back({-1, -1, false, false, false, particleChunks});
                 Phase ph{kHook, -1, false, false, false, 1};
@@ -325,6 +343,23 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
         }
         vi = decay * vel;
     };
+    // Particles [b, e): the end of the substep and/or the start of the next.
+    auto particles = [&](size_t b, size_t e, bool end, bool next, int tid) {
+        for (size_t i = b; i < e; ++i) {
+            double* p = x + 4 * i;
+            if (end) finish(i, p, v[i], tid);
+            if (next) predictAndKeep(i, p, v[i]);
+        }
+    };
+    auto callHook = [&](int substep, int iteration) {
+        XpbdParticles view(x, v.data(), n);
+        const XpbdIterationInfo info{substep, iteration, substeps, s.iterations, h, iteration == s.iterations};
+        try {
+            iterationHook(view, info);
+        } catch (...) {
+            m_hookFailed = true;
+        }
+    };
     execute(threads, pool, [&](const Phase& ph, uint32_t chunk, int tid) {
         if (ph.colour >= 0) {
             if (ph.forces)
@@ -339,22 +374,23 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
             return;
         }
         if (ph.colour == kHook) {
-            XpbdParticles view(x, v.data(), n);
-            const XpbdIterationInfo info{
-                ph.substep, ph.iteration, substeps, s.iterations, h, ph.iteration == s.iterations};
-            try {
-                iterationHook(view, info);
-            } catch (...) {
-                m_hookFailed = true;
-            }
+            callHook(ph.substep, ph.iteration);
+            return;
+        }
+        if (ph.colour == kHookTail && chunk > 0) {
+            particles(m_outside[chunk - 1].first, m_outside[chunk - 1].second, true, ph.predictNext, tid);
+            return;
+        }
+        if (ph.colour == kHookTail) { // the hook's particles, in the order of the phases it stands for
+            const size_t e = std::min(hookEnd, n), b = std::min(hookFirst, e);
+            callHook(ph.substep, ph.iteration);
+            particles(b, e, true, false, tid);
+            callHook(ph.substep, s.iterations);
+            particles(b, e, false, ph.predictNext, tid);
             return;
         }
         const size_t b = size_t(chunk) * kChunkParticles, e = std::min(n, b + kChunkParticles);
-        for (size_t i = b; i < e; ++i) {
-            double* p = x + 4 * i;
-            if (ph.colour != kPredictOnly) finish(i, p, v[i], tid);
-            if (ph.predictNext) predictAndKeep(i, p, v[i]);
-        }
+        particles(b, e, ph.colour != kPredictOnly, ph.predictNext, tid);
     });
 
     st.substeps = substeps;
@@ -378,6 +414,31 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
         st.maxDisplacement = 0;
     }
     return st;
+}
+
+double Engine::energy(int threads, WorkerPool* pool) {
+    // Parts of at least kEnergyPartUnits units, at most kEnergyParts per block: fixed by the
+    // blocks alone, so the sum (in part order) is the same for any number of threads.
+    constexpr size_t kEnergyPartUnits = 1024, kEnergyParts = 16;
+    m_energyParts.clear();
+    for (size_t b = 0; b < blocks.size(); ++b) {
+        const size_t units = blocks[b]->unitCount();
+        const size_t parts = std::clamp<size_t>(units / kEnergyPartUnits, 1, kEnergyParts);
+        for (size_t k = 0; k < parts; ++k)
+            m_energyParts.push_back({b, units * k / parts, units * (k + 1) / parts});
+    }
+    m_energySums.assign(m_energyParts.size(), 0.0);
+    m_phases.assign(1, Phase{kEnergy, -1, false, false, false, static_cast<uint32_t>(m_energyParts.size())});
+    m_phaseStart = {0, m_phases[0].chunks};
+    const int t = usefulThreads(pool ? std::min(threads, pool->size()) : 1);
+    execute(t, pool, [&](const Phase&, uint32_t chunk, int) {
+        const EnergyPart& p = m_energyParts[chunk];
+        m_energySums[chunk] = blocks[p.block]->energy(xw.data(), p.begin, p.end);
+    });
+    double e = 0;
+    for (double s : m_energySums)
+        e += s;
+    return e;
 }
 
 bool Engine::supportsPrimalCorrection() const {

@@ -64,8 +64,9 @@ public:
     virtual int unitParticles(size_t u, int32_t* out) const = 0;
     /// Solves the units of packs [packBegin, packEnd) (all of one colour) once, in place.
     virtual void solve(size_t packBegin, size_t packEnd, const SolveContext& ctx) = 0;
-    /// Stored energy (J) at the particle positions; hard constraints count 0.
-    virtual double energy(const double* xw) const = 0;
+    /// Stored energy (J) of units [unitBegin, unitEnd) at the particle positions; hard
+    /// constraints count 0.
+    virtual double energy(const double* xw, size_t unitBegin, size_t unitEnd) const = 0;
     /// Sweep order: all colours of stage 0 (elasticity), then stage 1 (strain limits), then
     /// stage 2 (couplings), so that limits and ties are the last word of every sweep.
     virtual int stage() const { return 0; }
@@ -113,6 +114,16 @@ public:
     /// Optional: called by frame() after every sweep (see XpbdIterationHook). Empty: frame()
     /// runs exactly the schedule it runs without hooks.
     XpbdIterationHook iterationHook;
+    /// False: the next frames run without calling iterationHook, on the schedule without hooks
+    /// (a frame in which no hook has anything to do: no tool near the tissue, nothing held).
+    bool iterationHookActive = true;
+    /// Particles [hookFirst, hookEnd) are all that iterationHook reads and writes (default:
+    /// every particle). With a narrower range, each substep ends in one phase: one chunk runs
+    /// the last iteration's hook, the end of the substep for those particles, the velocity-pass
+    /// hook and their next prediction, while the other chunks end the substep of every other
+    /// particle and predict the next in one pass (the same results as the phases one after the
+    /// other, without three barriers and a second pass over the particles).
+    size_t hookFirst = 0, hookEnd = SIZE_MAX;
 
     size_t particleCount() const { return mass.size(); }
     /// Appends particles (positions, masses, fixed flags; all the same size); returns the index
@@ -137,6 +148,9 @@ public:
     /// in seconds. Parallel like a sweep (colour by colour, bit-identical for any thread count);
     /// O(particles + units). Only when supportsPrimalCorrection().
     double primalCorrection(const std::vector<Vec3>& xTilde, int threads, WorkerPool* pool);
+    /// Stored energy of every block (J), summed in a fixed order of fixed parts of each block, so
+    /// the same for any thread count; the parts run in parallel like a sweep.
+    double energy(int threads, WorkerPool* pool);
     /// True when every block supports the primal correction.
     bool supportsPrimalCorrection() const;
     /// Threads worth using (≤ threads): 1 when no colour is large enough to split.
@@ -160,15 +174,22 @@ private:
         bool forces = false;            ///< colour pass of the primal correction: Σ ∇Cᵀλ into m_force
         int substep = 0, iteration = 0; ///< kHook: where in the frame
     };
+    /// Chunk 0: the hooks' end of a substep (see hookFirst); chunk k > 0: the end of the substep
+    /// and the next prediction of the particles of m_outside[k − 1].
+    static constexpr int kHookTail = -5;
     static constexpr int kPredictOnly = -2;
     /// Particle pass of the primal correction: x = x̃ + w f, f = 0.
     static constexpr int kCorrect = -3;
     /// One chunk: the iteration hook (after the sweep, and the correction, of an iteration).
     static constexpr int kHook = -4;
+    /// One chunk: the energy of m_energyParts[chunk] into m_energySums[chunk].
+    static constexpr int kEnergy = -6;
     enum class Schedule { Frame, Sweep, Correction };
     /// s: needed for Schedule::Frame only.
     void buildSchedule(Schedule kind, const XpbdSettings* s, int threads);
     void appendCorrectionPhases(int threads);
+    /// The chunks of m_outside; true when the hook's range leaves particles out (kHookTail).
+    bool cutOutsideHookRange();
     /// Chunks of a phase of colour c: a few per thread, each at least kMinChunkPacks packs.
     uint32_t colourChunks(int c, int threads) const;
     void forceColourChunk(int c, uint32_t chunk, uint32_t chunks);
@@ -194,6 +215,12 @@ private:
     size_t m_cursorCount = 0;
     alignas(64) std::atomic<uint32_t> m_doneChunks{0};
     std::vector<Vec3> m_prev;
+    std::vector<std::pair<size_t, size_t>> m_outside; ///< particle chunks outside the hook's range
+    struct EnergyPart {
+        size_t block, begin, end;
+    };
+    std::vector<EnergyPart> m_energyParts; ///< fixed parts of the blocks' units (see energy())
+    std::vector<double> m_energySums;
     ParticleArray m_frameStart;
     std::vector<Vec3> m_v0;
     std::vector<int> m_clamps;   ///< per thread
