@@ -13,6 +13,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 namespace viscera::player {
 namespace {
@@ -237,6 +238,33 @@ void publishLive(const sim::World& world, const HapticRig* rig, const std::vecto
     g.tools = render::toolPoses(world);
 }
 
+/// A console link that never answered or degraded (dropped, or zeroed the forces or refused
+/// packets out of order on 1 % or more): the session was not driven by the trainee's hands as it
+/// should have been, so it is a warning and a failed status.
+void checkLink(const HapticsResult& h, SessionResult& r) {
+    if (h.backend != "console") return;
+    const haptics::LinkStats& l = h.link;
+    const uint64_t ticks = h.servo.safety.ticks, zeroed = h.servo.safety.disconnected;
+    const double zeroedPct = ticks ? 100.0 * double(zeroed) / double(ticks) : 0.0;
+    const uint64_t refused = l.rejectedMalformed + l.rejectedVersion + l.rejectedChecksum + l.rejectedOrder;
+    char buf[400];
+    if (l.received == 0)
+        std::snprintf(buf, sizeof buf,
+                      "haptics: --device %s: the console never answered (0 valid state packets in %llu servo ticks, "
+                      "%llu packets refused): the tools did not move",
+                      h.spec.c_str(), (unsigned long long)ticks, (unsigned long long)refused);
+    else if (l.disconnects > 0 || zeroedPct >= 1.0 || double(l.rejectedOrder) >= 0.01 * double(l.received))
+        std::snprintf(buf, sizeof buf,
+                      "haptics: the console link degraded: %llu disconnects, forces zeroed for the link on %.1f %% of "
+                      "ticks, %llu packets out of order on %llu accepted (allowed: none, under 1 %%, under 1 %%)",
+                      (unsigned long long)l.disconnects, zeroedPct, (unsigned long long)l.rejectedOrder,
+                      (unsigned long long)l.received);
+    else
+        return;
+    r.warnings.push_back(buf);
+    r.errors.push_back(buf);
+}
+
 /// The device's figures at the end of a session with a rig.
 void collectHaptics(HapticRig& rig, SessionResult& r) {
     rig.finish();
@@ -251,6 +279,7 @@ void collectHaptics(HapticRig& rig, SessionResult& r) {
     if (ho.logErrors)
         r.errors.push_back("haptics: the hand-over log has " + std::to_string(ho.logErrors) +
                            " publishes out of order");
+    checkLink(*r.haptics, r);
 }
 
 /// The world's figures at the end of a session.

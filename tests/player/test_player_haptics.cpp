@@ -90,8 +90,9 @@ private:
 
 /// console-sim streams the bimanual script to the player (headless, real time, a probe for each
 /// hand) and records the forces it gets back: s/r.json (report), s/t.csv (trace), s/sum.json
-/// and s/forces.csv (console side).
-void runLoopback(const Scratch& s, int frames, std::vector<std::string> simArgs) {
+/// and s/forces.csv (console side). exitCode: the player's expected exit status (a link that
+/// dropped fails the session).
+void runLoopback(const Scratch& s, int frames, std::vector<std::string> simArgs, int exitCode = 0) {
     test::writeHapticCase(s / "slab.vcase", 2);
     const std::vector<std::string> common = {"--listen",  "127.0.0.1:0",  "--port-file",   s / "port",
                                              "--script",  "bimanual",     "--record",      s / "forces.csv",
@@ -111,8 +112,9 @@ void runLoopback(const Scratch& s, int frames, std::vector<std::string> simArgs)
     ASSERT_FALSE(port.empty()) << readText(s / "sim.err");
     auto r = player({"run", s / "slab.vcase", "--headless", "--frames", std::to_string(frames), "--device",
                      "console:127.0.0.1:" + port, "--report", s / "r.json", "--trace", s / "t.csv"});
-    ASSERT_EQ(r.exitCode, 0) << r.err;
+    ASSERT_EQ(r.exitCode, exitCode) << r.err << r.out;
     ASSERT_EQ(sim->waitFor(), 0) << readText(s / "sim.err");
+    if (exitCode != 0) ASSERT_THAT(r.out, HasSubstr("warning       haptics: the console link degraded"));
 }
 
 } // namespace
@@ -250,6 +252,24 @@ TEST(PlayerHaptics, RealTimeReplayTakesTheLockstepRunsInput) {
     EXPECT_EQ(outside, 0u) << "of " << realtime.size() << " ticks";
 }
 
+// A console that never answers (nothing listens at the port) does not end "status ok": the
+// session ran its frames with the tools still, and says so in a warning, the status, the report
+// and the exit status.
+TEST(PlayerHaptics, ConsoleThatNeverAnswersFailsTheSession) {
+    Scratch s;
+    test::writeHapticCase(s / "slab.vcase");
+    auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "30", "--device", "console:127.0.0.1:9",
+                     "--report", s / "r.json"});
+    EXPECT_EQ(r.exitCode, 3) << r.out << r.err;
+    EXPECT_THAT(r.out, HasSubstr("warning       haptics: --device console:127.0.0.1:9: the console never answered (0 "
+                                 "valid state packets in "));
+    EXPECT_THAT(r.out, HasSubstr("status        FAILED: haptics: --device console:127.0.0.1:9: the console never"));
+    const auto j = readJson(s / "r.json");
+    EXPECT_EQ(j["haptics"]["link"]["received"], 0);
+    ASSERT_EQ(j["errors"].size(), 1u);
+    EXPECT_THAT(j["errors"][0].get<std::string>(), HasSubstr("never answered"));
+}
+
 TEST(PlayerHaptics, BadDeviceSpecsAndTrajectoriesGiveOneLineErrors) {
     Scratch s;
     test::writeHapticCase(s / "slab.vcase");
@@ -279,7 +299,8 @@ TEST(PlayerHaptics, BadDeviceSpecsAndTrajectoriesGiveOneLineErrors) {
 TEST(PlayerHaptics, ConsoleLoopbackWithADisconnectMidSession) {
     Scratch s;
     // The console streams 3.5 s of the bimanual script, silent from 1.0 s to 1.6 s.
-    ASSERT_NO_FATAL_FAILURE(runLoopback(s, 180, {"--duration", "3.5", "--pause-at", "1.0", "--pause-for", "0.6"}));
+    // The dropped link fails the session (a warning, status FAILED, exit 3) after it ran on.
+    ASSERT_NO_FATAL_FAILURE(runLoopback(s, 180, {"--duration", "3.5", "--pause-at", "1.0", "--pause-for", "0.6"}, 3));
     const auto j = readJson(s / "r.json");
     const auto& h = j["haptics"];
     EXPECT_EQ(h["mode"], "realtime");
