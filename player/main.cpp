@@ -3,7 +3,7 @@
 //   viscera-player verify <case.vcase>
 //   viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]
 //                  [--report report.json] [--screenshot out.png] [--trace trace.csv] [--realtime]
-//                  [--plots DIR]
+//                  [--plots DIR] [--pairing-key FILE]
 //   viscera-player plot <report.json> -o DIR
 //
 // --device: replay:<file>, scripted:<name>, console:<host:port>, keyboard (window mode only).
@@ -52,7 +52,7 @@ void usage(std::FILE* out) {
                "                      [--report report.json] [--screenshot out.png] [--trace trace.csv]\n"
                "                      [--realtime | --lockstep] [--servo "
                "shared|shared:US|sleep|sleep:CPU|spin:US|busy|busy:CPU]\n"
-               "                      [--plots DIR]\n"
+               "                      [--plots DIR] [--pairing-key FILE]\n"
                "       viscera-player plot <report.json> -o DIR\n"
                "       viscera-player soak <case.vcase[@SPEC]>... [--minutes M] [--frames N] [--report soak.json]\n"
                "       SPEC: replay:<file> | scripted:<name> | console:<host:port> | keyboard\n"
@@ -80,6 +80,8 @@ constexpr const char* kRunHelp =
     "  --device SPEC         drive the case's tools: replay:<file.csv> | scripted:<name>\n"
     "                        (idle, press, circle, bimanual, clutch, roll) | console:<host:port>\n"
     "                        | keyboard (window only). A device that drives no tool is warned about.\n"
+    "  --pairing-key FILE    console: the key shared with the console (64 hex digits); the link is\n"
+    "                        authenticated with it (packaging/console-protocol.md)\n"
     "  --realtime            pace headless physics to the wall clock (console and window always are)\n"
     "  --lockstep            window: step a replay or scripted device with the physics instead of\n"
     "                        the wall clock (what happens is what the headless run shows)\n"
@@ -202,7 +204,7 @@ ServoChoice parseServoMode(const std::string& v) {
 }
 
 struct RunArgs {
-    std::optional<std::string> casePath, reportPath, screenshot, device, tracePath, plotsDir;
+    std::optional<std::string> casePath, reportPath, screenshot, device, tracePath, plotsDir, pairingKey;
     bool headless = false, realtime = false, lockstep = false, framesGiven = false;
     ServoChoice servo;
     int frames = 300;
@@ -240,6 +242,8 @@ RunArgs parseRunArgs(const std::vector<std::string>& args) {
             r.screenshot = value("--screenshot");
         else if (a == "--device")
             r.device = value("--device");
+        else if (a == "--pairing-key")
+            r.pairingKey = value("--pairing-key");
         else if (a == "--servo")
             r.servo = parseServoMode(value("--servo"));
         else if (!a.empty() && a[0] == '-')
@@ -398,7 +402,11 @@ int cmdRun(const std::vector<std::string>& args) {
     std::optional<haptics::DeviceSpec> spec;
     if (auto refused = refuseRun(r, spec)) return *refused;
     std::unique_ptr<haptics::Device> dev;
-    if (spec) dev = haptics::openDevice(*spec);
+    if (spec) {
+        haptics::DeviceOpenOptions o;
+        o.pairingKeyFile = r.pairingKey.value_or("");
+        dev = haptics::openDevice(*spec, o);
+    }
     // The window paces to the wall clock unless --lockstep asks for a replay or script stepped
     // with the physics (shown at physics speed where that is slower than real time).
     const bool rt = !r.lockstep && (r.realtime || (dev && dev->capabilities().realtime) || !r.headless);

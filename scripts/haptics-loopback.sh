@@ -37,7 +37,10 @@ fi
 case_file="${LOOPBACK_CASE:-$out/haptic-slab.vcase}"
 [ -n "${LOOPBACK_CASE:-}" ] || "$build/tests/player/make_haptic_case" "$out/haptic-slab.vcase" 2 >/dev/null
 rm -f "$out/port"
+# The pairing key both ends share (the authenticated link, packaging/console-protocol.md).
+"$build/player/viscera-console-sim" --make-pairing-key "$out/pairing.key" >/dev/null
 ${sim_cpus:+taskset -c "$sim_cpus"} "$build/player/viscera-console-sim" --listen 127.0.0.1:0 --port-file "$out/port" --script bimanual --loop \
+  --pairing-key "$out/pairing.key" \
   --duration "$(( secs * 4 + 10 ))" --until-player-stops --record "$out/console-forces.csv" --summary "$out/console-summary.json" \
   > "$out/console-sim.log" 2>&1 &
 sim=$!
@@ -48,11 +51,11 @@ player_rc=0 # the figures are printed either way; the script exits with the play
 if [ "${LOOPBACK_WINDOW:-0}" = 1 ]; then
   env -u QT_QPA_PLATFORM LIBGL_ALWAYS_SOFTWARE=1 xvfb-run -a -s "-screen 0 1920x1200x24 -nolisten tcp" \
     "$build/player/viscera-player" run "$case_file" --frames "$frames" --screenshot "$out/window.png" \
-    --device "console:127.0.0.1:$port" --servo "$servo" --report "$out/report.json" --trace "$out/trace.csv" \
+    --device "console:127.0.0.1:$port" --pairing-key "$out/pairing.key" --servo "$servo" --report "$out/report.json" --trace "$out/trace.csv" \
     2>/dev/null || player_rc=$?
 else
   "$build/player/viscera-player" run "$case_file" --headless --frames "$frames" \
-    --device "console:127.0.0.1:$port" --servo "$servo" --report "$out/report.json" --trace "$out/trace.csv" \
+    --device "console:127.0.0.1:$port" --pairing-key "$out/pairing.key" --servo "$servo" --report "$out/report.json" --trace "$out/trace.csv" \
     2>/dev/null || player_rc=$?
 fi
 wait "$sim"

@@ -3,7 +3,7 @@
 namespace viscera::haptics {
 
 ConsoleDevice::ConsoleDevice(const Endpoint& console, const ConsoleDeviceOptions& options)
-    : m_console(console), m_opt(options), m_socket([] {
+    : m_console(console), m_opt(options), m_pairing(options.pairingKey), m_socket([] {
           Endpoint any;
           any.addr.sin_family = AF_INET;
           any.addr.sin_addr.s_addr = htonl(INADDR_ANY);
@@ -31,28 +31,15 @@ void ConsoleDevice::poll(int64_t now_ns, DeviceState& out) {
         int64_t queued = 0;
         const long n = m_socket.receive(m_rx, sizeof m_rx, &from, &queued);
         if (n < 0) break;
-        if (!(from == m_console) || n > static_cast<long>(sizeof m_rx)) {
+        if (!(from == m_console)) { // the console's address is the only one read
+            m_count.peer.fetch_add(1, std::memory_order_relaxed);
+            continue;
+        }
+        if (n > static_cast<long>(sizeof m_rx)) {
             m_count.malformed.fetch_add(1, std::memory_order_relaxed);
             continue;
         }
-        const DecodeError e = decode(m_rx, static_cast<size_t>(n), pkt);
-        if (e == DecodeError::BadVersion) {
-            m_count.version.fetch_add(1, std::memory_order_relaxed);
-            continue;
-        }
-        if (e == DecodeError::BadChecksum) {
-            m_count.checksum.fetch_add(1, std::memory_order_relaxed);
-            continue;
-        }
-        if (e != DecodeError::None) {
-            m_count.malformed.fetch_add(1, std::memory_order_relaxed);
-            continue;
-        }
-        // After a disconnect the console may have restarted its sequence: accept any number then.
-        if (m_seqValid && !newer(pkt.sequence, m_lastSeq)) {
-            m_count.order.fetch_add(1, std::memory_order_relaxed);
-            continue;
-        }
+        if (!take(m_rx, static_cast<size_t>(n), pkt, now_ns - queued)) continue;
         if (fresh) m_count.flood.fetch_add(1, std::memory_order_relaxed);
         fresh = true;
         m_haveState = true;
@@ -60,7 +47,7 @@ void ConsoleDevice::poll(int64_t now_ns, DeviceState& out) {
         m_lastSeq = pkt.sequence;
         // Arrival on this poll's clock: a servo tick that ran late must not take a packet that
         // waited in the queue for a fresh one (the device timeout counts from the arrival).
-        m_lastArrival_ns = now_ns - queued;
+        m_lastArrival_ns = m_lastLife_ns = now_ns - queued;
         m_last.timestamp_ns = m_lastArrival_ns;
         m_last.sequence += 1;
         m_last.pedals = pkt.pedals;
@@ -69,7 +56,9 @@ void ConsoleDevice::poll(int64_t now_ns, DeviceState& out) {
         m_count.received.fetch_add(1, std::memory_order_relaxed);
     }
     const bool connected = m_haveState && now_ns - m_lastArrival_ns <= m_opt.timeout_ns;
-    if (!connected) m_seqValid = false;
+    // Nothing valid for the timeout since the last state or welcome: hellos again (a restarted
+    // console); states of the old session still count meanwhile.
+    if (now_ns - m_lastLife_ns > m_opt.timeout_ns) m_wantSession = true;
     if (m_connected && !connected) m_count.disconnects.fetch_add(1, std::memory_order_relaxed);
     if (!m_connected && connected) {
         if (m_everConnected) m_count.reconnects.fetch_add(1, std::memory_order_relaxed);
@@ -80,14 +69,65 @@ void ConsoleDevice::poll(int64_t now_ns, DeviceState& out) {
     out.connected = connected;
 }
 
+bool ConsoleDevice::take(const uint8_t* data, size_t size, StatePacket& pkt, int64_t arrived_ns) {
+    auto refuse = [&](DecodeError e) {
+        auto& c = e == DecodeError::BadVersion ? m_count.version
+                  : e == DecodeError::BadMac   ? m_count.auth
+                                               : m_count.malformed;
+        c.fetch_add(1, std::memory_order_relaxed);
+        return false;
+    };
+    if (peekType(data, size) == static_cast<uint16_t>(PacketType::Welcome)) {
+        WelcomePacket w;
+        if (const DecodeError e = decode(data, size, w, m_pairing); e != DecodeError::None) return refuse(e);
+        if (!m_helloSent || w.client != m_clientNonce) { // an old or replayed welcome
+            m_count.order.fetch_add(1, std::memory_order_relaxed);
+            return false;
+        }
+        m_session.setKey(sessionKey(m_opt.pairingKey, m_clientNonce, w.server));
+        m_helloSent = false;
+        m_wantSession = false;
+        m_seqValid = false; // a new session numbers its states afresh
+        m_lastLife_ns = arrived_ns;
+        m_count.handshakes.fetch_add(1, std::memory_order_relaxed);
+        return false;
+    }
+    // Without a session every state fails its MAC (counted as authentication).
+    if (const DecodeError e = decode(data, size, pkt, m_session); e != DecodeError::None) return refuse(e);
+    if (m_seqValid && !newer(pkt.sequence, m_lastSeq)) { // a replay, a duplicate or late
+        m_count.order.fetch_add(1, std::memory_order_relaxed);
+        return false;
+    }
+    if (m_seqValid && uint32_t(pkt.sequence - m_lastSeq) > kMaxSequenceJump) {
+        m_count.jump.fetch_add(1, std::memory_order_relaxed);
+        return false;
+    }
+    return true;
+}
+
+void ConsoleDevice::sendHello(int64_t now_ns) {
+    HelloPacket h;
+    h.sequence = ++m_sendSeq;
+    h.timestamp_ns = now_ns;
+    m_clientNonce = randomNonce();
+    h.client = m_clientNonce;
+    const size_t n = encode(h, m_tx, sizeof m_tx, m_pairing);
+    m_helloSent = true;
+    m_lastHello_ns = now_ns;
+    if (!m_socket.sendTo(m_tx, n, m_console)) m_count.sendErrors.fetch_add(1, std::memory_order_relaxed);
+}
+
 void ConsoleDevice::send(const DeviceCommand& command) {
+    if (m_wantSession && (!m_helloSent || command.timestamp_ns - m_lastHello_ns >= m_opt.helloInterval_ns))
+        sendHello(command.timestamp_ns);
+    if (!m_session.hasKey()) return; // no session yet: only hellos go out
     CommandPacket p;
     p.sequence = ++m_sendSeq;
     p.timestamp_ns = command.timestamp_ns;
     p.echoSequence = m_lastSeq;
     p.flags = command.flags;
     p.arm = command.arms;
-    const size_t n = encode(p, m_tx, sizeof m_tx);
+    const size_t n = encode(p, m_tx, sizeof m_tx, m_session);
     if (m_socket.sendTo(m_tx, n, m_console))
         m_count.sent.fetch_add(1, std::memory_order_relaxed);
     else
@@ -100,8 +140,11 @@ LinkStats ConsoleDevice::linkStats() const {
     s.received = r(m_count.received);
     s.rejectedMalformed = r(m_count.malformed);
     s.rejectedVersion = r(m_count.version);
-    s.rejectedChecksum = r(m_count.checksum);
+    s.rejectedAuth = r(m_count.auth);
     s.rejectedOrder = r(m_count.order);
+    s.rejectedJump = r(m_count.jump);
+    s.rejectedPeer = r(m_count.peer);
+    s.handshakes = r(m_count.handshakes);
     s.droppedFlood = r(m_count.flood);
     s.sent = r(m_count.sent);
     s.sendErrors = r(m_count.sendErrors);

@@ -1,13 +1,16 @@
 #pragma once
 /// Network backend for the bimanual console (2 × 7-DOF masters with grip, 5 pedals, [B §4]) over
-/// UDP, protocol version 1 (console_protocol.hpp, packaging/console-protocol.md).
+/// UDP, protocol version 2 (console_protocol.hpp, packaging/console-protocol.md).
 ///
-/// The player binds an ephemeral local port and sends a command packet every servo tick to the
-/// console's address; the console answers with state packets to the address the commands come
-/// from. poll() drains at most maxPacketsPerPoll datagrams per tick and keeps the newest valid
-/// one; malformed, wrong-version, corrupted and out-of-order packets are counted and ignored.
-/// With no valid packet for `timeout`, the device reports disconnected (the safety filter then
-/// zeroes the force); the next valid packet reconnects it.
+/// The player binds an ephemeral local port and opens a session: a hello under the pairing key
+/// (every helloInterval until a valid welcome answers it), then a command packet every servo
+/// tick under the session key; the console answers with state packets. Only packets from the
+/// console's address are read (others count as peer). poll() drains at most maxPacketsPerPoll
+/// datagrams per tick and keeps the newest valid state; malformed, wrong-version, forged (MAC),
+/// replayed (not newer), jumped and foreign packets are counted by reason and move nothing.
+/// With no valid state for `timeout`, the device reports disconnected (the safety filter then
+/// zeroes the force) and sends hellos again; states of the old session still reconnect it until
+/// a welcome opens a new one (a restarted console).
 #include "haptics/console_protocol.hpp"
 #include "haptics/device.hpp"
 #include "haptics/udp_socket.hpp"
@@ -18,6 +21,8 @@
 namespace viscera::haptics {
 
 struct ConsoleDeviceOptions {
+    LinkKey pairingKey{}; ///< shared with the console (loadPairingKey)
+    int64_t helloInterval_ns = 50'000'000;
     int64_t timeout_ns = 100'000'000; ///< no valid packet for this long = disconnected
     int maxPacketsPerPoll = 64;
     double maxForce = 15.0; ///< N per arm, the console's motors [B §4]
@@ -36,11 +41,16 @@ public:
 
 private:
     struct Counters {
-        std::atomic<uint64_t> received{0}, malformed{0}, version{0}, checksum{0}, order{0}, flood{0}, sent{0},
-            sendErrors{0}, disconnects{0}, reconnects{0};
+        std::atomic<uint64_t> received{0}, malformed{0}, version{0}, auth{0}, order{0}, jump{0}, peer{0}, flood{0},
+            sent{0}, sendErrors{0}, disconnects{0}, reconnects{0}, handshakes{0};
     };
+    /// One datagram of the console's: a welcome (opens the session) or a state; true when it was
+    /// a valid state (then in pkt).
+    bool take(const uint8_t* data, size_t size, StatePacket& pkt, int64_t arrived_ns);
+    void sendHello(int64_t now_ns);
     Endpoint m_console;
     ConsoleDeviceOptions m_opt;
+    LinkMac m_pairing, m_session; ///< MACs under the pairing key (handshake) and the session key
     DeviceCapabilities m_caps;
     UdpSocket m_socket;
     Counters m_count;
@@ -52,6 +62,11 @@ private:
     bool m_everConnected = false;
     uint32_t m_lastSeq = 0;
     uint32_t m_sendSeq = 0;
+    Nonce m_clientNonce{};
+    bool m_helloSent = false;  ///< m_clientNonce went out in a hello that no welcome answered yet
+    bool m_wantSession = true; ///< no session, or the link timed out: hellos go out
+    int64_t m_lastHello_ns = 0;
+    int64_t m_lastLife_ns = 0; ///< arrival of the last valid state or welcome
     alignas(8) uint8_t m_rx[kMaxPacketSize];
     alignas(8) uint8_t m_tx[kMaxPacketSize];
 };

@@ -18,10 +18,13 @@ struct LinkStats {
     uint64_t received = 0;          ///< samples/packets accepted
     uint64_t rejectedMalformed = 0; ///< wrong size, bad magic, bad field, non-finite value
     uint64_t rejectedVersion = 0;   ///< protocol version this build does not speak
-    uint64_t rejectedChecksum = 0;
-    uint64_t rejectedOrder = 0; ///< duplicate or out-of-order sequence numbers
-    uint64_t droppedFlood = 0;  ///< valid packets superseded within one tick (only the newest is used)
-    uint64_t sent = 0;          ///< commands sent
+    uint64_t rejectedAuth = 0;      ///< MAC mismatch (forged, corrupted or of another session), or no session yet
+    uint64_t rejectedOrder = 0;     ///< duplicate or out-of-order sequence numbers (a replay)
+    uint64_t rejectedJump = 0;      ///< sequence too far ahead of the last accepted one
+    uint64_t rejectedPeer = 0;      ///< from another address than the console's
+    uint64_t handshakes = 0;        ///< sessions opened (hello answered by a valid welcome)
+    uint64_t droppedFlood = 0;      ///< valid packets superseded within one tick (only the newest is used)
+    uint64_t sent = 0;              ///< commands sent
     uint64_t sendErrors = 0;
     uint64_t disconnects = 0; ///< connected → disconnected transitions
     uint64_t reconnects = 0;  ///< disconnected → connected transitions (after a first connection)

@@ -47,6 +47,11 @@ std::unique_ptr<Device> openDevice(const DeviceSpec& spec, const DeviceOpenOptio
         return std::make_unique<ScriptedDevice>(spec.argument, options.maxForce);
     case DeviceSpec::Kind::Console: {
         ConsoleDeviceOptions o;
+        if (options.pairingKeyFile.empty())
+            throw InputError("--device '" + spec.text +
+                             "': the console link needs the pairing key shared with the console: --pairing-key FILE "
+                             "(viscera-console-sim --make-pairing-key FILE makes one)");
+        o.pairingKey = loadPairingKey(options.pairingKeyFile);
         o.timeout_ns = options.consoleTimeout_ns;
         o.maxForce = options.maxForce;
         return std::make_unique<ConsoleDevice>(parseEndpoint(spec.argument, "--device '" + spec.text + "'"), o);

@@ -24,11 +24,13 @@ DeviceSpec parseDeviceSpec(const std::string& spec);
 struct DeviceOpenOptions {
     double maxForce = 15.0; ///< N, the device's capability where the backend has none
     int64_t consoleTimeout_ns = 100'000'000;
+    /// console: the pairing key file shared with the console (64 hex digits); required.
+    std::string pairingKeyFile;
     bool loopReplay = false;
 };
 
-/// Opens the device (reads the trajectory, binds the socket). Throws viscera::InputError naming
-/// the file or address and the rule.
+/// Opens the device (reads the trajectory or the pairing key, binds the socket). Throws
+/// viscera::InputError naming the file or address and the rule.
 std::unique_ptr<Device> openDevice(const DeviceSpec& spec, const DeviceOpenOptions& options = {});
 
 } // namespace viscera::haptics

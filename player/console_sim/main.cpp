@@ -1,13 +1,20 @@
 // viscera-console-sim: a stand-in for the bimanual console (2 × 7-DOF masters with grip, five
 // pedals, [B §4]). It speaks the console protocol (packaging/console-protocol.md) over UDP:
 // replays a recorded trajectory (or a scripted motion) as state packets at 1 kHz to the player
-// that contacts it, and records every force command it receives.
+// that opened a session with it (a hello under the shared pairing key), and records every force
+// command it receives, clamped to its motors' 15 N.
 //
-//   viscera-console-sim --listen HOST:PORT (--trajectory FILE | --script NAME) [--duration S]
-//                       [--rate HZ] [--loop] [--record forces.csv] [--summary summary.json]
-//                       [--port-file FILE] [--pause-at S --pause-for S] [--wait-player S]
-//                       [--until-player-stops]
+//   viscera-console-sim --listen HOST:PORT --pairing-key FILE (--trajectory FILE | --script NAME)
+//                       [--duration S] [--rate HZ] [--loop] [--record forces.csv]
+//                       [--summary summary.json] [--port-file FILE] [--pause-at S --pause-for S]
+//                       [--wait-player S] [--until-player-stops]
 //   viscera-console-sim --write-trajectory OUT.csv --script NAME --duration S [--rate HZ]
+//   viscera-console-sim --make-pairing-key FILE
+//
+// The session: a hello from any address opens it while no session is live (no valid command for
+// 1 s) or from the session's own address; the console then reads only that address. Hellos are
+// accepted once (a replayed nonce is refused); commands must carry the session's MAC and a newer
+// sequence no more than kMaxSequenceJump ahead. Refusals are counted by reason in the summary.
 //
 // --until-player-stops streams like the real console until the player has sent nothing for 1 s
 // (its session ended), --duration bounding the whole run: a player that falls behind the wall
@@ -18,6 +25,7 @@
 // usage, 3 no player contacted it.
 #include "haptics/clock.hpp"
 #include "haptics/console_protocol.hpp"
+#include "haptics/link_auth.hpp"
 #include "haptics/scripted_device.hpp"
 #include "haptics/trajectory.hpp"
 #include "haptics/udp_socket.hpp"
@@ -32,6 +40,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -45,7 +54,8 @@ using namespace viscera::haptics;
 
 struct Options {
     std::string listen = "127.0.0.1:7400";
-    std::optional<std::string> trajectory, script, record, summary, portFile, writeTrajectory;
+    std::optional<std::string> trajectory, script, record, summary, portFile, writeTrajectory, pairingKey,
+        makePairingKey;
     double duration = -1, rate = 1000, pauseAt = -1, pauseFor = 0, waitPlayer = 30;
     bool loop = false;
     bool untilPlayerStops = false;
@@ -88,6 +98,10 @@ Options parse(const std::vector<std::string>& args) {
             o.portFile = value();
         else if (a == "--write-trajectory")
             o.writeTrajectory = value();
+        else if (a == "--pairing-key")
+            o.pairingKey = value();
+        else if (a == "--make-pairing-key")
+            o.makePairingKey = value();
         else if (a == "--duration")
             o.duration = number(a, value(), 0.001, 86400);
         else if (a == "--rate")
@@ -105,6 +119,7 @@ Options parse(const std::vector<std::string>& args) {
         else
             throw std::invalid_argument("unknown option '" + a + "'");
     }
+    if (o.makePairingKey) return o;
     if (o.trajectory.has_value() == o.script.has_value())
         throw std::invalid_argument("give exactly one of --trajectory FILE or --script NAME");
     if (o.writeTrajectory && (!o.script || o.duration <= 0))
@@ -144,6 +159,78 @@ private:
     std::unique_ptr<ScriptedDevice> m_script;
 };
 
+/// The console's end of the session (packaging/console-protocol.md, version 2): who it talks to,
+/// under which key, and what it refused.
+struct Link {
+    static constexpr double kMaxForce = 15.0;                ///< N per arm: the console's motors
+    static constexpr int64_t kSessionIdleNs = 1'000'000'000; ///< no valid command this long: a new peer may open one
+    explicit Link(const LinkKey& key) : pairingKey(key), pairing(key) {}
+
+    LinkKey pairingKey;
+    LinkMac pairing, session;
+    Endpoint player;
+    bool havePlayer = false, commanded = false, seqValid = false;
+    uint32_t lastSeq = 0, sendSeq = 0;
+    int64_t lastHeard = 0;
+    std::vector<Nonce> nonces; ///< hellos already answered (a replayed hello is refused)
+    std::map<std::string, uint64_t> rejected;
+    uint64_t handshakes = 0, clamped = 0;
+
+    bool refuse(const char* reason) {
+        ++rejected[reason];
+        return false;
+    }
+    bool refuse(DecodeError e) {
+        return refuse(e == DecodeError::BadVersion ? "version" : e == DecodeError::BadMac ? "auth" : "malformed");
+    }
+
+    /// One datagram: a hello (opens a session, answered with a welcome) or a command (into c,
+    /// commanded = true). False when refused (counted by reason).
+    bool take(const uint8_t* data, size_t size, const Endpoint& from, int64_t arrived, UdpSocket& sock,
+              CommandPacket& c) {
+        commanded = false;
+        if (peekType(data, size) == static_cast<uint16_t>(PacketType::Hello))
+            return hello(data, size, from, arrived, sock);
+        if (!havePlayer) return refuse("auth"); // no session: nothing can carry its MAC
+        if (!(from == player)) return refuse("peer");
+        if (const DecodeError e = decode(data, size, c, session); e != DecodeError::None) return refuse(e);
+        if (seqValid && !newer(c.sequence, lastSeq)) return refuse("order");
+        if (seqValid && uint32_t(c.sequence - lastSeq) > kMaxSequenceJump) return refuse("jump");
+        seqValid = true;
+        lastSeq = c.sequence;
+        lastHeard = arrived;
+        for (ArmCommand& a : c.arm) // the motors' limit, whatever the player asked
+            if (const double f = a.servo_cf.force.norm(); f > kMaxForce) {
+                a.servo_cf.force *= kMaxForce / f;
+                ++clamped;
+            }
+        commanded = true;
+        return true;
+    }
+
+    bool hello(const uint8_t* data, size_t size, const Endpoint& from, int64_t arrived, UdpSocket& sock) {
+        HelloPacket h;
+        if (const DecodeError e = decode(data, size, h, pairing); e != DecodeError::None) return refuse(e);
+        if (std::find(nonces.begin(), nonces.end(), h.client) != nonces.end()) return refuse("replayed_hello");
+        if (havePlayer && !(from == player) && arrived - lastHeard < kSessionIdleNs) return refuse("peer");
+        nonces.push_back(h.client);
+        WelcomePacket w;
+        w.sequence = ++sendSeq;
+        w.timestamp_ns = arrived;
+        w.client = h.client;
+        w.server = randomNonce();
+        session.setKey(sessionKey(pairingKey, w.client, w.server));
+        player = from;
+        havePlayer = true;
+        seqValid = false;
+        lastHeard = arrived;
+        ++handshakes;
+        uint8_t out[kMaxPacketSize];
+        sock.sendTo(out, encode(w, out, sizeof out, pairing), player);
+        return true;
+    }
+};
+
 int writeTrajectory(const Options& o) {
     Source src(o);
     Trajectory out;
@@ -167,7 +254,19 @@ int writeTrajectory(const Options& o) {
     return 0;
 }
 
+int makePairingKey(const std::string& path) {
+    requireWritableFile(path, "the pairing key");
+    writeFileAtomic(path, formatPairingKey(randomKey()), 0600);
+    std::printf("pairing key   %s (64 hex digits, readable by its owner only; give it to the player with "
+                "--pairing-key)\n",
+                std::filesystem::absolute(path).c_str());
+    return 0;
+}
+
 int run(const Options& o) {
+    if (!o.pairingKey)
+        throw std::invalid_argument("--pairing-key FILE is needed: the key the player has (--make-pairing-key FILE "
+                                    "makes one)");
     std::vector<std::filesystem::path> inputs;
     if (o.trajectory) inputs.emplace_back(*o.trajectory);
     for (const auto& [file, what] : {std::pair{o.record, "the force record"}, std::pair{o.summary, "the summary"}})
@@ -186,40 +285,32 @@ int run(const Options& o) {
 
     std::vector<Received> received;
     received.reserve(static_cast<size_t>(duration * o.rate * 1.2) + 1024);
-    uint64_t rejected[16] = {};
+    Link link(loadPairingKey(*o.pairingKey));
     uint8_t buf[kMaxPacketSize];
-    Endpoint player;
-    bool havePlayer = false;
     const int64_t waitEnd = monotonicNs() + int64_t(o.waitPlayer * 1e9);
-    int64_t t0 = 0, lastHeard = 0;
+    int64_t t0 = 0;
     auto drain = [&]() {
         while (true) {
             Endpoint from;
             int64_t queued = 0;
             const long n = sock.receive(buf, sizeof buf, &from, &queued);
             if (n < 0) break;
-            CommandPacket c;
-            const auto e = decode(buf, n > long(sizeof buf) ? sizeof buf + 1 : size_t(n), c);
-            if (e != DecodeError::None) {
-                ++rejected[static_cast<int>(e)];
-                continue;
-            }
             const int64_t arrived = monotonicNs() - queued;
-            if (!havePlayer) {
-                player = from;
-                havePlayer = true;
+            CommandPacket c;
+            const bool hadPlayer = link.havePlayer;
+            if (!link.take(buf, n > long(sizeof buf) ? sizeof buf + 1 : size_t(n), from, arrived, sock, c)) continue;
+            if (!hadPlayer && link.havePlayer) {
                 t0 = arrived;
-                std::fprintf(stderr, "viscera-console-sim: player at %s\n", player.text().c_str());
+                std::fprintf(stderr, "viscera-console-sim: player at %s\n", link.player.text().c_str());
             }
-            if (!(from == player)) continue;
-            lastHeard = arrived;
+            if (!link.commanded) continue; // the handshake
             // Time the command arrived, not when this loop got to it (the figures judge the
             // player's forces by when it sent them, whatever the load on this process).
             const double t = 1e-9 * double(arrived - t0);
             received.push_back({t, o.pauseAt >= 0 && t >= o.pauseAt && t < o.pauseAt + o.pauseFor, c});
         }
     };
-    while (!havePlayer) {
+    while (!link.havePlayer) {
         if (monotonicNs() > waitEnd) {
             std::fprintf(stderr, "viscera-console-sim: no player contacted %s within %.1f s\n", local.text().c_str(),
                          o.waitPlayer);
@@ -243,7 +334,7 @@ int run(const Options& o) {
         const double t = 1e-9 * double(now - t0);
         if (t > duration) break;
         drain();
-        if (o.untilPlayerStops && now - lastHeard > kPlayerSilentNs) break;
+        if (o.untilPlayerStops && now - link.lastHeard > kPlayerSilentNs) break;
         streamed = t;
         const bool paused = o.pauseAt >= 0 && t >= o.pauseAt && t < o.pauseAt + o.pauseFor;
         if (!paused) {
@@ -255,8 +346,8 @@ int run(const Options& o) {
             p.arms = static_cast<uint8_t>(src.arms());
             for (int a = 0; a < kMaxArms; ++a)
                 p.arm[a] = s.arms[a];
-            const size_t n = encode(p, buf, sizeof buf);
-            if (sock.sendTo(buf, n, player)) {
+            const size_t n = encode(p, buf, sizeof buf, link.session);
+            if (sock.sendTo(buf, n, link.player)) {
                 ++sent, sentAt.emplace_back(p.sequence, now);
                 // When the last state before the silence really left (this process may have
                 // been descheduled between reading the clock and sending).
@@ -304,8 +395,8 @@ int run(const Options& o) {
         return latency.empty() ? 0.0 : latency[std::min(latency.size() - 1, size_t(p * double(latency.size())))];
     };
     uint64_t rejectedAll = 0;
-    for (uint64_t r : rejected)
-        rejectedAll += r;
+    for (const auto& [reason, count] : link.rejected)
+        rejectedAll += count;
     if (o.record) {
         std::string csv = "t_s,seq,echo,flags,paused,f0x,f0y,f0z,f1x,f1y,f1z,grip0_n,grip1_n\n";
         char line[320];
@@ -324,6 +415,9 @@ int run(const Options& o) {
                           {"send_errors", sendErrors},
                           {"commands_received", received.size()},
                           {"commands_rejected", rejectedAll},
+                          {"rejected", link.rejected},
+                          {"handshakes", link.handshakes},
+                          {"commands_clamped", link.clamped},
                           {"commands_nonzero", nonZero},
                           {"commands_non_finite", nonFinite},
                           {"max_force_n", maxForce},
@@ -337,9 +431,10 @@ int run(const Options& o) {
                             {"max", latency.empty() ? 0.0 : latency.back()}}}};
     if (o.summary) writeFileAtomic(*o.summary, sum.dump(2) + "\n");
     std::printf(
-        "console-sim   %llu states sent, %zu commands received (%llu rejected), %llu non-zero, max force %.3f N\n",
-        (unsigned long long)sent, received.size(), (unsigned long long)rejectedAll, (unsigned long long)nonZero,
-        maxForce);
+        "console-sim   %llu states sent, %zu commands received (%llu packets refused, %llu clamped to %.0f N), %llu "
+        "non-zero, max force %.3f N, %llu sessions\n",
+        (unsigned long long)sent, received.size(), (unsigned long long)rejectedAll, (unsigned long long)link.clamped,
+        Link::kMaxForce, (unsigned long long)nonZero, maxForce, (unsigned long long)link.handshakes);
     std::printf("latency       state -> command echo p50 %.3f ms, p99 %.3f ms\n", pct(0.5), pct(0.99));
     if (pausedCmds)
         std::printf("pause         %llu commands during the pause, %llu non-zero after the device timeout\n",
@@ -348,10 +443,11 @@ int run(const Options& o) {
 }
 
 void usage(std::FILE* out) {
-    std::fputs("usage: viscera-console-sim --listen HOST:PORT (--trajectory FILE | --script NAME) [--duration S]\n"
-               "           [--rate HZ] [--loop] [--record forces.csv] [--summary summary.json] [--port-file FILE]\n"
-               "           [--pause-at S --pause-for S] [--wait-player S] [--until-player-stops]\n"
-               "       viscera-console-sim --write-trajectory OUT.csv --script NAME --duration S [--rate HZ]\n",
+    std::fputs("usage: viscera-console-sim --listen HOST:PORT --pairing-key FILE (--trajectory FILE | --script NAME)\n"
+               "           [--duration S] [--rate HZ] [--loop] [--record forces.csv] [--summary summary.json]\n"
+               "           [--port-file FILE] [--pause-at S --pause-for S] [--wait-player S] [--until-player-stops]\n"
+               "       viscera-console-sim --write-trajectory OUT.csv --script NAME --duration S [--rate HZ]\n"
+               "       viscera-console-sim --make-pairing-key FILE\n",
                out);
 }
 
@@ -363,6 +459,7 @@ int main(int argc, char** argv) {
     program.usage = usage;
     program.fallback = [](const sim::CliArgs& args) {
         const Options o = parse(args);
+        if (o.makePairingKey) return makePairingKey(*o.makePairingKey);
         return o.writeTrajectory ? writeTrajectory(o) : run(o);
     };
     return sim::runCli(program, argc, argv);

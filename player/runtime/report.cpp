@@ -105,8 +105,11 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
     json link = {{"received", l.received},
                  {"rejected_malformed", l.rejectedMalformed},
                  {"rejected_version", l.rejectedVersion},
-                 {"rejected_checksum", l.rejectedChecksum},
+                 {"rejected_auth", l.rejectedAuth},
                  {"rejected_order", l.rejectedOrder},
+                 {"rejected_jump", l.rejectedJump},
+                 {"rejected_peer", l.rejectedPeer},
+                 {"handshakes", l.handshakes},
                  {"dropped_flood", l.droppedFlood},
                  {"sent", l.sent},
                  {"send_errors", l.sendErrors},
@@ -431,11 +434,17 @@ std::string summaryText(const SessionResult& r) {
             (unsigned long long)ho.ticksOnOlderModel, (unsigned long long)ho.ticksChecked, ho.maxAgeOverStep,
             ho.stepMean_ms, ho.stepP99_ms, ho.stepMax_ms, (long long)ho.stepsOverPeriod);
         out += line;
-        if (h.link.disconnects || h.link.rejectedMalformed || h.link.rejectedVersion || h.link.rejectedChecksum) {
-            std::snprintf(line, sizeof line, "link          %llu disconnects, %llu reconnects, %llu packets rejected\n",
-                          (unsigned long long)h.link.disconnects, (unsigned long long)h.link.reconnects,
-                          (unsigned long long)(h.link.rejectedMalformed + h.link.rejectedVersion +
-                                               h.link.rejectedChecksum + h.link.rejectedOrder));
+        if (h.backend == "console") {
+            const haptics::LinkStats& l = h.link;
+            std::snprintf(line, sizeof line,
+                          "link          %llu sessions, %llu disconnects, %llu reconnects; refused: %llu forged or "
+                          "of no session, %llu replayed or late, %llu jumped, %llu from another address, %llu "
+                          "malformed, %llu of another version\n",
+                          (unsigned long long)l.handshakes, (unsigned long long)l.disconnects,
+                          (unsigned long long)l.reconnects, (unsigned long long)l.rejectedAuth,
+                          (unsigned long long)l.rejectedOrder, (unsigned long long)l.rejectedJump,
+                          (unsigned long long)l.rejectedPeer, (unsigned long long)l.rejectedMalformed,
+                          (unsigned long long)l.rejectedVersion);
             out += line;
         }
     }

@@ -1,6 +1,6 @@
-// The network console backend over real loopback UDP sockets: good packets, malformed,
-// truncated, wrong-version, corrupted, foreign and out-of-order packets, a flood, and a
-// disconnect followed by a reconnection. Forces must never spike or become NaN.
+// The network console backend over real loopback UDP sockets: the handshake, good packets,
+// malformed, truncated, wrong-version, forged, foreign, replayed, jumped and out-of-order packets,
+// a flood, and a disconnect followed by a reconnection. Forces must never spike or become NaN.
 #include "haptics/console_device.hpp"
 #include "haptics/servo_loop.hpp"
 
@@ -22,21 +22,48 @@ Endpoint loopback(uint16_t port = 0) {
     return parseEndpoint("127.0.0.1:" + std::to_string(port), "test", true);
 }
 
-/// A fake console: a socket the device sends commands to and receives states from.
+/// A fake console: a socket the device sends hellos and commands to and receives welcomes and
+/// states from, with the pairing key it shares with the device (options()).
 struct FakeConsole {
     UdpSocket socket{loopback()};
     Endpoint address = socket.local();
     Endpoint player;
-    bool knowsPlayer = false;
+    LinkKey key = randomKey();
+    LinkMac pairing{key}, session;
+    Nonce lastHelloNonce{};
     uint32_t seq = 0;
 
-    void learnPlayer(ConsoleDevice& dev) {
+    ConsoleDeviceOptions options(int64_t timeout_ns = 100 * kMs) const {
+        ConsoleDeviceOptions o;
+        o.pairingKey = key;
+        o.timeout_ns = timeout_ns;
+        return o;
+    }
+    /// The device's hello (its next send, at time now) answered with a welcome: a new session,
+    /// taken up by the device's next poll.
+    void learnPlayer(ConsoleDevice& dev, int64_t now = 0) {
         DeviceCommand c;
+        c.timestamp_ns = now;
         dev.send(c);
         uint8_t buf[kMaxPacketSize];
-        ASSERT_TRUE(socket.wait(1000));
-        ASSERT_GT(socket.receive(buf, sizeof buf, &player), 0);
-        knowsPlayer = true;
+        HelloPacket h;
+        for (;;) { // skip commands of an older session still in the queue
+            ASSERT_TRUE(socket.wait(1000));
+            const long n = socket.receive(buf, sizeof buf, &player);
+            ASSERT_GT(n, 0);
+            if (peekType(buf, size_t(n)) == uint16_t(PacketType::Hello)) {
+                ASSERT_EQ(decode(buf, size_t(n), h, pairing), DecodeError::None);
+                break;
+            }
+        }
+        lastHelloNonce = h.client;
+        WelcomePacket w;
+        w.client = h.client;
+        w.server = randomNonce();
+        session.setKey(sessionKey(key, w.client, w.server));
+        std::vector<uint8_t> b(kMaxPacketSize);
+        b.resize(encode(w, b.data(), b.size(), pairing));
+        sendRaw(b);
     }
     void sendRaw(const std::vector<uint8_t>& b) { ASSERT_TRUE(socket.sendTo(b.data(), b.size(), player)); }
     std::vector<uint8_t> state(const Vec3& p0, uint32_t pedals = kPedalDeadman, uint32_t sequence = 0) {
@@ -45,29 +72,21 @@ struct FakeConsole {
         s.pedals = pedals;
         s.arm[0].measured_cp.position = p0;
         std::vector<uint8_t> b(kMaxPacketSize);
-        b.resize(encode(s, b.data(), b.size()));
+        b.resize(encode(s, b.data(), b.size(), session));
         return b;
     }
     void send(const Vec3& p0, uint32_t pedals = kPedalDeadman) { sendRaw(state(p0, pedals)); }
+    /// Re-signs a packet after a deliberate change with the session key.
+    void reseal(std::vector<uint8_t>& b) const {
+        session.sign(b.data(), b.size() - kLinkTagSize, b.data() + b.size() - kLinkTagSize);
+    }
 };
-
-ConsoleDeviceOptions withTimeout(int64_t ns) {
-    ConsoleDeviceOptions o;
-    o.timeout_ns = ns;
-    return o;
-}
-
-void reseal(std::vector<uint8_t>& b) {
-    const uint32_t c = crc32(b.data(), b.size() - 4);
-    for (int k = 0; k < 4; ++k)
-        b[b.size() - 4 + k] = uint8_t(c >> (8 * k));
-}
 
 } // namespace
 
 TEST(ConsoleDevice, ReceivesStatesAndSendsCommands) {
     FakeConsole console;
-    ConsoleDevice dev(console.address);
+    ConsoleDevice dev(console.address, console.options());
     EXPECT_EQ(dev.capabilities().arms, 2);
     EXPECT_EQ(dev.capabilities().pedals, 5);
     EXPECT_EQ(dev.capabilities().arm[0].hand, Hand::Left);
@@ -87,7 +106,7 @@ TEST(ConsoleDevice, ReceivesStatesAndSendsCommands) {
     ASSERT_TRUE(console.socket.wait(1000));
     const long n = console.socket.receive(buf, sizeof buf, nullptr);
     CommandPacket got;
-    ASSERT_EQ(decode(buf, size_t(n), got), DecodeError::None);
+    ASSERT_EQ(decode(buf, size_t(n), got, console.session), DecodeError::None);
     EXPECT_TRUE(got.arm[1].servo_cf.force.isApprox(Vec3(0, 0, 2)));
     EXPECT_EQ(got.echoSequence, console.seq);
     EXPECT_EQ(dev.linkStats().received, 1u);
@@ -95,7 +114,7 @@ TEST(ConsoleDevice, ReceivesStatesAndSendsCommands) {
 
 TEST(ConsoleDevice, MalformedTruncatedWrongVersionAndCorruptPacketsAreCountedAndIgnored) {
     FakeConsole console;
-    ConsoleDevice dev(console.address);
+    ConsoleDevice dev(console.address, console.options());
     console.learnPlayer(dev);
     DeviceState st;
     console.send(Vec3(0.01, 0, 0));
@@ -106,19 +125,19 @@ TEST(ConsoleDevice, MalformedTruncatedWrongVersionAndCorruptPacketsAreCountedAnd
     for (size_t n = 0; n < good.size(); n += 7)
         console.sendRaw(std::vector<uint8_t>(good.begin(), good.begin() + long(n)));
     console.sendRaw(std::vector<uint8_t>(2000, 0xAB));
-    // Wrong version (valid CRC), corrupted payload.
-    auto v2 = good;
-    v2[4] = 2;
-    reseal(v2);
-    console.sendRaw(v2);
+    // Wrong version (valid MAC), corrupted payload.
+    auto v1 = good;
+    v1[4] = 1;
+    console.reseal(v1);
+    console.sendRaw(v1);
     auto bad = good;
     bad[50] ^= 1;
     console.sendRaw(bad);
-    // A NaN position behind a valid CRC.
+    // A NaN position behind a valid MAC.
     auto nan = good;
     const float f = NAN;
     std::memcpy(&nan[28], &f, 4);
-    reseal(nan);
+    console.reseal(nan);
     console.sendRaw(nan);
     for (int k = 0; k < 5; ++k)
         dev.poll((2 + k) * kMs, st);
@@ -127,17 +146,18 @@ TEST(ConsoleDevice, MalformedTruncatedWrongVersionAndCorruptPacketsAreCountedAnd
     EXPECT_TRUE(st.arms[0].measured_cp.position.allFinite());
     const LinkStats s = dev.linkStats();
     EXPECT_EQ(s.rejectedVersion, 1u);
-    EXPECT_EQ(s.rejectedChecksum, 1u);
+    EXPECT_EQ(s.rejectedAuth, 1u);
     EXPECT_EQ(s.rejectedMalformed, good.size() / 7 + 1 + 1 + 1);
     EXPECT_EQ(s.received, 1u);
 }
 
 TEST(ConsoleDevice, PacketsFromAnotherAddressAndOutOfOrderAreIgnored) {
     FakeConsole console;
-    ConsoleDevice dev(console.address);
+    ConsoleDevice dev(console.address, console.options());
     console.learnPlayer(dev);
-    FakeConsole intruder;
+    FakeConsole intruder; // even with the session's key, another address is not read
     intruder.player = console.player;
+    intruder.session.setKey(sessionKey(console.key, console.lastHelloNonce, randomNonce()));
     intruder.send(Vec3(0.3, 0.3, 0.3));
     DeviceState st;
     dev.poll(1 * kMs, st);
@@ -148,12 +168,61 @@ TEST(ConsoleDevice, PacketsFromAnotherAddressAndOutOfOrderAreIgnored) {
     dev.poll(2 * kMs, st);
     EXPECT_TRUE(st.arms[0].measured_cp.position.isApprox(Vec3(0.01, 0, 0), 1e-6));
     EXPECT_EQ(dev.linkStats().rejectedOrder, 2u);
-    EXPECT_EQ(dev.linkStats().rejectedMalformed, 1u);
+    EXPECT_EQ(dev.linkStats().rejectedPeer, 1u);
+    EXPECT_EQ(dev.linkStats().rejectedMalformed, 0u);
+}
+
+// The attacks of a local sender on the link: none moves anything, each is counted by its reason.
+// From the console's own address: a state signed with another key (forged), a state captured
+// earlier and sent again (replayed), a state with a valid MAC that jumps the sequence far ahead,
+// a welcome replayed from an earlier handshake; from another socket: anything.
+TEST(ConsoleDevice, ForgedReplayedJumpedAndForeignPacketsMoveNothing) {
+    FakeConsole console;
+    ConsoleDevice dev(console.address, console.options());
+    console.learnPlayer(dev);
+    DeviceState st;
+    const auto captured = console.state(Vec3(0.01, 0, 0));
+    console.sendRaw(captured);
+    console.send(Vec3(0.01, 0, 0));
+    dev.poll(1 * kMs, st);
+    ASSERT_TRUE(st.connected);
+    ASSERT_EQ(dev.linkStats().handshakes, 1u);
+    auto forged = console.state(Vec3(0.5, 0.5, 0.5));
+    LinkMac(randomKey())
+        .sign(forged.data(), forged.size() - kLinkTagSize, forged.data() + forged.size() - kLinkTagSize);
+    console.sendRaw(forged);
+    console.sendRaw(captured);                                                              // replayed
+    console.sendRaw(console.state(Vec3(0.5, 0.5, 0.5), kPedalDeadman, console.seq + 5000)); // jumped
+    WelcomePacket old;                                                                      // an old welcome
+    old.client = randomNonce();
+    old.server = randomNonce();
+    std::vector<uint8_t> w(kMaxPacketSize);
+    w.resize(encode(old, w.data(), w.size(), console.pairing));
+    console.sendRaw(w);
+    FakeConsole intruder;
+    intruder.player = console.player;
+    intruder.session.setKey(sessionKey(console.key, console.lastHelloNonce, randomNonce()));
+    for (int k = 0; k < 3; ++k)
+        intruder.send(Vec3(0.5, 0.5, 0.5), kPedalDeadman | kPedalEnergyCut);
+    dev.poll(2 * kMs, st);
+    EXPECT_TRUE(st.arms[0].measured_cp.position.isApprox(Vec3(0.01, 0, 0), 1e-6)) << "nothing moved";
+    EXPECT_EQ(st.pedals, uint32_t(kPedalDeadman)) << "no pedal was pressed by anyone else";
+    const LinkStats s = dev.linkStats();
+    EXPECT_EQ(s.received, 2u);
+    EXPECT_EQ(s.rejectedAuth, 1u);
+    EXPECT_EQ(s.rejectedOrder, 2u); // the replayed state and the old welcome
+    EXPECT_EQ(s.rejectedJump, 1u);
+    EXPECT_EQ(s.rejectedPeer, 3u);
+    EXPECT_EQ(s.handshakes, 1u);
+    // The genuine console goes on being heard.
+    console.send(Vec3(0.02, 0, 0));
+    dev.poll(3 * kMs, st);
+    EXPECT_TRUE(st.arms[0].measured_cp.position.isApprox(Vec3(0.02, 0, 0), 1e-6));
 }
 
 TEST(ConsoleDevice, DisconnectAfterTheTimeoutAndReconnect) {
     FakeConsole console;
-    ConsoleDevice dev(console.address, withTimeout(50 * kMs));
+    ConsoleDevice dev(console.address, console.options(50 * kMs));
     console.learnPlayer(dev);
     DeviceState st;
     console.send(Vec3(0.01, 0, 0));
@@ -164,12 +233,22 @@ TEST(ConsoleDevice, DisconnectAfterTheTimeoutAndReconnect) {
     dev.poll(61 * kMs, st);
     EXPECT_FALSE(st.connected);
     EXPECT_EQ(dev.linkStats().disconnects, 1u);
-    // A console that restarted its sequence numbers is accepted after the disconnect.
-    console.seq = 0;
-    console.send(Vec3(0.02, 0, 0));
-    dev.poll(200 * kMs, st);
+    // The same console resuming in its session reconnects (its sequence goes on).
+    console.send(Vec3(0.015, 0, 0));
+    dev.poll(100 * kMs, st);
     EXPECT_TRUE(st.connected);
     EXPECT_EQ(dev.linkStats().reconnects, 1u);
+    dev.poll(200 * kMs, st);
+    EXPECT_FALSE(st.connected);
+    // A console that restarted (a new session through the device's next hello, its sequence
+    // numbers from 1 again) is accepted.
+    console.learnPlayer(dev, 201 * kMs);
+    console.seq = 0;
+    console.send(Vec3(0.02, 0, 0));
+    dev.poll(202 * kMs, st);
+    EXPECT_TRUE(st.connected);
+    EXPECT_EQ(dev.linkStats().reconnects, 2u);
+    EXPECT_EQ(dev.linkStats().handshakes, 2u);
     EXPECT_TRUE(st.arms[0].measured_cp.position.isApprox(Vec3(0.02, 0, 0), 1e-6));
 }
 
@@ -177,7 +256,7 @@ TEST(ConsoleDevice, APacketThatWaitedInTheQueuePastTheTimeoutIsNotFresh) {
     // A servo tick that runs late (the thread was descheduled) reads packets that arrived long
     // before: the device timeout counts from their arrival, not from the read.
     FakeConsole console;
-    ConsoleDevice dev(console.address, withTimeout(100 * kMs));
+    ConsoleDevice dev(console.address, console.options(100 * kMs));
     console.learnPlayer(dev);
     DeviceState st;
     // The kernel switches arrival stamping on shortly after a socket asks for it (a deferred
@@ -230,7 +309,7 @@ TEST(UdpSocket, ReportsHowLongADatagramWaitedInTheQueue) {
 
 TEST(ConsoleDevice, AFloodOfPacketsCausesNoForceSpikeAndNoNaN) {
     FakeConsole console;
-    ConsoleDevice dev(console.address);
+    ConsoleDevice dev(console.address, console.options());
     console.learnPlayer(dev);
     ManualClock clock(0);
     ServoConfig cfg;

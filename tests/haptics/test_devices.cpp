@@ -5,8 +5,13 @@
 #include "haptics/scripted_device.hpp"
 #include "sim/util/error.hpp"
 
+#include "haptics/link_auth.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
 
 using namespace viscera::haptics;
 using ::testing::HasSubstr;
@@ -37,7 +42,28 @@ TEST(DeviceSpec, ParsesEveryBackendAndRejectsBadSpecs) {
     EXPECT_THAT(specError("scripted:dance"), HasSubstr("unknown script (known: idle, press"));
     EXPECT_THAT(specError("replay:/nonexistent/t.csv"), HasSubstr("/nonexistent/t.csv"));
     EXPECT_NE(openDevice(parseDeviceSpec("scripted:circle")), nullptr);
-    EXPECT_STREQ(openDevice(parseDeviceSpec("console:127.0.0.1:9"))->backend(), "console");
+    // The console needs the pairing key file: without one, or with a malformed one, one line.
+    const DeviceSpec console = parseDeviceSpec("console:127.0.0.1:9");
+    auto openError = [&](const DeviceOpenOptions& o) {
+        try {
+            openDevice(console, o);
+        } catch (const viscera::InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_THAT(openError({}), HasSubstr("the console link needs the pairing key shared with the console: "
+                                         "--pairing-key FILE"));
+    const std::string dir = ::testing::TempDir();
+    const std::string good = dir + "/viscera-test-pairing.key", bad = dir + "/viscera-test-bad.key";
+    std::ofstream(good) << formatPairingKey(randomKey());
+    std::ofstream(bad) << std::string(63, 'a') << "g\n";
+    DeviceOpenOptions o;
+    o.pairingKeyFile = bad;
+    EXPECT_EQ(openError(o), bad + ": a pairing key is 64 hexadecimal digits (character 64 is not one)");
+    o.pairingKeyFile = good;
+    EXPECT_STREQ(openDevice(console, o)->backend(), "console");
+    EXPECT_EQ(loadPairingKey(good).size(), kLinkKeySize);
 }
 
 TEST(ReplayDevice, PlaysOnTheCallersClockRepeatably) {

@@ -5,8 +5,11 @@
 #include "support/run_process.hpp"
 #include "support/scratch_dir.hpp"
 
+#include "haptics/console_protocol.hpp"
+#include "haptics/link_auth.hpp"
 #include "haptics/servo_loop.hpp"
 #include "haptics/trajectory.hpp"
+#include "haptics/udp_socket.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -88,15 +91,23 @@ private:
     bool m_active = false;
 };
 
+/// A pairing key file made by the console simulator (as an installer would).
+void writePairingKey(const std::string& path) {
+    const test::ProcessResult k = test::runProcess(VISCERA_CONSOLE_SIM_EXE, {"--make-pairing-key", path});
+    ASSERT_EQ(k.exitCode, 0) << k.err;
+}
+
 /// console-sim streams the bimanual script to the player (headless, real time, a probe for each
 /// hand) and records the forces it gets back: s/r.json (report), s/t.csv (trace), s/sum.json
 /// and s/forces.csv (console side). exitCode: the player's expected exit status (a link that
 /// dropped fails the session).
 void runLoopback(const Scratch& s, int frames, std::vector<std::string> simArgs, int exitCode = 0) {
     test::writeHapticCase(s / "slab.vcase", 2);
-    const std::vector<std::string> common = {"--listen",  "127.0.0.1:0",  "--port-file",   s / "port",
-                                             "--script",  "bimanual",     "--record",      s / "forces.csv",
-                                             "--summary", s / "sum.json", "--wait-player", "20"};
+    writePairingKey(s / "pairing.key");
+    const std::vector<std::string> common = {"--listen",      "127.0.0.1:0",    "--port-file",   s / "port",
+                                             "--script",      "bimanual",       "--record",      s / "forces.csv",
+                                             "--summary",     s / "sum.json",   "--wait-player", "20",
+                                             "--pairing-key", s / "pairing.key"};
     simArgs.insert(simArgs.end(), common.begin(), common.end());
     // The console is a machine of its own: its simulator inherits this thread's CPUs at the spawn,
     // so for that moment they leave out the CPU the player's servo will own; the player itself is
@@ -111,7 +122,8 @@ void runLoopback(const Scratch& s, int frames, std::vector<std::string> simArgs,
     const std::string port = waitForPort(s / "port");
     ASSERT_FALSE(port.empty()) << readText(s / "sim.err");
     auto r = player({"run", s / "slab.vcase", "--headless", "--frames", std::to_string(frames), "--device",
-                     "console:127.0.0.1:" + port, "--report", s / "r.json", "--trace", s / "t.csv"});
+                     "console:127.0.0.1:" + port, "--pairing-key", s / "pairing.key", "--report", s / "r.json",
+                     "--trace", s / "t.csv"});
     ASSERT_EQ(r.exitCode, exitCode) << r.err << r.out;
     ASSERT_EQ(sim->waitFor(), 0) << readText(s / "sim.err");
     if (exitCode != 0) ASSERT_THAT(r.out, HasSubstr("warning       haptics: the console link degraded"));
@@ -172,8 +184,10 @@ TEST(PlayerHaptics, TheConsoleSimulatorRefusesToRecordOverItsTrajectory) {
     Scratch s;
     ASSERT_NO_FATAL_FAILURE(writeSlabAndPress(s));
     const std::string before = readText(s / "press.csv");
-    auto r = test::runProcess(VISCERA_CONSOLE_SIM_EXE, {"--listen", "127.0.0.1:0", "--trajectory", s / "press.csv",
-                                                        "--record", s / "press.csv", "--wait-player", "0.1"});
+    writePairingKey(s / "pairing.key");
+    auto r = test::runProcess(VISCERA_CONSOLE_SIM_EXE,
+                              {"--listen", "127.0.0.1:0", "--trajectory", s / "press.csv", "--record", s / "press.csv",
+                               "--wait-player", "0.1", "--pairing-key", s / "pairing.key"});
     EXPECT_EQ(r.exitCode, 1) << r.err;
     EXPECT_THAT(r.err, HasSubstr((s / "press.csv") + ": cannot write the force record over the input '"));
     EXPECT_EQ(readText(s / "press.csv"), before);
@@ -255,11 +269,89 @@ TEST(PlayerHaptics, RealTimeReplayTakesTheLockstepRunsInput) {
 // A console that never answers (nothing listens at the port) does not end "status ok": the
 // session ran its frames with the tools still, and says so in a warning, the status, the report
 // and the exit status.
+// The console simulator's end of the link: a hello under another key opens nothing; the player's
+// hello opens a session and pins its address (a replayed hello and a second player's are refused);
+// forged, replayed and jumped commands and commands from another socket are refused and counted
+// by reason; a 999 N command is clamped to the motors' 15 N. Without a key it does not start.
+TEST(PlayerHaptics, ConsoleSimulatorKeepsItsSessionToThePlayerThatOpenedIt) {
+    Scratch s;
+    writePairingKey(s / "pairing.key");
+    const test::ProcessResult noKey =
+        test::runProcess(VISCERA_CONSOLE_SIM_EXE, {"--listen", "127.0.0.1:0", "--script", "idle", "--duration", "1"});
+    EXPECT_EQ(noKey.exitCode, 2);
+    EXPECT_THAT(noKey.err, HasSubstr("--pairing-key FILE is needed"));
+    const haptics::LinkKey key = haptics::loadPairingKey(s / "pairing.key");
+    Background sim(VISCERA_CONSOLE_SIM_EXE,
+                   {"--listen", "127.0.0.1:0", "--port-file", s / "port", "--script", "idle", "--duration", "1.5",
+                    "--summary", s / "sum.json", "--wait-player", "20", "--pairing-key", s / "pairing.key"},
+                   s / "sim");
+    const std::string port = waitForPort(s / "port");
+    ASSERT_FALSE(port.empty()) << readText(s / "sim.err");
+    const haptics::Endpoint console = haptics::parseEndpoint("127.0.0.1:" + port, "test", true);
+    haptics::UdpSocket me(haptics::parseEndpoint("127.0.0.1:0", "test", true));
+    haptics::UdpSocket other(haptics::parseEndpoint("127.0.0.1:0", "test", true));
+    const haptics::LinkMac pairing(key), stranger(haptics::randomKey());
+    std::vector<uint8_t> b(haptics::kMaxPacketSize);
+    auto send = [&](haptics::UdpSocket& from, const auto& packet, const haptics::LinkMac& mac) {
+        b.assign(haptics::kMaxPacketSize, 0);
+        b.resize(haptics::encode(packet, b.data(), b.size(), mac));
+        ASSERT_TRUE(from.sendTo(b.data(), b.size(), console));
+    };
+    haptics::HelloPacket h;
+    h.client = haptics::randomNonce();
+    send(me, h, stranger); // another pairing key: no session
+    send(me, h, pairing);
+    const std::vector<uint8_t> hello = b;
+    haptics::WelcomePacket w;
+    bool welcomed = false;
+    for (int k = 0; k < 200 && !welcomed; ++k) {
+        ASSERT_TRUE(me.wait(2000));
+        uint8_t in[haptics::kMaxPacketSize];
+        const long n = me.receive(in, sizeof in, nullptr);
+        welcomed = n > 0 && haptics::decode(in, size_t(n), w, pairing) == haptics::DecodeError::None;
+    }
+    ASSERT_TRUE(welcomed);
+    EXPECT_EQ(w.client, h.client);
+    const haptics::LinkMac session(haptics::sessionKey(key, h.client, w.server));
+    ASSERT_TRUE(me.sendTo(hello.data(), hello.size(), console)); // replayed hello
+    haptics::HelloPacket h2;
+    h2.client = haptics::randomNonce();
+    send(other, h2, pairing); // a second player while the session lives
+    haptics::CommandPacket c;
+    c.sequence = 10;
+    c.arm[0].servo_cf.force = haptics::Vec3(0, 0, 999); // beyond the motors
+    send(me, c, session);
+    const std::vector<uint8_t> first = b;
+    c.sequence = 11;
+    c.arm[0].servo_cf.force = haptics::Vec3(0, 0, 1);
+    send(me, c, session);
+    ASSERT_TRUE(me.sendTo(first.data(), first.size(), console)); // replayed
+    c.sequence = 11 + 5000;
+    send(me, c, session); // jumped
+    c.sequence = 12;
+    send(me, c, stranger);   // forged
+    send(other, c, session); // from another socket
+    ASSERT_EQ(sim.waitFor(), 0) << readText(s / "sim.err");
+    const auto sum = readJson(s / "sum.json");
+    EXPECT_EQ(sum["handshakes"], 1);
+    EXPECT_EQ(sum["commands_received"], 2);
+    EXPECT_EQ(sum["commands_clamped"], 1);
+    EXPECT_LE(sum["max_force_n"].get<double>(), 15.0 + 1e-9);
+    EXPECT_GE(sum["max_force_n"].get<double>(), 15.0 - 1e-3);
+    const auto& r = sum["rejected"];
+    EXPECT_EQ(r.value("auth", 0), 2) << r.dump(); // the stranger's hello and the forged command
+    EXPECT_EQ(r.value("replayed_hello", 0), 1) << r.dump();
+    EXPECT_EQ(r.value("peer", 0), 2) << r.dump();
+    EXPECT_EQ(r.value("order", 0), 1) << r.dump();
+    EXPECT_EQ(r.value("jump", 0), 1) << r.dump();
+}
+
 TEST(PlayerHaptics, ConsoleThatNeverAnswersFailsTheSession) {
     Scratch s;
     test::writeHapticCase(s / "slab.vcase");
+    writePairingKey(s / "pairing.key");
     auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "30", "--device", "console:127.0.0.1:9",
-                     "--report", s / "r.json"});
+                     "--pairing-key", s / "pairing.key", "--report", s / "r.json"});
     EXPECT_EQ(r.exitCode, 3) << r.out << r.err;
     EXPECT_THAT(r.out, HasSubstr("warning       haptics: --device console:127.0.0.1:9: the console never answered (0 "
                                  "valid state packets in "));
@@ -387,8 +479,8 @@ TEST(PlayerHaptics, SixtySecondConsoleLoopback) {
     EXPECT_LE(ho["max_age_over_step"].get<double>(), 1.0);
     EXPECT_EQ(ho["models_published"].get<int>(), 3601);
     EXPECT_EQ(h["safety"]["non_finite"], 0);
-    for (const char* k :
-         {"rejected_malformed", "rejected_version", "rejected_checksum", "rejected_order", "send_errors"})
+    for (const char* k : {"rejected_malformed", "rejected_version", "rejected_auth", "rejected_order", "rejected_jump",
+                          "rejected_peer", "send_errors"})
         EXPECT_EQ(h["link"][k], 0) << k;
     EXPECT_TRUE(j["invariants"]["all_finite"].get<bool>());
     EXPECT_LE(j["metrics"]["max_force_n"].get<double>(), h["case_max_force_n"].get<double>());

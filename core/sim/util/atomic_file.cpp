@@ -107,7 +107,7 @@ void requireWritableFolder(const std::filesystem::path& dir) {
         throw InputError(dir.string() + ": the output folder is not writable (" + why + ")");
 }
 
-void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes) {
+void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes, unsigned mode) {
     namespace fs = std::filesystem;
     fs::path dir = path.parent_path();
     if (dir.empty()) dir = ".";
@@ -126,7 +126,7 @@ void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes) 
     try {
         writeAll(fd, bytes, tmp);
         if (::fsync(fd) != 0) throw InputError(tmp.string() + ": fsync failed: " + errnoText());
-        ::fchmod(fd, 0644);
+        ::fchmod(fd, static_cast<mode_t>(mode));
     } catch (...) {
         ::close(fd);
         ::unlink(tmpl.c_str());

@@ -13,8 +13,9 @@
 namespace viscera {
 
 /// The temporary file is "<folder>/.<name>.<pid>.tmpXXXXXX"; temporaries of the same destination
-/// left by a writer that no longer runs (killed mid-write) are removed first.
-void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes);
+/// left by a writer that no longer runs (killed mid-write) are removed first. `mode`: the file's
+/// permissions (0600 for a secret: it is never readable by others, not even as the temporary).
+void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes, unsigned mode = 0644);
 
 /// Refuses, before any work, an output that is one of the inputs (the same file, through links
 /// or not): throws viscera::InputError "<output>: cannot write <what> over the input '<input>'".
