@@ -78,6 +78,23 @@ std::shared_ptr<const MaterialMaps> loadMaterialMaps(const CaseMaterialMaps& ent
     return maps;
 }
 
+void checkDecodedImageBudget(const std::vector<CaseMaterialMaps>& entries,
+                             const std::function<std::string_view(const std::string&)>& read, const std::string& origin,
+                             uint64_t budget) {
+    uint64_t total = 0;
+    size_t maps = 0;
+    for (const CaseMaterialMaps& e : entries)
+        for (const std::string& f : e.files()) {
+            const auto [w, h] = pngSize(read(f), origin + ":" + f);
+            total += uint64_t(w) * h * 4;
+            ++maps;
+        }
+    if (total <= budget) return;
+    auto mib = [](uint64_t b) { return std::to_string((b + (1u << 20) - 1) >> 20); };
+    throw InputError(origin + ": render.materials: the maps decode to " + mib(total) + " MiB (" + std::to_string(maps) +
+                     " maps), more than the " + mib(budget) + " MiB budget of a case's images");
+}
+
 size_t applyMaterialMaps(SceneView& view, const std::string& target, std::shared_ptr<const MaterialMaps> maps) {
     size_t changed = 0;
     std::optional<uint32_t> material; // one new material for all of the target's meshes

@@ -24,6 +24,7 @@
 #include <functional>
 #include <memory>
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -65,6 +66,17 @@ void readMapLayout(const sim::JsonField& j, float& tilesPerMetre, float& normalS
 std::shared_ptr<const MaterialMaps> loadMaterialMaps(const CaseMaterialMaps& entry,
                                                      const std::function<std::string_view(const std::string&)>& read,
                                                      const std::string& origin);
+
+/// Bytes the decoded maps of a case may take together (8-bit RGBA): 128 MiB, two 4096² maps or
+/// every map of four tissues at 2048².
+inline constexpr uint64_t kMaxDecodedImageBytes = uint64_t(128) << 20;
+/// Refuses, before any map is decoded, maps of `entries` that would decode to more than `budget`
+/// bytes together (their sizes read from the PNG headers). Throws viscera::InputError
+/// "<origin>: render.materials: the maps decode to 192 MiB (3 maps), more than the 128 MiB budget
+/// of a case's images".
+void checkDecodedImageBudget(const std::vector<CaseMaterialMaps>& entries,
+                             const std::function<std::string_view(const std::string&)>& read, const std::string& origin,
+                             uint64_t budget = kMaxDecodedImageBytes);
 
 class SceneView;
 /// Draws every mesh of `view` named `target` with a copy of its material that carries `maps`.

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace viscera::render {
@@ -36,5 +37,8 @@ std::string encodePng(const Image& image);
 /// size is checked against `maxSide` before anything is allocated. Throws viscera::InputError
 /// "<origin>: <rule>" for data that is not a PNG, is truncated or is too large.
 Image decodePng(std::string_view bytes, const std::string& origin, int maxSide = 8192);
+/// Width and height of PNG bytes from the header alone (nothing decoded). Throws
+/// viscera::InputError "<origin>: not a PNG image (...)" as decodePng does.
+std::pair<uint32_t, uint32_t> pngSize(std::string_view bytes, const std::string& origin);
 
 } // namespace viscera::render

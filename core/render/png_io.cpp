@@ -69,6 +69,17 @@ std::string encodePng(const Image& image) {
     return out;
 }
 
+std::pair<uint32_t, uint32_t> pngSize(std::string_view bytes, const std::string& origin) {
+    png_image png;
+    std::memset(&png, 0, sizeof png);
+    png.version = PNG_IMAGE_VERSION;
+    if (bytes.empty() || !png_image_begin_read_from_memory(&png, bytes.data(), bytes.size()))
+        throw InputError(origin + ": not a PNG image (" + std::string(bytes.empty() ? "empty" : png.message) + ")");
+    const std::pair<uint32_t, uint32_t> size{png.width, png.height};
+    png_image_free(&png);
+    return size;
+}
+
 Image decodePng(std::string_view bytes, const std::string& origin, int maxSide) {
     png_image png;
     std::memset(&png, 0, sizeof png);

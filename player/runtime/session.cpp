@@ -135,7 +135,10 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
         sd.nodeWeights = sim::parseNodeWeights(pkg.read(sd.nodeWeightsPath), pkg.name() + ":" + sd.nodeWeightsPath,
                                                surfaces[s].vertexCount());
     }
-    for (const render::CaseMaterialMaps& m : render::caseMaterialMaps(out.scene.render, pkg.name() + ":" + sceneName)) {
+    const std::vector<render::CaseMaterialMaps> materials =
+        render::caseMaterialMaps(out.scene.render, pkg.name() + ":" + sceneName);
+    const auto readEntry = [&pkg](const std::string& path) { return pkg.read(path); };
+    for (const render::CaseMaterialMaps& m : materials) {
         const std::string field = pkg.name() + ": " + sceneName + ": render.materials." + m.target + ": ";
         bool named = false;
         for (const sim::BodyDesc& b : out.scene.bodies)
@@ -145,10 +148,11 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
         if (!named) throw InputError(field + "'" + m.target + "' is not a body or surface of the scene");
         for (const std::string& f : m.files())
             if (!pkg.contains(f)) throw InputError(field + "'" + f + "' is not in the package");
-        out.materialMaps.emplace_back(m.target,
-                                      render::loadMaterialMaps(
-                                          m, [&pkg](const std::string& path) { return pkg.read(path); }, pkg.name()));
     }
+    // Before any map is decoded: what they take together, from their headers.
+    render::checkDecodedImageBudget(materials, readEntry, pkg.name() + ": " + sceneName);
+    for (const render::CaseMaterialMaps& m : materials)
+        out.materialMaps.emplace_back(m.target, render::loadMaterialMaps(m, readEntry, pkg.name()));
     if (out.scene.suture) { // the recorded needle trajectory travels with the case
         const std::string& path = out.scene.suture->trajectoryPath;
         if (!pkg.contains(path))

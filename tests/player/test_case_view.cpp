@@ -204,6 +204,58 @@ TEST(CaseView, BadMaterialMapsAreRefusedAtLoadNamingTheFieldAndTheRule) {
         << sizes;
 }
 
+namespace {
+
+/// A PNG whose header says width × height (8-bit RGBA) with no pixel data behind it: what a
+/// decompression bomb looks like to a reader that trusts the header.
+std::string pngHeaderOnly(uint32_t width, uint32_t height) {
+    auto crc = [](const std::string& bytes) {
+        uint32_t c = 0xFFFFFFFFu;
+        for (unsigned char b : bytes) {
+            c ^= b;
+            for (int k = 0; k < 8; ++k)
+                c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+        }
+        return c ^ 0xFFFFFFFFu;
+    };
+    auto be32 = [](uint32_t v) { return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; };
+    auto chunk = [&](const std::string& type, const std::string& data) {
+        return be32(uint32_t(data.size())) + type + data + be32(crc(type + data));
+    };
+    const std::string ihdr = be32(width) + be32(height) + std::string{8, 6, 0, 0, 0};
+    return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) + chunk("IDAT", "") + chunk("IEND", "");
+}
+
+} // namespace
+
+// Maps that would decode to more than the case budget (128 MiB) together are refused from their
+// headers before anything is decoded, with one line naming the total and the budget; each one
+// alone is within the 4096-pixel side.
+TEST(CaseView, MapsOverTheDecodedImageBudgetAreRefusedBeforeDecoding) {
+    const std::string bomb = pngHeaderOnly(4096, 4096); // 64 MiB decoded, 57 bytes here
+    ASSERT_LT(bomb.size(), 100u);
+    EXPECT_EQ(render::pngSize(bomb, "bomb"), (std::pair<uint32_t, uint32_t>{4096, 4096}));
+    const auto path = writeMappedCase(
+        "budget",
+        {{"materials",
+          {{"slab", {{"diffuse", "textures/d.png"}, {"roughness", "textures/r.png"}, {"normal", "textures/n.png"}}}}}},
+        {{"textures/d.png", bomb}, {"textures/r.png", bomb}, {"textures/n.png", bomb}});
+    const std::string e = loadError(path);
+    std::filesystem::remove(path);
+    EXPECT_NE(e.find(".vcase: scene.json: render.materials: the maps decode to 192 MiB (3 maps), more than the 128 "
+                     "MiB budget of a case's images"),
+              std::string::npos)
+        << e;
+    EXPECT_EQ(std::count(e.begin(), e.end(), '\n'), 0) << "one line";
+    // Two of them fit the budget: then the decoder itself finds there are no pixels.
+    const auto two = writeMappedCase(
+        "budget2", {{"materials", {{"slab", {{"diffuse", "textures/d.png"}, {"roughness", "textures/r.png"}}}}}},
+        {{"textures/d.png", bomb}, {"textures/r.png", bomb}});
+    const std::string e2 = loadError(two);
+    std::filesystem::remove(two);
+    EXPECT_NE(e2.find("textures/d.png: cannot decode PNG"), std::string::npos) << e2;
+}
+
 TEST(CaseView, MaterialEntriesComeSortedByNameWithTheirFiles) {
     // entries sorted by name, each with its files in the order diffuse, roughness, metallic, normal
     const auto entries = render::caseMaterialMaps(
