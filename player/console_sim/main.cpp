@@ -254,6 +254,92 @@ int writeTrajectory(const Options& o) {
     return 0;
 }
 
+/// What the console sent and when (for the echo latency and the pause figures).
+struct Stream {
+    uint64_t sent = 0, sendErrors = 0;
+    std::vector<std::pair<uint32_t, int64_t>> sentAt; ///< (sequence, time)
+    double lastStateBeforeResume = 0;                 ///< s after t0
+    double streamed = 0;                              ///< s from the session's start to the last state
+};
+
+/// The figures of a run: the force record, the summary JSON and the printed lines.
+void writeFigures(const Options& o, const Link& link, const std::vector<Received>& received, const Stream& st,
+                  int64_t t0) {
+    // Figures: forces, pauses, echo latency.
+    double maxForce = 0;
+    uint64_t nonZero = 0, pausedCmds = 0, pausedNonZeroLate = 0, nonFinite = 0;
+    std::vector<double> latency;
+    size_t j = 0;
+    for (const Received& r : received) {
+        double f = 0;
+        for (const auto& a : r.cmd.arm) {
+            if (!a.servo_cf.force.allFinite()) ++nonFinite;
+            f = std::max(f, a.servo_cf.force.norm());
+        }
+        maxForce = std::max(maxForce, f);
+        nonZero += f > 0;
+        if (r.paused) {
+            ++pausedCmds;
+            // Force still commanded 250 ms after the last state the player could have had: beyond
+            // its device timeout (100 ms) and the slack of a loaded machine.
+            if (f > 0 && r.t > st.lastStateBeforeResume + 0.25) ++pausedNonZeroLate;
+        }
+        while (j < st.sentAt.size() && newer(r.cmd.echoSequence, st.sentAt[j].first))
+            ++j;
+        if (!r.paused && j < st.sentAt.size() && st.sentAt[j].first == r.cmd.echoSequence)
+            latency.push_back(1e-6 * double(int64_t(std::llround(r.t * 1e9)) + t0 - st.sentAt[j].second));
+    }
+    std::sort(latency.begin(), latency.end());
+    auto pct = [&](double p) {
+        return latency.empty() ? 0.0 : latency[std::min(latency.size() - 1, size_t(p * double(latency.size())))];
+    };
+    uint64_t rejectedAll = 0;
+    for (const auto& [reason, count] : link.rejected)
+        rejectedAll += count;
+    if (o.record) {
+        std::string csv = "t_s,seq,echo,flags,paused,f0x,f0y,f0z,f1x,f1y,f1z,grip0_n,grip1_n\n";
+        char line[320];
+        for (const Received& r : received) {
+            const auto& a = r.cmd.arm;
+            std::snprintf(line, sizeof line, "%.6f,%u,%u,%u,%d,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.4g,%.4g\n", r.t,
+                          r.cmd.sequence, r.cmd.echoSequence, r.cmd.flags, int(r.paused), a[0].servo_cf.force.x(),
+                          a[0].servo_cf.force.y(), a[0].servo_cf.force.z(), a[1].servo_cf.force.x(),
+                          a[1].servo_cf.force.y(), a[1].servo_cf.force.z(), a[0].jaw_servo_jf, a[1].jaw_servo_jf);
+            csv += line;
+        }
+        writeFileAtomic(*o.record, csv);
+    }
+    nlohmann::json sum = {{"duration_s", st.streamed},
+                          {"states_sent", st.sent},
+                          {"send_errors", st.sendErrors},
+                          {"commands_received", received.size()},
+                          {"commands_rejected", rejectedAll},
+                          {"rejected", link.rejected},
+                          {"handshakes", link.handshakes},
+                          {"commands_clamped", link.clamped},
+                          {"commands_nonzero", nonZero},
+                          {"commands_non_finite", nonFinite},
+                          {"max_force_n", maxForce},
+                          {"paused_commands", pausedCmds},
+                          {"paused_nonzero_after_timeout", pausedNonZeroLate},
+                          {"last_state_before_resume_s", st.lastStateBeforeResume},
+                          {"echo_latency_ms",
+                           {{"count", latency.size()},
+                            {"p50", pct(0.5)},
+                            {"p99", pct(0.99)},
+                            {"max", latency.empty() ? 0.0 : latency.back()}}}};
+    if (o.summary) writeFileAtomic(*o.summary, sum.dump(2) + "\n");
+    std::printf(
+        "console-sim   %llu states sent, %zu commands received (%llu packets refused, %llu clamped to %.0f N), %llu "
+        "non-zero, max force %.3f N, %llu sessions\n",
+        (unsigned long long)st.sent, received.size(), (unsigned long long)rejectedAll, (unsigned long long)link.clamped,
+        Link::kMaxForce, (unsigned long long)nonZero, maxForce, (unsigned long long)link.handshakes);
+    std::printf("latency       state -> command echo p50 %.3f ms, p99 %.3f ms\n", pct(0.5), pct(0.99));
+    if (pausedCmds)
+        std::printf("pause         %llu commands during the pause, %llu non-zero after the device timeout\n",
+                    (unsigned long long)pausedCmds, (unsigned long long)pausedNonZeroLate);
+}
+
 int makePairingKey(const std::string& path) {
     requireWritableFile(path, "the pairing key");
     writeFileAtomic(path, formatPairingKey(randomKey()), 0600);
@@ -321,13 +407,10 @@ int run(const Options& o) {
     }
     const int64_t period = int64_t(std::llround(1e9 / o.rate));
     uint32_t seq = 0;
-    uint64_t sent = 0, sendErrors = 0;
-    std::vector<std::pair<uint32_t, int64_t>> sentAt; // (sequence, time) for the echo latency
-    sentAt.reserve(static_cast<size_t>(duration * o.rate) + 16);
+    Stream st;
+    st.sentAt.reserve(static_cast<size_t>(duration * o.rate) + 16);
     int64_t next = t0;
     DeviceState s;
-    double lastStateBeforeResume = 0; // s after t0
-    double streamed = 0;              // s from the player's first command to the last state
     constexpr int64_t kPlayerSilentNs = 1'000'000'000;
     while (true) {
         const int64_t now = monotonicNs();
@@ -335,7 +418,7 @@ int run(const Options& o) {
         if (t > duration) break;
         drain();
         if (o.untilPlayerStops && now - link.lastHeard > kPlayerSilentNs) break;
-        streamed = t;
+        st.streamed = t;
         const bool paused = o.pauseAt >= 0 && t >= o.pauseAt && t < o.pauseAt + o.pauseFor;
         if (!paused) {
             src.sample(t, s);
@@ -348,14 +431,14 @@ int run(const Options& o) {
                 p.arm[a] = s.arms[a];
             const size_t n = encode(p, buf, sizeof buf, link.session);
             if (sock.sendTo(buf, n, link.player)) {
-                ++sent, sentAt.emplace_back(p.sequence, now);
+                ++st.sent, st.sentAt.emplace_back(p.sequence, now);
                 // When the last state before the silence really left (this process may have
                 // been descheduled between reading the clock and sending).
                 const double left = 1e-9 * double(monotonicNs() - t0);
                 if (o.pauseAt >= 0 && left < o.pauseAt + o.pauseFor)
-                    lastStateBeforeResume = std::max(lastStateBeforeResume, left);
+                    st.lastStateBeforeResume = std::max(st.lastStateBeforeResume, left);
             } else
-                ++sendErrors;
+                ++st.sendErrors;
         }
         next += period;
         sleepUntil(next);
@@ -366,79 +449,7 @@ int run(const Options& o) {
         drain();
     }
 
-    // Figures: forces, pauses, echo latency.
-    double maxForce = 0;
-    uint64_t nonZero = 0, pausedCmds = 0, pausedNonZeroLate = 0, nonFinite = 0;
-    std::vector<double> latency;
-    size_t j = 0;
-    for (const Received& r : received) {
-        double f = 0;
-        for (const auto& a : r.cmd.arm) {
-            if (!a.servo_cf.force.allFinite()) ++nonFinite;
-            f = std::max(f, a.servo_cf.force.norm());
-        }
-        maxForce = std::max(maxForce, f);
-        nonZero += f > 0;
-        if (r.paused) {
-            ++pausedCmds;
-            // Force still commanded 250 ms after the last state the player could have had: beyond
-            // its device timeout (100 ms) and the slack of a loaded machine.
-            if (f > 0 && r.t > lastStateBeforeResume + 0.25) ++pausedNonZeroLate;
-        }
-        while (j < sentAt.size() && newer(r.cmd.echoSequence, sentAt[j].first))
-            ++j;
-        if (!r.paused && j < sentAt.size() && sentAt[j].first == r.cmd.echoSequence)
-            latency.push_back(1e-6 * double(int64_t(std::llround(r.t * 1e9)) + t0 - sentAt[j].second));
-    }
-    std::sort(latency.begin(), latency.end());
-    auto pct = [&](double p) {
-        return latency.empty() ? 0.0 : latency[std::min(latency.size() - 1, size_t(p * double(latency.size())))];
-    };
-    uint64_t rejectedAll = 0;
-    for (const auto& [reason, count] : link.rejected)
-        rejectedAll += count;
-    if (o.record) {
-        std::string csv = "t_s,seq,echo,flags,paused,f0x,f0y,f0z,f1x,f1y,f1z,grip0_n,grip1_n\n";
-        char line[320];
-        for (const Received& r : received) {
-            const auto& a = r.cmd.arm;
-            std::snprintf(line, sizeof line, "%.6f,%u,%u,%u,%d,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.4g,%.4g\n", r.t,
-                          r.cmd.sequence, r.cmd.echoSequence, r.cmd.flags, int(r.paused), a[0].servo_cf.force.x(),
-                          a[0].servo_cf.force.y(), a[0].servo_cf.force.z(), a[1].servo_cf.force.x(),
-                          a[1].servo_cf.force.y(), a[1].servo_cf.force.z(), a[0].jaw_servo_jf, a[1].jaw_servo_jf);
-            csv += line;
-        }
-        writeFileAtomic(*o.record, csv);
-    }
-    nlohmann::json sum = {{"duration_s", streamed},
-                          {"states_sent", sent},
-                          {"send_errors", sendErrors},
-                          {"commands_received", received.size()},
-                          {"commands_rejected", rejectedAll},
-                          {"rejected", link.rejected},
-                          {"handshakes", link.handshakes},
-                          {"commands_clamped", link.clamped},
-                          {"commands_nonzero", nonZero},
-                          {"commands_non_finite", nonFinite},
-                          {"max_force_n", maxForce},
-                          {"paused_commands", pausedCmds},
-                          {"paused_nonzero_after_timeout", pausedNonZeroLate},
-                          {"last_state_before_resume_s", lastStateBeforeResume},
-                          {"echo_latency_ms",
-                           {{"count", latency.size()},
-                            {"p50", pct(0.5)},
-                            {"p99", pct(0.99)},
-                            {"max", latency.empty() ? 0.0 : latency.back()}}}};
-    if (o.summary) writeFileAtomic(*o.summary, sum.dump(2) + "\n");
-    std::printf(
-        "console-sim   %llu states sent, %zu commands received (%llu packets refused, %llu clamped to %.0f N), %llu "
-        "non-zero, max force %.3f N, %llu sessions\n",
-        (unsigned long long)sent, received.size(), (unsigned long long)rejectedAll, (unsigned long long)link.clamped,
-        Link::kMaxForce, (unsigned long long)nonZero, maxForce, (unsigned long long)link.handshakes);
-    std::printf("latency       state -> command echo p50 %.3f ms, p99 %.3f ms\n", pct(0.5), pct(0.99));
-    if (pausedCmds)
-        std::printf("pause         %llu commands during the pause, %llu non-zero after the device timeout\n",
-                    (unsigned long long)pausedCmds, (unsigned long long)pausedNonZeroLate);
+    writeFigures(o, link, received, st, t0);
     return 0;
 }
 

@@ -338,6 +338,64 @@ nlohmann::json reportJson(const SessionResult& r) {
     return doc;
 }
 
+namespace {
+
+/// The summary's device lines: servo timing, pacing, forces, the hand-over and the console link.
+std::string hapticsSummary(const HapticsResult& h, const TaskMetrics& m) {
+    std::string out;
+    const auto& p = h.servo.period;
+    const auto& j = h.servo.jitter;
+    char line[512];
+    if (h.mode == "realtime") {
+        std::snprintf(line, sizeof line,
+                      "haptics       %s (%s), %llu ticks, period mean %.1f us, jitter p99 %.1f us, max %.1f us\n",
+                      h.spec.c_str(), h.mode.c_str(), (unsigned long long)h.servo.ticks, p.mean_us, j.p99_us, j.max_us);
+        out += line;
+        std::snprintf(line, sizeof line,
+                      "pacing        frames started late against the wall clock: mean %.1f ms, max %.1f ms, %lld "
+                      "over one frame, %lld without their own input, %lld from an earlier tick; servo %s, %s\n",
+                      h.lagMeanMs, h.lagMaxMs, (long long)h.framesLate, (long long)h.inputMissed,
+                      (long long)h.inputEarlier,
+                      h.servo.wait == haptics::ServoWait::Busy
+                          ? "busy"
+                          : ("sleep, spin " + std::to_string(h.servo.spinNs / 1000) + " us").c_str(),
+                      h.servo.cpu >= 0 ? ("on CPU " + std::to_string(h.servo.cpu) + ", the physics off it").c_str()
+                                       : "sharing the physics' CPUs");
+    } else
+        std::snprintf(line, sizeof line, "haptics       %s (%s), %llu ticks\n", h.spec.c_str(), h.mode.c_str(),
+                      (unsigned long long)h.servo.ticks);
+    out += line;
+    std::snprintf(
+        line, sizeof line,
+        "device force  max %.2f N, mean %.2f N (after the safety filter), contact model age max %.2f ms (%.2f "
+        "periods)\n",
+        m.maxForce_n, m.meanForce_n, h.servo.contactAge.max_us * 1e-3, h.maxContactAgeSteps);
+    out += line;
+    const haptics::HandoverFigures& ho = h.handover;
+    std::snprintf(line, sizeof line,
+                  "hand-over     %llu of %llu ticks on an older model than the newest published; age <= %.4f of the "
+                  "physics step in progress; steps mean %.2f ms, p99 %.2f, max %.2f (%lld over the period)\n",
+                  (unsigned long long)ho.ticksOnOlderModel, (unsigned long long)ho.ticksChecked, ho.maxAgeOverStep,
+                  ho.stepMean_ms, ho.stepP99_ms, ho.stepMax_ms, (long long)ho.stepsOverPeriod);
+    out += line;
+    if (h.backend == "console") {
+        const haptics::LinkStats& l = h.link;
+        std::snprintf(line, sizeof line,
+                      "link          %llu sessions, %llu disconnects, %llu reconnects; refused: %llu forged or "
+                      "of no session, %llu replayed or late, %llu jumped, %llu from another address, %llu "
+                      "malformed, %llu of another version\n",
+                      (unsigned long long)l.handshakes, (unsigned long long)l.disconnects,
+                      (unsigned long long)l.reconnects, (unsigned long long)l.rejectedAuth,
+                      (unsigned long long)l.rejectedOrder, (unsigned long long)l.rejectedJump,
+                      (unsigned long long)l.rejectedPeer, (unsigned long long)l.rejectedMalformed,
+                      (unsigned long long)l.rejectedVersion);
+        out += line;
+    }
+    return out;
+}
+
+} // namespace
+
 std::string summaryText(const SessionResult& r) {
     const StepTimeStats st = stepTimeStats(r.frames);
     std::string subs;
@@ -395,59 +453,7 @@ std::string summaryText(const SessionResult& r) {
                       r.metrics.toolPathLength_m * 1e3, r.metrics.maxContactForce_n);
         out += line + per + ")\n";
     }
-    if (r.haptics) {
-        const HapticsResult& h = *r.haptics;
-        const auto& p = h.servo.period;
-        const auto& j = h.servo.jitter;
-        char line[512];
-        if (h.mode == "realtime") {
-            std::snprintf(line, sizeof line,
-                          "haptics       %s (%s), %llu ticks, period mean %.1f us, jitter p99 %.1f us, max %.1f us\n",
-                          h.spec.c_str(), h.mode.c_str(), (unsigned long long)h.servo.ticks, p.mean_us, j.p99_us,
-                          j.max_us);
-            out += line;
-            std::snprintf(line, sizeof line,
-                          "pacing        frames started late against the wall clock: mean %.1f ms, max %.1f ms, %lld "
-                          "over one frame, %lld without their own input, %lld from an earlier tick; servo %s, %s\n",
-                          h.lagMeanMs, h.lagMaxMs, (long long)h.framesLate, (long long)h.inputMissed,
-                          (long long)h.inputEarlier,
-                          h.servo.wait == haptics::ServoWait::Busy
-                              ? "busy"
-                              : ("sleep, spin " + std::to_string(h.servo.spinNs / 1000) + " us").c_str(),
-                          h.servo.cpu >= 0 ? ("on CPU " + std::to_string(h.servo.cpu) + ", the physics off it").c_str()
-                                           : "sharing the physics' CPUs");
-        } else
-            std::snprintf(line, sizeof line, "haptics       %s (%s), %llu ticks\n", h.spec.c_str(), h.mode.c_str(),
-                          (unsigned long long)h.servo.ticks);
-        out += line;
-        std::snprintf(
-            line, sizeof line,
-            "device force  max %.2f N, mean %.2f N (after the safety filter), contact model age max %.2f ms (%.2f "
-            "periods)\n",
-            r.metrics.maxForce_n, r.metrics.meanForce_n, h.servo.contactAge.max_us * 1e-3, h.maxContactAgeSteps);
-        out += line;
-        const haptics::HandoverFigures& ho = h.handover;
-        std::snprintf(
-            line, sizeof line,
-            "hand-over     %llu of %llu ticks on an older model than the newest published; age <= %.4f of the "
-            "physics step in progress; steps mean %.2f ms, p99 %.2f, max %.2f (%lld over the period)\n",
-            (unsigned long long)ho.ticksOnOlderModel, (unsigned long long)ho.ticksChecked, ho.maxAgeOverStep,
-            ho.stepMean_ms, ho.stepP99_ms, ho.stepMax_ms, (long long)ho.stepsOverPeriod);
-        out += line;
-        if (h.backend == "console") {
-            const haptics::LinkStats& l = h.link;
-            std::snprintf(line, sizeof line,
-                          "link          %llu sessions, %llu disconnects, %llu reconnects; refused: %llu forged or "
-                          "of no session, %llu replayed or late, %llu jumped, %llu from another address, %llu "
-                          "malformed, %llu of another version\n",
-                          (unsigned long long)l.handshakes, (unsigned long long)l.disconnects,
-                          (unsigned long long)l.reconnects, (unsigned long long)l.rejectedAuth,
-                          (unsigned long long)l.rejectedOrder, (unsigned long long)l.rejectedJump,
-                          (unsigned long long)l.rejectedPeer, (unsigned long long)l.rejectedMalformed,
-                          (unsigned long long)l.rejectedVersion);
-            out += line;
-        }
-    }
+    if (r.haptics) out += hapticsSummary(*r.haptics, r.metrics);
     if (r.render) {
         std::string passes;
         for (const auto& p : r.render->passes) {

@@ -201,6 +201,61 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
     return r;
 }
 
+// The clip applier fires at the tip: a clip across the target vessel's local axis, on its nodes
+// inside the jaws (none there, or a region it cannot hold: no clip, the session goes on).
+void InteractionRuntime::fireClip(Instrument& in, double t) {
+    const Vec3 dir = in.key.direction;
+    in.fired = true;
+    auto c = std::make_unique<Clip>();
+    c->body = in.target;
+    const std::vector<Vec3>& x = m_sys->tetPositions(c->body);
+    // Clip frame: the vessel's local axis (principal direction of its nodes near the
+    // tip), the jaw normal across it and the shaft, the closing direction between them.
+    const double r = in.desc.jawLength;
+    Vec3 mean = Vec3::Zero();
+    int n = 0;
+    for (const Vec3& p : x)
+        if ((p - in.key.position).norm() < r) mean += p, ++n;
+    if (n < 4) return; // nothing to clip here: the applier fires into empty space
+    mean /= n;
+    Mat3 cov = Mat3::Zero();
+    for (const Vec3& p : x)
+        if ((p - in.key.position).norm() < r) cov += (p - mean) * (p - mean).transpose();
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(cov);
+    const Vec3 axis = eig.eigenvectors().col(2).normalized();
+    Vec3 normal = axis.cross(dir);
+    if (normal.norm() < 1e-6) normal = axis.unitOrthogonal();
+    normal.normalize();
+    const Vec3 third = axis.cross(normal).normalized();
+    Mat3 axes;
+    axes.col(0) = axis;
+    axes.col(1) = normal;
+    axes.col(2) = third;
+    ClipDesc cd;
+    cd.bounds = ClipBounds::box(in.key.position, axes, Vec3(0.001, 0.5 * r, 0.5 * r));
+    cd.jawNormal = normal;
+    for (int side : {-1, 1}) // the two legs of the clip, as segments' end points
+        for (int end : {-1, 1})
+            cd.vertices.push_back(in.key.position + side * 0.5 * r * normal + end * 0.5 * r * third);
+    for (size_t v = 0; v < x.size(); ++v)
+        if (cd.bounds.contains(x[v])) {
+            cd.contactPoints.push_back(x[v]);
+            c->contactVertices.push_back(static_cast<int32_t>(v));
+        }
+    try {
+        c->attachment = ClipAttachment::apply(*m_bodies[c->body], x, cd);
+    } catch (const std::invalid_argument&) {
+        return; // a region the clip cannot hold (logged as no clip); the session goes on
+    }
+    c->state.instrument = in.desc.name;
+    c->state.target = in.desc.target;
+    c->state.firedAt = t;
+    c->state.centre = c->attachment->centre();
+    c->state.regionVertices = static_cast<int>(c->attachment->regionVertices().size());
+    c->state.auxiliaryNodes = static_cast<int>(c->attachment->auxiliaryNodes().size());
+    m_clips.push_back(std::move(c));
+}
+
 void InteractionRuntime::beforeStep(double t, double dt) {
     const std::vector<Vec3>& sx = m_surfaceIsLayer ? m_sys->surfacePositions(m_surfaceIndex) : m_sys->tetPositions(0);
     auto t0 = std::chrono::steady_clock::now();
@@ -258,57 +313,7 @@ void InteractionRuntime::beforeStep(double t, double dt) {
                 in.heldLocal.clear();
             }
         }
-        if (in.desc.kind == InstrumentDesc::Kind::ClipApplier && !in.fired && in.key.act) {
-            in.fired = true;
-            auto c = std::make_unique<Clip>();
-            c->body = in.target;
-            const std::vector<Vec3>& x = m_sys->tetPositions(c->body);
-            // Clip frame: the vessel's local axis (principal direction of its nodes near the
-            // tip), the jaw normal across it and the shaft, the closing direction between them.
-            const double r = in.desc.jawLength;
-            Vec3 mean = Vec3::Zero();
-            int n = 0;
-            for (const Vec3& p : x)
-                if ((p - in.key.position).norm() < r) mean += p, ++n;
-            if (n < 4) continue; // nothing to clip here: the applier fires into empty space
-            mean /= n;
-            Mat3 cov = Mat3::Zero();
-            for (const Vec3& p : x)
-                if ((p - in.key.position).norm() < r) cov += (p - mean) * (p - mean).transpose();
-            Eigen::SelfAdjointEigenSolver<Mat3> eig(cov);
-            const Vec3 axis = eig.eigenvectors().col(2).normalized();
-            Vec3 normal = axis.cross(dir);
-            if (normal.norm() < 1e-6) normal = axis.unitOrthogonal();
-            normal.normalize();
-            const Vec3 third = axis.cross(normal).normalized();
-            Mat3 axes;
-            axes.col(0) = axis;
-            axes.col(1) = normal;
-            axes.col(2) = third;
-            ClipDesc cd;
-            cd.bounds = ClipBounds::box(in.key.position, axes, Vec3(0.001, 0.5 * r, 0.5 * r));
-            cd.jawNormal = normal;
-            for (int side : {-1, 1}) // the two legs of the clip, as segments' end points
-                for (int end : {-1, 1})
-                    cd.vertices.push_back(in.key.position + side * 0.5 * r * normal + end * 0.5 * r * third);
-            for (size_t v = 0; v < x.size(); ++v)
-                if (cd.bounds.contains(x[v])) {
-                    cd.contactPoints.push_back(x[v]);
-                    c->contactVertices.push_back(static_cast<int32_t>(v));
-                }
-            try {
-                c->attachment = ClipAttachment::apply(*m_bodies[c->body], x, cd);
-            } catch (const std::invalid_argument&) {
-                continue; // a region the clip cannot hold (logged as no clip); the session goes on
-            }
-            c->state.instrument = in.desc.name;
-            c->state.target = in.desc.target;
-            c->state.firedAt = t;
-            c->state.centre = c->attachment->centre();
-            c->state.regionVertices = static_cast<int>(c->attachment->regionVertices().size());
-            c->state.auxiliaryNodes = static_cast<int>(c->attachment->auxiliaryNodes().size());
-            m_clips.push_back(std::move(c));
-        }
+        if (in.desc.kind == InstrumentDesc::Kind::ClipApplier && !in.fired && in.key.act) fireClip(in, t);
     }
     m_summary.clipMs += msSince(t0);
     // A frame with no tool near the tissue and nothing held has no hook work: it runs the

@@ -123,6 +123,7 @@ private:
     struct Clip;
     InteractionRuntime() = default;
     void runHook(XpbdParticles& particles, const XpbdIterationInfo& info);
+    void fireClip(Instrument& in, double t);
 
     XpbdSystem* m_sys = nullptr;
     std::vector<const TetMesh*> m_bodies;

@@ -287,6 +287,46 @@ template <class RunChunk> void Engine::execute(int threads, WorkerPool* pool, co
     pool->run(threads, job);
 }
 
+// Particles [b, e): the end of the substep (velocity from the move, speed clamp, damping) and/or
+// the start of the next (remember x, predict x̃ = x + h (v + h g)).
+void Engine::particlePass(size_t b, size_t e, bool end, bool next, int tid, const SubstepKinematics& k) {
+    double* const x = xw.data();
+    const bool scaledGravity = !gravityScale.empty();
+    for (size_t i = b; i < e; ++i) {
+        double* p = x + 4 * i;
+        Vec3& vi = v[i];
+        if (end) {
+            if (p[3] == 0) {
+                vi.setZero();
+            } else {
+                Vec3 vel = (Vec3(p[0], p[1], p[2]) - m_prev[i]) * k.invH;
+                const double speed2 = vel.squaredNorm();
+                if (speed2 > k.vmax2) {
+                    vel *= k.vmax / std::sqrt(speed2);
+                    const Vec3 xi = m_prev[i] + k.h * vel;
+                    p[0] = xi.x();
+                    p[1] = xi.y();
+                    p[2] = xi.z();
+                    ++m_clamps[tid];
+                }
+                vi = k.decay * vel;
+            }
+        }
+        if (!next) continue;
+        m_prev[i] = Vec3(p[0], p[1], p[2]);
+        if (p[3] != 0) {
+            if (scaledGravity)
+                vi += gravityScale[i] * k.hg;
+            else
+                vi += k.hg;
+            p[0] += k.h * vi.x();
+            p[1] += k.h * vi.y();
+            p[2] += k.h * vi.z();
+        }
+        if (k.keepPrediction) m_xTilde[i] = Vec3(p[0], p[1], p[2]);
+    }
+}
+
 StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
     StepStats st;
     const int substeps = s.substeps;
@@ -308,49 +348,8 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
     m_hookFailed = false;
     buildSchedule(Schedule::Frame, &s, threads);
     double* const x = xw.data();
-    // Start of a substep for particle i: remember x, predict x̃ = x + h (v + h g).
-    const bool scaledGravity = !gravityScale.empty();
-    auto predict = [&](size_t i, double* p, Vec3& vi) {
-        m_prev[i] = Vec3(p[0], p[1], p[2]);
-        if (p[3] == 0) return;
-        if (scaledGravity)
-            vi += gravityScale[i] * hg;
-        else
-            vi += hg;
-        p[0] += h * vi.x();
-        p[1] += h * vi.y();
-        p[2] += h * vi.z();
-    };
-    auto predictAndKeep = [&](size_t i, double* p, Vec3& vi) {
-        predict(i, p, vi);
-        if (s.primalCorrection) m_xTilde[i] = Vec3(p[0], p[1], p[2]);
-    };
-    // End of a substep for particle i (velocity, speed clamp, damping).
-    auto finish = [&](size_t i, double* p, Vec3& vi, int tid) {
-        if (p[3] == 0) {
-            vi.setZero();
-            return;
-        }
-        Vec3 vel = (Vec3(p[0], p[1], p[2]) - m_prev[i]) * invH;
-        const double speed2 = vel.squaredNorm();
-        if (speed2 > vmax2) {
-            vel *= vmax / std::sqrt(speed2);
-            const Vec3 xi = m_prev[i] + h * vel;
-            p[0] = xi.x();
-            p[1] = xi.y();
-            p[2] = xi.z();
-            ++m_clamps[tid];
-        }
-        vi = decay * vel;
-    };
-    // Particles [b, e): the end of the substep and/or the start of the next.
-    auto particles = [&](size_t b, size_t e, bool end, bool next, int tid) {
-        for (size_t i = b; i < e; ++i) {
-            double* p = x + 4 * i;
-            if (end) finish(i, p, v[i], tid);
-            if (next) predictAndKeep(i, p, v[i]);
-        }
-    };
+    const SubstepKinematics k{h, invH, decay, vmax, vmax2, hg, s.primalCorrection};
+    auto particles = [&](size_t b, size_t e, bool end, bool next, int tid) { particlePass(b, e, end, next, tid, k); };
     auto callHook = [&](int substep, int iteration) {
         XpbdParticles view(x, v.data(), n);
         const XpbdIterationInfo info{substep, iteration, substeps, s.iterations, h, iteration == s.iterations};

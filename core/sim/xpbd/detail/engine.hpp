@@ -188,6 +188,13 @@ private:
     /// s: needed for Schedule::Frame only.
     void buildSchedule(Schedule kind, const XpbdSettings* s, int threads);
     void appendCorrectionPhases(int threads);
+    /// A frame's substep figures for the particle passes.
+    struct SubstepKinematics {
+        double h, invH, decay, vmax, vmax2;
+        Vec3 hg;             ///< h · gravity
+        bool keepPrediction; ///< primal correction: x̃ into m_xTilde
+    };
+    void particlePass(size_t b, size_t e, bool end, bool next, int tid, const SubstepKinematics& k);
     /// The chunks of m_outside; true when the hook's range leaves particles out (kHookTail).
     bool cutOutsideHookRange();
     /// Chunks of a phase of colour c: a few per thread, each at least kMinChunkPacks packs.
