@@ -1,5 +1,7 @@
 #include "haptics/console_device.hpp"
 
+#include <algorithm>
+
 namespace viscera::haptics {
 
 ConsoleDevice::ConsoleDevice(const Endpoint& console, const ConsoleDeviceOptions& options)
@@ -80,12 +82,14 @@ bool ConsoleDevice::take(const uint8_t* data, size_t size, StatePacket& pkt, int
     if (peekType(data, size) == static_cast<uint16_t>(PacketType::Welcome)) {
         WelcomePacket w;
         if (const DecodeError e = decode(data, size, w, m_pairing); e != DecodeError::None) return refuse(e);
-        if (!m_helloSent || w.client != m_clientNonce) { // an old or replayed welcome
-            m_count.order.fetch_add(1, std::memory_order_relaxed);
+        const auto end = m_pending.begin() + static_cast<std::ptrdiff_t>(m_pendingCount);
+        if (!m_helloSent || std::find(m_pending.begin(), end, w.client) == end) { // an old or replayed welcome
+            m_count.staleWelcome.fetch_add(1, std::memory_order_relaxed);
             return false;
         }
-        m_session.setKey(sessionKey(m_opt.pairingKey, m_clientNonce, w.server));
+        m_session.setKey(sessionKey(m_pairing, w.client, w.server)); // no allocation: servo thread
         m_helloSent = false;
+        m_pendingCount = m_pendingNext = 0; // the pending nonces fill [0, count) again
         m_wantSession = false;
         m_seqValid = false; // a new session numbers its states afresh
         m_lastLife_ns = arrived_ns;
@@ -109,8 +113,10 @@ void ConsoleDevice::sendHello(int64_t now_ns) {
     HelloPacket h;
     h.sequence = ++m_sendSeq;
     h.timestamp_ns = now_ns;
-    m_clientNonce = randomNonce();
-    h.client = m_clientNonce;
+    h.client = m_nonces.next();
+    m_pending[m_pendingNext] = h.client;
+    m_pendingNext = (m_pendingNext + 1) % kPendingHellos;
+    m_pendingCount = std::min(m_pendingCount + 1, kPendingHellos);
     const size_t n = encode(h, m_tx, sizeof m_tx, m_pairing);
     m_helloSent = true;
     m_lastHello_ns = now_ns;
@@ -144,6 +150,7 @@ LinkStats ConsoleDevice::linkStats() const {
     s.rejectedOrder = r(m_count.order);
     s.rejectedJump = r(m_count.jump);
     s.rejectedPeer = r(m_count.peer);
+    s.staleWelcomes = r(m_count.staleWelcome);
     s.handshakes = r(m_count.handshakes);
     s.droppedFlood = r(m_count.flood);
     s.sent = r(m_count.sent);

@@ -15,6 +15,7 @@
 #include "haptics/device.hpp"
 #include "haptics/udp_socket.hpp"
 
+#include <array>
 #include <atomic>
 #include <memory>
 
@@ -41,8 +42,8 @@ public:
 
 private:
     struct Counters {
-        std::atomic<uint64_t> received{0}, malformed{0}, version{0}, auth{0}, order{0}, jump{0}, peer{0}, flood{0},
-            sent{0}, sendErrors{0}, disconnects{0}, reconnects{0}, handshakes{0};
+        std::atomic<uint64_t> received{0}, malformed{0}, version{0}, auth{0}, order{0}, jump{0}, peer{0},
+            staleWelcome{0}, flood{0}, sent{0}, sendErrors{0}, disconnects{0}, reconnects{0}, handshakes{0};
     };
     /// One datagram of the console's: a welcome (opens the session) or a state; true when it was
     /// a valid state (then in pkt).
@@ -62,8 +63,13 @@ private:
     bool m_everConnected = false;
     uint32_t m_lastSeq = 0;
     uint32_t m_sendSeq = 0;
-    Nonce m_clientNonce{};
-    bool m_helloSent = false;  ///< m_clientNonce went out in a hello that no welcome answered yet
+    /// Client nonces of the hellos still unanswered (the newest kPendingHellos): a welcome for any
+    /// of them opens the session, so a round trip longer than the hello interval still connects.
+    static constexpr size_t kPendingHellos = 4;
+    std::array<Nonce, kPendingHellos> m_pending{};
+    size_t m_pendingCount = 0, m_pendingNext = 0;
+    NonceSource m_nonces;
+    bool m_helloSent = false;  ///< a hello went out that no welcome answered yet
     bool m_wantSession = true; ///< no session, or the link timed out: hellos go out
     int64_t m_lastHello_ns = 0;
     int64_t m_lastLife_ns = 0; ///< arrival of the last valid state or welcome

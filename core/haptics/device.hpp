@@ -22,6 +22,7 @@ struct LinkStats {
     uint64_t rejectedOrder = 0;     ///< duplicate or out-of-order sequence numbers (a replay)
     uint64_t rejectedJump = 0;      ///< sequence too far ahead of the last accepted one
     uint64_t rejectedPeer = 0;      ///< from another address than the console's
+    uint64_t staleWelcomes = 0;     ///< welcomes that answer no pending hello (late or replayed)
     uint64_t handshakes = 0;        ///< sessions opened (hello answered by a valid welcome)
     uint64_t droppedFlood = 0;      ///< valid packets superseded within one tick (only the newest is used)
     uint64_t sent = 0;              ///< commands sent

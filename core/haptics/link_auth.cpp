@@ -1,27 +1,26 @@
+// The SHA-256 compression state is copied per message (RFC 2104 with precomputed pads): the only
+// way through OpenSSL 3.0 that neither allocates nor locks per message (EVP_MAC and EVP_MD_CTX
+// copies allocate), so the low-level SHA-256 interface is used on purpose.
+#define OPENSSL_SUPPRESS_DEPRECATED
 #include "haptics/link_auth.hpp"
 
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
 
-#include <openssl/core_names.h>
 #include <openssl/crypto.h>
-#include <openssl/evp.h>
-#include <openssl/hmac.h>
 #include <openssl/rand.h>
+#include <openssl/sha.h>
 
 #include <algorithm>
 #include <cctype>
 #include <stdexcept>
 
+#include <sys/stat.h>
+
 namespace viscera::haptics {
 
 struct LinkMac::Impl {
-    EVP_MAC* mac = nullptr;
-    EVP_MAC_CTX* ctx = nullptr;
-    ~Impl() {
-        EVP_MAC_CTX_free(ctx);
-        EVP_MAC_free(mac);
-    }
+    SHA256_CTX inner{}, outer{}; ///< after the key's ipad / opad block
 };
 
 LinkMac::LinkMac() : m_impl(std::make_unique<Impl>()) {}
@@ -33,43 +32,67 @@ LinkMac::LinkMac(const LinkKey& key) : LinkMac() {
 LinkMac::~LinkMac() = default;
 
 void LinkMac::setKey(const LinkKey& key) {
-    if (!m_impl->mac) m_impl->mac = EVP_MAC_fetch(nullptr, "HMAC", nullptr);
-    if (!m_impl->ctx && m_impl->mac) m_impl->ctx = EVP_MAC_CTX_new(m_impl->mac);
-    char digest[] = "SHA256";
-    const OSSL_PARAM params[] = {OSSL_PARAM_construct_utf8_string(OSSL_MAC_PARAM_DIGEST, digest, 0),
-                                 OSSL_PARAM_construct_end()};
-    if (!m_impl->ctx || EVP_MAC_init(m_impl->ctx, key.data(), key.size(), params) != 1)
-        throw std::runtime_error("haptics::LinkMac: OpenSSL cannot make an HMAC-SHA256");
+    uint8_t ipad[SHA256_CBLOCK], opad[SHA256_CBLOCK];
+    std::fill(ipad, ipad + SHA256_CBLOCK, uint8_t(0x36));
+    std::fill(opad, opad + SHA256_CBLOCK, uint8_t(0x5c));
+    for (size_t i = 0; i < key.size(); ++i) { // a 32-byte key is shorter than the block: padded with zeros
+        ipad[i] ^= key[i];
+        opad[i] ^= key[i];
+    }
+    SHA256_Init(&m_impl->inner);
+    SHA256_Update(&m_impl->inner, ipad, sizeof ipad);
+    SHA256_Init(&m_impl->outer);
+    SHA256_Update(&m_impl->outer, opad, sizeof opad);
+    OPENSSL_cleanse(ipad, sizeof ipad);
+    OPENSSL_cleanse(opad, sizeof opad);
     m_hasKey = true;
 }
 
+void LinkMac::digest(const uint8_t* data, size_t size, uint8_t* out) const {
+    uint8_t inner[SHA256_DIGEST_LENGTH];
+    SHA256_CTX c = m_impl->inner;
+    SHA256_Update(&c, data, size);
+    SHA256_Final(inner, &c);
+    c = m_impl->outer;
+    SHA256_Update(&c, inner, sizeof inner);
+    SHA256_Final(out, &c);
+}
+
 void LinkMac::sign(const uint8_t* data, size_t size, uint8_t* tag) const {
-    uint8_t full[EVP_MAX_MD_SIZE];
-    size_t n = 0;
-    // Re-initialising with no key keeps the key set last (no allocation).
-    if (!m_hasKey || EVP_MAC_init(m_impl->ctx, nullptr, 0, nullptr) != 1 ||
-        EVP_MAC_update(m_impl->ctx, data, size) != 1 || EVP_MAC_final(m_impl->ctx, full, &n, sizeof full) != 1 ||
-        n < kLinkTagSize) {
-        std::fill(tag, tag + kLinkTagSize, 0); // never verifies: verify() recomputes and fails alike
-        return;
-    }
+    uint8_t full[SHA256_DIGEST_LENGTH];
+    digest(data, size, full);
     std::copy(full, full + kLinkTagSize, tag);
 }
 
 bool LinkMac::verify(const uint8_t* data, size_t size, const uint8_t* tag) const {
     if (!m_hasKey) return false;
-    uint8_t expected[kLinkTagSize];
-    uint8_t full[EVP_MAX_MD_SIZE];
-    size_t n = 0;
-    if (EVP_MAC_init(m_impl->ctx, nullptr, 0, nullptr) != 1 || EVP_MAC_update(m_impl->ctx, data, size) != 1 ||
-        EVP_MAC_final(m_impl->ctx, full, &n, sizeof full) != 1 || n < kLinkTagSize)
-        return false;
-    std::copy(full, full + kLinkTagSize, expected);
-    return CRYPTO_memcmp(expected, tag, kLinkTagSize) == 0;
+    uint8_t full[SHA256_DIGEST_LENGTH];
+    digest(data, size, full);
+    return CRYPTO_memcmp(full, tag, kLinkTagSize) == 0;
+}
+
+NonceSource::NonceSource() {
+    m_mac.setKey(randomKey());
+}
+
+Nonce NonceSource::next() {
+    uint8_t counter[8], full[SHA256_DIGEST_LENGTH];
+    for (int k = 0; k < 8; ++k)
+        counter[k] = uint8_t(m_counter >> (8 * k));
+    ++m_counter;
+    m_mac.digest(counter, sizeof counter, full);
+    Nonce n{};
+    std::copy(full, full + kNonceSize, n.begin());
+    return n;
 }
 
 LinkKey loadPairingKey(const std::string& path) {
     const std::string text = readFile(path, 4096, "a pairing key file");
+    struct stat st {};
+    if (::stat(path.c_str(), &st) == 0 && (st.st_mode & (S_IROTH | S_IWOTH)))
+        throw InputError(path + ": the pairing key is open to other users (mode " +
+                         std::to_string((st.st_mode >> 6) & 7) + std::to_string((st.st_mode >> 3) & 7) +
+                         std::to_string(st.st_mode & 7) + "; chmod 600 it)");
     std::string hex = text;
     while (!hex.empty() && (hex.back() == '\n' || hex.back() == '\r'))
         hex.pop_back();
@@ -115,20 +138,19 @@ Nonce randomNonce() {
     return randomBytes<kNonceSize>();
 }
 
-LinkKey sessionKey(const LinkKey& pairing, const Nonce& client, const Nonce& server) {
+LinkKey sessionKey(const LinkMac& pairing, const Nonce& client, const Nonce& server) {
     static const char label[] = "viscera console session v2";
     uint8_t msg[sizeof label - 1 + 2 * kNonceSize];
     std::copy(label, label + sizeof label - 1, msg);
     std::copy(client.begin(), client.end(), msg + sizeof label - 1);
     std::copy(server.begin(), server.end(), msg + sizeof label - 1 + kNonceSize);
-    uint8_t full[EVP_MAX_MD_SIZE];
-    unsigned n = 0;
-    if (!HMAC(EVP_sha256(), pairing.data(), static_cast<int>(pairing.size()), msg, sizeof msg, full, &n) ||
-        n != kLinkKeySize)
-        throw std::runtime_error("haptics: OpenSSL cannot derive the session key (HMAC failed)");
     LinkKey k{};
-    std::copy(full, full + kLinkKeySize, k.begin());
+    pairing.digest(msg, sizeof msg, k.data());
     return k;
+}
+
+LinkKey sessionKey(const LinkKey& pairing, const Nonce& client, const Nonce& server) {
+    return sessionKey(LinkMac(pairing), client, server);
 }
 
 } // namespace viscera::haptics

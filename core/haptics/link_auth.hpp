@@ -1,8 +1,12 @@
 #pragma once
 /// Message authentication of the console link (protocol version 2, packaging/console-protocol.md):
-/// HMAC-SHA256 (OpenSSL) truncated to 128 bits. A pairing key shared by the player and the
-/// console authenticates the handshake; each handshake derives a fresh session key from it and
-/// both sides' nonces, which authenticates every state and command of that session.
+/// HMAC-SHA256 (RFC 2104 over OpenSSL's SHA-256) truncated to 128 bits. A pairing key shared by
+/// the player and the console authenticates the handshake; each handshake derives a fresh session
+/// key from it and both sides' nonces, which authenticates every state and command of that session.
+///
+/// Real-time safe after construction: signing, verifying, setting a key, deriving a session key
+/// and drawing a nonce from a NonceSource neither allocate, lock nor throw (the servo thread calls
+/// them at 1 kHz); constructors and loadPairingKey may.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -17,12 +21,11 @@ constexpr size_t kNonceSize = 16;
 using LinkKey = std::array<uint8_t, kLinkKeySize>;
 using Nonce = std::array<uint8_t, kNonceSize>;
 
-/// HMAC-SHA256 with one key, set once and reused for every packet (no allocation per packet).
-/// Without a key nothing verifies.
+/// HMAC-SHA256 under one key: the inner and outer hash states of the key are computed once
+/// (setKey) and copied for every message. Without a key nothing verifies.
 class LinkMac {
 public:
     LinkMac();
-    /// Throws std::runtime_error when OpenSSL cannot make the MAC.
     explicit LinkMac(const LinkKey& key);
     ~LinkMac();
     LinkMac(const LinkMac&) = delete;
@@ -30,7 +33,9 @@ public:
 
     void setKey(const LinkKey& key);
     bool hasKey() const { return m_hasKey; }
-    /// The first kLinkTagSize bytes of HMAC-SHA256(key, data[0, size)) into tag.
+    /// HMAC-SHA256(key, data[0, size)), all 32 bytes, into out.
+    void digest(const uint8_t* data, size_t size, uint8_t* out) const;
+    /// The first kLinkTagSize bytes of the HMAC into tag.
     void sign(const uint8_t* data, size_t size, uint8_t* tag) const;
     /// True when tag (kLinkTagSize bytes) is the MAC of data[0, size); constant time.
     bool verify(const uint8_t* data, size_t size, const uint8_t* tag) const;
@@ -41,15 +46,30 @@ private:
     bool m_hasKey = false;
 };
 
-/// Reads a pairing key file: 64 hexadecimal digits (a trailing newline allowed), a regular file.
-/// Throws viscera::InputError "<path>: <rule>".
+/// Fresh, unpredictable nonces without a system call per nonce: HMAC-SHA256 under a random seed
+/// (OpenSSL RAND_bytes at construction) of a counter. Construction throws std::runtime_error when
+/// no random bytes can be had.
+class NonceSource {
+public:
+    NonceSource();
+    Nonce next();
+
+private:
+    LinkMac m_mac;
+    uint64_t m_counter = 0;
+};
+
+/// Reads a pairing key file: 64 hexadecimal digits (a trailing newline allowed), a regular file
+/// that other users can neither read nor write. Throws viscera::InputError "<path>: <rule>".
 LinkKey loadPairingKey(const std::string& path);
 /// The key as the file holds it: 64 lowercase hex digits and a newline.
 std::string formatPairingKey(const LinkKey& key);
 /// Fresh random bytes (OpenSSL RAND_bytes); throws std::runtime_error when none can be had.
 LinkKey randomKey();
 Nonce randomNonce();
-/// The session key of one handshake: HMAC-SHA256(pairing, "viscera console session v2" ‖ client ‖ server).
+/// The session key of one handshake: HMAC-SHA256(pairing key, "viscera console session v2" ‖
+/// client ‖ server); `pairing` holds the pairing key.
+LinkKey sessionKey(const LinkMac& pairing, const Nonce& client, const Nonce& server);
 LinkKey sessionKey(const LinkKey& pairing, const Nonce& client, const Nonce& server);
 
 } // namespace viscera::haptics

@@ -11,10 +11,12 @@
 //   viscera-console-sim --write-trajectory OUT.csv --script NAME --duration S [--rate HZ]
 //   viscera-console-sim --make-pairing-key FILE
 //
-// The session: a hello from any address opens it while no session is live (no valid command for
-// 1 s) or from the session's own address; the console then reads only that address. Hellos are
-// accepted once (a replayed nonce is refused); commands must carry the session's MAC and a newer
-// sequence no more than kMaxSequenceJump ahead. Refusals are counted by reason in the summary.
+// The session: a hello from any address is answered while no session is live (no valid command
+// for 1 s), or from the session's own address; the session opens (or switches) when a command from
+// that address verifies under the key of that handshake, and the console then reads commands from
+// that address only. Hellos are answered once (a replayed nonce is refused); commands must carry
+// the session's MAC and a newer sequence no more than kMaxSequenceJump ahead. Refusals are counted
+// by reason in the summary.
 //
 // --until-player-stops streams like the real console until the player has sent nothing for 1 s
 // (its session ended), --duration bounding the whole run: a player that falls behind the wall
@@ -160,19 +162,26 @@ private:
 };
 
 /// The console's end of the session (packaging/console-protocol.md, version 2): who it talks to,
-/// under which key, and what it refused.
+/// under which key, and what it refused. A hello only proposes a session (answered with a
+/// welcome); the session switches when a command verifies under its key (key confirmation), so a
+/// replayed hello can neither re-key the live session nor pin another address.
 struct Link {
     static constexpr double kMaxForce = 15.0;                ///< N per arm: the console's motors
     static constexpr int64_t kSessionIdleNs = 1'000'000'000; ///< no valid command this long: a new peer may open one
-    explicit Link(const LinkKey& key) : pairingKey(key), pairing(key) {}
+    static constexpr size_t kMaxPending = 4;                 ///< proposed sessions kept (the newest)
+    explicit Link(const LinkKey& key) : pairing(key) {}
 
-    LinkKey pairingKey;
-    LinkMac pairing, session;
+    struct Proposal {
+        Endpoint from;
+        LinkKey key;
+    };
+    LinkMac pairing, session, candidate;
     Endpoint player;
     bool havePlayer = false, commanded = false, seqValid = false;
     uint32_t lastSeq = 0, sendSeq = 0;
     int64_t lastHeard = 0;
-    std::vector<Nonce> nonces; ///< hellos already answered (a replayed hello is refused)
+    std::vector<Nonce> nonces;       ///< hellos already answered (a replayed hello is refused)
+    std::vector<Proposal> proposals; ///< welcomed, not yet confirmed by a command
     std::map<std::string, uint64_t> rejected;
     uint64_t handshakes = 0, clamped = 0;
 
@@ -184,16 +193,21 @@ struct Link {
         return refuse(e == DecodeError::BadVersion ? "version" : e == DecodeError::BadMac ? "auth" : "malformed");
     }
 
-    /// One datagram: a hello (opens a session, answered with a welcome) or a command (into c,
+    /// One datagram: a hello (a proposal, answered with a welcome) or a command (into c,
     /// commanded = true). False when refused (counted by reason).
     bool take(const uint8_t* data, size_t size, const Endpoint& from, int64_t arrived, UdpSocket& sock,
               CommandPacket& c) {
         commanded = false;
         if (peekType(data, size) == static_cast<uint16_t>(PacketType::Hello))
             return hello(data, size, from, arrived, sock);
-        if (!havePlayer) return refuse("auth"); // no session: nothing can carry its MAC
-        if (!(from == player)) return refuse("peer");
-        if (const DecodeError e = decode(data, size, c, session); e != DecodeError::None) return refuse(e);
+        DecodeError e = DecodeError::BadMac;
+        if (havePlayer && from == player) e = decode(data, size, c, session);
+        if (e == DecodeError::BadMac && !confirm(data, size, from, c)) {
+            if (!havePlayer) return refuse("auth"); // no session: nothing can carry its MAC
+            if (!(from == player)) return refuse("peer");
+            return refuse(e);
+        }
+        if (e != DecodeError::None && e != DecodeError::BadMac) return refuse(e);
         if (seqValid && !newer(c.sequence, lastSeq)) return refuse("order");
         if (seqValid && uint32_t(c.sequence - lastSeq) > kMaxSequenceJump) return refuse("jump");
         seqValid = true;
@@ -208,6 +222,23 @@ struct Link {
         return true;
     }
 
+    /// A command that verifies under a proposal from its own address opens that session.
+    bool confirm(const uint8_t* data, size_t size, const Endpoint& from, CommandPacket& c) {
+        for (auto p = proposals.rbegin(); p != proposals.rend(); ++p) {
+            if (!(p->from == from)) continue;
+            candidate.setKey(p->key);
+            if (decode(data, size, c, candidate) != DecodeError::None) continue;
+            session.setKey(p->key);
+            player = from;
+            havePlayer = true;
+            seqValid = false;
+            ++handshakes;
+            proposals.clear();
+            return true;
+        }
+        return false;
+    }
+
     bool hello(const uint8_t* data, size_t size, const Endpoint& from, int64_t arrived, UdpSocket& sock) {
         HelloPacket h;
         if (const DecodeError e = decode(data, size, h, pairing); e != DecodeError::None) return refuse(e);
@@ -219,14 +250,10 @@ struct Link {
         w.timestamp_ns = arrived;
         w.client = h.client;
         w.server = randomNonce();
-        session.setKey(sessionKey(pairingKey, w.client, w.server));
-        player = from;
-        havePlayer = true;
-        seqValid = false;
-        lastHeard = arrived;
-        ++handshakes;
+        if (proposals.size() == kMaxPending) proposals.erase(proposals.begin());
+        proposals.push_back({from, sessionKey(pairing, w.client, w.server)});
         uint8_t out[kMaxPacketSize];
-        sock.sendTo(out, encode(w, out, sizeof out, pairing), player);
+        sock.sendTo(out, encode(w, out, sizeof out, pairing), from);
         return true;
     }
 };

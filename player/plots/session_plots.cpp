@@ -1,5 +1,7 @@
 #include "plots/session_plots.hpp"
 
+#include "runtime/report.hpp"
+
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
 
@@ -26,9 +28,9 @@ namespace {
 
 using nlohmann::json;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-/// The newest report schema these plots read (runtime/report.hpp kReportSchemaVersion; a
-/// report of a newer player may have changed a field's meaning).
-constexpr int kNewestSchema = 2;
+/// The newest report schema these plots read: the one this player writes (a report of a newer
+/// player may have changed a field's meaning).
+constexpr int kNewestSchema = kReportSchemaVersion;
 
 // ---- reading ----------------------------------------------------------------------------------
 

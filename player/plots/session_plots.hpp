@@ -62,7 +62,7 @@ struct PlotInput {
 
 /// Reads what the plots need from a parsed report; `origin` names it in messages. Throws
 /// viscera::InputError "<origin>: <field>: <rule>" (e.g. "r.json: frames[3].step_ms: must be a
-/// number", "r.json: schemaVersion: 7 is newer than this player reads (2)").
+/// number", "r.json: schemaVersion: 7 is newer than this player reads (3)").
 PlotInput readPlotInput(const nlohmann::json& report, const std::string& origin);
 /// The same from a file (size-capped read, JSON syntax errors named with their position).
 PlotInput readPlotInputFile(const std::filesystem::path& reportPath);

@@ -109,6 +109,7 @@ nlohmann::json hapticsJson(const HapticsResult& h) {
                  {"rejected_order", l.rejectedOrder},
                  {"rejected_jump", l.rejectedJump},
                  {"rejected_peer", l.rejectedPeer},
+                 {"stale_welcomes", l.staleWelcomes},
                  {"handshakes", l.handshakes},
                  {"dropped_flood", l.droppedFlood},
                  {"sent", l.sent},
@@ -383,12 +384,12 @@ std::string hapticsSummary(const HapticsResult& h, const TaskMetrics& m) {
         std::snprintf(line, sizeof line,
                       "link          %llu sessions, %llu disconnects, %llu reconnects; refused: %llu forged or "
                       "of no session, %llu replayed or late, %llu jumped, %llu from another address, %llu "
-                      "malformed, %llu of another version\n",
+                      "malformed, %llu of another version, %llu stale welcomes\n",
                       (unsigned long long)l.handshakes, (unsigned long long)l.disconnects,
                       (unsigned long long)l.reconnects, (unsigned long long)l.rejectedAuth,
                       (unsigned long long)l.rejectedOrder, (unsigned long long)l.rejectedJump,
                       (unsigned long long)l.rejectedPeer, (unsigned long long)l.rejectedMalformed,
-                      (unsigned long long)l.rejectedVersion);
+                      (unsigned long long)l.rejectedVersion, (unsigned long long)l.staleWelcomes);
         out += line;
     }
     return out;

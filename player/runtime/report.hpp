@@ -10,8 +10,10 @@ namespace viscera::player {
 
 /// The report's "schemaVersion": raised when a field changes meaning or goes away (new fields
 /// keep it). 2: tool names and per-tool forces, warnings, the largest node displacement is over
-/// the run (final_node_displacement_m is the end).
-constexpr int kReportSchemaVersion = 2;
+/// the run (final_node_displacement_m is the end). 3: the console link is authenticated
+/// (haptics.link: rejected_checksum gave way to rejected_auth, with rejected_jump, rejected_peer,
+/// stale_welcomes and handshakes).
+constexpr int kReportSchemaVersion = 3;
 nlohmann::json reportJson(const SessionResult& result);
 /// The force and pose trace (--trace): one row per servo tick and driven arm.
 /// Columns: t_s, arm, device_x/y/z (m, device frame), tool_x/y/z (m, scene), force_x/y/z (N,

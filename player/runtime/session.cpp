@@ -250,8 +250,8 @@ void checkLink(const HapticsResult& h, SessionResult& r) {
     const haptics::LinkStats& l = h.link;
     const uint64_t ticks = h.servo.safety.ticks, zeroed = h.servo.safety.disconnected;
     const double zeroedPct = ticks ? 100.0 * double(zeroed) / double(ticks) : 0.0;
-    const uint64_t refused =
-        l.rejectedMalformed + l.rejectedVersion + l.rejectedAuth + l.rejectedOrder + l.rejectedJump + l.rejectedPeer;
+    const uint64_t refused = l.rejectedMalformed + l.rejectedVersion + l.rejectedAuth + l.rejectedOrder +
+                             l.rejectedJump + l.rejectedPeer + l.staleWelcomes;
     char buf[400];
     if (l.received == 0)
         std::snprintf(buf, sizeof buf,

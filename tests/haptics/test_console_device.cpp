@@ -210,7 +210,8 @@ TEST(ConsoleDevice, ForgedReplayedJumpedAndForeignPacketsMoveNothing) {
     const LinkStats s = dev.linkStats();
     EXPECT_EQ(s.received, 2u);
     EXPECT_EQ(s.rejectedAuth, 1u);
-    EXPECT_EQ(s.rejectedOrder, 2u); // the replayed state and the old welcome
+    EXPECT_EQ(s.rejectedOrder, 1u); // the replayed state
+    EXPECT_EQ(s.staleWelcomes, 1u); // the old welcome
     EXPECT_EQ(s.rejectedJump, 1u);
     EXPECT_EQ(s.rejectedPeer, 3u);
     EXPECT_EQ(s.handshakes, 1u);

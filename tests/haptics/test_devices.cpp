@@ -10,6 +10,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -59,6 +60,12 @@ TEST(DeviceSpec, ParsesEveryBackendAndRejectsBadSpecs) {
     std::ofstream(good) << formatPairingKey(randomKey());
     std::ofstream(bad) << std::string(63, 'a') << "g\n";
     DeviceOpenOptions o;
+    o.pairingKeyFile = good;
+    std::filesystem::permissions(good, std::filesystem::perms::others_read, std::filesystem::perm_options::add);
+    EXPECT_NE(openError(o).find(good + ": the pairing key is open to other users (mode "), std::string::npos)
+        << openError(o);
+    for (const std::string& f : {good, bad})
+        std::filesystem::permissions(f, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
     o.pairingKeyFile = bad;
     EXPECT_EQ(openError(o), bad + ": a pairing key is 64 hexadecimal digits (character 64 is not one)");
     o.pairingKeyFile = good;

@@ -167,7 +167,7 @@ TEST(PlayerCli, RunWritesTheSessionReport) {
     EXPECT_GT(sag, 1e-4);
     EXPECT_LT(sag, 0.05);
     EXPECT_GE(j["metrics"]["max_node_displacement_m"].get<double>(), sag) << "the largest is over the run";
-    EXPECT_EQ(j["schemaVersion"].get<int>(), 2);
+    EXPECT_EQ(j["schemaVersion"].get<int>(), 3);
     EXPECT_TRUE(j["errors"].empty());
     EXPECT_TRUE(j["warnings"].empty());
     EXPECT_THAT(r.out, HasSubstr("displacement  largest node distance from rest"));

@@ -270,8 +270,10 @@ TEST(PlayerHaptics, RealTimeReplayTakesTheLockstepRunsInput) {
 // session ran its frames with the tools still, and says so in a warning, the status, the report
 // and the exit status.
 // The console simulator's end of the link: a hello under another key opens nothing; the player's
-// hello opens a session and pins its address (a replayed hello and a second player's are refused);
-// forged, replayed and jumped commands and commands from another socket are refused and counted
+// hello and its first command under the new key open a session and pin its address (a replayed
+// hello and a second player's are refused);
+// a hello that no command confirms gets a welcome and nothing else; forged, replayed and jumped
+// commands and commands from another socket are refused and counted
 // by reason; a 999 N command is clamped to the motors' 15 N. Without a key it does not start.
 TEST(PlayerHaptics, ConsoleSimulatorKeepsItsSessionToThePlayerThatOpenedIt) {
     Scratch s;
@@ -297,6 +299,9 @@ TEST(PlayerHaptics, ConsoleSimulatorKeepsItsSessionToThePlayerThatOpenedIt) {
         b.resize(haptics::encode(packet, b.data(), b.size(), mac));
         ASSERT_TRUE(from.sendTo(b.data(), b.size(), console));
     };
+    haptics::HelloPacket h0; // a valid hello that no command ever confirms: a welcome, no stream
+    h0.client = haptics::randomNonce();
+    send(other, h0, pairing);
     haptics::HelloPacket h;
     h.client = haptics::randomNonce();
     send(me, h, stranger); // another pairing key: no session
@@ -313,15 +318,15 @@ TEST(PlayerHaptics, ConsoleSimulatorKeepsItsSessionToThePlayerThatOpenedIt) {
     ASSERT_TRUE(welcomed);
     EXPECT_EQ(w.client, h.client);
     const haptics::LinkMac session(haptics::sessionKey(key, h.client, w.server));
+    haptics::CommandPacket c;
+    c.sequence = 10;
+    c.arm[0].servo_cf.force = haptics::Vec3(0, 0, 999); // beyond the motors; confirms the session
+    send(me, c, session);
+    const std::vector<uint8_t> first = b;
     ASSERT_TRUE(me.sendTo(hello.data(), hello.size(), console)); // replayed hello
     haptics::HelloPacket h2;
     h2.client = haptics::randomNonce();
     send(other, h2, pairing); // a second player while the session lives
-    haptics::CommandPacket c;
-    c.sequence = 10;
-    c.arm[0].servo_cf.force = haptics::Vec3(0, 0, 999); // beyond the motors
-    send(me, c, session);
-    const std::vector<uint8_t> first = b;
     c.sequence = 11;
     c.arm[0].servo_cf.force = haptics::Vec3(0, 0, 1);
     send(me, c, session);
@@ -332,6 +337,11 @@ TEST(PlayerHaptics, ConsoleSimulatorKeepsItsSessionToThePlayerThatOpenedIt) {
     send(me, c, stranger);   // forged
     send(other, c, session); // from another socket
     ASSERT_EQ(sim.waitFor(), 0) << readText(s / "sim.err");
+    int toOther = 0; // the unconfirmed hello's welcome only: no state went to that address
+    uint8_t in[haptics::kMaxPacketSize];
+    for (long n; (n = other.receive(in, sizeof in, nullptr)) >= 0; ++toOther)
+        EXPECT_EQ(haptics::peekType(in, size_t(n)), uint16_t(haptics::PacketType::Welcome));
+    EXPECT_EQ(toOther, 1);
     const auto sum = readJson(s / "sum.json");
     EXPECT_EQ(sum["handshakes"], 1);
     EXPECT_EQ(sum["commands_received"], 2);

@@ -73,7 +73,7 @@ TEST(RectumCase, ExportsRunsGraspsCutsAndClips) {
         EXPECT_GT(m["tool_path_length_per_tool_m"][t].get<double>(), 0.01) << t;
     EXPECT_GT(m["max_contact_force_per_tool_n"][0].get<double>(), 0.0);
     EXPECT_GT(m["tool_path_length_m"].get<double>(), 0.05);
-    EXPECT_EQ(doc["schemaVersion"].get<int>(), 2);
+    EXPECT_EQ(doc["schemaVersion"].get<int>(), 3);
 
     // The committed console replay drives the three instruments from two masters: the left
     // grasps and lifts, the right cuts with the pedal held, hands its arm to the clip applier

@@ -205,7 +205,7 @@ TEST(SessionPlots, MalformedReportsAreRefusedNamingTheField) {
     EXPECT_EQ(refusal(d), "r.json: schemaVersion: is missing");
     d = ok;
     d["schemaVersion"] = 9;
-    EXPECT_EQ(refusal(d), "r.json: schemaVersion: 9 is newer than this player reads (2)");
+    EXPECT_EQ(refusal(d), "r.json: schemaVersion: 9 is newer than this player reads (3)");
     d = ok;
     d["frames"][1]["step_ms"] = "fast";
     EXPECT_EQ(refusal(d), "r.json: frames[1].step_ms: must be a number");

@@ -175,7 +175,9 @@ public:
     /// The extra inertia of tet body b's nodes, kg (#V; zeros unless set).
     std::vector<double> addedInertia(size_t b) const;
 
-    double elasticEnergy() const;   ///< J: elasticity, membranes, compliant ties and strain limits, relative to rest
+    /// J: elasticity, membranes, compliant ties and strain limits, relative to rest. Summed on the
+    /// system's worker threads: not concurrently with step() or another elasticEnergy().
+    double elasticEnergy() const;
     double kineticEnergy() const;   ///< J
     double potentialEnergy() const; ///< J, gravity relative to the rest configuration
     double totalMass() const;       ///< kg
