@@ -1,5 +1,6 @@
 #include "runtime/session.hpp"
 
+#include "render/case_references.hpp"
 #include "runtime/realtime_watch.hpp"
 
 #include "sim/skeleton/node_weights_io.hpp"
@@ -91,19 +92,18 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
     out.scene = sim::parseScene(pkg.read(sceneName), pkg.name() + ":" + sceneName);
     render::RenderSettings look; // the look the case asks for is checked at load, not at the first frame
     render::applyCaseRender(look, out.scene.render, pkg.name() + ":" + sceneName);
+    // Every file the scene names is in the package (the table the studio's export writes by).
+    for (const render::CaseFileRef& ref : render::caseFileReferences(out.scene, pkg.name() + ":" + sceneName))
+        if (!pkg.contains(ref.path))
+            throw InputError(pkg.name() + ": " + sceneName + ": " + ref.field + ": '" + ref.path +
+                             "' is not in the package");
     std::vector<std::unique_ptr<sim::TetMesh>> meshes;
     for (const sim::BodyDesc& b : out.scene.bodies) {
-        if (!pkg.contains(b.meshPath))
-            throw InputError(pkg.name() + ": " + sceneName + ": body '" + b.name + "' uses mesh '" + b.meshPath +
-                             "', which is not in the package");
         meshes.push_back(sim::parseVtet(pkg.read(b.meshPath), pkg.name() + ":" + b.meshPath));
     }
     for (size_t i = 0; i < out.scene.bodies.size(); ++i) { // painted stiffness weights travel as files
         sim::BodyDesc& b = out.scene.bodies[i];
         if (b.nodeWeightsPath.empty()) continue;
-        if (!pkg.contains(b.nodeWeightsPath))
-            throw InputError(pkg.name() + ": " + sceneName + ": body '" + b.name + "' uses node weights '" +
-                             b.nodeWeightsPath + "', which are not in the package");
         b.nodeWeights = sim::parseNodeWeights(pkg.read(b.nodeWeightsPath), pkg.name() + ":" + b.nodeWeightsPath,
                                               meshes[i]->vertexCount());
     }
@@ -115,23 +115,16 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
             pkg.name() + ": " + sceneName + ": bodies[" + std::to_string(i) + "].sample_map_file: ";
         if (look.sampling.mode != render::SampleMode::Painted)
             throw InputError(field + "the case's render.sampling is not 'painted', so the map would not be used");
-        if (!pkg.contains(b.sampleMapPath)) throw InputError(field + "'" + b.sampleMapPath + "' is not in the package");
         out.sampleMaps[i] = render::parseSampleMap(pkg.read(b.sampleMapPath), pkg.name() + ":" + b.sampleMapPath,
                                                    meshes[i]->vertexCount());
     }
     std::vector<sim::TriMesh> surfaces;
     for (const sim::SurfaceDesc& sd : out.scene.surfaces) {
-        if (!pkg.contains(sd.meshPath))
-            throw InputError(pkg.name() + ": " + sceneName + ": surface '" + sd.name + "' uses mesh '" + sd.meshPath +
-                             "', which is not in the package");
         surfaces.push_back(sim::parseVtri(pkg.read(sd.meshPath), pkg.name() + ":" + sd.meshPath));
     }
     for (size_t s = 0; s < out.scene.surfaces.size(); ++s) { // so do those painted on a fascia
         sim::SurfaceDesc& sd = out.scene.surfaces[s];
         if (sd.nodeWeightsPath.empty()) continue;
-        if (!pkg.contains(sd.nodeWeightsPath))
-            throw InputError(pkg.name() + ": " + sceneName + ": surfaces[" + std::to_string(s) +
-                             "].node_weights_file: '" + sd.nodeWeightsPath + "' is not in the package");
         sd.nodeWeights = sim::parseNodeWeights(pkg.read(sd.nodeWeightsPath), pkg.name() + ":" + sd.nodeWeightsPath,
                                                surfaces[s].vertexCount());
     }
@@ -146,26 +139,17 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
         for (const sim::SurfaceDesc& sd : out.scene.surfaces)
             named |= sd.name == m.target;
         if (!named) throw InputError(field + "'" + m.target + "' is not a body or surface of the scene");
-        for (const std::string& f : m.files())
-            if (!pkg.contains(f)) throw InputError(field + "'" + f + "' is not in the package");
     }
     // Before any map is decoded: what they take together, from their headers.
     render::checkDecodedImageBudget(materials, readEntry, pkg.name() + ": " + sceneName);
     for (const render::CaseMaterialMaps& m : materials)
         out.materialMaps.emplace_back(m.target, render::loadMaterialMaps(m, readEntry, pkg.name()));
     if (out.scene.suture) { // the recorded needle trajectory travels with the case
-        const std::string& path = out.scene.suture->trajectoryPath;
-        if (!pkg.contains(path))
-            throw InputError(pkg.name() + ": " + sceneName + ": suture.trajectory: '" + path +
-                             "' is not in the package");
-        out.scene.suture->trajectoryText = pkg.read(path);
+        out.scene.suture->trajectoryText = pkg.read(out.scene.suture->trajectoryPath);
     }
     if (out.scene.interaction) // so do the instrument tracks
         for (size_t i = 0; i < out.scene.interaction->instruments.size(); ++i) {
             sim::InstrumentDesc& in = out.scene.interaction->instruments[i];
-            if (!pkg.contains(in.trackPath))
-                throw InputError(pkg.name() + ": " + sceneName + ": interaction.instruments[" + std::to_string(i) +
-                                 "].track: '" + in.trackPath + "' is not in the package");
             in.trackText = pkg.read(in.trackPath);
         }
     sim::checkWorkBudget(out.scene, meshes, surfaces, pkg.name() + ": " + sceneName); // names the scene's field

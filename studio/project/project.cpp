@@ -1,6 +1,7 @@
 #include "project/project.hpp"
 
 #include "bake/texture.hpp"
+#include "render/case_references.hpp"
 #include "render/case_settings.hpp"
 
 #include "bake/import.hpp"
@@ -23,6 +24,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <set>
 
 #include <unistd.h>
@@ -1036,14 +1038,28 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     sim::SceneDesc written = scene;
     written.render = renderWithMaterials(scene.render, textures.materials);
     writer.addFile("scene.json", sim::formatScene(written));
+    // The package holds exactly the files the scene names (render::caseFileReferences, the table
+    // the player's load checks), each made by one of the stages above.
+    std::map<std::string, std::string> made;
     for (auto& [path, bytes] : files)
-        writer.addFile(path, std::move(bytes));
+        made[path] = std::move(bytes);
     for (auto& [path, bytes] : textures.files)
-        writer.addFile(path, std::move(bytes));
-    if (scene.suture) writer.addFile(scene.suture->trajectoryPath, scene.suture->trajectoryText);
+        made[path] = std::move(bytes);
+    if (scene.suture) made[scene.suture->trajectoryPath] = scene.suture->trajectoryText;
     if (scene.interaction)
         for (const sim::InstrumentDesc& in : scene.interaction->instruments)
-            writer.addFile(in.trackPath, in.trackText);
+            made[in.trackPath] = in.trackText;
+    for (const render::CaseFileRef& ref : render::caseFileReferences(written, origin)) {
+        auto it = made.find(ref.path);
+        if (it == made.end())
+            throw std::logic_error("studio::exportCase(): " + ref.field + " names '" + ref.path +
+                                   "', which no export stage made");
+        writer.addFile(ref.path, std::move(it->second));
+        made.erase(it);
+    }
+    if (!made.empty())
+        throw std::logic_error("studio::exportCase(): '" + made.begin()->first +
+                               "' was made but the scene does not name it");
     const vcase::Manifest manifest = writer.write(out);
     result.casePath = out;
     result.features = manifest.features;

@@ -1,8 +1,10 @@
 #include "case/case_package.hpp"
 #include "project/project.hpp"
+#include "render/case_references.hpp"
 #include "render/sample_map.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/scene/scene.hpp"
+#include "sim/scene/scene_json.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
 
@@ -11,6 +13,7 @@
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -77,6 +80,48 @@ TEST_F(ProjectTest, ExportWritesOnlyWhatTheSceneUses) {
     write(replaced(kGood, "\"gravity\": [0, 0, -9.81],", ""));
     studio::ExportResult still = studio::exportCase(studio::loadProject(m_dir), out);
     EXPECT_EQ(still.features, std::vector<std::string>{"xpbd"});
+}
+
+// Export writes by the one table of file references that load checks
+// (render::caseFileReferences): the packages of the liver (meshes, a fascia, texture maps, a light
+// sample map) and the anastomosis (a needle trajectory) hold exactly scene.json and the files their
+// scenes name, each named once with its field.
+TEST_F(ProjectTest, PackagesHoldExactlyTheFilesTheirScenesName) {
+    for (const char* sample : {"liver", "anastomosis"}) {
+        SCOPED_TRACE(sample);
+        const auto out = m_dir / (std::string(sample) + ".vcase");
+        studio::exportCase(studio::loadProject(std::filesystem::path(VISCERA_SOURCE_DIR) / "projects" / sample), out);
+        auto pkg = vcase::CasePackage::open(out);
+        const sim::SceneDesc scene = sim::parseScene(pkg->read("scene.json"), "scene.json");
+        std::set<std::string> named = {"scene.json"}, packaged;
+        for (const render::CaseFileRef& ref : render::caseFileReferences(scene, "scene.json")) {
+            EXPECT_FALSE(ref.field.empty()) << ref.path;
+            EXPECT_TRUE(named.insert(ref.path).second) << ref.path << " listed twice";
+        }
+        for (const vcase::FileEntry& f : pkg->manifest().files)
+            packaged.insert(f.path);
+        EXPECT_EQ(packaged, named);
+        EXPECT_GE(named.size(), std::string(sample) == "liver" ? 5u : 3u);
+    }
+    // The table on a scene that names every kind of file, one path twice.
+    sim::SceneDesc scene;
+    scene.bodies.resize(2);
+    scene.bodies[0].meshPath = "meshes/a.vtet";
+    scene.bodies[0].nodeWeightsPath = "meshes/a.vweights";
+    scene.bodies[1].meshPath = "meshes/b.vtet";
+    scene.bodies[1].sampleMapPath = "meshes/b.vsamples";
+    scene.surfaces.resize(1);
+    scene.surfaces[0].meshPath = "meshes/a.vtet"; // the same path again: listed once
+    scene.render = R"({"materials": {"b": {"diffuse": "textures/b.png"}}})";
+    std::vector<std::pair<std::string, std::string>> got;
+    for (const render::CaseFileRef& ref : render::caseFileReferences(scene, "scene.json"))
+        got.emplace_back(ref.field, ref.path);
+    EXPECT_EQ(got,
+              (std::vector<std::pair<std::string, std::string>>{{"bodies[0].mesh", "meshes/a.vtet"},
+                                                                {"bodies[0].node_weights_file", "meshes/a.vweights"},
+                                                                {"bodies[1].mesh", "meshes/b.vtet"},
+                                                                {"bodies[1].sample_map_file", "meshes/b.vsamples"},
+                                                                {"render.materials.b", "textures/b.png"}}));
 }
 
 TEST_F(ProjectTest, LoadErrorsNameFileFieldAndRule) {
