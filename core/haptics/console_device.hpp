@@ -26,7 +26,7 @@ struct ConsoleDeviceOptions {
     int64_t helloInterval_ns = 50'000'000;
     int64_t timeout_ns = 100'000'000; ///< no valid packet for this long = disconnected
     int maxPacketsPerPoll = 64;
-    double maxForce = 15.0; ///< N per arm, the console's motors [B §4]
+    double maxForce = kConsoleMaxForce; ///< N per arm, the console's motors
 };
 
 class ConsoleDevice final : public Device {

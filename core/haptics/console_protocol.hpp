@@ -26,8 +26,9 @@ constexpr size_t kWelcomeSize = kHeaderSize + 2 * kNonceSize + kLinkTagSize;
 /// A state or command more than this many sequence numbers ahead of the last accepted one of its
 /// session is refused (a jump: 1 s of packets at 1 kHz; a longer gap ends in a new handshake).
 constexpr uint32_t kMaxSequenceJump = 1000;
-constexpr size_t kMaxPacketSize = 512;   ///< receive buffers; larger datagrams are malformed
-constexpr double kMaxWireForce = 1000.0; ///< N; a command beyond is malformed
+constexpr size_t kMaxPacketSize = 512;    ///< receive buffers; larger datagrams are malformed
+constexpr double kMaxWireForce = 1000.0;  ///< N; a command beyond is malformed
+constexpr double kConsoleMaxForce = 15.0; ///< N per arm: the console's motors [B §4]; it clamps commands to this
 
 enum class PacketType : uint16_t { State = 1, Command = 2, Hello = 3, Welcome = 4 };
 

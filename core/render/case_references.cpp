@@ -1,12 +1,11 @@
 #include "render/case_references.hpp"
 
-#include "render/case_settings.hpp"
-
 #include <algorithm>
 
 namespace viscera::render {
 
-std::vector<CaseFileRef> caseFileReferences(const sim::SceneDesc& scene, const std::string& origin) {
+std::vector<CaseFileRef> caseFileReferences(const sim::SceneDesc& scene,
+                                            const std::vector<CaseMaterialMaps>& materials) {
     std::vector<CaseFileRef> refs;
     auto add = [&](std::string field, const std::string& path) {
         if (path.empty()) return;
@@ -24,7 +23,7 @@ std::vector<CaseFileRef> caseFileReferences(const sim::SceneDesc& scene, const s
         add(at + "mesh", scene.surfaces[s].meshPath);
         add(at + "node_weights_file", scene.surfaces[s].nodeWeightsPath);
     }
-    for (const CaseMaterialMaps& m : caseMaterialMaps(scene.render, origin))
+    for (const CaseMaterialMaps& m : materials)
         for (const std::string& f : m.files())
             add("render.materials." + m.target, f);
     if (scene.suture) add("suture.trajectory", scene.suture->trajectoryPath);

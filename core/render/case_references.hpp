@@ -1,6 +1,7 @@
 #pragma once
 /// The one table of the files a case's scene refers to: what the studio's export writes into the
 /// package and what the player's load requires in it (and nothing else).
+#include "render/case_settings.hpp"
 #include "sim/scene/scene.hpp"
 
 #include <string>
@@ -16,9 +17,10 @@ struct CaseFileRef {
 };
 
 /// Every file `scene` refers to, in scene order: bodies[i].mesh, .node_weights_file,
-/// .sample_map_file; surfaces[s].mesh, .node_weights_file; render.materials.<target> (its maps);
-/// suture.trajectory; interaction.instruments[i].track. A path named twice is listed once (its
-/// first field). Throws viscera::InputError naming `origin` for a render block that does not parse.
-std::vector<CaseFileRef> caseFileReferences(const sim::SceneDesc& scene, const std::string& origin);
+/// .sample_map_file; surfaces[s].mesh, .node_weights_file; render.materials.<target> (the maps of
+/// `materials`, the scene's render block as caseMaterialMaps reads it); suture.trajectory;
+/// interaction.instruments[i].track. A path named twice is listed once (its first field).
+std::vector<CaseFileRef> caseFileReferences(const sim::SceneDesc& scene,
+                                            const std::vector<CaseMaterialMaps>& materials);
 
 } // namespace viscera::render

@@ -166,7 +166,6 @@ private:
 /// welcome); the session switches when a command verifies under its key (key confirmation), so a
 /// replayed hello can neither re-key the live session nor pin another address.
 struct Link {
-    static constexpr double kMaxForce = 15.0;                ///< N per arm: the console's motors
     static constexpr int64_t kSessionIdleNs = 1'000'000'000; ///< no valid command this long: a new peer may open one
     static constexpr size_t kMaxPending = 4;                 ///< proposed sessions kept (the newest)
     explicit Link(const LinkKey& key) : pairing(key) {}
@@ -214,8 +213,8 @@ struct Link {
         lastSeq = c.sequence;
         lastHeard = arrived;
         for (ArmCommand& a : c.arm) // the motors' limit, whatever the player asked
-            if (const double f = a.servo_cf.force.norm(); f > kMaxForce) {
-                a.servo_cf.force *= kMaxForce / f;
+            if (const double f = a.servo_cf.force.norm(); f > kConsoleMaxForce) {
+                a.servo_cf.force *= kConsoleMaxForce / f;
                 ++clamped;
             }
         commanded = true;
@@ -360,7 +359,7 @@ void writeFigures(const Options& o, const Link& link, const std::vector<Received
         "console-sim   %llu states sent, %zu commands received (%llu packets refused, %llu clamped to %.0f N), %llu "
         "non-zero, max force %.3f N, %llu sessions\n",
         (unsigned long long)st.sent, received.size(), (unsigned long long)rejectedAll, (unsigned long long)link.clamped,
-        Link::kMaxForce, (unsigned long long)nonZero, maxForce, (unsigned long long)link.handshakes);
+        kConsoleMaxForce, (unsigned long long)nonZero, maxForce, (unsigned long long)link.handshakes);
     std::printf("latency       state -> command echo p50 %.3f ms, p99 %.3f ms\n", pct(0.5), pct(0.99));
     if (pausedCmds)
         std::printf("pause         %llu commands during the pause, %llu non-zero after the device timeout\n",

@@ -92,8 +92,10 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
     out.scene = sim::parseScene(pkg.read(sceneName), pkg.name() + ":" + sceneName);
     render::RenderSettings look; // the look the case asks for is checked at load, not at the first frame
     render::applyCaseRender(look, out.scene.render, pkg.name() + ":" + sceneName);
+    const std::vector<render::CaseMaterialMaps> materials =
+        render::caseMaterialMaps(out.scene.render, pkg.name() + ":" + sceneName);
     // Every file the scene names is in the package (the table the studio's export writes by).
-    for (const render::CaseFileRef& ref : render::caseFileReferences(out.scene, pkg.name() + ":" + sceneName))
+    for (const render::CaseFileRef& ref : render::caseFileReferences(out.scene, materials))
         if (!pkg.contains(ref.path))
             throw InputError(pkg.name() + ": " + sceneName + ": " + ref.field + ": '" + ref.path +
                              "' is not in the package");
@@ -128,8 +130,6 @@ LoadedCase loadCase(const std::filesystem::path& casePath) {
         sd.nodeWeights = sim::parseNodeWeights(pkg.read(sd.nodeWeightsPath), pkg.name() + ":" + sd.nodeWeightsPath,
                                                surfaces[s].vertexCount());
     }
-    const std::vector<render::CaseMaterialMaps> materials =
-        render::caseMaterialMaps(out.scene.render, pkg.name() + ":" + sceneName);
     const auto readEntry = [&pkg](const std::string& path) { return pkg.read(path); };
     for (const render::CaseMaterialMaps& m : materials) {
         const std::string field = pkg.name() + ": " + sceneName + ": render.materials." + m.target + ": ";

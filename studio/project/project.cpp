@@ -1049,7 +1049,8 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     if (scene.interaction)
         for (const sim::InstrumentDesc& in : scene.interaction->instruments)
             made[in.trackPath] = in.trackText;
-    for (const render::CaseFileRef& ref : render::caseFileReferences(written, origin)) {
+    for (const render::CaseFileRef& ref :
+         render::caseFileReferences(written, render::caseMaterialMaps(written.render, origin))) {
         auto it = made.find(ref.path);
         if (it == made.end())
             throw std::logic_error("studio::exportCase(): " + ref.field + " names '" + ref.path +

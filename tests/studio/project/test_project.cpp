@@ -94,7 +94,8 @@ TEST_F(ProjectTest, PackagesHoldExactlyTheFilesTheirScenesName) {
         auto pkg = vcase::CasePackage::open(out);
         const sim::SceneDesc scene = sim::parseScene(pkg->read("scene.json"), "scene.json");
         std::set<std::string> named = {"scene.json"}, packaged;
-        for (const render::CaseFileRef& ref : render::caseFileReferences(scene, "scene.json")) {
+        for (const render::CaseFileRef& ref :
+             render::caseFileReferences(scene, render::caseMaterialMaps(scene.render, "scene.json"))) {
             EXPECT_FALSE(ref.field.empty()) << ref.path;
             EXPECT_TRUE(named.insert(ref.path).second) << ref.path << " listed twice";
         }
@@ -114,7 +115,8 @@ TEST_F(ProjectTest, PackagesHoldExactlyTheFilesTheirScenesName) {
     scene.surfaces[0].meshPath = "meshes/a.vtet"; // the same path again: listed once
     scene.render = R"({"materials": {"b": {"diffuse": "textures/b.png"}}})";
     std::vector<std::pair<std::string, std::string>> got;
-    for (const render::CaseFileRef& ref : render::caseFileReferences(scene, "scene.json"))
+    for (const render::CaseFileRef& ref :
+         render::caseFileReferences(scene, render::caseMaterialMaps(scene.render, "scene.json")))
         got.emplace_back(ref.field, ref.path);
     EXPECT_EQ(got,
               (std::vector<std::pair<std::string, std::string>>{{"bodies[0].mesh", "meshes/a.vtet"},

@@ -349,7 +349,6 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
     buildSchedule(Schedule::Frame, &s, threads);
     double* const x = xw.data();
     const SubstepKinematics k{h, invH, decay, vmax, vmax2, hg, s.primalCorrection};
-    auto particles = [&](size_t b, size_t e, bool end, bool next, int tid) { particlePass(b, e, end, next, tid, k); };
     auto callHook = [&](int substep, int iteration) {
         XpbdParticles view(x, v.data(), n);
         const XpbdIterationInfo info{substep, iteration, substeps, s.iterations, h, iteration == s.iterations};
@@ -377,19 +376,19 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
             return;
         }
         if (ph.colour == kHookTail && chunk > 0) {
-            particles(m_outside[chunk - 1].first, m_outside[chunk - 1].second, true, ph.predictNext, tid);
+            particlePass(m_outside[chunk - 1].first, m_outside[chunk - 1].second, true, ph.predictNext, tid, k);
             return;
         }
         if (ph.colour == kHookTail) { // the hook's particles, in the order of the phases it stands for
             const size_t e = std::min(hookEnd, n), b = std::min(hookFirst, e);
             callHook(ph.substep, ph.iteration);
-            particles(b, e, true, false, tid);
+            particlePass(b, e, true, false, tid, k);
             callHook(ph.substep, s.iterations);
-            particles(b, e, false, ph.predictNext, tid);
+            particlePass(b, e, false, ph.predictNext, tid, k);
             return;
         }
         const size_t b = size_t(chunk) * kChunkParticles, e = std::min(n, b + kChunkParticles);
-        particles(b, e, ph.colour != kPredictOnly, ph.predictNext, tid);
+        particlePass(b, e, ph.colour != kPredictOnly, ph.predictNext, tid, k);
     });
 
     st.substeps = substeps;
@@ -418,14 +417,16 @@ StepStats Engine::frame(const XpbdSettings& s, WorkerPool* pool) {
 double Engine::energy(int threads, WorkerPool* pool) {
     // Parts of at least kEnergyPartUnits units, at most kEnergyParts per block: fixed by the
     // blocks alone, so the sum (in part order) is the same for any number of threads.
+    // The blocks and their units are fixed once coloured (a cut deactivates units), so the parts
+    // are cut once.
     constexpr size_t kEnergyPartUnits = 1024, kEnergyParts = 16;
-    m_energyParts.clear();
-    for (size_t b = 0; b < blocks.size(); ++b) {
-        const size_t units = blocks[b]->unitCount();
-        const size_t parts = std::clamp<size_t>(units / kEnergyPartUnits, 1, kEnergyParts);
-        for (size_t k = 0; k < parts; ++k)
-            m_energyParts.push_back({b, units * k / parts, units * (k + 1) / parts});
-    }
+    if (m_energyParts.empty())
+        for (size_t b = 0; b < blocks.size(); ++b) {
+            const size_t units = blocks[b]->unitCount();
+            const size_t parts = std::clamp<size_t>(units / kEnergyPartUnits, 1, kEnergyParts);
+            for (size_t k = 0; k < parts; ++k)
+                m_energyParts.push_back({b, units * k / parts, units * (k + 1) / parts});
+        }
     m_energySums.assign(m_energyParts.size(), 0.0);
     m_phases.assign(1, Phase{kEnergy, -1, false, false, false, static_cast<uint32_t>(m_energyParts.size())});
     m_phaseStart = {0, m_phases[0].chunks};
