@@ -49,13 +49,18 @@ foreach(dir IN LISTS VISCERA_SAMPLE_PROJECTS)
   file(GLOB_RECURSE inputs CONFIGURE_DEPENDS ${dir}/*)
   set(out ${CMAKE_BINARY_DIR}/samples/${name}.vcase)
   add_custom_command(OUTPUT ${out}
-    COMMAND $<TARGET_FILE:viscera-studio> export ${dir} -o ${out}
-    DEPENDS viscera-studio ${inputs}
+    COMMAND $<TARGET_FILE:viscera-studio> export ${dir} -o ${out} --sign-key ${VISCERA_SAMPLE_KEY}
+            --signer "Viscera samples (test key)"
+    DEPENDS viscera-studio ${VISCERA_SAMPLE_KEY} ${inputs}
     COMMENT "Exporting the sample ${name}" VERBATIM)
   list(APPEND VISCERA_SAMPLE_CASES ${out})
 endforeach()
 add_custom_target(viscera_samples DEPENDS ${VISCERA_SAMPLE_CASES})
+add_dependencies(viscera_samples viscera_sample_key)
 install(FILES ${VISCERA_SAMPLE_CASES} DESTINATION share/viscera/samples COMPONENT samples OPTIONAL)
+# The samples' publisher key, trusted by the player installed beside it (the vendor trust folder).
+install(FILES ${VISCERA_SAMPLE_PUBLIC_KEY} DESTINATION share/viscera/trusted-publishers
+        RENAME viscera-samples.pem COMPONENT samples OPTIONAL)
 
 set(CPACK_PACKAGE_NAME "viscera")
 set(CPACK_PACKAGE_VENDOR "Viscera")

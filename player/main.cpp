@@ -13,6 +13,7 @@
 //
 // Exit codes: 0 success, 1 bad input (case, arguments), 2 usage, 3 the session broke an invariant.
 #include "case/case_package.hpp"
+#include "case/run_state.hpp"
 #include "haptics/device_spec.hpp"
 #include "haptics/servo_loop.hpp"
 #include "render/case_settings.hpp"
@@ -22,6 +23,7 @@
 #include "runtime/report.hpp"
 #include "runtime/session.hpp"
 #include "runtime/soak.hpp"
+#include "runtime/trust_options.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/cli_main.hpp"
 #include "sim/util/error.hpp"
@@ -47,12 +49,13 @@ using namespace viscera;
 using sim::kExitInput, sim::kExitUsage, sim::kExitInvariant;
 
 void usage(std::FILE* out) {
-    std::fputs("usage: viscera-player verify <case.vcase>\n"
+    std::fputs("usage: viscera-player verify <case.vcase> [--trust KEY.pem] [--allow-unsigned] [--state-dir DIR]\n"
                "       viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]\n"
                "                      [--report report.json] [--screenshot out.png] [--trace trace.csv]\n"
                "                      [--realtime | --lockstep] [--servo "
                "shared|shared:US|sleep|sleep:CPU|spin:US|busy|busy:CPU]\n"
-               "                      [--plots DIR] [--pairing-key FILE]\n"
+               "                      [--plots DIR] [--pairing-key FILE] [--trust KEY.pem] [--allow-unsigned]\n"
+               "                      [--state-dir DIR]\n"
                "       viscera-player plot <report.json> -o DIR\n"
                "       viscera-player soak <case.vcase[@SPEC]>... [--minutes M] [--frames N] [--report soak.json]\n"
                "       SPEC: replay:<file> | scripted:<name> | console:<host:port> | keyboard\n"
@@ -61,13 +64,16 @@ void usage(std::FILE* out) {
 }
 
 constexpr const char* kVerifyHelp =
-    "usage: viscera-player verify <case.vcase>\n"
+    "usage: viscera-player verify <case.vcase> [options]\n"
     "\n"
     "Checks a case package without running it, with every check 'run' makes before its first\n"
-    "frame: the manifest, every file's size and checksum, the features against those this player\n"
-    "supports, the scene, the meshes, the work budget of a frame and the assembled world's\n"
-    "stability. Prints the case id, version, file count and features. Exit 0 valid, 1 a broken\n"
-    "case (one line naming the file and the rule), 2 usage.\n";
+    "frame: the manifest, every file's size and checksum, the publisher's signature against the\n"
+    "trusted keys, the expiry, the version against those already run, the features against those\n"
+    "this player supports, the scene, the meshes, the work budget of a frame and the assembled\n"
+    "world's stability. Prints the case id, version, file count, features, signer and digest.\n"
+    "\n" VISCERA_PLAYER_TRUST_HELP "\n"
+    "Exit 0 valid, 1 a broken, unsigned, untrusted or expired case (one line naming the file and\n"
+    "the rule), 2 usage.\n";
 
 constexpr const char* kRunHelp =
     "usage: viscera-player run <case.vcase> [options]\n"
@@ -92,8 +98,8 @@ constexpr const char* kRunHelp =
     "  --report FILE.json    session report (schemaVersion, frames, metrics, haptics, errors)\n"
     "  --trace FILE.csv      per-tick device force and pose trace (needs --device)\n"
     "  --screenshot FILE.png the rendered last frame (headless: EGL, window: the window)\n"
-    "  --plots DIR           session plots (PNG) and session.html, as 'viscera-player plot' makes\n"
-    "\n"
+    "  --plots DIR           session plots (PNG) and session.html, as 'viscera-player plot' "
+    "makes\n" VISCERA_PLAYER_TRUST_HELP "\n"
     "Output paths are checked before the first frame. Exit 0 ok, 1 bad input or an output that\n"
     "cannot be written, 2 usage, 3 the session broke an invariant (non-finite state, energy).\n";
 
@@ -122,8 +128,7 @@ constexpr const char* kSoakHelp =
     "  --line-seconds S      one line per S seconds (default 60)\n"
     "  --frames N            frames per pass (default 300)\n"
     "  --energy-tolerance X  a pass's largest energy may exceed the first pass's by X (default 0.1)\n"
-    "  --report FILE.json    the lines, the cases and the errors\n"
-    "\n"
+    "  --report FILE.json    the lines, the cases and the errors\n" VISCERA_PLAYER_TRUST_HELP "\n"
     "Exit 0 ok, 1 bad input, 2 usage, 3 a non-finite state or an energy above the bound.\n";
 
 int fail(int code, const std::string& message) {
@@ -131,19 +136,27 @@ int fail(int code, const std::string& message) {
 }
 
 int cmdVerify(const std::vector<std::string>& args) {
-    if (args.size() != 1) {
+    player::TrustOptions trust;
+    std::vector<std::string> operands;
+    for (size_t i = 0; i < args.size(); ++i)
+        if (!trust.consume(args, i)) {
+            if (!args[i].empty() && args[i][0] == '-') throw std::invalid_argument("unknown option '" + args[i] + "'");
+            operands.push_back(args[i]);
+        }
+    if (operands.size() != 1) {
         usage(stderr);
         return kExitUsage;
     }
-    // Every check a run makes before its first frame: the package, the scene, the meshes, the
-    // work budget and the assembled world (stability), so that a case verify accepts also loads.
-    const player::LoadedCase loaded = player::loadCase(args[0]);
+    // Every check a run makes before its first frame: the package, its signature, expiry and
+    // version, the scene, the meshes, the work budget and the assembled world (stability), so
+    // that a case verify accepts also loads.
+    const player::LoadedCase loaded = player::loadCase(operands[0], trust.policy());
     const vcase::Manifest& m = loaded.package->manifest();
-    std::printf("%s: ok (case %s %s, %zu files, features:", args[0].c_str(), m.caseId.c_str(), m.caseVersion.c_str(),
-                m.files.size());
+    std::printf("%s: ok (case %s %s, %zu files, features:", operands[0].c_str(), m.caseId.c_str(),
+                m.caseVersion.c_str(), m.files.size());
     for (const auto& f : m.features)
         std::printf(" %s", f.c_str());
-    std::printf(")\n");
+    std::printf(")\n  package %s\n", player::packageSummary(loaded.provenance).c_str());
     return 0;
 }
 
@@ -207,6 +220,7 @@ struct RunArgs {
     std::optional<std::string> casePath, reportPath, screenshot, device, tracePath, plotsDir, pairingKey;
     bool headless = false, realtime = false, lockstep = false, framesGiven = false;
     ServoChoice servo;
+    player::TrustOptions trust;
     int frames = 300;
 };
 
@@ -218,6 +232,7 @@ RunArgs parseRunArgs(const std::vector<std::string>& args) {
             if (i + 1 >= args.size()) throw std::invalid_argument(std::string(flag) + " needs a value");
             return args[++i];
         };
+        if (r.trust.consume(args, i)) continue;
         if (a == "--headless")
             r.headless = true;
         else if (a == "--frames") {
@@ -419,7 +434,12 @@ int cmdRun(const std::vector<std::string>& args) {
         if (servo.cpu < 0) servo.cpu = haptics::defaultServoCpu();
         if (servo.cpu >= 0) haptics::pinCurrentThreadExcept(servo.cpu);
     }
-    player::LoadedCase loaded = player::loadCase(*r.casePath);
+    const vcase::TrustPolicy trust = r.trust.policy();
+    player::LoadedCase loaded = player::loadCase(*r.casePath, trust);
+    if (trust.stateFolder) { // this version has run: an older one is refused from now on
+        const vcase::Manifest& m = loaded.package->manifest();
+        vcase::recordVersionRun(*trust.stateFolder, m.caseId, m.caseVersion);
+    }
     player::RunOptions opts;
     opts.frames = r.frames;
     opts.device = dev.get();
@@ -464,6 +484,7 @@ int cmdSoak(const std::vector<std::string>& args) {
     opt.seconds = 3600;
     int frames = 300;
     std::optional<std::string> reportPath;
+    player::TrustOptions trust;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         auto value = [&]() -> std::string {
@@ -480,6 +501,8 @@ int cmdSoak(const std::vector<std::string>& args) {
             opt.energyTolerance = numberArg(a, value(), 0, 100);
         else if (a == "--report")
             reportPath = value();
+        else if (trust.consume(args, i))
+            continue;
         else if (!a.empty() && a[0] == '-')
             throw std::invalid_argument("unknown option '" + a + "'");
         else {
@@ -496,6 +519,7 @@ int cmdSoak(const std::vector<std::string>& args) {
         }
     }
     if (cases.empty()) throw std::invalid_argument("soak needs at least one case");
+    opt.trust = trust.policy();
     for (player::SoakCase& c : cases)
         c.frames = frames;
     if (reportPath) { // before the soak, which runs for minutes or hours

@@ -7,9 +7,12 @@ cd "$(dirname "$0")/.."
 PROJECT=${1:-tissue-slab}
 FRAMES=${2:-300}
 BUILD_DIR=${VISCERA_BUILD_DIR:-build}
-bash scripts/configure.sh viscera-studio viscera-player
+bash scripts/configure.sh viscera-studio viscera-player viscera_sample_key
 mkdir -p out
-"$BUILD_DIR/studio/cli/viscera-studio" export "projects/$PROJECT" -o "out/$PROJECT.vcase"
-"$BUILD_DIR/player/viscera-player" verify "out/$PROJECT.vcase"
-"$BUILD_DIR/player/viscera-player" run "out/$PROJECT.vcase" --headless --frames "$FRAMES" \
+# Signed with the build's sample publisher key (a test key); the player trusts its public half.
+key="$BUILD_DIR/keys/viscera-samples.pem"
+"$BUILD_DIR/studio/cli/viscera-studio" export "projects/$PROJECT" -o "out/$PROJECT.vcase" \
+  --sign-key "$key" --signer "Viscera samples (test key)"
+"$BUILD_DIR/player/viscera-player" verify "out/$PROJECT.vcase" --trust "${key%.pem}.pub.pem"
+"$BUILD_DIR/player/viscera-player" run "out/$PROJECT.vcase" --trust "${key%.pem}.pub.pem" --headless --frames "$FRAMES" \
   --report "out/$PROJECT-report.json"

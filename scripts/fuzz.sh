@@ -33,7 +33,8 @@ seeds="$out/seeds"
 rm -rf "$seeds"
 mkdir -p "$seeds"/{case_package,manifest,scene,vtet,vweights,console_protocol,instrument_track,device_trajectory,needle_trajectory}
 for p in tissue-slab organ-blob anastomosis rectum liver; do
-  "$build/studio/cli/viscera-studio" export "projects/$p" -o "$seeds/$p.vcase" >/dev/null 2>&1
+  "$build/studio/cli/viscera-studio" export "projects/$p" -o "$seeds/$p.vcase" \
+    --sign-key "$build/keys/viscera-samples.pem" >/dev/null 2>&1
   x="$seeds/x-$p"
   mkdir -p "$x"
   (cd "$x" && cmake -E tar xf "../$p.vcase")

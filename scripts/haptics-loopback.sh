@@ -35,7 +35,10 @@ if [ "$servo_cpu" -ge 0 ] && command -v taskset >/dev/null; then
   sim_cpus="$(echo "$cpus" | grep -vx "$servo_cpu" | paste -sd, -)"
 fi
 case_file="${LOOPBACK_CASE:-$out/haptic-slab.vcase}"
-[ -n "${LOOPBACK_CASE:-}" ] || "$build/tests/player/make_haptic_case" "$out/haptic-slab.vcase" 2 >/dev/null
+# Cases are signed with the build's sample publisher key (a test key; export LOOPBACK_CASE with
+# --sign-key build/keys/viscera-samples.pem) and the player trusts its public half.
+key="$build/keys/viscera-samples.pem"
+[ -n "${LOOPBACK_CASE:-}" ] || "$build/tests/player/make_haptic_case" "$out/haptic-slab.vcase" 2 "$key" >/dev/null
 rm -f "$out/port"
 # The pairing key both ends share (the authenticated link, packaging/console-protocol.md).
 "$build/player/viscera-console-sim" --make-pairing-key "$out/pairing.key" >/dev/null
@@ -50,11 +53,11 @@ frames=$(( secs * 60 ))
 player_rc=0 # the figures are printed either way; the script exits with the player's status
 if [ "${LOOPBACK_WINDOW:-0}" = 1 ]; then
   env -u QT_QPA_PLATFORM LIBGL_ALWAYS_SOFTWARE=1 xvfb-run -a -s "-screen 0 1920x1200x24 -nolisten tcp" \
-    "$build/player/viscera-player" run "$case_file" --frames "$frames" --screenshot "$out/window.png" \
+    "$build/player/viscera-player" run "$case_file" --trust "${key%.pem}.pub.pem" --frames "$frames" --screenshot "$out/window.png" \
     --device "console:127.0.0.1:$port" --pairing-key "$out/pairing.key" --servo "$servo" --report "$out/report.json" --trace "$out/trace.csv" \
     2>/dev/null || player_rc=$?
 else
-  "$build/player/viscera-player" run "$case_file" --headless --frames "$frames" \
+  "$build/player/viscera-player" run "$case_file" --trust "${key%.pem}.pub.pem" --headless --frames "$frames" \
     --device "console:127.0.0.1:$port" --pairing-key "$out/pairing.key" --servo "$servo" --report "$out/report.json" --trace "$out/trace.csv" \
     2>/dev/null || player_rc=$?
 fi

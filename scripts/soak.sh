@@ -12,8 +12,9 @@ minutes="${1:-60}"
 build="${2:-${VISCERA_BUILD_DIR:-build}}"
 out="${3:-out/soak}"
 mkdir -p "$out"
+key="$build/keys/viscera-samples.pem" # the build's sample publisher key (a test key)
 for p in rectum anastomosis; do
-  "$build/studio/cli/viscera-studio" export "projects/$p" -o "$out/$p.vcase" >/dev/null 2>&1 ||
+  "$build/studio/cli/viscera-studio" export "projects/$p" -o "$out/$p.vcase" --sign-key "$key" >/dev/null 2>&1 ||
     { echo "soak: cannot export projects/$p" >&2; exit 1; }
 done
 # The last tenth (at least a minute, at most 10) on the console loopback.
@@ -23,17 +24,19 @@ status=0
 "$build/player/viscera-player" soak \
   "$out/rectum.vcase@replay:projects/rectum/replays/dissection.csv" \
   "$out/anastomosis.vcase@replay:projects/anastomosis/replays/two-stitches.csv" \
-  --minutes "$soak" --frames 330 --report "$out/soak.json" 2>/dev/null || status=$?
+  --minutes "$soak" --frames 330 --report "$out/soak.json" --trust "${key%.pem}.pub.pem" 2>/dev/null || status=$?
 echo "== console loopback, rectum, $loop min =="
-rm -f "$out/port"
-"$build/player/viscera-console-sim" --listen 127.0.0.1:0 --port-file "$out/port" \
+rm -f "$out/port" "$out/pairing.key"
+"$build/player/viscera-console-sim" --make-pairing-key "$out/pairing.key" >/dev/null
+"$build/player/viscera-console-sim" --listen 127.0.0.1:0 --port-file "$out/port" --pairing-key "$out/pairing.key" \
   --trajectory projects/rectum/replays/dissection.csv --loop --duration $(( loop * 60 + 1 )) \
   --record "$out/console-forces.csv" --summary "$out/console-summary.json" > "$out/console-sim.log" 2>&1 &
 sim=$!
 for _ in $(seq 100); do [ -s "$out/port" ] && break; sleep 0.05; done
 # Frames for the loopback's wall time at the rectum's physics rate (it runs below real time).
 "$build/player/viscera-player" run "$out/rectum.vcase" --headless --frames $(( loop * 60 * 20 )) \
-  --device "console:127.0.0.1:$(cat "$out/port")" --report "$out/loopback.json" 2>/dev/null |
+  --device "console:127.0.0.1:$(cat "$out/port")" --pairing-key "$out/pairing.key" --trust "${key%.pem}.pub.pem" \
+  --report "$out/loopback.json" 2>/dev/null |
   grep -E '^(frames|status|real time|device force|haptics)' || status=1
 kill "$sim" 2>/dev/null || true
 wait "$sim" 2>/dev/null || true

@@ -2,6 +2,7 @@
 
 #include "case/detail/zip_archive.hpp"
 #include "case/sha256.hpp"
+#include "case/signing.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/entry_name.hpp"
@@ -20,7 +21,21 @@ namespace viscera::vcase {
 
 using sim::displayName;
 using sim::entryNameProblem;
+namespace detail {
+/// The package in memory after checks (a) to (h).
+struct VerifiedPackage {
+    Manifest manifest;
+    std::string manifestText;
+    std::optional<PackageSignature> signature;
+    std::string sha256; ///< of the whole package
+    uint64_t bytes = 0;
+    std::map<std::string, std::string, std::less<>> files;
+};
+} // namespace detail
+
 namespace {
+
+using Verified = detail::VerifiedPackage;
 
 // Unix st_mode file types as stored in zip external attributes (host independent).
 constexpr uint32_t kTypeMask = 0170000;
@@ -145,11 +160,18 @@ std::string readEntry(const Failure& fail, const detail::ZipReader& zip, const E
     }
 }
 
-/// The package in memory after checks (a) to (h).
-struct Verified {
-    Manifest manifest;
-    std::map<std::string, std::string, std::less<>> files;
-};
+/// (e') signature.json, when present: small, and well formed (whether it is valid and trusted is
+/// the player's check, vcase::checkProvenance).
+std::optional<PackageSignature> readSignature(const Failure& fail, const detail::ZipReader& zip,
+                                              const std::map<std::string_view, const Entry*>& files) {
+    auto it = files.find(kSignatureName);
+    if (it == files.end()) return std::nullopt;
+    const Entry& e = *it->second;
+    if (e.info.size > kMaxSignatureBytes)
+        fail.entry(kSignatureName, "size " + bytesText(e.info.size) + " exceeds the signature limit of " +
+                                       bytesText(kMaxSignatureBytes));
+    return PackageSignature::parse(readEntry(fail, zip, e), fail.origin(kSignatureName));
+}
 
 Verified verifyBytes(std::string_view bytes, const std::string& name, const Limits& limits) {
     if (!(limits.maxCompressionRatio > 0))
@@ -203,7 +225,11 @@ Verified verifyBytes(std::string_view bytes, const std::string& name, const Limi
         fail.entry(kManifestName, "size " + bytesText(me.info.size) + " exceeds the manifest limit of " +
                                       bytesText(limits.maxManifestBytes));
     Verified out;
-    out.manifest = Manifest::parse(readEntry(fail, *zip, me), fail.origin(kManifestName));
+    out.manifestText = readEntry(fail, *zip, me);
+    out.manifest = Manifest::parse(out.manifestText, fail.origin(kManifestName));
+    out.signature = readSignature(fail, *zip, files);
+    out.sha256 = sha256Hex(bytes);
+    out.bytes = bytes.size();
 
     // (f) listed files: present, size, sha256; then nothing unlisted.
     for (const FileEntry& listed : out.manifest.files) {
@@ -220,7 +246,8 @@ Verified verifyBytes(std::string_view bytes, const std::string& name, const Limi
         out.files.emplace(listed.path, std::move(data));
     }
     for (const Entry& e : entries)
-        if (!e.directory && e.info.name != kManifestName && !out.files.count(e.info.name))
+        if (!e.directory && e.info.name != kManifestName && e.info.name != kSignatureName &&
+            !out.files.count(e.info.name))
             fail.entry(e.info.name, "file is not listed in manifest.json");
 
     // (g) compatibility with this player.
@@ -259,23 +286,28 @@ Verified verifyFile(const std::filesystem::path& path, const Limits& limits) {
 
 } // namespace
 
-std::unique_ptr<CasePackage> CasePackage::open(const std::filesystem::path& path, const Limits& limits) {
-    Verified v = verifyFile(path, limits);
+std::unique_ptr<CasePackage> CasePackage::make(std::string name, detail::VerifiedPackage&& v) {
     std::unique_ptr<CasePackage> package(new CasePackage());
-    package->m_name = path.string();
+    package->m_name = std::move(name);
     package->m_manifest = std::move(v.manifest);
+    package->m_manifestText = std::move(v.manifestText);
+    package->m_signature = std::move(v.signature);
+    package->m_sha256 = std::move(v.sha256);
+    package->m_bytes = v.bytes;
     package->m_files = std::move(v.files);
     return package;
 }
 
+std::unique_ptr<CasePackage> CasePackage::open(const std::filesystem::path& path, const Limits& limits) {
+    return make(path.string(), verifyFile(path, limits));
+}
+
 std::unique_ptr<CasePackage> CasePackage::fromBytes(std::string_view bytes, std::string name, const Limits& limits) {
     Verified v = verifyBytes(bytes, name, limits);
-    std::unique_ptr<CasePackage> package(new CasePackage());
-    package->m_name = std::move(name);
-    package->m_manifest = std::move(v.manifest);
-    package->m_files = std::move(v.files);
-    return package;
+    return make(std::move(name), std::move(v));
 }
+
+CasePackage::~CasePackage() = default;
 
 bool CasePackage::contains(std::string_view path) const {
     return m_files.find(path) != m_files.end();

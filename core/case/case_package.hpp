@@ -12,22 +12,30 @@
 ///   (d) entries are stored or deflated, not encrypted; the declared uncompressed sizes respect
 ///       maxEntryBytes, maxTotalBytes and maxCompressionRatio;
 ///   (e) manifest.json is present, at most maxManifestBytes, valid JSON, and schema-valid
-///       (Manifest::parse);
-///   (f) every listed file is present with the listed size and sha256; no file is unlisted;
+///       (Manifest::parse); signature.json, when present, is at most kMaxSignatureBytes and
+///       well formed (PackageSignature::parse);
+///   (f) every listed file is present with the listed size and sha256; no file but manifest.json
+///       and signature.json is unlisted;
 ///   (g) the schemaVersion and minPlayerVersion suit this player (checkPlayerCompatibility);
 ///   (h) every listed file ending in ".vtet" parses with sim::parseVtet (origin
 ///       "<package>:<entry>").
 /// Example: "case.vcase: meshes/a.vtet: sha256 mismatch (manifest says 3a.., file has 9f..)".
 #include "case/limits.hpp"
 #include "case/manifest.hpp"
+#include "case/signing.hpp"
 
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
 namespace viscera::vcase {
+
+namespace detail {
+struct VerifiedPackage;
+}
 
 /// A verified package, held in memory. Non-copyable; open() returns a unique_ptr.
 /// Memory: the uncompressed bytes of every listed file (at most Limits::maxTotalBytes); the
@@ -41,6 +49,7 @@ public:
     /// stands for the file in messages. `bytes` is not retained.
     static std::unique_ptr<CasePackage> fromBytes(std::string_view bytes, std::string name, const Limits& limits = {});
 
+    ~CasePackage();
     CasePackage(const CasePackage&) = delete;
     CasePackage& operator=(const CasePackage&) = delete;
 
@@ -54,11 +63,25 @@ public:
     /// path that is not listed (manifest.json itself included: use manifest()).
     std::string_view read(std::string_view path) const;
 
+    /// The exact bytes of manifest.json (what a signature covers).
+    const std::string& manifestText() const { return m_manifestText; }
+    /// signature.json, well formed, when the package has one (not yet checked against any key:
+    /// vcase::checkProvenance does that).
+    const std::optional<PackageSignature>& signature() const { return m_signature; }
+    /// SHA-256 (64 lowercase hex) and size of the whole package file: which bytes were run.
+    const std::string& sha256() const { return m_sha256; }
+    uint64_t bytes() const { return m_bytes; }
+
 private:
     CasePackage() = default;
+    static std::unique_ptr<CasePackage> make(std::string name, detail::VerifiedPackage&& v);
 
     std::string m_name;
     Manifest m_manifest;
+    std::string m_manifestText;
+    std::optional<PackageSignature> m_signature;
+    std::string m_sha256;
+    uint64_t m_bytes = 0;
     std::map<std::string, std::string, std::less<>> m_files;
 };
 

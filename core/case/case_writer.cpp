@@ -35,12 +35,18 @@ void CaseWriter::addFile(std::string_view path, std::string bytes) {
     const std::string origin = "vcase::CaseWriter::addFile(): " + displayName(path) + ": ";
     if (auto problem = entryNameProblem(path)) throw InputError(origin + *problem);
     if (path == kManifestName) throw InputError(origin + "reserved name (the writer generates manifest.json)");
+    if (path == kSignatureName) throw InputError(origin + "reserved name (sign() makes signature.json)");
     auto [it, fresh] = m_foldedPaths.emplace(lower(path), std::string(path));
     if (!fresh)
         throw InputError(origin + (it->second == path
                                        ? "already added"
                                        : "collides with '" + it->second + "' (names differ only in letter case)"));
     m_files.emplace(std::string(path), std::move(bytes));
+}
+
+void CaseWriter::sign(const SigningKey& key, std::string signer) {
+    m_key = &key;
+    m_signer = std::move(signer);
 }
 
 Manifest CaseWriter::manifest() const {
@@ -56,6 +62,8 @@ std::string CaseWriter::buildNamed(const std::string& name, const Limits& limits
     std::vector<detail::ZipInput> inputs;
     inputs.reserve(m_files.size() + 1);
     inputs.push_back({kManifestName, manifestText});
+    const std::string signatureText = m_key ? signManifest(*m_key, m_signer, manifestText) : std::string();
+    if (m_key) inputs.push_back({kSignatureName, signatureText});
     for (const auto& [path, data] : m_files)
         inputs.push_back({path, data});
     std::string bytes;

@@ -6,14 +6,17 @@
 ///   header.minPlayerVersion = "0.1.0"; header.features = {"xpbd", "gravity"};
 ///   vcase::CaseWriter writer(header);
 ///   writer.addFile("meshes/liver.vtet", vtetText);
+///   writer.sign(key, "Viscera samples");   // optional: signature.json over manifest.json
 ///   vcase::Manifest written = writer.write("liver.vcase");
 ///
-/// The package is deterministic: manifest.json first, then the files sorted by path, deflate
+/// The package is deterministic: manifest.json first, signature.json (when signed; Ed25519
+/// signatures are deterministic) second, then the files sorted by path, deflate
 /// level 9, fixed timestamps (1980-01-01 00:00) and modes (0644), so the same header and files
 /// give byte-identical packages. Before anything is written the package is verified with the
 /// same checks as CasePackage::open(), so a package the player would reject is never produced.
 #include "case/limits.hpp"
 #include "case/manifest.hpp"
+#include "case/signing.hpp"
 
 #include <filesystem>
 #include <map>
@@ -31,9 +34,14 @@ public:
 
     /// Adds a file at `path` inside the package. Throws viscera::InputError
     /// ("vcase::CaseWriter::addFile(): ../x: entry name escapes the package ('..' component)")
-    /// for a name breaking entryNameProblem(), for "manifest.json", and for a path already added
+    /// for a name breaking entryNameProblem(), for "manifest.json" or "signature.json", and for a path already added
     /// (or equal to one ignoring letter case). Keeps a copy of the bytes until the writer dies.
     void addFile(std::string_view path, std::string bytes);
+
+    /// Signs the package with `key` (non-owning: it must outlive build() and write()) under the
+    /// display name `signer` (printable, at most kMaxSignerBytes; checked when the package is
+    /// verified before it is written).
+    void sign(const SigningKey& key, std::string signer);
 
     size_t fileCount() const { return m_files.size(); }
     const Manifest& header() const { return m_header; }
@@ -54,6 +62,8 @@ private:
     std::string buildNamed(const std::string& name, const Limits& limits, Manifest* written) const;
 
     Manifest m_header;
+    const SigningKey* m_key = nullptr;
+    std::string m_signer;
     std::map<std::string, std::string> m_files;       ///< sorted by path: the package order
     std::map<std::string, std::string> m_foldedPaths; ///< lower-case path -> path as added
 };

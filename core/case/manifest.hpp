@@ -7,6 +7,7 @@
 ///     "caseVersion": "1.2.0",                   semantic version
 ///     "minPlayerVersion": "0.1.0",              semantic version: oldest player that runs it
 ///     "title": "Liver resection",               optional string
+///     "expires": "2027-12-31T23:59:59Z",        optional UTC time: the player refuses the case after it
 ///     "features": ["xpbd", "gravity"],          unique [a-z0-9][a-z0-9_-]* subsystem names
 ///     "units": {"length": "m", "mass": "kg", "time": "s"},
 ///     "device": {},                             device requirements (any JSON object)
@@ -58,6 +59,8 @@ struct Manifest {
     std::string caseVersion;      ///< semantic version of the case content
     std::string minPlayerVersion; ///< semantic version
     std::optional<std::string> title;
+    /// UTC time "YYYY-MM-DDTHH:MM:SSZ" after which the player refuses the case; none: no expiry.
+    std::optional<std::string> expires;
     std::vector<std::string> features; ///< subsystems the case needs ("xpbd", "fem", "needle")
     std::map<std::string, std::string> units = {{"length", "m"}, {"mass", "kg"}, {"time", "s"}};
     nlohmann::json device = nlohmann::json::object(); ///< requirements; an object, may be empty
@@ -87,5 +90,10 @@ void checkPlayerCompatibility(const Manifest& manifest, std::string_view origin)
 /// every file that carries them (manifest.json, the studio's project.json). Throw InputError.
 std::string readCaseId(const sim::JsonField& field);
 std::string readSemVer(const sim::JsonField& field);
+
+/// Seconds since 1970-01-01T00:00:00Z of a UTC time written "YYYY-MM-DDTHH:MM:SSZ" (a real date
+/// and time of day, year 1970..9999), or nullopt for any other text. formatUtcTime is its inverse.
+std::optional<int64_t> parseUtcTime(std::string_view text);
+std::string formatUtcTime(int64_t secondsSinceEpoch);
 
 } // namespace viscera::vcase

@@ -15,8 +15,6 @@
 #include <cctype>
 #include <stdexcept>
 
-#include <sys/stat.h>
-
 namespace viscera::haptics {
 
 struct LinkMac::Impl {
@@ -88,11 +86,7 @@ Nonce NonceSource::next() {
 
 LinkKey loadPairingKey(const std::string& path) {
     const std::string text = readFile(path, 4096, "a pairing key file");
-    struct stat st {};
-    if (::stat(path.c_str(), &st) == 0 && (st.st_mode & (S_IROTH | S_IWOTH)))
-        throw InputError(path + ": the pairing key is open to other users (mode " +
-                         std::to_string((st.st_mode >> 6) & 7) + std::to_string((st.st_mode >> 3) & 7) +
-                         std::to_string(st.st_mode & 7) + "; chmod 600 it)");
+    requirePrivateFile(path, "the pairing key");
     std::string hex = text;
     while (!hex.empty() && (hex.back() == '\n' || hex.back() == '\r'))
         hex.pop_back();

@@ -253,11 +253,41 @@ static nlohmann::json timelineJson(const SessionTimeline& tl) {
     return {{"stride_frames", tl.stride}, {"t_s", t}, {"tools", tools}, {"events", events}};
 }
 
+namespace {
+
+/// Which bytes ran and who signed them.
+nlohmann::json packageJson(const vcase::Provenance& p) {
+    auto orNull = [](const std::string& s) { return s.empty() ? nlohmann::json() : nlohmann::json(s); };
+    return {{"file", p.file},
+            {"sha256", p.sha256},
+            {"bytes", p.bytes},
+            {"signature", p.signature},
+            {"signer", orNull(p.signer)},
+            {"key_id", orNull(p.keyId)},
+            {"expires", orNull(p.expires)},
+            {"allow_unsigned", p.allowUnsigned}};
+}
+
+} // namespace
+
+std::string packageSummary(const vcase::Provenance& p) {
+    std::string who;
+    if (p.signature == "trusted")
+        who = "signed by " + p.signer + " (" + p.keyId + ")";
+    else if (p.signature == "untrusted")
+        who = "NOT VERIFIED: signed by " + p.keyId + " ('" + p.signer +
+              "'), a key not trusted here (run with --allow-unsigned)";
+    else
+        who = "UNSIGNED (run with --allow-unsigned)";
+    return who + "; sha256 " + p.sha256 + ", " + std::to_string(p.bytes) + " bytes";
+}
+
 nlohmann::json reportJson(const SessionResult& r) {
     using nlohmann::json;
     json doc;
     doc["schemaVersion"] = kReportSchemaVersion;
     doc["case"] = {{"id", r.caseId}, {"version", r.caseVersion}, {"title", r.title}};
+    doc["package"] = packageJson(r.package);
     doc["active_subsystems"] = r.activeSubsystems;
     json frames = json::array();
     for (const auto& f : r.frames)
@@ -422,6 +452,7 @@ std::string summaryText(const SessionResult& r) {
                   r.ok() ? "ok"
                          : ("FAILED: " + (r.errors.empty() ? std::string("invariants") : r.errors.front())).c_str());
     std::string out = buf;
+    if (!r.package.sha256.empty()) out.insert(out.find('\n') + 1, "package       " + packageSummary(r.package) + "\n");
     if (const RealTimeFigures rt = realTimeFigures(r); rt.factorMean > 0) {
         char line[320];
         std::snprintf(line, sizeof line,

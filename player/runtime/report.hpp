@@ -13,7 +13,7 @@ namespace viscera::player {
 /// the run (final_node_displacement_m is the end). 3: the console link is authenticated
 /// (haptics.link: rejected_checksum gave way to rejected_auth, with rejected_jump, rejected_peer,
 /// stale_welcomes and handshakes).
-constexpr int kReportSchemaVersion = 3;
+constexpr int kReportSchemaVersion = 4;
 nlohmann::json reportJson(const SessionResult& result);
 /// The force and pose trace (--trace): one row per servo tick and driven arm.
 /// Columns: t_s, arm, device_x/y/z (m, device frame), tool_x/y/z (m, scene), force_x/y/z (N,
@@ -23,6 +23,8 @@ nlohmann::json reportJson(const SessionResult& result);
 std::string traceCsv(const SessionResult& result);
 /// A short human-readable summary (at most ~15 lines).
 std::string summaryText(const SessionResult& result);
+/// One line: who signed the package (or that no trusted publisher did) and its SHA-256 and size.
+std::string packageSummary(const vcase::Provenance& package);
 
 struct StepTimeStats {
     double mean = 0, p50 = 0, p99 = 0, max = 0; ///< ms

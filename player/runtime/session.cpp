@@ -82,10 +82,11 @@ double nodeDisplacement(const sim::World& world) {
 
 } // namespace
 
-LoadedCase loadCase(const std::filesystem::path& casePath) {
+LoadedCase loadCase(const std::filesystem::path& casePath, const vcase::TrustPolicy& trust) {
     LoadedCase out;
     out.package = vcase::CasePackage::open(casePath);
     const vcase::CasePackage& pkg = *out.package;
+    out.provenance = vcase::checkProvenance(pkg, trust); // before anything the publisher wrote is read
     const std::string sceneName = "scene.json";
     if (!pkg.contains(sceneName))
         throw InputError(pkg.name() + ": " + sceneName + ": required file is missing from the package");
@@ -294,6 +295,7 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     const vcase::Manifest& m = loaded.package->manifest();
     r.caseId = m.caseId;
     r.caseVersion = m.caseVersion;
+    r.package = loaded.provenance;
     r.title = m.title.value_or("");
     sim::World& world = *loaded.world;
     r.activeSubsystems = world.activeSubsystems();

@@ -1,6 +1,7 @@
 #pragma once
 /// Loading a verified case into a World and running a session on it.
 #include "case/case_package.hpp"
+#include "case/trust.hpp"
 #include "haptics/device.hpp"
 #include "render/scene_view.hpp"
 #include "render/tool_meshes.hpp"
@@ -22,6 +23,7 @@ namespace viscera::player {
 
 struct LoadedCase {
     std::unique_ptr<vcase::CasePackage> package;
+    vcase::Provenance provenance; ///< which bytes, signed by whom (vcase::checkProvenance)
     sim::SceneDesc scene;
     std::unique_ptr<sim::World> world;
     /// Per body: its painted light-sample classes per node (sample_map_file), empty when it has
@@ -31,10 +33,11 @@ struct LoadedCase {
     std::vector<std::pair<std::string, std::shared_ptr<const render::MaterialMaps>>> materialMaps;
 };
 
-/// Verifies the package, parses its scene and assembles a World with only the subsystems the
-/// manifest declares. Throws viscera::InputError naming the file, the field and the rule (also for
-/// a body's sample map when the case does not render with painted sampling: it would not be used).
-LoadedCase loadCase(const std::filesystem::path& casePath);
+/// Verifies the package, checks it against `trust` (signature, expiry, rollback) before reading
+/// its scene, parses the scene and assembles a World with only the subsystems the manifest
+/// declares. Throws viscera::InputError naming the file, the field and the rule (also for a body's
+/// sample map when the case does not render with painted sampling: it would not be used).
+LoadedCase loadCase(const std::filesystem::path& casePath, const vcase::TrustPolicy& trust);
 
 /// What the trainee sees of a loaded case: the world's bodies and surfaces
 /// (render::SceneView::fromWorld) with the case's painted sample maps on the bodies and on the
@@ -93,6 +96,7 @@ struct RenderFigures {
 
 struct SessionResult {
     std::string caseId, caseVersion, title;
+    vcase::Provenance package; ///< the package file's digest and signer
     std::vector<std::string> activeSubsystems;
     std::vector<sim::FrameRecord> frames;
     std::vector<sim::AccuracyRecord> accuracy;

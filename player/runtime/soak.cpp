@@ -39,7 +39,7 @@ SoakResult runSoak(const std::vector<SoakCase>& cases, const SoakOptions& option
                    const std::function<void(const SoakLine&)>& line) {
     if (cases.empty()) throw InputError("soak: no case given");
     for (const SoakCase& c : cases) { // refused before any time is spent
-        (void)loadCase(c.path);
+        (void)loadCase(c.path, options.trust);
         if (!c.device.empty()) (void)haptics::parseDeviceSpec(c.device);
     }
     using Clock = std::chrono::steady_clock;
@@ -63,7 +63,7 @@ SoakResult runSoak(const std::vector<SoakCase>& cases, const SoakOptions& option
         const SoakCase& c = cases[k];
         LoadedCase loaded;
         try {
-            loaded = loadCase(c.path);
+            loaded = loadCase(c.path, options.trust);
         } catch (const std::exception& e) {
             r.errors.push_back(std::string("pass ") + std::to_string(r.passes + 1) + ": " + e.what());
             break;

@@ -2,6 +2,8 @@
 /// The soak [issue 19 item 4]: cases run back to back in one process for a given wall time, each
 /// pass loaded afresh from its package (so loading and tearing down are soaked too), with a line
 /// per interval: frames, all finite, energy against the case's first pass, resident memory.
+#include "case/trust.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
@@ -21,6 +23,7 @@ struct SoakOptions {
     double seconds = 3600;        ///< wall time to run
     double lineSeconds = 60;      ///< one line per interval
     double energyTolerance = 0.1; ///< a pass's largest energy may exceed its case's first by this share
+    vcase::TrustPolicy trust;     ///< which packages may run (loadCase)
 };
 
 struct SoakLine {

@@ -78,6 +78,8 @@ void ExportRunner::readOutput() {
         static const QRegularExpression stage(QStringLiteral("^viscera-studio: (?:stage (\\d+)/(\\d+): )?(.*)$"));
         const auto m = stage.match(line);
         if (!m.hasMatch()) continue;
+        if (m.captured(1).isEmpty() && m.captured(3).startsWith(QStringLiteral("warning:")))
+            continue; // e.g. an unsigned case: kept in the output the window shows, not a stage
         if (!m.captured(1).isEmpty()) {
             m_done = m.captured(1).toInt() - 1;
             m_total = m.captured(2).toInt();

@@ -35,6 +35,7 @@
 #include "bake/texture.hpp"
 #include "haptics/trajectory.hpp"
 #include "project/project.hpp"
+#include "project/publishing.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/suture/anastomosis.hpp"
 #include "sim/util/atomic_file.hpp"
@@ -59,6 +60,8 @@ using namespace viscera;
 void usage(std::FILE* out) {
     std::fputs("usage: viscera-studio [open <project-dir>]           the desktop studio\n"
                "       viscera-studio export <project-dir> -o <case.vcase> [--project-file <json>]\n"
+               "                             [--sign-key KEY.pem [--signer NAME] | --unsigned] [--expires DATE]\n"
+               "       viscera-studio keygen [-o KEY.pem]\n"
                "       viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M]\n"
                "                             [--facet-size M] [-o out.vtet]\n"
                "       viscera-studio remesh [<mesh>...] [--sample kidney] [--subtract M] [--intersect M] [options] -o "
@@ -71,11 +74,26 @@ void usage(std::FILE* out) {
 
 constexpr const char* kExportHelp =
     "usage: viscera-studio export <project-dir> -o <case.vcase> [--project-file <json>]\n"
+    "                             [--sign-key KEY.pem [--signer NAME] | --unsigned] [--expires DATE]\n"
     "\n"
     "Builds a case package from a project: meshes the bodies, cuts the fascia, bakes paint and\n"
-    "textures, writes scene.json and the manifest with only the features the scene needs. The\n"
-    "output is written atomically; its folder is checked before the work starts.\n"
-    "  --project-file <json>  read the project from this file instead of <project-dir>/project.json\n";
+    "textures, writes scene.json and the manifest with only the features the scene needs, and\n"
+    "signs the manifest with the publisher key (Ed25519). The output is written atomically; its\n"
+    "folder and the key are checked before the work starts.\n"
+    "  --project-file <json>  read the project from this file instead of <project-dir>/project.json\n"
+    "  --sign-key KEY.pem     the publisher key (default ~/.config/viscera/publisher-key.pem where it\n"
+    "                         exists; never inside the project folder; mode 600)\n"
+    "  --signer NAME          the name in the signature (default: the key file's name)\n"
+    "  --unsigned             no signature (players run it only with --allow-unsigned)\n"
+    "  --expires DATE         players refuse the case after DATE (YYYY-MM-DD, end of day UTC, or\n"
+    "                         YYYY-MM-DDTHH:MM:SSZ)\n";
+constexpr const char* kKeygenHelp =
+    "usage: viscera-studio keygen [-o KEY.pem]\n"
+    "\n"
+    "Makes a publisher key pair for signing cases (Ed25519): the private key at KEY.pem (mode 600;\n"
+    "default ~/.config/viscera/publisher-key.pem, the key export uses when none is given) and the\n"
+    "public key at KEY.pub.pem, which players trust (--trust KEY.pub.pem, or a copy in\n"
+    "/etc/viscera/trusted-publishers named after the publisher). Never replaces an existing key.\n";
 constexpr const char* kImportHelp =
     "usage: viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M]\n"
     "                             [--facet-size M] [-o out.vtet]\n"
@@ -161,23 +179,65 @@ OperandArgs parseOperandArgs(const std::vector<std::string>& args, std::initiali
     return r;
 }
 
-int cmdExport(const std::vector<std::string>& args) {
-    const OperandArgs parsed = parseOperandArgs(args, {"--project-file"});
+int64_t secondsNow() {
+    return std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch())
+        .count();
+}
+
+/// The publisher key export signs with: --sign-key, else the default one where it exists; none
+/// with --unsigned. Loaded before the work, so that a bad key costs no meshing.
+std::optional<vcase::SigningKey> exportKey(const std::optional<std::string>& given, bool unsignedCase,
+                                           const std::string& projectDir) {
+    if (unsignedCase) {
+        if (given) throw std::invalid_argument("--unsigned and --sign-key exclude each other");
+        return std::nullopt;
+    }
+    const std::filesystem::path file = given ? std::filesystem::path(*given) : studio::defaultPublisherKeyPath();
+    std::error_code ec;
+    if (!given && !std::filesystem::exists(file, ec)) {
+        std::fprintf(stderr,
+                     "viscera-studio: warning: the case is not signed: no publisher key at %s (make one with "
+                     "'viscera-studio keygen'); players refuse it without --allow-unsigned\n",
+                     file.c_str());
+        return std::nullopt;
+    }
+    return studio::loadPublisherKey(file, projectDir);
+}
+
+int cmdExport(const std::vector<std::string>& argsIn) {
+    std::vector<std::string> args;
+    bool unsignedCase = false;
+    for (const std::string& a : argsIn)
+        (a == "--unsigned" ? unsignedCase = true : (args.push_back(a), false));
+    const OperandArgs parsed = parseOperandArgs(args, {"--project-file", "--sign-key", "--signer", "--expires"});
     const std::optional<std::string>& dir = parsed.operand;
     const std::optional<std::string>& out = parsed.out;
     const std::optional<std::string>& projectFile = parsed.extra[0];
     if (!dir || !out) throw std::invalid_argument("export needs <project-dir> and -o <case.vcase>");
     const auto t0 = std::chrono::steady_clock::now();
+    studio::CasePublishing publish;
+    if (parsed.extra[3]) publish.expires = studio::parseExpiry(*parsed.extra[3], secondsNow());
+    const std::optional<vcase::SigningKey> key = exportKey(parsed.extra[1], unsignedCase, *dir);
+    if (key) {
+        publish.key = &*key;
+        publish.signer = parsed.extra[2].value_or(
+            parsed.extra[1] ? std::filesystem::path(*parsed.extra[1]).stem().string() : std::string("publisher"));
+    }
     studio::Project project =
         projectFile ? studio::loadProjectText(readFile(*projectFile), *dir, *projectFile) : studio::loadProject(*dir);
     if (projectFile) requireNotAnInput(*out, "the case", {*projectFile}); // the project's own files: exportCase
-    studio::ExportResult r =
-        studio::exportCase(project, *out, [](size_t index, size_t total, const std::string& stage) {
+    studio::ExportResult r = studio::exportCase(
+        project, *out,
+        [](size_t index, size_t total, const std::string& stage) {
             std::fprintf(stderr, "viscera-studio: stage %zu/%zu: %s\n", index, total, stage.c_str());
-        });
+        },
+        publish);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("exported %s -> %s (%llu bytes, %.2f s)\n", project.caseId.c_str(), r.casePath.c_str(),
                 static_cast<unsigned long long>(r.bytes), secs);
+    std::printf("  package: %s; sha256 %s%s%s\n",
+                key ? ("signed by '" + publish.signer + "' (" + r.keyId + ")").c_str() : "UNSIGNED", r.sha256.c_str(),
+                publish.expires ? "; expires " : "", publish.expires.value_or("").c_str());
     std::printf("  features:");
     for (const auto& f : r.features)
         std::printf(" %s", f.c_str());
@@ -186,6 +246,17 @@ int cmdExport(const std::vector<std::string>& args) {
         std::printf("  body %s: %zu nodes, %zu tets, %zu fixed\n", b.name.c_str(), b.nodes, b.tets, b.fixedNodes);
         printQuality(b.quality);
     }
+    return 0;
+}
+
+int cmdKeygen(const std::vector<std::string>& args) {
+    const OperandArgs parsed = parseOperandArgs(args);
+    if (parsed.operand) throw std::invalid_argument("unexpected argument '" + *parsed.operand + "'");
+    const studio::NewPublisherKey k =
+        studio::makePublisherKey(parsed.out ? std::filesystem::path(*parsed.out) : studio::defaultPublisherKeyPath());
+    std::printf("publisher key %s\n  private %s (mode 600: keep it outside every project folder)\n  public  %s "
+                "(players trust it: --trust, or a copy in /etc/viscera/trusted-publishers)\n",
+                k.keyId.c_str(), k.privateFile.c_str(), k.publicFile.c_str());
     return 0;
 }
 
@@ -478,7 +549,8 @@ int main(int argc, char** argv) {
     program.usage = usage;
     program.subcommands = {{"export", cmdExport, kExportHelp},    {"import", cmdImport, kImportHelp},
                            {"open", cmdOpen, kOpenHelp},          {"remesh", cmdRemesh, kRemeshHelp},
-                           {"texture", cmdTexture, kTextureHelp}, {"replay", cmdReplay, kReplayHelp}};
+                           {"texture", cmdTexture, kTextureHelp}, {"replay", cmdReplay, kReplayHelp},
+                           {"keygen", cmdKeygen, kKeygenHelp}};
     program.noArguments = [] { return studio::runStudio(g_argc, g_argv, {}); };
     return sim::runCli(program, argc, argv);
 }

@@ -7,6 +7,7 @@
 #include "bake/import.hpp"
 #include "case/case_writer.hpp"
 #include "case/manifest.hpp"
+#include "case/sha256.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/scene_json.hpp"
@@ -1006,7 +1007,8 @@ std::unique_ptr<sim::World> assembleWorld(const BuiltScene& built, const std::st
     return sim::World::assemble(built.scene, std::move(meshes), built.surfaces, built.features, origin);
 }
 
-ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress) {
+ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress,
+                        const CasePublishing& publish) {
     // Before the work: the case can be written, and over none of the files it is made from.
     requireWritableFile(out, "the case");
     requireNotAnInput(out, "the case", projectInputFiles(project));
@@ -1033,8 +1035,10 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     header.caseVersion = project.caseVersion;
     header.minPlayerVersion = VISCERA_VERSION;
     if (!project.title.empty()) header.title = project.title;
+    header.expires = publish.expires;
     header.features = features;
     vcase::CaseWriter writer(header);
+    if (publish.key) writer.sign(*publish.key, publish.signer);
     sim::SceneDesc written = scene;
     written.render = renderWithMaterials(scene.render, textures.materials);
     writer.addFile("scene.json", sim::formatScene(written));
@@ -1065,6 +1069,8 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     result.casePath = out;
     result.features = manifest.features;
     result.bytes = std::filesystem::file_size(out);
+    result.sha256 = vcase::sha256Hex(readFile(out, result.bytes + 1));
+    if (publish.key) result.keyId = vcase::keyId(publish.key->publicKey());
     return result;
 }
 

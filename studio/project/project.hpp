@@ -53,6 +53,7 @@
 #include "bake/skeleton.hpp"
 #include "bake/tetrahedralize.hpp"
 #include "bake/texture.hpp"
+#include "case/signing.hpp"
 #include "render/case_settings.hpp"
 #include "render/sample_map.hpp"
 #include "sim/material/material.hpp"
@@ -239,9 +240,18 @@ struct BodyExport {
     sim::QualityReport quality;
 };
 
+/// How an exported case is published (packaging/vcase-spec.md, "Signatures").
+struct CasePublishing {
+    const vcase::SigningKey* key = nullptr; ///< non-owning; null: unsigned
+    std::string signer;                     ///< display name in signature.json
+    std::optional<std::string> expires;     ///< manifest "expires", UTC YYYY-MM-DDTHH:MM:SSZ
+};
+
 struct ExportResult {
     std::filesystem::path casePath;
     uint64_t bytes = 0;
+    std::string sha256; ///< of the package written
+    std::string keyId;  ///< the signing key (vcase::keyId); empty when unsigned
     std::vector<std::string> features;
     std::vector<BodyExport> bodies;
 };
@@ -314,7 +324,11 @@ std::unique_ptr<sim::World> assembleWorld(const BuiltScene& built, const std::st
 /// regions to node lists, and writes the case package atomically. Only what the scene uses is
 /// packaged, and the manifest's features list only the subsystems the scene needs. Before any of
 /// it, `out` must be writable and none of projectInputFiles (InputError naming `out`).
-ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress = {});
+///
+/// `publish`: the publisher's signature (none: an unsigned case, which players refuse without
+/// --allow-unsigned) and the case's expiry, both bound into manifest.json.
+ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress = {},
+                        const CasePublishing& publish = {});
 
 /// Builds one body's tet mesh from its source (exposed for the import command and tests).
 std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::string& origin);

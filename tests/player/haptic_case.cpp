@@ -7,6 +7,8 @@
 #include "sim/mesh/tet_io.hpp"
 #include "sim/scene/world.hpp"
 
+#include <optional>
+
 namespace viscera::test {
 namespace {
 sim::BoxSpec box() {
@@ -43,7 +45,7 @@ sim::SceneDesc hapticScene(int tools) {
     return scene;
 }
 
-void writeHapticCase(const std::filesystem::path& out, int tools) {
+void writeHapticCase(const std::filesystem::path& out, int tools, const std::filesystem::path& signingKey) {
     const sim::SceneDesc scene = hapticScene(tools);
     auto mesh = sim::makeBoxTetMesh(box());
     vcase::Manifest header;
@@ -55,6 +57,11 @@ void writeHapticCase(const std::filesystem::path& out, int tools) {
     vcase::CaseWriter w(header);
     w.addFile("scene.json", sim::formatScene(scene));
     w.addFile("meshes/tissue.vtet", sim::formatVtet(*mesh));
+    std::optional<vcase::SigningKey> key;
+    if (!signingKey.empty()) {
+        key = vcase::SigningKey::load(signingKey);
+        w.sign(*key, "Viscera tests");
+    }
     w.write(out);
 }
 

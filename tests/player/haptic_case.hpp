@@ -11,7 +11,8 @@ namespace viscera::test {
 
 /// The scene of the sample (meshes/tissue.vtet is made by writeHapticCase).
 sim::SceneDesc hapticScene(int tools = 1);
-/// Writes the .vcase; tools = 1 (right hand) or 2 (left and right probes).
-void writeHapticCase(const std::filesystem::path& out, int tools = 1);
+/// Writes the .vcase; tools = 1 (right hand) or 2 (left and right probes); signed with the PEM
+/// private key `signingKey` when one is given.
+void writeHapticCase(const std::filesystem::path& out, int tools = 1, const std::filesystem::path& signingKey = {});
 
 } // namespace viscera::test

@@ -5,6 +5,7 @@
 // machine.
 #include "render/headless.hpp"
 #include "render/image.hpp"
+#include "support/case_signing.hpp"
 #include "support/run_process.hpp"
 #include "support/scratch_dir.hpp"
 
@@ -27,8 +28,9 @@ using test::Scratch;
 /// Exports the tissue-slab sample project into the scratch folder; returns the case path.
 std::string exportTissueSlab(const Scratch& s) {
     const std::string vcase = s / "tissue-slab.vcase";
-    auto e = test::runProcess(VISCERA_STUDIO_EXE,
-                              {"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab", "-o", vcase});
+    auto e = test::runProcess(
+        VISCERA_STUDIO_EXE,
+        test::signingWithSampleKey({"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab", "-o", vcase}));
     EXPECT_EQ(e.exitCode, 0) << e.err;
     return vcase;
 }
@@ -43,8 +45,9 @@ TEST(PlayerScreenshot, HeadlessRunWritesARenderedFrameAndPassTimes) {
     const std::string vcase = exportTissueSlab(s);
     ASSERT_FALSE(::testing::Test::HasFailure());
     const auto png = s.dir / "frame.png", report = s.dir / "report.json";
-    auto r = test::runProcess(VISCERA_PLAYER_EXE, {"run", vcase, "--headless", "--frames", "20", "--screenshot",
-                                                   png.string(), "--report", report.string()});
+    auto r = test::runProcess(VISCERA_PLAYER_EXE,
+                              test::trustingSampleKey({"run", vcase, "--headless", "--frames", "20", "--screenshot",
+                                                       png.string(), "--report", report.string()}));
     ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
     EXPECT_THAT(r.out, HasSubstr("render        640x480 frame"));
 
@@ -84,7 +87,8 @@ TEST(PlayerScreenshot, TraineeWindowShowsTheRenderedView) {
     ASSERT_FALSE(::testing::Test::HasFailure());
     const auto png = s.dir / "window.png";
     ::setenv("QT_QPA_PLATFORM", "offscreen", 1);
-    auto r = test::runProcess(VISCERA_PLAYER_EXE, {"run", vcase, "--frames", "20", "--screenshot", png.string()});
+    auto r = test::runProcess(VISCERA_PLAYER_EXE,
+                              test::trustingSampleKey({"run", vcase, "--frames", "20", "--screenshot", png.string()}));
     ::unsetenv("QT_QPA_PLATFORM");
     if (r.exitCode == 2 && r.err.find("Qt6 Gui") != std::string::npos) GTEST_SKIP() << "player built without Qt6 Gui";
     ASSERT_EQ(r.exitCode, 0) << r.err << r.out;

@@ -23,6 +23,13 @@ using namespace viscera;
 
 namespace {
 
+/// The test cases are made here unsigned; the signature rules have tests of their own.
+vcase::TrustPolicy unsignedAllowed() {
+    vcase::TrustPolicy p;
+    p.allowUnsigned = true;
+    return p;
+}
+
 std::unique_ptr<sim::TetMesh> slab() {
     sim::BoxSpec spec;
     spec.size = sim::Vec3(0.08, 0.02, 0.04);
@@ -89,7 +96,7 @@ render::Image checker(int w, int h, uint8_t a, uint8_t b) {
 
 std::string loadError(const std::filesystem::path& p) {
     try {
-        player::loadCase(p);
+        player::loadCase(p, unsignedAllowed());
     } catch (const InputError& e) {
         return e.what();
     }
@@ -105,7 +112,7 @@ TEST(CaseView, PaintedSampleMapReachesTheRenderedBody) {
     render::paintSampleBrush(surface, {{0.08, 0.02, 0.0}}, 0.02, 4);
     const std::vector<uint8_t> nodes = render::nodeSampleClasses(surface, mesh->vertexCount());
     const auto path = writeCase("painted", "painted", render::formatSampleMap(nodes));
-    const player::LoadedCase loaded = player::loadCase(path);
+    const player::LoadedCase loaded = player::loadCase(path, unsignedAllowed());
     ASSERT_EQ(loaded.sampleMaps.size(), 1u);
     EXPECT_EQ(loaded.sampleMaps[0], nodes);
     const render::SceneView view = player::caseView(loaded);
@@ -131,7 +138,7 @@ TEST(CaseView, AMapTheCaseWouldNotUseOrAMalformedOneIsRefusedAtLoad) {
                                        std::to_string(zeros.size()));
     // painted sampling without a map: every vertex unpainted (the uniform count)
     auto none = writeCase("none", "painted", "");
-    const player::LoadedCase loaded = player::loadCase(none);
+    const player::LoadedCase loaded = player::loadCase(none, unsignedAllowed());
     EXPECT_TRUE(loaded.sampleMaps[0].empty());
     const render::SceneView view = player::caseView(loaded);
     for (float c : view.meshes()[0].sampleMap)
@@ -150,7 +157,7 @@ TEST(CaseView, MaterialMapsOfTheCaseAreDecodedAndPutOnTheNamedMesh) {
     const auto path = writeMappedCase("maps", render,
                                       {{"textures/slab_diffuse.png", render::encodePng(diffuse)},
                                        {"textures/slab_roughness.png", render::encodePng(rough)}});
-    const player::LoadedCase c = player::loadCase(path);
+    const player::LoadedCase c = player::loadCase(path, unsignedAllowed());
     ASSERT_EQ(c.materialMaps.size(), 1u);
     EXPECT_EQ(c.materialMaps[0].first, "slab");
     const render::MaterialMaps& maps = *c.materialMaps[0].second;

@@ -4,6 +4,7 @@
 // meshes/fascia.vweights, and a package whose scene names a weights file it lacks is refused.
 #include "case/case_package.hpp"
 #include "case/zip_craft.hpp"
+#include "support/case_signing.hpp"
 #include "support/run_process.hpp"
 
 #include <gmock/gmock.h>
@@ -20,7 +21,7 @@ using vcase::test::ScratchDir;
 namespace {
 
 test::ProcessResult run(const char* exe, const std::vector<std::string>& args) {
-    return test::runProcess(exe, args);
+    return test::runProcess(exe, test::signingWithSampleKey(test::trustingSampleKey(args)));
 }
 
 nlohmann::json readJson(const std::filesystem::path& p) {
@@ -120,7 +121,7 @@ TEST(PaintedCase, FasciaPolygonPaintTravelsAsVweightsAndStiffensTheLayer) {
     m.files = vcase::test::manifestFor(entries).files;
     const auto broken = dir.path() / "broken.vcase";
     std::ofstream(broken, std::ios::binary) << vcase::test::craftPackage(m, entries);
-    auto r = run(VISCERA_PLAYER_EXE, {"run", broken.string(), "--headless", "--frames", "2"});
+    auto r = run(VISCERA_PLAYER_EXE, {"run", broken.string(), "--headless", "--frames", "2", "--allow-unsigned"});
     EXPECT_NE(r.exitCode, 0);
     EXPECT_THAT(r.err, HasSubstr("surfaces[0].node_weights_file: 'meshes/fascia.vweights' is not in the package"));
 }

@@ -3,10 +3,12 @@
 // one-line message naming the file and the rule.
 #include "case/case_writer.hpp"
 #include "case/zip_craft.hpp"
+#include "player/slab_case.hpp"
 #include "sim/mesh/generators.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/util/atomic_file.hpp"
+#include "support/case_signing.hpp"
 #include "support/run_process.hpp"
 
 #include <gmock/gmock.h>
@@ -31,42 +33,24 @@ using vcase::test::ScratchDir;
 namespace {
 
 test::ProcessResult player(const std::vector<std::string>& args) {
-    return test::runProcess(VISCERA_PLAYER_EXE, args);
+    return test::runProcess(VISCERA_PLAYER_EXE, test::trustingSampleKey(args));
 }
 test::ProcessResult studio(const std::vector<std::string>& args) {
-    return test::runProcess(VISCERA_STUDIO_EXE, args);
+    return test::runProcess(VISCERA_STUDIO_EXE, test::signingWithSampleKey(args));
 }
 
 int lineCount(const std::string& s) {
     return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
 }
 
-/// A small cantilever case: a box fixed at x = 0, with the given features.
+/// The slab case (slab_case.hpp) with the given features, signed with the sample key.
 std::string writeSlabCase(const ScratchDir& dir, const std::string& name, std::vector<std::string> features,
                           sim::Vec3 gravity = sim::Vec3(0, 0, -9.81), const std::string& render = "") {
-    auto mesh = sim::makeBoxTetMesh({sim::Vec3::Zero(), sim::Vec3(0.08, 0.02, 0.02), {8, 2, 2}});
-    sim::SceneDesc scene;
-    scene.xpbd.gravity = gravity;
-    scene.xpbd.substeps = 50; // what the load-time stability check asks for
-    scene.render = render;
-    sim::BodyDesc body;
-    body.name = "slab";
-    body.meshPath = "meshes/slab.vtet";
-    body.material.youngsModulus = 20000;
-    for (int32_t v = 0; v < static_cast<int32_t>(mesh->vertexCount()); ++v)
-        if (mesh->positions()[v].x() < 1e-9) body.fixedNodes.push_back(v);
-    scene.bodies.push_back(body);
-    vcase::Manifest header;
-    header.caseId = "slab-test";
-    header.caseVersion = "1.0.0";
-    header.minPlayerVersion = "0.1.0";
-    header.features = std::move(features);
-    vcase::CaseWriter w(header);
-    w.addFile("scene.json", sim::formatScene(scene));
-    w.addFile("meshes/slab.vtet", sim::formatVtet(*mesh));
-    const auto path = dir.path() / name;
-    w.write(path);
-    return path.string();
+    test::SlabCase slab;
+    slab.features = std::move(features);
+    slab.gravity = gravity;
+    slab.render = render;
+    return test::writeSlabCase(dir.path() / name, slab).string();
 }
 
 nlohmann::json readJson(const std::filesystem::path& p) {
@@ -167,7 +151,7 @@ TEST(PlayerCli, RunWritesTheSessionReport) {
     EXPECT_GT(sag, 1e-4);
     EXPECT_LT(sag, 0.05);
     EXPECT_GE(j["metrics"]["max_node_displacement_m"].get<double>(), sag) << "the largest is over the run";
-    EXPECT_EQ(j["schemaVersion"].get<int>(), 3);
+    EXPECT_EQ(j["schemaVersion"].get<int>(), 4);
     EXPECT_TRUE(j["errors"].empty());
     EXPECT_TRUE(j["warnings"].empty());
     EXPECT_THAT(r.out, HasSubstr("displacement  largest node distance from rest"));
@@ -261,8 +245,8 @@ TEST(PlayerCli, AReportThatCannotBeWrittenAtTheEndKeepsTheSummaryAndIsSavedElsew
     ::setenv("TMPDIR", tmp.c_str(), 1);
     // Real time with a device: the 240 frames take 4 s of wall clock whatever this machine's speed.
     test::Background run(VISCERA_PLAYER_EXE,
-                         {"run", path, "--headless", "--realtime", "--device", "scripted:press", "--frames", "240",
-                          "--report", out.string()},
+                         test::trustingSampleKey({"run", path, "--headless", "--realtime", "--device", "scripted:press",
+                                                  "--frames", "240", "--report", out.string()}),
                          log.string());
     if (oldTmp)
         ::setenv("TMPDIR", savedTmp.c_str(), 1);

@@ -2,6 +2,7 @@
 // console loopback over UDP with viscera-console-sim including a disconnect mid-session, the
 // trainee window offscreen, and the one-line errors for bad device specs and trajectory files.
 #include "player/haptic_case.hpp"
+#include "support/case_signing.hpp"
 #include "support/run_process.hpp"
 #include "support/scratch_dir.hpp"
 
@@ -42,7 +43,7 @@ using test::Background;
 using test::Scratch;
 
 test::ProcessResult player(const std::vector<std::string>& args) {
-    return test::runProcess(VISCERA_PLAYER_EXE, args);
+    return test::runProcess(VISCERA_PLAYER_EXE, test::trustingSampleKey(args));
 }
 
 nlohmann::json readJson(const std::string& p) {
@@ -102,7 +103,7 @@ void writePairingKey(const std::string& path) {
 /// and s/forces.csv (console side). exitCode: the player's expected exit status (a link that
 /// dropped fails the session).
 void runLoopback(const Scratch& s, int frames, std::vector<std::string> simArgs, int exitCode = 0) {
-    test::writeHapticCase(s / "slab.vcase", 2);
+    test::writeHapticCase(s / "slab.vcase", 2, VISCERA_SAMPLE_KEY);
     writePairingKey(s / "pairing.key");
     const std::vector<std::string> common = {"--listen",      "127.0.0.1:0",    "--port-file",   s / "port",
                                              "--script",      "bimanual",       "--record",      s / "forces.csv",
@@ -133,7 +134,7 @@ void runLoopback(const Scratch& s, int frames, std::vector<std::string> simArgs,
 
 TEST(PlayerHaptics, ScriptedSessionIsRepeatableAndReportsTaskMetrics) {
     Scratch s;
-    test::writeHapticCase(s / "slab.vcase");
+    test::writeHapticCase(s / "slab.vcase", 1, VISCERA_SAMPLE_KEY);
     auto run = [&](const std::string& tag) {
         auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "200", "--device", "scripted:press",
                          "--report", s / (tag + ".json"), "--trace", s / (tag + ".csv")});
@@ -174,7 +175,7 @@ TEST(PlayerHaptics, ScriptedSessionIsRepeatableAndReportsTaskMetrics) {
 
 /// The haptic slab case and a 3 s "press" trajectory recorded by the console simulator.
 static void writeSlabAndPress(const Scratch& s) {
-    test::writeHapticCase(s / "slab.vcase");
+    test::writeHapticCase(s / "slab.vcase", 1, VISCERA_SAMPLE_KEY);
     auto w = test::runProcess(VISCERA_CONSOLE_SIM_EXE,
                               {"--write-trajectory", s / "press.csv", "--script", "press", "--duration", "3"});
     ASSERT_EQ(w.exitCode, 0) << w.err;
@@ -358,7 +359,7 @@ TEST(PlayerHaptics, ConsoleSimulatorKeepsItsSessionToThePlayerThatOpenedIt) {
 
 TEST(PlayerHaptics, ConsoleThatNeverAnswersFailsTheSession) {
     Scratch s;
-    test::writeHapticCase(s / "slab.vcase");
+    test::writeHapticCase(s / "slab.vcase", 1, VISCERA_SAMPLE_KEY);
     writePairingKey(s / "pairing.key");
     auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "30", "--device", "console:127.0.0.1:9",
                      "--pairing-key", s / "pairing.key", "--report", s / "r.json"});
@@ -374,7 +375,7 @@ TEST(PlayerHaptics, ConsoleThatNeverAnswersFailsTheSession) {
 
 TEST(PlayerHaptics, BadDeviceSpecsAndTrajectoriesGiveOneLineErrors) {
     Scratch s;
-    test::writeHapticCase(s / "slab.vcase");
+    test::writeHapticCase(s / "slab.vcase", 1, VISCERA_SAMPLE_KEY);
     std::ofstream(s / "bad.csv")
         << "# viscera-trajectory 1\nt,arm,x,y,z,qw,qx,qy,qz,grip,buttons,pedals\n0,0,0,0,0,1,0,0,0,0,0,99\n";
     struct Bad {
@@ -516,7 +517,7 @@ TEST(PlayerHaptics, SixtySecondConsoleLoopback) {
 
 TEST(PlayerHaptics, TraineeWindowRunsOffscreenAndWritesAScreenshot) {
     Scratch s;
-    test::writeHapticCase(s / "slab.vcase");
+    test::writeHapticCase(s / "slab.vcase", 1, VISCERA_SAMPLE_KEY);
     ::setenv("QT_QPA_PLATFORM", "offscreen", 1);
     auto r = player({"run", s / "slab.vcase", "--frames", "30", "--device", "scripted:press", "--screenshot",
                      s / "shot.png", "--report", s / "r.json"});
@@ -532,7 +533,7 @@ TEST(PlayerHaptics, TraineeWindowRunsOffscreenAndWritesAScreenshot) {
 
 TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
     Scratch s;
-    test::writeHapticCase(s / "slab.vcase");
+    test::writeHapticCase(s / "slab.vcase", 1, VISCERA_SAMPLE_KEY);
     auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "60", "--device", "scripted:press",
                      "--realtime", "--servo", "busy:0", "--report", s / "r.json"});
     ASSERT_EQ(r.exitCode, 0) << r.err;

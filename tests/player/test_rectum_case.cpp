@@ -3,6 +3,7 @@
 // and a clip applier on recorded tracks), viscera-player runs it headless and reports grasps,
 // cuts and the clip.
 #include "case/zip_craft.hpp"
+#include "support/case_signing.hpp"
 #include "support/run_process.hpp"
 
 #include <gmock/gmock.h>
@@ -20,10 +21,10 @@ using vcase::test::ScratchDir;
 namespace {
 
 test::ProcessResult player(const std::vector<std::string>& args) {
-    return test::runProcess(VISCERA_PLAYER_EXE, args);
+    return test::runProcess(VISCERA_PLAYER_EXE, test::trustingSampleKey(args));
 }
 test::ProcessResult studio(const std::vector<std::string>& args) {
-    return test::runProcess(VISCERA_STUDIO_EXE, args);
+    return test::runProcess(VISCERA_STUDIO_EXE, test::signingWithSampleKey(args));
 }
 
 nlohmann::json readJson(const std::filesystem::path& p) {
@@ -73,7 +74,7 @@ TEST(RectumCase, ExportsRunsGraspsCutsAndClips) {
         EXPECT_GT(m["tool_path_length_per_tool_m"][t].get<double>(), 0.01) << t;
     EXPECT_GT(m["max_contact_force_per_tool_n"][0].get<double>(), 0.0);
     EXPECT_GT(m["tool_path_length_m"].get<double>(), 0.05);
-    EXPECT_EQ(doc["schemaVersion"].get<int>(), 3);
+    EXPECT_EQ(doc["schemaVersion"].get<int>(), 4);
 
     // The committed console replay drives the three instruments from two masters: the left
     // grasps and lifts, the right cuts with the pedal held, hands its arm to the clip applier

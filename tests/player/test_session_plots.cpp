@@ -25,6 +25,13 @@ using nlohmann::json;
 
 namespace {
 
+/// The test cases are made here unsigned; the signature rules have tests of their own.
+vcase::TrustPolicy unsignedAllowed() {
+    vcase::TrustPolicy p;
+    p.allowUnsigned = true;
+    return p;
+}
+
 /// The haptic sample case (a block with one probe above it) run with scripted:press.
 struct PressedSession {
     test::Scratch scratch{"viscera-plots"};
@@ -33,7 +40,7 @@ struct PressedSession {
     PressedSession() {
         const std::string casePath = scratch / "haptic.vcase";
         test::writeHapticCase(casePath);
-        player::LoadedCase loaded = player::loadCase(casePath);
+        player::LoadedCase loaded = player::loadCase(casePath, unsignedAllowed());
         auto dev = haptics::openDevice(haptics::parseDeviceSpec("scripted:press"));
         player::RunOptions o;
         o.frames = 120;
@@ -98,7 +105,7 @@ TEST(SessionTimeline, RecordsTheProbeEveryFrameWithItsForce) {
 TEST(SessionTimeline, StaysBoundedOnALongSessionWithAUniformStride) {
     test::Scratch scratch("viscera-timeline");
     test::writeHapticCase(scratch / "haptic.vcase");
-    player::LoadedCase loaded = player::loadCase(scratch / "haptic.vcase");
+    player::LoadedCase loaded = player::loadCase(scratch / "haptic.vcase", unsignedAllowed());
     sim::World& world = *loaded.world;
     player::TimelineRecorder rec(world, 16);
     for (int f = 0; f < 100; ++f) {
@@ -205,7 +212,7 @@ TEST(SessionPlots, MalformedReportsAreRefusedNamingTheField) {
     EXPECT_EQ(refusal(d), "r.json: schemaVersion: is missing");
     d = ok;
     d["schemaVersion"] = 9;
-    EXPECT_EQ(refusal(d), "r.json: schemaVersion: 9 is newer than this player reads (3)");
+    EXPECT_EQ(refusal(d), "r.json: schemaVersion: 9 is newer than this player reads (4)");
     d = ok;
     d["frames"][1]["step_ms"] = "fast";
     EXPECT_EQ(refusal(d), "r.json: frames[1].step_ms: must be a number");

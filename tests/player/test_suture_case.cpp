@@ -2,6 +2,7 @@
 // recorded needle trajectory with 52 punctures and the thread pull), viscera-player runs it headless
 // and reports per-frame step time, active constraint rows, thread tension, and the closure.
 #include "case/zip_craft.hpp"
+#include "support/case_signing.hpp"
 #include "support/run_process.hpp"
 
 #include <gmock/gmock.h>
@@ -19,10 +20,10 @@ using vcase::test::ScratchDir;
 namespace {
 
 test::ProcessResult player(const std::vector<std::string>& args) {
-    return test::runProcess(VISCERA_PLAYER_EXE, args);
+    return test::runProcess(VISCERA_PLAYER_EXE, test::trustingSampleKey(args));
 }
 test::ProcessResult studio(const std::vector<std::string>& args) {
-    return test::runProcess(VISCERA_STUDIO_EXE, args);
+    return test::runProcess(VISCERA_STUDIO_EXE, test::signingWithSampleKey(args));
 }
 
 nlohmann::json readJson(const std::filesystem::path& p) {

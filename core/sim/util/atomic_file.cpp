@@ -207,4 +207,14 @@ void requireNotAnInput(const std::filesystem::path& output, std::string_view wha
     }
 }
 
+void requirePrivateFile(const std::filesystem::path& path, std::string_view what) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0)
+        throw InputError(path.string() + ": cannot open (" + std::strerror(errno) + ")");
+    if (st.st_mode & (S_IRWXG | S_IRWXO))
+        throw InputError(path.string() + ": " + std::string(what) + " is open to other users (mode " +
+                         std::to_string((st.st_mode >> 6) & 7) + std::to_string((st.st_mode >> 3) & 7) +
+                         std::to_string(st.st_mode & 7) + "; chmod 600 it)");
+}
+
 } // namespace viscera

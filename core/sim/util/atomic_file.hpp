@@ -45,4 +45,8 @@ inline constexpr std::uintmax_t kReadFileMaxBytes = std::uintmax_t{256} << 20;
 std::string readFile(const std::filesystem::path& path, std::uintmax_t maxBytes = kReadFileMaxBytes,
                      std::string_view limitName = {});
 
+/// Refuses a secret (a key) that users other than its owner could read or write: throws
+/// viscera::InputError "<path>: <what> is open to other users (mode 644; chmod 600 it)".
+void requirePrivateFile(const std::filesystem::path& path, std::string_view what);
+
 } // namespace viscera

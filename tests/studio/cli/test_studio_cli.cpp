@@ -3,6 +3,7 @@
 // viscera-studio texture <spec.json> -o <dir>: the files it writes and lists, one-line refusals.
 #include "case/case_package.hpp"
 #include "sim/util/atomic_file.hpp"
+#include "support/case_signing.hpp"
 #include "support/run_process.hpp"
 #include "support/scratch_dir.hpp"
 
@@ -23,7 +24,7 @@ namespace fs = std::filesystem;
 namespace {
 
 test::ProcessResult studio(const std::vector<std::string>& args) {
-    return test::runProcess(VISCERA_STUDIO_EXE, args);
+    return test::runProcess(VISCERA_STUDIO_EXE, test::signingWithSampleKey(args));
 }
 
 std::vector<std::string> lines(const std::string& text) {

@@ -1,0 +1,52 @@
+#include "case/run_state.hpp"
+
+#include "case/manifest.hpp"
+#include "case/semver.hpp"
+#include "sim/util/atomic_file.hpp"
+#include "sim/util/json_reader.hpp"
+
+#include <map>
+
+namespace viscera::vcase {
+namespace {
+
+using Versions = std::map<std::string, std::string>;
+
+Versions readState(const std::filesystem::path& folder) {
+    const std::filesystem::path file = folder / kRunStateName;
+    std::error_code ec;
+    if (!std::filesystem::exists(file, ec)) return {};
+    const std::string origin = file.string();
+    const nlohmann::json j = sim::parseJsonText(readFile(file, 1 << 20), origin);
+    const sim::JsonField root(j, "", origin);
+    root.object({"schemaVersion", "cases"});
+    const int version = root["schemaVersion"].integer();
+    if (version != 1) root.failAt("schemaVersion", std::to_string(version) + " is not supported (this player reads 1)");
+    Versions out;
+    for (const auto& [id, value] : root["cases"].members())
+        out[id] = readSemVer(value);
+    return out;
+}
+
+} // namespace
+
+std::optional<std::string> highestVersionRun(const std::filesystem::path& folder, const std::string& caseId) {
+    const Versions v = readState(folder);
+    auto it = v.find(caseId);
+    if (it == v.end()) return std::nullopt;
+    return it->second;
+}
+
+void recordVersionRun(const std::filesystem::path& folder, const std::string& caseId, const std::string& version) {
+    Versions v = readState(folder);
+    const std::optional<SemVer> next = SemVer::parse(version);
+    auto it = v.find(caseId);
+    if (it != v.end() && next && compare(*SemVer::parse(it->second), *next) >= 0) return;
+    v[caseId] = version;
+    nlohmann::json cases = nlohmann::json::object();
+    for (const auto& [id, ver] : v)
+        cases[id] = ver;
+    writeFileAtomic(folder / kRunStateName, nlohmann::json{{"schemaVersion", 1}, {"cases", cases}}.dump(2) + "\n");
+}
+
+} // namespace viscera::vcase
