@@ -89,6 +89,7 @@ std::string validate(const FemSettings& s) {
     if (s.cacheEvictSteps < 1) return "cache_evict_steps must be >= 1";
     if (s.refactorNodesPerSolve < 1) return "refactor_nodes_per_solve must be >= 1";
     if (s.prefetchNodesPerSolve < 0) return "prefetch_nodes_per_solve must be >= 0";
+    if (s.stepSubstitutions < 0) return "step_substitutions must be >= 0";
     return {};
 }
 
@@ -147,8 +148,8 @@ struct CorotationalFem::Impl {
     int swapStep = 0;
     std::vector<uint8_t> pinned; // per node: kept in the cache and carried by a refactorization
     std::vector<int> prefetch;   // nodes queued for caching ahead of use (FIFO)
-    bool stepMode = false;       // beginStep() was called: the amortized work is budgeted per step
-    bool stepWorkDone = false;   // this step's first solve has run
+    bool stepMode = false;       // beginStep() was called: the amortized work waits for endStep()
+    int stepWork = 0;            // the solves' work since beginStep(): substitutions and extra active-set iterations
     size_t prefetchHead = 0;
 
     std::vector<std::array<int32_t, 2>> edges; // unique tet edges, for the refactor test
@@ -315,7 +316,7 @@ struct CorotationalFem::Impl {
 
     /// Advances a refactorization at the start of a solve: joins the worker at its step, computes
     /// the next chunk of carried columns, or swaps the new factor in. Deterministic (see Job).
-    void advanceJob(FemSolveStats& st, bool firstOfStep) {
+    void advanceJob(FemSolveStats& st) {
         if (!job) return;
         if (!job->joined) {
             if (step < swapStep) return;
@@ -355,9 +356,20 @@ struct CorotationalFem::Impl {
         }
         const int k = static_cast<int>(j.nodes.size());
         if (j.done < k) {
-            // A step's first solve computes `refactorNodesPerSolve` nodes, its further solves (contact
-            // rounds) one each: a step of several solves costs little more than a step of one.
-            const int chunk = std::min(k - j.done, firstOfStep ? s.refactorNodesPerSolve : 1);
+            // Without steps every solve computes `refactorNodesPerSolve` nodes; with steps endStep() does.
+            if (!stepMode) carryChunk(st, s.refactorNodesPerSolve);
+            return;
+        }
+        takeJob(st);
+    }
+
+    /// Computes the K⁻¹ columns of up to `maxNodes` more carried nodes with the new factor.
+    void carryChunk(FemSolveStats& st, int maxNodes) {
+        Job& j = *job;
+        const int k = static_cast<int>(j.nodes.size());
+        {
+            const int chunk = std::min(k - j.done, maxNodes);
+            if (chunk <= 0) return;
             const int n = n3();
             if (j.cols.cols() < 3 * (j.done + chunk))
                 j.cols.conservativeResize(n, std::max<Eigen::Index>(3 * k, 2 * j.cols.cols()));
@@ -372,10 +384,11 @@ struct CorotationalFem::Impl {
             }
             j.done += chunk;
             st.substitutions += 3 * chunk;
-            return;
         }
-        takeJob(st);
     }
+
+    /// A refactorization's carried columns are being computed (the worker joined, the swap to come).
+    bool carrying() const { return job && job->joined && job->done < static_cast<int>(job->nodes.size()); }
 
     void takeJob(FemSolveStats& st) {
         std::shared_ptr<Job> j = std::move(job);
@@ -448,10 +461,10 @@ struct CorotationalFem::Impl {
         });
     }
 
-    /// Caches up to `prefetchNodesPerSolve` queued nodes that are not cached yet.
-    bool prefetchStep(FemSolveStats& st) {
+    /// Caches up to `maxNodes` queued nodes that are not cached yet.
+    bool prefetchStep(FemSolveStats& st, int maxNodes) {
         std::vector<int> batch;
-        while (prefetchHead < prefetch.size() && static_cast<int>(batch.size()) < s.prefetchNodesPerSolve) {
+        while (prefetchHead < prefetch.size() && static_cast<int>(batch.size()) < maxNodes) {
             const int node = prefetch[prefetchHead++];
             if (slotOf[node] < 0 && !(*fixed)[node]) batch.push_back(node);
         }
@@ -655,7 +668,24 @@ void CorotationalFem::prefetchNodes(const std::vector<int32_t>& nodes) {
 
 void CorotationalFem::beginStep() {
     m->stepMode = true;
-    m->stepWorkDone = false;
+    m->stepWork = 0;
+}
+
+FemSolveStats CorotationalFem::endStep() {
+    Impl& I = *m;
+    FemSolveStats st;
+    if (!I.stepMode) return st;
+    // What the step's solves left of its budget, in nodes (three substitutions each); a
+    // refactorization's carried columns always advance by one node, so the swap comes in bounded steps.
+    int nodes = std::max(0, I.s.stepSubstitutions - I.stepWork) / 3;
+    if (I.carrying()) {
+        const int carried = std::clamp(nodes, 1, I.s.refactorNodesPerSolve);
+        I.carryChunk(st, carried);
+        nodes -= carried;
+    }
+    if (nodes > 0 && !I.prefetch.empty()) I.prefetchStep(st, std::min(nodes, I.s.prefetchNodesPerSolve));
+    I.stepWork += st.substitutions;
+    return st;
 }
 
 bool CorotationalFem::refactorPending() const {
@@ -688,15 +718,18 @@ bool CorotationalFem::refactorAt(const std::vector<Vec3>& x, std::string* error)
 FemSolveStats CorotationalFem::solve() {
     Impl& I = *m;
     FemSolveStats st;
+    struct CountWork { // the step's own work, what endStep() fills up to its budget
+        Impl& impl;
+        const FemSolveStats& stats;
+        ~CountWork() { impl.stepWork += stats.substitutions + std::max(0, stats.activeSetIterations - 1); }
+    } count{I, st};
     ++I.step;
-    // The amortized work runs in the first solve of a step when the caller marks steps (beginStep()),
-    // else in every solve.
-    const bool firstOfStep = !I.stepMode || !I.stepWorkDone;
-    I.stepWorkDone = true;
-    I.advanceJob(st, firstOfStep);
+    // The amortized work runs in every solve, or once a step in endStep() when the caller marks steps.
+    I.advanceJob(st);
     if (st.refactored) ++m_factorizations;
     I.evict();
-    if (firstOfStep && !I.prefetch.empty()) I.prefetchStep(st); // a failure is reported in st.error; the solve goes on
+    if (!I.stepMode && !I.prefetch.empty())
+        I.prefetchStep(st, I.s.prefetchNodesPerSolve); // a failure is reported in st.error; the solve goes on
     const int n = I.n3();
     const auto& X0 = m_x0;
 

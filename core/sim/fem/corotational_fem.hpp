@@ -70,6 +70,12 @@ struct FemSettings {
     /// substitutions each) between the worker's join and the swap (see beginStep()).
     int refactorNodesPerSolve = 4;
     int prefetchNodesPerSolve = 4; ///< queued nodes (prefetchNodes()) cached per solve, >= 0
+    /// With steps (beginStep()/endStep()): the work a step may take, in substitutions (an active-set
+    /// iteration past a solve's first counts as one: a burst of contacts costs about that much). The
+    /// amortized work (carried columns, then prefetched nodes, three substitutions a node) fills what
+    /// the step's solves left of it at endStep(), so a burst of new constraints is not made worse by
+    /// work that can wait; a refactorization's carried columns still advance by one node a step.
+    int stepSubstitutions = 18;
     /// Simplicial: cheapest for the few-column substitutions of the constrained-node cache.
     CholeskyMethod cholesky = CholeskyMethod::Simplicial;
 };
@@ -175,14 +181,16 @@ public:
     // ---- solve ------------------------------------------------------------------------------
     /// One quasi-static solve with the current constraints. Never throws.
     FemSolveStats solve();
-    /// Marks the start of a step (a frame) of one or more solves. Once called, the amortized work is
-    /// budgeted per step: the prefetched nodes (`prefetchNodesPerSolve`) are cached in the first solve
-    /// of a step only, and a refactorization's carried columns take `refactorNodesPerSolve` nodes in
-    /// the first solve and one node in each further solve (contact rounds) — at least one per solve,
-    /// so the new rotations still take effect within a bounded number of solves. A step of several
-    /// solves then costs little more of this work than a step of one. Never called: every solve does
-    /// its full share. Counts only, never time: a run stays repeatable.
+    /// Marks the start of a step (a frame) of one or more solves. Once called, the amortized work
+    /// waits for endStep(), which gives it what the step's solves left of `stepSubstitutions`: a
+    /// refactorization's carried columns first (between one and `refactorNodesPerSolve` nodes, so the
+    /// new rotations still take effect within a bounded number of steps), then prefetched nodes (at
+    /// most `prefetchNodesPerSolve`). A step with a burst of new constraints then does none of it.
+    /// Never called: every solve does its full share. Counts only, never time: a run stays repeatable.
     void beginStep();
+    /// Ends a step begun with beginStep(): the amortized work above, its substitutions in the
+    /// returned stats. Never throws; without beginStep() it does nothing.
+    FemSolveStats endStep();
     /// Re-extracts the rotations from the current positions and refactorizes now (synchronous).
     bool refactorNow(std::string* error = nullptr);
     /// The same with the rotations of positions x (nodeCount() entries), e.g. those a background

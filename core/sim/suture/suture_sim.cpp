@@ -562,6 +562,10 @@ SutureStepStats SutureSimulation::step(const NeedleFrame& frame) {
     }
     pinHistoryNodes();
     readForces(st);
+    const FemSolveStats amortized = m_fem->endStep(); // carried columns and prefetch, in what the step left
+    st.substitutions += amortized.substitutions;
+    st.newCachedNodes += amortized.newCachedNodes;
+    if (!amortized.error.empty()) st.error = amortized.error;
     for (const HistoryEntry& e : m_history) {
         if (e.alpha >= 0 && e.alpha <= l) ++st.needleEntries;
         if (e.alpha < 0) ++st.threadEntries;

@@ -574,12 +574,16 @@ TEST(CorotationalFem, ReleasedGroupsLeaveTheSchurFactorAsAFactorizationWouldDo) 
     EXPECT_LT(maxDistance(fem->positions(), plain->positions()), 1e-10 * scale);
 }
 
-TEST(CorotationalFem, AStepOfSeveralSolvesDoesItsAmortizedWorkOnce) {
+TEST(CorotationalFem, AStepDoesItsAmortizedWorkAtItsEndInWhatItsSolvesLeft) {
+    // Prefetch with steps of three solves: the solves cache nothing ahead; endStep() caches
+    // prefetchNodesPerSolve nodes when the step's budget allows, fewer when it allows less, none
+    // when the step's own solves took it all (a burst of new constraints).
     const Drag d;
     FemSettings s;
     s.refactorMode = RefactorMode::Synchronous;
     s.refactorDisplacement = 1e9;
     s.prefetchNodesPerSolve = 2;
+    s.stepSubstitutions = 18;
     auto stepped = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
     auto plain = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
     std::vector<int32_t> ahead;
@@ -592,21 +596,46 @@ TEST(CorotationalFem, AStepOfSeveralSolvesDoesItsAmortizedWorkOnce) {
         for (int solve = 0; solve < 3; ++solve) {
             const FemSolveStats a = stepped->solve(), b = plain->solve();
             ASSERT_TRUE(a.finite && b.finite);
-            EXPECT_EQ(a.newCachedNodes, solve == 0 ? 2 : 0) << "step " << step << ", solve " << solve;
-            EXPECT_EQ(a.substitutions, solve == 0 ? 6 : 0);
+            EXPECT_EQ(a.newCachedNodes, 0) << "step " << step << ", solve " << solve;
+            EXPECT_EQ(a.substitutions, 0);
             EXPECT_EQ(b.newCachedNodes, std::max(0, std::min(2, 8 - 2 * (3 * step + solve))))
                 << "no steps: every solve";
         }
+        const FemSolveStats end = stepped->endStep();
+        EXPECT_EQ(end.newCachedNodes, 2) << "step " << step;
+        EXPECT_EQ(end.substitutions, 6);
     }
     EXPECT_EQ(stepped->cachedNodes(), 4);
     EXPECT_EQ(plain->cachedNodes(), 8);
     EXPECT_LT(maxDistance(stepped->positions(), plain->positions()), 1e-15) << "work moved, results unchanged";
+
+    // A budget of 3 substitutions: one node.
+    s.stepSubstitutions = 3;
+    auto small = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
+    small->prefetchNodes(ahead);
+    small->beginStep();
+    ASSERT_TRUE(small->solve().finite);
+    EXPECT_EQ(small->endStep().newCachedNodes, 1);
+    // A step whose solve cached the four nodes of a new constraint (12 substitutions) leaves 6: two
+    // nodes; one that took 12 of a budget of 12 leaves none.
+    for (const int budget : {18, 12}) {
+        s.stepSubstitutions = budget;
+        auto burst = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
+        burst->prefetchNodes(ahead);
+        burst->beginStep();
+        d.constrain(*burst);
+        const FemSolveStats a = burst->solve();
+        ASSERT_TRUE(a.finite);
+        ASSERT_EQ(a.newCachedNodes, 4);
+        EXPECT_EQ(burst->endStep().newCachedNodes, budget == 18 ? 2 : 0) << "budget " << budget;
+    }
+    EXPECT_EQ(plain->endStep().substitutions, 0) << "without beginStep() endStep() does nothing";
 }
 
-TEST(CorotationalFem, AStepOfSeveralSolvesCarriesOneNodePerFurtherSolve) {
+TEST(CorotationalFem, AStepCarriesBetweenOneNodeAndItsShareAndTheSwapStillComes) {
     // Background refactorization with 4 carried nodes per solve (28 carried: 24 pinned, 4 constrained)
-    // and steps of three solves: a step's first solve computes 4
-    // nodes' columns (12 substitutions), its further solves one node (3); the swap still comes.
+    // and steps of three solves: the solves carry nothing; endStep() carries 4 nodes (12 substitutions)
+    // when the step left room, one when it left none; the swap still comes.
     const Drag d;
     FemSettings s;
     s.refactorMode = RefactorMode::Background;
@@ -614,46 +643,55 @@ TEST(CorotationalFem, AStepOfSeveralSolvesCarriesOneNodePerFurtherSolve) {
     s.refactorLatencySteps = 1;
     s.refactorNodesPerSolve = 4;
     auto plain = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
+    s.stepSubstitutions = 12;
     auto stepped = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
+    s.stepSubstitutions = 0; // every step's budget taken: one node a step
+    auto starved = CorotationalFem::create(*d.bar.mesh, d.bar.fixed, s, d.bar.gravity);
     std::vector<int32_t> pins;
     for (int32_t v = 0; pins.size() < 24; ++v)
         if (!plain->isFixed(v)) pins.push_back(v);
-    for (auto* fem : {plain.get(), stepped.get()}) { // pinned and cached: carried by every refactorization
+    std::vector<CorotationalFem*> all{plain.get(), stepped.get(), starved.get()};
+    std::vector<int> ids;
+    for (auto* fem : all) { // pinned and cached: carried by every refactorization
         fem->pinNodes(pins);
         fem->prefetchNodes(pins);
+        for (int k = 0; k < 7; ++k) // cache the pins (prefetch, 4 a solve, no steps yet) before any refactorization
+            ASSERT_TRUE(fem->solve().finite);
+        ASSERT_EQ(fem->cachedNodes(), 24);
+        ids.push_back(d.constrain(*fem));
     }
-    const int ip = d.constrain(*plain), is = d.constrain(*stepped);
-    auto solvesToSwap = [](std::vector<int>& started, std::vector<int>& swapped) {
-        std::vector<int> out;
-        for (size_t i = 0; i < std::min(started.size(), swapped.size()); ++i)
-            out.push_back(swapped[i] - started[i]);
-        return out;
-    };
-    std::vector<int> startedP, swappedP, startedS, swappedS;
-    int carriedFirst = 0, carriedFurther = 0;
-    for (int k = 0; k < 90; ++k) {
-        if (k % 3 == 0) stepped->beginStep();
-        d.target(*plain, ip, k / 3);
-        d.target(*stepped, is, k / 3);
-        const bool pending = stepped->refactorPending();
-        const FemSolveStats a = plain->solve(), b = stepped->solve();
-        ASSERT_TRUE(a.finite && b.finite) << a.error << b.error;
-        if (a.refactorStarted) startedP.push_back(k);
-        if (a.refactored) swappedP.push_back(k);
-        if (b.refactorStarted) startedS.push_back(k);
-        if (b.refactored) swappedS.push_back(k);
-        if (pending && !b.refactored && b.newCachedNodes == 0 && b.substitutions > 1) {
-            const int carried = b.substitutions - b.substitutions % 3; // less the substitution of u
-            EXPECT_LE(carried, k % 3 == 0 ? 12 : 3) << "solve " << k;  // less when the last nodes are done
-            carriedFirst += k % 3 == 0 && carried == 12;
-            carriedFurther += k % 3 != 0 && carried == 3;
+    std::vector<std::vector<int>> started(3), swapped(3);
+    std::vector<int> carried(3, 0);
+    for (int k = 0; k < 300; ++k) {
+        for (size_t f = 0; f < all.size(); ++f) {
+            CorotationalFem& fem = *all[f];
+            const bool stepStart = f == 0 || k % 3 == 0;
+            if (f > 0 && stepStart) fem.beginStep();
+            d.target(fem, ids[f], k / 3);
+            const bool pending = fem.refactorPending();
+            const FemSolveStats a = fem.solve();
+            ASSERT_TRUE(a.finite) << a.error;
+            if (a.refactorStarted) started[f].push_back(k);
+            if (a.refactored) swapped[f].push_back(k);
+            if (f > 0 && pending && !a.refactored)
+                EXPECT_EQ(a.substitutions % 3, a.substitutions > 0 ? 1 : 0)
+                    << "stepped solves carry nothing (at most u's substitution), solve " << k;
+            if (f > 0 && k % 3 == 2) {
+                const FemSolveStats e = fem.endStep();
+                if (e.substitutions > 0) {
+                    EXPECT_EQ(e.substitutions, f == 1 ? 12 : 3) << "solve " << k; // less when the last nodes are done
+                    carried[f] += e.substitutions == (f == 1 ? 12 : 3);
+                }
+            }
         }
     }
-    EXPECT_GT(carriedFirst, 0);
-    EXPECT_GT(carriedFurther, 0);
-    ASSERT_GE(swappedS.size(), 1u) << "the new factor still takes effect";
-    const std::vector<int> p = solvesToSwap(startedP, swappedP), q = solvesToSwap(startedS, swappedS);
-    ASSERT_FALSE(p.empty());
-    EXPECT_GT(q[0], p[0]) << "fewer substitutions per solve, more solves to the swap";
-    EXPECT_LE(q[0], 1 + 24 + 4 + 1) << "at least one node per solve";
+    EXPECT_GT(carried[1], 0);
+    EXPECT_GT(carried[2], 0);
+    for (size_t f = 0; f < all.size(); ++f)
+        ASSERT_GE(swapped[f].size(), 1u) << "the new factor still takes effect, fem " << f;
+    auto firstSwap = [&](size_t f) { return swapped[f][0] - started[f][0]; };
+    EXPECT_LT(firstSwap(0), firstSwap(1)) << "carried once a step, not every solve";
+    EXPECT_LT(firstSwap(1), firstSwap(2)) << "a node a step when the steps leave no room";
+    EXPECT_LE(firstSwap(2), 3 * (1 + 28 + 2)) << "at least one node a step";
+    EXPECT_GE(firstSwap(2), 3 * 28) << "28 nodes carried, one a step";
 }
