@@ -12,6 +12,35 @@
 #include <filesystem>
 
 namespace viscera::studio {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Moves the project's own file paths (imported meshes, the needle trajectory, instrument tracks)
+/// from its folder to `to`, in the same layout, and makes `to` its folder. `moved` receives
+/// (old, new) of each path; `strict`: a path outside the folder throws InputError naming it,
+/// else it is left as it is.
+void rebaseProject(Project& p, const fs::path& to, std::vector<std::pair<fs::path, fs::path>>* moved, bool strict) {
+    const fs::path from = p.dir.lexically_normal();
+    auto relocate = [&](fs::path& f) {
+        if (f.empty()) return;
+        const fs::path rel = f.lexically_normal().lexically_relative(from);
+        if (rel.empty() || *rel.begin() == "..") {
+            if (strict) throw InputError(f.string() + ": is not inside the project folder " + p.dir.string());
+            return;
+        }
+        if (moved) moved->emplace_back(f, to / rel);
+        f = to / rel;
+    };
+    for (BodyProject& b : p.bodies)
+        if (b.mesh.kind == MeshSource::Kind::File) relocate(b.mesh.file);
+    if (p.scene.suture && !p.trajectory.generator) relocate(p.trajectory.file);
+    for (fs::path& t : p.trackFiles)
+        relocate(t);
+    p.dir = to;
+}
+
+} // namespace
 
 /// One edit: the model before and after. Consecutive commands with the same nonzero key merge
 /// (keeping the first `before`), so a drag of many mouse events is one undo step.
@@ -39,7 +68,11 @@ Document::Document(QObject* parent) : QObject(parent) {}
 Document::~Document() = default;
 
 void Document::replace(const Project& p) {
+    // A model from before a Save As names the old folder: it is restored into the folder the
+    // project lives in now (its files were copied there in the same layout).
+    const fs::path here = m_project->dir;
     *m_project = p;
+    if (m_project->dir != here) rebaseProject(*m_project, here, nullptr, false);
     ++m_revision;
     emit changed();
 }
@@ -85,22 +118,8 @@ void Document::saveAs(const QString& folder) {
     // The project's files (imported meshes, trajectory, instrument tracks, texture specs) go along, in the same
     // layout, so that the saved project is complete; then project.json, atomically.
     Project p = *m_project;
-    p.dir = abs.toStdString();
-    namespace fs = std::filesystem;
     std::vector<std::pair<fs::path, fs::path>> copies;
-    auto relocate = [&](fs::path& f) {
-        if (f.empty()) return;
-        const fs::path rel = f.lexically_normal().lexically_relative(m_project->dir.lexically_normal());
-        if (rel.empty() || *rel.begin() == "..")
-            throw InputError(f.string() + ": is not inside the project folder " + m_project->dir.string());
-        copies.emplace_back(f, p.dir / rel);
-        f = p.dir / rel;
-    };
-    for (BodyProject& b : p.bodies)
-        if (b.mesh.kind == MeshSource::Kind::File) relocate(b.mesh.file);
-    if (p.scene.suture && !p.trajectory.generator) relocate(p.trajectory.file);
-    for (fs::path& t : p.trackFiles)
-        relocate(t);
+    rebaseProject(p, abs.toStdString(), &copies, true);
     // texture specs (relative to the project folder) and the files they read travel too
     auto specOf = [&](const std::optional<TextureProject>& t) {
         if (!t) return;

@@ -9,6 +9,7 @@
 #include "app/plot_widget.hpp"
 #include "app/texture_panel.hpp"
 #include "app/viewport.hpp"
+#include "app/wheel_guard.hpp"
 #include "render/case_settings.hpp"
 #include "sim/material/material.hpp"
 
@@ -43,6 +44,7 @@
 #include <QTreeWidget>
 #include <QVBoxLayout>
 
+#include <algorithm>
 #include <cmath>
 
 namespace viscera::studio {
@@ -58,6 +60,7 @@ const char* const kSolverFields[] = {"dt", "substeps", "iterations", "damping"};
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_export(std::make_unique<ExportRunner>()) {
     setObjectName("studioMainWindow");
+    WheelGuard::install(); // the wheel scrolls docks; it never edits an unfocused field
     setDockNestingEnabled(true);
     setViewportHost(viewportHostFromText(QSettings().value("viewport/host").toString()).value_or(ViewportHost::Window));
     buildDocks();
@@ -1127,12 +1130,14 @@ QString MainWindow::setProperty(const QString& field, const QString& text) {
         }
     for (const char* f : kSolverFields)
         if (field == f) {
-            if ((field == "substeps" || field == "iterations") && (v != std::floor(v) || std::abs(v) > 1e6))
+            if ((field == "substeps" || field == "iterations") && v != std::floor(v))
                 return show(tr("solver.%1: '%2' must be a whole number").arg(field, text));
+            // A whole number past any valid count still reaches the reader's rule, which names the range.
+            const int count = static_cast<int>(std::clamp(v, -1e9, 1e9));
             return show(m_doc.edit(tr("Set solver %1").arg(field), [&](Project& p) {
                 if (field == "dt") p.scene.xpbd.dt = v;
-                if (field == "substeps") p.scene.xpbd.substeps = static_cast<int>(v);
-                if (field == "iterations") p.scene.xpbd.iterations = static_cast<int>(v);
+                if (field == "substeps") p.scene.xpbd.substeps = count;
+                if (field == "iterations") p.scene.xpbd.iterations = count;
                 if (field == "damping") p.scene.xpbd.damping = v;
             }));
         }

@@ -34,6 +34,7 @@
 #include <QSettings>
 #include <QToolBar>
 #include <QTreeWidget>
+#include <QWheelEvent>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -108,7 +109,47 @@ TEST_F(WindowFixture, ARejectedPropertyNamesTheFieldAndTheRuleAndChangesNothing)
     EXPECT_EQ(w->document()->undoStack()->count(), undo);
     EXPECT_EQ(studio::projectJsonText(w->document()->project()), before);
     EXPECT_TRUE(w->setProperty("substeps", "2.5").isEmpty() == false);
+    // A count far past the range is refused by the reader's rule, which names the range.
+    const QString huge = w->setProperty("substeps", "100000000");
+    EXPECT_TRUE(huge.contains("substeps") && huge.contains("1000") && !huge.contains("whole number"))
+        << huge.toStdString();
+    test::saveShot("substeps_rule");
+    EXPECT_EQ(w->document()->undoStack()->count(), undo);
     EXPECT_TRUE(w->setProperty("density", "nan").contains("not a finite number"));
+}
+
+TEST_F(WindowFixture, TheWheelOverAnUnfocusedFieldChangesNothing) {
+    // Scrolling a dock past a combo box or a spin box must not edit it; once clicked into, the
+    // wheel does (the same events, so the test would see a guard that blocked every wheel).
+    open("tissue-slab");
+    auto* dock = w->findChild<QDockWidget*>("paintDock");
+    ASSERT_NE(dock, nullptr);
+    dock->show();
+    auto* mode = w->findChild<QComboBox*>("paintMode");
+    const QList<QDoubleSpinBox*> spins = dock->findChildren<QDoubleSpinBox*>();
+    ASSERT_NE(mode, nullptr);
+    ASSERT_FALSE(spins.empty());
+    QDoubleSpinBox* spin = spins.front();
+    ASSERT_TRUE(test::waitFor([&] { return mode->isVisible() && spin->isVisible(); }, 5000));
+    auto wheel = [](QWidget* target) {
+        const QPointF at(target->width() / 2.0, target->height() / 2.0);
+        QWheelEvent e(at, target->mapToGlobal(at), QPoint(), QPoint(0, -120), Qt::NoButton, Qt::NoModifier,
+                      Qt::NoScrollPhase, false);
+        QCoreApplication::sendEvent(target, &e);
+    };
+    w->setFocus();
+    const int index = mode->currentIndex();
+    const double value = spin->value();
+    ASSERT_FALSE(mode->hasFocus());
+    wheel(mode);
+    wheel(spin);
+    EXPECT_EQ(mode->currentIndex(), index) << "an unfocused combo box keeps its value";
+    EXPECT_EQ(spin->value(), value) << "an unfocused spin box keeps its value";
+    w->activateWindow();
+    mode->setFocus();
+    ASSERT_TRUE(test::waitFor([&] { return mode->hasFocus(); }, 2000));
+    wheel(mode);
+    EXPECT_NE(mode->currentIndex(), index) << "the focused combo box takes the wheel";
 }
 
 TEST_F(WindowFixture, SaveAsWritesTheProjectAndRecentKeepsFive) {
@@ -135,6 +176,28 @@ TEST_F(WindowFixture, SaveAsWritesTheProjectAndRecentKeepsFive) {
     std::ofstream(bad / "project.json") << "{\"schemaVersion\": 1, \"caseId\": \"x\"";
     EXPECT_FALSE(w->openProject(QString::fromStdString(bad.string())));
     EXPECT_TRUE(w->windowTitle().contains("r5"));
+}
+
+TEST_F(WindowFixture, UndoAfterSaveAsKeepsTheNewFolder) {
+    // An edit, Save As, then undo and redo: the model keeps living in the folder it was saved to (the
+    // undo steps from before hold the old folder), and Save writes there, never into the old one.
+    const fs::path dir = open("tissue-slab");
+    const std::string original = viscera::readFile(dir / "project.json");
+    const double density = w->document()->project().bodies[0].scene.material.density;
+    ASSERT_EQ(w->setProperty("density", "1100"), "");
+    const fs::path copy = scratch.dir / "saved-as";
+    ASSERT_TRUE(w->saveProjectAs(QString::fromStdString(copy.string())));
+    const fs::path here = fs::weakly_canonical(copy);
+    w->document()->undoStack()->undo();
+    EXPECT_EQ(fs::weakly_canonical(w->document()->project().dir), here);
+    EXPECT_EQ(w->document()->project().bodies[0].scene.material.density, density) << "the edit is undone";
+    EXPECT_EQ(w->document()->folder().toStdString(), here.string());
+    EXPECT_TRUE(w->saveProject());
+    EXPECT_EQ(studio::loadProject(copy).bodies[0].scene.material.density, density);
+    EXPECT_EQ(viscera::readFile(dir / "project.json"), original) << "the old folder is left alone";
+    w->document()->undoStack()->redo();
+    EXPECT_EQ(fs::weakly_canonical(w->document()->project().dir), here);
+    EXPECT_EQ(w->document()->project().bodies[0].scene.material.density, 1100);
 }
 
 TEST_F(WindowFixture, SaveAsCarriesTheTextureSpecsSoTheCopyExports) {
