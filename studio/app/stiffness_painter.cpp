@@ -250,6 +250,15 @@ QString StiffnessPainter::end() {
     const std::vector<sim::BrushStroke> dabs = std::move(m_dabs);
     m_dabs.clear();
     if (dabs.empty()) return {};
+    if (m_live == m_committed) { // nothing to keep: no undo step, and the artist is told why
+        const QString why =
+            tr("the stroke changed no weight on '%1' (no node within the brush's %2 mm%3); nothing was recorded")
+                .arg(targetName())
+                .arg(1e3 * dabs.front().radius, 0, 'g', 3)
+                .arg(m_surface >= 0 ? QString() : tr(", which reaches the body's nodes through its curve skeleton"));
+        setStatus(why);
+        return why;
+    }
     static const char* const kModes[] = {"add", "subtract", "mix", "smooth"};
     const QString why =
         m_doc->edit(tr("Paint stiffness (%1) on '%2'").arg(kModes[static_cast<int>(dabs.front().mode)], targetName()),

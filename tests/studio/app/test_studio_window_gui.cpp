@@ -556,6 +556,16 @@ TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWe
     const QString verdictBefore = w->verdictLabel()->text();
     const int buildsBefore = w->log()->toPlainText().count("preview: building meshes");
 
+    // A stroke that reaches no node (a 1 mm brush on the surface, the skeleton centimetres below)
+    // leaves no undo step and says so.
+    w->findChild<QDoubleSpinBox*>("paintRadius")->setValue(1.0);
+    hostDrag(v, centre - QPoint(90, 0), centre + QPoint(90, 0));
+    EXPECT_EQ(w->document()->undoStack()->count(), undoBefore) << "a no-op stroke is no undo step";
+    EXPECT_TRUE(painter->status().contains("changed no weight")) << painter->status().toStdString();
+    test::saveShot("noop_stroke");
+    EXPECT_EQ(painter->weights(), before);
+    EXPECT_EQ(studio::projectJsonText(w->document()->project()), textBefore);
+
     // Add stroke: a drag across the body's surface
     // the brush selects through the skeleton: it must reach the slab's centre line from its surface
     w->findChild<QDoubleSpinBox*>("paintRadius")->setValue(25.0);
