@@ -436,7 +436,9 @@ int cmdRun(const std::vector<std::string>& args) {
     }
     const vcase::TrustPolicy trust = r.trust.policy();
     player::LoadedCase loaded = player::loadCase(*r.casePath, trust);
-    if (trust.stateFolder) { // this version has run: an older one is refused from now on
+    if (trust.stateFolder && loaded.provenance.signature == "trusted") {
+        // This version ran: an older one is refused from now on. Only a trusted publisher's runs
+        // count (an unsigned case allowed once must not lock the genuine one out).
         const vcase::Manifest& m = loaded.package->manifest();
         vcase::recordVersionRun(*trust.stateFolder, m.caseId, m.caseVersion);
     }

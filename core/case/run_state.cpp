@@ -3,9 +3,15 @@
 #include "case/manifest.hpp"
 #include "case/semver.hpp"
 #include "sim/util/atomic_file.hpp"
+#include "sim/util/error.hpp"
 #include "sim/util/json_reader.hpp"
 
+#include <cerrno>
+#include <cstring>
+#include <fcntl.h>
 #include <map>
+#include <sys/file.h>
+#include <unistd.h>
 
 namespace viscera::vcase {
 namespace {
@@ -28,6 +34,29 @@ Versions readState(const std::filesystem::path& folder) {
     return out;
 }
 
+/// Holds the state folder's lock (case-versions.lock, flock) for one read-modify-write, so that two
+/// players recording at once cannot lower each other's record.
+class StateLock {
+public:
+    explicit StateLock(const std::filesystem::path& folder) {
+        const std::filesystem::path file = folder / "case-versions.lock";
+        m_fd = ::open(file.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0600);
+        if (m_fd < 0) throw InputError(file.string() + ": cannot open the state lock (" + std::strerror(errno) + ")");
+        while (::flock(m_fd, LOCK_EX) != 0)
+            if (errno != EINTR) {
+                const int e = errno;
+                ::close(m_fd);
+                throw InputError(file.string() + ": cannot lock the state (" + std::strerror(e) + ")");
+            }
+    }
+    ~StateLock() { ::close(m_fd); } // closing releases the lock
+    StateLock(const StateLock&) = delete;
+    StateLock& operator=(const StateLock&) = delete;
+
+private:
+    int m_fd = -1;
+};
+
 } // namespace
 
 std::optional<std::string> highestVersionRun(const std::filesystem::path& folder, const std::string& caseId) {
@@ -38,6 +67,7 @@ std::optional<std::string> highestVersionRun(const std::filesystem::path& folder
 }
 
 void recordVersionRun(const std::filesystem::path& folder, const std::string& caseId, const std::string& version) {
+    const StateLock lock(folder);
     Versions v = readState(folder);
     const std::optional<SemVer> next = SemVer::parse(version);
     auto it = v.find(caseId);

@@ -6,6 +6,7 @@
 #include "sim/util/json_reader.hpp"
 
 #include <openssl/bio.h>
+#include <openssl/err.h>
 #include <openssl/evp.h>
 #include <openssl/pem.h>
 
@@ -34,6 +35,12 @@ using MdCtx = std::unique_ptr<EVP_MD_CTX, MdCtxFree>;
 /// Never prompts: an encrypted PEM key is refused instead of asking on the terminal.
 int noPassphrase(char*, int, int, void*) {
     return -1;
+}
+
+/// The key's type for a message ("RSA", "SM2", …); some keys have no name.
+std::string typeName(EVP_PKEY* key) {
+    const char* name = EVP_PKEY_get0_type_name(key);
+    return name ? name : "an unknown type";
 }
 
 Bio readBio(std::string_view text) {
@@ -110,9 +117,10 @@ SigningKey SigningKey::load(const std::filesystem::path& pemFile) {
     requirePrivateFile(pemFile, "the publisher key");
     Bio bio = readBio(text);
     Pkey key(PEM_read_bio_PrivateKey(bio.get(), nullptr, noPassphrase, nullptr));
+    ERR_clear_error(); // a failed parse leaves its reasons queued; the message below says it
     if (!key) throw InputError(origin + ": not an unencrypted PEM private key (make one with 'viscera-studio keygen')");
     if (EVP_PKEY_get_id(key.get()) != EVP_PKEY_ED25519)
-        throw InputError(origin + ": not an Ed25519 key (found " + OBJ_nid2sn(EVP_PKEY_get_id(key.get())) +
+        throw InputError(origin + ": not an Ed25519 key (found " + typeName(key.get()) +
                          "; packages are signed with Ed25519)");
     return SigningKey(std::make_unique<Impl>(Impl{std::move(key)}));
 }
@@ -166,9 +174,10 @@ bool verifySignature(std::string_view raw, std::string_view message, std::string
 std::string parsePublicKeyPem(std::string_view text, const std::string& origin) {
     Bio bio = readBio(text);
     Pkey key(PEM_read_bio_PUBKEY(bio.get(), nullptr, noPassphrase, nullptr));
+    ERR_clear_error();
     if (!key) throw InputError(origin + ": not a PEM public key ('-----BEGIN PUBLIC KEY-----')");
     if (EVP_PKEY_get_id(key.get()) != EVP_PKEY_ED25519)
-        throw InputError(origin + ": not an Ed25519 public key (found " + OBJ_nid2sn(EVP_PKEY_get_id(key.get())) + ")");
+        throw InputError(origin + ": not an Ed25519 public key (found " + typeName(key.get()) + ")");
     return rawPublicKey(key.get());
 }
 

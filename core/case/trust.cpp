@@ -3,10 +3,13 @@
 #include "case/run_state.hpp"
 #include "case/semver.hpp"
 #include "sim/util/atomic_file.hpp"
+#include "sim/util/entry_name.hpp"
 #include "sim/util/error.hpp"
 
 #include <algorithm>
 #include <cstdlib>
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace viscera::vcase {
 namespace {
@@ -66,14 +69,30 @@ void checkRollback(const CasePackage& package, const TrustPolicy& policy) {
                          policy.stateFolder->string() + ")");
 }
 
+/// A trust anchor must be as safe as the player: owned by root or by the user running it, and
+/// writable by nobody else (a folder under /tmp that another user made is refused, not read).
+void requireSafeAnchor(const std::filesystem::path& path, const char* what) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) return; // missing: readFile / addFolder say so, or skip it
+    const bool owner = st.st_uid == 0 || st.st_uid == ::geteuid();
+    if (!owner || (st.st_mode & (S_IWGRP | S_IWOTH)))
+        throw InputError(path.string() + ": " + what + " must be owned by root or by you and writable by no one " +
+                         "else (owner uid " + std::to_string(st.st_uid) + ", mode " +
+                         std::to_string((st.st_mode >> 6) & 7) + std::to_string((st.st_mode >> 3) & 7) +
+                         std::to_string(st.st_mode & 7) + ")");
+}
+
 } // namespace
 
 void TrustStore::addKeyFile(const std::filesystem::path& pemFile) {
     const std::string origin = pemFile.string();
     TrustedKey key;
-    key.publicKey = parsePublicKeyPem(readFile(pemFile, 16384, "a public key file"), origin);
+    const std::string text = readFile(pemFile, 16384, "a public key file");
+    requireSafeAnchor(pemFile, "a trusted publisher key");
+    key.publicKey = parsePublicKeyPem(text, origin);
     key.name = pemFile.stem().string(); // "hospital.pem" and "hospital.pub.pem" name "hospital"
     if (key.name.size() > 4 && key.name.ends_with(".pub")) key.name.resize(key.name.size() - 4);
+    key.name = sim::displayName(key.name); // printed on one summary line
     key.source = origin;
     m_keys.push_back(std::move(key));
 }
@@ -81,6 +100,7 @@ void TrustStore::addKeyFile(const std::filesystem::path& pemFile) {
 void TrustStore::addFolder(const std::filesystem::path& folder) {
     std::error_code ec;
     if (!std::filesystem::is_directory(folder, ec)) return;
+    requireSafeAnchor(folder, "a trust folder");
     std::vector<std::filesystem::path> files;
     for (const auto& e : std::filesystem::directory_iterator(folder, ec))
         if (e.path().extension() == ".pem") files.push_back(e.path());

@@ -86,7 +86,9 @@ LoadedCase loadCase(const std::filesystem::path& casePath, const vcase::TrustPol
     LoadedCase out;
     out.package = vcase::CasePackage::open(casePath);
     const vcase::CasePackage& pkg = *out.package;
-    out.provenance = vcase::checkProvenance(pkg, trust); // before anything the publisher wrote is read
+    // After the package's own checks (zip structure, sizes, digests, meshes: bounded by the limits)
+    // and before the scene is read, parsed or run: whose case it is, and whether it may run here.
+    out.provenance = vcase::checkProvenance(pkg, trust);
     const std::string sceneName = "scene.json";
     if (!pkg.contains(sceneName))
         throw InputError(pkg.name() + ": " + sceneName + ": required file is missing from the package");

@@ -18,8 +18,9 @@ namespace fs = std::filesystem;
 
 /// Moves the project's own file paths (imported meshes, the needle trajectory, instrument tracks)
 /// from its folder to `to`, in the same layout, and makes `to` its folder. `moved` receives
-/// (old, new) of each path; `strict`: a path outside the folder throws InputError naming it,
-/// else it is left as it is.
+/// (old, new) of each path. `strict` (Save As, which copies them): a path outside the folder
+/// throws InputError naming it. Not strict (an undo step from before a Save As): a path outside
+/// the folder, or one whose file was not copied to `to`, keeps naming the file that exists.
 void rebaseProject(Project& p, const fs::path& to, std::vector<std::pair<fs::path, fs::path>>* moved, bool strict) {
     const fs::path from = p.dir.lexically_normal();
     auto relocate = [&](fs::path& f) {
@@ -29,6 +30,8 @@ void rebaseProject(Project& p, const fs::path& to, std::vector<std::pair<fs::pat
             if (strict) throw InputError(f.string() + ": is not inside the project folder " + p.dir.string());
             return;
         }
+        std::error_code ec;
+        if (!strict && !fs::exists(to / rel, ec)) return;
         if (moved) moved->emplace_back(f, to / rel);
         f = to / rel;
     };

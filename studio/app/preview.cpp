@@ -419,6 +419,7 @@ void Preview::run() {
                                            static_cast<int>(built->scene.bodies.size()) - 1);
                     try {
                         probe = probeWorld(*built, static_cast<size_t>(probeBody), origin);
+                        probe->setAccuracyCancel(&m_stop); // stop() (closing, quitting) never waits for a reference
                     } catch (const std::exception& e) {
                         emit logMessage(tr("preview: no error sampling for body %1: %2")
                                             .arg(probeBody)

@@ -23,8 +23,9 @@ bool WheelGuard::eventFilter(QObject* watched, QEvent* event) {
     const bool valueField = qobject_cast<QComboBox*>(w) || qobject_cast<QAbstractSpinBox*>(w) ||
                             (qobject_cast<QAbstractSlider*>(w) && !qobject_cast<QScrollBar*>(w));
     if (!valueField) return false;
-    // Not this field's: the scroll area (or whatever holds it) gets the wheel.
-    if (QWidget* parent = w->parentWidget()) QCoreApplication::sendEvent(parent, event);
+    // Not this field's: ignored, Qt passes it up to the scroll area (or whatever holds it), in
+    // that widget's coordinates.
+    event->ignore();
     return true;
 }
 

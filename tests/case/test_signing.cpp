@@ -15,6 +15,8 @@
 
 #include <filesystem>
 
+#include <unistd.h>
+
 namespace viscera::vcase {
 namespace {
 
@@ -111,6 +113,48 @@ TEST(Signing, KeysRoundTripThroughPemAndSecretsStayPrivate) {
     EXPECT_THAT(messageOf([&] { parsePublicKeyPem("hello", "x.pem"); }), StartsWith("x.pem: not a PEM public key"));
     EXPECT_THAT(messageOf([&] { SigningKey::load(dir.path() / "missing.pem"); }),
                 StartsWith((dir.path() / "missing.pem").string()));
+}
+
+TEST(Signing, KeysOfAnotherTypeAreRefusedByName) {
+    // Public keys of other types (fixed test data, nothing secret): P-256 and SM2 (whose OpenSSL id
+    // has no short name: the message must still be made, not crash).
+    const std::string p256 = "-----BEGIN PUBLIC KEY-----\n"
+                             "MFkwEwYHKoZIzj0CAQYIKoZIzj0DAQcDQgAEoPoXI7OFZ0XqDjNcHjSBrUQtbBQX\n"
+                             "eTiCrJgSDIdxq0N62/UVLWSL/FRVt67KZCBrzbWOhXwlucctbdD6kvMNpw==\n"
+                             "-----END PUBLIC KEY-----\n";
+    const std::string sm2 = "-----BEGIN PUBLIC KEY-----\n"
+                            "MFkwEwYHKoZIzj0CAQYIKoEcz1UBgi0DQgAEDzejYxqw5gHobV6N9biPvGbWWosi\n"
+                            "OQuNF+CWzYkzAw7cteQ8HXaAzjB+cFYZ+fBijsG7sqeMztpIwS6XJPIW3Q==\n"
+                            "-----END PUBLIC KEY-----\n";
+    EXPECT_THAT(messageOf([&] { parsePublicKeyPem(p256, "ec.pem"); }),
+                StartsWith("ec.pem: not an Ed25519 public key (found "));
+    EXPECT_THAT(messageOf([&] { parsePublicKeyPem(sm2, "sm2.pem"); }),
+                StartsWith("sm2.pem: not an Ed25519 public key (found "));
+}
+
+TEST(Signing, TrustAnchorsWritableByOthersAreRefused) {
+    test::ScratchDir dir;
+    const SigningKey k = SigningKey::generate();
+    const fs::path folder = dir.path() / "trusted", key = folder / "pub.pem";
+    fs::create_directories(folder);
+    fs::permissions(folder, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                                fs::perms::others_read | fs::perms::others_exec);
+    writeFileAtomic(key, k.publicPem());
+    TrustStore good;
+    good.addFolder(folder);
+    EXPECT_EQ(good.keys().size(), 1u);
+    fs::permissions(key, fs::perms::group_write, fs::perm_options::add);
+    TrustStore file;
+    EXPECT_EQ(messageOf([&] { file.addKeyFile(key); }),
+              key.string() +
+                  ": a trusted publisher key must be owned by root or by you and writable by no one else "
+                  "(owner uid " +
+                  std::to_string(::geteuid()) + ", mode 664)");
+    fs::permissions(key, fs::perms::group_write, fs::perm_options::remove);
+    fs::permissions(folder, fs::perms::others_write, fs::perm_options::add);
+    TrustStore open;
+    EXPECT_THAT(messageOf([&] { open.addFolder(folder); }),
+                StartsWith(folder.string() + ": a trust folder must be owned by root or by you"));
 }
 
 TEST(Signing, SignatureFileIsParsedStrictly) {

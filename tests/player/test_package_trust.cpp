@@ -146,6 +146,14 @@ TEST(PackageTrust, AnOlderVersionIsRefusedOnceANewerOneRanWithAStateFolder) {
         << "verify makes the same check";
     EXPECT_EQ(player({"verify", v11.string(), "--trust", kTrust}).exitCode, 0) << "no state folder, no record";
     EXPECT_THAT(readFile(state / "case-versions.json"), HasSubstr("\"trust-slab\": \"1.2.0\""));
+    // An unsigned run allowed once records nothing: it cannot lock the trusted versions out.
+    const fs::path v99 = writeSlab(dir, "v99.vcase", "99.0.0", "");
+    EXPECT_EQ(
+        player({"run", v99.string(), "--headless", "--frames", "2", "--allow-unsigned", "--state-dir", state.string()})
+            .exitCode,
+        0);
+    EXPECT_EQ(run(v12).exitCode, 0) << "the trusted 1.2.0 still runs";
+    EXPECT_THAT(readFile(state / "case-versions.json"), HasSubstr("\"trust-slab\": \"1.2.0\""));
 }
 
 TEST(PackageTrust, TheStudioSignsWithAKeyKeptOutsideTheProject) {

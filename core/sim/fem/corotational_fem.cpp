@@ -139,6 +139,7 @@ struct CorotationalFem::Impl {
         bool joined = false;
         std::vector<int> nodes; // carried nodes, in order; columns of the first `done` are in cols
         int done = 0;
+        bool topped = false;  // the nodes that came into use meanwhile were added (once: then the swap)
         Eigen::MatrixXd cols; // 3#V × 3·capacity
     };
     std::shared_ptr<Job> job;
@@ -347,8 +348,11 @@ struct CorotationalFem::Impl {
             carriedNodes(job->nodes);
         }
         Job& j = *job;
-        if (j.done == static_cast<int>(j.nodes.size())) {
-            // Nodes that came into use while the columns were computed travel too; swap when none is left.
+        if (j.done == static_cast<int>(j.nodes.size()) && !j.topped) {
+            // Nodes that came into use while the columns were computed travel too, collected once:
+            // then the swap, whatever came into use since (those are cached on demand with the new
+            // factor), so a stream of new constraints cannot put the new rotations off for ever.
+            j.topped = true;
             std::vector<int> more;
             carriedNodes(more);
             for (int node : more)
@@ -721,7 +725,9 @@ FemSolveStats CorotationalFem::solve() {
     struct CountWork { // the step's own work, what endStep() fills up to its budget
         Impl& impl;
         const FemSolveStats& stats;
-        ~CountWork() { impl.stepWork += stats.substitutions + std::max(0, stats.activeSetIterations - 1); }
+        ~CountWork() {
+            if (impl.stepMode) impl.stepWork += stats.substitutions + std::max(0, stats.activeSetIterations - 1);
+        }
     } count{I, st};
     ++I.step;
     // The amortized work runs in every solve, or once a step in endStep() when the caller marks steps.

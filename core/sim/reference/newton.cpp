@@ -252,6 +252,8 @@ const char* newtonStatusName(NewtonStatus status) {
         return "factorization_failed";
     case NewtonStatus::NonFinite:
         return "non_finite";
+    case NewtonStatus::Cancelled:
+        return "cancelled";
     }
     return "unknown";
 }
@@ -313,6 +315,8 @@ NewtonResult solveNewton(const StepProblem& p, const std::vector<Vec3>& x0, cons
     std::vector<Vec3> xTry(nv);
     constexpr double eps = std::numeric_limits<double>::epsilon();
     for (int k = 0; k < s.maxIterations; ++k) {
+        if (s.cancel && s.cancel->load(std::memory_order_relaxed))
+            return finish(NewtonStatus::Cancelled, "cancelled at iteration " + std::to_string(k));
         if (!assembler.assemble(r.x, projected.data(), tryExact ? exact.data() : nullptr))
             return finish(NewtonStatus::NonFinite, "element Hessian not finite at iteration " + std::to_string(k));
         bool factored = false;

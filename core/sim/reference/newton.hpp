@@ -27,6 +27,7 @@
 #include "sim/xpbd/step_problem.hpp"
 
 #include <array>
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,9 @@ struct NewtonSettings {
     double fdStep = 1e-5;
     /// The solve stops (see above) when ‖α d‖∞ ≤ stepTolerance · max(‖x‖∞, mean tet size).
     double stepTolerance = 1e-15;
+    /// When set (non-owning; e.g. a studio preview stopping), the solve ends before its next
+    /// iteration with NewtonStatus::Cancelled: a long reference never holds up the one who waits.
+    const std::atomic<bool>* cancel = nullptr;
 };
 
 /// scale ∂Ψ/∂F(F) Dm⁻ᵀ of tet t at its node positions xe (scale = h² V w for the step's term):
@@ -72,9 +76,10 @@ enum class NewtonStatus {
     MaxIterations,       ///< maxIterations reached before the gradient criterion
     FactorizationFailed, ///< CHOLMOD failed (matrix not positive definite, out of memory, ...)
     NonFinite,           ///< x_0, f or ∇f not finite
+    Cancelled,           ///< NewtonSettings::cancel was set; x is where the solve stopped
 };
 
-/// "converged", "stalled", "max_iterations", "factorization_failed", "non_finite".
+/// "converged", "stalled", "max_iterations", "factorization_failed", "non_finite", "cancelled".
 const char* newtonStatusName(NewtonStatus status);
 
 struct NewtonResult {

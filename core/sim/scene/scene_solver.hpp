@@ -11,6 +11,7 @@
 #include "sim/scene/scene.hpp"
 #include "sim/xpbd/xpbd_settings.hpp"
 
+#include <atomic>
 #include <memory>
 #include <string>
 #include <vector>
@@ -122,6 +123,9 @@ public:
     /// sampling rejects 'accuracy' at assembly and appends nothing. Never throws (a failed measurement is recorded as
     /// an empty trace).
     virtual void sampleAccuracy(const FrameClock& clock, std::vector<AccuracyRecord>& out) = 0;
+    /// A flag (non-owning) that, once set, ends a sampleAccuracy() in progress within one Newton
+    /// iteration and records nothing for it. Null: none.
+    virtual void setAccuracyCancel(const std::atomic<bool>* flag) { (void)flag; }
 
     virtual const std::vector<Vec3>& positions(size_t body) const = 0;     ///< #V of the body, m
     virtual const std::vector<Vec3>& surfacePositions(size_t s) const = 0; ///< #V of surface s, m

@@ -73,6 +73,10 @@ std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::
     return w;
 }
 
+void World::setAccuracyCancel(const std::atomic<bool>* flag) {
+    m_solver->setAccuracyCancel(flag);
+}
+
 FrameRecord World::step() {
     const FrameClock clock{m_frame, m_time, m_dt};
     if (m_scene.accuracy && m_frame % m_scene.accuracy->everyFrames == 0) m_solver->sampleAccuracy(clock, m_accuracy);

@@ -61,6 +61,10 @@ public:
     const std::vector<AccuracyRecord>& accuracy() const { return m_accuracy; }
     /// Forgets the accuracy records so far (a long-running sampler keeps only what it reads).
     void clearAccuracy() { m_accuracy.clear(); }
+    /// A flag (non-owning, outliving the world or reset to null) that ends a step's accuracy
+    /// measurement in progress within one Newton iteration and records nothing for it: whoever
+    /// stops a sampler does not wait for a converged reference.
+    void setAccuracyCancel(const std::atomic<bool>* flag);
     double time() const { return m_time; }
     double dt() const { return m_dt; } ///< s, the frame time step of the scene's solver
     int frameCount() const { return m_frame; }

@@ -203,10 +203,17 @@ void XpbdSceneSolver::sampleAccuracy(const FrameClock& clock, std::vector<Accura
         r.timeMs = std::move(t.timeMs);
         out.push_back(std::move(r));
     };
+    NewtonSettings reference;
+    reference.cancel = m_accuracyCancel;
+    auto cancelled = [&] { return m_accuracyCancel && m_accuracyCancel->load(std::memory_order_relaxed); };
     try {
-        keep(measureXpbd(*m_single, m_accuracy->maxIterations, {},
-                         m_primalCorrection ? XpbdIteration::PrimalCorrected : XpbdIteration::Standard));
-        keep(measureNewton(*m_single));
+        AccuracyTrace xpbd = measureXpbd(*m_single, m_accuracy->maxIterations, reference,
+                                         m_primalCorrection ? XpbdIteration::PrimalCorrected : XpbdIteration::Standard);
+        if (cancelled()) return; // measured against an unfinished reference: nothing to record
+        AccuracyTrace newton = measureNewton(*m_single, reference);
+        if (cancelled()) return;
+        keep(std::move(xpbd));
+        keep(std::move(newton));
     } catch (const std::exception&) {
         AccuracyRecord r;
         r.frame = clock.frame;

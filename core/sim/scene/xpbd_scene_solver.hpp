@@ -34,6 +34,7 @@ public:
     StepStats step(const FrameClock& clock) override;
     bool recordFrame(const FrameClock&) override { return true; }
     void sampleAccuracy(const FrameClock& clock, std::vector<AccuracyRecord>& out) override;
+    void setAccuracyCancel(const std::atomic<bool>* flag) override { m_accuracyCancel = flag; }
     const std::vector<Vec3>& positions(size_t body) const override { return m_sys->tetPositions(body); }
     const std::vector<Vec3>& surfacePositions(size_t s) const override { return m_sys->surfacePositions(s); }
     double totalEnergy() const override;
@@ -55,6 +56,7 @@ private:
     XpbdSystem* m_sys = nullptr;                       ///< the one that runs: m_single's system or m_layered
     std::unique_ptr<InteractionRuntime> m_interaction; ///< null unless the scene has "interaction"
     std::optional<AccuracySampling> m_accuracy;
+    const std::atomic<bool>* m_accuracyCancel = nullptr;
     bool m_primalCorrection = false;
     std::vector<double> m_addedInertia;
 };

@@ -5,6 +5,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
+
 #include <Eigen/Geometry>
 
 #include <cmath>
@@ -88,6 +90,22 @@ TEST(Newton, ConvergesInFewIterationsOnAGravityBlock) {
     // the element Hessians that are indefinite at x* keeps it from being quadratic).
     const size_t n = r.gradientNorms.size();
     EXPECT_LT(r.gradientNorms[n - 1], 0.1 * r.gradientNorms[n - 2]);
+}
+
+TEST(Newton, ACancelFlagEndsTheSolveBeforeItsNextIteration) {
+    // A preview that stops does not wait for a converged reference: set before the solve, no step
+    // is taken; clear, the same solve converges.
+    const StepProblem p = makeBlockProblem({});
+    std::atomic<bool> cancel{true};
+    NewtonSettings s;
+    s.cancel = &cancel;
+    const NewtonResult stopped = solveNewton(p, p.xTilde, s);
+    EXPECT_EQ(stopped.status, NewtonStatus::Cancelled);
+    EXPECT_EQ(stopped.iterations, 0);
+    EXPECT_STREQ(newtonStatusName(stopped.status), "cancelled");
+    EXPECT_EQ(stopped.message, "cancelled at iteration 0");
+    cancel = false;
+    EXPECT_EQ(solveNewton(p, p.xTilde, s).status, NewtonStatus::Converged);
 }
 
 TEST(Newton, ExactHessianWhenDefiniteConvergesQuadratically) {

@@ -4,6 +4,7 @@
 #include "sim/material/material.hpp"
 #include "sim/mesh/generators.hpp"
 #include "sim/reference/accuracy.hpp"
+
 #include "sim/scene/fem_scene_solver.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/world.hpp"
@@ -11,6 +12,7 @@
 #include "sim/util/error.hpp"
 #include "sim/xpbd/xpbd_solver.hpp"
 #include "sim/xpbd/xpbd_system.hpp"
+#include <atomic>
 
 #include "suture_fixture.hpp"
 
@@ -96,6 +98,16 @@ TEST(SceneSolver, OneBodyXpbdIsTheXpbdSolverBitForBit) {
         EXPECT_EQ(solver->totalEnergy(), ref->elasticEnergy() + ref->kineticEnergy() + ref->potentialEnergy());
     }
     ASSERT_EQ(acc.size(), 8u); // xpbd and newton on each call
+    // A sampler stopping sets the cancel flag: the measurement in progress records nothing.
+    std::atomic<bool> cancel{true};
+    solver->setAccuracyCancel(&cancel);
+    solver->sampleAccuracy({4, 4 * s.xpbd.dt, s.xpbd.dt}, acc);
+    EXPECT_EQ(acc.size(), 8u) << "a cancelled sample is not recorded";
+    cancel = false;
+    solver->sampleAccuracy({4, 4 * s.xpbd.dt, s.xpbd.dt}, acc);
+    EXPECT_EQ(acc.size(), 10u);
+    acc.resize(8);
+    solver->setAccuracyCancel(nullptr);
     EXPECT_EQ(acc[0].solver, "xpbd");
     EXPECT_EQ(acc[1].solver, "newton");
     EXPECT_EQ(acc[2].frame, 1);
