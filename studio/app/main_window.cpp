@@ -846,6 +846,18 @@ bool MainWindow::saveProjectAs(const QString& folder) {
 
 bool MainWindow::startExport(const QString& out) {
     if (!m_doc.hasProject()) return false;
+    if (m_realTime.slower()) { // said before the work: the trainee's session would fall behind
+        const QString warning =
+            tr("warning: the case runs at ×%1 of real time in the preview (%2 ms per %3 ms frame over the last %4 "
+               "frames, one solver thread): a trainee's session would fall behind; fewer substeps or a coarser "
+               "mesh would help")
+                .arg(m_realTime.factor, 0, 'f', 2)
+                .arg(numberText(m_realTime.meanMs))
+                .arg(numberText(m_realTime.budgetMs))
+                .arg(m_realTime.frames);
+        logLine(warning);
+        statusBar()->showMessage(warning);
+    }
     QString why;
     if (!m_export->start(m_doc.project(), out, &why)) {
         logLine(why);
@@ -1166,8 +1178,23 @@ void MainWindow::pollPreview() {
             c.x.push_back(first + static_cast<double>(i));
             c.y.push_back(s.frameMs[i]);
         }
-        m_costPlot->setSeries({c});
-        m_costPlot->setNote(tr("last %1 ms, frame %2").arg(numberText(s.stepMs)).arg(s.frames));
+        // The frame's budget beside the cost, and what it says of real time.
+        const double dt = m_doc.hasProject() ? m_doc.project().scene.xpbd.dt : 0;
+        m_realTime = estimateRealTime(s.frameMs, dt);
+        std::vector<PlotWidget::Series> series{c};
+        if (dt > 0 && !c.x.empty())
+            series.push_back({tr("%1 ms frame").arg(1e3 * dt, 0, 'f', 1),
+                              {c.x.front(), c.x.back()},
+                              {1e3 * dt, 1e3 * dt},
+                              QColor(120, 120, 120)});
+        m_costPlot->setSeries(std::move(series));
+        QString note = tr("last %1 ms").arg(s.stepMs, 0, 'f', 1);
+        if (m_realTime.frames > 0)
+            note += tr(", mean %1 ms: ×%2 real time%3")
+                        .arg(m_realTime.meanMs, 0, 'f', 1)
+                        .arg(m_realTime.factor, 0, 'f', 2)
+                        .arg(m_realTime.slower() ? tr(" — TOO SLOW") : QString());
+        m_costPlot->setNote(note);
     }
     QString verdict = s.verdict;
     if (!s.error.isEmpty()) verdict += (verdict.isEmpty() ? "" : "\n") + s.error;

@@ -92,6 +92,7 @@ public:
     QTreeWidget* tree() { return m_tree; }
     PlotWidget* errorPlot() { return m_errorPlot; }
     PlotWidget* costPlot() { return m_costPlot; }
+    const RealTimeEstimate& realTime() const { return m_realTime; }
     QLabel* verdictLabel() { return m_verdict; }
     QLabel* propertyError() { return m_propertyError; }
     QPlainTextEdit* log() { return m_log; }
@@ -172,6 +173,7 @@ private:
     QLabel* m_propertyError = nullptr;
     QPlainTextEdit* m_log = nullptr;
     PlotWidget *m_errorPlot = nullptr, *m_costPlot = nullptr;
+    RealTimeEstimate m_realTime; ///< of the preview's last frames (the cost plot's note, the export warning)
     QLabel* m_verdict = nullptr;
     QComboBox* m_previewMode = nullptr;
     QMenu* m_recentMenu = nullptr;

@@ -511,4 +511,18 @@ void Preview::run() {
     }
 }
 
+RealTimeEstimate estimateRealTime(const std::deque<double>& frameMs, double frameDt, size_t window, size_t minFrames) {
+    RealTimeEstimate e;
+    const size_t n = std::min(window, frameMs.size());
+    if (n < std::max<size_t>(1, minFrames) || !(frameDt > 0)) return e;
+    double sum = 0;
+    for (size_t i = frameMs.size() - n; i < frameMs.size(); ++i)
+        sum += frameMs[i];
+    e.frames = static_cast<int>(n);
+    e.meanMs = sum / static_cast<double>(n);
+    e.budgetMs = 1e3 * frameDt;
+    e.factor = e.meanMs > 0 ? e.budgetMs / e.meanMs : 0;
+    return e;
+}
+
 } // namespace viscera::studio

@@ -142,4 +142,18 @@ private:
     uint64_t m_serial = 0;
 };
 
+/// What the preview's physics cost says of real time: the mean of the last `window` frames against
+/// the scene's frame time (16.7 ms at 60 Hz). The preview runs one solver thread beside the UI, so
+/// this is what a trainee's machine of this class would see at worst.
+struct RealTimeEstimate {
+    int frames = 0;      ///< frames averaged (0: no estimate yet)
+    double meanMs = 0;   ///< physics ms per frame
+    double budgetMs = 0; ///< the frame time, ms
+    double factor = 0;   ///< budget / mean: 1 keeps real time exactly
+    bool slower() const { return frames > 0 && factor < 1; }
+};
+/// `frameDt` in s; at least `minFrames` of `frameMs` are needed (else frames = 0).
+RealTimeEstimate estimateRealTime(const std::deque<double>& frameMs, double frameDt, size_t window = 60,
+                                  size_t minFrames = 10);
+
 } // namespace viscera::studio

@@ -152,6 +152,26 @@ TEST_F(WindowFixture, TheWheelOverAnUnfocusedFieldChangesNothing) {
     EXPECT_NE(mode->currentIndex(), index) << "the focused combo box takes the wheel";
 }
 
+TEST_F(WindowFixture, TheStudioShowsTheRealTimeBudgetAndWarnsBeforeExportingASlowCase) {
+    // The slab at its shipped setting keeps real time in the preview; at 1,000 substeps it cannot:
+    // the cost plot says so against the frame's budget, and Export warns before it starts.
+    open("tissue-slab");
+    ASSERT_TRUE(test::waitFor([&] { return w->realTime().frames >= 10; }, 60000));
+    EXPECT_FALSE(w->realTime().slower()) << w->realTime().meanMs;
+    EXPECT_NEAR(w->realTime().budgetMs, 1e3 * w->document()->project().scene.xpbd.dt, 1e-9);
+    ASSERT_EQ(w->setProperty("substeps", "1000"), "");
+    ASSERT_TRUE(test::waitFor([&] { return w->realTime().slower(); }, 120000)) << w->realTime().meanMs;
+    ASSERT_TRUE(test::waitFor([&] { return w->costPlot()->note().contains("TOO SLOW"); }, 10000))
+        << w->costPlot()->note().toStdString();
+    test::saveShot("realtime_budget");
+    const fs::path out = scratch.dir / "slow.vcase";
+    ASSERT_TRUE(w->startExport(QString::fromStdString(out.string())));
+    EXPECT_TRUE(w->log()->toPlainText().contains("warning: the case runs at ×"))
+        << w->log()->toPlainText().toStdString();
+    EXPECT_TRUE(w->log()->toPlainText().contains("a trainee's session would fall behind"));
+    w->exportRunner()->cancel();
+}
+
 TEST_F(WindowFixture, SaveAsWritesTheProjectAndRecentKeepsFive) {
     open("tissue-slab");
     ASSERT_EQ(w->setProperty("density", "1100"), "");
