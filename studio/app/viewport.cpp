@@ -790,7 +790,9 @@ void Viewport::mouseMoveEvent(QMouseEvent* e) {
         const Eigen::Vector3f up = right.cross(fwd);
         const float scale = 2.0f * m_distance * std::tan(0.5f * 55.0f * 3.14159265f / 180.0f) / std::max(1, height());
         m_target += (-dp.x() * right + dp.y() * up) * scale;
-    } else if (m_button == Qt::LeftButton) {
+    } else if (m_button == Qt::LeftButton || m_button == Qt::RightButton) {
+        // Right drag orbits in every mode (in paint mode the left button paints, and Alt + drag is
+        // taken by most Linux window managers).
         m_yaw -= 0.01f * dp.x();
         m_pitch += 0.01f * dp.y();
     } else {

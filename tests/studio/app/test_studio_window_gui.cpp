@@ -586,6 +586,24 @@ TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWe
     EXPECT_EQ(painter->weights(), before);
     EXPECT_EQ(studio::projectJsonText(w->document()->project()), textBefore);
 
+    // A right drag orbits in paint mode (no Alt needed): the camera turns, nothing is painted; the
+    // same drag back turns it home.
+    if (QWindow* win = v->canvasWindow()) {
+        const Eigen::Vector3f eye = v->camera().position;
+        auto rightDrag = [&](QPoint from, QPoint to) {
+            QTest::mousePress(win, Qt::RightButton, Qt::NoModifier, from);
+            for (int i = 1; i <= 10; ++i)
+                QTest::mouseMove(win, from + (to - from) * i / 10);
+            QTest::mouseRelease(win, Qt::RightButton, Qt::NoModifier, to);
+        };
+        rightDrag(centre - QPoint(60, 0), centre + QPoint(60, 0));
+        EXPECT_GT((v->camera().position - eye).norm(), 1e-3f * (eye - v->camera().target).norm()) << "orbited";
+        EXPECT_EQ(w->document()->undoStack()->count(), undoBefore) << "nothing painted";
+        EXPECT_EQ(painter->weights(), before);
+        rightDrag(centre + QPoint(60, 0), centre - QPoint(60, 0));
+        EXPECT_LT((v->camera().position - eye).norm(), 1e-4f) << "back home";
+    }
+
     // Add stroke: a drag across the body's surface
     // the brush selects through the skeleton: it must reach the slab's centre line from its surface
     w->findChild<QDoubleSpinBox*>("paintRadius")->setValue(25.0);
