@@ -56,7 +56,8 @@ Manifest CaseWriter::manifest() const {
     return m;
 }
 
-std::string CaseWriter::buildNamed(const std::string& name, const Limits& limits, Manifest* written) const {
+std::string CaseWriter::buildNamed(const std::string& name, const Limits& limits, Manifest* written,
+                                   std::string* sha256) const {
     Manifest m = manifest();
     const std::string manifestText = m.toJsonText();
     std::vector<detail::ZipInput> inputs;
@@ -72,18 +73,19 @@ std::string CaseWriter::buildNamed(const std::string& name, const Limits& limits
     } catch (const detail::ZipError& error) {
         throw InputError(name + ": cannot build the zip archive: " + error.what());
     }
-    CasePackage::fromBytes(bytes, name, limits); // the player's checks, throws InputError
+    const auto verified = CasePackage::fromBytes(bytes, name, limits); // the player's checks, throws InputError
+    if (sha256) *sha256 = verified->sha256();
     if (written) *written = std::move(m);
     return bytes;
 }
 
 std::string CaseWriter::build(const Limits& limits) const {
-    return buildNamed("vcase::CaseWriter::build()", limits, nullptr);
+    return buildNamed("vcase::CaseWriter::build()", limits, nullptr, nullptr);
 }
 
-Manifest CaseWriter::write(const std::filesystem::path& path, const Limits& limits) const {
+Manifest CaseWriter::write(const std::filesystem::path& path, const Limits& limits, std::string* sha256) const {
     Manifest written;
-    std::string bytes = buildNamed(path.string(), limits, &written);
+    std::string bytes = buildNamed(path.string(), limits, &written, sha256);
     writeFileAtomic(path, bytes);
     return written;
 }

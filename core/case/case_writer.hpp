@@ -55,11 +55,12 @@ public:
     std::string build(const Limits& limits = {}) const;
 
     /// Builds and verifies the package (messages name `path`), then writes it with
-    /// viscera::writeFileAtomic. Returns the manifest written. Throws viscera::InputError.
-    Manifest write(const std::filesystem::path& path, const Limits& limits = {}) const;
+    /// viscera::writeFileAtomic. Returns the manifest written; `sha256`, when given, receives the
+    /// digest of the package's bytes (the verification computed it). Throws viscera::InputError.
+    Manifest write(const std::filesystem::path& path, const Limits& limits = {}, std::string* sha256 = nullptr) const;
 
 private:
-    std::string buildNamed(const std::string& name, const Limits& limits, Manifest* written) const;
+    std::string buildNamed(const std::string& name, const Limits& limits, Manifest* written, std::string* sha256) const;
 
     Manifest m_header;
     const SigningKey* m_key = nullptr;

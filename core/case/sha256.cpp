@@ -12,11 +12,16 @@ std::string sha256Hex(std::string_view bytes) {
     unsigned int length = 0;
     if (EVP_Digest(bytes.data(), bytes.size(), digest, &length, EVP_sha256(), nullptr) != 1 || length != 32)
         throw std::runtime_error("vcase::sha256Hex(): OpenSSL EVP_Digest failed");
+    return hexText(std::string_view(reinterpret_cast<const char*>(digest), length));
+}
+
+std::string hexText(std::string_view bytes) {
     static constexpr char kHex[] = "0123456789abcdef";
-    std::string hex(2 * length, '0');
-    for (unsigned int i = 0; i < length; ++i) {
-        hex[2 * i] = kHex[digest[i] >> 4];
-        hex[2 * i + 1] = kHex[digest[i] & 0xf];
+    std::string hex(2 * bytes.size(), '0');
+    for (size_t i = 0; i < bytes.size(); ++i) {
+        const auto b = static_cast<unsigned char>(bytes[i]);
+        hex[2 * i] = kHex[b >> 4];
+        hex[2 * i + 1] = kHex[b & 0xf];
     }
     return hex;
 }

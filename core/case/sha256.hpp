@@ -9,6 +9,9 @@ namespace viscera::vcase {
 /// 1 GB/s. Throws std::runtime_error only if OpenSSL itself fails.
 std::string sha256Hex(std::string_view bytes);
 
+/// `bytes` as lowercase hexadecimal, two characters a byte (digests, keys, signatures).
+std::string hexText(std::string_view bytes);
+
 /// True for exactly 64 characters in [0-9a-f] (the manifest's sha256 form).
 bool isSha256Hex(std::string_view text);
 

@@ -65,17 +65,6 @@ std::string rawPublicKey(EVP_PKEY* key) {
     return raw;
 }
 
-std::string hex(std::string_view bytes) {
-    static constexpr char kDigits[] = "0123456789abcdef";
-    std::string out;
-    out.reserve(2 * bytes.size());
-    for (unsigned char b : bytes) {
-        out += kDigits[b >> 4];
-        out += kDigits[b & 15];
-    }
-    return out;
-}
-
 /// Lowercase hex of exactly `bytes` bytes, or the field's error.
 std::string unhex(const sim::JsonField& f, size_t bytes) {
     const std::string text = f.string();
@@ -185,8 +174,8 @@ std::string PackageSignature::toJsonText() const {
     nlohmann::json j = {{"schemaVersion", 1},
                         {"algorithm", "ed25519"},
                         {"signer", signer},
-                        {"publicKey", hex(publicKey)},
-                        {"signature", hex(signature)}};
+                        {"publicKey", hexText(publicKey)},
+                        {"signature", hexText(signature)}};
     return j.dump(2) + "\n";
 }
 

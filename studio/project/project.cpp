@@ -7,7 +7,6 @@
 #include "bake/import.hpp"
 #include "case/case_writer.hpp"
 #include "case/manifest.hpp"
-#include "case/sha256.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/scene_json.hpp"
@@ -1065,11 +1064,10 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     if (!made.empty())
         throw std::logic_error("studio::exportCase(): '" + made.begin()->first +
                                "' was made but the scene does not name it");
-    const vcase::Manifest manifest = writer.write(out);
+    const vcase::Manifest manifest = writer.write(out, {}, &result.sha256);
     result.casePath = out;
     result.features = manifest.features;
     result.bytes = std::filesystem::file_size(out);
-    result.sha256 = vcase::sha256Hex(readFile(out, result.bytes + 1));
     if (publish.key) result.keyId = vcase::keyId(publish.key->publicKey());
     return result;
 }

@@ -6,9 +6,9 @@
 #include "case/sha256.hpp"
 #include "case/signing.hpp"
 #include "case/zip_craft.hpp"
-#include "player/slab_case.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "support/run_process.hpp"
+#include "support/slab_case.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -3,13 +3,13 @@
 // one-line message naming the file and the rule.
 #include "case/case_writer.hpp"
 #include "case/zip_craft.hpp"
-#include "player/slab_case.hpp"
 #include "sim/mesh/generators.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "support/case_signing.hpp"
 #include "support/run_process.hpp"
+#include "support/slab_case.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,5 +1,6 @@
-// The cantilever slab case of the player's end-to-end tests (slab_case.hpp). Not a test itself.
-#include "player/slab_case.hpp"
+// Fixture, not a test: builds the cantilever slab case the player end-to-end tests run and assert on
+// (slab_case.hpp); the assertions are in test_player_cli.cpp and test_package_trust.cpp.
+#include "support/slab_case.hpp"
 
 #include "case/case_writer.hpp"
 #include "case/signing.hpp"
