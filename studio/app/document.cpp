@@ -49,35 +49,69 @@ void rebaseProject(Project& p, const fs::path& to, std::vector<std::pair<fs::pat
 /// (keeping the first `before`), so a drag of many mouse events is one undo step.
 class ProjectCommand : public QUndoCommand {
 public:
-    ProjectCommand(Document* doc, const QString& text, Project before, Project after, int key)
-        : QUndoCommand(text), m_doc(doc), m_before(std::move(before)), m_after(std::move(after)), m_key(key) {}
+    ProjectCommand(Document* doc, const QString& text, Project before, Project after, int key, Change what)
+        : QUndoCommand(text), m_doc(doc), m_before(std::move(before)), m_after(std::move(after)), m_key(key),
+          m_what(what) {}
     int id() const override { return m_key ? 1 : -1; }
     bool mergeWith(const QUndoCommand* other) override {
         const auto* o = static_cast<const ProjectCommand*>(other);
         if (o->m_key != m_key) return false;
         m_after = o->m_after;
+        m_what.parts |= o->m_what.parts;
+        if (m_what.body != o->m_what.body) m_what.body = -1;
         return true;
     }
-    void redo() override { m_doc->replace(m_after); }
-    void undo() override { m_doc->replace(m_before); }
+    void redo() override { m_doc->replace(m_after, m_what); }
+    void undo() override { m_doc->replace(m_before, m_what); }
 
 private:
     Document* m_doc;
     Project m_before, m_after;
+    int m_key;
+    Change m_what;
+};
+
+/// A typed edit of one body's material: the material before and after, nothing else. A drag
+/// (the same nonzero key) merges into one step, keeping the first `before`.
+class MaterialCommand : public QUndoCommand {
+public:
+    MaterialCommand(Document* doc, const QString& text, int body, sim::Material before, sim::Material after, int key)
+        : QUndoCommand(text), m_doc(doc), m_body(body), m_before(std::move(before)), m_after(std::move(after)),
+          m_key(key) {}
+    int id() const override { return m_key ? 2 : -1; }
+    bool mergeWith(const QUndoCommand* other) override {
+        const auto* o = static_cast<const MaterialCommand*>(other);
+        if (o->m_key != m_key || o->m_body != m_body) return false;
+        m_after = o->m_after;
+        return true;
+    }
+    void redo() override { m_doc->setMaterial(m_body, m_after); }
+    void undo() override { m_doc->setMaterial(m_body, m_before); }
+
+private:
+    Document* m_doc;
+    int m_body;
+    sim::Material m_before, m_after;
     int m_key;
 };
 
 Document::Document(QObject* parent) : QObject(parent) {}
 Document::~Document() = default;
 
-void Document::replace(const Project& p) {
+void Document::replace(const Project& p, Change what) {
     // A model from before a Save As names the old folder: it is restored into the folder the
     // project lives in now (its files were copied there in the same layout).
     const fs::path here = m_project->dir;
     *m_project = p;
     if (m_project->dir != here) rebaseProject(*m_project, here, nullptr, false);
     ++m_revision;
-    emit changed();
+    emit changed(what);
+}
+
+void Document::setMaterial(int body, const sim::Material& m) {
+    m_project->bodies.at(static_cast<size_t>(body)).scene.material = m;
+    ++m_revision;
+    emit changed(Change::material(body));
 }
 
 void Document::open(const QString& folder) {
@@ -87,7 +121,7 @@ void Document::open(const QString& folder) {
     m_folder = QDir(folder).absolutePath();
     ++m_revision;
     emit logMessage(tr("opened %1").arg(m_folder));
-    emit changed();
+    emit changed(Change::everything());
 }
 
 void Document::createNew(const QString& folder, const QString& caseId) {
@@ -103,7 +137,7 @@ void Document::createNew(const QString& folder, const QString& caseId) {
     m_folder = abs;
     ++m_revision;
     emit logMessage(tr("created %1").arg(abs));
-    emit changed();
+    emit changed(Change::everything());
 }
 
 void Document::save() {
@@ -162,7 +196,7 @@ void Document::saveAs(const QString& folder) {
     m_folder = abs;
     m_undo.setClean();
     emit logMessage(tr("saved %1/project.json").arg(abs));
-    emit changed();
+    emit changed(Change::everything());
 }
 
 QString Document::check(const Project& p) {
@@ -177,7 +211,7 @@ QString Document::check(const Project& p) {
     return {};
 }
 
-QString Document::edit(const QString& text, const std::function<void(Project&)>& fn, int mergeKey) {
+QString Document::edit(const QString& text, const std::function<void(Project&)>& fn, int mergeKey, Change what) {
     if (!m_project) return tr("no project is open");
     Project after = *m_project;
     try {
@@ -186,7 +220,25 @@ QString Document::edit(const QString& text, const std::function<void(Project&)>&
         return QString::fromStdString(e.what());
     }
     if (QString why = check(after); !why.isEmpty()) return why;
-    m_undo.push(new ProjectCommand(this, text, *m_project, std::move(after), mergeKey));
+    m_undo.push(new ProjectCommand(this, text, *m_project, std::move(after), mergeKey, what));
+    return {};
+}
+
+QString Document::editMaterial(const QString& text, int body, const sim::Material& material, int mergeKey) {
+    if (!m_project) return tr("no project is open");
+    if (body < 0 || body >= static_cast<int>(m_project->bodies.size())) return tr("no body selected");
+    const BodyProject& b = m_project->bodies[static_cast<size_t>(body)];
+    const std::string where =
+        (m_project->dir / "project.json").string() + ": bodies[" + std::to_string(body) + "].material: ";
+    // The reader's rules for a material value: sim::validate (readMaterial's check) and the
+    // constraint model with its curves (what check() builds for every body).
+    if (const std::string why = sim::validate(material); !why.empty()) return QString::fromStdString(where + why);
+    try {
+        sim::makeConstraintModel(material, b.scene.name);
+    } catch (const std::exception& e) {
+        return QString::fromStdString(where + e.what());
+    }
+    m_undo.push(new MaterialCommand(this, text, body, b.scene.material, material, mergeKey));
     return {};
 }
 

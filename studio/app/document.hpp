@@ -1,11 +1,15 @@
 #pragma once
 /// The studio's open project: the one model (studio::Project, the same the headless export
-/// reads), its folder and the undo stack whose commands edit it. Every change goes through
-/// edit(): the edited copy is checked by the rules of load and export (the project text is
-/// written and read back by the project reader, every body's material is turned into
-/// constraints) and refused with that reader's one-line message, so a value the export would
-/// reject never enters the model. An undo command holds the model before and after, so undo
-/// restores it exactly; commands with the same merge key (one drag) merge into one step.
+/// reads), its folder and the undo stack whose commands edit it.
+///
+/// Edits are undo commands of two kinds. A typed edit (editMaterial) holds only the old and new
+/// value of what it edits, is checked by the rules the reader applies to that value
+/// (sim::validate and the constraint model of the material: no project text is written) and
+/// announces what it changed (Change), so the panels and the preview update only that. The
+/// general edit() applies a function to a copy of the model and checks the copy by the rules of
+/// load and export (the project text written and read back by the project reader); its command
+/// holds both models. Either way a value the export would reject never enters the model, undo
+/// restores it exactly, and commands with the same merge key (one drag) merge into one step.
 #include "project/project.hpp"
 
 #include <QObject>
@@ -16,6 +20,25 @@
 #include <memory>
 
 namespace viscera::studio {
+
+/// What an edit changed: the panels and the preview redo only what depends on it.
+struct Change {
+    enum Part : unsigned {
+        Material = 1u << 0,     ///< one body's material (body) or every body's (-1)
+        Paint = 1u << 1,        ///< stiffness paint strokes of a body or surface
+        LightSamples = 1u << 2, ///< light-sample paint of a body
+        Texture = 1u << 3,      ///< material-map blocks
+        Structure = 1u << 4,    ///< anything else: meshes, names, solver, scene, a new project
+        All = ~0u,
+    };
+    unsigned parts = All;
+    int body = -1; ///< the body a Material change edits (-1: any)
+
+    bool only(unsigned mask) const { return (parts & ~mask) == 0; }
+    bool touches(unsigned mask) const { return (parts & mask) != 0; }
+    static Change everything() { return {}; }
+    static Change material(int body) { return {Material, body}; }
+};
 
 class Document : public QObject {
     Q_OBJECT
@@ -46,7 +69,14 @@ public:
     /// an undo command holding both models. Returns the empty string when applied, else the
     /// check's message (the model is then unchanged). Commands pushed with the same nonzero
     /// `mergeKey` one after another merge into one undo step (a drag).
-    QString edit(const QString& text, const std::function<void(Project&)>& fn, int mergeKey = 0);
+    /// `what`: what the edit changes (the panels and the preview redo only that).
+    QString edit(const QString& text, const std::function<void(Project&)>& fn, int mergeKey = 0,
+                 Change what = Change::everything());
+    /// Sets body `body`'s material to `material` as one typed undo command (old and new material
+    /// only). Checked by the reader's rules for a material (sim::validate, then the constraint
+    /// model with its curves) without writing the project; refused with the rule as
+    /// "<folder>/project.json: bodies[i].material: <rule>". Same merge rule as edit().
+    QString editMaterial(const QString& text, int body, const sim::Material& material, int mergeKey = 0);
     /// A fresh merge key for one drag or one continuous gesture.
     int newMergeKey() { return ++m_lastMergeKey; }
 
@@ -56,14 +86,16 @@ public:
     static QString check(const Project& p);
 
 signals:
-    /// The model changed (any edit, undo, redo, open, new).
-    void changed();
+    /// The model changed (any edit, undo, redo, open, new): `what` says what.
+    void changed(const viscera::studio::Change& what);
     /// A one-line message for the log dock.
     void logMessage(const QString& line);
 
 private:
     friend class ProjectCommand;
-    void replace(const Project& p);
+    friend class MaterialCommand;
+    void replace(const Project& p, Change what);
+    void setMaterial(int body, const sim::Material& m);
 
     std::unique_ptr<Project> m_project;
     QString m_folder;

@@ -124,10 +124,11 @@ bool FitDialog::runFit() {
 
 QString FitDialog::apply() {
     if (!m_fitResult) return tr("nothing fitted yet");
-    const sim::ValanisLandelCurves c = m_fitResult->curves;
-    const int b = m_body;
-    return m_doc->edit(tr("Fit curves to test data"),
-                       [&](Project& p) { sim::setMaterialCurves(p.bodies.at(b).scene.material, c); });
+    if (!m_doc->hasProject() || m_body < 0 || m_body >= static_cast<int>(m_doc->project().bodies.size()))
+        return tr("no body selected");
+    sim::Material m = m_doc->project().bodies[m_body].scene.material;
+    sim::setMaterialCurves(m, m_fitResult->curves);
+    return m_doc->editMaterial(tr("Fit curves to test data"), m_body, m);
 }
 
 } // namespace viscera::studio

@@ -125,7 +125,11 @@ MaterialPanel::MaterialPanel(Document* doc, QWidget* parent) : QWidget(parent), 
     connect(m_fit, &QPushButton::clicked, this, [this] {
         if (m_body >= 0) emit fitRequested(m_body);
     });
-    connect(m_doc, &Document::changed, this, &MaterialPanel::refresh);
+    connect(m_doc, &Document::changed, this, [this](const Change& what) {
+        if (what.touches(Change::Structure) ||
+            (what.touches(Change::Material) && (what.body < 0 || what.body == m_body)))
+            refresh();
+    });
     refresh();
 }
 
@@ -170,28 +174,32 @@ void MaterialPanel::connectEditor(int k) {
 
 QString MaterialPanel::editPoints(int k, const QString& text,
                                   const std::function<void(std::vector<std::array<double, 2>>&)>& fn, int mergeKey) {
-    if (m_body < 0) return tr("no body selected");
-    const int b = m_body;
-    return m_doc->edit(
-        text,
-        [&](Project& p) {
-            auto& slot = p.bodies.at(b).scene.material.*kSlots[k];
-            if (!slot) throw std::invalid_argument("the material has no curve " + std::string(kNames[k]));
-            fn(slot->points);
-        },
-        mergeKey);
+    if (m_body < 0 || !m_doc->hasProject() || m_body >= static_cast<int>(m_doc->project().bodies.size()))
+        return tr("no body selected");
+    sim::Material m = m_doc->project().bodies[m_body].scene.material;
+    auto& slot = m.*kSlots[k];
+    if (!slot) return tr("the material has no curve %1").arg(kNames[k]);
+    try {
+        fn(slot->points);
+    } catch (const std::exception& e) {
+        return QString::fromStdString(e.what());
+    }
+    return m_doc->editMaterial(text, m_body, m, mergeKey);
 }
 
 QString MaterialPanel::applyPreset(const QString& law, double E, double nu) {
-    if (m_body < 0) return tr("no body selected");
-    const int b = m_body;
-    return m_doc->edit(tr("Preset %1").arg(law), [&](Project& p) {
-        sim::Material& m = p.bodies.at(b).scene.material;
+    if (m_body < 0 || !m_doc->hasProject() || m_body >= static_cast<int>(m_doc->project().bodies.size()))
+        return tr("no body selected");
+    sim::Material m = m_doc->project().bodies[m_body].scene.material;
+    try {
         const sim::ValanisLandelCurves c = sim::editableCurves(law.toStdString(), E, nu);
         sim::setMaterialCurves(m, c);
-        m.youngsModulus = E;
-        m.poissonRatio = nu;
-    });
+    } catch (const std::exception& e) {
+        return QString::fromStdString(e.what());
+    }
+    m.youngsModulus = E;
+    m.poissonRatio = nu;
+    return m_doc->editMaterial(tr("Preset %1").arg(law), m_body, m);
 }
 
 QString MaterialPanel::applyTypedPoint() {

@@ -194,14 +194,19 @@ void Preview::sample() {
     }
 }
 
-uint64_t Preview::submit(const Project& project, Mode mode, int body, uint64_t* framesAtSubmit) {
+uint64_t Preview::submit(const Project& project, Mode mode, int body, uint64_t* framesAtSubmit, Change what) {
     uint64_t serial;
     {
         std::lock_guard lock(m_mutex);
         serial = ++m_serial;
         if (framesAtSubmit) *framesAtSubmit = m_snapshot.frames;
         m_lastSubmitNs = Clock::now().time_since_epoch().count();
-        m_pending = Pending{project, mode, body, serial};
+        // a model not taken yet is replaced; what it changed still counts
+        if (m_pending) {
+            what.parts |= m_pending->what.parts;
+            if (what.body != m_pending->what.body) what.body = -1;
+        }
+        m_pending = Pending{project, mode, body, serial, what};
     }
     if (!m_thread.joinable()) m_thread = std::thread([this] { run(); });
     if (!m_sampler.joinable()) m_sampler = std::thread([this] { sample(); });
@@ -249,38 +254,23 @@ Project Preview::specimenProject(const Project& source, const sim::Material& mat
     return p;
 }
 
-void Preview::run() {
-    // The preview yields to the UI thread (nice 5): an editor stays responsive when the machine
-    // is busy; the preview's frame rate gives way instead.
-    ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 5);
-    std::string builtKey, builtTextures, builtRest;
+/// The worker thread's state (run() and its parts only).
+struct Preview::Worker {
+    std::string builtKey, builtTextures, builtRest; ///< what the built meshes, maps and world were made from
+    Mode builtMode = Mode::Scene;
     std::optional<BuiltScene> built;
     std::unique_ptr<sim::World> world;
     std::shared_ptr<sim::World> probe; ///< the selected body alone, for error sampling
     int probeBody = -1;
     uint64_t sceneRevision = 0, frames = 0;
     std::deque<double> history;
-    // When the project's material maps changed: a new view of `w` with them (no meshing again).
-    auto showMaps = [&](const Project& project, const sim::World& w) {
-        std::string textures = texturesKey(project);
-        if (textures == builtTextures) return;
-        auto view = std::make_shared<render::SceneView>(render::SceneView::fromWorld(w));
-        try {
-            applyTextures(project, *view);
-        } catch (const std::exception& e) {
-            emit logMessage(tr("preview: %1 (drawn without its material maps)").arg(e.what()));
-        }
-        builtTextures = std::move(textures);
-        std::lock_guard lock(m_mutex);
-        m_view = std::move(view);
-        m_snapshot.scene = ++sceneRevision;
-        ++m_revision;
-    };
-    auto publishStatus = [&](auto&& fn) {
-        std::lock_guard lock(m_mutex);
-        fn(m_snapshot);
-        ++m_revision;
-    };
+};
+
+void Preview::run() {
+    // The preview yields to the UI thread (nice 5): an editor stays responsive when the machine
+    // is busy; the preview's frame rate gives way instead.
+    ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 5);
+    Worker w;
     while (!m_stop) {
         const auto frameStart = Clock::now();
         std::optional<Pending> job;
@@ -290,225 +280,271 @@ void Preview::run() {
             job.swap(m_pending);
             takenAfter = m_snapshot.frames;
         }
-        if (job) {
-            Project project = job->project;
-            if (job->mode == Mode::Specimen) {
-                const int i = std::clamp(job->body, 0, std::max(0, static_cast<int>(project.bodies.size()) - 1));
-                project = specimenProject(job->project,
-                                          project.bodies.empty() ? sim::Material{} : project.bodies[i].scene.material);
-            }
-            const std::string origin = (project.dir / "project.json").string();
-            try {
-                const std::string key = structureKey(project, job->mode, job->body);
-                const std::string rest = allButTexturesKey(project, job->mode);
-                std::unique_ptr<sim::World> next;
-                const bool mapsOnly = built && world && key == builtKey && rest == builtRest;
-                if (mapsOnly) {
-                    // only material maps changed: the running world goes on, the view is new
-                    showMaps(project, *world);
-                } else if (!built || key != builtKey) {
-                    emit logMessage(tr("preview: building meshes"));
-                    BuiltScene b = buildScene(project);
-                    // one solver thread: the other core stays with the UI and the viewport's renderer
-                    b.scene.xpbd.threads = 1;
-                    bool ok = true;
-                    const QString verdict = stabilityVerdict(b, ok);
-                    publishStatus([&](Snapshot& s) {
-                        s.verdict = verdict;
-                        s.verdictOk = ok;
-                    });
-                    if (!ok) throw std::runtime_error(tr("the preview keeps the last stable model").toStdString());
-                    next = assembleWorld(b, origin);
-                    auto view = std::make_shared<render::SceneView>(render::SceneView::fromWorld(*next));
-                    if (job->mode == Mode::Scene && hasTextures(project)) {
-                        try {
-                            applyTextures(project, *view);
-                        } catch (const std::exception& e) { // the scene is still shown, procedural
-                            emit logMessage(tr("preview: %1 (drawn without its material maps)").arg(e.what()));
-                        }
-                    }
-                    std::vector<std::shared_ptr<const sim::TetMesh>> meshes;
-                    std::vector<std::shared_ptr<const sim::TriMesh>> surfaceMeshes;
-                    if (job->mode == Mode::Scene) {
-                        for (const auto& m : b.meshes)
-                            meshes.push_back(std::shared_ptr<const sim::TetMesh>(m->clone()));
-                        for (const sim::TriMesh& m : b.surfaces)
-                            surfaceMeshes.push_back(std::make_shared<const sim::TriMesh>(m));
-                    }
-                    built = std::move(b);
-                    builtKey = key;
-                    builtRest = rest;
-                    builtTextures = texturesKey(project);
-                    {
-                        std::lock_guard lock(m_mutex);
-                        m_view = std::move(view);
-                        m_bodyMeshes = std::move(meshes);
-                        m_surfaceMeshes = std::move(surfaceMeshes);
-                        m_snapshot.scene = ++sceneRevision;
-                        ++m_revision;
-                    }
-                    emit logMessage(tr("preview: %1 bodies, %2 substeps per frame")
-                                        .arg(built->scene.bodies.size())
-                                        .arg(built->scene.xpbd.substeps));
-                } else {
-                    BuiltScene& b = *built;
-                    std::vector<sim::Material> old;
-                    std::vector<std::vector<double>> oldWeights, oldSurfaceWeights;
-                    auto restore = [&] {
-                        for (size_t i = 0; i < old.size(); ++i) {
-                            b.scene.bodies[i].material = old[i];
-                            b.scene.bodies[i].nodeWeights = oldWeights[i];
-                        }
-                        for (size_t s = 0; s < oldSurfaceWeights.size(); ++s)
-                            b.scene.surfaces[s].nodeWeights = oldSurfaceWeights[s];
-                    };
-                    bool ok = true;
-                    QString verdict;
-                    try {
-                        for (size_t i = 0; i < b.scene.bodies.size(); ++i) {
-                            old.push_back(b.scene.bodies[i].material);
-                            oldWeights.push_back(b.scene.bodies[i].nodeWeights);
-                            b.scene.bodies[i].material = project.bodies[i].scene.material;
-                            // painted bodies: their strokes again, through the skeleton already made
-                            if (project.bodies[i].paint && i < b.skeletons.size())
-                                b.scene.bodies[i].nodeWeights =
-                                    bodyNodeWeights(project.bodies[i], *b.meshes[i], b.skeletons[i], origin,
-                                                    "bodies[" + std::to_string(i) + "]");
-                        }
-                        for (size_t s = 0; s < b.scene.surfaces.size() && s < project.surfaces.size(); ++s) {
-                            oldSurfaceWeights.push_back(b.scene.surfaces[s].nodeWeights);
-                            if (project.surfaces[s].paint) // painted fascia: its strokes again
-                                b.scene.surfaces[s].nodeWeights = surfaceNodeWeights(
-                                    project.surfaces[s], b.surfaces[s], origin, "surfaces[" + std::to_string(s) + "]");
-                        }
-                        verdict = stabilityVerdict(b, ok);
-                        if (ok) next = assembleWorld(b, origin);
-                    } catch (...) {
-                        restore();
-                        throw;
-                    }
-                    publishStatus([&](Snapshot& s) {
-                        s.verdict = verdict;
-                        s.verdictOk = ok;
-                    });
-                    if (!ok) {
-                        restore();
-                        throw std::runtime_error(tr("the preview keeps the last stable material").toStdString());
-                    }
-                    if (world && world->bodyCount() == next->bodyCount() &&
-                        world->surfaceCount() == next->surfaceCount() && b.scene.solverType == "xpbd") {
-                        // the motion goes on under the new material (instruments restart their tracks)
-                        for (size_t i = 0; i < next->bodyCount(); ++i)
-                            next->setState(i, world->positions(i), world->velocities(i));
-                        for (size_t i = 0; i < next->surfaceCount(); ++i)
-                            next->setSurfaceState(i, world->surfacePositions(i), world->surfaceVelocities(i));
-                    }
-                    builtRest = rest;
-                    if (job->mode == Mode::Scene) {
-                        // new material maps on the same meshes: a new view, without meshing again
-                        showMaps(project, *next);
-                    }
-                }
-                if (!mapsOnly) {
-                    world = std::move(next);
-                    probeBody = -1;
-                    probe.reset();
-                }
-                if (!mapsOnly && built->scene.solverType == "xpbd" && !built->scene.bodies.empty()) {
-                    probeBody = std::clamp(job->mode == Mode::Specimen ? 0 : job->body, 0,
-                                           static_cast<int>(built->scene.bodies.size()) - 1);
-                    try {
-                        probe = probeWorld(*built, static_cast<size_t>(probeBody), origin);
-                        probe->setAccuracyCancel(&m_stop); // stop() (closing, quitting) never waits for a reference
-                    } catch (const std::exception& e) {
-                        emit logMessage(tr("preview: no error sampling for body %1: %2")
-                                            .arg(probeBody)
-                                            .arg(QString::fromStdString(e.what())));
-                        probeBody = -1;
-                    }
-                }
-                const QString sampled = !probe ? tr("nothing (no XPBD body)")
-                                        : sim::supportsAccuracySampling(built->scene)
-                                            ? tr("the scene")
-                                            : tr("body '%1' alone (its layers are not coupled in the reference)")
-                                                  .arg(QString::fromStdString(built->scene.bodies[probeBody].name));
-                publishStatus([&](Snapshot& s) {
-                    s.serial = job->serial;
-                    s.appliedAfter = takenAfter;
-                    s.accuracyOf = sampled;
-                    s.error.clear();
-                });
-            } catch (const std::exception& e) {
-                const QString why = QString::fromStdString(e.what());
-                publishStatus([&](Snapshot& s) {
-                    s.serial = job->serial; // seen, not shown
-                    s.appliedAfter = takenAfter;
-                    s.error = why;
-                });
-                emit logMessage(tr("preview: %1").arg(why));
-                emit frameReady();
-            }
-        }
-        if (!world || m_paused) {
+        if (job) takeJob(w, *job, takenAfter);
+        if (!w.world || m_paused) {
             std::unique_lock lock(m_mutex);
             m_wake.wait_for(lock, std::chrono::milliseconds(50), [&] { return m_stop || m_pending.has_value(); });
             continue;
         }
-        const sim::FrameRecord r = world->step();
-        ++frames;
-        bool finite = r.finite;
-        for (size_t i = 0; finite && i < world->bodyCount(); ++i)
-            finite = allFinite(world->positions(i));
-        if (!finite) {
-            emit logMessage(tr("preview: the state became non-finite at frame %1; restarting from rest").arg(r.index));
-            try {
-                world = assembleWorld(*built, "preview");
-            } catch (const std::exception& e) {
-                world.reset(); // shows nothing until the next model comes
-                emit logMessage(tr("preview: %1").arg(QString::fromStdString(e.what())));
-            }
-            continue;
-        }
-        // Sampling waits for a quiet moment (no edit for kQuietMs): during a drag its reference
-        // solve would take the core the UI and the preview need.
-        const bool quiet = Clock::now().time_since_epoch().count() - m_lastSubmitNs.load() >
-                           std::chrono::duration_cast<Clock::duration>(std::chrono::milliseconds(kQuietMs)).count();
-        if (probe && quiet && frames >= m_nextSample) {
-            // the selected body's state goes to the sampler thread, which solves the first
-            // substep from it to convergence; the preview does not wait for it
-            std::lock_guard lock(m_sampleMutex);
-            if (!m_sampleJob && !m_sampling) {
-                const auto b = static_cast<size_t>(probeBody);
-                m_sampleJob = SampleJob{probe, world->positions(b), world->velocities(b), static_cast<int>(frames)};
-                m_nextSample = frames + static_cast<uint64_t>(std::max(1, m_accuracyEvery.load()));
-                m_sampleWake.notify_all();
-            }
-        }
-        history.push_back(r.stepMs);
-        while (history.size() > kHistory)
-            history.pop_front();
-        {
-            std::lock_guard lock(m_mutex);
-            Snapshot& s = m_snapshot;
-            s.frame = r.index;
-            s.frames = frames;
-            s.stepMs = r.stepMs;
-            s.frameMs = history;
-            s.bodies.resize(world->bodyCount());
-            for (size_t i = 0; i < world->bodyCount(); ++i)
-                s.bodies[i] = world->positions(i);
-            s.surfaces.resize(world->surfaceCount());
-            for (size_t i = 0; i < world->surfaceCount(); ++i)
-                s.surfaces[i] = world->surfacePositions(i);
-            ++m_revision;
-        }
+        if (!stepFrame(w)) continue;
         emit frameReady();
-        if (m_realTime && built) {
-            const auto due = frameStart + std::chrono::duration<double>(built->scene.xpbd.dt);
+        if (m_realTime && w.built) {
+            const auto due = frameStart + std::chrono::duration<double>(w.built->scene.xpbd.dt);
             std::unique_lock lock(m_mutex);
             m_wake.wait_until(lock, due, [&] { return m_stop || m_pending.has_value(); });
         }
     }
+}
+
+void Preview::publishStatus(const std::function<void(Snapshot&)>& fn) {
+    std::lock_guard lock(m_mutex);
+    fn(m_snapshot);
+    ++m_revision;
+}
+
+void Preview::takeJob(Worker& w, const Pending& job, uint64_t takenAfter) {
+    Project project = job.project;
+    if (job.mode == Mode::Specimen) {
+        const int i = std::clamp(job.body, 0, std::max(0, static_cast<int>(project.bodies.size()) - 1));
+        project =
+            specimenProject(job.project, project.bodies.empty() ? sim::Material{} : project.bodies[i].scene.material);
+    }
+    const std::string origin = (project.dir / "project.json").string();
+    try {
+        // A typed edit of materials or paint strokes says so: the meshes stay, nothing is
+        // compared (no project text is written); any other change compares what it touched.
+        const bool typed =
+            w.built && w.world && job.mode == w.builtMode && job.what.only(Change::Material | Change::Paint);
+        std::string key, rest;
+        if (!typed) {
+            key = structureKey(project, job.mode, job.body);
+            rest = allButTexturesKey(project, job.mode);
+        }
+        const bool mapsOnly = !typed && w.built && w.world && key == w.builtKey && rest == w.builtRest;
+        if (mapsOnly) {
+            showMaps(w, project, *w.world); // only material maps changed: the running world goes on
+        } else {
+            std::unique_ptr<sim::World> next;
+            if (!typed && (!w.built || key != w.builtKey)) {
+                next = buildWorld(w, project, job.mode, origin);
+                w.builtKey = key;
+            } else {
+                next = applyMaterials(w, project, origin);
+                // new material maps on the same meshes: a new view, without meshing again
+                if (!typed && job.mode == Mode::Scene) showMaps(w, project, *next);
+            }
+            w.builtRest = rest; // empty after a typed edit: the next comparison applies the model again
+            w.world = std::move(next);
+            makeProbe(w, job, origin);
+        }
+        const QString sampled = !w.probe ? tr("nothing (no XPBD body)")
+                                : sim::supportsAccuracySampling(w.built->scene)
+                                    ? tr("the scene")
+                                    : tr("body '%1' alone (its layers are not coupled in the reference)")
+                                          .arg(QString::fromStdString(w.built->scene.bodies[w.probeBody].name));
+        publishStatus([&](Snapshot& s) {
+            s.serial = job.serial;
+            s.appliedAfter = takenAfter;
+            s.accuracyOf = sampled;
+            s.error.clear();
+        });
+    } catch (const std::exception& e) {
+        const QString why = QString::fromStdString(e.what());
+        publishStatus([&](Snapshot& s) {
+            s.serial = job.serial; // seen, not shown
+            s.appliedAfter = takenAfter;
+            s.error = why;
+        });
+        emit logMessage(tr("preview: %1").arg(why));
+        emit frameReady();
+    }
+}
+
+void Preview::showMaps(Worker& w, const Project& project, const sim::World& world) {
+    std::string textures = texturesKey(project);
+    if (textures == w.builtTextures) return;
+    auto view = std::make_shared<render::SceneView>(render::SceneView::fromWorld(world));
+    try {
+        applyTextures(project, *view);
+    } catch (const std::exception& e) {
+        emit logMessage(tr("preview: %1 (drawn without its material maps)").arg(e.what()));
+    }
+    w.builtTextures = std::move(textures);
+    std::lock_guard lock(m_mutex);
+    m_view = std::move(view);
+    m_snapshot.scene = ++w.sceneRevision;
+    ++m_revision;
+}
+
+std::unique_ptr<sim::World> Preview::buildWorld(Worker& w, const Project& project, Mode mode,
+                                                const std::string& origin) {
+    emit logMessage(tr("preview: building meshes"));
+    BuiltScene b = buildScene(project);
+    // one solver thread: the other core stays with the UI and the viewport's renderer
+    b.scene.xpbd.threads = 1;
+    bool ok = true;
+    const QString verdict = stabilityVerdict(b, ok);
+    publishStatus([&](Snapshot& s) {
+        s.verdict = verdict;
+        s.verdictOk = ok;
+    });
+    if (!ok) throw std::runtime_error(tr("the preview keeps the last stable model").toStdString());
+    std::unique_ptr<sim::World> next = assembleWorld(b, origin);
+    auto view = std::make_shared<render::SceneView>(render::SceneView::fromWorld(*next));
+    if (mode == Mode::Scene && hasTextures(project)) {
+        try {
+            applyTextures(project, *view);
+        } catch (const std::exception& e) { // the scene is still shown, procedural
+            emit logMessage(tr("preview: %1 (drawn without its material maps)").arg(e.what()));
+        }
+    }
+    std::vector<std::shared_ptr<const sim::TetMesh>> meshes;
+    std::vector<std::shared_ptr<const sim::TriMesh>> surfaceMeshes;
+    if (mode == Mode::Scene) {
+        for (const auto& m : b.meshes)
+            meshes.push_back(std::shared_ptr<const sim::TetMesh>(m->clone()));
+        for (const sim::TriMesh& m : b.surfaces)
+            surfaceMeshes.push_back(std::make_shared<const sim::TriMesh>(m));
+    }
+    w.built = std::move(b);
+    w.builtMode = mode;
+    w.builtTextures = texturesKey(project);
+    {
+        std::lock_guard lock(m_mutex);
+        m_view = std::move(view);
+        m_bodyMeshes = std::move(meshes);
+        m_surfaceMeshes = std::move(surfaceMeshes);
+        m_snapshot.scene = ++w.sceneRevision;
+        ++m_revision;
+    }
+    emit logMessage(tr("preview: %1 bodies, %2 substeps per frame")
+                        .arg(w.built->scene.bodies.size())
+                        .arg(w.built->scene.xpbd.substeps));
+    return next;
+}
+
+std::unique_ptr<sim::World> Preview::applyMaterials(Worker& w, const Project& project, const std::string& origin) {
+    BuiltScene& b = *w.built;
+    std::vector<sim::Material> old;
+    std::vector<std::vector<double>> oldWeights, oldSurfaceWeights;
+    auto restore = [&] {
+        for (size_t i = 0; i < old.size(); ++i) {
+            b.scene.bodies[i].material = old[i];
+            b.scene.bodies[i].nodeWeights = oldWeights[i];
+        }
+        for (size_t s = 0; s < oldSurfaceWeights.size(); ++s)
+            b.scene.surfaces[s].nodeWeights = oldSurfaceWeights[s];
+    };
+    bool ok = true;
+    QString verdict;
+    std::unique_ptr<sim::World> next;
+    try {
+        for (size_t i = 0; i < b.scene.bodies.size(); ++i) {
+            old.push_back(b.scene.bodies[i].material);
+            oldWeights.push_back(b.scene.bodies[i].nodeWeights);
+            b.scene.bodies[i].material = project.bodies[i].scene.material;
+            // painted bodies: their strokes again, through the skeleton already made
+            if (project.bodies[i].paint && i < b.skeletons.size())
+                b.scene.bodies[i].nodeWeights = bodyNodeWeights(project.bodies[i], *b.meshes[i], b.skeletons[i], origin,
+                                                                "bodies[" + std::to_string(i) + "]");
+        }
+        for (size_t s = 0; s < b.scene.surfaces.size() && s < project.surfaces.size(); ++s) {
+            oldSurfaceWeights.push_back(b.scene.surfaces[s].nodeWeights);
+            if (project.surfaces[s].paint) // painted fascia: its strokes again
+                b.scene.surfaces[s].nodeWeights = surfaceNodeWeights(project.surfaces[s], b.surfaces[s], origin,
+                                                                     "surfaces[" + std::to_string(s) + "]");
+        }
+        verdict = stabilityVerdict(b, ok);
+        if (ok) next = assembleWorld(b, origin);
+    } catch (...) {
+        restore();
+        throw;
+    }
+    publishStatus([&](Snapshot& s) {
+        s.verdict = verdict;
+        s.verdictOk = ok;
+    });
+    if (!ok) {
+        restore();
+        throw std::runtime_error(tr("the preview keeps the last stable material").toStdString());
+    }
+    if (w.world && w.world->bodyCount() == next->bodyCount() && w.world->surfaceCount() == next->surfaceCount() &&
+        b.scene.solverType == "xpbd") {
+        // the motion goes on under the new material (instruments restart their tracks)
+        for (size_t i = 0; i < next->bodyCount(); ++i)
+            next->setState(i, w.world->positions(i), w.world->velocities(i));
+        for (size_t i = 0; i < next->surfaceCount(); ++i)
+            next->setSurfaceState(i, w.world->surfacePositions(i), w.world->surfaceVelocities(i));
+    }
+    return next;
+}
+
+void Preview::makeProbe(Worker& w, const Pending& job, const std::string& origin) {
+    w.probeBody = -1;
+    w.probe.reset();
+    if (w.built->scene.solverType != "xpbd" || w.built->scene.bodies.empty()) return;
+    w.probeBody =
+        std::clamp(job.mode == Mode::Specimen ? 0 : job.body, 0, static_cast<int>(w.built->scene.bodies.size()) - 1);
+    try {
+        w.probe = probeWorld(*w.built, static_cast<size_t>(w.probeBody), origin);
+        w.probe->setAccuracyCancel(&m_stop); // stop() (closing, quitting) never waits for a reference
+    } catch (const std::exception& e) {
+        emit logMessage(
+            tr("preview: no error sampling for body %1: %2").arg(w.probeBody).arg(QString::fromStdString(e.what())));
+        w.probeBody = -1;
+    }
+}
+
+bool Preview::stepFrame(Worker& w) {
+    const sim::FrameRecord r = w.world->step();
+    ++w.frames;
+    bool finite = r.finite;
+    for (size_t i = 0; finite && i < w.world->bodyCount(); ++i)
+        finite = allFinite(w.world->positions(i));
+    if (!finite) {
+        emit logMessage(tr("preview: the state became non-finite at frame %1; restarting from rest").arg(r.index));
+        try {
+            w.world = assembleWorld(*w.built, "preview");
+        } catch (const std::exception& e) {
+            w.world.reset(); // shows nothing until the next model comes
+            emit logMessage(tr("preview: %1").arg(QString::fromStdString(e.what())));
+        }
+        return false;
+    }
+    offerSample(w);
+    w.history.push_back(r.stepMs);
+    while (w.history.size() > kHistory)
+        w.history.pop_front();
+    std::lock_guard lock(m_mutex);
+    Snapshot& s = m_snapshot;
+    s.frame = r.index;
+    s.frames = w.frames;
+    s.stepMs = r.stepMs;
+    s.frameMs = w.history;
+    s.bodies.resize(w.world->bodyCount());
+    for (size_t i = 0; i < w.world->bodyCount(); ++i)
+        s.bodies[i] = w.world->positions(i);
+    s.surfaces.resize(w.world->surfaceCount());
+    for (size_t i = 0; i < w.world->surfaceCount(); ++i)
+        s.surfaces[i] = w.world->surfacePositions(i);
+    ++m_revision;
+    return true;
+}
+
+void Preview::offerSample(Worker& w) {
+    // Sampling waits for a quiet moment (no edit for kQuietMs): during a drag its reference
+    // solve would take the core the UI and the preview need.
+    const bool quiet = Clock::now().time_since_epoch().count() - m_lastSubmitNs.load() >
+                       std::chrono::duration_cast<Clock::duration>(std::chrono::milliseconds(kQuietMs)).count();
+    if (!w.probe || !quiet || w.frames < m_nextSample) return;
+    // the selected body's state goes to the sampler thread, which solves the first substep from
+    // it to convergence; the preview does not wait for it
+    std::lock_guard lock(m_sampleMutex);
+    if (m_sampleJob || m_sampling) return;
+    const auto b = static_cast<size_t>(w.probeBody);
+    m_sampleJob = SampleJob{w.probe, w.world->positions(b), w.world->velocities(b), static_cast<int>(w.frames)};
+    m_nextSample = w.frames + static_cast<uint64_t>(std::max(1, m_accuracyEvery.load()));
+    m_sampleWake.notify_all();
 }
 
 RealTimeEstimate estimateRealTime(const std::deque<double>& frameMs, double frameDt, size_t window, size_t minFrames) {

@@ -18,6 +18,7 @@
 /// error [A eq. 4.45] against wall time for the current settings, the live error plot. The Newton reference takes one
 /// tet body, so in a layered scene the body's couplings to the other layers are left out, which the snapshot says
 /// (accuracyOf).
+#include "app/document.hpp"
 #include "project/project.hpp"
 #include "render/scene_view.hpp"
 #include "sim/scene/scene_solver.hpp"
@@ -28,6 +29,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -69,7 +71,10 @@ public:
     /// The model to simulate (mode Specimen: a 20 × 20 × 60 mm specimen of body `body`'s
     /// material hanging under gravity, fixed at its top). Returns the serial of this submission;
     /// `framesAtSubmit` (optional) gets the frames completed at this moment.
-    uint64_t submit(const Project& project, Mode mode, int body, uint64_t* framesAtSubmit = nullptr);
+    /// `what`: what changed since the last submission (a typed material or paint edit keeps the
+    /// meshes without comparing the models).
+    uint64_t submit(const Project& project, Mode mode, int body, uint64_t* framesAtSubmit = nullptr,
+                    Change what = Change::everything());
     void setAccuracyEvery(int frames) { m_accuracyEvery = frames; }
     void setRealTime(bool on) { m_realTime = on; }
     /// Paused: edits are still taken (verdict, new world), no frame is simulated.
@@ -107,9 +112,22 @@ private:
         Mode mode;
         int body;
         uint64_t serial;
+        Change what;
     };
+    struct Worker;
     void run();
     void sample();
+    /// run()'s parts: apply a submitted model (a new world from new meshes, or new materials on
+    /// the meshes built), then step and publish frames.
+    void takeJob(Worker& w, const Pending& job, uint64_t takenAfter);
+    std::unique_ptr<sim::World> buildWorld(Worker& w, const Project& project, Mode mode, const std::string& origin);
+    std::unique_ptr<sim::World> applyMaterials(Worker& w, const Project& project, const std::string& origin);
+    void showMaps(Worker& w, const Project& project, const sim::World& world);
+    void makeProbe(Worker& w, const Pending& job, const std::string& origin);
+    /// One frame, published; false when the state became non-finite (the world restarts).
+    bool stepFrame(Worker& w);
+    void offerSample(Worker& w);
+    void publishStatus(const std::function<void(Snapshot&)>& fn);
 
     /// A state to sample: the probe world (one body, accuracy on every frame) and the body's
     /// positions and velocities at preview frame `frame`.

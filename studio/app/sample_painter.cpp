@@ -29,8 +29,9 @@ std::array<float, 4> sampleClassColour(int samples) {
 }
 
 SamplePainter::SamplePainter(Document* doc, QObject* parent) : QObject(parent), m_doc(doc) {
-    connect(m_doc, &Document::changed, this, [this] {
-        if (m_ready && !stroking()) recompute(); // undo, redo, another edit of the operations
+    connect(m_doc, &Document::changed, this, [this](const Change& what) {
+        // undo, redo, another edit of the operations (a material edit leaves the classes)
+        if (m_ready && !stroking() && what.touches(Change::LightSamples | Change::Structure)) recompute();
     });
 }
 
@@ -157,8 +158,9 @@ QString SamplePainter::end() {
     const QString what = op.samples == 0 ? tr("erase") : tr("%1×").arg(op.samples);
     const QString text = op.tool == render::SamplePaintOp::Tool::Fill ? tr("Fill light samples (%1) on '%2'")
                                                                       : tr("Paint light samples (%1) on '%2'");
-    const QString why =
-        m_doc->edit(text.arg(what, name), [&](Project& p) { p.bodies[body].lightSamples.push_back(op); });
+    const QString why = m_doc->edit(
+        text.arg(what, name), [&](Project& p) { p.bodies[body].lightSamples.push_back(op); }, 0,
+        Change{Change::LightSamples, body});
     if (!why.isEmpty()) setStatus(why);
     recompute(); // the committed operations (or, refused, the classes as they were)
     return why;

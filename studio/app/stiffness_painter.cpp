@@ -17,8 +17,9 @@ struct StiffnessPainter::Prepared {
 };
 
 StiffnessPainter::StiffnessPainter(Document* doc, QObject* parent) : QObject(parent), m_doc(doc) {
-    connect(m_doc, &Document::changed, this, [this] {
-        if (m_ready && !m_stroking) recompute(); // undo, redo, another edit of the strokes
+    connect(m_doc, &Document::changed, this, [this](const Change& what) {
+        // undo, redo, another edit of the strokes (a material edit leaves the weights)
+        if (m_ready && !m_stroking && what.touches(Change::Paint | Change::Structure)) recompute();
     });
 }
 
@@ -260,14 +261,15 @@ QString StiffnessPainter::end() {
         return why;
     }
     static const char* const kModes[] = {"add", "subtract", "mix", "smooth"};
-    const QString why =
-        m_doc->edit(tr("Paint stiffness (%1) on '%2'").arg(kModes[static_cast<int>(dabs.front().mode)], targetName()),
-                    [&](Project& p) {
-                        std::optional<StiffnessPaintProject>& paint =
-                            m_surface >= 0 ? p.surfaces[m_surface].paint : p.bodies[m_body].paint;
-                        if (!paint) paint = StiffnessPaintProject{};
-                        paint->strokes.insert(paint->strokes.end(), dabs.begin(), dabs.end());
-                    });
+    const QString why = m_doc->edit(
+        tr("Paint stiffness (%1) on '%2'").arg(kModes[static_cast<int>(dabs.front().mode)], targetName()),
+        [&](Project& p) {
+            std::optional<StiffnessPaintProject>& paint =
+                m_surface >= 0 ? p.surfaces[m_surface].paint : p.bodies[m_body].paint;
+            if (!paint) paint = StiffnessPaintProject{};
+            paint->strokes.insert(paint->strokes.end(), dabs.begin(), dabs.end());
+        },
+        0, Change{Change::Paint, m_surface >= 0 ? -1 : m_body});
     if (!why.isEmpty()) setStatus(why);
     recompute(); // the committed strokes (or, refused, the weights as they were)
     return why;

@@ -328,7 +328,9 @@ TexturePanel::TexturePanel(Document* doc, QWidget* parent) : QWidget(parent), m_
     connect(m_copyHex, &QPushButton::clicked, this, [this] { QGuiApplication::clipboard()->setText(pickedHexText()); });
     connect(m_usePicked, &QPushButton::clicked, this, [this] { usePickedPalette(); });
     connectGeneratorFields();
-    connect(m_doc, &Document::changed, this, &TexturePanel::refresh);
+    connect(m_doc, &Document::changed, this, [this](const Change& what) {
+        if (what.touches(Change::Texture | Change::Structure)) refresh(); // a material drag redraws nothing here
+    });
     refresh();
 }
 
@@ -949,14 +951,17 @@ QString TexturePanel::applyFields() {
     }
     const Target kind = m_kind;
     const int index = m_index;
-    why = m_doc->edit(tr("Set the material maps of '%1'").arg(targetName()), [&](Project& p) {
-        (kind == Target::Body ? p.bodies[index].texture : p.surfaces[index].texture) = t;
-        // the project's rules first (the spec path lies inside the project folder, a generator
-        // parses), then a spec file must parse: a block the preview and the export cannot bake
-        // never enters the model
-        if (const QString rule = Document::check(p); !rule.isEmpty()) throw InputError(rule.toStdString());
-        if (t.generator.empty()) bake::loadTextureSpec(p.dir / t.spec);
-    });
+    why = m_doc->edit(
+        tr("Set the material maps of '%1'").arg(targetName()),
+        [&](Project& p) {
+            (kind == Target::Body ? p.bodies[index].texture : p.surfaces[index].texture) = t;
+            // the project's rules first (the spec path lies inside the project folder, a generator
+            // parses), then a spec file must parse: a block the preview and the export cannot bake
+            // never enters the model
+            if (const QString rule = Document::check(p); !rule.isEmpty()) throw InputError(rule.toStdString());
+            if (t.generator.empty()) bake::loadTextureSpec(p.dir / t.spec);
+        },
+        0, Change{Change::Texture});
     setStatus(why);
     return why;
 }
@@ -974,9 +979,10 @@ QString TexturePanel::newGenerator() {
     t.generator = defaultGenerator(targetName().toStdString()).dump();
     const Target kind = m_kind;
     const int index = m_index;
-    const QString why = m_doc->edit(tr("New material generator for '%1'").arg(targetName()), [&](Project& p) {
-        (kind == Target::Body ? p.bodies[index].texture : p.surfaces[index].texture) = t;
-    });
+    const QString why = m_doc->edit(
+        tr("New material generator for '%1'").arg(targetName()),
+        [&](Project& p) { (kind == Target::Body ? p.bodies[index].texture : p.surfaces[index].texture) = t; }, 0,
+        Change{Change::Texture});
     setStatus(why);
     return why;
 }
@@ -988,9 +994,10 @@ QString TexturePanel::removeTexture() {
     }
     const Target kind = m_kind;
     const int index = m_index;
-    const QString why = m_doc->edit(tr("Remove the material maps of '%1'").arg(targetName()), [&](Project& p) {
-        (kind == Target::Body ? p.bodies[index].texture : p.surfaces[index].texture).reset();
-    });
+    const QString why = m_doc->edit(
+        tr("Remove the material maps of '%1'").arg(targetName()),
+        [&](Project& p) { (kind == Target::Body ? p.bodies[index].texture : p.surfaces[index].texture).reset(); }, 0,
+        Change{Change::Texture});
     setStatus(why);
     return why;
 }
@@ -1030,7 +1037,7 @@ QString TexturePanel::editGenerator(const QString& what, const void* source,
     const QString why = m_doc->edit(
         tr("%1 of '%2'").arg(what, targetName()),
         [&](Project& p) { (kind == Target::Body ? p.bodies[index].texture : p.surfaces[index].texture) = t; },
-        m_lastMergeKey);
+        m_lastMergeKey, Change{Change::Texture});
     if (why.isEmpty()) {
         m_lastSource = source;
         m_lastUndoIndex = undo->index();

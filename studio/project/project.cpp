@@ -18,6 +18,7 @@
 #include "sim/util/error.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <nlohmann/json.hpp>
 
@@ -581,7 +582,16 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     return p;
 }
 
+namespace {
+std::atomic<uint64_t> g_projectTexts{0};
+} // namespace
+
+uint64_t projectTextCount() {
+    return g_projectTexts.load();
+}
+
 std::string projectJsonText(const Project& p) {
+    ++g_projectTexts;
     const WriteContext w{p.dir, (p.dir / "project.json").string()};
     const sim::SceneDesc& scene = p.scene;
     json doc = {{"schemaVersion", p.schemaVersion}, {"caseId", p.caseId}, {"caseVersion", p.caseVersion}};

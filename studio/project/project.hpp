@@ -221,6 +221,9 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
 /// project.dir ("<dir>/project.json: bodies[0].mesh.file: '/x/liver.obj' is not inside the
 /// project folder"), std::invalid_argument when trackFiles does not match the instruments.
 std::string projectJsonText(const Project& project);
+/// How many times projectJsonText ran in this process (a test counts the serializations an edit
+/// costs; an edit of one value should cost none).
+uint64_t projectTextCount();
 
 /// Writes projectJsonText(project) to <dir>/project.json atomically (a crash leaves the old file
 /// or the new one). `dir` must be an existing, writable folder; file references stay relative to

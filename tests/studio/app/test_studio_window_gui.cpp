@@ -8,6 +8,8 @@
 #include "app/main_window.hpp"
 #include "app/material_panel.hpp"
 #include "app/plot_widget.hpp"
+#include "app/project_tree_panel.hpp"
+#include "app/properties_panel.hpp"
 #include "app/sample_compare.hpp"
 #include "app/sample_painter.hpp"
 #include "app/stiffness_painter.hpp"
@@ -380,6 +382,70 @@ TEST_F(WindowFixture, LivePreviewShowsAnEditTheNextFrameAndTheStabilityVerdict) 
     // the sampler runs below every other thread: on a busy machine it may take a while
     EXPECT_TRUE(test::waitFor([&] { return !w->errorPlot()->series().empty(); }, 180000));
     EXPECT_FALSE(w->costPlot()->series().empty());
+}
+
+// Item 1 of issue 39: a curve drag is a run of typed material edits. 100 mouse moves write no
+// project text anywhere (the document's checks, the preview's comparisons), make no tree item and
+// no property field, are one undo step, and the preview takes the dragged material.
+TEST_F(WindowFixture, ACurveDragOfAHundredMovesWritesNoProjectTextAndBuildsNoPanel) {
+    open("tissue-slab");
+    ASSERT_TRUE(waitForPreview()) << w->verdictLabel()->text().toStdString();
+    // the slab's curve material needs a few more substeps than its neo-Hookean one
+    w->selection()->set(studio::Selection::Kind::Solver);
+    ASSERT_EQ(w->setProperty("substeps", "70"), "");
+    w->selectBody(0);
+    ASSERT_EQ(w->setProperty("model", "valanis_landel"), "");
+    auto caughtUp = [&] { return w->preview()->snapshot().serial >= w->lastPreviewSubmit().first; };
+    ASSERT_TRUE(test::waitFor(caughtUp, 60000));
+    QCoreApplication::processEvents();
+    studio::CurveEditor* f = w->materialPanel()->editor(0);
+    f->frameAll();
+    const auto before = w->document()->project().bodies[0].scene.material.fPrime->points;
+    // the inner point with the most room down to its left neighbour, dragged down (softer: the
+    // slab stays stable at its substeps) within it
+    size_t i = 1;
+    auto room = [&](size_t k) {
+        return std::abs(f->toWidget({before[k][0], before[k - 1][1]}).y() -
+                        f->toWidget({before[k][0], before[k][1]}).y());
+    };
+    for (size_t k = 1; k + 1 < before.size(); ++k)
+        if (before[k][0] != 1.0 && room(k) > room(i)) i = k;
+    const QPointF from = f->toWidget({before[i][0], before[i][1]});
+    const QPointF to = f->toWidget({before[i][0], before[i][1] - 0.9 * (before[i][1] - before[i - 1][1])});
+    ASSERT_GT(std::abs(to.y() - from.y()), 5.0) << "the drag spans pixels";
+    const uint64_t texts = studio::projectTextCount();
+    const int treeBuilds = w->projectTree()->builds(), fieldBuilds = w->propertiesPanel()->builds();
+    const int undo = w->document()->undoStack()->count();
+    test::sendMouse(f, QEvent::MouseButtonPress, from, Qt::LeftButton, Qt::LeftButton);
+    for (int s = 1; s <= 100; ++s) {
+        test::sendMouse(f, QEvent::MouseMove, from + (s / 100.0) * (to - from), Qt::NoButton, Qt::LeftButton);
+        QCoreApplication::processEvents(); // the panels' reactions run as they would between events
+    }
+    test::sendMouse(f, QEvent::MouseButtonRelease, to, Qt::LeftButton, Qt::NoButton);
+    ASSERT_TRUE(test::waitFor(caughtUp, 60000));
+    QCoreApplication::processEvents();
+    const auto after = w->document()->project().bodies[0].scene.material.fPrime->points;
+    EXPECT_LT(after[i][1], before[i][1]) << "the drag moved the point";
+    EXPECT_EQ(w->document()->undoStack()->count(), undo + 1) << "one drag, one undo step";
+    EXPECT_EQ(studio::projectTextCount(), texts) << "no project text was written for the drag";
+    EXPECT_EQ(w->projectTree()->builds(), treeBuilds);
+    EXPECT_EQ(w->propertiesPanel()->builds(), fieldBuilds);
+    EXPECT_TRUE(w->preview()->snapshot().error.isEmpty())
+        << w->preview()->snapshot().error.toStdString() << " / " << w->preview()->snapshot().verdict.toStdString();
+    // a structural edit still compares (and so writes) the project, and rebuilds the fields
+    w->selection()->set(studio::Selection::Kind::Solver);
+    ASSERT_EQ(w->setProperty("damping", "3"), "");
+    ASSERT_TRUE(test::waitFor(caughtUp, 60000));
+    ASSERT_TRUE(test::waitFor([&] { return w->propertiesPanel()->builds() > fieldBuilds; }, 5000));
+    EXPECT_GT(studio::projectTextCount(), texts);
+    // undo of the drag is again a typed edit: no project text
+    w->document()->undoStack()->undo(); // damping
+    ASSERT_TRUE(test::waitFor(caughtUp, 60000));
+    const uint64_t texts2 = studio::projectTextCount();
+    w->document()->undoStack()->undo(); // the drag
+    ASSERT_TRUE(test::waitFor(caughtUp, 60000));
+    EXPECT_EQ(w->document()->project().bodies[0].scene.material.fPrime->points, before);
+    EXPECT_EQ(studio::projectTextCount(), texts2);
 }
 
 TEST_F(WindowFixture, FitToSyntheticNeoHookeanData) {

@@ -1,0 +1,211 @@
+#include "app/properties_panel.hpp"
+
+#include "app/material_panel.hpp"
+#include "app/number_text.hpp"
+#include "sim/material/material.hpp"
+
+#include <QComboBox>
+#include <QFormLayout>
+#include <QLabel>
+#include <QLineEdit>
+#include <QTimer>
+#include <QVBoxLayout>
+
+#include <algorithm>
+#include <cmath>
+
+namespace viscera::studio {
+namespace {
+
+const char* const kBodyFields[] = {"youngs_modulus", "poisson_ratio", "density"};
+const char* const kSolverFields[] = {"dt", "substeps", "iterations", "damping"};
+
+/// The text field `name` shows for the project (empty: not a field of this selection).
+QString valueText(const Project& p, int body, const QString& name) {
+    if (body >= 0 && body < static_cast<int>(p.bodies.size())) {
+        const sim::Material& m = p.bodies[body].scene.material;
+        if (name == "youngs_modulus") return numberText(m.youngsModulus);
+        if (name == "poisson_ratio") return numberText(m.poissonRatio);
+        if (name == "density") return numberText(m.density);
+    }
+    const auto& x = p.scene.xpbd;
+    if (name == "dt") return numberText(x.dt);
+    if (name == "substeps") return QString::number(x.substeps);
+    if (name == "iterations") return QString::number(x.iterations);
+    if (name == "damping") return numberText(x.damping);
+    return {};
+}
+
+} // namespace
+
+PropertiesPanel::PropertiesPanel(Document* doc, Selection* selection, MaterialPanel* material, QWidget* parent)
+    : QWidget(parent), m_doc(doc), m_sel(selection), m_material(material) {
+    setObjectName("propertiesPanel");
+    auto* root = new QVBoxLayout(this);
+    m_form = new QFormLayout;
+    root->addLayout(m_form);
+    m_error = new QLabel(this);
+    m_error->setObjectName("propertyError");
+    m_error->setWordWrap(true);
+    m_error->setStyleSheet("color: #b00020");
+    root->addWidget(m_error);
+    root->addStretch();
+    connect(m_sel, &Selection::changed, this, [this] {
+        m_error->clear(); // a rule broken on another selection no longer applies
+        scheduleRebuild();
+    });
+    connect(m_doc, &Document::changed, this, [this](const Change& what) {
+        if (what.touches(Change::Structure))
+            scheduleRebuild();
+        else if (what.touches(Change::Material))
+            fillValues(false);
+    });
+}
+
+void PropertiesPanel::scheduleRebuild() {
+    if (m_pending) return;
+    m_pending = true;
+    QTimer::singleShot(0, this, [this] {
+        m_pending = false;
+        rebuild();
+    });
+}
+
+void PropertiesPanel::addField(const QString& name, const QString& label) {
+    auto* e = new QLineEdit(this);
+    e->setObjectName(name);
+    connect(e, &QLineEdit::editingFinished, this, [this, e, name] {
+        if (e->isModified()) {
+            e->setModified(false);
+            setProperty(name, e->text());
+        }
+    });
+    m_form->addRow(label, e);
+}
+
+void PropertiesPanel::rebuild() {
+    ++m_builds;
+    while (m_form->rowCount() > 0)
+        m_form->removeRow(0);
+    if (!m_doc->hasProject()) return;
+    const Project& p = m_doc->project();
+    const int body = m_sel->body(), surface = m_sel->surface();
+    if (body >= 0 && body < static_cast<int>(p.bodies.size())) {
+        const sim::Material& m = p.bodies[body].scene.material;
+        m_form->addRow(tr("Body"), new QLabel(QString::fromStdString(p.bodies[body].scene.name), this));
+        auto* model = new QComboBox(this);
+        model->setObjectName("model");
+        for (auto mm :
+             {sim::MaterialModel::StableNeoHookean, sim::MaterialModel::NeoHookean, sim::MaterialModel::Linear,
+              sim::MaterialModel::StVenantKirchhoff, sim::MaterialModel::Corotated, sim::MaterialModel::ValanisLandel})
+            model->addItem(QString::fromStdString(sim::materialModelName(mm)));
+        model->setCurrentText(QString::fromStdString(sim::materialModelName(m.model)));
+        connect(model, &QComboBox::currentTextChanged, this, [this](const QString& t) { setProperty("model", t); });
+        m_form->addRow(tr("Material model"), model);
+        addField("youngs_modulus", tr("Young's modulus E [Pa]"));
+        addField("poisson_ratio", tr("Poisson ratio ν"));
+        addField("density", tr("Density [kg/m³]"));
+    } else if (m_sel->kind() == Selection::Kind::Solver && p.scene.solverType == "xpbd") {
+        addField("dt", tr("Frame step dt [s]"));
+        addField("substeps", tr("Substeps per frame"));
+        addField("iterations", tr("Iterations per substep"));
+        addField("damping", tr("Damping [1/s]"));
+    } else if (m_sel->kind() == Selection::Kind::Render) {
+        auto* l =
+            new QLabel(p.scene.render.empty() ? tr("renderer defaults") : QString::fromStdString(p.scene.render), this);
+        l->setWordWrap(true);
+        m_form->addRow(tr("Render"), l);
+    } else if (surface >= 0 && surface < static_cast<int>(p.surfaces.size())) {
+        const auto& s = p.surfaces[surface].scene;
+        m_form->addRow(tr("Surface"), new QLabel(QString::fromStdString(s.name), this));
+        m_form->addRow(tr("Stretch stiffness"), new QLabel(numberText(s.stretchStiffness), this));
+        m_form->addRow(tr("Areal density"), new QLabel(numberText(s.arealDensity), this));
+    }
+    fillValues(true);
+}
+
+void PropertiesPanel::fillValues(bool force) {
+    if (!m_doc->hasProject()) return;
+    const Project& p = m_doc->project();
+    for (QLineEdit* e : findChildren<QLineEdit*>()) {
+        const QString v = valueText(p, m_sel->body(), e->objectName());
+        if (v.isEmpty() || e->text() == v || (!force && e->isModified())) continue;
+        e->setText(v);
+        e->setModified(false);
+    }
+    if (auto* model = findChild<QComboBox*>("model");
+        model && m_sel->body() >= 0 && m_sel->body() < static_cast<int>(p.bodies.size())) {
+        const QString name =
+            QString::fromStdString(sim::materialModelName(p.bodies[m_sel->body()].scene.material.model));
+        if (model->currentText() != name) {
+            const QSignalBlocker quiet(model);
+            model->setCurrentText(name);
+        }
+    }
+}
+
+QString PropertiesPanel::setProperty(const QString& field, const QString& text) {
+    QString why;
+    const bool material =
+        field == "model" || std::find(std::begin(kBodyFields), std::end(kBodyFields), field) != std::end(kBodyFields);
+    const bool solver = std::find(std::begin(kSolverFields), std::end(kSolverFields), field) != std::end(kSolverFields);
+    if (material) {
+        why = setMaterialValue(field, text);
+    } else if (solver) {
+        const std::optional<double> v = parseNumberText(text, field, why);
+        if (v) why = setSolverValue(field, *v, text);
+    } else {
+        why = tr("%1: not a property of the selection").arg(field);
+    }
+    m_error->setText(why);
+    if (!why.isEmpty()) {
+        emit logMessage(why);
+        fillValues(true); // the field shows the model's value again
+    }
+    return why;
+}
+
+QString PropertiesPanel::setMaterialValue(const QString& field, const QString& text) {
+    const int b = m_sel->body();
+    if (!m_doc->hasProject() || b < 0 || b >= static_cast<int>(m_doc->project().bodies.size()))
+        return tr("no body selected");
+    sim::Material m = m_doc->project().bodies[b].scene.material;
+    if (field == "model") {
+        if (text == "valanis_landel") // editable curves of the neo-Hookean law at the body's E and ν
+            return m.model == sim::MaterialModel::ValanisLandel
+                       ? QString()
+                       : m_material->applyPreset("neo_hookean", m.youngsModulus, m.poissonRatio);
+        try {
+            m.model = sim::materialModelFromName(text.toStdString());
+        } catch (const std::exception& e) {
+            return QString::fromStdString(e.what());
+        }
+        m.curvePreset.clear();
+        m.fPrime.reset();
+        m.gPrime.reset();
+        m.hPrime.reset();
+        return m_doc->editMaterial(tr("Set material model"), b, m);
+    }
+    QString why;
+    const std::optional<double> v = parseNumberText(text, field, why);
+    if (!v) return why;
+    if (field == "youngs_modulus") m.youngsModulus = *v;
+    if (field == "poisson_ratio") m.poissonRatio = *v;
+    if (field == "density") m.density = *v;
+    return m_doc->editMaterial(tr("Set %1").arg(field), b, m);
+}
+
+QString PropertiesPanel::setSolverValue(const QString& field, double v, const QString& text) {
+    if ((field == "substeps" || field == "iterations") && v != std::floor(v))
+        return tr("solver.%1: '%2' must be a whole number").arg(field, text);
+    // A whole number past any valid count still reaches the reader's rule, which names the range.
+    const int count = static_cast<int>(std::clamp(v, -1e9, 1e9));
+    return m_doc->edit(tr("Set solver %1").arg(field), [&](Project& p) {
+        if (field == "dt") p.scene.xpbd.dt = v;
+        if (field == "substeps") p.scene.xpbd.substeps = count;
+        if (field == "iterations") p.scene.xpbd.iterations = count;
+        if (field == "damping") p.scene.xpbd.damping = v;
+    });
+}
+
+} // namespace viscera::studio
