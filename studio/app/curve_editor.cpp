@@ -53,8 +53,16 @@ void CurveEditor::setCurve(const QString& name, const std::vector<sim::CurvePoin
         m_selected = -1;
         m_dragging = -1;
     }
-    if (frame || !sameCount) frameAll();
+    // the view frames itself after a preset, a fit or a curve-wide edit that left points out of
+    // sight (not during a drag: the curve must not move under the mouse)
+    if (frame || !sameCount || (m_dragging < 0 && !inView())) frameAll();
     update();
+}
+
+bool CurveEditor::inView() const {
+    for (const sim::CurvePoint& p : m_points)
+        if (!m_view.contains(QPointF(p.x, p.y))) return false;
+    return true;
 }
 
 void CurveEditor::clearCurve(const QString& name, const QString& message) {
@@ -99,6 +107,75 @@ QPointF CurveEditor::constrain(int index, QPointF want) const {
         if ((index > 0 && !(y > m_points[index - 1].y)) || (index < n - 1 && !(y < m_points[index + 1].y))) y = p.y;
     }
     return {x, y};
+}
+
+namespace {
+
+/// Pushes the values of `v` after `from` up and those before it down so that v stays strictly
+/// increasing by at least gap() between neighbours (v[from] is where it must be).
+void pushApart(std::vector<double>& v, size_t from) {
+    for (size_t m = from + 1; m < v.size(); ++m)
+        v[m] = std::max(v[m], v[m - 1] + gap(v[m - 1]));
+    for (size_t m = from; m-- > 0;)
+        v[m] = std::min(v[m], v[m + 1] - gap(v[m + 1]));
+}
+
+/// The bounds [lo, hi] of coordinate c of point i when the pinned points (and, below, `floor`)
+/// stay: room for the points between, each a gap apart.
+std::pair<double, double> pushBounds(const std::vector<double>& c, const std::vector<bool>& pinned, size_t i,
+                                     double floor) {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    double lo = floor, hi = inf;
+    size_t from = 0; // the points from `from` to i - 1 must fit above lo
+    for (size_t j = i; j-- > 0;)
+        if (pinned[j]) {
+            lo = c[j];
+            from = j;
+            break;
+        }
+    if (std::isfinite(lo))
+        for (size_t m = from; m < i; ++m)
+            lo += 2 * gap(lo);
+    for (size_t j = i + 1; j < c.size(); ++j)
+        if (pinned[j]) {
+            hi = c[j];
+            for (size_t m = i; m < j; ++m)
+                hi -= 2 * gap(hi);
+            break;
+        }
+    return {lo, hi};
+}
+
+} // namespace
+
+std::vector<sim::CurvePoint> CurveEditor::dragged(const std::vector<sim::CurvePoint>& base, int index, QPointF want,
+                                                  bool strictlyIncreasing) {
+    std::vector<sim::CurvePoint> out = base;
+    const int n = static_cast<int>(base.size());
+    if (index < 0 || index >= n || isRestPoint(base[index])) return out;
+    std::vector<bool> pinned(base.size());
+    std::vector<double> xs(base.size()), ys(base.size());
+    for (size_t k = 0; k < base.size(); ++k) {
+        pinned[k] = isRestPoint(base[k]);
+        xs[k] = base[k].x;
+        ys[k] = base[k].y;
+    }
+    const auto i = static_cast<size_t>(index);
+    auto place = [&](std::vector<double>& c, double w, double floor) {
+        if (!std::isfinite(w)) return;
+        const auto [lo, hi] = pushBounds(c, pinned, i, floor);
+        if (!(lo < hi)) return; // no room at all: the point stays
+        c[i] = std::clamp(w, lo, hi);
+        pushApart(c, i);
+    };
+    place(xs, std::max(want.x(), 0.01), 0.01);
+    if (strictlyIncreasing)
+        place(ys, want.y(), -std::numeric_limits<double>::infinity());
+    else if (std::isfinite(want.y()))
+        ys[i] = want.y();
+    for (size_t k = 0; k < base.size(); ++k)
+        out[k] = {xs[k], ys[k]};
+    return out;
 }
 
 QRectF CurveEditor::plotArea() const {
@@ -256,6 +333,7 @@ void CurveEditor::mousePressEvent(QMouseEvent* e) {
         setSelected(hit);
         if (!isRestPoint(m_points[hit])) {
             m_dragging = hit;
+            m_dragBase = m_points;
             emit dragStarted(hit);
         }
         return;
@@ -284,8 +362,8 @@ void CurveEditor::mouseMoveEvent(QMouseEvent* e) {
         const double sx = gridStepX(), sy = gridStepY();
         d = QPointF(std::round(d.x() / sx) * sx, std::round(d.y() / sy) * sy);
     }
-    const QPointF c = constrain(m_dragging, d);
-    emit pointDragged(m_dragging, c.x(), c.y());
+    if (m_dragBase.size() != m_points.size()) m_dragBase = m_points; // the curve changed under the drag
+    emit curveDragged(m_dragging, dragged(m_dragBase, m_dragging, d, m_strict));
 }
 
 void CurveEditor::mouseReleaseEvent(QMouseEvent* e) {
@@ -296,7 +374,9 @@ void CurveEditor::mouseReleaseEvent(QMouseEvent* e) {
     if (e->button() == Qt::LeftButton && m_dragging >= 0) {
         const int i = m_dragging;
         m_dragging = -1;
+        m_dragBase.clear();
         emit dragFinished(i);
+        if (!inView()) frameAll(); // a drag may leave points out of sight: shown again at its end
     }
 }
 

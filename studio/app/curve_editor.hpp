@@ -2,16 +2,19 @@
 /// Editor of one Valanis–Landel response curve (f′, g′ or h′) [A §4.3.3, Fig. 4.7]: the curve
 /// and its control points on a grid, in data units (x: stretch or stretch product, y: Pa).
 ///
-/// Mouse and keys: a left click on a point selects it and a drag moves it; a left click near
+/// Mouse and keys: a left click on a point selects it and a drag moves it (free: the neighbours it
+/// would pass are pushed along, so the curve stays valid instead of the point stopping); a left click near
 /// the curve (within kPickPixels) inserts a point there, on the curve; Delete removes the
 /// selected point (not an end point, not the rest point); Ctrl during a drag snaps to the grid;
 /// Home frames all points; the wheel zooms about the cursor; a middle drag pans.
 ///
 /// The editor never changes the model: it asks (signals) and the owner pushes undo commands,
-/// then shows the result with setCurve(). What it asks for already obeys the shape rule
-/// (constrain()): a point stays strictly between its neighbours in x, and, on a strictly
-/// increasing curve, in y; the rest point x = 1 is pinned (its value f′(1), g′(1) or h′(1) is
-/// what keeps the stress at rest zero, §4.3.3).
+/// then shows the result with setCurve(). What it asks for already obeys the shape rule: x
+/// strictly increasing and, on a strictly increasing curve, y too; the rest point x = 1 is pinned
+/// (its value f′(1), g′(1) or h′(1) is what keeps the stress at rest zero, §4.3.3). A drag
+/// (dragged()) moves the point where the mouse is and pushes the neighbours it would pass, from
+/// the curve as it was when the drag began (moving back restores them); only the rest point
+/// stops it. A typed value (constrain()) must lie between its neighbours.
 #include "sim/material/curve.hpp"
 
 #include <QPointF>
@@ -48,8 +51,14 @@ public:
     /// The point at x = 1 (rest) is pinned.
     static bool isRestPoint(const sim::CurvePoint& p) { return p.x == 1.0; }
     bool removable(int index) const;
-    /// The position nearest to `want` that point `index` may take by the shape rule.
+    /// The position nearest to `want` that point `index` may take by the shape rule, its
+    /// neighbours staying where they are.
     QPointF constrain(int index, QPointF want) const;
+    /// The curve `base` after point `index` moved as near `want` as the shape rule allows, the
+    /// neighbours it would pass pushed along (a gap of 1e-6 relative); the pinned rest point stays
+    /// and bounds the move. x stays at least 0.01 (stretches and volume ratios are positive).
+    static std::vector<sim::CurvePoint> dragged(const std::vector<sim::CurvePoint>& base, int index, QPointF want,
+                                                bool strictlyIncreasing);
 
     void frameAll();
     QRectF view() const { return m_view; } ///< data rectangle shown
@@ -65,8 +74,8 @@ signals:
     void selectionChanged(int index);
     /// A drag begins on point `index` (the owner starts one undo step).
     void dragStarted(int index);
-    /// The dragged point should move to (x, y) (already constrained).
-    void pointDragged(int index, double x, double y);
+    /// The curve should become `points` (point `index` dragged, its neighbours pushed; valid).
+    void curveDragged(int index, const std::vector<sim::CurvePoint>& points);
     void dragFinished(int index);
     void insertRequested(double x, double y);
     void removeRequested(int index);
@@ -82,11 +91,14 @@ protected:
 
 private:
     QRectF plotArea() const;
+    /// Every point lies in the view.
+    bool inView() const;
     int pointAt(QPointF widgetPos) const;
     static double niceStep(double range);
 
     QString m_name, m_message;
     std::vector<sim::CurvePoint> m_points;
+    std::vector<sim::CurvePoint> m_dragBase; ///< the curve when the drag began
     std::optional<sim::MonotoneCurve> m_curve;
     bool m_strict = true;
     int m_selected = -1;

@@ -89,6 +89,7 @@ MaterialPanel::MaterialPanel(Document* doc, QWidget* parent) : QWidget(parent), 
     split->setStretchFactor(1, 2);
     root->addWidget(split, 1);
 
+    buildCurveRow(root);
     auto* pointRow = new QHBoxLayout;
     m_x = new QLineEdit(this);
     m_x->setObjectName("pointX");
@@ -133,6 +134,80 @@ MaterialPanel::MaterialPanel(Document* doc, QWidget* parent) : QWidget(parent), 
     refresh();
 }
 
+void MaterialPanel::buildCurveRow(QVBoxLayout* root) {
+    auto* row = new QHBoxLayout;
+    auto button = [&](const QString& text, const char* name, const QString& tip) {
+        auto* b = new QPushButton(text, this);
+        b->setObjectName(name);
+        b->setToolTip(tip);
+        row->addWidget(b);
+        return b;
+    };
+    row->addWidget(new QLabel(tr("Whole curve (the one last clicked):"), this));
+    QPushButton* scale =
+        button(tr("Scale ×"), "scaleCurve",
+               tr("Every point's distance from the rest value times the factor: stiffer above 1, softer "
+                  "below; the rest point stays"));
+    m_scale = new QLineEdit("1.25", this);
+    m_scale->setObjectName("scaleFactor");
+    m_scale->setMaximumWidth(70);
+    row->addWidget(m_scale);
+    QPushButton* smooth =
+        button(tr("Smooth"), "smoothCurve", tr("Each free point halfway towards the line through its neighbours"));
+    QPushButton* reset = button(tr("Reset"), "resetCurve",
+                                tr("The curve of the preset law above at the body's E and ν (the other curves stay)"));
+    row->addStretch();
+    root->addLayout(row);
+    connect(scale, &QPushButton::clicked, this, [this] {
+        QString why;
+        const auto f = parseNumberText(m_scale->text(), tr("scale factor"), why);
+        setStatus(f ? scaleCurve(m_active, *f) : why);
+    });
+    connect(smooth, &QPushButton::clicked, this, [this] { setStatus(smoothCurve(m_active)); });
+    connect(reset, &QPushButton::clicked, this, [this] { setStatus(resetCurve(m_active)); });
+}
+
+QString MaterialPanel::scaleCurve(int k, double factor) {
+    if (!(factor > 0) || !std::isfinite(factor))
+        return tr("scale factor %1: must be a positive number (it keeps the curve's order)").arg(numberText(factor));
+    return editPoints(k, tr("Scale %1 by %2").arg(kNames[k], numberText(factor)), [&](auto& pts) {
+        double rest = NAN;
+        for (const auto& p : pts)
+            if (p[0] == 1.0) rest = p[1];
+        if (!std::isfinite(rest)) throw std::invalid_argument("the curve has no rest point (x = 1) to scale about");
+        for (auto& p : pts)
+            p[1] = rest + factor * (p[1] - rest);
+    });
+}
+
+QString MaterialPanel::smoothCurve(int k) {
+    return editPoints(k, tr("Smooth %1").arg(kNames[k]), [&](auto& pts) {
+        const auto old = pts;
+        for (size_t i = 1; i + 1 < pts.size(); ++i) {
+            if (old[i][0] == 1.0) continue; // the rest point is pinned
+            const double t = (old[i][0] - old[i - 1][0]) / (old[i + 1][0] - old[i - 1][0]);
+            const double line = old[i - 1][1] + t * (old[i + 1][1] - old[i - 1][1]);
+            pts[i][1] = 0.5 * (old[i][1] + line); // between the neighbours: the order stays
+        }
+    });
+}
+
+QString MaterialPanel::resetCurve(int k) {
+    if (m_body < 0 || !m_doc->hasProject() || m_body >= static_cast<int>(m_doc->project().bodies.size()))
+        return tr("no body selected");
+    sim::Material m = m_doc->project().bodies[m_body].scene.material;
+    if (!(m.*kSlots[k])) return tr("the material has no curve %1").arg(kNames[k]);
+    sim::Material preset = m;
+    try {
+        sim::setMaterialCurves(
+            preset, sim::editableCurves(m_law->currentText().toStdString(), m.youngsModulus, m.poissonRatio));
+    } catch (const std::exception& e) {
+        return QString::fromStdString(e.what());
+    }
+    m.*kSlots[k] = preset.*kSlots[k];
+    return m_doc->editMaterial(tr("Reset %1 to %2").arg(kNames[k], m_law->currentText()), m_body, m);
+}
+
 void MaterialPanel::setStatus(const QString& error) {
     m_status->setText(error);
 }
@@ -147,11 +222,13 @@ void MaterialPanel::connectEditor(int k) {
         m_active = k;
         m_dragKey = m_doc->newMergeKey();
     });
-    connect(e, &CurveEditor::pointDragged, this, [this, k](int i, double x, double y) {
+    connect(e, &CurveEditor::curveDragged, this, [this, k](int, const std::vector<sim::CurvePoint>& points) {
         setStatus(editPoints(
             k, tr("Move %1 point").arg(kNames[k]),
             [&](auto& pts) {
-                pts.at(i) = {x, y};
+                if (points.size() != pts.size()) throw std::invalid_argument("the curve changed under the drag");
+                for (size_t q = 0; q < pts.size(); ++q)
+                    pts[q] = {points[q].x, points[q].y};
             },
             m_dragKey));
     });

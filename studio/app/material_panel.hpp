@@ -20,6 +20,7 @@ class QComboBox;
 class QLabel;
 class QLineEdit;
 class QPushButton;
+class QVBoxLayout;
 
 namespace viscera::studio {
 
@@ -50,6 +51,15 @@ public:
     QString applyPreset(const QString& law, double E, double nu);
     /// Sets the selected point of the editor that has the focus to the typed x and y fields.
     QString applyTypedPoint();
+    /// Curve-wide edits of curve k (0 f′, 1 g′, 2 h′), each one undo step; the error, or empty.
+    /// Scale: every value's distance from the rest value times `factor` (> 0; the rest point and
+    /// the order stay). Smooth: each free point halfway towards the line through its neighbours
+    /// (the order stays). Reset: the curve of the preset law chosen above at the body's E and ν.
+    QString scaleCurve(int k, double factor);
+    QString smoothCurve(int k);
+    QString resetCurve(int k);
+    /// The editor the curve-wide buttons and the typed point act on (the one last clicked).
+    int activeCurve() const { return m_active; }
 
     /// The curves of a Valanis–Landel material with explicit curves (nullopt otherwise).
     static std::optional<sim::ValanisLandelCurves> curvesOf(const sim::Material& m);
@@ -75,6 +85,8 @@ private:
     QLineEdit *m_x = nullptr, *m_y = nullptr, *m_E = nullptr, *m_nu = nullptr;
     QComboBox* m_law = nullptr;
     QPushButton *m_applyPreset = nullptr, *m_fit = nullptr;
+    QLineEdit* m_scale = nullptr;
+    void buildCurveRow(QVBoxLayout* root);
 };
 
 } // namespace viscera::studio

@@ -243,6 +243,22 @@ std::string objCount(size_t n, char kind) {
     return std::to_string(n) + " " + (n == 1 ? objKindName(kind) : plural);
 }
 
+/// A 'v' line: at least x y z, each a finite number.
+void checkObjVertex(const std::string& where, size_t vi, const std::vector<std::string_view>& tok) {
+    if (tok.size() < 4)
+        throw InputError(where + "vertex " + std::to_string(vi) + " has " + std::to_string(tok.size() - 1) +
+                         " coordinates (needs x y z)");
+    for (int k = 1; k <= 3; ++k) {
+        const auto v = parseDouble(tok[k]);
+        if (!v)
+            throw InputError(where + "vertex " + std::to_string(vi) + ": cannot parse coordinate " + quoted(tok[k]) +
+                             " as a number");
+        if (!std::isfinite(*v))
+            throw InputError(where + "vertex " + std::to_string(vi) + " has a non-finite coordinate (" +
+                             std::string(tok[k]) + "); coordinates must be finite");
+    }
+}
+
 void checkObj(const std::string& label, std::string_view b) {
     size_t counts[3] = {0, 0, 0}; // v, vt, vn
     size_t faces = 0, polygons = 0;
@@ -276,19 +292,7 @@ void checkObj(const std::string& label, std::string_view b) {
         if (tok.empty()) continue;
         const std::string where = label + ": line " + std::to_string(firstLine) + ": ";
         if (tok[0] == "v") {
-            const size_t vi = ++counts[0];
-            if (tok.size() < 4)
-                throw InputError(where + "vertex " + std::to_string(vi) + " has " + std::to_string(tok.size() - 1) +
-                                 " coordinates (needs x y z)");
-            for (int k = 1; k <= 3; ++k) {
-                const auto v = parseDouble(tok[k]);
-                if (!v)
-                    throw InputError(where + "vertex " + std::to_string(vi) + ": cannot parse coordinate " +
-                                     quoted(tok[k]) + " as a number");
-                if (!std::isfinite(*v))
-                    throw InputError(where + "vertex " + std::to_string(vi) + " has a non-finite coordinate (" +
-                                     std::string(tok[k]) + "); coordinates must be finite");
-            }
+            checkObjVertex(where, ++counts[0], tok);
         } else if (tok[0] == "vt") {
             ++counts[1];
         } else if (tok[0] == "vn") {
@@ -537,10 +541,52 @@ private:
     bool m_parseError = false;
 };
 
-void checkPly(const std::string& label, std::string_view b) {
+/// The PLY header: the body's encoding, the declared elements, and where the body starts.
+struct PlyHeader {
+    PlyEncoding encoding = PlyEncoding::Ascii;
+    std::vector<PlyElement> elements;
+    size_t bodyStart = 0;
+};
+
+PlyEncoding parsePlyFormat(const std::string& label, const std::string& where,
+                           const std::vector<std::string_view>& tok) {
+    if (tok.size() < 2) fail(label, where + "'format' needs an encoding");
+    if (tok[1] == "ascii") return PlyEncoding::Ascii;
+    if (tok[1] == "binary_little_endian") return PlyEncoding::BinaryLE;
+    if (tok[1] == "binary_big_endian") return PlyEncoding::BinaryBE;
+    fail(label, where + "unknown encoding " + quoted(tok[1]) + " (ascii, binary_little_endian or binary_big_endian)");
+}
+
+PlyElement parsePlyElement(const std::string& label, const std::string& where,
+                           const std::vector<std::string_view>& tok) {
+    if (tok.size() != 3) fail(label, where + "expected 'element <name> <count>'");
+    const auto count = parseInt(tok[2]);
+    if (!count || *count < 0) fail(label, where + "element count " + quoted(tok[2]) + " is not a non-negative integer");
+    return {std::string(tok[1]), static_cast<uint64_t>(*count), {}};
+}
+
+PlyProperty parsePlyProperty(const std::string& label, const std::string& where,
+                             const std::vector<std::string_view>& tok) {
+    if (tok.size() >= 2 && tok[1] == "list") {
+        if (tok.size() != 5) fail(label, where + "expected 'property list <count type> <item type> <name>'");
+        const auto ct = plyType(tok[2]);
+        const auto it = plyType(tok[3]);
+        if (!ct || !plyIsInteger(*ct))
+            fail(label, where + "list count type " + quoted(tok[2]) + " is not an integer type");
+        if (!it) fail(label, where + "unknown property type " + quoted(tok[3]));
+        return {std::string(tok[4]), *it, true, *ct};
+    }
+    if (tok.size() != 3) fail(label, where + "expected 'property <type> <name>'");
+    const auto t = plyType(tok[1]);
+    if (!t) fail(label, where + "unknown property type " + quoted(tok[1]));
+    return {std::string(tok[2]), *t, false, PlyType::UInt8};
+}
+
+PlyHeader parsePlyHeader(const std::string& label, std::string_view b) {
     // Header: "ply", format, elements with properties, end_header.
     std::optional<PlyEncoding> encoding;
-    std::vector<PlyElement> elements;
+    PlyHeader header;
+    std::vector<PlyElement>& elements = header.elements;
     size_t pos = 0, lineNo = 0;
     bool ended = false;
     while (pos < b.size()) {
@@ -560,47 +606,31 @@ void checkPly(const std::string& label, std::string_view b) {
             break;
         }
         if (key == "format") {
-            if (tok.size() < 2) fail(label, where + "'format' needs an encoding");
-            if (tok[1] == "ascii")
-                encoding = PlyEncoding::Ascii;
-            else if (tok[1] == "binary_little_endian")
-                encoding = PlyEncoding::BinaryLE;
-            else if (tok[1] == "binary_big_endian")
-                encoding = PlyEncoding::BinaryBE;
-            else
-                fail(label, where + "unknown encoding " + quoted(tok[1]) +
-                                " (ascii, binary_little_endian or binary_big_endian)");
+            encoding = parsePlyFormat(label, where, tok);
         } else if (key == "element") {
-            if (tok.size() != 3) fail(label, where + "expected 'element <name> <count>'");
-            const auto count = parseInt(tok[2]);
-            if (!count || *count < 0)
-                fail(label, where + "element count " + quoted(tok[2]) + " is not a non-negative integer");
-            elements.push_back({std::string(tok[1]), static_cast<uint64_t>(*count), {}});
+            elements.push_back(parsePlyElement(label, where, tok));
         } else if (key == "property") {
             if (elements.empty()) fail(label, where + "'property' before any 'element'");
-            PlyProperty prop;
-            if (tok.size() >= 2 && tok[1] == "list") {
-                if (tok.size() != 5) fail(label, where + "expected 'property list <count type> <item type> <name>'");
-                const auto ct = plyType(tok[2]);
-                const auto it = plyType(tok[3]);
-                if (!ct || !plyIsInteger(*ct))
-                    fail(label, where + "list count type " + quoted(tok[2]) + " is not an integer type");
-                if (!it) fail(label, where + "unknown property type " + quoted(tok[3]));
-                prop = {std::string(tok[4]), *it, true, *ct};
-            } else {
-                if (tok.size() != 3) fail(label, where + "expected 'property <type> <name>'");
-                const auto t = plyType(tok[1]);
-                if (!t) fail(label, where + "unknown property type " + quoted(tok[1]));
-                prop = {std::string(tok[2]), *t, false, PlyType::UInt8};
-            }
-            elements.back().props.push_back(std::move(prop));
+            elements.back().props.push_back(parsePlyProperty(label, where, tok));
         } else {
             fail(label, where + "unknown keyword " + quoted(key));
         }
     }
     if (!ended) fail(label, "PLY header has no 'end_header' line (truncated or not a PLY file)");
     if (!encoding) fail(label, "PLY header has no 'format' line");
+    header.encoding = *encoding;
+    header.bodyStart = std::min(pos, b.size());
+    return header;
+}
 
+/// Pointers into PlyHeader::elements.
+struct PlyGeometry {
+    const PlyElement* vertexElem = nullptr;
+    const PlyElement* faceElem = nullptr;
+    const PlyProperty* indexProp = nullptr;
+};
+
+PlyGeometry findPlyGeometry(const std::string& label, const std::vector<PlyElement>& elements) {
     // Which element/properties carry the geometry.
     const PlyElement* vertexElem = nullptr;
     const PlyElement* faceElem = nullptr;
@@ -623,15 +653,20 @@ void checkPly(const std::string& label, std::string_view b) {
     if (!indexProp) fail(label, "PLY 'face' element has no 'vertex_indices' list property");
     if (!plyIsInteger(indexProp->type))
         fail(label, "PLY face property '" + indexProp->name + "' has a non-integer item type");
+    return {vertexElem, faceElem, indexProp};
+}
 
+/// Returns the number of faces with 3 or more vertices.
+uint64_t checkPlyBody(const std::string& label, std::string_view b, const PlyHeader& header,
+                      const PlyGeometry& geometry) {
     // Body: every declared element must be present; geometry must be finite and in range.
-    PlyBodyReader reader(b.substr(std::min(pos, b.size())), *encoding);
-    const uint64_t vertexCount = vertexElem->count;
+    PlyBodyReader reader(b.substr(header.bodyStart), header.encoding);
+    const uint64_t vertexCount = geometry.vertexElem->count;
     uint64_t polygons = 0;
-    for (const PlyElement& e : elements) {
+    for (const PlyElement& e : header.elements) {
         if (e.props.empty()) continue;
-        const bool isVertex = &e == vertexElem;
-        const bool isFace = &e == faceElem;
+        const bool isVertex = &e == geometry.vertexElem;
+        const bool isFace = &e == geometry.faceElem;
         for (uint64_t i = 0; i < e.count; ++i) {
             auto where = [&] { return "PLY element '" + e.name + "' " + std::to_string(i); };
             auto truncated = [&]() {
@@ -658,7 +693,7 @@ void checkPly(const std::string& label, std::string_view b) {
                 get(p.countType, nd);
                 if (nd < 0) fail(label, where() + ": list '" + p.name + "' has a negative length");
                 const uint64_t n = static_cast<uint64_t>(nd);
-                const bool indices = isFace && &p == indexProp;
+                const bool indices = isFace && &p == geometry.indexProp;
                 for (uint64_t k = 0; k < n; ++k) {
                     get(p.type, v);
                     if (indices && (v < 0 || v >= static_cast<double>(vertexCount)))
@@ -670,6 +705,13 @@ void checkPly(const std::string& label, std::string_view b) {
             }
         }
     }
+    return polygons;
+}
+
+void checkPly(const std::string& label, std::string_view b) {
+    const PlyHeader header = parsePlyHeader(label, b);
+    const PlyGeometry geometry = findPlyGeometry(label, header.elements);
+    const uint64_t polygons = checkPlyBody(label, b, header, geometry);
     if (polygons == 0) fail(label, "no faces: no PLY face has 3 or more vertices");
 }
 

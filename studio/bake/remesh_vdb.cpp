@@ -132,11 +132,11 @@ double largestHoleDiameter(const sim::TriMesh& mesh) {
 /// Holes up to this many voxels across may be closed over by the level set (then checked).
 constexpr double kMaxClosedHoleVoxels = 3.0;
 
-sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const RemeshParams& params,
-                                const RemeshProgress& progress, const std::atomic<bool>* cancel, RemeshReport& report) {
-    openvdb::initialize();
-    auto stage = [&](const std::string& name, double fraction) { reportStage(progress, cancel, name, fraction); };
-    // The grid: one voxel size for every part, from the bounds of them all.
+namespace {
+
+/// The grid: one voxel size for every part, from the bounds of them all (checked against the
+/// per-axis cap). Returns the voxel size.
+double gridVoxelSize(const std::vector<RemeshPart>& parts, const RemeshParams& params, RemeshReport& report) {
     sim::Vec3 lo = sim::Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     for (const RemeshPart& part : parts) {
         const auto [a, b] = part.surface.bounds();
@@ -157,90 +157,101 @@ sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const Reme
         report.voxels[k] = int(n);
     }
     report.voxelSize = vs;
-    const auto xform = openvdb::math::Transform::createLinearTransform(vs);
-    const float band = float(params.bandVoxels);
-    CancelInterrupter interrupter(cancel);
+    return vs;
+}
 
-    const auto t0 = Clock::now();
-    openvdb::FloatGrid::Ptr combined;
+/// What the level sets of all parts share: the grid, the band, cancellation, and the buffers the
+/// current part's surface is converted into (reused from part to part).
+struct LevelSetContext {
+    const openvdb::math::Transform& xform;
+    double voxelSize;
+    float band;
+    CancelInterrupter& interrupter;
+    const std::atomic<bool>* cancel;
     std::vector<openvdb::Vec3s> points;
     std::vector<openvdb::Vec3I> tris;
-    const std::vector<openvdb::Vec4I> noQuads;
-    const double levelSetShare = 0.6;
-    for (size_t i = 0; i < parts.size(); ++i) {
-        const RemeshPart& part = parts[i];
-        stage("level set " + std::to_string(i + 1) + "/" + std::to_string(parts.size()) + ": " + part.name,
-              levelSetShare * double(i) / double(parts.size()));
-        toVdb(part.surface, points, tris);
-        openvdb::FloatGrid::Ptr grid;
-        const double hole = part.surface.isClosedOriented() ? 0.0 : largestHoleDiameter(part.surface);
-        bool thicken = hole >= kMaxClosedHoleVoxels * vs;
-        if (!thicken) {
-            // Closed, or with holes of at most three voxels, which OpenVDB's sign flood often
-            // closes over; whether it did is checked: the level set must hold at least half the
-            // part's enclosed volume, else the part is thickened like an open one.
-            grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(interrupter, *xform, points, tris, band);
-            checkCancel(cancel);
-            const double inside = openvdb::tools::levelSetVolume(*grid);
-            const double enclosed = std::abs(part.surface.signedVolume());
-            if (!(inside >= 0.5 * enclosed)) {
-                thicken = true;
-                ++report.leakedParts;
-            } else {
-                report.sourceVolume += enclosed;
-                if (hole > 0) ++report.closedHoles;
-            }
-        }
-        if (thicken) {
-            // No inside: thicken the open surface into a closed shell 1.5 voxels thick (the
-            // unsigned distance at 0.75 voxels), then take the shell's level set.
-            ++report.openParts;
-            auto udf = openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(interrupter, *xform, points,
-                                                                                       tris, noQuads, band);
-            checkCancel(cancel);
-            std::vector<openvdb::Vec3s> shellPoints;
-            std::vector<openvdb::Vec3I> shellTris;
-            std::vector<openvdb::Vec4I> shellQuads;
-            openvdb::tools::volumeToMesh(*udf, shellPoints, shellTris, shellQuads, 0.75 * vs, 0.0);
-            if (shellTris.empty() && shellQuads.empty())
-                throw InputError(part.name + ": the open part is thinner than the voxel grid resolves (voxel size " +
-                                 sim::formatNumber(vs * 1e3) + " mm)");
-            grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(interrupter, *xform, shellPoints, shellTris,
-                                                                      shellQuads, band);
-        }
-        checkCancel(cancel);
-        if (!combined) {
-            combined = grid;
-            continue;
-        }
-        switch (part.op) {
-        case CsgOp::Union:
-            openvdb::tools::csgUnion(*combined, *grid);
-            break;
-        case CsgOp::Difference:
-            openvdb::tools::csgDifference(*combined, *grid);
-            break;
-        case CsgOp::Intersection:
-            openvdb::tools::csgIntersection(*combined, *grid);
-            break;
-        }
-    }
-    if (params.smoothingIterations > 0) {
-        openvdb::tools::LevelSetFilter<openvdb::FloatGrid> filter(*combined);
-        for (int i = 0; i < params.smoothingIterations; ++i) {
-            stage("smoothing", levelSetShare + 0.1 * double(i) / params.smoothingIterations);
-            filter.meanCurvature();
-        }
-    }
-    report.activeVoxels = size_t(combined->activeVoxelCount());
-    report.levelSetSeconds = secondsSince(t0);
+};
 
-    stage("isosurface", levelSetShare + 0.1);
+/// The level set of a part that is closed or has small holes, or null when it leaked (then the
+/// part is to be thickened like an open one).
+openvdb::FloatGrid::Ptr closedLevelSet(const RemeshPart& part, double hole, LevelSetContext& ctx,
+                                       RemeshReport& report) {
+    // Closed, or with holes of at most three voxels, which OpenVDB's sign flood often
+    // closes over; whether it did is checked: the level set must hold at least half the
+    // part's enclosed volume, else the part is thickened like an open one.
+    openvdb::FloatGrid::Ptr grid =
+        openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(ctx.interrupter, ctx.xform, ctx.points, ctx.tris, ctx.band);
+    checkCancel(ctx.cancel);
+    const double inside = openvdb::tools::levelSetVolume(*grid);
+    const double enclosed = std::abs(part.surface.signedVolume());
+    if (!(inside >= 0.5 * enclosed)) {
+        ++report.leakedParts;
+        return nullptr;
+    }
+    report.sourceVolume += enclosed;
+    if (hole > 0) ++report.closedHoles;
+    return grid;
+}
+
+/// The level set of an open part, thickened into a closed shell.
+openvdb::FloatGrid::Ptr shellLevelSet(const RemeshPart& part, LevelSetContext& ctx, RemeshReport& report) {
+    // No inside: thicken the open surface into a closed shell 1.5 voxels thick (the
+    // unsigned distance at 0.75 voxels), then take the shell's level set.
+    ++report.openParts;
+    const std::vector<openvdb::Vec4I> noQuads;
+    auto udf = openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(ctx.interrupter, ctx.xform, ctx.points,
+                                                                               ctx.tris, noQuads, ctx.band);
+    checkCancel(ctx.cancel);
+    std::vector<openvdb::Vec3s> shellPoints;
+    std::vector<openvdb::Vec3I> shellTris;
+    std::vector<openvdb::Vec4I> shellQuads;
+    openvdb::tools::volumeToMesh(*udf, shellPoints, shellTris, shellQuads, 0.75 * ctx.voxelSize, 0.0);
+    if (shellTris.empty() && shellQuads.empty())
+        throw InputError(part.name + ": the open part is thinner than the voxel grid resolves (voxel size " +
+                         sim::formatNumber(ctx.voxelSize * 1e3) + " mm)");
+    return openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(ctx.interrupter, ctx.xform, shellPoints, shellTris,
+                                                              shellQuads, ctx.band);
+}
+
+/// One part's level set: closed (holes included, if they close) or thickened.
+openvdb::FloatGrid::Ptr partLevelSet(const RemeshPart& part, LevelSetContext& ctx, RemeshReport& report) {
+    toVdb(part.surface, ctx.points, ctx.tris);
+    openvdb::FloatGrid::Ptr grid;
+    const double hole = part.surface.isClosedOriented() ? 0.0 : largestHoleDiameter(part.surface);
+    const bool thicken = hole >= kMaxClosedHoleVoxels * ctx.voxelSize;
+    if (!thicken) grid = closedLevelSet(part, hole, ctx, report);
+    if (!grid) grid = shellLevelSet(part, ctx, report);
+    checkCancel(ctx.cancel);
+    return grid;
+}
+
+/// Applies a part's operation to the combination (the first part starts it).
+void combine(openvdb::FloatGrid::Ptr& combined, const openvdb::FloatGrid::Ptr& grid, CsgOp op) {
+    if (!combined) {
+        combined = grid;
+        return;
+    }
+    switch (op) {
+    case CsgOp::Union:
+        openvdb::tools::csgUnion(*combined, *grid);
+        break;
+    case CsgOp::Difference:
+        openvdb::tools::csgDifference(*combined, *grid);
+        break;
+    case CsgOp::Intersection:
+        openvdb::tools::csgIntersection(*combined, *grid);
+        break;
+    }
+}
+
+/// The zero isosurface of the combined level set, within the triangle cap.
+sim::TriMesh isosurface(const openvdb::FloatGrid& combined, const RemeshParams& params, double vs,
+                        RemeshReport& report) {
     const auto t1 = Clock::now();
     std::vector<openvdb::Vec3s> isoPoints;
     std::vector<openvdb::Vec3I> isoTris;
     std::vector<openvdb::Vec4I> isoQuads;
-    openvdb::tools::volumeToMesh(*combined, isoPoints, isoTris, isoQuads, 0.0, 0.0);
+    openvdb::tools::volumeToMesh(combined, isoPoints, isoTris, isoQuads, 0.0, 0.0);
     const size_t triangles = isoTris.size() + 2 * isoQuads.size();
     if (triangles == 0)
         throw InputError("remesh: the combined volume is empty (the operations leave nothing inside at voxel size " +
@@ -253,6 +264,41 @@ sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const Reme
     report.isoTriangles = iso.triangleCount();
     report.isosurfaceSeconds = secondsSince(t1);
     return iso;
+}
+
+} // namespace
+
+sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const RemeshParams& params,
+                                const RemeshProgress& progress, const std::atomic<bool>* cancel, RemeshReport& report) {
+    openvdb::initialize();
+    auto stage = [&](const std::string& name, double fraction) { reportStage(progress, cancel, name, fraction); };
+    // The grid: one voxel size for every part, from the bounds of them all.
+    const double vs = gridVoxelSize(parts, params, report);
+    const auto xform = openvdb::math::Transform::createLinearTransform(vs);
+    CancelInterrupter interrupter(cancel);
+    LevelSetContext ctx{*xform, vs, float(params.bandVoxels), interrupter, cancel, {}, {}};
+
+    const auto t0 = Clock::now();
+    openvdb::FloatGrid::Ptr combined;
+    const double levelSetShare = 0.6;
+    for (size_t i = 0; i < parts.size(); ++i) {
+        const RemeshPart& part = parts[i];
+        stage("level set " + std::to_string(i + 1) + "/" + std::to_string(parts.size()) + ": " + part.name,
+              levelSetShare * double(i) / double(parts.size()));
+        combine(combined, partLevelSet(part, ctx, report), part.op);
+    }
+    if (params.smoothingIterations > 0) {
+        openvdb::tools::LevelSetFilter<openvdb::FloatGrid> filter(*combined);
+        for (int i = 0; i < params.smoothingIterations; ++i) {
+            stage("smoothing", levelSetShare + 0.1 * double(i) / params.smoothingIterations);
+            filter.meanCurvature();
+        }
+    }
+    report.activeVoxels = size_t(combined->activeVoxelCount());
+    report.levelSetSeconds = secondsSince(t0);
+
+    stage("isosurface", levelSetShare + 0.1);
+    return isosurface(*combined, params, vs, report);
 }
 
 } // namespace viscera::bake::detail

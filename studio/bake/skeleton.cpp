@@ -196,43 +196,50 @@ double secondsSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-} // namespace
+/// The normalized frame of the surface: bounding-box centre at the origin, unit diagonal; and
+/// which vertices the triangles reference.
+struct NormalizedFrame {
+    std::vector<char> used;
+    sim::Vec3 centre;
+    double diagonal = 0;
+    double scale = 0;
+};
 
-SkeletonResult extractSkeleton(const sim::TriMesh& surface, const SkeletonParams& params) {
-    const auto t0 = std::chrono::steady_clock::now();
-    validateParams(params);
-    const std::string& label = params.label;
-    // Declared first, so every CGAL object of this call is destroyed before it (see above).
-    const size_t reserveBytes =
-        std::min(size_t{1} << 40, (size_t{1} << 30) + (size_t{256} << 10) * surface.triangleCount());
-    const detail::ScratchArena arena(reserveBytes);
-
-    // ---- surface checks (indices of `surface` in every message) ------------------------------
-    detail::checkInputSurface(label, surface);
-
+NormalizedFrame normalizedFrame(const std::string& label, const sim::TriMesh& surface) {
     // Normalized frame: bounding-box centre at the origin, unit diagonal.
-    std::vector<char> used(surface.vertexCount(), 0);
+    NormalizedFrame frame;
+    frame.used.assign(surface.vertexCount(), 0);
     sim::Vec3 lo = sim::Vec3::Constant(HUGE_VAL), hi = sim::Vec3::Constant(-HUGE_VAL);
     for (const sim::Tri& t : surface.triangles())
         for (int32_t v : t) {
-            used[v] = 1;
+            frame.used[v] = 1;
             lo = lo.cwiseMin(surface.positions()[v]);
             hi = hi.cwiseMax(surface.positions()[v]);
         }
-    const double diagonal = (hi - lo).norm();
-    if (!(diagonal > 0)) fail(label, "surface has zero extent");
-    const sim::Vec3 centre = 0.5 * (lo + hi);
-    const double scale = 1.0 / diagonal;
+    frame.diagonal = (hi - lo).norm();
+    if (!(frame.diagonal > 0)) fail(label, "surface has zero extent");
+    frame.centre = 0.5 * (lo + hi);
+    frame.scale = 1.0 / frame.diagonal;
+    return frame;
+}
 
+/// The CGAL surface in the normalized frame, with the map back to the input's vertices.
+struct CgalSurface {
     SurfaceMesh sm;
-    std::vector<SurfaceMesh::Vertex_index> vmap(surface.vertexCount());
     std::vector<int32_t> inputOf; // Surface_mesh vertex index -> surface vertex
-    inputOf.reserve(surface.vertexCount());
+};
+
+/// Fills `out` from the referenced vertices; checks degenerate and non-manifold triangles.
+void buildSurfaceMesh(const std::string& label, const sim::TriMesh& surface, const NormalizedFrame& frame,
+                      CgalSurface& out) {
+    SurfaceMesh& sm = out.sm;
+    std::vector<SurfaceMesh::Vertex_index> vmap(surface.vertexCount());
+    out.inputOf.reserve(surface.vertexCount());
     for (size_t v = 0; v < surface.vertexCount(); ++v)
-        if (used[v]) {
-            const sim::Vec3 p = (surface.positions()[v] - centre) * scale;
+        if (frame.used[v]) {
+            const sim::Vec3 p = (surface.positions()[v] - frame.centre) * frame.scale;
             vmap[v] = sm.add_vertex(K::Point_3(p.x(), p.y(), p.z()));
-            inputOf.push_back(static_cast<int32_t>(v));
+            out.inputOf.push_back(static_cast<int32_t>(v));
         }
     const auto& tris = surface.triangles();
     for (size_t t = 0; t < tris.size(); ++t) {
@@ -241,26 +248,28 @@ SkeletonResult extractSkeleton(const sim::TriMesh& surface, const SkeletonParams
         if (sm.add_face(vmap[tris[t][0]], vmap[tris[t][1]], vmap[tris[t][2]]) == SurfaceMesh::null_face())
             fail(label, "surface is not manifold at triangle " + std::to_string(t));
     }
-    {
-        std::vector<std::pair<SurfaceMesh::Face_index, SurfaceMesh::Face_index>> pairs;
-        PMP::self_intersections(sm, std::back_inserter(pairs));
-        if (!pairs.empty()) {
-            std::pair<size_t, size_t> first(std::numeric_limits<size_t>::max(), 0);
-            for (const auto& [f, g] : pairs) {
-                const size_t a = f, b = g;
-                first = std::min(first, std::pair<size_t, size_t>(std::min(a, b), std::max(a, b)));
-            }
-            fail(label, "surface self-intersects: triangles " + std::to_string(first.first) + " and " +
-                            std::to_string(first.second) + " intersect (" + std::to_string(pairs.size()) +
-                            " intersecting pair(s) in all)");
-        }
-    }
-    const double volume = std::abs(surface.signedVolume());
-    if (!(volume > 1e-12 * diagonal * diagonal * diagonal))
-        fail(label, "surface encloses no volume (" + std::to_string(volume) + " m^3)");
+}
 
-    // ---- contraction ---------------------------------------------------------------------------
-    CgalSkeleton cs;
+void checkSelfIntersections(const std::string& label, const SurfaceMesh& sm) {
+    std::vector<std::pair<SurfaceMesh::Face_index, SurfaceMesh::Face_index>> pairs;
+    PMP::self_intersections(sm, std::back_inserter(pairs));
+    if (!pairs.empty()) {
+        std::pair<size_t, size_t> first(std::numeric_limits<size_t>::max(), 0);
+        for (const auto& [f, g] : pairs) {
+            const size_t a = f, b = g;
+            first = std::min(first, std::pair<size_t, size_t>(std::min(a, b), std::max(a, b)));
+        }
+        fail(label, "surface self-intersects: triangles " + std::to_string(first.first) + " and " +
+                        std::to_string(first.second) + " intersect (" + std::to_string(pairs.size()) +
+                        " intersecting pair(s) in all)");
+    }
+}
+
+/// Runs the mean curvature flow contraction of `sm` into `cs`; `reserveBytes` is the arena's size
+/// and `surfaceTriangles` the input's triangle count (both for the out-of-memory message).
+void contract(const SurfaceMesh& sm, const SkeletonParams& params, size_t reserveBytes, size_t surfaceTriangles,
+              CgalSkeleton& cs) {
+    const std::string& label = params.label;
     try {
         Skeletonization mcfs(sm);
         mcfs.set_max_triangle_angle(params.maxTriangleAngleDeg * std::numbers::pi / 180.0);
@@ -275,20 +284,21 @@ SkeletonResult extractSkeleton(const sim::TriMesh& surface, const SkeletonParams
         fail(label, std::string("skeletonization failed: ") + e.what());
     } catch (const std::bad_alloc&) {
         fail(label, "skeletonization needs more than " + std::to_string(reserveBytes >> 20) +
-                        " MiB of scratch memory (surface of " + std::to_string(surface.triangleCount()) +
+                        " MiB of scratch memory (surface of " + std::to_string(surfaceTriangles) +
                         " triangles; simplify it first)");
     }
+}
 
-    // ---- export ----------------------------------------------------------------------------------
-    SkeletonResult result;
-    sim::Skeleton& s = result.skeleton;
+/// Nodes (back in the input frame) with the vertices they list, and the edges, of `cs` into `s`.
+void exportSkeleton(const std::string& label, const sim::TriMesh& surface, const NormalizedFrame& frame,
+                    const std::vector<int32_t>& inputOf, const CgalSkeleton& cs, sim::Skeleton& s) {
     const size_t m = boost::num_vertices(cs);
     if (m == 0) fail(label, "skeletonization produced no skeleton nodes");
     s.nodes.resize(m);
     s.vertexNode.assign(surface.vertexCount(), sim::kNone);
     for (size_t j = 0; j < m; ++j) {
         const auto& vm = cs[j];
-        s.nodes[j] = sim::Vec3(vm.point.x(), vm.point.y(), vm.point.z()) / scale + centre;
+        s.nodes[j] = sim::Vec3(vm.point.x(), vm.point.y(), vm.point.z()) / frame.scale + frame.centre;
         if (!s.nodes[j].allFinite())
             fail(label, "skeletonization produced a non-finite node (" + std::to_string(j) + ")");
         for (const SurfaceMesh::Vertex_index vd : vm.vertices) {
@@ -305,25 +315,63 @@ SkeletonResult extractSkeleton(const sim::TriMesh& surface, const SkeletonParams
     s.edges.reserve(edges.size());
     for (const auto& [a, b] : edges)
         s.edges.push_back({a, b});
+}
 
+/// Assigns the nearest node to each referenced vertex that no node lists; returns their count.
+size_t assignUnlistedVertices(const sim::TriMesh& surface, const std::vector<char>& used, sim::Skeleton& s) {
     // Vertices the correspondence did not list (not expected): nearest node.
-    SkeletonReport& r = result.report;
+    size_t unlisted = 0;
     for (size_t v = 0; v < surface.vertexCount(); ++v) {
         if (!used[v] || s.vertexNode[v] != sim::kNone) continue;
         double best = HUGE_VAL;
-        for (size_t j = 0; j < m; ++j) {
+        for (size_t j = 0; j < s.nodes.size(); ++j) {
             const double d = (surface.positions()[v] - s.nodes[j]).squaredNorm();
             if (d < best) {
                 best = d;
                 s.vertexNode[v] = static_cast<int32_t>(j);
             }
         }
-        ++r.unlistedVertices;
+        ++unlisted;
     }
+    return unlisted;
+}
 
-    r.surfaceVertices = inputOf.size();
+} // namespace
+
+SkeletonResult extractSkeleton(const sim::TriMesh& surface, const SkeletonParams& params) {
+    const auto t0 = std::chrono::steady_clock::now();
+    validateParams(params);
+    const std::string& label = params.label;
+    // Declared first, so every CGAL object of this call is destroyed before it (see above).
+    const size_t reserveBytes =
+        std::min(size_t{1} << 40, (size_t{1} << 30) + (size_t{256} << 10) * surface.triangleCount());
+    const detail::ScratchArena arena(reserveBytes);
+
+    // ---- surface checks (indices of `surface` in every message) ------------------------------
+    detail::checkInputSurface(label, surface);
+    const NormalizedFrame frame = normalizedFrame(label, surface);
+    CgalSurface input;
+    buildSurfaceMesh(label, surface, frame, input);
+    checkSelfIntersections(label, input.sm);
+    const double diagonal = frame.diagonal;
+    const double volume = std::abs(surface.signedVolume());
+    if (!(volume > 1e-12 * diagonal * diagonal * diagonal))
+        fail(label, "surface encloses no volume (" + std::to_string(volume) + " m^3)");
+
+    // ---- contraction ---------------------------------------------------------------------------
+    CgalSkeleton cs;
+    contract(input.sm, params, reserveBytes, surface.triangleCount(), cs);
+
+    // ---- export ----------------------------------------------------------------------------------
+    SkeletonResult result;
+    sim::Skeleton& s = result.skeleton;
+    exportSkeleton(label, surface, frame, input.inputOf, cs, s);
+    SkeletonReport& r = result.report;
+    r.unlistedVertices += assignUnlistedVertices(surface, frame.used, s);
+
+    r.surfaceVertices = input.inputOf.size();
     r.surfaceTriangles = surface.triangleCount();
-    r.nodes = m;
+    r.nodes = s.nodes.size();
     r.edges = s.edges.size();
     std::vector<int32_t> comp;
     r.components = s.components(comp);

@@ -170,9 +170,106 @@ double secondsSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+/// The parameters with their automatic values filled in (from the surface's bounding-box
+/// diagonal); checks that the surface encloses volume and that the sizes give a feasible count.
+MeshingParams resolveParams(const std::string& label, const sim::TriMesh& surface, const MeshingParams& params,
+                            MeshingReport& report) {
+    sim::Vec3 lo = sim::Vec3::Constant(HUGE_VAL), hi = sim::Vec3::Constant(-HUGE_VAL);
+    for (const sim::Tri& t : surface.triangles())
+        for (int32_t v : t) {
+            lo = lo.cwiseMin(surface.positions()[v]);
+            hi = hi.cwiseMax(surface.positions()[v]);
+        }
+    const double diagonal = (hi - lo).norm();
+    MeshingParams p = params;
+    if (p.facetSize == 0) p.facetSize = diagonal / 20;
+    if (p.facetDistance == 0) p.facetDistance = p.facetSize / 10;
+    if (p.cellSize == 0) p.cellSize = p.facetSize;
+    if (p.edgeSize == 0) p.edgeSize = p.facetSize;
+    report.resolved = p;
+    if (!(report.surfaceVolume > 1e-12 * diagonal * diagonal * diagonal))
+        fail(label, "surface encloses no volume (" + std::to_string(report.surfaceVolume) + " m^3)");
+    const double s = std::min(p.cellSize, p.facetSize);
+    const double estimate = report.surfaceVolume / (kRegularTetVolumePerR3 * s * s * s);
+    if (estimate > static_cast<double>(p.maxEstimatedTets))
+        fail(label, "sizes too small for the volume: cellSize " + std::to_string(p.cellSize) + " m and facetSize " +
+                        std::to_string(p.facetSize) + " m give about " +
+                        std::to_string(static_cast<long long>(estimate)) +
+                        " tets (limit MeshingParams::maxEstimatedTets = " + std::to_string(p.maxEstimatedTets) + ")");
+    return p;
+}
+
+/// Counts the edges sharper than `featureAngleDeg` (the property map is removed again).
+size_t countSharpEdges(SurfaceMesh& sm, double featureAngleDeg) {
+    size_t count = 0;
+    auto sharp = sm.add_property_map<SurfaceMesh::Edge_index, bool>("e:viscera_sharp", false).first;
+    PMP::detect_sharp_edges(sm, featureAngleDeg, sharp);
+    for (auto e : sm.edges())
+        count += sharp[e] ? 1 : 0;
+    sm.remove_property_map(sharp);
+    return count;
+}
+
+/// Runs the enabled optimizers on the refined complex.
+void optimize(C3t3& c3t3, const Domain& domain, const MeshingParams& p, const Progress& progress) {
+    namespace cp = CGAL::parameters;
+    // ---- optimizers (same order as make_mesh_3) ---------------------------------------------
+    if (p.odt) {
+        progress.begin(MeshingStage::Odt);
+        CGAL::odt_optimize_mesh_3(c3t3, domain, cp::max_iteration_number = p.smoothingMaxIterations);
+    }
+    if (p.lloyd) {
+        progress.begin(MeshingStage::Lloyd);
+        CGAL::lloyd_optimize_mesh_3(c3t3, domain, cp::max_iteration_number = p.smoothingMaxIterations);
+    }
+    if (p.perturb) {
+        progress.begin(MeshingStage::Perturb);
+        CGAL::perturb_mesh_3(c3t3, domain);
+    }
+    if (p.exude) {
+        progress.begin(MeshingStage::Exude);
+        CGAL::exude_mesh_3(c3t3);
+    }
+}
+
+/// The cells of a complex as arrays: compact vertices, positively oriented tets.
+struct TetArrays {
+    std::vector<sim::Vec3> positions;
+    std::vector<sim::Tet> tets;
+    double volume = 0;
+};
+
+TetArrays exportTets(const C3t3& c3t3) {
+    const Tr& tr = c3t3.triangulation();
+    const auto point = tr.geom_traits().construct_point_3_object();
+    std::unordered_map<Tr::Vertex_handle, int32_t> vertexIndex;
+    TetArrays out;
+    std::vector<sim::Vec3>& positions = out.positions;
+    out.tets.reserve(c3t3.number_of_cells_in_complex());
+    for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c) {
+        sim::Tet tet{};
+        for (int i = 0; i < 4; ++i) {
+            const Tr::Vertex_handle vh = c->vertex(i);
+            const auto [it, inserted] = vertexIndex.try_emplace(vh, static_cast<int32_t>(positions.size()));
+            if (inserted) {
+                const K::Point_3 q = point(tr.point(vh));
+                positions.emplace_back(q.x(), q.y(), q.z());
+            }
+            tet[i] = it->second;
+        }
+        const sim::Vec3& a = positions[tet[0]];
+        const double vol = (positions[tet[1]] - a).cross(positions[tet[2]] - a).dot(positions[tet[3]] - a);
+        if (vol < 0) std::swap(tet[2], tet[3]);
+        out.volume += std::abs(vol) / 6;
+        out.tets.push_back(tet);
+    }
+    return out;
+}
+
 } // namespace
 
 std::string_view stageName(MeshingStage stage) {
+
     switch (stage) {
     case MeshingStage::CheckSurface:
         return "check surface";
@@ -210,40 +307,13 @@ TetrahedralizeResult tetrahedralize(const sim::TriMesh& surface, const MeshingPa
         report.surfaceVolume = std::abs(surface.signedVolume());
 
         // ---- parameters with automatic values -------------------------------------------------
-        sim::Vec3 lo = sim::Vec3::Constant(HUGE_VAL), hi = sim::Vec3::Constant(-HUGE_VAL);
-        for (const sim::Tri& t : surface.triangles())
-            for (int32_t v : t) {
-                lo = lo.cwiseMin(surface.positions()[v]);
-                hi = hi.cwiseMax(surface.positions()[v]);
-            }
-        const double diagonal = (hi - lo).norm();
-        MeshingParams p = params;
-        if (p.facetSize == 0) p.facetSize = diagonal / 20;
-        if (p.facetDistance == 0) p.facetDistance = p.facetSize / 10;
-        if (p.cellSize == 0) p.cellSize = p.facetSize;
-        if (p.edgeSize == 0) p.edgeSize = p.facetSize;
-        report.resolved = p;
-        if (!(report.surfaceVolume > 1e-12 * diagonal * diagonal * diagonal))
-            fail(label, "surface encloses no volume (" + std::to_string(report.surfaceVolume) + " m^3)");
-        const double s = std::min(p.cellSize, p.facetSize);
-        const double estimate = report.surfaceVolume / (kRegularTetVolumePerR3 * s * s * s);
-        if (estimate > static_cast<double>(p.maxEstimatedTets))
-            fail(label,
-                 "sizes too small for the volume: cellSize " + std::to_string(p.cellSize) + " m and facetSize " +
-                     std::to_string(p.facetSize) + " m give about " + std::to_string(static_cast<long long>(estimate)) +
-                     " tets (limit MeshingParams::maxEstimatedTets = " + std::to_string(p.maxEstimatedTets) + ")");
+        const MeshingParams p = resolveParams(label, surface, params, report);
 
         // ---- domain and refinement --------------------------------------------------------------
         progress.begin(MeshingStage::BuildDomain);
         const DefaultRandomScope randomScope(p.seed);
         CGAL::Random domainRandom(p.seed);
-        if (p.featureAngleDeg > 0) {
-            auto sharp = sm.add_property_map<SurfaceMesh::Edge_index, bool>("e:viscera_sharp", false).first;
-            PMP::detect_sharp_edges(sm, p.featureAngleDeg, sharp);
-            for (auto e : sm.edges())
-                report.featureEdgeCount += sharp[e] ? 1 : 0;
-            sm.remove_property_map(sharp);
-        }
+        if (p.featureAngleDeg > 0) report.featureEdgeCount += countSharpEdges(sm, p.featureAngleDeg);
         Domain domain(sm, &domainRandom);
         if (p.featureAngleDeg > 0) domain.detect_features(p.featureAngleDeg);
 
@@ -256,63 +326,23 @@ TetrahedralizeResult tetrahedralize(const sim::TriMesh& surface, const MeshingPa
             CGAL::make_mesh_3<C3t3>(domain, criteria, cp::no_perturb(), cp::no_exude(), cp::no_odt(), cp::no_lloyd());
         const auto tOpt = std::chrono::steady_clock::now();
         report.refineSeconds = std::chrono::duration<double>(tOpt - t0).count();
-
-        // ---- optimizers (same order as make_mesh_3) ---------------------------------------------
-        if (p.odt) {
-            progress.begin(MeshingStage::Odt);
-            CGAL::odt_optimize_mesh_3(c3t3, domain, cp::max_iteration_number = p.smoothingMaxIterations);
-        }
-        if (p.lloyd) {
-            progress.begin(MeshingStage::Lloyd);
-            CGAL::lloyd_optimize_mesh_3(c3t3, domain, cp::max_iteration_number = p.smoothingMaxIterations);
-        }
-        if (p.perturb) {
-            progress.begin(MeshingStage::Perturb);
-            CGAL::perturb_mesh_3(c3t3, domain);
-        }
-        if (p.exude) {
-            progress.begin(MeshingStage::Exude);
-            CGAL::exude_mesh_3(c3t3);
-        }
+        optimize(c3t3, domain, p, progress);
         report.optimizeSeconds = secondsSince(tOpt);
 
         // ---- export: cells of the complex, compact vertices, positive orientation --------------
         progress.begin(MeshingStage::Export);
         if (c3t3.number_of_cells_in_complex() == 0)
             fail(label, "meshing produced no tets (sizes too large for the surface?)");
-        const Tr& tr = c3t3.triangulation();
-        const auto point = tr.geom_traits().construct_point_3_object();
-        std::unordered_map<Tr::Vertex_handle, int32_t> vertexIndex;
-        std::vector<sim::Vec3> positions;
-        std::vector<sim::Tet> tets;
-        double tetVolume = 0;
-        tets.reserve(c3t3.number_of_cells_in_complex());
-        for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c) {
-            sim::Tet tet{};
-            for (int i = 0; i < 4; ++i) {
-                const Tr::Vertex_handle vh = c->vertex(i);
-                const auto [it, inserted] = vertexIndex.try_emplace(vh, static_cast<int32_t>(positions.size()));
-                if (inserted) {
-                    const K::Point_3 q = point(tr.point(vh));
-                    positions.emplace_back(q.x(), q.y(), q.z());
-                }
-                tet[i] = it->second;
-            }
-            const sim::Vec3& a = positions[tet[0]];
-            const double vol = (positions[tet[1]] - a).cross(positions[tet[2]] - a).dot(positions[tet[3]] - a);
-            if (vol < 0) std::swap(tet[2], tet[3]);
-            tetVolume += std::abs(vol) / 6;
-            tets.push_back(tet);
-        }
+        TetArrays arrays = exportTets(c3t3);
         report.boundaryTriangleCount = c3t3.number_of_facets_in_complex();
 
         TetrahedralizeResult result;
-        result.mesh =
-            sim::TetMesh::fromArrays(std::move(positions), std::move(tets), "bake::tetrahedralize(" + label + ")");
+        result.mesh = sim::TetMesh::fromArrays(std::move(arrays.positions), std::move(arrays.tets),
+                                               "bake::tetrahedralize(" + label + ")");
         report.vertexCount = result.mesh->vertexCount();
         report.tetCount = result.mesh->tetCount();
         report.quality = result.mesh->quality();
-        report.tetVolume = tetVolume;
+        report.tetVolume = arrays.volume;
         report.volumeRelError = (report.tetVolume - report.surfaceVolume) / report.surfaceVolume;
         report.totalSeconds = secondsSince(t0);
         result.report = std::move(report);

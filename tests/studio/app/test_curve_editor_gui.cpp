@@ -3,11 +3,13 @@
 // undo/redo restoring the model bit-exactly, the shape rule after every sequence of edits.
 #include "app/document.hpp"
 #include "app/material_panel.hpp"
+#include "app/plot_widget.hpp"
 #include "gui_test_support.hpp"
 
 #include <QKeyEvent>
 #include <QLabel>
 #include <QLineEdit>
+#include <QPushButton>
 
 #include <gtest/gtest.h>
 
@@ -122,12 +124,19 @@ TEST_F(PanelFixture, FiftyEventDragIsOneUndoStepAndUndoRestoresBitExactly) {
     EXPECT_EQ(doc.undoStack()->count(), undo + 1) << "one drag, one undo step";
     const Points after = f();
     EXPECT_NE(after, before);
-    EXPECT_LT(after[i][0], before[i + 1][0]) << "the point never passes its neighbour";
-    EXPECT_GT(after[i][1], before[i - 1][1]);
-    // the rule is enforced during the drag: the point follows the mouse up to its neighbours
-    // (clamped there), it is not merely left where a refused event found it
-    EXPECT_NEAR(after[i][0], before[i + 1][0], 1e-5 * before[i + 1][0]);
-    EXPECT_NEAR(after[i][1], before[i - 1][1], 1e-5 * std::abs(before[i - 1][1]) + 1e-9);
+    // free edits: the point follows the mouse and pushes the neighbours it passes along; only the
+    // pinned rest point (x = 1) stops it
+    const size_t rest = restIndex(before);
+    ASSERT_GT(rest, i);
+    EXPECT_GT(after[i][0], before[i + 1][0]) << "the point passed its old neighbour";
+    EXPECT_LT(after[i][0], 1.0) << "but not the rest point";
+    EXPECT_NEAR(after[i][0], 1.0, 1e-4);
+    EXPECT_NEAR(after[i][1], before[i - 1][1] - 5000.0, 1.0) << "the point is where the mouse is";
+    EXPECT_LT(after[i][1], before[i - 1][1]) << "below its old left neighbour";
+    EXPECT_LT(after[i - 1][1], after[i][1]) << "which was pushed down";
+    EXPECT_EQ(after[rest], before[rest]) << "the rest point stays";
+    for (size_t k = rest; k < before.size(); ++k)
+        EXPECT_EQ(after[k], before[k]) << "nothing beyond the rest point moves";
     expectShapeRule();
     doc.undoStack()->undo();
     EXPECT_EQ(f(), before) << "bit-exact";
@@ -235,3 +244,79 @@ TEST_F(PanelFixture, ManyMixedEditsKeepEveryCurveStrictlyIncreasing) {
 }
 
 } // namespace
+
+namespace {
+
+/// The uniaxial response plot's stress at the sample nearest stretch `lambda`.
+double uniaxialAt(studio::MaterialPanel& panel, double lambda) {
+    const auto& s = panel.uniaxialPlot()->series().at(0);
+    size_t best = 0;
+    for (size_t i = 0; i < s.x.size(); ++i)
+        if (std::abs(s.x[i] - lambda) < std::abs(s.x[best] - lambda)) best = i;
+    return s.y.at(best);
+}
+
+} // namespace
+
+// Issue 39 item 2: a drag of the point beside the rest point, which used to be clamped between
+// neighbours a few pixels apart, moves freely (its neighbours pushed along) and changes the
+// material's response.
+TEST_F(PanelFixture, ADragNearRestMovesFreelyAndChangesTheResponse) {
+    const Points before = f();
+    const size_t rest = restIndex(before);
+    ASSERT_LT(rest + 2, before.size());
+    const size_t i = rest + 1; // the first point in tension
+    const double stressBefore = uniaxialAt(*panel, 1.2);
+    const QPointF from = at(fe(), i);
+    drag(fe(), from, from + QPointF(0, -60), 30); // 60 px up: far past its right neighbour's value
+    const Points after = f();
+    EXPECT_EQ(after[rest], before[rest]) << "the rest point stays";
+    EXPECT_GT(after[i][1], before[i + 1][1]) << "the point passed its old neighbour's value";
+    EXPECT_GT(after[i + 1][1], after[i][1]) << "which was pushed up";
+    expectShapeRule();
+    const double stressAfter = uniaxialAt(*panel, 1.2);
+    EXPECT_GT(stressAfter, stressBefore * 1.02) << "the response at 20 % stretch changed";
+    for (const auto& p : after) // a drag that left points out of sight frames the view at its end
+        EXPECT_TRUE(fe()->view().contains(QPointF(p[0], p[1]))) << p[0] << ", " << p[1];
+}
+
+TEST_F(PanelFixture, ScaleSmoothAndResetAreOneUndoStepEachAndKeepTheShape) {
+    const Points preset = f();
+    const size_t rest = restIndex(preset);
+    const int undo = doc.undoStack()->count();
+    panel->findChild<QLineEdit*>("scaleFactor")->setText("2");
+    fe()->setSelected(1); // makes f' the active curve
+    panel->findChild<QPushButton*>("scaleCurve")->click();
+    ASSERT_EQ(panel->statusLabel()->text(), "");
+    const Points scaled = f();
+    ASSERT_EQ(scaled.size(), preset.size());
+    for (size_t k = 0; k < preset.size(); ++k)
+        EXPECT_NEAR(scaled[k][1] - preset[rest][1], 2.0 * (preset[k][1] - preset[rest][1]),
+                    1e-9 * std::abs(preset[k][1]) + 1e-9);
+    EXPECT_EQ(scaled[rest], preset[rest]);
+    expectShapeRule();
+    // the editor framed itself: every point is in view
+    for (const auto& p : scaled)
+        EXPECT_TRUE(fe()->view().contains(QPointF(p[0], p[1]))) << p[0] << ", " << p[1];
+    EXPECT_EQ(doc.undoStack()->count(), undo + 1);
+    panel->findChild<QPushButton*>("smoothCurve")->click();
+    ASSERT_EQ(panel->statusLabel()->text(), "");
+    EXPECT_NE(f(), scaled);
+    EXPECT_EQ(f()[rest], preset[rest]);
+    expectShapeRule();
+    EXPECT_EQ(doc.undoStack()->count(), undo + 2);
+    panel->findChild<QPushButton*>("resetCurve")->click();
+    ASSERT_EQ(panel->statusLabel()->text(), "");
+    EXPECT_EQ(f(), preset) << "reset gives the preset's curve again";
+    EXPECT_EQ(doc.undoStack()->count(), undo + 3);
+    // a factor that would reverse the curve is refused with the rule
+    panel->findChild<QLineEdit*>("scaleFactor")->setText("-1");
+    panel->findChild<QPushButton*>("scaleCurve")->click();
+    EXPECT_TRUE(panel->statusLabel()->text().contains("must be a positive number"))
+        << panel->statusLabel()->text().toStdString();
+    EXPECT_EQ(doc.undoStack()->count(), undo + 3);
+    doc.undoStack()->undo();
+    doc.undoStack()->undo();
+    doc.undoStack()->undo();
+    EXPECT_EQ(f(), preset);
+}
