@@ -2,9 +2,13 @@
 /// Fit to test data [A §4.3.3]: a two-column text/CSV file of a uniaxial test (stretch or
 /// engineering strain; nominal stress in Pa), fitted by least squares of the curves' control
 /// values under their shape rule (sim::fitUniaxial). Shows the data over the fitted response
-/// with SSE, R², the largest relative error and the stretch range the data covers; Apply
-/// writes the fitted curves into the body's material as one undo step. A bad file is refused
-/// with the reader's one line (file, line, column, rule).
+/// with SSE, R², the largest relative error and the stretch range the data covers, and what the
+/// fit changed and left (small-strain E and ν: f′ alone, the default, keeps ν); Apply writes the
+/// fitted curves into the body's material as one undo step. A fit whose material would be
+/// unstable (no uniaxial state, a stress that falls with stretch over 0.6–1.6 and the data's
+/// range, E or ν out of range) is shown but cannot be applied, with the reason. Enter runs the
+/// fit; editing the file name drops the previous fit. A bad file is refused with the reader's
+/// one line (file, line, column, rule).
 #include "app/plot_widget.hpp"
 #include "sim/material/curve_fit.hpp"
 
@@ -41,6 +45,12 @@ public:
     QString apply();
 
 private:
+    /// What the fit changed and what it left: small-strain E and ν before and after.
+    QString changesText(const sim::ValanisLandelCurves& before, const sim::ValanisLandelCurves& after) const;
+    /// The fitted response into `fit`; the reason the fitted material would be unstable (no
+    /// uniaxial state, a falling stress, E or ν out of range), empty when it is not.
+    QString fittedResponse(const sim::CurveFitResult& r, PlotWidget::Series& fit) const;
+
     Document* m_doc;
     int m_body;
     QLineEdit* m_file;

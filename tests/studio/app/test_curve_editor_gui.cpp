@@ -274,6 +274,7 @@ TEST_F(PanelFixture, ADragNearRestMovesFreelyAndChangesTheResponse) {
     EXPECT_GT(after[i][1], before[i + 1][1]) << "the point passed its old neighbour's value";
     EXPECT_GT(after[i + 1][1], after[i][1]) << "which was pushed up";
     expectShapeRule();
+    test::saveShot("curve_drag_near_rest");
     const double stressAfter = uniaxialAt(*panel, 1.2);
     EXPECT_GT(stressAfter, stressBefore * 1.02) << "the response at 20 % stretch changed";
     for (const auto& p : after) // a drag that left points out of sight frames the view at its end

@@ -18,10 +18,12 @@
 #include "gui_test_support.hpp"
 #include "render/image.hpp"
 #include "render/sample_map.hpp"
+#include "sim/material/editable_curves.hpp"
 #include "sim/material/laws.hpp"
 #include "sim/material/material_response.hpp"
 #include "sim/skeleton/skeleton.hpp"
 #include "sim/util/atomic_file.hpp"
+#include "sim/util/format.hpp"
 #include "window_fixture.hpp"
 
 #include <QAction>
@@ -465,6 +467,8 @@ TEST_F(WindowFixture, FitToSyntheticNeoHookeanData) {
     }
     studio::FitDialog dlg(w->document(), 0, w.get());
     dlg.show();
+    // compressible data at another ν than the start: f' and h' both
+    dlg.curves()->setCurrentIndex(1);
     dlg.fileField()->setText(QString::fromStdString(data.string()));
     QTest::mouseClick(dlg.fitButton(), Qt::LeftButton);
     ASSERT_TRUE(dlg.result().has_value()) << dlg.resultLabel()->text().toStdString();
@@ -484,6 +488,61 @@ TEST_F(WindowFixture, FitToSyntheticNeoHookeanData) {
     const std::string why = dlg.resultLabel()->text().toStdString();
     EXPECT_NE(why.find("line 2"), std::string::npos) << why;
     EXPECT_NE(why.find("column 2"), std::string::npos) << why;
+}
+
+// Issue 39 item 2: clean incompressible Ogden data (two terms, strain-stiffening like soft
+// tissue) fitted with the dialog's defaults reaches R² ≥ 0.999; the dialog says that ν was kept;
+// Enter in the file field runs a new fit instead of applying the previous one.
+TEST_F(WindowFixture, FitToCleanOgdenDataByDefaultAndEnterRunsTheFit) {
+    open("tissue-slab");
+    ASSERT_EQ(w->materialPanel()->applyPreset("neo_hookean", 3000, 0.45), "");
+    const double mu[2] = {600.0, 40.0}, alpha[2] = {2.0, 9.0}; // Pa, dimensionless
+    auto ogden = [&](double l) {
+        double p = 0;
+        for (int k = 0; k < 2; ++k)
+            p += mu[k] * (std::pow(l, alpha[k] - 1) - std::pow(l, -0.5 * alpha[k] - 1));
+        return p;
+    };
+    const fs::path data = scratch.dir / "ogden.csv";
+    {
+        std::ofstream f(data);
+        f.precision(17);
+        f << "stretch,nominal stress (Pa)\n";
+        for (int i = 0; i < 41; ++i) {
+            const double l = 0.7 + 0.8 * i / 40.0;
+            f << l << "," << ogden(l) << "\n";
+        }
+    }
+    studio::FitDialog dlg(w->document(), 0, w.get());
+    dlg.show();
+    ASSERT_TRUE(QTest::qWaitForWindowExposed(&dlg));
+    EXPECT_EQ(dlg.curves()->currentIndex(), 0) << "f' only by default";
+    dlg.fileField()->setFocus();
+    dlg.fileField()->setText(QString::fromStdString(data.string()));
+    QTest::keyClick(dlg.fileField(), Qt::Key_Return); // Enter fits
+    ASSERT_TRUE(dlg.result().has_value()) << dlg.resultLabel()->text().toStdString();
+    EXPECT_TRUE(dlg.isVisible()) << "Enter did not apply and close";
+    const auto& r = *dlg.result();
+    std::printf("ogden fit (default): R^2 %.6f, max relative error %.3g %%\n", r.rSquared, 100 * r.maxRelativeError);
+    EXPECT_GE(r.rSquared, 0.999);
+    const QString text = dlg.resultLabel()->text();
+    EXPECT_TRUE(text.contains("h′ and g′ kept")) << text.toStdString();
+    EXPECT_TRUE(dlg.applyButton()->isEnabled());
+    test::saveShot("fit_ogden");
+    const double nuBefore =
+        sim::smallStrainConstants(*studio::MaterialPanel::curvesOf(w->document()->project().bodies[0].scene.material))
+            .poissonRatio;
+    EXPECT_EQ(dlg.apply(), "");
+    const double nuAfter =
+        sim::smallStrainConstants(*studio::MaterialPanel::curvesOf(w->document()->project().bodies[0].scene.material))
+            .poissonRatio;
+    // what the dialog said ν became is what the material got
+    EXPECT_TRUE(text.contains(QString::fromStdString(sim::formatNumber(nuAfter, 3)))) << text.toStdString();
+    EXPECT_TRUE(text.contains(QString::fromStdString(sim::formatNumber(nuBefore, 3)))) << text.toStdString();
+    // editing the file name drops the fit: nothing stale can be applied
+    QTest::keyClick(dlg.fileField(), Qt::Key_X);
+    EXPECT_FALSE(dlg.applyButton()->isEnabled());
+    EXPECT_FALSE(dlg.result().has_value());
 }
 
 TEST_F(WindowFixture, GuiExportEqualsCliExport) {
