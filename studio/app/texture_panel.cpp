@@ -214,6 +214,28 @@ std::vector<bake::PaletteColor> pickPalette(const std::filesystem::path& image, 
 
 TexturePanel::TexturePanel(Document* doc, QWidget* parent) : QWidget(parent), m_doc(doc) {
     auto* root = new QVBoxLayout(this);
+    buildBlockFields(root);
+    buildThumbnails(root);
+    buildGeneratorBox(root);
+    buildPicker(root);
+    root->addStretch(1);
+
+    connectBlockFields();
+    connectGeneratorFields();
+    connect(m_doc, &Document::changed, this, [this](const Change& what) {
+        if (what.touches(Change::Texture | Change::Structure)) refresh(); // a material drag redraws nothing here
+    });
+    refresh();
+}
+
+TexturePanel::~TexturePanel() {
+    // A thumbnail or palette job still running would outlive the panel (at exit, the application
+    // whose image types it builds): wait for it, as the other panels with background jobs do.
+    for (QFutureWatcherBase* w : findChildren<QFutureWatcherBase*>())
+        w->waitForFinished();
+}
+
+void TexturePanel::buildBlockFields(QVBoxLayout* root) {
     m_header = new QLabel(this);
     m_header->setObjectName("textureHeader");
     root->addWidget(m_header);
@@ -253,7 +275,9 @@ TexturePanel::TexturePanel(Document* doc, QWidget* parent) : QWidget(parent), m_
     m_status->setObjectName("textureStatus");
     m_status->setWordWrap(true);
     root->addWidget(m_status);
+}
 
+void TexturePanel::buildThumbnails(QVBoxLayout* root) {
     auto* grid = new QGridLayout;
     for (int m = 0; m < 4; ++m) {
         m_thumbLabels[m] = new QLabel(this);
@@ -278,9 +302,9 @@ TexturePanel::TexturePanel(Document* doc, QWidget* parent) : QWidget(parent), m_
     m_specSwatches = new QGridLayout(m_specSwatchHost);
     m_specSwatches->setContentsMargins(0, 0, 0, 0);
     root->addWidget(m_specSwatchHost);
+}
 
-    buildGeneratorBox(root);
-
+void TexturePanel::buildPicker(QVBoxLayout* root) {
     auto* pickRow = new QHBoxLayout;
     m_pick = new QPushButton(tr("Pick palette from image…"), this);
     m_pick->setObjectName("pickPalette");
@@ -312,8 +336,9 @@ TexturePanel::TexturePanel(Document* doc, QWidget* parent) : QWidget(parent), m_
     m_pickedSwatches = new QGridLayout(m_pickedSwatchHost);
     m_pickedSwatches->setContentsMargins(0, 0, 0, 0);
     root->addWidget(m_pickedSwatchHost);
-    root->addStretch(1);
+}
 
+void TexturePanel::connectBlockFields() {
     connect(m_apply, &QPushButton::clicked, this, [this] { applyFields(); });
     connect(m_new, &QPushButton::clicked, this, [this] { newGenerator(); });
     connect(m_remove, &QPushButton::clicked, this, [this] { removeTexture(); });
@@ -327,18 +352,6 @@ TexturePanel::TexturePanel(Document* doc, QWidget* parent) : QWidget(parent), m_
     });
     connect(m_copyHex, &QPushButton::clicked, this, [this] { QGuiApplication::clipboard()->setText(pickedHexText()); });
     connect(m_usePicked, &QPushButton::clicked, this, [this] { usePickedPalette(); });
-    connectGeneratorFields();
-    connect(m_doc, &Document::changed, this, [this](const Change& what) {
-        if (what.touches(Change::Texture | Change::Structure)) refresh(); // a material drag redraws nothing here
-    });
-    refresh();
-}
-
-TexturePanel::~TexturePanel() {
-    // A thumbnail or palette job still running would outlive the panel (at exit, the application
-    // whose image types it builds): wait for it, as the other panels with background jobs do.
-    for (QFutureWatcherBase* w : findChildren<QFutureWatcherBase*>())
-        w->waitForFinished();
 }
 
 void TexturePanel::buildGeneratorBox(QVBoxLayout* root) {
@@ -349,7 +362,22 @@ void TexturePanel::buildGeneratorBox(QVBoxLayout* root) {
     m_genSource->setObjectName("generatorSource");
     m_genSource->setWordWrap(true);
     box->addWidget(m_genSource);
+    buildQuadtreeFields(box);
+    buildPatternFields(box);
 
+    m_paletteNote = new QLabel(m_genBox);
+    m_paletteNote->setObjectName("paletteNote");
+    m_paletteNote->setWordWrap(true);
+    box->addWidget(m_paletteNote);
+    m_paletteHost = new QWidget(m_genBox);
+    m_paletteHost->setObjectName("paletteColours");
+    m_paletteRow = new QHBoxLayout(m_paletteHost);
+    m_paletteRow->setContentsMargins(0, 0, 0, 0);
+    box->addWidget(m_paletteHost);
+    root->addWidget(m_genBox);
+}
+
+void TexturePanel::buildQuadtreeFields(QVBoxLayout* box) {
     auto* form = new QFormLayout;
     m_layerBox = new QComboBox(m_genBox);
     m_layerBox->setObjectName("generatorLayer");
@@ -394,7 +422,9 @@ void TexturePanel::buildGeneratorBox(QVBoxLayout* root) {
     m_base->setObjectName("generatorBase");
     form->addRow(tr("Base"), m_base);
     box->addLayout(form);
+}
 
+void TexturePanel::buildPatternFields(QVBoxLayout* box) {
     auto* patternRow = new QHBoxLayout;
     m_patternBox = new QComboBox(m_genBox);
     m_patternBox->setObjectName("generatorPattern");
@@ -456,20 +486,15 @@ void TexturePanel::buildGeneratorBox(QVBoxLayout* root) {
     m_pBlend->setToolTip(tr("How this level combines with the coarser levels above it"));
     pf->addRow(tr("Blend"), m_pBlend);
     box->addLayout(pf);
-
-    m_paletteNote = new QLabel(m_genBox);
-    m_paletteNote->setObjectName("paletteNote");
-    m_paletteNote->setWordWrap(true);
-    box->addWidget(m_paletteNote);
-    m_paletteHost = new QWidget(m_genBox);
-    m_paletteHost->setObjectName("paletteColours");
-    m_paletteRow = new QHBoxLayout(m_paletteHost);
-    m_paletteRow->setContentsMargins(0, 0, 0, 0);
-    box->addWidget(m_paletteHost);
-    root->addWidget(m_genBox);
 }
 
 void TexturePanel::connectGeneratorFields() {
+    connectQuadtreeFields();
+    connectPatternFields();
+    connectPatternButtons();
+}
+
+void TexturePanel::connectQuadtreeFields() {
     connect(m_layerBox, &QComboBox::currentIndexChanged, this, [this](int i) { chooseLayer(std::max(0, i)); });
     connect(m_addLayer, &QPushButton::clicked, this, [this] { addLayer(); });
     connect(m_removeLayer, &QPushButton::clicked, this, [this] { removeLayer(); });
@@ -498,6 +523,9 @@ void TexturePanel::connectGeneratorFields() {
     connect(m_base, &QDoubleSpinBox::valueChanged, this, [this](double v) {
         editGenerator(tr("Set the base value"), m_base, [&](json& layer, json&) { layer["base"] = v; });
     });
+}
+
+void TexturePanel::connectPatternFields() {
     // pattern fields: each writes its key of the chosen pattern
     auto pattern = [this](const QString& what, const void* source, const std::function<void(json & p)>& fn) {
         const int index = m_pattern;
@@ -571,6 +599,9 @@ void TexturePanel::connectGeneratorFields() {
         const std::string mode = m_pBlend->itemData(i).toString().toStdString();
         pattern(tr("Set the blend mode"), m_pBlend, [&](json& p) { p["blend"] = mode; });
     });
+}
+
+void TexturePanel::connectPatternButtons() {
     connect(m_addPattern, &QPushButton::clicked, this, [this] {
         const bake::QuadtreeParams* q = chosenQuadtree();
         if (!q) return;
@@ -840,7 +871,11 @@ void TexturePanel::fillGenerator() {
         m_pProbability->setValue(p.probability);
         m_pBlend->setCurrentIndex(static_cast<int>(p.blend));
     }
+    fillPaletteColours(*spec);
+    m_usePicked->setEnabled(!m_picked.empty() && current() != nullptr);
+}
 
+void TexturePanel::fillPaletteColours(const bake::TextureSpec& spec) {
     // the palette's editable colours: explicit ones, or those of the synthetic reference photograph
     while (QLayoutItem* item = m_paletteRow->takeAt(0)) {
         delete item->widget();
@@ -848,9 +883,9 @@ void TexturePanel::fillGenerator() {
     }
     std::vector<bake::Rgb8> colors;
     QString note;
-    const bake::LayerSpec* chosen = m_layer > 0 ? &spec->layers[static_cast<size_t>(m_layer - 1)] : nullptr;
+    const bake::LayerSpec* chosen = m_layer > 0 ? &spec.layers[static_cast<size_t>(m_layer - 1)] : nullptr;
     const bool shared = chosen && !chosen->palette;
-    if (const std::optional<bake::PaletteSpec>& pal = shared || !chosen ? spec->palette : chosen->palette; !pal) {
+    if (const std::optional<bake::PaletteSpec>& pal = shared || !chosen ? spec.palette : chosen->palette; !pal) {
         note = tr("No palette (the spec writes no diffuse map)");
     } else if (shared && !pal->colors.empty()) {
         colors = pal->colors;
@@ -885,7 +920,6 @@ void TexturePanel::fillGenerator() {
         m_paletteRow->addWidget(b);
     }
     m_paletteRow->addStretch(1);
-    m_usePicked->setEnabled(!m_picked.empty() && current() != nullptr);
 }
 
 QList<QToolButton*> TexturePanel::paletteButtons() const {

@@ -184,10 +184,22 @@ public:
     QList<QToolButton*> paletteButtons() const;
 
 private:
+    // the constructor's parts, in the order of the panel
+    void buildBlockFields(QVBoxLayout* root); ///< header, spec / tiles / normal fields, buttons, status
+    void buildThumbnails(QVBoxLayout* root);  ///< the four thumbnails and the swatches of the maps' palette
     void buildGeneratorBox(QVBoxLayout* root);
+    void buildQuadtreeFields(QVBoxLayout* box); ///< layer row and opacity, size, seed, levels, tiling, base
+    void buildPatternFields(QVBoxLayout* box);  ///< pattern row and the chosen pattern's fields
+    void buildPicker(QVBoxLayout* root);        ///< palette picking from a photo
+    void connectBlockFields();
     void connectGeneratorFields();
+    void connectQuadtreeFields();
+    void connectPatternFields();
+    void connectPatternButtons(); ///< add / remove a pattern
     void refresh();
     void fillGenerator();
+    /// The chosen layer's editable palette colours (or a note on where its palette comes from).
+    void fillPaletteColours(const bake::TextureSpec& spec);
     void setStatus(const QString& error);
     void showThumbnails(const TextureThumbnails& t);
     void showPicked();

@@ -337,6 +337,17 @@ struct TextureSpec {
 TextureSpec parseTextureSpec(std::string_view text, const std::string& origin, const std::filesystem::path& folder);
 /// Reads and parses a spec file; origin is the path as given, files resolve against its folder.
 TextureSpec loadTextureSpec(const std::filesystem::path& file);
+/// The JSON text of a spec (2-space indent, keys sorted, a final newline): every field the
+/// reader reads, under its key, defaults written out, so that parseTextureSpec(text, origin,
+/// folder) gives back an equal spec (origin aside) when the spec's folder is `folder`. Files
+/// (the palette's image, image tiles) are the relative paths the spec holds, never written
+/// here; a layer's seed is written only when it is not the default (base seed + 1 + index).
+/// The spec's bit_depth is that of its palette, prominent or reference map (else 8); every
+/// other map writes its own. Fields the reader derives rather than reads (origin,
+/// material.tileable, the palettes' seeds, a layer's size and tiling, parameters of a palette
+/// method not chosen) are not written; a spec that sets them otherwise, or a value the reader
+/// refuses, does not read back equal. Cost: O(size of the spec).
+std::string textureSpecText(const TextureSpec& spec);
 /// The files a spec reads besides itself (the palette's image, image tiles), as written in it
 /// (relative to the spec's folder), each once: what must travel with the spec.
 std::vector<std::string> specInputFiles(const TextureSpec& spec);

@@ -1,4 +1,5 @@
-// The texture spec (JSON, read through sim::JsonField) and the bake of its files.
+// The texture spec (JSON, read through sim::JsonField; written back by textureSpecText, each
+// writer beside its reader, one rule per field) and the bake of its files.
 #include "bake/texture.hpp"
 
 #include <algorithm>
@@ -43,6 +44,11 @@ Range readRange(const JsonField& f, const NumberRule& rule) {
 Range readRange(const JsonField& parent, std::string_view key, Range fallback, const NumberRule& rule) {
     auto f = parent.find(key);
     return f ? readRange(*f, rule) : fallback;
+}
+
+/// A number when lo == hi, else [lo, hi] (readRange reads both).
+nlohmann::json rangeJson(Range r) {
+    return r.lo == r.hi ? nlohmann::json(r.lo) : nlohmann::json::array({r.lo, r.hi});
 }
 
 int readBits(const JsonField& parent, int fallback) {
@@ -106,6 +112,20 @@ Tile readTile(const JsonField& f, const fs::path& folder) {
     return t;
 }
 
+nlohmann::json tileJson(const Tile& t) {
+    switch (t.shape) {
+    case TileShape::Disc:
+        return {{"shape", "disc"}};
+    case TileShape::Gaussian:
+        return {{"shape", "gaussian"}, {"sigma", t.sigma}};
+    case TileShape::Bell:
+        return {{"shape", "bell"}};
+    case TileShape::Image:
+        return {{"shape", "image"}, {"file", t.file}}; // the path as the spec wrote it
+    }
+    return {};
+}
+
 LevelPattern readPattern(const JsonField& f, int levels, const fs::path& folder) {
     f.object({"level", "tile", "rotation_deg", "offset", "scale", "opacity", "probability", "blend"});
     LevelPattern p;
@@ -142,6 +162,35 @@ LevelPattern readPattern(const JsonField& f, int levels, const fs::path& folder)
     return p;
 }
 
+const char* blendName(BlendMode mode) {
+    switch (mode) {
+    case BlendMode::Add:
+        return "add";
+    case BlendMode::Subtract:
+        return "subtract";
+    case BlendMode::Max:
+        return "max";
+    case BlendMode::Min:
+        return "min";
+    case BlendMode::Multiply:
+        return "multiply";
+    }
+    return "";
+}
+
+nlohmann::json patternJson(const LevelPattern& p) {
+    nlohmann::json f = {{"level", p.level},
+                        {"tile", tileJson(p.tile)},
+                        {"rotation_deg", rangeJson(p.rotationDeg)},
+                        {"offset", {{"radius", rangeJson(p.offsetRadius)}, {"angle_deg", rangeJson(p.offsetAngleDeg)}}},
+                        {"opacity", rangeJson(p.opacity)},
+                        {"probability", p.probability},
+                        {"blend", blendName(p.blend)}};
+    f["scale"] = p.uniformScale ? nlohmann::json{{"uniform", rangeJson(p.width)}}
+                                : nlohmann::json{{"width", rangeJson(p.width)}, {"height", rangeJson(p.height)}};
+    return f;
+}
+
 /// A colour "#rrggbb".
 Rgb8 readColor(const JsonField& c) {
     const std::optional<Rgb8> rgb = parseHexColor(c.string());
@@ -173,6 +222,18 @@ ReferenceSpec readReference(const JsonField& f) {
     r.noise = f.number("noise", r.noise, NumberRule::closed(0, 64));
     r.blurPx = f.number("blur_px", r.blurPx, NumberRule::closed(0, 16));
     return r;
+}
+
+nlohmann::json colorsJson(const std::vector<Rgb8>& colors) {
+    nlohmann::json list = nlohmann::json::array();
+    for (Rgb8 c : colors)
+        list.push_back(hexColor(c));
+    return list;
+}
+
+nlohmann::json referenceJson(const ReferenceSpec& r) {
+    return {{"size", r.size},     {"seed", r.seed},   {"colors", colorsJson(r.colors)},
+            {"shares", r.shares}, {"noise", r.noise}, {"blur_px", r.blurPx}};
 }
 
 PaletteSpec readPalette(const JsonField& f, const fs::path& folder, uint64_t seed) {
@@ -221,11 +282,37 @@ PaletteSpec readPalette(const JsonField& f, const fs::path& folder, uint64_t see
     return p;
 }
 
+/// Explicit colours alone; else the source and the parameters its method reads (the seed is the
+/// quadtree's: not written).
+nlohmann::json paletteJson(const PaletteSpec& p) {
+    if (!p.colors.empty()) return {{"colors", colorsJson(p.colors)}};
+    nlohmann::json f;
+    if (p.reference)
+        f["reference"] = referenceJson(*p.reference);
+    else
+        f["image"] = p.imageFile;
+    if (p.params.method == PaletteMethod::Threshold) {
+        f["method"] = "threshold";
+        f["threshold"] = p.params.threshold;
+    } else {
+        f["method"] = "kmeans";
+        f["k"] = p.params.k;
+        f["iterations"] = p.params.maxIterations;
+    }
+    f["max_colors"] = p.params.maxColors;
+    f["prominent_threshold"] = p.prominentThreshold;
+    return f;
+}
+
 MaskMapping readValues(const JsonField& map, MaskMapping fallback) {
     auto v = map.find("values");
     if (!v) return fallback;
     const std::vector<JsonField> e = v->items(2, 2);
     return {e[0].number(NumberRule::closed(0, 1)), e[1].number(NumberRule::closed(0, 1))};
+}
+
+nlohmann::json valuesJson(MaskMapping m) {
+    return nlohmann::json::array({m.atZero, m.atOne});
 }
 
 /// maps.diffuse's gradient: palette indices and optional stops (one per index, non-decreasing).
@@ -242,6 +329,12 @@ void readDiffuse(const JsonField& f, std::vector<int>& indices, std::vector<doub
                 items[i].fail("must not be below the stop before it (" + formatNumber(stops[i - 1]) + ")");
         }
     }
+}
+
+/// "colors" and "stops" into the diffuse map's object `f` when there are any.
+void writeDiffuse(const std::vector<int>& indices, const std::vector<double>& stops, nlohmann::json& f) {
+    if (!indices.empty()) f["colors"] = indices;
+    if (!stops.empty()) f["stops"] = stops;
 }
 
 /// Explicit palette colours must cover the diffuse indices.
@@ -304,6 +397,55 @@ void readMaps(const JsonField& m, int bits, TextureSpec& spec) {
     }
 }
 
+/// maps: one object per request. The palette, prominent and reference maps have no bit_depth
+/// of their own (they take the spec's, specBits); the others write theirs.
+nlohmann::json mapsJson(const TextureSpec& spec) {
+    const MaterialParams& mat = spec.material;
+    nlohmann::json m = nlohmann::json::object();
+    for (const MapRequest& r : spec.maps) {
+        nlohmann::json f = nlohmann::json::object();
+        switch (r.kind) {
+        case MapKind::Mask:
+            break;
+        case MapKind::Diffuse:
+            writeDiffuse(spec.diffuseIndices, mat.diffuseStops, f);
+            break;
+        case MapKind::Roughness:
+        case MapKind::Metallic:
+            f["values"] = valuesJson(r.kind == MapKind::Roughness ? mat.roughness : mat.metallic);
+            break;
+        case MapKind::Height:
+            f["values"] = valuesJson(mat.height);
+            f["blur_px"] = mat.heightBlurPx;
+            break;
+        case MapKind::Normal:
+            f["depth"] = mat.normalDepth;
+            break;
+        case MapKind::Palette:
+            f["swatch_px"] = spec.swatchPx;
+            break;
+        case MapKind::Prominent:
+            f["width"] = spec.prominentWidth;
+            f["height"] = spec.prominentHeight;
+            break;
+        case MapKind::Reference:
+            break;
+        }
+        if (r.kind != MapKind::Palette && r.kind != MapKind::Prominent && r.kind != MapKind::Reference)
+            f["bit_depth"] = r.bits;
+        m[std::string(mapName(r.kind))] = std::move(f);
+    }
+    return m;
+}
+
+/// The spec's bit_depth: that of its palette, prominent or reference map (which have no
+/// bit_depth of their own), else 8.
+int specBits(const TextureSpec& spec) {
+    for (const MapRequest& r : spec.maps)
+        if (r.kind == MapKind::Palette || r.kind == MapKind::Prominent || r.kind == MapKind::Reference) return r.bits;
+    return 8;
+}
+
 bool wants(const std::vector<MapRequest>& maps, MapKind kind) {
     for (const MapRequest& r : maps)
         if (r.kind == kind) return true;
@@ -325,6 +467,15 @@ void readQuadtree(const JsonField& f, QuadtreeParams& q, const fs::path& dir) {
                 patterns[i]["level"].fail("level " + std::to_string(q.patterns[i].level) + " already has a pattern (" +
                                           patterns[j].path() + ")");
     }
+}
+
+void writeQuadtree(const QuadtreeParams& q, nlohmann::json& f) {
+    f["levels"] = q.levels;
+    f["base"] = q.base;
+    nlohmann::json patterns = nlohmann::json::array();
+    for (const LevelPattern& p : q.patterns)
+        patterns.push_back(patternJson(p));
+    f["patterns"] = std::move(patterns);
 }
 
 /// A file-name part: "A-Z a-z 0-9 . _ -", no '/'.
@@ -389,6 +540,43 @@ LayerSpec readLayer(const JsonField& f, const TextureSpec& spec, size_t index, i
     return layer;
 }
 
+/// layers[index]; the seed only when it is not the default (the base's + 1 + index), which may
+/// lie beyond the range an explicit seed has.
+nlohmann::json layerJson(const LayerSpec& layer, const TextureSpec& spec, size_t index) {
+    nlohmann::json f = {{"name", layer.name}, {"opacity", layer.opacity}};
+    if (layer.quadtree.seed != spec.quadtree.seed + 1 + index) f["seed"] = layer.quadtree.seed;
+    writeQuadtree(layer.quadtree, f);
+    if (layer.palette) f["palette"] = paletteJson(*layer.palette);
+    auto writes = [&](MapKind kind) -> const MapRequest* {
+        for (const MapRequest& r : layer.files)
+            if (r.kind == kind) return &r;
+        return nullptr;
+    };
+    nlohmann::json m = nlohmann::json::object();
+    if (const MapRequest* r = writes(MapKind::Mask)) m["mask"] = {{"bit_depth", r->bits}};
+    const MapSelection& paints = layer.paints;
+    for (MapKind kind : {MapKind::Diffuse, MapKind::Roughness, MapKind::Metallic, MapKind::Height}) {
+        const bool painted = kind == MapKind::Diffuse     ? paints.diffuse
+                             : kind == MapKind::Roughness ? paints.roughness
+                             : kind == MapKind::Metallic  ? paints.metallic
+                                                          : paints.height;
+        if (!painted) continue;
+        nlohmann::json c = nlohmann::json::object();
+        if (kind == MapKind::Diffuse)
+            writeDiffuse(layer.diffuseIndices, layer.material.diffuseStops, c);
+        else
+            c["values"] = valuesJson(kind == MapKind::Roughness  ? layer.material.roughness
+                                     : kind == MapKind::Metallic ? layer.material.metallic
+                                                                 : layer.material.height);
+        const MapRequest* r = writes(kind);
+        c["write"] = r != nullptr;
+        if (r) c["bit_depth"] = r->bits;
+        m[std::string(mapName(kind))] = std::move(c);
+    }
+    f["maps"] = std::move(m);
+    return f;
+}
+
 std::string defaultName(const std::string& origin) {
     const std::string stem = fs::path(origin).stem().string();
     return !stem.empty() && !sim::entryNameProblem(stem) ? stem : "texture";
@@ -449,6 +637,24 @@ TextureSpec parseTextureSpec(std::string_view text, const std::string& origin, c
         }
     }
     return spec;
+}
+
+std::string textureSpecText(const TextureSpec& spec) {
+    nlohmann::json root = {{"name", spec.name},
+                           {"size", spec.quadtree.size},
+                           {"seed", spec.quadtree.seed},
+                           {"tileable", spec.quadtree.tileable},
+                           {"bit_depth", specBits(spec)}};
+    writeQuadtree(spec.quadtree, root);
+    if (spec.palette) root["palette"] = paletteJson(*spec.palette);
+    root["maps"] = mapsJson(spec);
+    if (!spec.layers.empty()) {
+        nlohmann::json layers = nlohmann::json::array();
+        for (size_t i = 0; i < spec.layers.size(); ++i)
+            layers.push_back(layerJson(spec.layers[i], spec, i));
+        root["layers"] = std::move(layers);
+    }
+    return root.dump(2) + "\n";
 }
 
 std::vector<std::string> specInputFiles(const TextureSpec& spec) {
@@ -608,18 +814,8 @@ std::vector<EncodedFile> encodeMap(const TextureSpec& spec, const TextureSet& se
         j["source"] = p.reference           ? nlohmann::json("reference")
                       : p.imageFile.empty() ? nlohmann::json("colors")
                                             : nlohmann::json(p.imageFile);
-        if (p.reference) {
-            nlohmann::json colors = nlohmann::json::array();
-            for (Rgb8 c : p.reference->colors)
-                colors.push_back(hexColor(c));
-            j["reference"] = {
-                {"size", p.reference->size},     {"seed", p.reference->seed},   {"colors", colors},
-                {"shares", p.reference->shares}, {"noise", p.reference->noise}, {"blur_px", p.reference->blurPx}};
-        }
-        nlohmann::json colors = nlohmann::json::array();
-        for (Rgb8 c : set.colors)
-            colors.push_back(hexColor(c));
-        j["colors"] = colors;
+        if (p.reference) j["reference"] = referenceJson(*p.reference);
+        j["colors"] = colorsJson(set.colors);
         j["palette"] = colorList(set.palette);
         j["prominent"] = colorList(set.prominent);
         add("palette.json", j.dump(2) + "\n");
