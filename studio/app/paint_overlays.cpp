@@ -53,6 +53,34 @@ Eigen::Vector4f weightColour(double w, double base) {
     return {c.x(), c.y(), c.z(), w == base ? 0.35f : 0.9f};
 }
 
+render::RenderMesh brushRingMesh(const Eigen::Vector3d& centre, const Eigen::Vector3d& normal, double radius,
+                                 uint32_t material) {
+    render::RenderMesh m;
+    m.name = "brush";
+    m.material = material;
+    m.doubleSided = true;
+    if (!(radius > 0) || !centre.allFinite() || !(normal.norm() > 0) || !normal.allFinite()) return m;
+    const Eigen::Vector3d n = normal.normalized(), u = n.unitOrthogonal(), w = n.cross(u);
+    const double band = std::max(0.04 * radius, 1.5e-4);
+    const Eigen::Vector3d c = centre + 0.01 * radius * n;
+    constexpr int kSegments = 48;
+    for (int k = 0; k < kSegments; ++k) {
+        const double phi = 2 * 3.14159265358979 * k / kSegments;
+        const Eigen::Vector3d dir = std::cos(phi) * u + std::sin(phi) * w;
+        push(m.positions, c + (radius - 0.5 * band) * dir);
+        push(m.positions, c + (radius + 0.5 * band) * dir);
+    }
+    for (uint32_t k = 0; k < kSegments; ++k) {
+        const uint32_t i0 = 2 * k, o0 = i0 + 1, i1 = 2 * ((k + 1) % kSegments), o1 = i1 + 1;
+        m.indices.insert(m.indices.end(), {i0, i1, o1, i0, o1, o0});
+    }
+    finish(m);
+    m.overlay.clear();
+    for (size_t i = 0; i < m.positions.size() / 3; ++i)
+        pushColour(m.overlay, {1.0f, 0.95f, 0.55f, 1.0f});
+    return m;
+}
+
 render::RenderMesh skeletonMesh(const sim::Skeleton& skeleton, float radius, uint32_t material) {
     render::RenderMesh m;
     m.name = "skeleton";

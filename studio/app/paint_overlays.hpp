@@ -22,6 +22,13 @@ Eigen::Vector4f weightColour(double w, double base);
 /// coloured by an opaque yellow overlay. Empty mesh for an empty skeleton.
 render::RenderMesh skeletonMesh(const sim::Skeleton& skeleton, float radius, uint32_t material);
 
+/// The brush's outline on the surface: a flat ring of radius `radius` (m) about `centre` in the
+/// plane normal to `normal` (drawn surface frame), its band 4 % of the radius wide (at least
+/// 0.15 mm), lifted 1 % of the radius off the surface along the normal so that it is not hidden
+/// in it; 48 segments, opaque light-yellow overlay, double-sided. Named "brush".
+render::RenderMesh brushRingMesh(const Eigen::Vector3d& centre, const Eigen::Vector3d& normal, double radius,
+                                 uint32_t material);
+
 /// A plane {x : n·x = offset} with unit normal n; the side n·x > offset is cut away.
 struct CutPlane {
     Eigen::Vector3d normal = Eigen::Vector3d::UnitX();

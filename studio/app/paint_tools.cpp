@@ -99,9 +99,31 @@ void PaintTools::retarget() {
     if (paintingSamples()) m_samplePainter.setTarget(body, mesh);
 }
 
+void PaintTools::pushAuthoring() {
+    if (!m_viewport) return;
+    std::vector<render::RenderMesh> meshes = m_extra;
+    const bool fill = paintingSamples() && m_samplePainter.brush.tool == render::SamplePaintOp::Tool::Fill;
+    if (m_hover && (painting() || paintingSamples()) && !fill) {
+        const double radius = paintingSamples() ? m_samplePainter.brush.radius : m_painter.brush.radius;
+        meshes.push_back(brushRingMesh(m_hover->first, m_hover->second, radius, 0));
+    }
+    m_viewport->setAuthoringMeshes(std::move(meshes));
+}
+
 void PaintTools::connectViewport(Viewport* v) {
     m_viewport = v;
+    m_hover.reset();
     if (!v) return;
+    // the brush's outline on the surface under the cursor, at the brush's radius
+    connect(v, &Viewport::brushHovered, this, [this](const Viewport::SurfaceHit& hit) {
+        m_hover = std::make_pair(hit.world.cast<double>(), hit.normal.cast<double>());
+        pushAuthoring();
+    });
+    connect(v, &Viewport::brushLeft, this, [this] {
+        if (!m_hover) return;
+        m_hover.reset();
+        pushAuthoring();
+    });
     // a dab only on the painted body's own surface
     auto onBody = [this](const Viewport::SurfaceHit& hit) {
         const auto& meshes = m_viewport->view().meshes();
@@ -223,7 +245,8 @@ void PaintTools::showOverlay() {
     std::vector<render::RenderMesh> extra;
     if (skeleton) extra.push_back(skeletonMesh(m_painter.skeleton(), 0.0006f, 0));
     if (cut && mesh) extra.push_back(sliceMesh(*mesh, w, base, *cut, 0));
-    m_viewport->setAuthoringMeshes(std::move(extra));
+    m_extra = std::move(extra);
+    pushAuthoring();
 }
 
 QDockWidget* PaintTools::addToolDock(QWidget* host, const QString& title, const char* name) {
@@ -277,11 +300,19 @@ void PaintTools::buildPaintDock() {
             strength->setMaximum(1.0);
         else
             strength->setMaximum(100.0);
+        pushAuthoring(); // the outline takes the new radius
     };
     connect(mode, &QComboBox::currentIndexChanged, this, sync);
     for (QDoubleSpinBox* s : {radius, strength, target})
         connect(s, &QDoubleSpinBox::valueChanged, this, sync);
     sync();
+    auto* skeletonOnly = new QCheckBox(tr("Reach only through the skeleton (eq. 4.26)"), host);
+    skeletonOnly->setObjectName("paintSkeletonOnly");
+    skeletonOnly->setToolTip(tr("Off: the brush changes the nodes it touches and the cross-sections of the skeleton "
+                                "nodes inside it. On: only the latter (a surface far from the skeleton stays)"));
+    connect(skeletonOnly, &QCheckBox::toggled, this,
+            [this](bool on) { m_painter.brush.reach = on ? sim::BrushReach::Skeleton : sim::BrushReach::Sphere; });
+    form->addRow(skeletonOnly);
     m_paintSkeleton = new QCheckBox(tr("Show the curve skeleton"), host);
     m_paintSkeleton->setObjectName("paintSkeleton");
     m_paintSkeleton->setChecked(true);
@@ -332,7 +363,8 @@ void PaintTools::showSampleClasses() {
     };
     showPaintedBody(render::RenderMesh::Source::Body, show ? m_samplePainter.body() : -1,
                     show ? std::function<Eigen::Vector4f(int32_t)>(colour) : nullptr, std::nullopt);
-    m_viewport->setAuthoringMeshes({});
+    m_extra.clear();
+    pushAuthoring();
     if (!m_sampleLegend) return;
     // the legend: the three classes' colours and their share of the body's surface
     const std::array<double, 4> a = show ? m_samplePainter.areas() : std::array<double, 4>{0, 0, 0, 0};
@@ -395,6 +427,7 @@ void PaintTools::buildSampleDock() {
         m_samplePainter.brush.maxAngleDeg = angle->value();
         radius->setEnabled(kind->currentIndex() == 0);
         angle->setEnabled(kind->currentIndex() == 1);
+        pushAuthoring(); // the outline takes the new radius (none for a fill)
     };
     connect(kind, &QComboBox::currentIndexChanged, this, sync);
     connect(cls, &QComboBox::currentIndexChanged, this, sync);

@@ -66,6 +66,8 @@ private:
     /// `host` in a scrolling dock tabbed beside the properties, hidden until its tool starts.
     QDockWidget* addToolDock(QWidget* host, const QString& title, const char* name);
     void showSampleClasses();
+    /// The authoring meshes (skeleton, section) and the brush outline where the cursor is.
+    void pushAuthoring();
     /// The painted body at rest, alone, with `rgbaOfNode` colouring its render meshes (null: the
     /// paint view is off and every mesh is shown as it is).
     void showPaintedBody(render::RenderMesh::Source source, int index,
@@ -88,6 +90,9 @@ private:
     QSlider* m_paintCutAt = nullptr;
     QLabel *m_sampleStatus = nullptr, *m_sampleLegend = nullptr;
     SampleCompareDialog* m_compare = nullptr;
+    std::vector<render::RenderMesh> m_extra; ///< skeleton and section meshes
+    std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>>
+        m_hover; ///< the surface point under the cursor and its normal
 };
 
 } // namespace viscera::studio

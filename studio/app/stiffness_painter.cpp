@@ -200,7 +200,8 @@ sim::BrushStroke StiffnessPainter::dabAt(const sim::Vec3& center) const {
     s.mode = brush.mode;
     s.amplitude = brush.strength;
     s.target = brush.target;
-    if (m_invert && m_stroking) { // Ctrl: the inverse of the brush
+    if (m_surface < 0) s.reach = brush.reach; // a fascia's polygon paint selects by sphere anyway
+    if (m_invert && m_stroking) {             // Ctrl: the inverse of the brush
         if (s.mode == sim::BrushMode::Add)
             s.mode = sim::BrushMode::Subtract;
         else if (s.mode == sim::BrushMode::Subtract)
@@ -256,7 +257,9 @@ QString StiffnessPainter::end() {
             tr("the stroke changed no weight on '%1' (no node within the brush's %2 mm%3); nothing was recorded")
                 .arg(targetName())
                 .arg(1e3 * dabs.front().radius, 0, 'g', 3)
-                .arg(m_surface >= 0 ? QString() : tr(", which reaches the body's nodes through its curve skeleton"));
+                .arg(m_surface >= 0 || dabs.front().reach == sim::BrushReach::Sphere
+                         ? QString()
+                         : tr(", which reaches the body's nodes through its curve skeleton only"));
         setStatus(why);
         return why;
     }

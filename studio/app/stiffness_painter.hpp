@@ -32,6 +32,10 @@ public:
         double radius = 0.01;  ///< m, the poly6 support h
         double strength = 1.0; ///< Add/Subtract: weight added at the centre; Mix/Smooth: in [0, 1]
         double target = 2.0;   ///< Mix: the weight approached
+        /// A body's nodes the brush reaches: the surface it touches and, through the curve
+        /// skeleton, the members of the skeleton nodes inside it (Sphere, the default), or only
+        /// the latter (Skeleton, eq. 4.26 as printed).
+        sim::BrushReach reach = sim::BrushReach::Sphere;
     };
 
     explicit StiffnessPainter(Document* doc, QObject* parent = nullptr);

@@ -665,6 +665,7 @@ std::optional<Viewport::SurfaceHit> Viewport::hitAt(QPoint pos) const {
         u = (c - b).cross(hit.world - b).dot(n) / area; // weight of a
         v = (a - c).cross(hit.world - c).dot(n) / area; // weight of b
     }
+    if (area > 0) hit.normal = n.normalized();
     hit.rest = u * corner(m.rest, m.indices[bestFace]) + v * corner(m.rest, m.indices[bestFace + 1]) +
                (1 - u - v) * corner(m.rest, m.indices[bestFace + 2]);
     return hit;
@@ -745,6 +746,8 @@ void Viewport::setPaintMode(bool on) {
     if (m_painting && !on) emit paintCancelled();
     m_painting = false;
     m_paintMode = on;
+    trackMouse(on); // the brush outline follows the cursor without a button
+    if (!on) emit brushLeft();
     setCursor(on ? Qt::CrossCursor : Qt::ArrowCursor);
 }
 
@@ -753,7 +756,7 @@ void Viewport::mousePressEvent(QMouseEvent* e) {
     if (m_adjust != Adjust::None) { // the click sets the brush size or strength
         emit brushAdjusted(m_adjust == Adjust::Strength, e->position().x() - m_adjustFrom.x(), true);
         m_adjust = Adjust::None;
-        trackMouse(false);
+        trackMouse(m_paintMode); // the brush outline still follows the cursor
         return;
     }
     m_pressPos = m_lastPos = e->position().toPoint();
@@ -778,6 +781,12 @@ void Viewport::mouseMoveEvent(QMouseEvent* e) {
         return;
     }
     if ((p - m_pressPos).manhattanLength() > 3) m_dragged = true;
+    if (m_paintMode && (m_button == Qt::NoButton || m_painting)) { // the brush outline follows the cursor
+        if (const auto hit = hitAt(p))
+            emit brushHovered(*hit);
+        else
+            emit brushLeft();
+    }
     if (m_painting) {
         if (const auto hit = hitAt(p)) emit paintMoved(*hit); // off the surface: no dab
         return;
@@ -838,7 +847,7 @@ void Viewport::keyPressEvent(QKeyEvent* e) {
     if (e->key() == Qt::Key_Escape && m_adjust != Adjust::None) {
         emit brushAdjusted(m_adjust == Adjust::Strength, 0, true);
         m_adjust = Adjust::None;
-        trackMouse(false);
+        trackMouse(m_paintMode); // the brush outline still follows the cursor
         return;
     }
     if (e->key() == Qt::Key_Escape && m_painting) {

@@ -84,6 +84,7 @@ public:
         Eigen::Vector3f world = Eigen::Vector3f::Zero(); ///< on the drawn (deformed) surface
         Eigen::Vector3f rest = Eigen::Vector3f::Zero();  ///< the same surface point at rest
         bool invert = false; ///< paintPressed: Ctrl was held (the stroke does the brush's inverse)
+        Eigen::Vector3f normal = Eigen::Vector3f::UnitZ(); ///< unit normal of the drawn triangle hit
     };
     std::optional<SurfaceHit> hitAt(QPoint pos) const;
     /// The meshes drawn (the UI thread's copy).
@@ -102,6 +103,7 @@ public:
     /// Static meshes drawn after the scene's (the paint tool's skeleton and section); not hit.
     void setAuthoringMeshes(std::vector<render::RenderMesh> meshes);
     size_t authoringMeshCount() const { return m_authoring.size(); }
+    const std::vector<render::RenderMesh>& authoringMeshes() const { return m_authoring; }
     /// Paint mode: a left drag paints (paintPressed/Moved/Released at the surface under the
     /// cursor, Esc: paintCancelled) instead of orbiting; Alt + left drag orbits, middle drag
     /// pans, the wheel zooms.
@@ -130,6 +132,10 @@ signals:
     void bodyClicked(const QString& name);
     void paintPressed(const Viewport::SurfaceHit& hit);
     void paintMoved(const Viewport::SurfaceHit& hit);
+    /// Paint mode: the cursor is over `hit` (with or without a button): where the brush outline
+    /// goes. brushLeft(): over no surface.
+    void brushHovered(const Viewport::SurfaceHit& hit);
+    void brushLeft();
     void paintReleased();
     void paintCancelled();
     /// Paint mode, F (radius) or Shift+F (strength) then a mouse move: `dx` pixels moved right

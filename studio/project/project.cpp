@@ -315,7 +315,10 @@ StiffnessPaintProject readPaint(const JsonField& j, bool skeleton) {
     const std::vector<JsonField> strokes = j["strokes"].items(1);
     for (size_t k = 0; k < strokes.size(); ++k) {
         const JsonField& st = strokes[k];
-        st.object({"center", "radius", "amplitude", "scale", "mode", "target"});
+        if (skeleton)
+            st.object({"center", "radius", "amplitude", "scale", "mode", "target", "reach"});
+        else
+            st.object({"center", "radius", "amplitude", "scale", "mode", "target"});
         sim::BrushStroke s;
         s.center = st["center"].vec3();
         s.radius = st["radius"].number(NumberRule::closed(sim::kMinBrushRadius, sim::kMaxBrushRadius));
@@ -330,6 +333,9 @@ StiffnessPaintProject readPaint(const JsonField& j, bool skeleton) {
                      : mode == "mix"      ? sim::BrushMode::Mix
                                           : sim::BrushMode::Smooth;
         }
+        if (auto r = st.find("reach")) // "skeleton" (eq. 4.26, the default) or "sphere" (and the nodes touched)
+            s.reach = r->choice({"skeleton", "sphere"}, "a brush reach") == "sphere" ? sim::BrushReach::Sphere
+                                                                                     : sim::BrushReach::Skeleton;
         if (auto t = st.find("target")) {
             if (s.mode != sim::BrushMode::Mix) t->fail("only a mix stroke has a target");
             s.target = t->number(NumberRule::positive());
@@ -358,6 +364,7 @@ json paintJson(const StiffnessPaintProject& p, bool skeleton) {
                         : s.mode == sim::BrushMode::Mix    ? "mix"
                                                            : "smooth";
         if (s.mode == sim::BrushMode::Mix) j["target"] = s.target;
+        if (skeleton && s.reach == sim::BrushReach::Sphere) j["reach"] = "sphere";
         strokes.push_back(std::move(j));
     }
     json out = {{"base_weight", p.params.baseWeight},

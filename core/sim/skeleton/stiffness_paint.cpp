@@ -178,6 +178,9 @@ void applyBrushStroke(const std::vector<Vec3>& positions, const Skeleton& skelet
     for (size_t j = 0; j < skeleton.nodes.size(); ++j)
         if ((skeleton.nodes[j] - stroke.center).norm() < stroke.radius)
             selected.insert(selected.end(), map.members.begin() + map.start[j], map.members.begin() + map.start[j + 1]);
+    if (stroke.reach == BrushReach::Sphere) // and the nodes the brush touches itself
+        for (size_t i = 0; i < positions.size(); ++i)
+            if ((positions[i] - stroke.center).norm() < stroke.radius) selected.push_back(static_cast<int32_t>(i));
     std::sort(selected.begin(), selected.end());
     selected.erase(std::unique(selected.begin(), selected.end()), selected.end());
     applyToSelection(positions, selected, stroke, params, weights, report, neighbours, index);

@@ -41,6 +41,15 @@ enum class BrushScale {
 /// Mix and Smooth take a >= 0 as the brush's strength; t never overshoots.
 enum class BrushMode { Add, Subtract, Mix, Smooth };
 
+/// Which nodes of a tet body a stroke selects (the kernel is always taken at the node's own
+/// distance from the centre, so a node outside the sphere never changes):
+///   Skeleton  the members Π_j of every skeleton node p_j strictly inside the sphere [A eq. 4.26]:
+///             a brush on the surface of a thick body whose skeleton lies deeper than its radius
+///             selects nothing;
+///   Sphere    those, and every node strictly inside the sphere: the surface nodes the artist
+///             touches as well (the studio's default for new strokes).
+enum class BrushReach { Skeleton, Sphere };
+
 /// Accepted brush radii, metres (keeps 1/h⁹ and the peak 315/(64π h³) finite).
 inline constexpr double kMinBrushRadius = 1e-6;
 inline constexpr double kMaxBrushRadius = 1e3;
@@ -52,7 +61,8 @@ struct BrushStroke {
     double amplitude = 1.0;     ///< weight to add (see BrushScale); < 0 softens
     BrushScale scale = BrushScale::Peak;
     BrushMode mode = BrushMode::Add;
-    double target = 1.0; ///< Mix: the weight approached (finite, > 0)
+    double target = 1.0;                     ///< Mix: the weight approached (finite, > 0)
+    BrushReach reach = BrushReach::Skeleton; ///< tet bodies only (a surface's polygon paint is by sphere)
 };
 
 /// The mesh neighbours of every node (its edges), compressed: node i's are
@@ -97,7 +107,8 @@ struct StiffnessPaintResult {
 void validateStroke(const BrushStroke& stroke, size_t index, const std::string& origin);
 
 /// Applies one stroke to `weights` (#n, one per node of `positions`) [A eq. 4.26]: the selected
-/// nodes are ∪ Π_j over skeleton nodes with |p_j − c| < h; each selected node i changes by the
+/// nodes are ∪ Π_j over skeleton nodes with |p_j − c| < h (and, with BrushReach::Sphere, every
+/// node with |x_i − c| < h); each selected node i changes by the
 /// stroke's mode (BrushMode) with k = kernel(|x_i − c|, h) (zero outside the sphere), then the
 /// selected nodes are clamped to [minWeight, maxWeight]. `neighbours` (of the same nodes) is
 /// needed by Smooth only. Updates the stroke figures of `report`. Throws std::invalid_argument

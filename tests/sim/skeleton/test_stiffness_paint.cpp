@@ -179,6 +179,38 @@ TEST(StiffnessPaint, SelectionGoesThroughTheSkeleton) {
         EXPECT_EQ(w, 1.0);
 }
 
+TEST(StiffnessPaint, TheSphereReachAlsoChangesTheNodesTheBrushTouches) {
+    // The brush of SelectionGoesThroughTheSkeleton, reaching by sphere: every node strictly inside
+    // the brush changes by the kernel at its own distance, no other.
+    Bar b = makeBar(4);
+    BrushStroke s{Vec3(0.025, 0.01, 0.01), 0.011, 5.0, BrushScale::Peak};
+    s.reach = BrushReach::Sphere;
+    const StiffnessPaintResult r = bakeStiffnessPaint(*b.mesh, b.skeleton, {s});
+    size_t inside = 0;
+    for (size_t i = 0; i < b.mesh->vertexCount(); ++i) {
+        const double v = (b.mesh->positions()[i] - s.center).norm();
+        if (v < s.radius) {
+            ++inside;
+            const long double k = referenceKernel(v, s.radius) / referenceKernel(0.0L, s.radius);
+            EXPECT_NEAR(r.weights[i], static_cast<double>(1.0L + 5.0L * k), 1e-12 * r.weights[i]) << "node " << i;
+        } else {
+            EXPECT_EQ(r.weights[i], 1.0) << "node " << i << " outside the brush";
+        }
+    }
+    EXPECT_GT(inside, 0u);
+    EXPECT_EQ(r.report.strokeSelected[0], inside);
+    // reaching by skeleton as well: a brush over skeleton nodes selects their members and the
+    // nodes inside it, the union
+    BrushStroke t{Vec3(0.05, 0.0, 0.0), 0.02, 1.0, BrushScale::Peak};
+    t.reach = BrushReach::Sphere;
+    const StiffnessPaintResult both = bakeStiffnessPaint(*b.mesh, b.skeleton, {t});
+    t.reach = BrushReach::Skeleton;
+    const StiffnessPaintResult skel = bakeStiffnessPaint(*b.mesh, b.skeleton, {t});
+    EXPECT_GE(both.report.strokeSelected[0], skel.report.strokeSelected[0]);
+    for (size_t i = 0; i < b.mesh->vertexCount(); ++i)
+        if (skel.weights[i] != 1.0) EXPECT_EQ(both.weights[i], skel.weights[i]) << "node " << i;
+}
+
 TEST(StiffnessPaint, WeightsAreClampedToThePositiveFloorAndCeiling) {
     Bar b = makeBar(10);
     PaintParams p;

@@ -82,3 +82,24 @@ TEST(PaintOverlays, SkeletonTubesAndRamp) {
     const Eigen::Vector4f nan = studio::weightColour(NAN, 1.0);
     EXPECT_TRUE(nan.allFinite());
 }
+
+TEST(PaintOverlays, TheBrushRingLiesOnTheTangentPlaneAtTheBrushRadius) {
+    const Eigen::Vector3d c(0.01, -0.02, 0.03), n = Eigen::Vector3d(1, 2, 2).normalized();
+    const double radius = 0.012;
+    const render::RenderMesh ring = studio::brushRingMesh(c, n, radius, 0);
+    EXPECT_EQ(ring.name, "brush");
+    ASSERT_EQ(ring.vertexCount(), 96u);
+    ASSERT_EQ(ring.triangleCount(), 96u);
+    const double band = 0.04 * radius;
+    for (size_t v = 0; v < ring.vertexCount(); ++v) {
+        const Eigen::Vector3d p(ring.positions[3 * v], ring.positions[3 * v + 1], ring.positions[3 * v + 2]);
+        const Eigen::Vector3d d = p - c;
+        EXPECT_NEAR(d.dot(n), 0.01 * radius, 1e-7) << "lifted off the surface by 1 % of the radius";
+        const double r = (d - d.dot(n) * n).norm();
+        EXPECT_NEAR(r, radius, 0.5 * band + 1e-7) << v;
+    }
+    ASSERT_EQ(ring.overlay.size(), 4 * ring.vertexCount());
+    // nothing for a degenerate brush
+    EXPECT_EQ(studio::brushRingMesh(c, Eigen::Vector3d::Zero(), radius, 0).vertexCount(), 0u);
+    EXPECT_EQ(studio::brushRingMesh(c, n, 0.0, 0).vertexCount(), 0u);
+}

@@ -27,6 +27,7 @@
 #include "window_fixture.hpp"
 
 #include <QAction>
+#include <QCheckBox>
 #include <QComboBox>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
@@ -615,8 +616,9 @@ long double peakKernel(long double v, long double h) {
 }
 
 /// The weights a list of Add / Mix dabs gives, evaluated independently of the painter: nodes
-/// selected through the skeleton (a skeleton node inside the brush selects its members), then
-/// the mode's update with the kernel above, then the clamp.
+/// selected through the skeleton (a skeleton node inside the brush selects its members) and, with
+/// the sphere reach, the nodes inside the brush, then the mode's update with the kernel above,
+/// then the clamp.
 std::vector<long double> referenceWeights(const sim::TetMesh& mesh, const sim::Skeleton& sk,
                                           const std::vector<sim::BrushStroke>& dabs, const sim::PaintParams& p) {
     const sim::SkeletonNodeMap map = sim::mapNodesToSkeleton(mesh, sk);
@@ -627,6 +629,9 @@ std::vector<long double> referenceWeights(const sim::TetMesh& mesh, const sim::S
             if ((sk.nodes[j] - s.center).norm() < s.radius)
                 for (int32_t q = map.start[j]; q < map.start[j + 1]; ++q)
                     sel.insert(map.members[q]);
+        if (s.reach == sim::BrushReach::Sphere)
+            for (size_t i = 0; i < mesh.vertexCount(); ++i)
+                if ((mesh.positions()[i] - s.center).norm() < s.radius) sel.insert(static_cast<int32_t>(i));
         for (int32_t i : sel) {
             const long double k = s.amplitude * peakKernel((mesh.positions()[i] - s.center).norm(), s.radius);
             if (s.mode == sim::BrushMode::Mix)
@@ -701,13 +706,78 @@ TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWe
     const QString verdictBefore = w->verdictLabel()->text();
     const int buildsBefore = w->log()->toPlainText().count("preview: building meshes");
 
-    // A stroke that reaches no node (a 1 mm brush on the surface, the skeleton centimetres below)
-    // leaves no undo step and says so.
+    // The brush's outline follows the cursor over the surface, at the brush's radius, and goes
+    // when the cursor leaves it.
+    if (QWindow* win = v->canvasWindow()) {
+        w->findChild<QDoubleSpinBox*>("paintRadius")->setValue(8.0);
+        QTest::mouseMove(win, centre + QPoint(20, 5));
+        auto ring = [&]() -> const render::RenderMesh* {
+            for (const render::RenderMesh& m : v->authoringMeshes())
+                if (m.name == "brush") return &m;
+            return nullptr;
+        };
+        const render::RenderMesh* r = ring();
+        ASSERT_NE(r, nullptr) << "an outline under the cursor";
+        const auto hit = v->hitAt(centre + QPoint(20, 5));
+        ASSERT_TRUE(hit.has_value());
+        double rMin = INFINITY, rMax = 0;
+        for (size_t k = 0; k < r->vertexCount(); ++k) {
+            const Eigen::Vector3d p(r->positions[3 * k], r->positions[3 * k + 1], r->positions[3 * k + 2]);
+            const double d = (p - hit->world.cast<double>()).norm();
+            rMin = std::min(rMin, d);
+            rMax = std::max(rMax, d);
+        }
+        EXPECT_GT(rMin, 0.0075);
+        EXPECT_LT(rMax, 0.0085);
+        test::saveShot("brush_outline");
+        w->findChild<QDoubleSpinBox*>("paintRadius")->setValue(4.0); // the outline takes the new size
+        ASSERT_NE(ring(), nullptr);
+        EXPECT_LT((Eigen::Vector3d(ring()->positions[0], ring()->positions[1], ring()->positions[2]) -
+                   hit->world.cast<double>())
+                      .norm(),
+                  0.0045);
+        QTest::mouseMove(win, QPoint(3, 3)); // a corner: no surface
+        EXPECT_EQ(ring(), nullptr);
+    }
+
+    // A stroke that reaches no node (a 1 mm brush on the surface reaching only through the
+    // skeleton, which lies centimetres below) leaves no undo step and says so.
+    auto* skeletonOnly = w->findChild<QCheckBox*>("paintSkeletonOnly");
+    ASSERT_NE(skeletonOnly, nullptr);
+    EXPECT_FALSE(skeletonOnly->isChecked()) << "the brush reaches the surface by default";
+    skeletonOnly->setChecked(true);
     w->findChild<QDoubleSpinBox*>("paintRadius")->setValue(1.0);
     hostDrag(v, centre - QPoint(90, 0), centre + QPoint(90, 0));
     EXPECT_EQ(w->document()->undoStack()->count(), undoBefore) << "a no-op stroke is no undo step";
     EXPECT_TRUE(painter->status().contains("changed no weight")) << painter->status().toStdString();
     test::saveShot("noop_stroke");
+    EXPECT_EQ(painter->weights(), before);
+    EXPECT_EQ(studio::projectJsonText(w->document()->project()), textBefore);
+
+    // The default reach: a small brush away from the skeleton changes the surface nodes it passes
+    // (and nothing farther than its radius from its path), as one undo step; undo restores them.
+    skeletonOnly->setChecked(false);
+    w->findChild<QDoubleSpinBox*>("paintRadius")->setValue(3.0);
+    hostDrag(v, centre - QPoint(90, 0), centre + QPoint(90, 0));
+    ASSERT_EQ(w->document()->undoStack()->count(), undoBefore + 1) << painter->status().toStdString();
+    {
+        const auto& dabs = w->document()->project().bodies[0].paint->strokes;
+        for (const sim::BrushStroke& s : dabs)
+            for (const sim::Vec3& p : painter->skeleton().nodes)
+                ASSERT_GE((p - s.center).norm(), s.radius) << "no skeleton node within the brush";
+        size_t changed = 0;
+        for (size_t i = 0; i < before.size(); ++i) {
+            if (painter->weights()[i] == before[i]) continue;
+            ++changed;
+            double nearest = INFINITY;
+            for (const sim::BrushStroke& s : dabs)
+                nearest = std::min(nearest, (mesh->positions()[i] - s.center).norm());
+            EXPECT_LT(nearest, 0.003) << "node " << i << " changed beyond the brush";
+        }
+        EXPECT_GT(changed, 2u) << "the stroke away from the skeleton changed the weights";
+        test::saveShot("surface_stroke");
+    }
+    w->document()->undoStack()->undo();
     EXPECT_EQ(painter->weights(), before);
     EXPECT_EQ(studio::projectJsonText(w->document()->project()), textBefore);
 
@@ -723,7 +793,7 @@ TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWe
         };
         rightDrag(centre - QPoint(60, 0), centre + QPoint(60, 0));
         EXPECT_GT((v->camera().position - eye).norm(), 1e-3f * (eye - v->camera().target).norm()) << "orbited";
-        EXPECT_EQ(w->document()->undoStack()->count(), undoBefore) << "nothing painted";
+        EXPECT_EQ(w->document()->undoStack()->index(), undoBefore) << "nothing painted";
         EXPECT_EQ(painter->weights(), before);
         rightDrag(centre + QPoint(60, 0), centre - QPoint(60, 0));
         EXPECT_LT((v->camera().position - eye).norm(), 1e-4f) << "back home";

@@ -269,6 +269,28 @@ TEST_F(FieldRules, BrushModesRoundTripAndBadModesNameTheRule) {
     EXPECT_THAT(loadError(bad.dump(1)), HasSubstr("a mix or smooth strength must be >= 0"));
 }
 
+TEST_F(FieldRules, BrushReachRoundTripsDefaultsToTheSkeletonAndBadValuesNameTheRule) {
+    json doc = copySample("rectum");
+    json& strokes = doc["bodies"][0]["stiffness_paint"]["strokes"];
+    json sphere = strokes[0];
+    sphere["reach"] = "sphere";
+    strokes.push_back(sphere);
+    ASSERT_EQ(loadError(doc.dump(1)), "accepted");
+    const studio::Project p = studio::loadProject(m_dir);
+    const auto& s = p.bodies[0].paint->strokes;
+    EXPECT_EQ(s.front().reach, sim::BrushReach::Skeleton) << "a stroke without a reach: eq. 4.26 as before";
+    EXPECT_EQ(s.back().reach, sim::BrushReach::Sphere);
+    const std::string text = studio::projectJsonText(p);
+    const studio::Project again = studio::loadProjectText(text, m_dir, (m_dir / "project.json").string());
+    EXPECT_EQ(again.bodies[0].paint->strokes.back().reach, sim::BrushReach::Sphere);
+    EXPECT_EQ(studio::projectJsonText(again), text);
+    const std::string where = (m_dir / "project.json").string() + ": bodies[0].stiffness_paint.strokes[" +
+                              std::to_string(strokes.size() - 1) + "].reach: ";
+    json bad = doc;
+    bad["bodies"][0]["stiffness_paint"]["strokes"].back()["reach"] = "everything";
+    EXPECT_THAT(loadError(bad.dump(1)), StartsWith(where));
+}
+
 TEST_F(FieldRules, ProjectAndSceneShareTheRangeOfEverySharedField) {
     // A shared field refused in one file with a rule is refused in the other with the same rule.
     json doc = copySample("liver");
