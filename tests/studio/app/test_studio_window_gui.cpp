@@ -177,6 +177,34 @@ TEST_F(WindowFixture, TheStudioShowsTheRealTimeBudgetAndWarnsBeforeExportingASlo
     w->exportRunner()->cancel();
 }
 
+// Issue 39: switching the liver to a curve material multiplies its cost; the studio says so
+// against the frame's budget and warns before export (the liver's neo-Hookean material keeps real
+// time in the same preview).
+TEST_F(WindowFixture, TheRealTimeWarningAppearsForTheCurveMaterialLiver) {
+    open("liver");
+    ASSERT_TRUE(test::waitFor([&] { return w->realTime().frames >= 30; }, 180000))
+        << w->verdictLabel()->text().toStdString();
+    const double neoHookeanMs = w->realTime().meanMs;
+    std::printf("liver preview, stable neo-Hookean: %.2f ms per frame (x%.2f real time)\n", neoHookeanMs,
+                w->realTime().factor);
+    w->selectBody(0);
+    ASSERT_EQ(w->setProperty("model", "valanis_landel"), "");
+    ASSERT_TRUE(test::waitFor([&] { return w->realTime().slower(); }, 180000))
+        << w->realTime().meanMs << " ms; " << w->verdictLabel()->text().toStdString();
+    QTest::qWait(3000); // the last 60 frames all with the curve material
+    std::printf("liver preview, curve material: %.2f ms per frame (x%.2f real time)\n", w->realTime().meanMs,
+                w->realTime().factor);
+    EXPECT_TRUE(w->realTime().slower());
+    EXPECT_TRUE(w->verdictLabel()->text().contains("stable at")) << "a stable material, only slower";
+    ASSERT_TRUE(test::waitFor([&] { return w->costPlot()->note().contains("TOO SLOW"); }, 10000))
+        << w->costPlot()->note().toStdString();
+    test::saveShot("liver_curve_material_budget");
+    ASSERT_TRUE(w->startExport(QString::fromStdString((scratch.dir / "liver.vcase").string())));
+    EXPECT_TRUE(w->log()->toPlainText().contains("a trainee's session would fall behind"))
+        << w->log()->toPlainText().toStdString();
+    w->exportRunner()->cancel();
+}
+
 TEST_F(WindowFixture, SaveAsWritesTheProjectAndRecentKeepsFive) {
     open("tissue-slab");
     ASSERT_EQ(w->setProperty("density", "1100"), "");
