@@ -9,7 +9,8 @@
 //     handling (edit, check, undo command, plots), the viewport's frame time (on its render
 //     thread with the default host), the slowest event deliveries on the UI thread (receiver,
 //     event type, and how much of it was widget painting) and each widget's paint cost;
-//   - the preview's physics cost per frame.
+//   - the preview's physics cost per frame;
+//   - the project texts written during the drag (studio::projectTextCount: 0 for typed edits).
 // Writes <out>/studio_preview.json and screenshots of the main window (<out>/studio_main.png,
 // the material dock, the viewport). Run under a display (Xvfb):
 //   xvfb-run -a -s "-screen 0 1920x1200x24" ./build/bench/bench_studio_preview [out-dir] [seconds] [scene|paused]
@@ -194,6 +195,7 @@ int main(int argc, char** argv) {
     std::vector<PendingEdit> pending;
     const auto s0 = w.preview()->snapshot();
     const uint64_t frames0 = s0.frames;
+    const uint64_t texts0 = studio::projectTextCount(); // project serializations (none for a typed edit)
     w.preview()->setPaused(paused);
     probe.start();
     app.recording = true;
@@ -298,6 +300,7 @@ int main(int argc, char** argv) {
     j["drag_seconds"] = seconds;
     j["preview_paused"] = paused;
     j["drag_events"] = events;
+    j["project_texts_during_drag"] = studio::projectTextCount() - texts0;
     j["preview_frames_during_drag"] = s1.frames - frames0;
     j["edits_resolved"] = latencyFrames.size();
     j["edit_to_preview_frames"] = {
