@@ -198,6 +198,14 @@ void MainWindow::buildViewMenu(QMenu* view, QToolBar* toolbar) {
     m_frameAction = view->addAction(tr("&Frame all"));
     m_frameAction->setShortcut(QKeySequence(Qt::Key_F));
     connect(m_frameAction, &QAction::triggered, this, [this] { m_viewport->frameAll(); });
+    m_lookAction = view->addAction(tr("&Trainee's look (the case's render settings)"));
+    m_lookAction->setObjectName("actionTraineeLook");
+    m_lookAction->setCheckable(true);
+    m_lookAction->setShortcut(QKeySequence(Qt::Key_T));
+    m_lookAction->setToolTip(tr("Off: the authoring look (flat light, no post effects, a grid and the selection's "
+                                "outline). On: the scene as the player shows it"));
+    connect(m_lookAction, &QAction::toggled, this,
+            [this](bool on) { m_viewport->setLook(on ? Viewport::Look::Trainee : Viewport::Look::Authoring); });
     // the paint tools: checkable, one at a time, each with its dock
     m_paint = new PaintTools(this, &m_doc, &m_preview, &m_sel, view);
     toolbar->addSeparator();
@@ -247,6 +255,7 @@ void MainWindow::setViewportHost(ViewportHost host) {
         v->setPositions(s.bodies, s.surfaces);
     }
     v->setSelectedName(selected);
+    if (m_lookAction) v->setLook(m_lookAction->isChecked() ? Viewport::Look::Trainee : Viewport::Look::Authoring);
     v->setPaintMode(painting() || paintingSamples());
     m_paint->showOverlay();
     QSettings().setValue("viewport/host", viewportHostText(host));
@@ -301,6 +310,7 @@ bool MainWindow::openProject(const QString& folder) {
         return false;
     }
     addRecent(m_doc.folder());
+    m_viewport->frameNextScene(); // the new project's scene is shown whole
     m_sel.clear();
     selectBody(m_doc.project().bodies.empty() ? -1 : 0);
     statusBar()->showMessage(tr("Opened %1").arg(m_doc.folder()));

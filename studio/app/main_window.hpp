@@ -129,6 +129,7 @@ private:
     Viewport* m_viewport = nullptr;
     QAction* m_widgetHostAction = nullptr;
     QAction* m_frameAction = nullptr;
+    QAction* m_lookAction = nullptr;
     PaintTools* m_paint = nullptr;
     MaterialPanel* m_material = nullptr;
     TexturePanel* m_texture = nullptr;

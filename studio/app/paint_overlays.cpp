@@ -81,6 +81,59 @@ render::RenderMesh brushRingMesh(const Eigen::Vector3d& centre, const Eigen::Vec
     return m;
 }
 
+namespace {
+
+/// `edges` between `nodes` as tubes of `radius`, named `name`, in one opaque colour.
+render::RenderMesh lineTubes(std::vector<sim::Vec3> nodes, std::vector<std::array<int32_t, 2>> edges, double radius,
+                             const char* name, const Eigen::Vector4f& rgba, uint32_t material) {
+    sim::Skeleton lines;
+    lines.nodes = std::move(nodes);
+    for (const auto& e : edges)
+        lines.edges.push_back({e[0], e[1]});
+    render::RenderMesh m = skeletonMesh(lines, static_cast<float>(radius), material);
+    m.name = name;
+    m.overlay.clear();
+    for (size_t i = 0; i < m.vertexCount(); ++i)
+        pushColour(m.overlay, rgba);
+    return m;
+}
+
+} // namespace
+
+render::RenderMesh gridMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, uint32_t material) {
+    const double size = std::max({hi.x() - lo.x(), hi.y() - lo.y(), 1e-3});
+    const double raw = size / 5, mag = std::pow(10.0, std::floor(std::log10(raw))), f = raw / mag;
+    const double step = mag * (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0);
+    const Eigen::Vector2d c(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()));
+    const double half = 0.75 * size;
+    const double x0 = std::floor((c.x() - half) / step) * step, y0 = std::floor((c.y() - half) / step) * step;
+    const double x1 = std::ceil((c.x() + half) / step) * step, y1 = std::ceil((c.y() + half) / step) * step;
+    std::vector<sim::Vec3> nodes;
+    std::vector<std::array<int32_t, 2>> edges;
+    auto line = [&](const sim::Vec3& a, const sim::Vec3& b) {
+        edges.push_back({static_cast<int32_t>(nodes.size()), static_cast<int32_t>(nodes.size() + 1)});
+        nodes.push_back(a);
+        nodes.push_back(b);
+    };
+    for (double x = x0; x <= x1 + 0.5 * step; x += step)
+        line({x, y0, lo.z()}, {x, y1, lo.z()});
+    for (double y = y0; y <= y1 + 0.5 * step; y += step)
+        line({x0, y, lo.z()}, {x1, y, lo.z()});
+    return lineTubes(std::move(nodes), std::move(edges), 0.002 * size, "grid", {0.42f, 0.43f, 0.46f, 1.0f}, material);
+}
+
+render::RenderMesh boxOutlineMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, uint32_t material) {
+    std::vector<sim::Vec3> nodes;
+    for (int k = 0; k < 8; ++k)
+        nodes.emplace_back(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z());
+    std::vector<std::array<int32_t, 2>> edges;
+    for (int32_t a = 0; a < 8; ++a)
+        for (int bit : {1, 2, 4})
+            if (!(a & bit)) edges.push_back({a, a | bit});
+    return lineTubes(std::move(nodes), std::move(edges), 0.004 * (hi - lo).norm(), "selection",
+                     {0.35f, 0.75f, 1.0f, 1.0f}, material);
+}
+
 render::RenderMesh skeletonMesh(const sim::Skeleton& skeleton, float radius, uint32_t material) {
     render::RenderMesh m;
     m.name = "skeleton";

@@ -29,6 +29,15 @@ render::RenderMesh skeletonMesh(const sim::Skeleton& skeleton, float radius, uin
 render::RenderMesh brushRingMesh(const Eigen::Vector3d& centre, const Eigen::Vector3d& normal, double radius,
                                  uint32_t material);
 
+/// The authoring look's ground grid under a scene of bounds [lo, hi] (m; z up): lines at a round
+/// step (1, 2 or 5 × 10^k, about a fifth of the scene's larger horizontal size) over 1.5 times
+/// that size, in the plane z = lo.z, as thin grey tubes. Named "grid".
+render::RenderMesh gridMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, uint32_t material);
+
+/// The twelve edges of the box [lo, hi] as thin light-blue tubes (the selection's outline),
+/// radius 0.4 % of the box's diagonal. Named "selection".
+render::RenderMesh boxOutlineMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, uint32_t material);
+
 /// A plane {x : n·x = offset} with unit normal n; the side n·x > offset is cut away.
 struct CutPlane {
     Eigen::Vector3d normal = Eigen::Vector3d::UnitX();

@@ -1,5 +1,6 @@
 #include "app/viewport.hpp"
 
+#include "app/paint_overlays.hpp"
 #include "render/camera.hpp"
 #include "render/case_settings.hpp"
 #include "render/headless.hpp"
@@ -66,6 +67,7 @@ struct ViewportFrame {
     uint64_t lookSerial = 0;  ///< the case's render block changed: settings made again
     std::string caseRender;
     render::Camera camera;
+    bool authoring = true; ///< the authoring look (Viewport::Look)
 };
 
 namespace {
@@ -131,6 +133,12 @@ public:
             }
             d.stereo.mode = render::StereoMode::Off; // the author's view is mono
             d.timePasses = false;
+            if (f.authoring) { // flat and plain: the shapes, not the trainee's look
+                d.post.disableAll();
+                d.subsurface = false;
+                d.ambient = Eigen::Vector3f(0.22f, 0.22f, 0.22f);
+                d.background = Eigen::Vector3f(0.16f, 0.17f, 0.19f);
+            }
             s = d;
             m_look = f.lookSerial;
         }
@@ -505,6 +513,9 @@ ViewportFrame Viewport::frame() {
         auto view = std::make_shared<render::SceneView>(m_view);
         for (const render::RenderMesh& m : m_authoring)
             view->meshes().push_back(m);
+        if (m_look == Look::Authoring)
+            for (const render::RenderMesh& m : m_guides)
+                view->meshes().push_back(m);
         m_published = std::move(view);
     }
     ViewportFrame f;
@@ -513,6 +524,7 @@ ViewportFrame Viewport::frame() {
     f.lookSerial = m_lookSerial;
     f.caseRender = m_caseRender;
     f.camera = m_camera;
+    f.authoring = m_look == Look::Authoring;
     return f;
 }
 
@@ -544,7 +556,33 @@ void Viewport::setScene(const render::SceneView& view) {
         m_baseMaterial.push_back(m.material);
     if (!m_framed) frameAll();
     applyRestPose();
-    setSelectedName(m_selected); // hands the new view over
+    setSelectedName(m_selected); // hands the new view over (and makes the guides)
+}
+
+void Viewport::setLook(Look look) {
+    if (look == m_look) return;
+    m_look = look;
+    ++m_lookSerial;  // settings are made again on the next frame
+    ++m_sceneSerial; // the guides come or go: other meshes
+    viewChanged();
+}
+
+void Viewport::rebuildGuides() {
+    m_guides.clear();
+    if (m_view.meshes().empty()) return;
+    const auto [lo, hi] = m_view.bounds();
+    if (!lo.allFinite() || !hi.allFinite()) return;
+    m_guides.push_back(gridMesh(lo.cast<double>(), hi.cast<double>(), 0));
+    for (const render::RenderMesh& m : m_view.meshes()) {
+        if (m_selected.isEmpty() || QString::fromStdString(m.name) != m_selected) continue;
+        Eigen::Vector3d a = Eigen::Vector3d::Constant(INFINITY), b = -a;
+        for (size_t v = 0; v < m.vertexCount(); ++v) {
+            const Eigen::Vector3d p(m.rest[3 * v], m.rest[3 * v + 1], m.rest[3 * v + 2]);
+            a = a.cwiseMin(p);
+            b = b.cwiseMax(p);
+        }
+        if (a.allFinite() && b.allFinite()) m_guides.push_back(boxOutlineMesh(a, b, 0));
+    }
 }
 
 void Viewport::setCaseRender(const std::string& json) {
@@ -587,6 +625,9 @@ void Viewport::setSelectedName(const QString& name) {
     const size_t base = m_view.materials().size() / 2;
     for (size_t i = 0; i < meshes.size() && i < m_baseMaterial.size(); ++i)
         meshes[i].material = m_baseMaterial[i] + (QString::fromStdString(meshes[i].name) == name && base ? base : 0);
+    const size_t guides = m_guides.size();
+    rebuildGuides();
+    if (m_guides.size() != guides) ++m_sceneSerial; // other meshes: new buffers
     viewChanged();
 }
 

@@ -72,6 +72,18 @@ public:
     /// The case's "render" block (project.json; empty: renderer defaults): the viewport shows the
     /// case's look (SSS, light sampling, post effects), in mono.
     void setCaseRender(const std::string& json);
+    /// The look: Authoring (the studio's default: flat light, no post effects or subsurface
+    /// scattering, a grey background, a grid under the scene and the selection's outline) or
+    /// Trainee (the case's render settings, as the player shows them).
+    enum class Look { Authoring, Trainee };
+    void setLook(Look look);
+    Look look() const { return m_look; }
+    /// The authoring look's grid and selection outline (drawn only in that look).
+    const std::vector<render::RenderMesh>& guideMeshes() const { return m_guides; }
+    /// The camera's target (the point it orbits), world frame.
+    Eigen::Vector3f cameraTarget() const { return m_target; }
+    /// The next scene set is framed (a project was opened: its scene is shown whole).
+    void frameNextScene() { m_framed = false; }
     /// Highlights the body (or surface) named `name` (empty: none).
     void setSelectedName(const QString& name);
     const QString& selectedName() const { return m_selected; }
@@ -177,6 +189,11 @@ private:
     Qt::MouseButton m_button = Qt::NoButton;
     bool m_dragged = false;
     bool m_framed = false;
+    Look m_look = Look::Authoring;
+    /// The authoring look's grid and the selection's outline (rebuilt with the scene and the
+    /// selection), drawn after the authoring meshes.
+    std::vector<render::RenderMesh> m_guides;
+    void rebuildGuides();
     bool m_paintMode = false, m_painting = false;
     int m_restBody = -1; ///< the mesh drawn at rest: its source index and kind
     render::RenderMesh::Source m_restSource = render::RenderMesh::Source::Body;

@@ -205,6 +205,52 @@ TEST_F(WindowFixture, TheRealTimeWarningAppearsForTheCurveMaterialLiver) {
     w->exportRunner()->cancel();
 }
 
+// Issue 39 item 3: the studio opens in the authoring look (flat light, no post effects, a grey
+// background, a grid under the scene, the selection outlined), the trainee's look one key away,
+// and a project opened is framed whole.
+TEST_F(WindowFixture, TheAuthoringLookHasAGridTheSelectionOutlineAndFramesTheProjectOnOpen) {
+    open("liver");
+    ASSERT_TRUE(waitForPreview()) << w->verdictLabel()->text().toStdString();
+    studio::Viewport* v = w->viewport();
+    EXPECT_EQ(v->look(), studio::Viewport::Look::Authoring);
+    auto named = [&](const char* name) {
+        for (const render::RenderMesh& m : v->guideMeshes())
+            if (m.name == name) return true;
+        return false;
+    };
+    EXPECT_TRUE(named("grid"));
+    EXPECT_TRUE(named("selection")) << "body 0 is selected on open";
+    w->selection()->set(studio::Selection::Kind::Solver);
+    EXPECT_FALSE(named("selection")) << "nothing outlined without a selected body";
+    w->selectBody(0);
+    EXPECT_TRUE(named("selection"));
+    ASSERT_TRUE(test::waitFor([&] { return v->rendererReady() && v->paintCount() > 2; }, 60000));
+    auto corner = [&] {
+        const QImage img = v->grabFramebuffer();
+        return img.isNull() ? -1 : qGray(img.pixel(4, 4));
+    };
+    const int authoring = corner();
+    test::saveShot("look_authoring");
+    auto* action = w->findChild<QAction*>("actionTraineeLook");
+    ASSERT_NE(action, nullptr);
+    action->trigger();
+    EXPECT_EQ(v->look(), studio::Viewport::Look::Trainee);
+    QTest::qWait(300);
+    const int trainee = corner();
+    test::saveShot("look_trainee");
+    std::printf("background corner grey: authoring %d, trainee %d\n", authoring, trainee);
+    EXPECT_GT(authoring, trainee + 30) << "a grey authoring background, the case's dark one for the trainee";
+    action->trigger();
+    // another project opened: framed on its own scene
+    open("tissue-slab");
+    ASSERT_TRUE(test::waitFor([&] { return w->preview()->snapshot().frames > 3 && v->meshCount() > 0; }, 60000));
+    QCoreApplication::processEvents();
+    const auto& sv = w->preview()->sceneView();
+    ASSERT_NE(sv, nullptr);
+    const auto [lo, hi] = sv->bounds();
+    EXPECT_LT((v->cameraTarget() - 0.5f * (lo + hi)).norm(), 0.05f * (hi - lo).norm()) << "framed on the slab";
+}
+
 TEST_F(WindowFixture, SaveAsWritesTheProjectAndRecentKeepsFive) {
     open("tissue-slab");
     ASSERT_EQ(w->setProperty("density", "1100"), "");
