@@ -6,6 +6,7 @@
 #include "app/number_text.hpp"
 #include "app/project_tree_panel.hpp"
 #include "app/properties_panel.hpp"
+#include "app/start_page.hpp"
 #include "app/texture_panel.hpp"
 #include "app/wheel_guard.hpp"
 
@@ -23,6 +24,7 @@
 #include <QRegularExpression>
 #include <QScrollArea>
 #include <QSettings>
+#include <QStackedWidget>
 #include <QStatusBar>
 #include <QTimer>
 #include <QToolBar>
@@ -35,6 +37,14 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_export(std::mak
     setDockNestingEnabled(true);
     buildDocks();
     buildActions();
+    // the centre: the start page until a project is open, then the viewport
+    m_centre = new QStackedWidget(this);
+    m_start = new StartPage(m_centre);
+    m_centre->addWidget(m_start);
+    setCentralWidget(m_centre);
+    connect(m_start, &StartPage::newRequested, this, &MainWindow::askNewProject);
+    connect(m_start, &StartPage::openRequested, this, &MainWindow::askOpenProject);
+    connect(m_start, &StartPage::openRecent, this, [this](const QString& f) { openProject(f); });
     setViewportHost(viewportHostFromText(QSettings().value("viewport/host").toString()).value_or(ViewportHost::Window));
     statusBar()->showMessage(tr("Open or create a project (File menu)"));
     connect(&m_doc, &Document::changed, this, &MainWindow::onDocumentChanged);
@@ -69,12 +79,8 @@ MainWindow::~MainWindow() {
     m_preview.stop();
 }
 
-QTreeWidget* MainWindow::tree() {
-    return m_tree;
-}
-
-QLabel* MainWindow::propertyError() {
-    return m_properties->errorLabel();
+QWidget* MainWindow::centreWidget() const {
+    return m_centre->currentWidget();
 }
 
 void MainWindow::connectExport() {
@@ -154,19 +160,9 @@ void MainWindow::buildFileMenu(QMenu* file, QToolBar* toolbar) {
         if (onToolbar) toolbar->addAction(a);
     };
     add(
-        tr("&New project…"), QKeySequence::New,
-        [this] {
-            const QString dir = QFileDialog::getExistingDirectory(this, tr("Folder of the new project"));
-            if (!dir.isEmpty()) newProject(dir);
-        },
-        true);
+        tr("&New project…"), QKeySequence::New, [this] { askNewProject(); }, true);
     add(
-        tr("&Open project…"), QKeySequence::Open,
-        [this] {
-            const QString dir = QFileDialog::getExistingDirectory(this, tr("Project folder (with project.json)"));
-            if (!dir.isEmpty()) openProject(dir);
-        },
-        true);
+        tr("&Open project…"), QKeySequence::Open, [this] { askOpenProject(); }, true);
     m_recentMenu = file->addMenu(tr("Open &recent"));
     add(
         tr("&Save"), QKeySequence::Save, [this] { saveProject(); }, true);
@@ -231,9 +227,11 @@ void MainWindow::setViewportHost(ViewportHost host) {
     // The old viewport goes first: a QOpenGLWidget added to the window makes Qt recreate the
     // top-level native window, which would take an embedded window still in it along.
     if (m_viewport) {
+        Viewport* old = m_viewport;
         m_viewport = nullptr;
         m_paint->connectViewport(nullptr);
-        delete takeCentralWidget();
+        m_centre->removeWidget(old);
+        delete old;
     }
     auto* v = new Viewport(host, this);
     v->setObjectName("viewport");
@@ -245,7 +243,8 @@ void MainWindow::setViewportHost(ViewportHost host) {
     });
     connect(v, &Viewport::rendererFailed, this, &MainWindow::logLine);
     m_paint->connectViewport(v);
-    setCentralWidget(v);
+    m_centre->addWidget(v);
+    if (m_doc.hasProject()) m_centre->setCurrentWidget(v);
     m_viewport = v;
     // the new host shows what the old one did
     if (m_doc.hasProject()) v->setCaseRender(m_doc.project().scene.render);
@@ -262,23 +261,29 @@ void MainWindow::setViewportHost(ViewportHost host) {
     if (m_widgetHostAction) m_widgetHostAction->setChecked(host == ViewportHost::Widget);
 }
 
+void MainWindow::askNewProject() {
+    const QString dir = QFileDialog::getExistingDirectory(this, tr("Folder of the new project"));
+    if (!dir.isEmpty()) newProject(dir);
+}
+
+void MainWindow::askOpenProject() {
+    const QString dir = QFileDialog::getExistingDirectory(this, tr("Project folder (with project.json)"));
+    if (!dir.isEmpty()) openProject(dir);
+}
+
 QStringList MainWindow::recentProjects() const {
-    return QSettings().value("recentProjects").toStringList();
+    return StartPage::recentProjects();
 }
 
 void MainWindow::addRecent(const QString& folder) {
-    QStringList list = recentProjects();
-    list.removeAll(folder);
-    list.prepend(folder);
-    while (list.size() > kMaxRecent)
-        list.removeLast();
-    QSettings().setValue("recentProjects", list);
+    StartPage::addRecent(folder, kMaxRecent);
     rebuildRecentMenu();
 }
 
 void MainWindow::rebuildRecentMenu() {
     m_recentMenu->clear();
     const QStringList list = recentProjects();
+    m_start->setRecent(list);
     for (const QString& f : list) {
         QAction* a = m_recentMenu->addAction(f);
         connect(a, &QAction::triggered, this, [this, f] { openProject(f); });
@@ -418,6 +423,7 @@ void MainWindow::updateTitle() {
 
 void MainWindow::onDocumentChanged(const Change& what) {
     if (!m_doc.hasProject()) return;
+    if (m_centre->currentWidget() != m_viewport) m_centre->setCurrentWidget(m_viewport); // the project's view
     // a selection the edit took away (undo of an added body) goes
     const Project& p = m_doc.project();
     if ((m_sel.body() >= static_cast<int>(p.bodies.size())) || (m_sel.surface() >= static_cast<int>(p.surfaces.size())))

@@ -10,6 +10,8 @@
 #include "app/paint_tools.hpp"
 #include "app/preview.hpp"
 #include "app/preview_panel.hpp"
+#include "app/project_tree_panel.hpp"
+#include "app/properties_panel.hpp"
 #include "app/selection.hpp"
 #include "app/viewport.hpp"
 
@@ -23,6 +25,7 @@ class QLabel;
 class QMenu;
 class QPlainTextEdit;
 class QProgressDialog;
+class QStackedWidget;
 class QTimer;
 class QTreeWidget;
 
@@ -31,8 +34,7 @@ namespace viscera::studio {
 class ExportRunner;
 class MaterialPanel;
 class PlotWidget;
-class ProjectTreePanel;
-class PropertiesPanel;
+class StartPage;
 class TexturePanel;
 
 class MainWindow : public QMainWindow {
@@ -73,6 +75,10 @@ public:
     TexturePanel* texturePanel() { return m_texture; }
     PropertiesPanel* propertiesPanel() { return m_properties; }
     ProjectTreePanel* projectTree() { return m_tree; }
+    /// Shown instead of the viewport while no project is open.
+    StartPage* startPage() { return m_start; }
+    /// The start page or the viewport, whichever is shown.
+    QWidget* centreWidget() const;
     PaintTools* paintTools() { return m_paint; }
     StiffnessPainter* painter() { return m_paint->painter(); }
     /// Paint stiffness mode (the toolbar's Paint action): the viewport's left drag paints the
@@ -86,12 +92,12 @@ public:
     bool paintingSamples() const { return m_paint->paintingSamples(); }
     /// Opens the side-by-side render of uniform 1× and the painted map for the current scene.
     SampleCompareDialog* openSampleCompare() { return m_paint->openSampleCompare(); }
-    QTreeWidget* tree();
+    QTreeWidget* tree() { return m_tree; }
     PlotWidget* errorPlot() { return m_previewPanel->errorPlot(); }
     PlotWidget* costPlot() { return m_previewPanel->costPlot(); }
     const RealTimeEstimate& realTime() const { return m_previewPanel->realTime(); }
     QLabel* verdictLabel() { return m_previewPanel->verdictLabel(); }
-    QLabel* propertyError();
+    QLabel* propertyError() { return m_properties->errorLabel(); }
     QPlainTextEdit* log() { return m_log; }
     ExportRunner* exportRunner() { return m_export.get(); }
     QProgressDialog* exportProgress() { return m_progress; }
@@ -116,6 +122,8 @@ private:
     void onSelectionChanged();
     void updateTitle();
     void addRecent(const QString& folder);
+    void askNewProject();  ///< asks for a folder, then newProject()
+    void askOpenProject(); ///< asks for a folder, then openProject()
     void rebuildRecentMenu();
     bool maybeDiscard();
     void logLine(const QString& line);
@@ -130,6 +138,8 @@ private:
     QAction* m_widgetHostAction = nullptr;
     QAction* m_frameAction = nullptr;
     QAction* m_lookAction = nullptr;
+    QStackedWidget* m_centre = nullptr; ///< the start page, or the viewport once a project is open
+    StartPage* m_start = nullptr;
     PaintTools* m_paint = nullptr;
     MaterialPanel* m_material = nullptr;
     TexturePanel* m_texture = nullptr;

@@ -12,6 +12,7 @@
 #include "app/properties_panel.hpp"
 #include "app/sample_compare.hpp"
 #include "app/sample_painter.hpp"
+#include "app/start_page.hpp"
 #include "app/stiffness_painter.hpp"
 #include "app/viewport.hpp"
 #include "case/case_package.hpp"
@@ -33,6 +34,7 @@
 #include <QDoubleSpinBox>
 #include <QLabel>
 #include <QLineEdit>
+#include <QListWidget>
 #include <QPlainTextEdit>
 #include <QProgressDialog>
 #include <QPushButton>
@@ -249,6 +251,33 @@ TEST_F(WindowFixture, TheAuthoringLookHasAGridTheSelectionOutlineAndFramesThePro
     ASSERT_NE(sv, nullptr);
     const auto [lo, hi] = sv->bounds();
     EXPECT_LT((v->cameraTarget() - 0.5f * (lo + hi)).norm(), 0.05f * (hi - lo).norm()) << "framed on the slab";
+}
+
+// Issue 39 item 3: without a project the studio shows a start page with the recent projects; a
+// click on one opens it and the viewport takes the page's place.
+TEST_F(WindowFixture, TheStartPageListsTheRecentProjectsAndOpensOne) {
+    const fs::path slab = test::copySample(scratch, "tissue-slab");
+    const fs::path gone = scratch.dir / "moved-away";
+    QSettings().setValue("recentProjects",
+                         QStringList{QString::fromStdString(slab.string()), QString::fromStdString(gone.string())});
+    w = std::make_unique<studio::MainWindow>(); // a fresh start with those recent projects
+    w->setConfirmDiscard(false);
+    w->resize(1500, 950);
+    w->show();
+    ASSERT_TRUE(QTest::qWaitForWindowExposed(w.get()));
+    ASSERT_EQ(w->centreWidget(), w->startPage());
+    QListWidget* list = w->startPage()->recentList();
+    ASSERT_EQ(list->count(), 2);
+    EXPECT_TRUE(list->item(0)->flags() & Qt::ItemIsEnabled);
+    EXPECT_FALSE(list->item(1)->flags() & Qt::ItemIsEnabled) << "a folder without a project is not offered";
+    EXPECT_TRUE(list->item(1)->text().contains("no project.json"));
+    test::saveShot("start_page");
+    QTest::mouseClick(list->viewport(), Qt::LeftButton, Qt::NoModifier, list->visualItemRect(list->item(1)).center());
+    EXPECT_FALSE(w->document()->hasProject());
+    QTest::mouseClick(list->viewport(), Qt::LeftButton, Qt::NoModifier, list->visualItemRect(list->item(0)).center());
+    ASSERT_TRUE(w->document()->hasProject());
+    EXPECT_EQ(w->document()->folder().toStdString(), slab.string());
+    EXPECT_EQ(w->centreWidget(), w->viewport());
 }
 
 TEST_F(WindowFixture, SaveAsWritesTheProjectAndRecentKeepsFive) {
