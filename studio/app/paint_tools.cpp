@@ -84,8 +84,8 @@ void PaintTools::setPaintTool(QAction* action, bool on) {
             d->show();
             d->raise();
         }
-        retarget();
     }
+    retarget(); // on: the painters take the selection; off: the dock says what it would paint
     showOverlay();
 }
 
@@ -97,6 +97,20 @@ void PaintTools::retarget() {
     else if (painting())
         m_painter.setTarget(body, mesh);
     if (paintingSamples()) m_samplePainter.setTarget(body, mesh);
+    // a dock whose tool is off says what it would paint now (never the previous project's body)
+    QString name;
+    if (m_doc->hasProject() && body >= 0 && body < static_cast<int>(m_doc->project().bodies.size()))
+        name = QString::fromStdString(m_doc->project().bodies[body].scene.name);
+    if (m_doc->hasProject() && m_sel->surface() >= 0 &&
+        m_sel->surface() < static_cast<int>(m_doc->project().surfaces.size()))
+        name = QString::fromStdString(m_doc->project().surfaces[m_sel->surface()].scene.name);
+    if (!painting() && m_paintStatus)
+        m_paintStatus->setText(name.isEmpty() ? tr("Select a tet body or a fascia surface to paint its stiffness.")
+                                              : tr("'%1' selected: Paint stiffness (P) paints its weights.").arg(name));
+    if (!paintingSamples() && m_sampleStatus)
+        m_sampleStatus->setText(
+            body < 0 ? tr("Select a tet body to paint its light samples.")
+                     : tr("'%1' selected: Paint light samples (L) paints its sample classes.").arg(name));
 }
 
 void PaintTools::pushAuthoring() {

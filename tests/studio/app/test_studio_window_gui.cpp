@@ -280,6 +280,34 @@ TEST_F(WindowFixture, TheStartPageListsTheRecentProjectsAndOpensOne) {
     EXPECT_EQ(w->centreWidget(), w->viewport());
 }
 
+// Issue 39 item 3: the fields and docks follow the project and the selection: another project's
+// preset E and ν and the paint docks' texts never carry over.
+TEST_F(WindowFixture, FieldsAndDocksResetPerProjectAndSelection) {
+    open("organ-blob");
+    const std::string organ = w->document()->project().bodies[0].scene.name;
+    w->materialPanel()->presetE()->setText("400");
+    w->setPaintingSamples(true);
+    w->setPaintingSamples(false);
+    auto* samples = w->findChild<QLabel*>("sampleStatus");
+    auto* paint = w->findChild<QLabel*>("paintStatus");
+    ASSERT_NE(samples, nullptr);
+    ASSERT_NE(paint, nullptr);
+    EXPECT_TRUE(samples->text().contains(QString::fromStdString(organ))) << samples->text().toStdString();
+    open("tissue-slab");
+    const studio::Project& p = w->document()->project();
+    const std::string slab = p.bodies[0].scene.name;
+    EXPECT_EQ(w->materialPanel()->presetE()->text().toStdString(),
+              sim::formatNumber(p.bodies[0].scene.material.youngsModulus, 6))
+        << "the preset starts from this body's E, not the value typed for the other project";
+    for (QLabel* l : {samples, paint}) {
+        EXPECT_FALSE(l->text().contains(QString::fromStdString(organ))) << l->text().toStdString();
+        EXPECT_TRUE(l->text().contains(QString::fromStdString(slab))) << l->text().toStdString();
+    }
+    w->selection()->set(studio::Selection::Kind::Solver);
+    EXPECT_TRUE(samples->text().startsWith("Select a tet body")) << samples->text().toStdString();
+    EXPECT_TRUE(w->propertiesPanel()->errorLabel()->text().isEmpty());
+}
+
 TEST_F(WindowFixture, SaveAsWritesTheProjectAndRecentKeepsFive) {
     open("tissue-slab");
     ASSERT_EQ(w->setProperty("density", "1100"), "");
