@@ -2,7 +2,9 @@
 
 #include "bake/texture.hpp"
 
+#include "render/sample_map.hpp"
 #include "sim/material/material.hpp"
+#include "sim/skeleton/stiffness_paint.hpp"
 #include "sim/util/error.hpp"
 
 #include <QDir>
@@ -71,27 +73,101 @@ private:
     Change m_what;
 };
 
-/// A typed edit of one body's material: the material before and after, nothing else. A drag
-/// (the same nonzero key) merges into one step, keeping the first `before`.
-class MaterialCommand : public QUndoCommand {
+/// What a typed edit edits: the value's place in the model (`of`), what changing it announces and
+/// the reader's rules for it (`check`: empty, or "<path>: <rule>").
+struct MaterialSlot {
+    using Value = sim::Material;
+    static constexpr int kId = 2;
+    static Value& of(Project& p, int body) { return p.bodies.at(static_cast<size_t>(body)).scene.material; }
+    static Change change(int body) { return Change::material(body); }
+    static std::string check(const Project& p, int body, const Value& m) {
+        const std::string where = "bodies[" + std::to_string(body) + "].material: ";
+        // readMaterial's check, then the constraint model with its curves (what check() builds)
+        if (std::string why = sim::validate(m); !why.empty()) return where + why;
+        try {
+            sim::makeConstraintModel(m, p.bodies.at(static_cast<size_t>(body)).scene.name);
+        } catch (const std::exception& e) {
+            return where + e.what();
+        }
+        return {};
+    }
+};
+
+struct SolverSlot {
+    using Value = sim::XpbdSettings;
+    static constexpr int kId = 3;
+    static Value& of(Project& p, int) { return p.scene.xpbd; }
+    static Change change(int) { return {Change::Solver, -1}; }
+    static std::string check(const Project&, int, const Value& s) {
+        const std::string why = sim::validate(s); // the limits readSolver applies (XpbdLimits)
+        return why.empty() ? why : "solver: " + why;
+    }
+};
+
+/// A body's stiffness paint (target >= 0) or surface -1 - target's.
+struct PaintSlot {
+    using Value = std::optional<StiffnessPaintProject>;
+    static constexpr int kId = 4;
+    static Value& of(Project& p, int t) {
+        return t >= 0 ? p.bodies.at(static_cast<size_t>(t)).paint : p.surfaces.at(static_cast<size_t>(-1 - t)).paint;
+    }
+    static Change change(int t) { return {Change::Paint, t >= 0 ? t : -1}; }
+    static std::string check(const Project&, int t, const Value& v) {
+        if (!v) return {};
+        const std::string where =
+            (t >= 0 ? "bodies[" + std::to_string(t) : "surfaces[" + std::to_string(-1 - t)) + "].stiffness_paint";
+        const sim::PaintParams& q = v->params;
+        if (!(q.minWeight > 0 && q.minWeight <= q.baseWeight && q.baseWeight <= q.maxWeight))
+            return where + ": min_weight <= base_weight <= max_weight must hold";
+        try { // readPaint's rule for every stroke
+            for (size_t k = 0; k < v->strokes.size(); ++k)
+                sim::validateStroke(v->strokes[k], k, where + ".strokes");
+        } catch (const std::exception& e) {
+            return e.what();
+        }
+        return {};
+    }
+};
+
+struct LightSamplesSlot {
+    using Value = std::vector<render::SamplePaintOp>;
+    static constexpr int kId = 5;
+    static Value& of(Project& p, int body) { return p.bodies.at(static_cast<size_t>(body)).lightSamples; }
+    static Change change(int body) { return {Change::LightSamples, body}; }
+    static std::string check(const Project&, int body, const Value& ops) {
+        try { // readLightSamples' rule for every operation
+            for (size_t k = 0; k < ops.size(); ++k)
+                render::validateSamplePaintOp(ops[k], "bodies[" + std::to_string(body) + "].light_samples[" +
+                                                          std::to_string(k) + "]");
+        } catch (const std::exception& e) {
+            return e.what();
+        }
+        return {};
+    }
+};
+
+/// A typed edit: one value of the model before and after, nothing else. A drag (the same nonzero
+/// key, the same value) merges into one step, keeping the first `before`.
+template <class Slot> class ValueCommand : public QUndoCommand {
 public:
-    MaterialCommand(Document* doc, const QString& text, int body, sim::Material before, sim::Material after, int key)
-        : QUndoCommand(text), m_doc(doc), m_body(body), m_before(std::move(before)), m_after(std::move(after)),
+    using Value = typename Slot::Value;
+    ValueCommand(Document* doc, const QString& text, int target, Value before, Value after, int key)
+        : QUndoCommand(text), m_doc(doc), m_target(target), m_before(std::move(before)), m_after(std::move(after)),
           m_key(key) {}
-    int id() const override { return m_key ? 2 : -1; }
+    int id() const override { return m_key ? Slot::kId : -1; }
     bool mergeWith(const QUndoCommand* other) override {
-        const auto* o = static_cast<const MaterialCommand*>(other);
-        if (o->m_key != m_key || o->m_body != m_body) return false;
+        const auto* o = static_cast<const ValueCommand*>(other);
+        if (o->m_key != m_key || o->m_target != m_target) return false;
         m_after = o->m_after;
         return true;
     }
-    void redo() override { m_doc->setMaterial(m_body, m_after); }
-    void undo() override { m_doc->setMaterial(m_body, m_before); }
+    void redo() override { m_doc->setValue<Slot>(m_target, m_after); }
+    void undo() override { m_doc->setValue<Slot>(m_target, m_before); }
 
 private:
     Document* m_doc;
-    int m_body;
-    sim::Material m_before, m_after;
+    int m_target;
+    Value m_before, m_after;
     int m_key;
 };
 
@@ -108,10 +184,19 @@ void Document::replace(const Project& p, Change what) {
     emit changed(what);
 }
 
-void Document::setMaterial(int body, const sim::Material& m) {
-    m_project->bodies.at(static_cast<size_t>(body)).scene.material = m;
+template <class Slot> void Document::setValue(int target, const typename Slot::Value& v) {
+    Slot::of(*m_project, target) = v;
     ++m_revision;
-    emit changed(Change::material(body));
+    emit changed(Slot::change(target));
+}
+
+template <class Slot>
+QString Document::editValue(const QString& text, int target, const typename Slot::Value& value, int mergeKey) {
+    if (!m_project) return tr("no project is open");
+    if (const std::string why = Slot::check(*m_project, target, value); !why.empty())
+        return QString::fromStdString((m_project->dir / "project.json").string() + ": " + why);
+    m_undo.push(new ValueCommand<Slot>(this, text, target, Slot::of(*m_project, target), value, mergeKey));
+    return {};
 }
 
 void Document::open(const QString& folder) {
@@ -225,21 +310,26 @@ QString Document::edit(const QString& text, const std::function<void(Project&)>&
 }
 
 QString Document::editMaterial(const QString& text, int body, const sim::Material& material, int mergeKey) {
+    if (!m_project || body < 0 || body >= static_cast<int>(m_project->bodies.size())) return tr("no body selected");
+    return editValue<MaterialSlot>(text, body, material, mergeKey);
+}
+
+QString Document::editSolver(const QString& text, const sim::XpbdSettings& settings) {
+    return editValue<SolverSlot>(text, 0, settings, 0);
+}
+
+QString Document::editStiffnessPaint(const QString& text, int body, int surface,
+                                     const std::optional<StiffnessPaintProject>& paint) {
     if (!m_project) return tr("no project is open");
-    if (body < 0 || body >= static_cast<int>(m_project->bodies.size())) return tr("no body selected");
-    const BodyProject& b = m_project->bodies[static_cast<size_t>(body)];
-    const std::string where =
-        (m_project->dir / "project.json").string() + ": bodies[" + std::to_string(body) + "].material: ";
-    // The reader's rules for a material value: sim::validate (readMaterial's check) and the
-    // constraint model with its curves (what check() builds for every body).
-    if (const std::string why = sim::validate(material); !why.empty()) return QString::fromStdString(where + why);
-    try {
-        sim::makeConstraintModel(material, b.scene.name);
-    } catch (const std::exception& e) {
-        return QString::fromStdString(where + e.what());
-    }
-    m_undo.push(new MaterialCommand(this, text, body, b.scene.material, material, mergeKey));
-    return {};
+    const bool isBody = body >= 0 && body < static_cast<int>(m_project->bodies.size());
+    const bool isSurface = surface >= 0 && surface < static_cast<int>(m_project->surfaces.size());
+    if (isBody == isSurface) return tr("paint a body or a surface");
+    return editValue<PaintSlot>(text, isBody ? body : -1 - surface, paint, 0);
+}
+
+QString Document::editLightSamples(const QString& text, int body, const std::vector<render::SamplePaintOp>& ops) {
+    if (!m_project || body < 0 || body >= static_cast<int>(m_project->bodies.size())) return tr("no body selected");
+    return editValue<LightSamplesSlot>(text, body, ops, 0);
 }
 
 } // namespace viscera::studio

@@ -2,7 +2,8 @@
 /// The studio's open project: the one model (studio::Project, the same the headless export
 /// reads), its folder and the undo stack whose commands edit it.
 ///
-/// Edits are undo commands of two kinds. A typed edit (editMaterial) holds only the old and new
+/// Edits are undo commands of two kinds. A typed edit (editMaterial, editSolver,
+/// editStiffnessPaint, editLightSamples) holds only the old and new
 /// value of what it edits, is checked by the rules the reader applies to that value
 /// (sim::validate and the constraint model of the material: no project text is written) and
 /// announces what it changed (Change), so the panels and the preview update only that. The
@@ -11,6 +12,7 @@
 /// holds both models. Either way a value the export would reject never enters the model, undo
 /// restores it exactly, and commands with the same merge key (one drag) merge into one step.
 #include "project/project.hpp"
+#include "render/sample_map.hpp"
 
 #include <QObject>
 #include <QString>
@@ -28,7 +30,8 @@ struct Change {
         Paint = 1u << 1,        ///< stiffness paint strokes of a body or surface
         LightSamples = 1u << 2, ///< light-sample paint of a body
         Texture = 1u << 3,      ///< material-map blocks
-        Structure = 1u << 4,    ///< anything else: meshes, names, solver, scene, a new project
+        Structure = 1u << 4,    ///< anything else: meshes, names, scene, a new project
+        Solver = 1u << 5,       ///< the XPBD solver settings (substeps, dt, damping, ...)
         All = ~0u,
     };
     unsigned parts = All;
@@ -77,6 +80,14 @@ public:
     /// model with its curves) without writing the project; refused with the rule as
     /// "<folder>/project.json: bodies[i].material: <rule>". Same merge rule as edit().
     QString editMaterial(const QString& text, int body, const sim::Material& material, int mergeKey = 0);
+    /// The other typed edits, each checked by the reader's rules for its value: the solver
+    /// settings (sim::validate(XpbdSettings), XpbdLimits); the stiffness paint of body `body` or
+    /// surface `surface` (the other -1; sim::validateStroke per stroke, the weights' order); the
+    /// light-sample paint of a body (render::validateSamplePaintOp per operation).
+    QString editSolver(const QString& text, const sim::XpbdSettings& settings);
+    QString editStiffnessPaint(const QString& text, int body, int surface,
+                               const std::optional<StiffnessPaintProject>& paint);
+    QString editLightSamples(const QString& text, int body, const std::vector<render::SamplePaintOp>& ops);
     /// A fresh merge key for one drag or one continuous gesture.
     int newMergeKey() { return ++m_lastMergeKey; }
 
@@ -93,9 +104,11 @@ signals:
 
 private:
     friend class ProjectCommand;
-    friend class MaterialCommand;
+    template <class Slot> friend class ValueCommand;
     void replace(const Project& p, Change what);
-    void setMaterial(int body, const sim::Material& m);
+    template <class Slot> void setValue(int target, const typename Slot::Value& v);
+    template <class Slot>
+    QString editValue(const QString& text, int target, const typename Slot::Value& value, int mergeKey);
 
     std::unique_ptr<Project> m_project;
     QString m_folder;

@@ -313,8 +313,8 @@ void Preview::takeJob(Worker& w, const Pending& job, uint64_t takenAfter) {
     try {
         // A typed edit of materials or paint strokes says so: the meshes stay, nothing is
         // compared (no project text is written); any other change compares what it touched.
-        const bool typed =
-            w.built && w.world && job.mode == w.builtMode && job.what.only(Change::Material | Change::Paint);
+        const bool typed = w.built && w.world && job.mode == w.builtMode &&
+                           job.what.only(Change::Material | Change::Paint | Change::Solver);
         std::string key, rest;
         if (!typed) {
             key = structureKey(project, job.mode, job.body);
@@ -438,7 +438,16 @@ std::unique_ptr<sim::World> Preview::applyMaterials(Worker& w, const Project& pr
     bool ok = true;
     QString verdict;
     std::unique_ptr<sim::World> next;
+    const sim::XpbdSettings oldSolver = b.scene.xpbd;
+    auto restoreAll = [&] {
+        restore();
+        b.scene.xpbd = oldSolver;
+    };
     try {
+        if (project.scene.solverType == b.scene.solverType) { // the solver settings too (one thread here)
+            b.scene.xpbd = project.scene.xpbd;
+            b.scene.xpbd.threads = 1;
+        }
         for (size_t i = 0; i < b.scene.bodies.size(); ++i) {
             old.push_back(b.scene.bodies[i].material);
             oldWeights.push_back(b.scene.bodies[i].nodeWeights);
@@ -457,7 +466,7 @@ std::unique_ptr<sim::World> Preview::applyMaterials(Worker& w, const Project& pr
         verdict = stabilityVerdict(b, ok);
         if (ok) next = assembleWorld(b, origin);
     } catch (...) {
-        restore();
+        restoreAll();
         throw;
     }
     publishStatus([&](Snapshot& s) {
@@ -465,7 +474,7 @@ std::unique_ptr<sim::World> Preview::applyMaterials(Worker& w, const Project& pr
         s.verdictOk = ok;
     });
     if (!ok) {
-        restore();
+        restoreAll();
         throw std::runtime_error(tr("the preview keeps the last stable material").toStdString());
     }
     if (w.world && w.world->bodyCount() == next->bodyCount() && w.world->surfaceCount() == next->surfaceCount() &&

@@ -57,7 +57,7 @@ PropertiesPanel::PropertiesPanel(Document* doc, Selection* selection, MaterialPa
     connect(m_doc, &Document::changed, this, [this](const Change& what) {
         if (what.touches(Change::Structure))
             scheduleRebuild();
-        else if (what.touches(Change::Material))
+        else if (what.touches(Change::Material | Change::Solver))
             fillValues(false);
     });
 }
@@ -200,12 +200,13 @@ QString PropertiesPanel::setSolverValue(const QString& field, double v, const QS
         return tr("solver.%1: '%2' must be a whole number").arg(field, text);
     // A whole number past any valid count still reaches the reader's rule, which names the range.
     const int count = static_cast<int>(std::clamp(v, -1e9, 1e9));
-    return m_doc->edit(tr("Set solver %1").arg(field), [&](Project& p) {
-        if (field == "dt") p.scene.xpbd.dt = v;
-        if (field == "substeps") p.scene.xpbd.substeps = count;
-        if (field == "iterations") p.scene.xpbd.iterations = count;
-        if (field == "damping") p.scene.xpbd.damping = v;
-    });
+    if (!m_doc->hasProject()) return tr("no project is open");
+    sim::XpbdSettings s = m_doc->project().scene.xpbd;
+    if (field == "dt") s.dt = v;
+    if (field == "substeps") s.substeps = count;
+    if (field == "iterations") s.iterations = count;
+    if (field == "damping") s.damping = v;
+    return m_doc->editSolver(tr("Set solver %1").arg(field), s);
 }
 
 } // namespace viscera::studio

@@ -158,9 +158,9 @@ QString SamplePainter::end() {
     const QString what = op.samples == 0 ? tr("erase") : tr("%1×").arg(op.samples);
     const QString text = op.tool == render::SamplePaintOp::Tool::Fill ? tr("Fill light samples (%1) on '%2'")
                                                                       : tr("Paint light samples (%1) on '%2'");
-    const QString why = m_doc->edit(
-        text.arg(what, name), [&](Project& p) { p.bodies[body].lightSamples.push_back(op); }, 0,
-        Change{Change::LightSamples, body});
+    std::vector<render::SamplePaintOp> ops = m_doc->project().bodies[body].lightSamples;
+    ops.push_back(op);
+    const QString why = m_doc->editLightSamples(text.arg(what, name), body, ops);
     if (!why.isEmpty()) setStatus(why);
     recompute(); // the committed operations (or, refused, the classes as they were)
     return why;

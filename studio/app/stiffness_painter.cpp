@@ -264,15 +264,14 @@ QString StiffnessPainter::end() {
         return why;
     }
     static const char* const kModes[] = {"add", "subtract", "mix", "smooth"};
-    const QString why = m_doc->edit(
+    const Project& project = m_doc->project();
+    std::optional<StiffnessPaintProject> paint =
+        m_surface >= 0 ? project.surfaces.at(m_surface).paint : project.bodies.at(m_body).paint;
+    if (!paint) paint = StiffnessPaintProject{};
+    paint->strokes.insert(paint->strokes.end(), dabs.begin(), dabs.end());
+    const QString why = m_doc->editStiffnessPaint(
         tr("Paint stiffness (%1) on '%2'").arg(kModes[static_cast<int>(dabs.front().mode)], targetName()),
-        [&](Project& p) {
-            std::optional<StiffnessPaintProject>& paint =
-                m_surface >= 0 ? p.surfaces[m_surface].paint : p.bodies[m_body].paint;
-            if (!paint) paint = StiffnessPaintProject{};
-            paint->strokes.insert(paint->strokes.end(), dabs.begin(), dabs.end());
-        },
-        0, Change{Change::Paint, m_surface >= 0 ? -1 : m_body});
+        m_surface >= 0 ? -1 : m_body, m_surface, paint);
     if (!why.isEmpty()) setStatus(why);
     recompute(); // the committed strokes (or, refused, the weights as they were)
     return why;

@@ -321,3 +321,34 @@ TEST_F(PanelFixture, ScaleSmoothAndResetAreOneUndoStepEachAndKeepTheShape) {
     doc.undoStack()->undo();
     EXPECT_EQ(f(), preset);
 }
+
+// Issue 39 item 1: every typed edit is checked by the reader's rule for its value and refused
+// with the file, the field and the rule; a refused edit leaves the model and the undo stack.
+TEST_F(PanelFixture, TypedEditsAreCheckedByTheReadersRulesAndUndoExactly) {
+    const int undo = doc.undoStack()->count();
+    const std::string file = (doc.project().dir / "project.json").string();
+    sim::XpbdSettings s = doc.project().scene.xpbd;
+    s.substeps = 0;
+    EXPECT_EQ(doc.editSolver("substeps", s).toStdString(), file + ": solver: substeps must be in [1, 1000]");
+    s.substeps = 77;
+    EXPECT_EQ(doc.editSolver("substeps", s), "");
+    EXPECT_EQ(doc.project().scene.xpbd.substeps, 77);
+    std::optional<studio::StiffnessPaintProject> paint = studio::StiffnessPaintProject{};
+    sim::BrushStroke bad;
+    bad.radius = 0; // the reader's rule: radius in [1e-6, 1e3] m
+    paint->strokes.push_back(bad);
+    const QString why = doc.editStiffnessPaint("paint", 0, -1, paint);
+    EXPECT_TRUE(why.startsWith(QString::fromStdString(file + ": bodies[0].stiffness_paint.strokes: stroke 0: radius")))
+        << why.toStdString();
+    paint->strokes.front().radius = 0.01;
+    EXPECT_EQ(doc.editStiffnessPaint("paint", 0, -1, paint), "");
+    render::SamplePaintOp op;
+    op.samples = 3; // not a sample class
+    op.points.push_back(sim::Vec3::Zero());
+    EXPECT_TRUE(doc.editLightSamples("samples", 0, {op}).contains("light_samples[0]"));
+    EXPECT_EQ(doc.undoStack()->count(), undo + 2) << "two accepted edits, two steps";
+    doc.undoStack()->undo();
+    EXPECT_FALSE(doc.project().bodies[0].paint.has_value());
+    doc.undoStack()->undo();
+    EXPECT_NE(doc.project().scene.xpbd.substeps, 77);
+}

@@ -566,13 +566,20 @@ TEST_F(WindowFixture, ACurveDragOfAHundredMovesWritesNoProjectTextAndBuildsNoPan
     EXPECT_EQ(w->propertiesPanel()->builds(), fieldBuilds);
     EXPECT_TRUE(w->preview()->snapshot().error.isEmpty())
         << w->preview()->snapshot().error.toStdString() << " / " << w->preview()->snapshot().verdict.toStdString();
-    // a structural edit still compares (and so writes) the project, and rebuilds the fields
+    // a solver field is a typed edit too (no project text), and the preview takes it
     w->selection()->set(studio::Selection::Kind::Solver);
     ASSERT_EQ(w->setProperty("damping", "3"), "");
     ASSERT_TRUE(test::waitFor(caughtUp, 60000));
-    ASSERT_TRUE(test::waitFor([&] { return w->propertiesPanel()->builds() > fieldBuilds; }, 5000));
+    EXPECT_EQ(studio::projectTextCount(), texts);
+    EXPECT_EQ(w->document()->project().scene.xpbd.damping, 3.0);
+    // a general edit still compares (and so writes) the project, and rebuilds the fields
+    const int fieldsNow = w->propertiesPanel()->builds();
+    ASSERT_EQ(w->document()->edit("title", [](studio::Project& p) { p.title = "renamed"; }), "");
+    ASSERT_TRUE(test::waitFor(caughtUp, 60000));
+    ASSERT_TRUE(test::waitFor([&] { return w->propertiesPanel()->builds() > fieldsNow; }, 5000));
     EXPECT_GT(studio::projectTextCount(), texts);
     // undo of the drag is again a typed edit: no project text
+    w->document()->undoStack()->undo(); // title
     w->document()->undoStack()->undo(); // damping
     ASSERT_TRUE(test::waitFor(caughtUp, 60000));
     const uint64_t texts2 = studio::projectTextCount();
