@@ -20,7 +20,7 @@
 
 namespace viscera::studio {
 FitDialog::FitDialog(Document* doc, int body, QWidget* parent) : QDialog(parent), m_doc(doc), m_body(body) {
-    setWindowTitle(tr("Fit material curves to a uniaxial test"));
+    setWindowTitle(tr("Fit material curves to test data"));
     setObjectName("fitDialog");
     resize(720, 620); // room for the plot and the figures under it
     auto* root = new QVBoxLayout(this);
@@ -37,6 +37,24 @@ FitDialog::FitDialog(Document* doc, int body, QWidget* parent) : QDialog(parent)
     m_measure->addItems({tr("stretch λ = l/L (dimensionless)"), tr("engineering strain ε = (l − L)/L")});
     form->addRow(tr("Column 1"), m_measure);
     form->addRow(tr("Column 2"), new QLabel(tr("nominal stress (force / undeformed area), Pa"), this));
+    // a second test of the same material pins what one uniaxial test leaves free (ν)
+    auto* secondRow = new QHBoxLayout;
+    m_secondFile = new QLineEdit(this);
+    m_secondFile->setObjectName("fitSecondFile");
+    m_secondFile->setPlaceholderText(tr("optional: a second test of the same material"));
+    m_secondCase = new QComboBox(this);
+    m_secondCase->setObjectName("fitSecondCase");
+    m_secondCase->addItems({tr("equibiaxial"), tr("planar shear")});
+    auto* browse2 = new QPushButton(tr("Browse…"), this);
+    secondRow->addWidget(m_secondFile, 1);
+    secondRow->addWidget(m_secondCase);
+    secondRow->addWidget(browse2);
+    form->addRow(tr("Second test"), secondRow);
+    connect(browse2, &QPushButton::clicked, this, [this] {
+        const QString f = QFileDialog::getOpenFileName(this, tr("Equibiaxial or planar shear test data"), QString(),
+                                                       tr("Text and CSV (*.csv *.txt *.dat);;All files (*)"));
+        if (!f.isEmpty()) m_secondFile->setText(f);
+    });
     m_curves = new QComboBox(this);
     m_curves->setObjectName("fitCurves");
     // f′ alone by default: a uniaxial test fixes one function of stretch, and f′ carries it; h′
@@ -64,10 +82,11 @@ FitDialog::FitDialog(Document* doc, int body, QWidget* parent) : QDialog(parent)
     for (QAbstractButton* b : buttons->buttons())
         if (auto* p = qobject_cast<QPushButton*>(b); p && p != m_fitButton) p->setAutoDefault(false);
     connect(m_file, &QLineEdit::returnPressed, this, [this] { runFit(); });
-    connect(m_file, &QLineEdit::textEdited, this, [this] { // a fit of another file is not applied
-        m_fitResult.reset();
-        m_apply->setEnabled(false);
-    });
+    for (QLineEdit* f : {m_file, m_secondFile}) // a fit of another file is not applied
+        connect(f, &QLineEdit::textEdited, this, [this] {
+            m_fitResult.reset();
+            m_apply->setEnabled(false);
+        });
     root->addWidget(buttons);
     connect(browse, &QPushButton::clicked, this, [this] {
         const QString f = QFileDialog::getOpenFileName(this, tr("Uniaxial test data"), QString(),
@@ -94,12 +113,10 @@ bool FitDialog::runFit() {
         const sim::Material& m = m_doc->project().bodies[m_body].scene.material;
         const auto start = MaterialPanel::curvesOf(m);
         if (!start) throw std::invalid_argument("the material has no editable curves: apply a preset first");
-        m_data = sim::readUniaxialData(m_file->text().toStdString(), m_measure->currentIndex() == 0
-                                                                         ? sim::StrainMeasure::Stretch
-                                                                         : sim::StrainMeasure::EngineeringStrain);
+        m_data = readData();
         sim::FitOptions opt;
         opt.curves = m_curves->currentIndex() == 1 ? sim::FitCurves::FPrimeAndHPrime : sim::FitCurves::FPrime;
-        m_fitResult = sim::fitUniaxial(*start, *m_data, opt);
+        m_fitResult = bestFit(*start, *m_data, opt);
     } catch (const std::exception& e) {
         m_result->setText(QString::fromStdString(e.what()));
         m_plot->setSeries({});
@@ -116,16 +133,86 @@ bool FitDialog::runFit() {
             .arg(r.iterations)
             .arg(r.converged ? tr("converged") : tr("iteration limit"));
     text += "\n" + changesText(*MaterialPanel::curvesOf(m_doc->project().bodies[m_body].scene.material), r.curves);
-    PlotWidget::Series data{tr("test data"), m_data->stretch, m_data->nominalStress, QColor(30, 30, 30), true};
+    if (!m_startNote.isEmpty()) text += "\n" + m_startNote;
     PlotWidget::Series fit{tr("fitted curves"), {}, {}, QColor(200, 60, 40)};
     const QString unstable = fittedResponse(r, fit);
     if (!unstable.isEmpty()) text += "\n" + tr("Not applied: %1").arg(unstable);
     m_result->setText(text);
     m_result->setStyleSheet(unstable.isEmpty() ? QString() : QStringLiteral("color: #b00020"));
     m_plot->setNote(text.section('\n', 0, 0));
-    m_plot->setSeries({fit, data});
+    std::vector<PlotWidget::Series> series{fit};
+    secondTestSeries(r, series);
+    m_plot->setSeries(std::move(series));
     m_apply->setEnabled(unstable.isEmpty());
     return true;
+}
+
+sim::UniaxialData FitDialog::readData() const {
+    const auto measure =
+        m_measure->currentIndex() == 0 ? sim::StrainMeasure::Stretch : sim::StrainMeasure::EngineeringStrain;
+    sim::UniaxialData uni = sim::readUniaxialData(m_file->text().toStdString(), measure);
+    if (m_secondFile->text().trimmed().isEmpty()) return uni;
+    const sim::UniaxialData second = sim::readUniaxialData(m_secondFile->text().trimmed().toStdString(), measure);
+    return sim::combineTests({{sim::LoadCase::Uniaxial, uni}, {secondCase(), second}});
+}
+
+sim::LoadCase FitDialog::secondCase() const {
+    return m_secondCase->currentIndex() == 0 ? sim::LoadCase::Equibiaxial : sim::LoadCase::PlanarShear;
+}
+
+sim::CurveFitResult FitDialog::bestFit(const sim::ValanisLandelCurves& start, const sim::UniaxialData& data,
+                                       const sim::FitOptions& opt) {
+    m_startNote.clear();
+    sim::CurveFitResult best = sim::fitUniaxial(start, data, opt);
+    if (data.loadCase.empty() || opt.curves != sim::FitCurves::FPrimeAndHPrime) return best;
+    // Two tests and h′ free: the fit is local and the start's ν decides where it ends; the
+    // Neo-Hookean curves at the material's small-strain E and several ν are tried too, the
+    // smallest SSE kept.
+    const double E0 = sim::smallStrainConstants(start).youngsModulus;
+    QString won = tr("the material's curves");
+    for (const double E : {0.5 * E0, E0, 2 * E0})
+        for (const double nu : {0.3, 0.4, 0.45, 0.49}) {
+            try {
+                sim::CurveFitResult r = sim::fitUniaxial(sim::editableCurves("neo_hookean", E, nu), data, opt);
+                if (r.sse < best.sse) {
+                    best = std::move(r);
+                    won = tr("the Neo-Hookean curves at E %1 Pa, ν %2").arg(numberText(E, 4), numberText(nu, 3));
+                }
+            } catch (const std::exception&) { // a start without a state at some data stretch: not a candidate
+            }
+        }
+    m_startNote = tr("Two tests: fitted from the material's curves and from Neo-Hookean curves at ½, 1 and 2 times "
+                     "its E and ν 0.3–0.49; the best started from %1.")
+                      .arg(won);
+    return best;
+}
+
+void FitDialog::secondTestSeries(const sim::CurveFitResult& r, std::vector<PlotWidget::Series>& series) const {
+    const sim::UniaxialData& d = *m_data;
+    PlotWidget::Series uni{tr("uniaxial data"), {}, {}, QColor(30, 30, 30), true};
+    PlotWidget::Series other{tr("%1 data").arg(sim::loadCaseName(secondCase())), {}, {}, QColor(30, 120, 60), true};
+    for (size_t i = 0; i < d.size(); ++i) {
+        const bool second = !d.loadCase.empty() && d.loadCase[i] != sim::LoadCase::Uniaxial;
+        (second ? other : uni).x.push_back(d.stretch[i]);
+        (second ? other : uni).y.push_back(d.nominalStress[i]);
+    }
+    series.push_back(uni);
+    if (other.x.empty()) return;
+    // the fitted material in the second test, over that test's range
+    PlotWidget::Series fit{tr("fitted, %1").arg(sim::loadCaseName(secondCase())), {}, {}, QColor(60, 160, 90)};
+    try {
+        const sim::ValanisLandelDensity density("fit", r.curves);
+        const auto [lo, hi] = std::minmax_element(other.x.begin(), other.x.end());
+        for (int k = 0; k <= 60; ++k) {
+            const double s = *lo + (*hi - *lo) * k / 60.0;
+            const sim::UniaxialResponse u = sim::solveLoadCase(density, secondCase(), s);
+            fit.x.push_back(s);
+            fit.y.push_back(u.solved ? u.nominalStress : NAN);
+        }
+    } catch (const std::exception&) {
+    }
+    series.push_back(fit);
+    series.push_back(other);
 }
 
 QString FitDialog::changesText(const sim::ValanisLandelCurves& before, const sim::ValanisLandelCurves& after) const {

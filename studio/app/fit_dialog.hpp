@@ -1,7 +1,8 @@
 #pragma once
 /// Fit to test data [A §4.3.3]: a two-column text/CSV file of a uniaxial test (stretch or
-/// engineering strain; nominal stress in Pa), fitted by least squares of the curves' control
-/// values under their shape rule (sim::fitUniaxial). Shows the data over the fitted response
+/// engineering strain; nominal stress in Pa) and, optionally, a second test of the same material
+/// (equibiaxial or planar shear, the same format), fitted together by least squares of the
+/// curves' control values under their shape rule (sim::fitUniaxial). Shows the data over the fitted response
 /// with SSE, R², the largest relative error and the stretch range the data covers, and what the
 /// fit changed and left (small-strain E and ν: f′ alone, the default, keeps ν); Apply writes the
 /// fitted curves into the body's material as one undo step. A fit whose material would be
@@ -44,7 +45,19 @@ public:
     /// Writes the fitted curves into the body's material (a Document edit). Returns the error.
     QString apply();
 
+    QLineEdit* secondFileField() { return m_secondFile; }
+    QComboBox* secondCaseBox() { return m_secondCase; }
+
 private:
+    /// The uniaxial file's rows and, when named, the second test's (combined, each row marked).
+    sim::UniaxialData readData() const;
+    sim::LoadCase secondCase() const;
+    /// fitUniaxial from `start`; with two tests and h′ free also from Neo-Hookean curves at several
+    /// ν (the fit is local), the smallest SSE kept (m_startNote says which start won).
+    sim::CurveFitResult bestFit(const sim::ValanisLandelCurves& start, const sim::UniaxialData& data,
+                                const sim::FitOptions& opt);
+    /// The data of each test as points, and the fitted response in the second test.
+    void secondTestSeries(const sim::CurveFitResult& r, std::vector<PlotWidget::Series>& series) const;
     /// What the fit changed and what it left: small-strain E and ν before and after.
     QString changesText(const sim::ValanisLandelCurves& before, const sim::ValanisLandelCurves& after) const;
     /// The fitted response into `fit`; the reason the fitted material would be unstable (no
@@ -55,6 +68,9 @@ private:
     int m_body;
     QLineEdit* m_file;
     QComboBox *m_measure, *m_curves;
+    QLineEdit* m_secondFile = nullptr;
+    QComboBox* m_secondCase = nullptr;
+    QString m_startNote;
     QLabel* m_result;
     PlotWidget* m_plot;
     QPushButton *m_fitButton, *m_apply;

@@ -179,7 +179,7 @@ public:
         m_trialLateral.resize(n);
         if (stress) stress->resize(n);
         for (std::size_t i = 0; i < n; ++i) {
-            const UniaxialResponse u = solveUniaxial(*density, m_data.stretch[i], m_lateral[i]);
+            const UniaxialResponse u = solveLoadCase(*density, caseOf(i), m_data.stretch[i], m_lateral[i]);
             if (!u.solved) return false;
             const double ri = (u.nominalStress - m_data.nominalStress[i]) * m_weight(static_cast<Eigen::Index>(i));
             if (!std::isfinite(ri)) return false;
@@ -189,6 +189,7 @@ public:
         }
         return true;
     }
+    LoadCase caseOf(std::size_t i) const { return m_data.loadCase.empty() ? LoadCase::Uniaxial : m_data.loadCase[i]; }
     /// The lateral stretches of the last successful residuals() become the warm start.
     void commitLateral() { m_lateral = m_trialLateral; }
 
@@ -332,9 +333,13 @@ void checkInput(const ValanisLandelCurves& start, const UniaxialData& data, cons
     if (data.size() < UniaxialDataLimits::minRows)
         throw std::invalid_argument(where + "data has " + std::to_string(data.size()) + " rows, at least " +
                                     std::to_string(UniaxialDataLimits::minRows) + " are needed");
+    if (!data.loadCase.empty() && data.loadCase.size() != data.size())
+        throw std::invalid_argument(where + "data has " + std::to_string(data.loadCase.size()) + " test marks for " +
+                                    std::to_string(data.size()) + " rows");
     for (std::size_t i = 0; i < data.size(); ++i) {
         const double s = data.stretch[i];
-        if (!std::isfinite(s) || !(s > 0) || (i > 0 && !(s > data.stretch[i - 1])))
+        const bool sameTest = i > 0 && (data.loadCase.empty() || data.loadCase[i] == data.loadCase[i - 1]);
+        if (!std::isfinite(s) || !(s > 0) || (sameTest && !(s > data.stretch[i - 1])))
             throw std::invalid_argument(where + "data row " + std::to_string(i) + ": stretch " + formatNumber(s, 12) +
                                         " must be finite, positive and above the previous row's");
         if (!std::isfinite(data.nominalStress[i]))
@@ -375,9 +380,9 @@ CurveFitResult fitUniaxial(const ValanisLandelCurves& start, const UniaxialData&
         // Name the first data stretch without a uniaxial state.
         const ValanisLandelDensity density("fit start", *problem.curves(theta));
         for (std::size_t i = 0; i < data.size(); ++i)
-            if (!solveUniaxial(density, data.stretch[i]).solved)
-                throw InputError(std::string(kWhere) + "start curves: no uniaxial state at stretch " +
-                                 formatNumber(data.stretch[i], 12) +
+            if (!solveLoadCase(density, problem.caseOf(i), data.stretch[i]).solved)
+                throw InputError(std::string(kWhere) + "start curves: no " + loadCaseName(problem.caseOf(i)) +
+                                 " state at stretch " + formatNumber(data.stretch[i], 12) +
                                  (data.line.size() == data.size() ? " (data line " + std::to_string(data.line[i]) + ")"
                                                                   : std::string()));
         throw InputError(std::string(kWhere) + "start curves: the uniaxial stress is not finite at a data stretch");
@@ -446,8 +451,8 @@ CurveFitResult fitUniaxial(const ValanisLandelCurves& start, const UniaxialData&
                      std::abs(e) / std::max(std::abs(data.nominalStress[i]), result.relativeErrorFloor));
     }
     result.rSquared = sst > 0 ? 1.0 - result.sse / sst : 1.0 - result.sse / (result.sse + 1.0);
-    result.stretchMin = data.stretch.front();
-    result.stretchMax = data.stretch.back();
+    result.stretchMin = *std::min_element(data.stretch.begin(), data.stretch.end());
+    result.stretchMax = *std::max_element(data.stretch.begin(), data.stretch.end());
     result.evaluations = problem.evaluations();
     return result;
 }

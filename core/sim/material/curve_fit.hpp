@@ -96,9 +96,12 @@ struct CurveFitResult {
     bool converged = false; ///< stop != IterationLimit
 };
 
-/// Fits `start`'s control values to `data` (see the file comment). Throws std::invalid_argument
+/// Fits `start`'s control values to `data` (see the file comment). Rows marked with another test
+/// (UniaxialData::loadCase, combineTests: equibiaxial, planar shear) are fitted with that test's
+/// nominal stress (material_response.hpp, solveLoadCase): a second test pins what one uniaxial
+/// test leaves free (the volume response, so h′ and ν). Throws std::invalid_argument
 /// for a broken precondition (data with fewer than UniaxialDataLimits::minRows rows, lengths
-/// that differ, stretches not finite, positive and strictly increasing, stresses not finite,
+/// that differ, stretches not finite, positive and strictly increasing within a test, stresses not finite,
 /// named by 0-based row: "sim::fitUniaxial(): data row 4: stretch 1.02 must be ...";
 /// maxIterations < 1; tolerance not positive; regularization negative; no f′, or no h′ with FPrimeAndHPrime; a fitted
 /// curve without a control point at x = 1) and viscera::InputError when the start curves are

@@ -16,25 +16,43 @@ struct AxialStress {
     double p11 = 0, p22 = 0;
 };
 
-/// P11 and P22 at F = diag(λ, t, t): a Valanis–Landel density in its principal frame (no SVD),
-/// any other through stress().
+/// P11 and the free face's stress (p22: P22 uniaxial, P33 otherwise) at the load case's F: a
+/// Valanis–Landel density in its principal frame (no SVD), any other through stress().
 class AxialEvaluator {
 public:
-    explicit AxialEvaluator(const EnergyDensity& density)
-        : m_density(density), m_vl(dynamic_cast<const ValanisLandelDensity*>(&density)) {}
+    explicit AxialEvaluator(const EnergyDensity& density, LoadCase c = LoadCase::Uniaxial)
+        : m_density(density), m_vl(dynamic_cast<const ValanisLandelDensity*>(&density)), m_case(c) {}
 
-    AxialStress operator()(double lambda, double t) const {
-        if (m_vl) {
-            const Eigen::Vector3d d = m_vl->stressPrincipal(Eigen::Vector3d(lambda, t, t));
-            return {d(0), d(1)};
+    Eigen::Vector3d stretches(double lambda, double t) const {
+        switch (m_case) {
+        case LoadCase::Equibiaxial:
+            return {lambda, lambda, t};
+        case LoadCase::PlanarShear:
+            return {lambda, 1.0, t};
+        default:
+            return {lambda, t, t};
         }
-        const Mat3 P = m_density.stress(Eigen::Vector3d(lambda, t, t).asDiagonal());
-        return {P(0, 0), P(1, 1)};
+    }
+    double guess(double lambda) const {
+        return m_case == LoadCase::Uniaxial      ? 1.0 / std::sqrt(lambda)
+               : m_case == LoadCase::Equibiaxial ? 1.0 / (lambda * lambda)
+                                                 : 1.0 / lambda;
+    }
+    AxialStress operator()(double lambda, double t) const {
+        const int free = m_case == LoadCase::Uniaxial ? 1 : 2;
+        const Eigen::Vector3d s = stretches(lambda, t);
+        if (m_vl) {
+            const Eigen::Vector3d d = m_vl->stressPrincipal(s);
+            return {d(0), d(free)};
+        }
+        const Mat3 P = m_density.stress(s.asDiagonal());
+        return {P(0, 0), P(free, free)};
     }
 
 private:
     const EnergyDensity& m_density;
     const ValanisLandelDensity* m_vl;
+    LoadCase m_case;
 };
 
 /// The uniaxial solve with what a failure message needs.
@@ -79,7 +97,7 @@ Solve solve(const AxialEvaluator& eval, double lambda, double guess) {
         return out;
     };
 
-    double t = std::clamp(guess > 0 ? guess : 1.0 / std::sqrt(lambda), kMinLateralStretch, kMaxLateralStretch);
+    double t = std::clamp(guess > 0 ? guess : eval.guess(lambda), kMinLateralStretch, kMaxLateralStretch);
     AxialStress st = g(t);
     out.firstT = t;
     out.firstP22 = st.p22;
@@ -155,6 +173,22 @@ Solve solve(const AxialEvaluator& eval, double lambda, double guess) {
 UniaxialResponse solveUniaxial(const EnergyDensity& density, double stretch, double lateralGuess) {
     checkStretch("sim::solveUniaxial(): ", stretch);
     return solve(AxialEvaluator(density), stretch, lateralGuess).response;
+}
+
+const char* loadCaseName(LoadCase c) {
+    switch (c) {
+    case LoadCase::Equibiaxial:
+        return "equibiaxial";
+    case LoadCase::PlanarShear:
+        return "planar shear";
+    default:
+        return "uniaxial";
+    }
+}
+
+UniaxialResponse solveLoadCase(const EnergyDensity& density, LoadCase c, double stretch, double lateralGuess) {
+    checkStretch("sim::solveLoadCase(): ", stretch);
+    return solve(AxialEvaluator(density, c), stretch, lateralGuess).response;
 }
 
 UniaxialResponse uniaxialNominalStress(const EnergyDensity& density, double stretch) {

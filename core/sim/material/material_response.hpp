@@ -30,6 +30,17 @@
 
 namespace viscera::sim {
 
+/// Homogeneous tests with one free face: the loading axis x stretched by λ, P11 the test's nominal
+/// stress, the lateral stretch t solved so that the free face carries no load:
+///   Uniaxial     F = diag(λ, t, t), P22 = P33 = 0 (tension and compression);
+///   Equibiaxial  F = diag(λ, λ, t), P33 = 0 (x and y stretched alike; P22 = P11);
+///   PlanarShear  F = diag(λ, 1, t), P33 = 0 (pure shear: y held, as in a wide strip).
+/// The same safeguarded Newton search as the uniaxial solve, from t = λ^(-1/2), λ^(-2), λ^(-1)
+/// (the incompressible values).
+enum class LoadCase { Uniaxial, Equibiaxial, PlanarShear };
+/// "uniaxial", "equibiaxial", "planar shear".
+const char* loadCaseName(LoadCase c);
+
 /// Search range of the lateral stretch t of the uniaxial solve (dimensionless).
 inline constexpr double kMinLateralStretch = 1e-6;
 inline constexpr double kMaxLateralStretch = 1e6;
@@ -54,6 +65,9 @@ UniaxialResponse uniaxialNominalStress(const EnergyDensity& density, double stre
 /// (finite fields) instead. `lateralGuess` (> 0, e.g. the previous point's t) starts the search;
 /// 0 picks λ^(-1/2) (the incompressible value). Precondition as above (std::invalid_argument).
 UniaxialResponse solveUniaxial(const EnergyDensity& density, double stretch, double lateralGuess = 0);
+/// The test `c` at axial stretch `stretch` (see LoadCase), as solveUniaxial: solved = false when no
+/// t in the search range frees the face; nominalStress = P11, lateralStretch = t.
+UniaxialResponse solveLoadCase(const EnergyDensity& density, LoadCase c, double stretch, double lateralGuess = 0);
 
 struct ShearResponse {
     double shear = 0;                   ///< γ (dimensionless)

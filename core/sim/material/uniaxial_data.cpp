@@ -1,5 +1,7 @@
 #include "sim/material/uniaxial_data.hpp"
 
+#include "sim/material/material_response.hpp"
+
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
 #include "sim/util/format.hpp"
@@ -125,6 +127,17 @@ UniaxialData parseUniaxialData(std::string_view text, const std::string& origin,
 UniaxialData readUniaxialData(const std::filesystem::path& path, StrainMeasure measure) {
     return parseUniaxialData(readFile(path, UniaxialDataLimits::maxBytes, "UniaxialDataLimits::maxBytes"),
                              path.filename().string(), measure);
+}
+
+UniaxialData combineTests(const std::vector<std::pair<LoadCase, UniaxialData>>& tests) {
+    UniaxialData all;
+    for (const auto& [c, d] : tests) {
+        all.stretch.insert(all.stretch.end(), d.stretch.begin(), d.stretch.end());
+        all.nominalStress.insert(all.nominalStress.end(), d.nominalStress.begin(), d.nominalStress.end());
+        all.line.insert(all.line.end(), d.line.begin(), d.line.end());
+        all.loadCase.insert(all.loadCase.end(), d.size(), c);
+    }
+    return all;
 }
 
 } // namespace viscera::sim

@@ -33,12 +33,22 @@ enum class StrainMeasure {
     EngineeringStrain, ///< column 1 is ε = (l − L)/L, λ = 1 + ε
 };
 
+/// Homogeneous tests (material_response.hpp): what a data row's stretch and stress mean.
+enum class LoadCase;
+
 struct UniaxialData {
-    std::vector<double> stretch;       ///< λ (#rows), strictly increasing, > 0
+    std::vector<double> stretch;       ///< λ (#rows), strictly increasing within each test, > 0
     std::vector<double> nominalStress; ///< P11 (#rows), Pa
     std::vector<int> line;             ///< source line of each row (1-based), for messages
+    /// The test of each row (#rows); empty: every row is uniaxial. Rows of one test are
+    /// consecutive (combineTests()).
+    std::vector<LoadCase> loadCase;
     std::size_t size() const { return stretch.size(); }
 };
+
+/// The rows of several tests in one data set (e.g. a uniaxial and an equibiaxial test of the same
+/// material, fitted together), each row marked with its test.
+UniaxialData combineTests(const std::vector<std::pair<LoadCase, UniaxialData>>& tests);
 
 struct UniaxialDataLimits {
     static constexpr std::uintmax_t maxBytes = std::uintmax_t{8} << 20; ///< file size cap (8 MiB)

@@ -229,3 +229,28 @@ TEST(MaterialResponse, SamplingCostPerDragEvent) {
     RecordProperty("uniaxial_cold_solve_evaluations", std::to_string(one.evaluations));
     EXPECT_EQ(c.unsolved, 0);
 }
+
+TEST(MaterialResponse, EquibiaxialAndPlanarShearAreTheDerivativeOfTheEnergyAlongTheirTests) {
+    // F = diag(λ, λ, t) and diag(λ, 1, t) with the free face P33 = 0: the Ψ-gradient there
+    // vanishes and its x component is the test's nominal stress P11 (central differences of Ψ),
+    // every density, stretch 0.85–1.15.
+    for (const LoadCase c : {LoadCase::Equibiaxial, LoadCase::PlanarShear}) {
+        for (const auto& [label, density, invariant] : allDensities(1e3, 1e4)) {
+            for (double s : stretches(0.85, 1.15, 13)) { // St. Venant–Kirchhoff has no equibiaxial state at 1.3
+                const UniaxialResponse u = solveLoadCase(*density, c, s);
+                ASSERT_TRUE(u.solved) << loadCaseName(c) << " " << label << " stretch " << s;
+                const double y = c == LoadCase::Equibiaxial ? s : 1.0;
+                const Mat3 F = Eigen::Vector3d(s, y, u.lateralStretch).asDiagonal();
+                const Mat3 g = centralDifference([&](const Mat3& G) { return density->psi(G); }, F);
+                const double scale = 1e4 + 2e3;
+                EXPECT_LT(std::abs(g(2, 2)), 1e-6 * scale) << loadCaseName(c) << " " << label << " stretch " << s;
+                EXPECT_NEAR(g(0, 0), u.nominalStress, 1e-6 * scale) << loadCaseName(c) << " " << label;
+                if (c == LoadCase::Equibiaxial) EXPECT_NEAR(g(1, 1), u.nominalStress, 1e-6 * scale) << label;
+            }
+        }
+    }
+    // the uniaxial case is solveUniaxial itself
+    auto nh = makeEnergyDensity("neo_hookean", 1e3, 1e4);
+    EXPECT_EQ(solveLoadCase(*nh, LoadCase::Uniaxial, 1.3).nominalStress, solveUniaxial(*nh, 1.3).nominalStress);
+    EXPECT_STREQ(loadCaseName(LoadCase::PlanarShear), "planar shear");
+}

@@ -684,6 +684,47 @@ TEST_F(WindowFixture, FitToCleanOgdenDataByDefaultAndEnterRunsTheFit) {
     EXPECT_FALSE(dlg.result().has_value());
 }
 
+// Issue 39 item 2: the fit takes the tests a tech artist has: a uniaxial and an equibiaxial test of
+// the same compressible Neo-Hookean material (μ 1 kPa, λ 10 kPa: ν 0.4545), f′ and h′ fitted to both.
+TEST_F(WindowFixture, FitToAUniaxialAndAnEquibiaxialTest) {
+    open("tissue-slab");
+    ASSERT_EQ(w->materialPanel()->applyPreset("neo_hookean", 6000, 0.3), "");
+    auto nh = sim::makeEnergyDensity("neo_hookean", 1000.0, 10000.0);
+    auto write = [&](const char* name, sim::LoadCase c, double lo, double hi) {
+        const fs::path f = scratch.dir / name;
+        std::ofstream out(f);
+        out.precision(17);
+        out << "stretch,nominal stress (Pa)\n";
+        for (int i = 0; i <= 20; ++i) {
+            const double l = lo + (hi - lo) * i / 20.0;
+            out << l << "," << sim::solveLoadCase(*nh, c, l).nominalStress << "\n";
+        }
+        return QString::fromStdString(f.string());
+    };
+    studio::FitDialog dlg(w->document(), 0, w.get());
+    dlg.show();
+    dlg.fileField()->setText(write("uni.csv", sim::LoadCase::Uniaxial, 0.7, 1.5));
+    dlg.secondFileField()->setText(write("equi.csv", sim::LoadCase::Equibiaxial, 0.85, 1.3));
+    dlg.secondCaseBox()->setCurrentIndex(0);
+    dlg.curves()->setCurrentIndex(1); // f' and h'
+    QTest::mouseClick(dlg.fitButton(), Qt::LeftButton);
+    ASSERT_TRUE(dlg.result().has_value()) << dlg.resultLabel()->text().toStdString();
+    const auto& r = *dlg.result();
+    const double nu = sim::smallStrainConstants(r.curves).poissonRatio;
+    std::printf("uniaxial + equibiaxial fit: R^2 %.6f, max relative error %.3g %%, nu %.4f\n", r.rSquared,
+                100 * r.maxRelativeError, nu);
+    EXPECT_GT(r.rSquared, 0.999);
+    EXPECT_NEAR(nu, 0.4545, 0.02);
+    EXPECT_EQ(dlg.plot()->series().size(), 4u) << "fit and data of both tests";
+    EXPECT_TRUE(dlg.resultLabel()->text().contains("Two tests")) << dlg.resultLabel()->text().toStdString();
+    test::saveShot("fit_two_tests");
+    // a second file that is not data is refused with the reader's line
+    std::ofstream(scratch.dir / "bad2.csv") << "1.0,0\n1.1,x\n1.2,5\n";
+    dlg.secondFileField()->setText(QString::fromStdString((scratch.dir / "bad2.csv").string()));
+    EXPECT_FALSE(dlg.runFit());
+    EXPECT_TRUE(dlg.resultLabel()->text().contains("bad2.csv")) << dlg.resultLabel()->text().toStdString();
+}
+
 TEST_F(WindowFixture, GuiExportEqualsCliExport) {
     const fs::path dir = open("tissue-slab");
     const fs::path gui = scratch.dir / "gui.vcase", cli = scratch.dir / "cli.vcase";
