@@ -311,16 +311,19 @@ void Preview::takeJob(Worker& w, const Pending& job, uint64_t takenAfter) {
     }
     const std::string origin = (project.dir / "project.json").string();
     try {
-        // A typed edit of materials or paint strokes says so: the meshes stay, nothing is
-        // compared (no project text is written); any other change compares what it touched.
-        const bool typed = w.built && w.world && job.mode == w.builtMode &&
-                           job.what.only(Change::Material | Change::Paint | Change::Solver);
+        // What changed decides (no project text is written): a typed edit of materials, paint
+        // strokes or solver settings keeps the meshes; an edit of material maps or light-sample
+        // paint keeps the running world; only a general edit compares the models, so that one
+        // which leaves the meshes alone does not mesh the scene again.
+        const bool same = w.built && w.world && job.mode == w.builtMode;
+        const bool typed = same && job.what.only(Change::Material | Change::Paint | Change::Solver);
+        const bool looks = same && job.what.only(Change::Texture | Change::LightSamples);
         std::string key, rest;
-        if (!typed) {
+        if (!typed && !looks) {
             key = structureKey(project, job.mode, job.body);
             rest = allButTexturesKey(project, job.mode);
         }
-        const bool mapsOnly = !typed && w.built && w.world && key == w.builtKey && rest == w.builtRest;
+        const bool mapsOnly = looks || (w.built && w.world && key == w.builtKey && rest == w.builtRest);
         if (mapsOnly) {
             showMaps(w, project, *w.world); // only material maps changed: the running world goes on
         } else {

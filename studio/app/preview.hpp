@@ -3,10 +3,12 @@
 /// material) simulated on a worker thread while the user edits.
 ///
 /// submit() hands the worker the latest model and returns at once (the UI thread never waits
-/// for the simulation). The worker takes the newest submitted model at the start of each frame:
-/// an edit that changes only materials is applied to the running world by the next frame (a new
-/// world from the cached meshes, carrying positions and velocities over); any other change
-/// rebuilds the meshes first. Before a material enters the preview its stability is assessed
+/// for the simulation). The worker takes the newest submitted model at the start of each frame,
+/// with what changed since the last (Change, accumulated): an edit of materials, paint strokes or
+/// solver settings is applied to the running world by the next frame (a new world from the cached
+/// meshes, carrying positions and velocities over); one of material maps or light samples gives
+/// a new view of the same world; a general edit compares the models and rebuilds the meshes only
+/// when they changed. Before a material enters the preview its stability is assessed
 /// (sim::assessStability, the player's load rule): an edit that would be unstable is shown as
 /// a verdict ("needs at least 67 substeps") and the preview keeps the last stable material, so
 /// no NaN reaches the screen. A frame whose state is not finite is never published; the world
