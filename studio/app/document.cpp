@@ -6,11 +6,13 @@
 #include "sim/material/material.hpp"
 #include "sim/skeleton/stiffness_paint.hpp"
 #include "sim/util/error.hpp"
+#include "sim/util/json_reader.hpp"
 
 #include <QDir>
 #include <QFileInfo>
 
 #include <QUndoCommand>
+#include <cmath>
 #include <filesystem>
 
 namespace viscera::studio {
@@ -117,8 +119,10 @@ struct PaintSlot {
         const std::string where =
             (t >= 0 ? "bodies[" + std::to_string(t) : "surfaces[" + std::to_string(-1 - t)) + "].stiffness_paint";
         const sim::PaintParams& q = v->params;
-        if (!(q.minWeight > 0 && q.minWeight <= q.baseWeight && q.baseWeight <= q.maxWeight))
+        if (!(q.minWeight > 0 && q.minWeight <= q.baseWeight && q.baseWeight <= q.maxWeight &&
+              std::isfinite(q.maxWeight)))
             return where + ": min_weight <= base_weight <= max_weight must hold";
+        if (v->strokes.empty()) return where + ".strokes: must have at least 1 item";
         try { // readPaint's rule for every stroke
             for (size_t k = 0; k < v->strokes.size(); ++k)
                 sim::validateStroke(v->strokes[k], k, where + ".strokes");
@@ -135,10 +139,16 @@ struct LightSamplesSlot {
     static Value& of(Project& p, int body) { return p.bodies.at(static_cast<size_t>(body)).lightSamples; }
     static Change change(int body) { return {Change::LightSamples, body}; }
     static std::string check(const Project&, int body, const Value& ops) {
-        try { // readLightSamples' rule for every operation
-            for (size_t k = 0; k < ops.size(); ++k)
-                render::validateSamplePaintOp(ops[k], "bodies[" + std::to_string(body) + "].light_samples[" +
-                                                          std::to_string(k) + "]");
+        try { // readLightSamples' rules for every operation
+            for (size_t k = 0; k < ops.size(); ++k) {
+                const std::string where =
+                    "bodies[" + std::to_string(body) + "].light_samples[" + std::to_string(k) + "]";
+                if (!render::isSampleClass(ops[k].samples)) return where + ".samples: must be 0 (erase), 1, 4 or 8";
+                const sim::NumberRule radius = sim::NumberRule::closed(kMinSampleBrushRadius, kMaxSampleBrushRadius);
+                if (ops[k].tool == render::SamplePaintOp::Tool::Brush && !radius.admits(ops[k].radius))
+                    return where + ".radius: " + radius.describe();
+                render::validateSamplePaintOp(ops[k], where);
+            }
         } catch (const std::exception& e) {
             return e.what();
         }

@@ -81,12 +81,15 @@ FitDialog::FitDialog(Document* doc, int body, QWidget* parent) : QDialog(parent)
     m_fitButton->setDefault(true);
     for (QAbstractButton* b : buttons->buttons())
         if (auto* p = qobject_cast<QPushButton*>(b); p && p != m_fitButton) p->setAutoDefault(false);
-    connect(m_file, &QLineEdit::returnPressed, this, [this] { runFit(); });
-    for (QLineEdit* f : {m_file, m_secondFile}) // a fit of another file is not applied
-        connect(f, &QLineEdit::textEdited, this, [this] {
-            m_fitResult.reset();
-            m_apply->setEnabled(false);
-        });
+    // a fit of other data or other settings is never applied (Browse sets the text too)
+    auto drop = [this] {
+        m_fitResult.reset();
+        m_apply->setEnabled(false);
+    };
+    for (QLineEdit* f : {m_file, m_secondFile})
+        connect(f, &QLineEdit::textChanged, this, drop);
+    for (QComboBox* c : {m_measure, m_curves, m_secondCase})
+        connect(c, &QComboBox::currentIndexChanged, this, drop);
     root->addWidget(buttons);
     connect(browse, &QPushButton::clicked, this, [this] {
         const QString f = QFileDialog::getOpenFileName(this, tr("Uniaxial test data"), QString(),
@@ -163,8 +166,15 @@ sim::LoadCase FitDialog::secondCase() const {
 sim::CurveFitResult FitDialog::bestFit(const sim::ValanisLandelCurves& start, const sim::UniaxialData& data,
                                        const sim::FitOptions& opt) {
     m_startNote.clear();
-    sim::CurveFitResult best = sim::fitUniaxial(start, data, opt);
-    if (data.loadCase.empty() || opt.curves != sim::FitCurves::FPrimeAndHPrime) return best;
+    if (data.loadCase.empty() || opt.curves != sim::FitCurves::FPrimeAndHPrime)
+        return sim::fitUniaxial(start, data, opt);
+    std::optional<sim::CurveFitResult> best;
+    std::string firstError;
+    try {
+        best = sim::fitUniaxial(start, data, opt);
+    } catch (const std::exception& e) { // the material's curves may have no state in the second test
+        firstError = e.what();
+    }
     // Two tests and h′ free: the fit is local and the start's ν decides where it ends; the
     // Neo-Hookean curves at the material's small-strain E and several ν are tried too, the
     // smallest SSE kept.
@@ -174,7 +184,7 @@ sim::CurveFitResult FitDialog::bestFit(const sim::ValanisLandelCurves& start, co
         for (const double nu : {0.3, 0.4, 0.45, 0.49}) {
             try {
                 sim::CurveFitResult r = sim::fitUniaxial(sim::editableCurves("neo_hookean", E, nu), data, opt);
-                if (r.sse < best.sse) {
+                if (!best || r.sse < best->sse) {
                     best = std::move(r);
                     won = tr("the Neo-Hookean curves at E %1 Pa, ν %2").arg(numberText(E, 4), numberText(nu, 3));
                 }
@@ -184,7 +194,8 @@ sim::CurveFitResult FitDialog::bestFit(const sim::ValanisLandelCurves& start, co
     m_startNote = tr("Two tests: fitted from the material's curves and from Neo-Hookean curves at ½, 1 and 2 times "
                      "its E and ν 0.3–0.49; the best started from %1.")
                       .arg(won);
-    return best;
+    if (!best) throw std::invalid_argument(firstError); // no start had a state at every data stretch
+    return *best;
 }
 
 void FitDialog::secondTestSeries(const sim::CurveFitResult& r, std::vector<PlotWidget::Series>& series) const {

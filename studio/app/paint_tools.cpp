@@ -117,9 +117,16 @@ void PaintTools::pushAuthoring() {
     if (!m_viewport) return;
     std::vector<render::RenderMesh> meshes = m_extra;
     const bool fill = paintingSamples() && m_samplePainter.brush.tool == render::SamplePaintOp::Tool::Fill;
-    if (m_hover && (painting() || paintingSamples()) && !fill) {
+    if (painting() || paintingSamples()) {
+        // While a tool is on the ring is always there, hidden off the surface: the same meshes
+        // keep their buffers (a mesh coming and going would make the viewport's renderer anew).
+        if (m_hover) m_lastHover = m_hover;
         const double radius = paintingSamples() ? m_samplePainter.brush.radius : m_painter.brush.radius;
-        meshes.push_back(brushRingMesh(m_hover->first, m_hover->second, radius, 0));
+        const auto at =
+            m_lastHover.value_or(std::make_pair(Eigen::Vector3d::Zero().eval(), Eigen::Vector3d::UnitZ().eval()));
+        render::RenderMesh ring = brushRingMesh(at.first, at.second, radius, 0);
+        ring.visible = m_hover.has_value() && !fill;
+        meshes.push_back(std::move(ring));
     }
     m_viewport->setAuthoringMeshes(std::move(meshes));
 }

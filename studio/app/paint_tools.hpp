@@ -93,6 +93,7 @@ private:
     std::vector<render::RenderMesh> m_extra; ///< skeleton and section meshes
     std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>>
         m_hover; ///< the surface point under the cursor and its normal
+    std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> m_lastHover; ///< where the hidden ring stays
 };
 
 } // namespace viscera::studio

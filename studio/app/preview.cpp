@@ -18,13 +18,16 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// The project text with every material replaced by the default one and no paint strokes:
-/// equal keys mean that two models differ in their materials and strokes at most, so the built
-/// meshes (and the skeletons the strokes go through) can be kept.
+/// The project text with every material replaced by the default one, no paint strokes or light
+/// samples and default solver settings: equal keys mean that two models differ at most in what
+/// applyMaterials() puts on the built meshes (materials, strokes through the skeletons already
+/// made, solver settings) or what the view shows, so the meshes can be kept.
 std::string structureKey(const Project& p, Preview::Mode mode, int body) {
     Project q = p;
+    q.scene.xpbd = sim::XpbdSettings{};
     for (BodyProject& b : q.bodies) {
         b.scene.material = sim::Material{};
+        b.lightSamples.clear();
         if (b.paint) b.paint->strokes.clear();
     }
     for (SurfaceProject& sp : q.surfaces) {
@@ -259,6 +262,7 @@ struct Preview::Worker {
     std::string builtKey, builtTextures, builtRest; ///< what the built meshes, maps and world were made from
     Mode builtMode = Mode::Scene;
     std::optional<BuiltScene> built;
+    bool stale = false; ///< a general edit failed: `built` is not the submitted model's structure
     std::unique_ptr<sim::World> world;
     std::shared_ptr<sim::World> probe; ///< the selected body alone, for error sampling
     int probeBody = -1;
@@ -315,7 +319,8 @@ void Preview::takeJob(Worker& w, const Pending& job, uint64_t takenAfter) {
         // strokes or solver settings keeps the meshes; an edit of material maps or light-sample
         // paint keeps the running world; only a general edit compares the models, so that one
         // which leaves the meshes alone does not mesh the scene again.
-        const bool same = w.built && w.world && job.mode == w.builtMode;
+        // (not after a general edit that failed: the meshes built are another model's)
+        const bool same = w.built && w.world && job.mode == w.builtMode && !w.stale;
         const bool typed = same && job.what.only(Change::Material | Change::Paint | Change::Solver);
         const bool looks = same && job.what.only(Change::Texture | Change::LightSamples);
         std::string key, rest;
@@ -337,6 +342,7 @@ void Preview::takeJob(Worker& w, const Pending& job, uint64_t takenAfter) {
                 if (!typed && job.mode == Mode::Scene) showMaps(w, project, *next);
             }
             w.builtRest = rest; // empty after a typed edit: the next comparison applies the model again
+            w.stale = false;
             w.world = std::move(next);
             makeProbe(w, job, origin);
         }
@@ -355,6 +361,10 @@ void Preview::takeJob(Worker& w, const Pending& job, uint64_t takenAfter) {
         const QString why = QString::fromStdString(e.what());
         publishStatus([&](Snapshot& s) {
             s.serial = job.serial; // seen, not shown
+            // a general edit not shown leaves meshes of another model: no fast path until one is
+            if (!job.what.only(Change::Material | Change::Paint | Change::Solver | Change::Texture |
+                               Change::LightSamples))
+                w.stale = true;
             s.appliedAfter = takenAfter;
             s.error = why;
         });
@@ -428,6 +438,11 @@ std::unique_ptr<sim::World> Preview::buildWorld(Worker& w, const Project& projec
 
 std::unique_ptr<sim::World> Preview::applyMaterials(Worker& w, const Project& project, const std::string& origin) {
     BuiltScene& b = *w.built;
+    if (project.bodies.size() != b.scene.bodies.size() || project.surfaces.size() < b.scene.surfaces.size())
+        throw std::runtime_error(tr("the meshes shown are another model's (%1 bodies, the project has %2)")
+                                     .arg(b.scene.bodies.size())
+                                     .arg(project.bodies.size())
+                                     .toStdString());
     std::vector<sim::Material> old;
     std::vector<std::vector<double>> oldWeights, oldSurfaceWeights;
     auto restore = [&] {

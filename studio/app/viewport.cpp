@@ -583,6 +583,11 @@ void Viewport::rebuildGuides() {
         }
         if (a.allFinite() && b.allFinite()) m_guides.push_back(boxOutlineMesh(a, b, 0));
     }
+    ++m_guideRevision; // new values in the buffers the guides have: the renderer uploads them again
+    for (render::RenderMesh& m : m_guides) {
+        m.revision = m_guideRevision;
+        m.staticRevision = m_guideRevision;
+    }
 }
 
 void Viewport::setCaseRender(const std::string& json) {

@@ -193,6 +193,7 @@ private:
     /// The authoring look's grid and the selection's outline (rebuilt with the scene and the
     /// selection), drawn after the authoring meshes.
     std::vector<render::RenderMesh> m_guides;
+    uint64_t m_guideRevision = 0;
     void rebuildGuides();
     bool m_paintMode = false, m_painting = false;
     int m_restBody = -1; ///< the mesh drawn at rest: its source index and kind

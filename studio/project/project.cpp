@@ -422,7 +422,7 @@ std::vector<render::SamplePaintOp> readLightSamples(const JsonField& j) {
         if (tool == "brush") {
             o.object({"tool", "samples", "radius", "points"});
             op.tool = render::SamplePaintOp::Tool::Brush;
-            op.radius = o["radius"].number(NumberRule::closed(1e-4, 10.0));
+            op.radius = o["radius"].number(NumberRule::closed(kMinSampleBrushRadius, kMaxSampleBrushRadius));
             for (const JsonField& pt : o["points"].items(1))
                 op.points.push_back(pt.vec3());
         } else {

@@ -143,6 +143,10 @@ TextureProject embedTextureSpec(const TextureProject& t, const std::filesystem::
 /// A tet body: its scene description (what the case's scene.json carries: name, material,
 /// strain limits, embedding; read by the same code as the player's scene) plus what only
 /// authoring needs. meshPath, fixedNodes and nodeWeights of `scene` are filled at export.
+/// The range of a light-sample brush radius in project.json, m (the reader's rule and the studio's
+/// typed edits: NumberRule::closed of these).
+inline constexpr double kMinSampleBrushRadius = 1e-4, kMaxSampleBrushRadius = 10.0;
+
 struct BodyProject {
     sim::BodyDesc scene;
     MeshSource mesh;

@@ -308,6 +308,34 @@ TEST_F(WindowFixture, FieldsAndDocksResetPerProjectAndSelection) {
     EXPECT_TRUE(w->propertiesPanel()->errorLabel()->text().isEmpty());
 }
 
+// Review fix: a project whose scene the preview cannot build leaves the previous project's meshes
+// in the worker; a typed edit then must not take the fast path onto them (a 3-body liver under a
+// 1-body slab read past the slab's bodies).
+TEST_F(WindowFixture, ATypedEditAfterAFailedBuildDoesNotUseThePreviousProjectsMeshes) {
+    open("liver");
+    ASSERT_TRUE(waitForPreview()) << w->verdictLabel()->text().toStdString();
+    const fs::path slab = test::copySample(scratch, "tissue-slab");
+    {
+        nlohmann::json doc = nlohmann::json::parse(readFile(slab / "project.json"));
+        doc["solver"]["substeps"] = 2; // far too few: the preview refuses to build it
+        writeFileAtomic(slab / "project.json", doc.dump(1));
+    }
+    ASSERT_TRUE(w->openProject(QString::fromStdString(slab.string())));
+    auto caughtUp = [&] { return w->preview()->snapshot().serial >= w->lastPreviewSubmit().first; };
+    ASSERT_TRUE(test::waitFor(caughtUp, 60000));
+    EXPECT_FALSE(w->preview()->snapshot().error.isEmpty()) << "the slab at 2 substeps is not shown";
+    ASSERT_EQ(w->setProperty("density", "1100"), ""); // typed: it must not go onto the liver's meshes
+    ASSERT_TRUE(test::waitFor(caughtUp, 60000));
+    EXPECT_FALSE(w->preview()->snapshot().error.isEmpty()) << "still the slab's verdict, not the liver's world";
+    w->selection()->set(studio::Selection::Kind::Solver);
+    ASSERT_EQ(w->setProperty("substeps", "60"), "");
+    ASSERT_TRUE(test::waitFor(caughtUp, 120000));
+    ASSERT_TRUE(test::waitFor([&] { return w->preview()->snapshot().error.isEmpty(); }, 60000))
+        << w->preview()->snapshot().error.toStdString();
+    EXPECT_TRUE(test::waitFor([&] { return w->preview()->snapshot().bodies.size() == 1; }, 30000))
+        << "the slab's one body is simulated";
+}
+
 TEST_F(WindowFixture, SaveAsWritesTheProjectAndRecentKeepsFive) {
     open("tissue-slab");
     ASSERT_EQ(w->setProperty("density", "1100"), "");
@@ -678,10 +706,16 @@ TEST_F(WindowFixture, FitToCleanOgdenDataByDefaultAndEnterRunsTheFit) {
     // what the dialog said ν became is what the material got
     EXPECT_TRUE(text.contains(QString::fromStdString(sim::formatNumber(nuAfter, 3)))) << text.toStdString();
     EXPECT_TRUE(text.contains(QString::fromStdString(sim::formatNumber(nuBefore, 3)))) << text.toStdString();
-    // editing the file name drops the fit: nothing stale can be applied
+    // editing the file name (typed or by Browse) drops the fit: nothing stale can be applied
     QTest::keyClick(dlg.fileField(), Qt::Key_X);
     EXPECT_FALSE(dlg.applyButton()->isEnabled());
     EXPECT_FALSE(dlg.result().has_value());
+    dlg.fileField()->setText(QString::fromStdString(data.string()));
+    ASSERT_TRUE(dlg.runFit());
+    dlg.fileField()->setText(QString::fromStdString((scratch.dir / "other.csv").string())); // as Browse does
+    EXPECT_FALSE(dlg.result().has_value());
+    EXPECT_FALSE(dlg.runFit()); // other.csv does not exist: refused with its name
+    EXPECT_TRUE(dlg.resultLabel()->text().contains("other.csv")) << dlg.resultLabel()->text().toStdString();
 }
 
 // Issue 39 item 2: the fit takes the tests a tech artist has: a uniaxial and an equibiaxial test of
@@ -890,9 +924,9 @@ TEST_F(WindowFixture, StiffnessPaintStrokeIsEq428AndOneUndoStepAndEscLeavesTheWe
     if (QWindow* win = v->canvasWindow()) {
         w->findChild<QDoubleSpinBox*>("paintRadius")->setValue(8.0);
         QTest::mouseMove(win, centre + QPoint(20, 5));
-        auto ring = [&]() -> const render::RenderMesh* {
+        auto ring = [&]() -> const render::RenderMesh* { // the outline shown (hidden off the surface)
             for (const render::RenderMesh& m : v->authoringMeshes())
-                if (m.name == "brush") return &m;
+                if (m.name == "brush" && m.visible) return &m;
             return nullptr;
         };
         const render::RenderMesh* r = ring();
