@@ -46,6 +46,17 @@ test::ProcessResult player(const std::vector<std::string>& args) {
     return test::runProcess(VISCERA_PLAYER_EXE, test::trustingSampleKey(args));
 }
 
+/// A paced (--realtime) run that checks the servo, not the machine's speed: it succeeds, or fails
+/// only by the real-time verdict (exit 3, "status  FAILED: real time: ...") when the machine was
+/// too busy to keep the wall clock (e.g. a parallel build); any other failure fails the test.
+::testing::AssertionResult ranPaced(const test::ProcessResult& r) {
+    if (r.exitCode == 0) return ::testing::AssertionSuccess();
+    if (r.exitCode == 3 && r.out.find("FAILED: real time:") != std::string::npos &&
+        r.out.find("invariants    all finite: yes") != std::string::npos)
+        return ::testing::AssertionSuccess() << "fell behind the wall clock on a busy machine";
+    return ::testing::AssertionFailure() << "exit " << r.exitCode << "\n" << r.out << r.err;
+}
+
 nlohmann::json readJson(const std::string& p) {
     std::ifstream in(p);
     return nlohmann::json::parse(in);
@@ -244,7 +255,7 @@ TEST(PlayerHaptics, RealTimeReplayTakesTheLockstepRunsInput) {
         auto r =
             player({"run", s / "slab.vcase", "--headless", "--frames", frames, mode, "--device",
                     "replay:" + (s / "press.csv"), "--report", s / (tag + ".json"), "--trace", s / (tag + ".csv")});
-        EXPECT_EQ(r.exitCode, 0) << r.err;
+        EXPECT_TRUE(ranPaced(r)); // the input, not the machine's speed, is checked here
         return readJson(s / (tag + ".json"));
     };
     // Lockstep runs on for 30 more frames: the real-time servo ticks on until the session stops it.
@@ -536,7 +547,7 @@ TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
     test::writeHapticCase(s / "slab.vcase", 1, VISCERA_SAMPLE_KEY);
     auto r = player({"run", s / "slab.vcase", "--headless", "--frames", "60", "--device", "scripted:press",
                      "--realtime", "--servo", "busy:0", "--report", s / "r.json"});
-    ASSERT_EQ(r.exitCode, 0) << r.err;
+    ASSERT_TRUE(ranPaced(r));
     const auto servo = readJson(s / "r.json")["haptics"]["servo"];
     EXPECT_EQ(servo["wait"], "busy");
     EXPECT_EQ(servo["cpu"], 0);
@@ -554,22 +565,22 @@ TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
     }
     auto sleep = player({"run", s / "slab.vcase", "--headless", "--frames", "10", "--device", "scripted:press",
                          "--realtime", "--report", s / "r2.json"});
-    ASSERT_EQ(sleep.exitCode, 0) << sleep.err;
+    ASSERT_TRUE(ranPaced(sleep));
     EXPECT_EQ(readJson(s / "r2.json")["haptics"]["servo"]["wait"], "sleep");
     EXPECT_EQ(readJson(s / "r2.json")["haptics"]["servo"]["cpu"], -1) << "shared by default";
     auto spin = player({"run", s / "slab.vcase", "--headless", "--frames", "10", "--device", "scripted:press",
                         "--realtime", "--servo", "spin:900", "--report", s / "r3.json"});
-    ASSERT_EQ(spin.exitCode, 0) << spin.err;
+    ASSERT_TRUE(ranPaced(spin));
     EXPECT_EQ(readJson(s / "r3.json")["haptics"]["servo"]["spin_us"], 900);
     auto shared = player({"run", s / "slab.vcase", "--headless", "--frames", "10", "--device", "scripted:press",
                           "--realtime", "--servo", "shared:30", "--report", s / "r5.json"});
-    ASSERT_EQ(shared.exitCode, 0) << shared.err;
+    ASSERT_TRUE(ranPaced(shared));
     EXPECT_EQ(readJson(s / "r5.json")["haptics"]["servo"]["spin_us"], 30);
     EXPECT_EQ(readJson(s / "r5.json")["haptics"]["servo"]["cpu"], -1);
     // "sleep" reserves the highest CPU for the servo; the physics keeps the others.
     auto reserved = player({"run", s / "slab.vcase", "--headless", "--frames", "10", "--device", "scripted:press",
                             "--realtime", "--servo", "sleep", "--report", s / "r6.json"});
-    ASSERT_EQ(reserved.exitCode, 0) << reserved.err;
+    ASSERT_TRUE(ranPaced(reserved));
     const auto rs = readJson(s / "r6.json")["haptics"]["servo"];
     const std::vector<int> cpus = haptics::allowedCpus();
     if (cpus.size() >= 2) {
@@ -590,7 +601,7 @@ TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
         outside = player({"run", s / "slab.vcase", "--headless", "--frames", "1", "--device", "scripted:press",
                           "--realtime", "--servo", "sleep:" + std::to_string(allowed.back() + 1)});
     }
-    ASSERT_EQ(masked.exitCode, 0) << masked.err;
+    ASSERT_TRUE(ranPaced(masked));
     const auto m = readJson(s / "r4.json")["haptics"]["servo"];
     EXPECT_EQ(m["cpu"], -1);
     EXPECT_EQ(m["physics_cpus"].get<std::vector<int>>(), std::vector<int>{allowed.front()});
