@@ -480,6 +480,7 @@ LiveState HapticRig::live() const {
     s.maxForce_n = m_caseMaxForce;
     s.lagMs = m_lagMs;
     s.lagGrowthMs = std::max(0.0, m_lagGrowthMs);
+    s.lagGrowthMaxMs = std::max(0.0, m_lagGrowthMaxMs);
     const sim::InteractionRuntime* interaction = m_world.interaction();
     for (int a = 0; a < kMaxArms; ++a) {
         s.force[a] = p.force[a];

@@ -100,8 +100,10 @@ struct LiveState {
     double realTimeFactor = 0;
     /// Real time: how late the frame started against the wall clock, ms (HapticsResult::lagMaxMs).
     double lagMs = 0;
-    /// Real time: how much further behind than after the warm-up (HapticsResult::lagGrowthMaxMs).
+    /// Real time: how much further behind than after the warm-up now, and at most so far
+    /// (HapticsResult::lagGrowthMaxMs, what the end verdict takes).
     double lagGrowthMs = 0;
+    double lagGrowthMaxMs = 0;
     /// Set by the session once it estimated that this machine cannot keep real time (shown in red).
     std::string realTimeWarning;
 };

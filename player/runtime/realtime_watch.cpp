@@ -53,4 +53,20 @@ std::string RealTimeWatch::verdict(const std::vector<sim::FrameRecord>& frames, 
     return e + "): the picture trailed the hands and the forces went stale, so this session was not the authored one";
 }
 
+std::vector<std::string> RealTimeWatch::windowNotice(bool estimateWarned, int frame, double lagMs, double lagGrowthMs,
+                                                     double lagGrowthMaxMs) {
+    if (estimateWarned) return {"Not real time on this machine:", "the picture trails your hands"};
+    if (frame <= 0) return {};
+    char line[96];
+    if (lagGrowthMs > kMaxLagMs) {
+        std::snprintf(line, sizeof line, "Behind real time by %.1f s:", 1e-3 * lagMs);
+        return {line, "the picture trails your hands"};
+    }
+    if (lagGrowthMaxMs > kMaxLagMs) {
+        std::snprintf(line, sizeof line, "Fell behind real time (%.1f s):", 1e-3 * lagGrowthMaxMs);
+        return {line, "not the authored session"};
+    }
+    return {};
+}
+
 } // namespace viscera::player

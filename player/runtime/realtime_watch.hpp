@@ -43,6 +43,14 @@ public:
     /// that took the latest input instead of their own instant's.
     std::string verdict(const std::vector<sim::FrameRecord>& frames, double lagGrowthMs, int64_t inputMissed = 0) const;
 
+    /// What the trainee window says in red about real time (none, or two lines), from the live
+    /// figures: the load-time estimate's warning; "Behind real time by X s" while the frames run
+    /// more than kMaxLagMs later than after the warm-up; once they fell that far behind, also after
+    /// they caught up again, that the session was not the authored one (the verdict at the end).
+    /// `frame`: frames done; lag figures in ms.
+    static std::vector<std::string> windowNotice(bool estimateWarned, int frame, double lagMs, double lagGrowthMs,
+                                                 double lagGrowthMaxMs);
+
 private:
     /// Mean step, ms, over frames [begin, end) (0 when empty).
     static double meanStepMs(const std::vector<sim::FrameRecord>& frames, size_t begin, size_t end);

@@ -285,15 +285,12 @@ public:
         if (s.safetyRules & haptics::kRuleSimStale) p.drawText(px, y, "Forces off: simulation stale"), y += 20;
         if (s.safetyRules & haptics::kRuleDisconnected) p.drawText(px, y, "Forces off: device not answering"), y += 20;
         if (s.safetyRules & haptics::kRuleDeadman) p.drawText(px, y, "Forces off: hold the deadman pedal"), y += 20;
-        if (!s.realTimeWarning.empty()) { // estimated from the first frames: this machine cannot keep up
-            p.setPen(QColor(230, 80, 60));
-            p.drawText(px, h - 76, "Not real time on this machine:");
-            p.drawText(px, h - 56, "the picture trails your hands");
-        } else if (s.frame > 0 && s.lagGrowthMs > RealTimeWatch::kMaxLagMs) { // fell behind later (not a slow start)
-            p.setPen(QColor(230, 80, 60));
-            p.drawText(px, h - 76, QString::asprintf("Behind real time by %.1f s:", 1e-3 * s.lagMs));
-            p.drawText(px, h - 56, "the picture trails your hands");
-        }
+        // the estimate's warning, or lag that grew past the limit (now, or earlier: the verdict)
+        const std::vector<std::string> notice =
+            RealTimeWatch::windowNotice(!s.realTimeWarning.empty(), s.frame, s.lagMs, s.lagGrowthMs, s.lagGrowthMaxMs);
+        p.setPen(QColor(230, 80, 60));
+        for (size_t k = 0; k < notice.size(); ++k)
+            p.drawText(px, h - 76 + 20 * static_cast<int>(k), QString::fromStdString(notice[k]));
         if (s.realTimeFactor > 0) {
             // Physics slower than real time: the tissue moves in slow motion; say so in red.
             const bool slow = s.realTimeFactor < 1;

@@ -71,3 +71,22 @@ TEST(RealTimeWatch, LongStallsFailShortSpikesDoNot) {
     EXPECT_FALSE(bad.afterFrame(steps(35, 50.0)).has_value());
     EXPECT_EQ(bad.verdict(steps(100, 50.0), 900), "");
 }
+
+TEST(RealTimeWatch, TheWindowSaysWhenTheSessionFellBehindEvenAfterItCaughtUp) {
+    using W = RealTimeWatch;
+    EXPECT_TRUE(W::windowNotice(false, 0, 0, 0, 0).empty()) << "nothing before the first frame";
+    EXPECT_TRUE(W::windowNotice(false, 100, 40, 30, 150).empty()) << "within the 200 ms allowance";
+    const auto est = W::windowNotice(true, 40, 0, 0, 0);
+    ASSERT_EQ(est.size(), 2u);
+    EXPECT_EQ(est[0], "Not real time on this machine:");
+    const auto now = W::windowNotice(false, 300, 450, 400, 400);
+    ASSERT_EQ(now.size(), 2u);
+    EXPECT_EQ(now[0], "Behind real time by 0.5 s:") << "the lag now";
+    // caught up again, but the end verdict fails on the largest growth: the window says so too
+    const auto after = W::windowNotice(false, 600, 20, 10, 298);
+    ASSERT_EQ(after.size(), 2u);
+    EXPECT_EQ(after[0], "Fell behind real time (0.3 s):");
+    EXPECT_EQ(after[1], "not the authored session");
+    // the verdict's rule, the same limit
+    EXPECT_TRUE(W::windowNotice(false, 600, 0, 0, W::kMaxLagMs).empty());
+}
