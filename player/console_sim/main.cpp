@@ -484,7 +484,8 @@ void usage(std::FILE* out) {
                "           [--duration S] [--rate HZ] [--loop] [--record forces.csv] [--summary summary.json]\n"
                "           [--port-file FILE] [--pause-at S --pause-for S] [--wait-player S] [--until-player-stops]\n"
                "       viscera-console-sim --write-trajectory OUT.csv --script NAME --duration S [--rate HZ]\n"
-               "       viscera-console-sim --make-pairing-key FILE\n",
+               "       viscera-console-sim --make-pairing-key FILE\n"
+               "       viscera-console-sim --version\n",
                out);
 }
 
@@ -493,6 +494,7 @@ void usage(std::FILE* out) {
 int main(int argc, char** argv) {
     sim::CliProgram program;
     program.name = "viscera-console-sim";
+    program.version = VISCERA_VERSION;
     program.usage = usage;
     program.fallback = [](const sim::CliArgs& args) {
         const Options o = parse(args);

@@ -615,3 +615,25 @@ TEST(PlayerHaptics, BusyServoWaitPinsTheServoThreadAndReportsItsPriority) {
         EXPECT_THAT(b.err, HasSubstr("--servo")) << bad;
     }
 }
+
+// Every program says its version, and the player's and console simulator's man pages document
+// every subcommand and --version their usage lists (the soak was missing from the man page).
+TEST(PlayerHaptics, EveryProgramSaysItsVersionAndItsManPageListsEveryCommand) {
+    const auto sim = test::runProcess(VISCERA_CONSOLE_SIM_EXE, {"--version"});
+    EXPECT_EQ(sim.exitCode, 0) << sim.err;
+    EXPECT_EQ(sim.out, std::string("viscera-console-sim ") + VISCERA_VERSION + "\n");
+    const auto pl = test::runProcess(VISCERA_PLAYER_EXE, {"--version"});
+    EXPECT_EQ(pl.exitCode, 0) << pl.err;
+    EXPECT_EQ(pl.out, std::string("viscera-player ") + VISCERA_VERSION + "\n");
+    const std::string man = readText(std::filesystem::path(VISCERA_SOURCE_DIR) / "packaging/man/viscera-player.1");
+    for (const char* cmd : {"verify", "run", "plot", "soak"}) {
+        EXPECT_THAT(man, HasSubstr(std::string(".B viscera-player ") + cmd + "\n")) << cmd << " in the synopsis";
+        EXPECT_THAT(man, HasSubstr(std::string(".TP\n.B ") + cmd + "\n")) << cmd << " under COMMANDS";
+    }
+    EXPECT_THAT(man, HasSubstr(".B viscera-player \\-\\-version"));
+    const std::string simMan =
+        readText(std::filesystem::path(VISCERA_SOURCE_DIR) / "packaging/man/viscera-console-sim.1");
+    EXPECT_THAT(simMan, HasSubstr(".B viscera-console-sim \\-\\-version"));
+    const auto help = test::runProcess(VISCERA_CONSOLE_SIM_EXE, {"--help"});
+    EXPECT_THAT(help.out, HasSubstr("viscera-console-sim --version"));
+}
