@@ -113,22 +113,33 @@ void PaintTools::retarget() {
                      : tr("'%1' selected: Paint light samples (L) paints its sample classes.").arg(name));
 }
 
+render::RenderMesh PaintTools::brushRing() {
+    // While a tool is on the ring is always there, hidden off the surface: the same meshes keep
+    // their buffers (a mesh coming and going would make the viewport's renderer anew).
+    if (m_hover) m_lastHover = m_hover;
+    const bool fill = paintingSamples() && m_samplePainter.brush.tool == render::SamplePaintOp::Tool::Fill;
+    const double radius = paintingSamples() ? m_samplePainter.brush.radius : m_painter.brush.radius;
+    const auto at =
+        m_lastHover.value_or(std::make_pair(Eigen::Vector3d::Zero().eval(), Eigen::Vector3d::UnitZ().eval()));
+    render::RenderMesh ring = brushRingMesh(at.first, at.second, radius, 0);
+    ring.visible = m_hover.has_value() && !fill;
+    return ring;
+}
+
 void PaintTools::pushAuthoring() {
     if (!m_viewport) return;
     std::vector<render::RenderMesh> meshes = m_extra;
-    const bool fill = paintingSamples() && m_samplePainter.brush.tool == render::SamplePaintOp::Tool::Fill;
-    if (painting() || paintingSamples()) {
-        // While a tool is on the ring is always there, hidden off the surface: the same meshes
-        // keep their buffers (a mesh coming and going would make the viewport's renderer anew).
-        if (m_hover) m_lastHover = m_hover;
-        const double radius = paintingSamples() ? m_samplePainter.brush.radius : m_painter.brush.radius;
-        const auto at =
-            m_lastHover.value_or(std::make_pair(Eigen::Vector3d::Zero().eval(), Eigen::Vector3d::UnitZ().eval()));
-        render::RenderMesh ring = brushRingMesh(at.first, at.second, radius, 0);
-        ring.visible = m_hover.has_value() && !fill;
-        meshes.push_back(std::move(ring));
-    }
+    if (painting() || paintingSamples()) meshes.push_back(brushRing());
     m_viewport->setAuthoringMeshes(std::move(meshes));
+}
+
+void PaintTools::moveRing() {
+    if (!m_viewport) return;
+    // the cursor moved: only the ring changes (the skeleton and section meshes stay as they are)
+    if ((painting() || paintingSamples()) && m_viewport->authoringMeshCount() == m_extra.size() + 1)
+        m_viewport->setAuthoringMesh(m_extra.size(), brushRing());
+    else
+        pushAuthoring();
 }
 
 void PaintTools::connectViewport(Viewport* v) {
@@ -138,12 +149,12 @@ void PaintTools::connectViewport(Viewport* v) {
     // the brush's outline on the surface under the cursor, at the brush's radius
     connect(v, &Viewport::brushHovered, this, [this](const Viewport::SurfaceHit& hit) {
         m_hover = std::make_pair(hit.world.cast<double>(), hit.normal.cast<double>());
-        pushAuthoring();
+        moveRing();
     });
     connect(v, &Viewport::brushLeft, this, [this] {
         if (!m_hover) return;
         m_hover.reset();
-        pushAuthoring();
+        moveRing();
     });
     // a dab only on the painted body's own surface
     auto onBody = [this](const Viewport::SurfaceHit& hit) {
@@ -321,7 +332,7 @@ void PaintTools::buildPaintDock() {
             strength->setMaximum(1.0);
         else
             strength->setMaximum(100.0);
-        pushAuthoring(); // the outline takes the new radius
+        moveRing(); // the outline takes the new radius
     };
     connect(mode, &QComboBox::currentIndexChanged, this, sync);
     for (QDoubleSpinBox* s : {radius, strength, target})
@@ -448,7 +459,7 @@ void PaintTools::buildSampleDock() {
         m_samplePainter.brush.maxAngleDeg = angle->value();
         radius->setEnabled(kind->currentIndex() == 0);
         angle->setEnabled(kind->currentIndex() == 1);
-        pushAuthoring(); // the outline takes the new radius (none for a fill)
+        moveRing(); // the outline takes the new radius (none for a fill)
     };
     connect(kind, &QComboBox::currentIndexChanged, this, sync);
     connect(cls, &QComboBox::currentIndexChanged, this, sync);

@@ -68,6 +68,10 @@ private:
     void showSampleClasses();
     /// The authoring meshes (skeleton, section) and the brush outline where the cursor is.
     void pushAuthoring();
+    /// The brush outline where the cursor is (hidden off the surface and for a fill).
+    render::RenderMesh brushRing();
+    /// The cursor moved: the outline alone is updated.
+    void moveRing();
     /// The painted body at rest, alone, with `rgbaOfNode` colouring its render meshes (null: the
     /// paint view is off and every mesh is shown as it is).
     void showPaintedBody(render::RenderMesh::Source source, int index,

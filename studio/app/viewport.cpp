@@ -783,6 +783,17 @@ void Viewport::setAuthoringMeshes(std::vector<render::RenderMesh> meshes) {
     viewChanged();
 }
 
+void Viewport::setAuthoringMesh(size_t k, render::RenderMesh mesh) {
+    if (k >= m_authoring.size()) return;
+    render::RenderMesh& old = m_authoring[k];
+    const bool inPlace = mesh.indices == old.indices;
+    mesh.revision = old.revision + 1;
+    mesh.staticRevision = old.staticRevision + 1;
+    old = std::move(mesh);
+    if (!inPlace) ++m_sceneSerial;
+    viewChanged();
+}
+
 void Viewport::trackMouse(bool on) {
     setMouseTracking(on); // moves without a button reach the viewport (a window host sends all)
     if (QWidget* w = canvasWidget()) w->setMouseTracking(on);

@@ -116,6 +116,9 @@ public:
     void setAuthoringMeshes(std::vector<render::RenderMesh> meshes);
     size_t authoringMeshCount() const { return m_authoring.size(); }
     const std::vector<render::RenderMesh>& authoringMeshes() const { return m_authoring; }
+    /// Replaces authoring mesh k alone (a brush outline following the cursor): updated in the
+    /// buffers it has when its triangles are the same, the others untouched.
+    void setAuthoringMesh(size_t k, render::RenderMesh mesh);
     /// Paint mode: a left drag paints (paintPressed/Moved/Released at the surface under the
     /// cursor, Esc: paintCancelled) instead of orbiting; Alt + left drag orbits, middle drag
     /// pans, the wheel zooms.

@@ -6,6 +6,7 @@
 
 #include "sim/util/atomic_file.hpp"
 #include "support/scratch_dir.hpp"
+#include "texture_spec_fixture.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -195,21 +196,9 @@ void expectRoundTrip(const TextureSpec& spec, const fs::path& folder) {
     EXPECT_EQ(nlohmann::json::parse(text).dump(2) + "\n", text); // 2-space indent, keys sorted
 }
 
-/// The 7-level spec of the texture tests (test_texture.cpp specText), with `extra` members.
+/// The 7-level spec of the texture tests, with `extra` members.
 std::string testSpecText(const std::string& extra = "") {
-    return R"({
-  "name": "layer", "size": 128, "seed": 4, "levels": 6, "bit_depth": 8,
-  "patterns": [
-    {"level": 3, "tile": {"shape": "gaussian", "sigma": 0.45}, "rotation_deg": [0, 360],
-     "offset": {"radius": [0, 0.5], "angle_deg": [0, 360]}, "scale": {"width": [0.8, 1.8], "height": [0.6, 1.4]},
-     "opacity": [0.5, 1], "blend": "add"},
-    {"level": 5, "tile": {"shape": "bell"}, "offset": {"radius": [0, 0.6]}, "scale": {"uniform": [0.6, 1.6]},
-     "opacity": [0.2, 0.6], "probability": 0.7, "blend": "max"}
-  ],
-  "palette": {"colors": ["#7a1f24", "#c65a4f", "#efc1a8"]},
-  "maps": {"mask": {"bit_depth": 16}, "diffuse": {}, "roughness": {"values": [0.6, 0.3]}, "metallic": {"values": [0, 0.1]},
-           "height": {"blur_px": 1}, "normal": {"depth": 0.02}, "palette": {"swatch_px": 8}})" +
-           extra + "}";
+    return viscera::test::specText(4, extra);
 }
 
 /// Every key the reader knows, each value away from its default: a layer with its own image
