@@ -6,6 +6,7 @@
 
 #include "bake/remesh.hpp"
 #include "bake/surface_check.hpp"
+#include "bake/uv_transfer.hpp"
 
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
@@ -54,6 +55,37 @@ void validate(const RemeshParams& p) {
     require(std::isfinite(p.featureAngleDeg) && p.featureAngleDeg > 0 && p.featureAngleDeg <= 180, "featureAngleDeg",
             "must be in (0, 180]");
     require(p.maxTriangles >= 4, "maxTriangles", "must be at least 4");
+    require(p.seamCut.snapFraction >= 0 && p.seamCut.snapFraction <= 0.45, "seamCut.snapFraction",
+            "must be in [0, 0.45]");
+    require(p.seamCut.refineRounds >= 0 && p.seamCut.refineRounds <= 8, "seamCut.refineRounds", "must be in [0, 8]");
+}
+
+/// Isotropic remeshing of `sm` to `edge` in one call (each call would rebuild its projection tree
+/// from the current mesh, so iterations would project onto the previous output and drift), with
+/// the edges over the feature angle and `hard` (vertex pairs) held as constraints: they may be
+/// split or collapsed along themselves, never flipped or moved off their line. Returns the
+/// feature edges found.
+size_t remeshWithHardEdges(SurfaceMesh& sm, double edge, const RemeshParams& params,
+                           const std::vector<std::array<int32_t, 2>>& hard,
+                           SurfaceMesh::Property_map<SurfaceMesh::Edge_index, bool>& ecm, bool protect = false) {
+    ecm = sm.add_property_map<SurfaceMesh::Edge_index, bool>("e:hard", false).first;
+    PMP::detect_sharp_edges(sm, params.featureAngleDeg, ecm);
+    size_t features = 0;
+    for (auto e : sm.edges())
+        features += ecm[e] ? 1 : 0;
+    for (const auto& [a, b] : hard) {
+        const auto h = sm.halfedge(SurfaceMesh::Vertex_index(uint32_t(a)), SurfaceMesh::Vertex_index(uint32_t(b)));
+        if (h != SurfaceMesh::null_halfedge()) ecm[sm.edge(h)] = true;
+    }
+    PMP::isotropic_remeshing(faces(sm), edge, sm,
+                             PMP::parameters::number_of_iterations(unsigned(params.remeshIterations))
+                                 .edge_is_constrained_map(ecm)
+                                 .protect_constraints(protect));
+    if (sm.number_of_faces() > params.maxTriangles)
+        throw InputError("remesh: remeshing gives " + std::to_string(sm.number_of_faces()) +
+                         " triangles (cap RemeshParams::maxTriangles = " + std::to_string(params.maxTriangles) +
+                         "); use a longer target edge length");
+    return features;
 }
 
 SurfaceMesh toSurfaceMesh(const sim::TriMesh& m) {
@@ -68,6 +100,18 @@ SurfaceMesh toSurfaceMesh(const sim::TriMesh& m) {
             throw InputError("remesh: the isosurface is not manifold at triangle " + std::to_string(t));
     }
     return sm;
+}
+
+Eigen::Vector3d point(const SurfaceMesh& sm, SurfaceMesh::Vertex_index v) {
+    const K::Point_3& p = sm.point(v);
+    return {p.x(), p.y(), p.z()};
+}
+
+Eigen::Vector3d centroid(const SurfaceMesh& sm, SurfaceMesh::Face_index f) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (auto v : vertices_around_face(sm.halfedge(f), sm))
+        c += point(sm, v) / 3.0;
+    return c;
 }
 
 sim::TriMesh toTriMesh(SurfaceMesh& sm) {
@@ -122,23 +166,49 @@ RemeshResult voxelRemesh(const std::vector<RemeshPart>& parts, const RemeshParam
     const auto t0 = Clock::now();
     SurfaceMesh sm = toSurfaceMesh(iso);
     if (params.remeshIterations > 0) {
-        auto ecm = sm.add_property_map<SurfaceMesh::Edge_index, bool>("e:hard", false).first;
-        PMP::detect_sharp_edges(sm, params.featureAngleDeg, ecm);
-        for (auto e : sm.edges())
-            report.featureEdges += ecm[e] ? 1 : 0;
-        // One call for all iterations: each call would rebuild its projection tree from the
-        // current mesh, so iterations would project onto the previous output and drift.
         stage("remeshing (" + std::to_string(params.remeshIterations) + " iterations)", 0.72);
-        PMP::isotropic_remeshing(
-            faces(sm), report.targetEdgeLength, sm,
-            PMP::parameters::number_of_iterations(unsigned(params.remeshIterations)).edge_is_constrained_map(ecm));
-        if (sm.number_of_faces() > params.maxTriangles)
-            throw InputError("remesh: remeshing gives " + std::to_string(sm.number_of_faces()) +
-                             " triangles (cap RemeshParams::maxTriangles = " + std::to_string(params.maxTriangles) +
-                             "); use a longer target edge length");
+        SurfaceMesh::Property_map<SurfaceMesh::Edge_index, bool> ecm;
+        report.featureEdges = remeshWithHardEdges(sm, report.targetEdgeLength, params, {}, ecm);
     }
     sim::TriMesh result = toTriMesh(sm);
     report.remeshSeconds = secondsSince(t0);
+
+    RemeshResult out;
+    const bool withUv =
+        params.transferUv && std::all_of(parts.begin(), parts.end(), [](const RemeshPart& p) { return !p.uv.empty(); });
+    if (withUv) {
+        // [A §3.3.4, Algorithm 1]: cut along the seams, remesh with the chart borders held
+        // (protected: neither split nor collapsed, so no border is straightened over a bend), transfer.
+        stage("seam cut", 0.8);
+        const auto tu = Clock::now();
+        const UvSource source(parts);
+        UvMesh cut = cutAlongSeams(source, result, params.seamCut, &report.seamCut);
+        if (params.remeshIterations > 0) {
+            stage("remeshing along the seams", 0.84);
+            sm = toSurfaceMesh(cut.mesh);
+            SurfaceMesh::Property_map<SurfaceMesh::Edge_index, bool> ecm;
+            remeshWithHardEdges(sm, report.targetEdgeLength, params, cut.chartBorders, ecm, true);
+            sm.collect_garbage();
+            cut.mesh = toTriMesh(sm);
+            cut.seamEdges.clear();
+            for (auto e : sm.edges()) // the held edges that lie on a seam or between two islands
+                if (ecm[e] && !sm.is_border(e)) {
+                    const auto h = sm.halfedge(e);
+                    const auto a = sm.source(h), b = sm.target(h);
+                    if (isSeamEdge(source, point(sm, a), point(sm, b), centroid(sm, sm.face(h)),
+                                   centroid(sm, sm.face(sm.opposite(h)))))
+                        cut.seamEdges.push_back({int32_t(a.idx()), int32_t(b.idx())});
+                }
+        }
+        sm = toSurfaceMesh(cut.mesh);
+        out.uncut = std::move(result);
+        result = std::move(cut.mesh);
+        out.seamEdges = std::move(cut.seamEdges);
+        out.uv = transferUv(source, result, UvTransferMethod::SeamCutting);
+        report.uvTransferred = true;
+        report.seamEdges = out.seamEdges.size();
+        report.uvSeconds = secondsSince(tu);
+    }
 
     stage("checks", 0.93);
     const auto t1 = Clock::now();
@@ -189,7 +259,9 @@ RemeshResult voxelRemesh(const std::vector<RemeshPart>& parts, const RemeshParam
         throw InputError("remesh result: " + std::to_string(report.selfIntersections) +
                          " pair(s) of triangles intersect (try a shorter target edge length or more smoothing)");
     stage("done", 1.0);
-    return {std::move(result), report};
+    out.mesh = std::move(result);
+    out.report = report;
+    return out;
 }
 
 namespace detail {

@@ -40,10 +40,33 @@ enum class CsgOp { Union, Difference, Intersection };
 /// "union", "difference", "intersection".
 std::string_view csgOpName(CsgOp op);
 
+/// The UVs of a triangle's three corners (render anatomy carries one per corner: a seam is an edge
+/// whose two triangles give its ends different UVs).
+using CornerUv = std::array<Eigen::Vector2d, 3>;
+
 struct RemeshPart {
     std::string name; ///< for messages ("kidney.obj")
     sim::TriMesh surface;
-    CsgOp op = CsgOp::Union; ///< how the part combines with the parts before it (ignored for the first)
+    CsgOp op = CsgOp::Union;  ///< how the part combines with the parts before it (ignored for the first)
+    std::vector<CornerUv> uv; ///< empty, or one per triangle of `surface`
+};
+
+/// Seam cutting [A §3.3.4] (bake/uv_transfer.hpp).
+struct SeamCutParams {
+    /// A crossing closer than this fraction of the edge to an end snaps that vertex onto the seam
+    /// instead of splitting the edge (the split would leave a sliver), in [0, 0.45].
+    double snapFraction = 0.2;
+    int refineRounds = 6; ///< halvings of edges over a strip of a third chart, before the cut, in [0, 8]
+};
+
+struct SeamCutReport {
+    size_t crossedEdges = 0;     ///< target edges between two charts (split at their border)
+    size_t snappedVertices = 0;  ///< vertices moved onto the seam instead of a split
+    size_t refinedEdges = 0;     ///< edges over a strip of a third chart, halved before the cut
+    size_t splitTriangles = 0;   ///< triangles replaced by their pieces
+    size_t seamEdges = 0;        ///< edges of the cut mesh lying on a seam (held hard)
+    size_t unresolvedPieces = 0; ///< pieces still over two charts after the refinement
+    size_t recutTriangles = 0;   ///< triangles of the remeshed cut split again (a border the remesh straightened)
 };
 
 struct RemeshParams {
@@ -58,6 +81,10 @@ struct RemeshParams {
     double featureAngleDeg = 60;     ///< dihedral angle that makes an edge hard, degrees, in (0, 180]
     int maxVoxelsPerAxis = 2048;     ///< refuses finer grids
     size_t maxTriangles = 2'000'000; ///< refuses larger results (isosurface or remeshed)
+    /// When every part has UVs: cut the remeshed surface along the parts' seams, remesh it again
+    /// with the seam edges hard and transfer the UVs by seam cutting (RemeshResult::uv).
+    bool transferUv = true;
+    SeamCutParams seamCut;
 };
 
 struct RemeshReport {
@@ -81,11 +108,20 @@ struct RemeshReport {
     double volume = 0;              ///< m³, enclosed by the result
     double volumeChangeFromIso = 0; ///< (volume − isoVolume) / isoVolume: what remeshing changed
     double levelSetSeconds = 0, isosurfaceSeconds = 0, remeshSeconds = 0, checkSeconds = 0;
+    bool uvTransferred = false; ///< the parts had UVs and transferUv was set
+    SeamCutReport seamCut;      ///< the cut before the second remesh
+    size_t seamEdges = 0;       ///< hard seam edges of the result
+    double uvSeconds = 0;       ///< cut, second remesh and transfer
 };
 
 struct RemeshResult {
     sim::TriMesh mesh;
     RemeshReport report;
+    std::vector<CornerUv> uv;                      ///< one per triangle when report.uvTransferred
+    std::vector<std::array<int32_t, 2>> seamEdges; ///< the result's edges on the source's seams
+    /// When report.uvTransferred: the remeshed surface before the cut (what the closest-point and
+    /// island-labelled transfers work on, for comparison).
+    sim::TriMesh uncut;
 };
 
 /// Progress: called on the calling thread at each stage with its name ("level set 2/3: ureter.obj", "union",

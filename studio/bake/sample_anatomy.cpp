@@ -2,7 +2,9 @@
 
 #include "sim/mesh/generators.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace viscera::bake {
 namespace {
@@ -22,6 +24,112 @@ sim::TriMesh uncapped(const sim::TriMesh& tube, const sim::Vec3& a, const sim::V
         if (!atA && !atB) kept.push_back(t);
     }
     return sim::TriMesh::fromArrays(tube.positions(), std::move(kept), "ureter");
+}
+
+constexpr double kPi = std::numbers::pi;
+
+/// A rectangle of the texture atlas: [x0, x1] × [y0, y1].
+struct Rect {
+    double x0, y0, x1, y1;
+    Eigen::Vector2d at(double u, double v) const { return {x0 + u * (x1 - x0), y0 + v * (y1 - y0)}; }
+};
+
+/// Angle coordinates of a triangle's corners, unwrapped so that they lie within π of each other
+/// and their mean within [−π, π): the seam falls on the edges between triangles on either side of
+/// ±π. Corners with no angle (a pole, an axis point: `defined` false) take the mean of the others.
+std::array<double, 3> unwrapped(std::array<double, 3> phi, const std::array<bool, 3>& defined) {
+    int ref = -1;
+    for (int k = 0; k < 3; ++k)
+        if (defined[k] && ref < 0) ref = k;
+    if (ref < 0) return {0, 0, 0};
+    double sum = 0;
+    int count = 0;
+    for (int k = 0; k < 3; ++k) {
+        if (!defined[k]) continue;
+        while (phi[k] - phi[ref] > kPi)
+            phi[k] -= 2 * kPi;
+        while (phi[k] - phi[ref] < -kPi)
+            phi[k] += 2 * kPi;
+        sum += phi[k];
+        ++count;
+    }
+    double mean = sum / count;
+    const double shift = mean >= kPi ? -2 * kPi : mean < -kPi ? 2 * kPi : 0.0;
+    mean += shift;
+    for (int k = 0; k < 3; ++k)
+        phi[k] = defined[k] ? phi[k] + shift : mean;
+    return phi;
+}
+
+/// Latitude–longitude UVs of an ellipsoid part about its z axis, from its undeformed positions:
+/// `islands` equal sectors of longitude, each its own island in rects[i] (u: longitude across the
+/// sector, v: latitude), so the sector borders are seams between islands; with one island the
+/// seam at longitude ±π lies inside it (its two sides are far apart in the atlas). Each pole is
+/// one point of its island: the pole's fan is pinched in UV, as in any latitude–longitude map.
+std::vector<CornerUv> latLongUv(const sim::TriMesh& undeformed, const sim::Vec3& centre, const sim::Vec3& radii,
+                                const std::vector<Rect>& rects) {
+    const int islands = int(rects.size());
+    std::vector<CornerUv> uv;
+    for (const sim::Tri& t : undeformed.triangles()) {
+        std::array<double, 3> phi{}, theta{};
+        std::array<bool, 3> defined{};
+        for (int k = 0; k < 3; ++k) {
+            const sim::Vec3 q = (undeformed.positions()[t[k]] - centre).cwiseQuotient(radii);
+            theta[k] = std::acos(std::clamp(q.z(), -1.0, 1.0));
+            defined[k] = std::hypot(q.x(), q.y()) > 1e-9;
+            phi[k] = defined[k] ? std::atan2(q.y(), q.x()) : 0.0;
+        }
+        phi = unwrapped(phi, defined);
+        const double mean = (phi[0] + phi[1] + phi[2]) / 3.0;
+        const double sector = 2 * kPi / islands;
+        const int i = std::clamp(int(std::floor((mean + kPi) / sector)), 0, islands - 1);
+        CornerUv c;
+        for (int k = 0; k < 3; ++k) {
+            const double u = defined[k] ? (phi[k] + kPi - i * sector) / sector : 0.5;
+            c[k] = rects[size_t(i)].at(u, theta[k] / kPi);
+        }
+        uv.push_back(c);
+    }
+    return uv;
+}
+
+/// UVs of a tube from a to b: the side unwrapped around the axis (u: angle, v: along; the seam at
+/// angle ±π inside the island `side`), each end cap (triangles with every corner on an end plane)
+/// projected along the axis into its own island.
+std::vector<CornerUv> tubeUv(const sim::TriMesh& tube, const sim::Vec3& a, const sim::Vec3& b, double radius,
+                             const Rect& side, const Rect& capA, const Rect& capB) {
+    const sim::Vec3 axis = (b - a).normalized();
+    const double length = (b - a).norm();
+    const sim::Vec3 e1 = axis.cross(std::abs(axis.x()) < 0.9 ? sim::Vec3::UnitX() : sim::Vec3::UnitY()).normalized();
+    const sim::Vec3 e2 = axis.cross(e1);
+    std::vector<CornerUv> uv;
+    for (const sim::Tri& t : tube.triangles()) {
+        std::array<double, 3> phi{}, along{};
+        std::array<bool, 3> defined{};
+        std::array<sim::Vec3, 3> local{};
+        bool atA = true, atB = true;
+        for (int k = 0; k < 3; ++k) {
+            const sim::Vec3 d = tube.positions()[t[k]] - a;
+            along[k] = d.dot(axis) / length;
+            local[k] = sim::Vec3(d.dot(e1), d.dot(e2), 0) / radius;
+            defined[k] = local[k].norm() > 1e-9;
+            phi[k] = defined[k] ? std::atan2(local[k].y(), local[k].x()) : 0.0;
+            atA = atA && std::abs(along[k]) < 1e-9;
+            atB = atB && std::abs(along[k] - 1) < 1e-9;
+        }
+        CornerUv c;
+        if (atA || atB) {
+            const Rect& r = atA ? capA : capB;
+            for (int k = 0; k < 3; ++k)
+                c[k] = r.at(0.5 + 0.5 * local[k].x(), 0.5 + 0.5 * (atA ? -1 : 1) * local[k].y());
+        } else {
+            phi = unwrapped(phi, defined);
+            for (int k = 0; k < 3; ++k)
+                c[k] = side.at((phi[k] + kPi) / (2 * kPi), along[k]);
+        }
+        uv.push_back(c);
+    }
+    return uv;
 }
 
 } // namespace
@@ -47,20 +155,29 @@ std::vector<RemeshPart> kidneyAnatomy(int slices) {
             hole = t;
         }
     }
+    // The texture atlas [issue 16 item 7]: the cortex one island (its seam inside it, along the
+    // lateral meridian), the pelvis two (front and back: two seams between islands), the ureter
+    // one (a seam along its length), the artery three (side and end caps).
+    std::vector<CornerUv> cortexUv =
+        latLongUv(ellipsoid, sim::Vec3::Zero(), sim::Vec3(0.03, 0.055, 0.02), {{0.02, 0.02, 0.58, 0.98}});
+    cortexUv.erase(cortexUv.begin() + long(hole));
     tris.erase(tris.begin() + long(hole));
     std::vector<RemeshPart> parts;
-    parts.push_back({"cortex", sim::TriMesh::fromArrays(std::move(p), std::move(tris), "cortex"), CsgOp::Union});
-    parts.push_back(
-        {"pelvis",
-         sim::makeEllipsoidSurface(sim::Vec3(0.012, 0, 0), sim::Vec3(0.018, 0.014, 0.01), slices / 2, slices / 4),
-         CsgOp::Union});
+    parts.push_back({"cortex", sim::TriMesh::fromArrays(std::move(p), std::move(tris), "cortex"), CsgOp::Union,
+                     std::move(cortexUv)});
+    const sim::Vec3 pc(0.012, 0, 0), pr(0.018, 0.014, 0.01);
+    sim::TriMesh pelvis = sim::makeEllipsoidSurface(pc, pr, slices / 2, slices / 4);
+    std::vector<CornerUv> pelvisUv = latLongUv(pelvis, pc, pr, {{0.62, 0.52, 0.79, 0.98}, {0.81, 0.52, 0.98, 0.98}});
+    parts.push_back({"pelvis", std::move(pelvis), CsgOp::Union, std::move(pelvisUv)});
     const sim::Vec3 ua(0.022, -0.006, 0), ub(0.03, -0.09, -0.004);
-    parts.push_back(
-        {"ureter", uncapped(sim::makeTubeSurface(ua, ub, 0.004, slices / 3, slices / 3), ua, ub), CsgOp::Union});
-    parts.push_back({"artery",
-                     sim::makeTubeSurface(sim::Vec3(0.015, 0.008, 0.004), sim::Vec3(0.06, 0.02, 0.01), 0.003,
-                                          slices / 4, slices / 8),
-                     CsgOp::Union});
+    sim::TriMesh ureter = uncapped(sim::makeTubeSurface(ua, ub, 0.004, slices / 3, slices / 3), ua, ub);
+    std::vector<CornerUv> ureterUv = tubeUv(ureter, ua, ub, 0.004, {0.62, 0.02, 0.79, 0.48}, {}, {});
+    parts.push_back({"ureter", std::move(ureter), CsgOp::Union, std::move(ureterUv)});
+    const sim::Vec3 aa(0.015, 0.008, 0.004), ab(0.06, 0.02, 0.01);
+    sim::TriMesh artery = sim::makeTubeSurface(aa, ab, 0.003, slices / 4, slices / 8);
+    std::vector<CornerUv> arteryUv =
+        tubeUv(artery, aa, ab, 0.003, {0.81, 0.14, 0.98, 0.48}, {0.81, 0.02, 0.885, 0.12}, {0.905, 0.02, 0.98, 0.12});
+    parts.push_back({"artery", std::move(artery), CsgOp::Union, std::move(arteryUv)});
     return parts;
 }
 

@@ -16,6 +16,9 @@ namespace viscera::bake {
 ///   "pelvis"  an ellipsoid in the hilum, overlapping the cortex and the dent;
 ///   "ureter"  an open tube (no end caps) from the pelvis downwards, radius 4 mm;
 ///   "artery"  a closed capped tube into the hilum, radius 3 mm, overlapping the pelvis.
+/// Each part carries per-corner UVs in one texture atlas: the cortex a latitude–longitude island
+/// with its seam inside it (the lateral meridian), the pelvis two islands (front and back), the
+/// ureter one (a seam along it), the artery three (side and both caps).
 /// `slices` sets the tessellation (the cortex has slices × slices/2 quads). Deterministic.
 std::vector<RemeshPart> kidneyAnatomy(int slices = 96);
 

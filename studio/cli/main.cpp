@@ -33,6 +33,7 @@
 #include "bake/sample_anatomy.hpp"
 #include "bake/tetrahedralize.hpp"
 #include "bake/texture.hpp"
+#include "bake/uv_transfer.hpp"
 #include "haptics/trajectory.hpp"
 #include "project/project.hpp"
 #include "project/publishing.hpp"
@@ -42,6 +43,7 @@
 #include "sim/util/cli_main.hpp"
 #include "sim/util/error.hpp"
 #include "sim/util/format.hpp"
+#include "uv_report.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -120,7 +122,15 @@ constexpr const char* kRemeshHelp =
     "  --smooth N          mean-curvature smoothing passes (default 0)\n"
     "  --edge-length M     target edge length, m (default 1.5 voxels)\n"
     "  --iterations N      remeshing iterations (default 3; 0 keeps the isosurface)\n"
-    "  --feature-angle D   dihedral angle that makes an edge hard, degrees (default 60)\n";
+    "  --feature-angle D   dihedral angle that makes an edge hard, degrees (default 60)\n"
+    "When every part has UVs (the sample does), the result is cut along the parts' UV seams,\n"
+    "remeshed with the seam edges hard and given UVs by seam cutting [A 3.3.4]; the closest-point\n"
+    "and island-labelled transfers are measured beside it (triangles over two islands or over a\n"
+    "seam, angle and area distortion, UV error), one 'name value' line each, and the OBJ carries\n"
+    "the UVs (vt) of the method chosen.\n"
+    "  --uv-transfer M     the UVs written: seam-cut (default), closest or island\n"
+    "  --no-uv             no UV transfer\n"
+    "  --uv-preview P.png  checker preview: source, closest point, seam cutting (headless EGL)\n";
 constexpr const char* kOpenHelp = "usage: viscera-studio open <project-dir>\n"
                                   "\n"
                                   "Opens the desktop studio on a project (without a folder: an empty studio).\n";
@@ -442,13 +452,21 @@ int cmdRemesh(const std::vector<std::string>& args) {
     bool sample = false;
     bake::ImportOptions opt;
     bake::RemeshParams params;
+    std::optional<std::string> preview;
+    bake::UvTransferMethod uvMethod = bake::UvTransferMethod::SeamCutting;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         auto value = [&]() -> std::string {
             if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
             return args[++i];
         };
-        if (a == "--sample") {
+        if (a == "--no-uv")
+            params.transferUv = false;
+        else if (a == "--uv-transfer")
+            uvMethod = parseUvTransferOption(value());
+        else if (a == "--uv-preview")
+            preview = value();
+        else if (a == "--sample") {
             if (value() != "kidney") throw std::invalid_argument("--sample: the built-in sample is 'kidney'");
             sample = true;
         } else if (a == "--subtract")
@@ -488,6 +506,12 @@ int cmdRemesh(const std::vector<std::string>& args) {
     for (const auto& part : inputs)
         inputPaths.emplace_back(part.file);
     requireNotAnInput(*out, "the remeshed surface", inputPaths);
+    if (preview) {
+        if (std::filesystem::path(*preview).extension() != ".png")
+            throw std::invalid_argument("--uv-preview '" + *preview + "': the preview is written as PNG (.png)");
+        requireWritableFile(*preview, "the UV preview");
+        requireNotAnInput(*preview, "the UV preview", inputPaths);
+    }
     std::vector<bake::RemeshPart> parts;
     if (sample)
         for (bake::RemeshPart& part : bake::kidneyAnatomy()) {
@@ -501,7 +525,7 @@ int cmdRemesh(const std::vector<std::string>& args) {
         std::printf("part %s (%s): %zu vertices, %zu triangles, closed: %s\n", in.file.c_str(),
                     std::string(bake::csgOpName(in.op)).c_str(), m.vertexCount(), m.triangleCount(),
                     m.isClosedOriented() ? "yes" : "no");
-        parts.push_back({std::filesystem::path(in.file).filename().string(), std::move(m), in.op});
+        parts.push_back({std::filesystem::path(in.file).filename().string(), std::move(m), in.op, {}});
     }
     const auto t0 = std::chrono::steady_clock::now();
     const bake::RemeshResult r = bake::voxelRemesh(parts, params, [](std::string_view stage, double f) {
@@ -510,7 +534,7 @@ int cmdRemesh(const std::vector<std::string>& args) {
     });
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const bake::RemeshReport& q = r.report;
-    bake::writeObj(*out, r.mesh);
+    if (!q.uvTransferred) bake::writeObj(*out, r.mesh);
     std::printf("grid: voxel %.4g mm, %d x %d x %d voxels, %zu active; %zu open part(s) thickened (%zu of them "
                 "leaked), %zu closed over small holes\n",
                 q.voxelSize * 1e3, q.voxels[0], q.voxels[1], q.voxels[2], q.activeVoxels, q.openParts, q.leakedParts,
@@ -524,8 +548,17 @@ int cmdRemesh(const std::vector<std::string>& args) {
     std::printf("volume: result %.6g m^3, isosurface %.6g m^3 (remeshing %+.3f%%), source parts %.6g m^3 (%+.3f%%)\n",
                 q.volume, q.isoVolume, 100.0 * q.volumeChangeFromIso, q.sourceVolume,
                 q.sourceVolume > 0 ? 100.0 * (q.volume - q.sourceVolume) / q.sourceVolume : 0.0);
-    std::printf("time: level sets %.2f s, isosurface %.2f s, remeshing %.2f s, checks %.2f s (total %.2f s)\n",
-                q.levelSetSeconds, q.isosurfaceSeconds, q.remeshSeconds, q.checkSeconds, secs);
+    std::printf("time: level sets %.2f s, isosurface %.2f s, remeshing %.2f s, UV cut and transfer %.2f s, checks "
+                "%.2f s (total %.2f s)\n",
+                q.levelSetSeconds, q.isosurfaceSeconds, q.remeshSeconds, q.uvSeconds, q.checkSeconds, secs);
+    if (!q.uvTransferred) {
+        if (params.transferUv) std::printf("uv: not transferred (a part has no UVs)\n");
+        std::printf("wrote %s\n", out->c_str());
+        return 0;
+    }
+    const UvChoice choice = reportUvTransfers(parts, r, uvMethod, preview);
+    bake::writeObjWithUv(*out, *choice.mesh, choice.uv);
+    std::printf("uv.written %s\n", std::string(uvTransferOptionName(uvMethod)).c_str());
     std::printf("wrote %s\n", out->c_str());
     return 0;
 }

@@ -52,7 +52,7 @@ bake::RemeshParams params(int voxels = 64) {
 
 // Two 2 cm cubes overlapping in a 1 cm cube.
 std::vector<bake::RemeshPart> twoCubes(bake::CsgOp op) {
-    return {{"a", box(0, 0, 0, 0.02), bake::CsgOp::Union}, {"b", box(0.01, 0.01, 0.01, 0.02), op}};
+    return {{"a", box(0, 0, 0, 0.02), bake::CsgOp::Union, {}}, {"b", box(0.01, 0.01, 0.01, 0.02), op, {}}};
 }
 
 void expectSound(const bake::RemeshResult& r) {
@@ -90,7 +90,7 @@ TEST(bake_remesh, DifferenceAndIntersectionGiveTheirVolumes) {
 }
 
 TEST(bake_remesh, AnOpenPartIsThickenedIntoAClosedShell) {
-    std::vector<bake::RemeshPart> parts{{"open", openBox(0, 0, 0, 0.02), bake::CsgOp::Union}};
+    std::vector<bake::RemeshPart> parts{{"open", openBox(0, 0, 0, 0.02), bake::CsgOp::Union, {}}};
     ASSERT_FALSE(parts[0].surface.isClosedOriented());
     const bake::RemeshResult r = bake::voxelRemesh(parts, params());
     expectSound(r);
@@ -149,8 +149,8 @@ TEST(bake_remesh, CapsAndParameterRulesNameThemselves) {
         EXPECT_THAT(e.what(), HasSubstr("RemeshParams::bandVoxels must be in [3, 16]"));
     }
     // Disjoint parts intersect in nothing.
-    std::vector<bake::RemeshPart> apart{{"a", box(0, 0, 0, 0.01), bake::CsgOp::Union},
-                                        {"b", box(0.02, 0, 0, 0.01), bake::CsgOp::Intersection}};
+    std::vector<bake::RemeshPart> apart{{"a", box(0, 0, 0, 0.01), bake::CsgOp::Union, {}},
+                                        {"b", box(0.02, 0, 0, 0.01), bake::CsgOp::Intersection, {}}};
     try {
         bake::voxelRemesh(apart, params(32));
         ADD_FAILURE();
@@ -202,7 +202,7 @@ TEST(bake_remesh, HolesOfAtMostThreeVoxelsAreClosedWiderOnesThickened) {
     const sim::TriMesh e = sim::makeEllipsoidSurface(sim::Vec3::Zero(), sim::Vec3(0.03, 0.02, 0.015), 128, 64);
     std::vector<sim::Tri> tris = e.triangles();
     tris.erase(tris.begin() + long(tris.size() / 3));
-    std::vector<bake::RemeshPart> parts{{"e", sim::TriMesh::fromArrays(e.positions(), tris), bake::CsgOp::Union}};
+    std::vector<bake::RemeshPart> parts{{"e", sim::TriMesh::fromArrays(e.positions(), tris), bake::CsgOp::Union, {}}};
     const double hole = bake::detail::largestHoleDiameter(parts[0].surface);
     EXPECT_GT(hole, 0.001);
     EXPECT_LT(hole, 0.0024);

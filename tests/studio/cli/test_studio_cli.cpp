@@ -196,3 +196,17 @@ TEST(StudioCli, ImportChecksItsOutputFirstAndReportsMeshingStages) {
     EXPECT_THAT(up.err, HasSubstr("up.obj: line 1: mtllib '../outside.mtl': leaves the file's folder"));
     EXPECT_EQ(lines(up.err).size(), 1u) << up.err;
 }
+
+TEST(StudioCli, TheUvMethodWrittenIsChosenAndAnUnknownOneIsRefusedByName) {
+    test::Scratch s("viscera-studio-cli-gl");
+    auto r = test::runProcess(VISCERA_STUDIO_EXE, {"remesh", "--sample", "kidney", "--voxels", "40", "--uv-transfer",
+                                                   "closest", "-o", s / "closest.obj"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_THAT(r.out, HasSubstr("uv.written closest\n"));
+    EXPECT_THAT(readFile(s / "closest.obj"), HasSubstr("\nvt "));
+    r = test::runProcess(VISCERA_STUDIO_EXE,
+                         {"remesh", "--sample", "kidney", "--uv-transfer", "nearest", "-o", s / "bad.obj"});
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_THAT(r.err, HasSubstr("--uv-transfer 'nearest': the methods are seam-cut, closest and island"));
+    EXPECT_FALSE(fs::exists(s / "bad.obj"));
+}
