@@ -23,9 +23,11 @@ std::vector<CaseFileRef> caseFileReferences(const sim::SceneDesc& scene,
         add(at + "mesh", scene.surfaces[s].meshPath);
         add(at + "node_weights_file", scene.surfaces[s].nodeWeightsPath);
     }
-    for (const CaseMaterialMaps& m : materials)
+    for (const CaseMaterialMaps& m : materials) {
         for (const std::string& f : m.files())
             add("render.materials." + m.target, f);
+        add("render.materials." + m.target + ".uv", m.uv);
+    }
     if (scene.suture) add("suture.trajectory", scene.suture->trajectoryPath);
     if (scene.interaction)
         for (size_t i = 0; i < scene.interaction->instruments.size(); ++i)

@@ -16,7 +16,7 @@ std::vector<CaseMaterialMaps> readMaterials(const sim::JsonField& root) {
     auto materials = root.find("materials");
     if (!materials) return out;
     for (const auto& [name, m] : materials->anyObject().members()) {
-        m.object({"diffuse", "roughness", "metallic", "normal", "tiles_per_metre", "normal_strength"});
+        m.object({"diffuse", "roughness", "metallic", "normal", "tiles_per_metre", "normal_strength", "uv"});
         CaseMaterialMaps c;
         c.target = name;
         const std::pair<const char*, std::string*> maps[] = {
@@ -24,6 +24,7 @@ std::vector<CaseMaterialMaps> readMaterials(const sim::JsonField& root) {
         for (const auto& [key, path] : maps)
             if (auto f = m.find(key)) *path = f->entryPath();
         if (c.files().empty()) m.fail("names no map (give at least one of diffuse, roughness, metallic, normal)");
+        if (auto f = m.find("uv")) c.uv = f->entryPath();
         readMapLayout(m, c.tilesPerMetre, c.normalStrength);
         out.push_back(std::move(c));
     }

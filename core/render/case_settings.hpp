@@ -12,7 +12,10 @@
 ///       "organ": {"diffuse": "textures/organ_diffuse.png", "roughness": "textures/organ_roughness.png",
 ///                 "metallic": "...", "normal": "...",   package entries (PNG); at least one map
 ///                 "tiles_per_metre": 20,               triplanar repeats per metre, (0, 10000]
-///                 "normal_strength": 1}                [0, 4]
+///                 "normal_strength": 1,                [0, 4]
+///                 "uv": "meshes/organ.vuv"}            a body's UVs per boundary corner
+///                                                      (render/corner_uv.hpp): the maps are laid
+///                                                      by them instead of triplanar
 ///     }
 ///   }
 ///
@@ -46,7 +49,8 @@ struct CaseMaterialMaps {
     std::string diffuse, roughness, metallic, normal; ///< package entries; empty: that map is not used
     float tilesPerMetre = 20.0f;
     float normalStrength = 1.0f;
-    /// The entries named, in the order diffuse, roughness, metallic, normal.
+    std::string uv; ///< package entry of the body's corner UVs (render/corner_uv.hpp), or empty
+    /// The map entries named, in the order diffuse, roughness, metallic, normal (not `uv`).
     std::vector<std::string> files() const;
 };
 

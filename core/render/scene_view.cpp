@@ -22,14 +22,23 @@ std::vector<Eigen::Vector3f> toFloat(const std::vector<sim::Vec3>& p) {
     return out;
 }
 
-void computeNormals(const std::vector<float>& pos, const std::vector<uint32_t>& idx, std::vector<float>& nrm) {
+/// Area-weighted vertex normals; with `weld` (#V: the vertex each one's normal is shared with)
+/// the copies of a vertex split at a UV seam get one normal.
+void computeNormals(const std::vector<float>& pos, const std::vector<uint32_t>& idx, std::vector<float>& nrm,
+                    const std::vector<uint32_t>& weld = {}) {
     std::fill(nrm.begin(), nrm.end(), 0.0f);
+    const bool welded = !weld.empty() && weld.size() * 3 == nrm.size();
     for (size_t t = 0; t + 2 < idx.size(); t += 3) {
         const Eigen::Map<const Eigen::Vector3f> a(&pos[3 * idx[t]]), b(&pos[3 * idx[t + 1]]), c(&pos[3 * idx[t + 2]]);
         const Eigen::Vector3f n = (b - a).cross(c - a); // area-weighted
         for (int k = 0; k < 3; ++k)
-            Eigen::Map<Eigen::Vector3f>(&nrm[3 * idx[t + k]]) += n;
+            Eigen::Map<Eigen::Vector3f>(&nrm[3 * (welded ? weld[idx[t + k]] : idx[t + k])]) += n;
     }
+    if (welded)
+        for (size_t v = 0; v < weld.size(); ++v)
+            if (weld[v] != v)
+                for (int c = 0; c < 3; ++c)
+                    nrm[3 * v + size_t(c)] = nrm[3 * weld[v] + size_t(c)];
     for (size_t v = 0; v < nrm.size(); v += 3) {
         Eigen::Map<Eigen::Vector3f> n(&nrm[v]);
         const float len = n.norm();
@@ -336,7 +345,7 @@ size_t SceneView::exposedCutFaces(size_t body) const {
 
 void SceneView::recomputeNormals(size_t i) {
     RenderMesh& m = m_meshes.at(i);
-    computeNormals(m.positions, m.indices, m.normals);
+    computeNormals(m.positions, m.indices, m.normals, m.weld);
     ++m.revision;
 }
 

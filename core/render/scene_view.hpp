@@ -44,6 +44,9 @@ struct RenderMesh {
     std::vector<float> sampleMap;  ///< #V: painted light samples (0 unpainted, else 1, 4 or 8)
     /// #V × 2 or empty: texture coordinates for the material's maps (none: triplanar on `rest`)
     std::vector<float> uv;
+    /// #V or empty: for vertices split at UV seams (applyCornerUv), the first copy of each
+    /// vertex: the copies' normals are accumulated there and shared, so a seam shades smoothly.
+    std::vector<uint32_t> weld;
     /// Empty, or with `uv`: the thickness baked per texel (bakeThicknessTexture, R = thickness /
     /// 0.05 m), sampled by the G-buffer pass instead of the per-vertex `thickness`.
     Image thicknessMap;

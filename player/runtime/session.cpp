@@ -82,6 +82,29 @@ double nodeDisplacement(const sim::World& world) {
 
 } // namespace
 
+namespace {
+
+/// The corner UVs a material entry names: only for a body, one per boundary triangle.
+void loadCornerUvs(LoadedCase& out, const std::vector<render::CaseMaterialMaps>& materials,
+                   const std::vector<std::unique_ptr<sim::TetMesh>>& meshes, const std::string& sceneName) {
+    const vcase::CasePackage& pkg = *out.package;
+    for (const render::CaseMaterialMaps& m : materials) {
+        if (m.uv.empty()) continue;
+        size_t body = out.scene.bodies.size();
+        for (size_t i = 0; i < out.scene.bodies.size(); ++i)
+            if (out.scene.bodies[i].name == m.target) body = i;
+        if (body == out.scene.bodies.size())
+            throw InputError(pkg.name() + ": " + sceneName + ": render.materials." + m.target +
+                             ".uv: only a body's maps can be laid by UVs ('" + m.target + "' is not a body)");
+        auto probe = meshes[body]->clone(); // the boundary in the render mesh's order
+        probe->requireLevel(3);
+        out.cornerUvs.emplace_back(m.target, render::parseCornerUv(pkg.read(m.uv), pkg.name() + ":" + m.uv,
+                                                                   probe->boundary().triangleCount()));
+    }
+}
+
+} // namespace
+
 LoadedCase loadCase(const std::filesystem::path& casePath, const vcase::TrustPolicy& trust) {
     LoadedCase out;
     out.package = vcase::CasePackage::open(casePath);
@@ -147,6 +170,7 @@ LoadedCase loadCase(const std::filesystem::path& casePath, const vcase::TrustPol
     render::checkDecodedImageBudget(materials, readEntry, pkg.name() + ": " + sceneName);
     for (const render::CaseMaterialMaps& m : materials)
         out.materialMaps.emplace_back(m.target, render::loadMaterialMaps(m, readEntry, pkg.name()));
+    loadCornerUvs(out, materials, meshes, sceneName);
     if (out.scene.suture) { // the recorded needle trajectory travels with the case
         out.scene.suture->trajectoryText = pkg.read(out.scene.suture->trajectoryPath);
     }
@@ -167,6 +191,8 @@ render::SceneView caseView(const LoadedCase& loaded) {
         if (!loaded.sampleMaps[b].empty())
             render::applyBodySampleMap(view, b, loaded.scene.bodies[b].name, loaded.sampleMaps[b],
                                        loaded.scene.surfaces);
+    for (const auto& [target, uv] : loaded.cornerUvs) // before the maps: the maps are then laid by them
+        render::applyCornerUv(view, target, uv);
     for (const auto& [target, maps] : loaded.materialMaps)
         render::applyMaterialMaps(view, target, maps);
     return view;

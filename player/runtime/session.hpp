@@ -3,6 +3,7 @@
 #include "case/case_package.hpp"
 #include "case/trust.hpp"
 #include "haptics/device.hpp"
+#include "render/corner_uv.hpp"
 #include "render/scene_view.hpp"
 #include "render/tool_meshes.hpp"
 #include "runtime/haptic_rig.hpp"
@@ -31,6 +32,8 @@ struct LoadedCase {
     std::vector<std::vector<uint8_t>> sampleMaps;
     /// The material maps of render.materials, decoded: (body or surface name, maps).
     std::vector<std::pair<std::string, std::shared_ptr<const render::MaterialMaps>>> materialMaps;
+    /// Bodies drawn with UVs of their own ("render.materials.<body>.uv"): body name and corner UVs.
+    std::vector<std::pair<std::string, std::vector<render::CornerUvF>>> cornerUvs;
 };
 
 /// Verifies the package, checks it against `trust` (signature, expiry, rollback) before reading

@@ -39,8 +39,13 @@ void rebaseProject(Project& p, const fs::path& to, std::vector<std::pair<fs::pat
         if (moved) moved->emplace_back(f, to / rel);
         f = to / rel;
     };
-    for (BodyProject& b : p.bodies)
+    for (BodyProject& b : p.bodies) {
         if (b.mesh.kind == MeshSource::Kind::File) relocate(b.mesh.file);
+        if (b.mesh.kind != MeshSource::Kind::Remesh) continue;
+        for (RemeshSource::Part& part : b.mesh.remesh.parts)
+            relocate(part.file);
+        if (!b.mesh.remesh.texture.empty()) relocate(b.mesh.remesh.texture);
+    }
     if (p.scene.suture && !p.trajectory.generator) relocate(p.trajectory.file);
     for (fs::path& t : p.trackFiles)
         relocate(t);

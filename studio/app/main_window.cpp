@@ -1,5 +1,6 @@
 #include "app/main_window.hpp"
 
+#include "app/anatomy_steps.hpp"
 #include "app/export_runner.hpp"
 #include "app/fit_dialog.hpp"
 #include "app/material_panel.hpp"
@@ -139,6 +140,9 @@ void MainWindow::buildActions() {
     auto* toolbar = addToolBar(tr("Main"));
     toolbar->setObjectName("mainToolBar");
     buildFileMenu(menuBar()->addMenu(tr("&File")), toolbar);
+    m_anatomy = new AnatomySteps(&m_doc, &m_sel, this);
+    connect(m_anatomy, &AnatomySteps::logMessage, this, &MainWindow::logLine);
+    m_anatomy->buildMenu(menuBar()->addMenu(tr("&Mesh")));
     QMenu* edit = menuBar()->addMenu(tr("&Edit"));
     QAction* undo = m_doc.undoStack()->createUndoAction(this, tr("&Undo"));
     undo->setShortcut(QKeySequence::Undo);

@@ -31,6 +31,7 @@ class QTreeWidget;
 
 namespace viscera::studio {
 
+class AnatomySteps;
 class ExportRunner;
 class MaterialPanel;
 class PlotWidget;
@@ -80,6 +81,7 @@ public:
     /// The start page or the viewport, whichever is shown.
     QWidget* centreWidget() const;
     PaintTools* paintTools() { return m_paint; }
+    AnatomySteps* anatomySteps() { return m_anatomy; }
     StiffnessPainter* painter() { return m_paint->painter(); }
     /// Paint stiffness mode (the toolbar's Paint action): the viewport's left drag paints the
     /// selected body's node weights, shown as a colour ramp.
@@ -134,6 +136,7 @@ private:
     Selection m_sel;
     Preview m_preview;
     std::unique_ptr<ExportRunner> m_export;
+    AnatomySteps* m_anatomy = nullptr;
     Viewport* m_viewport = nullptr;
     QAction* m_widgetHostAction = nullptr;
     QAction* m_frameAction = nullptr;

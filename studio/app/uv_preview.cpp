@@ -30,6 +30,32 @@ render::Image uvCheckerImage(int size, int checks) {
     return img;
 }
 
+std::vector<float> stretchOverlay(const sim::TriMesh& mesh, const std::vector<double>& faceStretch,
+                                  const std::vector<std::array<int32_t, 2>>& seamEdges) {
+    std::vector<double> worst(mesh.vertexCount(), 1.0);
+    for (size_t t = 0; t < mesh.triangleCount() && t < faceStretch.size(); ++t)
+        for (int32_t v : mesh.triangles()[t])
+            worst[size_t(v)] = std::max(worst[size_t(v)], faceStretch[t]);
+    std::vector<float> rgba(4 * worst.size());
+    for (size_t v = 0; v < worst.size(); ++v) {
+        float* c = &rgba[4 * v];
+        if (std::isinf(worst[v])) { // flipped
+            c[0] = 1, c[1] = 0, c[2] = 1, c[3] = 0.9f;
+            continue;
+        }
+        // 1 → blue, the threshold and beyond → red, on a log scale
+        const float s = float(std::clamp(std::log(worst[v]) / std::log(bake::kUvStretchThreshold), 0.0, 1.0));
+        c[0] = s, c[1] = 0.25f * (1 - s), c[2] = 1 - s, c[3] = 0.75f;
+    }
+    for (const auto& e : seamEdges)
+        for (int32_t v : e)
+            if (size_t(v) < worst.size()) {
+                float* c = &rgba[4 * size_t(v)];
+                c[0] = c[1] = c[2] = 0.02f, c[3] = 1.0f;
+            }
+    return rgba;
+}
+
 void writeUvPreview(const std::filesystem::path& png, const std::vector<UvPreviewItem>& items, int width, int height) {
     if (items.empty()) throw std::invalid_argument("studio::writeUvPreview(): nothing to show");
     double span = 0;
@@ -56,7 +82,8 @@ void writeUvPreview(const std::filesystem::path& png, const std::vector<UvPrevie
         const UvPreviewItem& it = items[i];
         std::map<std::tuple<int32_t, double, double>, int32_t> index;
         std::vector<sim::Vec3> pos;
-        std::vector<float> uv;
+        std::vector<float> uv, overlay;
+        const bool withOverlay = it.overlay.size() == 4 * it.mesh.vertexCount();
         std::vector<sim::Tri> tris;
         const sim::Vec3 shift(1.25 * span * double(i), 0, 0);
         for (size_t t = 0; t < it.mesh.triangleCount(); ++t) {
@@ -69,6 +96,9 @@ void writeUvPreview(const std::filesystem::path& png, const std::vector<UvPrevie
                     pos.push_back(it.mesh.positions()[v] + shift);
                     uv.push_back(float(it.uv[t][k].x()));
                     uv.push_back(float(it.uv[t][k].y()));
+                    if (withOverlay)
+                        overlay.insert(overlay.end(), it.overlay.begin() + 4 * long(v),
+                                       it.overlay.begin() + 4 * long(v + 1));
                 }
                 f[k] = slot->second;
             }
@@ -78,6 +108,7 @@ void writeUvPreview(const std::filesystem::path& png, const std::vector<UvPrevie
             view.addMesh(it.name, sim::TriMesh::fromArrays(std::move(pos), std::move(tris), it.name), material, bake);
         view.meshes()[m].uv = std::move(uv);
         view.meshes()[m].doubleSided = true;
+        if (withOverlay) view.setOverlay(m, overlay);
     }
     // Seen from above (+z, y up), framed on the row of surfaces, the head light at the camera.
     render::RenderSettings s = render::defaultSettingsFor(view, width, height);

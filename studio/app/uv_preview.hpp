@@ -4,6 +4,7 @@
 /// A transfer that keeps the source's parameterization shows the same even checks as the source;
 /// a triangle over a seam shows the whole atlas squeezed into it (a smear of tints).
 #include "bake/remesh.hpp"
+#include "bake/uv_transfer.hpp"
 #include "render/image.hpp"
 
 #include <filesystem>
@@ -16,7 +17,16 @@ struct UvPreviewItem {
     std::string name;
     sim::TriMesh mesh;
     std::vector<bake::CornerUv> uv; ///< one per triangle
+    /// Empty, or #V × 4 (RGBA in [0, 1], one per vertex of `mesh`): drawn over the checker by its
+    /// alpha (the stretch heat map and the seams).
+    std::vector<float> overlay;
 };
+
+/// The stretch heat map of a transfer with its seams: per vertex of `mesh`, the largest stretch
+/// of its triangles (UvTransferStats::faceStretch: 1 = none, ≥ kUvStretchThreshold = red,
+/// infinite = flipped, magenta) as an RGBA overlay; vertices of `seamEdges` dark.
+std::vector<float> stretchOverlay(const sim::TriMesh& mesh, const std::vector<double>& faceStretch,
+                                  const std::vector<std::array<int32_t, 2>>& seamEdges);
 
 /// The checker texture: `size` × `size`, `checks` checks per side.
 render::Image uvCheckerImage(int size = 512, int checks = 16);

@@ -178,6 +178,8 @@ PosKey keyOf(const sim::Vec3& p) {
 struct Merged {
     std::vector<sim::Vec3> positions;
     std::vector<sim::Tri> triangles;
+    std::vector<std::array<Eigen::Vector2d, 3>> uv; ///< per triangle, when every mesh has UVs
+    bool allUv = true;
     size_t instances = 0;
 };
 
@@ -238,12 +240,26 @@ Merged mergeScene(const std::string& label, const aiScene* scene, const ImportOp
                 if (inserted) out.positions.push_back(p);
                 remap[v] = it->second;
             }
+            const bool uv = options.keepUv && mesh->HasTextureCoords(0);
+            out.allUv = out.allUv && uv;
             for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
                 const aiFace& face = mesh->mFaces[f];
                 if (face.mNumIndices != 3) continue; // points and lines are not surface
                 sim::Tri t{remap[face.mIndices[0]], remap[face.mIndices[1]], remap[face.mIndices[2]]};
-                if (mirrored) std::swap(t[1], t[2]);
+                std::array<Eigen::Vector2d, 3> c{};
+                for (int k = 0; k < 3 && uv; ++k) {
+                    const aiVector3D& w = mesh->mTextureCoords[0][face.mIndices[k]];
+                    c[size_t(k)] = Eigen::Vector2d(w.x, w.y);
+                    if (!c[size_t(k)].allFinite())
+                        fail(label, meshName(mesh, mi) + " face " + std::to_string(f) +
+                                        ": a texture coordinate is not finite");
+                }
+                if (mirrored) {
+                    std::swap(t[1], t[2]);
+                    std::swap(c[1], c[2]);
+                }
                 out.triangles.push_back(t);
+                if (uv) out.uv.push_back(c);
             }
         }
         for (unsigned c = node->mNumChildren; c-- > 0;)
@@ -305,11 +321,10 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file, const Im
     auto* io = new FolderIOSystem(file); // owned by the importer
     importer.SetIOHandler(io);
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
-                                                            aiComponent_COLORS | aiComponent_TEXCOORDS |
-                                                            aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
-                                                            aiComponent_TEXTURES | aiComponent_LIGHTS |
-                                                            aiComponent_CAMERAS | aiComponent_MATERIALS);
+    const int removed = aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS | aiComponent_COLORS |
+                        aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS | aiComponent_TEXTURES | aiComponent_LIGHTS |
+                        aiComponent_CAMERAS | aiComponent_MATERIALS;
+    importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, options.keepUv ? removed : removed | aiComponent_TEXCOORDS);
     importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
 
     const aiScene* scene = nullptr;
@@ -347,8 +362,13 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file, const Im
     // Drop triangles that collapsed when vertices were joined, then unreferenced vertices.
     std::vector<sim::Tri> triangles;
     triangles.reserve(merged.triangles.size());
-    for (const sim::Tri& t : merged.triangles)
-        if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) triangles.push_back(t);
+    const bool withUv = options.keepUv && merged.allUv && merged.uv.size() == merged.triangles.size();
+    std::vector<std::array<Eigen::Vector2d, 3>> uv;
+    for (size_t i = 0; i < merged.triangles.size(); ++i)
+        if (const sim::Tri& t = merged.triangles[i]; t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) {
+            triangles.push_back(t);
+            if (withUv) uv.push_back(merged.uv[i]);
+        }
     report.degenerateTrianglesDropped = merged.triangles.size() - triangles.size();
     if (triangles.empty())
         fail(label, "no faces: all " + std::to_string(merged.triangles.size()) +
@@ -370,7 +390,7 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file, const Im
                   " triangle(s) that collapse when identical vertices are joined");
 
     try {
-        return {sim::TriMesh::fromArrays(std::move(positions), std::move(triangles), label), report};
+        return {sim::TriMesh::fromArrays(std::move(positions), std::move(triangles), label), report, std::move(uv)};
     } catch (const std::invalid_argument& e) {
         throw InputError(e.what());
     }

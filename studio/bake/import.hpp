@@ -16,6 +16,11 @@
 /// Dropped triangles are counted in ImportReport and logged through viscera::log (warning).
 #include "sim/mesh/tri_mesh.hpp"
 
+#include <Eigen/Core>
+
+#include <array>
+#include <vector>
+
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -43,6 +48,9 @@ struct ImportOptions {
     /// refused naming the cap, before the vertices are copied.
     size_t maxVertices = 10'000'000;
     size_t maxTriangles = 20'000'000;
+    /// Keep the first texture-coordinate set, per triangle corner (ImportResult::uv): anatomy for
+    /// the remesh with UV transfer. Vertices are still joined by position.
+    bool keepUv = false;
 };
 
 struct ImportReport {
@@ -56,6 +64,9 @@ struct ImportReport {
 struct ImportResult {
     sim::TriMesh mesh; ///< positions in metres, file's world frame; triangles as in the file
     ImportReport report;
+    /// With ImportOptions::keepUv: (u, v) of each triangle's three corners, one per triangle of
+    /// `mesh`; empty when a mesh of the file has no texture coordinates.
+    std::vector<std::array<Eigen::Vector2d, 3>> uv;
 };
 
 /// Checks the extension and the content of `file` and returns its format without parsing the

@@ -7,6 +7,7 @@
 //                         [-o out.vtet]
 //   viscera-studio remesh <mesh>... [--subtract M] [--intersect M] [options] -o out.obj
 //   viscera-studio texture <spec.json> -o <dir>
+//   viscera-studio sample kidney -o <project-dir>
 //
 // remesh runs the voxel remesh (bake/remesh.hpp) on the parts and prints its figures.
 //
@@ -37,6 +38,7 @@
 #include "haptics/trajectory.hpp"
 #include "project/project.hpp"
 #include "project/publishing.hpp"
+#include "project/sample_kidney.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/suture/anastomosis.hpp"
 #include "sim/util/atomic_file.hpp"
@@ -69,6 +71,7 @@ void usage(std::FILE* out) {
                "       viscera-studio remesh [<mesh>...] [--sample kidney] [--subtract M] [--intersect M] [options] -o "
                "out.obj\n"
                "       viscera-studio texture <spec.json> -o <dir>\n"
+               "       viscera-studio sample kidney -o <project-dir>\n"
                "       viscera-studio replay <project-dir> -o <replay.csv> [--frames N]\n"
                "       viscera-studio --version\n",
                out);
@@ -97,7 +100,7 @@ constexpr const char* kKeygenHelp =
     "public key at KEY.pub.pem, which players trust (--trust KEY.pub.pem, or a copy in\n"
     "/etc/viscera/trusted-publishers named after the publisher). Never replaces an existing key.\n";
 constexpr const char* kImportHelp =
-    "usage: viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M]\n"
+    "usage: viscera-studio import <mesh>... [--scale S] [--tetrahedralize] [--cell-size M]\n"
     "                             [--facet-size M] [-o out.vtet]\n"
     "\n"
     "Reads a surface mesh (OBJ, STL, PLY, glTF/GLB through assimp), checks it, prints its size,\n"
@@ -131,6 +134,14 @@ constexpr const char* kRemeshHelp =
     "  --uv-transfer M     the UVs written: seam-cut (default), closest or island\n"
     "  --no-uv             no UV transfer\n"
     "  --uv-preview P.png  checker preview: source, closest point, seam cutting (headless EGL)\n";
+constexpr const char* kSampleHelp =
+    "usage: viscera-studio sample kidney -o <project-dir>\n"
+    "\n"
+    "Writes the kidney sample project, made by code: the kidney-like render anatomy (four\n"
+    "overlapping parts with UV islands and seams) as anatomy/*.obj with UVs, its texture atlas\n"
+    "anatomy/kidney.png, and a project.json whose body is made from them by the remesh block\n"
+    "(voxel remesh, seam-cutting UV transfer, tetrahedralize). Export it with\n"
+    "'viscera-studio export <project-dir> -o kidney.vcase'.\n";
 constexpr const char* kOpenHelp = "usage: viscera-studio open <project-dir>\n"
                                   "\n"
                                   "Opens the desktop studio on a project (without a folder: an empty studio).\n";
@@ -271,7 +282,8 @@ int cmdKeygen(const std::vector<std::string>& args) {
 }
 
 int cmdImport(const std::vector<std::string>& args) {
-    std::optional<std::string> in, out;
+    std::vector<std::string> ins;
+    std::optional<std::string> out;
     bool tetra = false;
     bake::ImportOptions opt;
     bake::MeshingParams meshing;
@@ -293,25 +305,32 @@ int cmdImport(const std::vector<std::string>& args) {
             out = value();
         else if (!a.empty() && a[0] == '-')
             throw std::invalid_argument("unknown option '" + a + "'");
-        else if (!in)
-            in = a;
         else
-            throw std::invalid_argument("unexpected argument '" + a + "'");
+            ins.push_back(a);
     }
-    if (!in) throw std::invalid_argument("import needs a mesh file");
+    if (ins.empty()) throw std::invalid_argument("import needs a mesh file");
+    if (tetra && ins.size() > 1) throw std::invalid_argument("--tetrahedralize meshes one surface: give one mesh file");
     if (out && !tetra) throw std::invalid_argument("-o writes a tet mesh; add --tetrahedralize");
     if (out) { // before meshing, which can take minutes
         requireWritableFile(*out, "the tet mesh");
-        requireNotAnInput(*out, "the tet mesh", {*in});
+        requireNotAnInput(*out, "the tet mesh", {ins[0]});
     }
-    sim::TriMesh surface = bake::importSurface(*in, opt);
-    auto [lo, hi] = surface.bounds();
-    std::printf("%s: %zu vertices, %zu triangles, closed: %s, bounds [%g %g %g] - [%g %g %g] m\n", in->c_str(),
-                surface.vertexCount(), surface.triangleCount(), surface.isClosedOriented() ? "yes" : "no", lo.x(),
-                lo.y(), lo.z(), hi.x(), hi.y(), hi.z());
+    opt.keepUv = !tetra; // tells whether the parts carry texture coordinates
+    sim::TriMesh surface;
+    for (size_t i = 0; i < ins.size(); ++i) {
+        const std::string& in = ins[i];
+        if (ins.size() > 1) // progress for the studio's import task; one file keeps its one-line error
+            std::fprintf(stderr, "viscera-studio: stage %zu/%zu: importing %s\n", i + 1, ins.size(), in.c_str());
+        bake::ImportResult r = bake::importSurfaceWithReport(in, opt);
+        surface = std::move(r.mesh);
+        auto [lo, hi] = surface.bounds();
+        std::printf("%s: %zu vertices, %zu triangles, closed: %s, bounds [%g %g %g] - [%g %g %g] m%s\n", in.c_str(),
+                    surface.vertexCount(), surface.triangleCount(), surface.isClosedOriented() ? "yes" : "no", lo.x(),
+                    lo.y(), lo.z(), hi.x(), hi.y(), hi.z(), tetra ? "" : (r.uv.empty() ? ", uv: no" : ", uv: yes"));
+    }
     if (!tetra) return 0;
     const auto t0 = std::chrono::steady_clock::now();
-    meshing.label = std::filesystem::path(*in).filename().string();
+    meshing.label = std::filesystem::path(ins[0]).filename().string();
     // Progress on stderr, a line per stage: "viscera-studio: meshing: refine (10%)".
     bake::TetrahedralizeResult r = bake::tetrahedralize(surface, meshing, [](bake::MeshingStage stage, double f) {
         std::fprintf(stderr, "viscera-studio: meshing: %s (%.0f%%)\n", std::string(bake::stageName(stage)).c_str(),
@@ -442,6 +461,19 @@ int parseCount(const std::string& flag, const std::string& v, int lo, int hi) {
     return int(n);
 }
 
+int cmdSample(const std::vector<std::string>& args) {
+    if (args.size() != 3 || args[0] != "kidney" || args[1] != "-o")
+        throw std::invalid_argument("sample needs 'kidney -o <project-dir>' (the built-in sample is 'kidney')");
+    const std::filesystem::path dir = args[2];
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec); // a failure is reported by the check
+    requireWritableFile(dir / "project.json", "the sample project");
+    const studio::Project p = studio::writeKidneySample(dir);
+    std::printf("wrote %s: %zu anatomy parts, texture %s\n", (dir / "project.json").c_str(),
+                p.bodies.at(0).mesh.remesh.parts.size(), p.bodies.at(0).mesh.remesh.texture.filename().c_str());
+    return 0;
+}
+
 int cmdRemesh(const std::vector<std::string>& args) {
     struct Input {
         std::string file;
@@ -520,12 +552,15 @@ int cmdRemesh(const std::vector<std::string>& args) {
                         part.surface.isClosedOriented() ? "yes" : "no");
             parts.push_back(std::move(part));
         }
+    opt.keepUv = params.transferUv; // the parts' UVs, transferred when every part has them
     for (const Input& in : inputs) {
-        sim::TriMesh m = bake::importSurface(in.file, opt);
+        bake::ImportResult imported = bake::importSurfaceWithReport(in.file, opt);
+        sim::TriMesh m = std::move(imported.mesh);
         std::printf("part %s (%s): %zu vertices, %zu triangles, closed: %s\n", in.file.c_str(),
                     std::string(bake::csgOpName(in.op)).c_str(), m.vertexCount(), m.triangleCount(),
                     m.isClosedOriented() ? "yes" : "no");
-        parts.push_back({std::filesystem::path(in.file).filename().string(), std::move(m), in.op, {}});
+        parts.push_back(
+            {std::filesystem::path(in.file).filename().string(), std::move(m), in.op, std::move(imported.uv)});
     }
     const auto t0 = std::chrono::steady_clock::now();
     const bake::RemeshResult r = bake::voxelRemesh(parts, params, [](std::string_view stage, double f) {
@@ -583,7 +618,7 @@ int main(int argc, char** argv) {
     program.subcommands = {{"export", cmdExport, kExportHelp},    {"import", cmdImport, kImportHelp},
                            {"open", cmdOpen, kOpenHelp},          {"remesh", cmdRemesh, kRemeshHelp},
                            {"texture", cmdTexture, kTextureHelp}, {"replay", cmdReplay, kReplayHelp},
-                           {"keygen", cmdKeygen, kKeygenHelp}};
+                           {"keygen", cmdKeygen, kKeygenHelp},    {"sample", cmdSample, kSampleHelp}};
     program.noArguments = [] { return studio::runStudio(g_argc, g_argv, {}); };
     return sim::runCli(program, argc, argv);
 }

@@ -90,14 +90,18 @@ UvChoice reportUvTransfers(const std::vector<bake::RemeshPart>& parts, const bak
         std::vector<bake::CornerUv> uv = cut ? r.uv : bake::transferUv(source, mesh, m);
         const double took =
             cut ? r.report.uvSeconds : std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        printStats(uvTransferOptionName(m), bake::measureUvTransfer(source, mesh, uv), took);
+        const bake::UvTransferStats st = bake::measureUvTransfer(source, mesh, uv);
+        printStats(uvTransferOptionName(m), st, took);
         if (m != bake::UvTransferMethod::IslandLabelled)
-            items.push_back({cut ? "seam cutting" : "closest point", mesh, uv});
+            items.push_back({cut ? "seam cutting" : "closest point", mesh, uv, {}});
+        if (cut) // the seam cut's stretch heat map with its seams, beside it
+            items.push_back({"seam-cut stretch", mesh, uv, studio::stretchOverlay(mesh, st.faceStretch, r.seamEdges)});
         if (m == chosen) choice = {&mesh, std::move(uv)};
     }
     if (preview) {
         studio::writeUvPreview(*preview, items);
-        std::printf("wrote %s (left to right: source, closest point, seam cutting)\n", preview->c_str());
+        std::printf("wrote %s (left to right: source, closest point, seam cutting, its stretch and seams)\n",
+                    preview->c_str());
     }
     return choice;
 }

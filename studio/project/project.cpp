@@ -119,8 +119,80 @@ sim::Vec3 positiveVec3(const JsonField& f, const char* rule) {
     return v;
 }
 
+/// The "remesh" block (RemeshSource): the numbers by the rules of bake::RemeshParams.
+RemeshSource readRemesh(const JsonField& r, const std::filesystem::path& dir) {
+    r.object({"parts", "scale", "voxel_size", "voxel_count", "smoothing", "edge_length", "iterations", "uv_transfer",
+              "texture"});
+    RemeshSource out;
+    const JsonField parts = r["parts"];
+    if (!parts.value().is_array() || parts.value().empty() || parts.value().size() > 64)
+        parts.fail("must be an array of 1 to 64 parts");
+    for (const JsonField& p : parts.items()) {
+        p.object({"file", "op"});
+        RemeshSource::Part part;
+        part.file = projectFile(p["file"], dir);
+        const std::string op = p.find("op") ? p["op"].choice({"union", "difference", "intersection"}, "a CSG operation")
+                                            : std::string("union");
+        part.op = op == "union"        ? bake::CsgOp::Union
+                  : op == "difference" ? bake::CsgOp::Difference
+                                       : bake::CsgOp::Intersection;
+        out.parts.push_back(part);
+    }
+    out.scale = r.number("scale", out.scale, NumberRule::positive());
+    bake::RemeshParams& q = out.params;
+    if (r.find("voxel_size") && r.find("voxel_count")) r.fail("give voxel_size or voxel_count, not both");
+    q.voxelSize = r.number("voxel_size", 0.0, NumberRule::positive());
+    q.voxelCount = r.integer("voxel_count", q.voxelCount, 8, q.maxVoxelsPerAxis);
+    q.smoothingIterations = r.integer("smoothing", q.smoothingIterations, 0, 100);
+    q.targetEdgeLength = r.number("edge_length", 0.0, NumberRule::positive());
+    q.remeshIterations = r.integer("iterations", q.remeshIterations, 0, 20);
+    if (auto u = r.find("uv_transfer")) {
+        const std::string m = u->choice({"seam-cut", "closest", "island", "none"}, "a UV transfer method");
+        out.uvTransfer = m == "none"      ? std::nullopt
+                         : m == "closest" ? std::optional(bake::UvTransferMethod::ClosestPoint)
+                         : m == "island"  ? std::optional(bake::UvTransferMethod::IslandLabelled)
+                                          : std::optional(bake::UvTransferMethod::SeamCutting);
+    }
+    if (auto t = r.find("texture")) {
+        out.texture = projectFile(*t, dir);
+        if (out.texture.extension() != ".png") t->fail("must be a PNG image (.png)");
+        if (!out.uvTransfer) t->fail("needs UVs: uv_transfer is 'none'");
+    }
+    return out;
+}
+
+json remeshJson(const RemeshSource& r, const WriteContext& w, const std::string& field) {
+    json parts = json::array();
+    for (size_t i = 0; i < r.parts.size(); ++i)
+        parts.push_back(
+            {{"file", projectFileJson(r.parts[i].file, w, field + ".parts[" + std::to_string(i) + "].file")},
+             {"op", std::string(bake::csgOpName(r.parts[i].op))}});
+    json j = {{"parts", parts},
+              {"scale", r.scale},
+              {"smoothing", r.params.smoothingIterations},
+              {"iterations", r.params.remeshIterations},
+              {"uv_transfer", r.uvTransfer ? (*r.uvTransfer == bake::UvTransferMethod::ClosestPoint     ? "closest"
+                                              : *r.uvTransfer == bake::UvTransferMethod::IslandLabelled ? "island"
+                                                                                                        : "seam-cut")
+                                           : "none"}};
+    if (r.params.voxelSize > 0)
+        j["voxel_size"] = r.params.voxelSize;
+    else
+        j["voxel_count"] = r.params.voxelCount;
+    if (r.params.targetEdgeLength > 0) j["edge_length"] = r.params.targetEdgeLength;
+    if (!r.texture.empty()) j["texture"] = projectFileJson(r.texture, w, field + ".texture");
+    return j;
+}
+
 MeshSource readMeshSource(const JsonField& m, const std::filesystem::path& dir) {
     MeshSource s;
+    if (m.anyObject().has("remesh")) {
+        m.object({"remesh", "meshing"});
+        s.kind = MeshSource::Kind::Remesh;
+        s.remesh = readRemesh(m["remesh"], dir);
+        s.meshing = readMeshing(m);
+        return s;
+    }
     if (m.anyObject().has("file")) {
         m.object({"file", "scale", "meshing"});
         s.kind = MeshSource::Kind::File;
@@ -182,6 +254,8 @@ MeshSource readMeshSource(const JsonField& m, const std::filesystem::path& dir) 
 json meshSourceJson(const MeshSource& s, const WriteContext& w, const std::string& field) {
     using K = MeshSource::Kind;
     switch (s.kind) {
+    case K::Remesh:
+        return {{"remesh", remeshJson(s.remesh, w, field + ".remesh")}, {"meshing", meshingJson(s.meshing)}};
     case K::File:
         return {{"file", projectFileJson(s.file, w, field + ".file")},
                 {"scale", s.scale},
@@ -504,6 +578,11 @@ std::vector<std::filesystem::path> projectInputFiles(const Project& p) {
     };
     for (const BodyProject& b : p.bodies) {
         if (b.mesh.kind == MeshSource::Kind::File) files.push_back(b.mesh.file);
+        if (b.mesh.kind == MeshSource::Kind::Remesh) {
+            for (const RemeshSource::Part& part : b.mesh.remesh.parts)
+                files.push_back(part.file);
+            if (!b.mesh.remesh.texture.empty()) files.push_back(b.mesh.remesh.texture);
+        }
         texture(b.texture);
     }
     for (const SurfaceProject& s : p.surfaces)
@@ -688,7 +767,58 @@ Project newProject(const std::filesystem::path& dir, const std::string& caseId) 
     return p;
 }
 
-std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::string& origin) {
+namespace {
+
+/// The remesh block's parts, imported with their UVs (when the block transfers them).
+std::vector<bake::RemeshPart> importParts(const RemeshSource& r) {
+    std::vector<bake::RemeshPart> parts;
+    for (const RemeshSource::Part& p : r.parts) {
+        bake::ImportOptions opt;
+        opt.scale = r.scale;
+        opt.keepUv = r.uvTransfer.has_value();
+        bake::ImportResult in = bake::importSurfaceWithReport(p.file, opt);
+        if (opt.keepUv && in.uv.empty())
+            throw InputError(p.file.string() + ": has no texture coordinates (uv_transfer needs UVs on every part; "
+                                               "'none' remeshes without them)");
+        parts.push_back({p.file.filename().string(), std::move(in.mesh), p.op, std::move(in.uv)});
+    }
+    return parts;
+}
+
+/// Remesh, transfer the UVs, tetrahedralize; the boundary's corner UVs into `boundaryUv`
+/// (transferred from the remeshed surface, one host chart per boundary triangle).
+std::unique_ptr<sim::TetMesh> remeshBody(const RemeshSource& r, const bake::MeshingParams& meshing,
+                                         std::vector<render::CornerUvF>* boundaryUv) {
+    const std::vector<bake::RemeshPart> parts = importParts(r);
+    bake::RemeshParams params = r.params;
+    params.transferUv = r.uvTransfer == bake::UvTransferMethod::SeamCutting;
+    bake::RemeshResult result = bake::voxelRemesh(parts, params);
+    std::vector<bake::CornerUv> uv = std::move(result.uv);
+    if (r.uvTransfer && *r.uvTransfer != bake::UvTransferMethod::SeamCutting)
+        uv = bake::transferUv(bake::UvSource(parts), result.mesh, *r.uvTransfer);
+    // The tets fill the remeshed surface before the seam cut (its triangles are well shaped; the
+    // cut's pieces along the seams would become features and slivers): the cut surface is where
+    // the boundary's UVs come from.
+    const sim::TriMesh& hull = result.uncut.triangleCount() > 0 ? result.uncut : result.mesh;
+    bake::MeshingParams smooth = meshing;
+    smooth.featureAngleDeg = 0; // the voxel remesh rounded every edge: no feature to protect
+    std::unique_ptr<sim::TetMesh> mesh = bake::tetrahedralize(hull, smooth).mesh;
+    if (!boundaryUv || uv.empty()) return mesh;
+    const bake::UvSource remeshed({{"remeshed surface", result.mesh, bake::CsgOp::Union, std::move(uv)}});
+    auto probe = mesh->clone(); // the boundary in the render mesh's order
+    probe->requireLevel(3);
+    const std::vector<bake::CornerUv> corner =
+        bake::transferUv(remeshed, probe->boundary(), bake::UvTransferMethod::SeamCutting);
+    boundaryUv->clear();
+    for (const bake::CornerUv& c : corner)
+        boundaryUv->push_back({c[0].cast<float>(), c[1].cast<float>(), c[2].cast<float>()});
+    return mesh;
+}
+
+} // namespace
+
+std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::string& origin,
+                                            std::vector<render::CornerUvF>* boundaryUv) {
     const MeshSource& s = body.mesh;
     bake::MeshingParams params = s.meshing;
     params.label = origin + ": body '" + body.scene.name + "'";
@@ -709,6 +839,8 @@ std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::
         params.label = s.file.filename().string();
         return bake::tetrahedralize(bake::importSurface(s.file, opt), params).mesh;
     }
+    case MeshSource::Kind::Remesh:
+        return remeshBody(s.remesh, params, boundaryUv);
     }
     throw InputError(origin + ": unknown mesh source");
 }
@@ -889,8 +1021,9 @@ std::string renderWithMaterials(const std::string& render, const std::vector<ren
     json& m = doc["materials"] = json::object();
     for (const render::CaseMaterialMaps& e : materials) {
         json j = {{"tiles_per_metre", e.tilesPerMetre}, {"normal_strength", e.normalStrength}};
-        for (const auto& [key, path] : {std::pair{"diffuse", &e.diffuse}, std::pair{"roughness", &e.roughness},
-                                        std::pair{"metallic", &e.metallic}, std::pair{"normal", &e.normal}})
+        for (const auto& [key, path] :
+             {std::pair{"diffuse", &e.diffuse}, std::pair{"roughness", &e.roughness},
+              std::pair{"metallic", &e.metallic}, std::pair{"normal", &e.normal}, std::pair{"uv", &e.uv}})
             if (!path->empty()) j[key] = *path;
         m[e.target] = std::move(j);
     }
@@ -898,6 +1031,30 @@ std::string renderWithMaterials(const std::string& render, const std::vector<ren
 }
 
 namespace {
+
+/// A remeshed body with UVs: its corner UVs, and the remesh block's texture as its diffuse map
+/// (only when something is laid by them: that texture, or the body's texture block).
+void addUvMaterial(BuiltScene& built, const BodyProject& b, const std::vector<render::CornerUvF>& uv,
+                   const std::string& origin, const std::string& field) {
+    const std::string& name = b.scene.name;
+    const std::filesystem::path& texture = b.mesh.remesh.texture;
+    if (texture.empty() && !b.texture) return;
+    if (!texture.empty() && b.texture)
+        throw InputError(origin + ": " + field +
+                         ".mesh.remesh.texture: the body has a texture block too (give one of them)");
+    render::CaseMaterialMaps m;
+    m.target = name;
+    m.uv = "meshes/" + name + ".vuv";
+    built.files.emplace_back(m.uv, render::cornerUvBytes(uv));
+    if (!texture.empty()) {
+        m.diffuse = "textures/" + name + "_diffuse.png";
+        std::string bytes = readFile(texture, 64u << 20);
+        const auto read = [&](const std::string&) { return std::string_view(bytes); };
+        render::loadMaterialMaps(m, read, texture.string()); // a PNG the player can decode, or refused here
+        built.files.emplace_back(m.diffuse, std::move(bytes));
+    }
+    built.materials.push_back(std::move(m));
+}
 
 BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
     const std::string origin = (project.dir / "project.json").string();
@@ -915,11 +1072,13 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
         const std::string field = "bodies[" + std::to_string(i) + "] ('" + name + "')";
         stage("meshing body '" + name + "'");
         std::unique_ptr<sim::TetMesh> mesh;
+        std::vector<render::CornerUvF> boundaryUv;
         try {
-            mesh = buildBodyMesh(b, origin);
+            mesh = buildBodyMesh(b, origin, &boundaryUv);
         } catch (const std::invalid_argument& e) {
             throw InputError(origin + ": " + field + ".mesh: " + e.what());
         }
+        if (!boundaryUv.empty()) addUvMaterial(built, b, boundaryUv, origin, field);
         BodyExport be;
         be.name = name;
         be.nodes = mesh->vertexCount();
@@ -1055,6 +1214,14 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     header.features = features;
     vcase::CaseWriter writer(header);
     if (publish.key) writer.sign(*publish.key, publish.signer);
+    for (const render::CaseMaterialMaps& m : built.materials) { // a texture block laid by UVs, or the remesh texture
+        auto it = std::find_if(textures.materials.begin(), textures.materials.end(),
+                               [&](const render::CaseMaterialMaps& t) { return t.target == m.target; });
+        if (it != textures.materials.end())
+            it->uv = m.uv;
+        else
+            textures.materials.push_back(m);
+    }
     sim::SceneDesc written = scene;
     written.render = renderWithMaterials(scene.render, textures.materials);
     writer.addFile("scene.json", sim::formatScene(written));

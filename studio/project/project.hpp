@@ -17,7 +17,8 @@
 ///          | {"generator": "tube", "start": [..], "end": [..], "radius": 0.004, "meshing": {..}}
 ///          | {"generator": "hollow_tube", "start": [..], "end": [..], "inner_radius": 0.0038,
 ///             "outer_radius": 0.005, "slices": 33, "layers": 2, "rings": 8}   (structured, no CGAL)
-///          | {"file": "liver.obj", "scale": 0.001, "meshing": {..}},
+///          | {"file": "liver.obj", "scale": 0.001, "meshing": {..}}
+///          | {"remesh": {..see RemeshSource..}, "meshing": {..}},
 ///     "material": {see readMaterial in core/sim/scene/scene_json.hpp},
 ///     "fixed": {"min": [..], "max": [..]},     nodes inside this box (metres) are fixed
 ///     "stiffness_regions": [{"min": [..], "max": [..], "weight": 4}],
@@ -50,11 +51,14 @@
 /// project folder: no '..', not absolute (sim/util/entry_name.hpp).
 /// "meshing" (CGAL Mesh_3, metres and degrees): facet_angle, facet_size, facet_distance,
 /// cell_radius_edge_ratio, cell_size, seed.
+#include "bake/remesh.hpp"
 #include "bake/skeleton.hpp"
 #include "bake/tetrahedralize.hpp"
 #include "bake/texture.hpp"
+#include "bake/uv_transfer.hpp"
 #include "case/signing.hpp"
 #include "render/case_settings.hpp"
+#include "render/corner_uv.hpp"
 #include "render/sample_map.hpp"
 #include "sim/material/material.hpp"
 #include "sim/mesh/generators.hpp"
@@ -77,8 +81,33 @@ class World;
 
 namespace viscera::studio {
 
+/// Render anatomy made simulation-ready [issue 38 item 2]: overlapping, open parts with UVs,
+/// combined and remeshed on a voxel grid (bake::voxelRemesh), their UVs transferred onto the
+/// result, which is then tetrahedralized with the mesh's "meshing".
+///   "mesh": {"remesh": {"parts": [{"file": "anatomy/cortex.obj", "op": "union"}, ...],
+///                       "scale": 1, "voxel_size": 0.001 | "voxel_count": 128, "smoothing": 0,
+///                       "edge_length": 0.0015, "iterations": 3,
+///                       "uv_transfer": "seam-cut" | "closest" | "island" | "none",
+///                       "texture": "anatomy/kidney.png"},
+///            "meshing": {..}}
+/// The texture (a PNG of the project) is the parts' diffuse map: export lays it on the body by
+/// the transferred UVs (render.materials.<body>: diffuse + uv). A body's texture block, when it
+/// has one, is laid by them instead.
+struct RemeshSource {
+    struct Part {
+        std::filesystem::path file; ///< resolved against the project folder
+        bake::CsgOp op = bake::CsgOp::Union;
+        bool operator==(const Part&) const = default;
+    };
+    std::vector<Part> parts;
+    double scale = 1.0;        ///< file units → metres
+    bake::RemeshParams params; ///< voxel size or count, smoothing, edge length, iterations
+    std::optional<bake::UvTransferMethod> uvTransfer = bake::UvTransferMethod::SeamCutting; ///< none: no UVs
+    std::filesystem::path texture;                                                          ///< empty: none
+};
+
 struct MeshSource {
-    enum class Kind { Box, Ellipsoid, Liver, Tube, HollowTube, File };
+    enum class Kind { Box, Ellipsoid, Liver, Tube, HollowTube, File, Remesh };
     Kind kind = Kind::Box;
     sim::HollowTubeSpec hollow; ///< Kind::HollowTube
     sim::BoxSpec box;
@@ -90,6 +119,7 @@ struct MeshSource {
     std::filesystem::path file; ///< Kind::File: resolved against the project folder (dir / "file")
     double scale = 1.0;
     bake::MeshingParams meshing;
+    RemeshSource remesh; ///< Kind::Remesh
 };
 
 /// Nodes inside an axis-aligned box get a stiffness weight (the skeleton brush comes later).
@@ -281,6 +311,9 @@ struct BuiltScene {
     ExportResult result; ///< per-body figures (casePath and bytes empty)
     /// per body: the curve skeleton its stiffness paint went through (empty: no paint)
     std::vector<std::optional<sim::Skeleton>> skeletons;
+    /// render.materials entries of remeshed bodies with UVs: the corner-UV file and, from the
+    /// remesh block's texture, the diffuse map (both in `files`)
+    std::vector<render::CaseMaterialMaps> materials;
 };
 
 /// The node weights of body `b` on `mesh`: its stiffness regions times its stiffness paint
@@ -338,6 +371,7 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
                         const CasePublishing& publish = {});
 
 /// Builds one body's tet mesh from its source (exposed for the import command and tests).
-std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::string& origin);
+std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::string& origin,
+                                            std::vector<render::CornerUvF>* boundaryUv = nullptr);
 
 } // namespace viscera::studio

@@ -105,3 +105,32 @@ TEST(PlayerScreenshot, TraineeWindowShowsTheRenderedView) {
         }
     EXPECT_GT(colours.size(), 1000u);
 }
+
+TEST(PlayerScreenshot, TheKidneyMadeFromRenderAnatomyShowsItsTexture) {
+    ::setenv("LIBGL_ALWAYS_SOFTWARE", "1", 0);
+    std::string why;
+    if (!render::headlessContextAvailable(&why)) GTEST_SKIP() << "no headless GL context: " << why;
+    Scratch s("viscera-kidney-shot");
+    auto k = test::runProcess(VISCERA_STUDIO_EXE, {"sample", "kidney", "-o", s / "kidney"});
+    ASSERT_EQ(k.exitCode, 0) << k.err;
+    const std::string vcase = s / "kidney.vcase";
+    auto e = test::runProcess(VISCERA_STUDIO_EXE, test::signingWithSampleKey({"export", s / "kidney", "-o", vcase}));
+    ASSERT_EQ(e.exitCode, 0) << e.err;
+    const auto png = s.dir / "kidney.png";
+    auto r = test::runProcess(VISCERA_PLAYER_EXE, test::trustingSampleKey({"run", vcase, "--headless", "--frames", "30",
+                                                                           "--screenshot", png.string()}));
+    ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
+    EXPECT_THAT(r.out, HasSubstr("all finite: yes"));
+    // The atlas's colours on the body: the cortex's dark red and the pelvis's and ureter's pale
+    // yellow, each over a good part of the frame (a body drawn without its UVs is one tissue colour).
+    const render::Image img = render::readPng(png);
+    size_t red = 0, pale = 0;
+    for (size_t i = 0; i + 3 < img.rgba.size(); i += 4) {
+        const int R = img.rgba[i], G = img.rgba[i + 1], B = img.rgba[i + 2];
+        red += R > 45 && R > 2 * G && R > 2 * B ? 1 : 0;
+        pale += R > 110 && G > 85 && B > 55 && G > R / 2 && std::abs(R - G) < 70 ? 1 : 0;
+    }
+    const size_t pixels = size_t(img.width) * size_t(img.height);
+    EXPECT_GT(red, pixels / 100) << "cortex";
+    EXPECT_GT(pale, pixels / 100) << "pelvis and ureter";
+}

@@ -3,6 +3,7 @@
 // refused when the case would not use them or when the file is malformed.
 #include "case/case_writer.hpp"
 #include "render/case_settings.hpp"
+#include "render/corner_uv.hpp"
 #include "render/image.hpp"
 #include "render/sample_map.hpp"
 #include "runtime/session.hpp"
@@ -12,10 +13,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <functional>
+#include <set>
 
 #include <unistd.h>
 
@@ -274,4 +279,100 @@ TEST(CaseView, MaterialEntriesComeSortedByNameWithTheirFiles) {
     EXPECT_EQ(entries[1].files(), (std::vector<std::string>{"t/b_n.png"}));
     EXPECT_TRUE(render::caseMaterialMaps("", "scene.json").empty());
     EXPECT_TRUE(render::caseMaterialMaps(R"({"sss": true})", "scene.json").empty());
+}
+
+namespace {
+
+/// Corner UVs for the slab's boundary: u from x (0..1 over the slab), the triangles with their
+/// centroid at x > 4 cm in a second island (u + 2): a seam across the slab at x = 4 cm.
+std::vector<render::CornerUvF> slabCornerUv(size_t* seamVertices = nullptr) {
+    auto mesh = slab();
+    mesh->requireLevel(3);
+    const sim::TriMesh& b = mesh->boundary();
+    std::vector<render::CornerUvF> uv;
+    std::set<int32_t> onSeam;
+    for (const sim::Tri& t : b.triangles()) {
+        const sim::Vec3 c = (b.positions()[t[0]] + b.positions()[t[1]] + b.positions()[t[2]]) / 3.0;
+        render::CornerUvF corner;
+        for (int k = 0; k < 3; ++k) {
+            const sim::Vec3& p = b.positions()[t[k]];
+            corner[size_t(k)] = Eigen::Vector2f(float(p.x() / 0.08 + (c.x() > 0.04 ? 2 : 0)), float(p.z() / 0.04));
+            if (std::abs(p.x() - 0.04) < 1e-9) onSeam.insert(t[k]);
+        }
+        uv.push_back(corner);
+    }
+    if (seamVertices) *seamVertices = onSeam.size();
+    return uv;
+}
+
+} // namespace
+
+TEST(CaseView, CornerUvsLayTheMapsAndSplitTheBodyAtItsSeams) {
+    size_t seam = 0;
+    const std::vector<render::CornerUvF> uv = slabCornerUv(&seam);
+    ASSERT_GT(seam, 0u);
+    const nlohmann::json render = {
+        {"materials", {{"slab", {{"diffuse", "textures/slab_diffuse.png"}, {"uv", "meshes/slab.vuv"}}}}}};
+    const auto path = writeMappedCase("uv", render,
+                                      {{"textures/slab_diffuse.png", render::encodePng(checker(16, 16, 10, 250))},
+                                       {"meshes/slab.vuv", render::cornerUvBytes(uv)}});
+    const player::LoadedCase c = player::loadCase(path, unsignedAllowed());
+    ASSERT_EQ(c.cornerUvs.size(), 1u);
+    EXPECT_EQ(c.cornerUvs[0].first, "slab");
+    ASSERT_EQ(c.cornerUvs[0].second.size(), uv.size());
+    render::SceneView view = player::caseView(c);
+    ASSERT_EQ(view.meshes().size(), 1u);
+    const render::RenderMesh& m = view.meshes()[0];
+    auto mesh = slab();
+    mesh->requireLevel(3);
+    // One render vertex per (node, UV): the seam's nodes appear twice, every other node once.
+    EXPECT_EQ(m.vertexCount(), mesh->boundaryVertexMap().size() + seam);
+    ASSERT_EQ(m.uv.size(), 2 * m.vertexCount());
+    ASSERT_EQ(m.weld.size(), m.vertexCount());
+    for (size_t t = 0; t < uv.size(); ++t)
+        for (size_t k = 0; k < 3; ++k) {
+            const uint32_t v = m.indices[3 * t + k];
+            EXPECT_EQ(m.uv[2 * v], uv[t][k].x());
+            EXPECT_EQ(m.uv[2 * v + 1], uv[t][k].y());
+        }
+    // The copies of a node move with it and share one normal.
+    view.recomputeNormals(0);
+    for (size_t v = 0; v < m.vertexCount(); ++v) {
+        const uint32_t w = m.weld[v];
+        EXPECT_EQ(m.sourceVertex[v], m.sourceVertex[w]);
+        for (int k = 0; k < 3; ++k)
+            EXPECT_FLOAT_EQ(m.normals[3 * v + size_t(k)], m.normals[3 * w + size_t(k)]);
+    }
+    std::filesystem::remove(path);
+}
+
+TEST(CaseView, BadCornerUvsAreRefusedAtLoadNamingTheEntryAndTheRule) {
+    std::vector<render::CornerUvF> uv = slabCornerUv();
+    const std::string png = render::encodePng(checker(16, 16, 10, 250));
+    const nlohmann::json render = {
+        {"materials", {{"slab", {{"diffuse", "textures/slab_diffuse.png"}, {"uv", "meshes/slab.vuv"}}}}}};
+    auto refused = [&](const std::string& bytes, const std::string& rule) {
+        const auto path =
+            writeMappedCase("baduv", render, {{"textures/slab_diffuse.png", png}, {"meshes/slab.vuv", bytes}});
+        try {
+            player::loadCase(path, unsignedAllowed());
+            ADD_FAILURE() << "accepted: " << rule;
+        } catch (const InputError& e) {
+            EXPECT_THAT(e.what(), ::testing::HasSubstr("meshes/slab.vuv: " + rule));
+        }
+        std::filesystem::remove(path);
+    };
+    std::vector<render::CornerUvF> fewer(uv.begin(), uv.end() - 1);
+    refused(render::cornerUvBytes(fewer),
+            std::to_string(fewer.size()) + " triangles, the body's boundary has " + std::to_string(uv.size()));
+    refused("JPEG....", "not a corner-UV file");
+    std::string cut = render::cornerUvBytes(uv);
+    cut.pop_back();
+    refused(cut, std::to_string(cut.size()) + " bytes");
+    std::string nan = render::cornerUvBytes(uv);
+    const float bad = std::nanf("");
+    std::memcpy(&nan[8 + 24 * 5 + 8], &bad, 4); // triangle 5, corner 1, u
+    refused(nan, "triangle 5 corner 1: the UV is not finite");
+    EXPECT_THROW(render::cornerUvBytes({{Eigen::Vector2f(1e9f, 0), Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero()}}),
+                 std::invalid_argument);
 }

@@ -780,7 +780,7 @@ TEST_F(WindowFixture, GuiExportEqualsCliExport) {
     EXPECT_EQ(manifestFiles(gui), manifestFiles(cli));
     // nothing else left in the folder
     for (const auto& e : fs::directory_iterator(scratch.dir))
-        EXPECT_EQ(e.path().filename().string().rfind(".viscera-export", 0), std::string::npos) << e.path();
+        EXPECT_EQ(e.path().filename().string().rfind(".viscera-", 0), std::string::npos) << e.path();
 }
 
 TEST_F(WindowFixture, CancelTakesEffectWithinHalfASecondAndLeavesNoFile) {
@@ -809,7 +809,7 @@ TEST_F(WindowFixture, CancelTakesEffectWithinHalfASecondAndLeavesNoFile) {
     EXPECT_EQ(message, "cancelled");
     EXPECT_FALSE(fs::exists(out));
     for (const auto& e : fs::directory_iterator(scratch.dir))
-        EXPECT_EQ(e.path().filename().string().rfind(".viscera-export", 0), std::string::npos) << e.path();
+        EXPECT_EQ(e.path().filename().string().rfind(".viscera-", 0), std::string::npos) << e.path();
     // an output folder that is not writable is refused before anything runs
     QString why;
     studio::ExportRunner r;

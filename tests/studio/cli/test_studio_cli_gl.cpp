@@ -1,6 +1,7 @@
 // viscera-studio remesh --sample kidney --uv-preview (label gl: the preview renders headless):
 // the figures of the three transfers, seam cutting with no triangle over two islands,
-// the OBJ with its UVs and the checker preview, three surfaces side by side.
+// the OBJ with its UVs and the checker preview, four surfaces side by side (the last the seam cut's stretch heat map
+// and seams).
 #include "render/image.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "support/run_process.hpp"
@@ -51,21 +52,21 @@ TEST(StudioCliGl, RemeshTheKidneySampleWithItsUvsAndTheCheckerPreview) {
     const std::string obj = readFile(s / "kidney.obj");
     EXPECT_THAT(obj, HasSubstr("\nvt "));
     EXPECT_TRUE(std::regex_search(obj, std::regex(R"(\nf \d+/\d+ \d+/\d+ \d+/\d+\n)")));
-    // The preview: three surfaces across the image, checker-textured (many distinct colours).
+    // The preview: four surfaces across the image, checker-textured (many distinct colours).
     const render::Image img = render::readPng(s / "preview.png");
     ASSERT_EQ(img.width, 1800);
     ASSERT_EQ(img.height, 700);
     const uint8_t* corner = img.pixel(0, 0);
-    std::array<size_t, 3> covered{};
+    std::array<size_t, 4> covered{};
     std::set<int> colours;
     for (int y = 0; y < img.height; ++y)
         for (int x = 0; x < img.width; ++x) {
             const uint8_t* p = img.pixel(x, y);
             if (std::abs(p[0] - corner[0]) + std::abs(p[1] - corner[1]) + std::abs(p[2] - corner[2]) < 12) continue;
-            ++covered[size_t(3 * x / img.width)];
+            ++covered[size_t(4 * x / img.width)];
             colours.insert((p[0] >> 4) << 8 | (p[1] >> 4) << 4 | (p[2] >> 4));
         }
-    for (size_t third = 0; third < 3; ++third)
-        EXPECT_GT(covered[third], size_t(img.width * img.height / 60)) << "third " << third;
+    for (size_t quarter = 0; quarter < 4; ++quarter) // source, closest point, seam cutting, its stretch and seams
+        EXPECT_GT(covered[quarter], size_t(img.width * img.height / 80)) << "quarter " << quarter;
     EXPECT_GT(colours.size(), 40u);
 }

@@ -1,0 +1,90 @@
+#pragma once
+/// From render anatomy to a simulation body in the studio [issue 38 item 3]: the Mesh menu's
+/// three steps, each run as a StudioTask (progress, a cancel that takes effect at once) and
+/// applied to the model as one undo step.
+///
+///   Import anatomy…          parts (OBJ/STL/PLY/glTF/GLB/FBX, the import's safety rules) and an
+///                            optional PNG texture: checked by `viscera-studio import`, copied
+///                            into the project's anatomy/ folder, and a new body made from them by
+///                            a remesh block (seam-cut UVs when every part has them);
+///   Make simulation-ready…   the voxel grid drawn over the parts before running; the remesh with
+///                            its UV transfer; then source, closest-point and seam-cut transfers
+///                            side by side with a checker, the seam-cut stretch heat map with its
+///                            seams, and the share of faces over the stretch threshold; Apply
+///                            writes the grid and transfer settings into the body's block;
+///   Tetrahedralize…          the body meshed and checked as export does: nodes, tets, min
+///                            dihedral, slivers; where the stability check asks for more substeps
+///                            than allowed, the fixes offered in place (coarser cells, inertia
+///                            scaling, more substeps), each an undoable edit.
+#include "app/studio_task.hpp"
+
+#include <QObject>
+#include <QPointer>
+#include <QProgressDialog>
+#include <QString>
+#include <QStringList>
+
+class QAction;
+class QDialog;
+class QLabel;
+class QMenu;
+class QWidget;
+
+namespace viscera::studio {
+
+class Document;
+class Selection;
+
+class AnatomySteps : public QObject {
+    Q_OBJECT
+public:
+    AnatomySteps(Document* doc, Selection* sel, QWidget* window);
+
+    /// Adds the three actions to `menu`.
+    void buildMenu(QMenu* menu);
+    QAction* importAction() const { return m_import; }
+    QAction* simulationReadyAction() const { return m_ready; }
+    QAction* tetrahedralizeAction() const { return m_tetra; }
+
+    /// The steps with their inputs (the actions ask for them). Each returns false and sets `why`
+    /// (one line) when it cannot start; the result arrives through the task.
+    bool importAnatomy(const QStringList& files, QString* why);
+    bool makeSimulationReady(int voxels, int smoothing, const QString& uvMethod, QString* why);
+    bool tetrahedralize(QString* why);
+
+    StudioTask& task() { return m_task; }
+    /// The open dialogs (null when closed): the step's settings, its progress, its result.
+    QDialog* settingsDialog() const { return m_settings; }
+    QProgressDialog* progressDialog() const { return m_progress; }
+    QDialog* resultDialog() const { return m_result; }
+    /// The body the steps act on: the selected body with a remesh block, else -1.
+    int remeshBody() const;
+
+signals:
+    void logMessage(const QString& line);
+
+private:
+    void askImport();
+    void askSimulationReady();
+    bool run(const QString& name, const QStringList& args, int stages, QString* why);
+    void onFinished(bool ok, const QString& message);
+    void applyImport(const QString& output);
+    void showRemeshResult(const QString& output);
+    void showMeshingResult(bool ok, const QString& output, const QString& message);
+    QString copyIntoProject(const QString& file, QString* why) const;
+
+    Document* m_doc;
+    Selection* m_sel;
+    QWidget* m_window;
+    StudioTask m_task;
+    QAction *m_import = nullptr, *m_ready = nullptr, *m_tetra = nullptr;
+    QPointer<QDialog> m_settings, m_result;
+    QPointer<QProgressDialog> m_progress;
+    QStringList m_pendingFiles; ///< import: the files checked by the running task
+    struct Pending {
+        int voxels = 0, smoothing = 0;
+        QString uvMethod;
+    } m_pendingRemesh;
+};
+
+} // namespace viscera::studio

@@ -1,0 +1,69 @@
+#pragma once
+/// The studio's one kind of long job (import, remesh, tetrahedralize, export): the same
+/// `viscera-studio <command>` a user runs headless, run as a child process in a private temporary
+/// folder, so the studio never blocks and a cancel takes effect at once, also inside CGAL or
+/// OpenVDB (the child is killed: nothing it wrote survives, the model is untouched).
+///
+/// Progress: one step per line the child prints as "viscera-studio: [stage i/n: ]<stage>" on its
+/// error stream. The result (its output, the files it wrote in workDir()) is handed back on the
+/// UI thread by finished(); the caller applies it to the model as one undo step.
+#include <QObject>
+#include <QProcess>
+#include <QString>
+#include <QStringList>
+
+#include <memory>
+
+class QTemporaryDir;
+
+namespace viscera::studio {
+
+class StudioTask : public QObject {
+    Q_OBJECT
+public:
+    explicit StudioTask(QObject* parent = nullptr);
+    ~StudioTask() override;
+
+    /// The viscera-studio executable to run (default: this program).
+    void setProgram(const QString& path) { m_program = path; }
+    const QString& program() const { return m_program; }
+
+    /// Makes the private folder inside `parentDir` (the folder a result will be moved to, so the
+    /// move is a rename) and returns its path, or an empty string and `why` when it cannot.
+    /// Call before start(), to place arguments (files the child reads or writes) in it.
+    QString prepare(const QString& parentDir, QString* why);
+    /// Runs `viscera-studio args...` (after prepare()); `stages` is the expected number of stage
+    /// lines (progress maximum, grown when the child prints more). Returns false and sets `why`
+    /// when a task is running or prepare() was not called.
+    bool start(const QString& name, const QStringList& args, int stages, QString* why);
+    /// Kills the child; finished(false, "cancelled") has been emitted when it returns.
+    void cancel();
+
+    bool running() const { return m_process && m_process->state() != QProcess::NotRunning; }
+    const QString& name() const { return m_name; }
+    int stageCount() const { return m_total; }
+    int stagesDone() const { return m_done; }
+    /// The child's output so far (stdout and stderr, merged).
+    const QString& output() const { return m_output; }
+    /// The private folder (valid from prepare() until the next prepare() or the task's end is
+    /// handled: finished() receivers may read and move files from it).
+    QString workDir() const;
+
+signals:
+    void progress(int done, int total, const QString& stage);
+    /// ok: the child succeeded (its files are in workDir() while the signal is handled); else
+    /// `message` is the child's last line (it names the file, field and rule) or "cancelled".
+    void finished(bool ok, const QString& message);
+
+private:
+    void readOutput();
+    void onFinished(int code, QProcess::ExitStatus status);
+
+    QString m_program, m_name, m_output, m_lineBuffer;
+    std::unique_ptr<QProcess> m_process;
+    std::unique_ptr<QTemporaryDir> m_tmp;
+    int m_total = 0, m_done = 0;
+    bool m_cancelled = false;
+};
+
+} // namespace viscera::studio

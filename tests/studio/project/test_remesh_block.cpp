@@ -1,0 +1,159 @@
+// The "remesh" mesh block of project.json [issue 38 item 2] and the kidney sample made by code
+// [item 4]: the sample round-trips through the one reader and writer; every field's rule names
+// the field; the export remeshes the parts, transfers their UVs onto the tet boundary and
+// packages them with the texture (render.materials.<body>: diffuse + uv).
+#include "case/case_package.hpp"
+#include "project/project.hpp"
+#include "project/sample_kidney.hpp"
+#include "render/case_settings.hpp"
+#include "render/corner_uv.hpp"
+#include "sim/mesh/tet_io.hpp"
+#include "sim/scene/scene_json.hpp"
+#include "sim/util/atomic_file.hpp"
+#include "sim/util/error.hpp"
+#include "support/scratch_dir.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+
+using namespace viscera;
+using ::testing::HasSubstr;
+using json = nlohmann::json;
+
+namespace {
+
+class RemeshBlock : public ::testing::Test {
+protected:
+    test::Scratch m_scratch{"viscera-remesh-block"};
+    std::filesystem::path m_dir = m_scratch.dir / "kidney";
+
+    /// The error of loading the sample's project.json with `edit` applied ("accepted" when it loads).
+    std::string loadError(const std::function<void(json&)>& edit) {
+        json doc = json::parse(readFile(m_dir / "project.json"));
+        edit(doc["bodies"][0]["mesh"]["remesh"]);
+        try {
+            studio::loadProjectText(doc.dump(1), m_dir, (m_dir / "project.json").string());
+        } catch (const InputError& e) {
+            return e.what();
+        }
+        return "accepted";
+    }
+};
+
+} // namespace
+
+TEST_F(RemeshBlock, TheKidneySampleRoundTripsThroughTheOneReaderAndWriter) {
+    const studio::Project p = studio::writeKidneySample(m_dir);
+    ASSERT_EQ(p.bodies.size(), 1u);
+    const studio::MeshSource& m = p.bodies[0].mesh;
+    ASSERT_EQ(m.kind, studio::MeshSource::Kind::Remesh);
+    ASSERT_EQ(m.remesh.parts.size(), 4u);
+    EXPECT_EQ(m.remesh.parts[0].file, m_dir / "anatomy" / "cortex.obj");
+    EXPECT_EQ(m.remesh.params.voxelCount, 64);
+    EXPECT_EQ(m.remesh.uvTransfer, bake::UvTransferMethod::SeamCutting);
+    EXPECT_EQ(m.remesh.texture, m_dir / "anatomy" / "kidney.png");
+    const std::string text = readFile(m_dir / "project.json");
+    EXPECT_EQ(studio::projectJsonText(p), text);
+    // Every optional field set the other way survives the writer.
+    json doc = json::parse(text);
+    json& r = doc["bodies"][0]["mesh"]["remesh"];
+    r.erase("voxel_count");
+    r["voxel_size"] = 0.0015;
+    r["edge_length"] = 0.002;
+    r["smoothing"] = 2;
+    r["uv_transfer"] = "island";
+    r["parts"][1]["op"] = "difference";
+    const studio::Project q = studio::loadProjectText(doc.dump(1), m_dir, (m_dir / "project.json").string());
+    const studio::RemeshSource& s = q.bodies[0].mesh.remesh;
+    EXPECT_EQ(s.params.voxelSize, 0.0015);
+    EXPECT_EQ(s.params.targetEdgeLength, 0.002);
+    EXPECT_EQ(s.params.smoothingIterations, 2);
+    EXPECT_EQ(s.uvTransfer, bake::UvTransferMethod::IslandLabelled);
+    EXPECT_EQ(s.parts[1].op, bake::CsgOp::Difference);
+    const std::string again = studio::projectJsonText(q);
+    EXPECT_EQ(studio::projectJsonText(studio::loadProjectText(again, m_dir, "again")), again);
+}
+
+TEST_F(RemeshBlock, EveryFieldIsRefusedByNameAndRule) {
+    studio::writeKidneySample(m_dir);
+    const std::string at = "bodies[0].mesh.remesh.";
+    EXPECT_THAT(loadError([](json& r) { r["parts"] = json::array(); }),
+                HasSubstr(at + "parts: must be an array of 1 to 64 parts"));
+    EXPECT_THAT(loadError([](json& r) { r["voxel_size"] = 0.001; }),
+                HasSubstr("give voxel_size or voxel_count, not both"));
+    EXPECT_THAT(loadError([](json& r) { r["voxel_count"] = 4; }), HasSubstr(at + "voxel_count"));
+    EXPECT_THAT(loadError([](json& r) { r["smoothing"] = 101; }), HasSubstr(at + "smoothing"));
+    EXPECT_THAT(loadError([](json& r) { r["iterations"] = -1; }), HasSubstr(at + "iterations"));
+    EXPECT_THAT(loadError([](json& r) { r["scale"] = 0; }), HasSubstr(at + "scale"));
+    EXPECT_THAT(loadError([](json& r) { r["uv_transfer"] = "nearest"; }), HasSubstr(at + "uv_transfer"));
+    EXPECT_THAT(loadError([](json& r) { r["texture"] = "anatomy/kidney.jpg"; }),
+                HasSubstr(at + "texture: must be a PNG image (.png)"));
+    EXPECT_THAT(loadError([](json& r) { r["uv_transfer"] = "none"; }), HasSubstr(at + "texture: needs UVs"));
+    EXPECT_THAT(loadError([](json& r) { r["parts"][0]["file"] = "../cortex.obj"; }), HasSubstr(at + "parts[0].file"));
+    EXPECT_THAT(loadError([](json& r) { r["parts"][0]["op"] = "xor"; }), HasSubstr(at + "parts[0].op"));
+    EXPECT_THAT(loadError([](json& r) { r["colour"] = 1; }), HasSubstr("colour"));
+}
+
+TEST_F(RemeshBlock, ExportLaysTheTextureOnTheTetBoundaryByTheTransferredUvs) {
+    studio::writeKidneySample(m_dir);
+    const studio::Project p = studio::loadProject(m_dir);
+    const auto out = m_scratch.dir / "kidney.vcase";
+    const studio::ExportResult r = studio::exportCase(p, out);
+    ASSERT_EQ(r.bodies.size(), 1u);
+    EXPECT_GT(r.bodies[0].tets, 500u);
+    EXPECT_TRUE(r.bodies[0].quality.inverted.empty());
+    EXPECT_TRUE(r.bodies[0].quality.slivers.empty());
+    const auto pkg = vcase::CasePackage::open(out);
+    ASSERT_TRUE(pkg->contains("meshes/kidney.vuv"));
+    ASSERT_TRUE(pkg->contains("textures/kidney_diffuse.png"));
+    EXPECT_EQ(pkg->read("textures/kidney_diffuse.png"), readFile(m_dir / "anatomy" / "kidney.png"));
+    const sim::SceneDesc scene = sim::parseScene(pkg->read("scene.json"), "scene.json");
+    const auto materials = render::caseMaterialMaps(scene.render, "scene.json");
+    ASSERT_EQ(materials.size(), 1u);
+    EXPECT_EQ(materials[0].uv, "meshes/kidney.vuv");
+    EXPECT_EQ(materials[0].diffuse, "textures/kidney_diffuse.png");
+    auto mesh = sim::parseVtet(pkg->read("meshes/kidney.vtet"), "kidney.vtet");
+    mesh->requireLevel(3);
+    const auto uv =
+        render::parseCornerUv(pkg->read("meshes/kidney.vuv"), "kidney.vuv", mesh->boundary().triangleCount());
+    // The UVs lie in the atlas (the sample's islands span [0.02, 0.98]²) and vary over the body.
+    float lo = 1, hi = 0;
+    for (const auto& c : uv)
+        for (const auto& w : c) {
+            EXPECT_GE(w.x(), 0.0f);
+            EXPECT_LE(w.x(), 1.0f);
+            lo = std::min(lo, w.x());
+            hi = std::max(hi, w.x());
+        }
+    EXPECT_GT(hi - lo, 0.5f);
+}
+
+TEST_F(RemeshBlock, APartWithoutUvsIsRefusedAtExportNamingTheFile) {
+    studio::writeKidneySample(m_dir);
+    std::string obj = readFile(m_dir / "anatomy" / "artery.obj");
+    std::string plain;
+    for (size_t at = 0; at < obj.size();) { // drop the vt lines and the /vt of the faces
+        const size_t end = obj.find('\n', at);
+        std::string line = obj.substr(at, end - at);
+        at = end == std::string::npos ? obj.size() : end + 1;
+        if (line.rfind("vt ", 0) == 0) continue;
+        if (line.rfind("f ", 0) == 0)
+            for (size_t s = line.find('/'); s != std::string::npos; s = line.find('/')) {
+                const size_t e = line.find(' ', s);
+                line.erase(s, (e == std::string::npos ? line.size() : e) - s);
+            }
+        plain += line + "\n";
+    }
+    writeFileAtomic(m_dir / "anatomy" / "artery.obj", plain);
+    const studio::Project p = studio::loadProject(m_dir);
+    try {
+        studio::exportCase(p, m_scratch.dir / "kidney.vcase");
+        ADD_FAILURE() << "exported";
+    } catch (const InputError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("artery.obj: has no texture coordinates"));
+    }
+    EXPECT_FALSE(std::filesystem::exists(m_scratch.dir / "kidney.vcase"));
+}
