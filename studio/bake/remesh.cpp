@@ -148,6 +148,43 @@ std::string_view csgOpName(CsgOp op) {
     return "union";
 }
 
+namespace {
+
+/// The seam-cut surface remeshed with its chart borders held (protected: neither split nor
+/// collapsed, so no border is straightened over a bend), its seam edges found again. Where that
+/// remesh makes triangles intersect (held short edges in a thin region), the cut surface is kept
+/// as it is (report.seamCut.remeshKept false), cut again without snapping: only splits of
+/// `uncut`'s triangles in their planes, which cannot make triangles intersect.
+void remeshCut(const UvSource& source, const sim::TriMesh& uncut, const RemeshParams& params, RemeshReport& report,
+               UvMesh& cut) {
+    SurfaceMesh sm = toSurfaceMesh(cut.mesh);
+    SurfaceMesh::Property_map<SurfaceMesh::Edge_index, bool> ecm;
+    remeshWithHardEdges(sm, report.targetEdgeLength, params, cut.chartBorders, ecm, true);
+    sm.collect_garbage();
+    std::vector<std::pair<SurfaceMesh::Face_index, SurfaceMesh::Face_index>> pairs;
+    PMP::self_intersections(sm, std::back_inserter(pairs));
+    report.seamCut.remeshKept = pairs.empty();
+    if (!pairs.empty()) {
+        SeamCutParams plain = params.seamCut;
+        plain.snapFraction = 0;
+        cut = cutAlongSeams(source, uncut, plain, &report.seamCut);
+        report.seamCut.remeshKept = false;
+        return;
+    }
+    cut.mesh = toTriMesh(sm);
+    cut.seamEdges.clear();
+    for (auto e : sm.edges()) // the held edges that lie on a seam or between two islands
+        if (ecm[e] && !sm.is_border(e)) {
+            const auto h = sm.halfedge(e);
+            const auto a = sm.source(h), b = sm.target(h);
+            if (isSeamEdge(source, point(sm, a), point(sm, b), centroid(sm, sm.face(h)),
+                           centroid(sm, sm.face(sm.opposite(h)))))
+                cut.seamEdges.push_back({int32_t(a.idx()), int32_t(b.idx())});
+        }
+}
+
+} // namespace
+
 RemeshResult voxelRemesh(const std::vector<RemeshPart>& parts, const RemeshParams& params,
                          const RemeshProgress& progress, const std::atomic<bool>* cancel) {
     validate(params);
@@ -177,28 +214,14 @@ RemeshResult voxelRemesh(const std::vector<RemeshPart>& parts, const RemeshParam
     const bool withUv =
         params.transferUv && std::all_of(parts.begin(), parts.end(), [](const RemeshPart& p) { return !p.uv.empty(); });
     if (withUv) {
-        // [A §3.3.4, Algorithm 1]: cut along the seams, remesh with the chart borders held
-        // (protected: neither split nor collapsed, so no border is straightened over a bend), transfer.
+        // [A §3.3.4, Algorithm 1]: cut along the seams, remesh with the chart borders held, transfer.
         stage("seam cut", 0.8);
         const auto tu = Clock::now();
         const UvSource source(parts);
         UvMesh cut = cutAlongSeams(source, result, params.seamCut, &report.seamCut);
         if (params.remeshIterations > 0) {
             stage("remeshing along the seams", 0.84);
-            sm = toSurfaceMesh(cut.mesh);
-            SurfaceMesh::Property_map<SurfaceMesh::Edge_index, bool> ecm;
-            remeshWithHardEdges(sm, report.targetEdgeLength, params, cut.chartBorders, ecm, true);
-            sm.collect_garbage();
-            cut.mesh = toTriMesh(sm);
-            cut.seamEdges.clear();
-            for (auto e : sm.edges()) // the held edges that lie on a seam or between two islands
-                if (ecm[e] && !sm.is_border(e)) {
-                    const auto h = sm.halfedge(e);
-                    const auto a = sm.source(h), b = sm.target(h);
-                    if (isSeamEdge(source, point(sm, a), point(sm, b), centroid(sm, sm.face(h)),
-                                   centroid(sm, sm.face(sm.opposite(h)))))
-                        cut.seamEdges.push_back({int32_t(a.idx()), int32_t(b.idx())});
-                }
+            remeshCut(source, result, params, report, cut);
         }
         sm = toSurfaceMesh(cut.mesh);
         out.uncut = std::move(result);

@@ -66,7 +66,10 @@ struct SeamCutReport {
     size_t splitTriangles = 0;   ///< triangles replaced by their pieces
     size_t seamEdges = 0;        ///< edges of the cut mesh lying on a seam (held hard)
     size_t unresolvedPieces = 0; ///< pieces still over two charts after the refinement
-    size_t recutTriangles = 0;   ///< triangles of the remeshed cut split again (a border the remesh straightened)
+    /// The cut surface was remeshed with its chart borders held; false: that remesh made
+    /// triangles intersect and the cut surface is the result as it is.
+    bool remeshKept = true;
+    size_t recutTriangles = 0; ///< triangles of the remeshed cut split again (a border the remesh straightened)
 };
 
 struct RemeshParams {

@@ -140,7 +140,9 @@ public:
         std::unordered_map<uint64_t, int32_t> at;
         for (const auto& [a, b] : edges()) {
             if (m_chart[a] < 0 || m_chart[b] < 0 || m_chart[a] == m_chart[b]) continue;
-            at[edgeKey(a, b)] = addVertex(m_pos[a] + border(a, b) * (m_pos[b] - m_pos[a]), -1);
+            // A split within 1 % of an end (a snap refused) leaves a sliver, not a degenerate triangle.
+            const double t = std::clamp(border(a, b), 0.01, 0.99);
+            at[edgeKey(a, b)] = addVertex(m_pos[a] + t * (m_pos[b] - m_pos[a]), -1);
         }
         crossed = at.size();
         m_pieceChart.clear();
