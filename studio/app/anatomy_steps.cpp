@@ -117,18 +117,23 @@ AnatomySteps::AnatomySteps(Document* doc, Selection* sel, QWidget* window)
         m_progress->setLabelText(m_task.name() + ": " + stage);
     });
     connect(&m_task, &StudioTask::finished, this, &AnatomySteps::onFinished);
-}
-
-void AnatomySteps::buildMenu(QMenu* menu) {
-    m_import = menu->addAction(tr("&Import anatomy…"), this, &AnatomySteps::askImport);
-    m_import->setObjectName("importAnatomy");
-    m_ready = menu->addAction(tr("Make &simulation-ready…"), this, &AnatomySteps::askSimulationReady);
-    m_ready->setObjectName("makeSimulationReady");
-    m_tetra = menu->addAction(tr("&Tetrahedralize…"), this, [this] {
+    m_import = new QAction(tr("&Import anatomy…"), this);
+    m_import->setObjectName("actionImportAnatomy");
+    connect(m_import, &QAction::triggered, this, &AnatomySteps::askImport);
+    m_ready = new QAction(tr("Make &simulation-ready…"), this);
+    m_ready->setObjectName("actionMakeSimulationReady");
+    connect(m_ready, &QAction::triggered, this, &AnatomySteps::askSimulationReady);
+    m_tetra = new QAction(tr("&Tetrahedralize…"), this);
+    m_tetra->setObjectName("actionTetrahedralize");
+    connect(m_tetra, &QAction::triggered, this, [this] {
         QString why;
         if (!tetrahedralize(&why)) emit logMessage(why);
     });
-    m_tetra->setObjectName("tetrahedralize");
+}
+
+void AnatomySteps::buildMenu(QMenu* mesh) {
+    mesh->addAction(m_ready);
+    mesh->addAction(m_tetra);
 }
 
 int AnatomySteps::remeshBody() const {

@@ -1,7 +1,7 @@
 #pragma once
-/// From render anatomy to a simulation body in the studio [issue 38 item 3]: the Mesh menu's
-/// three steps, each run as a StudioTask (progress, a cancel that takes effect at once) and
-/// applied to the model as one undo step.
+/// From render anatomy to a simulation body in the studio [issue 38 item 3]: three steps
+/// (File → Import anatomy, Mesh → the other two), each run as a StudioTask (progress, a cancel
+/// that takes effect at once) and applied to the model as one undo step.
 ///
 ///   Import anatomy…          parts (OBJ/STL/PLY/glTF/GLB/FBX, the import's safety rules) and an
 ///                            optional PNG texture: checked by `viscera-studio import`, copied
@@ -40,8 +40,9 @@ class AnatomySteps : public QObject {
 public:
     AnatomySteps(Document* doc, Selection* sel, QWidget* window);
 
-    /// Adds the three actions to `menu`.
-    void buildMenu(QMenu* menu);
+    /// Adds Make simulation-ready and Tetrahedralize to the Mesh menu (Import anatomy belongs to
+    /// the File menu: importAction()).
+    void buildMenu(QMenu* mesh);
     QAction* importAction() const { return m_import; }
     QAction* simulationReadyAction() const { return m_ready; }
     QAction* tetrahedralizeAction() const { return m_tetra; }

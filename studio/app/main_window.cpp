@@ -139,9 +139,9 @@ void MainWindow::buildDocks() {
 void MainWindow::buildActions() {
     auto* toolbar = addToolBar(tr("Main"));
     toolbar->setObjectName("mainToolBar");
-    buildFileMenu(menuBar()->addMenu(tr("&File")), toolbar);
     m_anatomy = new AnatomySteps(&m_doc, &m_sel, this);
     connect(m_anatomy, &AnatomySteps::logMessage, this, &MainWindow::logLine);
+    buildFileMenu(menuBar()->addMenu(tr("&File")), toolbar);
     m_anatomy->buildMenu(menuBar()->addMenu(tr("&Mesh")));
     QMenu* edit = menuBar()->addMenu(tr("&Edit"));
     QAction* undo = m_doc.undoStack()->createUndoAction(this, tr("&Undo"));
@@ -160,6 +160,10 @@ void MainWindow::buildFileMenu(QMenu* file, QToolBar* toolbar) {
     auto add = [&](const QString& text, QKeySequence key, auto fn, bool onToolbar) {
         QAction* a = file->addAction(text);
         a->setShortcut(key);
+        QString name = "action"; // "&Export case…" → "actionExportCase"
+        for (const QString& word : QString(text).remove('&').remove(QChar(0x2026)).split(' ', Qt::SkipEmptyParts))
+            name += word.left(1).toUpper() + word.mid(1);
+        a->setObjectName(name);
         connect(a, &QAction::triggered, this, fn);
         if (onToolbar) toolbar->addAction(a);
     };
@@ -178,6 +182,7 @@ void MainWindow::buildFileMenu(QMenu* file, QToolBar* toolbar) {
         },
         false);
     file->addSeparator();
+    file->addAction(m_anatomy->importAction());
     add(
         tr("&Export case…"), QKeySequence(tr("Ctrl+E")),
         [this] {

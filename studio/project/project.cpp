@@ -94,13 +94,17 @@ bake::MeshingParams readMeshing(const JsonField& mesh) {
     bake::MeshingParams p;
     auto m = mesh.find("meshing");
     if (!m) return p;
-    m->object({"facet_angle", "facet_size", "facet_distance", "cell_radius_edge_ratio", "cell_size", "seed"});
+    m->object(
+        {"facet_angle", "facet_size", "facet_distance", "cell_radius_edge_ratio", "cell_size", "seed", "max_tets"});
     p.facetAngleDeg = m->number("facet_angle", p.facetAngleDeg, NumberRule::positive());
     p.facetSize = m->number("facet_size", p.facetSize, NumberRule::positive());
     p.facetDistance = m->number("facet_distance", p.facetDistance, NumberRule::positive());
     p.cellRadiusEdgeRatio = m->number("cell_radius_edge_ratio", p.cellRadiusEdgeRatio, NumberRule::positive());
     p.cellSize = m->number("cell_size", p.cellSize, NumberRule::positive());
     p.seed = static_cast<unsigned>(m->integer("seed", static_cast<int>(p.seed), 0, 1 << 30));
+    // the cap on the tets the sizes may ask for (refused before meshing): at most the default
+    p.maxEstimatedTets =
+        size_t(m->integer("max_tets", int(p.maxEstimatedTets), 1000, int(bake::MeshingParams{}.maxEstimatedTets)));
     return p;
 }
 
@@ -110,6 +114,7 @@ json meshingJson(const bake::MeshingParams& p) {
     if (p.facetSize > 0) j["facet_size"] = p.facetSize;
     if (p.facetDistance > 0) j["facet_distance"] = p.facetDistance;
     if (p.cellSize > 0) j["cell_size"] = p.cellSize;
+    if (p.maxEstimatedTets != bake::MeshingParams{}.maxEstimatedTets) j["max_tets"] = p.maxEstimatedTets;
     return j;
 }
 

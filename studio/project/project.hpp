@@ -50,7 +50,8 @@
 /// Every file reference ("file" of a mesh or trajectory, "track") is a path relative to the
 /// project folder: no '..', not absolute (sim/util/entry_name.hpp).
 /// "meshing" (CGAL Mesh_3, metres and degrees): facet_angle, facet_size, facet_distance,
-/// cell_radius_edge_ratio, cell_size, seed.
+/// cell_radius_edge_ratio, cell_size, seed, max_tets (the cap on the tets the sizes may ask
+/// for, refused before meshing; [1000, 2000000]).
 #include "bake/remesh.hpp"
 #include "bake/skeleton.hpp"
 #include "bake/tetrahedralize.hpp"

@@ -10,6 +10,8 @@
 #include "project/sample_kidney.hpp"
 #include "window_fixture.hpp"
 
+#include <QAction>
+#include <QApplication>
 #include <QDialog>
 #include <QDialogButtonBox>
 #include <QFileDialog>
@@ -23,6 +25,7 @@
 #include <QPushButton>
 #include <QSettings>
 #include <QSpinBox>
+#include <QTimer>
 #include <QUndoStack>
 
 #include <gtest/gtest.h>
@@ -164,7 +167,22 @@ TEST_F(AnatomyFixture, ImportMakeSimulationReadyTetrahedralizeAndExportByGuiActi
         ok = k;
         done = true;
     });
-    ASSERT_TRUE(w->startExport(QString::fromStdString(out.string())));
+    // File → Export case…: the save dialog the action opens gets the path typed and Enter.
+    auto* exportAction = w->findChild<QAction*>("actionExportCase");
+    ASSERT_NE(exportAction, nullptr);
+    QTimer typer;
+    QObject::connect(&typer, &QTimer::timeout, [&] {
+        auto* dlg = qobject_cast<QFileDialog*>(QApplication::activeModalWidget());
+        if (!dlg || !dlg->isVisible()) return;
+        typer.stop();
+        auto* name = dlg->findChild<QLineEdit*>("fileNameEdit");
+        name->clear();
+        QTest::keyClicks(name, QString::fromStdString(out.string()));
+        QTest::keyClick(name, Qt::Key_Return);
+    });
+    typer.start(100);
+    exportAction->trigger(); // the dialog runs its own loop until the keys accept it
+    EXPECT_FALSE(typer.isActive()) << "no save dialog appeared";
     ASSERT_TRUE(test::waitFor([&] { return done; }, 180000));
     ASSERT_TRUE(ok) << w->exportRunner()->output().toStdString();
     {

@@ -95,6 +95,19 @@ TEST_F(RemeshBlock, EveryFieldIsRefusedByNameAndRule) {
     EXPECT_THAT(loadError([](json& r) { r["parts"][0]["file"] = "../cortex.obj"; }), HasSubstr(at + "parts[0].file"));
     EXPECT_THAT(loadError([](json& r) { r["parts"][0]["op"] = "xor"; }), HasSubstr(at + "parts[0].op"));
     EXPECT_THAT(loadError([](json& r) { r["colour"] = 1; }), HasSubstr("colour"));
+    // the meshing block beside it: the cap on the tets
+    json doc = json::parse(readFile(m_dir / "project.json"));
+    doc["bodies"][0]["mesh"]["meshing"]["max_tets"] = 10;
+    try {
+        studio::loadProjectText(doc.dump(1), m_dir, "project.json");
+        ADD_FAILURE() << "max_tets 10 accepted";
+    } catch (const InputError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("bodies[0].mesh.meshing.max_tets"));
+    }
+    doc["bodies"][0]["mesh"]["meshing"]["max_tets"] = 50000;
+    const studio::Project capped = studio::loadProjectText(doc.dump(1), m_dir, "project.json");
+    EXPECT_EQ(capped.bodies[0].mesh.meshing.maxEstimatedTets, 50000u);
+    EXPECT_THAT(studio::projectJsonText(capped), HasSubstr("\"max_tets\": 50000"));
 }
 
 TEST_F(RemeshBlock, ExportLaysTheTextureOnTheTetBoundaryByTheTransferredUvs) {
