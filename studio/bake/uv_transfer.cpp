@@ -586,8 +586,10 @@ Distortion distortion(const UvSource& source, const std::array<Vec3, 3>& p, cons
     const double det = C.determinant();
     if (!(det > 0) || !C.allFinite()) return {Distortion::Flipped};
     const Eigen::Vector2d s = Eigen::JacobiSVD<Eigen::Matrix2d>(C).singularValues();
-    return {Distortion::Measured, s[1] > 0 ? s[0] / s[1] : std::numeric_limits<double>::infinity(),
-            std::max(det, 1.0 / det)};
+    // A UV image squeezed to (nearly) a line is degenerate: counted with the flipped ones, so the
+    // figures stay finite.
+    if (!(s[1] > 1e-9 * s[0]) || !(det > 1e-12)) return {Distortion::Flipped};
+    return {Distortion::Measured, s[0] / s[1], std::max(det, 1.0 / det)};
 }
 
 } // namespace

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -41,6 +42,9 @@ TEST(StudioCliGl, RemeshTheKidneySampleWithItsUvsAndTheCheckerPreview) {
         for (const char* name : {"triangles", "over_two_islands", "flipped", "angle_p50", "angle_p95", "area_p50",
                                  "area_p95", "over_threshold_pct", "uv_error_mean", "uv_error_p95"})
             EXPECT_TRUE(fig.count(std::string("uv.") + method + "." + name)) << method << " " << name << "\n" << r.out;
+    for (const char* method : {"closest", "island", "seam-cut"}) // never an infinite figure shown
+        for (const char* name : {"angle_max", "area_max", "uv_error_max"})
+            EXPECT_TRUE(std::isfinite(fig[std::string("uv.") + method + "." + name])) << method << " " << name;
     EXPECT_GT(fig["uv.closest.over_two_islands"], 0);
     EXPECT_EQ(fig["uv.island.over_two_islands"], fig["uv.closest.over_two_islands"]); // the same uncut mesh
     EXPECT_EQ(fig["uv.seam-cut.over_two_islands"], 0);
