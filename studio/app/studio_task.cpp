@@ -2,8 +2,10 @@
 
 #include <QCoreApplication>
 #include <QFileInfo>
+#include <QFutureWatcher>
 #include <QRegularExpression>
 #include <QTemporaryDir>
+#include <QtConcurrent/QtConcurrentRun>
 
 #include <algorithm>
 
@@ -14,7 +16,7 @@ StudioTask::StudioTask(QObject* parent) : QObject(parent) {
 }
 
 StudioTask::~StudioTask() {
-    if (running()) {
+    if (m_process && m_process->state() != QProcess::NotRunning) {
         m_process->disconnect(this);
         m_process->kill();
         m_process->waitForFinished(2000);
@@ -89,7 +91,33 @@ void StudioTask::readOutput() {
     }
 }
 
+void StudioTask::runInProcess(const QString& name, std::function<std::any()> work, std::function<void(std::any)> done) {
+    m_name = name;
+    const uint64_t generation = ++m_inProcessGeneration;
+    m_inProcessRunning = true;
+    m_total = 1;
+    m_done = 0;
+    emit progress(0, 1, tr("starting"));
+    auto* watcher = new QFutureWatcher<std::any>(this);
+    connect(watcher, &QFutureWatcherBase::finished, this, [this, watcher, generation, done] {
+        watcher->deleteLater();
+        if (generation != m_inProcessGeneration) return; // superseded or cancelled
+        m_inProcessRunning = false;
+        m_done = 1;
+        done(watcher->result());
+        emit progress(1, 1, tr("done"));
+        emit finished(true, QString());
+    });
+    watcher->setFuture(QtConcurrent::run(std::move(work)));
+}
+
 void StudioTask::cancel() {
+    if (m_inProcessRunning) {
+        ++m_inProcessGeneration; // its result is dropped
+        m_inProcessRunning = false;
+        emit finished(false, tr("cancelled"));
+        return;
+    }
     if (!running()) return;
     m_cancelled = true;
     m_process->kill();

@@ -7,11 +7,17 @@
 /// Progress: one step per line the child prints as "viscera-studio: [stage i/n: ]<stage>" on its
 /// error stream. The result (its output, the files it wrote in workDir()) is handed back on the
 /// UI thread by finished(); the caller applies it to the model as one undo step.
+///
+/// Short work that needs no process of its own (the texture panel's live thumbnails) runs the
+/// same way in process (runInProcess): on a pool thread, its result handed back on the UI thread;
+/// a cancel, or a newer request, drops the running job's result (the job itself ends on its own).
 #include <QObject>
 #include <QProcess>
 #include <QString>
 #include <QStringList>
 
+#include <any>
+#include <functional>
 #include <memory>
 
 class QTemporaryDir;
@@ -36,10 +42,16 @@ public:
     /// lines (progress maximum, grown when the child prints more). Returns false and sets `why`
     /// when a task is running or prepare() was not called.
     bool start(const QString& name, const QStringList& args, int stages, QString* why);
-    /// Kills the child; finished(false, "cancelled") has been emitted when it returns.
+    /// Kills the child; finished(false, "cancelled") has been emitted when it returns. An
+    /// in-process job's result is dropped (finished(false, "cancelled") at once).
     void cancel();
 
-    bool running() const { return m_process && m_process->state() != QProcess::NotRunning; }
+    /// Runs `work` on a pool thread; `done` gets its result on the UI thread, then finished(true,
+    /// "") is emitted. A job started while one runs supersedes it: the older one's result is
+    /// dropped. `work` must not touch the model or widgets.
+    void runInProcess(const QString& name, std::function<std::any()> work, std::function<void(std::any)> done);
+
+    bool running() const { return (m_process && m_process->state() != QProcess::NotRunning) || m_inProcessRunning; }
     const QString& name() const { return m_name; }
     int stageCount() const { return m_total; }
     int stagesDone() const { return m_done; }
@@ -64,6 +76,8 @@ private:
     std::unique_ptr<QTemporaryDir> m_tmp;
     int m_total = 0, m_done = 0;
     bool m_cancelled = false;
+    bool m_inProcessRunning = false;
+    uint64_t m_inProcessGeneration = 0; ///< a job's result is used only when it is the latest
 };
 
 } // namespace viscera::studio

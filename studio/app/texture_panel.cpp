@@ -1149,27 +1149,29 @@ void TexturePanel::regenerateThumbnails() {
     m_thumbPending = true;
     m_thumbStatus->setText(tr("generating the thumbnails…"));
     m_thumbStatus->setStyleSheet({});
-    auto* watcher = new QFutureWatcher<ThumbnailResult>(this);
-    connect(watcher, &QFutureWatcherBase::finished, this, [this, watcher, generation] {
-        watcher->deleteLater();
-        if (generation != m_thumbGeneration) return; // superseded by a later request
-        m_thumbPending = false;
-        const ThumbnailResult r = watcher->result();
-        showThumbnails(r.thumbs);
-        m_thumbStatus->setText(
-            r.error.isEmpty() ? tr("%1 × %1 px preview, seed %2").arg(r.thumbs.size).arg(QString::number(r.thumbs.seed))
-                              : r.error);
-        m_thumbStatus->setStyleSheet(r.error.isEmpty() ? QString() : QStringLiteral("color: #b00020"));
-    });
-    watcher->setFuture(QtConcurrent::run([b = *block, dir, layer] {
-        ThumbnailResult r;
-        try {
-            r.thumbs = makeTextureThumbnails(b, dir, kThumbnailSide, layer);
-        } catch (const std::exception& e) {
-            r.error = QString::fromStdString(e.what());
-        }
-        return r;
-    }));
+    // The studio's task type, in process: a newer request supersedes this one (its result dropped).
+    m_thumbTask.runInProcess(
+        tr("thumbnails"),
+        [b = *block, dir, layer]() -> std::any {
+            ThumbnailResult r;
+            try {
+                r.thumbs = makeTextureThumbnails(b, dir, kThumbnailSide, layer);
+            } catch (const std::exception& e) {
+                r.error = QString::fromStdString(e.what());
+            }
+            return r;
+        },
+        [this, generation](std::any result) {
+            if (generation != m_thumbGeneration) return;
+            m_thumbPending = false;
+            const ThumbnailResult r = std::any_cast<ThumbnailResult>(std::move(result));
+            showThumbnails(r.thumbs);
+            m_thumbStatus->setText(
+                r.error.isEmpty()
+                    ? tr("%1 × %1 px preview, seed %2").arg(r.thumbs.size).arg(QString::number(r.thumbs.seed))
+                    : r.error);
+            m_thumbStatus->setStyleSheet(r.error.isEmpty() ? QString() : QStringLiteral("color: #b00020"));
+        });
 }
 
 void TexturePanel::showThumbnails(const TextureThumbnails& t) {

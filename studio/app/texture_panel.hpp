@@ -11,8 +11,10 @@
 /// bake::parseTextureSpec (the one reader of specs): a value the export could not bake is refused
 /// with that reader's one-line message and the model is unchanged. A block that names a spec
 /// file is embedded into project.json (studio::embedTextureSpec) by its first parameter edit;
-/// the file itself is never written. The thumbnails and the picked palette are made off the UI
-/// thread (QtConcurrent); a request made while one runs supersedes it, whose result is dropped.
+/// the file itself is never written. The thumbnails are made off the UI thread by the studio's
+/// task type (StudioTask::runInProcess), the picked palette by QtConcurrent; a request made while
+/// one runs supersedes it, whose result is dropped.
+#include "app/studio_task.hpp"
 #include "bake/texture.hpp"
 #include "project/project.hpp"
 
@@ -245,6 +247,7 @@ private:
     std::optional<bake::TextureSpec> m_parsed;
     TextureThumbnails m_thumbs;
     std::vector<bake::PaletteColor> m_picked;
+    StudioTask m_thumbTask; ///< the live thumbnails (in process: a newer request supersedes)
     uint64_t m_thumbGeneration = 0, m_paletteGeneration = 0;
     bool m_thumbPending = false, m_palettePending = false;
     QString m_shownKey;    ///< what the thumbnails were last requested for

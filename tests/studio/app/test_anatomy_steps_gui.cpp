@@ -6,6 +6,7 @@
 #include "app/anatomy_steps.hpp"
 #include "app/document.hpp"
 #include "app/export_runner.hpp"
+#include "app/studio_task.hpp"
 #include "case/case_package.hpp"
 #include "project/sample_kidney.hpp"
 #include "window_fixture.hpp"
@@ -25,12 +26,14 @@
 #include <QPushButton>
 #include <QSettings>
 #include <QSpinBox>
+#include <QThread>
 #include <QTimer>
 #include <QUndoStack>
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <any>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -240,4 +243,33 @@ TEST_F(AnatomyFixture, CancelDuringRemeshAndMeshingTakesEffectAtOnceAndLeavesThe
     cancelNow("tetrahedralize");
     for (const auto& e : fs::directory_iterator(fs::path(w->document()->folder().toStdString())))
         EXPECT_EQ(e.path().filename().string().rfind(".viscera-", 0), std::string::npos) << e.path();
+}
+
+TEST(StudioTaskGui, InProcessWorkIsSupersededByANewerRequestAndDroppedOnCancel) {
+    test::guiApp();
+    studio::StudioTask task;
+    std::vector<int> delivered;
+    int finishedOk = 0, cancelled = 0;
+    QObject::connect(&task, &studio::StudioTask::finished,
+                     [&](bool ok, const QString& m) { ok ? ++finishedOk : (m == "cancelled" ? ++cancelled : 0); });
+    auto job = [](int value, int ms) {
+        return [value, ms]() -> std::any {
+            QThread::msleep(ms);
+            return value;
+        };
+    };
+    auto keep = [&](std::any v) { delivered.push_back(std::any_cast<int>(v)); };
+    task.runInProcess("first", job(1, 300), keep);
+    task.runInProcess("second", job(2, 10), keep); // supersedes the first
+    ASSERT_TRUE(test::waitFor([&] { return !task.running(); }, 5000));
+    QTest::qWait(400); // the first job ends too; its result must not arrive
+    EXPECT_EQ(delivered, std::vector<int>{2});
+    EXPECT_EQ(finishedOk, 1);
+    task.runInProcess("third", job(3, 200), keep);
+    EXPECT_TRUE(task.running());
+    task.cancel();
+    EXPECT_FALSE(task.running());
+    EXPECT_EQ(cancelled, 1);
+    QTest::qWait(400);
+    EXPECT_EQ(delivered, std::vector<int>{2}) << "a cancelled job's result is dropped";
 }
