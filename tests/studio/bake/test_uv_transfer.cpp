@@ -61,11 +61,8 @@ bake::RemeshPart sheetWithTwoIslands() {
     return part;
 }
 
-/// An open tube of radius 4 mm along z, 2 cm long, side unwrapped into one island: u the angle,
-/// v along; the seam at angle ±π lies inside the island.
-bake::RemeshPart unwrappedTube(int slices) {
-    const sim::Vec3 a(0, 0, 0), b(0, 0, 0.02);
-    const sim::TriMesh closed = sim::makeTubeSurface(a, b, 0.004, slices, 8);
+/// The side of a capped tube along z (its caps' triangles, those touching the axis, dropped).
+sim::TriMesh tubeSide(const sim::TriMesh& closed) {
     std::vector<sim::Tri> side;
     for (const sim::Tri& t : closed.triangles()) {
         bool cap = false;
@@ -73,7 +70,14 @@ bake::RemeshPart unwrappedTube(int slices) {
             cap = cap || closed.positions()[v].head<2>().norm() < 1e-9;
         if (!cap) side.push_back(t);
     }
-    bake::RemeshPart part{"tube", sim::TriMesh::fromArrays(closed.positions(), side), bake::CsgOp::Union, {}};
+    return sim::TriMesh::fromArrays(closed.positions(), side);
+}
+
+/// An open tube of radius 4 mm along z, 2 cm long, side unwrapped into one island: u the angle,
+/// v along; the seam at angle ±π lies inside the island.
+bake::RemeshPart unwrappedTube(int slices) {
+    const sim::Vec3 a(0, 0, 0), b(0, 0, 0.02);
+    bake::RemeshPart part{"tube", tubeSide(sim::makeTubeSurface(a, b, 0.004, slices, 8)), bake::CsgOp::Union, {}};
     for (const sim::Tri& t : part.surface.triangles()) {
         std::array<double, 3> phi{};
         for (int k = 0; k < 3; ++k) {
@@ -97,15 +101,7 @@ bake::RemeshPart unwrappedTube(int slices) {
 }
 
 sim::TriMesh tubeTarget(int slices) {
-    const sim::TriMesh closed = sim::makeTubeSurface({0, 0, 0.001}, {0, 0, 0.019}, 0.004, slices, 7);
-    std::vector<sim::Tri> side;
-    for (const sim::Tri& t : closed.triangles()) {
-        bool cap = false;
-        for (int32_t v : t)
-            cap = cap || closed.positions()[v].head<2>().norm() < 1e-9;
-        if (!cap) side.push_back(t);
-    }
-    return sim::TriMesh::fromArrays(closed.positions(), side);
+    return tubeSide(sim::makeTubeSurface({0, 0, 0.001}, {0, 0, 0.019}, 0.004, slices, 7));
 }
 
 } // namespace
