@@ -112,7 +112,7 @@ size_t applyCornerUv(SceneView& view, const std::string& target, const std::vect
             for (size_t k = 0; k < 3; ++k) {
                 const uint32_t v = m.indices[3 * t + k];
                 const auto [it, fresh] =
-                    index.try_emplace({v, uv[t][k].x(), uv[t][k].y()}, uint32_t(out.sourceVertex.size()));
+                    index.try_emplace({v, uv[t][k].x(), uv[t][k].y()}, uint32_t(out.uv.size() / 2));
                 if (fresh) {
                     appendVertex(m, v, out);
                     out.uv.push_back(uv[t][k].x());

@@ -143,7 +143,10 @@ int AnatomySteps::remeshBody() const {
 }
 
 bool AnatomySteps::run(const QString& name, const QStringList& args, int stages, QString* why) {
-    if (!m_task.start(name, args, stages, why)) return false;
+    if (!m_task.start(name, args, stages, why)) {
+        m_task.discard();
+        return false;
+    }
     m_progress = new QProgressDialog(name, tr("Cancel"), 0, stages, m_window);
     m_progress->setObjectName("taskProgress");
     m_progress->setWindowTitle(tr("Working"));
@@ -367,13 +370,12 @@ bool AnatomySteps::makeSimulationReady(int voxels, int smoothing, const QString&
     else
         args << "--uv-transfer" << uvMethod << "--uv-preview" << QDir(work).filePath("preview.png");
     args << "-o" << QDir(work).filePath("result.obj");
-    m_pendingRemesh = {voxels, smoothing, uvMethod};
+    m_pendingRemesh = {voxels, smoothing, uvMethod,
+                       QString::fromStdString(m_doc->project().bodies[size_t(b)].scene.name)};
     return run(kReady, args, 8, why);
 }
 
 void AnatomySteps::showRemeshResult(const QString& output) {
-    const int b = remeshBody();
-    if (b < 0) return;
     auto* dlg = new QDialog(m_window);
     dlg->setObjectName("simulationReadyResult");
     dlg->setWindowTitle(tr("Simulation-ready surface"));
@@ -406,7 +408,19 @@ void AnatomySteps::showRemeshResult(const QString& output) {
     apply->setObjectName("applyRemesh");
     connect(buttons->button(QDialogButtonBox::Discard), &QPushButton::clicked, dlg, &QDialog::close);
     const Pending chosen = m_pendingRemesh;
-    connect(apply, &QPushButton::clicked, this, [this, dlg, b, chosen] {
+    connect(apply, &QPushButton::clicked, this, [this, dlg, chosen] {
+        // The body the remesh ran on, by name: the selection or the bodies may have changed since.
+        int b = -1;
+        const auto& bodies = m_doc->project().bodies;
+        for (size_t i = 0; i < bodies.size(); ++i)
+            if (QString::fromStdString(bodies[i].scene.name) == chosen.body &&
+                bodies[i].mesh.kind == MeshSource::Kind::Remesh)
+                b = int(i);
+        if (b < 0) {
+            emit logMessage(tr("Make simulation-ready: the body '%1' made from anatomy is gone").arg(chosen.body));
+            dlg->close();
+            return;
+        }
         const QString problem = m_doc->edit(
             tr("Make simulation-ready"),
             [&](Project& p) {
@@ -446,6 +460,7 @@ bool AnatomySteps::tetrahedralize(QString* why) {
         std::ofstream f(projectFile.toStdString(), std::ios::binary);
         f << projectJsonText(m_doc->project());
         if (!f.flush()) {
+            m_task.discard();
             if (why) *why = tr("%1: cannot be written").arg(projectFile);
             return false;
         }

@@ -85,6 +85,7 @@ private:
     struct Pending {
         int voxels = 0, smoothing = 0;
         QString uvMethod;
+        QString body; ///< the body the remesh ran on (by name: the selection may change meanwhile)
     } m_pendingRemesh;
 };
 

@@ -32,7 +32,10 @@ bool ExportRunner::start(const Project& project, const QString& out, QString* wh
     {
         std::ofstream f(projectFile.toStdString(), std::ios::binary);
         f << projectJsonText(project);
-        if (!f.flush()) return fail(tr("%1: cannot be written").arg(projectFile));
+        if (!f.flush()) {
+            m_task.discard();
+            return fail(tr("%1: cannot be written").arg(projectFile));
+        }
     }
     m_out = target.absoluteFilePath();
     return m_task.start(tr("export"),

@@ -29,12 +29,20 @@ QString StudioTask::prepare(const QString& parentDir, QString* why) {
         return {};
     }
     m_tmp = std::make_unique<QTemporaryDir>(parentDir + "/.viscera-task-XXXXXX");
+    ++m_folderGeneration;
+    m_fresh = true;
     if (!m_tmp->isValid()) {
         if (why) *why = tr("%1: cannot create a temporary folder (%2)").arg(parentDir, m_tmp->errorString());
         m_tmp.reset();
         return {};
     }
     return m_tmp->path();
+}
+
+void StudioTask::discard() {
+    if (running()) return;
+    m_tmp.reset();
+    m_fresh = false;
 }
 
 QString StudioTask::workDir() const {
@@ -46,10 +54,11 @@ bool StudioTask::start(const QString& name, const QStringList& args, int stages,
         if (why) *why = tr("%1 is already running").arg(m_name);
         return false;
     }
-    if (!m_tmp) {
+    if (!m_tmp || !m_fresh) { // each run its own folder: the last one's may be removed when it ends
         if (why) *why = tr("%1: no work folder (StudioTask::prepare)").arg(name);
         return false;
     }
+    m_fresh = false;
     m_name = name;
     m_output.clear();
     m_lineBuffer.clear();
@@ -144,9 +153,9 @@ void StudioTask::onFinished(int code, QProcess::ExitStatus status) {
         emit progress(m_done, m_total, tr("done"));
     }
     if (m_process) m_process->deleteLater(), m_process.release();
-    const QTemporaryDir* mine = m_tmp.get();
+    const uint64_t mine = m_folderGeneration;
     emit finished(ok, message);
-    if (m_tmp.get() == mine) m_tmp.reset(); // the receivers took what they need (unless one started anew)
+    if (m_folderGeneration == mine) m_tmp.reset(); // the receivers took what they need (unless one prepared anew)
 }
 
 } // namespace viscera::studio

@@ -38,7 +38,9 @@ public:
     /// move is a rename) and returns its path, or an empty string and `why` when it cannot.
     /// Call before start(), to place arguments (files the child reads or writes) in it.
     QString prepare(const QString& parentDir, QString* why);
-    /// Runs `viscera-studio args...` (after prepare()); `stages` is the expected number of stage
+    /// Removes the folder prepare() made, when the run it was for will not start.
+    void discard();
+    /// Runs `viscera-studio args...` (after prepare(), one run per prepare()); `stages` is the expected number of stage
     /// lines (progress maximum, grown when the child prints more). Returns false and sets `why`
     /// when a task is running or prepare() was not called.
     bool start(const QString& name, const QStringList& args, int stages, QString* why);
@@ -77,6 +79,8 @@ private:
     int m_total = 0, m_done = 0;
     bool m_cancelled = false;
     bool m_inProcessRunning = false;
+    bool m_fresh = false;               ///< prepare() made a folder no run has used yet
+    uint64_t m_folderGeneration = 0;    ///< bumped by every prepare()
     uint64_t m_inProcessGeneration = 0; ///< a job's result is used only when it is the latest
 };
 

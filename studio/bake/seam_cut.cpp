@@ -187,6 +187,7 @@ public:
             for (int k = 0; k < 3 && split; ++k)
                 halve.emplace(edgeKey(t[k], t[(k + 1) % 3]), -1);
         }
+        if (halve.empty()) return stray; // nothing split: the pieces and their charts stand (finish reads them)
         std::vector<uint64_t> keys;
         for (const auto& [key, v] : halve)
             keys.push_back(key);
@@ -196,7 +197,7 @@ public:
             halve[key] = addVertex(x, chartAt(x));
         }
         subdivide(m_pos, m_tris, halve);
-        m_pieceChart.clear();
+        m_pieceChart.clear(); // the next cut labels the new pieces
         return stray;
     }
 

@@ -1083,7 +1083,11 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
         } catch (const std::invalid_argument& e) {
             throw InputError(origin + ": " + field + ".mesh: " + e.what());
         }
-        if (!boundaryUv.empty()) addUvMaterial(built, b, boundaryUv, origin, field);
+        try {
+            if (!boundaryUv.empty()) addUvMaterial(built, b, boundaryUv, origin, field);
+        } catch (const std::invalid_argument& e) { // a UV beyond the corner-UV file's range
+            throw InputError(origin + ": " + field + ".mesh.remesh: " + e.what());
+        }
         BodyExport be;
         be.name = name;
         be.nodes = mesh->vertexCount();
