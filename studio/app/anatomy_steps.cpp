@@ -29,6 +29,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 namespace viscera::studio {
 namespace {
@@ -91,12 +92,15 @@ private:
     int m_voxels = 64;
 };
 
-/// `name value` figures the remesh prints (uv.<method>.<figure> value).
-double figure(const QString& output, const QString& name) {
+/// A `name value` figure the remesh prints (uv.<method>.<figure> value); none when it is
+/// missing or not a finite number (nothing is shown for it).
+std::optional<double> figure(const QString& output, const QString& name) {
     const QRegularExpression re("^" + QRegularExpression::escape(name) + " (\\S+)$",
                                 QRegularExpression::MultilineOption);
     const auto m = re.match(output);
-    return m.hasMatch() ? m.captured(1).toDouble() : std::nan("");
+    bool ok = false;
+    const double v = m.hasMatch() ? m.captured(1).toDouble(&ok) : 0.0;
+    return ok && std::isfinite(v) ? std::optional(v) : std::nullopt;
 }
 
 QString uvOption(const std::optional<bake::UvTransferMethod>& m) {
@@ -392,13 +396,15 @@ void AnatomySteps::showRemeshResult(const QString& output) {
     const QRegularExpression checks("^checks: .*$", QRegularExpression::MultilineOption);
     if (const auto m = checks.match(output); m.hasMatch()) text += m.captured(0) + "\n";
     for (const QString& method : {QStringLiteral("closest"), QStringLiteral("island"), QStringLiteral("seam-cut")}) {
-        const double over = figure(output, "uv." + method + ".over_two_islands");
-        if (std::isnan(over)) continue;
+        const auto over = figure(output, "uv." + method + ".over_two_islands");
+        const auto stretched = figure(output, "uv." + method + ".over_threshold_pct");
+        const auto error = figure(output, "uv." + method + ".uv_error_mean");
+        if (!over || !stretched || !error) continue;
         text += tr("%1: %2 triangles over two islands, %3 % of the faces stretched over 2×, UV error %4\n")
                     .arg(method)
-                    .arg(over)
-                    .arg(figure(output, "uv." + method + ".over_threshold_pct"), 0, 'f', 2)
-                    .arg(figure(output, "uv." + method + ".uv_error_mean"), 0, 'g', 3);
+                    .arg(*over)
+                    .arg(*stretched, 0, 'f', 2)
+                    .arg(*error, 0, 'g', 3);
     }
     auto* figures = new QLabel(text, dlg);
     figures->setObjectName("remeshFigures");
