@@ -19,6 +19,7 @@
 #include "render/case_settings.hpp"
 #include "render/headless.hpp"
 #include "render/scene_view.hpp"
+#include "render/scope_view.hpp"
 #include "render/tool_meshes.hpp"
 #include "runtime/report.hpp"
 #include "runtime/session.hpp"
@@ -98,6 +99,8 @@ constexpr const char* kRunHelp =
     "  --report FILE.json    session report (schemaVersion, frames, metrics, haptics, errors)\n"
     "  --trace FILE.csv      per-tick device force and pose trace (needs --device)\n"
     "  --screenshot FILE.png the rendered last frame (headless: EGL, window: the window)\n"
+    "  --view scope|overview headless screenshot through the case's laparoscope (the default where\n"
+    "                        the case has one) or framed on the whole tissue from above\n"
     "  --plots DIR           session plots (PNG) and session.html, as 'viscera-player plot' "
     "makes\n" VISCERA_PLAYER_TRUST_HELP "\n"
     "Output paths are checked before the first frame. Exit 0 ok, 1 bad input or an output that\n"
@@ -219,6 +222,7 @@ ServoChoice parseServoMode(const std::string& v) {
 struct RunArgs {
     std::optional<std::string> casePath, reportPath, screenshot, device, tracePath, plotsDir, pairingKey;
     bool headless = false, realtime = false, lockstep = false, framesGiven = false;
+    bool overview = false; ///< --view overview: framed on the tissue, not through the laparoscope
     ServoChoice servo;
     player::TrustOptions trust;
     int frames = 300;
@@ -255,7 +259,12 @@ RunArgs parseRunArgs(const std::vector<std::string>& args) {
             r.lockstep = true;
         else if (a == "--screenshot")
             r.screenshot = value("--screenshot");
-        else if (a == "--device")
+        else if (a == "--view") {
+            const std::string v = value("--view");
+            if (v != "scope" && v != "overview")
+                throw std::invalid_argument("--view '" + v + "' must be scope or overview");
+            r.overview = v == "overview";
+        } else if (a == "--device")
             r.device = value("--device");
         else if (a == "--pairing-key")
             r.pairingKey = value("--pairing-key");
@@ -317,13 +326,16 @@ std::optional<int> refuseRun(const RunArgs& r, std::optional<haptics::DeviceSpec
 /// Renders the last frame headless (EGL; Mesa llvmpipe where there is no GPU) to `path`, with its
 /// figures in result.render. The error text when it could not (a bad output, not a failed session).
 std::string headlessScreenshot(player::LoadedCase& loaded, player::SessionResult& result, const std::string& path,
-                               const std::string& casePath) {
+                               const std::string& casePath, bool noScope) {
     try {
         render::SceneView view = player::caseView(loaded);
         render::RenderSettings rs = render::defaultSettingsFor(view); // framed on the tissue
         render::applyCaseRender(rs, loaded.scene.render, casePath);
-        // Instruments, probes, clips, needle and thread at the last frame.
-        const render::ToolMeshes tools(view, render::toolPoses(*loaded.world));
+        // Instruments, probes, clips, needle and thread at the last frame; through the case's
+        // laparoscope where it has one.
+        const render::ToolPoses poses = render::toolPoses(*loaded.world);
+        if (!noScope) render::viewThroughScope(rs, poses.scope);
+        const render::ToolMeshes tools(view, poses);
         std::string why;
         auto renderer = render::HeadlessRenderer::create(rs, &why);
         if (!renderer) throw std::runtime_error("no OpenGL context: " + why);
@@ -467,7 +479,8 @@ int cmdRun(const std::vector<std::string>& args) {
         result = player::runWindow(loaded, opts, r.screenshot.value_or(""));
     }
     std::string screenshotError;
-    if (r.headless && r.screenshot) screenshotError = headlessScreenshot(loaded, result, *r.screenshot, *r.casePath);
+    if (r.headless && r.screenshot)
+        screenshotError = headlessScreenshot(loaded, result, *r.screenshot, *r.casePath, r.overview);
     return finishRun(r, result, screenshotError);
 }
 

@@ -47,9 +47,10 @@ struct ToolPoseState {
     std::array<Vec3, kMaxArms> proxy{Vec3::Zero(), Vec3::Zero()};  ///< m, scene: simulated tool centre
     std::array<Vec3, kMaxArms> target{Vec3::Zero(), Vec3::Zero()}; ///< m, scene: where the master points
     std::array<Quat, kMaxArms> orientation{Quat::Identity(), Quat::Identity()};
-    std::array<double, kMaxArms> grip{0, 0};      ///< rad
-    std::array<uint32_t, kMaxArms> buttons{0, 0}; ///< the arm's button bits
-    std::array<double, kMaxArms> force{0, 0};     ///< N, magnitude sent to the device (after safety)
+    std::array<Vec3, kMaxArms> device{Vec3::Zero(), Vec3::Zero()}; ///< m, device frame: every arm's master
+    std::array<double, kMaxArms> grip{0, 0};                       ///< rad
+    std::array<uint32_t, kMaxArms> buttons{0, 0};                  ///< the arm's button bits
+    std::array<double, kMaxArms> force{0, 0};                      ///< N, magnitude sent to the device (after safety)
     uint32_t safetyRules = 0;
 };
 

@@ -49,7 +49,7 @@ void KeyboardDevice::poll(int64_t now_ns, DeviceState& out) {
     out.timestamp_ns = now_ns;
     out.sequence = ++m_seq;
     out.connected = true;
-    out.pedals = (k & KeyClutch) ? uint32_t(kPedalClutch) : 0u;
+    out.pedals = ((k & KeyClutch) ? uint32_t(kPedalClutch) : 0u) | ((k & KeyCamera) ? uint32_t(kPedalCamera) : 0u);
     out.arms[0].measured_cp.position = m_pos;
     out.arms[0].measured_cp.orientation = Quat::Identity();
     out.arms[0].measured_cv.linear = m_vel;

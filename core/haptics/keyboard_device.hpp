@@ -20,7 +20,8 @@ public:
         KeyDown = 8,
         KeyPageUp = 16,
         KeyPageDown = 32,
-        KeyClutch = 64
+        KeyClutch = 64,
+        KeyCamera = 128 ///< the Cam pedal: the keys steer the laparoscope
     };
     explicit KeyboardDevice(double speed = 0.05, double metresPerPixel = 2e-4);
     const DeviceCapabilities& capabilities() const override { return m_caps; }

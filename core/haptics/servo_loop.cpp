@@ -134,11 +134,13 @@ void ServoLoop::tick(int64_t now, int64_t due) {
         }
     }
     const bool clutch = (m_state.pedals & kPedalClutch) != 0;
-    const bool hold = clutch || !m_state.connected;
+    // The Cam pedal gives the masters to the laparoscope: the tools hold as under the clutch.
+    const bool camera = (m_state.pedals & kPedalCamera) != 0;
+    const bool hold = clutch || camera || !m_state.connected;
     m_desired = DeviceCommand{};
     m_desired.timestamp_ns = now;
     m_desired.sequence = ++m_seq;
-    m_desired.flags = clutch ? uint32_t(kFlagClutch) : 0u;
+    m_desired.flags = clutch || camera ? uint32_t(kFlagClutch) : 0u;
     ToolPoseState poses;
     poses.timestamp_ns = due;
     poses.tick = m_seq;
@@ -146,14 +148,22 @@ void ServoLoop::tick(int64_t now, int64_t due) {
     poses.pedals = m_state.pedals;
     const int arms = std::clamp(m_device.capabilities().arms, 1, kMaxArms);
     std::array<Vec3, kMaxArms> proxy{Vec3::Zero(), Vec3::Zero()};
+    for (int a = 0; a < arms; ++a) { // every master, driving a tool or not (the laparoscope reads them)
+        poses.device[a] = m_state.arms[a].measured_cp.position;
+        poses.orientation[a] = m_state.arms[a].measured_cp.orientation;
+    }
     for (int a = 0; a < arms; ++a) {
         const ToolMapping& map = m_config.tools[a];
         if (!map.enabled) continue;
         const ArmState& arm = m_state.arms[a];
         const Vec3 centre = m_device.capabilities().arm[a].workspaceCentre();
-        const Vec3 mapped = map.sceneStart + map.motionScale * (arm.measured_cp.position - centre);
+        // Control point: the tip, or (laparoscopic port) the handle outside the body.
+        const bool handle = map.throughPort && map.port.desc.mode == sim::PortMode::Laparoscopic;
+        const Vec3 move = arm.measured_cp.position - centre;
+        const Vec3 mapped = handle ? Vec3(map.port.restHandle + map.port.handScale * move)
+                                   : Vec3(map.sceneStart + map.motionScale * move);
         if (!m_haveTarget[a]) {
-            m_target[a] = map.sceneStart;
+            m_target[a] = handle ? map.port.restHandle : map.sceneStart;
             m_offset[a] = m_target[a] - mapped;
             m_haveTarget[a] = m_state.connected;
         }
@@ -162,7 +172,10 @@ void ServoLoop::tick(int64_t now, int64_t due) {
             m_offset[a] = m_target[a] - mapped;
         else
             m_target[a] = mapped + m_offset[a];
-        const Vec3& x = m_target[a];
+        sim::PortPose portPose;
+        if (map.throughPort)
+            portPose = handle ? sim::fulcrumTip(map.port, m_target[a]) : sim::constrainToPort(map.port, m_target[a]);
+        const Vec3 x = map.throughPort ? portPose.tip : m_target[a];
         const ToolContactModel& tm = contact.tools[a];
         Vec3 p = x;
         double fn = 0;
@@ -180,7 +193,9 @@ void ServoLoop::tick(int64_t now, int64_t due) {
             }
         }
         proxy[a] = p;
-        m_desired.arms[a].servo_cf.force = map.forceScale * fn * tm.n;
+        const Vec3 tipForce = fn * tm.n;
+        m_desired.arms[a].servo_cf.force =
+            map.forceScale * (map.throughPort ? sim::handForce(map.port, portPose, tipForce) : tipForce);
         poses.proxy[a] = p;
         poses.target[a] = x;
         poses.orientation[a] = arm.measured_cp.orientation;

@@ -17,6 +17,7 @@
 #include "haptics/device.hpp"
 #include "haptics/lockfree.hpp"
 #include "haptics/safety_filter.hpp"
+#include "sim/scene/port.hpp"
 
 #include <atomic>
 #include <cmath>
@@ -35,6 +36,12 @@ struct ToolMapping {
     double forceScale = 1.0;           ///< device newtons per scene newton
     double couplingStiffness = 2000.0; ///< N/m, scene: virtual coupling proxy ↔ master
     double couplingDamping = 2.0;      ///< N·s/m, scene: damps the normal approach while in contact
+    /// Through a trocar port (sim/scene/port.hpp): laparoscopic, the master moves the handle
+    /// (port.restHandle + port.handScale · device motion) and the tip pivots about the port, the
+    /// force going back through the lever; robotic, the master places the tip as without a port
+    /// and the tip is held to the port's limits (remote centre of motion).
+    bool throughPort = false;
+    sim::PortFrame port;
 };
 
 /// How the servo thread waits for its deadline.

@@ -23,6 +23,8 @@ std::vector<CaseFileRef> caseFileReferences(const sim::SceneDesc& scene,
         add(at + "mesh", scene.surfaces[s].meshPath);
         add(at + "node_weights_file", scene.surfaces[s].nodeWeightsPath);
     }
+    for (size_t k = 0; k < scene.scenery.size(); ++k)
+        add("scenery[" + std::to_string(k) + "].mesh", scene.scenery[k].meshPath);
     for (const CaseMaterialMaps& m : materials) {
         for (const std::string& f : m.files())
             add("render.materials." + m.target, f);

@@ -104,6 +104,10 @@ uint32_t SceneView::addMaterial(const TissueMaterial& material) {
     return uint32_t(m_materials.size() - 1);
 }
 
+size_t addScenery(SceneView& view, const std::string& name, const sim::TriMesh& mesh) {
+    return view.addMesh(name, mesh, view.addMaterial(defaultMaterialFor(name)));
+}
+
 size_t SceneView::addMesh(const std::string& name, const sim::TriMesh& mesh, uint32_t material,
                           const ThicknessBakeSettings& bake) {
     if (material >= m_materials.size())

@@ -83,6 +83,11 @@ struct RenderMesh {
 /// thickness baked. What SceneView::fromWorld draws for a body, and what the studio paints on.
 RenderMesh bodySurfaceMesh(const sim::TetMesh& rest, const std::string& name, size_t body = 0);
 
+class SceneView;
+/// Adds a scenery surface (sim::SceneryDesc: drawn, never simulated) to `view` with the material
+/// defaultMaterialFor(name), seen from both sides when open. Returns its mesh index.
+size_t addScenery(SceneView& view, const std::string& name, const sim::TriMesh& mesh);
+
 class SceneView {
 public:
     SceneView() = default;

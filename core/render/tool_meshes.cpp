@@ -111,7 +111,7 @@ private:
     std::vector<uint32_t>* m_idx;
 };
 
-constexpr double kShaftLength = 0.16; ///< m drawn behind the jaws (the rest is outside the view)
+constexpr double kBeyondPort = 0.03; ///< m of shaft drawn outside a port
 
 /// A stable axis ⟂ to the shaft: the jaws open in the plane of the shaft and this axis.
 Vec3 openingAxis(const Vec3& d) {
@@ -126,8 +126,9 @@ void buildInstrument(Builder& b, const ToolPoses::Instrument& in) {
     const double r = std::max(in.radius, 5e-4), L = in.jawLength;
     const double shaftR = 1.6 * r;
     const Vec3 hinge = in.tip - L * d;
+    const double shaft = std::clamp(in.shaftLength, 0.01, 1.0);
     if (in.kind == "energy_hook") {
-        b.segment(hinge - kShaftLength * d, hinge, shaftR, 12);
+        b.segment(hinge - shaft * d, hinge, shaftR, 12);
         b.segment(hinge, in.tip, 0.45 * r, 8);                               // insulated rod
         b.segment(in.tip - 0.15 * L * u, in.tip + 0.35 * L * u, 0.4 * r, 8); // the hook, across the shaft
         return;
@@ -135,7 +136,7 @@ void buildInstrument(Builder& b, const ToolPoses::Instrument& in) {
     // Grasper and clip applier: two jaws hinged at the clevis, opened in the (d, u) plane.
     const bool clip = in.kind == "clip_applier";
     const double half = (clip ? 12.0 : 28.0) * M_PI / 180.0 * std::clamp(in.jaw, 0.0, 1.0);
-    b.segment(hinge - kShaftLength * d, hinge, shaftR, 12);
+    b.segment(hinge - shaft * d, hinge, shaftR, 12);
     for (int k : {-1, 1}) {
         const Vec3 dir = std::cos(half) * d + k * std::sin(half) * u;
         const Vec3 base = hinge + k * 0.35 * r * u;
@@ -205,6 +206,7 @@ ToolPoses toolPoses(const sim::World& world) {
                 t.direction = k.direction;
                 t.jaw = k.jaw;
             }
+            if (d.port.declared) t.shaftLength = (t.tip - d.port.position).norm() + kBeyondPort - t.jawLength;
             if (d.kind == sim::InstrumentDesc::Kind::ClipApplier) ++p.maxClips;
             p.instruments.push_back(std::move(t));
         }
@@ -213,7 +215,12 @@ ToolPoses toolPoses(const sim::World& world) {
     }
     for (size_t t = 0; t < world.toolCount(); ++t) {
         const sim::ToolContact& c = world.toolContact(t);
-        p.probes.push_back({c.centre, world.toolDesc(t).radius});
+        const sim::ToolDesc& d = world.toolDesc(t);
+        p.probes.push_back({c.centre, d.radius, d.port.declared, d.port.position});
+    }
+    if (const sim::Laparoscope* scope = world.laparoscope()) {
+        const sim::ScopePose& s = scope->pose();
+        p.scope = {true, s.tip, s.view, s.up, scope->desc().fovDeg, scope->steering()};
     }
     if (const sim::SutureReport* s = world.sutureReport()) {
         const sim::NeedleCurve curve = s->needleCurve();
@@ -265,10 +272,17 @@ bool ToolMeshes::build(B& b, const Part& part, const ToolPoses& poses, RenderMes
         m.material = in.kind == "energy_hook" && in.act ? m_active : m_steel;
         return true;
     }
-    case Part::Kind::Probe:
+    case Part::Kind::Probe: {
         if (part.index >= poses.probes.size()) return false;
-        b.sphere(poses.probes[part.index].centre, poses.probes[part.index].radius);
+        const ToolPoses::Probe& pr = poses.probes[part.index];
+        b.sphere(pr.centre, pr.radius);
+        if (pr.hasPort) { // the shaft from the sphere out through the port
+            const Vec3 out = pr.port - pr.centre;
+            const Vec3 d = out.norm() > 1e-9 ? Vec3(out.normalized()) : Vec3(Vec3::UnitZ());
+            b.segment(pr.centre, pr.port + kBeyondPort * d, 0.3 * pr.radius, 12);
+        }
         return true;
+    }
     case Part::Kind::Clip: {
         m.visible = part.index < poses.clips.size();
         if (!m.visible) { // not fired yet: hidden, with the fired clip's three plates so the topology is fixed

@@ -35,10 +35,23 @@ struct ToolPoses {
         bool act = false;                                      ///< energized / firing
         int grasped = 0;                                       ///< vertices held
         double radius = 0.0025, jawLength = 0.012;             ///< m
+        /// m drawn behind the jaws: through the port and a little beyond when it has one.
+        double shaftLength = 0.16;
     };
     struct Probe {
         Eigen::Vector3d centre = Eigen::Vector3d::Zero();
         double radius = 0.005;
+        bool hasPort = false;                           ///< a shaft from the centre out through it
+        Eigen::Vector3d port = Eigen::Vector3d::Zero(); ///< m
+    };
+    /// The laparoscope (sim/scene/laparoscope.hpp): what the camera of the view is.
+    struct Scope {
+        bool present = false;
+        Eigen::Vector3d tip = Eigen::Vector3d::Zero();
+        Eigen::Vector3d view = -Eigen::Vector3d::UnitZ(); ///< unit
+        Eigen::Vector3d up = Eigen::Vector3d::UnitY();    ///< unit
+        double fovDeg = 70;
+        bool steering = false; ///< the Cam pedal is held
     };
     std::vector<Instrument> instruments;
     std::vector<Probe> probes;
@@ -46,6 +59,7 @@ struct ToolPoses {
     size_t maxClips = 0;                               ///< clips the case can fire (one per applier)
     std::vector<Eigen::Vector3d> needle;               ///< points along the needle, end to tip; empty: none
     std::vector<Eigen::Vector3d> thread;               ///< puncture points then the needle's end
+    Scope scope;
     bool empty() const { return instruments.empty() && probes.empty() && needle.empty(); }
 };
 

@@ -31,12 +31,14 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
             if (m_armTools[a].empty()) return a;
         return exclusive ? -1 : 0;
     };
-    auto mapArm = [&](int arm, const sim::Vec3& start, double motion, double force) {
+    auto mapArm = [&](int arm, const sim::Vec3& start, double motion, double force, const sim::PortDesc* port) {
         haptics::ToolMapping& m = cfg.tools[arm];
         m.enabled = true;
         m.sceneStart = start;
         m.motionScale = motion;
         m.forceScale = force;
+        m.throughPort = port && port->declared;
+        if (m.throughPort) m.port = sim::makePortFrame(*port, start, motion);
     };
     for (size_t t = 0; t < world.toolCount(); ++t) { // probes: one arm each
         const sim::ToolDesc& d = world.toolDesc(t);
@@ -51,7 +53,7 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
         m_caseMaxForce = std::min(m_caseMaxForce, d.maxForceN);
         if (arm < 0) continue;
         m_armTools[arm].push_back(static_cast<int>(m_rig.size() - 1));
-        mapArm(arm, d.start, d.motionScale, d.forceScale);
+        mapArm(arm, d.start, d.motionScale, d.forceScale, &d.port);
     }
     if (sim::InteractionRuntime* in = world.interaction()) // instruments: arms may be shared
         for (size_t i = 0; i < in->instrumentCount(); ++i) {
@@ -74,7 +76,8 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
             m_caseMaxForce = std::min(m_caseMaxForce, d.device.maxForceN);
             if (arm < 0) continue;
             // The arm's first instrument sets its mapping: workspace centre at its rest tip.
-            if (m_armTools[arm].empty()) mapArm(arm, rt.rest.position, d.device.motionScale, d.device.forceScale);
+            if (m_armTools[arm].empty())
+                mapArm(arm, rt.rest.position, d.device.motionScale, d.device.forceScale, &d.port);
             m_armTools[arm].push_back(static_cast<int>(m_rig.size() - 1));
         }
     if (sim::NeedleDrive* nd = world.needleDrive();
@@ -93,7 +96,7 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
         m_caseMaxForce = std::min(m_caseMaxForce, d.maxForceN);
         if (arm >= 0) {
             m_armTools[arm].push_back(static_cast<int>(m_rig.size() - 1));
-            mapArm(arm, rest.pose.translation(), d.motionScale, d.forceScale);
+            mapArm(arm, rest.pose.translation(), d.motionScale, d.forceScale, nullptr);
         }
         int other = -1;
         for (int a = 0; a < arms; ++a)
@@ -107,7 +110,7 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
         m_rig.push_back(th);
         if (other >= 0) {
             m_armTools[other].push_back(static_cast<int>(m_rig.size() - 1));
-            mapArm(other, sim::Vec3::Zero(), 1.0, d.forceScale); // device metres: the lift itself
+            mapArm(other, sim::Vec3::Zero(), 1.0, d.forceScale, nullptr); // device metres: the lift itself
         }
     }
     for (int a = 0; a < kMaxArms; ++a)
@@ -115,6 +118,10 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
             RigTool& first = m_rig[static_cast<size_t>(m_armTools[a][0])];
             if (first.kind == RigTool::Kind::Instrument) first.offset = first.rest.position - cfg.tools[a].sceneStart;
         }
+    if (const sim::Laparoscope* scope = world.laparoscope()) {
+        const std::string& hand = scope->desc().hand;
+        m_scopeArm = arms == 2 && hand == "right" ? 1 : 0;
+    }
     m_aboveDamage.assign(world.toolCount(), false);
     for (size_t t = 0; t < m_rig.size(); ++t) // instruments are measured by the session, scripted or driven
         if (m_rig[t].kind != RigTool::Kind::Instrument) {
@@ -257,6 +264,25 @@ void HapticRig::start() {
     }
 }
 
+void HapticRig::steerScope(const haptics::ToolPoseState& poses) {
+    sim::Laparoscope* scope = m_world.laparoscope();
+    if (!scope || m_scopeArm < 0) return;
+    const bool cam = poses.tick != 0 && poses.connected && (poses.pedals & haptics::kPedalCamera) != 0;
+    const haptics::Vec3& at = poses.device[m_scopeArm];
+    const haptics::Quat& q = poses.orientation[m_scopeArm];
+    if (cam && !scope->steering()) { // the pedal went down: the master's pose now is the reference
+        scope->grab();
+        m_scopeGrab = at;
+        m_scopeGrabQ = q;
+    }
+    if (cam) {
+        const haptics::Quat r = q * m_scopeGrabQ.inverse();
+        scope->steer(at - m_scopeGrab,
+                     sim::twistAbout(Eigen::Vector4d(r.w(), r.x(), r.y(), r.z()), sim::Vec3::UnitZ()));
+    }
+    scope->setSteering(cam);
+}
+
 void HapticRig::beforeStep() {
     // Frame k simulates [k dt, (k+1) dt) and takes the tool poses of the last servo tick before
     // (k+1) dt, in lockstep and in real time alike.
@@ -273,6 +299,7 @@ void HapticRig::beforeStep() {
     if (m_realtime) measureLag(m_t0 + end);
     const haptics::ToolPoseState poses = m_realtime ? framePoses(m_t0 + end) : m_servo->toolPoses();
     m_servo->notifyStepStart();
+    steerScope(poses);
     sim::InteractionRuntime* interaction = m_world.interaction();
     std::array<int, kMaxArms> active{-1, -1};
     if (poses.tick != 0)
@@ -323,6 +350,12 @@ void HapticRig::beforeStep() {
         sim::InstrumentKey k;
         k.position = poses.proxy[a] + rt.offset;
         k.direction = poses.orientation[a] * rt.rest.direction;
+        // Through a port the shaft's direction is the port's (InteractionRuntime); the master's
+        // twist about the shaft rolls the jaws.
+        if (interaction->instrumentDesc(rt.index).port.declared) {
+            const haptics::Quat& q = poses.orientation[a];
+            k.roll = sim::twistAbout(Eigen::Vector4d(q.w(), q.x(), q.y(), q.z()), rt.rest.direction);
+        }
         const bool grip = m_device.capabilities().arm[a].grip;
         k.jaw = grip ? std::clamp(poses.grip[a] / rt.gripOpen, 0.0, 1.0) : rt.rest.jaw;
         switch (interaction->instrumentDesc(rt.index).kind) {

@@ -147,6 +147,8 @@ private:
     /// and returns the poses of the last servo tick before it (the lockstep run's input).
     haptics::ToolPoseState framePoses(int64_t due);
     haptics::LocalContactModel contactModel(int64_t now) const;
+    /// The laparoscope follows its master's motion since the Cam pedal went down, while it is held.
+    void steerScope(const haptics::ToolPoseState& poses);
     /// Publishes the contact model of m_frame and logs it for the hand-over audit.
     void publish();
     haptics::Device& m_device;
@@ -192,6 +194,9 @@ private:
     std::array<sim::Vec3, haptics::kMaxArms> m_last{sim::Vec3::Zero(), sim::Vec3::Zero()};
     std::array<sim::Vec3, haptics::kMaxArms> m_armProxy{sim::Vec3::Zero(), sim::Vec3::Zero()};
     std::vector<bool> m_aboveDamage;
+    int m_scopeArm = -1; ///< the master that steers the laparoscope (-1: none)
+    sim::Vec3 m_scopeGrab = sim::Vec3::Zero();
+    haptics::Quat m_scopeGrabQ = haptics::Quat::Identity();
     double m_forceSum = 0, m_contactSum = 0;
     uint64_t m_forceCount = 0, m_contactCount = 0;
     double m_maxAgeSteps = 0;

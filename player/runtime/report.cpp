@@ -228,6 +228,23 @@ static nlohmann::json sutureJson(const SessionResult& r) {
     return doc;
 }
 
+/// Tools through trocar ports: the port, its limits and what the run did with them.
+static nlohmann::json portsJson(const std::vector<PortFigures>& ports) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const PortFigures& p : ports)
+        a.push_back({{"tool", p.tool},
+                     {"kind", p.kind},
+                     {"mode", sim::portModeName(p.port.mode)},
+                     {"position_m", {p.port.position.x(), p.port.position.y(), p.port.position.z()}},
+                     {"insertion_limits_m", {p.port.insertionMin, p.port.insertionMax}},
+                     {"max_angle_deg", p.port.maxAngleDeg},
+                     {"insertion_used_m", {p.insertionMin_m, p.insertionMax_m}},
+                     {"max_shaft_distance_m", p.maxShaftDistance_m},
+                     {"frames_at_limit", p.framesAtLimit},
+                     {"frames", p.frames}});
+    return a;
+}
+
 /// The session's timeline (tool tips, forces, task events): what `viscera-player plot` draws.
 /// Positions rounded to 1 µm, forces to 0.1 mN, times to 1 µs.
 static nlohmann::json timelineJson(const SessionTimeline& tl) {
@@ -250,7 +267,16 @@ static nlohmann::json timelineJson(const SessionTimeline& tl) {
     for (const SessionTimeline::Event& e : tl.events)
         events.push_back(
             {{"t_s", round(e.t_s, 1e-6)}, {"frame", e.frame}, {"kind", e.kind}, {"tool", e.tool}, {"count", e.count}});
-    return {{"stride_frames", tl.stride}, {"t_s", t}, {"tools", tools}, {"events", events}};
+    json doc = {{"stride_frames", tl.stride}, {"t_s", t}, {"tools", tools}, {"events", events}};
+    if (!tl.cameraTip.empty()) {
+        json tip = json::array(), steering = json::array();
+        for (const Eigen::Vector3d& p : tl.cameraTip)
+            tip.push_back({round(p.x(), 1e-6), round(p.y(), 1e-6), round(p.z(), 1e-6)});
+        for (char c : tl.cameraSteering)
+            steering.push_back(c != 0);
+        doc["camera"] = {{"tip_m", tip}, {"steering", steering}};
+    }
+    return doc;
 }
 
 namespace {
@@ -351,6 +377,7 @@ nlohmann::json reportJson(const SessionResult& r) {
     if (r.haptics) doc["haptics"] = hapticsJson(*r.haptics);
     if (r.suture) doc["suture"] = sutureJson(r);
     if (r.interaction) doc["interaction"] = interactionJson(*r.interaction);
+    if (!r.ports.empty()) doc["ports"] = portsJson(r.ports);
     if (r.render) {
         json passes = json::array();
         for (const auto& p : r.render->passes)
@@ -527,6 +554,16 @@ std::string summaryText(const SessionResult& r) {
                           c.target.c_str(), c.firedAt, c.travel * 1e3, c.rotationDeg, c.maxContactDrift * 1e3);
             out += line;
         }
+    }
+    for (const PortFigures& p : r.ports) {
+        char line[256];
+        std::snprintf(line, sizeof line,
+                      "port          %s (%s): shaft within %.3f mm of the port, insertion %.0f-%.0f mm of "
+                      "%.0f-%.0f, %d of %d frames at a limit\n",
+                      p.tool.c_str(), sim::portModeName(p.port.mode), p.maxShaftDistance_m * 1e3,
+                      p.insertionMin_m * 1e3, p.insertionMax_m * 1e3, p.port.insertionMin * 1e3,
+                      p.port.insertionMax * 1e3, p.framesAtLimit, p.frames);
+        out += line;
     }
     // Error against run time on the last sampled frame [A eq. 4.45].
     for (auto it = r.accuracy.rbegin(); it != r.accuracy.rend(); ++it) {

@@ -1,5 +1,7 @@
 #include "runtime/session.hpp"
 
+#include "render/embedded_tint.hpp"
+
 #include "render/case_references.hpp"
 #include "runtime/realtime_watch.hpp"
 
@@ -150,6 +152,8 @@ LoadedCase loadCase(const std::filesystem::path& casePath, const vcase::TrustPol
     for (const sim::SurfaceDesc& sd : out.scene.surfaces) {
         surfaces.push_back(sim::parseVtri(pkg.read(sd.meshPath), pkg.name() + ":" + sd.meshPath));
     }
+    for (const sim::SceneryDesc& sc : out.scene.scenery) // drawn only: no physics reads them
+        out.scenery.push_back(sim::parseVtri(pkg.read(sc.meshPath), pkg.name() + ":" + sc.meshPath));
     for (size_t s = 0; s < out.scene.surfaces.size(); ++s) { // so do those painted on a fascia
         sim::SurfaceDesc& sd = out.scene.surfaces[s];
         if (sd.nodeWeightsPath.empty()) continue;
@@ -164,7 +168,9 @@ LoadedCase loadCase(const std::filesystem::path& casePath, const vcase::TrustPol
             named |= b.name == m.target;
         for (const sim::SurfaceDesc& sd : out.scene.surfaces)
             named |= sd.name == m.target;
-        if (!named) throw InputError(field + "'" + m.target + "' is not a body or surface of the scene");
+        for (const sim::SceneryDesc& sc : out.scene.scenery)
+            named |= sc.name == m.target;
+        if (!named) throw InputError(field + "'" + m.target + "' is not a body, surface or scenery of the scene");
     }
     // Before any map is decoded: what they take together, from their headers.
     render::checkDecodedImageBudget(materials, readEntry, pkg.name() + ": " + sceneName);
@@ -187,6 +193,8 @@ LoadedCase loadCase(const std::filesystem::path& casePath, const vcase::TrustPol
 
 render::SceneView caseView(const LoadedCase& loaded) {
     render::SceneView view = render::SceneView::fromWorld(*loaded.world);
+    for (size_t k = 0; k < loaded.scenery.size() && k < loaded.scene.scenery.size(); ++k)
+        render::addScenery(view, loaded.scene.scenery[k].name, loaded.scenery[k]);
     for (size_t b = 0; b < loaded.sampleMaps.size(); ++b) // fascia cut from a body show its map too
         if (!loaded.sampleMaps[b].empty())
             render::applyBodySampleMap(view, b, loaded.scene.bodies[b].name, loaded.sampleMaps[b],
@@ -195,6 +203,7 @@ render::SceneView caseView(const LoadedCase& loaded) {
         render::applyCornerUv(view, target, uv);
     for (const auto& [target, maps] : loaded.materialMaps)
         render::applyMaterialMaps(view, target, maps);
+    render::tintSurfacesOverEmbeddedBodies(view, *loaded.world); // a vessel seen through the fascia
     return view;
 }
 
@@ -355,6 +364,7 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     }
     InstrumentMeter meter;
     TimelineRecorder timeline(world);
+    PortMeter ports;
     if (options.live) {
         std::lock_guard<std::mutex> lock(options.live->mutex);
         for (size_t t = 0; t < world.toolCount(); ++t)
@@ -375,6 +385,7 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         if (rig) rig->afterStep();
         if (const sim::InteractionRuntime* in = world.interaction()) meter.record(*in, frameDt);
         timeline.record(world);
+        ports.record(world);
         r.maxNodeDisplacement = std::max(r.maxNodeDisplacement, nodeDisplacement(world));
         if (options.live)
             publishLive(world, rig.get(), r.frames, rec, frameDt, realTimeWarning, *options.live,
@@ -410,6 +421,7 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         meter.addTo(r.metrics, *in);
     }
     r.timeline = timeline.take();
+    r.ports = ports.take();
     return r;
 }
 

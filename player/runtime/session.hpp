@@ -7,6 +7,7 @@
 #include "render/scene_view.hpp"
 #include "render/tool_meshes.hpp"
 #include "runtime/haptic_rig.hpp"
+#include "runtime/port_meter.hpp"
 #include "runtime/timeline.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/world.hpp"
@@ -34,6 +35,8 @@ struct LoadedCase {
     std::vector<std::pair<std::string, std::shared_ptr<const render::MaterialMaps>>> materialMaps;
     /// Bodies drawn with UVs of their own ("render.materials.<body>.uv"): body name and corner UVs.
     std::vector<std::pair<std::string, std::vector<render::CornerUvF>>> cornerUvs;
+    /// The scene's scenery meshes (scene.scenery[k]): drawn, never simulated.
+    std::vector<sim::TriMesh> scenery;
 };
 
 /// Verifies the package, checks it against `trust` (signature, expiry, rollback) before reading
@@ -126,7 +129,8 @@ struct SessionResult {
     std::optional<sim::SutureSummary> suture;           ///< solver "fem" cases (needle and thread)
     std::vector<sim::SutureFrameRecord> sutureFrames;   ///< one per frame of a "fem" case
     std::optional<sim::InteractionSummary> interaction; ///< cases with scripted instruments
-    SessionTimeline timeline; ///< tool tips, forces and task events over the run (plots, report)
+    SessionTimeline timeline;       ///< tool tips, forces and task events over the run (plots, report)
+    std::vector<PortFigures> ports; ///< tools through trocar ports (port_meter.hpp)
     /// Paced sessions (a device on the wall clock): the physics' real-time factor estimated from
     /// the first frames (RealTimeWatch); 0 when not estimated.
     double realTimeEstimate = 0;

@@ -47,6 +47,10 @@ void TimelineRecorder::sample(const sim::World& world) {
         m_tl.tools[k].force_n.push_back(fr.empty() ? 0.0 : fr.back().needleForce);
         ++k;
     }
+    if (const sim::Laparoscope* scope = world.laparoscope()) {
+        m_tl.cameraTip.push_back(scope->pose().tip);
+        m_tl.cameraSteering.push_back(scope->steering() ? 1 : 0);
+    }
     // Every tool has one entry per sample (a tool the world no longer reports holds its last).
     for (SessionTimeline::Tool& tool : m_tl.tools)
         while (tool.tip.size() < m_tl.t_s.size()) {
@@ -92,6 +96,8 @@ void TimelineRecorder::record(const sim::World& world) {
             v.resize(w);
         };
         halve(m_tl.t_s);
+        halve(m_tl.cameraTip);
+        halve(m_tl.cameraSteering);
         for (SessionTimeline::Tool& tool : m_tl.tools) {
             halve(tool.tip);
             halve(tool.force_n);

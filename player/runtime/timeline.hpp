@@ -35,6 +35,10 @@ struct SessionTimeline {
     int stride = 1;          ///< frames per sample
     std::vector<Tool> tools;
     std::vector<Event> events;
+    /// The laparoscope (cases that have one): its tip and whether the Cam pedal steered it, one
+    /// per sample.
+    std::vector<Eigen::Vector3d> cameraTip;
+    std::vector<char> cameraSteering;
     bool empty() const { return tools.empty() && events.empty(); }
 };
 

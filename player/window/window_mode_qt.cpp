@@ -7,6 +7,7 @@
 #include "render/case_settings.hpp"
 #include "render/headless.hpp"
 #include "render/scene_view.hpp"
+#include "render/scope_view.hpp"
 #include "runtime/realtime_watch.hpp"
 #include "runtime/render_pacer.hpp"
 #include "sim/util/atomic_file.hpp"
@@ -50,9 +51,11 @@ public:
             m_offset += world.restMesh(b).vertexCount();
         }
         render::RenderSettings settings = render::defaultSettingsFor(m_view, width, height);
-        render::applyCaseRender(settings, caseRender, "scene.json");    // checked at load already
-        m_tools = render::ToolMeshes(m_view, render::toolPoses(world)); // after the framing: tissue only
-        settings.timePasses = false; // one wait per frame: the window shows the total only
+        render::applyCaseRender(settings, caseRender, "scene.json"); // checked at load already
+        const render::ToolPoses poses = render::toolPoses(world);
+        render::viewThroughScope(settings, poses.scope); // the laparoscope at rest, where the case has one
+        m_tools = render::ToolMeshes(m_view, poses);     // after the framing: tissue only
+        settings.timePasses = false;                     // one wait per frame: the window shows the total only
         m_renderer = render::HeadlessRenderer::create(settings, &m_whyNot);
         if (m_renderer && softwareGl(m_renderer->description())) {
             // Without a GPU the G-buffer's fragments are most of the frame (llvmpipe, rectum:
@@ -64,6 +67,27 @@ public:
         if (m_renderer) refresh(); // the rest state, until the first frame arrives
     }
     bool available() const { return m_renderer != nullptr; }
+    /// The window's stereo switch: off → side by side → anaglyph → off (the case's mode first).
+    void cycleStereo() {
+        if (!m_renderer) return;
+        render::RenderSettings s = m_renderer->settings();
+        using render::StereoMode;
+        s.stereo.mode = s.stereo.mode == StereoMode::Off          ? StereoMode::SideBySide
+                        : s.stereo.mode == StereoMode::SideBySide ? StereoMode::Anaglyph
+                                                                  : StereoMode::Off;
+        m_renderer->setSettings(s);
+    }
+    const char* stereoName() const {
+        if (!m_renderer) return "off";
+        switch (m_renderer->settings().stereo.mode) {
+        case render::StereoMode::SideBySide:
+            return "side by side";
+        case render::StereoMode::Anaglyph:
+            return "anaglyph";
+        default:
+            return "off";
+        }
+    }
     const std::string& whyNot() const { return m_whyNot; }
     const QImage& image() const { return m_image; }
     double lastFrameMs() const { return m_frameMs; }
@@ -78,6 +102,11 @@ public:
             m_snap = m_live.geometry;
         }
         if (m_snap.nodes.size() == m_offset) apply(m_snap);
+        if (m_snap.tools.scope.present) { // the camera follows the laparoscope
+            render::RenderSettings s = m_renderer->settings();
+            render::viewThroughScope(s, m_snap.tools.scope);
+            m_renderer->setSettings(s);
+        }
         m_frameMs = m_renderer->renderFrame(m_view).totalMs;
         const render::Image img = m_renderer->readPixels();
         QImage q(img.rgba.data(), img.width, img.height, img.width * 4, QImage::Format_RGBA8888);
@@ -147,7 +176,7 @@ private:
 class TraineeWindow final : public QRasterWindow {
 public:
     TraineeWindow(LiveView& live, std::string title, std::string instructions, KeyboardDevice* keyboard,
-                  std::atomic<bool>& stop, const Viewport3D* viewport)
+                  std::atomic<bool>& stop, Viewport3D* viewport)
         : m_live(live), m_title(std::move(title)), m_instructions(std::move(instructions)), m_keyboard(keyboard),
           m_stop(stop), m_viewport(viewport) {
         setTitle(QString::fromStdString("Viscera — " + m_title));
@@ -248,7 +277,15 @@ public:
         y += 40;
         p.setPen(QColor(235, 235, 235));
         p.drawText(px, y, (s.pedals & haptics::kPedalClutch) ? "Clutch: ENGAGED (tool holds)" : "Clutch: released");
-        y += 28;
+        y += 20;
+        if (m_viewport && m_viewport->available())
+            p.drawText(px, y, QString("Stereo: %1 (S switches)").arg(m_viewport->stereoName())), y += 20;
+        if (s.pedals & haptics::kPedalCamera) {
+            p.setPen(QColor(120, 200, 255));
+            p.drawText(px, y, "Cam: steering the laparoscope");
+            p.setPen(QColor(235, 235, 235));
+        }
+        y += 8;
         for (int a = 0; a < haptics::kMaxArms; ++a) {
             if (!s.toolActive[a]) continue;
             const double frac = std::clamp(s.force[a] / std::max(1e-9, s.maxForce_n), 0.0, 1.0);
@@ -334,7 +371,14 @@ protected:
 
 private:
     void key(QKeyEvent* e, bool down) {
-        if (!m_keyboard || e->isAutoRepeat()) return;
+        if (e->isAutoRepeat()) return;
+        if (e->key() == Qt::Key_S && down && m_viewport) { // the stereo switch, with any device
+            m_viewport->cycleStereo();
+            m_viewport->refresh();
+            update();
+            return;
+        }
+        if (!m_keyboard) return;
         switch (e->key()) {
         case Qt::Key_Left:
             m_keyboard->setKey(KeyboardDevice::KeyLeft, down);
@@ -357,6 +401,9 @@ private:
         case Qt::Key_Space:
             m_keyboard->setKey(KeyboardDevice::KeyClutch, down);
             break;
+        case Qt::Key_C: // held: the Cam pedal
+            m_keyboard->setKey(KeyboardDevice::KeyCamera, down);
+            break;
         default:
             break;
         }
@@ -365,7 +412,7 @@ private:
     std::string m_title, m_instructions;
     KeyboardDevice* m_keyboard;
     std::atomic<bool>& m_stop;
-    const Viewport3D* m_viewport;
+    Viewport3D* m_viewport;
     QPointF m_mouse;
 };
 

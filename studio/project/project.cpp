@@ -601,7 +601,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     const json doc = sim::parseJsonText(text, origin);
     const JsonField root(doc, "", origin);
     root.object({"schemaVersion", "caseId", "caseVersion", "title", "instructions", "solver", "gravity", "bodies",
-                 "surfaces", "accuracy", "render", "suture", "interaction", "tools"});
+                 "surfaces", "accuracy", "render", "suture", "interaction", "tools", "laparoscope", "bend", "scenery"});
     Project p;
     p.dir = dir;
     p.schemaVersion = root["schemaVersion"].integer(1, 1);
@@ -661,6 +661,9 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
             p.surfaces.push_back(std::move(sp));
         }
     if (auto t = root.find("tools")) scene.tools = sim::readTools(*t, names);
+    if (auto l = root.find("laparoscope")) scene.laparoscope = sim::readLaparoscope(*l);
+    if (auto b = root.find("bend")) p.bend = readBend(*b);
+    if (auto sc = root.find("scenery")) p.scenery = readSceneryProject(*sc, names);
     if (auto in = root.find("interaction")) scene.interaction = readInteractionProject(*in, dir, p.trackFiles);
     // Cross-references (embedding cages, interaction names) are checked now, before any meshing.
     std::vector<const sim::BodyDesc*> bodies;
@@ -695,6 +698,9 @@ std::string projectJsonText(const Project& p) {
     if (scene.suture) doc["suture"] = sutureProjectJson(*scene.suture, p.trajectory, w);
     if (scene.interaction) doc["interaction"] = interactionProjectJson(*scene.interaction, p.trackFiles, w);
     sim::writeTools(scene.tools, doc);
+    if (scene.laparoscope) sim::writeLaparoscope(*scene.laparoscope, doc);
+    if (p.bend) doc["bend"] = bendJson(*p.bend);
+    if (!p.scenery.empty()) doc["scenery"] = sceneryJson(p.scenery);
 
     doc["bodies"] = json::array();
     for (size_t i = 0; i < p.bodies.size(); ++i) {
@@ -1061,6 +1067,36 @@ void addUvMaterial(BuiltScene& built, const BodyProject& b, const std::vector<re
     built.materials.push_back(std::move(m));
 }
 
+/// The anatomy made by code, after every body and surface was generated, fixed and painted flat:
+/// the bend (bodies and surfaces), then the mesh files; the scenery surfaces and their files.
+void shapeAndWriteMeshes(const Project& project, BuiltScene& built, const std::string& origin) {
+    if (project.bend) {
+        try {
+            for (size_t i = 0; i < built.meshes.size(); ++i) {
+                std::vector<sim::Vec3> pos = built.meshes[i]->positions();
+                bendPoints(*project.bend, pos);
+                built.meshes[i] = sim::TetMesh::fromArrays(std::move(pos), built.meshes[i]->tets(), "bend");
+            }
+            for (sim::TriMesh& s : built.surfaces) {
+                std::vector<sim::Vec3> pos = s.positions();
+                bendPoints(*project.bend, pos);
+                s = sim::TriMesh::fromArrays(std::move(pos), s.triangles(), "bend");
+            }
+        } catch (const std::invalid_argument& e) {
+            throw InputError(origin + ": bend.radius: " + e.what());
+        }
+    }
+    for (size_t i = 0; i < built.meshes.size(); ++i)
+        built.files.emplace_back(built.scene.bodies[i].meshPath, sim::formatVtet(*built.meshes[i]));
+    for (size_t s = 0; s < built.surfaces.size(); ++s)
+        built.files.emplace_back(built.scene.surfaces[s].meshPath, sim::formatVtri(built.surfaces[s]));
+    for (const SceneryProject& sp : project.scenery) {
+        sim::SceneryDesc d{sp.name, "meshes/" + sp.name + ".vtri"};
+        built.files.emplace_back(d.meshPath, sim::formatVtri(scenerySurface(sp)));
+        built.scene.scenery.push_back(std::move(d));
+    }
+}
+
 BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
     const std::string origin = (project.dir / "project.json").string();
     BuiltScene built;
@@ -1128,8 +1164,7 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
         }
         built.skeletons.push_back(std::move(skeleton));
         be.fixedNodes = desc.fixedNodes.size();
-        files.emplace_back(desc.meshPath, sim::formatVtet(*mesh));
-        scene.bodies.push_back(std::move(desc));
+        scene.bodies.push_back(std::move(desc)); // its mesh file once shaped (shapeAndWriteMeshes)
         result.bodies.push_back(std::move(be));
         meshes.push_back(std::move(mesh));
     }
@@ -1149,7 +1184,6 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
         }
         sim::SurfaceDesc sd = sp.scene;
         sd.meshPath = "meshes/" + sd.name + ".vtri";
-        files.emplace_back(sd.meshPath, sim::formatVtri(tri));
         if (sp.paint) {
             sd.nodeWeights = surfaceNodeWeights(sp, tri, origin, "surfaces[" + std::to_string(s) + "]");
             sd.nodeWeightsPath = "meshes/" + sd.name + ".vweights";
@@ -1158,6 +1192,7 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
         scene.surfaces.push_back(std::move(sd));
         surfaces.push_back(std::move(tri));
     }
+    shapeAndWriteMeshes(project, built, origin);
     built.features = sim::requiredFeatures(scene); // only what the scene needs
     return built;
 }

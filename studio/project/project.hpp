@@ -43,7 +43,9 @@
 ///              "trajectory": {"generator": "anastomosis", "stitches": 5, ...AnastomosisSpec fields}
 ///                          | {"file": "needle.traj"}}     with "solver": {"type": "fem", "dt": ..}
 ///   "interaction": {...the scene's interaction section (core/sim/scene/interaction.hpp), with
-///                   every instrument's "track" a file of the project folder}
+///                   every instrument's "track" a file of the project folder},
+///   "laparoscope": {...the scene's (core/sim/scene/laparoscope.hpp)},
+///   "bend": {...}, "scenery": [...]          anatomy made by code (project/anatomy_shapes.hpp)
 /// }
 /// The suture trajectory is generated (or read and checked) at load and exported as
 /// tools/needle.traj; instrument tracks are checked at load and exported as tools/<name>.track.
@@ -58,6 +60,7 @@
 #include "bake/texture.hpp"
 #include "bake/uv_transfer.hpp"
 #include "case/signing.hpp"
+#include "project/anatomy_shapes.hpp"
 #include "render/case_settings.hpp"
 #include "render/corner_uv.hpp"
 #include "render/sample_map.hpp"
@@ -234,6 +237,10 @@ struct Project {
     TrajectorySource trajectory; ///< when scene.suture is set
     /// The "track" file of every instrument of scene.interaction, in the same order (one each).
     std::vector<std::filesystem::path> trackFiles;
+    /// Anatomy made by code (anatomy_shapes.hpp): the bend of the bodies and surfaces, and the
+    /// render-only scenery surfaces.
+    std::optional<BendSpec> bend;
+    std::vector<SceneryProject> scenery;
 };
 
 /// Reads <dir>/project.json: loadProjectText of the file's text. Throws viscera::InputError.

@@ -60,9 +60,14 @@ struct Rig {
     ManualClock clock{0};
     ServoConfig cfg;
     std::unique_ptr<ServoLoop> servo;
-    Rig(double kc = 2000) {
+    /// port: the tool through it, its rest tip at the scene start (the origin).
+    explicit Rig(double kc = 2000, const viscera::sim::PortDesc* port = nullptr) {
         cfg.tools[0].enabled = true;
         cfg.tools[0].motionScale = 1.0;
+        if (port) {
+            cfg.tools[0].throughPort = true;
+            cfg.tools[0].port = viscera::sim::makePortFrame(*port, Vec3::Zero(), 1.0);
+        }
         cfg.tools[0].couplingStiffness = kc;
         cfg.tools[0].couplingDamping = 0;
         cfg.safety.maxForceRate = 1e6; // the rate rule has its own tests
@@ -78,7 +83,19 @@ struct Rig {
         }
     }
     double force() const { return dev.last.arms[0].servo_cf.force.z(); }
+    void tickAt(const Vec3& device) {
+        dev.state.arms[0].measured_cp.position = device;
+        clock.advance(kMs);
+        servo->tick(clock.now_ns());
+    }
 };
+
+/// A wall x = 0 with its normal +x (tissue on the −x side), stiffness k.
+LocalContactModel sideWall(int64_t t, int64_t frame, double k = 400) {
+    LocalContactModel m = wall(t, frame, k);
+    m.tools[0].n = Vec3::UnitX();
+    return m;
+}
 
 } // namespace
 
@@ -270,4 +287,43 @@ TEST(ServoLoop, PoseHistoryGivesTheLastTickBeforeAnInstant) {
     ASSERT_EQ(q.servo->poseBefore(3 * kMs + 500'000, p), PoseLookup::Found);
     EXPECT_EQ(p.timestamp_ns, kMs);
     EXPECT_EQ(q.servo->poseBefore(4 * kMs + 1, p), PoseLookup::NotYet);
+}
+
+TEST(ServoLoop, ThroughAPortTheFulcrumInvertsTheHandAndTheForceStillOpposesIt) {
+    // A port 10 cm above the tool's rest tip; the master moves 1 cm to +x.
+    viscera::sim::PortDesc port;
+    port.declared = true;
+    port.position = Vec3(0, 0, 0.10);
+    port.insertionMin = 0.03;
+    port.insertionMax = 0.15;
+    port.shaftLength = 0.30;
+    for (auto mode : {viscera::sim::PortMode::Laparoscopic, viscera::sim::PortMode::Robotic}) {
+        port.mode = mode;
+        const bool lap = mode == viscera::sim::PortMode::Laparoscopic;
+        Rig r(2000, &port);
+        r.tickAt(Vec3::Zero());
+        EXPECT_LT(r.servo->toolPoses().target[0].norm(), 1e-12) << "the master's centre holds the rest tip";
+        r.tickAt(Vec3(0.01, 0, 0));
+        const Vec3 tip = r.servo->toolPoses().target[0];
+        // Sideways the tip moves motion_scale (1) per device metre: opposite in laparoscopic mode.
+        EXPECT_NEAR(tip.x(), lap ? -0.01 : 0.01, lap ? 5e-4 : 1e-12) << viscera::sim::portModeName(mode);
+        // Into a side wall on the side the tip went: the force pushes the hand back.
+        const Vec3 hand = lap ? Vec3(0.004, 0, 0) : Vec3(-0.004, 0, 0);
+        r.servo->publishContact(sideWall(r.clock.now_ns(), 0));
+        r.tickAt(hand);
+        const Vec3 f = r.dev.last.arms[0].servo_cf.force;
+        EXPECT_LT(f.dot(hand), 0.0) << viscera::sim::portModeName(mode) << ": the force opposes the hand";
+        EXPECT_GT(r.servo->toolPoses().force[0], 0.0);
+        // The master pushed 1 m down (the handle past the port in laparoscopic mode): the insertion
+        // stops at its maximum; pulled 1 m up, at its minimum.
+        r.servo->publishContact(wall(r.clock.now_ns(), 1, 0));
+        for (double z : {-1.0, 1.0}) {
+            r.tickAt(Vec3(0, 0, z));
+            const Vec3 t = r.servo->toolPoses().target[0];
+            ASSERT_TRUE(t.allFinite());
+            EXPECT_NEAR((t - port.position).norm(), z < 0 ? port.insertionMax : port.insertionMin, 1e-9)
+                << viscera::sim::portModeName(mode) << " z " << z;
+            EXPECT_LT(t.z(), port.position.z()) << "the tip stays inside the body";
+        }
+    }
 }

@@ -192,7 +192,7 @@ TEST(CaseView, BadMaterialMapsAreRefusedAtLoadNamingTheFieldAndTheRule) {
                   .find(where + "slab: 'textures/d.png' is not in the package"),
               std::string::npos);
     EXPECT_NE(error("target", {{"liver", {{"diffuse", "textures/d.png"}}}}, {{"textures/d.png", png}})
-                  .find(where + "liver: 'liver' is not a body or surface of the scene"),
+                  .find(where + "liver: 'liver' is not a body, surface or scenery of the scene"),
               std::string::npos);
     EXPECT_NE(error("none", {{"slab", {{"tiles_per_metre", 10}}}}, {}).find("render.materials.slab: names no map"),
               std::string::npos);

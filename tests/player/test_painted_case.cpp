@@ -149,5 +149,13 @@ TEST(PaintedCase, TheLiverProbeIsDrivenByADevice) {
         EXPECT_GT(doc["metrics"]["tool_path_length_m"].get<double>(), 0.02) << device;
         EXPECT_GT(doc["metrics"]["max_force_n"].get<double>(), 0.1) << device << ": the probe pressed the organ";
         EXPECT_LE(doc["metrics"]["max_force_n"].get<double>(), doc["haptics"]["case_max_force_n"].get<double>() + 1e-9);
+        // The probe through its laparoscopic port in every frame.
+        ASSERT_EQ(doc["ports"].size(), 1u) << device;
+        const nlohmann::json& port = doc["ports"][0];
+        EXPECT_EQ(port["mode"], "laparoscopic");
+        EXPECT_EQ(port["frames"].get<int>(), 200);
+        EXPECT_LT(port["max_shaft_distance_m"].get<double>(), 5e-4) << device;
+        EXPECT_GT(port["insertion_used_m"][1].get<double>(), port["insertion_used_m"][0].get<double>() + 0.01)
+            << device << ": the probe went in through the port";
     }
 }

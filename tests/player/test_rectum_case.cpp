@@ -6,13 +6,16 @@
 #include "support/case_signing.hpp"
 #include "support/run_process.hpp"
 
+#include <Eigen/Core>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <tuple>
 
 using namespace viscera;
 using ::testing::HasSubstr;
@@ -102,6 +105,17 @@ TEST(RectumCase, ExportsRunsGraspsCutsAndClips) {
         EXPECT_GT(rd["metrics"]["tool_path_length_per_tool_m"][t].get<double>(), 0.01) << t;
     EXPECT_GT(rd["metrics"]["max_force_n"].get<double>(), 0.0) << "force reached the device";
     EXPECT_LE(rd["metrics"]["max_force_n"].get<double>(), rd["haptics"]["case_max_force_n"].get<double>() + 1e-9);
+    // Each instrument through its trocar port in every frame of the replay (the console: robotic).
+    const nlohmann::json& ports = rd["ports"];
+    ASSERT_EQ(ports.size(), 3u);
+    for (const auto& p : ports) {
+        EXPECT_EQ(p["mode"], "robotic");
+        EXPECT_EQ(p["frames"].get<int>(), 290);
+        EXPECT_LT(p["max_shaft_distance_m"].get<double>(), 5e-4) << p["tool"];
+        EXPECT_GE(p["insertion_used_m"][0].get<double>(), p["insertion_limits_m"][0].get<double>() - 1e-9);
+        EXPECT_LE(p["insertion_used_m"][1].get<double>(), p["insertion_limits_m"][1].get<double>() + 1e-9);
+    }
+    EXPECT_THAT(rr.out, HasSubstr("port          hook (robotic): shaft within 0.000 mm of the port"));
 
     // The timeline has the task in order: the grasp, then the hook's cuts, then the clip; the
     // plots were drawn from it.
@@ -161,4 +175,64 @@ TEST(RectumCase, BrokenTracksAndSectionsAreRejectedAtExport) {
     auto b3 = exportWith(p);
     EXPECT_EQ(b3.exitCode, 1);
     EXPECT_THAT(b3.err, HasSubstr("stiffness_paint.strokes[0].radius"));
+}
+
+// The laparoscope moves only while the Cam pedal is held, and the instruments hold still
+// meanwhile: a replay holds the pedal from 1.1 s to 2.0 s while the right master moves 5 cm, then
+// moves the master back with the pedal up (the hook follows, the camera stays).
+TEST(RectumCase, TheLaparoscopeMovesOnlyWithTheCamPedalHeld) {
+    ScratchDir dir;
+    const auto out = dir.path() / "rectum.vcase";
+    auto e = studio({"export", std::string(VISCERA_SOURCE_DIR) + "/projects/rectum", "-o", out.string()});
+    ASSERT_EQ(e.exitCode, 0) << e.err;
+    const auto replay = dir.path() / "cam.csv";
+    {
+        std::ofstream f(replay);
+        f << "# viscera-trajectory 1\nt,arm,x,y,z,qw,qx,qy,qz,grip,buttons,pedals\n";
+        // t, right master x, pedals (deadman 4, + Cam 2)
+        const std::vector<std::tuple<double, double, int>> keys = {
+            {0.0, 0.0, 4}, {1.1, 0.0, 6}, {1.8, 0.05, 6}, {2.0, 0.05, 4}, {3.0, 0.0, 4}};
+        for (const auto& [t, x, pedals] : keys)
+            for (int arm : {0, 1})
+                f << t << "," << arm << "," << (arm == 1 ? x : 0.0) << ",0,0,1,0,0,0,1.0,0," << pedals << "\n";
+    }
+    const auto report = dir.path() / "cam.json";
+    auto r = player({"run", out.string(), "--headless", "--frames", "200", "--device", "replay:" + replay.string(),
+                     "--report", report.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
+    const nlohmann::json doc = readJson(report);
+    const nlohmann::json& tl = doc["timeline"];
+    ASSERT_TRUE(tl.contains("camera"));
+    const nlohmann::json& cam = tl["camera"];
+    const size_t n = tl["t_s"].size();
+    ASSERT_EQ(cam["tip_m"].size(), n);
+    ASSERT_EQ(cam["steering"].size(), n);
+    size_t hook = 99;
+    for (size_t k = 0; k < tl["tools"].size(); ++k)
+        if (tl["tools"][k]["name"] == "hook") hook = k;
+    ASSERT_LT(hook, tl["tools"].size());
+    auto at = [](const nlohmann::json& p) { return Eigen::Vector3d(p[0], p[1], p[2]); };
+    double camMovedSteering = 0, camMovedOtherwise = 0, hookMovedSteering = 0, hookMovedOtherwise = 0;
+    int steered = 0;
+    for (size_t k = 1; k < n; ++k) {
+        const double dc = (at(cam["tip_m"][k]) - at(cam["tip_m"][k - 1])).norm();
+        const double dh = (at(tl["tools"][hook]["tip_m"][k]) - at(tl["tools"][hook]["tip_m"][k - 1])).norm();
+        if (cam["steering"][k].get<bool>()) {
+            ++steered;
+            camMovedSteering += dc;
+            hookMovedSteering += dh;
+        } else {
+            camMovedOtherwise += dc;
+            hookMovedOtherwise += dh;
+        }
+    }
+    std::printf("camera: %d frames steered, moved %.2f mm then, %.4f mm otherwise; hook moved %.4f mm while "
+                "steering, %.2f mm otherwise\n",
+                steered, camMovedSteering * 1e3, camMovedOtherwise * 1e3, hookMovedSteering * 1e3,
+                hookMovedOtherwise * 1e3);
+    EXPECT_NEAR(steered, 54, 2) << "the pedal is held 0.9 s";
+    EXPECT_NEAR(camMovedSteering, 0.3 * 0.05, 1e-3) << "5 cm of the master at the scope's motion scale 0.3";
+    EXPECT_LT(camMovedOtherwise, 1e-9) << "the camera stays while the pedal is up";
+    EXPECT_LT(hookMovedSteering, 1e-6) << "the instruments hold still while the camera moves";
+    EXPECT_GT(hookMovedOtherwise, 0.015) << "the hook follows its master once the pedal is up";
 }

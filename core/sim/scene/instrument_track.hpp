@@ -28,6 +28,7 @@ struct InstrumentKey {
     Vec3 direction = -Vec3::UnitZ(); ///< unit, shaft towards the tip
     double jaw = 1;                  ///< 0 closed … 1 open
     bool act = false;                ///< energy on / clip fired
+    double roll = 0;                 ///< rad about the shaft (a device's; tracks carry none)
 };
 
 class InstrumentTrack {

@@ -41,7 +41,7 @@ InteractionDesc readInteractionSection(const JsonField& doc) {
     }
     std::set<std::string> names;
     for (const JsonField& j : doc["instruments"].items(1, 8)) {
-        j.object({"name", "kind", "track", "radius", "jaw_length", "temperature_c", "target", "device"});
+        j.object({"name", "kind", "track", "radius", "jaw_length", "temperature_c", "target", "device", "port"});
         InstrumentDesc in;
         in.name = readName(j["name"], names); // it names the track file of the case
         const std::string kind = j["kind"].choice({"grasper", "energy_hook", "clip_applier"}, "an instrument");
@@ -68,6 +68,7 @@ InteractionDesc readInteractionSection(const JsonField& doc) {
             dd.damageForceN = dev->number("damage_force_n", dd.damageForceN, NumberRule::aboveUpTo(0, 1000.0));
             dd.gripOpenRad = dev->number("grip_open_rad", dd.gripOpenRad, NumberRule::closed(0.05, M_PI));
         }
+        if (auto port = j.find("port")) readPort(*port, in.port);
         d.instruments.push_back(std::move(in));
     }
     if (auto t = doc.find("tissues")) {
@@ -130,6 +131,7 @@ json interactionJson(const InteractionDesc& d) {
             j["device"]["damage_force_n"] = dd.damageForceN;
             j["device"]["grip_open_rad"] = dd.gripOpenRad;
         }
+        if (in.port.declared) writePort(in.port, j["port"]);
         doc["instruments"].push_back(j);
     }
     if (!d.tissues.empty()) {

@@ -32,6 +32,7 @@
 /// Units SI; temperatures °C. Parsing is strict; errors name the origin, the field and the rule.
 #include "sim/scene/device_mapping.hpp"
 #include "sim/scene/instrument_track.hpp"
+#include "sim/scene/port.hpp"
 
 #include <string>
 #include <string_view>
@@ -56,6 +57,9 @@ struct InstrumentDesc {
     double temperatureC = 170; ///< energy hook
     std::string target;        ///< clip applier: the tet body (vessel) it clips
     InstrumentDeviceDesc device;
+    /// "port" (port.hpp): the shaft passes through it, on the track and under a device; the
+    /// track's directions are then replaced by the port's, its tips held to the port's limits.
+    PortDesc port;
 };
 
 struct DissectionTissueDesc {

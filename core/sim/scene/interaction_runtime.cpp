@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 namespace viscera::sim {
 namespace {
@@ -19,10 +20,12 @@ double msSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// Rigid frame of an instrument: +x along the shaft towards the tip, origin at `origin`.
-ToolShape::Pose framePose(const Vec3& origin, const Vec3& direction) {
+/// Rigid frame of an instrument: +x along the shaft towards the tip, origin at `origin`, turned
+/// by `roll` (rad) about the shaft.
+ToolShape::Pose framePose(const Vec3& origin, const Vec3& direction, double roll) {
     ToolShape::Pose p = ToolShape::Pose::Identity();
-    p.linear() = Eigen::Quaterniond::FromTwoVectors(Vec3::UnitX(), direction).toRotationMatrix();
+    p.linear() = Eigen::AngleAxisd(std::isfinite(roll) ? roll : 0.0, direction).toRotationMatrix() *
+                 Eigen::Quaterniond::FromTwoVectors(Vec3::UnitX(), direction).toRotationMatrix();
     p.translation() = origin;
     return p;
 }
@@ -50,6 +53,8 @@ struct InteractionRuntime::Instrument {
     InstrumentDesc desc;
     InstrumentTrack track;
     InstrumentKey key;
+    std::optional<PortFrame> port;    ///< desc.port, declared
+    PortPose portPose;                ///< this frame, with a port
     std::unique_ptr<ToolShape> shape; ///< null: no collision (clip applier)
     std::unique_ptr<CollisionSolver> collision;
     XpbdIterationHook hook;
@@ -126,6 +131,14 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
         in->desc = desc.instruments[i];
         in->track = InstrumentTrack::parse(in->desc.trackText, origin + ": " + in->desc.trackPath);
         in->key = in->track.sample(0);
+        if (in->desc.port.declared) {
+            const PortDesc& pd = in->desc.port;
+            if (const std::string why = restTipError(pd, in->key.position); !why.empty())
+                fail("instruments[" + std::to_string(i) + "].port", "the track's first tip " + why);
+            in->port = makePortFrame(pd, in->key.position, in->desc.device.motionScale);
+            in->portPose = constrainToPort(*in->port, in->key.position);
+            in->key.direction = in->portPose.direction;
+        }
         switch (in->desc.kind) {
         case InstrumentDesc::Kind::Grasper:
             in->shape =
@@ -279,6 +292,12 @@ void InteractionRuntime::beforeStep(double t, double dt) {
             in.key = k;
         } else
             in.key = in.track.sample(t);
+        if (in.port) {
+            // Through the port: the shaft from the port towards the tip, the tip within its limits.
+            in.portPose = constrainToPort(*in.port, in.key.position);
+            in.key.position = in.portPose.tip;
+            in.key.direction = in.portPose.direction;
+        }
         in.forceSum = Vec3::Zero();
         in.forceSubsteps = 0;
         in.holdImpulse = Vec3::Zero();
@@ -288,7 +307,7 @@ void InteractionRuntime::beforeStep(double t, double dt) {
             // length (grasper) or half the shaft piece (hook capsule centre) behind it.
             const double back =
                 in.desc.kind == InstrumentDesc::Kind::Grasper ? in.desc.jawLength : 0.5 * in.desc.jawLength;
-            in.pose = framePose(in.key.position - back * dir, dir);
+            in.pose = framePose(in.key.position - back * dir, dir, in.key.roll);
             in.shape->setPose(in.pose);
             in.shape->setOpening(kMaxJawOpening * in.key.jaw);
             const auto box = in.shape->bounds();
@@ -391,6 +410,10 @@ void InteractionRuntime::afterStep() {
         s.grasped = static_cast<int>(in.held.size());
         s.force = in.force;
         s.driven = in.driven;
+        if (in.port) {
+            s.insertion = in.portPose.insertion;
+            s.atPortLimit = in.portPose.insertionLimited || in.portPose.angleLimited;
+        }
         contacts += s.contacts;
         m_summary.instruments.push_back(s);
     }

@@ -40,6 +40,10 @@ struct InstrumentState {
     int grasped = 0;           ///< vertices held
     Vec3 force = Vec3::Zero(); ///< N, on the instrument from the tissue, mean over the frame's substeps
     bool driven = false;       ///< a device drove it this frame (else its track)
+    /// With a port (InstrumentDesc::port): port to tip (m), and whether the tip was held back
+    /// at the port's insertion or angle limit this frame.
+    double insertion = 0;
+    bool atPortLimit = false;
 };
 
 struct ClipState {

@@ -58,7 +58,7 @@ std::vector<ToolDesc> readTools(const JsonField& tools, std::set<std::string>& n
     if (list.size() > 2) tools.fail("at most 2 tools (one per master)");
     for (const JsonField& t : list) {
         t.object({"name", "shape", "radius", "hand", "start", "motion_scale", "force_scale", "stiffness", "max_force_n",
-                  "damage_force_n"});
+                  "damage_force_n", "port"});
         ToolDesc d;
         d.name = readName(t["name"], names);
         if (auto shape = t.find("shape")) shape->choice({"sphere"}, "a tool shape");
@@ -70,9 +70,82 @@ std::vector<ToolDesc> readTools(const JsonField& tools, std::set<std::string>& n
         d.maxForceN = t.number("max_force_n", d.maxForceN, NumberRule::aboveUpTo(0, 50.0));
         d.damageForceN = t.number("damage_force_n", d.damageForceN, NumberRule::aboveUpTo(0, 1000.0));
         d.stiffness = t.number("stiffness", d.stiffness, NumberRule::nonNegative());
+        if (auto port = t.find("port")) readPort(*port, d.port);
         out.push_back(d);
     }
     return out;
+}
+
+void readPort(const JsonField& port, PortDesc& out) {
+    port.object({"position", "insertion", "max_angle_deg", "shaft_length", "mode"});
+    out.declared = true;
+    out.position = port["position"].vec3();
+    if (auto ins = port.find("insertion")) {
+        const std::vector<JsonField> range = ins->items(2, 2);
+        out.insertionMin = range[0].number(NumberRule::aboveUpTo(0, 0.5));
+        out.insertionMax = range[1].number(NumberRule::aboveUpTo(0, 0.5));
+        if (!(out.insertionMin < out.insertionMax)) ins->fail("must be [min, max] with min < max");
+    }
+    out.maxAngleDeg = port.number("max_angle_deg", out.maxAngleDeg, NumberRule::aboveUpTo(0, 89));
+    out.shaftLength = port.number("shaft_length", out.shaftLength, NumberRule::aboveUpTo(0, 1.0));
+    if (out.shaftLength < out.insertionMax + 0.05)
+        port.failAt("shaft_length", "must be at least the largest insertion + 0.05 m (" +
+                                        std::to_string(out.insertionMax + 0.05) + ")");
+    if (auto mode = port.find("mode"))
+        out.mode = mode->choice({"laparoscopic", "robotic"}, "a port mode") == "robotic" ? PortMode::Robotic
+                                                                                         : PortMode::Laparoscopic;
+}
+
+void writePort(const PortDesc& p, json& port) {
+    port["position"] = {p.position.x(), p.position.y(), p.position.z()};
+    port["insertion"] = {p.insertionMin, p.insertionMax};
+    port["max_angle_deg"] = p.maxAngleDeg;
+    port["shaft_length"] = p.shaftLength;
+    port["mode"] = portModeName(p.mode);
+}
+
+std::vector<SceneryDesc> readScenery(const JsonField& scenery, std::set<std::string>& names) {
+    std::vector<SceneryDesc> out;
+    for (const JsonField& j : scenery.items(1, 16)) {
+        j.object({"name", "mesh"});
+        SceneryDesc d;
+        d.name = readName(j["name"], names);
+        d.meshPath = j["mesh"].entryPath();
+        out.push_back(std::move(d));
+    }
+    return out;
+}
+
+void writeScenery(const std::vector<SceneryDesc>& scenery, json& doc) {
+    for (const SceneryDesc& d : scenery)
+        doc["scenery"].push_back({{"name", d.name}, {"mesh", d.meshPath}});
+}
+
+LaparoscopeDesc readLaparoscope(const JsonField& scope) {
+    scope.object({"port", "tip", "optic_deg", "fov_deg", "hand", "motion_scale"});
+    LaparoscopeDesc d;
+    const JsonField port = scope["port"];
+    readPort(port, d.port);
+    d.port.mode = PortMode::Robotic; // a scope holder: the port is a remote centre of motion
+    d.tip = scope["tip"].vec3();     // within the port's reach: checked by World::assemble (restTipError)
+    if (auto optic = scope.find("optic_deg")) {
+        d.opticDeg = optic->number(NumberRule::closed(0, 30));
+        if (d.opticDeg != 0 && d.opticDeg != 30) optic->fail("must be 0 or 30 (the optics made)");
+    }
+    d.fovDeg = scope.number("fov_deg", d.fovDeg, NumberRule::closed(20, 120));
+    if (auto hand = scope.find("hand")) d.hand = hand->choice({"left", "right", "any"}, "a hand");
+    d.motionScale = scope.number("motion_scale", d.motionScale, NumberRule::aboveUpTo(0, 10.0));
+    return d;
+}
+
+void writeLaparoscope(const LaparoscopeDesc& d, json& doc) {
+    json& j = doc["laparoscope"];
+    writePort(d.port, j["port"]);
+    j["tip"] = {d.tip.x(), d.tip.y(), d.tip.z()};
+    j["optic_deg"] = d.opticDeg;
+    j["fov_deg"] = d.fovDeg;
+    j["hand"] = d.hand;
+    j["motion_scale"] = d.motionScale;
 }
 
 void readDeviceMapping(const JsonField& dev, DeviceMapping& out) {
@@ -91,7 +164,7 @@ void writeDeviceMapping(const DeviceMapping& m, json& device) {
 }
 
 void writeTools(const std::vector<ToolDesc>& tools, json& doc) {
-    for (const ToolDesc& t : tools)
+    for (const ToolDesc& t : tools) {
         doc["tools"].push_back({{"name", t.name},
                                 {"shape", "sphere"},
                                 {"radius", t.radius},
@@ -102,6 +175,8 @@ void writeTools(const std::vector<ToolDesc>& tools, json& doc) {
                                 {"stiffness", t.stiffness},
                                 {"max_force_n", t.maxForceN},
                                 {"damage_force_n", t.damageForceN}});
+        if (t.port.declared) writePort(t.port, doc["tools"].back()["port"]);
+    }
 }
 
 void readSolver(const JsonField& doc, SceneDesc& scene) {
@@ -243,7 +318,7 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     const json doc = parseJsonText(text, origin);
     const JsonField root(doc, "", origin);
     root.object({"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces", "tools", "render", "suture",
-                 "interaction"});
+                 "interaction", "laparoscope", "scenery"});
     SceneDesc scene;
     readSolver(root, scene);
     if (auto su = root.find("suture")) scene.suture = readSutureSection(*su);
@@ -282,6 +357,8 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
             scene.surfaces.push_back(std::move(sd));
         }
     if (auto t = root.find("tools")) scene.tools = readTools(*t, names);
+    if (auto l = root.find("laparoscope")) scene.laparoscope = readLaparoscope(*l);
+    if (auto sc = root.find("scenery")) scene.scenery = readScenery(*sc, names);
     if (auto in = root.find("interaction")) scene.interaction = readInteractionSection(*in);
     std::vector<const BodyDesc*> bodies;
     for (const BodyDesc& b : scene.bodies)
@@ -320,6 +397,8 @@ json sceneJson(const SceneDesc& scene) {
         }
     }
     writeTools(scene.tools, doc);
+    if (scene.laparoscope) writeLaparoscope(*scene.laparoscope, doc);
+    writeScenery(scene.scenery, doc);
     return doc;
 }
 

@@ -25,6 +25,8 @@
 ///                 "node_weights_file": "meshes/fascia.vweights"}],   optional (or "node_weights"):
 ///                                  painted stiffness, one weight per vertex
 ///   "tools": [{"name": "probe", "shape": "sphere", ...see tool_probe.hpp...}]   optional
+///   "laparoscope": {...see scene/laparoscope.hpp...}   optional: the camera on its port
+///   "scenery": [{"name": "pelvic_wall", "mesh": "meshes/pelvic_wall.vtri"}]   optional: drawn only
 ///   "interaction": {...see scene/interaction.hpp...}   optional, xpbd: instruments on recorded
 ///              tracks (grasper, energy hook, clip applier) and the tissues the hook can cut
 ///   "suture": {...see suture/suture_scene.hpp...}   with "solver": {"type": "fem", "dt": ..}: the
@@ -34,6 +36,7 @@
 /// }
 #include "sim/material/material.hpp"
 #include "sim/scene/interaction.hpp"
+#include "sim/scene/laparoscope.hpp"
 #include "sim/scene/tool_probe.hpp"
 #include "sim/suture/suture_scene.hpp"
 #include "sim/xpbd/strain_limit.hpp"
@@ -90,6 +93,15 @@ struct AccuracySampling {
 /// (JsonField::displayText), one rule for scene.json and project.json.
 inline constexpr size_t kMaxInstructionsBytes = 2000;
 
+/// A surface of the case that is drawn and never simulated: the anatomy around the working space
+/// (pelvic side walls, peritoneum, an organ the task does not touch). It costs no physics; a
+/// render.materials entry of its name gives it maps, as for a body.
+///   "scenery": [{"name": "pelvic_wall", "mesh": "meshes/pelvic_wall.vtri"}]
+struct SceneryDesc {
+    std::string name;     ///< unique with the bodies, surfaces and tools
+    std::string meshPath; ///< .vtri entry of the case
+};
+
 struct SceneDesc {
     std::string instructions; ///< shown to the trainee; may be empty
     /// The "render" object as JSON text (empty: renderer defaults). The simulation does not read
@@ -104,6 +116,10 @@ struct SceneDesc {
     std::optional<SutureSceneDesc> suture; ///< solver "fem" only (features fem, needle, thread, contact)
     /// Scripted instruments (features collision, dissection, clip); XPBD scenes only.
     std::optional<InteractionDesc> interaction;
+    /// Render-only surfaces (scene "scenery"): drawn with the tissue, never simulated.
+    std::vector<SceneryDesc> scenery;
+    /// The camera on its port (laparoscope.hpp); without it the renderer frames the tissue.
+    std::optional<LaparoscopeDesc> laparoscope;
 };
 
 /// Throws viscera::InputError ("scene.json: bodies[0].material.poisson_ratio: must be in [0, 0.5)").

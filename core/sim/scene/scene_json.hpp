@@ -27,6 +27,15 @@ void writeAccuracy(const std::optional<AccuracySampling>& accuracy, nlohmann::js
 /// The name rule of bodies, surfaces and tools: 1–64 characters of [A-Za-z0-9_-] (it names the
 /// files of the case), unique among all of them (`names`).
 std::string readName(const JsonField& name, std::set<std::string>& names);
+/// A "port" block (sim/scene/port.hpp); marks it declared.
+void readPort(const JsonField& port, PortDesc& out);
+void writePort(const PortDesc& port, nlohmann::json& block);
+/// "scenery" (render-only surfaces); names unique with the others. Writes it when there is any.
+std::vector<SceneryDesc> readScenery(const JsonField& scenery, std::set<std::string>& names);
+void writeScenery(const std::vector<SceneryDesc>& scenery, nlohmann::json& doc);
+/// "laparoscope" (laparoscope.hpp): its port and the rest tip within the port's insertion.
+LaparoscopeDesc readLaparoscope(const JsonField& scope);
+void writeLaparoscope(const LaparoscopeDesc& scope, nlohmann::json& doc);
 /// The common fields of a "device" block (hand, motion_scale, force_scale, max_force_n); marks it
 /// declared. The caller checks the block's key set.
 void readDeviceMapping(const JsonField& device, DeviceMapping& out);

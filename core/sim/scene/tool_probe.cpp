@@ -34,6 +34,10 @@ void ToolProbes::setPosition(size_t t, const Vec3& centre) {
     const double r = m_tools[t].radius, n = d.norm();
     if (n > r) d *= r / n;
     m_pos[t] += d;
+    // A probe through a port: its shaft from the port to the centre, within the port's limits.
+    if (m_tools[t].port.declared)
+        m_pos[t] =
+            constrainToPort(makePortFrame(m_tools[t].port, m_tools[t].start, m_tools[t].motionScale), m_pos[t]).tip;
 }
 
 std::vector<char> ToolProbes::apply(std::vector<std::vector<Vec3>>& x, std::vector<std::vector<Vec3>>& v,

@@ -12,6 +12,7 @@
 /// Contact is node-based: a probe smaller than the node spacing can slip between surface nodes.
 /// Cost per frame O(#tools × #nodes).
 #include "sim/mesh/tet_mesh.hpp"
+#include "sim/scene/port.hpp"
 
 #include <string>
 #include <vector>
@@ -20,7 +21,7 @@ namespace viscera::sim {
 
 /// scene.json "tools": [{"name": "probe", "shape": "sphere", "radius": 0.005, "hand": "right",
 ///   "start": [0.06, 0.02, 0.04], "motion_scale": 0.25, "force_scale": 1.0, "stiffness": 0,
-///   "max_force_n": 15, "damage_force_n": 4}]
+///   "max_force_n": 15, "damage_force_n": 4, "port": {...}}]      port: sim/scene/port.hpp
 struct ToolDesc {
     std::string name;
     std::string hand = "any";  ///< "left", "right" or "any": which master drives it
@@ -31,6 +32,7 @@ struct ToolDesc {
     double stiffness = 0;      ///< N/m linear contact stiffness; 0 = Hertz from the body's material
     double maxForceN = 15.0;   ///< N, the case's maximum device force
     double damageForceN = 4.0; ///< N, contact force above which tissue is damaged (session metric)
+    PortDesc port;             ///< "port" (port.hpp): the probe's shaft passes through it
 };
 
 /// One probe's contact after the last frame.
@@ -56,7 +58,8 @@ public:
     const ToolDesc& desc(size_t t) const { return m_tools[t]; }
     const ToolContact& contact(size_t t) const { return m_contacts[t]; }
     /// Non-finite positions are ignored; a move longer than the radius is cut to the radius per
-    /// frame (no tunnelling through thin tissue).
+    /// frame (no tunnelling through thin tissue); with a port, the centre is then held to the
+    /// port's limits (constrainToPort).
     void setPosition(size_t t, const Vec3& centre);
     const Vec3& position(size_t t) const { return m_pos[t]; }
     /// x[b], v[b]: positions and velocities of body b (in/out). Returns, per body, whether it

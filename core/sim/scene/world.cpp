@@ -68,6 +68,16 @@ std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::
         }
         w->m_probes = std::make_unique<ToolProbes>(scene.tools, std::move(pb), scene.xpbd.dt);
     }
+    // Rules between a tool's rest tip and its port.
+    for (size_t t = 0; t < scene.tools.size(); ++t)
+        if (scene.tools[t].port.declared)
+            if (const std::string why = restTipError(scene.tools[t].port, scene.tools[t].start); !why.empty())
+                throw InputError(origin + ": tools[" + std::to_string(t) + "].start: " + why);
+    if (scene.laparoscope) {
+        if (const std::string why = restTipError(scene.laparoscope->port, scene.laparoscope->tip); !why.empty())
+            throw InputError(origin + ": laparoscope.tip: " + why);
+        w->m_scope = std::make_unique<Laparoscope>(*scene.laparoscope);
+    }
     w->m_active = std::move(needed);
     w->m_invariants.maxEnergy = w->totalEnergy();
     return w;

@@ -113,6 +113,10 @@ public:
     /// The needle of a suturing scene, for a device to drive (suture "device"); null otherwise.
     NeedleDrive* needleDrive() { return m_solver->needleDrive(); }
     const NeedleDrive* needleDrive() const { return m_solver->needleDrive(); }
+    // ---- the laparoscope (scene "laparoscope"): the camera on its port, steered between frames --
+    /// Null unless the scene declares one. Kinematic: it changes nothing of the physics.
+    const Laparoscope* laparoscope() const { return m_scope.get(); }
+    Laparoscope* laparoscope() { return m_scope.get(); }
     /// The scene the world was assembled from.
     const SceneDesc& scene() const { return m_scene; }
     /// One record per step of a "fem" scene; empty otherwise.
@@ -131,6 +135,7 @@ private:
     std::vector<TriMesh> m_surfaces;
     std::unique_ptr<SceneSolver> m_solver; ///< after the meshes it reads from
     std::unique_ptr<ToolProbes> m_probes;  ///< null unless the scene has tools
+    std::unique_ptr<Laparoscope> m_scope;  ///< null unless the scene has a laparoscope
     Invariants m_invariants;
     std::vector<AccuracyRecord> m_accuracy;
     double m_time = 0;

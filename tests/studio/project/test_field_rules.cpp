@@ -27,8 +27,10 @@ const std::filesystem::path kProjects = std::filesystem::path(VISCERA_SOURCE_DIR
 const std::vector<std::string> kSamples = {"tissue-slab", "organ-blob", "liver", "rectum", "anastomosis"};
 
 /// Keys whose numbers may be negative (positions, directions, signed curve values, brush amplitude).
-const std::set<std::string> kSigned = {"origin", "center",    "start", "end",   "min",   "max",  "gravity",
-                                       "points", "amplitude", "slack", "lower", "upper", "axes", "needle_centre"};
+const std::set<std::string>
+    kSigned = {"origin",   "center",    "start",  "end",      "min",     "max",  "gravity",
+               "points",   "amplitude", "slack",  "lower",    "upper",   "axes", "needle_centre",
+               "position", "tip",       "normal", "from_deg", "center_y"}; // ports, laparoscope, scenery and bend
 
 struct Leaf {
     json::json_pointer pointer;

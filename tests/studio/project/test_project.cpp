@@ -84,10 +84,11 @@ TEST_F(ProjectTest, ExportWritesOnlyWhatTheSceneUses) {
 
 // Export writes by the one table of file references that load checks
 // (render::caseFileReferences): the packages of the liver (meshes, a fascia, texture maps, a light
-// sample map) and the anastomosis (a needle trajectory) hold exactly scene.json and the files their
+// sample map), the anastomosis (a needle trajectory) and the rectum (scenery surfaces, tracks) hold
+// exactly scene.json and the files their
 // scenes name, each named once with its field.
 TEST_F(ProjectTest, PackagesHoldExactlyTheFilesTheirScenesName) {
-    for (const char* sample : {"liver", "anastomosis"}) {
+    for (const char* sample : {"liver", "anastomosis", "rectum"}) {
         SCOPED_TRACE(sample);
         const auto out = m_dir / (std::string(sample) + ".vcase");
         studio::exportCase(studio::loadProject(std::filesystem::path(VISCERA_SOURCE_DIR) / "projects" / sample), out);
