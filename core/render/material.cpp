@@ -50,13 +50,12 @@ TissueMaterial defaultMaterialFor(const std::string& rawName) {
         m.roughness = 0.3f;
         m.sssColour = {1.0f, 0.4f, 0.3f};
     } else if (has(name, "peritoneum") || has(name, "wall") || has(name, "pelvi")) {
-        m.surface.colour = {0.74f, 0.50f, 0.46f}; // a thin glossy lining over muscle, small vessels in it
-        m.granular = {{0.62f, 0.36f, 0.34f}, 0.3f, 300.0f};
-        m.connective = {{0.90f, 0.78f, 0.72f}, 0.4f, 120.0f};
-        m.submucosa = {{0.50f, 0.08f, 0.10f}, 0.35f, 60.0f};
-        m.roughness = 0.22f;
-        m.reflection = 0.4f;
-        m.sssColour = {1.0f, 0.5f, 0.4f};
+        m.surface.colour = {0.66f, 0.40f, 0.38f}; // a thin lining over muscle
+        m.granular = {{0.58f, 0.32f, 0.30f}, 0.3f, 600.0f};
+        m.connective = {{0.84f, 0.68f, 0.62f}, 0.3f, 160.0f};
+        m.submucosa = {{0.45f, 0.08f, 0.10f}, 0.3f, 70.0f};
+        m.roughness = 0.3f;
+        m.sssColour = {1.0f, 0.45f, 0.35f};
     } else if (has(name, "fat")) {
         m.surface.colour = {0.80f, 0.62f, 0.22f};
         m.granular = {{0.72f, 0.50f, 0.15f}, 0.6f, 500.0f};

@@ -12,11 +12,11 @@ void viewThroughScope(RenderSettings& s, const ToolPoses::Scope& scope) {
     s.camera.target = tip + kScopeWorkingDistance * scope.view.normalized().cast<float>();
     s.camera.up = scope.up.normalized().cast<float>();
     s.camera.fovYDeg = static_cast<float>(scope.fovDeg);
-    s.camera.nearPlane = 0.002f;
+    s.camera.nearPlane = 0.005f;
     s.camera.farPlane = 0.6f;
     // The light ring around the optic: at the tip, facing the view.
     s.light.followCamera = true;
-    s.light.cameraOffset = Eigen::Vector3f::Zero();
+    s.light.cameraOffset = Eigen::Vector3f(0.004f, 0.0f, 0.0f); // the fibres beside the lens
     s.light.width = 0.008f;
     s.light.height = 0.004f;
     const float d = kScopeWorkingDistance;
