@@ -43,9 +43,9 @@ float fbm2(vec3 p) { return 0.65 * valueNoise(p) + 0.35 * valueNoise(2.03 * p + 
 // Display encoding (sRGB transfer curve).
 vec3 linearToSrgb(vec3 c) {
     c = clamp(c, 0.0, 1.0);
-    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+    return mix(12.92 * c, 1.055 * pow(max(c, vec3(0.0)), vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
 }
 vec3 srgbToLinear(vec3 c) {
     c = clamp(c, 0.0, 1.0);
-    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
+    return mix(c / 12.92, pow(max((c + 0.055) / 1.055, vec3(0.0)), vec3(2.4)), step(vec3(0.04045), c));
 }

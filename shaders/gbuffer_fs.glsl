@@ -97,7 +97,7 @@ void main() {
     float granule = smoothstep(0.45, 0.8, valueNoise(vRest * uLayerFrequency.y));
     vec3 q = vRest * uLayerFrequency.z;
     q += uFibreAxis * (dot(q, uFibreAxis) * -0.85); // stretch cells along the fibre axis
-    float fibre = pow(1.0 - abs(2.0 * valueNoise(q) - 1.0), 6.0);
+    float fibre = pow(max(1.0 - abs(2.0 * valueNoise(q) - 1.0), 0.0), 6.0);
     float ridge = 1.0 - abs(2.0 * fbm2(vRest * uLayerFrequency.w) - 1.0);
     float thickness = uHasThicknessMap != 0 ? texture(uThicknessMap, vUv).r * uThicknessRange : vThickness;
     float thin = 1.0 - clamp(thickness / (0.5 * uThicknessRange), 0.0, 1.0);

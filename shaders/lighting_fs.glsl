@@ -92,7 +92,7 @@ void main() {
 
     vec3 F0 = mix(vec3(uF0[id]), albedo, metallic);
     float nv = max(dot(N, V), 1e-4);
-    vec3 Fv = F0 + (1.0 - F0) * pow(1.0 - nv, 5.0);
+    vec3 Fv = F0 + (1.0 - F0) * pow(max(1.0 - nv, 0.0), 5.0);
     vec3 kd = (1.0 - Fv) * (1.0 - metallic);
     vec3 R = reflect(-V, N);
     float cosCone = uUseCone != 0 ? coneCos(roughness) : -2.0;
@@ -123,7 +123,9 @@ void main() {
             float dd = nh * nh * (a2 - 1.0) + 1.0;
             float D = a2 / (PI * dd * dd);
             float G = gv * nl / (nl * (1.0 - k) + k);
-            vec3 F = F0 + (1.0 - F0) * pow(1.0 - max(dot(H, V), 0.0), 5.0);
+            // pow of a negative base is undefined in GLSL: with the light at the eye, H = V and
+            // dot(H, V) rounds above 1 (NaN specks in the highlight before this clamp).
+            vec3 F = F0 + (1.0 - F0) * pow(clamp(1.0 - dot(H, V), 0.0, 1.0), 5.0);
             specSum += (D * G * F / (4.0 * nv * nl)) * nl * g;
         }
     }

@@ -109,9 +109,10 @@ std::vector<SceneryProject> readSceneryProject(const JsonField& scenery, std::se
         const std::string gen = j["generator"].choice({"cylinder", "disc"}, "a scenery generator");
         s.generator = gen == "disc" ? SceneryProject::Generator::Disc : SceneryProject::Generator::Cylinder;
         if (s.generator == SceneryProject::Generator::Cylinder)
-            j.object({"name", "generator", "start", "end", "radius", "from_deg", "to_deg", "slices", "rings"});
+            j.object(
+                {"name", "generator", "start", "end", "radius", "from_deg", "to_deg", "slices", "rings", "texture"});
         else
-            j.object({"name", "generator", "center", "normal", "radius", "slices", "rings"});
+            j.object({"name", "generator", "center", "normal", "radius", "slices", "rings", "texture"});
         s.name = sim::readName(j["name"], names);
         s.radius = j["radius"].number(NumberRule::aboveUpTo(0, 1.0));
         s.slices = j.integer("slices", s.slices, 8, 256);

@@ -17,7 +17,8 @@
 ///                "radius": 0.075, "from_deg": 60, "to_deg": 300, "slices": 48, "rings": 16},
 ///               {"name": "peritoneum", "generator": "disc", "center": [..], "normal": [..],
 ///                "radius": 0.075, "slices": 48, "rings": 8}]
-///       render-only surfaces in scene coordinates (not bent), exported as meshes/<name>.vtri and
+///       render-only surfaces in scene coordinates (not bent), each with an optional "texture"
+///       (a body's texture block, read by the project reader), exported as meshes/<name>.vtri and
 ///       the scene's "scenery" (sim::SceneryDesc). Cylinder: the part of a cylinder around the
 ///       segment start–end between the angles from_deg and to_deg (0° is the scene's +z across
 ///       the axis, 90° is axis × (+z); default the whole turn), open at its ends. Disc: a flat
@@ -59,7 +60,8 @@ sim::Vec3 bendPoint(const BendSpec& bend, const sim::Vec3& p);
 /// that lies at or below the line's depth (radius + z <= 0).
 void bendPoints(const BendSpec& bend, std::vector<sim::Vec3>& points);
 
-/// "scenery"; names must be new to `names` (bodies, surfaces, tools) and are added to it.
+/// "scenery"; names must be new to `names` (bodies, surfaces, tools) and are added to it. A
+/// "texture" key is the caller's (Project::sceneryTextures).
 std::vector<SceneryProject> readSceneryProject(const sim::JsonField& scenery, std::set<std::string>& names);
 nlohmann::json sceneryJson(const std::vector<SceneryProject>& scenery);
 /// The surface of one scenery entry, in scene coordinates.

@@ -592,6 +592,8 @@ std::vector<std::filesystem::path> projectInputFiles(const Project& p) {
     }
     for (const SurfaceProject& s : p.surfaces)
         texture(s.texture);
+    for (const auto& t : p.sceneryTextures)
+        texture(t);
     if (!p.trajectory.file.empty()) files.push_back(p.trajectory.file);
     files.insert(files.end(), p.trackFiles.begin(), p.trackFiles.end());
     return files;
@@ -663,7 +665,13 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     if (auto t = root.find("tools")) scene.tools = sim::readTools(*t, names);
     if (auto l = root.find("laparoscope")) scene.laparoscope = sim::readLaparoscope(*l);
     if (auto b = root.find("bend")) p.bend = readBend(*b);
-    if (auto sc = root.find("scenery")) p.scenery = readSceneryProject(*sc, names);
+    if (auto sc = root.find("scenery")) {
+        p.scenery = readSceneryProject(*sc, names);
+        const std::vector<JsonField> items = sc->items();
+        p.sceneryTextures.resize(p.scenery.size());
+        for (size_t k = 0; k < items.size() && k < p.scenery.size(); ++k)
+            if (auto t = items[k].find("texture")) p.sceneryTextures[k] = readTexture(*t, dir);
+    }
     if (auto in = root.find("interaction")) scene.interaction = readInteractionProject(*in, dir, p.trackFiles);
     // Cross-references (embedding cages, interaction names) are checked now, before any meshing.
     std::vector<const sim::BodyDesc*> bodies;
@@ -700,7 +708,11 @@ std::string projectJsonText(const Project& p) {
     sim::writeTools(scene.tools, doc);
     if (scene.laparoscope) sim::writeLaparoscope(*scene.laparoscope, doc);
     if (p.bend) doc["bend"] = bendJson(*p.bend);
-    if (!p.scenery.empty()) doc["scenery"] = sceneryJson(p.scenery);
+    if (!p.scenery.empty()) {
+        doc["scenery"] = sceneryJson(p.scenery);
+        for (size_t k = 0; k < p.scenery.size() && k < p.sceneryTextures.size(); ++k)
+            if (p.sceneryTextures[k]) doc["scenery"][k]["texture"] = textureJson(*p.sceneryTextures[k]);
+    }
 
     doc["bodies"] = json::array();
     for (size_t i = 0; i < p.bodies.size(); ++i) {
@@ -1023,6 +1035,9 @@ ProjectTextures bakeProjectTextures(const Project& project) {
     for (size_t i = 0; i < project.surfaces.size(); ++i)
         if (const SurfaceProject& s = project.surfaces[i]; s.texture)
             bake(s.scene.name, *s.texture, "surfaces[" + std::to_string(i) + "]");
+    for (size_t k = 0; k < project.scenery.size() && k < project.sceneryTextures.size(); ++k)
+        if (project.sceneryTextures[k])
+            bake(project.scenery[k].name, *project.sceneryTextures[k], "scenery[" + std::to_string(k) + "]");
     return out;
 }
 
@@ -1204,6 +1219,8 @@ bool hasTextures(const Project& project) {
         if (b.texture) return true;
     for (const SurfaceProject& s : project.surfaces)
         if (s.texture) return true;
+    for (const auto& t : project.sceneryTextures)
+        if (t) return true;
     return false;
 }
 

@@ -241,6 +241,7 @@ struct Project {
     /// render-only scenery surfaces.
     std::optional<BendSpec> bend;
     std::vector<SceneryProject> scenery;
+    std::vector<std::optional<TextureProject>> sceneryTextures; ///< scenery[k]'s "texture", one each
 };
 
 /// Reads <dir>/project.json: loadProjectText of the file's text. Throws viscera::InputError.
@@ -345,7 +346,7 @@ struct ProjectTextures {
     std::vector<render::CaseMaterialMaps> materials;
 };
 ProjectTextures bakeProjectTextures(const Project& project);
-/// True when a body or surface of the project has a texture block.
+/// True when a body, surface or scenery surface of the project has a texture block.
 bool hasTextures(const Project& project);
 
 /// `scene.render` (JSON text, may be empty) with "materials" set to `materials`.

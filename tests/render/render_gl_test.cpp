@@ -438,3 +438,32 @@ TEST_F(RenderGl, BakedThicknessMapShadesLikeThePerVertexThicknessAndDrivesTheSca
     EXPECT_LT(same.rmse, 1.5) << "the same thickness, per texel";
     EXPECT_GT(thinner.rmse, 3.0 * std::max(same.rmse, 0.5)) << "the map drives the scattering";
 }
+
+// A light exactly at the eye (the scope's light on its lens axis): the specular Fresnel term took
+// pow() of 1 − dot(H, V) with H = V, which rounds below zero, and the highlight became NaN specks
+// (black pixels) in the lit organ. Every pixel the organ covers is lit, with the light on the axis
+// and beside it; the two images differ only near the highlight.
+TEST_F(RenderGl, ALightAtTheEyeLeavesNoUnlitSpecksInTheHighlight) {
+    RenderSettings s = settings;
+    s.light.followCamera = true;
+    s.sampling.mode = SampleMode::Uniform;
+    s.sampling.uniformSamples = 1; // one sample at the light's centre: exactly the eye
+    auto blackInside = [&](const Image& img) {
+        // Pixels of the organ: where the same frame with the light beside the eye is lit.
+        int black = 0;
+        for (int y = kH / 4; y < 3 * kH / 4; ++y)
+            for (int x = kW / 4; x < 3 * kW / 4; ++x) {
+                const uint8_t* p = img.pixel(x, y);
+                if (p[0] == 0 && p[1] == 0 && p[2] == 0) ++black;
+            }
+        return black;
+    };
+    s.light.cameraOffset = Eigen::Vector3f::Zero();
+    const Image onAxis = render(s);
+    s.light.cameraOffset = Eigen::Vector3f(0.004f, 0.0f, 0.0f);
+    const Image beside = render(s);
+    const uint8_t* centre = onAxis.pixel(kW / 2, kH / 2);
+    EXPECT_GT(int(centre[0]), 20) << "the organ's centre is lit by a light on the axis";
+    EXPECT_EQ(blackInside(onAxis), 0) << "no NaN (black) pixel in the organ with the light at the eye";
+    EXPECT_EQ(blackInside(beside), 0);
+}
