@@ -37,10 +37,10 @@ uniform vec3 uAmbient;
 uniform vec3 uBackground;
 uniform vec3 uEnvironment;
 uniform float uThicknessRange;
-uniform float uKsss[16];
-uniform vec3 uSssColour[16];
-uniform vec3 uSigma[16];
-uniform float uF0[16];
+uniform float uKsss[32];
+uniform vec3 uSssColour[32];
+uniform vec3 uSigma[32];
+uniform float uF0[32];
 
 vec2 samplePoint(int i, int m) {
     float radical = float(bitfieldReverse(uint(i))) * 2.3283064365386963e-10;
@@ -77,7 +77,7 @@ void main() {
     vec3 N = decodeNormal(g0.xy);
     vec3 V = normalize(uEyePos - P);
     if (dot(N, V) < 0.0) N = normalize(N + V * (0.01 - dot(N, V))); // silhouettes: keep n·v > 0
-    int id = clamp(int(g0.w + 0.5), 0, 15);
+    int id = clamp(int(g0.w + 0.5), 0, 31);
     float roughness = g1.r, metallic = g1.g, T = g1.b * uThicknessRange, reflection = g1.a;
     vec3 albedo = g2.rgb;
     float heat = g2.a;

@@ -135,7 +135,7 @@ void ServoLoop::tick(int64_t now, int64_t due) {
     }
     const bool clutch = (m_state.pedals & kPedalClutch) != 0;
     // The Cam pedal gives the masters to the laparoscope: the tools hold as under the clutch.
-    const bool camera = (m_state.pedals & kPedalCamera) != 0;
+    const bool camera = m_config.cameraPedalHolds && (m_state.pedals & kPedalCamera) != 0;
     const bool hold = clutch || camera || !m_state.connected;
     m_desired = DeviceCommand{};
     m_desired.timestamp_ns = now;
@@ -160,7 +160,7 @@ void ServoLoop::tick(int64_t now, int64_t due) {
         // Control point: the tip, or (laparoscopic port) the handle outside the body.
         const bool handle = map.throughPort && map.port.desc.mode == sim::PortMode::Laparoscopic;
         const Vec3 move = arm.measured_cp.position - centre;
-        const Vec3 mapped = handle ? Vec3(map.port.restHandle + map.port.handScale * move)
+        const Vec3 mapped = handle ? Vec3(map.port.restHandle + sim::handleMove(map.port, move, map.motionScale))
                                    : Vec3(map.sceneStart + map.motionScale * move);
         if (!m_haveTarget[a]) {
             m_target[a] = handle ? map.port.restHandle : map.sceneStart;
@@ -173,9 +173,22 @@ void ServoLoop::tick(int64_t now, int64_t due) {
         else
             m_target[a] = mapped + m_offset[a];
         sim::PortPose portPose;
-        if (map.throughPort)
+        if (map.throughPort) {
             portPose = handle ? sim::fulcrumTip(map.port, m_target[a]) : sim::constrainToPort(map.port, m_target[a]);
+            // At a limit the master is re-indexed as under the clutch: moving back moves the tool
+            // back at once (no motion stored past the limit).
+            if (portPose.insertionLimited || portPose.angleLimited) {
+                m_target[a] = handle ? sim::fulcrumHandle(map.port, portPose.tip) : portPose.tip;
+                m_offset[a] = m_target[a] - mapped;
+            }
+        }
         const Vec3 x = map.throughPort ? portPose.tip : m_target[a];
+        // The tip's velocity for the coupling's damping: through a laparoscopic port the lever
+        // reverses and scales it across the shaft (handForce is that same linear map).
+        const Vec3 tipVelocity =
+            handle
+                ? sim::handForce(map.port, portPose, sim::handleMove(map.port, arm.measured_cv.linear, map.motionScale))
+                : Vec3(map.motionScale * arm.measured_cv.linear);
         const ToolContactModel& tm = contact.tools[a];
         Vec3 p = x;
         double fn = 0;
@@ -187,7 +200,7 @@ void ServoLoop::tick(int64_t now, int64_t due) {
                 const double st = (x - tm.p0).dot(tm.n);
                 const double sp = (tm.f0 - k * tm.gap + kc * st) / (kc + k);
                 fn = kc * (sp - st);
-                fn -= map.couplingDamping * map.motionScale * arm.measured_cv.linear.dot(tm.n);
+                fn -= map.couplingDamping * tipVelocity.dot(tm.n);
                 fn = std::max(0.0, fn);
                 p = x + (sp - st) * tm.n;
             }

@@ -69,6 +69,9 @@ struct ServoConfig {
                   ///< ServoLoop::config() has it resolved; the player passes defaultServoCpu())
     bool realtimePriority = true; ///< try SCHED_FIFO for the servo thread (ignored when refused)
     SafetyLimits safety;
+    /// The Cam pedal gives the masters to the laparoscope (cases that have one): the tools hold
+    /// as under the clutch while it is held. Off: the pedal is only reported.
+    bool cameraPedalHolds = false;
     std::array<ToolMapping, kMaxArms> tools{};
     size_t traceCapacity = 1 << 16; ///< samples (one per enabled arm per tick)
 };

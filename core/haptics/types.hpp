@@ -20,7 +20,7 @@ constexpr int kMaxArms = 2;
 /// Pedal bits of DeviceState::pedals (the bimanual console has five pedals).
 enum Pedal : uint32_t {
     kPedalClutch = 1u << 0,  ///< held: the tool stays, the master can be re-centred; no force
-    kPedalCamera = 1u << 1,  ///< held: the masters steer the laparoscope; the tools hold as under the clutch
+    kPedalCamera = 1u << 1,  ///< held: the masters steer the laparoscope (ServoConfig::cameraPedalHolds)
     kPedalDeadman = 1u << 2, ///< must be held for any force to reach a device that has pedals
     kPedalEnergyCut = 1u << 3,
     kPedalEnergyCoag = 1u << 4,

@@ -75,9 +75,16 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
             m_rig.push_back(rt);
             m_caseMaxForce = std::min(m_caseMaxForce, d.device.maxForceN);
             if (arm < 0) continue;
-            // The arm's first instrument sets its mapping: workspace centre at its rest tip.
+            // The arm's first instrument sets its mapping: workspace centre at its rest tip, and
+            // its port (the others on the arm are held to their own ports by the interaction).
             if (m_armTools[arm].empty())
                 mapArm(arm, rt.rest.position, d.device.motionScale, d.device.forceScale, &d.port);
+            else if (const sim::PortDesc& first = in->instrumentDesc(m_rig[size_t(m_armTools[arm][0])].index).port;
+                     first.declared != d.port.declared || first.position != d.port.position ||
+                     first.mode != d.port.mode)
+                m_notes.push_back("instrument '" + d.name + "' shares its master with '" +
+                                  in->instrumentDesc(m_rig[size_t(m_armTools[arm][0])].index).name +
+                                  "' but not its port: the master is mapped through the first one's port");
             m_armTools[arm].push_back(static_cast<int>(m_rig.size() - 1));
         }
     if (sim::NeedleDrive* nd = world.needleDrive();
@@ -121,6 +128,7 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
     if (const sim::Laparoscope* scope = world.laparoscope()) {
         const std::string& hand = scope->desc().hand;
         m_scopeArm = arms == 2 && hand == "right" ? 1 : 0;
+        cfg.cameraPedalHolds = true;
     }
     m_aboveDamage.assign(world.toolCount(), false);
     for (size_t t = 0; t < m_rig.size(); ++t) // instruments are measured by the session, scripted or driven

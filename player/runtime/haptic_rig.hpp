@@ -137,6 +137,9 @@ public:
     /// Tools of the scene that no arm of the device drives (the player warns about them), and
     /// whether any tool is driven at all.
     std::vector<std::string> undrivenTools() const;
+    /// Mappings the case's tools cannot have as declared (e.g. two instruments on one master
+    /// through different ports); the session reports them as warnings.
+    const std::vector<std::string>& mappingNotes() const { return m_notes; }
     bool drivesAnyTool() const;
 
 private:
@@ -194,6 +197,7 @@ private:
     std::array<sim::Vec3, haptics::kMaxArms> m_last{sim::Vec3::Zero(), sim::Vec3::Zero()};
     std::array<sim::Vec3, haptics::kMaxArms> m_armProxy{sim::Vec3::Zero(), sim::Vec3::Zero()};
     std::vector<bool> m_aboveDamage;
+    std::vector<std::string> m_notes;
     int m_scopeArm = -1; ///< the master that steers the laparoscope (-1: none)
     sim::Vec3 m_scopeGrab = sim::Vec3::Zero();
     haptics::Quat m_scopeGrabQ = haptics::Quat::Identity();

@@ -239,9 +239,10 @@ static nlohmann::json portsJson(const std::vector<PortFigures>& ports) {
                      {"insertion_limits_m", {p.port.insertionMin, p.port.insertionMax}},
                      {"max_angle_deg", p.port.maxAngleDeg},
                      {"insertion_used_m", {p.insertionMin_m, p.insertionMax_m}},
-                     {"max_shaft_distance_m", p.maxShaftDistance_m},
                      {"frames_at_limit", p.framesAtLimit},
                      {"frames", p.frames}});
+    for (size_t k = 0; k < ports.size(); ++k)
+        if (ports[k].shaftMeasured) a[k]["max_shaft_distance_m"] = ports[k].maxShaftDistance_m;
     return a;
 }
 
@@ -556,13 +557,14 @@ std::string summaryText(const SessionResult& r) {
         }
     }
     for (const PortFigures& p : r.ports) {
-        char line[256];
+        char line[256], shaft[64] = "";
+        if (p.shaftMeasured)
+            std::snprintf(shaft, sizeof shaft, "shaft within %.3f mm of the port, ", p.maxShaftDistance_m * 1e3);
         std::snprintf(line, sizeof line,
-                      "port          %s (%s): shaft within %.3f mm of the port, insertion %.0f-%.0f mm of "
-                      "%.0f-%.0f, %d of %d frames at a limit\n",
-                      p.tool.c_str(), sim::portModeName(p.port.mode), p.maxShaftDistance_m * 1e3,
-                      p.insertionMin_m * 1e3, p.insertionMax_m * 1e3, p.port.insertionMin * 1e3,
-                      p.port.insertionMax * 1e3, p.framesAtLimit, p.frames);
+                      "port          %s (%s): %sinsertion %.0f-%.0f mm of %.0f-%.0f, %d of %d frames at a limit\n",
+                      p.tool.c_str(), sim::portModeName(p.port.mode), shaft, p.insertionMin_m * 1e3,
+                      p.insertionMax_m * 1e3, p.port.insertionMin * 1e3, p.port.insertionMax * 1e3, p.framesAtLimit,
+                      p.frames);
         out += line;
     }
     // Error against run time on the last sampled frame [A eq. 4.45].

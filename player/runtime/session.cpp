@@ -356,6 +356,8 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
             r.warnings.push_back("--device " + options.deviceSpec +
                                  ": the case declares no tool a device can drive (no 'tools', no instrument "
                                  "with a 'device'); the session runs as without it");
+        for (const std::string& n : rig->mappingNotes())
+            r.warnings.push_back("--device " + options.deviceSpec + ": " + n);
         for (const std::string& t : rig->undrivenTools())
             r.warnings.push_back("--device " + options.deviceSpec + ": tool '" + t +
                                  "' has no arm of this device to drive it");

@@ -471,15 +471,18 @@ std::unique_ptr<sim::World> Preview::applyMaterials(Worker& w, const Project& pr
             oldWeights.push_back(b.scene.bodies[i].nodeWeights);
             b.scene.bodies[i].material = project.bodies[i].scene.material;
             // painted bodies: their strokes again, through the skeleton already made
+            // (on the flat mesh where the project bends it: the strokes are placed there)
             if (project.bodies[i].paint && i < b.skeletons.size())
-                b.scene.bodies[i].nodeWeights = bodyNodeWeights(project.bodies[i], *b.meshes[i], b.skeletons[i], origin,
-                                                                "bodies[" + std::to_string(i) + "]");
+                b.scene.bodies[i].nodeWeights =
+                    bodyNodeWeights(project.bodies[i], i < b.flatMeshes.size() ? *b.flatMeshes[i] : *b.meshes[i],
+                                    b.skeletons[i], origin, "bodies[" + std::to_string(i) + "]");
         }
         for (size_t s = 0; s < b.scene.surfaces.size() && s < project.surfaces.size(); ++s) {
             oldSurfaceWeights.push_back(b.scene.surfaces[s].nodeWeights);
             if (project.surfaces[s].paint) // painted fascia: its strokes again
-                b.scene.surfaces[s].nodeWeights = surfaceNodeWeights(project.surfaces[s], b.surfaces[s], origin,
-                                                                     "surfaces[" + std::to_string(s) + "]");
+                b.scene.surfaces[s].nodeWeights = surfaceNodeWeights(
+                    project.surfaces[s], s < b.flatSurfaces.size() ? b.flatSurfaces[s] : b.surfaces[s], origin,
+                    "surfaces[" + std::to_string(s) + "]");
         }
         verdict = stabilityVerdict(b, ok);
         if (ok) next = assembleWorld(b, origin);

@@ -1086,6 +1086,9 @@ void addUvMaterial(BuiltScene& built, const BodyProject& b, const std::vector<re
 /// the bend (bodies and surfaces), then the mesh files; the scenery surfaces and their files.
 void shapeAndWriteMeshes(const Project& project, BuiltScene& built, const std::string& origin) {
     if (project.bend) {
+        for (const auto& m : built.meshes)
+            built.flatMeshes.push_back(sim::TetMesh::fromArrays(m->positions(), m->tets(), "flat"));
+        built.flatSurfaces = built.surfaces;
         try {
             for (size_t i = 0; i < built.meshes.size(); ++i) {
                 std::vector<sim::Vec3> pos = built.meshes[i]->positions();

@@ -323,6 +323,10 @@ struct BuiltScene {
     /// render.materials entries of remeshed bodies with UVs: the corner-UV file and, from the
     /// remesh block's texture, the diffuse map (both in `files`)
     std::vector<render::CaseMaterialMaps> materials;
+    /// With the project's bend: the meshes and surfaces as they were before it (flat), where the
+    /// fixed box, the stiffness regions and the paint strokes apply; empty without a bend.
+    std::vector<std::unique_ptr<sim::TetMesh>> flatMeshes;
+    std::vector<sim::TriMesh> flatSurfaces;
 };
 
 /// The node weights of body `b` on `mesh`: its stiffness regions times its stiffness paint

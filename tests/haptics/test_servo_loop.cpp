@@ -61,7 +61,7 @@ struct Rig {
     ServoConfig cfg;
     std::unique_ptr<ServoLoop> servo;
     /// port: the tool through it, its rest tip at the scene start (the origin).
-    explicit Rig(double kc = 2000, const viscera::sim::PortDesc* port = nullptr) {
+    explicit Rig(double kc = 2000, const viscera::sim::PortDesc* port = nullptr, double damping = 0) {
         cfg.tools[0].enabled = true;
         cfg.tools[0].motionScale = 1.0;
         if (port) {
@@ -69,7 +69,7 @@ struct Rig {
             cfg.tools[0].port = viscera::sim::makePortFrame(*port, Vec3::Zero(), 1.0);
         }
         cfg.tools[0].couplingStiffness = kc;
-        cfg.tools[0].couplingDamping = 0;
+        cfg.tools[0].couplingDamping = damping;
         cfg.safety.maxForceRate = 1e6; // the rate rule has its own tests
         dev.state.connected = true;
         dev.state.pedals = kPedalDeadman;
@@ -314,6 +314,19 @@ TEST(ServoLoop, ThroughAPortTheFulcrumInvertsTheHandAndTheForceStillOpposesIt) {
         const Vec3 f = r.dev.last.arms[0].servo_cf.force;
         EXPECT_LT(f.dot(hand), 0.0) << viscera::sim::portModeName(mode) << ": the force opposes the hand";
         EXPECT_GT(r.servo->toolPoses().force[0], 0.0);
+        // Damping resists the approach: the same pose with the hand moving on into the wall pushes
+        // back harder (through a laparoscopic port the tip's velocity is the hand's reversed).
+        {
+            Rig d(2000, &port, 20.0);
+            d.tickAt(Vec3::Zero());
+            d.servo->publishContact(sideWall(d.clock.now_ns(), 0));
+            d.tickAt(hand);
+            const double still = d.dev.last.arms[0].servo_cf.force.norm();
+            d.dev.state.arms[0].measured_cv.linear = hand.normalized() * 0.05; // 5 cm/s on into the wall
+            d.tickAt(hand);
+            const double moving = d.dev.last.arms[0].servo_cf.force.norm();
+            EXPECT_GT(moving, still + 1e-3) << viscera::sim::portModeName(mode);
+        }
         // The master pushed 1 m down (the handle past the port in laparoscopic mode): the insertion
         // stops at its maximum; pulled 1 m up, at its minimum.
         r.servo->publishContact(wall(r.clock.now_ns(), 1, 0));

@@ -18,7 +18,7 @@ namespace viscera::render {
 namespace {
 
 constexpr float kThicknessRange = kThicknessMapRange; ///< m: G-buffer thickness 1.0 (the bake's default maximum)
-constexpr int kMaxMaterials = 16;
+constexpr int kMaxMaterials = 32;                     // as many as the lighting shader's arrays hold
 constexpr int kAttributeFloats = 11; ///< static attributes per vertex: rest xyz, thickness, samples, overlay rgba, uv
 constexpr GLsizei kAttributeBytes = kAttributeFloats * 4;
 

@@ -410,6 +410,8 @@ void InteractionRuntime::afterStep() {
         s.grasped = static_cast<int>(in.held.size());
         s.force = in.force;
         s.driven = in.driven;
+        s.shaftPoint = in.shape ? Vec3(in.pose.translation()) : in.key.position;
+        s.shaftAxis = in.shape ? Vec3(in.pose.linear().col(0)) : in.key.direction;
         if (in.port) {
             s.insertion = in.portPose.insertion;
             s.atPortLimit = in.portPose.insertionLimited || in.portPose.angleLimited;

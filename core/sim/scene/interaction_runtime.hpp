@@ -44,6 +44,10 @@ struct InstrumentState {
     /// at the port's insertion or angle limit this frame.
     double insertion = 0;
     bool atPortLimit = false;
+    /// The shaft of the collision shape as posed this frame (its frame's origin and +x axis,
+    /// towards the tip); the tip and direction for an instrument without a shape.
+    Vec3 shaftPoint = Vec3::Zero();
+    Vec3 shaftAxis = -Vec3::UnitZ();
 };
 
 struct ClipState {

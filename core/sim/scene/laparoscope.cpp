@@ -15,11 +15,13 @@ ScopePose scopePose(const LaparoscopeDesc& desc, const PortFrame& port, const Ve
     s.insertion = p.insertion;
     s.atLimit = p.insertionLimited || p.angleLimited;
     s.roll = std::isfinite(roll) ? roll : 0.0;
-    // The optic's "down" at roll 0: the scene's −z across the shaft (any perpendicular when the
-    // shaft is vertical), turned by the roll about the shaft.
-    Vec3 down = -Vec3::UnitZ() - (-Vec3::UnitZ()).dot(s.shaft) * s.shaft;
-    if (down.norm() < 1e-6) down = s.shaft.unitOrthogonal();
-    down = Eigen::AngleAxisd(s.roll, s.shaft) * down.normalized();
+    // The optic's "down" at roll 0: the scene's −z across the rest axis (any perpendicular when
+    // that is vertical), carried to the shaft by the smallest turn from the axis (the shaft stays
+    // within 89° of it, so the image never flips), then turned by the roll about the shaft.
+    Vec3 down = -Vec3::UnitZ() - (-Vec3::UnitZ()).dot(port.axis) * port.axis;
+    if (down.norm() < 1e-6) down = port.axis.unitOrthogonal();
+    down = Eigen::Quaterniond::FromTwoVectors(port.axis, s.shaft) * down.normalized();
+    down = Eigen::AngleAxisd(s.roll, s.shaft) * (down - down.dot(s.shaft) * s.shaft).normalized();
     const double a = desc.opticDeg * M_PI / 180.0;
     s.view = (std::cos(a) * s.shaft + std::sin(a) * down).normalized();
     // The image's up: away from the optic's down, perpendicular to the view.

@@ -40,6 +40,11 @@ const char* portModeName(PortMode mode) {
     return mode == PortMode::Robotic ? "robotic" : "laparoscopic";
 }
 
+Vec3 handleMove(const PortFrame& port, const Vec3& deviceMove, double motionScale) {
+    const Vec3 along = deviceMove.dot(port.axis) * port.axis;
+    return motionScale * along + port.handScale * (deviceMove - along);
+}
+
 PortFrame makePortFrame(const PortDesc& port, const Vec3& restTip, double motionScale) {
     PortFrame f;
     f.desc = port;
@@ -82,21 +87,22 @@ PortPose constrainToPort(const PortFrame& port, const Vec3& target) {
 
 PortPose fulcrumTip(const PortFrame& port, const Vec3& handle) {
     const PortDesc& p = port.desc;
-    const Vec3 u = p.position - handle;
+    if (!handle.allFinite()) return constrainToPort(port, port.restTip);
+    // A handle at or past the port's level (pushed in to its end) is held just outside it, its
+    // sideways offset kept: the shaft fully in, continuous as the handle crosses the level.
+    Vec3 h = handle;
+    const double level = (p.position - h).dot(port.axis);
+    const bool past = level < kMinLeverOutside;
+    if (past) h -= (kMinLeverOutside - level) * port.axis;
+    const Vec3 u = p.position - h;
     const double outside = u.norm();
-    if (!u.allFinite() || outside < kTiny) return constrainToPort(port, port.restTip);
-    // The handle at or past the port's level (pushed in to its end): the shaft fully inserted.
-    if (u.dot(port.axis) < kMinLeverOutside) {
-        PortPose deepest = constrainToPort(port, p.position + port.axis * p.insertionMax);
-        deepest.insertionLimited = true;
-        return deepest;
-    }
+    if (outside < kTiny) return constrainToPort(port, port.restTip);
     const Vec3 d = u / outside;
     const double inside = p.shaftLength - outside;
     // A handle pulled back past the shaft's length would put the tip outside: the shaft stops at
     // its shortest insertion, still along the handle's line.
     PortPose pose = constrainToPort(port, p.position + d * std::max(inside, p.insertionMin));
-    pose.insertionLimited = pose.insertionLimited || inside < p.insertionMin;
+    pose.insertionLimited = pose.insertionLimited || inside < p.insertionMin || past;
     return pose;
 }
 

@@ -61,8 +61,9 @@ struct PortPose {
 struct PortFrame {
     PortDesc desc;
     Vec3 axis = -Vec3::UnitZ();
-    /// Laparoscopic: handle metres per device metre, chosen so that at the rest insertion the
-    /// tip moves `motionScale` scene metres per device metre sideways (opposite to the hand).
+    /// Laparoscopic: handle metres per device metre across the axis, chosen so that at the rest
+    /// insertion the tip moves `motionScale` scene metres per device metre sideways (opposite to
+    /// the hand); along the axis the handle moves motionScale (handleMove).
     double handScale = 1.0;
     Vec3 restTip = Vec3::Zero();
     Vec3 restHandle = Vec3::Zero(); ///< laparoscopic: the handle when the tip is at restTip
@@ -71,6 +72,11 @@ struct PortFrame {
 /// The frame of `port` for a tool whose rest tip is `restTip` (its track's first key, its start).
 /// `motionScale`: the device mapping's scene metres per device metre.
 PortFrame makePortFrame(const PortDesc& port, const Vec3& restTip, double motionScale);
+
+/// Laparoscopic: how far the handle moves for a master's move `deviceMove` (device metres, in the
+/// scene's axes): along the rest axis by `motionScale` (the tip slides in as far), across it by
+/// handScale (the tip then moves motionScale the other way at the rest insertion).
+Vec3 handleMove(const PortFrame& port, const Vec3& deviceMove, double motionScale);
 
 /// The pose nearest `target` that the port allows: the shaft through the port towards the target,
 /// turned back to max_angle_deg from the axis (then the insertion is the target's projection on
