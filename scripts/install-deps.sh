@@ -18,6 +18,8 @@ PKGS=(
   libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri mesa-utils libpng-dev
   # Qt6 (studio widgets; the player uses QtGui at most)
   qt6-base-dev libqt6opengl6-dev xvfb xauth
+  # synthetic X input for the trainee window's GUI test
+  xdotool
   # tests and benchmarks; clang-format for the formatting check (tests/lint)
   libgtest-dev libgmock-dev googletest libbenchmark-dev clang-format
   # packages: cpack (dpkg-deb, fakeroot), checked with lintian
