@@ -105,7 +105,9 @@ uint32_t SceneView::addMaterial(const TissueMaterial& material) {
 }
 
 size_t addScenery(SceneView& view, const std::string& name, const sim::TriMesh& mesh) {
-    return view.addMesh(name, mesh, view.addMaterial(defaultMaterialFor(name)));
+    const size_t i = view.addMesh(name, mesh, view.addMaterial(defaultMaterialFor(name)));
+    view.meshes()[i].doubleSided = false; // seen from the side it faces (the working space)
+    return i;
 }
 
 size_t SceneView::addMesh(const std::string& name, const sim::TriMesh& mesh, uint32_t material,

@@ -85,7 +85,8 @@ RenderMesh bodySurfaceMesh(const sim::TetMesh& rest, const std::string& name, si
 
 class SceneView;
 /// Adds a scenery surface (sim::SceneryDesc: drawn, never simulated) to `view` with the material
-/// defaultMaterialFor(name), seen from both sides when open. Returns its mesh index.
+/// defaultMaterialFor(name), drawn from the side its triangles face only (a wall around the
+/// working space does not hide the tissue from outside). Returns its mesh index.
 size_t addScenery(SceneView& view, const std::string& name, const sim::TriMesh& mesh);
 
 class SceneView {

@@ -373,10 +373,22 @@ void Preview::takeJob(Worker& w, const Pending& job, uint64_t takenAfter) {
     }
 }
 
+namespace {
+
+/// The project's scenery (anatomy around the working space, drawn only) in the preview's view,
+/// as the player draws it.
+void addProjectScenery(const Project& project, render::SceneView& view) {
+    for (const SceneryProject& sp : project.scenery)
+        render::addScenery(view, sp.name, scenerySurface(sp));
+}
+
+} // namespace
+
 void Preview::showMaps(Worker& w, const Project& project, const sim::World& world) {
     std::string textures = texturesKey(project);
     if (textures == w.builtTextures) return;
     auto view = std::make_shared<render::SceneView>(render::SceneView::fromWorld(world));
+    addProjectScenery(project, *view);
     try {
         applyTextures(project, *view);
     } catch (const std::exception& e) {
@@ -404,6 +416,7 @@ std::unique_ptr<sim::World> Preview::buildWorld(Worker& w, const Project& projec
     if (!ok) throw std::runtime_error(tr("the preview keeps the last stable model").toStdString());
     std::unique_ptr<sim::World> next = assembleWorld(b, origin);
     auto view = std::make_shared<render::SceneView>(render::SceneView::fromWorld(*next));
+    if (mode == Mode::Scene) addProjectScenery(project, *view);
     if (mode == Mode::Scene && hasTextures(project)) {
         try {
             applyTextures(project, *view);

@@ -46,8 +46,13 @@ sim::TriMesh cylinder(const SceneryProject& s) {
         for (int k = 0; k < s.slices; ++k) {
             const int a0 = r * columns + k, a1 = r * columns + (k + 1) % columns;
             const int b0 = a0 + columns, b1 = a1 + columns;
-            t.push_back({a0, b0, b1}); // facing the axis: the surface is seen from inside
-            t.push_back({a0, b1, a1});
+            if (s.inward) { // facing the axis: the surface is seen from inside
+                t.push_back({a0, b0, b1});
+                t.push_back({a0, b1, a1});
+            } else {
+                t.push_back({a0, b1, b0});
+                t.push_back({a0, a1, b1});
+            }
         }
     return sim::TriMesh::fromArrays(std::move(p), std::move(t), "scenery '" + s.name + "'");
 }
@@ -109,8 +114,8 @@ std::vector<SceneryProject> readSceneryProject(const JsonField& scenery, std::se
         const std::string gen = j["generator"].choice({"cylinder", "disc"}, "a scenery generator");
         s.generator = gen == "disc" ? SceneryProject::Generator::Disc : SceneryProject::Generator::Cylinder;
         if (s.generator == SceneryProject::Generator::Cylinder)
-            j.object(
-                {"name", "generator", "start", "end", "radius", "from_deg", "to_deg", "slices", "rings", "texture"});
+            j.object({"name", "generator", "start", "end", "radius", "from_deg", "to_deg", "facing", "slices", "rings",
+                      "texture"});
         else
             j.object({"name", "generator", "center", "normal", "radius", "slices", "rings", "texture"});
         s.name = sim::readName(j["name"], names);
@@ -125,6 +130,7 @@ std::vector<SceneryProject> readSceneryProject(const JsonField& scenery, std::se
             s.toDeg = j.number("to_deg", s.toDeg, NumberRule::closed(-360, 360));
             if (!(s.fromDeg < s.toDeg && s.toDeg <= s.fromDeg + 360))
                 j.failAt("to_deg", "must lie above from_deg by at most 360");
+            if (auto f = j.find("facing")) s.inward = f->choice({"inward", "outward"}, "a facing") == "inward";
         } else {
             s.center = j["center"].vec3();
             s.normal = j["normal"].vec3();
@@ -145,6 +151,7 @@ json sceneryJson(const std::vector<SceneryProject>& scenery) {
             j["end"] = vec3(s.end);
             j["from_deg"] = s.fromDeg;
             j["to_deg"] = s.toDeg;
+            j["facing"] = s.inward ? "inward" : "outward";
         } else {
             j["generator"] = "disc";
             j["center"] = vec3(s.center);

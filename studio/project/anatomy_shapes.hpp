@@ -21,8 +21,11 @@
 ///       (a body's texture block, read by the project reader), exported as meshes/<name>.vtri and
 ///       the scene's "scenery" (sim::SceneryDesc). Cylinder: the part of a cylinder around the
 ///       segment start–end between the angles from_deg and to_deg (0° is the scene's +z across
-///       the axis, 90° is axis × (+z); default the whole turn), open at its ends. Disc: a flat
-///       disc of `radius` centred at `center`, facing `normal`. radius (0, 1] m, slices [8, 256],
+///       the axis, 90° is axis × (+z); default the whole turn), open at its ends, facing its axis
+///       ("facing": "inward", the default: a wall around the working space) or away from it
+///       ("outward": an organ). Disc: a flat disc of `radius` centred at `center`, facing
+///       `normal`. A scenery surface is drawn from the side it faces only, so from outside the
+///       working space (the studio's view) its walls do not hide the tissue. radius (0, 1] m, slices [8, 256],
 ///       rings [1, 256], angles in [−360, 360] with from < to ≤ from + 360.
 #include "sim/mesh/tri_mesh.hpp"
 #include "sim/util/json_reader.hpp"
@@ -49,6 +52,7 @@ struct SceneryProject {
     sim::Vec3 center = sim::Vec3::Zero(), normal = sim::Vec3::UnitZ(); ///< disc
     double radius = 0.05;
     double fromDeg = 0, toDeg = 360; ///< cylinder
+    bool inward = true;              ///< cylinder: faces its axis (a wall seen from inside), else outward
     int slices = 48, rings = 8;
 };
 

@@ -207,6 +207,23 @@ TEST_F(WindowFixture, TheRealTimeWarningAppearsForTheCurveMaterialLiver) {
     w->exportRunner()->cancel();
 }
 
+// Issue 42: the rectum's anatomy made by code shows in the preview as in the player: the bent
+// mesorectum and the scenery surfaces (rectum, pelvic side walls, peritoneum), drawn, not simulated.
+TEST_F(WindowFixture, TheRectumsSceneryIsDrawnInThePreview) {
+    open("rectum");
+    ASSERT_TRUE(waitForPreview(180000)) << w->verdictLabel()->text().toStdString();
+    const auto view = w->preview()->sceneView();
+    ASSERT_NE(view, nullptr);
+    std::set<std::string> names;
+    for (const render::RenderMesh& m : view->meshes())
+        if (m.source == render::RenderMesh::Source::Static) names.insert(m.name);
+    EXPECT_TRUE(names.count("rectum") && names.count("pelvic_wall") && names.count("peritoneum"))
+        << names.size() << " static meshes";
+    ASSERT_TRUE(
+        test::waitFor([&] { return w->viewport()->rendererReady() && w->viewport()->paintCount() > 2; }, 60000));
+    test::saveShot("rectum_scenery");
+}
+
 // Issue 39 item 3: the studio opens in the authoring look (flat light, no post effects, a grey
 // background, a grid under the scene, the selection outlined), the trainee's look one key away,
 // and a project opened is framed whole.

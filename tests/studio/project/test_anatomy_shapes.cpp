@@ -77,9 +77,22 @@ TEST(AnatomyShapes, SceneryGeneratorsGiveTheSurfacesAskedFor) {
     }
     EXPECT_NEAR(minZ, -0.075, 1e-12) << "through the bottom (180°)";
     EXPECT_NEAR(maxZ, 0.075 * std::cos(60 * M_PI / 180), 1e-12) << "open above 60°";
+    // Which way the triangles face: towards the axis (a wall seen from inside) or away (an organ).
+    auto facesAxis = [](const sim::TriMesh& m) {
+        int towards = 0;
+        for (const sim::Tri& t : m.triangles()) {
+            const Vec3 &a = m.positions()[t[0]], &b = m.positions()[t[1]], &c = m.positions()[t[2]];
+            const Vec3 n = (b - a).cross(c - a), centre = (a + b + c) / 3.0;
+            if (n.dot(Vec3(0, -centre.y(), -centre.z())) > 0) ++towards;
+        }
+        return towards;
+    };
+    EXPECT_EQ(facesAxis(wall), int(wall.triangleCount())) << "inward by default";
     cyl.fromDeg = 0;
     cyl.toDeg = 360;
     EXPECT_EQ(studio::scenerySurface(cyl).vertexCount(), size_t(24 * 5)) << "a whole turn closes on itself";
+    cyl.inward = false;
+    EXPECT_EQ(facesAxis(studio::scenerySurface(cyl)), 0) << "outward: every triangle faces away";
     studio::SceneryProject disc;
     disc.name = "peritoneum";
     disc.generator = studio::SceneryProject::Generator::Disc;
@@ -91,6 +104,10 @@ TEST(AnatomyShapes, SceneryGeneratorsGiveTheSurfacesAskedFor) {
     const sim::TriMesh d = studio::scenerySurface(disc);
     EXPECT_EQ(d.vertexCount(), size_t(1 + 16 * 3));
     EXPECT_EQ(d.triangleCount(), size_t(16 + 2 * 16 * 2));
+    for (const sim::Tri& t : d.triangles()) { // facing its normal (−x)
+        const Vec3 &a = d.positions()[t[0]], &b = d.positions()[t[1]], &c = d.positions()[t[2]];
+        EXPECT_LT((b - a).cross(c - a).x(), 0.0);
+    }
     for (const Vec3& p : d.positions()) {
         EXPECT_NEAR(p.x(), 0.11, 1e-15);
         EXPECT_LE(std::hypot(p.y(), p.z()), 0.05 + 1e-12);
@@ -130,6 +147,8 @@ TEST(AnatomyShapes, BadSceneryAndBendNameTheFieldAndRule) {
                 HasSubstr("project.json: scenery[1].to_deg: must lie above from_deg by at most 360"));
     EXPECT_THAT(error("\"name\": \"rectum\", \"generator\"", "\"name\": \"fat\", \"generator\""),
                 HasSubstr("project.json: scenery[0].name: 'fat' is used twice"));
+    EXPECT_THAT(error("\"facing\": \"outward\"", "\"facing\": \"sideways\""),
+                HasSubstr("project.json: scenery[0].facing: 'sideways' is not a facing (inward, outward)"));
     EXPECT_THAT(error("\"normal\": [-1, 0, 0]", "\"normal\": [0, 0, 0]"),
                 HasSubstr("project.json: scenery[2].normal: must not be zero"));
     EXPECT_THAT(error("\"bend\": {\"radius\": 0.032", "\"bend\": {\"radius\": 2"),
