@@ -188,12 +188,14 @@ public:
         std::vector<sim::Vec3> nodes;
         std::vector<double> radius;
         std::vector<render::ToolPoses::Instrument> instruments;
+        bool scope = false; // the case has a laparoscope (the Cam pedal steers it)
         {
             std::lock_guard<std::mutex> lock(m_live.mutex);
             s = m_live.state;
             if (!m_viewport || !m_viewport->available()) nodes = m_live.geometry.nodes; // the side view only
             radius = m_live.toolRadius;
             instruments = m_live.geometry.tools.instruments;
+            scope = m_live.geometry.tools.scope.present;
         }
         const int w = size.width(), h = size.height();
         p.fillRect(0, 0, w, h, QColor(24, 26, 30));
@@ -280,7 +282,7 @@ public:
         y += 20;
         if (m_viewport && m_viewport->available())
             p.drawText(px, y, QString("Stereo: %1 (S switches)").arg(m_viewport->stereoName())), y += 20;
-        if (s.pedals & haptics::kPedalCamera) {
+        if ((s.pedals & haptics::kPedalCamera) && scope) {
             p.setPen(QColor(120, 200, 255));
             p.drawText(px, y, "Cam: steering the laparoscope");
             p.setPen(QColor(235, 235, 235));

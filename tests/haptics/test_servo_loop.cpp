@@ -338,5 +338,12 @@ TEST(ServoLoop, ThroughAPortTheFulcrumInvertsTheHandAndTheForceStillOpposesIt) {
                 << viscera::sim::portModeName(mode) << " z " << z;
             EXPECT_LT(t.z(), port.position.z()) << "the tip stays inside the body";
         }
+        // Past a limit nothing is stored: from 1 m past the deepest insertion, 1 cm back draws the
+        // tip back at once.
+        r.tickAt(Vec3(0, 0, -1.0));
+        const double deepest = (r.servo->toolPoses().target[0] - port.position).norm();
+        r.tickAt(Vec3(0, 0, -0.99));
+        const double back = (r.servo->toolPoses().target[0] - port.position).norm();
+        EXPECT_NEAR(deepest - back, 0.01, 1e-3) << viscera::sim::portModeName(mode);
     }
 }

@@ -47,7 +47,9 @@ render::Image runWindow(const test::Scratch& s, const std::string& vcase, const 
         test::trustingSampleKey({"run", vcase, "--frames", "360", "--device", "scripted:idle", "--screenshot", png}),
         s / name);
     if (pressS) {
-        const test::ProcessResult found = test::runProcess(kXdotool, {"search", "--sync", "--name", "Viscera"});
+        // At most 60 s for the window to appear (a player that died would leave --sync waiting).
+        const test::ProcessResult found =
+            test::runProcess("/usr/bin/timeout", {"60", kXdotool, "search", "--sync", "--name", "Viscera"});
         EXPECT_EQ(found.exitCode, 0) << found.err;
         const std::string id = found.out.substr(0, found.out.find('\n'));
         EXPECT_FALSE(id.empty()) << "the trainee window never appeared";
