@@ -98,8 +98,9 @@ std::optional<double> figure(const QString& output, const QString& name) {
     const QRegularExpression re("^" + QRegularExpression::escape(name) + " (\\S+)$",
                                 QRegularExpression::MultilineOption);
     const auto m = re.match(output);
+    if (!m.hasMatch()) return std::nullopt;
     bool ok = false;
-    const double v = m.hasMatch() ? m.captured(1).toDouble(&ok) : 0.0;
+    const double v = m.captured(1).toDouble(&ok);
     return ok && std::isfinite(v) ? std::optional(v) : std::nullopt;
 }
 

@@ -21,8 +21,10 @@ std::vector<double> lumpedMasses(const TetMesh& mesh, double density, const std:
 ToolProbes::ToolProbes(std::vector<ToolDesc> tools, std::vector<Body> bodies, double dt)
     : m_tools(std::move(tools)), m_bodies(std::move(bodies)), m_dt(dt) {
     m_contacts.resize(m_tools.size());
-    for (const auto& t : m_tools)
+    for (const auto& t : m_tools) {
         m_pos.push_back(t.start);
+        m_portFrames.push_back(makePortFrame(t.port, t.start, t.motionScale)); // used where declared
+    }
     m_stepStart = m_pos;
     for (size_t t = 0; t < m_tools.size(); ++t)
         m_contacts[t].centre = m_pos[t];
@@ -35,9 +37,7 @@ void ToolProbes::setPosition(size_t t, const Vec3& centre) {
     if (n > r) d *= r / n;
     m_pos[t] += d;
     // A probe through a port: its shaft from the port to the centre, within the port's limits.
-    if (m_tools[t].port.declared)
-        m_pos[t] =
-            constrainToPort(makePortFrame(m_tools[t].port, m_tools[t].start, m_tools[t].motionScale), m_pos[t]).tip;
+    if (m_tools[t].port.declared) m_pos[t] = constrainToPort(m_portFrames[t], m_pos[t]).tip;
 }
 
 std::vector<char> ToolProbes::apply(std::vector<std::vector<Vec3>>& x, std::vector<std::vector<Vec3>>& v,

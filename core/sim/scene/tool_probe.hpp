@@ -71,6 +71,7 @@ private:
     std::vector<Body> m_bodies;
     std::vector<ToolContact> m_contacts;
     std::vector<Vec3> m_pos, m_stepStart;
+    std::vector<PortFrame> m_portFrames; ///< per tool, made once (its port, where declared)
     double m_dt;
 };
 

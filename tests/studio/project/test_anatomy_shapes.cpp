@@ -9,6 +9,7 @@
 #include "sim/mesh/tet_io.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/util/error.hpp"
+#include "support/scratch_dir.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -16,7 +17,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <unistd.h>
 
 using namespace viscera;
 using sim::Vec3;
@@ -162,9 +162,8 @@ TEST(AnatomyShapes, BadSceneryAndBendNameTheFieldAndRule) {
             return t;
         }(),
         src, "project.json");
-    char tmpl[] = "/tmp/viscera-bend-XXXXXX";
-    ASSERT_NE(mkdtemp(tmpl), nullptr);
-    const std::filesystem::path out = std::filesystem::path(tmpl) / "r.vcase";
+    const test::Scratch scratch("viscera-bend");
+    const std::filesystem::path out = scratch.dir / "r.vcase";
     try {
         studio::exportCase(tight, out);
         FAIL() << "exported a sheet bent past its axis";
@@ -173,13 +172,11 @@ TEST(AnatomyShapes, BadSceneryAndBendNameTheFieldAndRule) {
         EXPECT_THAT(e.what(), HasSubstr("at or below the bend's axis (radius 0.006"));
     }
     EXPECT_FALSE(std::filesystem::exists(out)) << "nothing written";
-    std::filesystem::remove_all(tmpl);
 }
 
 TEST(AnatomyShapes, TheRectumSampleExportsItsBentMesorectumAndItsScenery) {
-    char tmpl[] = "/tmp/viscera-anatomy-XXXXXX";
-    ASSERT_NE(mkdtemp(tmpl), nullptr);
-    const std::filesystem::path out = std::filesystem::path(tmpl) / "rectum.vcase";
+    const test::Scratch scratch("viscera-anatomy");
+    const std::filesystem::path out = scratch.dir / "rectum.vcase";
     const studio::Project p = studio::loadProject(std::filesystem::path(VISCERA_SOURCE_DIR) / "projects" / "rectum");
     ASSERT_TRUE(p.bend.has_value());
     ASSERT_EQ(p.scenery.size(), 3u);
@@ -209,5 +206,4 @@ TEST(AnatomyShapes, TheRectumSampleExportsItsBentMesorectumAndItsScenery) {
     EXPECT_NEAR(maxR, 0.032, 1e-9);
     for (int32_t v : scene.bodies[0].fixedNodes)
         EXPECT_NEAR(std::hypot(fat->positions()[v].y() - 0.01, fat->positions()[v].z() + 0.032), 0.024, 1e-6);
-    std::filesystem::remove_all(tmpl);
 }
