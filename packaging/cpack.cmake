@@ -3,14 +3,15 @@
 # scripts/package.sh: it builds the target viscera_samples (the exports), then runs
 # `cpack -G DEB` in the build folder and checks what it made.
 #
-# Every package carries /usr/share/doc/<package>/ (copyright, changelog.gz, README.md, the case
-# package and console protocol specs) and the man pages of its programs.
+# Every package carries /usr/share/doc/<package>/ (copyright, changelog.gz and its own guides:
+# VISCERA_DOCS_<component>) and the man pages of its programs.
 
 set(VISCERA_PACKAGES player studio samples)
 set(VISCERA_PKG_OUT ${CMAKE_BINARY_DIR}/packaging)
 
 # Man pages (version filled in) and the changelog, compressed without a timestamp (gzip -n).
-set(VISCERA_MAN_PAGES viscera-player viscera-console-sim viscera-studio)
+# viscera-results.1 is written beside the results program (packaging/man/viscera-results.1).
+set(VISCERA_MAN_PAGES viscera-player viscera-console-sim viscera-launcher viscera-results viscera-studio)
 set(VISCERA_PKG_GZ)
 foreach(page IN LISTS VISCERA_MAN_PAGES)
   set(VERSION ${PROJECT_VERSION})
@@ -27,13 +28,20 @@ add_custom_command(OUTPUT ${VISCERA_PKG_OUT}/changelog.gz
 list(APPEND VISCERA_PKG_GZ ${VISCERA_PKG_OUT}/changelog.gz)
 add_custom_target(viscera_package_docs ALL DEPENDS ${VISCERA_PKG_GZ})
 
+# The docs of each package. The player's are for trainees and training sites (the developer
+# README is not among them); the studio keeps the README, the reference of its command line and
+# desktop application.
+set(VISCERA_DOCS_player ${CMAKE_CURRENT_LIST_DIR}/doc/trainee-guide.md ${CMAKE_CURRENT_LIST_DIR}/doc/console-setup.md
+    ${CMAKE_CURRENT_LIST_DIR}/vcase-spec.md ${CMAKE_CURRENT_LIST_DIR}/console-protocol.md)
+set(VISCERA_DOCS_studio ${CMAKE_SOURCE_DIR}/README.md ${CMAKE_CURRENT_LIST_DIR}/vcase-spec.md
+    ${CMAKE_CURRENT_LIST_DIR}/console-protocol.md)
+set(VISCERA_DOCS_samples ${CMAKE_CURRENT_LIST_DIR}/vcase-spec.md)
 foreach(comp IN LISTS VISCERA_PACKAGES)
-  install(FILES ${CMAKE_CURRENT_LIST_DIR}/doc/copyright ${VISCERA_PKG_OUT}/changelog.gz
-                ${CMAKE_SOURCE_DIR}/README.md ${CMAKE_CURRENT_LIST_DIR}/vcase-spec.md
-                ${CMAKE_CURRENT_LIST_DIR}/console-protocol.md
+  install(FILES ${CMAKE_CURRENT_LIST_DIR}/doc/copyright ${VISCERA_PKG_OUT}/changelog.gz ${VISCERA_DOCS_${comp}}
           DESTINATION share/doc/viscera-${comp} COMPONENT ${comp})
 endforeach()
 install(FILES ${VISCERA_PKG_OUT}/viscera-player.1.gz ${VISCERA_PKG_OUT}/viscera-console-sim.1.gz
+              ${VISCERA_PKG_OUT}/viscera-launcher.1.gz ${VISCERA_PKG_OUT}/viscera-results.1.gz
         DESTINATION share/man/man1 COMPONENT player)
 install(FILES ${VISCERA_PKG_OUT}/viscera-studio.1.gz DESTINATION share/man/man1 COMPONENT studio)
 
@@ -58,6 +66,15 @@ endforeach()
 add_custom_target(viscera_samples DEPENDS ${VISCERA_SAMPLE_CASES})
 add_dependencies(viscera_samples viscera_sample_key)
 install(FILES ${VISCERA_SAMPLE_CASES} DESTINATION share/viscera/samples COMPONENT samples OPTIONAL)
+# The samples' recorded console sessions (`--device replay:FILE`): every projects/<project>/replays/*.csv
+# in share/viscera/samples/replays/<project>/.
+file(GLOB VISCERA_SAMPLE_REPLAYS CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/projects/*/replays/*.csv)
+foreach(replay IN LISTS VISCERA_SAMPLE_REPLAYS)
+  get_filename_component(dir ${replay} DIRECTORY)
+  get_filename_component(dir ${dir} DIRECTORY)
+  get_filename_component(name ${dir} NAME)
+  install(FILES ${replay} DESTINATION share/viscera/samples/replays/${name} COMPONENT samples)
+endforeach()
 # The samples' publisher key, trusted by the player installed beside it (the vendor trust folder).
 install(FILES ${VISCERA_SAMPLE_PUBLIC_KEY} DESTINATION share/viscera/trusted-publishers
         RENAME viscera-samples.pem COMPONENT samples OPTIONAL)
@@ -91,8 +108,9 @@ with force feedback, a recorded replay, a script or the keyboard.
 .
 It builds only the subsystems a case declares, writes a session report
 and plots, and renders headless through EGL (Mesa without a GPU). It
-links no authoring library. Includes viscera-console-sim, a console
-simulator speaking the console's UDP protocol.")
+links no authoring library. Includes viscera-launcher, a desktop case
+picker for trainees, and viscera-console-sim, a console simulator
+speaking the console's UDP protocol.")
 
 set(CPACK_DEBIAN_STUDIO_PACKAGE_NAME "viscera-studio")
 set(CPACK_DEBIAN_STUDIO_PACKAGE_SUGGESTS "viscera-player")
@@ -116,6 +134,7 @@ set(CPACK_DEBIAN_SAMPLES_DESCRIPTION
 Training cases for Viscera Player, in /usr/share/viscera/samples: a
 tissue slab and an organ under gravity, a liver to palpate with a
 probe, a rectal dissection (grasper, energy hook, clip applier) and an
-intestinal anastomosis with a running suture.")
+intestinal anastomosis with a running suture; their recorded console
+sessions in /usr/share/viscera/samples/replays.")
 
 include(CPack)

@@ -3,7 +3,7 @@
 //   viscera-player verify <case.vcase>
 //   viscera-player run <case.vcase> [--headless] [--frames N] [--device SPEC]
 //                  [--report report.json] [--screenshot out.png] [--trace trace.csv] [--realtime]
-//                  [--plots DIR] [--pairing-key FILE]
+//                  [--plots DIR] [--pairing-key FILE] [--trainee ID]
 //   viscera-player plot <report.json> -o DIR
 //
 // --device: replay:<file>, scripted:<name>, console:<host:port>, keyboard (window mode only).
@@ -35,6 +35,7 @@
 #endif
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -101,6 +102,9 @@ constexpr const char* kRunHelp =
     "  --screenshot FILE.png the rendered last frame (headless: EGL, window: the window)\n"
     "  --view scope|overview headless screenshot through the case's laparoscope (the default where\n"
     "                        the case has one) or framed on the whole tissue from above\n"
+    "  --end-screen FILE.png window: the end-of-session screen (the verdict) as shown\n"
+    "  --trainee ID          who runs the session (1-64 of A-Z a-z 0-9 . _ @ -), in the report's\n"
+    "                        record for 'viscera-results add'\n"
     "  --plots DIR           session plots (PNG) and session.html, as 'viscera-player plot' "
     "makes\n" VISCERA_PLAYER_TRUST_HELP "\n"
     "Output paths are checked before the first frame. Exit 0 ok, 1 bad input or an output that\n"
@@ -221,12 +225,23 @@ ServoChoice parseServoMode(const std::string& v) {
 
 struct RunArgs {
     std::optional<std::string> casePath, reportPath, screenshot, device, tracePath, plotsDir, pairingKey;
+    std::string trainee;                  ///< --trainee: recorded in the report
+    std::optional<std::string> endScreen; ///< --end-screen: the window's verdict screen (PNG)
     bool headless = false, realtime = false, lockstep = false, framesGiven = false;
     bool overview = false; ///< --view overview: framed on the tissue, not through the laparoscope
     ServoChoice servo;
     player::TrustOptions trust;
     int frames = 300;
 };
+
+/// A trainee id: 1–64 characters of [A-Za-z0-9._@-] (it names the trainee in the results database).
+std::string traineeId(const std::string& v) {
+    const bool ok = !v.empty() && v.size() <= 64 && std::all_of(v.begin(), v.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '@' || c == '-';
+    });
+    if (!ok) throw std::invalid_argument("--trainee '" + v + "' must be 1-64 characters of A-Z a-z 0-9 . _ @ -");
+    return v;
+}
 
 RunArgs parseRunArgs(const std::vector<std::string>& args) {
     RunArgs r;
@@ -268,6 +283,10 @@ RunArgs parseRunArgs(const std::vector<std::string>& args) {
             r.device = value("--device");
         else if (a == "--pairing-key")
             r.pairingKey = value("--pairing-key");
+        else if (a == "--end-screen")
+            r.endScreen = value("--end-screen");
+        else if (a == "--trainee")
+            r.trainee = traineeId(value("--trainee"));
         else if (a == "--servo")
             r.servo = parseServoMode(value("--servo"));
         else if (!a.empty() && a[0] == '-')
@@ -297,14 +316,17 @@ std::optional<int> refuseRun(const RunArgs& r, std::optional<haptics::DeviceSpec
         if (spec->kind == haptics::DeviceSpec::Kind::Keyboard && r.headless)
             throw InputError("--device 'keyboard': the keyboard device needs the trainee window; drop --headless");
     }
+    if (r.endScreen && r.headless)
+        return fail(kExitUsage, "--end-screen is the trainee window's verdict screen; drop --headless");
     if (r.tracePath && !r.device)
         return fail(kExitUsage, "--trace records the device forces and poses; it needs --device");
     // Outputs are checked before the run, so that results are never lost at its end, and never
     // written over what the run reads.
     std::vector<std::filesystem::path> inputs{*r.casePath};
     if (spec && spec->kind == haptics::DeviceSpec::Kind::Replay) inputs.emplace_back(spec->argument);
-    for (const auto& [path, what] : {std::pair{r.reportPath, "the report"}, std::pair{r.tracePath, "the trace"},
-                                     std::pair{r.screenshot, "the screenshot"}})
+    for (const auto& [path, what] :
+         {std::pair{r.reportPath, "the report"}, std::pair{r.tracePath, "the trace"},
+          std::pair{r.screenshot, "the screenshot"}, std::pair{r.endScreen, "the end-of-session screen"}})
         if (path) {
             requireWritableFile(*path, what);
             requireNotAnInput(*path, what, inputs);
@@ -463,6 +485,7 @@ int cmdRun(const std::vector<std::string>& args) {
     opts.servoWait = servo.wait;
     opts.servoCpu = servo.cpu;
     opts.servoSpinNs = servo.spinNs;
+    opts.trainee = r.trainee;
     player::SessionResult result;
     if (r.headless) {
         std::fprintf(
@@ -476,7 +499,7 @@ int cmdRun(const std::vector<std::string>& args) {
         result = player::runSession(loaded, opts);
     } else {
         if (!r.framesGiven) opts.frames = 0; // until the trainee closes the window
-        result = player::runWindow(loaded, opts, r.screenshot.value_or(""));
+        result = player::runWindow(loaded, opts, {r.screenshot.value_or(""), r.endScreen.value_or("")});
     }
     std::string screenshotError;
     if (r.headless && r.screenshot)

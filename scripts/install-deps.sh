@@ -26,6 +26,10 @@ PKGS=(
   dpkg-dev fakeroot lintian
   # peer solver for error-time comparisons
   libbullet-dev
+  # trainee results database (viscera-results: SQLite, PostgreSQL) and its page check in Chromium
+  libsqlite3-dev libpq-dev postgresql chromium
+  # the launcher's desktop entry is checked (scripts/package.sh)
+  desktop-file-utils
 )
 
 missing=()

@@ -34,7 +34,12 @@ for p in viscera-player viscera-studio viscera-samples; do
   for s in "${summaries[@]}"; do [[ "$s" != "$summary" ]] || fail "$p: its description is another package's"; done
   summaries+=("$summary")
   files=$(dpkg-deb -c "$f" | awk '{print $6}')
-  for d in copyright changelog.gz README.md vcase-spec.md console-protocol.md; do
+  case $p in # packaging/cpack.cmake's VISCERA_DOCS_<component>: the trainees' guides, not the developer README
+    viscera-player) docs="trainee-guide.md console-setup.md vcase-spec.md console-protocol.md" ;;
+    viscera-studio) docs="README.md vcase-spec.md console-protocol.md" ;;
+    viscera-samples) docs="vcase-spec.md" ;;
+  esac
+  for d in copyright changelog.gz $docs; do
     grep -qx "./usr/share/doc/$p/$d" <<<"$files" || fail "$p: no /usr/share/doc/$p/$d"
   done
   for b in $(grep '^\./usr/bin/' <<<"$files" | sed 's|^\./usr/bin/||'); do
@@ -63,15 +68,53 @@ done
 samples=("$root"/usr/share/viscera/samples/*.vcase)
 ((${#samples[@]} >= 5)) || fail "viscera-samples has ${#samples[@]} cases, expected the 5 sample projects"
 
+replays=("$root"/usr/share/viscera/samples/replays/*/*.csv)
+((${#replays[@]} >= 3)) || fail "viscera-samples has ${#replays[@]} replays, expected those of projects/*/replays"
+[[ -f "$root/usr/share/applications/viscera-launcher.desktop" ]] || fail "viscera-player has no launcher .desktop file"
+if command -v desktop-file-validate >/dev/null; then
+  desktop-file-validate "$root/usr/share/applications/viscera-launcher.desktop" || fail "viscera-launcher.desktop"
+fi
+
+# Every extracted program answers --version with "<name> <version>".
+version=$(dpkg-deb -f "${deb[viscera-player]}" Version)
+for b in "$root"/usr/bin/*; do
+  v=$("$b" --version) || fail "$(basename "$b") --version failed"
+  [[ "$v" == "$(basename "$b") $version" ]] || fail "$(basename "$b") --version said '$v'"
+done
+
 # The extracted player, from the temporary root: verify every sample, run two headless.
 player="$root/usr/bin/viscera-player"
-"$player" --version
 for c in "${samples[@]}"; do "$player" verify "$c"; done
 "$player" run "$root/usr/share/viscera/samples/tissue-slab.vcase" --headless --frames 60 --report "$root/slab.json" |
   grep -E '^(case|status)'
 "$player" run "$root/usr/share/viscera/samples/liver.vcase" --headless --frames 120 --device scripted:press \
   --report "$root/liver.json" --plots "$root/plots" | grep -E '^(case|status|tools|plots)'
 [[ -s "$root/plots/session.html" ]] || fail "the extracted player wrote no plots"
+
+# The three packages installed on this machine's root with apt (their Depends resolved as a user's
+# would be), run from /usr as installed: the samples verify against the publisher key the samples
+# package installs (no --trust), the launcher finds them and draws its case picker under Xvfb, every
+# program answers --version; then removed again. Root only (set VISCERA_PACKAGE_INSTALL=0 to skip
+# on a machine whose /usr must stay untouched).
+if [[ $(id -u) -eq 0 && ${VISCERA_PACKAGE_INSTALL:-1} != 0 ]]; then
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get install -y -qq --no-install-recommends "${deb[viscera-player]}" "${deb[viscera-studio]}" \
+    "${deb[viscera-samples]}" >"$out/install.log" 2>&1 || { cat "$out/install.log"; fail "apt-get install of the packages"; }
+  trap 'rm -rf "$root"; apt-get remove -y -qq viscera-player viscera-studio viscera-samples >/dev/null 2>&1 || true' EXIT
+  for p in viscera-player viscera-studio viscera-samples; do
+    dpkg-query -W -f='${Status}' "$p" | grep -q "install ok installed" || fail "$p is not installed"
+  done
+  for c in /usr/share/viscera/samples/*.vcase; do /usr/bin/viscera-player verify "$c" >/dev/null || fail "installed: verify $c"; done
+  n=$(/usr/bin/viscera-launcher --list 2>/dev/null | grep -c '^/usr/share/viscera/samples/' || true)
+  ((n >= 5)) || fail "the installed launcher lists $n of the 5 samples"
+  env -u QT_QPA_PLATFORM xvfb-run -a -s "-screen 0 1280x800x24 -nolisten tcp" \
+    /usr/bin/viscera-launcher --screenshot "$out/launcher.png" || fail "the installed launcher did not open under Xvfb"
+  [[ -s "$out/launcher.png" ]] || fail "the installed launcher drew no picture"
+  for b in viscera-player viscera-console-sim viscera-results viscera-launcher viscera-studio; do
+    "/usr/bin/$b" --version >/dev/null || fail "installed $b --version"
+  done
+  echo "package: installed on this root: $n sample cases in the launcher ($out/launcher.png)"
+fi
 
 # lintian: 0 errors (warnings are listed).
 lint="$out/lintian.txt"

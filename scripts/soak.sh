@@ -23,7 +23,7 @@ soak=$(( minutes - loop )); ((soak >= 1)) || soak=1
 status=0
 "$build/player/viscera-player" soak \
   "$out/rectum.vcase@replay:projects/rectum/replays/dissection.csv" \
-  "$out/anastomosis.vcase@replay:projects/anastomosis/replays/two-stitches.csv" \
+  "$out/anastomosis.vcase@replay:projects/anastomosis/replays/running-suture.csv" \
   --minutes "$soak" --frames 330 --report "$out/soak.json" --trust "${key%.pem}.pub.pem" 2>/dev/null || status=$?
 echo "== console loopback, rectum, $loop min =="
 rm -f "$out/port" "$out/pairing.key"

@@ -1,6 +1,9 @@
 #include "plots/session_plots.hpp"
 
+#include "plots/html_text.hpp"
+#include "plots/offscreen_gui.hpp"
 #include "runtime/report.hpp"
+#include "runtime/report_reader.hpp"
 
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
@@ -34,68 +37,18 @@ constexpr int kNewestSchema = kReportSchemaVersion;
 
 // ---- reading ----------------------------------------------------------------------------------
 
-struct Reader {
-    const std::string& origin;
-    [[noreturn]] void fail(const std::string& field, const std::string& rule) const {
-        throw InputError(origin + ": " + field + ": " + rule);
-    }
-    const json& member(const json& obj, const std::string& field, const char* key) const {
-        if (!obj.is_object()) fail(field, "must be an object");
-        auto it = obj.find(key);
-        if (it == obj.end()) fail(field.empty() ? key : field + "." + key, "is missing");
-        return *it;
-    }
-    const json* optional(const json& obj, const char* key) const {
-        if (!obj.is_object()) return nullptr;
-        auto it = obj.find(key);
-        return it == obj.end() ? nullptr : &*it;
-    }
-    /// A finite number.
-    double number(const json& v, const std::string& field) const {
-        if (!v.is_number()) fail(field, "must be a number");
-        const double d = v.get<double>();
-        if (!std::isfinite(d)) fail(field, "must be finite");
-        return d;
-    }
-    /// A number, or null for a figure the session could not compute (NaN, drawn as a gap).
-    double numberOrNull(const json& v, const std::string& field) const {
-        if (v.is_null()) return kNaN;
-        return number(v, field);
-    }
-    int integer(const json& v, const std::string& field) const {
-        if (!v.is_number_integer()) fail(field, "must be an integer");
-        if (v.is_number_unsigned() ? v.get<uint64_t>() > uint64_t(std::numeric_limits<int>::max())
-                                   : (v.get<int64_t>() > std::numeric_limits<int>::max() ||
-                                      v.get<int64_t>() < std::numeric_limits<int>::min()))
-            fail(field, "is out of range");
-        return v.get<int>();
-    }
-    std::string string(const json& v, const std::string& field) const {
-        if (!v.is_string()) fail(field, "must be a string");
-        return v.get<std::string>();
-    }
-    const json& array(const json& v, const std::string& field) const {
-        if (!v.is_array()) fail(field, "must be an array");
-        return v;
-    }
-    std::vector<double> numbers(const json& v, const std::string& field) const {
-        std::vector<double> out;
-        for (size_t i = 0; i < array(v, field).size(); ++i)
-            out.push_back(numberOrNull(v[i], field + "[" + std::to_string(i) + "]"));
-        return out;
-    }
-    std::vector<std::string> strings(const json& v, const std::string& field) const {
-        std::vector<std::string> out;
-        for (size_t i = 0; i < array(v, field).size(); ++i)
-            out.push_back(string(v[i], field + "[" + std::to_string(i) + "]"));
-        return out;
-    }
-};
+using Reader = ReportReader;
 
 std::string at(const std::string& field, size_t i) {
     return field + "[" + std::to_string(i) + "]";
 }
 
+} // namespace
+
+namespace {
+void readTimelineInput(const Reader& rd, const json& doc, const std::vector<std::string>& names,
+                       const std::vector<double>& paths, const std::vector<double>& forces, PlotInput& in);
+void readAssessmentInput(const Reader& rd, const json& doc, PlotInput& in);
 } // namespace
 
 PlotInput readPlotInput(const json& doc, const std::string& origin) {
@@ -119,15 +72,15 @@ PlotInput readPlotInput(const json& doc, const std::string& origin) {
         PlotInput::Frame fr;
         fr.stepMs = rd.number(rd.member(frames[i], f, "step_ms"), f + ".step_ms");
         if (fr.stepMs < 0) rd.fail(f + ".step_ms", "must not be negative");
-        fr.energyJ = rd.numberOrNull(rd.member(frames[i], f, "energy_j"), f + ".energy_j");
-        fr.maxDisplacementM = rd.numberOrNull(rd.member(frames[i], f, "max_displacement_m"), f + ".max_displacement_m");
+        fr.energyJ = rd.numberOrNaN(rd.member(frames[i], f, "energy_j"), f + ".energy_j");
+        fr.maxDisplacementM = rd.numberOrNaN(rd.member(frames[i], f, "max_displacement_m"), f + ".max_displacement_m");
         in.frames.push_back(fr);
     }
     const json& m = rd.member(doc, "", "metrics");
     in.frameDt_s = rd.number(rd.member(m, "metrics", "frame_dt_s"), "metrics.frame_dt_s");
     if (!(in.frameDt_s > 0)) rd.fail("metrics.frame_dt_s", "must be positive");
     auto metric = [&](const char* key, double& out) {
-        if (const json* v = rd.optional(m, key)) out = rd.numberOrNull(*v, std::string("metrics.") + key);
+        if (const json* v = rd.optional(m, key)) out = rd.numberOrNaN(*v, std::string("metrics.") + key);
     };
     metric("sim_time_s", in.simTime_s);
     metric("wall_time_s", in.wallTime_s);
@@ -149,7 +102,8 @@ PlotInput readPlotInput(const json& doc, const std::string& origin) {
         in.device = rd.string(rd.member(dev, "haptics.device", "spec"), "haptics.device.spec");
         if (const json* v = rd.optional(*h, "case_max_force_n"))
             in.caseMaxForceN = rd.number(*v, "haptics.case_max_force_n");
-        if (const json* v = rd.optional(m, "max_force_n")) in.maxDeviceForceN = rd.number(*v, "metrics.max_force_n");
+        const char* key = schema >= 5 ? "device_max_force_n" : "max_force_n"; // renamed in schema 5
+        if (const json* v = rd.optional(m, key)) in.maxDeviceForceN = rd.number(*v, std::string("metrics.") + key);
     }
     if (const json* i = rd.optional(doc, "interaction"))
         if (const json* g = rd.optional(*i, "grasps")) in.grasps = rd.integer(*g, "interaction.grasps");
@@ -177,6 +131,15 @@ PlotInput readPlotInput(const json& doc, const std::string& origin) {
         }
     }
 
+    readTimelineInput(rd, doc, names, paths, forces, in);
+    readAssessmentInput(rd, doc, in);
+    return in;
+}
+
+namespace {
+
+void readTimelineInput(const Reader& rd, const json& doc, const std::vector<std::string>& names,
+                       const std::vector<double>& paths, const std::vector<double>& forces, PlotInput& in) {
     if (const json* tl = rd.optional(doc, "timeline")) {
         in.hasTimeline = true;
         in.strideFrames = rd.integer(rd.member(*tl, "timeline", "stride_frames"), "timeline.stride_frames");
@@ -196,7 +159,7 @@ PlotInput readPlotInput(const json& doc, const std::string& origin) {
                 const std::string g = at(f + ".tip_m", s);
                 if (!tip[s].is_array() || tip[s].size() != 3) rd.fail(g, "must be [x, y, z]");
                 t.tip.push_back(
-                    {rd.numberOrNull(tip[s][0], g), rd.numberOrNull(tip[s][1], g), rd.numberOrNull(tip[s][2], g)});
+                    {rd.numberOrNaN(tip[s][0], g), rd.numberOrNaN(tip[s][1], g), rd.numberOrNaN(tip[s][2], g)});
             }
             t.forceN = rd.numbers(rd.member(tools[k], f, "force_n"), f + ".force_n");
             for (const auto& [field, n] : {std::pair{".tip_m", t.tip.size()}, std::pair{".force_n", t.forceN.size()}})
@@ -222,8 +185,58 @@ PlotInput readPlotInput(const json& doc, const std::string& origin) {
             in.events.push_back(std::move(ev));
         }
     }
-    return in;
 }
+
+MetricResult readMetricInput(const Reader& rd, const json& j, const std::string& f) {
+    MetricResult m;
+    m.name = rd.string(rd.member(j, f, "name"), f + ".name");
+    m.unit = rd.string(rd.member(j, f, "unit"), f + ".unit");
+    const std::string better = rd.string(rd.member(j, f, "better"), f + ".better");
+    if (better != "lower" && better != "higher") rd.fail(f + ".better", "must be lower or higher");
+    m.lowerIsBetter = better == "lower";
+    auto opt = [&](const char* key) -> std::optional<double> {
+        const json& v = rd.member(j, f, key);
+        return v.is_null() ? std::nullopt : std::optional<double>(rd.number(v, f + "." + key));
+    };
+    m.value = opt("value");
+    m.limit = opt("limit");
+    const json& passed = rd.member(j, f, "passed");
+    if (!passed.is_boolean()) rd.fail(f + ".passed", "must be true or false");
+    m.passed = passed.get<bool>();
+    if (const json& e = rd.member(j, f, "expert"); !e.is_null()) {
+        m.expert = sim::ExpertLevel{rd.number(rd.member(e, f + ".expert", "mean"), f + ".expert.mean"),
+                                    rd.number(rd.member(e, f + ".expert", "sd"), f + ".expert.sd")};
+        m.bound = rd.number(rd.member(e, f + ".expert", "bound"), f + ".expert.bound");
+        const json& w = rd.member(j, f, "within_expert");
+        if (!w.is_boolean()) rd.fail(f + ".within_expert", "must be true or false with an expert level");
+        m.withinExpert = w.get<bool>();
+    }
+    return m;
+}
+
+void readAssessmentInput(const Reader& rd, const json& doc, PlotInput& in) {
+    if (const json* r = rd.optional(doc, "record")) {
+        in.trainee = rd.string(rd.member(*r, "record", "trainee"), "record.trainee");
+        in.startedUtc = rd.string(rd.member(*r, "record", "started_utc"), "record.started_utc");
+    }
+    const json* a = rd.optional(doc, "assessment");
+    if (!a) return;
+    in.hasAssessment = true;
+    Assessment& out = in.assessment;
+    const json& judged = rd.member(*a, "assessment", "judged");
+    if (!judged.is_boolean()) rd.fail("assessment.judged", "must be true or false");
+    out.judged = judged.get<bool>();
+    const json& passed = rd.member(*a, "assessment", "passed");
+    if (out.judged && !passed.is_boolean()) rd.fail("assessment.passed", "must be true or false");
+    out.passed = !out.judged || passed.get<bool>();
+    const json& c = rd.member(*a, "assessment", "completion_time_s");
+    if (!c.is_null()) out.completionS = rd.number(c, "assessment.completion_time_s");
+    const json& metrics = rd.array(rd.member(*a, "assessment", "metrics"), "assessment.metrics");
+    for (size_t i = 0; i < metrics.size(); ++i)
+        out.metrics.push_back(readMetricInput(rd, metrics[i], at("assessment.metrics", i)));
+}
+
+} // namespace
 
 PlotInput readPlotInputFile(const std::filesystem::path& reportPath) {
     const std::string text = readFile(reportPath);
@@ -249,25 +262,6 @@ QColor toolColor(size_t k) {
     return kToolColors[k % (sizeof kToolColors / sizeof kToolColors[0])];
 }
 const QColor kInk(40, 40, 48), kGrid(225, 227, 232), kBudget(200, 30, 30);
-
-/// An offscreen QGuiApplication for fonts when the process has none (the headless player, the
-/// plot subcommand). Kept for the life of the process.
-void ensureGuiApplication() {
-    if (QGuiApplication::instance()) return;
-    // Nothing is written under the runtime folder; Qt's note that it is unset is noise here.
-    static const QtMessageHandler previous =
-        qInstallMessageHandler([](QtMsgType type, const QMessageLogContext& ctx, const QString& msg) {
-            if (msg.startsWith("QStandardPaths: XDG_RUNTIME_DIR not set")) return;
-            if (previous)
-                previous(type, ctx, msg);
-            else
-                std::fprintf(stderr, "%s\n", msg.toLocal8Bit().constData());
-        });
-    static int argc = 3;
-    static char arg0[] = "viscera-player", arg1[] = "-platform", arg2[] = "offscreen";
-    static char* argv[] = {arg0, arg1, arg2, nullptr};
-    static std::unique_ptr<QGuiApplication> app = std::make_unique<QGuiApplication>(argc, argv);
-}
 
 QString q(const std::string& s) {
     return QString::fromStdString(s);
@@ -593,7 +587,8 @@ QByteArray forcePlot(const PlotInput& in) {
     std::vector<std::pair<QString, QColor>> legend;
     for (size_t k = 0; k < in.tools.size(); ++k) {
         ch.line(in.t_s, in.tools[k].forceN, toolColor(k));
-        legend.push_back({q(in.tools[k].name) + fmt(" (max %.2f N)", in.tools[k].maxForceN), toolColor(k)});
+        legend.push_back(
+            {q(in.tools[k].name) + " (max " + q(formatFigure(in.tools[k].maxForceN)) + " N)", toolColor(k)});
     }
     ch.legend(legend);
     return c.png();
@@ -770,37 +765,39 @@ QByteArray accuracyPlot(const PlotInput& in) {
     return c.png();
 }
 
-std::string html(const std::string& s) {
-    std::string o;
-    for (char ch : s)
-        switch (ch) {
-        case '&':
-            o += "&amp;";
-            break;
-        case '<':
-            o += "&lt;";
-            break;
-        case '>':
-            o += "&gt;";
-            break;
-        case '"':
-            o += "&quot;";
-            break;
-        default:
-            o += ch;
-        }
-    return o;
-}
-
 std::string num(const char* f, double v) {
     return formatted(f, v);
+}
+
+/// The verdict and one row per metric: value, limit, pass or fail, expert level; each row also
+/// carries the summary's line for the metric (data-line), so the page and the summary agree.
+std::string verdictHtml(const Assessment& a) {
+    std::string s = "<h2 id=\"verdict\">";
+    if (a.judged)
+        s += std::string("<span class=\"") + (a.passed ? "pass\">PASS" : "bad\">FAIL") + "</span>";
+    else
+        s += "No verdict (the case has no assessment)";
+    s += "</h2>\n<p>completion " + formatFigure(a.completionS) + " s; " +
+         (a.withinExpertLevel() ? "within the expert level" : "not within the expert level") + "</p>\n";
+    s += "<table id=\"metrics\"><tr><th>metric</th><th>value</th><th>unit</th><th>limit</th><th>result</th><th>expert "
+         "level</th></tr>\n";
+    for (const MetricResult& m : a.metrics) {
+        const std::string dir = m.lowerIsBetter ? "≤ " : "≥ ";
+        s += "<tr data-line=\"" + htmlText(metricLine(m)) + "\"><td>" + htmlText(m.name) + "</td><td>" +
+             formatFigure(m.value) + "</td><td>" + htmlText(m.unit) + "</td><td>" +
+             (m.limit ? dir + formatFigure(m.limit) : "") + "</td><td" + (m.passed ? ">" : " class=\"bad\">") +
+             (m.limit ? (m.passed ? "pass" : "FAIL") : "") + "</td><td>" +
+             (m.expert ? dir + formatFigure(m.bound) + (*m.withinExpert ? " within" : " outside") : "") +
+             "</td></tr>\n";
+    }
+    return s + "</table>\n";
 }
 
 } // namespace
 
 PlotFiles writeSessionPlots(const PlotInput& in, const std::filesystem::path& dir) {
     requireWritableFolder(dir);
-    ensureGuiApplication();
+    ensureOffscreenGui();
     struct Item {
         const char* file;
         const char* caption;
@@ -834,22 +831,23 @@ PlotFiles writeSessionPlots(const PlotInput& in, const std::filesystem::path& di
     }
 
     // The page: headline figures, then the charts embedded.
-    std::string page = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>Session — " +
-                       html(in.title.empty() ? in.caseId : in.title) +
-                       "</title>\n<style>body{font-family:sans-serif;max-width:1140px;margin:24px auto;color:#28283"
-                       "0}table{border-collapse:collapse}td,th{padding:3px 12px 3px 0;text-align:left}th{color:#666;"
-                       "font-weight:normal}.bad{color:#b00}.warn{color:#a60}figure{margin:18px 0}img{max-width:100%;"
-                       "border:1px solid #ddd}</style></head><body>\n";
-    page += "<h1>" + html(in.title.empty() ? in.caseId : in.title) + "</h1>\n<p>Case " + html(in.caseId) + " " +
-            html(in.caseVersion) + (in.device.empty() ? "" : ", device " + html(in.device)) + "</p>\n";
+    std::string page =
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>Session — " +
+        htmlText(in.title.empty() ? in.caseId : in.title) +
+        "</title>\n<style>body{font-family:sans-serif;max-width:1140px;margin:24px auto;color:#28283"
+        "0}table{border-collapse:collapse}td,th{padding:3px 12px 3px 0;text-align:left}th{color:#666;"
+        "font-weight:normal}.pass{color:#070}.bad{color:#b00}.warn{color:#a60}figure{margin:18px 0}img{max-width:100%;"
+        "border:1px solid #ddd}</style></head><body>\n";
+    page += "<h1>" + htmlText(in.title.empty() ? in.caseId : in.title) + "</h1>\n<p>Case " + htmlText(in.caseId) + " " +
+            htmlText(in.caseVersion) + (in.device.empty() ? "" : ", device " + htmlText(in.device)) + "</p>\n";
     const bool ok = in.errors.empty() && in.allFinite;
     page += std::string("<p class=\"") + (ok ? "" : "bad") + "\"><b>" +
             (ok ? "Session ran to the end without a broken invariant." : "The session broke an invariant.") +
             "</b></p>\n";
     for (const std::string& e : in.errors)
-        page += "<p class=\"bad\">" + html(e) + "</p>\n";
+        page += "<p class=\"bad\">" + htmlText(e) + "</p>\n";
     for (const std::string& w : in.warnings)
-        page += "<p class=\"warn\">warning: " + html(w) + "</p>\n";
+        page += "<p class=\"warn\">warning: " + htmlText(w) + "</p>\n";
     page += "<table>\n";
     auto row = [&](const std::string& k, const std::string& v) {
         page += "<tr><th>" + k + "</th><td>" + v + "</td></tr>\n";
@@ -861,11 +859,12 @@ PlotFiles writeSessionPlots(const PlotInput& in, const std::filesystem::path& di
             num("%.2f", in.realTimeFactor) + (in.realTimeFactor < 1 ? " — slower than real time" : ""));
     row("step time", num("mean %.2f ms", in.stepMsMean) + num(", p99 %.2f ms", in.stepMsP99) +
                          num(" (budget %.1f ms)", in.frameDt_s * 1e3));
+    if (!in.trainee.empty()) row("trainee", htmlText(in.trainee) + ", started " + htmlText(in.startedUtc));
     for (const auto& t : in.tools)
-        row(html(t.name) + " (" + html(t.kind) + ")",
-            num("path %.1f mm", t.pathM * 1e3) + num(", largest force %.2f N", t.maxForceN));
+        row(htmlText(t.name) + " (" + htmlText(t.kind) + ")",
+            "path " + formatFigure(t.pathM) + " m, largest force " + formatFigure(t.maxForceN) + " N");
     if (!in.device.empty())
-        row("device force", num("max %.2f N", in.maxDeviceForceN) +
+        row("device force", "max " + formatFigure(in.maxDeviceForceN) + " N" +
                                 (in.caseMaxForceN > 0 ? num(" (case limit %.1f N)", in.caseMaxForceN) : ""));
     std::map<std::string, int64_t> counts;
     for (const auto& e : in.events)
@@ -875,10 +874,11 @@ PlotFiles writeSessionPlots(const PlotInput& in, const std::filesystem::path& di
     if (in.clips || counts["clip"]) row("clips", std::to_string(in.clips));
     if (in.punctures || counts["puncture"]) row("punctures", std::to_string(in.punctures));
     page += "</table>\n";
+    if (in.hasAssessment) page += verdictHtml(in.assessment);
     for (const Item& it : items)
         page += "<figure><img alt=\"" + std::string(it.file) + "\" src=\"data:image/png;base64," +
-                it.png.toBase64().toStdString() + "\"><figcaption>" + html(it.caption) + "</figcaption></figure>\n";
-    page += "<p style=\"color:#888\">Made by viscera-player from " + html(in.origin) + ".</p>\n</body></html>\n";
+                it.png.toBase64().toStdString() + "\"><figcaption>" + htmlText(it.caption) + "</figcaption></figure>\n";
+    page += "<p style=\"color:#888\">Made by viscera-player from " + htmlText(in.origin) + ".</p>\n</body></html>\n";
     out.page = dir / "session.html";
     writeFileAtomic(out.page, page);
     return out;

@@ -9,6 +9,8 @@
 ///
 /// Drawn with QtGui (QImage + QPainter, no window, no display: an offscreen QGuiApplication is
 /// made when none exists).
+#include "runtime/assessment.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <array>
@@ -58,6 +60,10 @@ struct PlotInput {
     int punctures = 0, clips = 0, cutEdges = 0, grasps = 0;
     bool allFinite = true;
     std::vector<std::string> errors, warnings;
+    /// The report's "assessment" (schema 5): the metrics and the verdict, as the summary gives them.
+    bool hasAssessment = false;
+    Assessment assessment;
+    std::string trainee, startedUtc; ///< the report's "record"
 };
 
 /// Reads what the plots need from a parsed report; `origin` names it in messages. Throws

@@ -130,14 +130,6 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
         m_scopeArm = arms == 2 && hand == "right" ? 1 : 0;
         cfg.cameraPedalHolds = true;
     }
-    m_aboveDamage.assign(world.toolCount(), false);
-    for (size_t t = 0; t < m_rig.size(); ++t) // instruments are measured by the session, scripted or driven
-        if (m_rig[t].kind != RigTool::Kind::Instrument) {
-            m_rig[t].slot = static_cast<int>(m_metrics.toolNames.size());
-            m_metrics.toolNames.push_back(m_tools[t].name);
-            m_metrics.toolPathLengthPerTool_m.push_back(0.0);
-            m_metrics.maxForcePerTool_n.push_back(0.0);
-        }
     cfg.safety.maxForce = m_caseMaxForce;
     if (m_realtime) {
         m_clock = std::make_unique<haptics::SteadyClock>();
@@ -419,27 +411,6 @@ haptics::ToolPoseState HapticRig::framePoses(int64_t due) {
 void HapticRig::afterStep() {
     ++m_frame;
     publish();
-    if (const sim::NeedleDrive* nd = m_world.needleDrive())
-        for (const RigTool& rt : m_rig)
-            if (rt.slot >= 0 && (rt.kind == RigTool::Kind::Needle || rt.kind == RigTool::Kind::Thread)) {
-                const double f = rt.kind == RigTool::Kind::Needle ? nd->needleForce().norm() : nd->threadTension();
-                if (!std::isfinite(f)) continue;
-                double& m = m_metrics.maxForcePerTool_n[static_cast<size_t>(rt.slot)];
-                m = std::max(m, f);
-                m_metrics.maxContactForce_n = std::max(m_metrics.maxContactForce_n, f);
-            }
-    for (size_t t = 0; t < m_world.toolCount(); ++t) {
-        const double f = m_world.toolContact(t).force.norm();
-        const double thr = m_world.toolDesc(t).damageForceN;
-        m_metrics.maxContactForce_n = std::max(m_metrics.maxContactForce_n, f);
-        m_metrics.maxForcePerTool_n[static_cast<size_t>(m_rig[t].slot)] =
-            std::max(m_metrics.maxForcePerTool_n[static_cast<size_t>(m_rig[t].slot)], f);
-        if (f > thr) {
-            m_metrics.tissueDamage_ns += (f - thr) * m_dt;
-            if (!m_aboveDamage[t]) ++m_metrics.damageEvents;
-        }
-        m_aboveDamage[t] = f > thr;
-    }
     drain();
 }
 
@@ -452,15 +423,6 @@ void HapticRig::drain() {
         m_metrics.maxForce_n = std::max(m_metrics.maxForce_n, f);
         m_forceSum += f;
         ++m_forceCount;
-        if (f > 0) m_contactSum += f, ++m_contactCount;
-        const int t = activeTool(a);
-        if (m_haveLast[a] && t >= 0 && m_rig[static_cast<size_t>(t)].slot >= 0) {
-            const double d = (s.tool - m_last[a]).norm();
-            m_metrics.toolPathLength_m += d;
-            m_metrics.toolPathLengthPerTool_m[static_cast<size_t>(m_rig[static_cast<size_t>(t)].slot)] += d;
-        }
-        m_last[a] = s.tool;
-        m_haveLast[a] = true;
         if (s.contactAge_s >= 0 && m_dt > 0) m_maxAgeSteps = std::max(m_maxAgeSteps, s.contactAge_s / m_dt);
         if (s.t_ns != m_lastAuditTick) { // one sample per driven arm and tick, one model per tick
             m_audit.used(s.t_ns, s.contactFrame);
@@ -478,7 +440,6 @@ void HapticRig::finish() {
     drain();
     m_metrics.time_s = double(m_frame) * m_dt;
     m_metrics.meanForce_n = m_forceCount ? m_forceSum / double(m_forceCount) : 0;
-    m_metrics.meanContactForce_n = m_contactCount ? m_contactSum / double(m_contactCount) : 0;
 }
 
 HapticsResult HapticRig::result() const {

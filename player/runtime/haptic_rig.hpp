@@ -24,21 +24,15 @@ namespace viscera::player {
 
 /// Task metrics of a session (report "metrics"). Tools: the scene's probes, then the
 /// interaction's instruments (scripted on their tracks or driven by the device).
+/// The session's counts and the device's forces. The task's figures (paths, the tissue's forces,
+/// damage) are the assessment's (assessment.hpp), measured from the timeline.
 struct TaskMetrics {
-    double time_s = 0;           ///< simulated session time
-    double toolPathLength_m = 0; ///< sum over tools, scene frame
-    std::vector<std::string> toolNames;
-    std::vector<double> toolPathLengthPerTool_m;
-    std::vector<double> maxForcePerTool_n; ///< tissue on tool, from the physics
-    double maxForce_n = 0;                 ///< device force after the safety filter
-    double meanForce_n = 0;                ///< over all servo ticks of driven arms
-    double meanContactForce_n = 0;         ///< over ticks with a non-zero force
-    double tissueDamage_ns = 0;            ///< ∫ max(0, contact force − damage threshold) dt, N·s
-    int damageEvents = 0;                  ///< times the contact force rose above the threshold
-    double maxContactForce_n = 0;          ///< N, tissue on tool, from the physics
-    int punctures = 0;                     ///< needle punctures (suturing cases)
-    int clips = 0;                         ///< clips applied (cases with a clip applier)
-    int cutEdges = 0;                      ///< edges dissected by energy (cases with an energy hook)
+    double time_s = 0;      ///< simulated session time
+    double maxForce_n = 0;  ///< device force after the safety filter
+    double meanForce_n = 0; ///< over all servo ticks of driven arms
+    int punctures = 0;      ///< needle punctures (suturing cases)
+    int clips = 0;          ///< clips applied (cases with a clip applier)
+    int cutEdges = 0;       ///< edges dissected by energy (cases with an energy hook)
 };
 
 struct HapticsResult {
@@ -174,7 +168,6 @@ private:
         sim::InstrumentKey rest;
         Eigen::Isometry3d needleRest = Eigen::Isometry3d::Identity();
         double pullScale = 0, pull = 0; ///< thread: scale and the pull so far (m)
-        int slot = -1;                  ///< its entry in the task metrics' per-tool lists (instruments: the session's)
     };
     std::vector<RigTool> m_rig;
     std::array<std::vector<int>, haptics::kMaxArms> m_armTools; ///< rig tools per arm, in scene order
@@ -193,16 +186,13 @@ private:
     std::vector<TraceRow> m_trace;
     uint64_t m_samples = 0;
     TaskMetrics m_metrics;
-    std::array<bool, haptics::kMaxArms> m_haveLast{false, false};
-    std::array<sim::Vec3, haptics::kMaxArms> m_last{sim::Vec3::Zero(), sim::Vec3::Zero()};
     std::array<sim::Vec3, haptics::kMaxArms> m_armProxy{sim::Vec3::Zero(), sim::Vec3::Zero()};
-    std::vector<bool> m_aboveDamage;
     std::vector<std::string> m_notes;
     int m_scopeArm = -1; ///< the master that steers the laparoscope (-1: none)
     sim::Vec3 m_scopeGrab = sim::Vec3::Zero();
     haptics::Quat m_scopeGrabQ = haptics::Quat::Identity();
-    double m_forceSum = 0, m_contactSum = 0;
-    uint64_t m_forceCount = 0, m_contactCount = 0;
+    double m_forceSum = 0;
+    uint64_t m_forceCount = 0;
     double m_maxAgeSteps = 0;
     haptics::HandoverAudit m_audit;
     int64_t m_lastAuditTick = INT64_MIN;

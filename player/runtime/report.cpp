@@ -262,12 +262,17 @@ static nlohmann::json timelineJson(const SessionTimeline& tl) {
             tip.push_back({round(p.x(), 1e-6), round(p.y(), 1e-6), round(p.z(), 1e-6)});
         for (double f : tool.force_n)
             force.push_back(round(f, 1e-4));
-        tools.push_back({{"name", tool.name}, {"kind", tool.kind}, {"tip_m", tip}, {"force_n", force}});
+        tools.push_back(
+            {{"name", tool.name}, {"kind", tool.kind}, {"hand", tool.hand}, {"tip_m", tip}, {"force_n", force}});
     }
     json events = json::array();
     for (const SessionTimeline::Event& e : tl.events)
-        events.push_back(
-            {{"t_s", round(e.t_s, 1e-6)}, {"frame", e.frame}, {"kind", e.kind}, {"tool", e.tool}, {"count", e.count}});
+        events.push_back({{"t_s", round(e.t_s, 1e-6)},
+                          {"frame", e.frame},
+                          {"kind", e.kind},
+                          {"tool", e.tool},
+                          {"count", e.count},
+                          {"at_m", {round(e.at.x(), 1e-6), round(e.at.y(), 1e-6), round(e.at.z(), 1e-6)}}});
     json doc = {{"stride_frames", tl.stride}, {"t_s", t}, {"tools", tools}, {"events", events}};
     if (!tl.cameraTip.empty()) {
         json tip = json::array(), steering = json::array();
@@ -281,6 +286,74 @@ static nlohmann::json timelineJson(const SessionTimeline& tl) {
 }
 
 namespace {
+
+nlohmann::json orNull(std::optional<double> v) {
+    return v && std::isfinite(*v) ? nlohmann::json(*v) : nlohmann::json();
+}
+
+/// The task figures of the "metrics" block, every one from the session's assessment (one
+/// definition each); the device's forces under their own names.
+void writeTaskMetrics(const SessionResult& r, nlohmann::json& m) {
+    const Assessment& a = r.assessment;
+    auto value = [&](const char* name) {
+        const MetricResult* x = a.find(name);
+        return x && x->value ? *x->value : 0.0;
+    };
+    m["time_s"] = r.metrics.time_s;
+    m["tool_path_length_m"] = value("path_length_m");
+    m["tool_names"] = nlohmann::json::array();
+    m["tool_path_length_per_tool_m"] = nlohmann::json::array();
+    m["max_contact_force_per_tool_n"] = nlohmann::json::array();
+    for (const ToolFigures& t : a.tools) {
+        m["tool_names"].push_back(t.name);
+        m["tool_path_length_per_tool_m"].push_back(t.pathM);
+        m["max_contact_force_per_tool_n"].push_back(t.forceMaxN);
+    }
+    m["mean_contact_force_n"] = value("force_mean_n");
+    m["max_contact_force_n"] = value("force_max_n");
+    m["tissue_damage_ns"] = value("tissue_damage_ns");
+    m["device_max_force_n"] = r.metrics.maxForce_n;
+    m["device_mean_force_n"] = r.metrics.meanForce_n;
+}
+
+/// Who ran what, when, with which player: what the results database files a session under.
+nlohmann::json recordJson(const SessionResult& r) {
+    return {{"trainee", r.trainee}, {"started_utc", r.startedUtc},   {"player_version", VISCERA_VERSION},
+            {"case_id", r.caseId},  {"case_version", r.caseVersion}, {"package_sha256", r.package.sha256}};
+}
+
+nlohmann::json assessmentJson(const Assessment& a) {
+    using nlohmann::json;
+    json metrics = json::array();
+    for (const MetricResult& m : a.metrics) {
+        json j = {{"name", m.name},           {"unit", m.unit},
+                  {"value", orNull(m.value)}, {"better", m.lowerIsBetter ? "lower" : "higher"},
+                  {"limit", orNull(m.limit)}, {"passed", m.passed},
+                  {"expert", nullptr},        {"within_expert", nullptr}};
+        if (m.expert) {
+            j["expert"] = {{"mean", m.expert->mean}, {"sd", m.expert->sd}, {"bound", m.bound}};
+            j["within_expert"] = *m.withinExpert;
+        }
+        metrics.push_back(j);
+    }
+    json tools = json::array();
+    for (const ToolFigures& t : a.tools)
+        tools.push_back({{"name", t.name},
+                         {"kind", t.kind},
+                         {"hand", t.hand},
+                         {"path_m", t.pathM},
+                         {"angular_path_rad", t.angularRad},
+                         {"force_max_n", t.forceMaxN},
+                         {"force_mean_n", t.forceMeanN},
+                         {"force_over_threshold_s", t.overThresholdS},
+                         {"tissue_damage_ns", t.damageNs}});
+    return {{"judged", a.judged},
+            {"passed", a.judged ? json(a.passed) : json()},
+            {"completion_time_s", orNull(a.completionS)},
+            {"within_expert_level", a.withinExpertLevel()},
+            {"metrics", metrics},
+            {"tools", tools}};
+}
 
 /// Which bytes ran and who signed them.
 nlohmann::json packageJson(const vcase::Provenance& p) {
@@ -359,19 +432,10 @@ nlohmann::json reportJson(const SessionResult& r) {
     if (r.realTimeEstimate > 0) doc["metrics"]["real_time_estimate"] = r.realTimeEstimate;
     for (const SessionResult::BodyInertia& b : r.inertia) // selective inertia scaling, per body
         doc["metrics"]["added_inertia"][b.name] = {{"mass_kg", b.massKg}, {"added_kg", b.addedKg}};
-    // Task metrics [issue 7]: time, tool path, forces, tissue damage, punctures, clips.
+    writeTaskMetrics(r, doc["metrics"]);
+    doc["record"] = recordJson(r);
+    doc["assessment"] = assessmentJson(r.assessment);
     const TaskMetrics& tm = r.metrics;
-    doc["metrics"]["time_s"] = tm.time_s;
-    doc["metrics"]["tool_path_length_m"] = tm.toolPathLength_m;
-    doc["metrics"]["tool_path_length_per_tool_m"] = tm.toolPathLengthPerTool_m;
-    doc["metrics"]["tool_names"] = tm.toolNames;
-    doc["metrics"]["max_contact_force_per_tool_n"] = tm.maxForcePerTool_n;
-    doc["metrics"]["max_force_n"] = tm.maxForce_n;
-    doc["metrics"]["mean_force_n"] = tm.meanForce_n;
-    doc["metrics"]["mean_contact_force_n"] = tm.meanContactForce_n;
-    doc["metrics"]["max_contact_force_n"] = tm.maxContactForce_n;
-    doc["metrics"]["tissue_damage_ns"] = tm.tissueDamage_ns;
-    doc["metrics"]["damage_events"] = tm.damageEvents;
     doc["metrics"]["punctures"] = tm.punctures;
     doc["metrics"]["clips"] = tm.clips;
     doc["metrics"]["cut_edges"] = tm.cutEdges;
@@ -455,6 +519,39 @@ std::string hapticsSummary(const HapticsResult& h, const TaskMetrics& m) {
 
 } // namespace
 
+namespace {
+
+/// The tools line: each tool's path and largest tissue force, as the page and the plots give them.
+std::string toolsSummary(const Assessment& a) {
+    if (a.tools.empty()) return {};
+    std::string per;
+    for (const ToolFigures& t : a.tools)
+        per += (per.empty() ? "" : "; ") + t.name + " " + formatFigure(t.pathM) + " m, " + formatFigure(t.forceMaxN) +
+               " N";
+    const MetricResult* path = a.find("path_length_m");
+    const MetricResult* force = a.find("force_max_n");
+    return "tools         path " + formatFigure(path ? path->value : std::nullopt) +
+           " m, largest force from the tissue " + formatFigure(force ? force->value : std::nullopt) + " N (" + per +
+           ")\n";
+}
+
+} // namespace
+
+std::string assessmentSummary(const Assessment& a) {
+    std::string out;
+    for (const MetricResult& m : a.metrics)
+        out += "metric        " + metricLine(m) + "\n";
+    if (!a.judged) return out + "verdict       none (the case has no assessment)\n";
+    int failed = 0;
+    std::string names;
+    for (const MetricResult& m : a.metrics)
+        if (!m.passed) names += (failed++ ? ", " : "") + m.name;
+    out += "verdict       " + std::string(a.passed ? "PASS" : "FAIL") + (a.passed ? "" : " (" + names + ")") +
+           "; completion " + formatFigure(a.completionS) + " s; " +
+           (a.withinExpertLevel() ? "within the expert level" : "not within the expert level") + "\n";
+    return out;
+}
+
 std::string summaryText(const SessionResult& r) {
     const StepTimeStats st = stepTimeStats(r.frames);
     std::string subs;
@@ -499,21 +596,9 @@ std::string summaryText(const SessionResult& r) {
         }
     for (const std::string& w : r.warnings)
         out += "warning       " + w + "\n";
-    if (!r.metrics.toolNames.empty()) { // scripted and device-driven tools alike
-        std::string per;
-        for (size_t t = 0; t < r.metrics.toolNames.size(); ++t) {
-            char item[160];
-            std::snprintf(item, sizeof item, "%s%s %.1f mm, %.2f N", per.empty() ? "" : "; ",
-                          r.metrics.toolNames[t].c_str(), r.metrics.toolPathLengthPerTool_m[t] * 1e3,
-                          r.metrics.maxForcePerTool_n[t]);
-            per += item;
-        }
-        char line[160];
-        std::snprintf(line, sizeof line, "tools         path %.1f mm, largest force from the tissue %.2f N (",
-                      r.metrics.toolPathLength_m * 1e3, r.metrics.maxContactForce_n);
-        out += line + per + ")\n";
-    }
+    out += toolsSummary(r.assessment);
     if (r.haptics) out += hapticsSummary(*r.haptics, r.metrics);
+    if (!r.trainee.empty()) out += "trainee       " + r.trainee + ", started " + r.startedUtc + "\n";
     if (r.render) {
         std::string passes;
         for (const auto& p : r.render->passes) {
@@ -586,7 +671,7 @@ std::string summaryText(const SessionResult& r) {
         out += line;
         break;
     }
-    return out;
+    return out + assessmentSummary(r.assessment);
 }
 
 } // namespace viscera::player

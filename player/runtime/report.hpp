@@ -12,8 +12,10 @@ namespace viscera::player {
 /// keep it). 2: tool names and per-tool forces, warnings, the largest node displacement is over
 /// the run (final_node_displacement_m is the end). 3: the console link is authenticated
 /// (haptics.link: rejected_checksum gave way to rejected_auth, with rejected_jump, rejected_peer,
-/// stale_welcomes and handshakes).
-constexpr int kReportSchemaVersion = 4;
+/// stale_welcomes and handshakes). 5: "record" and "assessment"; the metrics' forces are the
+/// tissue's (device forces as device_max_force_n, device_mean_force_n; max_force_n, mean_force_n
+/// and damage_events went away).
+constexpr int kReportSchemaVersion = 5;
 nlohmann::json reportJson(const SessionResult& result);
 /// The force and pose trace (--trace): one row per servo tick and driven arm.
 /// Columns: t_s, arm, device_x/y/z (m, device frame), tool_x/y/z (m, scene), force_x/y/z (N,
@@ -21,8 +23,12 @@ nlohmann::json reportJson(const SessionResult& result);
 /// pedals, connected, safety_rules (SafetyRule bits), contact_age_ms, contact_frame (the physics
 /// frame of the contact model the tick used).
 std::string traceCsv(const SessionResult& result);
-/// A short human-readable summary (at most ~15 lines).
+/// A short human-readable summary: the session's figures, then one line per metric and the
+/// verdict (assessmentSummary).
 std::string summaryText(const SessionResult& result);
+/// "metric        <metricLine>" per metric, then "verdict       PASS|FAIL (failed metrics);
+/// completion <s> s; within|not within the expert level" (or "none" without an assessment).
+std::string assessmentSummary(const Assessment& assessment);
 /// One line: who signed the package (or that no trusted publisher did) and its SHA-256 and size.
 std::string packageSummary(const vcase::Provenance& package);
 

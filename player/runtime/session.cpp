@@ -17,58 +17,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 
 namespace viscera::player {
 namespace {
-
-/// Task figures of the interaction's instruments, scripted or driven: tip path, force from the
-/// tissue, damage above the threshold (the instrument's device damage_force_n, else 4 N).
-class InstrumentMeter {
-public:
-    void record(const sim::InteractionRuntime& in, double dt) {
-        const auto& now = in.summary().instruments;
-        if (m_path.empty()) {
-            m_path.assign(now.size(), 0.0);
-            m_maxForce.assign(now.size(), 0.0);
-            m_above.assign(now.size(), false);
-        }
-        for (size_t i = 0; i < now.size() && i < m_path.size(); ++i) {
-            if (m_haveLast) m_path[i] += (now[i].tip - m_last[i]).norm();
-            const double f = now[i].force.norm();
-            m_maxForce[i] = std::max(m_maxForce[i], f);
-            const sim::InstrumentDesc& d = in.instrumentDesc(i);
-            const double thr = d.device.declared ? d.device.damageForceN : sim::InstrumentDeviceDesc{}.damageForceN;
-            if (f > thr) {
-                m_damage += (f - thr) * dt;
-                if (!m_above[i]) ++m_events;
-            }
-            m_above[i] = f > thr;
-        }
-        m_last.resize(now.size());
-        for (size_t i = 0; i < now.size(); ++i)
-            m_last[i] = now[i].tip;
-        m_haveLast = true;
-    }
-    void addTo(TaskMetrics& m, const sim::InteractionRuntime& in) const {
-        for (size_t i = 0; i < m_path.size(); ++i) {
-            m.toolNames.push_back(in.instrumentDesc(i).name);
-            m.toolPathLengthPerTool_m.push_back(m_path[i]);
-            m.maxForcePerTool_n.push_back(m_maxForce[i]);
-            m.toolPathLength_m += m_path[i];
-            m.maxContactForce_n = std::max(m.maxContactForce_n, m_maxForce[i]);
-        }
-        m.tissueDamage_ns += m_damage;
-        m.damageEvents += m_events;
-    }
-
-private:
-    std::vector<double> m_path, m_maxForce;
-    std::vector<bool> m_above;
-    std::vector<sim::Vec3> m_last;
-    bool m_haveLast = false;
-    double m_damage = 0;
-    int m_events = 0;
-};
 
 /// m: the largest distance of a node from its rest position now (every body).
 double nodeDisplacement(const sim::World& world) {
@@ -292,6 +244,15 @@ void checkLink(const HapticsResult& h, SessionResult& r) {
     r.errors.push_back(buf);
 }
 
+std::string utcNow() {
+    const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+    std::tm tm{};
+    gmtime_r(&now, &tm);
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+    return buf;
+}
+
 /// The device's figures at the end of a session with a rig.
 void collectHaptics(HapticRig& rig, SessionResult& r) {
     rig.finish();
@@ -320,6 +281,10 @@ void collectWorld(const sim::World& world, SessionResult& r) {
         r.suture = world.sutureSummary();
         r.sutureFrames = world.sutureFrames();
         r.metrics.punctures = r.suture->punctures;
+        if (const sim::SutureReport* su = world.sutureReport()) {
+            r.puncturePoints = su->threadPath();
+            if (!r.puncturePoints.empty()) r.puncturePoints.pop_back(); // the needle's end
+        }
         if (!r.suture->finite) r.errors.push_back("suture: the closure gauge or the thread tension was not finite");
     }
     r.finalNodeDisplacement = nodeDisplacement(world);
@@ -334,6 +299,8 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     r.caseVersion = m.caseVersion;
     r.package = loaded.provenance;
     r.title = m.title.value_or("");
+    r.trainee = options.trainee;
+    r.startedUtc = utcNow();
     sim::World& world = *loaded.world;
     r.activeSubsystems = world.activeSubsystems();
     const std::vector<double> added = world.addedInertiaKg();
@@ -364,7 +331,6 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         for (const std::string& w : r.warnings)
             log::warn(w);
     }
-    InstrumentMeter meter;
     TimelineRecorder timeline(world);
     PortMeter ports;
     if (options.live) {
@@ -385,7 +351,6 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         if (rig) rig->beforeStep();
         sim::FrameRecord rec = world.step();
         if (rig) rig->afterStep();
-        if (const sim::InteractionRuntime* in = world.interaction()) meter.record(*in, frameDt);
         timeline.record(world);
         ports.record(world);
         r.maxNodeDisplacement = std::max(r.maxNodeDisplacement, nodeDisplacement(world));
@@ -420,10 +385,10 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
         r.interaction = in->summary();
         r.metrics.clips = static_cast<int>(r.interaction->clips.size());
         r.metrics.cutEdges = r.interaction->fasciaEdgesCut + r.interaction->fatEdgesCut;
-        meter.addTo(r.metrics, *in);
     }
     r.timeline = timeline.take();
     r.ports = ports.take();
+    r.assessment = assessSession(r, loaded.scene.assessment);
     return r;
 }
 

@@ -6,6 +6,7 @@
 #include "render/corner_uv.hpp"
 #include "render/scene_view.hpp"
 #include "render/tool_meshes.hpp"
+#include "runtime/assessment.hpp"
 #include "runtime/haptic_rig.hpp"
 #include "runtime/port_meter.hpp"
 #include "runtime/timeline.hpp"
@@ -84,6 +85,7 @@ struct RunOptions {
     int64_t servoSpinNs = -1;                ///< SleepSpin: spin this long before each deadline (-1: default 0.94 ms)
     const std::atomic<bool>* stop = nullptr; ///< set by the window when the trainee closes it
     LiveView* live = nullptr;                ///< filled every frame when set
+    std::string trainee;                     ///< who ran it (--trainee), for the report's record
 };
 
 /// One rendered frame (--screenshot on the headless path): per-pass wall times.
@@ -102,6 +104,8 @@ struct RenderFigures {
 
 struct SessionResult {
     std::string caseId, caseVersion, title;
+    std::string trainee;       ///< RunOptions::trainee
+    std::string startedUtc;    ///< "2026-12-05T19:50:00Z", when the session started
     vcase::Provenance package; ///< the package file's digest and signer
     std::vector<std::string> activeSubsystems;
     std::vector<sim::FrameRecord> frames;
@@ -134,6 +138,9 @@ struct SessionResult {
     /// Paced sessions (a device on the wall clock): the physics' real-time factor estimated from
     /// the first frames (RealTimeWatch); 0 when not estimated.
     double realTimeEstimate = 0;
+    /// m, scene: the needle's punctures in thread order (suturing cases).
+    std::vector<Eigen::Vector3d> puncturePoints;
+    Assessment assessment; ///< the metrics and, for a case with an assessment block, the verdict
     bool ok() const { return errors.empty() && invariants.allFinite; }
 };
 

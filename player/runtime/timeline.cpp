@@ -13,15 +13,20 @@ TimelineRecorder::TimelineRecorder(const sim::World& world, size_t maxSamples)
     if (const sim::InteractionRuntime* in = world.interaction()) {
         for (size_t i = 0; i < in->instrumentCount(); ++i) {
             const sim::InstrumentDesc& d = in->instrumentDesc(i);
-            m_tl.tools.push_back({d.name, sim::kindName(d.kind), {}, {}});
+            m_tl.tools.push_back({d.name, sim::kindName(d.kind), d.device.hand, d.radius, {}, {}, {}});
         }
         m_grasped.assign(in->instrumentCount(), 0);
         m_cut = in->summary().fasciaEdgesCut + in->summary().fatEdgesCut;
         m_clips = static_cast<int>(in->summary().clips.size());
     }
     for (size_t t = 0; t < world.toolCount(); ++t)
-        m_tl.tools.push_back({world.toolDesc(t).name, "probe", {}, {}});
-    if (world.sutureReport()) m_tl.tools.push_back({"needle", "needle", {}, {}});
+        m_tl.tools.push_back(
+            {world.toolDesc(t).name, "probe", world.toolDesc(t).hand, world.toolDesc(t).radius, {}, {}, {}});
+    if (world.sutureReport()) {
+        const auto& su = world.scene().suture;
+        m_tl.tools.push_back({"needle", "needle", su ? su->device.hand : "any", 0.0, {}, {}, {}});
+    }
+    if (const sim::Laparoscope* scope = world.laparoscope()) m_tl.cameraFovDeg = scope->desc().fovDeg;
 }
 
 void TimelineRecorder::sample(const sim::World& world) {
@@ -32,12 +37,15 @@ void TimelineRecorder::sample(const sim::World& world) {
             if (k >= m_tl.tools.size()) break;
             m_tl.tools[k].tip.push_back(s.tip);
             m_tl.tools[k].force_n.push_back(s.force.norm());
+            m_tl.tools[k].axis.push_back(s.shaftAxis.normalized());
             ++k;
         }
     for (size_t t = 0; t < world.toolCount() && k < m_tl.tools.size(); ++t, ++k) {
         const sim::ToolContact& c = world.toolContact(t);
         m_tl.tools[k].tip.push_back(c.centre);
         m_tl.tools[k].force_n.push_back(c.force.norm());
+        if (const sim::PortDesc& port = world.toolDesc(t).port; port.declared)
+            m_tl.tools[k].axis.push_back((c.centre - port.position).normalized());
     }
     if (const sim::SutureReport* su = world.sutureReport(); su && k < m_tl.tools.size()) {
         // The tip: the far end of the curve (the curve is parameterized by length from its end).
@@ -49,6 +57,8 @@ void TimelineRecorder::sample(const sim::World& world) {
     }
     if (const sim::Laparoscope* scope = world.laparoscope()) {
         m_tl.cameraTip.push_back(scope->pose().tip);
+        m_tl.cameraView.push_back(scope->pose().view);
+        m_tl.cameraUp.push_back(scope->pose().up);
         m_tl.cameraSteering.push_back(scope->steering() ? 1 : 0);
     }
     // Every tool has one entry per sample (a tool the world no longer reports holds its last).
@@ -66,25 +76,32 @@ void TimelineRecorder::record(const sim::World& world) {
         const sim::InteractionSummary& s = in->summary();
         for (size_t i = 0; i < s.instruments.size() && i < m_grasped.size(); ++i) {
             const int g = s.instruments[i].grasped;
-            if (g > 0 && m_grasped[i] == 0) m_tl.events.push_back({t, frame, "grasp", s.instruments[i].name, g});
-            if (g == 0 && m_grasped[i] > 0) m_tl.events.push_back({t, frame, "release", s.instruments[i].name, 1});
+            const Eigen::Vector3d& tip = s.instruments[i].tip;
+            if (g > 0 && m_grasped[i] == 0) m_tl.events.push_back({t, frame, "grasp", s.instruments[i].name, g, tip});
+            if (g == 0 && m_grasped[i] > 0) m_tl.events.push_back({t, frame, "release", s.instruments[i].name, 1, tip});
             m_grasped[i] = g;
         }
         const int cut = s.fasciaEdgesCut + s.fatEdgesCut;
         if (cut > m_cut) {
             std::string by; // the energized hook, else the first hook
+            Eigen::Vector3d at = Eigen::Vector3d::Zero();
             for (const sim::InstrumentState& st : s.instruments)
-                if (std::string_view(st.kind) == "energy_hook" && (by.empty() || st.act)) by = st.name;
-            m_tl.events.push_back({t, frame, "cut", by, cut - m_cut});
+                if (std::string_view(st.kind) == "energy_hook" && (by.empty() || st.act)) {
+                    by = st.name;
+                    at = st.tip;
+                }
+            m_tl.events.push_back({t, frame, "cut", by, cut - m_cut, at});
         }
         m_cut = cut;
         for (size_t c = static_cast<size_t>(m_clips); c < s.clips.size(); ++c)
-            m_tl.events.push_back({s.clips[c].firedAt, frame, "clip", s.clips[c].instrument, 1});
+            m_tl.events.push_back({s.clips[c].firedAt, frame, "clip", s.clips[c].instrument, 1, s.clips[c].centre});
         m_clips = static_cast<int>(s.clips.size());
     }
     if (const sim::SutureReport* su = world.sutureReport(); su && !su->frames().empty()) {
         const int p = su->frames().back().punctures;
-        if (p > m_punctures) m_tl.events.push_back({t, frame, "puncture", "needle", p - m_punctures});
+        if (p > m_punctures)
+            m_tl.events.push_back(
+                {t, frame, "puncture", "needle", p - m_punctures, su->needleCurve().point(su->needleLength())});
         m_punctures = p;
     }
     if (m_frames++ % m_tl.stride == 0) sample(world);
@@ -97,10 +114,13 @@ void TimelineRecorder::record(const sim::World& world) {
         };
         halve(m_tl.t_s);
         halve(m_tl.cameraTip);
+        halve(m_tl.cameraView);
+        halve(m_tl.cameraUp);
         halve(m_tl.cameraSteering);
         for (SessionTimeline::Tool& tool : m_tl.tools) {
             halve(tool.tip);
             halve(tool.force_n);
+            halve(tool.axis);
         }
         m_tl.stride *= 2;
     }

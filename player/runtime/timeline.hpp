@@ -21,8 +21,13 @@ struct SessionTimeline {
     struct Tool {
         std::string name;
         std::string kind;                 ///< grasper, energy_hook, clip_applier, probe, needle
+        std::string hand = "any";         ///< the master's hand that drives it: left, right or any
+        double radius = 0;                ///< m, jaw or probe radius (0: the needle)
         std::vector<Eigen::Vector3d> tip; ///< m, scene frame, one per sample
         std::vector<double> force_n;      ///< N, the tissue on the tool, one per sample
+        /// Unit, the shaft's direction towards the tip, one per sample (instruments and probes
+        /// through a port; empty for tools without a shaft).
+        std::vector<Eigen::Vector3d> axis;
     };
     struct Event {
         double t_s = 0;
@@ -30,6 +35,9 @@ struct SessionTimeline {
         std::string kind; ///< grasp, release, cut, clip, puncture
         std::string tool;
         int count = 1; ///< cut: edges cut that frame; puncture: punctures that frame
+        /// m, scene: where it happened (cut: the energized hook's tip; clip: the clip's centre when
+        /// fired; puncture: the needle's tip; grasp, release: the grasper's tip).
+        Eigen::Vector3d at = Eigen::Vector3d::Zero();
     };
     std::vector<double> t_s; ///< s, the end of each sampled frame
     int stride = 1;          ///< frames per sample
@@ -38,7 +46,9 @@ struct SessionTimeline {
     /// The laparoscope (cases that have one): its tip and whether the Cam pedal steered it, one
     /// per sample.
     std::vector<Eigen::Vector3d> cameraTip;
+    std::vector<Eigen::Vector3d> cameraView, cameraUp; ///< unit, the optic's view and image up
     std::vector<char> cameraSteering;
+    double cameraFovDeg = 0; ///< vertical field of view (0: no laparoscope)
     bool empty() const { return tools.empty() && events.empty(); }
 };
 

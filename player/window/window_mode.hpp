@@ -13,10 +13,18 @@ namespace viscera::player {
 /// display and no QT_QPA_PLATFORM).
 std::string windowModeUnavailable();
 
+/// PNG files the window writes (atomically) when not empty: the view at the session's last frame,
+/// and the end-of-session screen (the verdict).
+struct WindowShots {
+    std::string view, endScreen;
+};
+
 /// Runs the session on a physics thread while the window shows it (the GUI thread owns the
-/// window). options.frames = 0 runs until the window closes; otherwise the window closes when
-/// the frames are done, after writing `screenshot` (PNG, atomically) when it is not empty.
-/// Keys and the mouse drive a KeyboardDevice when options.device is one.
-SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::string& screenshot);
+/// window). When the session ends the window shows its verdict (window/verdict_screen.hpp).
+/// options.frames = 0 runs until the trainee ends it (closing the window or Esc), then shows the
+/// verdict until the window is closed again (Enter, Esc); otherwise the window closes when the
+/// frames are done, after writing `shots`. Keys and the mouse drive a KeyboardDevice when
+/// options.device is one.
+SessionResult runWindow(LoadedCase& loaded, RunOptions options, const WindowShots& shots);
 
 } // namespace viscera::player

@@ -7,7 +7,7 @@ std::string windowModeUnavailable() {
     return "window mode needs Qt6 Gui, which this build does not include; use --headless";
 }
 
-SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::string&) {
+SessionResult runWindow(LoadedCase& loaded, RunOptions options, const WindowShots&) {
     return runSession(loaded, options);
 }
 

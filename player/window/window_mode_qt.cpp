@@ -12,6 +12,7 @@
 #include "runtime/render_pacer.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/log.hpp"
+#include "window/verdict_screen.hpp"
 
 #include <QBuffer>
 #include <QElapsedTimer>
@@ -27,6 +28,7 @@
 #include <atomic>
 #include <cstdlib>
 #include <future>
+#include <optional>
 #include <thread>
 
 #include <pthread.h>
@@ -345,16 +347,32 @@ public:
     QImage render() {
         QImage img(size().isEmpty() ? QSize(960, 600) : size(), QImage::Format_RGB32);
         QPainter p(&img);
-        paintHud(p, img.size());
+        paint(p, img.size());
         return img;
     }
+    /// The session is over: the end-of-session screen replaces the view.
+    void showVerdict(const Assessment& a) {
+        m_verdict = a;
+        update();
+    }
+    bool showsVerdict() const { return m_verdict.has_value(); }
 
 protected:
     void paintEvent(QPaintEvent*) override {
         QPainter p(this);
-        paintHud(p, size());
+        paint(p, size());
     }
-    void keyPressEvent(QKeyEvent* e) override { key(e, true); }
+    void keyPressEvent(QKeyEvent* e) override {
+        if (!e->isAutoRepeat() &&
+            (e->key() == Qt::Key_Escape || e->key() == Qt::Key_Return || e->key() == Qt::Key_Enter)) {
+            if (m_verdict)
+                close(); // leave the end screen
+            else if (e->key() == Qt::Key_Escape)
+                m_stop = true; // end the session: its verdict follows
+            return;
+        }
+        key(e, true);
+    }
     void keyReleaseEvent(QKeyEvent* e) override { key(e, false); }
     void mouseMoveEvent(QMouseEvent* e) override {
         const QPointF pos = e->position();
@@ -367,11 +385,23 @@ protected:
         if (m_keyboard) m_keyboard->addMouse(0, 0, e->angleDelta().y() / 120.0);
     }
     bool event(QEvent* e) override {
+        if (e->type() == QEvent::Close && !m_verdict && !m_stop) {
+            // Closing a running session ends it; the window stays for its verdict.
+            m_stop = true;
+            e->ignore();
+            return true;
+        }
         if (e->type() == QEvent::Close) m_stop = true;
         return QRasterWindow::event(e);
     }
 
 private:
+    void paint(QPainter& p, const QSize& size) {
+        if (m_verdict)
+            paintVerdictScreen(p, size, *m_verdict, m_title);
+        else
+            paintHud(p, size);
+    }
     void key(QKeyEvent* e, bool down) {
         if (e->isAutoRepeat()) return;
         if (e->key() == Qt::Key_S && down && m_viewport) { // the stereo switch, with any device
@@ -416,6 +446,7 @@ private:
     std::atomic<bool>& m_stop;
     Viewport3D* m_viewport;
     QPointF m_mouse;
+    std::optional<Assessment> m_verdict;
 };
 
 } // namespace
@@ -428,7 +459,26 @@ std::string windowModeUnavailable() {
     return "window mode needs a display (DISPLAY or WAYLAND_DISPLAY), or QT_QPA_PLATFORM=offscreen; or use --headless";
 }
 
-SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::string& screenshot) {
+namespace {
+
+/// Writes `image` as PNG to `path` atomically; false (logged) when it cannot be written.
+bool savePng(const QImage& image, const std::string& path) {
+    QByteArray bytes;
+    QBuffer buf(&bytes);
+    buf.open(QIODevice::WriteOnly);
+    image.save(&buf, "PNG");
+    try {
+        writeFileAtomic(path, std::string_view(bytes.constData(), static_cast<size_t>(bytes.size())));
+        return true;
+    } catch (const std::exception& e) {
+        log::error(e.what());
+        return false;
+    }
+}
+
+} // namespace
+
+SessionResult runWindow(LoadedCase& loaded, RunOptions options, const WindowShots& shots) {
     LiveView live;
     std::atomic<bool> stop{false};
     options.live = &live;
@@ -440,10 +490,12 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
     // core a worker needed, and the whole step waited for it). The servo thread has its own
     // real-time priority.
     SessionResult result;
+    std::atomic<bool> resultReady{false};
     std::promise<void> windowUp;
     std::thread physics([&, up = windowUp.get_future()]() mutable {
         up.wait();
         if (!stop) result = runSession(loaded, options); // not when the window never came up
+        resultReady = true;
     });
     struct PhysicsGuard { // on every way out: the session is stopped and joined
         std::promise<void>& up;
@@ -476,7 +528,8 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
                          &viewport);
     window.show();
     guard.start();
-    bool failed = false;
+    std::vector<std::string> failed;
+    bool shotTaken = false;
     QTimer timer;
     // The 3D view never takes time the physics needs (RenderPacer); the HUD repaints at every tick.
     QElapsedTimer sinceRender;
@@ -497,20 +550,15 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
         window.requestUpdate();
         window.update();
         if (!finished) return;
+        if (!shotTaken && !shots.view.empty() && !savePng(window.render(), shots.view)) failed.push_back(shots.view);
+        shotTaken = true;
+        if (!resultReady) return; // the session's figures and verdict are being made
         timer.stop();
-        if (!screenshot.empty()) {
-            QByteArray bytes;
-            QBuffer buf(&bytes);
-            buf.open(QIODevice::WriteOnly);
-            window.render().save(&buf, "PNG");
-            try {
-                writeFileAtomic(screenshot, std::string_view(bytes.constData(), static_cast<size_t>(bytes.size())));
-            } catch (const std::exception& e) {
-                log::error(e.what());
-                failed = true;
-            }
-        }
-        app.quit();
+        window.showVerdict(result.assessment);
+        if (!shots.endScreen.empty() && !savePng(window.render(), shots.endScreen)) failed.push_back(shots.endScreen);
+        // A session of a given length (--frames) ends with it; the trainee's stays on its verdict
+        // until closed (Enter, Esc or the window's close button).
+        if (options.frames > 0) app.quit();
     });
     timer.start(33);
     app.exec();
@@ -518,7 +566,8 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const std::strin
     const sched_param normal{};
     // Back for the summary and report (refused without CAP_SYS_NICE: they then run at idle priority).
     pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal);
-    if (failed) result.errors.push_back("screenshot " + screenshot + " could not be written");
+    for (const std::string& f : failed)
+        result.errors.push_back("screenshot " + f + " could not be written");
     return result;
 }
 

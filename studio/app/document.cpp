@@ -4,6 +4,7 @@
 
 #include "render/sample_map.hpp"
 #include "sim/material/material.hpp"
+#include "sim/scene/scene_json.hpp"
 #include "sim/skeleton/stiffness_paint.hpp"
 #include "sim/util/error.hpp"
 #include "sim/util/json_reader.hpp"
@@ -108,6 +109,26 @@ struct SolverSlot {
     static std::string check(const Project&, int, const Value& s) {
         const std::string why = sim::validate(s); // the limits readSolver applies (XpbdLimits)
         return why.empty() ? why : "solver: " + why;
+    }
+};
+
+/// The case's assessment: the reader's rules on what the writer writes of it.
+struct AssessmentSlot {
+    using Value = std::optional<sim::AssessmentDesc>;
+    static constexpr int kId = 6;
+    static Value& of(Project& p, int) { return p.scene.assessment; }
+    static Change change(int) { return {Change::Assessment, -1}; }
+    static std::string check(const Project&, int, const Value& a) {
+        if (!a) return {};
+        try {
+            nlohmann::json doc;
+            sim::writeAssessment(*a, doc);
+            sim::readAssessment(sim::JsonField(doc["assessment"], "assessment", "project.json"));
+        } catch (const std::exception& e) {
+            const std::string why = e.what(); // "project.json: assessment...": editValue names the file
+            return why.rfind("project.json: ", 0) == 0 ? why.substr(14) : why;
+        }
+        return {};
     }
 };
 
@@ -331,6 +352,10 @@ QString Document::editMaterial(const QString& text, int body, const sim::Materia
 
 QString Document::editSolver(const QString& text, const sim::XpbdSettings& settings) {
     return editValue<SolverSlot>(text, 0, settings, 0);
+}
+
+QString Document::editAssessment(const QString& text, const std::optional<sim::AssessmentDesc>& assessment) {
+    return editValue<AssessmentSlot>(text, 0, assessment, 0);
 }
 
 QString Document::editStiffnessPaint(const QString& text, int body, int surface,

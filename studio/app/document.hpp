@@ -32,6 +32,7 @@ struct Change {
         Texture = 1u << 3,      ///< material-map blocks
         Structure = 1u << 4,    ///< anything else: meshes, names, scene, a new project
         Solver = 1u << 5,       ///< the XPBD solver settings (substeps, dt, damping, ...)
+        Assessment = 1u << 6,   ///< the case's assessment (targets, limits, expert levels)
         All = ~0u,
     };
     unsigned parts = All;
@@ -88,6 +89,9 @@ public:
     QString editStiffnessPaint(const QString& text, int body, int surface,
                                const std::optional<StiffnessPaintProject>& paint);
     QString editLightSamples(const QString& text, int body, const std::vector<render::SamplePaintOp>& ops);
+    /// The case's assessment (none: no verdict), checked by sim::readAssessment's rules on what
+    /// sim::writeAssessment writes of it ("assessment.metrics.path_length_m.expert.sd: ...").
+    QString editAssessment(const QString& text, const std::optional<sim::AssessmentDesc>& assessment);
     /// A fresh merge key for one drag or one continuous gesture.
     int newMergeKey() { return ++m_lastMergeKey; }
 

@@ -1,6 +1,7 @@
 #include "app/main_window.hpp"
 
 #include "app/anatomy_steps.hpp"
+#include "app/assessment_panel.hpp"
 #include "app/export_runner.hpp"
 #include "app/fit_dialog.hpp"
 #include "app/material_panel.hpp"
@@ -133,6 +134,9 @@ void MainWindow::buildDocks() {
     QDockWidget* plotsDock = dock("plotsDock", tr("Preview and plots"), m_previewPanel, Qt::RightDockWidgetArea);
     // a tab beside the plots, which stay in front: the panel needs the column's height
     tabifyDockWidget(plotsDock, dock("textureDock", tr("Material maps"), textureScroll, Qt::RightDockWidgetArea));
+    m_assessment = new AssessmentPanel(&m_doc, this);
+    m_assessment->setObjectName("assessmentPanel");
+    tabifyDockWidget(plotsDock, dock("assessmentDock", tr("Assessment"), m_assessment, Qt::RightDockWidgetArea));
     plotsDock->raise();
 }
 

@@ -37,6 +37,7 @@ class MaterialPanel;
 class PlotWidget;
 class StartPage;
 class TexturePanel;
+class AssessmentPanel;
 
 class MainWindow : public QMainWindow {
     Q_OBJECT
@@ -74,6 +75,7 @@ public:
     MaterialPanel* materialPanel() { return m_material; }
     /// The "Material maps" dock's panel: the selection's texture block, thumbnails, palette picker.
     TexturePanel* texturePanel() { return m_texture; }
+    AssessmentPanel* assessmentPanel() { return m_assessment; }
     PropertiesPanel* propertiesPanel() { return m_properties; }
     ProjectTreePanel* projectTree() { return m_tree; }
     /// Shown instead of the viewport while no project is open.
@@ -146,6 +148,7 @@ private:
     PaintTools* m_paint = nullptr;
     MaterialPanel* m_material = nullptr;
     TexturePanel* m_texture = nullptr;
+    AssessmentPanel* m_assessment = nullptr;
     ProjectTreePanel* m_tree = nullptr;
     PropertiesPanel* m_properties = nullptr;
     PreviewPanel* m_previewPanel = nullptr;

@@ -603,7 +603,8 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     const json doc = sim::parseJsonText(text, origin);
     const JsonField root(doc, "", origin);
     root.object({"schemaVersion", "caseId", "caseVersion", "title", "instructions", "solver", "gravity", "bodies",
-                 "surfaces", "accuracy", "render", "suture", "interaction", "tools", "laparoscope", "bend", "scenery"});
+                 "surfaces", "accuracy", "render", "suture", "interaction", "tools", "laparoscope", "bend", "scenery",
+                 "assessment"});
     Project p;
     p.dir = dir;
     p.schemaVersion = root["schemaVersion"].integer(1, 1);
@@ -664,6 +665,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
         }
     if (auto t = root.find("tools")) scene.tools = sim::readTools(*t, names);
     if (auto l = root.find("laparoscope")) scene.laparoscope = sim::readLaparoscope(*l);
+    if (auto a = root.find("assessment")) scene.assessment = sim::readAssessment(*a);
     if (auto b = root.find("bend")) p.bend = readBend(*b);
     if (auto sc = root.find("scenery")) {
         p.scenery = readSceneryProject(*sc, names);
@@ -707,6 +709,7 @@ std::string projectJsonText(const Project& p) {
     if (scene.interaction) doc["interaction"] = interactionProjectJson(*scene.interaction, p.trackFiles, w);
     sim::writeTools(scene.tools, doc);
     if (scene.laparoscope) sim::writeLaparoscope(*scene.laparoscope, doc);
+    if (scene.assessment) sim::writeAssessment(*scene.assessment, doc);
     if (p.bend) doc["bend"] = bendJson(*p.bend);
     if (!p.scenery.empty()) {
         doc["scenery"] = sceneryJson(p.scenery);

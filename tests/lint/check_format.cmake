@@ -4,7 +4,7 @@
 if(NOT CLANG_FORMAT OR NOT EXISTS "${CLANG_FORMAT}")
   message(FATAL_ERROR "clang-format not found: install Debian's clang-format (scripts/install-deps.sh)")
 endif()
-file(GLOB_RECURSE files "${SOURCE_DIR}/core/*.[ch]pp" "${SOURCE_DIR}/studio/*.[ch]pp" "${SOURCE_DIR}/player/*.[ch]pp"
+file(GLOB_RECURSE files "${SOURCE_DIR}/core/*.[ch]pp" "${SOURCE_DIR}/studio/*.[ch]pp" "${SOURCE_DIR}/player/*.[ch]pp" "${SOURCE_DIR}/launcher/*.[ch]pp"
      "${SOURCE_DIR}/tests/*.[ch]pp" "${SOURCE_DIR}/bench/*.[ch]pp")
 list(LENGTH files count)
 execute_process(COMMAND "${CLANG_FORMAT}" --style=file --dry-run -Werror ${files}

@@ -15,6 +15,10 @@ set(rules
   "player/runtime/=viscera::player"
   "player/window/=viscera::player"
   "player/plots/=viscera::player"
+  "player/results/main.cpp="
+  "player/results/=viscera::player"
+  "launcher/main.cpp="
+  "launcher/=viscera::launcher"
   "studio/cli/="
   "player/console_sim/="
   "player/main.cpp=")
@@ -22,11 +26,11 @@ set(rules
 # `namespace detail {` is allowed anywhere; core/sim/util holds the shared error and log types
 # (namespace viscera, viscera::log).
 set(libraries "viscera::sim" "viscera::vcase" "viscera::haptics" "viscera::render" "viscera::bake" "viscera::studio"
-    "viscera::player")
+    "viscera::player" "viscera::launcher")
 set(shared "viscera" "viscera::log")
 
 file(GLOB_RECURSE files RELATIVE "${SOURCE_DIR}" "${SOURCE_DIR}/core/*.[ch]pp" "${SOURCE_DIR}/studio/*.[ch]pp"
-     "${SOURCE_DIR}/player/*.[ch]pp")
+     "${SOURCE_DIR}/player/*.[ch]pp" "${SOURCE_DIR}/launcher/*.[ch]pp")
 set(problems "")
 set(count 0)
 foreach(f IN LISTS files)

@@ -151,7 +151,7 @@ TEST(PlayerCli, RunWritesTheSessionReport) {
     EXPECT_GT(sag, 1e-4);
     EXPECT_LT(sag, 0.05);
     EXPECT_GE(j["metrics"]["max_node_displacement_m"].get<double>(), sag) << "the largest is over the run";
-    EXPECT_EQ(j["schemaVersion"].get<int>(), 4);
+    EXPECT_EQ(j["schemaVersion"].get<int>(), 5);
     EXPECT_TRUE(j["errors"].empty());
     EXPECT_TRUE(j["warnings"].empty());
     EXPECT_THAT(r.out, HasSubstr("displacement  largest node distance from rest"));
@@ -396,7 +396,7 @@ TEST(PlayerCli, ADeviceThatDrivesNoToolIsWarnedAbout) {
     const nlohmann::json j = readJson(report);
     ASSERT_EQ(j["warnings"].size(), 1u);
     EXPECT_TRUE(j["haptics"]["tools"].empty());
-    EXPECT_EQ(j["metrics"]["max_force_n"].get<double>(), 0.0);
+    EXPECT_EQ(j["metrics"]["device_max_force_n"].get<double>(), 0.0);
 }
 
 TEST(StudioCli, ExportsAndThePlayerRunsTheSampleProject) {

@@ -155,13 +155,13 @@ TEST(PlayerHaptics, ScriptedSessionIsRepeatableAndReportsTaskMetrics) {
     const nlohmann::json a = run("a"), b = run("b");
     EXPECT_EQ(a["active_subsystems"], nlohmann::json({"gravity", "probe", "xpbd", "haptics"}));
     const auto& m = a["metrics"];
-    for (const char* key :
-         {"time_s", "tool_path_length_m", "max_force_n", "mean_force_n", "tissue_damage_ns", "punctures", "clips"})
+    for (const char* key : {"time_s", "tool_path_length_m", "device_max_force_n", "device_mean_force_n",
+                            "tissue_damage_ns", "punctures", "clips"})
         EXPECT_TRUE(m.contains(key)) << key;
     EXPECT_GT(m["tool_path_length_m"].get<double>(), 0.005);
-    EXPECT_GT(m["max_force_n"].get<double>(), 0.05) << "the probe pressed the tissue";
-    EXPECT_LE(m["max_force_n"].get<double>(), 15.0);
-    EXPECT_EQ(a["invariants"]["max_force_n"], m["max_force_n"]);
+    EXPECT_GT(m["device_max_force_n"].get<double>(), 0.05) << "the probe pressed the tissue";
+    EXPECT_LE(m["device_max_force_n"].get<double>(), 15.0);
+    EXPECT_EQ(a["invariants"]["max_force_n"], m["device_max_force_n"]);
     const auto& h = a["haptics"];
     EXPECT_EQ(h["mode"], "lockstep");
     EXPECT_EQ(h["servo"]["ticks"].get<int>(), 3334); // 1 kHz over 200 frames of 1/60 s (0.0166667 s)
@@ -175,7 +175,7 @@ TEST(PlayerHaptics, ScriptedSessionIsRepeatableAndReportsTaskMetrics) {
     EXPECT_NEAR(ho["physics_step_ms"]["mean"].get<double>(), 1000.0 / 60, 1e-6);
     EXPECT_EQ(h["safety"]["non_finite"], 0);
     // Lockstep sessions are repeatable: same forces, same path.
-    EXPECT_EQ(a["metrics"]["max_force_n"], b["metrics"]["max_force_n"]);
+    EXPECT_EQ(a["metrics"]["device_max_force_n"], b["metrics"]["device_max_force_n"]);
     EXPECT_EQ(a["metrics"]["tool_path_length_m"], b["metrics"]["tool_path_length_m"]);
     EXPECT_EQ(readText(s / "a.csv"), readText(s / "b.csv"));
     const std::string csv = readText(s / "a.csv");
@@ -214,7 +214,7 @@ TEST(PlayerHaptics, ReplaysARecordedTrajectory) {
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const auto j = readJson(s / "r.json");
     EXPECT_EQ(j["haptics"]["device"]["backend"], "replay");
-    EXPECT_GT(j["metrics"]["max_force_n"].get<double>(), 0.05);
+    EXPECT_GT(j["metrics"]["device_max_force_n"].get<double>(), 0.05);
     // Real-time factor: simulated time per physics wall time, from the same step times as the
     // step statistics (whatever this machine's speed), and the summary line that says it.
     const auto& m = j["metrics"];
@@ -505,7 +505,7 @@ TEST(PlayerHaptics, SixtySecondConsoleLoopback) {
                           "rejected_peer", "send_errors"})
         EXPECT_EQ(h["link"][k], 0) << k;
     EXPECT_TRUE(j["invariants"]["all_finite"].get<bool>());
-    EXPECT_LE(j["metrics"]["max_force_n"].get<double>(), h["case_max_force_n"].get<double>());
+    EXPECT_LE(j["metrics"]["device_max_force_n"].get<double>(), h["case_max_force_n"].get<double>());
     const auto sum = readJson(s / "sum.json");
     EXPECT_GT(sum["commands_received"].get<int>(), 0);
     EXPECT_EQ(sum["commands_non_finite"], 0);

@@ -77,7 +77,7 @@ TEST(RectumCase, ExportsRunsGraspsCutsAndClips) {
         EXPECT_GT(m["tool_path_length_per_tool_m"][t].get<double>(), 0.01) << t;
     EXPECT_GT(m["max_contact_force_per_tool_n"][0].get<double>(), 0.0);
     EXPECT_GT(m["tool_path_length_m"].get<double>(), 0.05);
-    EXPECT_EQ(doc["schemaVersion"].get<int>(), 4);
+    EXPECT_EQ(doc["schemaVersion"].get<int>(), 5);
 
     // The committed console replay drives the three instruments from two masters: the left
     // grasps and lifts, the right cuts with the pedal held, hands its arm to the clip applier
@@ -103,8 +103,9 @@ TEST(RectumCase, ExportsRunsGraspsCutsAndClips) {
     ASSERT_EQ(rd["interaction"]["clips"].size(), 1u) << "the squeezed grip fired the clip";
     for (size_t t = 0; t < 3; ++t)
         EXPECT_GT(rd["metrics"]["tool_path_length_per_tool_m"][t].get<double>(), 0.01) << t;
-    EXPECT_GT(rd["metrics"]["max_force_n"].get<double>(), 0.0) << "force reached the device";
-    EXPECT_LE(rd["metrics"]["max_force_n"].get<double>(), rd["haptics"]["case_max_force_n"].get<double>() + 1e-9);
+    EXPECT_GT(rd["metrics"]["device_max_force_n"].get<double>(), 0.0) << "force reached the device";
+    EXPECT_LE(rd["metrics"]["device_max_force_n"].get<double>(),
+              rd["haptics"]["case_max_force_n"].get<double>() + 1e-9);
     // Each instrument through its trocar port in every frame of the replay (the console: robotic).
     const nlohmann::json& ports = rd["ports"];
     ASSERT_EQ(ports.size(), 3u);

@@ -117,10 +117,11 @@ TEST(SutureCase, ADeviceDrivesTheNeedle) {
     const auto out = dir.path() / "anastomosis.vcase";
     ASSERT_EQ(studio({"export", project, "-o", out.string()}).exitCode, 0);
     const auto made = dir.path() / "made.csv";
-    auto m = studio({"replay", project, "-o", made.string(), "--frames", "160"});
+    // The committed replay: the whole running suture (13 stitches and the pull, 2130 frames).
+    auto m = studio({"replay", project, "-o", made.string(), "--frames", "2130"});
     ASSERT_EQ(m.exitCode, 0) << m.err;
-    EXPECT_THAT(m.out, HasSubstr("160 frames"));
-    std::ifstream a(made), b(project + "/replays/two-stitches.csv");
+    EXPECT_THAT(m.out, HasSubstr("2130 frames"));
+    std::ifstream a(made), b(project + "/replays/running-suture.csv");
     const std::string madeText((std::istreambuf_iterator<char>(a)), {}), kept((std::istreambuf_iterator<char>(b)), {});
     EXPECT_EQ(madeText, kept) << "the committed replay is what `viscera-studio replay` makes";
 
@@ -135,7 +136,7 @@ TEST(SutureCase, ADeviceDrivesTheNeedle) {
     const nlohmann::json rd = readJson(replayed);
     EXPECT_EQ(rd["suture"]["punctures"].get<int>(), trackPunctures);
     EXPECT_GT(trackPunctures, 0);
-    EXPECT_GT(rd["metrics"]["max_force_n"].get<double>(), 0.0);
+    EXPECT_GT(rd["metrics"]["device_max_force_n"].get<double>(), 0.0);
     EXPECT_EQ(rd["haptics"]["tools"][0]["name"], "needle");
     EXPECT_EQ(rd["haptics"]["tools"][1]["name"], "thread");
     int timelinePunctures = 0; // the report's timeline has each puncture, by the needle
@@ -154,7 +155,7 @@ TEST(SutureCase, ADeviceDrivesTheNeedle) {
     EXPECT_THAT(rl.err, HasSubstr("tool 'thread' has no arm of this device")) << "one-arm script: warned";
     const nlohmann::json ro = readJson(rolled);
     EXPECT_GT(ro["suture"]["punctures"].get<int>(), 0) << "the roll drove the needle into the wall";
-    EXPECT_GT(ro["metrics"]["max_force_n"].get<double>(), 0.0);
+    EXPECT_GT(ro["metrics"]["device_max_force_n"].get<double>(), 0.0);
     EXPECT_TRUE(ro["invariants"]["all_finite"].get<bool>());
     EXPECT_EQ(ro["warnings"].size(), 1u);
 

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 
@@ -82,4 +83,50 @@ TEST(TraineeWindowGui, TheSKeySwitchesTheViewToSideBySideStereo) {
     const double dm = halvesDifference(mono), ds = halvesDifference(stereo);
     std::printf("view halves differ by %.2f (mono) and %.2f (after S: side by side)\n", dm, ds);
     EXPECT_LT(ds, 0.5 * dm) << "after S the view shows the two eyes side by side";
+}
+
+// The end of a trainee's session [issue 41]: the trainee presses Esc in a running session (no
+// --frames: it would run until closed); the window shows the verdict screen, saved with
+// --end-screen, and Enter closes it. The rectum on its recorded tracks fires one clip of the two
+// the assessment asks for: FAIL, in red, on the screen as in the summary.
+TEST(TraineeWindowGui, EscEndsTheSessionOnItsVerdictScreenAndEnterClosesIt) {
+    ASSERT_NE(std::getenv("DISPLAY"), nullptr) << "no X display (run under xvfb-run)";
+    ::setenv("LIBGL_ALWAYS_SOFTWARE", "1", 0);
+    ::unsetenv("QT_QPA_PLATFORM");
+    test::Scratch s("viscera-window-end");
+    const std::string vcase = s / "rectum.vcase";
+    auto e = test::runProcess(
+        VISCERA_STUDIO_EXE,
+        test::signingWithSampleKey({"export", std::string(VISCERA_SOURCE_DIR) + "/projects/rectum", "-o", vcase}));
+    ASSERT_EQ(e.exitCode, 0) << e.err;
+    const std::string end = s / "end.png";
+    test::Background player(VISCERA_PLAYER_EXE,
+                            test::trustingSampleKey({"run", vcase, "--end-screen", end, "--trainee", "t-07"}),
+                            s / "end");
+    const test::ProcessResult found =
+        test::runProcess("/usr/bin/timeout", {"60", kXdotool, "search", "--sync", "--name", "Viscera"});
+    ASSERT_EQ(found.exitCode, 0) << found.err;
+    const std::string id = found.out.substr(0, found.out.find('\n'));
+    std::this_thread::sleep_for(std::chrono::seconds(2)); // a few frames of the session
+    EXPECT_EQ(test::runProcess(kXdotool, {"mousemove", "--window", id, "300", "300", "click", "1"}).exitCode, 0);
+    EXPECT_EQ(test::runProcess(kXdotool, {"key", "Escape"}).exitCode, 0);
+    for (int i = 0; i < 300 && !std::filesystem::exists(end); ++i) // the verdict screen is drawn
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    ASSERT_TRUE(std::filesystem::exists(end)) << "Esc ended the session and its verdict screen was saved";
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    EXPECT_EQ(test::runProcess(kXdotool, {"key", "Return"}).exitCode, 0);
+    EXPECT_EQ(player.waitFor(), 0) << "Enter closed the verdict screen and the player ended";
+    std::ifstream out(s / "end.out");
+    const std::string summary((std::istreambuf_iterator<char>(out)), {});
+    EXPECT_NE(summary.find("verdict       FAIL"), std::string::npos) << summary;
+    EXPECT_NE(summary.find("trainee       t-07"), std::string::npos);
+    // The headline "FAIL" in the fail colour (230, 80, 60) across the top middle of the screen.
+    const render::Image img = render::readPng(end);
+    int red = 0;
+    for (int y = 48; y < 112 && y < img.height; ++y)
+        for (int x = img.width / 2 - 80; x < img.width / 2 + 80; ++x) {
+            const uint8_t* p = img.pixel(x, y);
+            red += p[0] > 200 && p[1] < 110 && p[2] < 90;
+        }
+    EXPECT_GT(red, 300) << "the FAIL headline is drawn in red";
 }

@@ -65,8 +65,8 @@ struct InteractionRuntime::Instrument {
     std::vector<Vec3> heldLocal; ///< in the instrument frame at the grasp
     ToolShape::Pose pose = ToolShape::Pose::Identity();
     // clip applier
-    size_t target = 0; ///< tet body it clips
-    bool fired = false;
+    size_t target = 0;  ///< tet body it clips
+    bool fired = false; ///< fired during this squeeze (act held)
     int contacts = 0;
     // device drive
     bool driven = false;
@@ -332,7 +332,10 @@ void InteractionRuntime::beforeStep(double t, double dt) {
                 in.heldLocal.clear();
             }
         }
-        if (in.desc.kind == InstrumentDesc::Kind::ClipApplier && !in.fired && in.key.act) fireClip(in, t);
+        if (in.desc.kind == InstrumentDesc::Kind::ClipApplier) { // one clip per squeeze; re-armed on release
+            if (!in.fired && in.key.act) fireClip(in, t);
+            if (!in.key.act) in.fired = false;
+        }
     }
     m_summary.clipMs += msSince(t0);
     // A frame with no tool near the tissue and nothing held has no hook work: it runs the

@@ -318,7 +318,7 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     const json doc = parseJsonText(text, origin);
     const JsonField root(doc, "", origin);
     root.object({"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces", "tools", "render", "suture",
-                 "interaction", "laparoscope", "scenery"});
+                 "interaction", "laparoscope", "scenery", "assessment"});
     SceneDesc scene;
     readSolver(root, scene);
     if (auto su = root.find("suture")) scene.suture = readSutureSection(*su);
@@ -358,6 +358,7 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
         }
     if (auto t = root.find("tools")) scene.tools = readTools(*t, names);
     if (auto l = root.find("laparoscope")) scene.laparoscope = readLaparoscope(*l);
+    if (auto a = root.find("assessment")) scene.assessment = readAssessment(*a);
     if (auto sc = root.find("scenery")) scene.scenery = readScenery(*sc, names);
     if (auto in = root.find("interaction")) scene.interaction = readInteractionSection(*in);
     std::vector<const BodyDesc*> bodies;
@@ -398,6 +399,7 @@ json sceneJson(const SceneDesc& scene) {
     }
     writeTools(scene.tools, doc);
     if (scene.laparoscope) writeLaparoscope(*scene.laparoscope, doc);
+    if (scene.assessment) writeAssessment(*scene.assessment, doc);
     writeScenery(scene.scenery, doc);
     return doc;
 }

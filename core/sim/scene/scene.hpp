@@ -35,6 +35,7 @@
 ///              "post": {"tone_mapping": true, ...}}   (checked by render/case_settings.hpp)
 /// }
 #include "sim/material/material.hpp"
+#include "sim/scene/assessment.hpp"
 #include "sim/scene/interaction.hpp"
 #include "sim/scene/laparoscope.hpp"
 #include "sim/scene/tool_probe.hpp"
@@ -120,6 +121,8 @@ struct SceneDesc {
     std::vector<SceneryDesc> scenery;
     /// The camera on its port (laparoscope.hpp); without it the renderer frames the tissue.
     std::optional<LaparoscopeDesc> laparoscope;
+    /// The task's targets, metric limits and expert levels (assessment.hpp); none: no verdict.
+    std::optional<AssessmentDesc> assessment;
 };
 
 /// Throws viscera::InputError ("scene.json: bodies[0].material.poisson_ratio: must be in [0, 0.5)").

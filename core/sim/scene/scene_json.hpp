@@ -35,6 +35,9 @@ std::vector<SceneryDesc> readScenery(const JsonField& scenery, std::set<std::str
 void writeScenery(const std::vector<SceneryDesc>& scenery, nlohmann::json& doc);
 /// "laparoscope" (laparoscope.hpp): its port and the rest tip within the port's insertion.
 LaparoscopeDesc readLaparoscope(const JsonField& scope);
+/// "assessment" (assessment.hpp): targets, metric limits and expert levels.
+AssessmentDesc readAssessment(const JsonField& assessment);
+void writeAssessment(const AssessmentDesc& assessment, nlohmann::json& doc);
 void writeLaparoscope(const LaparoscopeDesc& scope, nlohmann::json& doc);
 /// The common fields of a "device" block (hand, motion_scale, force_scale, max_force_n); marks it
 /// declared. The caller checks the block's key set.

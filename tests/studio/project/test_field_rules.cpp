@@ -28,9 +28,10 @@ const std::vector<std::string> kSamples = {"tissue-slab", "organ-blob", "liver",
 
 /// Keys whose numbers may be negative (positions, directions, signed curve values, brush amplitude).
 const std::set<std::string>
-    kSigned = {"origin",   "center",    "start",  "end",      "min",     "max",  "gravity",
-               "points",   "amplitude", "slack",  "lower",    "upper",   "axes", "needle_centre",
-               "position", "tip",       "normal", "from_deg", "center_y"}; // ports, laparoscope, scenery and bend
+    kSigned = {"origin",   "center",    "start",  "end",      "min",      "max",  "gravity",
+               "points",   "amplitude", "slack",  "lower",    "upper",    "axes", "needle_centre",
+               "position", "tip",       "normal", "from_deg", "center_y", // ports, laparoscope, scenery and bend
+               "line",     "point"};                                      // assessment targets
 
 struct Leaf {
     json::json_pointer pointer;

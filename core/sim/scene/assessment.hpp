@@ -1,0 +1,96 @@
+#pragma once
+/// A case's assessment: the task's targets, a limit per metric and the expert level per metric
+/// [issue 41]. Read and written by the one scene reader (scene_json.hpp: readAssessment,
+/// writeAssessment) for the case's scene.json and the studio's project.json alike; evaluated
+/// over a session by the player (player/runtime/assessment.hpp).
+///
+/// scene.json:
+///   "assessment": {
+///     "targets": {
+///       "cut":  [{"line": [[x,y,z], ...], "radius": 0.005, "coverage": 0.5}],
+///       "clip": [{"position": [x,y,z], "tolerance": 0.008, "count": 2}],
+///       "suture": {"plane": {"point": [x,y,z], "normal": [x,y,z]}, "bites": 2,
+///                  "depth": [0.001, 0.006], "spacing": [0.001, 0.01], "max_gap": 0.0005}
+///     },
+///     "force_threshold_n": 1.0,
+///     "reference_path_m": 0.25,
+///     "metrics": {"completion_time_s": {"limit": 12, "expert": {"mean": 6, "sd": 1}}, ...}
+///   }
+///   cut      a marked line (≥ 2 points, m, scene) to open: met when `coverage` (0, 1] of its
+///            length has a cut within `radius` (m) of it; edges cut farther away count outside
+///   clip     a vessel site: met when `count` clips lie within `tolerance` (m) of `position`
+///   suture   the wound's plane between the two edges; a bite is two successive punctures on
+///            opposite sides, its depth the nearer puncture's distance from the plane; met when
+///            `bites` bites lie within `depth` and successive bites within `spacing` (m), and the
+///            gauge's gap is at most `max_gap` (m)
+///   force_threshold_n   tissue force above which time is counted and damage accrues (default 1.5)
+///   reference_path_m    an expert's instrument path for the task (economy of motion); optional
+///   metrics  by name (metricCatalogue()): "limit" ≥ 0 (pass or fail), "expert" {mean ≥ 0, sd ≥ 0}
+/// Units SI.
+#include <Eigen/Core>
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace viscera::sim {
+
+using Vec3 = Eigen::Vector3d;
+
+/// One metric a trainer uses: its name in the report, unit, which way is better and definition.
+struct MetricInfo {
+    std::string_view name;
+    std::string_view unit;
+    bool lowerIsBetter = true;
+    std::string_view definition;
+};
+
+/// Every metric the player can measure, in report order.
+const std::vector<MetricInfo>& metricCatalogue();
+/// Null when `name` is not a metric.
+const MetricInfo* findMetric(std::string_view name);
+
+struct CutTarget {
+    std::vector<Vec3> line; ///< m, scene
+    double radius = 0.005;  ///< m
+    double coverage = 0.5;  ///< fraction of the line's length to open, (0, 1]
+};
+
+struct ClipTarget {
+    Vec3 position = Vec3::Zero(); ///< m, scene
+    double tolerance = 0.008;     ///< m
+    int count = 1;
+};
+
+struct SutureTarget {
+    Vec3 planePoint = Vec3::Zero();
+    Vec3 planeNormal = Vec3::UnitZ(); ///< unit
+    int bites = 1;
+    double depthMin = 0.001, depthMax = 0.006;     ///< m
+    double spacingMin = 0.001, spacingMax = 0.012; ///< m
+    double maxGap = 0.0005;                        ///< m
+};
+
+struct ExpertLevel {
+    double mean = 0, sd = 0;
+};
+
+struct MetricLevel {
+    std::string name; ///< a catalogue name
+    std::optional<double> limit;
+    std::optional<ExpertLevel> expert;
+};
+
+struct AssessmentDesc {
+    std::vector<CutTarget> cuts;
+    std::vector<ClipTarget> clips;
+    std::optional<SutureTarget> suture;
+    double forceThresholdN = 1.5;
+    std::optional<double> referencePathM;
+    std::vector<MetricLevel> metrics; ///< in catalogue order
+    const MetricLevel* level(std::string_view name) const;
+    bool hasTargets() const { return !cuts.empty() || !clips.empty() || suture.has_value(); }
+};
+
+} // namespace viscera::sim

@@ -1,0 +1,48 @@
+#pragma once
+/// The "Assessment" panel [issue 41]: the case's verdict rules as a table of every metric the
+/// player measures (sim::metricCatalogue()): its unit, which way is better, the limit and the
+/// expert level (mean, sd); the force threshold; a summary of the task's targets. A typed cell is
+/// one undo step through Document::editAssessment, checked by the scene reader's rules: a refused
+/// value shows the rule under the table and the cell shows the model's value again. An empty cell
+/// removes the limit or the expert level. The targets themselves (lines, sites, the wound's plane)
+/// are geometry and are written in project.json.
+#include <QString>
+#include <QWidget>
+
+class QLabel;
+class QLineEdit;
+class QTableWidget;
+
+namespace viscera::studio {
+
+class Document;
+struct Change;
+
+class AssessmentPanel : public QWidget {
+    Q_OBJECT
+public:
+    enum Column { Metric = 0, Unit, Better, Limit, ExpertMean, ExpertSd, Columns };
+    explicit AssessmentPanel(Document* doc, QWidget* parent = nullptr);
+    QTableWidget* table() { return m_table; }
+    QLabel* errorLabel() { return m_error; }
+    QLabel* targetsLabel() { return m_targets; }
+    QLineEdit* thresholdField() { return m_threshold; }
+
+private:
+    /// The model's assessment into the table and the fields.
+    void fill();
+    /// A cell the user typed into: the edit through the Document, or the refusal shown.
+    void cellTyped(int row, int column);
+    void thresholdTyped();
+    /// Shows `why` (empty: accepted); a refusal puts the model's values back in the cells.
+    void apply(const QString& why);
+
+    Document* m_doc;
+    QTableWidget* m_table = nullptr;
+    QLabel* m_targets = nullptr;
+    QLabel* m_error = nullptr;
+    QLineEdit* m_threshold = nullptr;
+    bool m_filling = false;
+};
+
+} // namespace viscera::studio
