@@ -3,6 +3,7 @@
 #include <QGuiApplication>
 #include <QString>
 
+#include <clocale>
 #include <cstdio>
 #include <memory>
 
@@ -23,6 +24,7 @@ void ensureOffscreenGui() {
     static char arg0[] = "viscera", arg1[] = "-platform", arg2[] = "offscreen";
     static char* argv[] = {arg0, arg1, arg2, nullptr};
     static std::unique_ptr<QGuiApplication> app = std::make_unique<QGuiApplication>(argc, argv);
+    std::setlocale(LC_NUMERIC, "C"); // Qt took the user's locale: figures keep their decimal point
 }
 
 } // namespace viscera::player

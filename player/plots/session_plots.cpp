@@ -777,8 +777,7 @@ std::string verdictHtml(const Assessment& a) {
         s += std::string("<span class=\"") + (a.passed ? "pass\">PASS" : "bad\">FAIL") + "</span>";
     else
         s += "No verdict (the case has no assessment)";
-    s += "</h2>\n<p>completion " + formatFigure(a.completionS) + " s; " +
-         (a.withinExpertLevel() ? "within the expert level" : "not within the expert level") + "</p>\n";
+    s += "</h2>\n<p>" + htmlText(a.judged ? a.verdictDetail() : "") + "</p>\n";
     s += "<table id=\"metrics\"><tr><th>metric</th><th>value</th><th>unit</th><th>limit</th><th>result</th><th>expert "
          "level</th></tr>\n";
     for (const MetricResult& m : a.metrics) {

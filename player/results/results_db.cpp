@@ -133,7 +133,10 @@ void ResultsDb::createSchema() {
         }
         m_db->exec("COMMIT");
     } catch (...) {
-        m_db->exec("ROLLBACK");
+        try { // a lost connection must not replace the error that stopped the schema
+            m_db->exec("ROLLBACK");
+        } catch (...) {
+        }
         throw;
     }
 }

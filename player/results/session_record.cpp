@@ -82,7 +82,8 @@ SessionRecord readSessionRecord(const json& doc, const std::string& origin) {
     if (!r.is_object()) rd.fail("record", "must be an object");
     s.trainee = rd.nonEmpty(r, "record", "trainee");
     s.startedUtc = rd.nonEmpty(r, "record", "started_utc");
-    static const std::regex utc(R"(\d{4}-\d{2}-\d{2}T\d{2}:\d{2}:\d{2}(\.\d{1,9})?Z)");
+    // Whole seconds, as the player writes it: attempts are ordered by this text.
+    static const std::regex utc(R"(\d{4}-\d{2}-\d{2}T\d{2}:\d{2}:\d{2}Z)");
     if (!std::regex_match(s.startedUtc, utc))
         rd.fail("record.started_utc", "must be a UTC time like 2026-12-05T19:50:00Z");
     s.playerVersion = rd.nonEmpty(r, "record", "player_version");

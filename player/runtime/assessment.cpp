@@ -17,6 +17,8 @@ using Vec3 = Eigen::Vector3d;
 constexpr double kIdleSpeed = 0.002;       ///< m/s: a tip slower than this is idle
 constexpr double kContactForce = 0.01;     ///< N: a tool in contact
 constexpr double kCollisionMargin = 0.002; ///< m, beyond the radii
+constexpr double kCutHalfWidth = 0.001;    ///< m: a cut opens the marked line this far either side of the hook
+constexpr double kCutPassGap = 0.006;      ///< m: successive cuts this close are one pass of the hook (edges ~2 mm)
 
 bool finite(const Vec3& v) {
     return v.allFinite();
@@ -94,19 +96,28 @@ struct CutCoverage {
     }
 };
 
-/// Cut events against the marked lines; returns when every line reached its coverage.
+/// Cut events against the marked lines; returns when every line reached its coverage. A cut
+/// inside a line's radius opens the line within kCutHalfWidth of the hook, and along the way from
+/// the previous cut when that one was inside too and at most kCutPassGap away (one pass of the
+/// hook); the radius decides inside or outside only.
 std::optional<double> judgeCuts(const SessionTimeline& tl, const sim::AssessmentDesc& a, TargetFigures& out) {
     if (a.cuts.empty()) return 0.0;
     CutCoverage cov(a.cuts);
     std::optional<double> met;
+    std::vector<std::optional<Vec3>> last(a.cuts.size());
     for (const SessionTimeline::Event& e : tl.events) {
-        if (e.kind != "cut") continue;
+        if (e.kind != "cut" || !finite(e.at)) continue;
         bool inside = false;
         for (size_t t = 0; t < a.cuts.size(); ++t) {
-            if (lineDistance(e.at, a.cuts[t].line) > a.cuts[t].radius) continue;
+            if (lineDistance(e.at, a.cuts[t].line) > a.cuts[t].radius) {
+                last[t].reset();
+                continue;
+            }
             inside = true;
+            const Vec3 from = last[t] && (*last[t] - e.at).norm() <= kCutPassGap ? *last[t] : e.at;
             for (size_t k = 0; k < cov.bins[t].size(); ++k)
-                if ((cov.bins[t][k] - e.at).norm() <= a.cuts[t].radius) cov.hit[t][k] = 1;
+                if (pointSegment(cov.bins[t][k], from, e.at) <= kCutHalfWidth) cov.hit[t][k] = 1;
+            last[t] = e.at;
         }
         if (!inside) out.cutOutside += e.count;
         bool all = true;
@@ -146,44 +157,46 @@ std::optional<double> judgeClips(const SessionTimeline& tl, const sim::Assessmen
     return last;
 }
 
-/// Punctures on one side of the wound's plane, in thread order: their mean and the nearest one's
-/// distance from the plane.
-struct SideRun {
+/// One pass of the needle through one wall: two successive punctures (in and out) on one side of
+/// the wound's plane, in thread order; their mean and the nearer one's distance from the plane.
+/// A lone puncture (the needle went in and not out before crossing) is a pass of its own.
+struct WallPass {
     Vec3 mean = Vec3::Zero();
     double nearest = std::numeric_limits<double>::infinity();
     int n = 0;
     bool above = false;
 };
 
-std::vector<SideRun> sideRuns(const std::vector<Vec3>& p, const sim::SutureTarget& s) {
-    std::vector<SideRun> runs;
+std::vector<WallPass> wallPasses(const std::vector<Vec3>& p, const sim::SutureTarget& s) {
+    std::vector<WallPass> passes;
     for (const Vec3& x : p) {
         const double d = (x - s.planePoint).dot(s.planeNormal);
-        if (runs.empty() || runs.back().above != (d > 0)) runs.push_back({Vec3::Zero(), std::abs(d), 0, d > 0});
-        SideRun& r = runs.back();
-        r.mean += x, ++r.n, r.nearest = std::min(r.nearest, std::abs(d));
+        if (passes.empty() || passes.back().above != (d > 0) || passes.back().n == 2)
+            passes.push_back({Vec3::Zero(), std::abs(d), 0, d > 0});
+        WallPass& w = passes.back();
+        w.mean += x, ++w.n, w.nearest = std::min(w.nearest, std::abs(d));
     }
-    for (SideRun& r : runs)
-        r.mean /= r.n;
-    return runs;
+    for (WallPass& w : passes)
+        w.mean /= w.n;
+    return passes;
 }
 
-/// Bites from the puncture points in thread order: punctures on one side of the wound's plane
-/// followed by punctures on the other make a bite; its depth is the nearest puncture's distance
-/// from the plane. A run of punctures on one side that makes no bite, or a bite out of depth, is
-/// missed.
+/// Bites from the puncture points in thread order: a pass through the wall on one side of the
+/// wound followed by a pass on the other makes a bite; its depth is the nearest puncture's
+/// distance from the plane. A pass that makes no bite (a stitch through one wall only), or a bite
+/// out of depth, is missed.
 std::optional<double> judgeSuture(const SessionResult& r, const sim::AssessmentDesc& a, TargetFigures& out) {
     if (!a.suture) return 0.0;
     const sim::SutureTarget& s = *a.suture;
     std::vector<Vec3> mids;
-    const std::vector<SideRun> runs = sideRuns(r.puncturePoints, s);
+    const std::vector<WallPass> passes = wallPasses(r.puncturePoints, s);
     size_t i = 0;
-    while (i < runs.size()) {
-        if (i + 1 < runs.size()) {
-            const double depth = std::min(runs[i].nearest, runs[i + 1].nearest);
+    while (i < passes.size()) {
+        if (i + 1 < passes.size() && passes[i].above != passes[i + 1].above) {
+            const double depth = std::min(passes[i].nearest, passes[i + 1].nearest);
             if (depth >= s.depthMin && depth <= s.depthMax) {
                 ++out.bites;
-                mids.push_back(0.5 * (runs[i].mean + runs[i + 1].mean));
+                mids.push_back(0.5 * (passes[i].mean + passes[i + 1].mean));
             } else
                 ++out.bitesMissed;
             i += 2;
@@ -196,7 +209,8 @@ std::optional<double> judgeSuture(const SessionResult& r, const sim::AssessmentD
         const double d = (mids[k] - mids[k - 1]).norm();
         out.spacingError = std::max({out.spacingError, s.spacingMin - d, d - s.spacingMax});
     }
-    if (out.bites < s.bites || !r.suture || !(r.suture->finalGap <= s.maxGap)) return std::nullopt;
+    if (out.bites < s.bites || out.spacingError > 0 || !r.suture || !(r.suture->finalGap <= s.maxGap))
+        return std::nullopt;
     // Met at the first sampled frame after the last puncture with the gap closed.
     double lastPuncture = 0;
     for (const SessionTimeline::Event& e : r.timeline.events)
@@ -309,8 +323,9 @@ std::map<std::string, std::optional<double>> measure(const SessionResult& r,
     const SessionTimeline& tl = r.timeline;
     const std::vector<double> span = sampleSpans(tl);
     const double threshold = desc ? desc->forceThresholdN : sim::AssessmentDesc{}.forceThresholdN;
+    auto thresholdOf = [&](const SessionTimeline::Tool& t) { return t.damageForceN > 0 ? t.damageForceN : threshold; };
     for (const auto& t : tl.tools)
-        tools.push_back(toolFigures(t, span, threshold));
+        tools.push_back(toolFigures(t, span, thresholdOf(t)));
     TargetFigures targets;
     if (desc && desc->hasTargets()) {
         targets = judgeTargets(r, *desc);
@@ -333,7 +348,7 @@ std::map<std::string, std::optional<double>> measure(const SessionResult& r,
         for (size_t i = 0; i < span.size(); ++i) {
             bool any = false;
             for (const auto& t : tl.tools)
-                any |= i < t.force_n.size() && t.force_n[i] > threshold;
+                any |= i < t.force_n.size() && t.force_n[i] > thresholdOf(t);
             if (any) over += span[i];
         }
         v["path_length_m"] = path;
@@ -409,12 +424,27 @@ Assessment assessSession(const SessionResult& r, const std::optional<sim::Assess
     const auto values = measure(r, desc, a.tools, a.completionS);
     for (const sim::MetricInfo& info : sim::metricCatalogue()) {
         const auto it = values.find(std::string(info.name));
-        if (it == values.end()) continue;
-        a.metrics.push_back(judge(info, it->second, desc ? desc->level(info.name) : nullptr));
+        const sim::MetricLevel* level = desc ? desc->level(info.name) : nullptr;
+        // A metric the case judges but the session could not measure (no laparoscope for
+        // out_of_view_s, no suture for final_gap_m) is listed without a value: it fails its limit.
+        if (it == values.end() && !level) continue;
+        a.metrics.push_back(judge(info, it == values.end() ? std::nullopt : it->second, level));
         a.passed &= a.metrics.back().passed;
     }
     if (!a.judged) a.passed = true;
     return a;
+}
+
+std::string Assessment::verdictDetail() const {
+    std::string s;
+    if (find("completion_time_s")) s = "completion " + formatFigure(completionS) + " s";
+    bool levels = false;
+    for (const MetricResult& m : metrics)
+        levels |= m.expert.has_value();
+    if (levels)
+        s += (s.empty() ? "" : "; ") +
+             std::string(withinExpertLevel() ? "within the expert level" : "not within the expert level");
+    return s;
 }
 
 std::string formatFigure(std::optional<double> v) {

@@ -43,6 +43,9 @@ struct Assessment {
     const MetricResult* find(std::string_view name) const;
     /// Every metric with an expert level is within it (false when none has one).
     bool withinExpertLevel() const;
+    /// The verdict's second half: "completion 5.88 s; within the expert level" (each part only
+    /// where the case has targets, expert levels).
+    std::string verdictDetail() const;
 };
 
 /// Measures `r` (its timeline, suture and interaction figures) and judges it against `desc`

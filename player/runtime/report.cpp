@@ -546,9 +546,9 @@ std::string assessmentSummary(const Assessment& a) {
     std::string names;
     for (const MetricResult& m : a.metrics)
         if (!m.passed) names += (failed++ ? ", " : "") + m.name;
+    const std::string detail = a.verdictDetail();
     out += "verdict       " + std::string(a.passed ? "PASS" : "FAIL") + (a.passed ? "" : " (" + names + ")") +
-           "; completion " + formatFigure(a.completionS) + " s; " +
-           (a.withinExpertLevel() ? "within the expert level" : "not within the expert level") + "\n";
+           (detail.empty() ? "" : "; " + detail) + "\n";
     return out;
 }
 

@@ -13,18 +13,31 @@ TimelineRecorder::TimelineRecorder(const sim::World& world, size_t maxSamples)
     if (const sim::InteractionRuntime* in = world.interaction()) {
         for (size_t i = 0; i < in->instrumentCount(); ++i) {
             const sim::InstrumentDesc& d = in->instrumentDesc(i);
-            m_tl.tools.push_back({d.name, sim::kindName(d.kind), d.device.hand, d.radius, {}, {}, {}});
+            m_tl.tools.push_back({d.name,
+                                  sim::kindName(d.kind),
+                                  d.device.hand,
+                                  d.radius,
+                                  d.device.declared ? d.device.damageForceN : 0.0,
+                                  {},
+                                  {},
+                                  {}});
         }
         m_grasped.assign(in->instrumentCount(), 0);
         m_cut = in->summary().fasciaEdgesCut + in->summary().fatEdgesCut;
         m_clips = static_cast<int>(in->summary().clips.size());
     }
     for (size_t t = 0; t < world.toolCount(); ++t)
-        m_tl.tools.push_back(
-            {world.toolDesc(t).name, "probe", world.toolDesc(t).hand, world.toolDesc(t).radius, {}, {}, {}});
+        m_tl.tools.push_back({world.toolDesc(t).name,
+                              "probe",
+                              world.toolDesc(t).hand,
+                              world.toolDesc(t).radius,
+                              world.toolDesc(t).damageForceN,
+                              {},
+                              {},
+                              {}});
     if (world.sutureReport()) {
         const auto& su = world.scene().suture;
-        m_tl.tools.push_back({"needle", "needle", su ? su->device.hand : "any", 0.0, {}, {}, {}});
+        m_tl.tools.push_back({"needle", "needle", su ? su->device.hand : "any", 0.0, 0.0, {}, {}, {}});
     }
     if (const sim::Laparoscope* scope = world.laparoscope()) m_tl.cameraFovDeg = scope->desc().fovDeg;
 }
@@ -45,7 +58,9 @@ void TimelineRecorder::sample(const sim::World& world) {
         m_tl.tools[k].tip.push_back(c.centre);
         m_tl.tools[k].force_n.push_back(c.force.norm());
         if (const sim::PortDesc& port = world.toolDesc(t).port; port.declared)
-            m_tl.tools[k].axis.push_back((c.centre - port.position).normalized());
+            m_tl.tools[k].axis.push_back((c.centre - port.position).norm() > 1e-9
+                                             ? Eigen::Vector3d((c.centre - port.position).normalized())
+                                             : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
     }
     if (const sim::SutureReport* su = world.sutureReport(); su && k < m_tl.tools.size()) {
         // The tip: the far end of the curve (the curve is parameterized by length from its end).
@@ -84,7 +99,8 @@ void TimelineRecorder::record(const sim::World& world) {
         const int cut = s.fasciaEdgesCut + s.fatEdgesCut;
         if (cut > m_cut) {
             std::string by; // the energized hook, else the first hook
-            Eigen::Vector3d at = Eigen::Vector3d::Zero();
+            Eigen::Vector3d at =
+                Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()); // no hook: nowhere
             for (const sim::InstrumentState& st : s.instruments)
                 if (std::string_view(st.kind) == "energy_hook" && (by.empty() || st.act)) {
                     by = st.name;

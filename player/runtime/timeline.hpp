@@ -20,9 +20,12 @@ namespace viscera::player {
 struct SessionTimeline {
     struct Tool {
         std::string name;
-        std::string kind;                 ///< grasper, energy_hook, clip_applier, probe, needle
-        std::string hand = "any";         ///< the master's hand that drives it: left, right or any
-        double radius = 0;                ///< m, jaw or probe radius (0: the needle)
+        std::string kind;         ///< grasper, energy_hook, clip_applier, probe, needle
+        std::string hand = "any"; ///< the master's hand that drives it: left, right or any
+        double radius = 0;        ///< m, jaw or probe radius (0: the needle)
+        /// N, the tool's own damage threshold (its device block's damage_force_n; probes always
+        /// have one); 0: the case's (assessment force_threshold_n).
+        double damageForceN = 0;
         std::vector<Eigen::Vector3d> tip; ///< m, scene frame, one per sample
         std::vector<double> force_n;      ///< N, the tissue on the tool, one per sample
         /// Unit, the shaft's direction towards the tip, one per sample (instruments and probes

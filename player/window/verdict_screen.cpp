@@ -28,12 +28,16 @@ void paintHeadline(QPainter& p, int w, const Assessment& a, const std::string& t
     f.setBold(false);
     p.setFont(f);
     p.setPen(kText);
-    const std::string line =
-        !a.judged ? std::string("This case has no assessment: the figures below are for your information.")
-        : !a.completionS
-            ? std::string("Task not completed: its targets were not all met.")
-            : "Task completed in " + formatFigure(a.completionS) + " s" +
-                  (a.withinExpertLevel() ? " — within the expert level" : " — not yet within the expert level");
+    std::string line;
+    if (!a.judged)
+        line = "This case has no assessment: the figures below are for your information.";
+    else if (a.find("completion_time_s") && !a.completionS)
+        line = "Task not completed: its targets were not all met.";
+    else if (a.find("completion_time_s"))
+        line = "Task completed in " + formatFigure(a.completionS) + " s" +
+               (a.withinExpertLevel() ? " — within the expert level" : " — not yet within the expert level");
+    else
+        line = a.verdictDetail();
     p.drawText(QRect(0, 116, w, 22), Qt::AlignHCenter, q(line));
 }
 

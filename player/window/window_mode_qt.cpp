@@ -26,6 +26,7 @@
 #include <QWheelEvent>
 
 #include <atomic>
+#include <clocale>
 #include <cstdlib>
 #include <future>
 #include <optional>
@@ -521,6 +522,7 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const WindowShot
     static char arg0[] = "viscera-player";
     static char* argv[] = {arg0, nullptr};
     QGuiApplication app(argc, argv);
+    std::setlocale(LC_NUMERIC, "C"); // Qt took the user's locale: the summary's figures keep their point
     const std::string title = loaded.package->manifest().title.value_or(loaded.package->manifest().caseId);
     Viewport3D viewport(loaded, live, 640, 480);
     if (!viewport.available()) log::warn("3D view off (side view instead): " + viewport.whyNot());

@@ -51,7 +51,7 @@ player::SessionResult timeline(size_t n, std::vector<player::SessionTimeline::To
 /// A tool moving along +x at `speed` m/s for the first `moving` samples of n, then still; force f.
 player::SessionTimeline::Tool mover(const std::string& name, const std::string& hand, size_t n, size_t moving,
                                     double speed, double force, Vec3 start = Vec3::Zero()) {
-    player::SessionTimeline::Tool t{name, "grasper", hand, 0.002, {}, {}, {}};
+    player::SessionTimeline::Tool t{name, "grasper", hand, 0.002, 0.0, {}, {}, {}};
     Vec3 p = start;
     for (size_t i = 0; i < n; ++i) {
         if (i > 0 && i < moving) p.x() += speed * 0.1;
@@ -173,12 +173,12 @@ TEST(Assessment, TargetsAreMetInTimeAndCutsAndClipsOutsideThemCount) {
     d.clips.push_back({Vec3(0.01, 0, 0), 0.003, 2});
     d.metrics = {{"cut_coverage", 0.8, {}}, {"clips_off_target", 0.0, {}}};
     const player::Assessment a = player::assessSession(r, d);
-    // Covered: 0 .. 42 mm (40 mm + the 2 mm radius) of 50 mm.
-    EXPECT_NEAR(*a.find("cut_coverage")->value, 0.84, 0.011);
+    // Opened: 0 .. 40 mm along the cuts' pass, 1 mm beyond each end: 41 of 50 mm.
+    EXPECT_NEAR(*a.find("cut_coverage")->value, 0.82, 0.011);
     EXPECT_EQ(*a.find("cut_outside_edges")->value, 3.0);
     EXPECT_EQ(*a.find("clips_on_target")->value, 2.0);
     EXPECT_EQ(*a.find("clips_off_target")->value, 1.0);
-    // Coverage 0.8 reached at the cut at 38 mm (40 mm covered): 1.9 s; clips at 4.0 s.
+    // Coverage 0.8 reached at the cut at 39 mm (40 mm covered): 1.95 s; clips at 4.0 s.
     ASSERT_TRUE(a.completionS);
     EXPECT_NEAR(*a.completionS, 4.0, 1e-12);
     EXPECT_TRUE(a.find("cut_coverage")->passed);
@@ -262,4 +262,78 @@ TEST(Assessment, EveryMetricIsDocumentedInTheTraineesGuide) {
         EXPECT_NE(guide.find("`" + std::string(m.name) + "`"), std::string::npos) << m.name;
         EXPECT_FALSE(m.definition.empty()) << m.name;
     }
+}
+
+// A tool that declares its own damage threshold (damage_force_n) is judged by it; the others by
+// the case's force_threshold_n.
+TEST(Assessment, AToolsOwnDamageThresholdTakesPrecedenceOverTheCases) {
+    player::SessionResult r =
+        timeline(30, {mover("own", "left", 30, 0, 0, 2.0), mover("case", "right", 30, 0, 0, 2.0)});
+    r.timeline.tools[0].damageForceN = 3.0;
+    sim::AssessmentDesc d;
+    d.forceThresholdN = 1.5;
+    const player::Assessment a = player::assessSession(r, d);
+    EXPECT_EQ(a.tools[0].overThresholdS, 0.0) << "2 N under its own 3 N";
+    EXPECT_NEAR(a.tools[1].overThresholdS, 3.0, 1e-9);
+    EXPECT_NEAR(*a.find("tissue_damage_ns")->value, 0.5 * 3.0, 1e-9);
+    EXPECT_NEAR(*a.find("force_over_threshold_s")->value, 3.0, 1e-9);
+}
+
+// A stitch through one wall only is a missed bite, and its neighbours still make theirs; badly
+// spaced bites keep the suture target from being met even when the gap closes.
+TEST(Assessment, AStitchThroughOneWallIsMissedAndBadSpacingKeepsTheTargetOpen) {
+    player::SessionResult r = timeline(10, {});
+    auto wall = [&](double x, double z0, double z1) {
+        r.puncturePoints.push_back(Vec3(x, 0, z0));
+        r.puncturePoints.push_back(Vec3(x, 0, z1));
+    };
+    wall(0.000, -0.003, -0.002), wall(0.000, 0.002, 0.003); // bite
+    wall(0.002, -0.003, -0.002);                            // through one wall only
+    wall(0.004, -0.003, -0.002), wall(0.004, 0.002, 0.003); // bite
+    r.suture = sim::SutureSummary{};
+    r.suture->gauge = true;
+    r.suture->finalGap = 0.0001;
+    sim::AssessmentDesc d;
+    d.suture = sim::SutureTarget{Vec3::Zero(), Vec3::UnitZ(), 2, 0.001, 0.006, 0.001, 0.003, 0.0002};
+    player::Assessment a = player::assessSession(r, d);
+    EXPECT_EQ(*a.find("bites")->value, 2.0);
+    EXPECT_EQ(*a.find("bites_missed")->value, 1.0);
+    EXPECT_NEAR(*a.find("bite_spacing_error_m")->value, 0.001, 1e-12) << "4 mm between the two bites, 3 mm allowed";
+    EXPECT_FALSE(a.completionS) << "two bites and the gap closed, but spaced too far apart";
+    d.suture->spacingMax = 0.005;
+    a = player::assessSession(r, d);
+    EXPECT_TRUE(a.completionS);
+}
+
+// A metric the case judges but this session could not measure fails its limit, listed without
+// a value; a target metric without its target is refused when the case is read.
+TEST(Assessment, AJudgedMetricTheSessionCannotMeasureFailsAndOneWithoutItsTargetIsRefused) {
+    player::SessionResult r = timeline(5, {mover("a", "left", 5, 5, 0.01, 0)});
+    sim::AssessmentDesc d;
+    d.metrics = {{"out_of_view_s", 2.0, {}}}; // no laparoscope in this session
+    const player::Assessment a = player::assessSession(r, d);
+    ASSERT_TRUE(a.find("out_of_view_s"));
+    EXPECT_FALSE(a.find("out_of_view_s")->value);
+    EXPECT_FALSE(a.passed);
+    EXPECT_THAT(refusal(R"({"metrics": {"cut_coverage": {"limit": 0.8}}})"),
+                HasSubstr("assessment.metrics.cut_coverage: needs a cut target (targets.cut)"));
+    EXPECT_THAT(refusal(R"({"metrics": {"completion_time_s": {"limit": 8}}})"),
+                HasSubstr("assessment.metrics.completion_time_s: needs a target"));
+    EXPECT_THAT(refusal(R"({"metrics": {"economy_of_motion": {"limit": 0.5}}})"),
+                HasSubstr("assessment.metrics.economy_of_motion: needs reference_path_m"));
+}
+
+// Cuts every 3 mm along a line with a 5 mm radius open it along the way (one pass), but cuts
+// 10 mm apart open only 1 mm either side of each, however wide the radius.
+TEST(Assessment, CutCoverageIsTheLengthOpenedNotTheRadiusAroundEachCut) {
+    auto coverage = [](double step) {
+        player::SessionResult r = timeline(10, {mover("hook", "right", 10, 0, 0, 0)});
+        for (int k = 0; k * step <= 0.02 + 1e-12; ++k)
+            r.timeline.events.push_back({0.1 * k, k, "cut", "hook", 1, Vec3(k * step, 0, 0)});
+        sim::AssessmentDesc d;
+        d.cuts.push_back({{Vec3(0, 0, 0), Vec3(0.02, 0, 0)}, 0.005, 0.5});
+        return *player::assessSession(r, d).find("cut_coverage")->value;
+    };
+    EXPECT_NEAR(coverage(0.003), 19.0 / 20, 1e-9) << "one pass, 3 mm steps from 0 to 18 mm, 1 mm beyond";
+    EXPECT_NEAR(coverage(0.01), 4.0 / 20, 1e-9) << "cuts at 0, 10 and 20 mm: 1 + 2 + 1 mm opened";
 }

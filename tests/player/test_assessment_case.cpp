@@ -1,8 +1,8 @@
 // Assessment end to end [issue 41]: the samples exported by viscera-studio, run by
 // viscera-player on their committed replays and on replays changed to miss a target. The rectum's
 // dissection passes; cutting beside the marked line or clipping once fails on that metric, with
-// the figure and the limit printed. The anastomosis's running suture passes; a stitch through
-// one wall only fails on its bites. And every sample's figures agree across the summary, the
+// the figure and the limit printed. The anastomosis's running suture passes; a stitch that
+// misses the walls fails on its bites and their spacing. And every sample's figures agree across the summary, the
 // report, the plots' reader and the HTML page.
 #include "case/zip_craft.hpp"
 #include "support/sample_cli.hpp"
@@ -150,7 +150,8 @@ TEST(AssessmentCase, TheAnastomosisClosesItsGapAndAMissedBiteFails) {
         if (m["name"] == "final_gap_m") EXPECT_LT(m["value"].get<double>(), 0.0002) << "the replay closes the gap";
     EXPECT_THAT(metricLine(good.process.out, "final_gap_m"), HasSubstr("(limit ≤ 0.0002) pass"));
 
-    // Stitch 8 (frames 490–559) 4 mm up the needle's axis: it passes through one wall only.
+    // Stitch 8 (frames 490–559) 4 mm up the needle's axis: the needle misses the walls there, the
+    // running suture has 12 bites and a gap between the 7th and the next.
     const double dt = 1.0 / 30;
     const auto missed = editedReplay(replay, dir.path() / "missed.csv", 1, [&](double t, std::vector<std::string>& f) {
         if (t >= 490 * dt - 1e-6 && t < 560 * dt - 1e-6) f[4] = add(f[4], 0.04);
@@ -158,6 +159,7 @@ TEST(AssessmentCase, TheAnastomosisClosesItsGapAndAMissedBiteFails) {
     });
     const SessionRun miss = run(vcase, missed.string(), 2130, dir.path(), "missed");
     EXPECT_THAT(metricLine(miss.process.out, "bites"), HasSubstr("12 count (limit ≥ 13) FAIL"));
+    EXPECT_THAT(metricLine(miss.process.out, "bite_spacing_error_m"), HasSubstr("(limit ≤ 0.0005) FAIL"));
     EXPECT_THAT(miss.process.out, HasSubstr("verdict       FAIL ("));
     EXPECT_FALSE(miss.report["assessment"]["passed"].get<bool>());
 }

@@ -17,15 +17,20 @@ const std::vector<MetricInfo>& metricCatalogue() {
         {"economy_of_motion", "ratio", false, "the case's reference path over the instruments' path length"},
         {"jerk_rms_m_s3", "m/s³", true,
          "root mean square of the tips' third time derivative while they move (smoothness)"},
-        {"idle_time_s", "s", true, "time before the targets are met with no instrument tip moving faster than 2 mm/s"},
+        {"idle_time_s", "s", true,
+         "time from the first movement until the targets are met (or the end) with no instrument tip moving faster "
+         "than 2 mm/s"},
         {"instrument_collisions", "count", true, "times two instruments' tips came closer than their radii plus 2 mm"},
         {"out_of_view_s", "s", true,
-         "time an instrument in use (its tip moved over 1 mm within half a second) was outside the laparoscope's field "
-         "of view"},
+         "time an instrument in use (its tip moved over 1 mm within half a second) was outside the laparoscope's "
+         "round field of view (fov_deg across)"},
         {"force_mean_n", "N", true, "mean tissue force on the instruments over the samples in contact (> 0.01 N)"},
         {"force_max_n", "N", true, "largest tissue force on any instrument"},
-        {"force_over_threshold_s", "s", true, "time any instrument's tissue force exceeded the force threshold"},
-        {"tissue_damage_ns", "N·s", true, "integral over time of the tissue force above the force threshold"},
+        {"force_over_threshold_s", "s", true,
+         "time any instrument's tissue force exceeded its damage threshold (the tool's damage_force_n where it "
+         "declares one, else the case's force_threshold_n)"},
+        {"tissue_damage_ns", "N·s", true,
+         "integral over time of the tissue force above that threshold, summed over the tools"},
         {"cut_coverage", "fraction", false, "fraction of the marked lines' length opened by a cut within their radius"},
         {"cut_outside_edges", "count", true, "tissue edges cut farther than the radius from every marked line"},
         {"clips_on_target", "count", false, "clips applied within the tolerance of a clip target"},
@@ -125,6 +130,19 @@ void readMetricLevels(const JsonField& metrics, AssessmentDesc& a) {
             if (l.name == info.name) a.metrics.push_back(l);
 }
 
+/// A metric measured against a target needs that target in the block.
+void checkMetricsHaveTheirTargets(const JsonField& metrics, const AssessmentDesc& a) {
+    auto need = [&](std::initializer_list<std::string_view> names, bool has, const char* what) {
+        for (std::string_view n : names)
+            if (a.level(n) && !has) metrics.failAt(n, std::string("needs ") + what);
+    };
+    need({"completion_time_s"}, a.hasTargets(), "a target (targets.cut, targets.clip or targets.suture)");
+    need({"cut_coverage", "cut_outside_edges"}, !a.cuts.empty(), "a cut target (targets.cut)");
+    need({"clips_on_target", "clips_off_target"}, !a.clips.empty(), "a clip target (targets.clip)");
+    need({"bites", "bites_missed", "bite_spacing_error_m"}, a.suture.has_value(), "a suture target (targets.suture)");
+    need({"economy_of_motion"}, a.referencePathM.has_value(), "reference_path_m");
+}
+
 json vec(const Vec3& v) {
     return {v.x(), v.y(), v.z()};
 }
@@ -142,7 +160,10 @@ AssessmentDesc readAssessment(const JsonField& block) {
     }
     a.forceThresholdN = block.number("force_threshold_n", a.forceThresholdN, NumberRule::aboveUpTo(0, 50));
     if (auto r = block.find("reference_path_m")) a.referencePathM = r->number(NumberRule::aboveUpTo(0, 100));
-    if (auto m = block.find("metrics")) readMetricLevels(*m, a);
+    if (auto m = block.find("metrics")) {
+        readMetricLevels(*m, a);
+        checkMetricsHaveTheirTargets(*m, a);
+    }
     return a;
 }
 

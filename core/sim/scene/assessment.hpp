@@ -23,7 +23,8 @@
 ///            opposite sides, its depth the nearer puncture's distance from the plane; met when
 ///            `bites` bites lie within `depth` and successive bites within `spacing` (m), and the
 ///            gauge's gap is at most `max_gap` (m)
-///   force_threshold_n   tissue force above which time is counted and damage accrues (default 1.5)
+///   force_threshold_n   tissue force above which time is counted and damage accrues (default 1.5),
+///                       for the tools that declare no damage_force_n of their own
 ///   reference_path_m    an expert's instrument path for the task (economy of motion); optional
 ///   metrics  by name (metricCatalogue()): "limit" ≥ 0 (pass or fail), "expert" {mean ≥ 0, sd ≥ 0}
 /// Units SI.
