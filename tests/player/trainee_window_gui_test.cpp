@@ -110,7 +110,7 @@ TEST(TraineeWindowGui, EscEndsTheSessionOnItsVerdictScreenAndEnterClosesIt) {
     std::this_thread::sleep_for(std::chrono::seconds(2)); // a few frames of the session
     EXPECT_EQ(test::runProcess(kXdotool, {"mousemove", "--window", id, "300", "300", "click", "1"}).exitCode, 0);
     EXPECT_EQ(test::runProcess(kXdotool, {"key", "Escape"}).exitCode, 0);
-    for (int i = 0; i < 300 && !std::filesystem::exists(end); ++i) // the verdict screen is drawn
+    for (int i = 0; i < 900 && !std::filesystem::exists(end); ++i) // the verdict screen is drawn (at most 90 s)
         std::this_thread::sleep_for(std::chrono::milliseconds(100));
     ASSERT_TRUE(std::filesystem::exists(end)) << "Esc ended the session and its verdict screen was saved";
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
