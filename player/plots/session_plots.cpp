@@ -2,6 +2,7 @@
 
 #include "plots/html_text.hpp"
 #include "plots/offscreen_gui.hpp"
+#include "runtime/assessment_json.hpp"
 #include "runtime/report.hpp"
 #include "runtime/report_reader.hpp"
 
@@ -187,33 +188,6 @@ void readTimelineInput(const Reader& rd, const json& doc, const std::vector<std:
     }
 }
 
-MetricResult readMetricInput(const Reader& rd, const json& j, const std::string& f) {
-    MetricResult m;
-    m.name = rd.string(rd.member(j, f, "name"), f + ".name");
-    m.unit = rd.string(rd.member(j, f, "unit"), f + ".unit");
-    const std::string better = rd.string(rd.member(j, f, "better"), f + ".better");
-    if (better != "lower" && better != "higher") rd.fail(f + ".better", "must be lower or higher");
-    m.lowerIsBetter = better == "lower";
-    auto opt = [&](const char* key) -> std::optional<double> {
-        const json& v = rd.member(j, f, key);
-        return v.is_null() ? std::nullopt : std::optional<double>(rd.number(v, f + "." + key));
-    };
-    m.value = opt("value");
-    m.limit = opt("limit");
-    const json& passed = rd.member(j, f, "passed");
-    if (!passed.is_boolean()) rd.fail(f + ".passed", "must be true or false");
-    m.passed = passed.get<bool>();
-    if (const json& e = rd.member(j, f, "expert"); !e.is_null()) {
-        m.expert = sim::ExpertLevel{rd.number(rd.member(e, f + ".expert", "mean"), f + ".expert.mean"),
-                                    rd.number(rd.member(e, f + ".expert", "sd"), f + ".expert.sd")};
-        m.bound = rd.number(rd.member(e, f + ".expert", "bound"), f + ".expert.bound");
-        const json& w = rd.member(j, f, "within_expert");
-        if (!w.is_boolean()) rd.fail(f + ".within_expert", "must be true or false with an expert level");
-        m.withinExpert = w.get<bool>();
-    }
-    return m;
-}
-
 void readAssessmentInput(const Reader& rd, const json& doc, PlotInput& in) {
     if (const json* r = rd.optional(doc, "record")) {
         in.trainee = rd.string(rd.member(*r, "record", "trainee"), "record.trainee");
@@ -233,23 +207,13 @@ void readAssessmentInput(const Reader& rd, const json& doc, PlotInput& in) {
     if (!c.is_null()) out.completionS = rd.number(c, "assessment.completion_time_s");
     const json& metrics = rd.array(rd.member(*a, "assessment", "metrics"), "assessment.metrics");
     for (size_t i = 0; i < metrics.size(); ++i)
-        out.metrics.push_back(readMetricInput(rd, metrics[i], at("assessment.metrics", i)));
+        out.metrics.push_back(readMetricJson(rd, metrics[i], at("assessment.metrics", i)));
 }
 
 } // namespace
 
 PlotInput readPlotInputFile(const std::filesystem::path& reportPath) {
-    const std::string text = readFile(reportPath);
-    json doc;
-    try {
-        doc = json::parse(text);
-    } catch (const json::parse_error& e) {
-        // e.what() carries the byte position: "[json.exception.parse_error.101] parse error at line 3, column 5: ..."
-        std::string why = e.what();
-        if (auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
-        throw InputError(reportPath.string() + ": not a JSON session report (" + why + ")");
-    }
-    return readPlotInput(doc, reportPath.string());
+    return readPlotInput(parseReportText(readFile(reportPath), reportPath.string()), reportPath.string());
 }
 
 // ---- drawing ----------------------------------------------------------------------------------

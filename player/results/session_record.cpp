@@ -1,5 +1,6 @@
 #include "results/session_record.hpp"
 
+#include "runtime/assessment_json.hpp"
 #include "runtime/report_reader.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
@@ -28,33 +29,18 @@ struct Reader : ReportReader {
     }
 };
 
+/// The one reader of a report's metric entry (runtime/assessment_json.hpp), as the database keeps it.
 MetricRecord readMetric(const Reader& rd, const json& m, const std::string& f) {
+    const MetricResult r = readMetricJson(rd, m, f);
     MetricRecord out;
-    out.name = rd.nonEmpty(m, f, "name");
-    out.unit = rd.string(rd.member(m, f, "unit"), f + ".unit");
-    out.value = rd.numberOrNone(rd.member(m, f, "value"), f + ".value");
-    const std::string better = rd.string(rd.member(m, f, "better"), f + ".better");
-    if (better != "lower" && better != "higher") rd.fail(f + ".better", "must be \"lower\" or \"higher\"");
-    out.lowerIsBetter = better == "lower";
-    out.limit = rd.numberOrNone(rd.member(m, f, "limit"), f + ".limit");
-    out.passed = rd.boolean(rd.member(m, f, "passed"), f + ".passed");
-    const json& e = rd.member(m, f, "expert");
-    if (!e.is_null()) {
-        const std::string g = f + ".expert";
-        ExpertLevel x;
-        x.mean = rd.number(rd.member(e, g, "mean"), g + ".mean");
-        x.sd = rd.number(rd.member(e, g, "sd"), g + ".sd");
-        if (x.sd < 0) rd.fail(g + ".sd", "must not be negative");
-        x.bound = rd.number(rd.member(e, g, "bound"), g + ".bound");
-        out.expert = x;
-    }
-    const json& w = rd.member(m, f, "within_expert");
-    if (!w.is_null()) {
-        if (!out.expert) rd.fail(f + ".within_expert", "must be null when the metric has no expert level");
-        out.withinExpert = rd.boolean(w, f + ".within_expert");
-    } else if (out.expert && out.value) {
-        rd.fail(f + ".within_expert", "must be true or false when the metric has a value and an expert level");
-    }
+    out.name = r.name;
+    out.unit = r.unit;
+    out.value = r.value;
+    out.lowerIsBetter = r.lowerIsBetter;
+    out.limit = r.limit;
+    out.passed = r.passed;
+    if (r.expert) out.expert = ExpertLevel{r.expert->mean, r.expert->sd, r.bound};
+    out.withinExpert = r.withinExpert;
     return out;
 }
 
@@ -115,14 +101,7 @@ SessionRecord readSessionRecord(const json& doc, const std::string& origin) {
 
 SessionRecord readSessionRecordFile(const std::filesystem::path& reportPath) {
     const std::string text = readFile(reportPath);
-    json doc;
-    try {
-        doc = json::parse(text);
-    } catch (const json::parse_error& e) {
-        std::string why = e.what();
-        if (auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
-        throw InputError(reportPath.string() + ": not a JSON session report (" + why + ")");
-    }
+    const json doc = parseReportText(text, reportPath.string());
     SessionRecord s = readSessionRecord(doc, reportPath.string());
     s.reportSha256 = sha256Hex(text);
     return s;

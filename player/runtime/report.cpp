@@ -1,5 +1,7 @@
 #include "runtime/report.hpp"
 
+#include "runtime/assessment_json.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -287,10 +289,6 @@ static nlohmann::json timelineJson(const SessionTimeline& tl) {
 
 namespace {
 
-nlohmann::json orNull(std::optional<double> v) {
-    return v && std::isfinite(*v) ? nlohmann::json(*v) : nlohmann::json();
-}
-
 /// The task figures of the "metrics" block, every one from the session's assessment (one
 /// definition each); the device's forces under their own names.
 void writeTaskMetrics(const SessionResult& r, nlohmann::json& m) {
@@ -320,39 +318,6 @@ void writeTaskMetrics(const SessionResult& r, nlohmann::json& m) {
 nlohmann::json recordJson(const SessionResult& r) {
     return {{"trainee", r.trainee}, {"started_utc", r.startedUtc},   {"player_version", VISCERA_VERSION},
             {"case_id", r.caseId},  {"case_version", r.caseVersion}, {"package_sha256", r.package.sha256}};
-}
-
-nlohmann::json assessmentJson(const Assessment& a) {
-    using nlohmann::json;
-    json metrics = json::array();
-    for (const MetricResult& m : a.metrics) {
-        json j = {{"name", m.name},           {"unit", m.unit},
-                  {"value", orNull(m.value)}, {"better", m.lowerIsBetter ? "lower" : "higher"},
-                  {"limit", orNull(m.limit)}, {"passed", m.passed},
-                  {"expert", nullptr},        {"within_expert", nullptr}};
-        if (m.expert) {
-            j["expert"] = {{"mean", m.expert->mean}, {"sd", m.expert->sd}, {"bound", m.bound}};
-            j["within_expert"] = *m.withinExpert;
-        }
-        metrics.push_back(j);
-    }
-    json tools = json::array();
-    for (const ToolFigures& t : a.tools)
-        tools.push_back({{"name", t.name},
-                         {"kind", t.kind},
-                         {"hand", t.hand},
-                         {"path_m", t.pathM},
-                         {"angular_path_rad", t.angularRad},
-                         {"force_max_n", t.forceMaxN},
-                         {"force_mean_n", t.forceMeanN},
-                         {"force_over_threshold_s", t.overThresholdS},
-                         {"tissue_damage_ns", t.damageNs}});
-    return {{"judged", a.judged},
-            {"passed", a.judged ? json(a.passed) : json()},
-            {"completion_time_s", orNull(a.completionS)},
-            {"within_expert_level", a.withinExpertLevel()},
-            {"metrics", metrics},
-            {"tools", tools}};
 }
 
 /// Which bytes ran and who signed them.

@@ -15,6 +15,18 @@
 
 namespace viscera::player {
 
+/// A report's text as JSON; refused with the parser's position: "<origin>: not a JSON session
+/// report (parse error at line 3, column 5: ...)".
+inline nlohmann::json parseReportText(const std::string& text, const std::string& origin) {
+    try {
+        return nlohmann::json::parse(text);
+    } catch (const nlohmann::json::parse_error& e) {
+        std::string why = e.what(); // "[json.exception.parse_error.101] parse error at line 3, ..."
+        if (auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
+        throw InputError(origin + ": not a JSON session report (" + why + ")");
+    }
+}
+
 struct ReportReader {
     const std::string& origin;
     [[noreturn]] void fail(const std::string& field, const std::string& rule) const {
