@@ -2,6 +2,7 @@
 // instructor, export). Exit 0 on success, 2 on bad input (a malformed report, a bad option, an
 // unwritable output), 1 when the database itself fails.
 #include "plots/html_text.hpp"
+#include "results/expert_levels.hpp"
 #include "results/instructor_view.hpp"
 #include "results/learning_curve.hpp"
 #include "results/progress_page.hpp"
@@ -31,6 +32,9 @@ const char* kUsage =
     "  progress --trainee T [--case C] -o DIR [--db D]   learning curves: DIR/<metric>.png, DIR/progress.html\n"
     "  instructor [--case C] [-o page.html] [--db D]     every trainee per case: attempts, passes, proficiency\n"
     "  export [--format csv|json] [-o FILE] [--db D]     every session with its metrics (stdout without -o)\n"
+    "  expert-levels --case C --trainee E1,E2... [-o levels.json] [--db D]\n"
+    "                                                    expert levels (mean, sd) from the experts' sessions,\n"
+    "                                                    for the studio's Assessment dock (Import expert levels)\n"
     "  --help, --version\n"
     "D: a SQLite file (default $XDG_DATA_HOME/viscera/results.sqlite or ~/.local/share/viscera/results.sqlite)\n"
     "   or a PostgreSQL connection (postgresql://user@host/db, or \"host=... dbname=...\").\n"
@@ -50,7 +54,8 @@ Args parse(int argc, char** argv) {
         {"list", {"--db", "--trainee", "--case"}},
         {"progress", {"--db", "--trainee", "--case", "-o"}},
         {"instructor", {"--db", "--case", "-o"}},
-        {"export", {"--db", "--format", "-o"}}};
+        {"export", {"--db", "--format", "-o"}},
+        {"expert-levels", {"--db", "--case", "--trainee", "-o"}}};
     const auto it = allowed.find(a.command);
     if (it == allowed.end()) throw InputError("'" + a.command + "': unknown command (see viscera-results --help)");
     for (int i = 2; i < argc; ++i) {
@@ -164,6 +169,39 @@ int exportAll(const Args& a) {
     return 0;
 }
 
+/// Expert levels of a case from its experts' sessions (--trainee: a comma-separated list).
+int expertLevels(const Args& a) {
+    const std::string caseId = option(a, "--case"), out = option(a, "-o");
+    if (caseId.empty()) throw InputError("expert-levels: --case: is required");
+    std::vector<std::string> experts;
+    for (size_t p = 0, q; p <= option(a, "--trainee").size(); p = q + 1) {
+        q = option(a, "--trainee").find(',', p);
+        if (q == std::string::npos) q = option(a, "--trainee").size();
+        if (q > p) experts.push_back(option(a, "--trainee").substr(p, q - p));
+    }
+    if (experts.empty()) throw InputError("expert-levels: --trainee: name the experts (E1,E2,...)");
+    if (!out.empty()) requireWritableFile(out, "the expert levels");
+    auto db = openDb(a, true);
+    std::vector<SessionRecord> sessions;
+    for (const std::string& e : experts) {
+        const auto s = db->sessions({e, caseId});
+        if (s.empty()) throw InputError("expert-levels: --trainee: no session of '" + e + "' on case '" + caseId + "'");
+        sessions.insert(sessions.end(), s.begin(), s.end());
+    }
+    const auto levels = deriveExpertLevels(sessions);
+    for (const DerivedLevel& l : levels)
+        std::printf("%-24s n %-3d mean %-12s sd %s %s\n", l.name.c_str(), l.n, formatNumber("%.4g", l.mean).c_str(),
+                    formatNumber("%.4g", l.sd).c_str(), l.unit.c_str());
+    const std::string text = expertLevelsJson(caseId, experts, sessions.size(), levels);
+    if (out.empty())
+        std::fputs(text.c_str(), stdout);
+    else {
+        writeFileAtomic(out, text);
+        std::printf("wrote %s (%zu metrics from %zu sessions)\n", out.c_str(), levels.size(), sessions.size());
+    }
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -186,6 +224,7 @@ int main(int argc, char** argv) {
         if (a.command == "list") return list(a);
         if (a.command == "progress") return progress(a);
         if (a.command == "instructor") return instructor(a);
+        if (a.command == "expert-levels") return expertLevels(a);
         return exportAll(a);
     } catch (const InputError& e) {
         std::fprintf(stderr, "viscera-results: %s\n", e.what());

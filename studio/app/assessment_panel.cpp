@@ -2,6 +2,11 @@
 
 #include "app/document.hpp"
 #include "sim/scene/assessment.hpp"
+#include "sim/util/atomic_file.hpp"
+#include "sim/util/json_reader.hpp"
+
+#include <QFileDialog>
+#include <QPushButton>
 
 #include <QHeaderView>
 #include <QLabel>
@@ -60,7 +65,15 @@ AssessmentPanel::AssessmentPanel(Document* doc, QWidget* parent) : QWidget(paren
     m_threshold = new QLineEdit(this);
     m_threshold->setObjectName("force_threshold_n");
     row->addWidget(m_threshold);
+    auto* import = new QPushButton(tr("Import expert levels…"), this);
+    import->setObjectName("importExpertLevels");
+    import->setToolTip(tr("Expert means and SDs from viscera-results expert-levels (the experts' sessions)"));
+    row->addWidget(import);
     layout->addLayout(row);
+    connect(import, &QPushButton::clicked, this, [this] {
+        const QString path = QFileDialog::getOpenFileName(this, tr("Expert levels"), {}, tr("JSON (*.json)"));
+        if (!path.isEmpty()) importExpertLevels(path);
+    });
     const auto& metrics = sim::metricCatalogue();
     m_table = new QTableWidget(static_cast<int>(metrics.size()), Columns, this);
     m_table->setObjectName("assessmentTable");
@@ -152,6 +165,45 @@ void AssessmentPanel::thresholdTyped() {
     sim::AssessmentDesc a = *p->scene.assessment;
     a.forceThresholdN = *v;
     apply(m_doc->editAssessment(tr("Assessment: force threshold"), a));
+}
+
+QString AssessmentPanel::importExpertLevels(const QString& path) {
+    if (!m_doc->hasProject()) return tr("no project is open");
+    sim::AssessmentDesc a = m_doc->project().scene.assessment.value_or(sim::AssessmentDesc{});
+    int n = 0;
+    try {
+        const std::string file = path.toStdString();
+        const nlohmann::json doc = sim::parseJsonText(readFile(file), file);
+        const sim::JsonField root(doc, "", file);
+        root.object({"case_id", "experts", "sessions", "metrics"});
+        if (auto c = root.find("case_id"); c && c->string() != m_doc->project().caseId)
+            c->fail("'" + c->string() + "' is not this project's case ('" + m_doc->project().caseId + "')");
+        for (const auto& [name, m] : root["metrics"].members()) {
+            if (!sim::findMetric(name)) m.fail("is not a metric the player measures");
+            m.object({"expert", "n"});
+            const sim::JsonField e = m["expert"];
+            e.object({"mean", "sd"});
+            const sim::ExpertLevel level{e["mean"].number(sim::NumberRule::nonNegative()),
+                                         e["sd"].number(sim::NumberRule::nonNegative())};
+            std::vector<sim::MetricLevel> levels;
+            bool found = false;
+            for (const sim::MetricInfo& info : sim::metricCatalogue()) // catalogue order
+                if (info.name == name) {
+                    const sim::MetricLevel* old = a.level(name);
+                    levels.push_back({name, old ? old->limit : std::nullopt, level});
+                    found = true;
+                } else if (const sim::MetricLevel* l = a.level(info.name)) {
+                    levels.push_back(*l);
+                }
+            if (found) a.metrics = std::move(levels), ++n;
+        }
+    } catch (const std::exception& e) {
+        m_error->setText(QString::fromStdString(e.what()));
+        return m_error->text();
+    }
+    const QString why = m_doc->editAssessment(tr("Import %1 expert levels").arg(n), a);
+    apply(why);
+    return why;
 }
 
 void AssessmentPanel::apply(const QString& why) {

@@ -4,8 +4,10 @@
 /// expert level (mean, sd); the force threshold; a summary of the task's targets. A typed cell is
 /// one undo step through Document::editAssessment, checked by the scene reader's rules: a refused
 /// value shows the rule under the table and the cell shows the model's value again. An empty cell
-/// removes the limit or the expert level. The targets themselves (lines, sites, the wound's plane)
-/// are geometry and are written in project.json.
+/// removes the limit or the expert level. "Import expert levels…" takes the levels that
+/// `viscera-results expert-levels` derived from expert sessions (a JSON fragment) into the case,
+/// one undo step. The targets themselves (lines, sites, the wound's plane) are geometry and are
+/// written in project.json.
 #include <QString>
 #include <QWidget>
 
@@ -27,6 +29,9 @@ public:
     QLabel* errorLabel() { return m_error; }
     QLabel* targetsLabel() { return m_targets; }
     QLineEdit* thresholdField() { return m_threshold; }
+    /// Reads a `viscera-results expert-levels` file and sets those expert levels (limits kept).
+    /// Returns the error shown (one line naming the file, the field and the rule), empty when done.
+    QString importExpertLevels(const QString& path);
 
 private:
     /// The model's assessment into the table and the fields.

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -235,3 +236,29 @@ TEST_F(RESULTS_SUITE, BadOptionsAndOutputsExitTwo) {
 }
 
 } // namespace
+
+// Expert levels from expert sessions: t02's four attempts as the experts' (times 30, 12, none,
+// 12 s; paths 1.5, 0.9, 1.5, 0.9 m): the mean and the sample standard deviation of each metric
+// over the sessions that measured it, as the fragment the studio imports.
+TEST_F(RESULTS_SUITE, ExpertLevelsAreTheMeanAndSdOfTheExpertsSessions) {
+    addSessions();
+    const fs::path out = scratch / "levels.json";
+    const ProcessResult r = results({"expert-levels", "--case", "rectum", "--trainee", "t02", "-o", out.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const nlohmann::json doc = nlohmann::json::parse(slurp(out));
+    EXPECT_EQ(doc["case_id"], "rectum");
+    EXPECT_EQ(doc["sessions"].get<int>(), 4);
+    const nlohmann::json& t = doc["metrics"]["completion_time_s"];
+    EXPECT_EQ(t["n"].get<int>(), 3) << "the attempt that never met its targets has no time";
+    EXPECT_NEAR(t["expert"]["mean"].get<double>(), 18.0, 1e-12);
+    EXPECT_NEAR(t["expert"]["sd"].get<double>(), std::sqrt(108.0), 1e-9);
+    const nlohmann::json& p = doc["metrics"]["path_length_m"];
+    EXPECT_NEAR(p["expert"]["mean"].get<double>(), 1.2, 1e-12);
+    EXPECT_NEAR(p["expert"]["sd"].get<double>(), std::sqrt(0.12), 1e-9);
+    const ProcessResult both = results({"expert-levels", "--case", "rectum", "--trainee", "t01,t02"});
+    ASSERT_EQ(both.exitCode, 0) << both.err;
+    EXPECT_NE(both.out.find("\"sessions\": 14"), std::string::npos) << both.out;
+    const ProcessResult none = results({"expert-levels", "--case", "rectum", "--trainee", "nobody"});
+    EXPECT_EQ(none.exitCode, 2);
+    EXPECT_NE(none.err.find("no session of 'nobody' on case 'rectum'"), std::string::npos) << none.err;
+}

@@ -6,6 +6,7 @@
 #include "app/main_window.hpp"
 #include "gui_test_support.hpp"
 #include "project/project.hpp"
+#include "sim/util/atomic_file.hpp"
 #include "window_fixture.hpp"
 
 #include <QApplication>
@@ -117,6 +118,41 @@ TEST_F(AssessmentPanelFixture, ARefusedValueNamesTheRuleAndLeavesTheModelUnchang
     typeInto(path, Panel::Limit, "");
     EXPECT_FALSE(level("path_length_m")->limit);
     EXPECT_TRUE(level("path_length_m")->expert);
+}
+
+} // namespace
+
+namespace {
+
+// Expert levels derived by `viscera-results expert-levels` are imported into the case: one undo
+// step, limits kept; a file for another case, or with a metric the player does not measure, is
+// refused naming the file, the field and the rule.
+TEST_F(AssessmentPanelFixture, ExpertLevelsFromExpertSessionsAreImportedAsOneUndoStep) {
+    const std::filesystem::path dir = open("rectum");
+    const std::filesystem::path levels = dir / "levels.json";
+    writeFileAtomic(levels, R"({"case_id": "rectum", "experts": ["e1", "e2"], "sessions": 6,
+      "metrics": {"completion_time_s": {"expert": {"mean": 4.9, "sd": 0.4}, "n": 6},
+                  "jerk_rms_m_s3": {"expert": {"mean": 38, "sd": 6}, "n": 6}}})");
+    QUndoStack* undo = w->document()->undoStack();
+    const int steps = undo->count();
+    ASSERT_EQ(panel->importExpertLevels(QString::fromStdString(levels.string())), "");
+    EXPECT_EQ(undo->count(), steps + 1);
+    EXPECT_EQ(level("completion_time_s")->expert->mean, 4.9);
+    EXPECT_EQ(*level("completion_time_s")->limit, 9.0) << "the limit is kept";
+    EXPECT_EQ(level("jerk_rms_m_s3")->expert->sd, 6.0);
+    EXPECT_EQ(panel->table()->item(row("jerk_rms_m_s3"), Panel::ExpertMean)->text(), "38");
+    undo->undo();
+    EXPECT_EQ(level("completion_time_s")->expert->mean, 5.2);
+    EXPECT_EQ(level("jerk_rms_m_s3"), nullptr);
+
+    writeFileAtomic(levels, R"({"case_id": "liver", "metrics": {}})");
+    EXPECT_NE(panel->importExpertLevels(QString::fromStdString(levels.string()))
+                  .indexOf("case_id: 'liver' is not this project's case ('rectum')"),
+              -1);
+    writeFileAtomic(levels, R"({"case_id": "rectum", "metrics": {"speed": {"expert": {"mean": 1, "sd": 0}}}})");
+    const QString why = panel->importExpertLevels(QString::fromStdString(levels.string()));
+    EXPECT_NE(why.indexOf("levels.json: metrics.speed: is not a metric the player measures"), -1) << why.toStdString();
+    EXPECT_EQ(undo->count(), steps + 1) << "nothing refused reaches the undo stack";
 }
 
 } // namespace
