@@ -180,6 +180,10 @@ int expertLevels(const Args& a) {
         if (q > p) experts.push_back(option(a, "--trainee").substr(p, q - p));
     }
     if (experts.empty()) throw InputError("expert-levels: --trainee: name the experts (E1,E2,...)");
+    for (size_t i = 0; i < experts.size(); ++i)
+        for (size_t j = 0; j < i; ++j)
+            if (experts[i] == experts[j])
+                throw InputError("expert-levels: --trainee: '" + experts[i] + "' is named twice");
     if (!out.empty()) requireWritableFile(out, "the expert levels");
     auto db = openDb(a, true);
     std::vector<SessionRecord> sessions;
@@ -188,10 +192,17 @@ int expertLevels(const Args& a) {
         if (s.empty()) throw InputError("expert-levels: --trainee: no session of '" + e + "' on case '" + caseId + "'");
         sessions.insert(sessions.end(), s.begin(), s.end());
     }
+    for (const SessionRecord& s : sessions) // one version of the case: its metrics mean one thing
+        if (s.caseVersion != sessions.front().caseVersion)
+            throw InputError("expert-levels: --case: the experts' sessions ran versions " +
+                             sessions.front().caseVersion + " and " + s.caseVersion + " of '" + caseId +
+                             "'; levels need one version");
     const auto levels = deriveExpertLevels(sessions);
+    // The table to the terminal; without -o the JSON alone goes to standard output (redirectable).
+    std::FILE* table = out.empty() ? stderr : stdout;
     for (const DerivedLevel& l : levels)
-        std::printf("%-24s n %-3d mean %-12s sd %s %s\n", l.name.c_str(), l.n, formatNumber("%.4g", l.mean).c_str(),
-                    formatNumber("%.4g", l.sd).c_str(), l.unit.c_str());
+        std::fprintf(table, "%-24s n %-3d mean %-12s sd %s %s\n", l.name.c_str(), l.n,
+                     formatNumber("%.4g", l.mean).c_str(), formatNumber("%.4g", l.sd).c_str(), l.unit.c_str());
     const std::string text = expertLevelsJson(caseId, experts, sessions.size(), levels);
     if (out.empty())
         std::fputs(text.c_str(), stdout);

@@ -106,7 +106,11 @@ std::optional<double> judgeCuts(const SessionTimeline& tl, const sim::Assessment
     std::optional<double> met;
     std::vector<std::optional<Vec3>> last(a.cuts.size());
     for (const SessionTimeline::Event& e : tl.events) {
-        if (e.kind != "cut" || !finite(e.at)) continue;
+        if (e.kind != "cut") continue;
+        if (!finite(e.at)) { // no hook to say where: not on any line
+            out.cutOutside += e.count;
+            continue;
+        }
         bool inside = false;
         for (size_t t = 0; t < a.cuts.size(); ++t) {
             if (lineDistance(e.at, a.cuts[t].line) > a.cuts[t].radius) {
@@ -209,7 +213,11 @@ std::optional<double> judgeSuture(const SessionResult& r, const sim::AssessmentD
         const double d = (mids[k] - mids[k - 1]).norm();
         out.spacingError = std::max({out.spacingError, s.spacingMin - d, d - s.spacingMax});
     }
-    if (out.bites < s.bites || out.spacingError > 0 || !r.suture || !(r.suture->finalGap <= s.maxGap))
+    // Spacing within its range, or as far out of it as the case's bite_spacing_error_m limit allows.
+    const sim::MetricLevel* spacing = a.level("bite_spacing_error_m");
+    const double spacingAllowed = spacing && spacing->limit ? *spacing->limit : 0.0;
+    if (out.bites < s.bites || out.spacingError > spacingAllowed + 1e-12 || !r.suture ||
+        !(r.suture->finalGap <= s.maxGap))
         return std::nullopt;
     // Met at the first sampled frame after the last puncture with the gap closed.
     double lastPuncture = 0;
@@ -384,7 +392,11 @@ std::map<std::string, std::optional<double>> measure(const SessionResult& r,
 }
 
 MetricResult judge(const sim::MetricInfo& info, std::optional<double> value, const sim::MetricLevel* level) {
-    MetricResult m{std::string(info.name), std::string(info.unit), info.lowerIsBetter, value};
+    MetricResult m;
+    m.name = info.name;
+    m.unit = info.unit;
+    m.lowerIsBetter = info.lowerIsBetter;
+    m.value = value;
     if (m.value && !std::isfinite(*m.value)) m.value.reset();
     auto good = [&](double v, double edge) { return m.lowerIsBetter ? v <= edge : v >= edge; };
     if (level && level->limit) {

@@ -418,7 +418,6 @@ void HapticRig::drain() {
     haptics::TraceSample s;
     while (m_servo->popTrace(s)) {
         ++m_samples;
-        const int a = s.arm;
         const double f = s.force.norm();
         m_metrics.maxForce_n = std::max(m_metrics.maxForce_n, f);
         m_forceSum += f;

@@ -17,7 +17,7 @@ TimelineRecorder::TimelineRecorder(const sim::World& world, size_t maxSamples)
                                   sim::kindName(d.kind),
                                   d.device.hand,
                                   d.radius,
-                                  d.device.declared ? d.device.damageForceN : 0.0,
+                                  d.device.damageForceN.value_or(0.0),
                                   {},
                                   {},
                                   {}});
@@ -31,7 +31,7 @@ TimelineRecorder::TimelineRecorder(const sim::World& world, size_t maxSamples)
                               "probe",
                               world.toolDesc(t).hand,
                               world.toolDesc(t).radius,
-                              world.toolDesc(t).damageForceN,
+                              world.toolDesc(t).damageForceN.value_or(0.0),
                               {},
                               {},
                               {}});

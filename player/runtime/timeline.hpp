@@ -23,8 +23,8 @@ struct SessionTimeline {
         std::string kind;         ///< grasper, energy_hook, clip_applier, probe, needle
         std::string hand = "any"; ///< the master's hand that drives it: left, right or any
         double radius = 0;        ///< m, jaw or probe radius (0: the needle)
-        /// N, the tool's own damage threshold (its device block's damage_force_n; probes always
-        /// have one); 0: the case's (assessment force_threshold_n).
+        /// N, the tool's own damage threshold (its damage_force_n where the case gives one); 0:
+        /// the case's (assessment force_threshold_n).
         double damageForceN = 0;
         std::vector<Eigen::Vector3d> tip; ///< m, scene frame, one per sample
         std::vector<double> force_n;      ///< N, the tissue on the tool, one per sample

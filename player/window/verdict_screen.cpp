@@ -33,10 +33,12 @@ void paintHeadline(QPainter& p, int w, const Assessment& a, const std::string& t
         line = "This case has no assessment: the figures below are for your information.";
     else if (a.find("completion_time_s") && !a.completionS)
         line = "Task not completed: its targets were not all met.";
-    else if (a.find("completion_time_s"))
+    else if (a.find("completion_time_s")) {
+        const std::string detail = a.verdictDetail(); // "completion 5.88 s[; within the expert level]"
+        const size_t semi = detail.find("; ");
         line = "Task completed in " + formatFigure(a.completionS) + " s" +
-               (a.withinExpertLevel() ? " — within the expert level" : " — not yet within the expert level");
-    else
+               (semi == std::string::npos ? std::string() : " — " + detail.substr(semi + 2));
+    } else
         line = a.verdictDetail();
     p.drawText(QRect(0, 116, w, 22), Qt::AlignHCenter, q(line));
 }

@@ -176,11 +176,15 @@ QString AssessmentPanel::importExpertLevels(const QString& path) {
         const nlohmann::json doc = sim::parseJsonText(readFile(file), file);
         const sim::JsonField root(doc, "", file);
         root.object({"case_id", "experts", "sessions", "metrics"});
-        if (auto c = root.find("case_id"); c && c->string() != m_doc->project().caseId)
-            c->fail("'" + c->string() + "' is not this project's case ('" + m_doc->project().caseId + "')");
-        for (const auto& [name, m] : root["metrics"].members()) {
+        const sim::JsonField c = root["case_id"];
+        if (c.string() != m_doc->project().caseId)
+            c.fail("'" + c.string() + "' is not this project's case ('" + m_doc->project().caseId + "')");
+        const auto members = root["metrics"].members();
+        if (members.empty()) root.failAt("metrics", "has no expert level");
+        for (const auto& [name, m] : members) {
             if (!sim::findMetric(name)) m.fail("is not a metric the player measures");
             m.object({"expert", "n"});
+            m["n"].integer(2, 1000000); // sessions behind the level: a mean and an SD need two
             const sim::JsonField e = m["expert"];
             e.object({"mean", "sd"});
             const sim::ExpertLevel level{e["mean"].number(sim::NumberRule::nonNegative()),

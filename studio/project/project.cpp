@@ -683,6 +683,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     for (const SurfaceProject& s : p.surfaces)
         surfaces.push_back(&s.scene);
     sim::checkSceneReferences(bodies, surfaces, scene.interaction ? &*scene.interaction : nullptr, origin);
+    sim::checkAssessmentMeasurable(scene, origin);
     return p;
 }
 

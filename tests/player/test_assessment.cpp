@@ -69,7 +69,7 @@ TEST(Assessment, TheBlockIsReadAndWrittenByTheOneSceneReader) {
         "clip": [{"position": [0.01,0,0], "tolerance": 0.005, "count": 2}],
         "suture": {"plane": {"point": [0,0,0], "normal": [0,0,2]}, "bites": 3, "depth": [0.001, 0.005], "spacing": [0.001, 0.003], "max_gap": 0.0002}},
       "force_threshold_n": 2, "reference_path_m": 0.3,
-      "metrics": {"path_length_m": {"limit": 0.5}, "completion_time_s": {"limit": 9, "expert": {"mean": 5, "sd": 1}}}})");
+      "metrics": {"cut_coverage": {"limit": 0.5}, "completion_time_s": {"limit": 9, "expert": {"mean": 5, "sd": 1}}}})");
     ASSERT_TRUE(s.assessment);
     const sim::AssessmentDesc& a = *s.assessment;
     ASSERT_EQ(a.cuts.size(), 1u);
@@ -187,8 +187,8 @@ TEST(Assessment, TargetsAreMetInTimeAndCutsAndClipsOutsideThemCount) {
     EXPECT_THAT(player::assessmentSummary(a), HasSubstr("verdict       FAIL (clips_off_target)"));
 }
 
-// Punctures on either side of the wound's plane z = 0: bites are runs on one side followed by
-// runs on the other; a stitch through one side only makes no bite.
+// Punctures on either side of the wound's plane z = 0: a bite is a pass through the wall on one
+// side (two punctures) followed by one on the other; a bite too shallow is missed.
 TEST(Assessment, BitesAcrossTheWoundAreCountedWithDepthAndSpacing) {
     player::SessionResult r = timeline(10, {});
     auto stitch = [&](double x, double depth) {
@@ -336,4 +336,30 @@ TEST(Assessment, CutCoverageIsTheLengthOpenedNotTheRadiusAroundEachCut) {
     };
     EXPECT_NEAR(coverage(0.003), 19.0 / 20, 1e-9) << "one pass, 3 mm steps from 0 to 18 mm, 1 mm beyond";
     EXPECT_NEAR(coverage(0.01), 4.0 / 20, 1e-9) << "cuts at 0, 10 and 20 mm: 1 + 2 + 1 mm opened";
+}
+
+// With cut targets only, the completion time is the cut at which the coverage was reached: cuts
+// every 1 mm along a 50 mm line, 80 % (40 mm, with 1 mm beyond the last cut) at the cut at 39 mm.
+TEST(Assessment, TheCompletionTimeIsWhenTheLastTargetWasMet) {
+    player::SessionResult r = timeline(60, {mover("hook", "right", 60, 0, 0, 0)});
+    for (int k = 0; k <= 45; ++k)
+        r.timeline.events.push_back({0.05 * k, k, "cut", "hook", 1, Vec3(0.001 * k, 0, 0)});
+    r.timeline.events.push_back(
+        {2.4, 48, "cut", "hook", 2, Vec3::Constant(std::nan(""))}); // no hook position: counted outside
+    sim::AssessmentDesc d;
+    d.cuts.push_back({{Vec3(0, 0, 0), Vec3(0.05, 0, 0)}, 0.002, 0.8});
+    const player::Assessment a = player::assessSession(r, d);
+    ASSERT_TRUE(a.completionS);
+    EXPECT_NEAR(*a.completionS, 0.05 * 39, 1e-12);
+    EXPECT_EQ(*a.find("cut_outside_edges")->value, 2.0);
+}
+
+// Every judged metric is one the scene can measure; a scene that could never give one is refused.
+TEST(Assessment, AMetricTheSceneCannotMeasureIsRefusedWhenTheSceneIsRead) {
+    EXPECT_THAT(refusal(R"({"metrics": {"out_of_view_s": {"limit": 2}}})"),
+                HasSubstr("assessment.metrics.out_of_view_s: needs a laparoscope"));
+    EXPECT_THAT(refusal(R"({"metrics": {"final_gap_m": {"limit": 0.001}}})"),
+                HasSubstr("assessment.metrics.final_gap_m: needs a suture with a gauge"));
+    EXPECT_THAT(refusal(R"({"metrics": {"path_length_m": {"limit": 1}}})"),
+                HasSubstr("assessment.metrics.path_length_m: needs a tool"));
 }

@@ -19,9 +19,10 @@
 ///   cut      a marked line (≥ 2 points, m, scene) to open: met when `coverage` (0, 1] of its
 ///            length has a cut within `radius` (m) of it; edges cut farther away count outside
 ///   clip     a vessel site: met when `count` clips lie within `tolerance` (m) of `position`
-///   suture   the wound's plane between the two edges; a bite is two successive punctures on
-///            opposite sides, its depth the nearer puncture's distance from the plane; met when
-///            `bites` bites lie within `depth` and successive bites within `spacing` (m), and the
+///   suture   the wound's plane between the two edges; a bite is a pass through the wall on one
+///            side (two punctures) followed by one on the other, its depth the nearest puncture's
+///            distance from the plane; met when `bites` bites lie within `depth`, successive bites
+///            within `spacing` (m; or as far out as the bite_spacing_error_m limit allows), and the
 ///            gauge's gap is at most `max_gap` (m)
 ///   force_threshold_n   tissue force above which time is counted and damage accrues (default 1.5),
 ///                       for the tools that declare no damage_force_n of their own

@@ -65,7 +65,7 @@ InteractionDesc readInteractionSection(const JsonField& doc) {
             dev->object({"hand", "motion_scale", "force_scale", "max_force_n", "damage_force_n", "grip_open_rad"});
             InstrumentDeviceDesc& dd = in.device;
             readDeviceMapping(*dev, dd);
-            dd.damageForceN = dev->number("damage_force_n", dd.damageForceN, NumberRule::aboveUpTo(0, 1000.0));
+            if (auto f = dev->find("damage_force_n")) dd.damageForceN = f->number(NumberRule::aboveUpTo(0, 1000.0));
             dd.gripOpenRad = dev->number("grip_open_rad", dd.gripOpenRad, NumberRule::closed(0.05, M_PI));
         }
         if (auto port = j.find("port")) readPort(*port, in.port);
@@ -128,7 +128,7 @@ json interactionJson(const InteractionDesc& d) {
         if (in.device.declared) {
             const InstrumentDeviceDesc& dd = in.device;
             writeDeviceMapping(dd, j["device"]);
-            j["device"]["damage_force_n"] = dd.damageForceN;
+            if (dd.damageForceN) j["device"]["damage_force_n"] = *dd.damageForceN;
             j["device"]["grip_open_rad"] = dd.gripOpenRad;
         }
         if (in.port.declared) writePort(in.port, j["port"]);

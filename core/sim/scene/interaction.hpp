@@ -34,6 +34,7 @@
 #include "sim/scene/instrument_track.hpp"
 #include "sim/scene/port.hpp"
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -42,8 +43,10 @@ namespace viscera::sim {
 
 /// How a haptic master drives an instrument (scene "device" of an instrument; see above).
 struct InstrumentDeviceDesc : DeviceMapping {
-    double damageForceN = 4.0; ///< N, contact force above which tissue is damaged (session metric)
-    double gripOpenRad = 1.0;  ///< rad: the grip angle at which the jaws are fully open
+    /// N, contact force above which tissue is damaged (session metrics); none: the case's
+    /// assessment force_threshold_n.
+    std::optional<double> damageForceN;
+    double gripOpenRad = 1.0; ///< rad: the grip angle at which the jaws are fully open
 };
 
 struct InstrumentDesc {

@@ -68,7 +68,7 @@ std::vector<ToolDesc> readTools(const JsonField& tools, std::set<std::string>& n
         d.motionScale = t.number("motion_scale", d.motionScale, NumberRule::aboveUpTo(0, 10.0));
         d.forceScale = t.number("force_scale", d.forceScale, NumberRule::aboveUpTo(0, 10.0));
         d.maxForceN = t.number("max_force_n", d.maxForceN, NumberRule::aboveUpTo(0, 50.0));
-        d.damageForceN = t.number("damage_force_n", d.damageForceN, NumberRule::aboveUpTo(0, 1000.0));
+        if (auto f = t.find("damage_force_n")) d.damageForceN = f->number(NumberRule::aboveUpTo(0, 1000.0));
         d.stiffness = t.number("stiffness", d.stiffness, NumberRule::nonNegative());
         if (auto port = t.find("port")) readPort(*port, d.port);
         out.push_back(d);
@@ -173,8 +173,8 @@ void writeTools(const std::vector<ToolDesc>& tools, json& doc) {
                                 {"motion_scale", t.motionScale},
                                 {"force_scale", t.forceScale},
                                 {"stiffness", t.stiffness},
-                                {"max_force_n", t.maxForceN},
-                                {"damage_force_n", t.damageForceN}});
+                                {"max_force_n", t.maxForceN}});
+        if (t.damageForceN) doc["tools"].back()["damage_force_n"] = *t.damageForceN;
         if (t.port.declared) writePort(t.port, doc["tools"].back()["port"]);
     }
 }
@@ -314,6 +314,42 @@ void writeNodeWeightFields(const std::vector<double>& weights, const std::string
 
 } // namespace
 
+void checkAssessmentMeasurable(const SceneDesc& scene, const std::string& origin) {
+    if (!scene.assessment) return;
+    int tools = 0;
+    bool left = false, right = false, ported = false;
+    auto tool = [&](const std::string& hand, bool port) {
+        ++tools, left |= hand == "left", right |= hand == "right", ported |= port;
+    };
+    if (scene.interaction)
+        for (const InstrumentDesc& in : scene.interaction->instruments)
+            tool(in.device.hand, in.port.declared);
+    for (const ToolDesc& t : scene.tools)
+        tool(t.hand, t.port.declared);
+    if (scene.suture) tool(scene.suture->device.hand, false);
+    const bool gauge = scene.suture && !scene.suture->gauge[0].empty();
+    const std::pair<const char*, std::pair<bool, const char*>> rules[] = {
+        {"out_of_view_s", {scene.laparoscope.has_value(), "a laparoscope"}},
+        {"instrument_collisions", {tools >= 2, "two tools"}},
+        {"path_length_left_m", {left, "a tool in the left hand"}},
+        {"path_length_right_m", {right, "a tool in the right hand"}},
+        {"angular_path_rad", {ported, "an instrument or probe through a port"}},
+        {"final_gap_m", {gauge, "a suture with a gauge"}},
+        {"max_thread_tension_n", {scene.suture.has_value(), "a suture"}},
+    };
+    for (const auto& [name, rule] : rules)
+        if (scene.assessment->level(name) && !rule.first)
+            throw InputError(origin + ": assessment.metrics." + name + ": needs " + rule.second +
+                             " (this scene has none: no session could measure it)");
+    if (tools == 0)
+        for (const MetricLevel& m : scene.assessment->metrics)
+            for (const char* n : {"path_length_m", "economy_of_motion", "jerk_rms_m_s3", "idle_time_s", "force_mean_n",
+                                  "force_max_n", "force_over_threshold_s", "tissue_damage_ns"})
+                if (m.name == n)
+                    throw InputError(origin + ": assessment.metrics." + m.name +
+                                     ": needs a tool (this scene has none: no session could measure it)");
+}
+
 SceneDesc parseScene(std::string_view text, const std::string& origin) {
     const json doc = parseJsonText(text, origin);
     const JsonField root(doc, "", origin);
@@ -368,6 +404,7 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     for (const SurfaceDesc& s : scene.surfaces)
         surfaces.push_back(&s);
     checkSceneReferences(bodies, surfaces, scene.interaction ? &*scene.interaction : nullptr, origin);
+    checkAssessmentMeasurable(scene, origin);
     return scene;
 }
 

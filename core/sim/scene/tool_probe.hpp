@@ -14,6 +14,7 @@
 #include "sim/mesh/tet_mesh.hpp"
 #include "sim/scene/port.hpp"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,8 +32,10 @@ struct ToolDesc {
     double forceScale = 1.0;   ///< device newtons per scene newton
     double stiffness = 0;      ///< N/m linear contact stiffness; 0 = Hertz from the body's material
     double maxForceN = 15.0;   ///< N, the case's maximum device force
-    double damageForceN = 4.0; ///< N, contact force above which tissue is damaged (session metric)
-    PortDesc port;             ///< "port" (port.hpp): the probe's shaft passes through it
+    /// N, contact force above which tissue is damaged (session metrics); none: the case's
+    /// assessment force_threshold_n.
+    std::optional<double> damageForceN;
+    PortDesc port; ///< "port" (port.hpp): the probe's shaft passes through it
 };
 
 /// One probe's contact after the last frame.

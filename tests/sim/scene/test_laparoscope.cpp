@@ -44,7 +44,9 @@ TEST(Laparoscope, TheOpticLooksAlongItsShaftOrThirtyDegreesDown) {
         EXPECT_NEAR(p.view.norm(), 1, 1e-12);
         EXPECT_NEAR(p.up.dot(p.view), 0, 1e-12) << "the image's up is across the view";
         EXPECT_GT(p.up.z(), 0) << "and points up in the scene at roll 0";
-        if (optic > 0) EXPECT_LT(p.view.z(), p.shaft.z()) << "a 30° optic looks further down than its shaft";
+        if (optic > 0) {
+            EXPECT_LT(p.view.z(), p.shaft.z()) << "a 30° optic looks further down than its shaft";
+        }
     }
 }
 

@@ -149,7 +149,15 @@ TEST_F(AssessmentPanelFixture, ExpertLevelsFromExpertSessionsAreImportedAsOneUnd
     EXPECT_NE(panel->importExpertLevels(QString::fromStdString(levels.string()))
                   .indexOf("case_id: 'liver' is not this project's case ('rectum')"),
               -1);
-    writeFileAtomic(levels, R"({"case_id": "rectum", "metrics": {"speed": {"expert": {"mean": 1, "sd": 0}}}})");
+    writeFileAtomic(levels, R"({"metrics": {"jerk_rms_m_s3": {"expert": {"mean": 1, "sd": 0}, "n": 2}}})");
+    EXPECT_NE(panel->importExpertLevels(QString::fromStdString(levels.string()))
+                  .indexOf("case_id: required field is missing"),
+              -1)
+        << "a file that does not say its case is refused";
+    writeFileAtomic(levels, R"({"case_id": "rectum", "metrics": {}})");
+    EXPECT_NE(
+        panel->importExpertLevels(QString::fromStdString(levels.string())).indexOf("metrics: has no expert level"), -1);
+    writeFileAtomic(levels, R"({"case_id": "rectum", "metrics": {"speed": {"expert": {"mean": 1, "sd": 0}, "n": 2}}})");
     const QString why = panel->importExpertLevels(QString::fromStdString(levels.string()));
     EXPECT_NE(why.indexOf("levels.json: metrics.speed: is not a metric the player measures"), -1) << why.toStdString();
     EXPECT_EQ(undo->count(), steps + 1) << "nothing refused reaches the undo stack";
