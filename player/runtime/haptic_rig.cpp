@@ -16,33 +16,29 @@ using haptics::kMaxArms;
 
 } // namespace
 
-HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& world, bool realtime, bool keepTrace)
-    : m_device(device), m_spec(std::move(spec)), m_world(world), m_realtime(realtime), m_keepTrace(keepTrace) {
-    const haptics::DeviceCapabilities& caps = device.capabilities();
-    const int arms = std::clamp(caps.arms, 1, kMaxArms);
-    haptics::ServoConfig cfg;
-    m_caseMaxForce = 15.0;
-    // The arm a hand asks for: left → 0 and right → 1 on a bimanual device; "any" (or a one-arm
-    // device) → the first arm nothing is on yet, else arm 0.
-    auto armFor = [&](const std::string& hand, bool exclusive) {
-        if (arms == 2 && hand == "left") return 0;
-        if (arms == 2 && hand == "right") return 1;
-        for (int a = 0; a < arms; ++a)
-            if (m_armTools[a].empty()) return a;
-        return exclusive ? -1 : 0;
-    };
-    auto mapArm = [&](int arm, const sim::Vec3& start, double motion, double force, const sim::PortDesc* port) {
-        haptics::ToolMapping& m = cfg.tools[arm];
-        m.enabled = true;
-        m.sceneStart = start;
-        m.motionScale = motion;
-        m.forceScale = force;
-        m.throughPort = port && port->declared;
-        if (m.throughPort) m.port = sim::makePortFrame(*port, start, motion);
-    };
-    for (size_t t = 0; t < world.toolCount(); ++t) { // probes: one arm each
-        const sim::ToolDesc& d = world.toolDesc(t);
-        int arm = armFor(d.hand, true);
+int HapticRig::armFor(const std::string& hand, bool exclusive, int arms) const {
+    if (arms == 2 && hand == "left") return 0;
+    if (arms == 2 && hand == "right") return 1;
+    for (int a = 0; a < arms; ++a)
+        if (m_armTools[a].empty()) return a;
+    return exclusive ? -1 : 0;
+}
+
+void HapticRig::mapArm(haptics::ServoConfig& cfg, int arm, const sim::Vec3& start, double motion, double force,
+                       const sim::PortDesc* port) {
+    haptics::ToolMapping& m = cfg.tools[arm];
+    m.enabled = true;
+    m.sceneStart = start;
+    m.motionScale = motion;
+    m.forceScale = force;
+    m.throughPort = port && port->declared;
+    if (m.throughPort) m.port = sim::makePortFrame(*port, start, motion);
+}
+
+void HapticRig::rigProbes(haptics::ServoConfig& cfg, int arms) {
+    for (size_t t = 0; t < m_world.toolCount(); ++t) { // one arm each
+        const sim::ToolDesc& d = m_world.toolDesc(t);
+        int arm = armFor(d.hand, true, arms);
         if (arm >= 0 && !m_armTools[arm].empty()) arm = -1;
         m_tools.push_back({d.name, d.hand, arm, "probe", 0});
         RigTool rt;
@@ -53,73 +49,88 @@ HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& worl
         m_caseMaxForce = std::min(m_caseMaxForce, d.maxForceN);
         if (arm < 0) continue;
         m_armTools[arm].push_back(static_cast<int>(m_rig.size() - 1));
-        mapArm(arm, d.start, d.motionScale, d.forceScale, &d.port);
+        mapArm(cfg, arm, d.start, d.motionScale, d.forceScale, &d.port);
     }
-    if (sim::InteractionRuntime* in = world.interaction()) // instruments: arms may be shared
-        for (size_t i = 0; i < in->instrumentCount(); ++i) {
-            const sim::InstrumentDesc& d = in->instrumentDesc(i);
-            if (!d.device.declared) continue;
-            int arm = armFor(d.device.hand, false);
-            // An arm a probe holds is not shared.
-            if (arm >= 0 && std::any_of(m_armTools[arm].begin(), m_armTools[arm].end(), [&](int k) {
-                    return m_rig[static_cast<size_t>(k)].kind == RigTool::Kind::Probe;
-                }))
-                arm = -1;
-            m_tools.push_back({d.name, d.device.hand, arm, sim::kindName(d.kind), 0});
-            RigTool rt;
-            rt.kind = RigTool::Kind::Instrument;
-            rt.index = i;
-            rt.arm = arm;
-            rt.gripOpen = d.device.gripOpenRad;
-            rt.rest = in->restKey(i);
-            m_rig.push_back(rt);
-            m_caseMaxForce = std::min(m_caseMaxForce, d.device.maxForceN);
-            if (arm < 0) continue;
-            // The arm's first instrument sets its mapping: workspace centre at its rest tip, and
-            // its port (the others on the arm are held to their own ports by the interaction).
-            if (m_armTools[arm].empty())
-                mapArm(arm, rt.rest.position, d.device.motionScale, d.device.forceScale, &d.port);
-            else if (const sim::PortDesc& first = in->instrumentDesc(m_rig[size_t(m_armTools[arm][0])].index).port;
-                     first.declared != d.port.declared || first.position != d.port.position ||
-                     first.mode != d.port.mode)
-                m_notes.push_back("instrument '" + d.name + "' shares its master with '" +
-                                  in->instrumentDesc(m_rig[size_t(m_armTools[arm][0])].index).name +
-                                  "' but not its port: the master is mapped through the first one's port");
-            m_armTools[arm].push_back(static_cast<int>(m_rig.size() - 1));
-        }
-    if (sim::NeedleDrive* nd = world.needleDrive();
-        nd && world.scene().suture && world.scene().suture->device.declared) {
-        // The needle holder on its hand; the thread on the other arm (its lift pulls).
-        const sim::NeedleDeviceDesc& d = world.scene().suture->device;
-        int arm = armFor(d.hand, true);
-        if (arm >= 0 && !m_armTools[arm].empty()) arm = -1;
-        const sim::NeedleFrame rest = nd->restFrame();
-        m_tools.push_back({"needle", d.hand, arm, "needle", 0});
+}
+
+void HapticRig::rigInstruments(haptics::ServoConfig& cfg, int arms) {
+    sim::InteractionRuntime* in = m_world.interaction();
+    if (!in) return;
+    for (size_t i = 0; i < in->instrumentCount(); ++i) { // arms may be shared
+        const sim::InstrumentDesc& d = in->instrumentDesc(i);
+        if (!d.device.declared) continue;
+        int arm = armFor(d.device.hand, false, arms);
+        // An arm a probe holds is not shared.
+        if (arm >= 0 && std::any_of(m_armTools[arm].begin(), m_armTools[arm].end(),
+                                    [&](int k) { return m_rig[static_cast<size_t>(k)].kind == RigTool::Kind::Probe; }))
+            arm = -1;
+        m_tools.push_back({d.name, d.device.hand, arm, sim::kindName(d.kind), 0});
         RigTool rt;
-        rt.kind = RigTool::Kind::Needle;
+        rt.kind = RigTool::Kind::Instrument;
+        rt.index = i;
         rt.arm = arm;
-        rt.needleRest = rest.pose;
+        rt.gripOpen = d.device.gripOpenRad;
+        rt.rest = in->restKey(i);
         m_rig.push_back(rt);
-        m_caseMaxForce = std::min(m_caseMaxForce, d.maxForceN);
-        if (arm >= 0) {
-            m_armTools[arm].push_back(static_cast<int>(m_rig.size() - 1));
-            mapArm(arm, rest.pose.translation(), d.motionScale, d.forceScale, nullptr);
-        }
-        int other = -1;
-        for (int a = 0; a < arms; ++a)
-            if (a != arm && m_armTools[a].empty()) other = a;
-        const std::string otherHand = d.hand == "left" ? "right" : d.hand == "right" ? "left" : "any";
-        m_tools.push_back({"thread", otherHand, other, "thread", 0});
-        RigTool th;
-        th.kind = RigTool::Kind::Thread;
-        th.arm = other;
-        th.pullScale = d.pullScale;
-        m_rig.push_back(th);
-        if (other >= 0) {
-            m_armTools[other].push_back(static_cast<int>(m_rig.size() - 1));
-            mapArm(other, sim::Vec3::Zero(), 1.0, d.forceScale, nullptr); // device metres: the lift itself
-        }
+        m_caseMaxForce = std::min(m_caseMaxForce, d.device.maxForceN);
+        if (arm < 0) continue;
+        // The arm's first instrument sets its mapping: workspace centre at its rest tip, and
+        // its port (the others on the arm are held to their own ports by the interaction).
+        if (m_armTools[arm].empty())
+            mapArm(cfg, arm, rt.rest.position, d.device.motionScale, d.device.forceScale, &d.port);
+        else if (const sim::PortDesc& first = in->instrumentDesc(m_rig[size_t(m_armTools[arm][0])].index).port;
+                 first.declared != d.port.declared || first.position != d.port.position || first.mode != d.port.mode)
+            m_notes.push_back("instrument '" + d.name + "' shares its master with '" +
+                              in->instrumentDesc(m_rig[size_t(m_armTools[arm][0])].index).name +
+                              "' but not its port: the master is mapped through the first one's port");
+        m_armTools[arm].push_back(static_cast<int>(m_rig.size() - 1));
     }
+}
+
+void HapticRig::rigNeedle(haptics::ServoConfig& cfg, int arms) {
+    sim::NeedleDrive* nd = m_world.needleDrive();
+    if (!nd || !m_world.scene().suture || !m_world.scene().suture->device.declared) return;
+    // The needle holder on its hand; the thread on the other arm (its lift pulls).
+    const sim::NeedleDeviceDesc& d = m_world.scene().suture->device;
+    int arm = armFor(d.hand, true, arms);
+    if (arm >= 0 && !m_armTools[arm].empty()) arm = -1;
+    const sim::NeedleFrame rest = nd->restFrame();
+    m_tools.push_back({"needle", d.hand, arm, "needle", 0});
+    RigTool rt;
+    rt.kind = RigTool::Kind::Needle;
+    rt.arm = arm;
+    rt.needleRest = rest.pose;
+    m_rig.push_back(rt);
+    m_caseMaxForce = std::min(m_caseMaxForce, d.maxForceN);
+    if (arm >= 0) {
+        m_armTools[arm].push_back(static_cast<int>(m_rig.size() - 1));
+        mapArm(cfg, arm, rest.pose.translation(), d.motionScale, d.forceScale, nullptr);
+    }
+    int other = -1;
+    for (int a = 0; a < arms; ++a)
+        if (a != arm && m_armTools[a].empty()) other = a;
+    const std::string otherHand = d.hand == "left" ? "right" : d.hand == "right" ? "left" : "any";
+    m_tools.push_back({"thread", otherHand, other, "thread", 0});
+    RigTool th;
+    th.kind = RigTool::Kind::Thread;
+    th.arm = other;
+    th.pullScale = d.pullScale;
+    m_rig.push_back(th);
+    if (other >= 0) {
+        m_armTools[other].push_back(static_cast<int>(m_rig.size() - 1));
+        mapArm(cfg, other, sim::Vec3::Zero(), 1.0, d.forceScale, nullptr); // device metres: the lift itself
+    }
+}
+
+HapticRig::HapticRig(haptics::Device& device, std::string spec, sim::World& world, bool realtime, bool keepTrace)
+    : m_device(device), m_spec(std::move(spec)), m_world(world), m_realtime(realtime), m_keepTrace(keepTrace) {
+    const haptics::DeviceCapabilities& caps = device.capabilities();
+    const int arms = std::clamp(caps.arms, 1, kMaxArms);
+    haptics::ServoConfig cfg;
+    m_caseMaxForce = 15.0;
+    rigProbes(cfg, arms);
+    rigInstruments(cfg, arms);
+    rigNeedle(cfg, arms);
     for (int a = 0; a < kMaxArms; ++a)
         if (!m_armTools[a].empty()) {
             RigTool& first = m_rig[static_cast<size_t>(m_armTools[a][0])];

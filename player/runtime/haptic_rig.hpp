@@ -137,6 +137,17 @@ public:
     bool drivesAnyTool() const;
 
 private:
+    /// The arm a hand asks for: left → 0 and right → 1 on a bimanual device; "any" (or a one-arm
+    /// device) → the first arm nothing is on yet, else arm 0 (-1 with `exclusive`).
+    int armFor(const std::string& hand, bool exclusive, int arms) const;
+    /// Maps `arm` onto a tool at `start` (scene), through its port when it declares one.
+    static void mapArm(haptics::ServoConfig& cfg, int arm, const sim::Vec3& start, double motion, double force,
+                       const sim::PortDesc* port);
+    /// The rig's tools, in order: probes (an arm each), instruments with a device (arms may be
+    /// shared), the needle and the thread of a suture with a device.
+    void rigProbes(haptics::ServoConfig& cfg, int arms);
+    void rigInstruments(haptics::ServoConfig& cfg, int arms);
+    void rigNeedle(haptics::ServoConfig& cfg, int arms);
     void drain();
     /// Real time: how late the frame that is due at `due` (wall clock) starts (m_lag*).
     void measureLag(int64_t due);

@@ -500,6 +500,42 @@ std::string toolsSummary(const Assessment& a) {
            ")\n";
 }
 
+/// The port lines and the solver's error against run time on the last sampled frame [A eq. 4.45].
+std::string portsAndAccuracySummary(const SessionResult& r) {
+    std::string out;
+    for (const PortFigures& p : r.ports) {
+        char line[256], shaft[64] = "";
+        if (p.shaftMeasured)
+            std::snprintf(shaft, sizeof shaft, "shaft within %.3f mm of the port, ", p.maxShaftDistance_m * 1e3);
+        std::snprintf(line, sizeof line,
+                      "port          %s (%s): %sinsertion %.0f-%.0f mm of %.0f-%.0f, %d of %d frames at a limit\n",
+                      p.tool.c_str(), sim::portModeName(p.port.mode), shaft, p.insertionMin_m * 1e3,
+                      p.insertionMax_m * 1e3, p.port.insertionMin * 1e3, p.port.insertionMax * 1e3, p.framesAtLimit,
+                      p.frames);
+        out += line;
+    }
+    // Error against run time on the last sampled frame [A eq. 4.45].
+    for (auto it = r.accuracy.rbegin(); it != r.accuracy.rend(); ++it) {
+        if (it->solver != "xpbd" || it->relError.size() < 2) continue;
+        size_t k = 1;
+        while (k < it->relError.size() && it->relError[k] > 1e-4)
+            ++k;
+        char line[256];
+        if (k < it->relError.size())
+            std::snprintf(
+                line, sizeof line,
+                "accuracy      frame %d: XPBD rel. error %.2e after 1 iteration, <= 1e-4 after %d (%.3f ms)\n",
+                it->frame, it->relError[1], it->iterations[k], it->timeMs[k]);
+        else
+            std::snprintf(line, sizeof line,
+                          "accuracy      frame %d: XPBD rel. error %.2e after 1 iteration, %.2e after %d (%.3f ms)\n",
+                          it->frame, it->relError[1], it->relError.back(), it->iterations.back(), it->timeMs.back());
+        out += line;
+        break;
+    }
+    return out;
+}
+
 } // namespace
 
 std::string assessmentSummary(const Assessment& a) {
@@ -606,36 +642,7 @@ std::string summaryText(const SessionResult& r) {
             out += line;
         }
     }
-    for (const PortFigures& p : r.ports) {
-        char line[256], shaft[64] = "";
-        if (p.shaftMeasured)
-            std::snprintf(shaft, sizeof shaft, "shaft within %.3f mm of the port, ", p.maxShaftDistance_m * 1e3);
-        std::snprintf(line, sizeof line,
-                      "port          %s (%s): %sinsertion %.0f-%.0f mm of %.0f-%.0f, %d of %d frames at a limit\n",
-                      p.tool.c_str(), sim::portModeName(p.port.mode), shaft, p.insertionMin_m * 1e3,
-                      p.insertionMax_m * 1e3, p.port.insertionMin * 1e3, p.port.insertionMax * 1e3, p.framesAtLimit,
-                      p.frames);
-        out += line;
-    }
-    // Error against run time on the last sampled frame [A eq. 4.45].
-    for (auto it = r.accuracy.rbegin(); it != r.accuracy.rend(); ++it) {
-        if (it->solver != "xpbd" || it->relError.size() < 2) continue;
-        size_t k = 1;
-        while (k < it->relError.size() && it->relError[k] > 1e-4)
-            ++k;
-        char line[256];
-        if (k < it->relError.size())
-            std::snprintf(
-                line, sizeof line,
-                "accuracy      frame %d: XPBD rel. error %.2e after 1 iteration, <= 1e-4 after %d (%.3f ms)\n",
-                it->frame, it->relError[1], it->iterations[k], it->timeMs[k]);
-        else
-            std::snprintf(line, sizeof line,
-                          "accuracy      frame %d: XPBD rel. error %.2e after 1 iteration, %.2e after %d (%.3f ms)\n",
-                          it->frame, it->relError[1], it->relError.back(), it->iterations.back(), it->timeMs.back());
-        out += line;
-        break;
-    }
+    out += portsAndAccuracySummary(r);
     return out + assessmentSummary(r.assessment);
 }
 
