@@ -386,6 +386,12 @@ std::map<std::string, std::optional<double>> measure(const SessionResult& r,
         v["bites_missed"] = targets.bitesMissed;
         v["bite_spacing_error_m"] = targets.spacingError;
     }
+    if (desc && desc->vessel) {
+        double injury = 0;
+        for (size_t i = 0; i < tl.vesselNear.size() && i < span.size(); ++i)
+            injury += tl.vesselNear[i] ? span[i] : 0.0;
+        v["vessel_injury_s"] = injury;
+    }
     if (r.suture && r.suture->gauge) v["final_gap_m"] = r.suture->finalGap;
     if (r.suture) v["max_thread_tension_n"] = r.suture->maxThreadTension;
     return v;

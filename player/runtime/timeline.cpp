@@ -40,6 +40,23 @@ TimelineRecorder::TimelineRecorder(const sim::World& world, size_t maxSamples)
         m_tl.tools.push_back({"needle", "needle", su ? su->device.hand : "any", 0.0, 0.0, {}, {}, {}});
     }
     if (const sim::Laparoscope* scope = world.laparoscope()) m_tl.cameraFovDeg = scope->desc().fovDeg;
+    if (const auto& a = world.scene().assessment; a && a->vessel)
+        for (size_t b = 0; b < world.bodyCount(); ++b)
+            if (world.bodyName(b) == a->vessel->body) {
+                m_vesselBody = static_cast<int>(b);
+                m_vesselMargin = a->vessel->margin;
+            }
+}
+
+bool TimelineRecorder::hookNearVessel(const sim::World& world) const {
+    const sim::InteractionRuntime* in = world.interaction();
+    if (!in) return false;
+    const std::vector<sim::Vec3>& x = world.positions(static_cast<size_t>(m_vesselBody));
+    for (const sim::InstrumentState& s : in->summary().instruments)
+        if (std::string_view(s.kind) == "energy_hook" && s.act)
+            for (const sim::Vec3& p : x)
+                if ((p - s.tip).squaredNorm() <= m_vesselMargin * m_vesselMargin) return true;
+    return false;
 }
 
 void TimelineRecorder::sample(const sim::World& world) {
@@ -70,6 +87,7 @@ void TimelineRecorder::sample(const sim::World& world) {
         m_tl.tools[k].force_n.push_back(fr.empty() ? 0.0 : fr.back().needleForce);
         ++k;
     }
+    if (m_vesselBody >= 0) m_tl.vesselNear.push_back(hookNearVessel(world) ? 1 : 0);
     if (const sim::Laparoscope* scope = world.laparoscope()) {
         m_tl.cameraTip.push_back(scope->pose().tip);
         m_tl.cameraView.push_back(scope->pose().view);
@@ -133,6 +151,7 @@ void TimelineRecorder::record(const sim::World& world) {
         halve(m_tl.cameraView);
         halve(m_tl.cameraUp);
         halve(m_tl.cameraSteering);
+        halve(m_tl.vesselNear);
         for (SessionTimeline::Tool& tool : m_tl.tools) {
             halve(tool.tip);
             halve(tool.force_n);

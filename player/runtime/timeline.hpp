@@ -51,6 +51,9 @@ struct SessionTimeline {
     std::vector<Eigen::Vector3d> cameraTip;
     std::vector<Eigen::Vector3d> cameraView, cameraUp; ///< unit, the optic's view and image up
     std::vector<char> cameraSteering;
+    /// Per sample: an energized hook's tip within the margin of the assessment's vessel to protect
+    /// (cases with a targets.vessel).
+    std::vector<char> vesselNear;
     double cameraFovDeg = 0; ///< vertical field of view (0: no laparoscope)
     bool empty() const { return tools.empty() && events.empty(); }
 };
@@ -68,6 +71,10 @@ public:
 
 private:
     void sample(const sim::World& world);
+    /// An energized hook's tip within the margin of the vessel to protect (any of its nodes).
+    bool hookNearVessel(const sim::World& world) const;
+    int m_vesselBody = -1; ///< the assessment's vessel to protect; -1: none
+    double m_vesselMargin = 0;
     SessionTimeline m_tl;
     size_t m_maxSamples = kMaxSamples;
     int m_frames = 0;

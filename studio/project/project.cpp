@@ -683,7 +683,10 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     for (const SurfaceProject& s : p.surfaces)
         surfaces.push_back(&s.scene);
     sim::checkSceneReferences(bodies, surfaces, scene.interaction ? &*scene.interaction : nullptr, origin);
-    sim::checkAssessmentMeasurable(scene, origin);
+    std::vector<std::string> bodyNames;
+    for (const BodyProject& b : p.bodies)
+        bodyNames.push_back(b.scene.name);
+    sim::checkAssessmentMeasurable(scene, bodyNames, origin);
     return p;
 }
 

@@ -363,3 +363,23 @@ TEST(Assessment, AMetricTheSceneCannotMeasureIsRefusedWhenTheSceneIsRead) {
     EXPECT_THAT(refusal(R"({"metrics": {"path_length_m": {"limit": 1}}})"),
                 HasSubstr("assessment.metrics.path_length_m: needs a tool"));
 }
+
+// Vessel injury: the samples in which an energized hook was within the margin of the vessel to
+// protect, in seconds; a vessel that is not a body of the scene is refused.
+TEST(Assessment, VesselInjuryIsTheTimeTheEnergizedHookSpentAtTheVessel) {
+    player::SessionResult r = timeline(20, {mover("hook", "right", 20, 0, 0, 0)});
+    r.timeline.vesselNear.assign(20, 0);
+    for (size_t i = 5; i < 9; ++i)
+        r.timeline.vesselNear[i] = 1;
+    sim::AssessmentDesc d;
+    d.vessel = sim::VesselTarget{"vessel", 0.0015};
+    d.metrics = {{"vessel_injury_s", 0.1, {}}};
+    const player::Assessment a = player::assessSession(r, d);
+    EXPECT_NEAR(*a.find("vessel_injury_s")->value, 0.4, 1e-9);
+    EXPECT_FALSE(a.find("vessel_injury_s")->passed);
+    EXPECT_EQ(a.completionS, std::nullopt) << "a vessel to protect is not a task target";
+    EXPECT_THAT(refusal(R"({"targets": {"vessel": {"body": "aorta"}}})"),
+                HasSubstr("assessment.targets.vessel.body: 'aorta' is not a body of the scene"));
+    EXPECT_THAT(refusal(R"({"metrics": {"vessel_injury_s": {"limit": 0.1}}})"),
+                HasSubstr("assessment.metrics.vessel_injury_s: needs a vessel to protect (targets.vessel)"));
+}

@@ -130,6 +130,15 @@ TEST(AssessmentCase, TheRectumsDissectionPassesAndCuttingAsideOrClippingOnceFail
     EXPECT_THAT(metricLine(one.process.out, "clips_on_target"), HasSubstr("1 count (limit ≥ 2) FAIL"));
     EXPECT_THAT(metricLine(one.process.out, "completion_time_s"), HasSubstr("— s (limit ≤ 9) FAIL"));
     EXPECT_THAT(one.process.out, HasSubstr("verdict       FAIL (completion_time_s, clips_on_target)"));
+    // The hook 4.6 mm deeper while it cuts: it burns through the fat to the vessel to protect.
+    const auto deep = editedReplay(replay, dir.path() / "deep.csv", 1, [](double t, std::vector<std::string>& f) {
+        if (t >= 1.35 && t <= 2.91) f[4] = add(f[4], -0.012);
+        return true;
+    });
+    const SessionRun burn = run(vcase, deep.string(), 440, dir.path(), "deep");
+    EXPECT_THAT(metricLine(burn.process.out, "vessel_injury_s"),
+                ::testing::MatchesRegex(R"(vessel_injury_s 0\.[0-9]+ s \(limit ≤ 0\.1\) FAIL)"));
+    EXPECT_THAT(metricLine(good.process.out, "vessel_injury_s"), HasSubstr("0 s (limit ≤ 0.1) pass"));
     // The page says the same.
     const std::string page = readTextFile(dir.path() / "once" / "session.html");
     EXPECT_THAT(page, HasSubstr("<span class=\"bad\">FAIL</span>"));
@@ -147,7 +156,9 @@ TEST(AssessmentCase, TheAnastomosisClosesItsGapAndAMissedBiteFails) {
     EXPECT_THAT(metricLine(good.process.out, "completion_time_s"), HasSubstr("(limit ≤ 80) pass"));
     EXPECT_NEAR(good.report["suture"]["initial_gap_m"].get<double>(), 0.002, 1e-6);
     for (const auto& m : good.report["assessment"]["metrics"])
-        if (m["name"] == "final_gap_m") EXPECT_LT(m["value"].get<double>(), 0.0002) << "the replay closes the gap";
+        if (m["name"] == "final_gap_m") {
+            EXPECT_LT(m["value"].get<double>(), 0.0002) << "the replay closes the gap";
+        }
     EXPECT_THAT(metricLine(good.process.out, "final_gap_m"), HasSubstr("(limit ≤ 0.0002) pass"));
 
     // Stitch 8 (frames 490–559) 4 mm up the needle's axis: the needle misses the walls there, the

@@ -41,6 +41,8 @@ const std::vector<MetricInfo>& metricCatalogue() {
         {"bites_missed", "count", true,
          "passes through one wall (two punctures) that made no bite across the wound, or bites out of depth"},
         {"bite_spacing_error_m", "m", true, "largest distance of a spacing between successive bites outside its range"},
+        {"vessel_injury_s", "s", true,
+         "time the energized hook's tip was within the margin of the vessel to protect (targets.vessel)"},
         {"final_gap_m", "m", true, "largest gap between the wound's edges at the end"},
         {"max_thread_tension_n", "N", true, "largest tension of the thread"},
     };
@@ -144,6 +146,7 @@ void checkMetricsHaveTheirTargets(const JsonField& metrics, const AssessmentDesc
     need({"clips_on_target", "clips_off_target"}, !a.clips.empty(), "a clip target (targets.clip)");
     need({"bites", "bites_missed", "bite_spacing_error_m"}, a.suture.has_value(), "a suture target (targets.suture)");
     need({"economy_of_motion"}, a.referencePathM.has_value(), "reference_path_m");
+    need({"vessel_injury_s"}, a.vessel.has_value(), "a vessel to protect (targets.vessel)");
 }
 
 json vec(const Vec3& v) {
@@ -156,7 +159,12 @@ AssessmentDesc readAssessment(const JsonField& block) {
     block.object({"targets", "force_threshold_n", "reference_path_m", "metrics"});
     AssessmentDesc a;
     if (auto targets = block.find("targets")) {
-        targets->object({"cut", "clip", "suture"});
+        targets->object({"cut", "clip", "suture", "vessel"});
+        if (auto v = targets->find("vessel")) {
+            v->object({"body", "margin"});
+            a.vessel = VesselTarget{(*v)["body"].nonEmptyString()};
+            a.vessel->margin = v->number("margin", a.vessel->margin, NumberRule::aboveUpTo(0, 0.02));
+        }
         if (auto c = targets->find("cut")) readCutTargets(*c, a);
         if (auto c = targets->find("clip")) readClipTargets(*c, a);
         if (auto s = targets->find("suture")) a.suture = readSutureTarget(*s);
@@ -181,6 +189,7 @@ void writeAssessment(const AssessmentDesc& a, json& doc) {
     }
     for (const ClipTarget& c : a.clips)
         j["targets"]["clip"].push_back({{"position", vec(c.position)}, {"tolerance", c.tolerance}, {"count", c.count}});
+    if (const auto& v = a.vessel) j["targets"]["vessel"] = {{"body", v->body}, {"margin", v->margin}};
     if (const auto& s = a.suture)
         j["targets"]["suture"] = {{"plane", {{"point", vec(s->planePoint)}, {"normal", vec(s->planeNormal)}}},
                                   {"bites", s->bites},

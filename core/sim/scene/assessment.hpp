@@ -10,7 +10,8 @@
 ///       "cut":  [{"line": [[x,y,z], ...], "radius": 0.005, "coverage": 0.5}],
 ///       "clip": [{"position": [x,y,z], "tolerance": 0.008, "count": 2}],
 ///       "suture": {"plane": {"point": [x,y,z], "normal": [x,y,z]}, "bites": 2,
-///                  "depth": [0.001, 0.006], "spacing": [0.001, 0.01], "max_gap": 0.0005}
+///                  "depth": [0.001, 0.006], "spacing": [0.001, 0.01], "max_gap": 0.0005},
+///       "vessel": {"body": "vessel", "margin": 0.0015}
 ///     },
 ///     "force_threshold_n": 1.0,
 ///     "reference_path_m": 0.25,
@@ -24,6 +25,8 @@
 ///            distance from the plane; met when `bites` bites lie within `depth`, successive bites
 ///            within `spacing` (m; or as far out as the bite_spacing_error_m limit allows), and the
 ///            gauge's gap is at most `max_gap` (m)
+///   vessel   a body to protect: time the energized hook's tip is within `margin` (m) of its
+///            nodes is vessel injury (not a task target: it does not count for completion)
 ///   force_threshold_n   tissue force above which time is counted and damage accrues (default 1.5),
 ///                       for the tools that declare no damage_force_n of their own
 ///   reference_path_m    an expert's instrument path for the task (economy of motion); optional
@@ -74,6 +77,13 @@ struct SutureTarget {
     double maxGap = 0.0005;                        ///< m
 };
 
+/// A vessel to protect: the energized hook's tip within `margin` (m) of any of the body's nodes
+/// injures it (metric vessel_injury_s).
+struct VesselTarget {
+    std::string body;
+    double margin = 0.0015; ///< m
+};
+
 struct ExpertLevel {
     double mean = 0, sd = 0;
 };
@@ -88,6 +98,7 @@ struct AssessmentDesc {
     std::vector<CutTarget> cuts;
     std::vector<ClipTarget> clips;
     std::optional<SutureTarget> suture;
+    std::optional<VesselTarget> vessel; ///< not a task target: it does not count for completion
     double forceThresholdN = 1.5;
     std::optional<double> referencePathM;
     std::vector<MetricLevel> metrics; ///< in catalogue order

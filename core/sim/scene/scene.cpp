@@ -314,8 +314,11 @@ void writeNodeWeightFields(const std::vector<double>& weights, const std::string
 
 } // namespace
 
-void checkAssessmentMeasurable(const SceneDesc& scene, const std::string& origin) {
+void checkAssessmentMeasurable(const SceneDesc& scene, const std::vector<std::string>& bodies,
+                               const std::string& origin) {
     if (!scene.assessment) return;
+    if (const auto& v = scene.assessment->vessel; v && std::find(bodies.begin(), bodies.end(), v->body) == bodies.end())
+        throw InputError(origin + ": assessment.targets.vessel.body: '" + v->body + "' is not a body of the scene");
     int tools = 0;
     bool left = false, right = false, ported = false;
     auto tool = [&](const std::string& hand, bool port) {
@@ -404,7 +407,10 @@ SceneDesc parseScene(std::string_view text, const std::string& origin) {
     for (const SurfaceDesc& s : scene.surfaces)
         surfaces.push_back(&s);
     checkSceneReferences(bodies, surfaces, scene.interaction ? &*scene.interaction : nullptr, origin);
-    checkAssessmentMeasurable(scene, origin);
+    std::vector<std::string> bodyNames;
+    for (const BodyDesc& b : scene.bodies)
+        bodyNames.push_back(b.name);
+    checkAssessmentMeasurable(scene, bodyNames, origin);
     return scene;
 }
 

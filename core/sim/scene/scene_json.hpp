@@ -38,9 +38,11 @@ LaparoscopeDesc readLaparoscope(const JsonField& scope);
 /// "assessment" (assessment.hpp): targets, metric limits and expert levels.
 AssessmentDesc readAssessment(const JsonField& assessment);
 /// Every metric the assessment judges can be measured in `scene` (out_of_view_s needs a
-/// laparoscope, instrument_collisions two tools, final_gap_m a suture with a gauge, ...): throws
-/// viscera::InputError "<origin>: assessment.metrics.<name>: needs <what> (...)".
-void checkAssessmentMeasurable(const SceneDesc& scene, const std::string& origin);
+/// laparoscope, instrument_collisions two tools, final_gap_m a suture with a gauge, ...), and its
+/// vessel to protect is one of `bodies` (the scene's body names): throws viscera::InputError
+/// "<origin>: assessment.metrics.<name>: needs <what> (...)".
+void checkAssessmentMeasurable(const SceneDesc& scene, const std::vector<std::string>& bodies,
+                               const std::string& origin);
 void writeAssessment(const AssessmentDesc& assessment, nlohmann::json& doc);
 void writeLaparoscope(const LaparoscopeDesc& scope, nlohmann::json& doc);
 /// The common fields of a "device" block (hand, motion_scale, force_scale, max_force_n); marks it
