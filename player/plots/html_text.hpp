@@ -6,7 +6,8 @@ namespace viscera::player {
 
 /// `s` with & < > " escaped for HTML text and attribute values.
 std::string htmlText(const std::string& s);
-/// printf of one double, e.g. formatNumber("%.1f s", 12.34) == "12.3 s".
+/// printf of one double, e.g. formatNumber("%.1f s", 12.34) == "12.3 s"; a non-finite value
+/// prints as "—" in the conversion's place (never "nan").
 std::string formatNumber(const char* format, double v);
 /// The shared style sheet of the results pages.
 inline constexpr const char* kPageStyle =

@@ -485,22 +485,8 @@ std::vector<double> frameTimes(const PlotInput& in) {
     return t;
 }
 
-/// printf of one double; a non-finite value prints as "—" in its place (never "nan").
-std::string formatted(const char* f, double v) {
-    if (!std::isfinite(v)) {
-        std::string out = f;
-        const size_t a = out.find('%');
-        const size_t b = a == std::string::npos ? a : out.find_first_of("fge", a);
-        if (b != std::string::npos) out.replace(a, b - a + 1, "—");
-        return out;
-    }
-    char buf[96];
-    std::snprintf(buf, sizeof buf, f, v);
-    return buf;
-}
-
 QString fmt(const char* f, double v) {
-    return QString::fromStdString(formatted(f, v));
+    return QString::fromStdString(formatNumber(f, v));
 }
 
 QByteArray stepTimePlot(const PlotInput& in) {
@@ -729,10 +715,6 @@ QByteArray accuracyPlot(const PlotInput& in) {
     return c.png();
 }
 
-std::string num(const char* f, double v) {
-    return formatted(f, v);
-}
-
 /// The verdict and one row per metric: value, limit, pass or fail, expert level; each row also
 /// carries the summary's line for the metric (data-line), so the page and the summary agree.
 std::string verdictHtml(const Assessment& a) {
@@ -815,20 +797,20 @@ PlotFiles writeSessionPlots(const PlotInput& in, const std::filesystem::path& di
     auto row = [&](const std::string& k, const std::string& v) {
         page += "<tr><th>" + k + "</th><td>" + v + "</td></tr>\n";
     };
-    row("frames",
-        std::to_string(in.frames.size()) + num(" (%.2f s simulated", in.simTime_s) + num(" in %.2f s)", in.wallTime_s));
+    row("frames", std::to_string(in.frames.size()) + formatNumber(" (%.2f s simulated", in.simTime_s) +
+                      formatNumber(" in %.2f s)", in.wallTime_s));
     if (in.realTimeFactor > 0)
         row("real-time factor",
-            num("%.2f", in.realTimeFactor) + (in.realTimeFactor < 1 ? " — slower than real time" : ""));
-    row("step time", num("mean %.2f ms", in.stepMsMean) + num(", p99 %.2f ms", in.stepMsP99) +
-                         num(" (budget %.1f ms)", in.frameDt_s * 1e3));
+            formatNumber("%.2f", in.realTimeFactor) + (in.realTimeFactor < 1 ? " — slower than real time" : ""));
+    row("step time", formatNumber("mean %.2f ms", in.stepMsMean) + formatNumber(", p99 %.2f ms", in.stepMsP99) +
+                         formatNumber(" (budget %.1f ms)", in.frameDt_s * 1e3));
     if (!in.trainee.empty()) row("trainee", htmlText(in.trainee) + ", started " + htmlText(in.startedUtc));
     for (const auto& t : in.tools)
         row(htmlText(t.name) + " (" + htmlText(t.kind) + ")",
             "path " + formatFigure(t.pathM) + " m, largest force " + formatFigure(t.maxForceN) + " N");
     if (!in.device.empty())
         row("device force", "max " + formatFigure(in.maxDeviceForceN) + " N" +
-                                (in.caseMaxForceN > 0 ? num(" (case limit %.1f N)", in.caseMaxForceN) : ""));
+                                (in.caseMaxForceN > 0 ? formatNumber(" (case limit %.1f N)", in.caseMaxForceN) : ""));
     std::map<std::string, int64_t> counts;
     for (const auto& e : in.events)
         counts[e.kind] += e.kind == "cut" || e.kind == "puncture" ? e.count : 1;

@@ -239,12 +239,6 @@ TargetFigures judgeTargets(const SessionResult& r, const sim::AssessmentDesc& a)
     return out;
 }
 
-/// Motion figures over all tools: idle time (up to `until`), jerk, instrument collisions, out of view.
-struct MotionFigures {
-    double idleS = 0, jerkRms = 0, outOfViewS = 0;
-    int collisions = 0;
-};
-
 double idleTime(const SessionTimeline& tl, const std::vector<double>& span, double until) {
     double idle = 0;
     bool started = false;

@@ -91,7 +91,6 @@ void TimelineRecorder::sample(const sim::World& world) {
     if (const sim::Laparoscope* scope = world.laparoscope()) {
         m_tl.cameraTip.push_back(scope->pose().tip);
         m_tl.cameraView.push_back(scope->pose().view);
-        m_tl.cameraUp.push_back(scope->pose().up);
         m_tl.cameraSteering.push_back(scope->steering() ? 1 : 0);
     }
     // Every tool has one entry per sample (a tool the world no longer reports holds its last).
@@ -149,7 +148,6 @@ void TimelineRecorder::record(const sim::World& world) {
         halve(m_tl.t_s);
         halve(m_tl.cameraTip);
         halve(m_tl.cameraView);
-        halve(m_tl.cameraUp);
         halve(m_tl.cameraSteering);
         halve(m_tl.vesselNear);
         for (SessionTimeline::Tool& tool : m_tl.tools) {

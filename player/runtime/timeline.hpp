@@ -49,7 +49,7 @@ struct SessionTimeline {
     /// The laparoscope (cases that have one): its tip and whether the Cam pedal steered it, one
     /// per sample.
     std::vector<Eigen::Vector3d> cameraTip;
-    std::vector<Eigen::Vector3d> cameraView, cameraUp; ///< unit, the optic's view and image up
+    std::vector<Eigen::Vector3d> cameraView; ///< unit, the optic's viewing direction
     std::vector<char> cameraSteering;
     /// Per sample: an energized hook's tip within the margin of the assessment's vessel to protect
     /// (cases with a targets.vessel).

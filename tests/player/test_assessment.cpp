@@ -152,7 +152,6 @@ TEST(Assessment, OutOfViewCountsInstrumentsInUseOutsideTheScopesCone) {
     for (size_t i = 0; i < 20; ++i) { // the scope at x = -0.05 looking along +x, then turned away
         r.timeline.cameraTip.push_back(Vec3(-0.05, 0, 0));
         r.timeline.cameraView.push_back(Vec3(i < 10 ? 1 : -1, 0, 0)); // turned away for the second second
-        r.timeline.cameraUp.push_back(Vec3::UnitZ());
     }
     const player::Assessment a = player::assessSession(r, sim::AssessmentDesc{});
     EXPECT_NEAR(*a.find("out_of_view_s")->value, 1.0, 1e-9);
