@@ -1,8 +1,11 @@
 #include "case_catalog.hpp"
 
 #include "case/case_package.hpp"
+#include "case/trust.hpp"
+#include "sim/util/error.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <exception>
 #include <set>
@@ -30,17 +33,21 @@ std::string dateOf(const std::string& utc) {
 
 } // namespace
 
+std::string CaseInfo::verdict() const {
+    if (usable()) return "verified: signed by " + signer + (keyId.empty() ? std::string() : " (" + keyId + ")");
+    return "cannot run — " + refusal + ": " + reason();
+}
+
+std::string CaseInfo::reason() const {
+    const std::string prefix = path.string() + ": "; // the tile names the file already
+    return problem.rfind(prefix, 0) == 0 ? problem.substr(prefix.size()) : problem;
+}
+
 std::string CaseInfo::description() const {
-    if (!usable()) { // the reader's message names the file, which the tile shows already
-        const std::string prefix = path.string() + ": ";
-        return problem.rfind(prefix, 0) == 0 ? problem.substr(prefix.size()) : problem;
-    }
     std::string out;
     for (size_t i = 0; i < features.size(); ++i)
         out += (i ? ", " : "") + features[i];
-    out += out.empty() ? "" : " · ";
-    out += signer.empty() ? "not signed" : "signed by " + signer;
-    if (expires) out += " · expires " + dateOf(*expires);
+    if (expires) out += (out.empty() ? "" : " · ") + std::string("expires ") + dateOf(*expires);
     return out;
 }
 
@@ -59,26 +66,77 @@ CaseFolders CaseFolders::standard(const std::vector<fs::path>& extra) {
     return c;
 }
 
-CaseInfo readCaseInfo(const fs::path& file) {
+vcase::TrustPolicy launcherTrust(const std::vector<fs::path>& keyFiles) {
+    vcase::TrustPolicy p;
+    for (const fs::path& folder : vcase::systemTrustFolders())
+        p.trusted.addFolder(folder);
+    for (const fs::path& f : keyFiles)
+        p.trusted.addKeyFile(f);
+    try {
+        p.stateFolder = vcase::stateFolder(std::nullopt); // the versions this account has run
+    } catch (const InputError&) {
+        p.stateFolder.reset(); // the player will say why when a case is started
+    }
+    p.now =
+        std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+    return p;
+}
+
+namespace {
+
+/// The whole package (every file's size and SHA-256, the meshes), once per package bytes.
+void checkPayload(const fs::path& file, const std::string& sha256, const Verification& check, CaseInfo& info) {
+    const std::optional<PackageStamp> stamp = stampOf(file, sha256);
+    std::optional<std::string> problem = stamp && check.cache ? check.cache->find(*stamp) : std::nullopt;
+    if (!problem) {
+        try {
+            (void)vcase::CasePackage::open(file);
+            problem = "";
+        } catch (const std::exception& e) {
+            problem = e.what();
+        }
+        if (stamp && check.cache) check.cache->store(*stamp, *problem);
+    }
+    if (problem->empty()) return;
+    info.refusal = "tampered";
+    info.problem = *problem;
+}
+
+} // namespace
+
+CaseInfo readCaseInfo(const fs::path& file, const Verification& check) {
     CaseInfo info;
     info.path = file;
     info.title = file.stem().string();
+    std::string sha256;
     try {
-        const auto package = vcase::CasePackage::open(file);
-        const vcase::Manifest& m = package->manifest();
-        if (m.title && !m.title->empty()) info.title = *m.title;
-        info.caseId = m.caseId;
-        info.caseVersion = m.caseVersion;
-        info.features = m.features;
-        info.expires = m.expires;
-        if (package->signature()) info.signer = package->signature()->signer;
-    } catch (const std::exception& e) {
+        vcase::readPackageHead(file, [&](const vcase::PackageHead& head) {
+            const vcase::Manifest& m = head.manifest;
+            if (m.title && !m.title->empty()) info.title = *m.title;
+            info.caseId = m.caseId;
+            info.caseVersion = m.caseVersion;
+            info.features = m.features;
+            info.expires = m.expires;
+            if (head.signature) info.signer = head.signature->signer;
+            sha256 = head.sha256;
+            const vcase::Provenance p = vcase::checkProvenance(head, check.trust);
+            info.signer = p.signer;
+            info.keyId = p.keyId;
+        });
+    } catch (const vcase::TrustRefusal& e) {
+        info.refusal = vcase::TrustRefusal::label(e.kind());
         info.problem = e.what();
+        return info;
+    } catch (const std::exception& e) {
+        info.refusal = "cannot be read";
+        info.problem = e.what();
+        return info;
     }
+    checkPayload(file, sha256, check, info);
     return info;
 }
 
-std::vector<CaseInfo> findCases(const CaseFolders& where) {
+std::vector<CaseInfo> findCases(const CaseFolders& where, const Verification& check) {
     std::vector<CaseInfo> cases;
     std::set<fs::path> seen;
     for (const fs::path& folder : where.folders) {
@@ -90,9 +148,10 @@ std::vector<CaseInfo> findCases(const CaseFolders& where) {
             if (p.extension() != ".vcase" || !it->is_regular_file(fileEc)) continue;
             const fs::path canonical = fs::weakly_canonical(p, fileEc);
             if (!seen.insert(fileEc ? p : canonical).second) continue;
-            cases.push_back(readCaseInfo(p));
+            cases.push_back(readCaseInfo(p, check));
         }
     }
+    if (check.cache) check.cache->save();
     std::sort(cases.begin(), cases.end(), [](const CaseInfo& a, const CaseInfo& b) {
         return a.title != b.title ? a.title < b.title : a.path < b.path;
     });

@@ -1,8 +1,8 @@
 // viscera-launcher: the trainees' case picker. Lists the cases of the samples folder, the user's
 // case folder and the folders named, and starts the chosen one in viscera-player's trainee window.
 //
-//   viscera-launcher [--player PATH] [--device SPEC] [--pairing-key FILE] [FOLDER...]
-//   viscera-launcher --list [FOLDER...]
+//   viscera-launcher [--player PATH] [--device SPEC] [--pairing-key FILE] [--trust KEY.pem] [FOLDER...]
+//   viscera-launcher --list [--trust KEY.pem] [FOLDER...]
 //
 // Exit codes: 0 success, 1 bad input (a folder that is not one), 2 usage.
 #include "case_catalog.hpp"
@@ -32,19 +32,24 @@ using namespace viscera;
 namespace fs = std::filesystem;
 
 void usage(std::FILE* out) {
-    std::fputs("usage: viscera-launcher [--player PATH] [--device SPEC] [--pairing-key FILE] [FOLDER...]\n"
-               "       viscera-launcher --list [FOLDER...]\n"
+    std::fputs("usage: viscera-launcher [--player PATH] [--device SPEC] [--pairing-key FILE] [--trust KEY.pem]\n"
+               "                        [FOLDER...]\n"
+               "       viscera-launcher --list [--trust KEY.pem] [FOLDER...]\n"
                "       viscera-launcher --version\n"
                "\n"
                "Lists the cases (*.vcase) of /usr/share/viscera/samples, $XDG_DATA_HOME/viscera/cases\n"
-               "(~/.local/share/viscera/cases) and each FOLDER, and starts the chosen one with\n"
-               "'viscera-player run CASE' in the trainee window.\n"
+               "(~/.local/share/viscera/cases) and each FOLDER, each checked as the player would (signature\n"
+               "by a trusted publisher, expiry, no older version than one run, every file's digest), and\n"
+               "starts a verified one with 'viscera-player run CASE' in the trainee window. A case that\n"
+               "cannot run says why on its tile; a player that stops with an error shows its reason.\n"
                "\n"
                "  --player PATH       the player to start (default: viscera-player beside this program,\n"
                "                      else from PATH)\n"
                "  --device SPEC       passed to every run: console:HOST:PORT, keyboard, replay:FILE, scripted:NAME\n"
                "  --pairing-key FILE  passed to every run (with --device console:...)\n"
-               "  --list              print the cases found, one per line, and exit (no window)\n"
+               "  --trust KEY.pem     trust this publisher key too (repeatable; passed to every run)\n"
+               "  --list              print the cases found, one per line (path, case id, version, title,\n"
+               "                      verdict, facts), and exit (no window)\n"
                "  --screenshot FILE   open the picker, write it as PNG (atomically) and exit\n"
                "\n"
                "Keys: arrows choose, Enter starts, Esc quits; letters, digits and . _ - @ type the trainee id.\n"
@@ -75,6 +80,8 @@ Options parse(const sim::CliArgs& args) {
             o.launch.device = value();
         else if (a == "--pairing-key")
             o.launch.pairingKey = value();
+        else if (a == "--trust")
+            o.launch.trustKeys.push_back(fs::absolute(value()).string());
         else if (a == "--list")
             o.list = true;
         else if (a == "--screenshot") {
@@ -100,8 +107,9 @@ Options parse(const sim::CliArgs& args) {
 
 int listCases(const std::vector<launcher::CaseInfo>& cases) {
     for (const launcher::CaseInfo& c : cases)
-        std::printf("%s\t%s\t%s\t%s\t%s\n", c.path.c_str(), c.caseId.empty() ? "-" : c.caseId.c_str(),
-                    c.caseVersion.empty() ? "-" : c.caseVersion.c_str(), c.title.c_str(), c.description().c_str());
+        std::printf("%s\t%s\t%s\t%s\t%s\t%s\n", c.path.c_str(), c.caseId.empty() ? "-" : c.caseId.c_str(),
+                    c.caseVersion.empty() ? "-" : c.caseVersion.c_str(), c.title.c_str(), c.verdict().c_str(),
+                    c.description().c_str());
     if (cases.empty()) std::fprintf(stderr, "viscera-launcher: no case found\n");
     return 0;
 }
@@ -109,7 +117,10 @@ int listCases(const std::vector<launcher::CaseInfo>& cases) {
 int runLauncher(const sim::CliArgs& args) {
     const Options o = parse(args);
     const launcher::CaseFolders where = launcher::CaseFolders::standard(o.folders);
-    if (o.list) return listCases(launcher::findCases(where));
+    const std::vector<fs::path> keys(o.launch.trustKeys.begin(), o.launch.trustKeys.end());
+    launcher::VerifyCache cache(launcher::defaultVerifyCacheFile());
+    const launcher::Verification check{launcher::launcherTrust(keys), &cache};
+    if (o.list) return listCases(launcher::findCases(where, check));
     const char* platform = std::getenv("QT_QPA_PLATFORM");
     const char* display = std::getenv("DISPLAY");
     const char* wayland = std::getenv("WAYLAND_DISPLAY");
@@ -120,8 +131,26 @@ int runLauncher(const sim::CliArgs& args) {
     static char name[] = "viscera-launcher";
     static char* argv[] = {name, nullptr};
     QGuiApplication app(argc, argv);
-    launcher::PickerContent content{launcher::findCases(where), where.folders};
-    launcher::PickerWindow window(std::move(content), o.launch, launcher::launchDetached);
+    // The players started are the launcher's children (their reasons come back to the window):
+    // closing the window leaves a running session alone and quits when the last one has ended.
+    QGuiApplication::setQuitOnLastWindowClosed(false);
+    int running = 0;
+    bool closed = false;
+    const launcher::Launch launch = [&](const launcher::PlayerCommand& c, launcher::ExitHandler onExit) {
+        std::string why = launcher::launchWatched(c, [&, onExit](int code, const std::string& reason) {
+            --running;
+            onExit(code, reason);
+            if (closed && running == 0) app.quit();
+        });
+        if (why.empty()) ++running;
+        return why;
+    };
+    QObject::connect(&app, &QGuiApplication::lastWindowClosed, &app, [&] {
+        closed = true;
+        if (running == 0) app.quit();
+    });
+    launcher::PickerContent content{launcher::findCases(where, check), where.folders};
+    launcher::PickerWindow window(std::move(content), o.launch, launch);
     window.show();
     int status = 0;
     if (!o.screenshot.empty())

@@ -4,6 +4,7 @@
 #include <QKeyEvent>
 #include <QMouseEvent>
 #include <QPainter>
+#include <QPointer>
 
 #include <algorithm>
 
@@ -91,7 +92,7 @@ bool PickerWindow::startSelected() {
     }
     const CaseInfo& c = m_content.cases[static_cast<size_t>(m_selected)];
     if (!c.usable()) {
-        setStatus("This case cannot be started: " + c.problem, true);
+        setStatus("This case cannot be started: " + c.refusal + " — " + c.reason(), true);
         return false;
     }
     if (!m_trainee.empty()) {
@@ -101,7 +102,17 @@ bool PickerWindow::startSelected() {
         }
     }
     const PlayerCommand command = playerCommand(m_settings, c.path, m_trainee);
-    if (std::string why = m_launch(command); !why.empty()) {
+    const QPointer<PickerWindow> self(this);
+    ExitHandler onExit = [self, title = c.title](int code, const std::string& reason) {
+        if (!self) return;
+        if (code == 0)
+            self->setStatus(title + " ended.", false);
+        else
+            self->setStatus(title + " stopped (exit " + std::to_string(code) +
+                                "): " + (reason.empty() ? "the player gave no reason" : reason),
+                            true);
+    };
+    if (std::string why = m_launch(command, std::move(onExit)); !why.empty()) {
         setStatus("Not started: " + why, true);
         return false;
     }
@@ -246,14 +257,25 @@ void PickerWindow::paintTile(QPainter& p, const CaseInfo& c, QRect r, bool selec
     p.drawText(QRect(inner.left(), inner.top(), inner.width(), 34), Qt::AlignLeft | Qt::AlignVCenter, title);
     p.setFont(font(17, false));
     p.setPen(kDim);
-    const std::string idLine =
-        c.usable() ? c.caseId + "  ·  version " + c.caseVersion : c.path.filename().string() + "  ·  cannot be read";
-    p.drawText(QRect(inner.left(), inner.top() + 40, inner.width(), 26), Qt::AlignLeft | Qt::AlignVCenter,
+    const std::string idLine = c.caseId.empty() ? c.path.filename().string() + "  ·  cannot be read"
+                                                : c.caseId + "  ·  version " + c.caseVersion;
+    p.drawText(QRect(inner.left(), inner.top() + 38, inner.width(), 24), Qt::AlignLeft | Qt::AlignVCenter,
                p.fontMetrics().elidedText(q(idLine), Qt::ElideRight, inner.width()));
+    // What verified, or why it cannot run: the trainee sees it before choosing.
+    p.setFont(font(16, true));
+    p.setPen(c.usable() ? kAccent : kError);
+    // Two lines at most; the whole reason is in the status line when the tile is chosen.
+    const QRect verdictBox(inner.left(), inner.top() + 64, inner.width(), 2 * p.fontMetrics().lineSpacing());
+    QString verdict = q(c.verdict());
+    while (verdict.size() > 8 &&
+           p.fontMetrics().boundingRect(verdictBox, Qt::TextWordWrap, verdict).height() > verdictBox.height())
+        verdict = verdict.left(verdict.size() - 8) + "…";
+    p.drawText(verdictBox, Qt::AlignLeft | Qt::AlignTop | Qt::TextWordWrap, verdict);
     p.setFont(font(15, false));
-    p.setPen(c.usable() ? kDim : kError);
-    p.drawText(QRect(inner.left(), inner.top() + 70, inner.width(), inner.height() - 70),
-               Qt::AlignLeft | Qt::AlignTop | Qt::TextWordWrap, q(c.description()));
+    p.setPen(kDim);
+    p.drawText(QRect(inner.left(), verdictBox.bottom() + 2, inner.width(), inner.bottom() - verdictBox.bottom() - 2),
+               Qt::AlignLeft | Qt::AlignVCenter,
+               p.fontMetrics().elidedText(q(c.description()), Qt::ElideRight, inner.width()));
 }
 
 void PickerWindow::paintNoCases(QPainter& p, QSize size) const {

@@ -1,7 +1,7 @@
 #pragma once
 /// The command line the launcher starts a case with, and the function that starts it. The window
-/// builds a PlayerCommand and hands it to a Launch function: the real one starts the player
-/// detached (QProcess::startDetached), a test's records it.
+/// builds a PlayerCommand and hands it to a Launch function: the real one starts the player and
+/// watches it (launchWatched), a test's records it.
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -15,6 +15,7 @@ struct LaunchSettings {
     std::string player = "viscera-player"; ///< program: a path, or a name looked up in PATH
     std::string device;                    ///< --device SPEC for every run; empty: the player's default
     std::string pairingKey;                ///< --pairing-key FILE; empty: none
+    std::vector<std::string> trustKeys;    ///< --trust KEY.pem for every run (the launcher trusts them too)
 };
 
 struct PlayerCommand {
@@ -41,9 +42,19 @@ std::string traineeIdProblem(std::string_view id);
 PlayerCommand playerCommand(const LaunchSettings& settings, const std::filesystem::path& caseFile,
                             std::string_view traineeId);
 
-/// Starts a command; returns an empty string on success, else one line saying why not.
-using Launch = std::function<std::string(const PlayerCommand&)>;
-/// Starts the command detached from the launcher (QProcess::startDetached): the player outlives it.
-std::string launchDetached(const PlayerCommand& command);
+/// Called once a started player has exited: its exit status (non-zero: the case did not run to
+/// its end) and its one-line reason (the last line it wrote to stderr, without the program's name;
+/// control characters removed). Called on the launcher's thread.
+using ExitHandler = std::function<void(int exitCode, const std::string& reason)>;
+
+/// Starts a command and calls `onExit` when it ends; returns an empty string on success, else one
+/// line saying why it could not start.
+using Launch = std::function<std::string(const PlayerCommand&, ExitHandler onExit)>;
+/// Starts the command as a child of the launcher (QProcess), reading its stderr for the reason
+/// it gives when it refuses a case or fails. The player's own stdout is discarded.
+std::string launchWatched(const PlayerCommand& command, ExitHandler onExit);
+/// The reason in a player's stderr: its last non-empty line, "viscera-player: " dropped, control
+/// characters replaced by spaces, at most 300 characters.
+std::string exitReason(std::string_view stderrText);
 
 } // namespace viscera::launcher

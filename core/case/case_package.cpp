@@ -173,88 +173,89 @@ std::optional<PackageSignature> readSignature(const Failure& fail, const detail:
     return PackageSignature::parse(readEntry(fail, zip, e), fail.origin(kSignatureName));
 }
 
-Verified verifyBytes(std::string_view bytes, const std::string& name, const Limits& limits) {
-    if (!(limits.maxCompressionRatio > 0))
-        throw std::invalid_argument("vcase::Limits: maxCompressionRatio must be positive");
-    const Failure fail(name);
+/// (a) to (d): the archive's directory, every rule that needs no entry's data.
+struct Archive {
+    std::unique_ptr<detail::ZipReader> zip;
+    std::vector<Entry> entries;
+    std::map<std::string_view, const Entry*> files; ///< file entries by name (names are unique)
+};
 
+Archive openArchive(const Failure& fail, std::string_view bytes, const Limits& limits) {
     // (a) size; existence and readability were checked by the caller that read the file.
     if (bytes.size() > limits.maxPackageBytes)
         fail.package("package is " + bytesText(bytes.size()) + ", larger than the limit of " +
                      bytesText(limits.maxPackageBytes));
-
     // (b) zip container, entry count.
-    std::unique_ptr<detail::ZipReader> zip;
+    Archive a;
     try {
         if (bytes.size() < kMinZipBytes) throw detail::ZipError("too short for a zip archive");
-        zip = detail::ZipReader::open(bytes);
+        a.zip = detail::ZipReader::open(bytes);
     } catch (const detail::ZipError& error) {
         fail.package(std::string("not a valid zip archive (truncated or corrupt): ") + error.what());
     }
-    const uint64_t count = zip->entryCount();
+    const uint64_t count = a.zip->entryCount();
     if (count > limits.maxEntries)
         fail.package("package has " + std::to_string(count) + " entries, more than the limit of " +
                      std::to_string(limits.maxEntries));
-    std::vector<Entry> entries;
-    entries.reserve(count);
+    a.entries.reserve(count);
     for (uint64_t i = 0; i < count; ++i) {
         Entry e;
         try {
-            e.info = zip->entry(i);
+            e.info = a.zip->entry(i);
         } catch (const detail::ZipError& error) {
             fail.package("not a valid zip archive (truncated or corrupt): entry " + std::to_string(i) + ": " +
                          error.what());
         }
         e.index = i;
         e.directory = !e.info.name.empty() && e.info.name.back() == '/';
-        entries.push_back(std::move(e));
+        a.entries.push_back(std::move(e));
     }
-
     // (c) names; (d) sizes.
-    checkNames(fail, entries);
-    checkSizes(fail, entries, limits, bytes.size());
+    checkNames(fail, a.entries);
+    checkSizes(fail, a.entries, limits, bytes.size());
+    for (const Entry& e : a.entries)
+        if (!e.directory) a.files.emplace(e.info.name, &e);
+    return a;
+}
 
-    // (e) manifest.
-    std::map<std::string_view, const Entry*> files; // file entries by name (names are unique)
-    for (const Entry& e : entries)
-        if (!e.directory) files.emplace(e.info.name, &e);
-    auto manifestEntry = files.find(kManifestName);
-    if (manifestEntry == files.end()) fail.entry(kManifestName, "missing (a package needs manifest.json at its root)");
+/// (e) manifest.json and signature.json, the only entries inflated before the admission check.
+void readHead(const Failure& fail, const Archive& a, const Limits& limits, Verified& out) {
+    auto manifestEntry = a.files.find(kManifestName);
+    if (manifestEntry == a.files.end())
+        fail.entry(kManifestName, "missing (a package needs manifest.json at its root)");
     const Entry& me = *manifestEntry->second;
     if (me.info.size > limits.maxManifestBytes)
         fail.entry(kManifestName, "size " + bytesText(me.info.size) + " exceeds the manifest limit of " +
                                       bytesText(limits.maxManifestBytes));
-    Verified out;
-    out.manifestText = readEntry(fail, *zip, me);
+    out.manifestText = readEntry(fail, *a.zip, me);
     out.manifest = Manifest::parse(out.manifestText, fail.origin(kManifestName));
-    out.signature = readSignature(fail, *zip, files);
-    out.sha256 = sha256Hex(bytes);
-    out.bytes = bytes.size();
+    out.signature = readSignature(fail, *a.zip, a.files);
+}
 
-    // (f) listed files: present, size, sha256; then nothing unlisted.
+/// (f) listed files: present, size, sha256; then nothing unlisted.
+void readListedFiles(const Failure& fail, const Archive& a, Verified& out) {
     for (const FileEntry& listed : out.manifest.files) {
-        auto it = files.find(listed.path);
-        if (it == files.end()) fail.entry(listed.path, "listed in manifest.json but missing from the package");
+        auto it = a.files.find(listed.path);
+        if (it == a.files.end()) fail.entry(listed.path, "listed in manifest.json but missing from the package");
         const Entry& e = *it->second;
         if (e.info.size != listed.size)
             fail.entry(listed.path, "size mismatch (manifest says " + bytesText(listed.size) + ", entry has " +
                                         bytesText(e.info.size) + ")");
-        std::string data = readEntry(fail, *zip, e);
+        std::string data = readEntry(fail, *a.zip, e);
         std::string hash = sha256Hex(data);
         if (hash != listed.sha256)
             fail.entry(listed.path, "sha256 mismatch (manifest says " + listed.sha256 + ", file has " + hash + ")");
         out.files.emplace(listed.path, std::move(data));
     }
-    for (const Entry& e : entries)
+    for (const Entry& e : a.entries)
         if (!e.directory && e.info.name != kManifestName && e.info.name != kSignatureName &&
             !out.files.count(e.info.name))
             fail.entry(e.info.name, "file is not listed in manifest.json");
+}
 
-    // (g) compatibility with this player.
-    checkPlayerCompatibility(out.manifest, fail.origin(kManifestName));
-
-    // (h) meshes.
-    for (const auto& [path, data] : out.files) {
+/// (h) meshes.
+void parseMeshes(const std::string& name, const Verified& v) {
+    for (const auto& [path, data] : v.files) {
         if (!path.ends_with(".vtet")) continue;
         try {
             sim::parseVtet(data, name + ":" + path);
@@ -263,10 +264,36 @@ Verified verifyBytes(std::string_view bytes, const std::string& name, const Limi
             throw InputError(error.what());
         }
     }
+}
+
+PackageHead headOf(const std::string& name, const Verified& v) {
+    return PackageHead{name, v.manifest, v.manifestText, v.signature, v.sha256, v.bytes};
+}
+
+/// (a) to (e), the admission check, then (f) to (h). `headOnly`: stop after the admission check.
+Verified verifyBytes(std::string_view bytes, const std::string& name, const Limits& limits, const Admission& admit,
+                     bool headOnly = false) {
+    if (!(limits.maxCompressionRatio > 0))
+        throw std::invalid_argument("vcase::Limits: maxCompressionRatio must be positive");
+    const Failure fail(name);
+    const Archive archive = openArchive(fail, bytes, limits);
+    Verified out;
+    readHead(fail, archive, limits, out);
+    out.sha256 = sha256Hex(bytes);
+    out.bytes = bytes.size();
+    // Whose package it is, before any other entry is inflated: an untrusted or unsigned package
+    // costs its directory and two small entries, never its payload.
+    if (admit) admit(headOf(name, out));
+    if (headOnly) return out;
+    readListedFiles(fail, archive, out);
+    // (g) compatibility with this player.
+    checkPlayerCompatibility(out.manifest, fail.origin(kManifestName));
+    parseMeshes(name, out);
     return out;
 }
 
-Verified verifyFile(const std::filesystem::path& path, const Limits& limits) {
+Verified verifyFile(const std::filesystem::path& path, const Limits& limits, const Admission& admit,
+                    bool headOnly = false) {
     namespace fs = std::filesystem;
     const std::string name = path.string();
     const Failure fail(name);
@@ -281,7 +308,7 @@ Verified verifyFile(const std::filesystem::path& path, const Limits& limits) {
         fail.package("package is " + bytesText(size) + ", larger than the limit of " +
                      bytesText(limits.maxPackageBytes));
     std::string bytes = readFile(path, limits.maxPackageBytes); // InputError "<path>: ..."
-    return verifyBytes(bytes, name, limits);
+    return verifyBytes(bytes, name, limits, admit, headOnly);
 }
 
 } // namespace
@@ -298,12 +325,14 @@ std::unique_ptr<CasePackage> CasePackage::make(std::string name, detail::Verifie
     return package;
 }
 
-std::unique_ptr<CasePackage> CasePackage::open(const std::filesystem::path& path, const Limits& limits) {
-    return make(path.string(), verifyFile(path, limits));
+std::unique_ptr<CasePackage> CasePackage::open(const std::filesystem::path& path, const Limits& limits,
+                                               const Admission& admit) {
+    return make(path.string(), verifyFile(path, limits, admit));
 }
 
-std::unique_ptr<CasePackage> CasePackage::fromBytes(std::string_view bytes, std::string name, const Limits& limits) {
-    Verified v = verifyBytes(bytes, name, limits);
+std::unique_ptr<CasePackage> CasePackage::fromBytes(std::string_view bytes, std::string name, const Limits& limits,
+                                                    const Admission& admit) {
+    Verified v = verifyBytes(bytes, name, limits, admit);
     return make(std::move(name), std::move(v));
 }
 
@@ -320,7 +349,15 @@ std::string_view CasePackage::read(std::string_view path) const {
 }
 
 Manifest verify(const std::filesystem::path& path, const Limits& limits) {
-    return verifyFile(path, limits).manifest;
+    return verifyFile(path, limits, {}).manifest;
+}
+
+void readPackageHead(const std::filesystem::path& path, const Admission& admit, const Limits& limits) {
+    (void)verifyFile(path, limits, admit, true);
+}
+
+PackageHead CasePackage::head() const {
+    return PackageHead{m_name, m_manifest, m_manifestText, m_signature, m_sha256, m_bytes};
 }
 
 } // namespace viscera::vcase

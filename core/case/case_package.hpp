@@ -13,7 +13,9 @@
 ///       maxEntryBytes, maxTotalBytes and maxCompressionRatio;
 ///   (e) manifest.json is present, at most maxManifestBytes, valid JSON, and schema-valid
 ///       (Manifest::parse); signature.json, when present, is at most kMaxSignatureBytes and
-///       well formed (PackageSignature::parse);
+///       well formed (PackageSignature::parse); these two are the only entries inflated before
+///       the caller's admission check (vcase::checkProvenance: signature, trust, expiry,
+///       rollback), so an unsigned or untrusted package never costs its payload;
 ///   (f) every listed file is present with the listed size and sha256; no file but manifest.json
 ///       and signature.json is unlisted;
 ///   (g) the schemaVersion and minPlayerVersion suit this player (checkPlayerCompatibility);
@@ -24,7 +26,9 @@
 #include "case/manifest.hpp"
 #include "case/signing.hpp"
 
+#include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -37,17 +41,37 @@ namespace detail {
 struct VerifiedPackage;
 }
 
+/// What is known of a package when its admission is decided: its directory passed (a) to (d), and
+/// manifest.json and signature.json (e) were read; nothing else was inflated. Views into the
+/// package being opened, valid during the admission call.
+struct PackageHead {
+    const std::string& name; ///< the package as named in messages
+    const Manifest& manifest;
+    const std::string& manifestText; ///< the exact bytes a signature covers
+    const std::optional<PackageSignature>& signature;
+    const std::string& sha256; ///< of the whole package file
+    uint64_t bytes;
+};
+
+/// Called once the head is read and before any other entry is inflated; throws
+/// viscera::InputError to refuse the package (open() then throws it).
+using Admission = std::function<void(const PackageHead&)>;
+
 /// A verified package, held in memory. Non-copyable; open() returns a unique_ptr.
 /// Memory: the uncompressed bytes of every listed file (at most Limits::maxTotalBytes); the
 /// archive itself is released once verified.
 class CasePackage {
 public:
-    /// Reads and verifies the package at `path`. Cost: one read of the file, one decompression
-    /// and one SHA-256 pass over every entry, one parse of every .vtet. Throws viscera::InputError.
-    static std::unique_ptr<CasePackage> open(const std::filesystem::path& path, const Limits& limits = {});
+    /// Reads and verifies the package at `path`; `admit` (when set) decides after (e) whether the
+    /// rest is read at all. Cost: one read of the file and a SHA-256 pass over it; after
+    /// admission, one decompression and one SHA-256 pass over every entry, one parse of every
+    /// .vtet. Throws viscera::InputError.
+    static std::unique_ptr<CasePackage> open(const std::filesystem::path& path, const Limits& limits = {},
+                                             const Admission& admit = {});
     /// The same checks on a package already in memory (only (a)'s size rule applies); `name`
     /// stands for the file in messages. `bytes` is not retained.
-    static std::unique_ptr<CasePackage> fromBytes(std::string_view bytes, std::string name, const Limits& limits = {});
+    static std::unique_ptr<CasePackage> fromBytes(std::string_view bytes, std::string name, const Limits& limits = {},
+                                                  const Admission& admit = {});
 
     ~CasePackage();
     CasePackage(const CasePackage&) = delete;
@@ -71,6 +95,8 @@ public:
     /// SHA-256 (64 lowercase hex) and size of the whole package file: which bytes were run.
     const std::string& sha256() const { return m_sha256; }
     uint64_t bytes() const { return m_bytes; }
+    /// The package's head, as its admission saw it (views into this package).
+    PackageHead head() const;
 
 private:
     CasePackage() = default;
@@ -84,6 +110,11 @@ private:
     uint64_t m_bytes = 0;
     std::map<std::string, std::string, std::less<>> m_files;
 };
+
+/// Checks (a) to (e) of the package at `path` and hands its head to `admit`; no entry but
+/// manifest.json and signature.json is inflated (what the launcher lists cases by). Cost: one read
+/// of the file and one SHA-256 pass over it. Throws viscera::InputError.
+void readPackageHead(const std::filesystem::path& path, const Admission& admit, const Limits& limits = {});
 
 /// Runs every check of CasePackage::open() and returns the manifest; for tools that only need a
 /// verdict. Same cost as open(); the file contents are released before returning.

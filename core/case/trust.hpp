@@ -1,9 +1,10 @@
 #pragma once
 /// Whether a verified package may run here: its publisher's signature against the keys this
-/// player trusts, its expiry, and (where a state folder exists) no rollback to an older version
-/// of a case already run. The player's `verify`, `run` and `soak` apply it after
+/// player trusts, its expiry, and no rollback to an older version of a case already run (the
+/// state folder, on by default). The player's `verify`, `run` and `soak` apply it after
 /// CasePackage::open() and before the scene is read.
 #include "case/case_package.hpp"
+#include "sim/util/error.hpp"
 
 #include <cstdint>
 #include <filesystem>
@@ -12,6 +13,20 @@
 #include <vector>
 
 namespace viscera::vcase {
+
+/// Why checkProvenance refused a package, for tools that show it as a state rather than a message
+/// (the launcher's tiles). what() is the one-line message.
+class TrustRefusal : public InputError {
+public:
+    enum class Kind { Unsigned, Tampered, Untrusted, Expired, RolledBack };
+    TrustRefusal(Kind kind, const std::string& message) : InputError(message), m_kind(kind) {}
+    Kind kind() const { return m_kind; }
+    /// A few words for the kind: "not signed", "tampered", "untrusted key", "expired", ...
+    static const char* label(Kind kind);
+
+private:
+    Kind m_kind;
+};
 
 /// A publisher key the player trusts: its name is the key file's name without ".pem" (or ".pub.pem").
 struct TrustedKey {
@@ -46,7 +61,8 @@ struct TrustPolicy {
     /// Run a package with no signature, or one by a key not trusted here (never one whose
     /// signature does not verify). Noted in the summary and the report.
     bool allowUnsigned = false;
-    /// Where the highest version run of each case is kept; empty: no rollback check.
+    /// Where the highest version run of each case is kept (the player always sets it, stateFolder());
+    /// empty: no rollback check (tools that only read a package).
     std::optional<std::filesystem::path> stateFolder;
     /// Seconds since the epoch, UTC: the time the expiry is checked against.
     int64_t now = 0;
@@ -74,10 +90,25 @@ struct Provenance {
 ///   KEY.pem or to /etc/viscera/trusted-publishers)"
 ///   "<package>: manifest.json: expires: the case expired at 2020-01-01T00:00:00Z (now …)"
 ///   "<package>: manifest.json: caseVersion 1.0.0 is older than 1.2.0, already run for case 'x' (state folder …)"
+/// Applied to a package's head (CasePackage::open's admission, readPackageHead) it needs nothing
+/// but manifest.json and signature.json: an untrusted package is refused before its payload is
+/// inflated.
+Provenance checkProvenance(const PackageHead& package, const TrustPolicy& policy);
 Provenance checkProvenance(const CasePackage& package, const TrustPolicy& policy);
 
-/// The state folder to use: `given` (created when missing), else $XDG_STATE_HOME/viscera or
-/// ~/.local/state/viscera when that folder exists; nullopt otherwise.
-std::optional<std::filesystem::path> stateFolder(const std::optional<std::filesystem::path>& given);
+/// The kiosk stations' state folder, shared by every account of the station: used when it exists
+/// (the administrator makes it, owned by the trainee account or root, mode 0700).
+inline constexpr std::string_view kSystemStateFolder = "/var/lib/viscera/state";
+
+/// Where the player keeps the versions run when no --state-dir is given: kSystemStateFolder when it
+/// exists, else $XDG_STATE_HOME/viscera, else ~/.local/state/viscera. Throws viscera::InputError
+/// when none can be named (no XDG_STATE_HOME and no HOME).
+std::filesystem::path defaultStateFolder();
+
+/// The state folder to use: `given` (--state-dir) or defaultStateFolder(), created 0700 when
+/// missing. Rollback protection is always on. Throws viscera::InputError, one line naming the
+/// folder, when it is a symbolic link, it or a folder above it is writable by others than root and
+/// the user (requireSafeAnchor), or it cannot be created.
+std::filesystem::path stateFolder(const std::optional<std::filesystem::path>& given);
 
 } // namespace viscera::vcase

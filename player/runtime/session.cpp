@@ -61,11 +61,12 @@ void loadCornerUvs(LoadedCase& out, const std::vector<render::CaseMaterialMaps>&
 
 LoadedCase loadCase(const std::filesystem::path& casePath, const vcase::TrustPolicy& trust) {
     LoadedCase out;
-    out.package = vcase::CasePackage::open(casePath);
+    // Whose case it is and whether it may run here, decided on manifest.json and signature.json
+    // alone: an unsigned, untrusted, expired or rolled-back package is refused before any other
+    // entry is inflated (the zip's directory and limits were checked before).
+    out.package = vcase::CasePackage::open(
+        casePath, {}, [&](const vcase::PackageHead& head) { out.provenance = vcase::checkProvenance(head, trust); });
     const vcase::CasePackage& pkg = *out.package;
-    // After the package's own checks (zip structure, sizes, digests, meshes: bounded by the limits)
-    // and before the scene is read, parsed or run: whose case it is, and whether it may run here.
-    out.provenance = vcase::checkProvenance(pkg, trust);
     const std::string sceneName = "scene.json";
     if (!pkg.contains(sceneName))
         throw InputError(pkg.name() + ": " + sceneName + ": required file is missing from the package");

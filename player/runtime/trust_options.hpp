@@ -3,8 +3,8 @@
 ///   --trust KEY.pem      trust this publisher's Ed25519 public key (repeatable), besides the
 ///                        system folders (vcase::systemTrustFolders)
 ///   --allow-unsigned     run a case no trusted publisher signed (said in the summary and report)
-///   --state-dir DIR      keep the versions run here and refuse a rollback (default: the user's
-///                        state folder when it exists, vcase::stateFolder)
+///   --state-dir DIR      keep the versions run here instead of the default state folder
+///                        (vcase::defaultStateFolder); rollback is refused either way
 #include "case/trust.hpp"
 
 #include <optional>
@@ -16,8 +16,9 @@
     "  --trust KEY.pem       trust this publisher key (Ed25519 PEM public key; repeatable) besides\n"                  \
     "                        /etc/viscera/trusted-publishers and <prefix>/share/viscera/trusted-publishers\n"          \
     "  --allow-unsigned      accept a case no trusted publisher signed (said in the summary and report)\n"             \
-    "  --state-dir DIR       record the case versions run and refuse an older one (default\n"                          \
-    "                        $XDG_STATE_HOME/viscera or ~/.local/state/viscera, where it exists)\n"
+    "  --state-dir DIR       where the case versions run are kept (an older version is always refused;\n"              \
+    "                        default /var/lib/viscera/state where it exists, else $XDG_STATE_HOME/viscera\n"           \
+    "                        or ~/.local/state/viscera, created 0700)\n"
 
 namespace viscera::player {
 

@@ -474,7 +474,8 @@ int cmdSample(const std::vector<std::string>& args) {
     return 0;
 }
 
-int cmdRemesh(const std::vector<std::string>& args) {
+/// What `viscera-studio remesh` was asked for: its input meshes, the output and the options.
+struct RemeshArgs {
     struct Input {
         std::string file;
         bake::CsgOp op;
@@ -486,6 +487,11 @@ int cmdRemesh(const std::vector<std::string>& args) {
     bake::RemeshParams params;
     std::optional<std::string> preview;
     bake::UvTransferMethod uvMethod = bake::UvTransferMethod::SeamCutting;
+};
+
+RemeshArgs parseRemeshArgs(const std::vector<std::string>& args) {
+    RemeshArgs r;
+    bake::RemeshParams& params = r.params;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         auto value = [&]() -> std::string {
@@ -495,18 +501,18 @@ int cmdRemesh(const std::vector<std::string>& args) {
         if (a == "--no-uv")
             params.transferUv = false;
         else if (a == "--uv-transfer")
-            uvMethod = parseUvTransferOption(value());
+            r.uvMethod = parseUvTransferOption(value());
         else if (a == "--uv-preview")
-            preview = value();
+            r.preview = value();
         else if (a == "--sample") {
             if (value() != "kidney") throw std::invalid_argument("--sample: the built-in sample is 'kidney'");
-            sample = true;
+            r.sample = true;
         } else if (a == "--subtract")
-            inputs.push_back({value(), bake::CsgOp::Difference});
+            r.inputs.push_back({value(), bake::CsgOp::Difference});
         else if (a == "--intersect")
-            inputs.push_back({value(), bake::CsgOp::Intersection});
+            r.inputs.push_back({value(), bake::CsgOp::Intersection});
         else if (a == "--scale")
-            opt.scale = parsePositive(a, value());
+            r.opt.scale = parsePositive(a, value());
         else if (a == "--voxel-size")
             params.voxelSize = parsePositive(a, value());
         else if (a == "--voxels")
@@ -523,37 +529,49 @@ int cmdRemesh(const std::vector<std::string>& args) {
             params.featureAngleDeg = parsePositive(a, value());
             if (params.featureAngleDeg > 180) throw std::invalid_argument("--feature-angle must be in (0, 180]");
         } else if (a == "-o" || a == "--output")
-            out = value();
+            r.out = value();
         else if (!a.empty() && a[0] == '-')
             throw std::invalid_argument("unknown option '" + a + "'");
         else
-            inputs.push_back({a, bake::CsgOp::Union});
+            r.inputs.push_back({a, bake::CsgOp::Union});
     }
-    if ((inputs.empty() && !sample) || !out)
+    if ((r.inputs.empty() && !r.sample) || !r.out)
         throw std::invalid_argument("remesh needs at least one <mesh> (or --sample kidney) and -o out.obj");
-    if (std::filesystem::path(*out).extension() != ".obj")
-        throw std::invalid_argument("-o '" + *out + "': the result is written as OBJ (.obj)");
-    requireWritableFile(*out, "the remeshed surface"); // before the work, which can take minutes
+    return r;
+}
+
+/// Refuses, before the work (which can take minutes), an output that cannot be written or that
+/// would overwrite an input.
+void checkRemeshOutputs(const RemeshArgs& a) {
+    const std::string& out = *a.out;
+    if (std::filesystem::path(out).extension() != ".obj")
+        throw std::invalid_argument("-o '" + out + "': the result is written as OBJ (.obj)");
+    requireWritableFile(out, "the remeshed surface");
     std::vector<std::filesystem::path> inputPaths;
-    for (const auto& part : inputs)
+    for (const auto& part : a.inputs)
         inputPaths.emplace_back(part.file);
-    requireNotAnInput(*out, "the remeshed surface", inputPaths);
-    if (preview) {
-        if (std::filesystem::path(*preview).extension() != ".png")
-            throw std::invalid_argument("--uv-preview '" + *preview + "': the preview is written as PNG (.png)");
-        requireWritableFile(*preview, "the UV preview");
-        requireNotAnInput(*preview, "the UV preview", inputPaths);
+    requireNotAnInput(out, "the remeshed surface", inputPaths);
+    if (a.preview) {
+        if (std::filesystem::path(*a.preview).extension() != ".png")
+            throw std::invalid_argument("--uv-preview '" + *a.preview + "': the preview is written as PNG (.png)");
+        requireWritableFile(*a.preview, "the UV preview");
+        requireNotAnInput(*a.preview, "the UV preview", inputPaths);
     }
+}
+
+/// The parts to remesh: the kidney sample's (with --sample), then every input mesh, each reported.
+std::vector<bake::RemeshPart> loadRemeshParts(const RemeshArgs& a) {
     std::vector<bake::RemeshPart> parts;
-    if (sample)
+    if (a.sample)
         for (bake::RemeshPart& part : bake::kidneyAnatomy()) {
             std::printf("part %s (sample, union): %zu vertices, %zu triangles, closed: %s\n", part.name.c_str(),
                         part.surface.vertexCount(), part.surface.triangleCount(),
                         part.surface.isClosedOriented() ? "yes" : "no");
             parts.push_back(std::move(part));
         }
-    opt.keepUv = params.transferUv; // the parts' UVs, transferred when every part has them
-    for (const Input& in : inputs) {
+    bake::ImportOptions opt = a.opt;
+    opt.keepUv = a.params.transferUv; // the parts' UVs, transferred when every part has them
+    for (const RemeshArgs::Input& in : a.inputs) {
         bake::ImportResult imported = bake::importSurfaceWithReport(in.file, opt);
         sim::TriMesh m = std::move(imported.mesh);
         std::printf("part %s (%s): %zu vertices, %zu triangles, closed: %s\n", in.file.c_str(),
@@ -562,14 +580,10 @@ int cmdRemesh(const std::vector<std::string>& args) {
         parts.push_back(
             {std::filesystem::path(in.file).filename().string(), std::move(m), in.op, std::move(imported.uv)});
     }
-    const auto t0 = std::chrono::steady_clock::now();
-    const bake::RemeshResult r = bake::voxelRemesh(parts, params, [](std::string_view stage, double f) {
-        std::fprintf(stderr, "viscera-studio: remesh: %.*s (%.0f%%)\n", int(stage.size()), stage.data(), 100.0 * f);
-        return true;
-    });
-    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const bake::RemeshReport& q = r.report;
-    if (!q.uvTransferred) bake::writeObj(*out, r.mesh);
+    return parts;
+}
+
+void printRemeshReport(const bake::RemeshReport& q, double secs) {
     std::printf("grid: voxel %.4g mm, %d x %d x %d voxels, %zu active; %zu open part(s) thickened (%zu of them "
                 "leaked), %zu closed over small holes\n",
                 q.voxelSize * 1e3, q.voxels[0], q.voxels[1], q.voxels[2], q.activeVoxels, q.openParts, q.leakedParts,
@@ -586,15 +600,31 @@ int cmdRemesh(const std::vector<std::string>& args) {
     std::printf("time: level sets %.2f s, isosurface %.2f s, remeshing %.2f s, UV cut and transfer %.2f s, checks "
                 "%.2f s (total %.2f s)\n",
                 q.levelSetSeconds, q.isosurfaceSeconds, q.remeshSeconds, q.uvSeconds, q.checkSeconds, secs);
+}
+
+int cmdRemesh(const std::vector<std::string>& args) {
+    const RemeshArgs a = parseRemeshArgs(args);
+    checkRemeshOutputs(a);
+    const std::string& out = *a.out;
+    const std::vector<bake::RemeshPart> parts = loadRemeshParts(a);
+    const auto t0 = std::chrono::steady_clock::now();
+    const bake::RemeshResult r = bake::voxelRemesh(parts, a.params, [](std::string_view stage, double f) {
+        std::fprintf(stderr, "viscera-studio: remesh: %.*s (%.0f%%)\n", int(stage.size()), stage.data(), 100.0 * f);
+        return true;
+    });
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const bake::RemeshReport& q = r.report;
+    if (!q.uvTransferred) bake::writeObj(out, r.mesh);
+    printRemeshReport(q, secs);
     if (!q.uvTransferred) {
-        if (params.transferUv) std::printf("uv: not transferred (a part has no UVs)\n");
-        std::printf("wrote %s\n", out->c_str());
+        if (a.params.transferUv) std::printf("uv: not transferred (a part has no UVs)\n");
+        std::printf("wrote %s\n", out.c_str());
         return 0;
     }
-    const UvChoice choice = reportUvTransfers(parts, r, uvMethod, preview);
-    bake::writeObjWithUv(*out, *choice.mesh, choice.uv);
-    std::printf("uv.written %s\n", std::string(uvTransferOptionName(uvMethod)).c_str());
-    std::printf("wrote %s\n", out->c_str());
+    const UvChoice choice = reportUvTransfers(parts, r, a.uvMethod, a.preview);
+    bake::writeObjWithUv(out, *choice.mesh, choice.uv);
+    std::printf("uv.written %s\n", std::string(uvTransferOptionName(a.uvMethod)).c_str());
+    std::printf("wrote %s\n", out.c_str());
     return 0;
 }
 

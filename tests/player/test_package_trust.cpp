@@ -144,7 +144,8 @@ TEST(PackageTrust, AnOlderVersionIsRefusedOnceANewerOneRanWithAStateFolder) {
                                                 "for case 'trust-slab' (state folder "));
     EXPECT_EQ(player({"verify", v11.string(), "--trust", kTrust, "--state-dir", state.string()}).exitCode, 1)
         << "verify makes the same check";
-    EXPECT_EQ(player({"verify", v11.string(), "--trust", kTrust}).exitCode, 0) << "no state folder, no record";
+    EXPECT_EQ(player({"verify", v11.string(), "--trust", kTrust}).exitCode, 0)
+        << "the default state folder is another one, and it has no record";
     EXPECT_THAT(readFile(state / "case-versions.json"), HasSubstr("\"trust-slab\": \"1.2.0\""));
     // An unsigned run allowed once records nothing: it cannot lock the trusted versions out.
     const fs::path v99 = writeSlab(dir, "v99.vcase", "99.0.0", "");
@@ -154,6 +155,68 @@ TEST(PackageTrust, AnOlderVersionIsRefusedOnceANewerOneRanWithAStateFolder) {
         0);
     EXPECT_EQ(run(v12).exitCode, 0) << "the trusted 1.2.0 still runs";
     EXPECT_THAT(readFile(state / "case-versions.json"), HasSubstr("\"trust-slab\": \"1.2.0\""));
+}
+
+TEST(PackageTrust, AFreshAccountRefusesARollbackWithNoStateDir) {
+    ScratchDir dir;
+    const fs::path home = dir.path() / "home";
+    fs::create_directories(home);
+    const fs::path v2 = writeSlab(dir, "v2.vcase", "2.0.0"), v1 = writeSlab(dir, "v1.vcase", "1.0.0");
+    // A fresh account: HOME with nothing in it, no XDG_STATE_HOME, no --state-dir.
+    auto asFreshUser = [&](const std::vector<std::string>& args) {
+        std::vector<std::string> env{"-u", "XDG_STATE_HOME", "HOME=" + home.string(), VISCERA_PLAYER_EXE};
+        env.insert(env.end(), args.begin(), args.end());
+        return test::runProcess("/usr/bin/env", env);
+    };
+    const auto r2 = asFreshUser({"run", v2.string(), "--headless", "--frames", "2", "--trust", kTrust});
+    ASSERT_EQ(r2.exitCode, 0) << r2.err;
+    const fs::path state = home / ".local/state/viscera";
+    EXPECT_EQ(fs::status(state).permissions() & fs::perms::all, fs::perms::owner_all) << "created 0700";
+    EXPECT_THAT(readFile(state / "case-versions.json"), HasSubstr("\"trust-slab\": \"2.0.0\""));
+    const auto r1 = asFreshUser({"run", v1.string(), "--headless", "--frames", "2", "--trust", kTrust});
+    EXPECT_EQ(r1.exitCode, 1);
+    EXPECT_THAT(r1.err, HasSubstr(v1.string() +
+                                  ": manifest.json: caseVersion 1.0.0 is older than 2.0.0, already run "
+                                  "for case 'trust-slab' (state folder " +
+                                  state.string() + ")"));
+    EXPECT_EQ(lineCount(r1.err), 1) << r1.err;
+    EXPECT_EQ(asFreshUser({"verify", v1.string(), "--trust", kTrust}).exitCode, 1) << "verify makes the same check";
+    // A world-writable state folder, or one reached through a link, is refused with one line.
+    const fs::path open = dir.path() / "open-state";
+    fs::create_directories(open);
+    fs::permissions(open, fs::perms::all);
+    const auto w = player({"verify", v2.string(), "--trust", kTrust, "--state-dir", open.string()});
+    EXPECT_EQ(w.exitCode, 1);
+    EXPECT_THAT(w.err, HasSubstr(open.string() + ": the state folder must be owned by root or by you and writable by "
+                                                 "no one else"));
+    EXPECT_EQ(lineCount(w.err), 1) << w.err;
+    fs::create_symlink(state, dir.path() / "state-link");
+    const auto l =
+        player({"verify", v2.string(), "--trust", kTrust, "--state-dir", (dir.path() / "state-link").string()});
+    EXPECT_EQ(l.exitCode, 1);
+    EXPECT_THAT(l.err, HasSubstr("the state folder must not be a symbolic link"));
+}
+
+TEST(PackageTrust, ATrustKeyThroughALinkOrInAWorldWritableFolderIsRefused) {
+    ScratchDir dir;
+    const fs::path c = writeSlab(dir, "slab.vcase");
+    const fs::path open = dir.path() / "shared";
+    fs::create_directories(open);
+    fs::permissions(open, fs::perms::all);
+    fs::copy_file(kTrust, open / "publisher.pub.pem");
+    fs::permissions(open / "publisher.pub.pem",
+                    fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read | fs::perms::others_read);
+    const auto w = player({"verify", c.string(), "--trust", (open / "publisher.pub.pem").string()});
+    EXPECT_EQ(w.exitCode, 1);
+    EXPECT_THAT(w.err, HasSubstr((open / "publisher.pub.pem").string() + ": a trusted publisher key lies in " +
+                                 open.string() + ", a folder writable by others than root and you"));
+    EXPECT_EQ(lineCount(w.err), 1) << w.err;
+    fs::create_symlink(kTrust, dir.path() / "linked.pub.pem");
+    const auto l = player({"verify", c.string(), "--trust", (dir.path() / "linked.pub.pem").string()});
+    EXPECT_EQ(l.exitCode, 1);
+    EXPECT_THAT(l.err, HasSubstr((dir.path() / "linked.pub.pem").string() +
+                                 ": a trusted publisher key must not be a symbolic link"));
+    EXPECT_EQ(player({"verify", c.string(), "--trust", kTrust}).exitCode, 0) << "the key itself is fine";
 }
 
 TEST(PackageTrust, TheStudioSignsWithAKeyKeptOutsideTheProject) {

@@ -106,7 +106,9 @@ TEST(PlayerCli, VerifyRejectsEachBrokenPackageWithADistinctMessage) {
     std::set<std::string> messages;
     for (const auto& c : cases) {
         const auto path = dir.write(std::string(c.label) + ".vcase", c.bytes);
-        test::ProcessResult r = player({"verify", path.string()});
+        // Unsigned: admitted only with --allow-unsigned, so that the package rules after the
+        // admission (digests, listing, compatibility) are reached at all.
+        test::ProcessResult r = player({"verify", path.string(), "--allow-unsigned"});
         EXPECT_EQ(r.exitCode, 1) << c.label << ": " << r.err;
         EXPECT_THAT(r.err, HasSubstr(c.rule)) << c.label;
         EXPECT_THAT(r.err, HasSubstr(path.string())) << c.label;
