@@ -2,6 +2,7 @@
 
 #include "case/case_package.hpp"
 #include "case/trust.hpp"
+#include "sim/util/atomic_file.hpp"
 #include "sim/util/error.hpp"
 
 #include <algorithm>
@@ -73,7 +74,7 @@ vcase::TrustPolicy launcherTrust(const std::vector<fs::path>& keyFiles) {
     for (const fs::path& f : keyFiles)
         p.trusted.addKeyFile(f);
     try {
-        p.stateFolder = vcase::stateFolder(std::nullopt); // the versions this account has run
+        p.stateFolder = vcase::stateFolder(std::nullopt, vcase::StateUse::Check); // versions this account ran
     } catch (const InputError&) {
         p.stateFolder.reset(); // the player will say why when a case is started
     }
@@ -84,13 +85,15 @@ vcase::TrustPolicy launcherTrust(const std::vector<fs::path>& keyFiles) {
 
 namespace {
 
-/// The whole package (every file's size and SHA-256, the meshes), once per package bytes.
-void checkPayload(const fs::path& file, const std::string& sha256, const Verification& check, CaseInfo& info) {
+/// The whole package (every file's size and SHA-256, the meshes), once per package bytes: `bytes`
+/// are the ones whose head was admitted and whose SHA-256 is `sha256`.
+void checkPayload(const fs::path& file, std::string_view bytes, const std::string& sha256, const Verification& check,
+                  CaseInfo& info) {
     const std::optional<PackageStamp> stamp = stampOf(file, sha256);
     std::optional<std::string> problem = stamp && check.cache ? check.cache->find(*stamp) : std::nullopt;
     if (!problem) {
         try {
-            (void)vcase::CasePackage::open(file);
+            (void)vcase::CasePackage::fromBytes(bytes, file.string());
             problem = "";
         } catch (const std::exception& e) {
             problem = e.what();
@@ -98,6 +101,7 @@ void checkPayload(const fs::path& file, const std::string& sha256, const Verific
         if (stamp && check.cache) check.cache->store(*stamp, *problem);
     }
     if (problem->empty()) return;
+    // The signed manifest was admitted: what fails now is bytes that are not the ones signed.
     info.refusal = "tampered";
     info.problem = *problem;
 }
@@ -108,9 +112,11 @@ CaseInfo readCaseInfo(const fs::path& file, const Verification& check) {
     CaseInfo info;
     info.path = file;
     info.title = file.stem().string();
-    std::string sha256;
+    std::string bytes, sha256;
     try {
-        vcase::readPackageHead(file, [&](const vcase::PackageHead& head) {
+        // One read: the head admitted, the payload checked and the cache keyed are the same bytes.
+        bytes = readFile(file, vcase::Limits{}.maxPackageBytes, "a case package");
+        vcase::readPackageHead(bytes, file.string(), [&](const vcase::PackageHead& head) {
             const vcase::Manifest& m = head.manifest;
             if (m.title && !m.title->empty()) info.title = *m.title;
             info.caseId = m.caseId;
@@ -132,7 +138,7 @@ CaseInfo readCaseInfo(const fs::path& file, const Verification& check) {
         info.problem = e.what();
         return info;
     }
-    checkPayload(file, sha256, check, info);
+    checkPayload(file, bytes, sha256, check, info);
     return info;
 }
 

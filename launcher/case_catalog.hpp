@@ -3,8 +3,9 @@
 /// manifest says and what verified. No Qt, no simulation. A package's head (manifest.json and
 /// signature.json) is checked as the player would (vcase::checkProvenance: signature, trusted key,
 /// expiry, rollback) before anything else is inflated, so an unsigned or untrusted package costs
-/// only its directory; a package that verified is then checked whole once (every file's size and
-/// SHA-256, the meshes: CasePackage::open) and the outcome remembered (VerifyCache).
+/// one read and one SHA-256 pass of its file, never the inflation of its payload; a package that
+/// verified is then checked whole once (every file's size and SHA-256, the meshes, on the same
+/// bytes) and the outcome remembered (VerifyCache).
 #include "case/trust.hpp"
 #include "verify_cache.hpp"
 

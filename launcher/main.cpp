@@ -130,12 +130,13 @@ int runLauncher(const sim::CliArgs& args) {
     static int argc = 1;
     static char name[] = "viscera-launcher";
     static char* argv[] = {name, nullptr};
-    QGuiApplication app(argc, argv);
     // The players started are the launcher's children (their reasons come back to the window):
     // closing the window leaves a running session alone and quits when the last one has ended.
-    QGuiApplication::setQuitOnLastWindowClosed(false);
+    // Declared before the application, which owns the processes, so that they outlive it.
     int running = 0;
     bool closed = false;
+    QGuiApplication app(argc, argv);
+    QGuiApplication::setQuitOnLastWindowClosed(false);
     const launcher::Launch launch = [&](const launcher::PlayerCommand& c, launcher::ExitHandler onExit) {
         std::string why = launcher::launchWatched(c, [&, onExit](int code, const std::string& reason) {
             --running;

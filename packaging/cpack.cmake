@@ -1,12 +1,17 @@
 # Debian packages: viscera-player (the lean runtime and the console simulator), viscera-studio
 # (authoring) and viscera-samples (the sample projects exported as cases). Made by
 # scripts/package.sh: it builds the target viscera_samples (the exports), then runs
-# `cpack -G DEB` in the build folder and checks what it made.
+# `cpack -G DEB` in the build folder and checks what it made. packaging/samples/CMakeLists.txt
+# includes it too, to make the samples package alone from a studio already built (a release
+# signed with the publisher's key, without compiling).
 #
 # Every package carries /usr/share/doc/<package>/ (copyright, changelog.gz and its own guides:
 # VISCERA_DOCS_<component>) and the man pages of its programs.
 
-set(VISCERA_PACKAGES player studio samples)
+if(NOT DEFINED VISCERA_PACKAGES) # packaging/samples sets "samples"
+  set(VISCERA_PACKAGES player studio samples)
+endif()
+cmake_path(GET CMAKE_CURRENT_LIST_DIR PARENT_PATH VISCERA_ROOT) # the source tree
 set(VISCERA_PKG_OUT ${CMAKE_BINARY_DIR}/packaging)
 
 # Man pages (version filled in) and the changelog, compressed without a timestamp (gzip -n).
@@ -33,7 +38,7 @@ add_custom_target(viscera_package_docs ALL DEPENDS ${VISCERA_PKG_GZ})
 # desktop application.
 set(VISCERA_DOCS_player ${CMAKE_CURRENT_LIST_DIR}/doc/trainee-guide.md ${CMAKE_CURRENT_LIST_DIR}/doc/console-setup.md
     ${CMAKE_CURRENT_LIST_DIR}/vcase-spec.md ${CMAKE_CURRENT_LIST_DIR}/console-protocol.md)
-set(VISCERA_DOCS_studio ${CMAKE_SOURCE_DIR}/README.md ${CMAKE_CURRENT_LIST_DIR}/vcase-spec.md
+set(VISCERA_DOCS_studio ${VISCERA_ROOT}/README.md ${CMAKE_CURRENT_LIST_DIR}/vcase-spec.md
     ${CMAKE_CURRENT_LIST_DIR}/console-protocol.md)
 set(VISCERA_DOCS_samples ${CMAKE_CURRENT_LIST_DIR}/vcase-spec.md)
 foreach(comp IN LISTS VISCERA_PACKAGES)
@@ -45,9 +50,10 @@ install(FILES ${VISCERA_PKG_OUT}/viscera-player.1.gz ${VISCERA_PKG_OUT}/viscera-
         DESTINATION share/man/man1 COMPONENT player)
 install(FILES ${VISCERA_PKG_OUT}/viscera-studio.1.gz DESTINATION share/man/man1 COMPONENT studio)
 
-# The sample cases: every project in projects/ exported by the studio just built. Not part of
-# `all` (a minute of meshing); scripts/package.sh builds it before cpack.
-file(GLOB VISCERA_SAMPLE_PROJECTS LIST_DIRECTORIES true CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/projects/*)
+# The sample cases: every project in projects/ exported by the studio just built, signed with
+# VISCERA_SAMPLE_KEY (packaging/publisher_key.cmake). Not part of `all` (a minute of meshing);
+# scripts/package.sh builds it before cpack.
+file(GLOB VISCERA_SAMPLE_PROJECTS LIST_DIRECTORIES true CONFIGURE_DEPENDS ${VISCERA_ROOT}/projects/*)
 set(VISCERA_SAMPLE_CASES)
 foreach(dir IN LISTS VISCERA_SAMPLE_PROJECTS)
   if(NOT EXISTS ${dir}/project.json)
@@ -58,26 +64,44 @@ foreach(dir IN LISTS VISCERA_SAMPLE_PROJECTS)
   set(out ${CMAKE_BINARY_DIR}/samples/${name}.vcase)
   add_custom_command(OUTPUT ${out}
     COMMAND $<TARGET_FILE:viscera-studio> export ${dir} -o ${out} --sign-key ${VISCERA_SAMPLE_KEY}
-            --signer "Viscera samples (test key)"
+            --signer "${VISCERA_SAMPLE_SIGNER}"
     DEPENDS viscera-studio ${VISCERA_SAMPLE_KEY} ${inputs}
     COMMENT "Exporting the sample ${name}" VERBATIM)
   list(APPEND VISCERA_SAMPLE_CASES ${out})
 endforeach()
 add_custom_target(viscera_samples DEPENDS ${VISCERA_SAMPLE_CASES})
-add_dependencies(viscera_samples viscera_sample_key)
+if(TARGET viscera_sample_key) # the test key (studio/cli); packaging/samples has a publisher key
+  add_dependencies(viscera_samples viscera_sample_key)
+endif()
 install(FILES ${VISCERA_SAMPLE_CASES} DESTINATION share/viscera/samples COMPONENT samples OPTIONAL)
 # The samples' recorded console sessions (`--device replay:FILE`): every projects/<project>/replays/*.csv
 # in share/viscera/samples/replays/<project>/.
-file(GLOB VISCERA_SAMPLE_REPLAYS CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/projects/*/replays/*.csv)
+file(GLOB VISCERA_SAMPLE_REPLAYS CONFIGURE_DEPENDS ${VISCERA_ROOT}/projects/*/replays/*.csv)
 foreach(replay IN LISTS VISCERA_SAMPLE_REPLAYS)
   get_filename_component(dir ${replay} DIRECTORY)
   get_filename_component(dir ${dir} DIRECTORY)
   get_filename_component(name ${dir} NAME)
   install(FILES ${replay} DESTINATION share/viscera/samples/replays/${name} COMPONENT samples)
 endforeach()
-# The samples' publisher key, trusted by the player installed beside it (the vendor trust folder).
-install(FILES ${VISCERA_SAMPLE_PUBLIC_KEY} DESTINATION share/viscera/trusted-publishers
-        RENAME viscera-samples.pem COMPONENT samples OPTIONAL)
+# The samples' trust anchor: in a release (VISCERA_PUBLISHER_KEY) the publisher's public key,
+# KEY.pub.pem under its own name (which names the signer), trusted by every player on the machine
+# (the vendor trust folder). A test build installs none: its test key stays in the build folder,
+# and a site that runs its samples adds the key itself (VISCERA_SAMPLES_TRUST_NOTE).
+if(VISCERA_SAMPLE_TRUST_ANCHOR)
+  install(FILES ${VISCERA_SAMPLE_TRUST_ANCHOR} DESTINATION share/viscera/trusted-publishers COMPONENT samples)
+  get_filename_component(anchor ${VISCERA_SAMPLE_TRUST_ANCHOR} NAME)
+  set(VISCERA_SAMPLES_TRUST_NOTE
+"They are signed with the publisher's key, whose public half this
+package installs as a trusted publisher for every player on the
+machine: /usr/share/viscera/trusted-publishers/${anchor}")
+else()
+  set(VISCERA_SAMPLES_TRUST_NOTE
+"They are signed with a test key and this package installs no trusted
+publisher key: to run them, a site copies the signer's public key
+(KEY.pub.pem) into /etc/viscera/trusted-publishers/ (owned by root,
+mode 0644, the folder writable by no one else), or passes
+--trust KEY.pub.pem to viscera-player.")
+endif()
 
 set(CPACK_PACKAGE_NAME "viscera")
 set(CPACK_PACKAGE_VENDOR "Viscera")
@@ -135,6 +159,8 @@ Training cases for Viscera Player, in /usr/share/viscera/samples: a
 tissue slab and an organ under gravity, a liver to palpate with a
 probe, a rectal dissection (grasper, energy hook, clip applier) and an
 intestinal anastomosis with a running suture; their recorded console
-sessions in /usr/share/viscera/samples/replays.")
+sessions in /usr/share/viscera/samples/replays.
+.
+${VISCERA_SAMPLES_TRUST_NOTE}")
 
 include(CPack)

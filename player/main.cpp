@@ -157,7 +157,7 @@ int cmdVerify(const std::vector<std::string>& args) {
     // Every check a run makes before its first frame: the package, its signature, expiry and
     // version, the scene, the meshes, the work budget and the assembled world (stability), so
     // that a case verify accepts also loads.
-    const player::LoadedCase loaded = player::loadCase(operands[0], trust.policy());
+    const player::LoadedCase loaded = player::loadCase(operands[0], trust.policy(vcase::StateUse::Check));
     const vcase::Manifest& m = loaded.package->manifest();
     std::printf("%s: ok (case %s %s, %zu files, features:", operands[0].c_str(), m.caseId.c_str(),
                 m.caseVersion.c_str(), m.files.size());
@@ -468,7 +468,7 @@ int cmdRun(const std::vector<std::string>& args) {
         if (servo.cpu < 0) servo.cpu = haptics::defaultServoCpu();
         if (servo.cpu >= 0) haptics::pinCurrentThreadExcept(servo.cpu);
     }
-    const vcase::TrustPolicy trust = r.trust.policy();
+    const vcase::TrustPolicy trust = r.trust.policy(vcase::StateUse::Record);
     player::LoadedCase loaded = player::loadCase(*r.casePath, trust);
     if (trust.stateFolder && loaded.provenance.signature == "trusted") {
         // This version ran: an older one is refused from now on. Only a trusted publisher's runs
@@ -557,7 +557,7 @@ int cmdSoak(const std::vector<std::string>& args) {
         }
     }
     if (cases.empty()) throw std::invalid_argument("soak needs at least one case");
-    opt.trust = trust.policy();
+    opt.trust = trust.policy(vcase::StateUse::Check);
     for (player::SoakCase& c : cases)
         c.frames = frames;
     if (reportPath) { // before the soak, which runs for minutes or hours

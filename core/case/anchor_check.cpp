@@ -2,15 +2,22 @@
 
 #include "sim/util/error.hpp"
 
+#include <deque>
+#include <grp.h>
+#include <pwd.h>
 #include <string>
 #include <sys/stat.h>
 #include <system_error>
 #include <unistd.h>
+#include <vector>
 
 namespace viscera::vcase {
 namespace {
 
 namespace fs = std::filesystem;
+
+/// Links followed while resolving one path, as the kernel's limit (ELOOP).
+constexpr int kMaxLinks = 40;
 
 std::string modeText(mode_t mode) {
     std::string out;
@@ -19,65 +26,105 @@ std::string modeText(mode_t mode) {
     return out;
 }
 
-bool ownerIsSafe(const struct stat& st) {
-    return st.st_uid == 0 || st.st_uid == ::geteuid();
+/// The user's private group (Debian's default: a group of the user's name, the user's primary
+/// group, with no other member): its write bit gives no one else access.
+bool isPrivateGroup(gid_t gid) {
+    if (gid != ::getegid()) return false;
+    const struct passwd* pw = ::getpwuid(::geteuid());
+    const struct group* gr = ::getgrgid(gid);
+    if (!pw || !gr || std::string(pw->pw_name) != gr->gr_name) return false;
+    return !gr->gr_mem || !gr->gr_mem[0];
 }
 
-/// Writable by someone other than its owner (root's sticky folders excepted).
-bool othersMayWrite(const struct stat& st) {
-    if (!(st.st_mode & (S_IWGRP | S_IWOTH))) return false;
-    return !(S_ISDIR(st.st_mode) && (st.st_mode & S_ISVTX) && st.st_uid == 0);
+/// Owned by root or the user, and writable by no one else. `stickyRootOk`: a root-owned folder
+/// with the sticky bit (/tmp) passes too, as a folder *above* an anchor: there only an entry's
+/// owner can rename or remove it, and every entry below is checked in turn.
+bool safe(const struct stat& st, bool stickyRootOk) {
+    if (st.st_uid != 0 && st.st_uid != ::geteuid()) return false;
+    if (st.st_mode & S_IWOTH) return stickyRootOk && S_ISDIR(st.st_mode) && (st.st_mode & S_ISVTX) && st.st_uid == 0;
+    if (st.st_mode & S_IWGRP) return isPrivateGroup(st.st_gid);
+    return true;
 }
 
 [[noreturn]] void refuse(const fs::path& named, std::string_view what, const std::string& rule) {
     throw InputError(named.string() + ": " + std::string(what) + " " + rule);
 }
 
-/// The entry itself: owner and mode (a symbolic link was refused before).
-void checkEntry(const fs::path& named, std::string_view what, const struct stat& st) {
-    if (!ownerIsSafe(st) || othersMayWrite(st))
-        refuse(named, what,
-               "must be owned by root or by you and writable by no one else (owner uid " + std::to_string(st.st_uid) +
-                   ", mode " + modeText(st.st_mode) + ")");
+std::string facts(const struct stat& st) {
+    return "owner uid " + std::to_string(st.st_uid) + ", mode " + modeText(st.st_mode);
 }
 
-/// Every folder from `start` up to `/`: a folder that fails names itself in the message.
-void checkFolders(const fs::path& named, std::string_view what, fs::path start, bool followLinks) {
-    for (fs::path dir = start;; dir = dir.parent_path()) {
-        struct stat st {};
-        const int rc = followLinks ? ::stat(dir.c_str(), &st) : ::lstat(dir.c_str(), &st);
-        if (rc == 0 && !S_ISLNK(st.st_mode) && (!ownerIsSafe(st) || othersMayWrite(st)))
+/// The path's components after `base`, "" and "." dropped.
+void append(std::deque<std::string>& todo, const fs::path& p, bool front) {
+    std::vector<std::string> parts;
+    for (const fs::path& c : p.relative_path())
+        if (!c.empty() && c != ".") parts.push_back(c.string());
+    if (front)
+        todo.insert(todo.begin(), parts.begin(), parts.end());
+    else
+        todo.insert(todo.end(), parts.begin(), parts.end());
+}
+
+/// Resolves `named` one component at a time, as the kernel does, and checks every folder whose
+/// entries it passes through: a link is followed only out of a safe folder, so nobody but root
+/// and the user can change where the path leads. Returns the resolved path of the final entry
+/// (which may not exist) and, when it exists, its lstat.
+struct Walk {
+    fs::path resolved;
+    bool exists = false;
+    struct stat st {};
+};
+
+Walk walk(const fs::path& named, std::string_view what) {
+    std::error_code ec;
+    const fs::path start = fs::absolute(named, ec);
+    if (ec) refuse(named, what, "cannot be located (" + ec.message() + ")");
+    std::deque<std::string> todo;
+    append(todo, start, false);
+    fs::path dir = "/";
+    int links = 0;
+    for (;;) {
+        struct stat ds {};
+        if (::stat(dir.c_str(), &ds) == 0 && !safe(ds, true))
             refuse(named, what,
-                   "lies in " + dir.string() + ", a folder writable by others than root and you (owner uid " +
-                       std::to_string(st.st_uid) + ", mode " + modeText(st.st_mode) +
+                   "lies in " + dir.string() + ", a folder writable by others than root and you (" + facts(ds) +
                        "); keep it where only root or you can change it");
-        if (dir == dir.parent_path() || dir.empty()) break;
+        if (todo.empty()) return {dir, true, ds}; // named "/" itself
+        const std::string c = todo.front();
+        todo.pop_front();
+        if (c == "..") {
+            dir = dir.parent_path();
+            continue;
+        }
+        const fs::path next = dir / c;
+        Walk w{next, false, {}};
+        if (::lstat(next.c_str(), &w.st) != 0) return w; // missing: what is above it was checked
+        w.exists = true;
+        if (S_ISLNK(w.st.st_mode)) {
+            const fs::path target = fs::read_symlink(next, ec);
+            if (todo.empty())
+                refuse(named, what,
+                       "must not be a symbolic link" +
+                           (ec ? std::string() : " (it points to " + target.string() + ")") +
+                           "; put the file itself there");
+            if (ec || ++links > kMaxLinks) refuse(named, what, "cannot be resolved (too many links)");
+            append(todo, target, true);
+            if (target.is_absolute()) dir = "/";
+            continue;
+        }
+        if (todo.empty()) return w;
+        if (!S_ISDIR(w.st.st_mode)) return {next, false, {}}; // a file in the middle: the caller's read says so
+        dir = next;
     }
 }
 
 } // namespace
 
-void requireSafeAnchor(const fs::path& path, std::string_view what) {
-    std::error_code ec;
-    const fs::path named = fs::absolute(path, ec).lexically_normal();
-    if (ec) refuse(path, what, "cannot be located (" + ec.message() + ")");
-    struct stat st {};
-    if (::lstat(named.c_str(), &st) != 0) {                   // missing: the caller says so, skips it or makes it,
-        checkFolders(path, what, named.parent_path(), false); // but never under a folder others may write
-        return;
-    }
-    if (S_ISLNK(st.st_mode)) {
-        const fs::path target = fs::read_symlink(named, ec);
-        refuse(path, what,
-               "must not be a symbolic link" + (ec ? std::string() : " (it points to " + target.string() + ")") +
-                   "; copy the file there instead");
-    }
-    checkEntry(path, what, st);
-    // The folders as named (a link among them is judged by the folder holding it), then the
-    // folders it resolves to (where the bytes really are).
-    checkFolders(path, what, named.parent_path(), false);
-    const fs::path resolved = fs::canonical(named.parent_path(), ec);
-    if (!ec) checkFolders(path, what, resolved, true);
+std::filesystem::path requireSafeAnchor(const fs::path& path, std::string_view what) {
+    const Walk w = walk(path, what);
+    if (w.exists && !safe(w.st, false))
+        refuse(path, what, "must be owned by root or by you and writable by no one else (" + facts(w.st) + ")");
+    return w.resolved;
 }
 
 } // namespace viscera::vcase

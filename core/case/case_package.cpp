@@ -270,7 +270,7 @@ PackageHead headOf(const std::string& name, const Verified& v) {
     return PackageHead{name, v.manifest, v.manifestText, v.signature, v.sha256, v.bytes};
 }
 
-/// (a) to (e), the admission check, then (f) to (h). `headOnly`: stop after the admission check.
+/// (a) to (e) and (g), the admission check, then (f) and (h). `headOnly`: stop after the admission check.
 Verified verifyBytes(std::string_view bytes, const std::string& name, const Limits& limits, const Admission& admit,
                      bool headOnly = false) {
     if (!(limits.maxCompressionRatio > 0))
@@ -279,6 +279,8 @@ Verified verifyBytes(std::string_view bytes, const std::string& name, const Limi
     const Archive archive = openArchive(fail, bytes, limits);
     Verified out;
     readHead(fail, archive, limits, out);
+    // (g) compatibility with this player: the manifest's alone, so before the admission too.
+    checkPlayerCompatibility(out.manifest, fail.origin(kManifestName));
     out.sha256 = sha256Hex(bytes);
     out.bytes = bytes.size();
     // Whose package it is, before any other entry is inflated: an untrusted or unsigned package
@@ -286,8 +288,6 @@ Verified verifyBytes(std::string_view bytes, const std::string& name, const Limi
     if (admit) admit(headOf(name, out));
     if (headOnly) return out;
     readListedFiles(fail, archive, out);
-    // (g) compatibility with this player.
-    checkPlayerCompatibility(out.manifest, fail.origin(kManifestName));
     parseMeshes(name, out);
     return out;
 }
@@ -354,6 +354,10 @@ Manifest verify(const std::filesystem::path& path, const Limits& limits) {
 
 void readPackageHead(const std::filesystem::path& path, const Admission& admit, const Limits& limits) {
     (void)verifyFile(path, limits, admit, true);
+}
+
+void readPackageHead(std::string_view bytes, const std::string& name, const Admission& admit, const Limits& limits) {
+    (void)verifyBytes(bytes, name, limits, admit, true);
 }
 
 PackageHead CasePackage::head() const {

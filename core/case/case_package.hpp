@@ -18,7 +18,8 @@
 ///       rollback), so an unsigned or untrusted package never costs its payload;
 ///   (f) every listed file is present with the listed size and sha256; no file but manifest.json
 ///       and signature.json is unlisted;
-///   (g) the schemaVersion and minPlayerVersion suit this player (checkPlayerCompatibility);
+///   (g) the schemaVersion and minPlayerVersion suit this player (checkPlayerCompatibility; the
+///       manifest's alone, so it runs right after (e), before the admission);
 ///   (h) every listed file ending in ".vtet" parses with sim::parseVtet (origin
 ///       "<package>:<entry>").
 /// Example: "case.vcase: meshes/a.vtet: sha256 mismatch (manifest says 3a.., file has 9f..)".
@@ -115,8 +116,13 @@ private:
 /// manifest.json and signature.json is inflated (what the launcher lists cases by). Cost: one read
 /// of the file and one SHA-256 pass over it. Throws viscera::InputError.
 void readPackageHead(const std::filesystem::path& path, const Admission& admit, const Limits& limits = {});
+/// The same on a package already in memory (`name` stands for the file in messages): a caller that
+/// goes on to CasePackage::fromBytes() on the same bytes checks exactly what it admitted.
+void readPackageHead(std::string_view bytes, const std::string& name, const Admission& admit,
+                     const Limits& limits = {});
 
-/// Runs every check of CasePackage::open() and returns the manifest; for tools that only need a
+/// Runs every check of CasePackage::open() with no admission and returns the manifest: for a
+/// package one made oneself (the studio's tests and tools), never for one to be trusted; for tools that only need a
 /// verdict. Same cost as open(); the file contents are released before returning.
 Manifest verify(const std::filesystem::path& path, const Limits& limits = {});
 

@@ -21,7 +21,9 @@ using Versions = std::map<std::string, std::string>;
 Versions readState(const std::filesystem::path& folder) {
     const std::filesystem::path file = folder / kRunStateName;
     std::error_code ec;
-    if (!std::filesystem::exists(file, ec)) return {};
+    const bool present = std::filesystem::exists(file, ec);
+    if (ec) throw InputError(file.string() + ": cannot read the record of the versions run (" + ec.message() + ")");
+    if (!present) return {};
     const std::string origin = file.string();
     const nlohmann::json j = sim::parseJsonText(readFile(file, 1 << 20), origin);
     const sim::JsonField root(j, "", origin);

@@ -98,8 +98,9 @@ const char* TrustRefusal::label(Kind kind) {
 void TrustStore::addKeyFile(const std::filesystem::path& pemFile) {
     const std::string origin = pemFile.string();
     TrustedKey key;
-    requireSafeAnchor(pemFile, "a trusted publisher key"); // before a byte of it is read
-    const std::string text = readFile(pemFile, 16384, "a public key file");
+    // Checked before a byte of it is read, and read where the check resolved it to.
+    const std::filesystem::path real = requireSafeAnchor(pemFile, "a trusted publisher key");
+    const std::string text = readFile(real, 16384, "a public key file");
     key.publicKey = parsePublicKeyPem(text, origin);
     key.name = pemFile.stem().string(); // "hospital.pem" and "hospital.pub.pem" name "hospital"
     if (key.name.size() > 4 && key.name.ends_with(".pub")) key.name.resize(key.name.size() - 4);
@@ -109,12 +110,14 @@ void TrustStore::addKeyFile(const std::filesystem::path& pemFile) {
 }
 
 void TrustStore::addFolder(const std::filesystem::path& folder) {
-    requireSafeAnchor(folder, "a trust folder"); // a link is refused, not followed
+    struct stat st {};
+    if (::lstat(folder.c_str(), &st) != 0) return; // a folder that does not exist adds nothing
+    const std::filesystem::path real = requireSafeAnchor(folder, "a trust folder"); // a link is refused
     std::error_code ec;
-    if (!std::filesystem::is_directory(folder, ec)) return;
+    if (!std::filesystem::is_directory(real, ec)) return;
     std::vector<std::filesystem::path> files;
-    for (const auto& e : std::filesystem::directory_iterator(folder, ec))
-        if (e.path().extension() == ".pem") files.push_back(e.path());
+    for (const auto& e : std::filesystem::directory_iterator(real, ec))
+        if (e.path().extension() == ".pem") files.push_back(folder / e.path().filename());
     if (ec) throw InputError(folder.string() + ": cannot list the trusted publisher keys (" + ec.message() + ")");
     std::sort(files.begin(), files.end());
     for (const std::filesystem::path& f : files)
@@ -153,37 +156,63 @@ Provenance checkProvenance(const PackageHead& package, const TrustPolicy& policy
 
 namespace {
 
-/// Creates `folder` (its parents as the umask says, itself 0700) when missing.
+/// Creates `folder` (0700) and its missing parents (0755, whatever the umask: a group-writable
+/// parent would make the folder unsafe).
 void createStateFolder(const std::filesystem::path& folder) {
+    std::vector<std::filesystem::path> missing;
+    for (std::filesystem::path p = folder; !p.empty() && p != p.parent_path(); p = p.parent_path()) {
+        struct stat st {};
+        if (::lstat(p.c_str(), &st) == 0) break;
+        missing.push_back(p);
+    }
+    for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+        const mode_t mode = *it == folder ? 0700 : 0755;
+        if (::mkdir(it->c_str(), mode) != 0 && errno != EEXIST)
+            throw InputError(folder.string() + ": cannot create the state folder (" + it->string() + ": " +
+                             std::strerror(errno) + ")");
+        ::chmod(it->c_str(), mode); // the umask may have taken bits away; never adds any others may use
+    }
+}
+
+/// The kiosk folder, when it exists and this account may use it.
+bool usableKioskFolder() {
     std::error_code ec;
-    if (::mkdir(folder.c_str(), 0700) == 0 || errno == EEXIST) return;
-    std::filesystem::create_directories(folder.parent_path(), ec);
-    if (::mkdir(folder.c_str(), 0700) != 0 && errno != EEXIST)
-        throw InputError(folder.string() + ": cannot create the state folder (" + std::strerror(errno) + ")");
+    return std::filesystem::is_directory(kSystemStateFolder, ec) &&
+           ::access(std::string(kSystemStateFolder).c_str(), R_OK | W_OK | X_OK) == 0;
 }
 
 } // namespace
 
-std::filesystem::path defaultStateFolder() {
-    std::error_code ec;
-    if (std::filesystem::is_directory(kSystemStateFolder, ec)) return kSystemStateFolder;
+std::optional<std::filesystem::path> defaultStateFolder() {
+    if (usableKioskFolder()) return std::filesystem::path(kSystemStateFolder);
     if (const char* xdg = std::getenv("XDG_STATE_HOME"); xdg && *xdg == '/')
         return std::filesystem::path(xdg) / "viscera";
     if (const char* home = std::getenv("HOME"); home && *home == '/')
         return std::filesystem::path(home) / ".local/state/viscera";
-    throw InputError("the state folder: neither XDG_STATE_HOME nor HOME names a folder, so the versions run "
-                     "cannot be kept; give --state-dir DIR");
+    return std::nullopt;
 }
 
-std::filesystem::path stateFolder(const std::optional<std::filesystem::path>& given) {
-    const std::filesystem::path folder = given ? *given : defaultStateFolder();
-    requireSafeAnchor(folder, "the state folder"); // a link or a folder others may write: refused
-    createStateFolder(folder);
+std::optional<std::filesystem::path> stateFolder(const std::optional<std::filesystem::path>& given, StateUse use) {
+    const std::optional<std::filesystem::path> folder = given ? given : defaultStateFolder();
+    if (!folder) {
+        if (use == StateUse::Check) return std::nullopt; // nothing recorded can be found
+        throw InputError("the state folder: neither XDG_STATE_HOME nor HOME names a folder, so the case versions "
+                         "run cannot be kept; give --state-dir DIR");
+    }
+    requireSafeAnchor(*folder, "the state folder"); // a link or a folder others may write: refused
+    struct stat st {};
+    if (::lstat(folder->c_str(), &st) != 0) {
+        if (use == StateUse::Check) return std::nullopt; // no version was ever recorded there
+        createStateFolder(*folder);
+        requireSafeAnchor(*folder, "the state folder");
+    }
     std::error_code ec;
-    if (!std::filesystem::is_directory(folder, ec))
-        throw InputError(folder.string() + ": cannot use it as the state folder (not a folder" +
+    if (!std::filesystem::is_directory(*folder, ec))
+        throw InputError(folder->string() + ": cannot use it as the state folder (not a folder" +
                          (ec ? ", " + ec.message() : std::string()) + ")");
-    requireSafeAnchor(folder, "the state folder");
+    if (use == StateUse::Record && ::access(folder->c_str(), R_OK | W_OK | X_OK) != 0)
+        throw InputError(folder->string() + ": cannot use it as the state folder (" + std::strerror(errno) +
+                         "); give --state-dir DIR");
     return folder;
 }
 

@@ -1,8 +1,9 @@
 #pragma once
 /// Whether a verified package may run here: its publisher's signature against the keys this
 /// player trusts, its expiry, and no rollback to an older version of a case already run (the
-/// state folder, on by default). The player's `verify`, `run` and `soak` apply it after
-/// CasePackage::open() and before the scene is read.
+/// state folder, on by default). The player's `verify`, `run` and `soak` apply it as the package's
+/// admission (CasePackage::open's Admission): on manifest.json and signature.json, before any other
+/// entry is inflated and before the scene is read.
 #include "case/case_package.hpp"
 #include "sim/util/error.hpp"
 
@@ -96,19 +97,24 @@ struct Provenance {
 Provenance checkProvenance(const PackageHead& package, const TrustPolicy& policy);
 Provenance checkProvenance(const CasePackage& package, const TrustPolicy& policy);
 
-/// The kiosk stations' state folder, shared by every account of the station: used when it exists
-/// (the administrator makes it, owned by the trainee account or root, mode 0700).
+/// A kiosk station's state folder: used when it exists and the account running the player may
+/// read and write it (the administrator makes it for the station's trainee account, mode 0700).
 inline constexpr std::string_view kSystemStateFolder = "/var/lib/viscera/state";
 
-/// Where the player keeps the versions run when no --state-dir is given: kSystemStateFolder when it
-/// exists, else $XDG_STATE_HOME/viscera, else ~/.local/state/viscera. Throws viscera::InputError
-/// when none can be named (no XDG_STATE_HOME and no HOME).
-std::filesystem::path defaultStateFolder();
+/// Where the player keeps the versions run when no --state-dir is given: kSystemStateFolder when
+/// usable, else $XDG_STATE_HOME/viscera, else ~/.local/state/viscera; nullopt when none can be
+/// named (no XDG_STATE_HOME and no HOME).
+std::optional<std::filesystem::path> defaultStateFolder();
 
-/// The state folder to use: `given` (--state-dir) or defaultStateFolder(), created 0700 when
-/// missing. Rollback protection is always on. Throws viscera::InputError, one line naming the
-/// folder, when it is a symbolic link, it or a folder above it is writable by others than root and
-/// the user (requireSafeAnchor), or it cannot be created.
-std::filesystem::path stateFolder(const std::optional<std::filesystem::path>& given);
+/// What the state folder is for: `Check` (verify, soak: read a record where one exists) or
+/// `Record` (run: the folder is made, 0700 with 0755 parents, when missing).
+enum class StateUse { Check, Record };
+
+/// The state folder to use: `given` (--state-dir) or defaultStateFolder(). Rollback protection is
+/// always on: a run records, every check reads. nullopt only for `Check` when the folder does not
+/// exist or none can be named (no record can exist). Throws viscera::InputError, one line naming
+/// the folder, when it is a symbolic link, it or a folder it passes through is writable by others
+/// than root and the user (requireSafeAnchor), or (`Record`) it cannot be made or written.
+std::optional<std::filesystem::path> stateFolder(const std::optional<std::filesystem::path>& given, StateUse use);
 
 } // namespace viscera::vcase

@@ -22,14 +22,14 @@ bool TrustOptions::consume(const std::vector<std::string>& args, size_t& i) {
     return true;
 }
 
-vcase::TrustPolicy TrustOptions::policy() const {
+vcase::TrustPolicy TrustOptions::policy(vcase::StateUse use) const {
     vcase::TrustPolicy p;
     for (const std::filesystem::path& folder : vcase::systemTrustFolders())
         p.trusted.addFolder(folder);
     for (const std::string& f : keyFiles)
         p.trusted.addKeyFile(f);
     p.allowUnsigned = allowUnsigned;
-    p.stateFolder = vcase::stateFolder(stateDir ? std::optional<std::filesystem::path>(*stateDir) : std::nullopt);
+    p.stateFolder = vcase::stateFolder(stateDir ? std::optional<std::filesystem::path>(*stateDir) : std::nullopt, use);
     p.now =
         std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
     return p;

@@ -30,9 +30,10 @@ struct TrustOptions {
     /// When args[i] is one of the options above, takes it (and its value: i moves past it) and
     /// returns true. Throws std::invalid_argument for a missing value.
     bool consume(const std::vector<std::string>& args, size_t& i);
-    /// The policy: the system folders' keys, then --trust's; the state folder; the clock now.
+    /// The policy: the system folders' keys, then --trust's; the state folder (`run` records in
+    /// it and makes it, `verify` and `soak` only read it: vcase::StateUse); the clock now.
     /// Throws viscera::InputError naming a key file that is not an Ed25519 PEM public key.
-    vcase::TrustPolicy policy() const;
+    vcase::TrustPolicy policy(vcase::StateUse use) const;
 };
 
 } // namespace viscera::player

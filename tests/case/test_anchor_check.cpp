@@ -65,7 +65,7 @@ TEST_F(Anchors, ALinkInTheTrustFolderIsRefusedEvenToAGoodKey) {
     EXPECT_EQ(messageOf([&] { store.addFolder(trusted); }),
               (trusted / "linked.pem").string() +
                   ": a trusted publisher key must not be a symbolic link (it points to " +
-                  (dir.path() / "good.pem").string() + "); copy the file there instead");
+                  (dir.path() / "good.pem").string() + "); put the file itself there");
     EXPECT_TRUE(store.keys().empty()) << "a broken trust folder is never half read";
 }
 
@@ -104,21 +104,83 @@ TEST_F(Anchors, AKeyInAWorldWritableFolderIsRefusedAsTrust) {
 
 TEST_F(Anchors, AStateFolderOthersMayWriteOrALinkIsRefused) {
     const fs::path state = open / "state";
-    EXPECT_THAT(messageOf([&] { stateFolder(state); }),
+    EXPECT_THAT(messageOf([&] { stateFolder(state, StateUse::Record); }),
                 StartsWith(state.string() + ": the state folder lies in " + open.string()));
     EXPECT_FALSE(fs::exists(state)) << "refused before it was made";
     const fs::path wide = dir.path() / "wide";
     fs::create_directories(wide);
     fs::permissions(wide, fs::perms::all);
-    EXPECT_THAT(messageOf([&] { stateFolder(wide); }),
+    EXPECT_THAT(messageOf([&] { stateFolder(wide, StateUse::Check); }),
                 StartsWith(wide.string() + ": the state folder must be owned by root or by you and writable by no one "
                                            "else"));
     fs::create_symlink(trusted, dir.path() / "state-link");
-    EXPECT_THAT(messageOf([&] { stateFolder(dir.path() / "state-link"); }),
+    EXPECT_THAT(messageOf([&] { stateFolder(dir.path() / "state-link", StateUse::Check); }),
                 StartsWith((dir.path() / "state-link").string() + ": the state folder must not be a symbolic link"));
     const fs::path fresh = dir.path() / "private" / "state";
-    EXPECT_EQ(stateFolder(fresh), fresh);
+    EXPECT_EQ(stateFolder(fresh, StateUse::Check), std::nullopt) << "a check makes nothing";
+    EXPECT_FALSE(fs::exists(fresh));
+    EXPECT_EQ(stateFolder(fresh, StateUse::Record), fresh);
     EXPECT_EQ(modeOf(fresh), 0700u) << "created 0700 on first use";
+}
+
+TEST_F(Anchors, LinksAreFollowedOnlyOutOfFoldersNobodyElseMayWrite) {
+    // ".." after a link: resolved as the kernel does, through the link, into the open folder.
+    fs::create_directories(open / "sub");
+    fs::create_directories(open / "keys");
+    writeFileAtomic(open / "keys" / "k.pem", key.publicPem());
+    fs::create_directories(dir.path() / "safe");
+    fs::create_symlink(open / "sub", dir.path() / "safe" / "link");
+    const fs::path dotdot = dir.path() / "safe" / "link" / ".." / "keys" / "k.pem";
+    TrustStore store;
+    EXPECT_THAT(messageOf([&] { store.addKeyFile(dotdot); }),
+                StartsWith(dotdot.string() + ": a trusted publisher key lies in " + open.string() + ","));
+    // A link in a safe folder to a link in an open folder to a good key: the open folder is passed
+    // through, so another user could swap where the key comes from.
+    writeFileAtomic(trusted / "real.pem", key.publicPem());
+    fs::create_symlink(trusted / "real.pem", open / "hop");
+    fs::create_symlink(open / "hop", dir.path() / "safe" / "k");
+    fs::create_directories(dir.path() / "safe2");
+    const fs::path folderLink = dir.path() / "safe2" / "keys";
+    fs::create_symlink(open / "keys", folderLink); // a link to a folder, then a file in it
+    EXPECT_THAT(messageOf([&] { store.addKeyFile(folderLink / "k.pem"); }),
+                StartsWith((folderLink / "k.pem").string() + ": a trusted publisher key lies in " + open.string()));
+    EXPECT_THAT(messageOf([&] { store.addKeyFile(dir.path() / "safe" / "k"); }),
+                HasSubstr("must not be a symbolic link"));
+    EXPECT_TRUE(store.keys().empty());
+    // A link between safe folders is followed: the key is read where it resolves.
+    fs::create_symlink(trusted, dir.path() / "safe" / "trusted-link");
+    EXPECT_NO_THROW(store.addKeyFile(dir.path() / "safe" / "trusted-link" / "real.pem"));
+    EXPECT_EQ(store.keys().size(), 1u);
+}
+
+TEST_F(Anchors, AMissingTrustFolderAnywhereAddsNothing) {
+    TrustStore store; // e.g. <prefix>/share/viscera/trusted-publishers under a group-writable prefix
+    EXPECT_NO_THROW(store.addFolder(open / "share" / "viscera" / "trusted-publishers"));
+    EXPECT_TRUE(store.keys().empty());
+}
+
+TEST_F(Anchors, AStickyFolderIsNoStateFolderAndATrailingSlashNoWayAroundALink) {
+    const fs::path sticky = dir.path() / "sticky";
+    fs::create_directories(sticky);
+    fs::permissions(sticky, fs::perms::all | fs::perms::sticky_bit);
+    EXPECT_THAT(messageOf([&] { stateFolder(sticky, StateUse::Check); }),
+                StartsWith(sticky.string() + ": the state folder must be owned by root or by you and writable by no "
+                                             "one else"));
+    fs::create_symlink(trusted, dir.path() / "state-link");
+    const fs::path slash = dir.path().string() + "/state-link/";
+    EXPECT_THAT(messageOf([&] { stateFolder(slash, StateUse::Check); }),
+                HasSubstr("the state folder must not be a symbolic link"));
+}
+
+TEST_F(Anchors, AStateFolderIsMadeSafeWhateverTheUmask) {
+    const mode_t old = ::umask(002); // Debian's user-private-group umask
+    const fs::path fresh = dir.path() / "home" / ".local" / "state" / "viscera";
+    const std::optional<fs::path> made = stateFolder(fresh, StateUse::Record);
+    ::umask(old);
+    EXPECT_EQ(made, fresh);
+    EXPECT_EQ(modeOf(fresh), 0700u);
+    EXPECT_EQ(modeOf(fresh.parent_path()), 0755u) << "a parent the group may write would make it unsafe";
+    EXPECT_EQ(stateFolder(fresh, StateUse::Record), fresh) << "and it is accepted the next time";
 }
 
 /// Sets an environment variable for one test and puts the old value back.
@@ -168,7 +230,7 @@ TEST_F(Anchors, RollbackIsRefusedByDefaultInAFreshAccount) {
     writeFileAtomic(trusted / "publisher.pem", key.publicPem());
     TrustPolicy policy;
     policy.trusted.addKeyFile(trusted / "publisher.pem");
-    policy.stateFolder = stateFolder(std::nullopt); // what the player does with no --state-dir
+    policy.stateFolder = stateFolder(std::nullopt, StateUse::Record); // a run with no --state-dir
     EXPECT_EQ(modeOf(expected), 0700u);
     const auto v2 = CasePackage::fromBytes(signedPackage(header("2.0.0"), key), "v2.vcase");
     checkProvenance(*v2, policy);

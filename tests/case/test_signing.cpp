@@ -143,14 +143,17 @@ TEST(Signing, TrustAnchorsWritableByOthersAreRefused) {
     TrustStore good;
     good.addFolder(folder);
     EXPECT_EQ(good.keys().size(), 1u);
-    fs::permissions(key, fs::perms::group_write, fs::perm_options::add);
+    // Group-writable by a group others share (nogroup, where this user may hand the file to it;
+    // the user's own private group would be harmless), else writable by everyone.
+    const bool shared = ::chown(key.c_str(), static_cast<uid_t>(-1), 65534) == 0;
+    fs::permissions(key, shared ? fs::perms::group_write : fs::perms::others_write, fs::perm_options::add);
     TrustStore file;
     EXPECT_EQ(messageOf([&] { file.addKeyFile(key); }),
               key.string() +
                   ": a trusted publisher key must be owned by root or by you and writable by no one else "
                   "(owner uid " +
-                  std::to_string(::geteuid()) + ", mode 664)");
-    fs::permissions(key, fs::perms::group_write, fs::perm_options::remove);
+                  std::to_string(::geteuid()) + ", mode " + (shared ? "664" : "646") + ")");
+    fs::permissions(key, fs::perms::group_write | fs::perms::others_write, fs::perm_options::remove);
     fs::permissions(folder, fs::perms::others_write, fs::perm_options::add);
     TrustStore open;
     EXPECT_THAT(messageOf([&] { open.addFolder(folder); }),
