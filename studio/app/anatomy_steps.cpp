@@ -1,6 +1,7 @@
 #include "app/anatomy_steps.hpp"
 
 #include "app/document.hpp"
+#include "app/import_placement.hpp"
 #include "app/selection.hpp"
 #include "bake/import.hpp"
 #include "project/project.hpp"
@@ -57,6 +58,8 @@ public:
     }
     /// The voxel edge for `n` voxels along the longest axis, m.
     double voxelSize() const { return (m_hi - m_lo).maxCoeff() / std::max(m_voxels, 1); }
+    /// The parts' extents, m.
+    sim::Vec3 size() const { return m_parts.empty() ? sim::Vec3::Zero() : sim::Vec3(m_hi - m_lo); }
 
 protected:
     void paintEvent(QPaintEvent*) override {
@@ -132,8 +135,13 @@ AnatomySteps::AnatomySteps(Document* doc, Selection* sel, QWidget* window)
     m_tetra->setObjectName("actionTetrahedralize");
     connect(m_tetra, &QAction::triggered, this, [this] {
         QString why;
-        if (!tetrahedralize(&why)) emit logMessage(why);
+        if (!tetrahedralize(&why)) fail(why);
     });
+}
+
+void AnatomySteps::fail(const QString& line) {
+    emit logMessage(line);
+    emit failed(line);
 }
 
 void AnatomySteps::buildMenu(QMenu* mesh) {
@@ -175,9 +183,9 @@ void AnatomySteps::onFinished(bool ok, const QString& message) {
         return;
     }
     if (name == kImport) {
-        ok ? applyImport(m_task.output()) : emit logMessage(message);
+        ok ? askPlacement(m_task.output()) : fail(message);
     } else if (name == kReady) {
-        ok ? showRemeshResult(m_task.output()) : emit logMessage(message);
+        ok ? showRemeshResult(m_task.output()) : fail(message);
     } else if (name == kTetra) {
         showMeshingResult(ok, m_task.output(), message);
     }
@@ -198,7 +206,7 @@ void AnatomySteps::askImport() {
         if (!files.isEmpty())
             QSettings().setValue(QStringLiteral("studio/anatomyFolder"), QFileInfo(files[0]).absolutePath());
         QString why;
-        if (!importAnatomy(files, &why)) emit logMessage(why);
+        if (!importAnatomy(files, &why)) fail(why);
     });
     dlg->open();
 }
@@ -239,13 +247,28 @@ QString AnatomySteps::copyIntoProject(const QString& file, QString* why) const {
     return target;
 }
 
-void AnatomySteps::applyImport(const QString& output) {
+void AnatomySteps::askPlacement(const QString& output) {
+    const auto bounds = importedFileBounds(output);
+    if (!bounds) {
+        fail(tr("Import anatomy: the import check reported no bounds; the project is unchanged"));
+        return;
+    }
+    auto* dlg = new ImportPlacementDialog(*bounds, int(m_pendingFiles.size()), m_window);
+    dlg->setAttribute(Qt::WA_DeleteOnClose);
+    connect(dlg, &QDialog::accepted, this, [this, dlg, output] { applyImport(output, dlg->placement()); });
+    connect(dlg, &QDialog::rejected, this,
+            [this] { emit logMessage(tr("%1: cancelled; the project is unchanged").arg(kImport)); });
+    m_placement = dlg;
+    dlg->open();
+}
+
+void AnatomySteps::applyImport(const QString& output, const bake::ImportPlacement& placement) {
     QStringList copied;
     QString why;
     for (const QString& f : m_pendingFiles) {
         const QString c = copyIntoProject(f, &why);
         if (c.isEmpty()) {
-            emit logMessage(why);
+            fail(why);
             return;
         }
         copied << c;
@@ -269,6 +292,7 @@ void AnatomySteps::applyImport(const QString& output) {
         else
             r.parts.push_back({c.toStdString(), bake::CsgOp::Union});
     r.uvTransfer = allUv ? std::optional(bake::UvTransferMethod::SeamCutting) : std::nullopt;
+    r.placement = placement;
     r.params.voxelCount = 64;
     body.mesh.meshing.facetSize = 0.006;
     body.mesh.meshing.facetDistance = 0.001;
@@ -277,14 +301,17 @@ void AnatomySteps::applyImport(const QString& output) {
     const QString problem = m_doc->edit(
         tr("Import anatomy"), [&](Project& p) { p.bodies.push_back(body); }, 0, Change{Change::Structure});
     if (!problem.isEmpty()) {
-        emit logMessage(problem);
+        fail(problem);
         return;
     }
     m_sel->set(Selection::Kind::Body, index);
-    emit logMessage(tr("Imported %1 part(s) as body '%2'%3")
+    const auto bounds = importedFileBounds(output);
+    emit logMessage(tr("Imported %1 part(s) as body '%2'%3, in %4: %5")
                         .arg(r.parts.size())
                         .arg(name)
-                        .arg(allUv ? tr(" with their UVs") : tr(" (a part has no UVs: none transferred)")));
+                        .arg(allUv ? tr(" with their UVs") : tr(" (a part has no UVs: none transferred)"))
+                        .arg(QString::fromUtf8(bake::unitLongName(placement.unit).data()))
+                        .arg(bounds ? sizeText(placedSize(*bounds, placement)) : QString()));
 }
 
 // ---- make simulation-ready ---------------------------------------------------------------------
@@ -292,18 +319,16 @@ void AnatomySteps::applyImport(const QString& output) {
 void AnatomySteps::askSimulationReady() {
     const int b = remeshBody();
     if (b < 0) {
-        emit logMessage(tr("Make simulation-ready: select a body made from anatomy (File → Import anatomy…)"));
+        fail(tr("Make simulation-ready: select a body made from anatomy (File → Import anatomy…)"));
         return;
     }
     const RemeshSource& r = m_doc->project().bodies[size_t(b)].mesh.remesh;
     std::vector<sim::TriMesh> parts;
     for (const RemeshSource::Part& part : r.parts) {
         try {
-            bake::ImportOptions opt;
-            opt.scale = r.scale;
-            parts.push_back(bake::importSurface(part.file, opt));
+            parts.push_back(bake::importSurface(part.file, bake::placedOptions(r.placement)));
         } catch (const std::exception& e) {
-            emit logMessage(QString::fromUtf8(e.what()));
+            fail(QString::fromUtf8(e.what()));
             return;
         }
     }
@@ -326,6 +351,8 @@ void AnatomySteps::askSimulationReady() {
     uv->setCurrentText(uvOption(r.uvTransfer));
     auto* size = new QLabel(dlg);
     size->setObjectName("voxelSize");
+    auto* bodySize = new QLabel(sizeText(grid->size()), dlg); // before the long work: a wrong unit shows here
+    bodySize->setObjectName("bodySize");
     auto update = [grid, voxels, size] {
         grid->setVoxels(voxels->value());
         size->setText(tr("voxel %1 mm").arg(grid->voxelSize() * 1e3, 0, 'f', 2));
@@ -333,6 +360,7 @@ void AnatomySteps::askSimulationReady() {
     connect(voxels, &QSpinBox::valueChanged, dlg, update);
     update();
     auto* form = new QFormLayout;
+    form->addRow(tr("Body (placed parts)"), bodySize);
     form->addRow(tr("Voxels along the longest axis"), voxels);
     form->addRow(QString(), size);
     form->addRow(tr("Smoothing passes"), smoothing);
@@ -343,7 +371,7 @@ void AnatomySteps::askSimulationReady() {
     connect(buttons, &QDialogButtonBox::rejected, dlg, &QDialog::close);
     connect(runButton, &QPushButton::clicked, this, [this, voxels, smoothing, uv] {
         QString why;
-        if (!makeSimulationReady(voxels->value(), smoothing->value(), uv->currentText(), &why)) emit logMessage(why);
+        if (!makeSimulationReady(voxels->value(), smoothing->value(), uv->currentText(), &why)) fail(why);
     });
     auto* layout = new QHBoxLayout(dlg);
     layout->addWidget(grid, 1);
@@ -368,8 +396,10 @@ bool AnatomySteps::makeSimulationReady(int voxels, int smoothing, const QString&
     QStringList args{"remesh"};
     for (const RemeshSource::Part& part : r.parts)
         args << QString::fromStdString(part.file.string());
-    args << "--scale" << QString::number(r.scale, 'g', 17) << "--voxels" << QString::number(voxels) << "--smooth"
-         << QString::number(smoothing);
+    // The remesh command has no rotation: the preview's surface is remeshed in the files' frame
+    // (its figures do not depend on it); export meshes the placed parts (project.cpp).
+    args << "--scale" << QString::number(r.placement.metresPerFileUnit(), 'g', 17) << "--voxels"
+         << QString::number(voxels) << "--smooth" << QString::number(smoothing);
     if (uvMethod == "none")
         args << "--no-uv";
     else
@@ -424,7 +454,7 @@ void AnatomySteps::showRemeshResult(const QString& output) {
                 bodies[i].mesh.kind == MeshSource::Kind::Remesh)
                 b = int(i);
         if (b < 0) {
-            emit logMessage(tr("Make simulation-ready: the body '%1' made from anatomy is gone").arg(chosen.body));
+            fail(tr("Make simulation-ready: the body '%1' made from anatomy is gone").arg(chosen.body));
             dlg->close();
             return;
         }
@@ -442,10 +472,11 @@ void AnatomySteps::showRemeshResult(const QString& output) {
                 if (!r.uvTransfer) r.texture.clear();
             },
             0, Change{Change::Structure});
-        emit logMessage(
-            problem.isEmpty()
-                ? tr("Made simulation-ready: %1 voxels, %2 UV transfer").arg(chosen.voxels).arg(chosen.uvMethod)
-                : problem);
+        if (problem.isEmpty())
+            emit logMessage(
+                tr("Made simulation-ready: %1 voxels, %2 UV transfer").arg(chosen.voxels).arg(chosen.uvMethod));
+        else
+            fail(problem);
         dlg->close();
     });
     layout->addWidget(buttons);
@@ -511,9 +542,9 @@ void AnatomySteps::showMeshingResult(bool ok, const QString& output, const QStri
                 dlg->close();
                 QString why;
                 if (!problem.isEmpty())
-                    emit logMessage(problem);
+                    fail(problem);
                 else if (!tetrahedralize(&why))
-                    emit logMessage(why);
+                    fail(why);
             });
         };
         offer(tr("Use %1 substeps").arg(substeps), "fixSubsteps", substeps <= sim::XpbdLimits::maxSubsteps,

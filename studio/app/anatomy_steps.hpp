@@ -4,9 +4,11 @@
 /// that takes effect at once) and applied to the model as one undo step.
 ///
 ///   Import anatomy…          parts (OBJ/STL/PLY/glTF/GLB/FBX, the import's safety rules) and an
-///                            optional PNG texture: checked by `viscera-studio import`, copied
-///                            into the project's anatomy/ folder, and a new body made from them by
-///                            a remesh block (seam-cut UVs when every part has them);
+///                            optional PNG texture: checked by `viscera-studio import`, then
+///                            their unit (guessed from their size), scale and rotation asked
+///                            with the body's size shown (ImportPlacementDialog); copied into
+///                            the project's anatomy/ folder, and a new body made from them by a
+///                            remesh block (seam-cut UVs when every part has them);
 ///   Make simulation-ready…   the voxel grid drawn over the parts before running; the remesh with
 ///                            its UV transfer; then source, closest-point and seam-cut transfers
 ///                            side by side with a checker, the seam-cut stretch heat map with its
@@ -16,6 +18,7 @@
 ///                            dihedral, slivers; where the stability check asks for more substeps
 ///                            than allowed, the fixes offered in place (coarser cells, inertia
 ///                            scaling, more substeps), each an undoable edit.
+#include "app/import_placement.hpp"
 #include "app/studio_task.hpp"
 
 #include <QObject>
@@ -58,18 +61,24 @@ public:
     QDialog* settingsDialog() const { return m_settings; }
     QProgressDialog* progressDialog() const { return m_progress; }
     QDialog* resultDialog() const { return m_result; }
+    /// Import's unit, scale and rotation question (null when closed).
+    ImportPlacementDialog* placementDialog() const { return m_placement; }
     /// The body the steps act on: the selected body with a remesh block, else -1.
     int remeshBody() const;
 
 signals:
     void logMessage(const QString& line);
+    /// A step failed or cannot start: the one line (also sent to the log), for the window to show.
+    void failed(const QString& line);
 
 private:
     void askImport();
     void askSimulationReady();
     bool run(const QString& name, const QStringList& args, int stages, QString* why);
     void onFinished(bool ok, const QString& message);
-    void applyImport(const QString& output);
+    void askPlacement(const QString& output);
+    void applyImport(const QString& output, const bake::ImportPlacement& placement);
+    void fail(const QString& line);
     void showRemeshResult(const QString& output);
     void showMeshingResult(bool ok, const QString& output, const QString& message);
     QString copyIntoProject(const QString& file, QString* why) const;
@@ -81,6 +90,7 @@ private:
     QAction *m_import = nullptr, *m_ready = nullptr, *m_tetra = nullptr;
     QPointer<QDialog> m_settings, m_result;
     QPointer<QProgressDialog> m_progress;
+    QPointer<ImportPlacementDialog> m_placement;
     QStringList m_pendingFiles; ///< import: the files checked by the running task
     struct Pending {
         int voxels = 0, smoothing = 0;

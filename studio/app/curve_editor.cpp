@@ -26,7 +26,7 @@ double gap(double neighbour) {
 CurveEditor::CurveEditor(QWidget* parent) : QWidget(parent) {
     setFocusPolicy(Qt::StrongFocus);
     setMouseTracking(false);
-    setMinimumSize(240, 160);
+    setMinimumSize(240, 110);
     setAutoFillBackground(false);
 }
 

@@ -33,6 +33,9 @@ public:
     static constexpr double kPickPixels = 7.0;
 
     explicit CurveEditor(QWidget* parent = nullptr);
+    /// 240 × 160 wanted; 240 × 110 at least, so the main window with every dock open fits a
+    /// 1920 × 1080 screen.
+    QSize sizeHint() const override { return {240, 160}; }
 
     /// Shows `points` (x strictly increasing). Keeps the selection when the count is unchanged
     /// and the view when `frame` is false.

@@ -182,6 +182,17 @@ struct LightSamplesSlot {
     }
 };
 
+/// The placement of a body made from anatomy (its remesh block's unit, scale and rotation).
+struct PlacementSlot {
+    using Value = bake::ImportPlacement;
+    static constexpr int kId = 7;
+    static Value& of(Project& p, int body) { return p.bodies.at(static_cast<size_t>(body)).mesh.remesh.placement; }
+    static Change change(int) { return {Change::Structure, -1}; }
+    static std::string check(const Project&, int body, const Value& v) {
+        return placementProblem(v, "bodies[" + std::to_string(body) + "].mesh.remesh"); // readRemesh's rule
+    }
+};
+
 /// A typed edit: one value of the model before and after, nothing else. A drag (the same nonzero
 /// key, the same value) merges into one step, keeping the first `before`.
 template <class Slot> class ValueCommand : public QUndoCommand {
@@ -365,6 +376,15 @@ QString Document::editStiffnessPaint(const QString& text, int body, int surface,
     const bool isSurface = surface >= 0 && surface < static_cast<int>(m_project->surfaces.size());
     if (isBody == isSurface) return tr("paint a body or a surface");
     return editValue<PaintSlot>(text, isBody ? body : -1 - surface, paint, 0);
+}
+
+QString Document::editPlacement(const QString& text, int body, const bake::ImportPlacement& placement) {
+    if (!m_project || body < 0 || body >= static_cast<int>(m_project->bodies.size())) return tr("no body selected");
+    if (m_project->bodies[static_cast<size_t>(body)].mesh.kind != MeshSource::Kind::Remesh)
+        return tr("%1: bodies[%2]: only a body made from anatomy has a unit, scale and rotation")
+            .arg(QString::fromStdString((m_project->dir / "project.json").string()))
+            .arg(body);
+    return editValue<PlacementSlot>(text, body, placement, 0);
 }
 
 QString Document::editLightSamples(const QString& text, int body, const std::vector<render::SamplePaintOp>& ops) {

@@ -3,7 +3,7 @@
 /// reads), its folder and the undo stack whose commands edit it.
 ///
 /// Edits are undo commands of two kinds. A typed edit (editMaterial, editSolver,
-/// editStiffnessPaint, editLightSamples) holds only the old and new
+/// editStiffnessPaint, editLightSamples, editAssessment, editPlacement) holds only the old and new
 /// value of what it edits, is checked by the rules the reader applies to that value
 /// (sim::validate and the constraint model of the material: no project text is written) and
 /// announces what it changed (Change), so the panels and the preview update only that. The
@@ -89,6 +89,10 @@ public:
     QString editStiffnessPaint(const QString& text, int body, int surface,
                                const std::optional<StiffnessPaintProject>& paint);
     QString editLightSamples(const QString& text, int body, const std::vector<render::SamplePaintOp>& ops);
+    /// The unit, scale and rotation of a body made from anatomy (its remesh block), checked by the
+    /// reader's rule for them (placementProblem); announced as a Structure change (the body is
+    /// meshed anew).
+    QString editPlacement(const QString& text, int body, const bake::ImportPlacement& placement);
     /// The case's assessment (none: no verdict), checked by sim::readAssessment's rules on what
     /// sim::writeAssessment writes of it ("assessment.metrics.path_length_m.expert.sd: ...").
     QString editAssessment(const QString& text, const std::optional<sim::AssessmentDesc>& assessment);

@@ -2,6 +2,7 @@
 
 #include <QDir>
 #include <QFileInfo>
+#include <QRegularExpression>
 
 #include <filesystem>
 #include <fstream>
@@ -14,7 +15,7 @@ ExportRunner::ExportRunner(QObject* parent) : QObject(parent) {
     connect(&m_task, &StudioTask::finished, this, &ExportRunner::onFinished);
 }
 
-bool ExportRunner::start(const Project& project, const QString& out, QString* why) {
+bool ExportRunner::start(const Project& project, const QString& out, const ExportSigning& signing, QString* why) {
     auto fail = [&](const QString& w) {
         if (why) *why = w;
         return false;
@@ -38,10 +39,17 @@ bool ExportRunner::start(const Project& project, const QString& out, QString* wh
         }
     }
     m_out = target.absoluteFilePath();
-    return m_task.start(tr("export"),
-                        {"export", QString::fromStdString(project.dir.string()), "-o",
-                         QDir(work).filePath("case.vcase"), "--project-file", projectFile},
-                        static_cast<int>(exportStageCount(project)), why);
+    QStringList args{"export",
+                     QString::fromStdString(project.dir.string()),
+                     "-o",
+                     QDir(work).filePath("case.vcase"),
+                     "--project-file",
+                     projectFile};
+    if (signing.isUnsigned())
+        args << "--unsigned";
+    else
+        args << "--sign-key" << signing.keyFile << "--signer" << signing.signer;
+    return m_task.start(tr("export"), args, static_cast<int>(exportStageCount(project)), why);
 }
 
 void ExportRunner::onFinished(bool ok, const QString& message) {
@@ -55,7 +63,12 @@ void ExportRunner::onFinished(bool ok, const QString& message) {
         emit finished(false, tr("%1: cannot be written (%2)").arg(m_out, QString::fromStdString(ec.message())));
         return;
     }
-    emit finished(true, tr("exported %1").arg(m_out));
+    // the export's own line: "  package: signed by 'publisher' (ed25519:…); sha256 …" or "UNSIGNED; sha256 …"
+    const QRegularExpression packageLine("^  package: ([^;]*);", QRegularExpression::MultilineOption);
+    const QString how = packageLine.match(m_task.output()).captured(1);
+    emit finished(true, how == "UNSIGNED"
+                            ? tr("exported %1, UNSIGNED: players refuse it without --allow-unsigned").arg(m_out)
+                            : tr("exported %1, %2").arg(m_out, how));
 }
 
 } // namespace viscera::studio

@@ -7,7 +7,8 @@
 /// Progress: one step per stage line the child prints. Cancel kills the child at once; the child
 /// writes the package inside the task's folder (beside the chosen path) and the runner renames it
 /// onto the chosen path only after a successful export, so neither a cancel nor a failure leaves
-/// a partial file. The chosen folder is checked writable before anything runs.
+/// a partial file. The chosen folder is checked writable before anything runs. The signing is
+/// always explicit (--sign-key or --unsigned): the window decides it and says it before the work.
 #include "app/studio_task.hpp"
 #include "project/project.hpp"
 
@@ -16,6 +17,14 @@
 
 namespace viscera::studio {
 
+/// How the package is signed: with the publisher key `keyFile` under the name `signer`, or, with
+/// no key file, explicitly unsigned (--unsigned: players refuse it without --allow-unsigned).
+struct ExportSigning {
+    QString keyFile;
+    QString signer;
+    bool isUnsigned() const { return keyFile.isEmpty(); }
+};
+
 class ExportRunner : public QObject {
     Q_OBJECT
 public:
@@ -23,9 +32,9 @@ public:
 
     /// The viscera-studio executable to run (default: this program).
     void setProgram(const QString& path) { m_task.setProgram(path); }
-    /// Starts exporting `project` to `out`. Returns false and sets `why` (one line naming the
-    /// path and the rule) when it cannot start.
-    bool start(const Project& project, const QString& out, QString* why);
+    /// Starts exporting `project` to `out`, signed as `signing` says. Returns false and sets `why`
+    /// (one line naming the path and the rule) when it cannot start.
+    bool start(const Project& project, const QString& out, const ExportSigning& signing, QString* why);
     /// Kills the export and removes what it wrote; finished(false, "cancelled") has been emitted
     /// when it returns.
     void cancel() { m_task.cancel(); }
@@ -37,7 +46,8 @@ public:
 
 signals:
     void progress(int done, int total, const QString& stage);
-    /// ok: the package is at the chosen path; else `message` is the error (or "cancelled").
+    /// ok: the package is at the chosen path (`message`: "exported <path>, signed by 'publisher'
+    /// (ed25519:…)" or "exported <path>, UNSIGNED: …"); else `message` is the error (or "cancelled").
     void finished(bool ok, const QString& message);
 
 private:

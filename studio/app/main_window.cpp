@@ -2,6 +2,7 @@
 
 #include "app/anatomy_steps.hpp"
 #include "app/assessment_panel.hpp"
+#include "app/error_banner.hpp"
 #include "app/export_runner.hpp"
 #include "app/fit_dialog.hpp"
 #include "app/material_panel.hpp"
@@ -11,6 +12,7 @@
 #include "app/start_page.hpp"
 #include "app/texture_panel.hpp"
 #include "app/wheel_guard.hpp"
+#include "project/publishing.hpp"
 
 #include <QAction>
 #include <QCloseEvent>
@@ -23,6 +25,7 @@
 #include <QMessageBox>
 #include <QPlainTextEdit>
 #include <QProgressDialog>
+#include <QPushButton>
 #include <QRegularExpression>
 #include <QScrollArea>
 #include <QSettings>
@@ -30,6 +33,7 @@
 #include <QStatusBar>
 #include <QTimer>
 #include <QToolBar>
+#include <QVBoxLayout>
 
 namespace viscera::studio {
 
@@ -40,10 +44,17 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_export(std::mak
     buildDocks();
     buildActions();
     // the centre: the start page until a project is open, then the viewport
-    m_centre = new QStackedWidget(this);
+    auto* centre = new QWidget(this);
+    auto* column = new QVBoxLayout(centre);
+    column->setContentsMargins(0, 0, 0, 0);
+    column->setSpacing(2);
+    m_banner = new ErrorBanner(centre); // an action's error, where the user looks
+    column->addWidget(m_banner);
+    m_centre = new QStackedWidget(centre);
     m_start = new StartPage(m_centre);
     m_centre->addWidget(m_start);
-    setCentralWidget(m_centre);
+    column->addWidget(m_centre, 1);
+    setCentralWidget(centre);
     connect(m_start, &StartPage::newRequested, this, &MainWindow::askNewProject);
     connect(m_start, &StartPage::openRequested, this, &MainWindow::askOpenProject);
     connect(m_start, &StartPage::openRecent, this, [this](const QString& f) { openProject(f); });
@@ -92,9 +103,13 @@ void MainWindow::connectExport() {
         m_progress->setValue(done);
         m_progress->setLabelText(tr("Exporting: %1").arg(stage));
     });
-    connect(m_export.get(), &ExportRunner::finished, this, [this](bool, const QString& message) {
-        logLine(message);
-        statusBar()->showMessage(message);
+    connect(m_export.get(), &ExportRunner::finished, this, [this](bool ok, const QString& message) {
+        if (ok || message == tr("cancelled")) {
+            logLine(message);
+            statusBar()->showMessage(message);
+        } else {
+            showError(message);
+        }
         if (m_progress) {
             m_progress->reset();
             m_progress->hide();
@@ -145,6 +160,10 @@ void MainWindow::buildActions() {
     toolbar->setObjectName("mainToolBar");
     m_anatomy = new AnatomySteps(&m_doc, &m_sel, this);
     connect(m_anatomy, &AnatomySteps::logMessage, this, &MainWindow::logLine);
+    connect(m_anatomy, &AnatomySteps::failed, this, [this](const QString& line) {
+        m_banner->showError(line); // the log has it already
+        statusBar()->showMessage(line);
+    });
     buildFileMenu(menuBar()->addMenu(tr("&File")), toolbar);
     m_anatomy->buildMenu(menuBar()->addMenu(tr("&Mesh")));
     QMenu* edit = menuBar()->addMenu(tr("&Edit"));
@@ -254,7 +273,7 @@ void MainWindow::setViewportHost(ViewportHost host) {
         for (size_t i = 0; i < bodies.size(); ++i)
             if (QString::fromStdString(bodies[i].scene.name) == name) selectBody(static_cast<int>(i));
     });
-    connect(v, &Viewport::rendererFailed, this, &MainWindow::logLine);
+    connect(v, &Viewport::rendererFailed, this, &MainWindow::showError);
     m_paint->connectViewport(v);
     m_centre->addWidget(v);
     if (m_doc.hasProject()) m_centre->setCurrentWidget(v);
@@ -308,6 +327,12 @@ void MainWindow::logLine(const QString& line) {
     m_log->appendPlainText(QDateTime::currentDateTime().toString("hh:mm:ss  ") + line);
 }
 
+void MainWindow::showError(const QString& line) {
+    logLine(line);
+    statusBar()->showMessage(line);
+    m_banner->showError(line);
+}
+
 bool MainWindow::maybeDiscard() {
     if (!m_confirm || !m_doc.hasProject() || m_doc.undoStack()->isClean()) return true;
     const auto r = QMessageBox::question(this, tr("Unsaved changes"), tr("Save the changes to the project first?"),
@@ -322,9 +347,7 @@ bool MainWindow::openProject(const QString& folder) {
     try {
         m_doc.open(folder);
     } catch (const std::exception& e) {
-        const QString why = QString::fromStdString(e.what());
-        logLine(why);
-        statusBar()->showMessage(why);
+        showError(QString::fromStdString(e.what()));
         return false;
     }
     addRecent(m_doc.folder());
@@ -341,7 +364,7 @@ bool MainWindow::newProject(const QString& folder) {
         const QString id = QFileInfo(folder).fileName().toLower().replace(QRegularExpression("[^a-z0-9-]"), "-");
         m_doc.createNew(folder, id.isEmpty() ? QStringLiteral("new-case") : id);
     } catch (const std::exception& e) {
-        logLine(QString::fromStdString(e.what()));
+        showError(QString::fromStdString(e.what()));
         return false;
     }
     addRecent(m_doc.folder());
@@ -354,9 +377,7 @@ bool MainWindow::saveProject() {
     try {
         m_doc.save();
     } catch (const std::exception& e) {
-        const QString why = QString::fromStdString(e.what());
-        logLine(why);
-        statusBar()->showMessage(why);
+        showError(QString::fromStdString(e.what()));
         return false;
     }
     statusBar()->showMessage(tr("Saved"));
@@ -368,15 +389,30 @@ bool MainWindow::saveProjectAs(const QString& folder) {
     try {
         m_doc.saveAs(folder);
     } catch (const std::exception& e) {
-        logLine(QString::fromStdString(e.what()));
+        showError(QString::fromStdString(e.what()));
         return false;
     }
     addRecent(m_doc.folder());
     return true;
 }
 
-bool MainWindow::startExport(const QString& out) {
+bool MainWindow::startExport(const QString& out, Signing signing) {
     if (!m_doc.hasProject()) return false;
+    ExportSigning how; // unsigned unless the publisher key signs
+    if (signing == Signing::PublisherKey) {
+        const std::optional<std::filesystem::path> key = defaultPublisherKey();
+        if (!key) {
+            askUnsignedExport(out, QString::fromStdString(defaultPublisherKeyPath().string()));
+            return false;
+        }
+        try { // a key the export would refuse (unreadable, inside the project) is refused before the work
+            loadPublisherKey(*key, m_doc.project().dir);
+        } catch (const std::exception& e) {
+            showError(QString::fromStdString(e.what()));
+            return false;
+        }
+        how = {QString::fromStdString(key->string()), QString::fromStdString(defaultSignerName(std::nullopt))};
+    }
     const RealTimeEstimate& rt = realTime();
     if (rt.slower()) { // said before the work: the trainee's session would fall behind
         const QString warning =
@@ -391,9 +427,8 @@ bool MainWindow::startExport(const QString& out) {
         statusBar()->showMessage(warning);
     }
     QString why;
-    if (!m_export->start(m_doc.project(), out, &why)) {
-        logLine(why);
-        statusBar()->showMessage(why);
+    if (!m_export->start(m_doc.project(), out, how, &why)) {
+        showError(why);
         return false;
     }
     if (!m_progress) {
@@ -409,8 +444,53 @@ bool MainWindow::startExport(const QString& out) {
     m_progress->setValue(0);
     m_progress->setLabelText(tr("Exporting %1").arg(out));
     m_progress->show();
-    logLine(tr("exporting to %1").arg(out));
+    logLine(how.isUnsigned() ? tr("exporting to %1, unsigned (chosen)").arg(out)
+                             : tr("exporting to %1, signed with %2").arg(out, how.keyFile));
     return true;
+}
+
+void MainWindow::askUnsignedExport(const QString& out, const QString& keyFile) {
+    const QString why = QString::fromStdString(unsignedCaseWarning(keyFile.toStdString()));
+    logLine(tr("Export case: %1").arg(why));
+    statusBar()->showMessage(why);
+    if (m_unsignedBox) m_unsignedBox->close();
+    auto* box = new QMessageBox(
+        QMessageBox::Warning, tr("Export case: no publisher key"),
+        tr("The case cannot be signed: there is no publisher key at %1.\n\nPlayers refuse an unsigned case unless it "
+           "is run with --allow-unsigned. A publisher makes one key (as `viscera-studio keygen` does), keeps it "
+           "outside every project folder and gives its public half (%2) to the stations that run the cases.\n\n"
+           "Make the key now and sign with it, or export this case unsigned.")
+            .arg(keyFile, QString::fromStdString(publicKeyPathFor(keyFile.toStdString()).string())),
+        QMessageBox::Cancel, this);
+    box->setObjectName("unsignedExportBox");
+    QPushButton* make = box->addButton(tr("Make a key and sign"), QMessageBox::AcceptRole);
+    make->setObjectName("makeKeyAndSign");
+    QPushButton* plain = box->addButton(tr("Export unsigned"), QMessageBox::DestructiveRole);
+    plain->setObjectName("exportUnsigned");
+    box->setDefaultButton(make);
+    box->setAttribute(Qt::WA_DeleteOnClose);
+    connect(box, &QMessageBox::buttonClicked, this, [this, make, plain, out](QAbstractButton* b) {
+        if (b == make)
+            makeKeyAndExport(out);
+        else if (b == plain)
+            startExport(out, Signing::Unsigned);
+    });
+    m_unsignedBox = box;
+    box->open();
+}
+
+void MainWindow::makeKeyAndExport(const QString& out) {
+    try {
+        const NewPublisherKey k = makePublisherKey(defaultPublisherKeyPath());
+        logLine(tr("publisher key %1 made: private %2 (mode 600: keep it outside every project folder), public %3 "
+                   "(players trust it: --trust, or a copy in /etc/viscera/trusted-publishers)")
+                    .arg(QString::fromStdString(k.keyId), QString::fromStdString(k.privateFile.string()),
+                         QString::fromStdString(k.publicFile.string())));
+    } catch (const std::exception& e) {
+        showError(QString::fromStdString(e.what()));
+        return;
+    }
+    startExport(out, Signing::PublisherKey);
 }
 
 void MainWindow::closeEvent(QCloseEvent* e) {

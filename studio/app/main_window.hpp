@@ -16,6 +16,8 @@
 #include "app/viewport.hpp"
 
 #include <QMainWindow>
+#include <QMessageBox>
+#include <QPointer>
 #include <QStringList>
 
 #include <memory>
@@ -32,6 +34,7 @@ class QTreeWidget;
 namespace viscera::studio {
 
 class AnatomySteps;
+class ErrorBanner;
 class ExportRunner;
 class MaterialPanel;
 class PlotWidget;
@@ -47,14 +50,25 @@ public:
     explicit MainWindow(QWidget* parent = nullptr);
     ~MainWindow() override;
 
-    /// Opens a project folder; on failure the message (file, field, rule) goes to the log and
-    /// the status bar and false is returned (the open project stays).
+    /// Opens a project folder; on failure the message (file, field, rule) is shown (showError)
+    /// and false is returned (the open project stays).
     bool openProject(const QString& folder);
     bool saveProject();
     bool saveProjectAs(const QString& folder);
     bool newProject(const QString& folder);
-    /// Starts File → Export case… to `out` (no file dialog). False with the reason logged.
-    bool startExport(const QString& out);
+    /// How File → Export case… signs: with the publisher key (the one `viscera-studio export`
+    /// uses by default, studio::defaultPublisherKey), or unsigned because the user chose so.
+    enum class Signing { PublisherKey, Unsigned };
+    /// Starts File → Export case… to `out` (no file dialog). False with the reason shown. With
+    /// Signing::PublisherKey and no key, nothing starts: unsignedExportBox() says why and offers
+    /// to make a key (as `viscera-studio keygen`) and sign, or to export unsigned.
+    bool startExport(const QString& out, Signing signing = Signing::PublisherKey);
+    /// The open "no publisher key" question (null when none).
+    QMessageBox* unsignedExportBox() const { return m_unsignedBox; }
+
+    /// An error of an action: the log, the status bar and the banner over the viewport.
+    void showError(const QString& line);
+    ErrorBanner* errorBanner() { return m_banner; }
 
     /// Selects the body (tree, material editor, viewport highlight). -1: none.
     void selectBody(int index);
@@ -133,6 +147,8 @@ private:
     void logLine(const QString& line);
     void submitPreview(Change what = Change::everything());
     void connectExport();
+    void askUnsignedExport(const QString& out, const QString& keyFile);
+    void makeKeyAndExport(const QString& out);
 
     Document m_doc;
     Selection m_sel;
@@ -155,6 +171,8 @@ private:
     QPlainTextEdit* m_log = nullptr;
     QMenu* m_recentMenu = nullptr;
     QProgressDialog* m_progress = nullptr;
+    ErrorBanner* m_banner = nullptr;
+    QPointer<QMessageBox> m_unsignedBox;
     QTimer* m_poll = nullptr;
     uint64_t m_shownScene = 0, m_shownFrames = 0, m_shownRevision = ~uint64_t(0);
     std::pair<uint64_t, uint64_t> m_lastSubmit{0, 0};

@@ -22,7 +22,7 @@ double niceStep(double range) {
 } // namespace
 
 PlotWidget::PlotWidget(QWidget* parent) : QWidget(parent) {
-    setMinimumSize(220, 150);
+    setMinimumSize(220, 110);
 }
 
 void PlotWidget::setSeries(std::vector<Series> series) {

@@ -21,6 +21,8 @@ public:
     };
 
     explicit PlotWidget(QWidget* parent = nullptr);
+    /// 220 × 150 wanted; 220 × 110 at least (the main window fits a 1920 × 1080 screen).
+    QSize sizeHint() const override { return {220, 150}; }
     void setTitle(const QString& title) {
         m_title = title;
         update();

@@ -8,6 +8,7 @@
 #include <QFormLayout>
 #include <QLabel>
 #include <QLineEdit>
+#include <QRegularExpression>
 #include <QTimer>
 #include <QVBoxLayout>
 
@@ -19,6 +20,12 @@ namespace {
 
 const char* const kBodyFields[] = {"youngs_modulus", "poisson_ratio", "density"};
 const char* const kSolverFields[] = {"dt", "substeps", "iterations", "damping"};
+const char* const kPlacementFields[] = {"unit", "scale", "rotation_deg"};
+
+bool madeFromAnatomy(const Project& p, int body) {
+    return body >= 0 && body < static_cast<int>(p.bodies.size()) &&
+           p.bodies[static_cast<size_t>(body)].mesh.kind == MeshSource::Kind::Remesh;
+}
 
 /// The text field `name` shows for the project (empty: not a field of this selection).
 QString valueText(const Project& p, int body, const QString& name) {
@@ -27,6 +34,13 @@ QString valueText(const Project& p, int body, const QString& name) {
         if (name == "youngs_modulus") return numberText(m.youngsModulus);
         if (name == "poisson_ratio") return numberText(m.poissonRatio);
         if (name == "density") return numberText(m.density);
+    }
+    if (madeFromAnatomy(p, body)) {
+        const bake::ImportPlacement& q = p.bodies[static_cast<size_t>(body)].mesh.remesh.placement;
+        if (name == "scale") return numberText(q.scale);
+        if (name == "rotation_deg")
+            return QStringLiteral("%1 %2 %3")
+                .arg(numberText(q.rotationDeg.x()), numberText(q.rotationDeg.y()), numberText(q.rotationDeg.z()));
     }
     const auto& x = p.scene.xpbd;
     if (name == "dt") return numberText(x.dt);
@@ -83,6 +97,19 @@ void PropertiesPanel::addField(const QString& name, const QString& label) {
     m_form->addRow(label, e);
 }
 
+void PropertiesPanel::addPlacementFields(const bake::ImportPlacement& placement) {
+    auto* unit = new QComboBox(this);
+    unit->setObjectName("unit");
+    for (auto u :
+         {bake::LengthUnit::Metre, bake::LengthUnit::Centimetre, bake::LengthUnit::Millimetre, bake::LengthUnit::Inch})
+        unit->addItem(QString::fromUtf8(bake::unitName(u).data()));
+    unit->setCurrentText(QString::fromUtf8(bake::unitName(placement.unit).data()));
+    connect(unit, &QComboBox::currentTextChanged, this, [this](const QString& t) { setProperty("unit", t); });
+    m_form->addRow(tr("Length unit of the parts"), unit);
+    addField("scale", tr("Uniform scale"));
+    addField("rotation_deg", tr("Rotation x y z [°]"));
+}
+
 void PropertiesPanel::rebuild() {
     ++m_builds;
     while (m_form->rowCount() > 0)
@@ -105,6 +132,7 @@ void PropertiesPanel::rebuild() {
         addField("youngs_modulus", tr("Young's modulus E [Pa]"));
         addField("poisson_ratio", tr("Poisson ratio ν"));
         addField("density", tr("Density [kg/m³]"));
+        if (madeFromAnatomy(p, body)) addPlacementFields(p.bodies[static_cast<size_t>(body)].mesh.remesh.placement);
     } else if (m_sel->kind() == Selection::Kind::Solver && p.scene.solverType == "xpbd") {
         addField("dt", tr("Frame step dt [s]"));
         addField("substeps", tr("Substeps per frame"));
@@ -149,7 +177,11 @@ QString PropertiesPanel::setProperty(const QString& field, const QString& text) 
     const bool material =
         field == "model" || std::find(std::begin(kBodyFields), std::end(kBodyFields), field) != std::end(kBodyFields);
     const bool solver = std::find(std::begin(kSolverFields), std::end(kSolverFields), field) != std::end(kSolverFields);
-    if (material) {
+    const bool placement =
+        std::find(std::begin(kPlacementFields), std::end(kPlacementFields), field) != std::end(kPlacementFields);
+    if (placement) {
+        why = setPlacementValue(field, text);
+    } else if (material) {
         why = setMaterialValue(field, text);
     } else if (solver) {
         const std::optional<double> v = parseNumberText(text, field, why);
@@ -193,6 +225,31 @@ QString PropertiesPanel::setMaterialValue(const QString& field, const QString& t
     if (field == "poisson_ratio") m.poissonRatio = *v;
     if (field == "density") m.density = *v;
     return m_doc->editMaterial(tr("Set %1").arg(field), b, m);
+}
+
+QString PropertiesPanel::setPlacementValue(const QString& field, const QString& text) {
+    const int b = m_sel->body();
+    if (!m_doc->hasProject() || !madeFromAnatomy(m_doc->project(), b)) return tr("no body made from anatomy selected");
+    bake::ImportPlacement q = m_doc->project().bodies[static_cast<size_t>(b)].mesh.remesh.placement;
+    QString why;
+    if (field == "unit") {
+        const auto unit = bake::lengthUnitFromName(text.toStdString());
+        if (!unit) return tr("unit: '%1' is not a length unit (m, cm, mm, inch)").arg(text);
+        q.unit = *unit;
+    } else if (field == "scale") {
+        const std::optional<double> v = parseNumberText(text, field, why);
+        if (!v) return why;
+        q.scale = *v;
+    } else {
+        const QStringList parts = text.split(QRegularExpression("[\\s,]+"), Qt::SkipEmptyParts);
+        if (parts.size() != 3) return tr("rotation_deg: '%1' must be three angles (x y z, degrees)").arg(text);
+        for (int k = 0; k < 3; ++k) {
+            const std::optional<double> v = parseNumberText(parts[k], field, why);
+            if (!v) return why;
+            q.rotationDeg[k] = *v;
+        }
+    }
+    return m_doc->editPlacement(tr("Set %1").arg(field), b, q);
 }
 
 QString PropertiesPanel::setSolverValue(const QString& field, double v, const QString& text) {

@@ -1,5 +1,6 @@
 #pragma once
-/// The properties of the selection: a body's material model, E, ν and density; the solver's dt,
+/// The properties of the selection: a body's material model, E, ν and density (and, for a body
+/// made from anatomy, its parts' unit, scale and rotation); the solver's dt,
 /// substeps, iterations and damping; the render settings and a surface's figures. A typed value
 /// is one undo step through the Document (a material value as a typed material edit, checked by
 /// the reader's material rules); a refused value shows the rule under the fields and the field
@@ -43,6 +44,9 @@ private:
     void fillValues(bool force);
     QString setMaterialValue(const QString& field, const QString& text);
     QString setSolverValue(const QString& field, double v, const QString& text);
+    /// A body made from anatomy: its parts' unit, scale or rotation (Document::editPlacement).
+    QString setPlacementValue(const QString& field, const QString& text);
+    void addPlacementFields(const bake::ImportPlacement& placement);
     void addField(const QString& name, const QString& label);
 
     Document* m_doc;

@@ -15,12 +15,14 @@
 #include <assimp/scene.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -231,7 +233,7 @@ Merged mergeScene(const std::string& label, const aiScene* scene, const ImportOp
             for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
                 const aiVector3D& a = mesh->mVertices[v];
                 const Eigen::Vector4d h = world * Eigen::Vector4d(a.x, a.y, a.z, 1.0);
-                const sim::Vec3 p = scale * h.head<3>();
+                const sim::Vec3 p = options.rotation * (scale * h.head<3>());
                 if (!p.allFinite())
                     fail(label, meshName(mesh, mi) + " vertex " + std::to_string(v) +
                                     " is not finite after the node transform and unit scale " +
@@ -270,6 +272,81 @@ Merged mergeScene(const std::string& label, const aiScene* scene, const ImportOp
 
 } // namespace
 
+std::string_view unitName(LengthUnit unit) {
+    switch (unit) {
+    case LengthUnit::Metre:
+        return "m";
+    case LengthUnit::Centimetre:
+        return "cm";
+    case LengthUnit::Millimetre:
+        return "mm";
+    case LengthUnit::Inch:
+        return "inch";
+    }
+    return "m";
+}
+
+std::string_view unitLongName(LengthUnit unit) {
+    switch (unit) {
+    case LengthUnit::Metre:
+        return "metres";
+    case LengthUnit::Centimetre:
+        return "centimetres";
+    case LengthUnit::Millimetre:
+        return "millimetres";
+    case LengthUnit::Inch:
+        return "inches";
+    }
+    return "metres";
+}
+
+double metresPerUnit(LengthUnit unit) {
+    switch (unit) {
+    case LengthUnit::Metre:
+        return 1.0;
+    case LengthUnit::Centimetre:
+        return 0.01;
+    case LengthUnit::Millimetre:
+        return 0.001;
+    case LengthUnit::Inch:
+        return 0.0254;
+    }
+    return 1.0;
+}
+
+std::optional<LengthUnit> lengthUnitFromName(std::string_view name) {
+    for (LengthUnit u : {LengthUnit::Metre, LengthUnit::Centimetre, LengthUnit::Millimetre, LengthUnit::Inch})
+        if (unitName(u) == name) return u;
+    return std::nullopt;
+}
+
+LengthUnit guessLengthUnit(double extent) {
+    if (!(extent > 0) || !std::isfinite(extent) || (extent >= 0.01 && extent <= 1.0)) return LengthUnit::Metre;
+    LengthUnit best = LengthUnit::Metre;
+    double bestDistance = std::numeric_limits<double>::infinity();
+    for (LengthUnit u : {LengthUnit::Metre, LengthUnit::Centimetre, LengthUnit::Millimetre}) {
+        const double distance = std::abs(std::log(extent * metresPerUnit(u) / 0.08));
+        if (distance < bestDistance) {
+            best = u;
+            bestDistance = distance;
+        }
+    }
+    return best;
+}
+
+Eigen::Matrix3d ImportPlacement::rotation() const {
+    const Eigen::Vector3d r = rotationDeg * (std::acos(-1.0) / 180.0);
+    return (Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
+            Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()))
+        .toRotationMatrix();
+}
+
+ImportOptions placedOptions(const ImportPlacement& placement, ImportOptions base) {
+    base.scale = placement.metresPerFileUnit();
+    base.rotation = placement.rotation();
+    return base;
+}
+
 std::string_view formatName(SurfaceFormat format) {
     switch (format) {
     case SurfaceFormat::Obj:
@@ -304,6 +381,9 @@ ImportResult importSurfaceWithReport(const std::filesystem::path& file, const Im
     if (!std::isfinite(options.scale) || options.scale <= 0)
         throw std::invalid_argument("bake::importSurface(): ImportOptions::scale is " + std::to_string(options.scale) +
                                     " (must be finite and > 0)");
+    const Eigen::Matrix3d& r = options.rotation;
+    if (!r.allFinite() || !(r * r.transpose()).isIdentity(1e-9) || !(std::abs(r.determinant() - 1.0) < 1e-9))
+        throw std::invalid_argument("bake::importSurface(): ImportOptions::rotation is not a proper rotation");
     const std::string label = file.string();
     ImportReport report;
     {

@@ -213,16 +213,15 @@ std::optional<vcase::SigningKey> exportKey(const std::optional<std::string>& giv
         if (given) throw std::invalid_argument("--unsigned and --sign-key exclude each other");
         return std::nullopt;
     }
-    const std::filesystem::path file = given ? std::filesystem::path(*given) : studio::defaultPublisherKeyPath();
-    std::error_code ec;
-    if (!given && !std::filesystem::exists(file, ec)) {
-        std::fprintf(stderr,
-                     "viscera-studio: warning: the case is not signed: no publisher key at %s (make one with "
-                     "'viscera-studio keygen'); players refuse it without --allow-unsigned\n",
-                     file.c_str());
+    // The rule the studio's File → Export case… follows too (studio/project/publishing.hpp).
+    const std::optional<std::filesystem::path> file =
+        given ? std::optional<std::filesystem::path>(*given) : studio::defaultPublisherKey();
+    if (!file) {
+        std::fprintf(stderr, "viscera-studio: warning: %s\n",
+                     studio::unsignedCaseWarning(studio::defaultPublisherKeyPath()).c_str());
         return std::nullopt;
     }
-    return studio::loadPublisherKey(file, projectDir);
+    return studio::loadPublisherKey(*file, projectDir);
 }
 
 int cmdExport(const std::vector<std::string>& argsIn) {
@@ -241,8 +240,8 @@ int cmdExport(const std::vector<std::string>& argsIn) {
     const std::optional<vcase::SigningKey> key = exportKey(parsed.extra[1], unsignedCase, *dir);
     if (key) {
         publish.key = &*key;
-        publish.signer = parsed.extra[2].value_or(
-            parsed.extra[1] ? std::filesystem::path(*parsed.extra[1]).stem().string() : std::string("publisher"));
+        publish.signer = parsed.extra[2].value_or(studio::defaultSignerName(
+            parsed.extra[1] ? std::optional<std::filesystem::path>(*parsed.extra[1]) : std::nullopt));
     }
     studio::Project project =
         projectFile ? studio::loadProjectText(readFile(*projectFile), *dir, *projectFile) : studio::loadProject(*dir);

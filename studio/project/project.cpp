@@ -124,10 +124,27 @@ sim::Vec3 positiveVec3(const JsonField& f, const char* rule) {
     return v;
 }
 
+/// The placement fields of a remesh block (RemeshSource::placement): "unit", "scale",
+/// "rotation_deg", each optional.
+bake::ImportPlacement readPlacement(const JsonField& r) {
+    bake::ImportPlacement p;
+    if (auto u = r.find("unit"))
+        p.unit = *bake::lengthUnitFromName(u->choice({"m", "cm", "mm", "inch"}, "a length unit"));
+    p.scale = r.number("scale", p.scale, NumberRule::positive());
+    if (auto d = r.find("rotation_deg")) p.rotationDeg = d->vec3(NumberRule::closed(-360, 360));
+    return p;
+}
+
+void writePlacement(const bake::ImportPlacement& p, json& j) {
+    j["unit"] = std::string(bake::unitName(p.unit));
+    j["scale"] = p.scale;
+    j["rotation_deg"] = vec3Json(p.rotationDeg);
+}
+
 /// The "remesh" block (RemeshSource): the numbers by the rules of bake::RemeshParams.
 RemeshSource readRemesh(const JsonField& r, const std::filesystem::path& dir) {
-    r.object({"parts", "scale", "voxel_size", "voxel_count", "smoothing", "edge_length", "iterations", "uv_transfer",
-              "texture"});
+    r.object({"parts", "unit", "scale", "rotation_deg", "voxel_size", "voxel_count", "smoothing", "edge_length",
+              "iterations", "uv_transfer", "texture"});
     RemeshSource out;
     const JsonField parts = r["parts"];
     if (!parts.value().is_array() || parts.value().empty() || parts.value().size() > 64)
@@ -143,7 +160,7 @@ RemeshSource readRemesh(const JsonField& r, const std::filesystem::path& dir) {
                                        : bake::CsgOp::Intersection;
         out.parts.push_back(part);
     }
-    out.scale = r.number("scale", out.scale, NumberRule::positive());
+    out.placement = readPlacement(r);
     bake::RemeshParams& q = out.params;
     if (r.find("voxel_size") && r.find("voxel_count")) r.fail("give voxel_size or voxel_count, not both");
     q.voxelSize = r.number("voxel_size", 0.0, NumberRule::positive());
@@ -173,7 +190,6 @@ json remeshJson(const RemeshSource& r, const WriteContext& w, const std::string&
             {{"file", projectFileJson(r.parts[i].file, w, field + ".parts[" + std::to_string(i) + "].file")},
              {"op", std::string(bake::csgOpName(r.parts[i].op))}});
     json j = {{"parts", parts},
-              {"scale", r.scale},
               {"smoothing", r.params.smoothingIterations},
               {"iterations", r.params.remeshIterations},
               {"uv_transfer", r.uvTransfer ? (*r.uvTransfer == bake::UvTransferMethod::ClosestPoint     ? "closest"
@@ -186,6 +202,7 @@ json remeshJson(const RemeshSource& r, const WriteContext& w, const std::string&
         j["voxel_count"] = r.params.voxelCount;
     if (r.params.targetEdgeLength > 0) j["edge_length"] = r.params.targetEdgeLength;
     if (!r.texture.empty()) j["texture"] = projectFileJson(r.texture, w, field + ".texture");
+    writePlacement(r.placement, j);
     return j;
 }
 
@@ -599,6 +616,19 @@ std::vector<std::filesystem::path> projectInputFiles(const Project& p) {
     return files;
 }
 
+std::string placementProblem(const bake::ImportPlacement& placement, const std::string& field) {
+    json block;
+    writePlacement(placement, block);
+    const std::string origin = "project.json";
+    try {
+        readPlacement(JsonField(block, field, origin));
+    } catch (const InputError& e) {
+        const std::string why = e.what();
+        return why.rfind(origin + ": ", 0) == 0 ? why.substr(origin.size() + 2) : why;
+    }
+    return {};
+}
+
 Project loadProjectText(const std::string& text, const std::filesystem::path& dir, const std::string& origin) {
     const json doc = sim::parseJsonText(text, origin);
     const JsonField root(doc, "", origin);
@@ -803,8 +833,7 @@ namespace {
 std::vector<bake::RemeshPart> importParts(const RemeshSource& r) {
     std::vector<bake::RemeshPart> parts;
     for (const RemeshSource::Part& p : r.parts) {
-        bake::ImportOptions opt;
-        opt.scale = r.scale;
+        bake::ImportOptions opt = bake::placedOptions(r.placement);
         opt.keepUv = r.uvTransfer.has_value();
         bake::ImportResult in = bake::importSurfaceWithReport(p.file, opt);
         if (opt.keepUv && in.uv.empty())

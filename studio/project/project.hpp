@@ -54,6 +54,7 @@
 /// "meshing" (CGAL Mesh_3, metres and degrees): facet_angle, facet_size, facet_distance,
 /// cell_radius_edge_ratio, cell_size, seed, max_tets (the cap on the tets the sizes may ask
 /// for, refused before meshing; [1000, 2000000]).
+#include "bake/import.hpp"
 #include "bake/remesh.hpp"
 #include "bake/skeleton.hpp"
 #include "bake/tetrahedralize.hpp"
@@ -89,7 +90,8 @@ namespace viscera::studio {
 /// combined and remeshed on a voxel grid (bake::voxelRemesh), their UVs transferred onto the
 /// result, which is then tetrahedralized with the mesh's "meshing".
 ///   "mesh": {"remesh": {"parts": [{"file": "anatomy/cortex.obj", "op": "union"}, ...],
-///                       "scale": 1, "voxel_size": 0.001 | "voxel_count": 128, "smoothing": 0,
+///                       "unit": "m" | "cm" | "mm" | "inch", "scale": 1, "rotation_deg": [90, 0, 0],
+///                       "voxel_size": 0.001 | "voxel_count": 128, "smoothing": 0,
 ///                       "edge_length": 0.0015, "iterations": 3,
 ///                       "uv_transfer": "seam-cut" | "closest" | "island" | "none",
 ///                       "texture": "anatomy/kidney.png"},
@@ -97,6 +99,10 @@ namespace viscera::studio {
 /// The texture (a PNG of the project) is the parts' diffuse map: export lays it on the body by
 /// the transferred UVs (render.materials.<body>: diffuse + uv). A body's texture block, when it
 /// has one, is laid by them instead.
+/// The parts' placement (bake::ImportPlacement): "unit" the files' length unit (default "m"),
+/// "scale" a uniform factor on top of it (> 0, default 1), "rotation_deg" Euler angles about x,
+/// then y, then z (each in [-360, 360], default none); a part's file coordinate c becomes
+/// R · (metres per unit · scale · c) metres.
 struct RemeshSource {
     struct Part {
         std::filesystem::path file; ///< resolved against the project folder
@@ -104,11 +110,16 @@ struct RemeshSource {
         bool operator==(const Part&) const = default;
     };
     std::vector<Part> parts;
-    double scale = 1.0;        ///< file units → metres
-    bake::RemeshParams params; ///< voxel size or count, smoothing, edge length, iterations
+    bake::ImportPlacement placement; ///< file units → metres, then the rotation
+    bake::RemeshParams params;       ///< voxel size or count, smoothing, edge length, iterations
     std::optional<bake::UvTransferMethod> uvTransfer = bake::UvTransferMethod::SeamCutting; ///< none: no UVs
     std::filesystem::path texture;                                                          ///< empty: none
 };
+
+/// The rule readRemesh applies to the placement fields, on a value: empty when `placement` is
+/// admitted, else "<field>.<key>: <rule>" with `field` the block's JSON path
+/// ("bodies[1].mesh.remesh.rotation_deg[0]: must be in [-360, 360]").
+std::string placementProblem(const bake::ImportPlacement& placement, const std::string& field);
 
 struct MeshSource {
     enum class Kind { Box, Ellipsoid, Liver, Tube, HollowTube, File, Remesh };

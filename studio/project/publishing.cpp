@@ -17,6 +17,22 @@ fs::path defaultPublisherKeyPath() {
     return fs::path(home && *home == '/' ? home : "/root") / ".config/viscera/publisher-key.pem";
 }
 
+std::optional<fs::path> defaultPublisherKey() {
+    const fs::path file = defaultPublisherKeyPath();
+    std::error_code ec;
+    if (!fs::exists(file, ec)) return std::nullopt;
+    return file;
+}
+
+std::string defaultSignerName(const std::optional<fs::path>& namedKey) {
+    return namedKey ? namedKey->stem().string() : std::string("publisher");
+}
+
+std::string unsignedCaseWarning(const fs::path& missingKey) {
+    return "the case is not signed: no publisher key at " + missingKey.string() +
+           " (make one with 'viscera-studio keygen'); players refuse it without --allow-unsigned";
+}
+
 fs::path publicKeyPathFor(const fs::path& privateFile) {
     fs::path p = privateFile;
     if (p.extension() == ".pem") p.replace_extension();

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -14,6 +15,20 @@ namespace viscera::studio {
 /// Where the studio looks for the publisher key when none is given:
 /// $XDG_CONFIG_HOME/viscera/publisher-key.pem, else ~/.config/viscera/publisher-key.pem.
 std::filesystem::path defaultPublisherKeyPath();
+
+/// The key an export signs with when none is named (`viscera-studio export` without --sign-key,
+/// File → Export case… in the studio): defaultPublisherKeyPath() where that file exists, else none
+/// (the case then goes out unsigned, which the exporter says: unsignedCaseWarning).
+std::optional<std::filesystem::path> defaultPublisherKey();
+
+/// The signer a case names when no --signer is given: the stem of a named key file, "publisher"
+/// for the default key.
+std::string defaultSignerName(const std::optional<std::filesystem::path>& namedKey);
+
+/// Why a case goes out unsigned when no key is named and none is at `missingKey`, and how to
+/// sign it: "the case is not signed: no publisher key at <file> (make one with 'viscera-studio
+/// keygen'); players refuse it without --allow-unsigned".
+std::string unsignedCaseWarning(const std::filesystem::path& missingKey);
 
 /// The public key file beside a private one: "key.pem" -> "key.pub.pem" ("key" -> "key.pub.pem").
 std::filesystem::path publicKeyPathFor(const std::filesystem::path& privateFile);

@@ -6,6 +6,7 @@
 #include "app/anatomy_steps.hpp"
 #include "app/document.hpp"
 #include "app/export_runner.hpp"
+#include "app/import_placement.hpp"
 #include "app/studio_task.hpp"
 #include "case/case_package.hpp"
 #include "project/sample_kidney.hpp"
@@ -20,6 +21,7 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QListView>
+#include <QMessageBox>
 #include <QPlainTextEdit>
 #include <QProcess>
 #include <QProgressDialog>
@@ -82,6 +84,12 @@ struct AnatomyFixture : test::MainWindowFixture {
         auto* box = dlg->findChild<QDialogButtonBox*>("buttonBox");
         ASSERT_NE(box, nullptr);
         QTest::mouseClick(box->button(QDialogButtonBox::Open), Qt::LeftButton);
+        // the unit question: the sample's parts are in metres (a kidney 0.1 m long), as guessed
+        ASSERT_TRUE(test::waitFor([&] { return steps()->placementDialog() != nullptr; }, 60000))
+            << "the import check did not finish; log: " << w->log()->toPlainText().toStdString()
+            << "; task output: " << steps()->task().output().toStdString();
+        EXPECT_EQ(steps()->placementDialog()->guessedUnit(), bake::LengthUnit::Metre);
+        QTest::mouseClick(steps()->placementDialog()->findChild<QPushButton*>("importButton"), Qt::LeftButton);
         ASSERT_TRUE(test::waitFor([&] { return w->document()->project().bodies.size() == 2; }, 60000))
             << "the import did not finish; log: " << w->log()->toPlainText().toStdString()
             << "; task output: " << steps()->task().output().toStdString();
@@ -186,6 +194,10 @@ TEST_F(AnatomyFixture, ImportMakeSimulationReadyTetrahedralizeAndExportByGuiActi
     typer.start(100);
     exportAction->trigger(); // the dialog runs its own loop until the keys accept it
     EXPECT_FALSE(typer.isActive()) << "no save dialog appeared";
+    // no publisher key in the test's config folder: the studio says so and the case goes out
+    // unsigned by choice
+    ASSERT_TRUE(test::waitFor([&] { return w->unsignedExportBox() && w->unsignedExportBox()->isVisible(); }, 5000));
+    QTest::mouseClick(w->unsignedExportBox()->findChild<QPushButton*>("exportUnsigned"), Qt::LeftButton);
     ASSERT_TRUE(test::waitFor([&] { return done; }, 180000));
     ASSERT_TRUE(ok) << w->exportRunner()->output().toStdString();
     {

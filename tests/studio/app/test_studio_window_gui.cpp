@@ -17,6 +17,7 @@
 #include "app/viewport.hpp"
 #include "case/case_package.hpp"
 #include "gui_test_support.hpp"
+#include "project/publishing.hpp"
 #include "render/image.hpp"
 #include "render/sample_map.hpp"
 #include "sim/material/editable_curves.hpp"
@@ -172,7 +173,7 @@ TEST_F(WindowFixture, TheStudioShowsTheRealTimeBudgetAndWarnsBeforeExportingASlo
         << w->costPlot()->note().toStdString();
     test::saveShot("realtime_budget");
     const fs::path out = scratch.dir / "slow.vcase";
-    ASSERT_TRUE(w->startExport(QString::fromStdString(out.string())));
+    ASSERT_TRUE(w->startExport(QString::fromStdString(out.string()), studio::MainWindow::Signing::Unsigned));
     EXPECT_TRUE(w->log()->toPlainText().contains("warning: the case runs at ×"))
         << w->log()->toPlainText().toStdString();
     EXPECT_TRUE(w->log()->toPlainText().contains("a trainee's session would fall behind"));
@@ -201,7 +202,8 @@ TEST_F(WindowFixture, TheRealTimeWarningAppearsForTheCurveMaterialLiver) {
     ASSERT_TRUE(test::waitFor([&] { return w->costPlot()->note().contains("TOO SLOW"); }, 10000))
         << w->costPlot()->note().toStdString();
     test::saveShot("liver_curve_material_budget");
-    ASSERT_TRUE(w->startExport(QString::fromStdString((scratch.dir / "liver.vcase").string())));
+    ASSERT_TRUE(w->startExport(QString::fromStdString((scratch.dir / "liver.vcase").string()),
+                               studio::MainWindow::Signing::Unsigned));
     EXPECT_TRUE(w->log()->toPlainText().contains("a trainee's session would fall behind"))
         << w->log()->toPlainText().toStdString();
     w->exportRunner()->cancel();
@@ -778,6 +780,7 @@ TEST_F(WindowFixture, FitToAUniaxialAndAnEquibiaxialTest) {
 
 TEST_F(WindowFixture, GuiExportEqualsCliExport) {
     const fs::path dir = open("tissue-slab");
+    studio::makePublisherKey(studio::defaultPublisherKeyPath()); // the fixture's own config folder: both sign
     const fs::path gui = scratch.dir / "gui.vcase", cli = scratch.dir / "cli.vcase";
     bool done = false, ok = false;
     QObject::connect(w->exportRunner(), &studio::ExportRunner::finished, [&](bool success, const QString&) {
@@ -795,6 +798,8 @@ TEST_F(WindowFixture, GuiExportEqualsCliExport) {
         std::string(VISCERA_STUDIO_EXE) + " export '" + dir.string() + "' -o '" + cli.string() + "' > /dev/null 2>&1";
     ASSERT_EQ(std::system(cmd.c_str()), 0);
     EXPECT_EQ(manifestFiles(gui), manifestFiles(cli));
+    EXPECT_TRUE(vcase::CasePackage::open(gui)->signature());
+    EXPECT_TRUE(vcase::CasePackage::open(cli)->signature());
     // nothing else left in the folder
     for (const auto& e : fs::directory_iterator(scratch.dir))
         EXPECT_EQ(e.path().filename().string().rfind(".viscera-", 0), std::string::npos) << e.path();
@@ -810,7 +815,7 @@ TEST_F(WindowFixture, CancelTakesEffectWithinHalfASecondAndLeavesNoFile) {
         done = true;
         message = m;
     });
-    ASSERT_TRUE(w->startExport(QString::fromStdString(out.string())));
+    ASSERT_TRUE(w->startExport(QString::fromStdString(out.string()), studio::MainWindow::Signing::Unsigned));
     ASSERT_NE(w->exportProgress(), nullptr);
     EXPECT_TRUE(w->exportProgress()->isVisible());
     ASSERT_TRUE(test::waitFor([&] { return w->exportRunner()->stagesDone() >= 1; }, 30000));
@@ -830,7 +835,7 @@ TEST_F(WindowFixture, CancelTakesEffectWithinHalfASecondAndLeavesNoFile) {
     // an output folder that is not writable is refused before anything runs
     QString why;
     studio::ExportRunner r;
-    EXPECT_FALSE(r.start(w->document()->project(), "/proc/nonexistent/x.vcase", &why));
+    EXPECT_FALSE(r.start(w->document()->project(), "/proc/nonexistent/x.vcase", {}, &why));
     EXPECT_TRUE(why.contains("does not exist")) << why.toStdString();
 }
 
@@ -1273,7 +1278,13 @@ TEST_F(WindowFixture, LightSamplePaintingIsExactOneUndoStepAndEscLeavesTheMap) {
     w->findChild<QComboBox*>("sampleTool")->setCurrentIndex(0);
     w->findChild<QComboBox*>("sampleClass")->setCurrentIndex(0);
     w->findChild<QDoubleSpinBox*>("sampleRadius")->setValue(6.0);
-    hostDrag(v, centre - QPoint(80, 0), centre + QPoint(80, 0));
+    // a stroke 36 mm long on the slab whatever the viewport's size (the area bound below is a
+    // cell's band along the stroke's edge)
+    const auto aside = v->hitAt(centre + QPoint(40, 0));
+    ASSERT_TRUE(aside.has_value());
+    const double metresPerPixel = (aside->world - v->hitAt(centre)->world).norm() / 40;
+    const QPoint half(static_cast<int>(std::lround(0.018 / metresPerPixel)), 0);
+    hostDrag(v, centre - half, centre + half);
     ASSERT_EQ(w->document()->undoStack()->count(), undoBefore + 1) << "one stroke, one undo step";
     const auto& ops = w->document()->project().bodies[0].lightSamples;
     ASSERT_EQ(ops.size(), 1u);

@@ -1,6 +1,7 @@
 #pragma once
 // Shared by the studio's main-window GUI tests: a fresh main window per test (settings cleared,
-// no discard prompt, 1500 × 950, shown and exposed), a scratch copy of a sample project opened
+// no discard prompt, XDG_CONFIG_HOME in the scratch folder (no publisher key unless a test makes
+// one), 1500 × 950, shown and exposed), a scratch copy of a sample project opened
 // in it, and the live preview stopped at the end.
 #include "app/main_window.hpp"
 #include "gui_test_support.hpp"
@@ -21,6 +22,9 @@ struct MainWindowFixture : ::testing::Test {
 
     void SetUp() override {
         guiApp();
+        // the publisher key export signs with by default: the test's own folder, never the user's
+        std::filesystem::create_directories(scratch.dir / "config");
+        qputenv("XDG_CONFIG_HOME", QByteArray::fromStdString((scratch.dir / "config").string()));
         QSettings().clear();
         w = std::make_unique<studio::MainWindow>();
         w->setConfirmDiscard(false);

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <limits>
 
 using namespace viscera;
 using ::testing::HasSubstr;
@@ -169,4 +170,75 @@ TEST_F(RemeshBlock, APartWithoutUvsIsRefusedAtExportNamingTheFile) {
         EXPECT_THAT(e.what(), HasSubstr("artery.obj: has no texture coordinates"));
     }
     EXPECT_FALSE(std::filesystem::exists(m_scratch.dir / "kidney.vcase"));
+}
+
+// Issue 57 item 7: the parts' unit, uniform scale and rotation, read and written by the one reader;
+// a centimetre file comes in at its size in metres, a Y-up one turned Z-up.
+TEST_F(RemeshBlock, ThePartsUnitScaleAndRotationPlaceThemInMetres) {
+    studio::writeKidneySample(m_dir);
+    { // a 12 × 8 × 6 cm box, corner (1, 2, 3) cm, in centimetres
+        std::string obj;
+        for (int c = 0; c < 8; ++c)
+            obj += "v " + std::string(c & 1 ? "13" : "1") + (c & 2 ? " 10" : " 2") + (c & 4 ? " 9" : " 3") + "\n";
+        obj += "f 1 3 4\nf 1 4 2\nf 5 6 8\nf 5 8 7\nf 1 2 6\nf 1 6 5\nf 3 7 8\nf 3 8 4\nf 1 5 7\nf 1 7 3\nf 2 4 8\n"
+               "f 2 8 6\n";
+        writeFileAtomic(m_dir / "anatomy" / "box-cm.obj", obj);
+    }
+    json doc = json::parse(readFile(m_dir / "project.json"));
+    json& r = doc["bodies"][0]["mesh"]["remesh"];
+    EXPECT_EQ(r["unit"], "m") << "written explicitly, as every default";
+    EXPECT_EQ(r["rotation_deg"], json::array({0, 0, 0}));
+    r["parts"] = json::array({{{"file", "anatomy/box-cm.obj"}}});
+    r["uv_transfer"] = "none";
+    r.erase("texture");
+    r["unit"] = "cm";
+    r["scale"] = 2;
+    r["rotation_deg"] = {90, 0, 0};
+    const studio::Project p = studio::loadProjectText(doc.dump(1), m_dir, "project.json");
+    const bake::ImportPlacement& q = p.bodies[0].mesh.remesh.placement;
+    EXPECT_EQ(q.unit, bake::LengthUnit::Centimetre);
+    EXPECT_EQ(q.scale, 2.0);
+    EXPECT_EQ(q.rotationDeg, Eigen::Vector3d(90, 0, 0));
+    EXPECT_DOUBLE_EQ(q.metresPerFileUnit(), 0.02);
+    const std::string text = studio::projectJsonText(p);
+    EXPECT_EQ(studio::loadProjectText(text, m_dir, "again").bodies[0].mesh.remesh.placement, q);
+    // (x, y, z) cm × 2 → (x, −z, y) m: what export meshes (project.cpp imports every part so)
+    const auto [lo, hi] = bake::importSurface(m_dir / "anatomy" / "box-cm.obj", bake::placedOptions(q)).bounds();
+    EXPECT_LT((lo - sim::Vec3(0.02, -0.18, 0.04)).cwiseAbs().maxCoeff(), 1e-6) << lo.transpose();
+    EXPECT_LT((hi - sim::Vec3(0.26, -0.06, 0.20)).cwiseAbs().maxCoeff(), 1e-6) << hi.transpose();
+    bake::ImportPlacement plainCm;
+    plainCm.unit = bake::LengthUnit::Centimetre;
+    const auto [lo1, hi1] =
+        bake::importSurface(m_dir / "anatomy" / "box-cm.obj", bake::placedOptions(plainCm)).bounds();
+    EXPECT_LT((hi1 - lo1 - sim::Vec3(0.12, 0.08, 0.06)).cwiseAbs().maxCoeff(), 1e-6) << (hi1 - lo1).transpose();
+}
+
+TEST_F(RemeshBlock, ThePlacementsRulesNameTheFieldInTheFileAndOnAValue) {
+    studio::writeKidneySample(m_dir);
+    const std::string at = "bodies[0].mesh.remesh.";
+    EXPECT_THAT(loadError([](json& r) { r["unit"] = "ft"; }),
+                HasSubstr(at + "unit: 'ft' is not a length unit (m, cm, mm, inch)"));
+    EXPECT_THAT(loadError([](json& r) { r["scale"] = -1; }), HasSubstr(at + "scale: must be positive"));
+    EXPECT_THAT(loadError([](json& r) {
+                    r["rotation_deg"] = {0, 400, 0};
+                }),
+                HasSubstr(at + "rotation_deg[1]: must be in [-360, 360]"));
+    EXPECT_THAT(loadError([](json& r) {
+                    r["rotation_deg"] = {90, 0};
+                }),
+                HasSubstr(at + "rotation_deg: must be an array of 3 numbers"));
+    EXPECT_EQ(loadError([](json& r) { r["unit"] = "inch"; }), "accepted");
+    // the same rule on a value (the studio's typed edit)
+    bake::ImportPlacement q;
+    EXPECT_EQ(studio::placementProblem(q, "bodies[2].mesh.remesh"), "");
+    q.rotationDeg.z() = -361;
+    EXPECT_EQ(studio::placementProblem(q, "bodies[2].mesh.remesh"),
+              "bodies[2].mesh.remesh.rotation_deg[2]: must be in [-360, 360]");
+    q.rotationDeg.z() = 0;
+    q.scale = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_THAT(studio::placementProblem(q, "b"), HasSubstr("b.scale: must be"));
+    // importSurface refuses what is not a rotation
+    bake::ImportOptions skew;
+    skew.rotation(0, 1) = 0.5;
+    EXPECT_THROW(bake::importSurface(m_dir / "anatomy" / "cortex.obj", skew), std::invalid_argument);
 }
