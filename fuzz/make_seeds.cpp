@@ -1,11 +1,23 @@
 // Writes the seeds that are not taken from the exported samples into <dir>:
-//   console_protocol/  a state packet and a command packet as the console and the player send them
-//                      (two arms, pedals), so that the fuzzer starts past the header and checksum;
+//   console_protocol/  a state, command, hello and welcome packet as the console and the player
+//                      send them (two arms, pedals), signed with the harness's fixed key
+//                      (fuzz_link_key.hpp), each once as received (mode byte 0) and once to be
+//                      re-signed (mode byte 1), so that the fuzzer starts past the header and MAC;
+//   link_auth/         a key, the right tag, a flip byte and a message (a state packet's body);
 //   mesh_format/       a unit cube in each format the studio imports (OBJ with texture coordinates,
 //                      normals and a material library, ASCII and binary STL, ASCII and binary PLY,
 //                      GLB, glTF, ASCII FBX), each prefixed with the byte fuzz_mesh_format reads as
-//                      the extension.
+//                      the extension;
+//   scene_blocks/      the assessment, laparoscope and port blocks of every <dir>/scene/*.json
+//                      (the exported samples' scene.json, when fuzz.sh has put them there) and one
+//                      of each written here, each prefixed with the byte fuzz_scene_blocks reads as
+//                      the block (0 assessment, 1 laparoscope, 2 port);
+//   session_report/    a judged session report with a trainee record (schema 5) whose metrics have
+//                      limits and expert levels, beside the player's own reports that fuzz.sh adds.
+#include "fuzz_link_key.hpp"
 #include "haptics/console_protocol.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <array>
 #include <cstdint>
@@ -13,7 +25,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -172,6 +186,125 @@ std::string fbxAscii() {
            "\t\tPolygonVertexIndex: *3 {\n\t\t\ta: 0,1,-3\n\t\t}\n\t}\n}\n";
 }
 
+/// Writes `bytes` with the mode byte `prefix` in front.
+bool writeBytes(const std::filesystem::path& file, char prefix, const uint8_t* bytes, size_t n) {
+    return write(file, prefix, std::string(reinterpret_cast<const char*>(bytes), n));
+}
+
+bool consoleSeeds(const std::filesystem::path& dir, const std::filesystem::path& linkDir) {
+    using namespace viscera::haptics;
+    const LinkMac mac(viscera::fuzz::kFuzzLinkKey);
+    uint8_t buf[kMaxPacketSize];
+    StatePacket s;
+    s.sequence = 7;
+    s.timestamp_ns = 123456789;
+    s.arms = 2;
+    s.pedals = 0x5;
+    CommandPacket c;
+    c.sequence = 9;
+    c.echoSequence = 7;
+    HelloPacket h;
+    h.sequence = 1;
+    h.client = Nonce{1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16};
+    WelcomePacket w;
+    w.sequence = 1;
+    w.client = h.client;
+    w.server = Nonce{16, 15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1};
+    bool ok = true;
+    auto both = [&](const char* name, size_t n) {
+        ok = ok && n > 0 && writeBytes(dir / (std::string(name) + ".bin"), 0, buf, n) &&
+             writeBytes(dir / (std::string(name) + "-resign.bin"), 1, buf, n);
+    };
+    both("state", encode(s, buf, sizeof buf, mac));
+    both("command", encode(c, buf, sizeof buf, mac));
+    both("hello", encode(h, buf, sizeof buf, mac));
+    both("welcome", encode(w, buf, sizeof buf, mac));
+    // link_auth: key, tag, flip byte, message (the state packet's signed part).
+    const size_t n = encode(s, buf, sizeof buf, mac);
+    std::string seed(viscera::fuzz::kFuzzLinkKey.begin(), viscera::fuzz::kFuzzLinkKey.end());
+    seed.append(reinterpret_cast<const char*>(buf + n - kLinkTagSize), kLinkTagSize);
+    seed += '\x2a';
+    seed.append(reinterpret_cast<const char*>(buf), n - kLinkTagSize);
+    std::ofstream(linkDir / "state.bin", std::ios::binary) << seed;
+    return ok && n > 0;
+}
+
+/// The blocks fuzz_scene_blocks reads, from a scene.json: its assessment, its laparoscope, and the
+/// port of every tool and instrument.
+void sceneBlockSeeds(const std::filesystem::path& sceneDir, const std::filesystem::path& out) {
+    if (!std::filesystem::is_directory(sceneDir)) return;
+    for (const auto& entry : std::filesystem::directory_iterator(sceneDir)) {
+        std::ifstream in(entry.path(), std::ios::binary);
+        std::stringstream text;
+        text << in.rdbuf();
+        const nlohmann::json doc = nlohmann::json::parse(text.str(), nullptr, false);
+        if (!doc.is_object()) continue;
+        const std::string stem = entry.path().stem().string();
+        if (doc.contains("assessment")) write(out / (stem + "-assessment.json"), 0, doc["assessment"].dump(1));
+        if (doc.contains("laparoscope")) write(out / (stem + "-laparoscope.json"), 1, doc["laparoscope"].dump(1));
+        int k = 0;
+        auto ports = [&](const nlohmann::json& list) {
+            if (!list.is_array()) return;
+            for (const auto& t : list)
+                if (t.is_object() && t.contains("port"))
+                    write(out / (stem + "-port" + std::to_string(k++) + ".json"), 2, t["port"].dump(1));
+        };
+        if (doc.contains("tools")) ports(doc["tools"]);
+        if (doc.contains("interaction") && doc["interaction"].is_object() && doc["interaction"].contains("instruments"))
+            ports(doc["interaction"]["instruments"]);
+    }
+}
+
+bool builtInBlocks(const std::filesystem::path& out) {
+    const std::string assessment = R"({"targets": {
+  "cut": [{"line": [[0, 0, 0.02], [0.03, 0, 0.02]], "radius": 0.005, "coverage": 0.6}],
+  "clip": [{"position": [0.01, 0.01, 0.02], "tolerance": 0.008, "count": 2}],
+  "suture": {"plane": {"point": [0, 0, 0], "normal": [1, 0, 0]}, "bites": 2, "depth": [0.001, 0.006],
+             "spacing": [0.001, 0.01], "max_gap": 0.0005},
+  "vessel": {"body": "vessel", "margin": 0.0015}},
+ "force_threshold_n": 1.0, "reference_path_m": 0.25,
+ "metrics": {"completion_time_s": {"limit": 120, "expert": {"mean": 60, "sd": 10}},
+             "path_length_m": {"limit": 2.5}, "out_of_view_s": {"expert": {"mean": 1, "sd": 0.5}},
+             "instrument_collisions": {"limit": 3}, "economy_of_motion": {"limit": 4},
+             "vessel_injury_s": {"limit": 0.1}, "cut_coverage": {"limit": 0.6},
+             "clips_on_target": {"limit": 2}}})";
+    const std::string laparoscope = R"({"port": {"position": [0, -0.15, 0.09], "insertion": [0.02, 0.3],
+ "max_angle_deg": 60, "shaft_length": 0.36}, "tip": [-0.01, -0.045, 0.055], "optic_deg": 30, "fov_deg": 70,
+ "hand": "right", "motion_scale": 0.3})";
+    const std::string port = R"({"position": [0, 0, 0.15], "insertion": [0.02, 0.3], "max_angle_deg": 60,
+ "shaft_length": 0.36, "mode": "robotic"})";
+    return write(out / "builtin-assessment.json", 0, assessment) &&
+           write(out / "builtin-laparoscope.json", 1, laparoscope) && write(out / "builtin-port.json", 2, port);
+}
+
+/// A judged report as the player writes it (schema 5): the record, the assessment with a metric of
+/// each kind (limit, expert level, no value), and a few of the other sections.
+std::string judgedReport() {
+    return R"({
+  "schemaVersion": 5,
+  "case": {"id": "rectum", "version": "1.0.0", "title": "Rectum"},
+  "record": {"trainee": "trainee.01@example", "started_utc": "2026-12-05T19:50:00Z", "player_version": "0.1.0",
+             "case_id": "rectum", "case_version": "1.0.0",
+             "package_sha256": "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef"},
+  "assessment": {"judged": true, "passed": false, "completion_time_s": 12.5, "within_expert_level": false,
+    "metrics": [
+      {"name": "completion_time_s", "unit": "s", "value": 12.5, "better": "lower", "limit": 20, "passed": true,
+       "expert": {"mean": 6, "sd": 1, "bound": 8}, "within_expert": false},
+      {"name": "cut_coverage", "unit": "1", "value": 0.8, "better": "higher", "limit": 0.6, "passed": true,
+       "expert": {"mean": 0.9, "sd": 0.05, "bound": 0.8}, "within_expert": true},
+      {"name": "vessel_injury_s", "unit": "s", "value": 0.65, "better": "lower", "limit": 0.1, "passed": false,
+       "expert": null, "within_expert": null},
+      {"name": "out_of_view_s", "unit": "s", "value": null, "better": "lower", "limit": null, "passed": true,
+       "expert": {"mean": 1, "sd": 0.5, "bound": 2}, "within_expert": false}],
+    "tools": [{"name": "hook", "kind": "hook", "hand": "right", "path_m": 0.4, "angular_path_rad": 1.2,
+               "force_max_n": 2.1, "force_mean_n": 0.4, "force_over_threshold_s": 0.3, "tissue_damage_ns": 0.02}]},
+  "frames": [{"index": 0, "step_ms": 1.5, "substeps": 10, "iterations": 1, "energy_j": 0.001,
+              "max_displacement_m": 0.0001}],
+  "metrics": {"frames": 1, "sim_time_s": 0.0166}
+}
+)";
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -181,27 +314,22 @@ int main(int argc, char** argv) {
     }
     const std::filesystem::path root = argv[1];
     const std::filesystem::path console = root / "console_protocol";
+    const std::filesystem::path link = root / "link_auth";
     const std::filesystem::path mesh = root / "mesh_format";
-    std::filesystem::create_directories(console);
-    std::filesystem::create_directories(mesh);
-    uint8_t buf[2048];
-    viscera::haptics::StatePacket s;
-    s.sequence = 7;
-    s.timestamp_ns = 123456789;
-    s.arms = 2;
-    s.pedals = 0x5;
-    const size_t ns = viscera::haptics::encode(s, buf, sizeof buf);
-    std::ofstream(console / "state.bin", std::ios::binary).write(reinterpret_cast<const char*>(buf), long(ns));
-    viscera::haptics::CommandPacket c;
-    c.sequence = 9;
-    c.echoSequence = 7;
-    const size_t nc = viscera::haptics::encode(c, buf, sizeof buf);
-    std::ofstream(console / "command.bin", std::ios::binary).write(reinterpret_cast<const char*>(buf), long(nc));
+    const std::filesystem::path blocks = root / "scene_blocks";
+    const std::filesystem::path report = root / "session_report";
+    for (const auto& d : {console, link, mesh, blocks, report})
+        std::filesystem::create_directories(d);
+    bool ok = consoleSeeds(console, link);
     // The prefix byte is the index in fuzz_mesh_format's list: .obj .stl .ply .glb .gltf .fbx
-    bool ok = write(mesh / "cube.obj", 0, obj()) && write(mesh / "cube-ascii.stl", 1, stlAscii()) &&
-              write(mesh / "cube-binary.stl", 1, stlBinary()) && write(mesh / "cube-ascii.ply", 2, plyAscii()) &&
-              write(mesh / "cube-binary.ply", 2, plyBinary()) && write(mesh / "cube.glb", 3, glb()) &&
-              write(mesh / "cube.gltf", 4, gltfJson(false)) && write(mesh / "cube.fbx", 5, fbxAscii());
-    std::printf("make_seeds: %zu + %zu bytes in %s, 8 meshes in %s\n", ns, nc, console.c_str(), mesh.c_str());
-    return ns && nc && ok ? 0 : 1;
+    ok = ok && write(mesh / "cube.obj", 0, obj()) && write(mesh / "cube-ascii.stl", 1, stlAscii()) &&
+         write(mesh / "cube-binary.stl", 1, stlBinary()) && write(mesh / "cube-ascii.ply", 2, plyAscii()) &&
+         write(mesh / "cube-binary.ply", 2, plyBinary()) && write(mesh / "cube.glb", 3, glb()) &&
+         write(mesh / "cube.gltf", 4, gltfJson(false)) && write(mesh / "cube.fbx", 5, fbxAscii());
+    sceneBlockSeeds(root / "scene", blocks);
+    ok = ok && builtInBlocks(blocks);
+    ok = ok && static_cast<bool>(std::ofstream(report / "judged.json", std::ios::binary) << judgedReport());
+    std::printf("make_seeds: packets in %s and %s, 8 meshes in %s, blocks in %s, a report in %s\n", console.c_str(),
+                link.c_str(), mesh.c_str(), blocks.c_str(), report.c_str());
+    return ok ? 0 : 1;
 }

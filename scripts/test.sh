@@ -25,6 +25,9 @@ echo "== GUI tests (Xvfb + Mesa) =="
 env -u QT_QPA_PLATFORM LIBGL_ALWAYS_SOFTWARE=1 \
   xvfb-run -a -s "-screen 0 1920x1200x24 -nolisten tcp" \
   ctest --test-dir "$BUILD_DIR" --output-on-failure -j1 -L '^gui$' || status=1
+echo "== fuzz (every libFuzzer harness built, -O0 + ASan/UBSan, and run 3 s) =="
+# A harness that no longer builds, a finding or a harness that runs no input fails the step.
+VISCERA_FUZZ_QUICK=1 bash scripts/fuzz.sh 3 "$BUILD_DIR" || status=1
 echo "== packages (cpack, lintian, the extracted player) =="
 bash scripts/package.sh || status=1
 exit $status

@@ -20,7 +20,8 @@ namespace viscera::player {
 inline nlohmann::json parseReportText(const std::string& text, const std::string& origin) {
     try {
         return nlohmann::json::parse(text);
-    } catch (const nlohmann::json::parse_error& e) {
+    } catch (const nlohmann::json::exception& e) {
+        // parse_error, and out_of_range for a number like 1e999 ("number overflow parsing '1e999'")
         std::string why = e.what(); // "[json.exception.parse_error.101] parse error at line 3, ..."
         if (auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
         throw InputError(origin + ": not a JSON session report (" + why + ")");

@@ -254,4 +254,13 @@ TEST(SessionPlots, MalformedReportsAreRefusedNamingTheField) {
                   0u)
             << e.what();
     }
+    // A number past a double's range (found by fuzz_session_report): refused as input, naming it.
+    writeFileAtomic(dir / "big.json", "{\"schemaVersion\": 1e400}");
+    try {
+        player::readPlotInputFile(dir / "big.json");
+        FAIL() << "accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  dir / "big.json" + ": not a JSON session report (number overflow parsing '1e400')");
+    }
 }

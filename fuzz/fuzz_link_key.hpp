@@ -1,0 +1,12 @@
+#pragma once
+// The fixed link key of the console protocol harnesses and their seeds (fuzz_make_seeds signs the
+// seed packets with it, fuzz_console_protocol decodes under it): a test key, never a real one.
+#include "haptics/link_auth.hpp"
+
+namespace viscera::fuzz {
+
+inline constexpr haptics::LinkKey kFuzzLinkKey{0x56, 0x69, 0x73, 0x63, 0x65, 0x72, 0x61, 0x20, 0x66, 0x75, 0x7a,
+                                               0x7a, 0x20, 0x6b, 0x65, 0x79, 0x00, 0x01, 0x02, 0x03, 0x04, 0x05,
+                                               0x06, 0x07, 0x08, 0x09, 0x0a, 0x0b, 0x0c, 0x0d, 0x0e, 0x0f};
+
+} // namespace viscera::fuzz
