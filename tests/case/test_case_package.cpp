@@ -324,9 +324,11 @@ TEST_F(VcasePackage, UnparsableVtetIsRejected) {
 TEST_F(VcasePackage, ChecksRunInTheDocumentedOrder) {
     auto files = goodFiles();
     Manifest m = manifestFor(files);
-    m.schemaVersion = 99;                         // (g)
+    m.schemaVersion = 99;                         // (g): the manifest's alone, so before (f)
     files.push_back({"meshes/bad.vtet", "junk"}); // (f) unlisted, and (h)
     files[1].bytes[0] = '[';                      // (f) hash of scene.json
+    EXPECT_THAT(rejection(craftPackage(m, files)), HasSubstr("manifest.json: schemaVersion 99 is newer"));
+    m.schemaVersion = 1;
     EXPECT_THAT(rejection(craftPackage(m, files)), HasSubstr("scene.json: sha256 mismatch"));
     m.files[1].sha256 = sha256Hex(files[1].bytes);
     EXPECT_THAT(rejection(craftPackage(m, files)), HasSubstr("meshes/bad.vtet: file is not listed in manifest.json"));
