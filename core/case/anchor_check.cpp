@@ -54,15 +54,16 @@ std::string facts(const struct stat& st) {
     return "owner uid " + std::to_string(st.st_uid) + ", mode " + modeText(st.st_mode);
 }
 
-/// The path's components after `base`, "" and "." dropped.
-void append(std::deque<std::string>& todo, const fs::path& p, bool front) {
+/// Queues the components of `p` ("" and "." dropped) at the front or the back of `pending`, the
+/// components still to resolve.
+void queueComponents(std::deque<std::string>& pending, const fs::path& p, bool front) {
     std::vector<std::string> parts;
     for (const fs::path& c : p.relative_path())
         if (!c.empty() && c != ".") parts.push_back(c.string());
     if (front)
-        todo.insert(todo.begin(), parts.begin(), parts.end());
+        pending.insert(pending.begin(), parts.begin(), parts.end());
     else
-        todo.insert(todo.end(), parts.begin(), parts.end());
+        pending.insert(pending.end(), parts.begin(), parts.end());
 }
 
 /// Resolves `named` one component at a time, as the kernel does, and checks every folder whose
@@ -79,8 +80,8 @@ Walk walk(const fs::path& named, std::string_view what) {
     std::error_code ec;
     const fs::path start = fs::absolute(named, ec);
     if (ec) refuse(named, what, "cannot be located (" + ec.message() + ")");
-    std::deque<std::string> todo;
-    append(todo, start, false);
+    std::deque<std::string> pending;
+    queueComponents(pending, start, false);
     fs::path dir = "/";
     int links = 0;
     for (;;) {
@@ -89,9 +90,9 @@ Walk walk(const fs::path& named, std::string_view what) {
             refuse(named, what,
                    "lies in " + dir.string() + ", a folder writable by others than root and you (" + facts(ds) +
                        "); keep it where only root or you can change it");
-        if (todo.empty()) return {dir, true, ds}; // named "/" itself
-        const std::string c = todo.front();
-        todo.pop_front();
+        if (pending.empty()) return {dir, true, ds}; // named "/" itself
+        const std::string c = pending.front();
+        pending.pop_front();
         if (c == "..") {
             dir = dir.parent_path();
             continue;
@@ -102,17 +103,17 @@ Walk walk(const fs::path& named, std::string_view what) {
         w.exists = true;
         if (S_ISLNK(w.st.st_mode)) {
             const fs::path target = fs::read_symlink(next, ec);
-            if (todo.empty())
+            if (pending.empty())
                 refuse(named, what,
                        "must not be a symbolic link" +
                            (ec ? std::string() : " (it points to " + target.string() + ")") +
                            "; put the file itself there");
             if (ec || ++links > kMaxLinks) refuse(named, what, "cannot be resolved (too many links)");
-            append(todo, target, true);
+            queueComponents(pending, target, true);
             if (target.is_absolute()) dir = "/";
             continue;
         }
-        if (todo.empty()) return w;
+        if (pending.empty()) return w;
         if (!S_ISDIR(w.st.st_mode)) return {next, false, {}}; // a file in the middle: the caller's read says so
         dir = next;
     }

@@ -48,14 +48,7 @@ std::string package(const Manifest& m, const SigningKey* key) {
     return w.build();
 }
 
-std::string messageOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
+using test::messageOf;
 
 struct SignedPackage : ::testing::Test {
     test::ScratchDir dir;

@@ -2,6 +2,7 @@
 
 #include "case/sha256.hpp"
 #include "sim/util/atomic_file.hpp"
+#include "sim/util/error.hpp"
 
 #include <zip.h>
 
@@ -83,6 +84,15 @@ size_t patchBytes(std::string& bytes, const std::string& from, const std::string
         ++count;
     }
     return count;
+}
+
+std::string messageOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(no error)";
 }
 
 ScratchDir::ScratchDir() {

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -39,6 +40,9 @@ std::string unitTetVtet();
 
 /// Replaces every occurrence of `from` with `to` (same length) in `bytes`; returns the count.
 size_t patchBytes(std::string& bytes, const std::string& from, const std::string& to);
+
+/// The one-line message of the viscera::InputError `f` throws, or "(no error)".
+std::string messageOf(const std::function<void()>& f);
 
 /// A fresh folder under the system temp folder, removed with its contents on destruction.
 class ScratchDir {
