@@ -1,6 +1,7 @@
 #pragma once
-/// The trainee window: case title, instructions, timer, device/pedal/clutch state, force bars
-/// and a side view of the tissue and tools (QtGui raster window, no Qt Widgets, no editing UI).
+/// The trainee window: case title, instructions, the task's numbered steps, timer,
+/// device/pedal/clutch state, force bars and a side view of the tissue and tools (QtGui raster
+/// window, no Qt Widgets, no editing UI).
 /// Built only when Qt6 Gui is found (window_mode_qt.cpp); otherwise window_mode_none.cpp
 /// refuses window mode with a message.
 #include "runtime/session.hpp"

@@ -178,12 +178,29 @@ private:
 
 class TraineeWindow final : public QRasterWindow {
 public:
-    TraineeWindow(LiveView& live, std::string title, std::string instructions, KeyboardDevice* keyboard,
-                  std::atomic<bool>& stop, Viewport3D* viewport)
-        : m_live(live), m_title(std::move(title)), m_instructions(std::move(instructions)), m_keyboard(keyboard),
-          m_stop(stop), m_viewport(viewport) {
+    TraineeWindow(LiveView& live, std::string title, std::string instructions, std::vector<std::string> steps,
+                  KeyboardDevice* keyboard, std::atomic<bool>& stop, Viewport3D* viewport)
+        : m_live(live), m_title(std::move(title)), m_instructions(std::move(instructions)), m_steps(std::move(steps)),
+          m_keyboard(keyboard), m_stop(stop), m_viewport(viewport) {
         setTitle(QString::fromStdString("Viscera — " + m_title));
         resize(960, 600);
+    }
+
+    /// The task's steps as a numbered list from baseline `y` in the column at `px` (wrapped, up to
+    /// `bottom`); returns the next line's baseline.
+    int paintSteps(QPainter& p, int px, int y, int bottom) const {
+        if (m_steps.empty()) return y;
+        p.setPen(QColor(200, 200, 200));
+        p.drawText(px, y, "Steps:");
+        y += 20;
+        const int ascent = p.fontMetrics().ascent();
+        for (size_t k = 0; k < m_steps.size() && y < bottom; ++k) {
+            QRect used;
+            p.drawText(QRect(px, y - ascent, 236, bottom - y), Qt::AlignLeft | Qt::AlignTop | Qt::TextWordWrap,
+                       QString("%1. %2").arg(k + 1).arg(QString::fromStdString(m_steps[k])), &used);
+            y += used.height() + 4;
+        }
+        return y + 8;
     }
 
     void paintHud(QPainter& p, const QSize& size) {
@@ -323,6 +340,7 @@ public:
             y += 20;
         }
         if (!instruments.empty()) y += 8;
+        y = paintSteps(p, px, y, h - 100);
         p.setPen(QColor(230, 120, 100));
         if (s.safetyRules & haptics::kRuleSimStale) p.drawText(px, y, "Forces off: simulation stale"), y += 20;
         if (s.safetyRules & haptics::kRuleDisconnected) p.drawText(px, y, "Forces off: device not answering"), y += 20;
@@ -443,6 +461,7 @@ private:
     }
     LiveView& m_live;
     std::string m_title, m_instructions;
+    std::vector<std::string> m_steps; ///< the task's ordered steps (scene "steps"), shown numbered
     KeyboardDevice* m_keyboard;
     std::atomic<bool>& m_stop;
     Viewport3D* m_viewport;
@@ -526,8 +545,8 @@ SessionResult runWindow(LoadedCase& loaded, RunOptions options, const WindowShot
     const std::string title = loaded.package->manifest().title.value_or(loaded.package->manifest().caseId);
     Viewport3D viewport(loaded, live, 640, 480);
     if (!viewport.available()) log::warn("3D view off (side view instead): " + viewport.whyNot());
-    TraineeWindow window(live, title, loaded.scene.instructions, dynamic_cast<KeyboardDevice*>(options.device), stop,
-                         &viewport);
+    TraineeWindow window(live, title, loaded.scene.instructions, loaded.scene.steps,
+                         dynamic_cast<KeyboardDevice*>(options.device), stop, &viewport);
     window.show();
     guard.start();
     std::vector<std::string> failed;

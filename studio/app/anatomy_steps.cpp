@@ -5,6 +5,8 @@
 #include "app/selection.hpp"
 #include "bake/import.hpp"
 #include "project/project.hpp"
+#include "project/remesh_cache.hpp"
+#include "project/step_result.hpp"
 
 #include <QAction>
 #include <QComboBox>
@@ -21,7 +23,6 @@
 #include <QPixmap>
 #include <QProgressDialog>
 #include <QPushButton>
-#include <QRegularExpression>
 #include <QSettings>
 #include <QSpinBox>
 #include <QVBoxLayout>
@@ -30,6 +31,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <optional>
 
 namespace viscera::studio {
@@ -95,16 +97,37 @@ private:
     int m_voxels = 64;
 };
 
-/// A `name value` figure the remesh prints (uv.<method>.<figure> value); none when it is
-/// missing or not a finite number (nothing is shown for it).
-std::optional<double> figure(const QString& output, const QString& name) {
-    const QRegularExpression re("^" + QRegularExpression::escape(name) + " (\\S+)$",
-                                QRegularExpression::MultilineOption);
-    const auto m = re.match(output);
-    if (!m.hasMatch()) return std::nullopt;
-    bool ok = false;
-    const double v = m.captured(1).toDouble(&ok);
-    return ok && std::isfinite(v) ? std::optional(v) : std::nullopt;
+/// The remesh block as Make simulation-ready's settings `chosen` make it (Run remeshes this block;
+/// Apply writes it into the body).
+void applyChoice(RemeshSource& r, int voxels, int smoothing, const QString& uvMethod) {
+    r.params.voxelSize = 0;
+    r.params.voxelCount = voxels;
+    r.params.smoothingIterations = smoothing;
+    r.uvTransfer = uvMethod == "none"      ? std::nullopt
+                   : uvMethod == "closest" ? std::optional(bake::UvTransferMethod::ClosestPoint)
+                   : uvMethod == "island"  ? std::optional(bake::UvTransferMethod::IslandLabelled)
+                                           : std::optional(bake::UvTransferMethod::SeamCutting);
+    if (!r.uvTransfer) r.texture.clear();
+}
+
+/// Writes `project`'s text to `file` (the model as it is in the editor, for a child to read with
+/// --project-file); false and `why` when it cannot.
+bool writeProjectFile(const Project& project, const QString& file, QString* why) {
+    std::ofstream f(file.toStdString(), std::ios::binary);
+    f << projectJsonText(project);
+    if (f.flush()) return true;
+    if (why) *why = QObject::tr("%1: cannot be written").arg(file);
+    return false;
+}
+
+/// The parts' box in file units: the union of the import result's boxes.
+std::array<Eigen::Vector3d, 2> partsBounds(const ImportStepResult& r) {
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const ImportedPartResult& p : r.parts) {
+        lo = lo.cwiseMin(Eigen::Vector3d(p.bounds[0][0], p.bounds[0][1], p.bounds[0][2]));
+        hi = hi.cwiseMax(Eigen::Vector3d(p.bounds[1][0], p.bounds[1][1], p.bounds[1][2]));
+    }
+    return {lo, hi};
 }
 
 QString uvOption(const std::optional<bake::UvTransferMethod>& m) {
@@ -182,12 +205,21 @@ void AnatomySteps::onFinished(bool ok, const QString& message) {
         emit logMessage(tr("%1: cancelled; the project is unchanged").arg(name));
         return;
     }
-    if (name == kImport) {
-        ok ? askPlacement(m_task.output()) : fail(message);
-    } else if (name == kReady) {
-        ok ? showRemeshResult(m_task.output()) : fail(message);
-    } else if (name == kTetra) {
-        showMeshingResult(ok, m_task.output(), message);
+    if (!ok) {
+        fail(message);
+        return;
+    }
+    // The child's typed result (project/step_result.hpp); a malformed one is refused by its line.
+    const std::filesystem::path file = m_task.resultFile().toStdString();
+    try {
+        if (name == kImport)
+            askPlacement(readStepResult<ImportStepResult>(file));
+        else if (name == kReady)
+            showRemeshResult(readStepResult<RemeshStepResult>(file));
+        else if (name == kTetra)
+            showMeshingResult(readStepResult<MeshingStepResult>(file));
+    } catch (const std::exception& e) {
+        fail(QString::fromUtf8(e.what()));
     }
 }
 
@@ -225,7 +257,7 @@ bool AnatomySteps::importAnatomy(const QStringList& files, QString* why) {
     if (images.size() > 1) return fail(tr("Import anatomy: at most one PNG texture (%1 chosen)").arg(images.size()));
     if (m_task.prepare(m_doc->folder(), why).isEmpty()) return false;
     m_pendingFiles = meshes + images;
-    QStringList args{"import"};
+    QStringList args{"import", "--result", m_task.resultFile()};
     for (const QString& m : meshes)
         args << QFileInfo(m).absoluteFilePath();
     return run(kImport, args, int(meshes.size()), why);
@@ -247,22 +279,17 @@ QString AnatomySteps::copyIntoProject(const QString& file, QString* why) const {
     return target;
 }
 
-void AnatomySteps::askPlacement(const QString& output) {
-    const auto bounds = importedFileBounds(output);
-    if (!bounds) {
-        fail(tr("Import anatomy: the import check reported no bounds; the project is unchanged"));
-        return;
-    }
-    auto* dlg = new ImportPlacementDialog(*bounds, int(m_pendingFiles.size()), m_window);
+void AnatomySteps::askPlacement(const ImportStepResult& imported) {
+    auto* dlg = new ImportPlacementDialog(partsBounds(imported), int(m_pendingFiles.size()), m_window);
     dlg->setAttribute(Qt::WA_DeleteOnClose);
-    connect(dlg, &QDialog::accepted, this, [this, dlg, output] { applyImport(output, dlg->placement()); });
+    connect(dlg, &QDialog::accepted, this, [this, dlg, imported] { applyImport(imported, dlg->placement()); });
     connect(dlg, &QDialog::rejected, this,
             [this] { emit logMessage(tr("%1: cancelled; the project is unchanged").arg(kImport)); });
     m_placement = dlg;
     dlg->open();
 }
 
-void AnatomySteps::applyImport(const QString& output, const bake::ImportPlacement& placement) {
+void AnatomySteps::applyImport(const ImportStepResult& imported, const bake::ImportPlacement& placement) {
     QStringList copied;
     QString why;
     for (const QString& f : m_pendingFiles) {
@@ -273,7 +300,8 @@ void AnatomySteps::applyImport(const QString& output, const bake::ImportPlacemen
         }
         copied << c;
     }
-    const bool allUv = !output.contains(QStringLiteral(", uv: no"));
+    const bool allUv =
+        std::all_of(imported.parts.begin(), imported.parts.end(), [](const ImportedPartResult& p) { return p.hasUv; });
     const Project& now = m_doc->project();
     BodyProject body;
     QString name = "anatomy";
@@ -282,8 +310,7 @@ void AnatomySteps::applyImport(const QString& output, const bake::ImportPlacemen
          ++n)
         name = QString("anatomy%1").arg(n);
     body.scene.name = name.toStdString();
-    body.scene.material = now.bodies.empty() ? newProject(now.dir, "anatomy").bodies[0].scene.material
-                                             : now.bodies.front().scene.material;
+    body.scene.material = now.bodies.empty() ? newBodyMaterial() : now.bodies.front().scene.material;
     body.mesh.kind = MeshSource::Kind::Remesh;
     RemeshSource& r = body.mesh.remesh;
     for (const QString& c : copied)
@@ -305,13 +332,12 @@ void AnatomySteps::applyImport(const QString& output, const bake::ImportPlacemen
         return;
     }
     m_sel->set(Selection::Kind::Body, index);
-    const auto bounds = importedFileBounds(output);
     emit logMessage(tr("Imported %1 part(s) as body '%2'%3, in %4: %5")
                         .arg(r.parts.size())
                         .arg(name)
                         .arg(allUv ? tr(" with their UVs") : tr(" (a part has no UVs: none transferred)"))
                         .arg(QString::fromUtf8(bake::unitLongName(placement.unit).data()))
-                        .arg(bounds ? sizeText(placedSize(*bounds, placement)) : QString()));
+                        .arg(sizeText(placedSize(partsBounds(imported), placement))));
 }
 
 // ---- make simulation-ready ---------------------------------------------------------------------
@@ -390,98 +416,127 @@ bool AnatomySteps::makeSimulationReady(int voxels, int smoothing, const QString&
         if (why) *why = tr("Make simulation-ready: select a body made from anatomy");
         return false;
     }
-    const RemeshSource& r = m_doc->project().bodies[size_t(b)].mesh.remesh;
     const QString work = m_task.prepare(m_doc->folder(), why);
     if (work.isEmpty()) return false;
-    QStringList args{"remesh"};
-    for (const RemeshSource::Part& part : r.parts)
-        args << QString::fromStdString(part.file.string());
-    // The remesh command has no rotation: the preview's surface is remeshed in the files' frame
-    // (its figures do not depend on it); export meshes the placed parts (project.cpp).
-    args << "--scale" << QString::number(r.placement.metresPerFileUnit(), 'g', 17) << "--voxels"
-         << QString::number(voxels) << "--smooth" << QString::number(smoothing);
-    if (uvMethod == "none")
-        args << "--no-uv";
-    else
-        args << "--uv-transfer" << uvMethod << "--uv-preview" << QDir(work).filePath("preview.png");
-    args << "-o" << QDir(work).filePath("result.obj");
-    m_pendingRemesh = {voxels, smoothing, uvMethod,
-                       QString::fromStdString(m_doc->project().bodies[size_t(b)].scene.name)};
+    // The body's block as the settings make it, remeshed as export remeshes it (with the parts'
+    // placement): Apply keeps this very surface (remesh_cache.hpp).
+    Project candidate = m_doc->project();
+    BodyProject& body = candidate.bodies[size_t(b)];
+    applyChoice(body.mesh.remesh, voxels, smoothing, uvMethod);
+    const QString projectFile = QDir(work).filePath("project.json");
+    if (!writeProjectFile(candidate, projectFile, why)) {
+        m_task.discard();
+        return false;
+    }
+    const QString name = QString::fromStdString(body.scene.name);
+    QStringList args{"remesh",
+                     "--project",
+                     m_doc->folder(),
+                     "--project-file",
+                     projectFile,
+                     "--body",
+                     name,
+                     "-o",
+                     QDir(work).filePath("remesh.vremesh"),
+                     "--result",
+                     m_task.resultFile()};
+    if (uvMethod != "none") args << "--uv-preview" << QDir(work).filePath("preview.png");
+    m_pendingRemesh = {voxels, smoothing, uvMethod, name};
     return run(kReady, args, 8, why);
 }
 
-void AnatomySteps::showRemeshResult(const QString& output) {
+void AnatomySteps::showRemeshResult(const RemeshStepResult& result) {
     auto* dlg = new QDialog(m_window);
     dlg->setObjectName("simulationReadyResult");
     dlg->setWindowTitle(tr("Simulation-ready surface"));
     dlg->setAttribute(Qt::WA_DeleteOnClose);
     auto* layout = new QVBoxLayout(dlg);
-    const QString png = QDir(m_task.workDir()).filePath("preview.png");
-    if (QFileInfo::exists(png)) {
+    if (!result.preview.empty()) {
         auto* picture = new QLabel(dlg);
         picture->setObjectName("uvPreview");
-        picture->setPixmap(QPixmap(png).scaledToWidth(1100, Qt::SmoothTransformation));
+        picture->setPixmap(
+            QPixmap(QString::fromStdString(result.preview)).scaledToWidth(1100, Qt::SmoothTransformation));
         layout->addWidget(picture);
     }
-    QString text;
-    const QRegularExpression checks("^checks: .*$", QRegularExpression::MultilineOption);
-    if (const auto m = checks.match(output); m.hasMatch()) text += m.captured(0) + "\n";
-    for (const QString& method : {QStringLiteral("closest"), QStringLiteral("island"), QStringLiteral("seam-cut")}) {
-        const auto over = figure(output, "uv." + method + ".over_two_islands");
-        const auto stretched = figure(output, "uv." + method + ".over_threshold_pct");
-        const auto error = figure(output, "uv." + method + ".uv_error_mean");
-        if (!over || !stretched || !error) continue;
+    QString text = tr("%1 vertices, %2 triangles in %3 s\n")
+                       .arg(result.vertices)
+                       .arg(result.triangles)
+                       .arg(result.seconds, 0, 'f', 1);
+    text += tr("checks: closed %1, manifold %2, self-intersecting pairs %3\n")
+                .arg(result.closed ? tr("yes") : tr("no"), result.manifold ? tr("yes") : tr("no"))
+                .arg(result.selfIntersections);
+    for (const UvTransferFigures& m : result.uv)
         text += tr("%1: %2 triangles over two islands, %3 % of the faces stretched over 2×, UV error %4\n")
-                    .arg(method)
-                    .arg(*over)
-                    .arg(*stretched, 0, 'f', 2)
-                    .arg(*error, 0, 'g', 3);
-    }
+                    .arg(QString::fromStdString(m.method))
+                    .arg(m.overTwoIslands)
+                    .arg(m.overThresholdPct, 0, 'f', 2)
+                    .arg(m.uvErrorMean, 0, 'g', 3);
     auto* figures = new QLabel(text, dlg);
     figures->setObjectName("remeshFigures");
     layout->addWidget(figures);
+    // The surface leaves the task's folder (removed when this returns) for the project's cache
+    // folder, under a pending name: Apply gives it its kept name, Discard removes it.
+    const QDir project(m_doc->folder());
+    project.mkpath("cache");
+    static int runs = 0;
+    const QString pending = project.filePath(
+        QString("cache/.pending-%1-%2.vremesh").arg(QString::fromStdString(result.cacheKey).left(16)).arg(++runs));
+    QFile::remove(pending);
+    if (!QFile::rename(QString::fromStdString(result.surface), pending))
+        emit logMessage(
+            tr("%1: cannot be moved to %2; export will remesh").arg(QString::fromStdString(result.surface), pending));
+    connect(dlg, &QObject::destroyed, this, [pending] { QFile::remove(pending); });
     auto* buttons = new QDialogButtonBox(QDialogButtonBox::Discard, dlg);
     QPushButton* apply = buttons->addButton(tr("Apply to the body"), QDialogButtonBox::AcceptRole);
     apply->setObjectName("applyRemesh");
     connect(buttons->button(QDialogButtonBox::Discard), &QPushButton::clicked, dlg, &QDialog::close);
     const Pending chosen = m_pendingRemesh;
-    connect(apply, &QPushButton::clicked, this, [this, dlg, chosen] {
-        // The body the remesh ran on, by name: the selection or the bodies may have changed since.
-        int b = -1;
-        const auto& bodies = m_doc->project().bodies;
-        for (size_t i = 0; i < bodies.size(); ++i)
-            if (QString::fromStdString(bodies[i].scene.name) == chosen.body &&
-                bodies[i].mesh.kind == MeshSource::Kind::Remesh)
-                b = int(i);
-        if (b < 0) {
-            fail(tr("Make simulation-ready: the body '%1' made from anatomy is gone").arg(chosen.body));
-            dlg->close();
-            return;
-        }
-        const QString problem = m_doc->edit(
-            tr("Make simulation-ready"),
-            [&](Project& p) {
-                RemeshSource& r = p.bodies.at(size_t(b)).mesh.remesh;
-                r.params.voxelSize = 0;
-                r.params.voxelCount = chosen.voxels;
-                r.params.smoothingIterations = chosen.smoothing;
-                r.uvTransfer = chosen.uvMethod == "none"      ? std::nullopt
-                               : chosen.uvMethod == "closest" ? std::optional(bake::UvTransferMethod::ClosestPoint)
-                               : chosen.uvMethod == "island"  ? std::optional(bake::UvTransferMethod::IslandLabelled)
-                                                              : std::optional(bake::UvTransferMethod::SeamCutting);
-                if (!r.uvTransfer) r.texture.clear();
-            },
-            0, Change{Change::Structure});
-        if (problem.isEmpty())
-            emit logMessage(
-                tr("Made simulation-ready: %1 voxels, %2 UV transfer").arg(chosen.voxels).arg(chosen.uvMethod));
-        else
-            fail(problem);
+    const std::string key = result.cacheKey;
+    connect(apply, &QPushButton::clicked, this, [this, dlg, chosen, key, pending] {
+        applyRemesh(chosen, key, pending);
         dlg->close();
     });
     layout->addWidget(buttons);
     m_result = dlg;
     dlg->show();
+}
+
+void AnatomySteps::applyRemesh(const Pending& chosen, const std::string& key, const QString& pending) {
+    // The body the remesh ran on, by name: the selection or the bodies may have changed since.
+    int b = -1;
+    const auto& bodies = m_doc->project().bodies;
+    for (size_t i = 0; i < bodies.size(); ++i)
+        if (QString::fromStdString(bodies[i].scene.name) == chosen.body &&
+            bodies[i].mesh.kind == MeshSource::Kind::Remesh)
+            b = int(i);
+    if (b < 0) {
+        fail(tr("Make simulation-ready: the body '%1' made from anatomy is gone").arg(chosen.body));
+        return;
+    }
+    const QString problem = m_doc->edit(
+        tr("Make simulation-ready"),
+        [&](Project& p) {
+            applyChoice(p.bodies.at(size_t(b)).mesh.remesh, chosen.voxels, chosen.smoothing, chosen.uvMethod);
+        },
+        0, Change{Change::Structure});
+    if (!problem.isEmpty()) {
+        fail(problem);
+        return;
+    }
+    emit logMessage(tr("Made simulation-ready: %1 voxels, %2 UV transfer").arg(chosen.voxels).arg(chosen.uvMethod));
+    // Kept under the block's key, when the block is the one remeshed (its parts unchanged since).
+    QString why;
+    try {
+        const RemeshSource& now = m_doc->project().bodies.at(size_t(b)).mesh.remesh;
+        if (remeshKey(now) != key) why = tr("the parts changed since the run");
+    } catch (const std::exception& e) {
+        why = QString::fromUtf8(e.what());
+    }
+    const QString kept = QString::fromStdString(keptRemeshFile(m_doc->folder().toStdString(), key).string());
+    if (why.isEmpty() && QFileInfo::exists(kept)) QFile::remove(kept);
+    if (why.isEmpty() && !QFile::rename(pending, kept)) why = tr("%1 cannot be written").arg(kept);
+    emit logMessage(why.isEmpty() ? tr("Kept the remeshed surface (%1): export and Tetrahedralize reuse it").arg(kept)
+                                  : tr("The remeshed surface is not kept (%1): export will remesh").arg(why));
 }
 
 // ---- tetrahedralize -----------------------------------------------------------------------------
@@ -491,46 +546,64 @@ bool AnatomySteps::tetrahedralize(QString* why) {
         if (why) *why = tr("Tetrahedralize: save the project first");
         return false;
     }
+    const int b = m_sel->body();
+    if (b < 0 || b >= int(m_doc->project().bodies.size())) {
+        if (why) *why = tr("Tetrahedralize: select a body");
+        return false;
+    }
     const QString work = m_task.prepare(m_doc->folder(), why);
     if (work.isEmpty()) return false;
     const QString projectFile = QDir(work).filePath("project.json");
-    {
-        std::ofstream f(projectFile.toStdString(), std::ios::binary);
-        f << projectJsonText(m_doc->project());
-        if (!f.flush()) {
-            m_task.discard();
-            if (why) *why = tr("%1: cannot be written").arg(projectFile);
-            return false;
-        }
+    if (!writeProjectFile(m_doc->project(), projectFile, why)) {
+        m_task.discard();
+        return false;
     }
+    // The body meshed and checked alone (viscera-studio mesh), not a whole export.
     return run(kTetra,
-               {"export", m_doc->folder(), "-o", QDir(work).filePath("check.vcase"), "--project-file", projectFile,
-                "--unsigned"},
-               int(exportStageCount(m_doc->project())), why);
+               {"mesh", m_doc->folder(), "--body",
+                QString::fromStdString(m_doc->project().bodies[size_t(b)].scene.name), "--project-file", projectFile,
+                "--result", m_task.resultFile()},
+               2, why);
 }
 
-void AnatomySteps::showMeshingResult(bool ok, const QString& output, const QString& message) {
+void AnatomySteps::showMeshingResult(const MeshingStepResult& result) {
     auto* dlg = new QDialog(m_window);
     dlg->setObjectName("tetrahedralizeResult");
     dlg->setWindowTitle(tr("Tetrahedralize"));
     dlg->setAttribute(Qt::WA_DeleteOnClose);
     auto* layout = new QVBoxLayout(dlg);
-    QString text;
-    const QRegularExpression lines("^  (body .*|quality: .*|\\s+\\d+ inverted.*)$",
-                                   QRegularExpression::MultilineOption);
-    for (auto it = lines.globalMatch(output); it.hasNext();)
-        text += it.next().captured(1).trimmed() + "\n";
-    if (!ok) text += message + "\n";
+    const BodyFigures& f = result.body;
+    QString text = tr("body %1: %2 nodes, %3 tets, %4 fixed in %5 s%6\n")
+                       .arg(QString::fromStdString(f.name))
+                       .arg(f.nodes)
+                       .arg(f.tets)
+                       .arg(f.fixedNodes)
+                       .arg(result.seconds, 0, 'f', 1)
+                       .arg(result.remeshReused ? tr(" (the kept remesh)") : QString());
+    text += tr("quality: min dihedral %1 deg, max dihedral %2 deg, mean ratio min %3\n")
+                .arg(f.minDihedralDeg, 0, 'f', 2)
+                .arg(f.maxDihedralDeg, 0, 'f', 2)
+                .arg(f.minMeanRatio, 0, 'f', 3);
+    text += tr("%1 inverted, %2 degenerate, %3 slivers; volume %4 m³\n")
+                .arg(f.inverted)
+                .arg(f.degenerate)
+                .arg(f.slivers)
+                .arg(f.volume, 0, 'g', 4);
+    const bool unstable = result.requiredSubsteps > result.substeps;
+    if (unstable) // the load-time stability rule: the export would refuse this
+        text += tr("unstable: stiffness number %1 at %2 substeps per frame; use at least %3 substeps\n")
+                    .arg(result.stiffnessNumber, 0, 'g', 3)
+                    .arg(result.substeps)
+                    .arg(result.requiredSubsteps);
     auto* figures = new QLabel(text, dlg);
     figures->setObjectName("meshingFigures");
     figures->setWordWrap(true);
     layout->addWidget(figures);
     auto* buttons = new QDialogButtonBox(QDialogButtonBox::Close, dlg);
     connect(buttons, &QDialogButtonBox::rejected, dlg, &QDialog::close);
-    const QRegularExpression needs("use at least (\\d+) substeps");
-    if (const auto m = needs.match(message); !ok && m.hasMatch()) {
+    if (unstable) {
         // The stability check's dead end, turned into the fixes the artist can take here.
-        const int substeps = m.captured(1).toInt();
+        const int substeps = result.requiredSubsteps;
         const sim::XpbdSettings now = m_doc->project().scene.xpbd;
         auto offer = [&](const QString& label, const QString& objectName, bool possible,
                          const std::function<void(Project&)>& fix) {
@@ -563,7 +636,7 @@ void AnatomySteps::showMeshingResult(bool ok, const QString& output, const QStri
     layout->addWidget(buttons);
     m_result = dlg;
     dlg->show();
-    emit logMessage(ok ? tr("Tetrahedralized: %1").arg(text.section('\n', 0, 0)) : message);
+    emit logMessage(tr("Tetrahedralized: %1").arg(text.section('\n', 0, 0)));
 }
 
 } // namespace viscera::studio

@@ -14,12 +14,17 @@
 ///                            side by side with a checker, the seam-cut stretch heat map with its
 ///                            seams, and the share of faces over the stretch threshold; Apply
 ///                            writes the grid and transfer settings into the body's block;
-///   Tetrahedralize…          the body meshed and checked as export does: nodes, tets, min
+///   Tetrahedralize…          the selected body meshed and checked alone as export meshes and
+///                            checks it (`viscera-studio mesh`, no case written): nodes, tets, min
 ///                            dihedral, slivers; where the stability check asks for more substeps
 ///                            than allowed, the fixes offered in place (coarser cells, inertia
 ///                            scaling, more substeps), each an undoable edit.
+/// Each child hands back a typed result file (--result, project/step_result.hpp); Apply of Make
+/// simulation-ready keeps the remeshed surface in the project's cache folder (remesh_cache.hpp),
+/// so Tetrahedralize and export do not remesh again.
 #include "app/import_placement.hpp"
 #include "app/studio_task.hpp"
+#include "project/step_result.hpp"
 
 #include <QObject>
 #include <QPointer>
@@ -76,11 +81,13 @@ private:
     void askSimulationReady();
     bool run(const QString& name, const QStringList& args, int stages, QString* why);
     void onFinished(bool ok, const QString& message);
-    void askPlacement(const QString& output);
-    void applyImport(const QString& output, const bake::ImportPlacement& placement);
+    struct Pending;
+    void askPlacement(const ImportStepResult& imported);
+    void applyImport(const ImportStepResult& imported, const bake::ImportPlacement& placement);
     void fail(const QString& line);
-    void showRemeshResult(const QString& output);
-    void showMeshingResult(bool ok, const QString& output, const QString& message);
+    void showRemeshResult(const RemeshStepResult& result);
+    void applyRemesh(const Pending& chosen, const std::string& key, const QString& pending);
+    void showMeshingResult(const MeshingStepResult& result);
     QString copyIntoProject(const QString& file, QString* why) const;
 
     Document* m_doc;

@@ -1,4 +1,5 @@
 #include "app/document.hpp"
+#include "app/value_command.hpp"
 
 #include "bake/texture.hpp"
 
@@ -112,13 +113,14 @@ struct SolverSlot {
     }
 };
 
-/// The case's assessment: the reader's rules on what the writer writes of it.
+/// The case's assessment: the reader's rules on what the writer writes of it, and the reader's
+/// measurability rule against the project's scene (every metric the scene cannot measure).
 struct AssessmentSlot {
     using Value = std::optional<sim::AssessmentDesc>;
     static constexpr int kId = 6;
     static Value& of(Project& p, int) { return p.scene.assessment; }
     static Change change(int) { return {Change::Assessment, -1}; }
-    static std::string check(const Project&, int, const Value& a) {
+    static std::string check(const Project& p, int, const Value& a) {
         if (!a) return {};
         try {
             nlohmann::json doc;
@@ -128,7 +130,13 @@ struct AssessmentSlot {
             const std::string why = e.what(); // "project.json: assessment...": editValue names the file
             return why.rfind("project.json: ", 0) == 0 ? why.substr(14) : why;
         }
-        return {};
+        std::vector<std::string> bodies;
+        for (const BodyProject& b : p.bodies)
+            bodies.push_back(b.scene.name);
+        std::string all;
+        for (const std::string& why : sim::unmeasurableMetrics(*a, p.scene, bodies))
+            all += (all.empty() ? "" : "; ") + why;
+        return all;
     }
 };
 
@@ -193,31 +201,6 @@ struct PlacementSlot {
     }
 };
 
-/// A typed edit: one value of the model before and after, nothing else. A drag (the same nonzero
-/// key, the same value) merges into one step, keeping the first `before`.
-template <class Slot> class ValueCommand : public QUndoCommand {
-public:
-    using Value = typename Slot::Value;
-    ValueCommand(Document* doc, const QString& text, int target, Value before, Value after, int key)
-        : QUndoCommand(text), m_doc(doc), m_target(target), m_before(std::move(before)), m_after(std::move(after)),
-          m_key(key) {}
-    int id() const override { return m_key ? Slot::kId : -1; }
-    bool mergeWith(const QUndoCommand* other) override {
-        const auto* o = static_cast<const ValueCommand*>(other);
-        if (o->m_key != m_key || o->m_target != m_target) return false;
-        m_after = o->m_after;
-        return true;
-    }
-    void redo() override { m_doc->setValue<Slot>(m_target, m_after); }
-    void undo() override { m_doc->setValue<Slot>(m_target, m_before); }
-
-private:
-    Document* m_doc;
-    int m_target;
-    Value m_before, m_after;
-    int m_key;
-};
-
 Document::Document(QObject* parent) : QObject(parent) {}
 Document::~Document() = default;
 
@@ -229,21 +212,6 @@ void Document::replace(const Project& p, Change what) {
     if (m_project->dir != here) rebaseProject(*m_project, here, nullptr, false);
     ++m_revision;
     emit changed(what);
-}
-
-template <class Slot> void Document::setValue(int target, const typename Slot::Value& v) {
-    Slot::of(*m_project, target) = v;
-    ++m_revision;
-    emit changed(Slot::change(target));
-}
-
-template <class Slot>
-QString Document::editValue(const QString& text, int target, const typename Slot::Value& value, int mergeKey) {
-    if (!m_project) return tr("no project is open");
-    if (const std::string why = Slot::check(*m_project, target, value); !why.empty())
-        return QString::fromStdString((m_project->dir / "project.json").string() + ": " + why);
-    m_undo.push(new ValueCommand<Slot>(this, text, target, Slot::of(*m_project, target), value, mergeKey));
-    return {};
 }
 
 void Document::open(const QString& folder) {

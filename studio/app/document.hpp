@@ -33,6 +33,7 @@ struct Change {
         Structure = 1u << 4,    ///< anything else: meshes, names, scene, a new project
         Solver = 1u << 5,       ///< the XPBD solver settings (substeps, dt, damping, ...)
         Assessment = 1u << 6,   ///< the case's assessment (targets, limits, expert levels)
+        Scene = 1u << 7,        ///< the scene's instruments, ports, laparoscope, task (no meshing)
         All = ~0u,
     };
     unsigned parts = All;
@@ -96,6 +97,59 @@ public:
     /// The case's assessment (none: no verdict), checked by sim::readAssessment's rules on what
     /// sim::writeAssessment writes of it ("assessment.metrics.path_length_m.expert.sd: ...").
     QString editAssessment(const QString& text, const std::optional<sim::AssessmentDesc>& assessment);
+    // Laparoscope and task [issue 57] (document_scene.cpp), announced as Change::Scene.
+    /// The case's laparoscope (none: the case has no scope; the out_of_view_s metric then has
+    /// nothing to measure and is refused). Checked by the scene reader's rule on what
+    /// sim::writeLaparoscope writes of it (sim::readLaparoscope), then the rest tip within the
+    /// port's reach (sim::restTipError, World::assemble's rule); refused as
+    /// "<folder>/project.json: laparoscope.<field>: <rule>". Same merge rule as edit().
+    QString editLaparoscope(const QString& text, const std::optional<sim::LaparoscopeDesc>& value, int mergeKey = 0);
+    /// The task shown to the trainee: the case title (vcase::kMaxTitleBytes), the instructions
+    /// (sim::kMaxInstructionsBytes) and the ordered steps (sim::kMaxSteps of at most
+    /// sim::kMaxStepBytes each), each printable UTF-8 text (the readers' JsonField::displayText),
+    /// refused as "<folder>/project.json: <field>: <rule>"; one undo step for all three.
+    QString editTask(const QString& text, const std::string& title, const std::string& instructions,
+                     const std::vector<std::string>& steps);
+    // Instruments [issue 57] (document_instruments.cpp), announced as Change::Scene.
+    /// Sets instrument `index` of the scene's interaction to `value` as one typed undo command
+    /// (old and new instrument only; its case track path follows its name). Checked by the scene
+    /// reader's rules for it: the section with `value` in place, written by sim::interactionJson,
+    /// read back by sim::readInteractionSection, its names checked against the bodies and
+    /// surfaces (sim::checkInteractionNames), the assessment still measurable
+    /// (sim::checkAssessmentMeasurable), its track text parsed (sim::InstrumentTrack::parse) and a
+    /// port's rest tip (the track's first key) within its insertion (sim::restTipError, the rule
+    /// World::assemble applies). Refused as "<folder>/project.json: interaction.instruments[i].
+    /// <field>: <rule>", the model unchanged. Same merge rule as edit().
+    QString editInstrument(const QString& text, int index, const sim::InstrumentDesc& value, int mergeKey = 0);
+    /// Adds an instrument of `kind` driven by the master `hand` ("left", "right" or "any"), one
+    /// undo step: named after its kind and new among the instruments (grasper, grasper_2, ...),
+    /// with a port (the reader's defaults) above the bodies' bounds on the hand's side and a
+    /// resting one-key track whose tip lies just above the bodies, written at once to
+    /// tools/<name>.track in the project folder (the project's files enter its folder with the
+    /// edit, as imported anatomy does; save writes it again when it changed or went). A clip
+    /// applier clips the body the others clip, else the first body; an energy hook in a scene
+    /// with no tissue brings one (the first surface, else the first body: the reader's rule). A
+    /// project with no "interaction" gets one. Checked by the rules of load (check()).
+    QString addInstrument(const QString& text, sim::InstrumentDesc::Kind kind, const std::string& hand);
+    /// Removes instrument `index` (its track file stays in the folder; undo brings the
+    /// instrument back with its track text), one undo step; the last one takes the
+    /// "interaction" block with it (the reader needs at least one instrument). Checked by the
+    /// rules of load: an assessment that needs the instrument refuses it.
+    QString removeInstrument(const QString& text, int index);
+    // Bodies [issue 57 item 7] (document_bodies.cpp), announced as Structure, Scene and Assessment.
+    /// Renames body `body` to `name`, one undo step; every reference to the old name in the
+    /// model follows it (other bodies' embedded_in, surfaces' from_boundary_of, clip targets,
+    /// tissue layers, the assessment's vessel, the suture's gauge). Refused by the reader's rule
+    /// for a body name (sim::readName: characters, length, unique) and the rules of load
+    /// (check()), as one line "<folder>/project.json: bodies[i].name: <rule>", the model
+    /// unchanged. Returns the empty string when done (also when `name` is the body's name).
+    QString renameBody(int body, const QString& name);
+    /// Removes body `body`, one undo step (undo brings it back exactly). Refused while anything
+    /// else in the model names it, naming each reference ("<folder>/project.json: bodies[0].name:
+    /// 'liver' is named by bodies[1].embedded_in (change or delete that first)"), or when the
+    /// rules of load refuse the result; the model is then unchanged. Returns the empty string
+    /// when done.
+    QString removeBody(int body);
     /// A fresh merge key for one drag or one continuous gesture.
     int newMergeKey() { return ++m_lastMergeKey; }
 

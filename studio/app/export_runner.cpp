@@ -2,7 +2,6 @@
 
 #include <QDir>
 #include <QFileInfo>
-#include <QRegularExpression>
 
 #include <filesystem>
 #include <fstream>
@@ -44,7 +43,9 @@ bool ExportRunner::start(const Project& project, const QString& out, const Expor
                      "-o",
                      QDir(work).filePath("case.vcase"),
                      "--project-file",
-                     projectFile};
+                     projectFile,
+                     "--result",
+                     m_task.resultFile()};
     if (signing.isUnsigned())
         args << "--unsigned";
     else
@@ -57,18 +58,23 @@ void ExportRunner::onFinished(bool ok, const QString& message) {
         emit finished(false, message);
         return;
     }
+    try {
+        m_result = readStepResult<ExportStepResult>(m_task.resultFile().toStdString());
+    } catch (const std::exception& e) {
+        emit finished(false, QString::fromUtf8(e.what()));
+        return;
+    }
     std::error_code ec;
     std::filesystem::rename(QDir(m_task.workDir()).filePath("case.vcase").toStdString(), m_out.toStdString(), ec);
     if (ec) {
         emit finished(false, tr("%1: cannot be written (%2)").arg(m_out, QString::fromStdString(ec.message())));
         return;
     }
-    // the export's own line: "  package: signed by 'publisher' (ed25519:…); sha256 …" or "UNSIGNED; sha256 …"
-    const QRegularExpression packageLine("^  package: ([^;]*);", QRegularExpression::MultilineOption);
-    const QString how = packageLine.match(m_task.output()).captured(1);
-    emit finished(true, how == "UNSIGNED"
-                            ? tr("exported %1, UNSIGNED: players refuse it without --allow-unsigned").arg(m_out)
-                            : tr("exported %1, %2").arg(m_out, how));
+    emit finished(
+        true, m_result.keyId.empty()
+                  ? tr("exported %1, UNSIGNED: players refuse it without --allow-unsigned").arg(m_out)
+                  : tr("exported %1, signed by '%2' (%3)")
+                        .arg(m_out, QString::fromStdString(m_result.signer), QString::fromStdString(m_result.keyId)));
 }
 
 } // namespace viscera::studio

@@ -11,6 +11,7 @@
 /// always explicit (--sign-key or --unsigned): the window decides it and says it before the work.
 #include "app/studio_task.hpp"
 #include "project/project.hpp"
+#include "project/step_result.hpp"
 
 #include <QObject>
 #include <QString>
@@ -43,6 +44,9 @@ public:
     int stagesDone() const { return m_task.stagesDone(); }
     /// The child's output so far (stage lines, the export summary or its error).
     const QString& output() const { return m_task.output(); }
+    /// The last successful export's typed result (read from the child's --result file); its
+    /// casePath is where the child wrote it, before the move onto the chosen path.
+    const ExportStepResult& result() const { return m_result; }
 
 signals:
     void progress(int done, int total, const QString& stage);
@@ -55,6 +59,7 @@ private:
 
     StudioTask m_task;
     QString m_out;
+    ExportStepResult m_result;
 };
 
 } // namespace viscera::studio

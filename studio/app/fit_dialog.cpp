@@ -57,9 +57,10 @@ FitDialog::FitDialog(Document* doc, int body, QWidget* parent) : QDialog(parent)
     });
     m_curves = new QComboBox(this);
     m_curves->setObjectName("fitCurves");
-    // f′ alone by default: a uniaxial test fixes one function of stretch, and f′ carries it; h′
-    // (the volume response, ν) is left as it is unless the artist asks for it
-    m_curves->addItems({tr("f′ only (the stretch response; volume stiffness kept)"), tr("f′ and h′ (ν too)")});
+    // f′ alone by default: a uniaxial test fixes one function of stretch, and f′ carries it; ν
+    // stays where the artist put it (h′ follows the fitted shear stiffness) unless the artist
+    // asks for it to be fitted too
+    m_curves->addItems({tr("f′ only (the stretch response; ν kept)"), tr("f′ and h′ (ν fitted too)")});
     form->addRow(tr("Fit"), m_curves);
     root->addLayout(form);
     m_plot = new PlotWidget(this);
@@ -118,7 +119,9 @@ bool FitDialog::runFit() {
         if (!start) throw std::invalid_argument("the material has no editable curves: apply a preset first");
         m_data = readData();
         sim::FitOptions opt;
-        opt.curves = m_curves->currentIndex() == 1 ? sim::FitCurves::FPrimeAndHPrime : sim::FitCurves::FPrime;
+        opt.curves = m_curves->currentIndex() == 1 ? sim::FitCurves::FPrimeAndHPrime
+                     : keepsPoisson(*start)        ? sim::FitCurves::FPrimeKeepingPoisson
+                                                   : sim::FitCurves::FPrime;
         m_fitResult = bestFit(*start, *m_data, opt);
     } catch (const std::exception& e) {
         m_result->setText(QString::fromStdString(e.what()));
@@ -226,15 +229,22 @@ void FitDialog::secondTestSeries(const sim::CurveFitResult& r, std::vector<PlotW
     series.push_back(other);
 }
 
+bool FitDialog::keepsPoisson(const sim::ValanisLandelCurves& curves) {
+    return curves.hPrime && curves.hPrime->derivative(1.0) > 0;
+}
+
 QString FitDialog::changesText(const sim::ValanisLandelCurves& before, const sim::ValanisLandelCurves& after) const {
     const sim::SmallStrainConstants a = sim::smallStrainConstants(before), b = sim::smallStrainConstants(after);
     QString t = tr("Small strain: E %1 → %2 Pa, ν %3 → %4")
                     .arg(numberText(a.youngsModulus, 4), numberText(b.youngsModulus, 4), numberText(a.poissonRatio, 3),
                          numberText(b.poissonRatio, 3));
     if (m_curves->currentIndex() == 1) return t + tr(" (f′ and h′ fitted; g′ kept)");
-    // f′ alone moves the shear stiffness only: the volume stiffness (Lamé λ, from g′ and h′) stays
-    return t + tr(" (h′ and g′ kept: the volume stiffness λ stays %1 Pa, so ν follows the fitted shear "
-                  "stiffness; choose \"f′ and h′\" to fit ν to the data)")
+    if (keepsPoisson(before))
+        return t + tr(" (ν kept: h′ scaled with the fitted shear stiffness, g′ kept; choose \"f′ and h′\" to fit "
+                      "ν to the data)");
+    // no h′ to scale: the volume stiffness (Lamé λ, from g′) stays and ν follows the shear stiffness
+    return t + tr(" (this material has no h′ to keep ν with: g′ kept, the volume stiffness λ stays %1 Pa, so ν "
+                  "follows the fitted shear stiffness; apply the Neo-Hookean preset to keep ν)")
                    .arg(numberText(b.lameLambda, 4));
 }
 

@@ -4,7 +4,9 @@
 /// (equibiaxial or planar shear, the same format), fitted together by least squares of the
 /// curves' control values under their shape rule (sim::fitUniaxial). Shows the data over the fitted response
 /// with SSE, R², the largest relative error and the stretch range the data covers, and what the
-/// fit changed and left (small-strain E and ν: f′ alone, the default, keeps ν); Apply writes the
+/// fit changed and left (small-strain E and ν: f′ alone, the default, keeps ν where the artist put
+/// it, sim::FitCurves::FPrimeKeepingPoisson, with one test or two; a material without an h′ keeps
+/// its volume stiffness instead, and says so; "f′ and h′" fits ν too); Apply writes the
 /// fitted curves into the body's material as one undo step. A fit whose material would be
 /// unstable (no uniaxial state, a stress that falls with stretch over 0.6–1.6 and the data's
 /// range, E or ν out of range) is shown but cannot be applied, with the reason. Enter runs the
@@ -58,6 +60,8 @@ private:
                                 const sim::FitOptions& opt);
     /// The data of each test as points, and the fitted response in the second test.
     void secondTestSeries(const sim::CurveFitResult& r, std::vector<PlotWidget::Series>& series) const;
+    /// f′ alone keeps ν (FitCurves::FPrimeKeepingPoisson) when the curves have an h′ rising at 1.
+    static bool keepsPoisson(const sim::ValanisLandelCurves& curves);
     /// What the fit changed and what it left: small-strain E and ν before and after.
     QString changesText(const sim::ValanisLandelCurves& before, const sim::ValanisLandelCurves& after) const;
     /// The fitted response into `fit`; the reason the fitted material would be unstable (no

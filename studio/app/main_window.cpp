@@ -5,10 +5,13 @@
 #include "app/error_banner.hpp"
 #include "app/export_runner.hpp"
 #include "app/fit_dialog.hpp"
+#include "app/instrument_panel.hpp"
 #include "app/material_panel.hpp"
 #include "app/number_text.hpp"
+#include "app/port_tool.hpp"
 #include "app/project_tree_panel.hpp"
 #include "app/properties_panel.hpp"
+#include "app/scope_task_panel.hpp"
 #include "app/start_page.hpp"
 #include "app/texture_panel.hpp"
 #include "app/wheel_guard.hpp"
@@ -107,6 +110,13 @@ void MainWindow::connectExport() {
         if (ok || message == tr("cancelled")) {
             logLine(message);
             statusBar()->showMessage(message);
+            const std::vector<std::string>& warnings = ok ? m_export->result().warnings : std::vector<std::string>{};
+            for (const std::string& w : warnings)
+                logLine(tr("warning: %1").arg(QString::fromStdString(w)));
+            // a port that cannot reach its targets is worth more than a log line: the strip shows the first
+            if (!warnings.empty())
+                m_banner->showError(tr("%1 — %n warning(s), the first: %2", "", int(warnings.size()))
+                                        .arg(message, QString::fromStdString(warnings.front())));
         } else {
             showError(message);
         }
@@ -114,6 +124,19 @@ void MainWindow::connectExport() {
             m_progress->reset();
             m_progress->hide();
         }
+    });
+}
+
+void MainWindow::followPortDocks() {
+    // the current port is the one of the dock in view: the selected instrument, or the laparoscope
+    connect(m_instruments, &InstrumentPanel::selectedChanged, this, [this](int i) {
+        m_portTool->setCurrent(i < 0 ? PortTool::kNoPort : i); // choosing an instrument chooses its port
+    });
+    connect(m_instrumentDock, &QDockWidget::visibilityChanged, this, [this](bool on) {
+        if (on) m_portTool->setCurrent(m_instruments->selected() < 0 ? PortTool::kNoPort : m_instruments->selected());
+    });
+    connect(m_scopeTaskDock, &QDockWidget::visibilityChanged, this, [this](bool on) {
+        if (on) m_portTool->setCurrent(PortTool::kScopePort);
     });
 }
 
@@ -126,6 +149,7 @@ void MainWindow::buildDocks() {
         return d;
     };
     m_tree = new ProjectTreePanel(&m_doc, &m_sel, this);
+    connect(m_tree, &ProjectTreePanel::refused, this, &MainWindow::showError); // rename / delete body
     dock("projectDock", tr("Project"), m_tree, Qt::LeftDockWidgetArea);
     m_material = new MaterialPanel(&m_doc, this);
     m_material->setObjectName("materialPanel");
@@ -152,6 +176,22 @@ void MainWindow::buildDocks() {
     m_assessment = new AssessmentPanel(&m_doc, this);
     m_assessment->setObjectName("assessmentPanel");
     tabifyDockWidget(plotsDock, dock("assessmentDock", tr("Assessment"), m_assessment, Qt::RightDockWidgetArea));
+    auto* scopeTask = new ScopeTaskPanel(
+        &m_doc, [this] { return m_viewport; }, this); // [issue 57]: the scope and the task
+    scopeTask->setObjectName("scopeTaskPanel");
+    auto* scopeTaskScroll = new QScrollArea(this); // a short dock scrolls instead of clipping the fields
+    scopeTaskScroll->setWidget(scopeTask);
+    scopeTaskScroll->setWidgetResizable(true);
+    m_scopeTaskDock = dock("scopeTaskDock", tr("Laparoscope and task"), scopeTaskScroll, Qt::RightDockWidgetArea);
+    tabifyDockWidget(plotsDock, m_scopeTaskDock);
+    auto* instruments = new InstrumentPanel(&m_doc, this); // [issue 57]: the scene's instruments
+    instruments->setObjectName("instrumentPanel");
+    auto* instrumentScroll = new QScrollArea(this); // a short dock scrolls instead of clipping the fields
+    instrumentScroll->setWidget(instruments);
+    instrumentScroll->setWidgetResizable(true);
+    m_instruments = instruments;
+    m_instrumentDock = dock("instrumentDock", tr("Instruments"), instrumentScroll, Qt::RightDockWidgetArea);
+    tabifyDockWidget(plotsDock, m_instrumentDock);
     plotsDock->raise();
 }
 
@@ -239,6 +279,20 @@ void MainWindow::buildViewMenu(QMenu* view, QToolBar* toolbar) {
     toolbar->addSeparator();
     toolbar->addAction(m_paint->stiffnessAction());
     toolbar->addAction(m_paint->samplesAction());
+    // [issue 57] the port tool: clicks put the current port (Instruments / Laparoscope dock) on a surface
+    m_portTool = new PortTool(&m_doc, this);
+    view->addAction(m_portTool->action());
+    toolbar->addAction(m_portTool->action());
+    connect(m_portTool, &PortTool::activeChanged, this, [this](bool on) {
+        if (!on) return;
+        m_paint->setPaintTool(m_paint->stiffnessAction(), false);
+        m_paint->setPaintTool(m_paint->samplesAction(), false);
+    });
+    connect(m_paint, &PaintTools::toolChanged, this, [this](bool any) {
+        if (any) m_portTool->action()->setChecked(false);
+    });
+    connect(m_portTool, &PortTool::refused, this, &MainWindow::showError);
+    followPortDocks();
     m_widgetHostAction = view->addAction(tr("Compatibility viewport (QOpenGLWidget, slower)"));
     m_widgetHostAction->setObjectName("actionWidgetViewport");
     m_widgetHostAction->setCheckable(true);
@@ -262,6 +316,7 @@ void MainWindow::setViewportHost(ViewportHost host) {
         Viewport* old = m_viewport;
         m_viewport = nullptr;
         m_paint->connectViewport(nullptr);
+        m_portTool->connectViewport(nullptr);
         m_centre->removeWidget(old);
         delete old;
     }
@@ -275,6 +330,7 @@ void MainWindow::setViewportHost(ViewportHost host) {
     });
     connect(v, &Viewport::rendererFailed, this, &MainWindow::showError);
     m_paint->connectViewport(v);
+    m_portTool->connectViewport(v);
     m_centre->addWidget(v);
     if (m_doc.hasProject()) m_centre->setCurrentWidget(v);
     m_viewport = v;
@@ -287,7 +343,7 @@ void MainWindow::setViewportHost(ViewportHost host) {
     }
     v->setSelectedName(selected);
     if (m_lookAction) v->setLook(m_lookAction->isChecked() ? Viewport::Look::Trainee : Viewport::Look::Authoring);
-    v->setPaintMode(painting() || paintingSamples());
+    v->setPaintMode(painting() || paintingSamples() || m_portTool->action()->isChecked());
     m_paint->showOverlay();
     QSettings().setValue("viewport/host", viewportHostText(host));
     if (m_widgetHostAction) m_widgetHostAction->setChecked(host == ViewportHost::Widget);

@@ -31,9 +31,12 @@ class QStackedWidget;
 class QTimer;
 class QTreeWidget;
 
+class QDockWidget;
 namespace viscera::studio {
 
 class AnatomySteps;
+class PortTool;
+class InstrumentPanel;
 class ErrorBanner;
 class ExportRunner;
 class MaterialPanel;
@@ -97,6 +100,8 @@ public:
     /// The start page or the viewport, whichever is shown.
     QWidget* centreWidget() const;
     PaintTools* paintTools() { return m_paint; }
+    /// Placing trocar ports in the viewport (port_tool.hpp).
+    PortTool* portTool() { return m_portTool; }
     AnatomySteps* anatomySteps() { return m_anatomy; }
     StiffnessPainter* painter() { return m_paint->painter(); }
     /// Paint stiffness mode (the toolbar's Paint action): the viewport's left drag paints the
@@ -134,6 +139,8 @@ protected:
 private:
     void buildActions();
     void buildDocks();
+    /// The port tool's current port follows the Instruments dock's selection and the Laparoscope dock.
+    void followPortDocks();
     void buildFileMenu(QMenu* file, QToolBar* toolbar);
     void buildViewMenu(QMenu* view, QToolBar* toolbar);
     void onDocumentChanged(const Change& what);
@@ -162,6 +169,10 @@ private:
     QStackedWidget* m_centre = nullptr; ///< the start page, or the viewport once a project is open
     StartPage* m_start = nullptr;
     PaintTools* m_paint = nullptr;
+    PortTool* m_portTool = nullptr;
+    InstrumentPanel* m_instruments = nullptr;
+    QDockWidget* m_instrumentDock = nullptr;
+    QDockWidget* m_scopeTaskDock = nullptr;
     MaterialPanel* m_material = nullptr;
     TexturePanel* m_texture = nullptr;
     AssessmentPanel* m_assessment = nullptr;

@@ -81,9 +81,6 @@ render::RenderMesh brushRingMesh(const Eigen::Vector3d& centre, const Eigen::Vec
     return m;
 }
 
-namespace {
-
-/// `edges` between `nodes` as tubes of `radius`, named `name`, in one opaque colour.
 render::RenderMesh lineTubes(std::vector<sim::Vec3> nodes, std::vector<std::array<int32_t, 2>> edges, double radius,
                              const char* name, const Eigen::Vector4f& rgba, uint32_t material) {
     sim::Skeleton lines;
@@ -97,8 +94,6 @@ render::RenderMesh lineTubes(std::vector<sim::Vec3> nodes, std::vector<std::arra
         pushColour(m.overlay, rgba);
     return m;
 }
-
-} // namespace
 
 render::RenderMesh gridMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, uint32_t material) {
     const double size = std::max({hi.x() - lo.x(), hi.y() - lo.y(), 1e-3});

@@ -22,6 +22,11 @@ Eigen::Vector4f weightColour(double w, double base);
 /// coloured by an opaque yellow overlay. Empty mesh for an empty skeleton.
 render::RenderMesh skeletonMesh(const sim::Skeleton& skeleton, float radius, uint32_t material);
 
+/// `edges` between `nodes` (m) as six-sided tubes of radius `radius` (m), named `name`, in one
+/// opaque overlay colour `rgba`. Empty mesh for no edges.
+render::RenderMesh lineTubes(std::vector<sim::Vec3> nodes, std::vector<std::array<int32_t, 2>> edges, double radius,
+                             const char* name, const Eigen::Vector4f& rgba, uint32_t material);
+
 /// The brush's outline on the surface: a flat ring of radius `radius` (m) about `centre` in the
 /// plane normal to `normal` (drawn surface frame), its band 4 % of the radius wide (at least
 /// 0.15 mm), lifted 1 % of the radius off the surface along the normal so that it is not hidden

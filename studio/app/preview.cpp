@@ -307,6 +307,7 @@ void Preview::publishStatus(const std::function<void(Snapshot&)>& fn) {
 }
 
 void Preview::takeJob(Worker& w, const Pending& job, uint64_t takenAfter) {
+    if (job.mode == Mode::Scene && job.project.bodies.empty()) return showEmpty(w, job, takenAfter);
     Project project = job.project;
     if (job.mode == Mode::Specimen) {
         const int i = std::clamp(job.body, 0, std::max(0, static_cast<int>(project.bodies.size()) - 1));
@@ -383,6 +384,38 @@ void addProjectScenery(const Project& project, render::SceneView& view) {
 }
 
 } // namespace
+
+void Preview::showEmpty(Worker& w, const Pending& job, uint64_t takenAfter) {
+    w.built.reset();
+    w.world.reset();
+    w.probe.reset();
+    w.probeBody = -1;
+    w.builtKey.clear();
+    w.builtRest.clear();
+    w.builtTextures.clear();
+    w.stale = false;
+    auto view = std::make_shared<render::SceneView>();
+    addProjectScenery(job.project, *view);
+    {
+        std::lock_guard lock(m_mutex);
+        m_view = std::move(view);
+        m_bodyMeshes.clear();
+        m_surfaceMeshes.clear();
+        m_snapshot.scene = ++w.sceneRevision;
+        m_snapshot.serial = job.serial;
+        m_snapshot.appliedAfter = takenAfter;
+        m_snapshot.frame = 0;
+        m_snapshot.bodies.clear();
+        m_snapshot.surfaces.clear();
+        m_snapshot.verdict.clear();
+        m_snapshot.verdictOk = true;
+        m_snapshot.error.clear();
+        m_snapshot.accuracyOf = tr("nothing (no body)");
+        ++m_revision;
+    }
+    emit logMessage(tr("preview: no body yet (import anatomy or add a body)"));
+    emit frameReady();
+}
 
 void Preview::showMaps(Worker& w, const Project& project, const sim::World& world) {
     std::string textures = texturesKey(project);

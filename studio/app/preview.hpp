@@ -122,6 +122,8 @@ private:
     /// run()'s parts: apply a submitted model (a new world from new meshes, or new materials on
     /// the meshes built), then step and publish frames.
     void takeJob(Worker& w, const Pending& job, uint64_t takenAfter);
+    /// A project without a body (File → New): no world; the view shows its scenery alone.
+    void showEmpty(Worker& w, const Pending& job, uint64_t takenAfter);
     std::unique_ptr<sim::World> buildWorld(Worker& w, const Project& project, Mode mode, const std::string& origin);
     std::unique_ptr<sim::World> applyMaterials(Worker& w, const Project& project, const std::string& origin);
     void showMaps(Worker& w, const Project& project, const sim::World& world);

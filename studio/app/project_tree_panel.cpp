@@ -2,7 +2,12 @@
 
 #include "sim/material/material.hpp"
 
+#include <QAction>
 #include <QHeaderView>
+#include <QKeyEvent>
+#include <QMenu>
+#include <QMessageBox>
+#include <QMetaMethod>
 #include <QTreeWidgetItemIterator>
 
 namespace viscera::studio {
@@ -35,6 +40,99 @@ ProjectTreePanel::ProjectTreePanel(Document* doc, Selection* selection, QWidget*
     });
     connect(m_doc, &Document::changed, this, &ProjectTreePanel::onChanged);
     connect(m_sel, &Selection::changed, this, &ProjectTreePanel::follow);
+
+    // Renaming and deleting a body [issue 57 item 7]: the body items' context menu, F2 and Delete.
+    m_rename = new QAction(tr("Rename body…"), this);
+    m_rename->setObjectName("renameBodyAction");
+    m_rename->setShortcut(QKeySequence(Qt::Key_F2));
+    m_delete = new QAction(tr("Delete body"), this);
+    m_delete->setObjectName("deleteBodyAction");
+    m_delete->setShortcut(QKeySequence(Qt::Key_Delete));
+    for (QAction* a : {m_rename, m_delete}) {
+        a->setShortcutContext(Qt::WidgetShortcut); // only while the tree has the focus
+        a->setShortcutVisibleInContextMenu(true);
+        addAction(a);
+    }
+    connect(m_rename, &QAction::triggered, this, &ProjectTreePanel::startRename);
+    connect(m_delete, &QAction::triggered, this, &ProjectTreePanel::deleteCurrentBody);
+    connect(this, &QTreeWidget::currentItemChanged, this, &ProjectTreePanel::updateActions);
+    setContextMenuPolicy(Qt::CustomContextMenu);
+    connect(this, &QWidget::customContextMenuRequested, this, [this](const QPoint& at) {
+        QTreeWidgetItem* item = itemAt(at);
+        if (!item || item->data(0, kKindRole).toInt() != kindValue(Selection::Kind::Body)) return;
+        setCurrentItem(item);
+        QMenu menu(this);
+        menu.addAction(m_rename);
+        menu.addAction(m_delete);
+        menu.exec(viewport()->mapToGlobal(at));
+    });
+    updateActions();
+}
+
+int ProjectTreePanel::currentBody() const {
+    const QTreeWidgetItem* item = currentItem();
+    if (!item || item->data(0, kKindRole).toInt() != kindValue(Selection::Kind::Body)) return -1;
+    return item->data(0, kIndexRole).toInt();
+}
+
+void ProjectTreePanel::updateActions() {
+    const bool body = currentBody() >= 0;
+    m_rename->setEnabled(body);
+    m_delete->setEnabled(body);
+}
+
+void ProjectTreePanel::keyPressEvent(QKeyEvent* event) {
+    // the keys of the actions when no shortcut took them (the window not active)
+    if (currentBody() >= 0 && event->key() == Qt::Key_F2 && event->modifiers() == Qt::NoModifier) {
+        startRename();
+        return event->accept();
+    }
+    if (currentBody() >= 0 && event->key() == Qt::Key_Delete && event->modifiers() == Qt::NoModifier) {
+        deleteCurrentBody();
+        return event->accept();
+    }
+    QTreeWidget::keyPressEvent(event);
+}
+
+void ProjectTreePanel::startRename() {
+    const int body = currentBody();
+    if (body < 0 || !m_doc->hasProject()) return;
+    if (m_renameDialog) m_renameDialog->close();
+    const QString from = QString::fromStdString(m_doc->project().bodies.at(static_cast<size_t>(body)).scene.name);
+    auto* dialog = new QInputDialog(this);
+    dialog->setObjectName("renameBodyDialog");
+    dialog->setAttribute(Qt::WA_DeleteOnClose);
+    dialog->setWindowTitle(tr("Rename body"));
+    dialog->setLabelText(tr("New name of body '%1' (1-64 characters of A-Z a-z 0-9 _ -):").arg(from));
+    dialog->setTextValue(from);
+    connect(dialog, &QInputDialog::textValueSelected, this, [this, from](const QString& name) {
+        // the body by its name: an undo while the dialog was open may have moved it
+        int index = -1;
+        for (size_t i = 0; m_doc->hasProject() && i < m_doc->project().bodies.size() && index < 0; ++i)
+            if (m_doc->project().bodies[i].scene.name == from.toStdString()) index = static_cast<int>(i);
+        report(index < 0 ? tr("body '%1' is gone; nothing renamed").arg(from) : m_doc->renameBody(index, name));
+    });
+    m_renameDialog = dialog;
+    dialog->open();
+}
+
+void ProjectTreePanel::deleteCurrentBody() {
+    const int body = currentBody();
+    if (body < 0) return;
+    const QString why = m_doc->removeBody(body);
+    if (why.isEmpty() && m_sel->body() >= body) m_sel->clear(); // it named the body gone or one that moved
+    report(why);
+}
+
+void ProjectTreePanel::report(const QString& why) {
+    m_refusal = why;
+    if (why.isEmpty()) return;
+    if (isSignalConnected(QMetaMethod::fromSignal(&ProjectTreePanel::refused))) return emit refused(why);
+    emit m_doc->logMessage(why); // nobody shows it: the log, and a message box
+    auto* box = new QMessageBox(QMessageBox::Warning, tr("Body not changed"), why, QMessageBox::Ok, this);
+    box->setObjectName("bodyEditRefusal");
+    box->setAttribute(Qt::WA_DeleteOnClose);
+    box->open();
 }
 
 void ProjectTreePanel::onChanged(const Change& what) {
@@ -107,6 +205,7 @@ void ProjectTreePanel::rebuild() {
     }
     m_rebuilding = false;
     follow();
+    updateActions();
 }
 
 } // namespace viscera::studio

@@ -49,6 +49,10 @@ QString StudioTask::workDir() const {
     return m_tmp ? m_tmp->path() : QString();
 }
 
+QString StudioTask::resultFile() const {
+    return m_tmp ? m_tmp->filePath(QStringLiteral("result.json")) : QString();
+}
+
 bool StudioTask::start(const QString& name, const QStringList& args, int stages, QString* why) {
     if (running()) {
         if (why) *why = tr("%1 is already running").arg(m_name);

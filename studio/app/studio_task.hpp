@@ -5,8 +5,10 @@
 /// OpenVDB (the child is killed: nothing it wrote survives, the model is untouched).
 ///
 /// Progress: one step per line the child prints as "viscera-studio: [stage i/n: ]<stage>" on its
-/// error stream. The result (its output, the files it wrote in workDir()) is handed back on the
-/// UI thread by finished(); the caller applies it to the model as one undo step.
+/// error stream (that line protocol is all that is read from its text). The result is the typed
+/// file the child writes with `--result resultFile()` (project/step_result.hpp) and the files it
+/// wrote in workDir(), handed back on the UI thread by finished(); the caller reads it with
+/// readStepResult and applies it to the model as one undo step.
 ///
 /// Short work that needs no process of its own (the texture panel's live thumbnails) runs the
 /// same way in process (runInProcess): on a pool thread, its result handed back on the UI thread;
@@ -62,6 +64,9 @@ public:
     /// The private folder (valid from prepare() until the next prepare() or the task's end is
     /// handled: finished() receivers may read and move files from it).
     QString workDir() const;
+    /// <workDir()>/result.json: the typed result file to pass to the child as `--result` (valid
+    /// as workDir() is).
+    QString resultFile() const;
 
 signals:
     void progress(int done, int total, const QString& stage);

@@ -6,6 +6,8 @@
 //   viscera-studio import <mesh> [--scale S] [--tetrahedralize] [--cell-size M] [--facet-size M]
 //                         [-o out.vtet]
 //   viscera-studio remesh <mesh>... [--subtract M] [--intersect M] [options] -o out.obj
+//   viscera-studio remesh --project <project-dir> --body NAME [--project-file <json>] -o out.vremesh
+//   viscera-studio mesh <project-dir> --body NAME [--project-file <json>] [-o out.vtet]
 //   viscera-studio texture <spec.json> -o <dir>
 //   viscera-studio sample kidney -o <project-dir>
 //
@@ -27,6 +29,10 @@
 // failure is one line "viscera-studio: <message>" (no "stage"), exit code 1. The summary goes to
 // stdout.
 //
+// Typed results: import, remesh, mesh and export take --result FILE and write what they did as
+// one small JSON file (studio/project/step_result.hpp), atomically, after the work succeeded; the
+// studio reads that file, never the text on stdout (which is for people).
+//
 // Exit codes: 0 success, 1 bad input (project, mesh, texture spec), 2 usage.
 #include "app/studio_app.hpp"
 #include "bake/import.hpp"
@@ -38,13 +44,16 @@
 #include "haptics/trajectory.hpp"
 #include "project/project.hpp"
 #include "project/publishing.hpp"
+#include "project/remesh_cache.hpp"
 #include "project/sample_kidney.hpp"
+#include "project/step_result.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/suture/anastomosis.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/cli_main.hpp"
 #include "sim/util/error.hpp"
 #include "sim/util/format.hpp"
+#include "step_commands.hpp"
 #include "uv_report.hpp"
 
 #include <chrono>
@@ -70,6 +79,9 @@ void usage(std::FILE* out) {
                "                             [--facet-size M] [-o out.vtet]\n"
                "       viscera-studio remesh [<mesh>...] [--sample kidney] [--subtract M] [--intersect M] [options] -o "
                "out.obj\n"
+               "       viscera-studio remesh --project <project-dir> --body NAME [--project-file <json>] -o "
+               "out.vremesh\n"
+               "       viscera-studio mesh <project-dir> --body NAME [--project-file <json>] [-o out.vtet]\n"
                "       viscera-studio texture <spec.json> -o <dir>\n"
                "       viscera-studio sample kidney -o <project-dir>\n"
                "       viscera-studio replay <project-dir> -o <replay.csv> [--frames N]\n"
@@ -91,7 +103,8 @@ constexpr const char* kExportHelp =
     "  --signer NAME          the name in the signature (default: the key file's name)\n"
     "  --unsigned             no signature (players run it only with --allow-unsigned)\n"
     "  --expires DATE         players refuse the case after DATE (YYYY-MM-DD, end of day UTC, or\n"
-    "                         YYYY-MM-DDTHH:MM:SSZ)\n";
+    "                         YYYY-MM-DDTHH:MM:SSZ)\n"
+    "  --result FILE          write the export's figures as a typed result (JSON) for the studio\n";
 constexpr const char* kKeygenHelp =
     "usage: viscera-studio keygen [-o KEY.pem]\n"
     "\n"
@@ -107,7 +120,8 @@ constexpr const char* kImportHelp =
     "closedness and bounds; with --tetrahedralize meshes its volume (CGAL) and prints the quality.\n"
     "  --scale S        metres per file unit (default 1)\n"
     "  --cell-size M    largest tetrahedron size, m;  --facet-size M  largest surface facet, m\n"
-    "  -o out.vtet      write the tet mesh (needs --tetrahedralize)\n";
+    "  -o out.vtet      write the tet mesh (needs --tetrahedralize)\n"
+    "  --result FILE    write each file's figures as a typed result (JSON) for the studio\n";
 constexpr const char* kRemeshHelp =
     "usage: viscera-studio remesh <mesh>... [--subtract <mesh>] [--intersect <mesh>] [options] -o out.obj\n"
     "\n"
@@ -133,7 +147,11 @@ constexpr const char* kRemeshHelp =
     "the UVs (vt) of the method chosen.\n"
     "  --uv-transfer M     the UVs written: seam-cut (default), closest or island\n"
     "  --no-uv             no UV transfer\n"
-    "  --uv-preview P.png  checker preview: source, closest point, seam cutting (headless EGL)\n";
+    "  --uv-preview P.png  checker preview: source, closest point, seam cutting (headless EGL)\n"
+    "  --result FILE       write the figures as a typed result (JSON) for the studio\n"
+    "With --project <project-dir> --body NAME [--project-file <json>] the parts and settings are\n"
+    "those of the body's remesh block, remeshed as export remeshes them, and -o names the kept\n"
+    "remesh (.vremesh) the studio's Apply moves into <project-dir>/cache for export to reuse.\n";
 constexpr const char* kSampleHelp =
     "usage: viscera-studio sample kidney -o <project-dir>\n"
     "\n"
@@ -163,13 +181,6 @@ double parsePositive(const std::string& flag, const std::string& v) {
     if (*end != '\0' || !(d > 0) || !std::isfinite(d))
         throw std::invalid_argument(flag + " '" + v + "' must be a positive number");
     return d;
-}
-
-void printQuality(const sim::QualityReport& q) {
-    std::printf("  quality: min dihedral %.2f deg, max dihedral %.2f deg, mean ratio min %.3f mean %.3f\n"
-                "           %zu inverted, %zu degenerate, %zu slivers; volume %.6g m^3\n",
-                q.minDihedralDeg, q.maxDihedralDeg, q.minMeanRatio, q.meanMeanRatio, q.inverted.size(),
-                q.degenerate.size(), q.slivers.size(), q.totalVolume);
 }
 
 /// The arguments of a command taking one operand, -o/--output <value> and the value options
@@ -229,7 +240,8 @@ int cmdExport(const std::vector<std::string>& argsIn) {
     bool unsignedCase = false;
     for (const std::string& a : argsIn)
         (a == "--unsigned" ? unsignedCase = true : (args.push_back(a), false));
-    const OperandArgs parsed = parseOperandArgs(args, {"--project-file", "--sign-key", "--signer", "--expires"});
+    const OperandArgs parsed =
+        parseOperandArgs(args, {"--project-file", "--sign-key", "--signer", "--expires", "--result"});
     const std::optional<std::string>& dir = parsed.operand;
     const std::optional<std::string>& out = parsed.out;
     const std::optional<std::string>& projectFile = parsed.extra[0];
@@ -246,6 +258,9 @@ int cmdExport(const std::vector<std::string>& argsIn) {
     studio::Project project =
         projectFile ? studio::loadProjectText(readFile(*projectFile), *dir, *projectFile) : studio::loadProject(*dir);
     if (projectFile) requireNotAnInput(*out, "the case", {*projectFile}); // the project's own files: exportCase
+    const std::optional<std::string>& resultFile = parsed.extra[4];
+    if (resultFile) requireWritableFile(*resultFile, "the step result");
+    const uint64_t remeshes = studio::remeshRunCount();
     studio::ExportResult r = studio::exportCase(
         project, *out,
         [](size_t index, size_t total, const std::string& stage) {
@@ -266,6 +281,23 @@ int cmdExport(const std::vector<std::string>& argsIn) {
         std::printf("  body %s: %zu nodes, %zu tets, %zu fixed\n", b.name.c_str(), b.nodes, b.tets, b.fixedNodes);
         printQuality(b.quality);
     }
+    for (const std::string& w : r.warnings)
+        std::fprintf(stderr, "viscera-studio: warning: %s\n", w.c_str());
+    if (resultFile) {
+        studio::ExportStepResult e;
+        e.casePath = std::filesystem::absolute(r.casePath).string();
+        e.bytes = int64_t(r.bytes);
+        e.sha256 = r.sha256;
+        e.keyId = key ? r.keyId : std::string();
+        e.signer = key ? publish.signer : std::string();
+        e.features = r.features;
+        for (const auto& b : r.bodies)
+            e.bodies.push_back(bodyFigures(b));
+        e.remeshes = int64_t(studio::remeshRunCount() - remeshes);
+        e.seconds = secs;
+        e.warnings = r.warnings;
+        studio::writeStepResult(*resultFile, e);
+    }
     return 0;
 }
 
@@ -282,7 +314,7 @@ int cmdKeygen(const std::vector<std::string>& args) {
 
 int cmdImport(const std::vector<std::string>& args) {
     std::vector<std::string> ins;
-    std::optional<std::string> out;
+    std::optional<std::string> out, resultFile;
     bool tetra = false;
     bake::ImportOptions opt;
     bake::MeshingParams meshing;
@@ -302,6 +334,8 @@ int cmdImport(const std::vector<std::string>& args) {
             meshing.facetSize = parsePositive(a, value());
         else if (a == "-o" || a == "--output")
             out = value();
+        else if (a == "--result")
+            resultFile = value();
         else if (!a.empty() && a[0] == '-')
             throw std::invalid_argument("unknown option '" + a + "'");
         else
@@ -314,6 +348,11 @@ int cmdImport(const std::vector<std::string>& args) {
         requireWritableFile(*out, "the tet mesh");
         requireNotAnInput(*out, "the tet mesh", {ins[0]});
     }
+    if (resultFile) {
+        requireWritableFile(*resultFile, "the step result");
+        requireNotAnInput(*resultFile, "the step result", {ins.begin(), ins.end()});
+    }
+    studio::ImportStepResult imported;
     opt.keepUv = !tetra; // tells whether the parts carry texture coordinates
     sim::TriMesh surface;
     for (size_t i = 0; i < ins.size(); ++i) {
@@ -326,7 +365,15 @@ int cmdImport(const std::vector<std::string>& args) {
         std::printf("%s: %zu vertices, %zu triangles, closed: %s, bounds [%g %g %g] - [%g %g %g] m%s\n", in.c_str(),
                     surface.vertexCount(), surface.triangleCount(), surface.isClosedOriented() ? "yes" : "no", lo.x(),
                     lo.y(), lo.z(), hi.x(), hi.y(), hi.z(), tetra ? "" : (r.uv.empty() ? ", uv: no" : ", uv: yes"));
+        const sim::Vec3 fileLo = lo / opt.scale, fileHi = hi / opt.scale; // in file units
+        imported.parts.push_back({std::filesystem::absolute(in).string(),
+                                  int64_t(surface.vertexCount()),
+                                  int64_t(surface.triangleCount()),
+                                  surface.isClosedOriented(),
+                                  !r.uv.empty(),
+                                  {{{fileLo.x(), fileLo.y(), fileLo.z()}, {fileHi.x(), fileHi.y(), fileHi.z()}}}});
     }
+    if (resultFile) studio::writeStepResult(*resultFile, imported);
     if (!tetra) return 0;
     const auto t0 = std::chrono::steady_clock::now();
     meshing.label = std::filesystem::path(ins[0]).filename().string();
@@ -486,6 +533,9 @@ struct RemeshArgs {
     bake::RemeshParams params;
     std::optional<std::string> preview;
     bake::UvTransferMethod uvMethod = bake::UvTransferMethod::SeamCutting;
+    std::optional<std::string> result;                     ///< --result: the typed result file
+    std::optional<std::string> project, projectFile, body; ///< --body mode: a project body's block
+    std::optional<std::string> setting;                    ///< the first remesh setting given (none in --body mode)
 };
 
 RemeshArgs parseRemeshArgs(const std::vector<std::string>& args) {
@@ -497,8 +547,19 @@ RemeshArgs parseRemeshArgs(const std::vector<std::string>& args) {
             if (i + 1 >= args.size()) throw std::invalid_argument(a + " needs a value");
             return args[++i];
         };
+        if (a != "--uv-preview" && a != "--result" && a != "--project" && a != "--project-file" && a != "--body" &&
+            a != "-o" && a != "--output" && !a.empty() && a[0] == '-' && !r.setting)
+            r.setting = a;
         if (a == "--no-uv")
             params.transferUv = false;
+        else if (a == "--result")
+            r.result = value();
+        else if (a == "--project")
+            r.project = value();
+        else if (a == "--project-file")
+            r.projectFile = value();
+        else if (a == "--body")
+            r.body = value();
         else if (a == "--uv-transfer")
             r.uvMethod = parseUvTransferOption(value());
         else if (a == "--uv-preview")
@@ -534,6 +595,17 @@ RemeshArgs parseRemeshArgs(const std::vector<std::string>& args) {
         else
             r.inputs.push_back({a, bake::CsgOp::Union});
     }
+    if (r.body || r.project || r.projectFile) {
+        if (!r.body || !r.project || !r.out)
+            throw std::invalid_argument(
+                "remesh --body needs --project <project-dir>, --body <name> and -o out.vremesh");
+        if (!r.inputs.empty() || r.sample)
+            throw std::invalid_argument("remesh --body: the parts are the body's; give no <mesh> or --sample");
+        if (r.setting)
+            throw std::invalid_argument("remesh --body: " + *r.setting +
+                                        ": the settings are the body's remesh block (edit it in the project)");
+        return r;
+    }
     if ((r.inputs.empty() && !r.sample) || !r.out)
         throw std::invalid_argument("remesh needs at least one <mesh> (or --sample kidney) and -o out.obj");
     return r;
@@ -543,8 +615,10 @@ RemeshArgs parseRemeshArgs(const std::vector<std::string>& args) {
 /// would overwrite an input.
 void checkRemeshOutputs(const RemeshArgs& a) {
     const std::string& out = *a.out;
-    if (std::filesystem::path(out).extension() != ".obj")
-        throw std::invalid_argument("-o '" + out + "': the result is written as OBJ (.obj)");
+    const char* ext = a.body ? ".vremesh" : ".obj";
+    if (std::filesystem::path(out).extension() != ext)
+        throw std::invalid_argument("-o '" + out + "': the result is written as " +
+                                    (a.body ? "a kept remesh (.vremesh)" : "OBJ (.obj)"));
     requireWritableFile(out, "the remeshed surface");
     std::vector<std::filesystem::path> inputPaths;
     for (const auto& part : a.inputs)
@@ -555,6 +629,10 @@ void checkRemeshOutputs(const RemeshArgs& a) {
             throw std::invalid_argument("--uv-preview '" + *a.preview + "': the preview is written as PNG (.png)");
         requireWritableFile(*a.preview, "the UV preview");
         requireNotAnInput(*a.preview, "the UV preview", inputPaths);
+    }
+    if (a.result) {
+        requireWritableFile(*a.result, "the step result");
+        requireNotAnInput(*a.result, "the step result", inputPaths);
     }
 }
 
@@ -601,29 +679,88 @@ void printRemeshReport(const bake::RemeshReport& q, double secs) {
                 q.levelSetSeconds, q.isosurfaceSeconds, q.remeshSeconds, q.uvSeconds, q.checkSeconds, secs);
 }
 
+/// The typed result of a remesh: its report's figures, each UV method's, where the files went.
+studio::RemeshStepResult remeshStepResult(const RemeshArgs& a, const bake::RemeshReport& q, const UvChoice& uv,
+                                          const std::string& uvMethod, double secs) {
+    studio::RemeshStepResult r;
+    r.surface = std::filesystem::absolute(*a.out).string();
+    r.vertices = int64_t(q.vertices);
+    r.triangles = int64_t(q.triangles);
+    r.closed = q.closed;
+    r.manifold = q.manifold;
+    r.selfIntersections = int64_t(q.selfIntersections);
+    r.uvMethod = q.uvTransferred ? uvMethod : "none";
+    for (const auto& [method, st] : uv.stats)
+        r.uv.push_back({method, int64_t(st.spanningIslands), 100.0 * st.overThreshold, st.uvErrorMean});
+    r.preview = a.preview && !uv.stats.empty() ? std::filesystem::absolute(*a.preview).string() : std::string();
+    r.seconds = secs;
+    return r;
+}
+
+bool remeshProgress(std::string_view stage, double f) {
+    std::fprintf(stderr, "viscera-studio: remesh: %.*s (%.0f%%)\n", int(stage.size()), stage.data(), 100.0 * f);
+    return true;
+}
+
+/// remesh --body: the block of a project's body remeshed as export remeshes it (remesh_cache.hpp),
+/// written as a kept remesh (.vremesh) that Make simulation-ready's Apply moves into the project.
+int remeshProjectBody(const RemeshArgs& a) {
+    const studio::Project project = a.projectFile
+                                        ? studio::loadProjectText(readFile(*a.projectFile), *a.project, *a.projectFile)
+                                        : studio::loadProject(*a.project);
+    const std::string origin = a.projectFile.value_or((std::filesystem::path(*a.project) / "project.json").string());
+    const studio::BodyProject* body = nullptr;
+    for (const studio::BodyProject& b : project.bodies)
+        if (b.scene.name == *a.body) body = &b;
+    if (!body || body->mesh.kind != studio::MeshSource::Kind::Remesh)
+        throw InputError(origin + ": bodies: no body '" + *a.body + "' made by a remesh block");
+    const studio::RemeshSource& block = body->mesh.remesh;
+    requireNotAnInput(*a.out, "the remeshed surface", studio::projectInputFiles(project));
+    const std::string key = studio::remeshKey(block);
+    studio::RemeshRun run;
+    const auto t0 = std::chrono::steady_clock::now();
+    const studio::RemeshedSurface surface = studio::remeshSurface(block, &run, remeshProgress);
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    printRemeshReport(run.result.report, secs);
+    UvChoice uv;
+    if (run.result.report.uvTransferred)
+        uv = reportUvTransfers(run.parts, run.result, bake::UvTransferMethod::SeamCutting, a.preview);
+    studio::writeRemeshedSurface(*a.out, surface);
+    std::printf("wrote %s (key %s)\n", a.out->c_str(), key.c_str());
+    if (a.result) {
+        const std::string method = block.uvTransfer ? std::string(uvTransferOptionName(*block.uvTransfer)) : "none";
+        studio::RemeshStepResult r = remeshStepResult(a, run.result.report, uv, method, secs);
+        r.uvMethod = method; // the block's, also where only the seam cut measures (closest, island)
+        r.cacheKey = key;
+        studio::writeStepResult(*a.result, r);
+    }
+    return 0;
+}
+
 int cmdRemesh(const std::vector<std::string>& args) {
     const RemeshArgs a = parseRemeshArgs(args);
     checkRemeshOutputs(a);
+    if (a.body) return remeshProjectBody(a);
     const std::string& out = *a.out;
     const std::vector<bake::RemeshPart> parts = loadRemeshParts(a);
     const auto t0 = std::chrono::steady_clock::now();
-    const bake::RemeshResult r = bake::voxelRemesh(parts, a.params, [](std::string_view stage, double f) {
-        std::fprintf(stderr, "viscera-studio: remesh: %.*s (%.0f%%)\n", int(stage.size()), stage.data(), 100.0 * f);
-        return true;
-    });
+    const bake::RemeshResult r = bake::voxelRemesh(parts, a.params, remeshProgress);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const bake::RemeshReport& q = r.report;
     if (!q.uvTransferred) bake::writeObj(out, r.mesh);
     printRemeshReport(q, secs);
+    UvChoice choice;
     if (!q.uvTransferred) {
         if (a.params.transferUv) std::printf("uv: not transferred (a part has no UVs)\n");
-        std::printf("wrote %s\n", out.c_str());
-        return 0;
+    } else {
+        choice = reportUvTransfers(parts, r, a.uvMethod, a.preview);
+        bake::writeObjWithUv(out, *choice.mesh, choice.uv);
+        std::printf("uv.written %s\n", std::string(uvTransferOptionName(a.uvMethod)).c_str());
     }
-    const UvChoice choice = reportUvTransfers(parts, r, a.uvMethod, a.preview);
-    bake::writeObjWithUv(out, *choice.mesh, choice.uv);
-    std::printf("uv.written %s\n", std::string(uvTransferOptionName(a.uvMethod)).c_str());
     std::printf("wrote %s\n", out.c_str());
+    if (a.result)
+        studio::writeStepResult(*a.result,
+                                remeshStepResult(a, q, choice, std::string(uvTransferOptionName(a.uvMethod)), secs));
     return 0;
 }
 
@@ -644,10 +781,10 @@ int main(int argc, char** argv) {
     program.name = "viscera-studio";
     program.version = VISCERA_VERSION;
     program.usage = usage;
-    program.subcommands = {{"export", cmdExport, kExportHelp},    {"import", cmdImport, kImportHelp},
-                           {"open", cmdOpen, kOpenHelp},          {"remesh", cmdRemesh, kRemeshHelp},
-                           {"texture", cmdTexture, kTextureHelp}, {"replay", cmdReplay, kReplayHelp},
-                           {"keygen", cmdKeygen, kKeygenHelp},    {"sample", cmdSample, kSampleHelp}};
+    program.subcommands = {
+        {"export", cmdExport, kExportHelp}, {"import", cmdImport, kImportHelp},    {"open", cmdOpen, kOpenHelp},
+        {"remesh", cmdRemesh, kRemeshHelp}, {"texture", cmdTexture, kTextureHelp}, {"replay", cmdReplay, kReplayHelp},
+        {"keygen", cmdKeygen, kKeygenHelp}, {"sample", cmdSample, kSampleHelp},    {"mesh", cmdMesh, kMeshHelp}};
     program.noArguments = [] { return studio::runStudio(g_argc, g_argv, {}); };
     return sim::runCli(program, argc, argv);
 }

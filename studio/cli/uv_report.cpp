@@ -92,11 +92,12 @@ UvChoice reportUvTransfers(const std::vector<bake::RemeshPart>& parts, const bak
             cut ? r.report.uvSeconds : std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         const bake::UvTransferStats st = bake::measureUvTransfer(source, mesh, uv);
         printStats(uvTransferOptionName(m), st, took);
+        choice.stats.emplace_back(std::string(uvTransferOptionName(m)), st);
         if (m != bake::UvTransferMethod::IslandLabelled)
             items.push_back({cut ? "seam cutting" : "closest point", mesh, uv, {}});
         if (cut) // the seam cut's stretch heat map with its seams, beside it
             items.push_back({"seam-cut stretch", mesh, uv, studio::stretchOverlay(mesh, st.faceStretch, r.seamEdges)});
-        if (m == chosen) choice = {&mesh, std::move(uv)};
+        if (m == chosen) choice.mesh = &mesh, choice.uv = std::move(uv);
     }
     if (preview) {
         studio::writeUvPreview(*preview, items);

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 /// "seam-cut", "closest", "island": the method names of --uv-transfer. Throws
@@ -20,6 +21,8 @@ std::string_view uvTransferOptionName(viscera::bake::UvTransferMethod method);
 struct UvChoice {
     const viscera::sim::TriMesh* mesh = nullptr;
     std::vector<viscera::bake::CornerUv> uv;
+    /// each method's figures, by its short name (closest, island, seam-cut), in that order
+    std::vector<std::pair<std::string, viscera::bake::UvTransferStats>> stats;
 };
 
 /// Prints the source, the cut and, for each method, `uv.<method>.<figure> value` lines (triangles,

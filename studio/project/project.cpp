@@ -1,5 +1,7 @@
 #include "project/project.hpp"
 
+#include "project/remesh_cache.hpp"
+
 #include "bake/texture.hpp"
 #include "render/case_references.hpp"
 #include "render/case_settings.hpp"
@@ -8,6 +10,7 @@
 #include "case/case_writer.hpp"
 #include "case/manifest.hpp"
 #include "sim/mesh/tet_io.hpp"
+#include "sim/scene/port_reach.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/scene_json.hpp"
 #include "sim/scene/world.hpp"
@@ -632,9 +635,9 @@ std::string placementProblem(const bake::ImportPlacement& placement, const std::
 Project loadProjectText(const std::string& text, const std::filesystem::path& dir, const std::string& origin) {
     const json doc = sim::parseJsonText(text, origin);
     const JsonField root(doc, "", origin);
-    root.object({"schemaVersion", "caseId", "caseVersion", "title", "instructions", "solver", "gravity", "bodies",
-                 "surfaces", "accuracy", "render", "suture", "interaction", "tools", "laparoscope", "bend", "scenery",
-                 "assessment"});
+    root.object({"schemaVersion", "caseId", "caseVersion", "title", "instructions", "steps", "solver", "gravity",
+                 "bodies", "surfaces", "accuracy", "render", "suture", "interaction", "tools", "laparoscope", "bend",
+                 "scenery", "assessment"});
     Project p;
     p.dir = dir;
     p.schemaVersion = root["schemaVersion"].integer(1, 1);
@@ -647,6 +650,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     sim::readSolver(root, scene);
     if (auto su = root.find("suture")) scene.suture = readSutureProject(*su, dir, p.trajectory);
     if (auto v = root.find("instructions")) scene.instructions = v->displayText(sim::kMaxInstructionsBytes);
+    if (auto v = root.find("steps")) scene.steps = sim::readSteps(*v);
     if (auto v = root.find("render")) {
         scene.render = v->anyObject().value().dump();
         render::RenderSettings check;
@@ -658,7 +662,8 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     scene.accuracy = sim::readAccuracy(root);
 
     std::set<std::string> names;
-    for (const JsonField& b : root["bodies"].items(1)) {
+    // A project may have no body yet (File → New); export asks for one (requireABody).
+    for (const JsonField& b : root["bodies"].items()) {
         b.object({"name", "mesh", "material", "strain_limits", "embedded_in", "embedding_compliance", "fixed",
                   "stiffness_regions", "stiffness_paint", "light_samples", "texture"});
         BodyProject body;
@@ -737,6 +742,7 @@ std::string projectJsonText(const Project& p) {
     // The scene part: the same writers as the player's scene.json.
     sim::writeSolver(scene, doc);
     if (!scene.instructions.empty()) doc["instructions"] = scene.instructions;
+    sim::writeSteps(scene.steps, doc);
     if (!scene.render.empty()) doc["render"] = json::parse(scene.render);
     sim::writeAccuracy(scene.accuracy, doc);
     if (scene.suture) doc["suture"] = sutureProjectJson(*scene.suture, p.trajectory, w);
@@ -782,6 +788,31 @@ std::string projectJsonText(const Project& p) {
     return doc.dump(2) + "\n";
 }
 
+namespace {
+
+/// Writes every instrument's track text (the model's) to its file, at the same place relative to
+/// `dir` as to project.dir, atomically; a file that holds the text already is not rewritten.
+void writeChangedTracks(const Project& project, const std::filesystem::path& dir) {
+    namespace fs = std::filesystem;
+    if (!project.scene.interaction) return;
+    const std::vector<sim::InstrumentDesc>& list = project.scene.interaction->instruments;
+    for (size_t i = 0; i < list.size() && i < project.trackFiles.size(); ++i) {
+        const fs::path base = fs::absolute(project.dir.empty() ? fs::path(".") : project.dir).lexically_normal();
+        const fs::path file = dir / fs::absolute(project.trackFiles[i]).lexically_normal().lexically_relative(base);
+        std::error_code ec;
+        if (fs::is_regular_file(file, ec)) {
+            try {
+                if (readFile(file) == list[i].trackText) continue;
+            } catch (const InputError&) { // unreadable: written anew below (or the write says why)
+            }
+        }
+        fs::create_directories(file.parent_path(), ec);
+        writeFileAtomic(file, list[i].trackText);
+    }
+}
+
+} // namespace
+
 void saveProject(const Project& project, const std::filesystem::path& dir) {
     namespace fs = std::filesystem;
     const fs::path file = dir / "project.json";
@@ -794,7 +825,17 @@ void saveProject(const Project& project, const std::filesystem::path& dir) {
         throw InputError(file.string() + ": cannot save: '" + dir.string() + "' is not a folder");
     if (::access(dir.c_str(), W_OK | X_OK) != 0)
         throw InputError(file.string() + ": cannot save: the folder is not writable (" + std::strerror(errno) + ")");
+    writeChangedTracks(project, dir); // first: project.json never names a track that is not there
     writeFileAtomic(file, text);
+}
+
+sim::Material newBodyMaterial() {
+    sim::Material m;
+    m.model = sim::MaterialModel::StableNeoHookean;
+    m.youngsModulus = 3000;
+    m.poissonRatio = 0.45;
+    m.density = 1050;
+    return m;
 }
 
 Project newProject(const std::filesystem::path& dir, const std::string& caseId) {
@@ -811,59 +852,29 @@ Project newProject(const std::filesystem::path& dir, const std::string& caseId) 
     scene.xpbd.iterations = 1;
     scene.xpbd.damping = 2.0;
     scene.xpbd.gravity = sim::Vec3(0, 0, -9.81);
-
-    BodyProject body;
-    body.scene.name = "tissue";
-    body.scene.material.model = sim::MaterialModel::StableNeoHookean;
-    body.scene.material.youngsModulus = 3000;
-    body.scene.material.poissonRatio = 0.45;
-    body.scene.material.density = 1050;
-    body.mesh.kind = MeshSource::Kind::Box;
-    body.mesh.box.origin = sim::Vec3::Zero();
-    body.mesh.box.size = sim::Vec3(0.1, 0.02, 0.04);
-    body.mesh.box.cells = {20, 4, 8};
-    body.fixedBox = std::array<sim::Vec3, 2>{sim::Vec3(-0.001, -0.001, -0.001), sim::Vec3(0.0001, 0.021, 0.041)};
-    p.bodies.push_back(std::move(body));
     return p;
+}
+
+void requireABody(const Project& project) {
+    if (project.bodies.empty())
+        throw InputError((project.dir / "project.json").string() +
+                         ": bodies: a case needs at least one body; import anatomy or add a body");
 }
 
 namespace {
 
-/// The remesh block's parts, imported with their UVs (when the block transfers them).
-std::vector<bake::RemeshPart> importParts(const RemeshSource& r) {
-    std::vector<bake::RemeshPart> parts;
-    for (const RemeshSource::Part& p : r.parts) {
-        bake::ImportOptions opt = bake::placedOptions(r.placement);
-        opt.keepUv = r.uvTransfer.has_value();
-        bake::ImportResult in = bake::importSurfaceWithReport(p.file, opt);
-        if (opt.keepUv && in.uv.empty())
-            throw InputError(p.file.string() + ": has no texture coordinates (uv_transfer needs UVs on every part; "
-                                               "'none' remeshes without them)");
-        parts.push_back({p.file.filename().string(), std::move(in.mesh), p.op, std::move(in.uv)});
-    }
-    return parts;
-}
-
-/// Remesh, transfer the UVs, tetrahedralize; the boundary's corner UVs into `boundaryUv`
-/// (transferred from the remeshed surface, one host chart per boundary triangle).
+/// Tetrahedralize the block's surface (the kept one when Apply kept it: remesh_cache.hpp), the
+/// boundary's corner UVs into `boundaryUv` (transferred from the UV surface, one host chart per
+/// boundary triangle).
 std::unique_ptr<sim::TetMesh> remeshBody(const RemeshSource& r, const bake::MeshingParams& meshing,
-                                         std::vector<render::CornerUvF>* boundaryUv) {
-    const std::vector<bake::RemeshPart> parts = importParts(r);
-    bake::RemeshParams params = r.params;
-    params.transferUv = r.uvTransfer == bake::UvTransferMethod::SeamCutting;
-    bake::RemeshResult result = bake::voxelRemesh(parts, params);
-    std::vector<bake::CornerUv> uv = std::move(result.uv);
-    if (r.uvTransfer && *r.uvTransfer != bake::UvTransferMethod::SeamCutting)
-        uv = bake::transferUv(bake::UvSource(parts), result.mesh, *r.uvTransfer);
-    // The tets fill the remeshed surface before the seam cut (its triangles are well shaped; the
-    // cut's pieces along the seams would become features and slivers): the cut surface is where
-    // the boundary's UVs come from.
-    const sim::TriMesh& hull = result.uncut.triangleCount() > 0 ? result.uncut : result.mesh;
+                                         std::vector<render::CornerUvF>* boundaryUv,
+                                         const std::filesystem::path& projectDir) {
+    RemeshedSurface s = keptOrFreshRemesh(r, projectDir);
     bake::MeshingParams smooth = meshing;
     smooth.featureAngleDeg = 0; // the voxel remesh rounded every edge: no feature to protect
-    std::unique_ptr<sim::TetMesh> mesh = bake::tetrahedralize(hull, smooth).mesh;
-    if (!boundaryUv || uv.empty()) return mesh;
-    const bake::UvSource remeshed({{"remeshed surface", result.mesh, bake::CsgOp::Union, std::move(uv)}});
+    std::unique_ptr<sim::TetMesh> mesh = bake::tetrahedralize(s.hull, smooth).mesh;
+    if (!boundaryUv || s.uv.empty()) return mesh;
+    const bake::UvSource remeshed({{"remeshed surface", std::move(s.surface), bake::CsgOp::Union, std::move(s.uv)}});
     auto probe = mesh->clone(); // the boundary in the render mesh's order
     probe->requireLevel(3);
     const std::vector<bake::CornerUv> corner =
@@ -877,7 +888,8 @@ std::unique_ptr<sim::TetMesh> remeshBody(const RemeshSource& r, const bake::Mesh
 } // namespace
 
 std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::string& origin,
-                                            std::vector<render::CornerUvF>* boundaryUv) {
+                                            std::vector<render::CornerUvF>* boundaryUv,
+                                            const std::filesystem::path& projectDir) {
     const MeshSource& s = body.mesh;
     bake::MeshingParams params = s.meshing;
     params.label = origin + ": body '" + body.scene.name + "'";
@@ -899,7 +911,7 @@ std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::
         return bake::tetrahedralize(bake::importSurface(s.file, opt), params).mesh;
     }
     case MeshSource::Kind::Remesh:
-        return remeshBody(s.remesh, params, boundaryUv);
+        return remeshBody(s.remesh, params, boundaryUv, projectDir);
     }
     throw InputError(origin + ": unknown mesh source");
 }
@@ -1152,6 +1164,7 @@ void shapeAndWriteMeshes(const Project& project, BuiltScene& built, const std::s
 }
 
 BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
+    requireABody(project);
     const std::string origin = (project.dir / "project.json").string();
     BuiltScene built;
     built.scene = project.scene; // what the player reads; the bodies follow with their meshes
@@ -1169,7 +1182,7 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
         std::unique_ptr<sim::TetMesh> mesh;
         std::vector<render::CornerUvF> boundaryUv;
         try {
-            mesh = buildBodyMesh(b, origin, &boundaryUv);
+            mesh = buildBodyMesh(b, origin, &boundaryUv, project.dir);
         } catch (const std::invalid_argument& e) {
             throw InputError(origin + ": " + field + ".mesh: " + e.what());
         }
@@ -1282,13 +1295,26 @@ std::unique_ptr<sim::World> assembleWorld(const BuiltScene& built, const std::st
     return sim::World::assemble(built.scene, std::move(meshes), built.surfaces, built.features, origin);
 }
 
+std::vector<std::string> reachWarnings(const Project& project) {
+    std::vector<std::string> out;
+    const std::string origin = (project.dir / "project.json").string();
+    for (const sim::ReachProblem& r : sim::unreachableTargets(project.scene))
+        out.push_back(origin + ": " + r.message);
+    return out;
+}
+
 ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress,
                         const CasePublishing& publish) {
     // Before the work: the case can be written, and over none of the files it is made from.
     requireWritableFile(out, "the case");
     requireNotAnInput(out, "the case", projectInputFiles(project));
-    StageCounter stage{progress, exportStageCount(project)};
+    requireABody(project); // before the material maps are baked
     const std::string origin = (project.dir / "project.json").string();
+    std::vector<std::string> bodyNames;
+    for (const BodyProject& b : project.bodies)
+        bodyNames.push_back(b.scene.name);
+    sim::checkAssessmentMeasurable(project.scene, bodyNames, origin); // every metric it cannot measure, at once
+    StageCounter stage{progress, exportStageCount(project)};
     ProjectTextures textures; // first: a broken spec is reported before the meshing
     if (hasTextures(project)) {
         stage("generating material maps");
@@ -1302,6 +1328,7 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     const sim::SceneDesc& scene = built.scene;
     const std::vector<std::string>& features = built.features;
     ExportResult result = std::move(built.result);
+    result.warnings = reachWarnings(project);
     auto& files = built.files;
 
     stage("packaging");

@@ -6,6 +6,7 @@
 /// {
 ///   "schemaVersion": 1,
 ///   "caseId": "tissue-slab", "caseVersion": "1.0.0", "title": "…", "instructions": "…",
+///   "steps": ["…", …],                      optional: the task's ordered steps (core/sim/scene/scene.hpp)
 ///   "solver": {"type": "xpbd", "dt": 0.0166667, "substeps": 10, "iterations": 1, "damping": 1.0},
 ///   "gravity": [0, 0, -9.81],
 ///   "bodies": [{
@@ -103,6 +104,11 @@ namespace viscera::studio {
 /// "scale" a uniform factor on top of it (> 0, default 1), "rotation_deg" Euler angles about x,
 /// then y, then z (each in [-360, 360], default none); a part's file coordinate c becomes
 /// R · (metres per unit · scale · c) metres.
+/// The remeshed surface is not part of the model: it is a function of the block and its part
+/// files. Make simulation-ready's Apply keeps the one it made in <project>/cache, named by the
+/// hash of the block and the parts' bytes (remesh_cache.hpp), and export and Tetrahedralize read
+/// it instead of remeshing again; an edit of the block or of a part file changes the name, so
+/// they remesh then.
 struct RemeshSource {
     struct Part {
         std::filesystem::path file; ///< resolved against the project folder
@@ -282,14 +288,22 @@ uint64_t projectTextCount();
 /// Writes projectJsonText(project) to <dir>/project.json atomically (a crash leaves the old file
 /// or the new one). `dir` must be an existing, writable folder; file references stay relative to
 /// project.dir (saving into another folder: copy the project's files there with the same layout).
-/// Throws viscera::InputError naming <dir>/project.json; nothing is left behind on failure.
+/// Every instrument's track text (the model's) is written first to its file, at the same place
+/// relative to `dir`, atomically, when the file is missing or holds another text (one that holds
+/// it is not rewritten). Throws viscera::InputError naming <dir>/project.json or the track file.
 void saveProject(const Project& project, const std::filesystem::path& dir);
 
-/// The model of File → New: one box body "tissue" (0.1 × 0.02 × 0.04 m, 20 × 4 × 8 cells, stable
-/// Neo-Hookean, E 3000 Pa, ν 0.45, 1050 kg/m³) fixed at its x = 0 end, under gravity, XPBD at
-/// dt 1/60 s with enough substeps for the load-time stability check; case version 1.0.0. Throws
-/// viscera::InputError when `caseId` breaks the case-id rule.
+/// The model of File → New: no body yet (the artist imports anatomy or adds one; export and the
+/// scene build refuse a project without one, requireABody), under gravity, XPBD at dt 1/60 s with
+/// 40 substeps (enough for the load-time stability check of a newBodyMaterial() body with 5 mm
+/// cells); case version 1.0.0, title = caseId. Throws viscera::InputError when `caseId` breaks
+/// the case-id rule.
 Project newProject(const std::filesystem::path& dir, const std::string& caseId);
+/// The material a new body starts with: stable Neo-Hookean, E 3000 Pa, ν 0.45, 1050 kg/m³.
+sim::Material newBodyMaterial();
+/// Throws viscera::InputError "<dir>/project.json: bodies: a case needs at least one body; import
+/// anatomy or add a body" when `project` has no body (a case, and a scene to simulate, need one).
+void requireABody(const Project& project);
 
 struct BodyExport {
     std::string name;
@@ -311,7 +325,16 @@ struct ExportResult {
     std::string keyId;  ///< the signing key (vcase::keyId); empty when unsigned
     std::vector<std::string> features;
     std::vector<BodyExport> bodies;
+    /// What the case allows but a trainee will find hard or impossible (reachWarnings): shown by
+    /// the studio and the command line; the case is written all the same.
+    std::vector<std::string> warnings;
 };
+
+/// Every task target an instrument cannot reach through its port (sim::unreachableTargets on the
+/// project's scene), one line each: "<dir>/project.json: interaction.instruments[2] 'clipper':
+/// its port cannot reach assessment.targets.clip[0] at (0.004, 0.009, -0.006): 0.300 m from the
+/// port, outside the insertion range [0.040, 0.260]". Empty when every port reaches its targets.
+std::vector<std::string> reachWarnings(const Project& project);
 
 /// Export progress: stage `index` of `total` (1-based; total is fixed for one export) and what it
 /// does ("meshing body 'organ'", "skeleton and stiffness paint of 'fat'", "cutting surface
@@ -376,7 +399,7 @@ bool usesPaintedSampling(const sim::SceneDesc& scene);
 size_t exportStageCount(const Project& project);
 
 /// Builds every body mesh and surface and fills in the scene (the first stages of exportCase).
-/// Throws viscera::InputError naming the body or surface and the rule.
+/// Throws viscera::InputError naming the body or surface and the rule (requireABody's first).
 BuiltScene buildScene(const Project& project, const ExportProgress& progress = {});
 
 /// World::assemble on copies of the built meshes: the world the player would run. Throws
@@ -387,15 +410,20 @@ std::unique_ptr<sim::World> assembleWorld(const BuiltScene& built, const std::st
 /// inverted or degenerate element is an error naming the body and element), resolves fixed
 /// regions to node lists, and writes the case package atomically. Only what the scene uses is
 /// packaged, and the manifest's features list only the subsystems the scene needs. Before any of
-/// it, `out` must be writable and none of projectInputFiles (InputError naming `out`).
+/// it, `out` must be writable and none of projectInputFiles (InputError naming `out`), and the
+/// project must have a body (requireABody).
 ///
 /// `publish`: the publisher's signature (none: an unsigned case, which players refuse without
 /// --allow-unsigned) and the case's expiry, both bound into manifest.json.
 ExportResult exportCase(const Project& project, const std::filesystem::path& out, const ExportProgress& progress = {},
                         const CasePublishing& publish = {});
 
-/// Builds one body's tet mesh from its source (exposed for the import command and tests).
+/// Builds one body's tet mesh from its source (exposed for the import command and tests). A
+/// remesh body's surface is the one kept in <projectDir>/cache by Make simulation-ready's Apply
+/// when it is there for the block as it is (remesh_cache.hpp), else it is remeshed now; an empty
+/// projectDir always remeshes.
 std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::string& origin,
-                                            std::vector<render::CornerUvF>* boundaryUv = nullptr);
+                                            std::vector<render::CornerUvF>* boundaryUv = nullptr,
+                                            const std::filesystem::path& projectDir = {});
 
 } // namespace viscera::studio

@@ -56,10 +56,10 @@ Project writeKidneySample(const std::filesystem::path& dir) {
     p.title = "Kidney made from render anatomy";
     p.scene.instructions = "A kidney made simulation-ready from overlapping render parts, textured through its "
                            "transferred UVs, hangs from its hilum and settles under gravity.";
-    BodyProject& body = p.bodies.at(0);
+    BodyProject& body = p.bodies.emplace_back();
     body.scene.name = "kidney";
+    body.scene.material = newBodyMaterial();
     body.scene.material.youngsModulus = 4000;
-    body.mesh = {};
     body.mesh.kind = MeshSource::Kind::Remesh;
     RemeshSource& r = body.mesh.remesh;
     for (const bake::RemeshPart& part : bake::kidneyAnatomy()) {

@@ -100,6 +100,45 @@ std::vector<CurvePoint> fromTheta(const CurveParameters& p, const Eigen::VectorX
     return pts;
 }
 
+double valueAt1(const std::optional<MonotoneCurve>& c) {
+    return c ? c->value(1.0) : 0.0;
+}
+double slopeAt1(const std::optional<MonotoneCurve>& c) {
+    return c ? c->derivative(1.0) : 0.0;
+}
+
+/// Small-strain Lamé μ_eff, λ_eff of curves (ValanisLandelDensity's formulas, without its checks).
+std::pair<double, double> lameAtRest(const ValanisLandelCurves& c) {
+    const double g1 = valueAt1(c.gPrime), g2 = slopeAt1(c.gPrime), h1 = valueAt1(c.hPrime);
+    return {0.5 * (slopeAt1(c.fPrime) + g2 - g1 - h1), g2 + g1 + slopeAt1(c.hPrime) + h1};
+}
+
+/// FitCurves::FPrimeKeepingPoisson: h′ scaled about h′(1) so that λ_eff/μ_eff stays the start's.
+class PoissonKeeper {
+public:
+    explicit PoissonKeeper(const ValanisLandelCurves& start) : m_h(*start.hPrime) {
+        const auto [mu, lambda] = lameAtRest(start);
+        m_ratio = lambda / mu;
+        m_rest = m_h.value(1.0);
+        m_slope = m_h.derivative(1.0);
+    }
+    /// `c` (f′ fitted, h′ the start's) with h′ scaled; false when no positive scale keeps ν.
+    bool apply(ValanisLandelCurves& c) const {
+        const auto [mu, lambda] = lameAtRest(c);
+        const double k = 1.0 + (m_ratio * mu - lambda) / m_slope;
+        if (!(k > 0) || !std::isfinite(k)) return false;
+        std::vector<CurvePoint> pts = m_h.controlPoints();
+        for (CurvePoint& q : pts)
+            q.y = q.y == m_rest ? m_rest : m_rest + k * (q.y - m_rest); // the rest point kept exactly
+        c.hPrime = MonotoneCurve(m_h.name(), std::move(pts), m_h.shape(), m_h.context());
+        return true;
+    }
+
+private:
+    const MonotoneCurve& m_h;
+    double m_ratio = 0, m_rest = 0, m_slope = 1;
+};
+
 /// θ ↔ curves, and the weighted data residuals of a θ.
 class Problem {
 public:
@@ -113,6 +152,7 @@ public:
             offset += m_params.back().count();
         }
         m_unknowns = offset;
+        if (options.curves == FitCurves::FPrimeKeepingPoisson) m_keeper.emplace(start);
         const std::size_t n = data.size();
         double maxAbs = 0;
         for (double s : data.nominalStress)
@@ -156,6 +196,7 @@ public:
                 const MonotoneCurve& old = *(m_start.*p.member);
                 c.*p.member = MonotoneCurve(old.name(), fromTheta(p, theta), old.shape(), old.context());
             }
+            if (m_keeper && !m_keeper->apply(c)) return std::nullopt;
         } catch (const InputError&) {
             return std::nullopt;
         }
@@ -197,6 +238,7 @@ private:
     const ValanisLandelCurves& m_start;
     const UniaxialData& m_data;
     std::vector<CurveParameters> m_params;
+    std::optional<PoissonKeeper> m_keeper;
     std::size_t m_unknowns = 0;
     double m_floor = 1, m_energy = 0;
     Eigen::VectorXd m_weight;
@@ -358,6 +400,9 @@ void checkInput(const ValanisLandelCurves& start, const UniaxialData& data, cons
     if (!start.fPrime) throw std::invalid_argument(where + "the start curves have no f' to fit");
     if (options.curves == FitCurves::FPrimeAndHPrime && !start.hPrime)
         throw std::invalid_argument(where + "the start curves have no h' to fit (use FitCurves::FPrime)");
+    if (options.curves == FitCurves::FPrimeKeepingPoisson && !(start.hPrime && start.hPrime->derivative(1.0) > 0))
+        throw std::invalid_argument(where + "the start curves have no h' rising at 1 to keep nu with (use "
+                                            "FitCurves::FPrime)");
 }
 
 } // namespace

@@ -6,7 +6,7 @@
 /// Unknowns: the control VALUES of f′ (and optionally h′); the control points' x stay where they
 /// are, and the point at x = 1 of every fitted curve keeps its value (pinned, as the editor pins
 /// it), so f′(1) + 2g′(1) + h′(1), the stress at rest, is exactly that of the start curves. g′
-/// and any curve not fitted stay as given.
+/// and any curve not fitted stay as given (h′ under FitCurves::FPrimeKeepingPoisson: scaled).
 ///
 /// Shape rule by parametrization: a StrictlyIncreasing curve is written as its pinned rest value
 /// plus positive increments between neighbouring points, y_{k+1} − y_k = exp(θ_k), so any θ gives
@@ -47,8 +47,15 @@
 namespace viscera::sim {
 
 enum class FitCurves {
-    FPrime,          ///< f′ only (h′, g′ as given)
+    FPrime,          ///< f′ only (h′, g′ as given: the volume stiffness λ is kept, so ν follows μ)
     FPrimeAndHPrime, ///< f′ and h′ (g′ as given); the start needs an h′
+    /// f′ only, with the small-strain ν of the start kept: h′ follows the fitted shear stiffness,
+    /// its deviations from h′(1) scaled by the one factor k > 0 that makes λ_eff/μ_eff the
+    /// start's, k = 1 + (λ₀/μ₀ · μ_eff − λ_eff)/h″(1) (λ_eff, μ_eff of f′ fitted and h′ as
+    /// given; editable_curves.hpp, SmallStrainConstants), so ν is the start's up to rounding
+    /// however stiff the data. g′ as given. The start needs an h′ with h″(1) > 0 (every
+    /// Neo-Hookean preset has one); a trial whose k would not be positive is not admissible.
+    FPrimeKeepingPoisson,
 };
 
 enum class FitWeighting {
@@ -103,7 +110,8 @@ struct CurveFitResult {
 /// for a broken precondition (data with fewer than UniaxialDataLimits::minRows rows, lengths
 /// that differ, stretches not finite, positive and strictly increasing within a test, stresses not finite,
 /// named by 0-based row: "sim::fitUniaxial(): data row 4: stretch 1.02 must be ...";
-/// maxIterations < 1; tolerance not positive; regularization negative; no f′, or no h′ with FPrimeAndHPrime; a fitted
+/// maxIterations < 1; tolerance not positive; regularization negative; no f′, no h′ with FPrimeAndHPrime, no h′
+/// rising at 1 with FPrimeKeepingPoisson; a fitted
 /// curve without a control point at x = 1) and viscera::InputError when the start curves are
 /// not a valid density or have no uniaxial state at a data stretch ("sim::fitUniaxial(): start
 /// curves: no uniaxial state at stretch 3 (data line 12)").

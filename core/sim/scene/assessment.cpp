@@ -1,6 +1,8 @@
 #include "sim/scene/assessment.hpp"
+#include "sim/scene/scene.hpp"
 #include "sim/scene/scene_json.hpp"
 
+#include <algorithm>
 #include <set>
 
 namespace viscera::sim {
@@ -204,6 +206,49 @@ void writeAssessment(const AssessmentDesc& a, json& doc) {
         if (m.limit) e["limit"] = *m.limit;
         if (m.expert) e["expert"] = {{"mean", m.expert->mean}, {"sd", m.expert->sd}};
     }
+}
+
+std::vector<std::string> unmeasurableMetrics(const AssessmentDesc& a, const SceneDesc& scene,
+                                             const std::vector<std::string>& bodies) {
+    std::vector<std::string> problems;
+    if (const auto& v = a.vessel; v && std::find(bodies.begin(), bodies.end(), v->body) == bodies.end())
+        problems.push_back("assessment.targets.vessel.body: '" + v->body + "' is not a body of the scene");
+    int tools = 0;
+    bool left = false, right = false, ported = false;
+    auto tool = [&](const std::string& hand, bool port) {
+        ++tools, left |= hand == "left", right |= hand == "right", ported |= port;
+    };
+    if (scene.interaction)
+        for (const InstrumentDesc& in : scene.interaction->instruments)
+            tool(in.device.hand, in.port.declared);
+    for (const ToolDesc& t : scene.tools)
+        tool(t.hand, t.port.declared);
+    if (scene.suture) tool(scene.suture->device.hand, false);
+    const bool gauge = scene.suture && !scene.suture->gauge[0].empty();
+    // What each metric needs of the scene; the tip metrics need any tool.
+    const std::pair<std::string_view, std::pair<bool, const char*>> rules[] = {
+        {"out_of_view_s", {scene.laparoscope.has_value(), "a laparoscope"}},
+        {"instrument_collisions", {tools >= 2, "two tools"}},
+        {"path_length_left_m", {left, "a tool in the left hand"}},
+        {"path_length_right_m", {right, "a tool in the right hand"}},
+        {"angular_path_rad", {ported, "an instrument or probe through a port"}},
+        {"final_gap_m", {gauge, "a suture with a gauge"}},
+        {"max_thread_tension_n", {scene.suture.has_value(), "a suture"}},
+        {"path_length_m", {tools > 0, "a tool"}},
+        {"economy_of_motion", {tools > 0, "a tool"}},
+        {"jerk_rms_m_s3", {tools > 0, "a tool"}},
+        {"idle_time_s", {tools > 0, "a tool"}},
+        {"force_mean_n", {tools > 0, "a tool"}},
+        {"force_max_n", {tools > 0, "a tool"}},
+        {"force_over_threshold_s", {tools > 0, "a tool"}},
+        {"tissue_damage_ns", {tools > 0, "a tool"}},
+    };
+    for (const MetricLevel& m : a.metrics) // catalogue order
+        for (const auto& [name, rule] : rules)
+            if (m.name == name && !rule.first)
+                problems.push_back("assessment.metrics." + m.name + ": needs " + rule.second +
+                                   " (this scene has none: no session could measure it)");
+    return problems;
 }
 
 } // namespace viscera::sim

@@ -42,6 +42,7 @@
 namespace viscera::sim {
 
 using Vec3 = Eigen::Vector3d;
+struct SceneDesc;
 
 /// One metric a trainer uses: its name in the report, unit, which way is better and definition.
 struct MetricInfo {
@@ -105,5 +106,20 @@ struct AssessmentDesc {
     const MetricLevel* level(std::string_view name) const;
     bool hasTargets() const { return !cuts.empty() || !clips.empty() || suture.has_value(); }
 };
+
+/// The measurability rule: every metric `assessment` judges (a limit or an expert level) can be
+/// measured in `scene` (its own assessment is not looked at), and its vessel to protect is one of
+/// `bodies` (the scene's body names). One problem per metric or field that breaks it, in
+/// catalogue order, each naming the field, what it needs and that the scene has none:
+///   "assessment.metrics.out_of_view_s: needs a laparoscope (this scene has none: no session
+///    could measure it)"
+/// out_of_view_s needs a laparoscope; instrument_collisions two tools; path_length_left_m /
+/// path_length_right_m a tool in that hand; angular_path_rad an instrument or probe through a
+/// port; final_gap_m a suture with a gauge; max_thread_tension_n a suture; the tip metrics
+/// (path_length_m, economy_of_motion, jerk_rms_m_s3, idle_time_s, force_*, tissue_damage_ns) a
+/// tool. Empty when the scene can measure everything. The scene reader (checkAssessmentMeasurable)
+/// and the studio's typed assessment edits apply it.
+std::vector<std::string> unmeasurableMetrics(const AssessmentDesc& assessment, const SceneDesc& scene,
+                                             const std::vector<std::string>& bodies);
 
 } // namespace viscera::sim

@@ -52,6 +52,19 @@ json strainLimitsJson(const TetStrainLimits& s) {
 
 } // namespace
 
+std::vector<std::string> readSteps(const JsonField& steps) {
+    std::vector<std::string> out;
+    for (const JsonField& s : steps.items(0, kMaxSteps)) {
+        out.push_back(s.displayText(kMaxStepBytes));
+        if (out.back().empty()) s.fail("must not be empty (a step the trainee reads)");
+    }
+    return out;
+}
+
+void writeSteps(const std::vector<std::string>& steps, json& doc) {
+    if (!steps.empty()) doc["steps"] = steps;
+}
+
 std::vector<ToolDesc> readTools(const JsonField& tools, std::set<std::string>& names) {
     std::vector<ToolDesc> out;
     const std::vector<JsonField> list = tools.items();
@@ -317,51 +330,22 @@ void writeNodeWeightFields(const std::vector<double>& weights, const std::string
 void checkAssessmentMeasurable(const SceneDesc& scene, const std::vector<std::string>& bodies,
                                const std::string& origin) {
     if (!scene.assessment) return;
-    if (const auto& v = scene.assessment->vessel; v && std::find(bodies.begin(), bodies.end(), v->body) == bodies.end())
-        throw InputError(origin + ": assessment.targets.vessel.body: '" + v->body + "' is not a body of the scene");
-    int tools = 0;
-    bool left = false, right = false, ported = false;
-    auto tool = [&](const std::string& hand, bool port) {
-        ++tools, left |= hand == "left", right |= hand == "right", ported |= port;
-    };
-    if (scene.interaction)
-        for (const InstrumentDesc& in : scene.interaction->instruments)
-            tool(in.device.hand, in.port.declared);
-    for (const ToolDesc& t : scene.tools)
-        tool(t.hand, t.port.declared);
-    if (scene.suture) tool(scene.suture->device.hand, false);
-    const bool gauge = scene.suture && !scene.suture->gauge[0].empty();
-    const std::pair<const char*, std::pair<bool, const char*>> rules[] = {
-        {"out_of_view_s", {scene.laparoscope.has_value(), "a laparoscope"}},
-        {"instrument_collisions", {tools >= 2, "two tools"}},
-        {"path_length_left_m", {left, "a tool in the left hand"}},
-        {"path_length_right_m", {right, "a tool in the right hand"}},
-        {"angular_path_rad", {ported, "an instrument or probe through a port"}},
-        {"final_gap_m", {gauge, "a suture with a gauge"}},
-        {"max_thread_tension_n", {scene.suture.has_value(), "a suture"}},
-    };
-    for (const auto& [name, rule] : rules)
-        if (scene.assessment->level(name) && !rule.first)
-            throw InputError(origin + ": assessment.metrics." + name + ": needs " + rule.second +
-                             " (this scene has none: no session could measure it)");
-    if (tools == 0)
-        for (const MetricLevel& m : scene.assessment->metrics)
-            for (const char* n : {"path_length_m", "economy_of_motion", "jerk_rms_m_s3", "idle_time_s", "force_mean_n",
-                                  "force_max_n", "force_over_threshold_s", "tissue_damage_ns"})
-                if (m.name == n)
-                    throw InputError(origin + ": assessment.metrics." + m.name +
-                                     ": needs a tool (this scene has none: no session could measure it)");
+    std::string all; // every problem, not the first only
+    for (const std::string& p : unmeasurableMetrics(*scene.assessment, scene, bodies))
+        all += (all.empty() ? "" : "; ") + p;
+    if (!all.empty()) throw InputError(origin + ": " + all);
 }
 
 SceneDesc parseScene(std::string_view text, const std::string& origin) {
     const json doc = parseJsonText(text, origin);
     const JsonField root(doc, "", origin);
-    root.object({"solver", "gravity", "instructions", "accuracy", "bodies", "surfaces", "tools", "render", "suture",
-                 "interaction", "laparoscope", "scenery", "assessment"});
+    root.object({"solver", "gravity", "instructions", "steps", "accuracy", "bodies", "surfaces", "tools", "render",
+                 "suture", "interaction", "laparoscope", "scenery", "assessment"});
     SceneDesc scene;
     readSolver(root, scene);
     if (auto su = root.find("suture")) scene.suture = readSutureSection(*su);
     if (auto v = root.find("instructions")) scene.instructions = v->displayText(kMaxInstructionsBytes);
+    if (auto v = root.find("steps")) scene.steps = readSteps(*v);
     if (auto v = root.find("render")) scene.render = v->anyObject().value().dump();
     scene.accuracy = readAccuracy(root);
 
@@ -420,6 +404,7 @@ json sceneJson(const SceneDesc& scene) {
     if (scene.suture) doc["suture"] = sutureJson(*scene.suture);
     if (scene.interaction) doc["interaction"] = interactionJson(*scene.interaction);
     if (!scene.instructions.empty()) doc["instructions"] = scene.instructions;
+    writeSteps(scene.steps, doc);
     if (!scene.render.empty()) doc["render"] = json::parse(scene.render);
     writeAccuracy(scene.accuracy, doc);
     doc["bodies"] = json::array();

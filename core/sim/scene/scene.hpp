@@ -8,6 +8,7 @@
 ///              "damping": 1.0, "max_speed": 20.0, "threads": 2},
 ///   "gravity": [0, 0, -9.81],
 ///   "instructions": "Watch the slab settle under gravity.",
+///   "steps": ["Lift the fundus", "Clip the duct twice"],   optional: the task's ordered steps
 ///   "accuracy": {"every_frames": 60, "max_iterations": 100},          optional
 ///   "bodies": [{"name": "organ", "mesh": "meshes/organ.vtet",
 ///               "material": {...see scene_json.hpp, readMaterial...},
@@ -93,6 +94,12 @@ struct AccuracySampling {
 /// The scene's instructions to the trainee: printable UTF-8 text of at most this many bytes
 /// (JsonField::displayText), one rule for scene.json and project.json.
 inline constexpr size_t kMaxInstructionsBytes = 2000;
+/// The task's ordered steps shown to the trainee as a numbered list ("steps", optional, default
+/// none): at most kMaxSteps steps, each non-empty printable UTF-8 text of at most kMaxStepBytes
+/// bytes (JsonField::displayText, the instructions' rule), one rule for scene.json and project.json
+/// (sim::readSteps).
+inline constexpr size_t kMaxSteps = 20;
+inline constexpr size_t kMaxStepBytes = 200;
 
 /// A surface of the case that is drawn and never simulated: the anatomy around the working space
 /// (pelvic side walls, peritoneum, an organ the task does not touch). It costs no physics; a
@@ -104,7 +111,8 @@ struct SceneryDesc {
 };
 
 struct SceneDesc {
-    std::string instructions; ///< shown to the trainee; may be empty
+    std::string instructions;       ///< shown to the trainee; may be empty
+    std::vector<std::string> steps; ///< the task's ordered steps, shown numbered; may be empty
     /// The "render" object as JSON text (empty: renderer defaults). The simulation does not read
     /// it; the player checks it at load (render::applyCaseRender) and hands it to the renderer.
     std::string render;

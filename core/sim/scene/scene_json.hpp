@@ -24,6 +24,10 @@ void writeSolver(const SceneDesc& scene, nlohmann::json& doc);
 std::optional<AccuracySampling> readAccuracy(const JsonField& doc);
 /// Writes "accuracy" into `doc` when `accuracy` is set.
 void writeAccuracy(const std::optional<AccuracySampling>& accuracy, nlohmann::json& doc);
+/// "steps": the task's ordered steps (kMaxSteps at most, each non-empty displayText of at most
+/// kMaxStepBytes). writeSteps writes "steps" into `doc` when there are any.
+std::vector<std::string> readSteps(const JsonField& steps);
+void writeSteps(const std::vector<std::string>& steps, nlohmann::json& doc);
 /// The name rule of bodies, surfaces and tools: 1–64 characters of [A-Za-z0-9_-] (it names the
 /// files of the case), unique among all of them (`names`).
 std::string readName(const JsonField& name, std::set<std::string>& names);
@@ -37,10 +41,10 @@ void writeScenery(const std::vector<SceneryDesc>& scenery, nlohmann::json& doc);
 LaparoscopeDesc readLaparoscope(const JsonField& scope);
 /// "assessment" (assessment.hpp): targets, metric limits and expert levels.
 AssessmentDesc readAssessment(const JsonField& assessment);
-/// Every metric the assessment judges can be measured in `scene` (out_of_view_s needs a
-/// laparoscope, instrument_collisions two tools, final_gap_m a suture with a gauge, ...), and its
-/// vessel to protect is one of `bodies` (the scene's body names): throws viscera::InputError
-/// "<origin>: assessment.metrics.<name>: needs <what> (...)".
+/// Every metric the assessment judges can be measured in `scene`, and its vessel to protect is one
+/// of `bodies` (the scene's body names): the rule of unmeasurableMetrics (assessment.hpp). Throws
+/// viscera::InputError listing every problem, joined by "; ": "<origin>: assessment.metrics.
+/// out_of_view_s: needs a laparoscope (...); assessment.metrics.instrument_collisions: needs two tools (...)".
 void checkAssessmentMeasurable(const SceneDesc& scene, const std::vector<std::string>& bodies,
                                const std::string& origin);
 void writeAssessment(const AssessmentDesc& assessment, nlohmann::json& doc);

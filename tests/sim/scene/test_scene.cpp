@@ -48,6 +48,34 @@ TEST(Scene, RoundTrip) {
     EXPECT_EQ(back.bodies[0].material.poissonRatio, s.bodies[0].material.poissonRatio);
 }
 
+TEST(Scene, StepsAreOrderedPrintableTextOfBoundedCount) {
+    SceneDesc s = slabScene();
+    EXPECT_TRUE(parseScene(formatScene(s), "scene.json").steps.empty()); // optional, default none
+    EXPECT_EQ(formatScene(s).find("\"steps\""), std::string::npos);      // none: not written
+    s.steps = {"Lift the fundus", "Clip the duct twice — é", "Cut between the clips"};
+    EXPECT_EQ(parseScene(formatScene(s), "scene.json").steps, s.steps); // order kept
+
+    const std::string head = R"({"solver": {"type": "xpbd", "substeps": 20}, "bodies": [{"name": "a",
+        "mesh": "m.vtet", "material": {"model": "neo_hookean", "youngs_modulus": 1000, "poisson_ratio": 0.3,
+        "density": 1000}}], "steps": )";
+    EXPECT_EQ(parseError(head + R"(["one", "two"]})"), "accepted");
+    EXPECT_THAT(parseError(head + R"("one"})"), HasSubstr("scene.json: steps: must be an array"));
+    EXPECT_THAT(parseError(head + R"(["one", 2]})"), HasSubstr("scene.json: steps[1]: must be a string"));
+    EXPECT_THAT(parseError(head + R"(["one", ""]})"), HasSubstr("scene.json: steps[1]: must not be empty"));
+    EXPECT_THAT(parseError(head + R"(["one", "a\u001bb"]})"),
+                HasSubstr("scene.json: steps[1]: must be printable text: control character U+001B"));
+    EXPECT_THAT(parseError(head + R"(["a\nb"]})"), HasSubstr("steps[0]: must be printable text"));
+    const std::string longest(kMaxStepBytes, 'x');
+    EXPECT_EQ(parseError(head + "[\"" + longest + "\"]}"), "accepted");
+    EXPECT_THAT(parseError(head + "[\"" + longest + "x\"]}"),
+                HasSubstr("steps[0]: must be at most " + std::to_string(kMaxStepBytes) + " bytes"));
+    std::string many = "[";
+    for (size_t k = 0; k <= kMaxSteps; ++k)
+        many += (k ? ", \"" : "\"") + std::to_string(k) + "\"";
+    EXPECT_THAT(parseError(head + many + "]}"),
+                HasSubstr("scene.json: steps: must have 0 to " + std::to_string(kMaxSteps) + " elements"));
+}
+
 TEST(Scene, RenderBlockAndPrimalCorrectionRoundTrip) {
     SceneDesc s = slabScene();
     s.render = R"({"post":{"tone_mapping":false},"sss":false})";

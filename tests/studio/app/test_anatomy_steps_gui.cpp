@@ -9,6 +9,7 @@
 #include "app/import_placement.hpp"
 #include "app/studio_task.hpp"
 #include "case/case_package.hpp"
+#include "project/remesh_cache.hpp"
 #include "project/sample_kidney.hpp"
 #include "window_fixture.hpp"
 
@@ -148,6 +149,9 @@ TEST_F(AnatomyFixture, ImportMakeSimulationReadyTetrahedralizeAndExportByGuiActi
     undo->undo();
     EXPECT_EQ(w->document()->project().bodies[1].mesh.remesh.params.voxelCount, 64) << "one undo step";
     undo->redo();
+    // Apply kept the remeshed surface under the block's key: meshing and export read it.
+    EXPECT_TRUE(
+        fs::exists(studio::keptRemeshFile(dir, studio::remeshKey(w->document()->project().bodies[1].mesh.remesh))));
 
     steps()->tetrahedralizeAction()->trigger();
     ASSERT_TRUE(test::waitFor([&] { return !steps()->task().running(); }, 120000)) << "meshing did not end";
@@ -169,6 +173,9 @@ TEST_F(AnatomyFixture, ImportMakeSimulationReadyTetrahedralizeAndExportByGuiActi
     EXPECT_TRUE(text.contains("body anatomy:")) << text.toStdString();
     EXPECT_TRUE(text.contains("min dihedral")) << text.toStdString();
     EXPECT_TRUE(text.contains("0 inverted")) << text.toStdString();
+    EXPECT_TRUE(text.contains("(the kept remesh)")) << "Tetrahedralize reused Apply's surface\n" << text.toStdString();
+    for (const auto& e : fs::recursive_directory_iterator(scratch.dir))
+        EXPECT_NE(e.path().extension(), ".vcase") << "Tetrahedralize runs no export: " << e.path();
     test::saveShot("anatomy_tetrahedralized");
     meshed->close();
 
@@ -200,6 +207,8 @@ TEST_F(AnatomyFixture, ImportMakeSimulationReadyTetrahedralizeAndExportByGuiActi
     QTest::mouseClick(w->unsignedExportBox()->findChild<QPushButton*>("exportUnsigned"), Qt::LeftButton);
     ASSERT_TRUE(test::waitFor([&] { return done; }, 180000));
     ASSERT_TRUE(ok) << w->exportRunner()->output().toStdString();
+    // the sample's own body (never made simulation-ready here) is remeshed; the imported one is not
+    EXPECT_EQ(w->exportRunner()->result().remeshes, 1) << "the export after Apply reads the kept remesh";
     {
         const auto pkg = vcase::CasePackage::open(out);
         EXPECT_TRUE(pkg->contains("meshes/anatomy.vuv"));

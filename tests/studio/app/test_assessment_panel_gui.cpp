@@ -120,6 +120,24 @@ TEST_F(AssessmentPanelFixture, ARefusedValueNamesTheRuleAndLeavesTheModelUnchang
     EXPECT_TRUE(level("path_length_m")->expert);
 }
 
+TEST_F(AssessmentPanelFixture, ALimitTheSceneCannotMeasureIsRefusedWhenTyped) {
+    // issue 57 item 7: the dock refuses what export would refuse, when it is typed
+    open("tissue-slab"); // no laparoscope
+    ASSERT_FALSE(w->document()->project().scene.laparoscope);
+    const int oov = row("out_of_view_s");
+    ASSERT_GE(oov, 0);
+    QUndoStack* undo = w->document()->undoStack();
+    const int steps = undo->count();
+    const std::string before = studio::projectJsonText(w->document()->project());
+    typeInto(oov, Panel::Limit, "5");
+    EXPECT_NE(panel->errorLabel()->text().indexOf("assessment.metrics.out_of_view_s: needs a laparoscope"), -1)
+        << panel->errorLabel()->text().toStdString();
+    EXPECT_EQ(level("out_of_view_s"), nullptr);
+    EXPECT_EQ(undo->count(), steps) << "the refused limit is not an undo step";
+    EXPECT_EQ(studio::projectJsonText(w->document()->project()), before) << "the model unchanged";
+    EXPECT_TRUE(panel->table()->item(oov, Panel::Limit)->text().isEmpty()) << "the cell shows the model again";
+}
+
 } // namespace
 
 namespace {

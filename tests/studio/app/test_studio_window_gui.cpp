@@ -433,12 +433,13 @@ TEST_F(WindowFixture, NewProjectIsWrittenAndAnExistingOneIsNotOverwritten) {
     EXPECT_EQ(w->document()->project().caseId, "fresh-case");
     EXPECT_FALSE(w->isWindowModified());
     const std::string before = viscera::readFile(dir / "project.json");
-    ASSERT_EQ(w->setProperty("density", "1200"), "");
+    EXPECT_TRUE(w->document()->project().bodies.empty()) << "File > New starts without a placeholder body";
+    ASSERT_EQ(w->document()->editTask("Task", "Fresh case", "", {}), "");
     EXPECT_FALSE(w->newProject(QString::fromStdString(dir.string()))) << "a folder with a project stays as it is";
     EXPECT_EQ(viscera::readFile(dir / "project.json"), before);
     EXPECT_TRUE(w->log()->toPlainText().contains("already holds a project"));
     EXPECT_TRUE(w->saveProject());
-    EXPECT_EQ(studio::loadProject(dir).bodies[0].scene.material.density, 1200);
+    EXPECT_EQ(studio::loadProject(dir).title, "Fresh case");
 }
 
 /// Share of sampled pixels that differ from the corner's: 0 for a blank frame.
@@ -712,7 +713,7 @@ TEST_F(WindowFixture, FitToCleanOgdenDataByDefaultAndEnterRunsTheFit) {
     std::printf("ogden fit (default): R^2 %.6f, max relative error %.3g %%\n", r.rSquared, 100 * r.maxRelativeError);
     EXPECT_GE(r.rSquared, 0.999);
     const QString text = dlg.resultLabel()->text();
-    EXPECT_TRUE(text.contains("h′ and g′ kept")) << text.toStdString();
+    EXPECT_TRUE(text.contains("ν kept: h′ scaled with the fitted shear stiffness")) << text.toStdString();
     EXPECT_TRUE(dlg.applyButton()->isEnabled());
     test::saveShot("fit_ogden");
     const double nuBefore =

@@ -2,6 +2,9 @@
 // references resolve against <project-dir>; the progress lines on stderr are numbered stages.
 // viscera-studio texture <spec.json> -o <dir>: the files it writes and lists, one-line refusals.
 #include "case/case_package.hpp"
+#include "project/remesh_cache.hpp"
+#include "project/sample_kidney.hpp"
+#include "project/step_result.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "support/case_signing.hpp"
 #include "support/run_process.hpp"
@@ -23,7 +26,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-test::ProcessResult studio(const std::vector<std::string>& args) {
+test::ProcessResult runStudio(const std::vector<std::string>& args) {
     return test::runProcess(VISCERA_STUDIO_EXE, test::signingWithSampleKey(args));
 }
 
@@ -59,7 +62,7 @@ TEST(StudioCli, ExportReadsTheProjectFileAndNumbersItsStages) {
     const fs::path text = scratch.dir / "unsaved" / "edit.json";
     writeFileAtomic(text, kProject);
     const fs::path out = scratch.dir / "cube.vcase";
-    auto r = studio({"export", dir.string(), "-o", out.string(), "--project-file", text.string()});
+    auto r = runStudio({"export", dir.string(), "-o", out.string(), "--project-file", text.string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_THAT(r.out, HasSubstr("exported cube -> "));
     EXPECT_EQ(vcase::CasePackage::open(out)->manifest().title.value_or(""), "From the project file");
@@ -75,13 +78,13 @@ TEST(StudioCli, ExportReadsTheProjectFileAndNumbersItsStages) {
 
     // Errors name the project file that was given; without it, <project-dir>/project.json is read.
     writeFileAtomic(text, "{");
-    auto bad = studio({"export", dir.string(), "-o", out.string(), "--project-file", text.string()});
+    auto bad = runStudio({"export", dir.string(), "-o", out.string(), "--project-file", text.string()});
     EXPECT_EQ(bad.exitCode, 1);
     EXPECT_THAT(bad.err, HasSubstr(text.string() + ": invalid JSON"));
-    auto none = studio({"export", dir.string(), "-o", out.string()});
+    auto none = runStudio({"export", dir.string(), "-o", out.string()});
     EXPECT_EQ(none.exitCode, 1);
     EXPECT_THAT(none.err, HasSubstr((dir / "project.json").string() + ": cannot open for reading"));
-    auto usage = studio({"export", dir.string(), "-o", out.string(), "--project-file"});
+    auto usage = runStudio({"export", dir.string(), "-o", out.string(), "--project-file"});
     EXPECT_EQ(usage.exitCode, 2);
     EXPECT_THAT(usage.err, HasSubstr("--project-file needs a value"));
 }
@@ -101,7 +104,7 @@ TEST(StudioCli, ExportRunsWithoutADisplayOrQtPlatform) {
     withoutDisplay();
     test::Scratch s("viscera-studio-cli");
     const std::string out = s / "slab.vcase";
-    const auto r = studio({"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab", "-o", out});
+    const auto r = runStudio({"export", std::string(VISCERA_SOURCE_DIR) + "/projects/tissue-slab", "-o", out});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_THAT(r.out, HasSubstr("exported tissue-slab"));
     EXPECT_NO_THROW(vcase::verify(out));
@@ -111,13 +114,13 @@ TEST(StudioCli, TheWindowWithoutADisplayIsRefusedWithOneLine) {
     withoutDisplay();
     for (const std::vector<std::string>& args :
          {std::vector<std::string>{}, {"open", std::string(VISCERA_SOURCE_DIR) + "/projects/liver"}}) {
-        const auto r = studio(args);
+        const auto r = runStudio(args);
         EXPECT_EQ(r.exitCode, 1);
         const auto l = lines(r.err);
         ASSERT_EQ(l.size(), 1u) << r.err;
         EXPECT_THAT(l[0], HasSubstr("no display"));
     }
-    const auto help = studio({"--help"});
+    const auto help = runStudio({"--help"});
     EXPECT_EQ(help.exitCode, 0);
     EXPECT_THAT(help.out, HasSubstr("open <project-dir>"));
 }
@@ -140,7 +143,7 @@ TEST(StudioCli, TextureWritesTheMapsOfASpecAndListsThem) {
     const fs::path spec = scratch.dir / "mucosa.json";
     writeFileAtomic(spec, kSpec);
     const fs::path out = scratch.dir / "maps";
-    const auto r = studio({"texture", spec.string(), "-o", out.string()});
+    const auto r = runStudio({"texture", spec.string(), "-o", out.string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_THAT(r.out, HasSubstr("texture mucosa: 64x64, 5 levels, 1 patterns, seed 3, tileable"));
     EXPECT_THAT(r.out, HasSubstr("palette: #7a1f24 #efc1a8"));
@@ -158,14 +161,14 @@ TEST(StudioCli, TextureWritesTheMapsOfASpecAndListsThem) {
     std::string bad = kSpec;
     bad.replace(bad.find("\"levels\": 5"), 11, "\"levels\": 5, \"colour\": 1");
     writeFileAtomic(spec, bad);
-    const auto refused = studio({"texture", spec.string(), "-o", out.string()});
+    const auto refused = runStudio({"texture", spec.string(), "-o", out.string()});
     EXPECT_EQ(refused.exitCode, 1);
     EXPECT_EQ(refused.err, "viscera-studio: " + spec.string() + ": colour: unknown field\n");
     // Usage errors: exit 2; the usage text lists the command.
-    const auto usage = studio({"texture", spec.string()});
+    const auto usage = runStudio({"texture", spec.string()});
     EXPECT_EQ(usage.exitCode, 2);
     EXPECT_THAT(usage.err, HasSubstr("texture needs <spec.json> and -o <dir>"));
-    EXPECT_THAT(studio({"--help"}).out, HasSubstr("viscera-studio texture <spec.json> -o <dir>"));
+    EXPECT_THAT(runStudio({"--help"}).out, HasSubstr("viscera-studio texture <spec.json> -o <dir>"));
 }
 
 // import --tetrahedralize: an output it cannot write is refused before meshing (no stage line),
@@ -177,13 +180,13 @@ TEST(StudioCli, ImportChecksItsOutputFirstAndReportsMeshingStages) {
                          "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
     writeFileAtomic(s / "file", "x");
     const auto refused =
-        studio({"import", obj, "--tetrahedralize", "-o", (fs::path(s / "file") / "cube.vtet").string()});
+        runStudio({"import", obj, "--tetrahedralize", "-o", (fs::path(s / "file") / "cube.vtet").string()});
     EXPECT_EQ(refused.exitCode, 1);
     EXPECT_THAT(refused.err, HasSubstr("cube.vtet: cannot write the tet mesh"));
     EXPECT_THAT(refused.err, ::testing::Not(HasSubstr("meshing:")));
     EXPECT_EQ(lines(refused.err).size(), 1u) << refused.err;
 
-    const auto r = studio({"import", obj, "--tetrahedralize", "-o", s / "cube.vtet"});
+    const auto r = runStudio({"import", obj, "--tetrahedralize", "-o", s / "cube.vtet"});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_THAT(r.err, HasSubstr("viscera-studio: meshing: check surface (0%)"));
     EXPECT_THAT(r.err, HasSubstr("viscera-studio: meshing: refine ("));
@@ -191,7 +194,7 @@ TEST(StudioCli, ImportChecksItsOutputFirstAndReportsMeshingStages) {
     EXPECT_TRUE(fs::exists(s / "cube.vtet"));
 
     writeFileAtomic(s / "up.obj", "mtllib ../outside.mtl\n" + readFile(obj));
-    const auto up = studio({"import", s / "up.obj"});
+    const auto up = runStudio({"import", s / "up.obj"});
     EXPECT_EQ(up.exitCode, 1);
     EXPECT_THAT(up.err, HasSubstr("up.obj: line 1: mtllib '../outside.mtl': leaves the file's folder"));
     EXPECT_EQ(lines(up.err).size(), 1u) << up.err;
@@ -209,4 +212,78 @@ TEST(StudioCli, TheUvMethodWrittenIsChosenAndAnUnknownOneIsRefusedByName) {
     EXPECT_NE(r.exitCode, 0);
     EXPECT_THAT(r.err, HasSubstr("--uv-transfer 'nearest': the methods are seam-cut, closest and island"));
     EXPECT_FALSE(fs::exists(s / "bad.obj"));
+}
+
+// --result [issue 57 item 6]: import, mesh, remesh --body and export each hand back a typed result
+// file (project/step_result.hpp) the studio reads instead of their text; mesh meshes one body
+// and writes no case.
+TEST(StudioCli, ImportMeshRemeshAndExportWriteTheirTypedResults) {
+    test::Scratch scratch("viscera-studio-cli-result");
+    const fs::path dir = scratch.dir / "project";
+    writeFileAtomic(dir / "meshes" / "cube.obj",
+                    "v 0 0 0\nv 10 0 0\nv 0 10 0\nv 10 10 0\nv 0 0 10\nv 10 0 10\nv 0 10 10\nv 10 10 10\n"
+                    "f 1 3 4\nf 1 4 2\nf 5 6 8\nf 5 8 7\nf 1 2 6\nf 1 6 5\nf 3 7 8\nf 3 8 4\nf 1 5 7\nf 1 7 3\n"
+                    "f 2 4 8\nf 2 8 6\n");
+    writeFileAtomic(dir / "project.json", kProject);
+
+    auto r = runStudio({"import", (dir / "meshes" / "cube.obj").string(), "--result", scratch / "import.json"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto imported = studio::readStepResult<studio::ImportStepResult>(scratch / "import.json");
+    ASSERT_EQ(imported.parts.size(), 1u);
+    EXPECT_EQ(imported.parts[0].file, (dir / "meshes" / "cube.obj").string());
+    EXPECT_EQ(imported.parts[0].vertices, 8);
+    EXPECT_EQ(imported.parts[0].triangles, 12);
+    EXPECT_TRUE(imported.parts[0].closed);
+    EXPECT_EQ(imported.parts[0].bounds[1][0], 10.0) << "file units";
+
+    r = test::runProcess(VISCERA_STUDIO_EXE,
+                         {"mesh", dir.string(), "--body", "cube", "--result", scratch / "mesh.json"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(lines(r.err), (std::vector<std::string>{"viscera-studio: stage 1/2: meshing body 'cube'",
+                                                      "viscera-studio: stage 2/2: checking body 'cube'"}));
+    const auto meshed = studio::readStepResult<studio::MeshingStepResult>(scratch / "mesh.json");
+    EXPECT_EQ(meshed.body.name, "cube");
+    EXPECT_GT(meshed.body.tets, 20); // CGAL's mesh of the 1 cm cube at the block's cell size
+    EXPECT_GT(meshed.body.fixedNodes, 0);
+    EXPECT_EQ(meshed.body.inverted, 0);
+    EXPECT_EQ(meshed.substeps, 100);
+    EXPECT_GT(meshed.stiffnessNumber, 0);
+    EXPECT_FALSE(meshed.remeshReused);
+    for (const auto& e : fs::recursive_directory_iterator(scratch.dir))
+        EXPECT_NE(e.path().extension(), ".vcase") << "meshing writes no case: " << e.path();
+    auto unknown = test::runProcess(VISCERA_STUDIO_EXE, {"mesh", dir.string(), "--body", "sphere"});
+    EXPECT_EQ(unknown.exitCode, 1);
+    EXPECT_THAT(unknown.err, HasSubstr("project.json: bodies: no body named 'sphere'"));
+
+    const fs::path out = scratch.dir / "cube.vcase";
+    r = runStudio({"export", dir.string(), "-o", out.string(), "--result", scratch / "export.json"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto exported = studio::readStepResult<studio::ExportStepResult>(scratch / "export.json");
+    EXPECT_EQ(exported.casePath, fs::absolute(out).string());
+    EXPECT_EQ(uint64_t(exported.bytes), fs::file_size(out));
+    EXPECT_EQ(exported.sha256, vcase::CasePackage::open(out)->sha256());
+    ASSERT_EQ(exported.bodies.size(), 1u);
+    EXPECT_EQ(exported.bodies[0].tets, meshed.body.tets) << "mesh meshes the body as export does";
+    EXPECT_FALSE(exported.keyId.empty()) << "signed with the sample key";
+    EXPECT_EQ(exported.remeshes, 0) << "no remesh block";
+
+    // remesh --body: the block of a project body, remeshed as export remeshes it; the settings
+    // are the block's, so none is taken on the command line.
+    const fs::path kidney = scratch.dir / "kidney";
+    studio::writeKidneySample(kidney);
+    auto refused = test::runProcess(VISCERA_STUDIO_EXE, {"remesh", "--project", kidney.string(), "--body", "kidney",
+                                                         "--voxels", "40", "-o", scratch / "k.vremesh"});
+    EXPECT_EQ(refused.exitCode, 2);
+    EXPECT_THAT(refused.err, HasSubstr("remesh --body: --voxels: the settings are the body's remesh block"));
+    r = test::runProcess(VISCERA_STUDIO_EXE, {"remesh", "--project", kidney.string(), "--body", "kidney", "-o",
+                                              scratch / "k.vremesh", "--result", scratch / "remesh.json"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto remeshed = studio::readStepResult<studio::RemeshStepResult>(scratch / "remesh.json");
+    const studio::Project kp = studio::loadProject(kidney);
+    EXPECT_EQ(remeshed.cacheKey, studio::remeshKey(kp.bodies[0].mesh.remesh));
+    EXPECT_EQ(remeshed.surface, (scratch.dir / "k.vremesh").string());
+    EXPECT_TRUE(remeshed.closed && remeshed.manifold);
+    EXPECT_EQ(remeshed.uvMethod, "seam-cut");
+    EXPECT_EQ(remeshed.uv.size(), 3u);
+    EXPECT_EQ(studio::readRemeshedSurface(scratch / "k.vremesh").surface.triangleCount(), size_t(remeshed.triangles));
 }

@@ -1,0 +1,236 @@
+// Renaming and deleting a body in the project tree [issue 57 item 7]: F2, Delete and the body's
+// context menu, driven with synthetic keys; each edit one undo step through the Document, checked
+// by the project reader's rules; a refused name or a referenced body names the field and the rule
+// and leaves the model unchanged; the references follow a rename; undo restores the model exactly.
+#include "app/document.hpp"
+#include "app/error_banner.hpp"
+#include "app/main_window.hpp"
+#include "app/project_tree_panel.hpp"
+#include "gui_test_support.hpp"
+#include "project/project.hpp"
+#include "window_fixture.hpp"
+
+#include <QAction>
+#include <QInputDialog>
+#include <QLineEdit>
+#include <QMenu>
+#include <QMessageBox>
+#include <QSignalSpy>
+#include <QTimer>
+#include <QUndoStack>
+
+#include <gtest/gtest.h>
+
+namespace {
+
+using namespace viscera;
+namespace fs = std::filesystem;
+
+struct BodyEditFixture : test::MainWindowFixture {
+    studio::ProjectTreePanel* tree = nullptr;
+    BodyEditFixture() : MainWindowFixture("viscera-gui-bodies") {}
+    void SetUp() override {
+        MainWindowFixture::SetUp();
+        tree = w->projectTree();
+        ASSERT_NE(tree, nullptr);
+    }
+    const studio::Project& project() { return w->document()->project(); }
+    std::string text() { return studio::projectJsonText(project()); }
+    QUndoStack* undo() { return w->document()->undoStack(); }
+    /// The body item named `name` (under "Bodies"), or null.
+    QTreeWidgetItem* bodyItem(const std::string& name) {
+        QTreeWidgetItem* bodies = tree->topLevelItem(0);
+        for (int i = 0; bodies && i < bodies->childCount(); ++i)
+            if (bodies->child(i)->text(0).toStdString() == name) return bodies->child(i);
+        return nullptr;
+    }
+    /// Clicks the body's item and gives the tree the focus.
+    void pick(const std::string& name) {
+        QTreeWidgetItem* item = bodyItem(name);
+        ASSERT_NE(item, nullptr) << name;
+        tree->scrollToItem(item);
+        test::click(tree->viewport(), tree->visualItemRect(item).center());
+        tree->setFocus();
+        ASSERT_EQ(tree->currentItem(), item);
+    }
+    /// F2 on the tree, `name` typed into the dialog over the old name, Return.
+    void renameWithKeys(const std::string& body, const QString& name) {
+        pick(body);
+        QTest::keyClick(tree, Qt::Key_F2);
+        ASSERT_TRUE(test::waitFor([&] { return tree->renameDialog() && tree->renameDialog()->isVisible(); }, 2000));
+        QInputDialog* dialog = tree->renameDialog();
+        EXPECT_EQ(dialog->objectName(), "renameBodyDialog");
+        auto* field = dialog->findChild<QLineEdit*>();
+        ASSERT_NE(field, nullptr);
+        EXPECT_EQ(field->text().toStdString(), body) << "the dialog starts from the old name";
+        field->setFocus();
+        field->selectAll();
+        if (name.isEmpty())
+            QTest::keyClick(field, Qt::Key_Delete);
+        else
+            QTest::keyClicks(field, name);
+        QTest::keyClick(field, Qt::Key_Return);
+        ASSERT_TRUE(test::waitFor([&] { return !tree->renameDialog(); }, 2000)) << "OK closes the dialog";
+        QCoreApplication::processEvents();
+    }
+};
+
+TEST_F(BodyEditFixture, RenameIsOneUndoStepAndEveryReferenceFollows) {
+    open("rectum");
+    QSignalSpy refused(tree, &studio::ProjectTreePanel::refused);
+    const std::string before = text();
+    const int steps = undo()->count();
+
+    renameWithKeys("vessel", "artery");
+    EXPECT_EQ(tree->lastRefusal().toStdString(), "");
+    EXPECT_EQ(refused.count(), 0);
+    EXPECT_EQ(undo()->count(), steps + 1) << "one rename, one undo step";
+    ASSERT_EQ(project().bodies.size(), 2u);
+    EXPECT_EQ(project().bodies[1].scene.name, "artery");
+    const auto& instruments = project().scene.interaction->instruments;
+    EXPECT_EQ(instruments[2].target, "artery") << "the clip applier's target follows";
+    ASSERT_TRUE(project().scene.assessment && project().scene.assessment->vessel);
+    EXPECT_EQ(project().scene.assessment->vessel->body, "artery") << "the vessel to protect follows";
+    EXPECT_NE(bodyItem("artery"), nullptr) << "the tree shows the new name";
+    EXPECT_EQ(bodyItem("vessel"), nullptr);
+
+    renameWithKeys("fat", "mesorectum");
+    EXPECT_EQ(tree->lastRefusal().toStdString(), "");
+    EXPECT_EQ(undo()->count(), steps + 2);
+    EXPECT_EQ(project().bodies[0].scene.name, "mesorectum");
+    EXPECT_EQ(project().bodies[1].scene.embeddedIn, "mesorectum") << "embedded_in follows";
+    EXPECT_EQ(project().surfaces[0].scene.attachTo, "mesorectum") << "from_boundary_of follows";
+    EXPECT_EQ(project().scene.interaction->tissues[1].layer, "mesorectum") << "the tissue layer follows";
+    // The renamed project passes the reader's rules (loads back from its own text).
+    EXPECT_EQ(studio::Document::check(project()).toStdString(), "");
+    const std::string renamed = text();
+
+    undo()->undo();
+    undo()->undo();
+    EXPECT_EQ(text(), before) << "undo restores the model exactly";
+    EXPECT_NE(bodyItem("vessel"), nullptr);
+    undo()->redo();
+    undo()->redo();
+    EXPECT_EQ(text(), renamed);
+}
+
+TEST_F(BodyEditFixture, RefusedNamesNameTheFieldAndRuleAndChangeNothing) {
+    const fs::path dir = open("rectum");
+    QSignalSpy refused(tree, &studio::ProjectTreePanel::refused);
+    const std::string before = text(), origin = (dir / "project.json").string();
+    const int steps = undo()->count();
+
+    struct Case {
+        QString name;
+        std::string rule;
+    };
+    const Case cases[] = {
+        {"fat", "'fat' is used twice"},       // another body
+        {"fascia", "'fascia' is used twice"}, // a surface: the reader's one set of names
+        {"", "must be 1-64 characters of [A-Za-z0-9_-]"},
+        {"blood vessel", "must be 1-64 characters of [A-Za-z0-9_-]"},
+        {"vessel/2", "must be 1-64 characters of [A-Za-z0-9_-]"},
+    };
+    for (const Case& c : cases) {
+        renameWithKeys("vessel", c.name);
+        EXPECT_EQ(tree->lastRefusal().toStdString(), origin + ": bodies[1].name: " + c.rule) << c.name.toStdString();
+        ASSERT_FALSE(refused.isEmpty());
+        EXPECT_EQ(refused.takeLast().at(0).toString(), tree->lastRefusal()) << "sent to whoever shows it";
+        EXPECT_EQ(undo()->count(), steps) << "no undo step";
+        EXPECT_EQ(text(), before) << "the model is unchanged";
+        EXPECT_NE(bodyItem("vessel"), nullptr);
+    }
+    // The same name: nothing to do, no undo step and no refusal.
+    renameWithKeys("vessel", "vessel");
+    EXPECT_EQ(tree->lastRefusal().toStdString(), "");
+    EXPECT_EQ(undo()->count(), steps);
+}
+
+TEST_F(BodyEditFixture, DeleteIsOneUndoStepAndUndoRestoresTheBodyExactly) {
+    open("liver");
+    QSignalSpy refused(tree, &studio::ProjectTreePanel::refused);
+    const std::string before = text();
+    const int steps = undo()->count();
+    ASSERT_EQ(project().bodies.size(), 2u);
+
+    pick("vessel"); // embedded in the organ; nothing names it
+    QTest::keyClick(tree, Qt::Key_Delete);
+    QCoreApplication::processEvents();
+    EXPECT_EQ(tree->lastRefusal().toStdString(), "");
+    EXPECT_EQ(refused.count(), 0);
+    EXPECT_EQ(undo()->count(), steps + 1) << "one delete, one undo step";
+    ASSERT_EQ(project().bodies.size(), 1u);
+    EXPECT_EQ(project().bodies[0].scene.name, "organ");
+    EXPECT_EQ(bodyItem("vessel"), nullptr) << "the tree lost the body";
+    EXPECT_EQ(studio::Document::check(project()).toStdString(), "");
+    const std::string deleted = text();
+
+    undo()->undo();
+    EXPECT_EQ(text(), before) << "undo brings the body back exactly (material, mesh, embedding)";
+    EXPECT_NE(bodyItem("vessel"), nullptr);
+    undo()->redo();
+    EXPECT_EQ(text(), deleted);
+}
+
+TEST_F(BodyEditFixture, DeletingAReferencedBodyIsRefusedNamingTheReferences) {
+    const fs::path dir = open("rectum");
+    QSignalSpy refused(tree, &studio::ProjectTreePanel::refused);
+    const std::string before = text(), origin = (dir / "project.json").string();
+    const int steps = undo()->count();
+
+    pick("fat");
+    QTest::keyClick(tree, Qt::Key_Delete);
+    QCoreApplication::processEvents();
+    EXPECT_EQ(tree->lastRefusal().toStdString(),
+              origin + ": bodies[0].name: 'fat' is named by bodies[1].embedded_in, surfaces[0].from_boundary_of, "
+                       "interaction.tissues[1].layer (change or delete that first)");
+    pick("vessel");
+    tree->deleteBodyAction()->trigger(); // the context menu's action
+    EXPECT_EQ(tree->lastRefusal().toStdString(),
+              origin + ": bodies[1].name: 'vessel' is named by interaction.instruments[2].target, "
+                       "assessment.targets.vessel.body (change or delete that first)");
+    EXPECT_EQ(refused.count(), 2);
+    EXPECT_EQ(undo()->count(), steps) << "no undo step";
+    EXPECT_EQ(text(), before) << "the model is unchanged";
+    EXPECT_EQ(project().bodies.size(), 2u);
+}
+
+TEST_F(BodyEditFixture, TheBodyItemsContextMenuRenamesAndDeletes) {
+    open("liver");
+    // The menu opens on a body item only, with the two actions.
+    QStringList shown;
+    QTimer::singleShot(0, tree, [&] {
+        test::waitFor([] { return QApplication::activePopupWidget() != nullptr; }, 2000);
+        if (auto* menu = qobject_cast<QMenu*>(QApplication::activePopupWidget())) {
+            for (QAction* a : menu->actions())
+                shown << a->text();
+            menu->close();
+        }
+    });
+    QTreeWidgetItem* item = bodyItem("vessel");
+    ASSERT_NE(item, nullptr);
+    const QPoint at = tree->visualItemRect(item).center();
+    QContextMenuEvent menuEvent(QContextMenuEvent::Mouse, at, tree->viewport()->mapToGlobal(at));
+    QApplication::sendEvent(tree->viewport(), &menuEvent);
+    EXPECT_EQ(shown, (QStringList{"Rename body…", "Delete body"}));
+    EXPECT_EQ(tree->currentItem(), item) << "the menu acts on the item it opened on";
+    EXPECT_TRUE(tree->renameBodyAction()->isEnabled());
+
+    // Not a body: the actions are off.
+    tree->setCurrentItem(tree->topLevelItem(0)); // the "Bodies" group
+    EXPECT_FALSE(tree->renameBodyAction()->isEnabled());
+    EXPECT_FALSE(tree->deleteBodyAction()->isEnabled());
+
+    // Rename through the action; the main window shows a refusal in its banner.
+    pick("vessel");
+    tree->renameBodyAction()->trigger();
+    ASSERT_TRUE(test::waitFor([&] { return tree->renameDialog() && tree->renameDialog()->isVisible(); }, 2000));
+    tree->renameDialog()->setTextValue("organ");
+    tree->renameDialog()->accept();
+    ASSERT_TRUE(test::waitFor([&] { return !tree->lastRefusal().isEmpty(); }, 2000));
+    EXPECT_NE(tree->lastRefusal().toStdString().find("bodies[1].name: 'organ' is used twice"), std::string::npos);
+    EXPECT_EQ(w->errorBanner()->text(), tree->lastRefusal());
+    EXPECT_EQ(project().bodies[1].scene.name, "vessel");
+}
+
+} // namespace

@@ -1,0 +1,184 @@
+// Placing trocar ports in the viewport [issue 57 item 1]: with "Place port" on, a click on a drawn
+// surface moves the current port there (one undo step, a drag merges), a position the reader
+// refuses leaves the model unchanged and says why, undo restores; the workspace cone and the
+// task targets (green reached, red not) are drawn while a port is current; the shipped rectum's
+// ports reach every target and a port moved away flags them, as the export check does.
+#include "app/document.hpp"
+#include "app/main_window.hpp"
+#include "app/port_tool.hpp"
+#include "app/viewport.hpp"
+#include "gui_test_support.hpp"
+#include "sim/scene/port_reach.hpp"
+#include "window_fixture.hpp"
+
+#include <QAction>
+#include <QListWidget>
+#include <QSignalSpy>
+#include <QUndoStack>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace {
+
+using namespace viscera;
+using studio::PortTool;
+using studio::Viewport;
+using ::testing::HasSubstr;
+
+struct PortToolFixture : test::MainWindowFixture {
+    PortTool* tool = nullptr;
+    PortToolFixture() : MainWindowFixture("viscera-gui-ports") {}
+    void SetUp() override {
+        MainWindowFixture::SetUp();
+        tool = w->portTool();
+        ASSERT_NE(tool, nullptr);
+        open("rectum");
+        ASSERT_TRUE(test::waitFor([&] { return w->viewport()->meshCount() > 0; }, 30000));
+    }
+    const studio::Project& model() const { return w->document()->project(); }
+    int instrument(const std::string& name) const {
+        const auto& ins = model().scene.interaction->instruments;
+        for (size_t i = 0; i < ins.size(); ++i)
+            if (ins[i].name == name) return static_cast<int>(i);
+        return -1;
+    }
+    const sim::PortDesc& port(int i) const { return model().scene.interaction->instruments[size_t(i)].port; }
+    /// The first widget position (on a grid over the viewport) whose surface point the port
+    /// tool may take for instrument `i`; none found: an invalid point.
+    QPoint placeablePoint(int i) {
+        Viewport* v = w->viewport();
+        for (int y = v->height() / 8; y < v->height(); y += v->height() / 8)
+            for (int x = v->width() / 8; x < v->width(); x += v->width() / 8) {
+                const auto hit = v->hitAt(QPoint(x, y));
+                if (!hit) continue;
+                sim::InstrumentDesc in = model().scene.interaction->instruments[size_t(i)];
+                const auto frame = sim::instrumentPortFrame(in);
+                const sim::Vec3 p = hit->world.cast<double>();
+                const double d = (frame->restTip - p).norm();
+                if (d > in.port.insertionMin + 1e-3 && d < in.port.insertionMax - 1e-3) return {x, y};
+            }
+        return {-1, -1};
+    }
+};
+
+TEST_F(PortToolFixture, TheShippedPortsReachEveryTargetAndTheWorkspaceIsDrawn) {
+    EXPECT_TRUE(sim::unreachableTargets(model().scene).empty());
+    const int hook = instrument("hook");
+    ASSERT_GE(hook, 0);
+    tool->setCurrent(PortTool::kNoPort);
+    EXPECT_FALSE(tool->action()->isEnabled()) << "no port is current";
+    // choosing the hook in the Instruments dock makes its port the current one
+    auto* list = w->findChild<QListWidget*>("instrumentList");
+    ASSERT_NE(list, nullptr);
+    list->setCurrentRow(hook == 0 ? 1 : 0);
+    list->setCurrentRow(hook);
+    EXPECT_EQ(tool->current(), hook);
+    EXPECT_TRUE(tool->action()->isEnabled());
+    const auto [reached, total] = tool->reachCounts();
+    EXPECT_GT(total, 10) << "the cut line sampled every 2 mm";
+    EXPECT_EQ(reached, total);
+    const auto& meshes = w->viewport()->authoringMeshes();
+    ASSERT_EQ(meshes.size(), 2u);
+    EXPECT_EQ(meshes[0].name, "port workspace");
+    EXPECT_EQ(meshes[1].name, "port targets");
+    test::saveShot("port_workspace_hook");
+    tool->setCurrent(PortTool::kNoPort);
+    EXPECT_TRUE(w->viewport()->authoringMeshes().empty());
+}
+
+TEST_F(PortToolFixture, AClickOnASurfaceMovesThePortAsOneUndoStepAndUndoRestoresIt) {
+    const int hook = instrument("hook");
+    tool->setCurrent(hook);
+    const QPoint at = placeablePoint(hook);
+    ASSERT_GE(at.x(), 0) << "some surface point in view lies within the hook's insertion range";
+    const sim::Vec3 before = port(hook).position;
+    const int steps = w->document()->undoStack()->count();
+    tool->action()->setChecked(true);
+    EXPECT_TRUE(w->viewport()->paintMode());
+    const auto hit = w->viewport()->hitAt(at);
+    ASSERT_TRUE(hit);
+    QWindow* canvas = w->viewport()->canvasWindow();
+    QWidget* widget = w->viewport()->canvasWidget();
+    if (canvas) {
+        QTest::mousePress(canvas, Qt::LeftButton, {}, at);
+        QTest::mouseRelease(canvas, Qt::LeftButton, {}, at);
+    } else {
+        QTest::mousePress(widget, Qt::LeftButton, {}, at);
+        QTest::mouseRelease(widget, Qt::LeftButton, {}, at);
+    }
+    QCoreApplication::processEvents();
+    EXPECT_EQ(w->document()->undoStack()->count(), steps + 1);
+    EXPECT_LT((port(hook).position - hit->world.cast<double>()).norm(), 1e-6);
+    w->document()->undoStack()->undo();
+    EXPECT_EQ(port(hook).position, before);
+    test::saveShot("port_placed_hook");
+}
+
+TEST_F(PortToolFixture, ADragIsOneStepAndARefusedPlaceLeavesTheModelUnchanged) {
+    const int clipper = instrument("clipper");
+    ASSERT_GE(clipper, 0);
+    tool->setCurrent(clipper);
+    const sim::Vec3 before = port(clipper).position;
+    const int steps = w->document()->undoStack()->count();
+    const int key = w->document()->newMergeKey();
+    const sim::Vec3 a = before + sim::Vec3(0.005, 0, 0), b = before + sim::Vec3(0.01, 0.002, 0);
+    EXPECT_EQ(tool->placeAt(a, key), "");
+    EXPECT_EQ(tool->placeAt(b, key), "");
+    EXPECT_EQ(w->document()->undoStack()->count(), steps + 1) << "one drag, one step";
+    EXPECT_EQ(port(clipper).position, b);
+    // 1 m away the clipper's rest tip lies outside the insertion range: refused, nothing changes
+    QSignalSpy refusals(tool, &PortTool::refused);
+    const QString why = tool->placeAt(b + sim::Vec3(0, 0, 1.0), w->document()->newMergeKey());
+    EXPECT_THAT(why.toStdString(), HasSubstr("interaction.instruments["));
+    EXPECT_THAT(why.toStdString(), HasSubstr("insertion"));
+    EXPECT_EQ(port(clipper).position, b);
+    EXPECT_EQ(w->document()->undoStack()->count(), steps + 1);
+    EXPECT_NE(tool->placeAt(sim::Vec3(NAN, 0, 0), 0), "");
+    w->document()->undoStack()->undo();
+    EXPECT_EQ(port(clipper).position, before);
+}
+
+TEST_F(PortToolFixture, APortThatCannotReachItsTargetsIsFlaggedInRedAndByTheExportCheck) {
+    const int clipper = instrument("clipper");
+    tool->setCurrent(clipper);
+    // the cone narrowed to 2° and the insertion stopped 1 mm past the rest tip (which lies above
+    // the vessel): the clip site is out of reach
+    sim::InstrumentDesc in = model().scene.interaction->instruments[size_t(clipper)];
+    const auto rest = sim::instrumentPortFrame(in);
+    ASSERT_TRUE(rest);
+    in.port.maxAngleDeg = 2;
+    in.port.insertionMax = std::max((rest->restTip - in.port.position).norm() + 0.001, in.port.insertionMin + 0.002);
+    const auto frame = sim::instrumentPortFrame(in);
+    ASSERT_TRUE(frame);
+    const sim::Vec3 site = model().scene.assessment->clips.at(0).position;
+    ASSERT_NE(sim::reachRule(*frame, site), "");
+    ASSERT_EQ(w->document()->editInstrument("narrow", clipper, in), "");
+    const auto [reached, total] = tool->reachCounts();
+    EXPECT_LT(reached, total);
+    const auto problems = sim::unreachableTargets(model().scene);
+    ASSERT_FALSE(problems.empty());
+    EXPECT_THAT(problems[0].message, HasSubstr("'clipper': its port cannot reach assessment.targets.clip[0]"));
+    // a red cross: some overlay vertex of the targets mesh is red
+    const auto& meshes = w->viewport()->authoringMeshes();
+    ASSERT_EQ(meshes.size(), 2u);
+    bool red = false;
+    for (size_t k = 0; k + 3 < meshes[1].overlay.size(); k += 4)
+        red = red || (meshes[1].overlay[k] > 0.9f && meshes[1].overlay[k + 1] < 0.2f);
+    EXPECT_TRUE(red);
+    test::saveShot("port_unreachable_clipper");
+}
+
+TEST_F(PortToolFixture, TheLaparoscopesPortIsPlacedTheSameWay) {
+    tool->setCurrent(PortTool::kScopePort);
+    ASSERT_TRUE(tool->currentFrame());
+    const sim::Vec3 before = model().scene.laparoscope->port.position;
+    const int steps = w->document()->undoStack()->count();
+    EXPECT_EQ(tool->placeAt(before + sim::Vec3(0, 0.004, 0), w->document()->newMergeKey()), "");
+    EXPECT_EQ(w->document()->undoStack()->count(), steps + 1);
+    EXPECT_NEAR(model().scene.laparoscope->port.position.y(), before.y() + 0.004, 1e-12);
+    w->document()->undoStack()->undo();
+    EXPECT_EQ(model().scene.laparoscope->port.position, before);
+}
+
+} // namespace
