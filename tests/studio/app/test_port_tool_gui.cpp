@@ -83,6 +83,8 @@ TEST_F(PortToolFixture, TheShippedPortsReachEveryTargetAndTheWorkspaceIsDrawn) {
     EXPECT_EQ(meshes[0].name, "port workspace");
     EXPECT_EQ(meshes[1].name, "port targets");
     test::saveShot("port_workspace_hook");
+    if (const char* dir = std::getenv("VISCERA_GUI_SHOTS"); dir && *dir) // the viewport's own frame
+        w->viewport()->grabFramebuffer().save(QString(dir) + "/port_workspace_hook_viewport.png");
     tool->setCurrent(PortTool::kNoPort);
     EXPECT_TRUE(w->viewport()->authoringMeshes().empty());
 }
