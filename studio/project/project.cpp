@@ -1152,6 +1152,8 @@ void shapeAndWriteMeshes(const Project& project, BuiltScene& built, const std::s
             throw InputError(origin + ": bend.radius: " + e.what());
         }
     }
+    for (auto& m : built.meshes) // the world's collision surfaces read the boundary (the player's loader has it)
+        m->requireLevel(3);
     for (size_t i = 0; i < built.meshes.size(); ++i)
         built.files.emplace_back(built.scene.bodies[i].meshPath, sim::formatVtet(*built.meshes[i]));
     for (size_t s = 0; s < built.surfaces.size(); ++s)
@@ -1290,8 +1292,10 @@ BuiltScene buildScene(const Project& project, const ExportProgress& progress) {
 
 std::unique_ptr<sim::World> assembleWorld(const BuiltScene& built, const std::string& origin) {
     std::vector<std::unique_ptr<sim::TetMesh>> meshes;
-    for (const auto& m : built.meshes)
+    for (const auto& m : built.meshes) {
         meshes.push_back(m->clone());
+        meshes.back()->requireLevel(3);
+    }
     return sim::World::assemble(built.scene, std::move(meshes), built.surfaces, built.features, origin);
 }
 
