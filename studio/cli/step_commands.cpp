@@ -109,22 +109,9 @@ int cmdMesh(const std::vector<std::string>& args) {
     } catch (const std::invalid_argument& e) {
         throw InputError(origin + ": " + field + ".mesh: " + e.what());
     }
-    studio::BodyExport be{b.scene.name, mesh->vertexCount(), mesh->tetCount(), 0, mesh->quality()};
-    if (!be.quality.inverted.empty())
-        throw InputError(origin + ": " + field + ".mesh: tet " + std::to_string(be.quality.inverted.front()) +
-                         " is inverted (" + std::to_string(be.quality.inverted.size()) + " inverted in all)");
-    if (!be.quality.degenerate.empty())
-        throw InputError(origin + ": " + field + ".mesh: tet " + std::to_string(be.quality.degenerate.front()) +
-                         " is degenerate (" + std::to_string(be.quality.degenerate.size()) + " in all)");
     std::fprintf(stderr, "viscera-studio: stage 2/2: checking body '%s'\n", b.scene.name.c_str());
     sim::BodyDesc desc = b.scene;
-    if (b.fixedBox)
-        for (int32_t v = 0; v < int32_t(mesh->vertexCount()); ++v) {
-            const sim::Vec3& p = mesh->positions()[size_t(v)];
-            if ((p.array() >= (*b.fixedBox)[0].array()).all() && (p.array() <= (*b.fixedBox)[1].array()).all())
-                desc.fixedNodes.push_back(v);
-        }
-    be.fixedNodes = desc.fixedNodes.size();
+    const studio::BodyExport be = studio::checkBodyMesh(b, *mesh, desc, origin, field);
     std::optional<sim::Skeleton> skeleton;
     desc.nodeWeights = studio::bodyNodeWeights(b, *mesh, skeleton, origin, field);
     studio::MeshingStepResult r;

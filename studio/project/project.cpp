@@ -1193,26 +1193,9 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
         } catch (const std::invalid_argument& e) { // a UV beyond the corner-UV file's range
             throw InputError(origin + ": " + field + ".mesh.remesh: " + e.what());
         }
-        BodyExport be;
-        be.name = name;
-        be.nodes = mesh->vertexCount();
-        be.tets = mesh->tetCount();
-        be.quality = mesh->quality();
-        if (!be.quality.inverted.empty())
-            throw InputError(origin + ": " + field + ".mesh: tet " + std::to_string(be.quality.inverted.front()) +
-                             " is inverted (" + std::to_string(be.quality.inverted.size()) + " inverted in all)");
-        if (!be.quality.degenerate.empty())
-            throw InputError(origin + ": " + field + ".mesh: tet " + std::to_string(be.quality.degenerate.front()) +
-                             " is degenerate (" + std::to_string(be.quality.degenerate.size()) + " in all)");
         sim::BodyDesc desc = b.scene;
         desc.meshPath = "meshes/" + name + ".vtet";
-        const auto& pos = mesh->positions();
-        if (b.fixedBox) {
-            for (int32_t v = 0; v < static_cast<int32_t>(pos.size()); ++v)
-                if (inBox(pos[v], (*b.fixedBox)[0], (*b.fixedBox)[1])) desc.fixedNodes.push_back(v);
-            if (desc.fixedNodes.empty())
-                throw InputError(origin + ": " + field + ".fixed: the box contains no mesh node");
-        }
+        BodyExport be = checkBodyMesh(b, *mesh, desc, origin, field);
         if (b.paint) stage("skeleton and stiffness paint of '" + name + "'");
         std::optional<sim::Skeleton> skeleton;
         desc.nodeWeights = bodyNodeWeights(b, *mesh, skeleton, origin, field);
@@ -1232,7 +1215,6 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
                                render::formatSampleMap(render::nodeSampleClasses(surface, mesh->vertexCount())));
         }
         built.skeletons.push_back(std::move(skeleton));
-        be.fixedNodes = desc.fixedNodes.size();
         scene.bodies.push_back(std::move(desc)); // its mesh file once shaped (shapeAndWriteMeshes)
         result.bodies.push_back(std::move(be));
         meshes.push_back(std::move(mesh));
@@ -1283,6 +1265,29 @@ size_t exportStageCount(const Project& project) {
     for (const BodyProject& b : project.bodies)
         n += b.paint ? 1 : 0;
     return n + (hasTextures(project) ? 1 : 0);
+}
+
+BodyExport checkBodyMesh(const BodyProject& b, const sim::TetMesh& mesh, sim::BodyDesc& desc, const std::string& origin,
+                         const std::string& field) {
+    BodyExport be;
+    be.name = b.scene.name;
+    be.nodes = mesh.vertexCount();
+    be.tets = mesh.tetCount();
+    be.quality = mesh.quality();
+    if (!be.quality.inverted.empty())
+        throw InputError(origin + ": " + field + ".mesh: tet " + std::to_string(be.quality.inverted.front()) +
+                         " is inverted (" + std::to_string(be.quality.inverted.size()) + " inverted in all)");
+    if (!be.quality.degenerate.empty())
+        throw InputError(origin + ": " + field + ".mesh: tet " + std::to_string(be.quality.degenerate.front()) +
+                         " is degenerate (" + std::to_string(be.quality.degenerate.size()) + " in all)");
+    const auto& pos = mesh.positions();
+    if (b.fixedBox) {
+        for (int32_t v = 0; v < static_cast<int32_t>(pos.size()); ++v)
+            if (inBox(pos[v], (*b.fixedBox)[0], (*b.fixedBox)[1])) desc.fixedNodes.push_back(v);
+        if (desc.fixedNodes.empty()) throw InputError(origin + ": " + field + ".fixed: the box contains no mesh node");
+    }
+    be.fixedNodes = desc.fixedNodes.size();
+    return be;
 }
 
 BuiltScene buildScene(const Project& project, const ExportProgress& progress) {

@@ -363,6 +363,12 @@ struct BuiltScene {
     std::vector<sim::TriMesh> flatSurfaces;
 };
 
+/// The checks and figures export applies to a body's built mesh, `field` "bodies[i]": nodes, tets,
+/// quality (InputError "<origin>: <field>.mesh: tet 4 is inverted (2 inverted in all)", the same
+/// for a degenerate tet) and the nodes in its fixed box into desc.fixedNodes ("<field>.fixed: the
+/// box contains no mesh node" when there are none). Used by export and `viscera-studio mesh`.
+BodyExport checkBodyMesh(const BodyProject& b, const sim::TetMesh& mesh, sim::BodyDesc& desc, const std::string& origin,
+                         const std::string& field);
 /// The node weights of body `b` on `mesh`: its stiffness regions times its stiffness paint
 /// (empty: neither). The paint's skeleton is extracted into `skeleton` when it is empty, and
 /// reused when given (the same mesh, painted again). Throws viscera::InputError naming
