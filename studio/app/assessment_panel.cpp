@@ -1,6 +1,7 @@
 #include "app/assessment_panel.hpp"
 
 #include "app/document.hpp"
+#include "app/target_panel.hpp"
 #include "sim/scene/assessment.hpp"
 #include "sim/util/atomic_file.hpp"
 #include "sim/util/json_reader.hpp"
@@ -11,6 +12,7 @@
 #include <QHeaderView>
 #include <QLabel>
 #include <QLineEdit>
+#include <QSplitter>
 #include <QTableWidget>
 #include <QVBoxLayout>
 
@@ -54,12 +56,20 @@ QString targetsText(const std::optional<sim::AssessmentDesc>& a) {
 
 } // namespace
 
-AssessmentPanel::AssessmentPanel(Document* doc, QWidget* parent) : QWidget(parent), m_doc(doc) {
+AssessmentPanel::AssessmentPanel(Document* doc, TargetTool* targets, QWidget* parent) : QWidget(parent), m_doc(doc) {
     auto* layout = new QVBoxLayout(this);
     m_targets = new QLabel(this);
     m_targets->setObjectName("assessmentTargets");
     m_targets->setWordWrap(true);
     layout->addWidget(m_targets);
+    // the targets above the metrics, the split between them the artist's to move
+    auto* split = new QSplitter(Qt::Vertical, this);
+    split->setObjectName("assessmentSplit");
+    split->setChildrenCollapsible(false);
+    if (targets) {
+        m_targetPanel = new TargetPanel(doc, targets, split);
+        split->addWidget(m_targetPanel);
+    }
     auto* row = new QHBoxLayout;
     row->addWidget(new QLabel(tr("Force threshold (N):"), this));
     m_threshold = new QLineEdit(this);
@@ -69,7 +79,6 @@ AssessmentPanel::AssessmentPanel(Document* doc, QWidget* parent) : QWidget(paren
     import->setObjectName("importExpertLevels");
     import->setToolTip(tr("Expert means and SDs from viscera-results expert-levels (the experts' sessions)"));
     row->addWidget(import);
-    layout->addLayout(row);
     connect(import, &QPushButton::clicked, this, [this] {
         const QString path = QFileDialog::getOpenFileName(this, tr("Expert levels"), {}, tr("JSON (*.json)"));
         if (!path.isEmpty()) importExpertLevels(path);
@@ -96,7 +105,13 @@ AssessmentPanel::AssessmentPanel(Document* doc, QWidget* parent) : QWidget(paren
         for (int c = Limit; c < Columns; ++c)
             m_table->setItem(r, c, new QTableWidgetItem);
     }
-    layout->addWidget(m_table, 1);
+    auto* metricsBox = new QWidget(split);
+    auto* metricsLayout = new QVBoxLayout(metricsBox);
+    metricsLayout->setContentsMargins(0, 0, 0, 0);
+    metricsLayout->addLayout(row);
+    metricsLayout->addWidget(m_table, 1);
+    split->addWidget(metricsBox);
+    layout->addWidget(split, 1);
     m_error = new QLabel(this);
     m_error->setObjectName("assessmentError");
     m_error->setWordWrap(true);

@@ -6,8 +6,8 @@
 /// value shows the rule under the table and the cell shows the model's value again. An empty cell
 /// removes the limit or the expert level. "Import expert levels…" takes the levels that
 /// `viscera-results expert-levels` derived from expert sessions (a JSON fragment) into the case,
-/// one undo step. The targets themselves (lines, sites, the wound's plane) are geometry and are
-/// written in project.json.
+/// one undo step. The targets themselves (cut lines, clip sites, the wound's plane, the vessel)
+/// are drawn on the anatomy with the target tool and listed above the metrics (target_panel.hpp).
 #include <QString>
 #include <QWidget>
 
@@ -18,13 +18,17 @@ class QTableWidget;
 namespace viscera::studio {
 
 class Document;
+class TargetPanel;
+class TargetTool;
 struct Change;
 
 class AssessmentPanel : public QWidget {
     Q_OBJECT
 public:
     enum Column { Metric = 0, Unit, Better, Limit, ExpertMean, ExpertSd, Columns };
-    explicit AssessmentPanel(Document* doc, QWidget* parent = nullptr);
+    /// `targets`: the tool the target rows' buttons drive (null: no target section).
+    AssessmentPanel(Document* doc, TargetTool* targets, QWidget* parent = nullptr);
+    TargetPanel* targetPanel() { return m_targetPanel; }
     QTableWidget* table() { return m_table; }
     QLabel* errorLabel() { return m_error; }
     QLabel* targetsLabel() { return m_targets; }
@@ -47,6 +51,7 @@ private:
     QLabel* m_targets = nullptr;
     QLabel* m_error = nullptr;
     QLineEdit* m_threshold = nullptr;
+    TargetPanel* m_targetPanel = nullptr;
     bool m_filling = false;
 };
 

@@ -13,6 +13,7 @@
 #include "app/properties_panel.hpp"
 #include "app/scope_task_panel.hpp"
 #include "app/start_page.hpp"
+#include "app/target_tool.hpp"
 #include "app/texture_panel.hpp"
 #include "app/wheel_guard.hpp"
 #include "project/publishing.hpp"
@@ -93,6 +94,9 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_export(std::mak
 
 MainWindow::~MainWindow() {
     m_preview.stop();
+    // the docks hide as the children go: nothing may follow them into tools already deleted
+    for (QDockWidget* d : findChildren<QDockWidget*>())
+        d->disconnect();
 }
 
 QWidget* MainWindow::centreWidget() const {
@@ -128,16 +132,36 @@ void MainWindow::connectExport() {
 }
 
 void MainWindow::followPortDocks() {
-    // the current port is the one of the dock in view: the selected instrument, or the laparoscope
+    // The current port is the one of the dock in view: the selected instrument, or the
+    // laparoscope; neither dock in view (another tab in front) and no port being placed: none, no
+    // workspace drawn. A tabbed dock behind another stays isVisible(): its visibilityChanged says.
     connect(m_instruments, &InstrumentPanel::selectedChanged, this, [this](int i) {
-        m_portTool->setCurrent(i < 0 ? PortTool::kNoPort : i); // choosing an instrument chooses its port
+        if (m_instrumentInView) m_portTool->setCurrent(i < 0 ? PortTool::kNoPort : i);
     });
     connect(m_instrumentDock, &QDockWidget::visibilityChanged, this, [this](bool on) {
+        m_instrumentInView = on;
         if (on) m_portTool->setCurrent(m_instruments->selected() < 0 ? PortTool::kNoPort : m_instruments->selected());
     });
     connect(m_scopeTaskDock, &QDockWidget::visibilityChanged, this, [this](bool on) {
+        m_scopeInView = on;
         if (on) m_portTool->setCurrent(PortTool::kScopePort);
     });
+    for (QDockWidget* d : {m_instrumentDock, m_scopeTaskDock})
+        connect(d, &QDockWidget::visibilityChanged, this, [this](bool on) {
+            if (!on && !m_instrumentInView && !m_scopeInView && !m_portTool->action()->isChecked())
+                m_portTool->setCurrent(PortTool::kNoPort);
+        });
+}
+
+void MainWindow::viewportToolOn(QObject* tool) {
+    // one tool at a time takes the viewport's clicks: the others go off
+    if (tool != m_paint) {
+        m_paint->setPaintTool(m_paint->stiffnessAction(), false);
+        m_paint->setPaintTool(m_paint->samplesAction(), false);
+    }
+    if (tool != m_portTool) m_portTool->action()->setChecked(false);
+    if (tool != m_targetTool && m_targetTool->pick() != TargetTool::Pick::None)
+        m_targetTool->action(m_targetTool->pick())->setChecked(false);
 }
 
 void MainWindow::buildDocks() {
@@ -173,9 +197,12 @@ void MainWindow::buildDocks() {
     QDockWidget* plotsDock = dock("plotsDock", tr("Preview and plots"), m_previewPanel, Qt::RightDockWidgetArea);
     // a tab beside the plots, which stay in front: the panel needs the column's height
     tabifyDockWidget(plotsDock, dock("textureDock", tr("Material maps"), textureScroll, Qt::RightDockWidgetArea));
-    m_assessment = new AssessmentPanel(&m_doc, this);
+    m_targetTool = new TargetTool(&m_doc, this); // [issue 57 item 2] the targets drawn on the anatomy
+    m_assessment = new AssessmentPanel(&m_doc, m_targetTool, this);
     m_assessment->setObjectName("assessmentPanel");
-    tabifyDockWidget(plotsDock, dock("assessmentDock", tr("Assessment"), m_assessment, Qt::RightDockWidgetArea));
+    QDockWidget* assessmentDock = dock("assessmentDock", tr("Assessment"), m_assessment, Qt::RightDockWidgetArea);
+    tabifyDockWidget(plotsDock, assessmentDock);
+    connect(assessmentDock, &QDockWidget::visibilityChanged, m_targetTool, &TargetTool::setShown);
     auto* scopeTask = new ScopeTaskPanel(
         &m_doc, [this] { return m_viewport; }, this); // [issue 57]: the scope and the task
     scopeTask->setObjectName("scopeTaskPanel");
@@ -283,15 +310,21 @@ void MainWindow::buildViewMenu(QMenu* view, QToolBar* toolbar) {
     m_portTool = new PortTool(&m_doc, this);
     view->addAction(m_portTool->action());
     toolbar->addAction(m_portTool->action());
+    view->addSeparator();
+    for (auto pick : {TargetTool::Pick::CutLine, TargetTool::Pick::ClipSite, TargetTool::Pick::SuturePlane,
+                      TargetTool::Pick::Vessel})
+        view->addAction(m_targetTool->action(pick)); // also the Assessment dock's buttons
     connect(m_portTool, &PortTool::activeChanged, this, [this](bool on) {
-        if (!on) return;
-        m_paint->setPaintTool(m_paint->stiffnessAction(), false);
-        m_paint->setPaintTool(m_paint->samplesAction(), false);
+        if (on) viewportToolOn(m_portTool);
+    });
+    connect(m_targetTool, &TargetTool::activeChanged, this, [this](bool on) {
+        if (on) viewportToolOn(m_targetTool);
     });
     connect(m_paint, &PaintTools::toolChanged, this, [this](bool any) {
-        if (any) m_portTool->action()->setChecked(false);
+        if (any) viewportToolOn(m_paint);
     });
     connect(m_portTool, &PortTool::refused, this, &MainWindow::showError);
+    connect(m_targetTool, &TargetTool::refused, this, &MainWindow::showError);
     followPortDocks();
     m_widgetHostAction = view->addAction(tr("Compatibility viewport (QOpenGLWidget, slower)"));
     m_widgetHostAction->setObjectName("actionWidgetViewport");
@@ -317,6 +350,7 @@ void MainWindow::setViewportHost(ViewportHost host) {
         m_viewport = nullptr;
         m_paint->connectViewport(nullptr);
         m_portTool->connectViewport(nullptr);
+        m_targetTool->connectViewport(nullptr);
         m_centre->removeWidget(old);
         delete old;
     }
@@ -331,6 +365,7 @@ void MainWindow::setViewportHost(ViewportHost host) {
     connect(v, &Viewport::rendererFailed, this, &MainWindow::showError);
     m_paint->connectViewport(v);
     m_portTool->connectViewport(v);
+    m_targetTool->connectViewport(v);
     m_centre->addWidget(v);
     if (m_doc.hasProject()) m_centre->setCurrentWidget(v);
     m_viewport = v;
@@ -343,7 +378,8 @@ void MainWindow::setViewportHost(ViewportHost host) {
     }
     v->setSelectedName(selected);
     if (m_lookAction) v->setLook(m_lookAction->isChecked() ? Viewport::Look::Trainee : Viewport::Look::Authoring);
-    v->setPaintMode(painting() || paintingSamples() || m_portTool->action()->isChecked());
+    v->setPaintMode(painting() || paintingSamples() || m_portTool->action()->isChecked() ||
+                    m_targetTool->pick() != TargetTool::Pick::None);
     m_paint->showOverlay();
     QSettings().setValue("viewport/host", viewportHostText(host));
     if (m_widgetHostAction) m_widgetHostAction->setChecked(host == ViewportHost::Widget);

@@ -36,6 +36,7 @@ namespace viscera::studio {
 
 class AnatomySteps;
 class PortTool;
+class TargetTool;
 class InstrumentPanel;
 class ErrorBanner;
 class ExportRunner;
@@ -102,6 +103,7 @@ public:
     PaintTools* paintTools() { return m_paint; }
     /// Placing trocar ports in the viewport (port_tool.hpp).
     PortTool* portTool() { return m_portTool; }
+    TargetTool* targetTool() { return m_targetTool; }
     AnatomySteps* anatomySteps() { return m_anatomy; }
     StiffnessPainter* painter() { return m_paint->painter(); }
     /// Paint stiffness mode (the toolbar's Paint action): the viewport's left drag paints the
@@ -140,6 +142,8 @@ private:
     void buildActions();
     void buildDocks();
     /// The port tool's current port follows the Instruments dock's selection and the Laparoscope dock.
+    /// `tool` (the paint tools, the port tool or the target tool) took the viewport's clicks: the others go off.
+    void viewportToolOn(QObject* tool);
     void followPortDocks();
     void buildFileMenu(QMenu* file, QToolBar* toolbar);
     void buildViewMenu(QMenu* view, QToolBar* toolbar);
@@ -170,9 +174,11 @@ private:
     StartPage* m_start = nullptr;
     PaintTools* m_paint = nullptr;
     PortTool* m_portTool = nullptr;
+    TargetTool* m_targetTool = nullptr; ///< [issue 57 item 2] the assessment's targets, drawn
     InstrumentPanel* m_instruments = nullptr;
     QDockWidget* m_instrumentDock = nullptr;
     QDockWidget* m_scopeTaskDock = nullptr;
+    bool m_instrumentInView = false, m_scopeInView = false; ///< their tabs in front (followPortDocks)
     MaterialPanel* m_material = nullptr;
     TexturePanel* m_texture = nullptr;
     AssessmentPanel* m_assessment = nullptr;

@@ -117,7 +117,8 @@ render::RenderMesh gridMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi
     return lineTubes(std::move(nodes), std::move(edges), 0.002 * size, "grid", {0.42f, 0.43f, 0.46f, 1.0f}, material);
 }
 
-render::RenderMesh boxOutlineMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, uint32_t material) {
+render::RenderMesh boxOutlineMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, uint32_t material,
+                                  const char* name, const Eigen::Vector4f& rgba) {
     std::vector<sim::Vec3> nodes;
     for (int k = 0; k < 8; ++k)
         nodes.emplace_back(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z());
@@ -125,8 +126,7 @@ render::RenderMesh boxOutlineMesh(const Eigen::Vector3d& lo, const Eigen::Vector
     for (int32_t a = 0; a < 8; ++a)
         for (int bit : {1, 2, 4})
             if (!(a & bit)) edges.push_back({a, a | bit});
-    return lineTubes(std::move(nodes), std::move(edges), 0.004 * (hi - lo).norm(), "selection",
-                     {0.35f, 0.75f, 1.0f, 1.0f}, material);
+    return lineTubes(std::move(nodes), std::move(edges), 0.004 * (hi - lo).norm(), name, rgba, material);
 }
 
 render::RenderMesh skeletonMesh(const sim::Skeleton& skeleton, float radius, uint32_t material) {

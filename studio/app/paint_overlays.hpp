@@ -40,8 +40,10 @@ render::RenderMesh brushRingMesh(const Eigen::Vector3d& centre, const Eigen::Vec
 render::RenderMesh gridMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, uint32_t material);
 
 /// The twelve edges of the box [lo, hi] as thin light-blue tubes (the selection's outline),
-/// radius 0.4 % of the box's diagonal. Named "selection".
-render::RenderMesh boxOutlineMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, uint32_t material);
+/// radius 0.4 % of the box's diagonal. Named "selection" unless `name` says otherwise.
+render::RenderMesh boxOutlineMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, uint32_t material,
+                                  const char* name = "selection",
+                                  const Eigen::Vector4f& rgba = {0.35f, 0.75f, 1.0f, 1.0f});
 
 /// A plane {x : n·x = offset} with unit normal n; the side n·x > offset is cut away.
 struct CutPlane {

@@ -6,16 +6,12 @@
 
 namespace viscera::studio {
 
-namespace {
-
-/// Two unit vectors perpendicular to unit `a` and to each other.
 std::pair<sim::Vec3, sim::Vec3> basisAbout(const sim::Vec3& a) {
     const sim::Vec3 helper = std::abs(a.z()) < 0.9 ? sim::Vec3::UnitZ() : sim::Vec3::UnitX();
     const sim::Vec3 u = a.cross(helper).normalized();
     return {u, a.cross(u)};
 }
 
-/// A ring of `n` nodes appended to `nodes` and closed by `edges`: centre `c`, radius `r`.
 void addRing(std::vector<sim::Vec3>& nodes, std::vector<std::array<int32_t, 2>>& edges, const sim::Vec3& c,
              const sim::Vec3& u, const sim::Vec3& v, double r, int n) {
     const auto first = static_cast<int32_t>(nodes.size());
@@ -25,8 +21,6 @@ void addRing(std::vector<sim::Vec3>& nodes, std::vector<std::array<int32_t, 2>>&
         edges.push_back({first + k, first + (k + 1) % n});
     }
 }
-
-} // namespace
 
 render::RenderMesh portWorkspaceMesh(const sim::PortFrame& port, uint32_t material) {
     const sim::PortDesc& p = port.desc;

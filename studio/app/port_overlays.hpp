@@ -5,9 +5,19 @@
 #include "render/scene_view.hpp"
 #include "sim/scene/port.hpp"
 
+#include <array>
+#include <utility>
 #include <vector>
 
 namespace viscera::studio {
+
+/// Two unit vectors perpendicular to unit `a` and to each other.
+std::pair<sim::Vec3, sim::Vec3> basisAbout(const sim::Vec3& a);
+
+/// A ring of `n` nodes appended to `nodes` and closed by `edges`: centre `c`, radius `r`, in the
+/// plane of unit `u` and `v`.
+void addRing(std::vector<sim::Vec3>& nodes, std::vector<std::array<int32_t, 2>>& edges, const sim::Vec3& c,
+             const sim::Vec3& u, const sim::Vec3& v, double r, int n);
 
 /// The workspace of `port` as thin tubes: 16 lines from the port (the apex) along the cone's
 /// surface, max_angle_deg about the rest axis, out to the insertion maximum; rims at the

@@ -42,6 +42,7 @@ void PortTool::connectViewport(Viewport* v) {
         m_dragKey = 0;
         m_action->setChecked(false);
     });
+    connect(v, &Viewport::paintEscaped, this, [this] { m_action->setChecked(false); });
     redraw();
 }
 
@@ -107,7 +108,7 @@ void PortTool::redraw() {
     if (!m_viewport) return;
     const std::optional<sim::PortFrame> frame = currentFrame();
     if (!frame) {
-        if (m_drawn) m_viewport->setAuthoringMeshes({});
+        if (m_drawn) m_viewport->setAuthoringLayer(Viewport::Layer::Port, {});
         m_drawn = false;
         return;
     }
@@ -121,7 +122,7 @@ void PortTool::redraw() {
                 markers.push_back({x, sim::reachRule(*frame, x).empty()});
         if (!markers.empty()) meshes.push_back(reachMarkersMesh(markers, 0.0015, 0));
     }
-    m_viewport->setAuthoringMeshes(std::move(meshes));
+    m_viewport->setAuthoringLayer(Viewport::Layer::Port, std::move(meshes));
     m_drawn = true;
 }
 

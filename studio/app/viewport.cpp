@@ -767,8 +767,28 @@ void Viewport::setRestPose(int index, render::RenderMesh::Source source) {
     viewChanged();
 }
 
-void Viewport::setAuthoringMeshes(std::vector<render::RenderMesh> meshes) {
-    if (meshes.empty() && m_authoring.empty()) return;
+size_t Viewport::layerStart(Layer layer) const {
+    size_t start = 0;
+    for (size_t k = 0; k < static_cast<size_t>(layer); ++k)
+        start += m_layerSize[k];
+    return start;
+}
+
+std::vector<render::RenderMesh> Viewport::authoringLayer(Layer layer) const {
+    const auto start = static_cast<std::ptrdiff_t>(layerStart(layer));
+    const auto size = static_cast<std::ptrdiff_t>(m_layerSize[static_cast<size_t>(layer)]);
+    return {m_authoring.begin() + start, m_authoring.begin() + start + size};
+}
+
+void Viewport::setAuthoringLayer(Layer layer, std::vector<render::RenderMesh> layerMeshes) {
+    const size_t start = layerStart(layer), old = m_layerSize[static_cast<size_t>(layer)];
+    if (layerMeshes.empty() && old == 0) return;
+    std::vector<render::RenderMesh> meshes(m_authoring.begin(),
+                                           m_authoring.begin() + static_cast<std::ptrdiff_t>(start));
+    for (render::RenderMesh& m : layerMeshes)
+        meshes.push_back(std::move(m));
+    meshes.insert(meshes.end(), m_authoring.begin() + static_cast<std::ptrdiff_t>(start + old), m_authoring.end());
+    m_layerSize[static_cast<size_t>(layer)] = layerMeshes.size();
     // The same meshes with new values (a stroke recolours the section) are updated in the GPU
     // buffers they have; other meshes need new buffers (a new renderer).
     bool inPlace = meshes.size() == m_authoring.size();
@@ -784,7 +804,7 @@ void Viewport::setAuthoringMeshes(std::vector<render::RenderMesh> meshes) {
 }
 
 void Viewport::setAuthoringMesh(size_t k, render::RenderMesh mesh) {
-    if (k >= m_authoring.size()) return;
+    if (k >= m_layerSize[static_cast<size_t>(Layer::Paint)]) return;
     render::RenderMesh& old = m_authoring[k];
     const bool inPlace = mesh.indices == old.indices;
     mesh.revision = old.revision + 1;
@@ -910,6 +930,10 @@ void Viewport::keyPressEvent(QKeyEvent* e) {
     if (e->key() == Qt::Key_Escape && m_painting) {
         m_painting = false;
         emit paintCancelled();
+        return;
+    }
+    if (e->key() == Qt::Key_Escape && m_paintMode) {
+        emit paintEscaped();
         return;
     }
     if (e->key() == Qt::Key_F || e->key() == Qt::Key_Home) {

@@ -30,6 +30,7 @@
 #include <QString>
 #include <QWidget>
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -112,12 +113,22 @@ public:
     /// Draws body (or, `source` Surface, fascia) `index` at its rest positions (the preview's
     /// positions are not applied to it); -1: everything as simulated.
     void setRestPose(int index, render::RenderMesh::Source source = render::RenderMesh::Source::Body);
-    /// Static meshes drawn after the scene's (the paint tool's skeleton and section); not hit.
-    void setAuthoringMeshes(std::vector<render::RenderMesh> meshes);
+    /// Who draws authoring meshes: each tool replaces its own layer, the layers drawn in this
+    /// order (the paint tools' skeleton and brush, a port's workspace, the assessment's targets).
+    enum class Layer { Paint = 0, Port, Targets, Count };
+    /// Static meshes of `layer` drawn after the scene's; not hit.
+    void setAuthoringLayer(Layer layer, std::vector<render::RenderMesh> meshes);
+    /// The paint layer's meshes (the paint tool's skeleton and section).
+    void setAuthoringMeshes(std::vector<render::RenderMesh> meshes) {
+        setAuthoringLayer(Layer::Paint, std::move(meshes));
+    }
     size_t authoringMeshCount() const { return m_authoring.size(); }
+    /// Every layer's meshes, in layer order.
     const std::vector<render::RenderMesh>& authoringMeshes() const { return m_authoring; }
-    /// Replaces authoring mesh k alone (a brush outline following the cursor): updated in the
-    /// buffers it has when its triangles are the same, the others untouched.
+    /// The meshes of one layer (a copy).
+    std::vector<render::RenderMesh> authoringLayer(Layer layer) const;
+    /// Replaces mesh k of the paint layer alone (a brush outline following the cursor): updated
+    /// in the buffers it has when its triangles are the same, the others untouched.
     void setAuthoringMesh(size_t k, render::RenderMesh mesh);
     /// Paint mode: a left drag paints (paintPressed/Moved/Released at the surface under the
     /// cursor, Esc: paintCancelled) instead of orbiting; Alt + left drag orbits, middle drag
@@ -153,6 +164,8 @@ signals:
     void brushLeft();
     void paintReleased();
     void paintCancelled();
+    /// Esc in paint mode with no stroke under way: the tool that set the mode ends.
+    void paintEscaped();
     /// Paint mode, F (radius) or Shift+F (strength) then a mouse move: `dx` pixels moved right
     /// since the key; `done` on the click that sets it (Esc: done with dx 0, the value restored).
     void brushAdjusted(bool strength, double dx, bool done);
@@ -203,7 +216,10 @@ private:
     render::RenderMesh::Source m_restSource = render::RenderMesh::Source::Body;
     enum class Adjust { None, Radius, Strength } m_adjust = Adjust::None;
     QPoint m_adjustFrom;
-    std::vector<render::RenderMesh> m_authoring;
+    std::vector<render::RenderMesh> m_authoring; ///< the layers' meshes, in layer order
+    std::array<size_t, static_cast<size_t>(Layer::Count)> m_layerSize{};
+    /// Where `layer`'s meshes start in m_authoring.
+    size_t layerStart(Layer layer) const;
     void applyRestPose();
     void trackMouse(bool on);
 };

@@ -12,6 +12,7 @@
 #include "window_fixture.hpp"
 
 #include <QAction>
+#include <QDockWidget>
 #include <QListWidget>
 #include <QSignalSpy>
 #include <QUndoStack>
@@ -35,6 +36,8 @@ struct PortToolFixture : test::MainWindowFixture {
         ASSERT_NE(tool, nullptr);
         open("rectum");
         ASSERT_TRUE(test::waitFor([&] { return w->viewport()->meshCount() > 0; }, 30000));
+        w->findChild<QDockWidget*>("instrumentDock")->raise(); // the ports of the dock in view
+        QCoreApplication::processEvents();
     }
     const studio::Project& model() const { return w->document()->project(); }
     int instrument(const std::string& name) const {
