@@ -263,8 +263,8 @@ bool AnatomySteps::importAnatomy(const QStringList& files, QString* why) {
     return run(kImport, args, int(meshes.size()), why);
 }
 
-QString AnatomySteps::copyIntoProject(const QString& file, QString* why) const {
-    const QDir project(m_doc->folder());
+QString copyIntoProject(const QString& projectFolder, const QString& file, QString* why) {
+    const QDir project(projectFolder);
     const QString abs = QFileInfo(file).absoluteFilePath();
     if (abs.startsWith(project.absolutePath() + "/")) return abs; // already one of the project's files
     project.mkpath("anatomy");
@@ -273,7 +273,7 @@ QString AnatomySteps::copyIntoProject(const QString& file, QString* why) const {
         target = project.filePath(
             QString("anatomy/%1-%2.%3").arg(QFileInfo(file).completeBaseName()).arg(n).arg(QFileInfo(file).suffix()));
     if (!QFile::copy(abs, target)) {
-        if (why) *why = tr("%1: cannot be copied into %2").arg(abs, project.filePath("anatomy"));
+        if (why) *why = QObject::tr("%1: cannot be copied into %2").arg(abs, project.filePath("anatomy"));
         return {};
     }
     return target;
@@ -293,7 +293,7 @@ void AnatomySteps::applyImport(const ImportStepResult& imported, const bake::Imp
     QStringList copied;
     QString why;
     for (const QString& f : m_pendingFiles) {
-        const QString c = copyIntoProject(f, &why);
+        const QString c = copyIntoProject(m_doc->folder(), f, &why);
         if (c.isEmpty()) {
             fail(why);
             return;

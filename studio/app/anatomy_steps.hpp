@@ -43,6 +43,10 @@ namespace viscera::studio {
 class Document;
 class Selection;
 
+/// `file` copied into <projectFolder>/anatomy/ (a free name: "liver-2.obj" beside "liver.obj"),
+/// or `file` itself when it is one of the project's files already. Empty on failure, with why.
+QString copyIntoProject(const QString& projectFolder, const QString& file, QString* why);
+
 class AnatomySteps : public QObject {
     Q_OBJECT
 public:
@@ -88,7 +92,6 @@ private:
     void showRemeshResult(const RemeshStepResult& result);
     void applyRemesh(const Pending& chosen, const std::string& key, const QString& pending);
     void showMeshingResult(const MeshingStepResult& result);
-    QString copyIntoProject(const QString& file, QString* why) const;
 
     Document* m_doc;
     Selection* m_sel;

@@ -9,7 +9,6 @@
 #include <QHBoxLayout>
 #include <QLabel>
 #include <QPushButton>
-#include <QRegularExpression>
 #include <QVBoxLayout>
 
 #include <algorithm>
@@ -26,30 +25,6 @@ QString unitLong(bake::LengthUnit u) {
 }
 
 } // namespace
-
-std::optional<std::array<Eigen::Vector3d, 2>> importedFileBounds(const QString& output) {
-    const QString n = QStringLiteral("(\\S+)");
-    const QRegularExpression re("bounds \\[" + n + " " + n + " " + n + "\\] - \\[" + n + " " + n + " " + n + "\\] m");
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    bool any = false;
-    for (auto it = re.globalMatch(output); it.hasNext();) {
-        const auto m = it.next();
-        Eigen::Vector3d a, b;
-        bool ok = true;
-        for (int k = 0; k < 3; ++k) {
-            bool okA = false, okB = false;
-            a[k] = m.captured(1 + k).toDouble(&okA);
-            b[k] = m.captured(4 + k).toDouble(&okB);
-            ok = ok && okA && okB;
-        }
-        if (!ok || !a.allFinite() || !b.allFinite()) continue;
-        lo = lo.cwiseMin(a);
-        hi = hi.cwiseMax(b);
-        any = true;
-    }
-    if (!any) return std::nullopt;
-    return std::array<Eigen::Vector3d, 2>{lo, hi};
-}
 
 Eigen::Vector3d placedSize(const std::array<Eigen::Vector3d, 2>& bounds, const bake::ImportPlacement& p) {
     const Eigen::Matrix3d r = p.rotation();

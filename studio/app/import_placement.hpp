@@ -19,10 +19,6 @@ class QLabel;
 
 namespace viscera::studio {
 
-/// The parts' bounding box in file units, from the lines `viscera-studio import` prints for
-/// each file ("bounds [x y z] - [x y z] m", at scale 1); none when no line has one.
-std::optional<std::array<Eigen::Vector3d, 2>> importedFileBounds(const QString& output);
-
 /// The size (x, y, z extents) of the box `bounds` (file units) once placed by `p`: its corners
 /// scaled and rotated. Exact for quarter turns; for other angles the box around the turned box.
 Eigen::Vector3d placedSize(const std::array<Eigen::Vector3d, 2>& bounds, const bake::ImportPlacement& p);

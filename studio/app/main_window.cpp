@@ -14,6 +14,7 @@
 #include "app/scope_task_panel.hpp"
 #include "app/start_page.hpp"
 #include "app/target_tool.hpp"
+#include "app/tet_import.hpp"
 #include "app/texture_panel.hpp"
 #include "app/wheel_guard.hpp"
 #include "project/publishing.hpp"
@@ -231,6 +232,9 @@ void MainWindow::buildActions() {
         m_banner->showError(line); // the log has it already
         statusBar()->showMessage(line);
     });
+    m_tetImport = new TetImport(&m_doc, &m_sel, this); // [issue 57 item 7] .msh / .vtu as tet bodies
+    connect(m_tetImport, &TetImport::logMessage, this, &MainWindow::logLine);
+    connect(m_tetImport, &TetImport::failed, this, &MainWindow::showError);
     buildFileMenu(menuBar()->addMenu(tr("&File")), toolbar);
     m_anatomy->buildMenu(menuBar()->addMenu(tr("&Mesh")));
     QMenu* edit = menuBar()->addMenu(tr("&Edit"));
@@ -273,6 +277,7 @@ void MainWindow::buildFileMenu(QMenu* file, QToolBar* toolbar) {
         false);
     file->addSeparator();
     file->addAction(m_anatomy->importAction());
+    file->addAction(m_tetImport->action());
     add(
         tr("&Export case…"), QKeySequence(tr("Ctrl+E")),
         [this] {

@@ -37,6 +37,7 @@ namespace viscera::studio {
 class AnatomySteps;
 class PortTool;
 class TargetTool;
+class TetImport;
 class InstrumentPanel;
 class ErrorBanner;
 class ExportRunner;
@@ -104,6 +105,7 @@ public:
     /// Placing trocar ports in the viewport (port_tool.hpp).
     PortTool* portTool() { return m_portTool; }
     TargetTool* targetTool() { return m_targetTool; }
+    TetImport* tetImport() { return m_tetImport; }
     AnatomySteps* anatomySteps() { return m_anatomy; }
     StiffnessPainter* painter() { return m_paint->painter(); }
     /// Paint stiffness mode (the toolbar's Paint action): the viewport's left drag paints the
@@ -174,6 +176,7 @@ private:
     StartPage* m_start = nullptr;
     PaintTools* m_paint = nullptr;
     PortTool* m_portTool = nullptr;
+    TetImport* m_tetImport = nullptr;
     TargetTool* m_targetTool = nullptr; ///< [issue 57 item 2] the assessment's targets, drawn
     InstrumentPanel* m_instruments = nullptr;
     QDockWidget* m_instrumentDock = nullptr;

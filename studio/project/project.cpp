@@ -9,6 +9,7 @@
 #include "bake/import.hpp"
 #include "case/case_writer.hpp"
 #include "case/manifest.hpp"
+#include "sim/mesh/gmsh_io.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/scene/port_reach.hpp"
 #include "sim/scene/scene.hpp"
@@ -219,11 +220,13 @@ MeshSource readMeshSource(const JsonField& m, const std::filesystem::path& dir) 
         return s;
     }
     if (m.anyObject().has("file")) {
-        m.object({"file", "scale", "meshing"});
         s.kind = MeshSource::Kind::File;
         s.file = projectFile(m["file"], dir);
+        // a tetrahedral mesh (.msh, .vtu, .vtet) is simulated as it is: nothing to mesh
+        const bool tets = sim::isTetFile(s.file);
+        tets ? m.object({"file", "scale"}) : m.object({"file", "scale", "meshing"});
         s.scale = m.number("scale", s.scale, NumberRule::positive());
-        s.meshing = readMeshing(m);
+        if (!tets) s.meshing = readMeshing(m);
         return s;
     }
     const std::string gen =
@@ -282,6 +285,7 @@ json meshSourceJson(const MeshSource& s, const WriteContext& w, const std::strin
     case K::Remesh:
         return {{"remesh", remeshJson(s.remesh, w, field + ".remesh")}, {"meshing", meshingJson(s.meshing)}};
     case K::File:
+        if (sim::isTetFile(s.file)) return {{"file", projectFileJson(s.file, w, field + ".file")}, {"scale", s.scale}};
         return {{"file", projectFileJson(s.file, w, field + ".file")},
                 {"scale", s.scale},
                 {"meshing", meshingJson(s.meshing)}};
@@ -905,6 +909,7 @@ std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::
     case MeshSource::Kind::HollowTube:
         return sim::makeHollowTubeTetMesh(s.hollow);
     case MeshSource::Kind::File: {
+        if (sim::isTetFile(s.file)) return sim::readTetFile(s.file, s.scale); // tets as they are
         bake::ImportOptions opt;
         opt.scale = s.scale;
         params.label = s.file.filename().string();

@@ -19,6 +19,7 @@
 ///          | {"generator": "hollow_tube", "start": [..], "end": [..], "inner_radius": 0.0038,
 ///             "outer_radius": 0.005, "slices": 33, "layers": 2, "rings": 8}   (structured, no CGAL)
 ///          | {"file": "liver.obj", "scale": 0.001, "meshing": {..}}
+///          | {"file": "liver.msh", "scale": 0.01}   a tet mesh (.msh, .vtu, .vtet; sim::readTetFile) as it is
 ///          | {"remesh": {..see RemeshSource..}, "meshing": {..}},
 ///     "material": {see readMaterial in core/sim/scene/scene_json.hpp},
 ///     "fixed": {"min": [..], "max": [..]},     nodes inside this box (metres) are fixed

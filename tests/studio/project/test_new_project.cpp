@@ -1,6 +1,7 @@
 // Issue 57 item 7: File → New starts without a body (the model, its reader and writer accept
 // one without; export and the scene build refuse it with one line), and export lists every
 // assessment limit the scene cannot measure in its one error, not the first only.
+#include "box_body.hpp"
 #include "project/project.hpp"
 #include "sim/scene/assessment.hpp"
 #include "sim/util/error.hpp"
@@ -26,19 +27,6 @@ std::string messageOf(const std::function<void()>& fn) {
         return e.what();
     }
     return "(accepted)";
-}
-
-/// A small box body, as File → New once added.
-studio::BodyProject boxBody() {
-    studio::BodyProject b;
-    b.scene.name = "tissue";
-    b.scene.material = studio::newBodyMaterial();
-    b.mesh.kind = studio::MeshSource::Kind::Box;
-    b.mesh.box.origin = sim::Vec3::Zero();
-    b.mesh.box.size = sim::Vec3(0.04, 0.02, 0.02);
-    b.mesh.box.cells = {4, 2, 2};
-    b.fixedBox = std::array<sim::Vec3, 2>{sim::Vec3(-0.001, -0.001, -0.001), sim::Vec3(0.0001, 0.021, 0.021)};
-    return b;
 }
 
 } // namespace
@@ -71,14 +59,14 @@ TEST(NewProject, ExportAndTheSceneBuildRefuseAProjectWithoutABody) {
     EXPECT_FALSE(fs::exists(scratch.dir / "empty.vcase")) << "nothing written";
     EXPECT_EQ(messageOf([&] { studio::buildScene(p); }), rule);
     studio::Project one = p;
-    one.bodies.push_back(boxBody());
+    one.bodies.push_back(test::boxBody(sim::Vec3(0.04, 0.02, 0.02), {4, 2, 2}));
     EXPECT_EQ(studio::exportCase(one, scratch.dir / "one.vcase").bodies.size(), 1u);
 }
 
 TEST(AssessmentMeasurability, ExportListsEveryLimitTheSceneCannotMeasureInOneError) {
     test::Scratch scratch("viscera-unmeasurable");
     studio::Project p = studio::newProject(scratch.dir, "no-tools");
-    p.bodies.push_back(boxBody());
+    p.bodies.push_back(test::boxBody(sim::Vec3(0.04, 0.02, 0.02), {4, 2, 2}));
     sim::AssessmentDesc a;
     // no laparoscope, no tool, no suture: none of these can be measured
     a.metrics = {{"path_length_m", 1.0, {}},

@@ -622,3 +622,24 @@ TEST_F(ProjectTest, ExportOverAnInputIsRefusedBeforeTheWork) {
     EXPECT_EQ(readFile(m_dir / "project.json"), before) << "the input is intact";
     EXPECT_EQ(studio::projectInputFiles(p), std::vector<std::filesystem::path>{m_dir / "project.json"});
 }
+
+namespace {
+
+// [issue 57 item 7] A tet mesh file (.msh) is a body's mesh as it is: read with its scale, no
+// meshing settings (refused, naming the field), built without CGAL's mesher.
+TEST_F(ProjectTest, ATetMeshFileIsABodysMeshAsItIs) {
+    writeFileAtomic(m_dir / "two.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 -1\n2 1 0 0\n"
+                                       "3 0 1 0\n4 0 0 0\n5 0 0 1\n$EndNodes\n$Elements\n2\n"
+                                       "1 4 0 1 2 3 4\n2 4 0 5 2 3 4\n$EndElements\n");
+    const std::string box = R"("mesh": {"generator": "box", "size": [0.04, 0.01, 0.01], "cells": [4, 1, 1]})";
+    write(replaced(kGood, box, R"("mesh": {"file": "two.msh", "scale": 0.01})"));
+    ASSERT_EQ(loadError(), "accepted");
+    const studio::Project p = studio::loadProject(m_dir);
+    const auto mesh = studio::buildBodyMesh(p.bodies[0], "project.json", nullptr, m_dir);
+    EXPECT_EQ(mesh->tets().size(), 2u);
+    EXPECT_DOUBLE_EQ(mesh->positions()[0].cwiseAbs().maxCoeff(), 0.01);
+    write(replaced(kGood, box, R"("mesh": {"file": "two.msh", "meshing": {"cell_size": 0.01}})"));
+    EXPECT_THAT(loadError(), HasSubstr("bodies[0].mesh.meshing: unknown field"));
+}
+
+} // namespace

@@ -1,5 +1,6 @@
 // Saving the project model: projectJsonText / loadProjectText round trips for every sample, re-saved
 // projects export the same case, saveProject's failures, newProject, and the export progress.
+#include "box_body.hpp"
 #include "case/case_package.hpp"
 #include "project/project.hpp"
 #include "sim/util/atomic_file.hpp"
@@ -180,14 +181,7 @@ TEST(ProjectSave, NewProjectExportsAndSaves) {
     studio::Project p = studio::newProject(scratch.dir, "new-case");
     EXPECT_TRUE(p.bodies.empty()) << "File → New starts without a placeholder body";
     // the slab the studio once added, by hand: a body is all a new project needs to export
-    studio::BodyProject& body = p.bodies.emplace_back();
-    body.scene.name = "tissue";
-    body.scene.material = studio::newBodyMaterial();
-    body.mesh.kind = studio::MeshSource::Kind::Box;
-    body.mesh.box.origin = sim::Vec3::Zero();
-    body.mesh.box.size = sim::Vec3(0.1, 0.02, 0.04);
-    body.mesh.box.cells = {20, 4, 8};
-    body.fixedBox = std::array<sim::Vec3, 2>{sim::Vec3(-0.001, -0.001, -0.001), sim::Vec3(0.0001, 0.021, 0.041)};
+    p.bodies.push_back(test::boxBody(sim::Vec3(0.1, 0.02, 0.04), {20, 4, 8}));
     studio::ExportResult r = studio::exportCase(p, scratch.dir / "new.vcase");
     EXPECT_EQ(r.features, (std::vector<std::string>{"gravity", "xpbd"}));
     ASSERT_EQ(r.bodies.size(), 1u);
