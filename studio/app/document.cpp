@@ -334,6 +334,12 @@ QString Document::editSolver(const QString& text, const sim::XpbdSettings& setti
 }
 
 QString Document::editAssessment(const QString& text, const std::optional<sim::AssessmentDesc>& assessment) {
+    const auto written = [](const std::optional<sim::AssessmentDesc>& a) {
+        nlohmann::json doc = nlohmann::json::object();
+        if (a) sim::writeAssessment(*a, doc);
+        return doc;
+    };
+    if (m_project && written(m_project->scene.assessment) == written(assessment)) return {}; // no change, no step
     return editValue<AssessmentSlot>(text, 0, assessment, 0);
 }
 

@@ -110,6 +110,12 @@ public:
     /// refused as "<folder>/project.json: <field>: <rule>"; one undo step for all three.
     QString editTask(const QString& text, const std::string& title, const std::string& instructions,
                      const std::vector<std::string>& steps);
+    /// The surroundings (render-only scenery primitives, `textures` one per primitive), one undo
+    /// step; checked by the project reader's rule for "scenery" (names new among the bodies,
+    /// surfaces and probes; radius, axis, angles), refused as "<folder>/project.json:
+    /// scenery[i].<field>: <rule>". Announced as Change::Structure (the scene is drawn anew).
+    QString editScenery(const QString& text, const std::vector<SceneryProject>& scenery,
+                        const std::vector<std::optional<TextureProject>>& textures, int mergeKey = 0);
     // Instruments [issue 57] (document_instruments.cpp), announced as Change::Scene.
     /// Sets instrument `index` of the scene's interaction to `value` as one typed undo command
     /// (old and new instrument only; its case track path follows its name). Checked by the scene

@@ -5,8 +5,12 @@
 #include "app/value_command.hpp"
 
 #include "case/manifest.hpp"
+#include "project/anatomy_shapes.hpp"
 #include "sim/scene/scene_json.hpp"
+#include "sim/scene/tool_probe.hpp"
 #include "sim/util/json_reader.hpp"
+
+#include <set>
 
 namespace viscera::studio {
 namespace {
@@ -88,7 +92,57 @@ struct TaskSlot {
     }
 };
 
+/// The surroundings [issue 57 item 1]: the render-only scenery primitives with their textures,
+/// one value (the textures stay one per primitive). Checked by the project reader's rule for
+/// "scenery" (readSceneryProject on what sceneryJson writes), its names new among the bodies,
+/// surfaces and probes as at load.
+struct Surroundings {
+    std::vector<SceneryProject> scenery;
+    std::vector<std::optional<TextureProject>> textures;
+};
+
+struct SurroundingsView {
+    Project& p;
+    operator Surroundings() const { return {p.scenery, p.sceneryTextures}; }
+    SurroundingsView& operator=(const Surroundings& s) {
+        p.scenery = s.scenery;
+        p.sceneryTextures = s.textures;
+        return *this;
+    }
+};
+
+struct SurroundingsSlot {
+    using Value = Surroundings;
+    static constexpr int kId = 10;
+    static SurroundingsView of(Project& p, int) { return {p}; }
+    static Change change(int) { return {Change::Structure, -1}; }
+    static std::string check(const Project& p, int, const Value& v) {
+        if (v.textures.size() != v.scenery.size()) return "scenery: a texture slot per surrounding is missing";
+        if (v.scenery.empty()) return {};
+        try {
+            std::set<std::string> names;
+            for (const BodyProject& b : p.bodies)
+                names.insert(b.scene.name);
+            for (const SurfaceProject& sp : p.surfaces)
+                names.insert(sp.scene.name);
+            for (const sim::ToolDesc& t : p.scene.tools)
+                names.insert(t.name);
+            const nlohmann::json doc = sceneryJson(v.scenery);
+            const std::string origin = "project.json"; // JsonField keeps a pointer to it
+            readSceneryProject(sim::JsonField(doc, "scenery", origin), names);
+        } catch (const std::exception& e) {
+            return withoutOrigin(e);
+        }
+        return {};
+    }
+};
+
 } // namespace
+
+QString Document::editScenery(const QString& text, const std::vector<SceneryProject>& scenery,
+                              const std::vector<std::optional<TextureProject>>& textures, int mergeKey) {
+    return editValue<SurroundingsSlot>(text, 0, Surroundings{scenery, textures}, mergeKey);
+}
 
 QString Document::editLaparoscope(const QString& text, const std::optional<sim::LaparoscopeDesc>& value, int mergeKey) {
     return editValue<LaparoscopeSlot>(text, 0, value, mergeKey);

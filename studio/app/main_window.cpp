@@ -13,6 +13,7 @@
 #include "app/properties_panel.hpp"
 #include "app/scope_task_panel.hpp"
 #include "app/start_page.hpp"
+#include "app/surroundings_panel.hpp"
 #include "app/target_tool.hpp"
 #include "app/tet_import.hpp"
 #include "app/texture_panel.hpp"
@@ -163,6 +164,9 @@ void MainWindow::viewportToolOn(QObject* tool) {
     if (tool != m_portTool) m_portTool->action()->setChecked(false);
     if (tool != m_targetTool && m_targetTool->pick() != TargetTool::Pick::None)
         m_targetTool->action(m_targetTool->pick())->setChecked(false);
+    // a tool going off sets the paint mode off: the one that came on (the paint tools set it
+    // before they say so) takes the clicks again
+    if (m_viewport) m_viewport->setPaintMode(true);
 }
 
 void MainWindow::buildDocks() {
@@ -212,6 +216,13 @@ void MainWindow::buildDocks() {
     scopeTaskScroll->setWidgetResizable(true);
     m_scopeTaskDock = dock("scopeTaskDock", tr("Laparoscope and task"), scopeTaskScroll, Qt::RightDockWidgetArea);
     tabifyDockWidget(plotsDock, m_scopeTaskDock);
+    auto* surroundings = new SurroundingsPanel(&m_doc, this); // [issue 57]: the static anatomy around
+    surroundings->setObjectName("surroundingsPanel");
+    auto* surroundingsScroll = new QScrollArea(this);
+    surroundingsScroll->setWidget(surroundings);
+    surroundingsScroll->setWidgetResizable(true);
+    tabifyDockWidget(plotsDock,
+                     dock("surroundingsDock", tr("Surroundings"), surroundingsScroll, Qt::RightDockWidgetArea));
     auto* instruments = new InstrumentPanel(&m_doc, this); // [issue 57]: the scene's instruments
     instruments->setObjectName("instrumentPanel");
     auto* instrumentScroll = new QScrollArea(this); // a short dock scrolls instead of clipping the fields
@@ -670,6 +681,7 @@ void MainWindow::pollPreview() {
         if (auto view = m_preview.sceneView()) m_viewport->setScene(*view);
         m_paint->retarget(); // the same mesh keeps its skeleton; a new one is mapped again
         m_paint->showOverlay();
+        m_targetTool->refresh(); // the vessel's box follows the new meshes
         m_shownScene = s.scene;
     }
     const bool newFrames = newScene || s.frames != m_shownFrames;

@@ -193,11 +193,21 @@ void ProjectTreePanel::rebuild() {
             leaf(surfaces, QString::fromStdString(p.surfaces[s].scene.name),
                  tr("on %1").arg(QString::fromStdString(p.surfaces[s].scene.attachTo)), kindValue(K::Surface),
                  static_cast<int>(s));
+        QTreeWidgetItem* surroundings = group(tr("Surroundings"), kGroup); // render-only scenery
+        for (const SceneryProject& sc : p.scenery)
+            leaf(surroundings, QString::fromStdString(sc.name),
+                 sc.generator == SceneryProject::Generator::Disc ? tr("disc") : tr("wall"), kGroup, -1);
         QTreeWidgetItem* instruments = group(tr("Instruments"), kGroup);
         if (p.scene.interaction)
-            for (size_t t = 0; t < p.scene.interaction->instruments.size(); ++t)
-                leaf(instruments, QString::fromStdString(p.scene.interaction->instruments[t].name), tr("scripted"),
-                     kindValue(K::Instrument), static_cast<int>(t));
+            for (size_t t = 0; t < p.scene.interaction->instruments.size(); ++t) {
+                const auto& in = p.scene.interaction->instruments[t];
+                const QString kind = in.kind == sim::InstrumentDesc::Kind::Grasper      ? tr("grasper")
+                                     : in.kind == sim::InstrumentDesc::Kind::EnergyHook ? tr("energy hook")
+                                                                                        : tr("clip applier");
+                leaf(instruments, QString::fromStdString(in.name),
+                     tr("%1, %2 hand").arg(kind, QString::fromStdString(in.device.hand)), kindValue(K::Instrument),
+                     static_cast<int>(t));
+            }
         if (p.scene.suture) leaf(instruments, tr("needle"), tr("suture trajectory"), kGroup, -1);
         group(tr("Render settings"), kindValue(K::Render));
         group(tr("Solver (%1)").arg(QString::fromStdString(p.scene.solverType)), kindValue(K::Solver));

@@ -140,6 +140,7 @@ void vesselRows(const AssessmentDesc& a, std::vector<Row>& rows) {
     Row body = textRow(t, QObject::tr("body"), Kind::Vessel, 0,
                        [](const AssessmentDesc& d) { return QString::fromStdString(d.vessel->body); });
     body.set = [](AssessmentDesc& d, const QString& typed) {
+        if (!d.vessel) return QObject::tr("there is no vessel to protect");
         d.vessel->body = typed.trimmed().toStdString();
         return QString();
     };
@@ -241,6 +242,9 @@ QString TargetPanel::removeTargetOf(int r) {
     if (r < 0 || r >= static_cast<int>(m_rows.size()) || !model()) return tr("no target is selected");
     const Row row = m_rows[static_cast<size_t>(r)];
     AssessmentDesc a = *model();
+    const auto in = [&](const auto& v) { return row.index >= 0 && row.index < static_cast<int>(v.size()); };
+    if ((row.kind == Kind::Cut && !in(a.cuts)) || (row.kind == Kind::Clip && !in(a.clips)))
+        return tr("no target is selected");
     switch (row.kind) {
     case Kind::Cut:
         a.cuts.erase(a.cuts.begin() + row.index);

@@ -53,6 +53,8 @@ public:
     void setShown(bool on);
     bool shown() const { return m_shown; }
     Defaults& defaults() { return m_defaults; }
+    /// Draws the targets again (a new scene arrived: the vessel's bounds are its meshes').
+    void refresh() { redraw(); }
 
     // The edits, each one undo step; each returns the refusal (one line naming the field and the
     // rule), empty when taken.

@@ -49,10 +49,24 @@ std::unique_ptr<TetMesh> finish(const Raw& raw, const std::string& origin, doubl
         }
         const Vec3 &a = positions[size_t(tet[0])], &b = positions[size_t(tet[1])], &c = positions[size_t(tet[2])],
                    &d = positions[size_t(tet[3])];
-        if ((b - a).cross(c - a).dot(d - a) < 0) std::swap(tet[2], tet[3]);
+        const double volume = (b - a).cross(c - a).dot(d - a);
+        if (!(std::abs(volume) > 0))
+            throw InputError(origin + ": tetrahedron " + std::to_string(t) + " (nodes " +
+                             std::to_string(raw.tets[t][0]) + " " + std::to_string(raw.tets[t][1]) + " " +
+                             std::to_string(raw.tets[t][2]) + " " + std::to_string(raw.tets[t][3]) + ") has no volume");
+        if (volume < 0) std::swap(tet[2], tet[3]);
         tets.push_back(tet);
     }
-    return TetMesh::fromArrays(std::move(positions), std::move(tets), origin);
+    try {
+        return TetMesh::fromArrays(std::move(positions), std::move(tets), origin);
+    } catch (const std::invalid_argument& e) { // the mesh rules (a repeated node, a facet of three tets)
+        throw InputError(e.what());
+    }
+}
+
+/// Adds node `tag` at `p`; a tag defined twice is refused.
+void addNode(LineReader& in, Raw& raw, int64_t tag, const Vec3& p) {
+    if (!raw.nodes.try_emplace(tag, p).second) in.fail("node " + std::to_string(tag) + " is defined twice");
 }
 
 int64_t count(LineReader& in, std::string_view tok, const char* what) {
@@ -74,40 +88,21 @@ Vec3 coordinates(LineReader& in, const std::vector<std::string_view>& tok, size_
     return p;
 }
 
-/// A Gmsh element of `type`: a linear tetrahedron is kept; another volume element is refused;
-/// anything else (points, lines, surfaces) skipped.
+/// A Gmsh element of `type`: a linear tetrahedron is kept; points, lines and surface elements
+/// (the boundary Gmsh saves with the volume) are skipped; any other element (a volume element
+/// other than the linear tetrahedron, or a type this reader does not know) is refused, since
+/// dropping it would leave a hole.
 bool keepGmshElement(LineReader& in, int type, int64_t tag) {
     if (type == kGmshTet) return true;
-    const char* name = nullptr;
-    switch (type) {
-    case 5:
-        name = "hexahedron";
-        break;
-    case 6:
-        name = "prism";
-        break;
-    case 7:
-        name = "pyramid";
-        break;
-    case 11:
-        name = "10-node tetrahedron";
-        break;
-    case 29:
-    case 30:
-    case 31:
-        name = "high-order tetrahedron";
-        break;
-    case 12:
-    case 13:
-    case 14:
-    case 17:
-    case 18:
-    case 19:
-        name = "high-order volume element";
-        break;
-    default:
-        return false;
-    }
+    const bool lowerDimension = type == 1 || type == 2 || type == 3 || (type >= 8 && type <= 10) || type == 15 ||
+                                type == 16 || (type >= 20 && type <= 28) || type == 34 || (type >= 36 && type <= 70);
+    if (lowerDimension) return false;
+    const char* name = type == 11   ? "10-node tetrahedron"
+                       : type == 5  ? "hexahedron"
+                       : type == 6  ? "prism"
+                       : type == 7  ? "pyramid"
+                       : type == 35 ? "polyhedron"
+                                    : "a volume or unknown element";
     in.fail("element " + std::to_string(tag) + " is of type " + std::to_string(type) + " (" + name +
             "): only linear tetrahedra (type 4) are read");
 }
@@ -119,7 +114,7 @@ void gmshNodesV2(LineReader& in, Raw& raw) {
     for (int64_t i = 0; i < n; ++i) {
         if (!in.next(tok)) in.failEof("node " + std::to_string(i));
         const auto tag = in.number<int64_t>(tok[0], "node tag");
-        raw.nodes[tag] = coordinates(in, tok, 1, "node " + std::to_string(tag));
+        addNode(in, raw, tag, coordinates(in, tok, 1, "node " + std::to_string(tag)));
     }
     expectLine(in, tok, "$EndNodes");
 }
@@ -135,7 +130,7 @@ void gmshElementsV2(LineReader& in, Raw& raw) {
         const auto type = in.number<int>(tok[1], "element type");
         const auto tags = in.number<int64_t>(tok[2], "tag count");
         if (!keepGmshElement(in, type, tag)) continue;
-        if (tags < 0 || static_cast<int64_t>(tok.size()) != 3 + tags + 4)
+        if (tags < 0 || tags > static_cast<int64_t>(tok.size()) || static_cast<int64_t>(tok.size()) != 3 + tags + 4)
             in.fail("element " + std::to_string(tag) + " (a tetrahedron) needs 4 node tags after its " +
                     std::to_string(tags) + " tag(s)");
         std::array<int64_t, 4> t{};
@@ -162,7 +157,7 @@ void gmshNodesV4(LineReader& in, Raw& raw) {
         for (int64_t i = 0; i < n; ++i) {
             if (!in.next(tok)) in.failEof("the coordinates of node " + std::to_string(tags[size_t(i)]));
             if (!parametric && tok.size() != 3) in.fail("node " + std::to_string(tags[size_t(i)]) + " needs x y z");
-            raw.nodes[tags[size_t(i)]] = coordinates(in, tok, 0, "node " + std::to_string(tags[size_t(i)]));
+            addNode(in, raw, tags[size_t(i)], coordinates(in, tok, 0, "node " + std::to_string(tags[size_t(i)])));
         }
     }
     expectLine(in, tok, "$EndNodes");
@@ -312,6 +307,10 @@ std::unique_ptr<TetMesh> parseVtuTets(std::string_view text, const std::string& 
     if (type != "UnstructuredGrid") vtu.fail("VTKFile type is '" + type + "': an UnstructuredGrid (.vtu) is read");
     if (text.find("<AppendedData") != std::string_view::npos)
         vtu.fail("appended data is not read: save the .vtu as ASCII (ParaView: Data Mode 'Ascii')");
+    size_t pieces = 0;
+    for (size_t at = text.find("<Piece"); at != std::string_view::npos; at = text.find("<Piece", at + 1))
+        ++pieces;
+    if (pieces != 1) vtu.fail("has " + std::to_string(pieces) + " <Piece> elements: one is read (merge the pieces)");
     const auto points = vtu.array<double>(vtu.section("Points"), "", "Points");
     const std::string_view cells = vtu.section("Cells");
     const auto connectivity = vtu.array<int64_t>(cells, "connectivity", "Cells/connectivity");
@@ -332,21 +331,24 @@ std::unique_ptr<TetMesh> parseVtuTets(std::string_view text, const std::string& 
         const int64_t to = offsets[c];
         if (to < from || to > static_cast<int64_t>(connectivity.size()))
             vtu.fail("Cells/offsets: offset " + std::to_string(c) + " (" + std::to_string(to) + ") is out of order");
-        constexpr int kVolumes[] = {11, 12, 13, 14, 15, 16, 24, 25, 26, 27, 29,
-                                    32, 33, 42, 71, 72, 73, 74, 78, 79, 81, 82};
-        const bool volume = std::find(std::begin(kVolumes), std::end(kVolumes), types[c]) != std::end(kVolumes);
+        // points, lines and surface cells are skipped; any other cell is refused (a hole otherwise)
+        constexpr int kLower[] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 21, 22, 23, 28, 30, 34, 35, 36, 68, 69, 70, 75, 76, 77};
+        const bool lower = std::find(std::begin(kLower), std::end(kLower), types[c]) != std::end(kLower);
         if (types[c] == kVtkTet) {
             if (to - from != 4)
                 vtu.fail("Cells: cell " + std::to_string(c) + " is a tetrahedron with " + std::to_string(to - from) +
                          " points");
             raw.tets.push_back({connectivity[size_t(from)], connectivity[size_t(from + 1)],
                                 connectivity[size_t(from + 2)], connectivity[size_t(from + 3)]});
-        } else if (volume) {
+        } else if (!lower) {
             vtu.fail("Cells: cell " + std::to_string(c) + " is of VTK type " + std::to_string(types[c]) +
-                     ": only linear tetrahedra (type 10) are read");
+                     ": only linear tetrahedra (type 10) are read (points, lines and surfaces are skipped)");
         }
         from = to;
     }
+    if (from != static_cast<int64_t>(connectivity.size()))
+        vtu.fail("Cells/offsets: the last offset (" + std::to_string(from) + ") is not the connectivity's length (" +
+                 std::to_string(connectivity.size()) + ")");
     return finish(raw, origin, scale);
 }
 

@@ -157,6 +157,20 @@ TEST(TetImport, MalformedFilesAreRefusedNamingTheFileTheLineAndTheRule) {
     EXPECT_THAT(refusal([&] { sim::parseGmshTets("$MeshFormat\n3.0 0 8\n", "old.msh"); }),
                 HasSubstr("MSH version 3.0 is not read"));
     EXPECT_THAT(refusal([&] { sim::parseGmshTets("", "empty.msh"); }), HasSubstr("empty.msh: unexpected end of file"));
+    s = kMsh22;
+    s.replace(s.find("5 0 0 1"), 7, "5 0.5 0.5 0"); // node 5 in the plane of 2, 3, 4: a flat tetrahedron
+    EXPECT_THAT(refusal([&] { sim::parseGmshTets(s, "flat.msh"); }),
+                HasSubstr("flat.msh: tetrahedron 1 (nodes 5 2 3 4) has no volume"));
+    s = kMsh22;
+    s.replace(s.find("9 5 5 5"), 7, "4 5 5 5");
+    EXPECT_THAT(refusal([&] { sim::parseGmshTets(s, "twice.msh"); }),
+                HasSubstr("twice.msh: line 15: node 4 is defined twice"));
+    s = kMsh22;
+    s.replace(s.find("4 4 2 1 1 5 2 3 4"), 17, "4 33 2 1 1 5 2 3 4");
+    EXPECT_THAT(refusal([&] { sim::parseGmshTets(s, "t28.msh"); }), HasSubstr("element 4 is of type 33"));
+    s = kMsh22;
+    s.replace(s.find("3 4 2 1 1 1 2 3 4"), 17, "3 4 9223372036854775806 1 2 3 4");
+    EXPECT_THAT(refusal([&] { sim::parseGmshTets(s, "tags.msh"); }), HasSubstr("needs 4 node tags"));
     // a surface-only file has nothing to simulate
     s = kMsh22;
     s.replace(s.find("3 4 2 1 1 1 2 3 4"), 17, "3 2 2 1 1 1 2 3");
@@ -178,6 +192,13 @@ TEST(TetImport, MalformedFilesAreRefusedNamingTheFileTheLineAndTheRule) {
     EXPECT_THAT(refusal([&] { sim::parseVtuTets(v, "x.vtu"); }),
                 HasSubstr("x.vtu: Points: value 14 'x' is not a valid number"));
     EXPECT_THAT(refusal([&] { sim::parseVtuTets("<html></html>", "page.vtu"); }), HasSubstr("is not a VTK XML file"));
+    v = kVtu;
+    v.replace(v.find("4 8 11"), 6, "4 8 10");
+    EXPECT_THAT(refusal([&] { sim::parseVtuTets(v, "short.vtu"); }),
+                HasSubstr("the last offset (10) is not the connectivity's length (11)"));
+    v = kVtu;
+    v.replace(v.find("</UnstructuredGrid>"), 0, "<Piece NumberOfPoints=\"0\" NumberOfCells=\"0\"></Piece>");
+    EXPECT_THAT(refusal([&] { sim::parseVtuTets(v, "two.vtu"); }), HasSubstr("two.vtu: has 2 <Piece> elements"));
 }
 
 TEST(TetImport, ReadTetFileGoesByTheExtension) {

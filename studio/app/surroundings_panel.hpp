@@ -1,0 +1,57 @@
+#pragma once
+/// The "Surroundings" panel [issue 57 item 1]: the static anatomy around the simulated tissue —
+/// the render-only scenery primitives (a cylinder wall seen from inside or outside, a disc) the
+/// trainee sees and the ports are placed on. Lists them; *Add wall* (a cylinder) and *Add floor*
+/// (a disc) add one, *Remove* takes the selected one out; the selected one's fields: name, radius
+/// (mm), for a wall its axis start and end (m, "x, y, z"), its arc (from / to, degrees) and its
+/// facing (inward: seen from inside), for a floor its centre and normal. Every value is one undo
+/// step through Document::editScenery, checked by the project reader's rule for "scenery"; a
+/// refused value shows the rule under the fields and the field shows the model's value again.
+#include <QString>
+#include <QWidget>
+#include <map>
+
+class QComboBox;
+class QLabel;
+class QLineEdit;
+class QListWidget;
+class QPushButton;
+
+namespace viscera::studio {
+
+class Document;
+
+class SurroundingsPanel : public QWidget {
+    Q_OBJECT
+public:
+    explicit SurroundingsPanel(Document* doc, QWidget* parent = nullptr);
+    QListWidget* list() { return m_list; }
+    /// The field named `key`: "name", "radius_mm", "start", "end", "from_deg", "to_deg", "center",
+    /// "normal" (null for another name).
+    QLineEdit* field(const QString& key) const;
+    QComboBox* facing() { return m_facing; }
+    QLabel* errorLabel() { return m_error; }
+    QPushButton* addWallButton() { return m_addWall; }
+    QPushButton* addFloorButton() { return m_addFloor; }
+    QPushButton* removeButton() { return m_remove; }
+    int selected() const { return m_selected; }
+
+private:
+    void fill();
+    /// The typed value of `key` into the selected primitive, one undo step (or the refusal shown).
+    void typed(const QString& key);
+    void add(bool wall);
+    void remove();
+    void show(const QString& why);
+
+    Document* m_doc;
+    QListWidget* m_list = nullptr;
+    std::map<QString, QLineEdit*> m_fields;
+    QComboBox* m_facing = nullptr;
+    QLabel* m_error = nullptr;
+    QPushButton *m_addWall = nullptr, *m_addFloor = nullptr, *m_remove = nullptr;
+    int m_selected = -1;
+    bool m_filling = false;
+};
+
+} // namespace viscera::studio
