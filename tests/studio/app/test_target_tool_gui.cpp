@@ -6,6 +6,7 @@
 #include "app/assessment_panel.hpp"
 #include "app/document.hpp"
 #include "app/main_window.hpp"
+#include "app/paint_tools.hpp"
 #include "app/target_panel.hpp"
 #include "app/target_tool.hpp"
 #include "app/viewport.hpp"
@@ -251,6 +252,21 @@ TEST_F(TargetToolFixture, TypedValuesAndRemovalsAreUndoableAndRefusalsLeaveTheMo
         undo()->undo();
     EXPECT_EQ(model().cuts[0].radius, radius);
     EXPECT_EQ(model().clips[0].count, 2);
+}
+
+// One viewport tool at a time, and the one that came on keeps the clicks: a paint tool taking
+// over from a target pick (or a pick from the port tool) leaves the viewport in paint mode.
+TEST_F(TargetToolFixture, TheToolThatComesOnKeepsTheViewportsClicks) {
+    choose(Pick::ClipSite);
+    w->paintTools()->stiffnessAction()->trigger();
+    EXPECT_EQ(tool->pick(), Pick::None) << "the pick went off";
+    EXPECT_TRUE(w->paintTools()->stiffnessAction()->isChecked());
+    EXPECT_TRUE(w->viewport()->paintMode()) << "the paint tool still takes the drag";
+    choose(Pick::CutLine);
+    EXPECT_FALSE(w->paintTools()->stiffnessAction()->isChecked());
+    EXPECT_TRUE(w->viewport()->paintMode());
+    QTest::keyClick(w->viewport(), Qt::Key_Escape);
+    EXPECT_FALSE(w->viewport()->paintMode());
 }
 
 } // namespace
