@@ -1,6 +1,7 @@
 #include "app/target_panel.hpp"
 
 #include "app/document.hpp"
+#include "app/number_text.hpp"
 #include "app/target_tool.hpp"
 
 #include <QHBoxLayout>
@@ -21,10 +22,6 @@ using Row = TargetPanel::Row;
 using Kind = Row::Kind;
 using sim::AssessmentDesc;
 
-QString number(double v) {
-    return QString::number(v, 'g', 6);
-}
-
 QString millimetres(const sim::Vec3& p) {
     return QString("%1, %2, %3").arg(p.x() * 1e3, 0, 'f', 1).arg(p.y() * 1e3, 0, 'f', 1).arg(p.z() * 1e3, 0, 'f', 1);
 }
@@ -36,7 +33,7 @@ Row numberRow(QString target, QString field, Kind kind, int index, double scale,
     r.text = [ref, scale](const AssessmentDesc& a) {
         AssessmentDesc copy = a;
         const double* v = ref(copy);
-        return v ? number(*v * scale) : QString();
+        return v ? numberText(*v * scale) : QString();
     };
     r.set = [ref, scale](AssessmentDesc& a, const QString& typed) {
         bool ok = false;

@@ -109,10 +109,10 @@ void TetImport::askUnit(const QString& file) {
                           .arg(p->nodes)
                           .arg(p->extent, 0, 'g', 4)
                           .arg(QString::fromUtf8(bake::unitLongName(p->guess).data())));
-    connect(dlg, &QInputDialog::textValueSelected, this, [this, file](const QString& text) {
+    connect(dlg, &QInputDialog::textValueSelected, this, [this, file, p](const QString& text) {
         for (bake::LengthUnit u : kUnits)
             if (text == QString::fromUtf8(bake::unitLongName(u).data())) {
-                const QString why = importFile(file, u);
+                const QString why = add(file, u, *p); // read once: the probe that asked
                 if (!why.isEmpty()) emit failed(why);
             }
     });
@@ -125,6 +125,14 @@ QString TetImport::importFile(const QString& file, bake::LengthUnit unit) {
     QString why;
     const std::optional<Probe> p = probe(file, &why); // refused here, nothing is copied
     if (!p) return why;
+    return add(file, unit, *p);
+}
+
+QString TetImport::add(const QString& file, bake::LengthUnit unit, const Probe& probed) {
+    if (!m_doc->hasProject() || m_doc->folder().isEmpty())
+        return tr("Import tet mesh: save the project first (the mesh is copied into its folder)");
+    const Probe* p = &probed;
+    QString why;
     const QString copied = copyIntoProject(m_doc->folder(), file, &why);
     if (copied.isEmpty()) return why;
     const Project& now = m_doc->project();

@@ -44,6 +44,8 @@ signals:
 private:
     void ask();
     void askUnit(const QString& file);
+    /// Copies `file` in and adds the body, `probed` being what probe() read of it.
+    QString add(const QString& file, bake::LengthUnit unit, const Probe& probed);
 
     Document* m_doc;
     Selection* m_sel;

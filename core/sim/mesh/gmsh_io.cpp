@@ -352,15 +352,24 @@ std::unique_ptr<TetMesh> parseVtuTets(std::string_view text, const std::string& 
     return finish(raw, origin, scale);
 }
 
-bool isTetFile(const std::filesystem::path& path) {
+namespace {
+
+/// The extension of `path`, lower case, with the dot.
+std::string lowerExtension(const std::filesystem::path& path) {
     std::string ext = path.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext;
+}
+
+} // namespace
+
+bool isTetFile(const std::filesystem::path& path) {
+    const std::string ext = lowerExtension(path);
     return ext == ".msh" || ext == ".vtu" || ext == ".vtet";
 }
 
 std::unique_ptr<TetMesh> readTetFile(const std::filesystem::path& path, double scale) {
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    const std::string ext = lowerExtension(path);
     const std::string origin = path.filename().string();
     constexpr std::uintmax_t kMaxBytes = std::uintmax_t{512} << 20;
     if (ext == ".msh") return parseGmshTets(readFile(path, kMaxBytes), origin, scale);
