@@ -14,6 +14,7 @@
 #include "sim/util/error.hpp"
 #include "sim/util/log.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -391,6 +392,11 @@ SessionResult runSession(LoadedCase& loaded, const RunOptions& options) {
     r.ports = ports.take();
     r.assessment = assessSession(r, loaded.scene.assessment);
     return r;
+}
+
+int replayFrames(double duration, double dt) {
+    if (!(dt > 0) || !std::isfinite(duration)) return 300;
+    return static_cast<int>(std::ceil((std::max(duration, 0.0) + 0.5) / dt));
 }
 
 } // namespace viscera::player

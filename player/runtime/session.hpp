@@ -151,6 +151,11 @@ inline double realTimeFactor(double dt, double stepMs) {
     return stepMs > 0 ? dt * 1e3 / stepMs : 0.0;
 }
 
+/// Frames a replay of `duration` s runs at the frame time step `dt`: its length and 0.5 s more (the
+/// tissue settles after the last motion); 300 when dt is not positive. The studio's rehearsal and
+/// the case replay tests run a replay this long.
+int replayFrames(double duration, double dt);
+
 /// Steps the world `frames` times, recording per-frame figures and invariants. Never throws.
 SessionResult runSession(LoadedCase& loaded, const RunOptions& options);
 

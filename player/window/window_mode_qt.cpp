@@ -8,6 +8,8 @@
 #include "render/headless.hpp"
 #include "render/scene_view.hpp"
 #include "render/scope_view.hpp"
+#include "runtime/keyboard_keys.hpp"
+#include "runtime/live_scene.hpp"
 #include "runtime/realtime_watch.hpp"
 #include "runtime/render_pacer.hpp"
 #include "sim/util/atomic_file.hpp"
@@ -45,19 +47,14 @@ using haptics::KeyboardDevice;
 /// QImage for the window's paint events. GUI thread only.
 class Viewport3D {
 public:
-    Viewport3D(const LoadedCase& loaded, LiveView& live, int width, int height) : m_live(live) {
+    Viewport3D(const LoadedCase& loaded, LiveView& live, int width, int height) : m_live(live), m_scene(loaded) {
         const sim::World& world = *loaded.world;
         const std::string& caseRender = loaded.scene.render;
-        m_view = caseView(loaded);
-        for (size_t b = 0; b < world.bodyCount(); ++b) {
-            m_bodyOffset.push_back(m_offset);
-            m_offset += world.restMesh(b).vertexCount();
-        }
-        render::RenderSettings settings = render::defaultSettingsFor(m_view, width, height);
+        render::RenderSettings settings = render::defaultSettingsFor(m_scene.view(), width, height);
         render::applyCaseRender(settings, caseRender, "scene.json"); // checked at load already
         const render::ToolPoses poses = render::toolPoses(world);
         render::viewThroughScope(settings, poses.scope); // the laparoscope at rest, where the case has one
-        m_tools = render::ToolMeshes(m_view, poses);     // after the framing: tissue only
+        m_scene.addTools(poses);                         // after the framing: tissue only
         settings.timePasses = false;                     // one wait per frame: the window shows the total only
         m_renderer = render::HeadlessRenderer::create(settings, &m_whyNot);
         if (m_renderer && softwareGl(m_renderer->description())) {
@@ -104,61 +101,19 @@ public:
             std::lock_guard<std::mutex> lock(m_live.mutex);
             m_snap = m_live.geometry;
         }
-        if (m_snap.nodes.size() == m_offset) apply(m_snap);
+        m_scene.apply(m_snap);
         if (m_snap.tools.scope.present) { // the camera follows the laparoscope
             render::RenderSettings s = m_renderer->settings();
             render::viewThroughScope(s, m_snap.tools.scope);
             m_renderer->setSettings(s);
         }
-        m_frameMs = m_renderer->renderFrame(m_view).totalMs;
+        m_frameMs = m_renderer->renderFrame(m_scene.view()).totalMs;
         const render::Image img = m_renderer->readPixels();
         QImage q(img.rgba.data(), img.width, img.height, img.width * 4, QImage::Format_RGBA8888);
         m_image = q.copy(); // own the pixels
     }
 
 private:
-    /// The copied geometry into the render meshes.
-    void apply(const LiveGeometry& g) {
-        // The fat's cut first: its cut mesh's slots name the nodes the copy below reads.
-        for (size_t b = 0; b < g.bodyTetMasks.size(); ++b)
-            if (!g.bodyTetMasks[b].empty()) m_view.setBodyCut(b, g.bodyTetMasks[b]);
-        for (size_t i = 0; i < m_view.meshes().size(); ++i) {
-            render::RenderMesh& m = m_view.meshes()[i];
-            const std::vector<sim::Vec3>* src = nullptr;
-            size_t base = 0;
-            if (m.source == render::RenderMesh::Source::Body && m.sourceIndex < m_bodyOffset.size()) {
-                src = &g.nodes;
-                base = m_bodyOffset[m.sourceIndex];
-            } else if (m.source == render::RenderMesh::Source::Surface && m.sourceIndex < g.surfaces.size()) {
-                src = &g.surfaces[m.sourceIndex];
-            }
-            if (!src) continue;
-            const size_t end = m.source == render::RenderMesh::Source::Body && m.sourceIndex + 1 < m_bodyOffset.size()
-                                   ? m_bodyOffset[m.sourceIndex + 1]
-                                   : src->size();
-            for (size_t v = 0; v < m.sourceVertex.size(); ++v) {
-                if (m.sourceVertex[v] < 0) continue;
-                const size_t k = base + static_cast<size_t>(m.sourceVertex[v]);
-                if (k >= end || k >= src->size()) continue;
-                for (int r = 0; r < 3; ++r)
-                    m.positions[3 * v + r] = static_cast<float>((*src)[k][r]);
-            }
-            m_view.recomputeNormals(i);
-            // The cut [A §5.3.1]: dropped faces and the heat tint along it.
-            const size_t s = m.sourceIndex;
-            const std::vector<float>* heat = nullptr;
-            if (m.source == render::RenderMesh::Source::Surface) {
-                if (s < g.surfaceMasks.size() && g.surfaceMasks[s].size() == m.triangleCount())
-                    m_view.setFaceMask(i, g.surfaceMasks[s]);
-                if (s < g.surfaceHeat.size()) heat = &g.surfaceHeat[s];
-            } else if (s < g.bodyHeat.size()) {
-                heat = &g.bodyHeat[s];
-            }
-            if (heat && !heat->empty()) m_view.setSourceHeat(i, *heat);
-        }
-        m_tools.update(m_view, g.tools);
-    }
-
     static bool softwareGl(const std::string& device) {
         for (const char* name : {"llvmpipe", "softpipe", "swrast", "SwiftShader"})
             if (device.find(name) != std::string::npos) return true;
@@ -166,11 +121,8 @@ private:
     }
     LiveView& m_live;
     LiveGeometry m_snap; ///< the last copy of the session's geometry (GUI thread)
-    render::SceneView m_view;
-    render::ToolMeshes m_tools;
+    LiveScene m_scene;
     std::unique_ptr<render::HeadlessRenderer> m_renderer;
-    std::vector<size_t> m_bodyOffset;
-    size_t m_offset = 0;
     std::string m_whyNot;
     QImage m_image;
     double m_frameMs = 0;
@@ -430,34 +382,7 @@ private:
             return;
         }
         if (!m_keyboard) return;
-        switch (e->key()) {
-        case Qt::Key_Left:
-            m_keyboard->setKey(KeyboardDevice::KeyLeft, down);
-            break;
-        case Qt::Key_Right:
-            m_keyboard->setKey(KeyboardDevice::KeyRight, down);
-            break;
-        case Qt::Key_Up:
-            m_keyboard->setKey(KeyboardDevice::KeyUp, down);
-            break;
-        case Qt::Key_Down:
-            m_keyboard->setKey(KeyboardDevice::KeyDown, down);
-            break;
-        case Qt::Key_PageUp:
-            m_keyboard->setKey(KeyboardDevice::KeyPageUp, down);
-            break;
-        case Qt::Key_PageDown:
-            m_keyboard->setKey(KeyboardDevice::KeyPageDown, down);
-            break;
-        case Qt::Key_Space:
-            m_keyboard->setKey(KeyboardDevice::KeyClutch, down);
-            break;
-        case Qt::Key_C: // held: the Cam pedal
-            m_keyboard->setKey(KeyboardDevice::KeyCamera, down);
-            break;
-        default:
-            break;
-        }
+        if (const auto k = keyboardKey(e->key())) m_keyboard->setKey(*k, down);
     }
     LiveView& m_live;
     std::string m_title, m_instructions;

@@ -11,6 +11,8 @@
 #include "app/port_tool.hpp"
 #include "app/project_tree_panel.hpp"
 #include "app/properties_panel.hpp"
+#include "app/rehearsal.hpp"
+#include "app/rehearse_panel.hpp"
 #include "app/scope_task_panel.hpp"
 #include "app/start_page.hpp"
 #include "app/surroundings_panel.hpp"
@@ -231,6 +233,14 @@ void MainWindow::buildDocks() {
     m_instruments = instruments;
     m_instrumentDock = dock("instrumentDock", tr("Instruments"), instrumentScroll, Qt::RightDockWidgetArea);
     tabifyDockWidget(plotsDock, m_instrumentDock);
+    m_rehearse = new RehearsePanel(&m_doc, this); // [issue 57 item 3] the case run as the player runs it
+    m_rehearse->setObjectName("rehearsePanel");
+    auto* rehearseScroll = new QScrollArea(this); // a short dock scrolls instead of clipping the verdict
+    rehearseScroll->setWidget(m_rehearse);
+    rehearseScroll->setWidgetResizable(true);
+    tabifyDockWidget(plotsDock, dock("rehearseDock", tr("Rehearse"), rehearseScroll, Qt::RightDockWidgetArea));
+    connect(m_rehearse, &RehearsePanel::refused, this, &MainWindow::showError);
+    connect(m_rehearse, &RehearsePanel::activeChanged, this, &MainWindow::onRehearsing);
     plotsDock->raise();
 }
 
@@ -367,6 +377,7 @@ void MainWindow::setViewportHost(ViewportHost host) {
         m_paint->connectViewport(nullptr);
         m_portTool->connectViewport(nullptr);
         m_targetTool->connectViewport(nullptr);
+        m_rehearse->connectViewport(nullptr);
         m_centre->removeWidget(old);
         delete old;
     }
@@ -382,6 +393,7 @@ void MainWindow::setViewportHost(ViewportHost host) {
     m_paint->connectViewport(v);
     m_portTool->connectViewport(v);
     m_targetTool->connectViewport(v);
+    m_rehearse->connectViewport(v);
     m_centre->addWidget(v);
     if (m_doc.hasProject()) m_centre->setCurrentWidget(v);
     m_viewport = v;
@@ -630,6 +642,7 @@ void MainWindow::onDocumentChanged(const Change& what) {
     if ((m_sel.body() >= static_cast<int>(p.bodies.size())) || (m_sel.surface() >= static_cast<int>(p.surfaces.size())))
         m_sel.clear();
     if (what.touches(Change::Structure)) m_viewport->setCaseRender(p.scene.render);
+    m_rehearse->refreshDevices(); // a new project has other replays
     updateTitle();
     submitPreview(what);
 }
@@ -670,7 +683,23 @@ QString MainWindow::setProperty(const QString& field, const QString& text) {
     return m_properties->setProperty(field, text);
 }
 
+void MainWindow::onRehearsing(bool on) {
+    if (on == m_rehearsing) return;
+    m_rehearsing = on;
+    if (on) {
+        // the viewport shows the session; the preview rests meanwhile (the CPU is the session's)
+        m_previewWasPaused = m_preview.paused();
+        m_preview.setPaused(true);
+        return;
+    }
+    m_preview.setPaused(m_previewWasPaused);
+    m_shownScene = 0; // the preview's scene comes back on the next poll
+    m_shownRevision = ~uint64_t(0);
+    pollPreview();
+}
+
 void MainWindow::pollPreview() {
+    if (m_rehearsing) return; // the viewport is the rehearsal's
     if (!m_doc.hasProject() || m_preview.revision() == m_shownRevision) return;
     m_shownRevision = m_preview.revision();
     const Preview::Snapshot s = m_preview.snapshot();

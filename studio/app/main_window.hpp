@@ -46,6 +46,7 @@ class PlotWidget;
 class StartPage;
 class TexturePanel;
 class AssessmentPanel;
+class RehearsePanel;
 
 class MainWindow : public QMainWindow {
     Q_OBJECT
@@ -105,6 +106,7 @@ public:
     /// Placing trocar ports in the viewport (port_tool.hpp).
     PortTool* portTool() { return m_portTool; }
     TargetTool* targetTool() { return m_targetTool; }
+    RehearsePanel* rehearsePanel() { return m_rehearse; }
     TetImport* tetImport() { return m_tetImport; }
     AnatomySteps* anatomySteps() { return m_anatomy; }
     StiffnessPainter* painter() { return m_paint->painter(); }
@@ -136,6 +138,8 @@ public:
     std::pair<uint64_t, uint64_t> lastPreviewSubmit() const { return m_lastSubmit; }
     /// Applies the preview's latest frame to the viewport and the plots (a 60 Hz timer calls it).
     void pollPreview();
+    /// A rehearsal took the viewport (on) or gave it back.
+    void onRehearsing(bool on);
 
 protected:
     void closeEvent(QCloseEvent*) override;
@@ -177,7 +181,9 @@ private:
     PaintTools* m_paint = nullptr;
     PortTool* m_portTool = nullptr;
     TetImport* m_tetImport = nullptr;
-    TargetTool* m_targetTool = nullptr; ///< [issue 57 item 2] the assessment's targets, drawn
+    TargetTool* m_targetTool = nullptr;  ///< [issue 57 item 2] the assessment's targets, drawn
+    RehearsePanel* m_rehearse = nullptr; ///< [issue 57 item 3] the case run in the viewport
+    bool m_rehearsing = false, m_previewWasPaused = false;
     InstrumentPanel* m_instruments = nullptr;
     QDockWidget* m_instrumentDock = nullptr;
     QDockWidget* m_scopeTaskDock = nullptr;
