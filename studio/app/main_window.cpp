@@ -225,6 +225,14 @@ void MainWindow::buildDocks() {
     surroundingsScroll->setWidgetResizable(true);
     tabifyDockWidget(plotsDock,
                      dock("surroundingsDock", tr("Surroundings"), surroundingsScroll, Qt::RightDockWidgetArea));
+    // a surrounding's maps are the Material maps dock's, as a body's are
+    connect(surroundings, &SurroundingsPanel::selectedChanged, this, [this](int k) {
+        if (k >= 0) m_texture->setTarget(TexturePanel::Target::Scenery, k);
+    });
+    connect(surroundings, &SurroundingsPanel::mapsRequested, this, [this](int k) {
+        m_texture->setTarget(TexturePanel::Target::Scenery, k);
+        if (auto* d = findChild<QDockWidget*>("textureDock")) d->raise();
+    });
     auto* instruments = new InstrumentPanel(&m_doc, this); // [issue 57]: the scene's instruments
     instruments->setObjectName("instrumentPanel");
     auto* instrumentScroll = new QScrollArea(this); // a short dock scrolls instead of clipping the fields

@@ -66,7 +66,10 @@ SurroundingsPanel::SurroundingsPanel(Document* doc, QWidget* parent) : QWidget(p
     m_addFloor->setToolTip(tr("A disc (the floor below the organs, an end wall)"));
     m_remove = new QPushButton(tr("Remove"), this);
     m_remove->setObjectName("removeScenery");
-    for (QPushButton* b : {m_addWall, m_addFloor, m_remove})
+    m_maps = new QPushButton(tr("Material maps…"), this);
+    m_maps->setObjectName("sceneryMaps");
+    m_maps->setToolTip(tr("The selected surrounding's texture: spec, tiles per metre, normal strength"));
+    for (QPushButton* b : {m_addWall, m_addFloor, m_remove, m_maps})
         buttons->addWidget(b);
     buttons->addStretch(1);
     layout->addLayout(buttons);
@@ -98,6 +101,10 @@ SurroundingsPanel::SurroundingsPanel(Document* doc, QWidget* parent) : QWidget(p
         if (m_filling) return;
         m_selected = row;
         fill();
+        emit selectedChanged(m_selected);
+    });
+    connect(m_maps, &QPushButton::clicked, this, [this] {
+        if (m_selected >= 0) emit mapsRequested(m_selected);
     });
     connect(m_addWall, &QPushButton::clicked, this, [this] { add(true); });
     connect(m_addFloor, &QPushButton::clicked, this, [this] { add(false); });
@@ -142,6 +149,7 @@ void SurroundingsPanel::fill() {
     m_facing->setCurrentIndex(s && !s->inward ? 1 : 0);
     m_facing->setEnabled(wall);
     m_remove->setEnabled(s != nullptr);
+    m_maps->setEnabled(s != nullptr);
     m_filling = false;
 }
 
@@ -193,6 +201,7 @@ void SurroundingsPanel::add(bool wall) {
     if (why.isEmpty()) m_selected = static_cast<int>(scenery.size()) - 1;
     show(why);
     fill();
+    if (why.isEmpty()) emit selectedChanged(m_selected);
 }
 
 void SurroundingsPanel::remove() {

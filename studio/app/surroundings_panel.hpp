@@ -7,6 +7,9 @@
 /// facing (inward: seen from inside), for a floor its centre and normal. Every value is one undo
 /// step through Document::editScenery, checked by the project reader's rule for "scenery"; a
 /// refused value shows the rule under the fields and the field shows the model's value again.
+/// The selected one's material maps (texture spec, tiles, normal strength, generator) are the
+/// Material maps dock's, as for a body: selecting one targets that dock (selectedChanged), and
+/// *Material maps…* brings it to the front (mapsRequested).
 #include <QString>
 #include <QWidget>
 #include <map>
@@ -34,7 +37,14 @@ public:
     QPushButton* addWallButton() { return m_addWall; }
     QPushButton* addFloorButton() { return m_addFloor; }
     QPushButton* removeButton() { return m_remove; }
+    QPushButton* mapsButton() { return m_maps; }
     int selected() const { return m_selected; }
+
+signals:
+    /// The selected primitive changed (-1: none).
+    void selectedChanged(int index);
+    /// *Material maps…*: the selected primitive's maps are wanted in front.
+    void mapsRequested(int index);
 
 private:
     void fill();
@@ -49,7 +59,7 @@ private:
     std::map<QString, QLineEdit*> m_fields;
     QComboBox* m_facing = nullptr;
     QLabel* m_error = nullptr;
-    QPushButton *m_addWall = nullptr, *m_addFloor = nullptr, *m_remove = nullptr;
+    QPushButton *m_addWall = nullptr, *m_addFloor = nullptr, *m_remove = nullptr, *m_maps = nullptr;
     int m_selected = -1;
     bool m_filling = false;
 };

@@ -645,22 +645,35 @@ bool TexturePanel::hasTarget() const {
     const Project& p = m_doc->project();
     if (m_kind == Target::Body) return m_index < static_cast<int>(p.bodies.size());
     if (m_kind == Target::Surface) return m_index < static_cast<int>(p.surfaces.size());
+    if (m_kind == Target::Scenery) return m_index < static_cast<int>(p.scenery.size());
     return false;
+}
+
+std::optional<TextureProject>& TexturePanel::textureSlot(Project& p, Target kind, int index) {
+    const auto i = static_cast<size_t>(index);
+    if (kind == Target::Body) return p.bodies.at(i).texture;
+    if (kind == Target::Surface) return p.surfaces.at(i).texture;
+    if (p.sceneryTextures.size() < p.scenery.size()) p.sceneryTextures.resize(p.scenery.size()); // one each
+    return p.sceneryTextures.at(i);
 }
 
 const TextureProject* TexturePanel::current() const {
     if (!hasTarget()) return nullptr;
     const Project& p = m_doc->project();
-    const std::optional<TextureProject>& t =
-        m_kind == Target::Body ? p.bodies[m_index].texture : p.surfaces[m_index].texture;
+    const auto i = static_cast<size_t>(m_index);
+    if (m_kind == Target::Scenery)
+        return i < p.sceneryTextures.size() && p.sceneryTextures[i] ? &*p.sceneryTextures[i] : nullptr;
+    const std::optional<TextureProject>& t = m_kind == Target::Body ? p.bodies[i].texture : p.surfaces[i].texture;
     return t ? &*t : nullptr;
 }
 
 QString TexturePanel::targetName() const {
     if (!hasTarget()) return {};
     const Project& p = m_doc->project();
-    return QString::fromStdString(m_kind == Target::Body ? p.bodies[m_index].scene.name
-                                                         : p.surfaces[m_index].scene.name);
+    const auto i = static_cast<size_t>(m_index);
+    return QString::fromStdString(m_kind == Target::Body      ? p.bodies[i].scene.name
+                                  : m_kind == Target::Surface ? p.surfaces[i].scene.name
+                                                              : p.scenery[i].name);
 }
 
 const bake::QuadtreeParams* TexturePanel::chosenQuadtree() const {
@@ -764,9 +777,10 @@ void TexturePanel::setTarget(Target kind, int index) {
 void TexturePanel::refresh() {
     const bool target = hasTarget();
     const TextureProject* t = current();
-    m_header->setText(!target                  ? tr("Select a body or a fascia surface")
-                      : m_kind == Target::Body ? tr("Body '%1'").arg(targetName())
-                                               : tr("Surface '%1'").arg(targetName()));
+    m_header->setText(!target                     ? tr("Select a body, a fascia surface or a surrounding")
+                      : m_kind == Target::Body    ? tr("Body '%1'").arg(targetName())
+                      : m_kind == Target::Surface ? tr("Surface '%1'").arg(targetName())
+                                                  : tr("Surrounding '%1'").arg(targetName()));
     for (QWidget* w : std::initializer_list<QWidget*>{m_spec, m_tiles, m_normal, m_apply, m_new})
         w->setEnabled(target);
     m_remove->setEnabled(t != nullptr);
@@ -958,7 +972,7 @@ void TexturePanel::setStatus(const QString& error) {
 
 QString TexturePanel::applyFields() {
     if (!hasTarget()) {
-        setStatus(tr("select a body or a fascia surface first"));
+        setStatus(tr("select a body, a fascia surface or a surrounding first"));
         return m_status->text();
     }
     QString why;
@@ -988,7 +1002,7 @@ QString TexturePanel::applyFields() {
     why = m_doc->edit(
         tr("Set the material maps of '%1'").arg(targetName()),
         [&](Project& p) {
-            (kind == Target::Body ? p.bodies[index].texture : p.surfaces[index].texture) = t;
+            textureSlot(p, kind, index) = t;
             // the project's rules first (the spec path lies inside the project folder, a generator
             // parses), then a spec file must parse: a block the preview and the export cannot bake
             // never enters the model
@@ -1002,7 +1016,7 @@ QString TexturePanel::applyFields() {
 
 QString TexturePanel::newGenerator() {
     if (!hasTarget()) {
-        setStatus(tr("select a body or a fascia surface first"));
+        setStatus(tr("select a body, a fascia surface or a surrounding first"));
         return m_status->text();
     }
     TextureProject t;
@@ -1014,9 +1028,8 @@ QString TexturePanel::newGenerator() {
     const Target kind = m_kind;
     const int index = m_index;
     const QString why = m_doc->edit(
-        tr("New material generator for '%1'").arg(targetName()),
-        [&](Project& p) { (kind == Target::Body ? p.bodies[index].texture : p.surfaces[index].texture) = t; }, 0,
-        Change{Change::Texture});
+        tr("New material generator for '%1'").arg(targetName()), [&](Project& p) { textureSlot(p, kind, index) = t; },
+        0, Change{Change::Texture});
     setStatus(why);
     return why;
 }
@@ -1030,8 +1043,7 @@ QString TexturePanel::removeTexture() {
     const int index = m_index;
     const QString why = m_doc->edit(
         tr("Remove the material maps of '%1'").arg(targetName()),
-        [&](Project& p) { (kind == Target::Body ? p.bodies[index].texture : p.surfaces[index].texture).reset(); }, 0,
-        Change{Change::Texture});
+        [&](Project& p) { textureSlot(p, kind, index).reset(); }, 0, Change{Change::Texture});
     setStatus(why);
     return why;
 }
@@ -1069,9 +1081,8 @@ QString TexturePanel::editGenerator(const QString& what, const void* source,
     const int index = m_index;
     const bool embedding = old->generator.empty();
     const QString why = m_doc->edit(
-        tr("%1 of '%2'").arg(what, targetName()),
-        [&](Project& p) { (kind == Target::Body ? p.bodies[index].texture : p.surfaces[index].texture) = t; },
-        m_lastMergeKey, Change{Change::Texture});
+        tr("%1 of '%2'").arg(what, targetName()), [&](Project& p) { textureSlot(p, kind, index) = t; }, m_lastMergeKey,
+        Change{Change::Texture});
     if (why.isEmpty()) {
         m_lastSource = source;
         m_lastUndoIndex = undo->index();

@@ -78,7 +78,7 @@ nlohmann::json defaultGenerator(const std::string& name);
 class TexturePanel : public QWidget {
     Q_OBJECT
 public:
-    enum class Target { None, Body, Surface };
+    enum class Target { None, Body, Surface, Scenery };
     static constexpr int kThumbnailSide = 256; ///< thumbnails cap the spec's size at this
 
     /// A pair of spin boxes editing one [lo, hi] range of a pattern.
@@ -89,8 +89,8 @@ public:
     explicit TexturePanel(Document* doc, QWidget* parent = nullptr);
     ~TexturePanel() override;
 
-    /// The body or surface whose texture block is shown (Target::None or an index out of range:
-    /// nothing is selected, the fields are disabled).
+    /// The body, surface or scenery primitive (a surrounding) whose texture block is shown
+    /// (Target::None or an index out of range: nothing is selected, the fields are disabled).
     void setTarget(Target kind, int index);
     Target targetKind() const { return m_kind; }
     int targetIndex() const { return m_index; }
@@ -208,6 +208,8 @@ private:
     /// The selection's texture block in the current model (null: none or nothing selected).
     const TextureProject* current() const;
     bool hasTarget() const;
+    /// The texture block of target `kind` `index` in `p` (a scenery primitive's made when missing).
+    static std::optional<TextureProject>& textureSlot(Project& p, Target kind, int index);
     QString targetName() const;
     /// What the thumbnails show: the model's block, or the spec file typed in the field.
     std::optional<TextureProject> previewBlock() const;

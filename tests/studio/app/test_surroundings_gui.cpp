@@ -5,6 +5,7 @@
 #include "app/document.hpp"
 #include "app/main_window.hpp"
 #include "app/surroundings_panel.hpp"
+#include "app/texture_panel.hpp"
 #include "gui_test_support.hpp"
 #include "window_fixture.hpp"
 
@@ -117,3 +118,59 @@ TEST_F(SurroundingsFixture, AddAndRemoveAreOneStepEachAndTheTreeListsThem) {
 }
 
 } // namespace
+
+TEST_F(SurroundingsFixture, ASurroundingsMaterialMapsAreEditedInTheMaterialMapsDockAsUndoSteps) {
+    const int wall = row("pelvic_wall");
+    ASSERT_GE(wall, 0);
+    const std::vector<std::optional<studio::TextureProject>> before = w->document()->project().sceneryTextures;
+    ASSERT_TRUE(before.at(static_cast<size_t>(wall)).has_value()) << "the sample's wall has a texture";
+    // a click on the wall's row, then Material maps…: the dock in front, on the wall
+    QListWidget* list = panel->list();
+    QTest::mouseClick(list->viewport(), Qt::LeftButton, {}, list->visualItemRect(list->item(wall)).center());
+    ASSERT_EQ(panel->selected(), wall);
+    QTest::mouseClick(panel->mapsButton(), Qt::LeftButton);
+    QCoreApplication::processEvents();
+    studio::TexturePanel* maps = w->texturePanel();
+    EXPECT_TRUE(maps->isVisible()) << "the Material maps dock came to the front";
+    EXPECT_EQ(maps->targetKind(), studio::TexturePanel::Target::Scenery);
+    EXPECT_EQ(maps->targetIndex(), wall);
+    EXPECT_EQ(maps->tilesField()->text(), "20");
+    // tiles per metre typed and applied: one undo step on the wall's block alone
+    const int steps = undo()->index();
+    maps->tilesField()->setFocus();
+    QTest::keyClick(maps->tilesField(), Qt::Key_A, Qt::ControlModifier);
+    QTest::keyClicks(maps->tilesField(), "32");
+    QTest::mouseClick(maps->applyButton(), Qt::LeftButton);
+    const auto& after = w->document()->project().sceneryTextures;
+    ASSERT_TRUE(after.at(static_cast<size_t>(wall)).has_value());
+    EXPECT_FLOAT_EQ(after[static_cast<size_t>(wall)]->tilesPerMetre, 32.0f)
+        << maps->statusLabel()->text().toStdString();
+    EXPECT_EQ(undo()->index(), steps + 1);
+    for (size_t k = 0; k < after.size(); ++k)
+        if (static_cast<int>(k) != wall) EXPECT_EQ(after[k], before[k]) << "scenery[" << k << "] untouched";
+    // a refused value: the rule shown, the model as it was
+    QTest::keyClick(maps->tilesField(), Qt::Key_A, Qt::ControlModifier);
+    QTest::keyClicks(maps->tilesField(), "-4");
+    QTest::mouseClick(maps->applyButton(), Qt::LeftButton);
+    EXPECT_THAT(maps->statusLabel()->text().toStdString(), HasSubstr("tiles_per_metre"));
+    EXPECT_FLOAT_EQ(w->document()->project().sceneryTextures[static_cast<size_t>(wall)]->tilesPerMetre, 32.0f);
+    EXPECT_EQ(undo()->index(), steps + 1);
+    // Remove, then undo twice: the sample's block again
+    QTest::mouseClick(maps->removeButton(), Qt::LeftButton);
+    EXPECT_FALSE(w->document()->project().sceneryTextures[static_cast<size_t>(wall)].has_value());
+    undo()->undo();
+    undo()->undo();
+    EXPECT_EQ(w->document()->project().sceneryTextures, before);
+    // a new floor has no maps; New generator gives it one as one step
+    QTest::mouseClick(panel->addFloorButton(), Qt::LeftButton);
+    const int floor = static_cast<int>(scenery().size()) - 1;
+    EXPECT_EQ(maps->targetIndex(), floor) << "the new floor is the one shown";
+    EXPECT_FALSE(maps->removeButton()->isEnabled()) << "no maps yet";
+    const int beforeNew = undo()->index();
+    QTest::mouseClick(maps->newButton(), Qt::LeftButton);
+    ASSERT_TRUE(w->document()->project().sceneryTextures.at(static_cast<size_t>(floor)).has_value())
+        << maps->statusLabel()->text().toStdString();
+    EXPECT_FALSE(w->document()->project().sceneryTextures[static_cast<size_t>(floor)]->generator.empty());
+    EXPECT_EQ(undo()->index(), beforeNew + 1);
+    test::saveShot("surroundings_material_maps");
+}
