@@ -5,12 +5,14 @@
 
 namespace viscera::haptics {
 
-RecordingDevice::RecordingDevice(Device& inner, double seconds, double interval)
-    : m_inner(inner), m_interval_ns(static_cast<int64_t>(std::max(interval, 1e-3) * 1e9)) {
+RecordingDevice::RecordingDevice(Device& inner, double seconds, double interval) : m_inner(inner) {
+    // NaN, negative or absurd requests become sane ones: 1 ms .. 10 s per sample, up to a day.
+    interval = std::isfinite(interval) ? std::clamp(interval, 1e-3, 10.0) : 0.01;
+    seconds = std::isfinite(seconds) ? std::clamp(seconds, 0.0, 86400.0) : 0.0;
+    m_interval_ns = static_cast<int64_t>(interval * 1e9);
     const int arms = std::clamp(inner.capabilities().arms, 1, kMaxArms);
-    // One row per arm per interval, and room for as many again for changes between them.
-    const double perArm = std::max(seconds, 0.0) / std::max(interval, 1e-3);
-    m_rows.resize(static_cast<size_t>(2.0 * arms * perArm) + 16);
+    // One row per arm per interval, a quarter more for the changes between them.
+    m_rows.resize(static_cast<size_t>(1.25 * arms * seconds / interval) + 16);
 }
 
 void RecordingDevice::poll(int64_t now_ns, DeviceState& out) {
@@ -50,15 +52,23 @@ void RecordingDevice::poll(int64_t now_ns, DeviceState& out) {
 }
 
 Trajectory RecordingDevice::trajectory() const {
-    Trajectory t;
+    // Two polls on one instant (a servo that caught up): the later one holds what the device
+    // said last, a press seen on it included.
+    std::array<std::vector<TrajectorySample>, kMaxArms> arms;
     const size_t n = m_count.load(std::memory_order_acquire);
     for (size_t i = 0; i < n; ++i) {
         const Row& r = m_rows[i];
-        const auto& arm = t.samples(r.arm);
-        if (!arm.empty() && !(r.t > arm.back().t)) continue; // two polls on one instant: the first
         if (!r.sample.pose.position.allFinite() || !r.sample.pose.orientation.coeffs().allFinite()) continue;
-        t.add(r.arm, r.sample);
+        std::vector<TrajectorySample>& a = arms[static_cast<size_t>(r.arm)];
+        if (!a.empty() && !(r.t > a.back().t))
+            a.back() = r.sample;
+        else
+            a.push_back(r.sample);
     }
+    Trajectory t;
+    for (int a = 0; a < kMaxArms; ++a)
+        for (const TrajectorySample& s : arms[static_cast<size_t>(a)])
+            t.add(a, s);
     return t;
 }
 

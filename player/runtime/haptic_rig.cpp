@@ -377,6 +377,8 @@ void HapticRig::beforeStep() {
             k.act = k.jaw < 0.2; // the grip squeezed shut fires the clip
             break;
         case sim::InstrumentDesc::Kind::Grasper:
+        case sim::InstrumentDesc::Kind::Scissors: // the jaws closing cut: the grip alone
+        case sim::InstrumentDesc::Kind::NeedleDriver:
             k.act = false;
             break;
         }

@@ -538,19 +538,22 @@ std::string portsAndAccuracySummary(const SessionResult& r) {
 
 } // namespace
 
-std::string assessmentSummary(const Assessment& a) {
-    std::string out;
-    for (const MetricResult& m : a.metrics)
-        out += "metric        " + metricLine(m) + "\n";
-    if (!a.judged) return out + "verdict       none (the case has no assessment)\n";
+std::string verdictText(const Assessment& a) {
+    if (!a.judged) return "none (the case has no assessment)";
     int failed = 0;
     std::string names;
     for (const MetricResult& m : a.metrics)
         if (!m.passed) names += (failed++ ? ", " : "") + m.name;
     const std::string detail = a.verdictDetail();
-    out += "verdict       " + std::string(a.passed ? "PASS" : "FAIL") + (a.passed ? "" : " (" + names + ")") +
-           (detail.empty() ? "" : "; " + detail) + "\n";
-    return out;
+    return std::string(a.passed ? "PASS" : "FAIL") + (a.passed ? "" : " (" + names + ")") +
+           (detail.empty() ? "" : "; " + detail);
+}
+
+std::string assessmentSummary(const Assessment& a) {
+    std::string out;
+    for (const MetricResult& m : a.metrics)
+        out += "metric        " + metricLine(m) + "\n";
+    return out + "verdict       " + verdictText(a) + "\n";
 }
 
 std::string summaryText(const SessionResult& r) {

@@ -29,6 +29,9 @@ std::string summaryText(const SessionResult& result);
 /// "metric        <metricLine>" per metric, then "verdict       PASS|FAIL (failed metrics);
 /// completion <s> s; within|not within the expert level" (or "none" without an assessment).
 std::string assessmentSummary(const Assessment& assessment);
+/// The verdict alone, as that summary's last line has it: "PASS; completion 5.88 s; within the
+/// expert level", "FAIL (clips_on_target, cut_coverage); ..." or "none (the case has no assessment)".
+std::string verdictText(const Assessment& assessment);
 /// One line: who signed the package (or that no trusted publisher did) and its SHA-256 and size.
 std::string packageSummary(const vcase::Provenance& package);
 

@@ -115,11 +115,12 @@ void TimelineRecorder::record(const sim::World& world) {
         }
         const int cut = s.fasciaEdgesCut + s.fatEdgesCut;
         if (cut > m_cut) {
-            std::string by; // the energized hook, else the first hook
+            std::string by; // the energized hook or the scissors that closed, else the first cutter
             Eigen::Vector3d at =
-                Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()); // no hook: nowhere
+                Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()); // no cutter: nowhere
             for (const sim::InstrumentState& st : s.instruments)
-                if (std::string_view(st.kind) == "energy_hook" && (by.empty() || st.act)) {
+                if ((std::string_view(st.kind) == "energy_hook" || std::string_view(st.kind) == "scissors") &&
+                    (by.empty() || st.act)) {
                     by = st.name;
                     at = st.tip;
                 }

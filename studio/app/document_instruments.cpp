@@ -173,6 +173,14 @@ sim::InstrumentDesc restingInstrument(const Project& p, Kind kind, const std::st
     sim::InstrumentDesc in;
     in.kind = kind;
     if (kind == Kind::ClipApplier) in.target = clipTarget(p);
+    if (kind == Kind::Scissors) { // long slim blades
+        in.jawLength = 0.014;
+        in.radius = 0.0015;
+    }
+    if (kind == Kind::NeedleDriver) { // short strong jaws
+        in.jawLength = 0.009;
+        in.radius = 0.002;
+    }
     in.device.declared = true;
     in.device.hand = hand;
     const Box box = bodiesBounds(p).value_or(Box{sim::Vec3::Zero(), sim::Vec3::Zero()});
@@ -259,7 +267,8 @@ QString Document::addInstrument(const QString& text, Kind kind, const std::strin
         [&](Project& q) {
             if (!q.scene.interaction) q.scene.interaction = sim::InteractionDesc{};
             sim::InteractionDesc& d = *q.scene.interaction;
-            if (kind == Kind::EnergyHook && d.tissues.empty()) d.tissues.push_back(defaultTissue(q));
+            if ((kind == Kind::EnergyHook || kind == Kind::Scissors) && d.tissues.empty())
+                d.tissues.push_back(defaultTissue(q)); // what they cut
             d.instruments.push_back(in);
             q.trackFiles.push_back(file);
         },

@@ -71,15 +71,7 @@ const InstrumentNumber* findNumber(const QString& key) {
 const char* const kHands[] = {"left", "right", "any"};
 
 QString kindLabel(Kind k) {
-    switch (k) {
-    case Kind::Grasper:
-        return QObject::tr("grasper");
-    case Kind::EnergyHook:
-        return QObject::tr("energy hook");
-    case Kind::ClipApplier:
-        return QObject::tr("clip applier");
-    }
-    return {};
+    return instrumentKindLabel(k);
 }
 
 const sim::InstrumentDesc* instrumentAt(const Document* doc, int i) {
@@ -89,6 +81,22 @@ const sim::InstrumentDesc* instrumentAt(const Document* doc, int i) {
 }
 
 } // namespace
+
+QString instrumentKindLabel(sim::InstrumentDesc::Kind k) {
+    switch (k) {
+    case Kind::Grasper:
+        return QObject::tr("grasper");
+    case Kind::EnergyHook:
+        return QObject::tr("energy hook");
+    case Kind::ClipApplier:
+        return QObject::tr("clip applier");
+    case Kind::Scissors:
+        return QObject::tr("scissors");
+    case Kind::NeedleDriver:
+        return QObject::tr("needle driver");
+    }
+    return {};
+}
 
 InstrumentPanel::InstrumentPanel(Document* doc, QWidget* parent) : QWidget(parent), m_doc(doc) {
     auto* layout = new QVBoxLayout(this);
@@ -100,9 +108,9 @@ InstrumentPanel::InstrumentPanel(Document* doc, QWidget* parent) : QWidget(paren
     auto* row = new QHBoxLayout;
     m_addKind = new QComboBox(this);
     m_addKind->setObjectName("instrumentAddKind");
-    for (Kind k : {Kind::Grasper, Kind::EnergyHook, Kind::ClipApplier})
+    for (Kind k : {Kind::Grasper, Kind::EnergyHook, Kind::ClipApplier, Kind::Scissors, Kind::NeedleDriver})
         m_addKind->addItem(kindLabel(k), static_cast<int>(k));
-    m_addKind->setToolTip(tr("The kind Add makes: a grasper on the left master, a hook or clip applier on the right"));
+    m_addKind->setToolTip(tr("The kind Add makes: a grasper on the left master, the others on the right"));
     row->addWidget(m_addKind, 1);
     m_add = new QPushButton(tr("Add"), this);
     m_add->setObjectName("instrumentAdd");

@@ -8,6 +8,8 @@
 /// angle limit, shaft length, laparoscopic or robotic mode). Every typed value is one undo step
 /// through Document::editInstrument, checked by the scene reader's rules; a refused value shows
 /// the rule under the fields and the field shows the model's value again.
+#include "sim/scene/interaction.hpp"
+
 #include <QString>
 #include <QWidget>
 
@@ -20,13 +22,13 @@ class QLineEdit;
 class QListWidget;
 class QPushButton;
 
-namespace viscera::sim {
-struct InstrumentDesc;
-}
-
 namespace viscera::studio {
 
 class Document;
+
+/// "grasper", "energy hook", "clip applier", "scissors", "needle driver": how the studio names a
+/// kind (the panel, the project tree).
+QString instrumentKindLabel(sim::InstrumentDesc::Kind kind);
 
 class InstrumentPanel : public QWidget {
     Q_OBJECT

@@ -98,6 +98,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), m_export(std::mak
 
 MainWindow::~MainWindow() {
     m_preview.stop();
+    if (m_rehearse) m_rehearse->disconnect(this); // a session ending now reports to no one
     // the docks hide as the children go: nothing may follow them into tools already deleted
     for (QDockWidget* d : findChildren<QDockWidget*>())
         d->disconnect();

@@ -1,5 +1,7 @@
 #include "app/project_tree_panel.hpp"
 
+#include "app/instrument_panel.hpp"
+
 #include "sim/material/material.hpp"
 
 #include <QAction>
@@ -136,7 +138,8 @@ void ProjectTreePanel::report(const QString& why) {
 }
 
 void ProjectTreePanel::onChanged(const Change& what) {
-    if (what.touches(Change::Structure)) return rebuild();
+    // the tree lists the instruments: a scene edit (add, remove, rename) rebuilds it too
+    if (what.touches(Change::Structure) || what.touches(Change::Scene)) return rebuild();
     if (!what.touches(Change::Material) || !m_doc->hasProject()) return;
     // a material edit: the material leaves' model names, in place
     const auto& bodies = m_doc->project().bodies;
@@ -201,9 +204,7 @@ void ProjectTreePanel::rebuild() {
         if (p.scene.interaction)
             for (size_t t = 0; t < p.scene.interaction->instruments.size(); ++t) {
                 const auto& in = p.scene.interaction->instruments[t];
-                const QString kind = in.kind == sim::InstrumentDesc::Kind::Grasper      ? tr("grasper")
-                                     : in.kind == sim::InstrumentDesc::Kind::EnergyHook ? tr("energy hook")
-                                                                                        : tr("clip applier");
+                const QString kind = instrumentKindLabel(in.kind);
                 leaf(instruments, QString::fromStdString(in.name),
                      tr("%1, %2 hand").arg(kind, QString::fromStdString(in.device.hand)), kindValue(K::Instrument),
                      static_cast<int>(t));

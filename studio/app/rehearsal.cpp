@@ -12,10 +12,14 @@
 #include <QRegularExpression>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <mutex>
 #include <thread>
+
+#include <unistd.h>
 
 namespace viscera::studio {
 
@@ -50,10 +54,14 @@ Rehearsal::Rehearsal(QObject* parent) : QObject(parent) {
     });
     connect(&m_export, &ExportRunner::finished, this, &Rehearsal::onExported);
     m_poll.setInterval(33);
-    connect(&m_poll, &QTimer::timeout, this, &Rehearsal::pollLive);
+    connect(&m_poll, &QTimer::timeout, this, [this] { pollLive(); });
 }
 
 Rehearsal::~Rehearsal() {
+    // Nothing is said any more: the window that listens may be half gone (the cancel below
+    // reports at once).
+    blockSignals(true);
+    m_export.disconnect(this);
     if (m_export.running()) m_export.cancel();
     m_run.reset(); // stops and joins the worker before the members it posts to go
 }
@@ -84,19 +92,25 @@ bool Rehearsal::start(const Project& project, const Options& options, QString* w
     m_tmp = std::make_unique<QTemporaryDir>(QDir::temp().filePath("viscera-rehearsal-XXXXXX"));
     if (!m_tmp->isValid())
         return refuse(tr("%1: no temporary folder for the rehearsal's package").arg(QDir::tempPath()));
-    ExportSigning unsignedPackage; // never leaves the studio: the session allows it
-    if (!m_export.start(project, m_tmp->filePath("rehearsal.vcase"), unsignedPackage, why)) return false;
     m_options = options;
     m_options.device = options.device.trimmed();
     m_outcome = Outcome{};
     m_outcome.device = m_options.device;
+    m_recorded = haptics::Trajectory{}; // a session that does not run leaves nothing to keep
     m_framesDone = 0;
-    setState(State::Exporting);
-    emit progress(tr("exporting the case"));
+    m_stopAsked = false;
+    setState(State::Exporting);    // before the start: a child that fails at once reports into this state
+    ExportSigning unsignedPackage; // never leaves the studio: the session allows it
+    if (!m_export.start(project, m_tmp->filePath("rehearsal.vcase"), unsignedPackage, why)) {
+        setState(State::Idle);
+        return false;
+    }
+    if (m_state == State::Exporting) emit progress(tr("exporting the case"));
     return true;
 }
 
 void Rehearsal::stop() {
+    m_stopAsked = m_state != State::Idle;
     if (m_state == State::Exporting)
         m_export.cancel(); // finished(false, "cancelled") follows
     else if (m_state == State::Running && m_run)
@@ -116,7 +130,7 @@ void Rehearsal::fail(const QString& why) {
 
 void Rehearsal::onExported(bool ok, const QString& message) {
     if (m_state != State::Exporting) return;
-    if (!ok) return fail(message == "cancelled" ? tr("rehearsal cancelled") : tr("export: %1").arg(message));
+    if (!ok) return fail(m_stopAsked ? tr("rehearsal stopped during the export") : tr("export: %1").arg(message));
     auto run = std::make_unique<Run>();
     run->spec = m_options.device.toStdString();
     try {
@@ -144,6 +158,7 @@ void Rehearsal::onExported(bool ok, const QString& message) {
                 std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch())
                     .count();
             player::LoadedCase loaded = player::loadCase(casePath, trust);
+            if (r->stop) throw std::runtime_error("rehearsal stopped while the case loaded");
             auto scene = std::make_unique<player::LiveScene>(loaded);
             scene->addTools(render::toolPoses(*loaded.world));
             {
@@ -182,28 +197,32 @@ void Rehearsal::onStarted() {
         m_scene = std::move(m_run->scene);
     }
     if (!m_scene) return;
+    m_appliedFrames = -1;
     m_poll.start();
     emit progress(m_run->keyboard ? tr("running: arrows, Page Up/Down and a drag move the tool; Space clutch")
                                   : tr("running %1").arg(m_options.device));
     emit started();
 }
 
-void Rehearsal::pollLive() {
+void Rehearsal::pollLive(bool always) {
     if (!m_run || !m_scene) return;
+    m_framesDone = m_run->framesDone.load(std::memory_order_relaxed);
+    if (!always && m_framesDone == m_appliedFrames) return; // no new frame: the viewport keeps its meshes
     player::LiveGeometry g;
     {
         std::lock_guard<std::mutex> lock(m_run->live.mutex);
         g = m_run->live.geometry;
     }
-    m_framesDone = m_run->framesDone.load(std::memory_order_relaxed);
-    if (m_scene->apply(g)) emit frame();
+    if (!m_scene->apply(g)) return;
+    m_appliedFrames = m_framesDone;
+    emit frame();
 }
 
 void Rehearsal::onDone() {
     if (!m_run) return;
     m_poll.stop();
     if (m_run->thread.joinable()) m_run->thread.join();
-    pollLive(); // the last frame
+    pollLive(true); // the last frame
     Run& r = *m_run;
     m_recorded = r.recorder ? r.recorder->trajectory() : haptics::Trajectory{};
     if (!r.ran) return fail(QString::fromStdString(r.error));
@@ -218,13 +237,14 @@ void Rehearsal::onDone() {
     o.physicsMs = s.frames.empty() ? 0 : sum / static_cast<double>(s.frames.size());
     o.judged = s.assessment.judged;
     o.passed = s.ok() && s.assessment.judged && s.assessment.passed;
-    const QString text = QString::fromStdString(player::assessmentSummary(s.assessment));
-    o.summary = text.split('\n', Qt::SkipEmptyParts);
-    o.verdict = o.summary.isEmpty() ? tr("no assessment") : o.summary.back().mid(14).trimmed();
+    o.summary = QString::fromStdString(player::assessmentSummary(s.assessment)).split('\n', Qt::SkipEmptyParts);
+    o.verdict = QString::fromStdString(player::verdictText(s.assessment));
+    o.recordingFull = r.recorder && r.recorder->full();
     if (!s.errors.empty())
         o.error = QString::fromStdString(s.errors.front());
     else if (!s.invariants.allFinite)
         o.error = tr("the session's state was not finite");
+    if (!o.error.isEmpty()) o.verdict = tr("FAIL (the session failed: %1)").arg(o.error);
     m_framesDone = o.frames;
     m_run.reset();
     setState(State::Idle);
@@ -242,6 +262,11 @@ QString Rehearsal::keepReplay(const std::filesystem::path& projectDir, const QSt
     if (!rule.match(name).hasMatch())
         return refuse(tr("replay name '%1': use 1 to 64 letters, digits, '-' or '_'").arg(name));
     if (m_recorded.arms() == 0) return refuse(tr("no session recorded yet: rehearse first"));
+    if (m_outcome.recordingFull)
+        return refuse(tr("the session ran longer than the recording holds (%1 s): rehearse a shorter one")
+                          .arg(m_recorded.duration(), 0, 'f', 0));
+    if (!m_outcome.ran || !m_outcome.error.isEmpty() || (m_outcome.judged && !m_outcome.passed))
+        return refuse(tr("a reference replay must pass its case: this session's verdict is %1").arg(m_outcome.verdict));
     const std::filesystem::path dir = projectDir / "replays";
     const std::filesystem::path file = dir / (name.toStdString() + ".csv");
     const QString shown = QString::fromStdString(file.string());
@@ -253,7 +278,15 @@ QString Rehearsal::keepReplay(const std::filesystem::path& projectDir, const QSt
                            m_outcome.device.toStdString() + ": " + m_outcome.verdict.toStdString() + "\n";
         const std::string body = m_recorded.format();
         text += body.substr(body.find('\n') + 1); // format() starts with the magic line
-        writeFileAtomic(file, text);
+        // Written whole beside it, then linked in: link() refuses a name that came meanwhile.
+        const std::filesystem::path part = dir / ("." + name.toStdString() + ".csv.part");
+        writeFileAtomic(part, text);
+        const int linked = ::link(part.c_str(), file.c_str());
+        const int err = errno;
+        std::filesystem::remove(part, ec);
+        if (linked != 0 && err == EEXIST) return refuse(tr("%1: exists; choose another name").arg(shown));
+        if (linked != 0)
+            return refuse(tr("%1: cannot be written: %2").arg(shown, QString::fromLocal8Bit(strerror(err))));
     } catch (const std::exception& e) {
         return refuse(QString::fromStdString(e.what()));
     }

@@ -47,13 +47,14 @@ public:
         bool ran = false;    ///< a session ran (false: the export, the load or the device failed)
         bool judged = false; ///< the case has an assessment (a verdict)
         bool passed = false;
-        QString verdict;      ///< "PASS", "FAIL (clips_on_target)" or "no assessment"
-        QStringList summary;  ///< the assessment's lines as the player prints them
-        QString device;       ///< the spec it ran with
-        int frames = 0;       ///< frames simulated
-        double physicsMs = 0; ///< mean physics time per frame
-        double frameDt = 0;   ///< s
-        QString error;        ///< why it did not run, or the session's first error
+        QString verdict;            ///< "PASS", "FAIL (clips_on_target)" or "no assessment"
+        QStringList summary;        ///< the assessment's lines as the player prints them
+        QString device;             ///< the spec it ran with
+        int frames = 0;             ///< frames simulated
+        double physicsMs = 0;       ///< mean physics time per frame
+        double frameDt = 0;         ///< s
+        QString error;              ///< why it did not run, or the session's first error
+        bool recordingFull = false; ///< the session outran the device's recording
     };
 
     explicit Rehearsal(QObject* parent = nullptr);
@@ -79,9 +80,11 @@ public:
     /// What the device did in the last session (empty before one ran).
     const haptics::Trajectory& recorded() const { return m_recorded; }
 
-    /// Writes the last session's device as `<project folder>/replays/<name>.csv` (atomically) and
-    /// returns its path; empty and `why` when the name is not [A-Za-z0-9_-]{1,64}, the file
-    /// exists, nothing was recorded or the folder cannot be written.
+    /// Writes the last session's device as `<project folder>/replays/<name>.csv` (never over a
+    /// file: written beside it, then linked in) and returns its path; empty and `why` when the name
+    /// is not [A-Za-z0-9_-]{1,64}, the file exists, nothing was recorded, the session did not pass
+    /// (a reference replay is a test that must pass: test_case_replays), outran the recording, or
+    /// the folder cannot be written.
     QString keepReplay(const std::filesystem::path& projectDir, const QString& name, QString* why) const;
 
 signals:
@@ -99,7 +102,8 @@ private:
     void onExported(bool ok, const QString& message);
     void onStarted();
     void onDone();
-    void pollLive();
+    /// The session's latest geometry into live() when a new frame came (`always`: in any case).
+    void pollLive(bool always = false);
     void fail(const QString& why);
     void setState(State s);
 
@@ -111,6 +115,8 @@ private:
     std::unique_ptr<player::LiveScene> m_scene;
     QTimer m_poll;
     int m_framesDone = 0;
+    int m_appliedFrames = -1; ///< the frames the scene shown was made after
+    bool m_stopAsked = false;
     Outcome m_outcome;
     haptics::Trajectory m_recorded;
 };

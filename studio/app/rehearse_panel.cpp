@@ -96,7 +96,11 @@ RehearsePanel::RehearsePanel(Document* doc, QWidget* parent)
     connect(m_keep, &QPushButton::clicked, this, [this] { keep(); });
     connect(m_rehearsal, &Rehearsal::progress, m_status, &QLabel::setText);
     connect(m_rehearsal, &Rehearsal::started, this, [this] {
-        if (m_viewport) m_viewport->setFocus();
+        m_dragging = false;
+        if (m_viewport) {
+            m_viewport->setRestPose(-1); // every mesh as the session moves it (a paint tool may have held one)
+            m_viewport->setFocus();
+        }
         showScene();
     });
     connect(m_rehearsal, &Rehearsal::frame, this, &RehearsePanel::showScene);
@@ -247,6 +251,15 @@ bool RehearsePanel::keyboardEvent(QEvent* event) {
         if (!m_dragging) return false;
         m_dragging = false;
         return true;
+    case QEvent::FocusOut:
+    case QEvent::WindowDeactivate:
+    case QEvent::Hide: {
+        // the releases would go elsewhere: nothing stays held, no drag carries on
+        for (uint32_t k = haptics::KeyboardDevice::KeyLeft; k <= haptics::KeyboardDevice::KeyCamera; k <<= 1)
+            kb->setKey(static_cast<haptics::KeyboardDevice::Key>(k), false);
+        m_dragging = false;
+        return false;
+    }
     case QEvent::Wheel: {
         auto* e = static_cast<QWheelEvent*>(event);
         if (e->modifiers() & Qt::AltModifier) return false;

@@ -10,7 +10,7 @@ namespace viscera::bake {
 namespace {
 
 /// The tube without its end caps: triangles with every vertex on an end plane are dropped.
-sim::TriMesh uncapped(const sim::TriMesh& tube, const sim::Vec3& a, const sim::Vec3& b) {
+sim::TriMesh uncapped(const sim::TriMesh& tube, const sim::Vec3& a, const sim::Vec3& b, const char* name = "ureter") {
     const sim::Vec3 axis = (b - a).normalized();
     const double length = (b - a).norm(), eps = 1e-9;
     std::vector<sim::Tri> kept;
@@ -23,7 +23,7 @@ sim::TriMesh uncapped(const sim::TriMesh& tube, const sim::Vec3& a, const sim::V
         }
         if (!atA && !atB) kept.push_back(t);
     }
-    return sim::TriMesh::fromArrays(tube.positions(), std::move(kept), "ureter");
+    return sim::TriMesh::fromArrays(tube.positions(), std::move(kept), name);
 }
 
 constexpr double kPi = std::numbers::pi;
@@ -178,6 +178,59 @@ std::vector<RemeshPart> kidneyAnatomy(int slices) {
     std::vector<CornerUv> arteryUv =
         tubeUv(artery, aa, ab, 0.003, {0.81, 0.14, 0.98, 0.48}, {0.81, 0.02, 0.885, 0.12}, {0.905, 0.02, 0.98, 0.12});
     parts.push_back({"artery", std::move(artery), CsgOp::Union, std::move(arteryUv)});
+    return parts;
+}
+
+std::vector<RemeshPart> hepatocysticAnatomy(int slices) {
+    std::vector<RemeshPart> parts;
+    // Liver: the right lobe's underside, a flattened ellipsoid; the triangles of its top (the bare
+    // area, z above 70 mm) are missing, as in a surface cut from a scan.
+    const sim::Vec3 lc(0, 0.01, 0.045), lr(0.09, 0.065, 0.03);
+    const sim::TriMesh liverWhole = sim::makeEllipsoidSurface(lc, lr, slices, slices / 2);
+    std::vector<CornerUv> liverUvWhole = latLongUv(liverWhole, lc, lr, {{0.02, 0.02, 0.58, 0.98}});
+    std::vector<sim::Tri> liverTris;
+    std::vector<CornerUv> liverUv;
+    for (size_t t = 0; t < liverWhole.triangles().size(); ++t) {
+        const sim::Tri& tri = liverWhole.triangles()[t];
+        const auto& x = liverWhole.positions();
+        if (x[tri[0]].z() > 0.07 && x[tri[1]].z() > 0.07 && x[tri[2]].z() > 0.07) continue; // the open top
+        liverTris.push_back(tri);
+        liverUv.push_back(liverUvWhole[t]);
+    }
+    parts.push_back({"liver", sim::TriMesh::fromArrays(liverWhole.positions(), std::move(liverTris), "liver"),
+                     CsgOp::Union, std::move(liverUv)});
+    // Gallbladder: a pear in its bed under the liver (its top 13 mm inside the liver), fundus at
+    // +y, tapering to the neck at −y; two UV islands (left and right halves).
+    const sim::Vec3 gc(0, -0.005, 0.012), gr(0.016, 0.042, 0.016);
+    const sim::TriMesh gallUndeformed = sim::makeEllipsoidSurface(gc, gr, slices / 2, slices / 4);
+    std::vector<CornerUv> gallUv =
+        latLongUv(gallUndeformed, gc, gr, {{0.62, 0.52, 0.79, 0.98}, {0.81, 0.52, 0.98, 0.98}});
+    std::vector<sim::Vec3> gp = gallUndeformed.positions();
+    for (sim::Vec3& x : gp) {
+        const double t = std::clamp((gc.y() - x.y()) / gr.y(), 0.0, 1.0); // 0 at the middle, 1 at the neck
+        const double k = 1.0 - 0.55 * t * t;
+        x.x() = gc.x() + k * (x.x() - gc.x());
+        x.z() = gc.z() + k * (x.z() - gc.z());
+    }
+    parts.push_back({"gallbladder", sim::TriMesh::fromArrays(std::move(gp), gallUndeformed.triangles(), "gallbladder"),
+                     CsgOp::Union, std::move(gallUv)});
+    // Cystic duct: an open tube from the neck down to the common bile duct.
+    const sim::Vec3 da(0, -0.043, 0.009), db(0.007, -0.072, 0.001);
+    sim::TriMesh duct = uncapped(sim::makeTubeSurface(da, db, 0.0025, slices / 4, slices / 4), da, db, "cystic_duct");
+    std::vector<CornerUv> ductUv = tubeUv(duct, da, db, 0.0025, {0.62, 0.27, 0.79, 0.48}, {}, {});
+    parts.push_back({"cystic_duct", std::move(duct), CsgOp::Union, std::move(ductUv)});
+    // Common bile duct: an open tube past the duct's end, overlapping it.
+    const sim::Vec3 ca(0.004, -0.055, 0.004), cb(0.013, -0.115, -0.008);
+    sim::TriMesh cbd =
+        uncapped(sim::makeTubeSurface(ca, cb, 0.004, slices / 4, slices / 4), ca, cb, "common_bile_duct");
+    std::vector<CornerUv> cbdUv = tubeUv(cbd, ca, cb, 0.004, {0.62, 0.02, 0.79, 0.23}, {}, {});
+    parts.push_back({"common_bile_duct", std::move(cbd), CsgOp::Union, std::move(cbdUv)});
+    // Cystic artery: a closed, capped tube up to the gallbladder's neck, its end inside it.
+    const sim::Vec3 aa(0.016, -0.07, 0.006), ab(0.006, -0.036, 0.012);
+    sim::TriMesh artery = sim::makeTubeSurface(aa, ab, 0.0015, slices / 6, slices / 6);
+    std::vector<CornerUv> arteryUv =
+        tubeUv(artery, aa, ab, 0.0015, {0.81, 0.14, 0.98, 0.48}, {0.81, 0.02, 0.885, 0.12}, {0.905, 0.02, 0.98, 0.12});
+    parts.push_back({"cystic_artery", std::move(artery), CsgOp::Union, std::move(arteryUv)});
     return parts;
 }
 

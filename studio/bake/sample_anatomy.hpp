@@ -22,4 +22,18 @@ namespace viscera::bake {
 /// `slices` sets the tessellation (the cortex has slices × slices/2 quads). Deterministic.
 std::vector<RemeshPart> kidneyAnatomy(int slices = 96);
 
+/// The hepatocystic triangle's anatomy made by code [issue 57 item 4], as bought render anatomy
+/// arrives: separate overlapping parts, some open, each with UVs in one atlas (the layout of
+/// hepatocysticAtlas in project/sample_hepatocystic.hpp). Metres, z up (the patient's anterior).
+///   "liver"             the right lobe's underside: a flattened ellipsoid 180 × 130 × 60 mm
+///                       whose top (the bare area) is missing: open; one island
+///   "gallbladder"       a pear 32 × 84 mm in its bed, its top 13 mm inside the liver, the fundus
+///                       at +y, tapering to the neck at −y; two islands
+///   "cystic_duct"       an open tube (radius 2.5 mm) from the neck to the common bile duct
+///   "common_bile_duct"  an open tube (radius 4 mm) past the cystic duct's end, overlapping it
+///   "cystic_artery"     a closed capped tube (radius 1.5 mm) whose end lies inside the neck;
+///                       three islands (side and caps)
+/// `slices` sets the tessellation. Deterministic.
+std::vector<RemeshPart> hepatocysticAnatomy(int slices = 64);
+
 } // namespace viscera::bake

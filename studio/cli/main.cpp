@@ -10,6 +10,7 @@
 //   viscera-studio mesh <project-dir> --body NAME [--project-file <json>] [-o out.vtet]
 //   viscera-studio texture <spec.json> -o <dir>
 //   viscera-studio sample kidney -o <project-dir>
+//   viscera-studio sample hepatocystic -o <folder>
 //
 // remesh runs the voxel remesh (bake/remesh.hpp) on the parts and prints its figures.
 //
@@ -45,6 +46,7 @@
 #include "project/project.hpp"
 #include "project/publishing.hpp"
 #include "project/remesh_cache.hpp"
+#include "project/sample_hepatocystic.hpp"
 #include "project/sample_kidney.hpp"
 #include "project/step_result.hpp"
 #include "sim/mesh/tet_io.hpp"
@@ -84,6 +86,7 @@ void usage(std::FILE* out) {
                "       viscera-studio mesh <project-dir> --body NAME [--project-file <json>] [-o out.vtet]\n"
                "       viscera-studio texture <spec.json> -o <dir>\n"
                "       viscera-studio sample kidney -o <project-dir>\n"
+               "       viscera-studio sample hepatocystic -o <folder>\n"
                "       viscera-studio replay <project-dir> -o <replay.csv> [--frames N]\n"
                "       viscera-studio --version\n",
                out);
@@ -154,12 +157,18 @@ constexpr const char* kRemeshHelp =
     "remesh (.vremesh) the studio's Apply moves into <project-dir>/cache for export to reuse.\n";
 constexpr const char* kSampleHelp =
     "usage: viscera-studio sample kidney -o <project-dir>\n"
+    "       viscera-studio sample hepatocystic -o <folder>\n"
     "\n"
     "Writes the kidney sample project, made by code: the kidney-like render anatomy (four\n"
     "overlapping parts with UV islands and seams) as anatomy/*.obj with UVs, its texture atlas\n"
     "anatomy/kidney.png, and a project.json whose body is made from them by the remesh block\n"
     "(voxel remesh, seam-cutting UV transfer, tetrahedralize). Export it with\n"
-    "'viscera-studio export <project-dir> -o kidney.vcase'.\n";
+    "'viscera-studio export <project-dir> -o kidney.vcase'.\n"
+    "\n"
+    "hepatocystic writes the anatomy of a cholecystectomy step as bought anatomy arrives, to import\n"
+    "in the studio (File > Import anatomy): liver, gallbladder, cystic_duct, common_bile_duct and\n"
+    "cystic_artery .obj (overlapping parts, the liver and the ducts open, UVs in one atlas) and the\n"
+    "atlas hepatocystic.png. No project is written: the case is built in the studio.\n";
 constexpr const char* kOpenHelp = "usage: viscera-studio open <project-dir>\n"
                                   "\n"
                                   "Opens the desktop studio on a project (without a folder: an empty studio).\n";
@@ -508,9 +517,16 @@ int parseCount(const std::string& flag, const std::string& v, int lo, int hi) {
 }
 
 int cmdSample(const std::vector<std::string>& args) {
-    if (args.size() != 3 || args[0] != "kidney" || args[1] != "-o")
-        throw std::invalid_argument("sample needs 'kidney -o <project-dir>' (the built-in sample is 'kidney')");
+    if (args.size() != 3 || (args[0] != "kidney" && args[0] != "hepatocystic") || args[1] != "-o")
+        throw std::invalid_argument(
+            "sample needs 'kidney -o <project-dir>' or 'hepatocystic -o <folder>' (the built-in samples)");
     const std::filesystem::path dir = args[2];
+    if (args[0] == "hepatocystic") {
+        const studio::HepatocysticFiles f = studio::writeHepatocysticAnatomy(dir);
+        std::printf("wrote %zu anatomy parts and the atlas %s into %s\n", f.parts.size(), f.atlas.filename().c_str(),
+                    dir.c_str());
+        return 0;
+    }
     std::error_code ec;
     std::filesystem::create_directories(dir, ec); // a failure is reported by the check
     requireWritableFile(dir / "project.json", "the sample project");

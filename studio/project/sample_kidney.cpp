@@ -1,5 +1,7 @@
 #include "project/sample_kidney.hpp"
 
+#include "project/sample_atlas.hpp"
+
 #include "bake/sample_anatomy.hpp"
 #include "bake/texture.hpp"
 #include "bake/uv_transfer.hpp"
@@ -14,36 +16,14 @@ namespace viscera::studio {
 namespace {
 
 /// The atlas the parts' UVs point into (bake::kidneyAnatomy): the cortex left, the pelvis's two
-/// islands upper right, the ureter and artery lower right. Tissue colours, with a faint grid of
-/// 16 lines per island so that a stretched or torn transfer shows.
+/// islands upper right, the ureter and artery lower right.
 bake::Rgb8Image kidneyAtlas(int size) {
-    struct Region {
-        double x0, y0, x1, y1;
-        bake::Rgb8 colour;
-    };
-    const Region regions[] = {{0.02, 0.02, 0.58, 0.98, {120, 38, 32}},   // cortex: dark red-brown
-                              {0.62, 0.52, 0.79, 0.98, {214, 186, 140}}, // pelvis front: fat-yellow
-                              {0.81, 0.52, 0.98, 0.98, {200, 170, 128}}, // pelvis back
-                              {0.62, 0.02, 0.79, 0.48, {222, 200, 170}}, // ureter: pale
-                              {0.81, 0.02, 0.98, 0.48, {170, 30, 36}}};  // artery and caps: red
-    bake::Rgb8Image img;
-    img.width = img.height = size;
-    img.pixels.assign(size_t(size) * size_t(size) * 3, 40);
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) {
-            const double u = (x + 0.5) / size, v = 1.0 - (y + 0.5) / size; // first row is v = 1
-            uint8_t* p = &img.pixels[(size_t(y) * size_t(size) + size_t(x)) * 3];
-            for (const Region& r : regions) {
-                if (u < r.x0 || u > r.x1 || v < r.y0 || v > r.y1) continue;
-                const double s = 16 * (u - r.x0) / (r.x1 - r.x0), t = 16 * (v - r.y0) / (r.y1 - r.y0);
-                const double line = std::min({std::abs(s - std::round(s)), std::abs(t - std::round(t))});
-                const double k = line < 0.06 ? 0.7 : 1.0;
-                p[0] = uint8_t(std::lround(k * r.colour.r));
-                p[1] = uint8_t(std::lround(k * r.colour.g));
-                p[2] = uint8_t(std::lround(k * r.colour.b));
-            }
-        }
-    return img;
+    const AtlasRegion regions[] = {{0.02, 0.02, 0.58, 0.98, {120, 38, 32}},   // cortex: dark red-brown
+                                   {0.62, 0.52, 0.79, 0.98, {214, 186, 140}}, // pelvis front: fat-yellow
+                                   {0.81, 0.52, 0.98, 0.98, {200, 170, 128}}, // pelvis back
+                                   {0.62, 0.02, 0.79, 0.48, {222, 200, 170}}, // ureter: pale
+                                   {0.81, 0.02, 0.98, 0.48, {170, 30, 36}}};  // artery and caps: red
+    return sampleAtlas(size, regions);
 }
 
 } // namespace

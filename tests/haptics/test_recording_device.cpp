@@ -87,11 +87,11 @@ TEST(RecordingDevice, ReplaysWhatTheDeviceDidWithItsPressesOnTheirTicks) {
 
 TEST(RecordingDevice, StopsRecordingWhenFullAndTheDeviceGoesOn) {
     ReplayDevice live(source());
-    RecordingDevice rec(live, 0.1, 0.01); // room for 2 × 0.1 s of two arms and 16 rows
+    RecordingDevice rec(live, 0.1, 0.01); // room for 1.25 × 0.1 s of two arms and 16 rows
     run(rec, 0, 1000);
     EXPECT_TRUE(rec.full());
     EXPECT_GT(rec.recordedSeconds(), 0.09);
-    EXPECT_LT(rec.recordedSeconds(), 0.3); // twice the rows asked for (room for changes), plus a few
+    EXPECT_LT(rec.recordedSeconds(), 0.25); // a quarter more rows than asked for (room for changes), plus 16
     DeviceState s;
     rec.poll(1000 * kMs, s); // still the live device's state
     EXPECT_NEAR(s.arms[0].measured_cp.position.x(), 0.1, 1e-9);
@@ -105,4 +105,33 @@ TEST(RecordingDevice, NothingPolledIsAnEmptyTrajectory) {
     EXPECT_EQ(rec.trajectory().arms(), 0);
     EXPECT_EQ(rec.samples(), 0u);
     EXPECT_FALSE(rec.full());
+}
+
+/// A device whose state the test sets.
+struct SetDevice final : LocalDevice {
+    DeviceCapabilities caps;
+    DeviceState state;
+    const DeviceCapabilities& capabilities() const override { return caps; }
+    void poll(int64_t, DeviceState& out) override { out = state; }
+    const char* backend() const override { return "set"; }
+};
+
+TEST(RecordingDevice, AbsurdSizesAreMadeSaneAndTwoPollsOnOneInstantKeepTheLater) {
+    SetDevice dev;
+    RecordingDevice nan(dev, std::nan(""), std::nan("")), negative(dev, -5, 1e9);
+    DeviceState s;
+    nan.poll(0, s);
+    negative.poll(0, s);
+    EXPECT_EQ(nan.samples(), 1u) << "one arm, the first poll";
+    EXPECT_EQ(negative.samples(), 1u) << "a tiny buffer still takes the first poll";
+    RecordingDevice rec(dev);
+    rec.poll(0, s);
+    rec.poll(10 * kMs, s); // a 10 ms sample
+    dev.state.arms[0].buttons = 1;
+    rec.poll(10 * kMs, s); // the same instant again, now pressed: a change, recorded
+    EXPECT_EQ(rec.samples(), 3u);
+    const Trajectory t = rec.trajectory();
+    ASSERT_EQ(t.samples(0).size(), 2u) << "one sample per instant";
+    EXPECT_NEAR(t.samples(0).back().t, 0.010, 1e-12);
+    EXPECT_EQ(t.samples(0).back().buttons, 1u) << "the later poll's press is kept";
 }

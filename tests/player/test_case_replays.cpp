@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 using namespace viscera;
 namespace fs = std::filesystem;
 
@@ -60,7 +62,17 @@ TEST(CaseReplays, TheSamplesHaveReplays) {
 
 TEST_P(CaseReplay, RunsToItsVerdict) {
     const Replay& r = GetParam();
-    const fs::path out = fs::temp_directory_path() / ("viscera-case-replay-" + testName({r, 0}) + ".vcase");
+    // a folder of this run's own (parallel build trees and runs never share it), gone at the end
+    struct Folder {
+        fs::path path;
+        ~Folder() {
+            std::error_code ec;
+            fs::remove_all(path, ec);
+        }
+    } folder{fs::temp_directory_path() /
+             ("viscera-case-replay-" + std::to_string(::getpid()) + "-" + testName({r, 0}))};
+    fs::create_directories(folder.path);
+    const fs::path out = folder.path / "case.vcase";
     const test::ProcessResult exported =
         test::sampleStudio({"export", r.project.string(), "-o", out.string()}); // signed with the sample key
     ASSERT_EQ(exported.exitCode, 0) << exported.err;
@@ -75,7 +87,6 @@ TEST_P(CaseReplay, RunsToItsVerdict) {
     o.device = &device;
     o.deviceSpec = "replay:" + r.file.string();
     const player::SessionResult s = player::runSession(loaded, o);
-    fs::remove(out);
     EXPECT_TRUE(s.ok()) << (s.errors.empty() ? "state not finite" : s.errors.front());
     EXPECT_EQ(static_cast<int>(s.frames.size()), o.frames);
     if (s.assessment.judged)

@@ -176,8 +176,15 @@ void Dissection::updateLayer(Layer& L, const EnergyTool& tool, const Vec3& from,
             if (L.heat[e] >= L.tissue.ignition) ignite.push_back(static_cast<int32_t>(e));
         }
     }
+    cutEdges(L, ignite, &tool, st);
+}
+
+void Dissection::cutEdges(Layer& L, const std::vector<int32_t>& edges, const EnergyTool* shrinkBy,
+                          DissectionLayerStats& st) {
+    EdgeStructure& E = L.edges;
+    const std::vector<Vec3>& x = L.tets ? m_sys->tetPositions(L.body) : m_sys->surfacePositions(L.body);
     m_newlyCut.clear();
-    for (int32_t e : ignite)
+    for (int32_t e : edges)
         if (E.dissect(static_cast<size_t>(e), &m_newlyCut)) ++st.edgesCut;
     st.primitivesCut = m_newlyCut.size();
     for (int32_t p : m_newlyCut) {
@@ -186,13 +193,13 @@ void Dissection::updateLayer(Layer& L, const EnergyTool& tool, const Vec3& from,
         else
             m_sys->setTriangleActive(L.body, p, false);
     }
-    if (L.tissue.shrinkage && !(L.tissue.shrink.array() == 1.0).all())
+    if (shrinkBy && L.tissue.shrinkage && !(L.tissue.shrink.array() == 1.0).all())
         for (int32_t p : m_newlyCut)
             for (int32_t e : E.edgesOf(p))
                 for (int32_t q : E.primitivesOf(e)) {
                     if (E.isCut(q) || L.shrunk[q]) continue;
                     L.shrunk[q] = 1;
-                    const Mat3 Fs = shrinkFrame(L, x, q, tool);
+                    const Mat3 Fs = shrinkFrame(L, x, q, *shrinkBy);
                     try {
                         if (L.tets)
                             m_sys->setTetRestShape(L.body, q, Fs);
@@ -207,6 +214,36 @@ void Dissection::updateLayer(Layer& L, const EnergyTool& tool, const Vec3& from,
     st.totalPrimitivesCut = E.cutPrimitiveCount();
     for (size_t e = 0; e < E.edgeCount(); ++e)
         if (!E.isDissected(e)) st.maxEdgeHeat = std::max(st.maxEdgeHeat, L.heat[e]);
+}
+
+DissectionFrameStats Dissection::shear(const Vec3& a, const Vec3& b, double radius) {
+    const std::string where = "sim::Dissection::shear(): ";
+    if (!a.allFinite() || !b.allFinite() || !std::isfinite(radius))
+        throw std::invalid_argument(where + "blade ends or radius not finite");
+    if (!(radius > 0)) throw std::invalid_argument(where + "radius is " + formatNumber(radius) + " (must be > 0)");
+    DissectionFrameStats st;
+    st.gridMin = m_heat.minTemperature();
+    st.gridMax = m_heat.maxTemperature();
+    for (std::optional<Layer>* Lp : {&m_fascia, &m_fat}) {
+        if (!Lp->has_value()) continue;
+        Layer& L = **Lp;
+        DissectionLayerStats& ls = Lp == &m_fascia ? st.fascia : st.fat;
+        const std::vector<Vec3>& x = L.tets ? m_sys->tetPositions(L.body) : m_sys->surfacePositions(L.body);
+        ls.vertexCount = x.size();
+        const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(radius), hi = a.cwiseMax(b) + Vec3::Constant(radius);
+        std::vector<int32_t> snipped;
+        for (size_t e = 0; e < L.edges.edgeCount(); ++e) {
+            if (L.edges.isDissected(e)) continue;
+            const Vec3& p = x[L.edges.edge(e)[0]];
+            const Vec3& q = x[L.edges.edge(e)[1]];
+            if ((p.cwiseMax(q).array() < lo.array()).any() || (p.cwiseMin(q).array() > hi.array()).any()) continue;
+            if (!(overlapFraction(a, b, radius, p, q) > 0)) continue;
+            ++ls.edgesTouched;
+            snipped.push_back(static_cast<int32_t>(e));
+        }
+        cutEdges(L, snipped, nullptr, ls); // a cold cut: no heat, no shrinking
+    }
+    return st;
 }
 
 Mat3 Dissection::shrinkFrame(const Layer& L, const std::vector<Vec3>& x, size_t p, const EnergyTool& tool) const {

@@ -115,6 +115,10 @@ public:
     /// the system and switches/reshapes its elements. Throws std::invalid_argument (changing
     /// nothing) on a non-finite or out-of-range tool or dt ≤ 0; valid input never throws.
     DissectionFrameStats update(const EnergyTool& tool, double dt);
+    /// A cold cut (scissors closing): every edge of each layer that passes within `radius` of the
+    /// blade segment a–b (m, world frame) is cut at once, with no heat and no shrinking. Throws
+    /// std::invalid_argument (changing nothing) on a non-finite segment or radius ≤ 0.
+    DissectionFrameStats shear(const Vec3& a, const Vec3& b, double radius);
 
     bool hasFascia() const { return m_fascia.has_value(); }
     bool hasFat() const { return m_fat.has_value(); }
@@ -151,6 +155,9 @@ private:
     };
     explicit Dissection(const HeatGridSettings& grid) : m_heat(grid) {}
     void updateLayer(Layer& L, const EnergyTool& tool, const Vec3& from, double dt, DissectionLayerStats& st);
+    /// Cuts `edges` of L (those not cut yet), switches off the elements that lost an edge and,
+    /// with `shrinkBy`, shrinks their neighbours [A eq. 5.12]; the layer's totals into `st`.
+    void cutEdges(Layer& L, const std::vector<int32_t>& edges, const EnergyTool* shrinkBy, DissectionLayerStats& st);
     Mat3 shrinkFrame(const Layer& L, const std::vector<Vec3>& x, size_t p, const EnergyTool& tool) const;
 
     XpbdSystem* m_sys = nullptr;

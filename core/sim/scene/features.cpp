@@ -51,8 +51,10 @@ std::vector<std::string> requiredFeatures(const SceneDesc& scene) {
     if (!scene.tools.empty()) f.push_back(kProbe);
     if (scene.interaction) {
         using K = InstrumentDesc::Kind;
-        if (scene.interaction->has(K::Grasper) || scene.interaction->has(K::EnergyHook)) f.push_back(kCollision);
-        if (scene.interaction->has(K::EnergyHook)) f.push_back(kDissection);
+        if (scene.interaction->has(K::Grasper) || scene.interaction->has(K::EnergyHook) ||
+            scene.interaction->has(K::Scissors) || scene.interaction->has(K::NeedleDriver))
+            f.push_back(kCollision);
+        if (scene.interaction->has(K::EnergyHook) || scene.interaction->has(K::Scissors)) f.push_back(kDissection);
         if (scene.interaction->has(K::ClipApplier)) f.push_back(kClip);
     }
     if (scene.suture) {

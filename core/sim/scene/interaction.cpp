@@ -22,6 +22,10 @@ const char* kindName(InstrumentDesc::Kind k) {
         return "energy_hook";
     case InstrumentDesc::Kind::ClipApplier:
         return "clip_applier";
+    case InstrumentDesc::Kind::Scissors:
+        return "scissors";
+    case InstrumentDesc::Kind::NeedleDriver:
+        return "needle_driver";
     }
     return "?";
 }
@@ -44,13 +48,12 @@ InteractionDesc readInteractionSection(const JsonField& doc) {
         j.object({"name", "kind", "track", "radius", "jaw_length", "temperature_c", "target", "device", "port"});
         InstrumentDesc in;
         in.name = readName(j["name"], names); // it names the track file of the case
-        const std::string kind = j["kind"].choice({"grasper", "energy_hook", "clip_applier"}, "an instrument");
-        if (kind == "grasper")
-            in.kind = InstrumentDesc::Kind::Grasper;
-        else if (kind == "energy_hook")
-            in.kind = InstrumentDesc::Kind::EnergyHook;
-        else
-            in.kind = InstrumentDesc::Kind::ClipApplier;
+        const std::string kind =
+            j["kind"].choice({"grasper", "energy_hook", "clip_applier", "scissors", "needle_driver"}, "an instrument");
+        for (InstrumentDesc::Kind k :
+             {InstrumentDesc::Kind::Grasper, InstrumentDesc::Kind::EnergyHook, InstrumentDesc::Kind::ClipApplier,
+              InstrumentDesc::Kind::Scissors, InstrumentDesc::Kind::NeedleDriver})
+            if (kind == kindName(k)) in.kind = k;
         in.trackPath = j["track"].entryPath();
         in.radius = j.number("radius", in.radius, NumberRule::closed(2e-4, 0.02));
         in.jawLength = j.number("jaw_length", in.jawLength, NumberRule::closed(1e-3, 0.05));
@@ -87,6 +90,8 @@ InteractionDesc readInteractionSection(const JsonField& doc) {
     }
     if (d.has(InstrumentDesc::Kind::EnergyHook) && d.tissues.empty())
         doc.failAt("tissues", "an energy_hook needs at least one tissue with an ignition temperature");
+    if (d.has(InstrumentDesc::Kind::Scissors) && d.tissues.empty())
+        doc.failAt("tissues", "scissors need at least one tissue to cut");
     return d;
 }
 

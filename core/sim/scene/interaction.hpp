@@ -11,10 +11,15 @@
 ///      "radius": 0.0012, "temperature_c": 170},                      → features collision, dissection
 ///     {"name": "clipper", "kind": "clip_applier", "track": "tools/clipper.track",
 ///      "target": "vessel", "jaw_length": 0.008}                      → features collision, clip
+///     {"name": "scissors", "kind": "scissors", "track": "tools/scissors.track",
+///      "radius": 0.0015, "jaw_length": 0.014}                        → features collision, dissection
+///     {"name": "driver", "kind": "needle_driver", "track": "tools/driver.track",
+///      "radius": 0.002, "jaw_length": 0.009}                         → features collision
 ///   ],
 ///   "tissues": [{"layer": "fascia", "ignition_c": 160, "conductivity": 0.4,
 ///                "shrink": [0.1, 0.3, 1.0]}]                         what the energy hook can cut
 /// }
+/// "tissues" lists what the energy hook and the scissors can cut (at least one with either).
 /// An instrument may also name the master that drives it when the player runs with a device:
 ///   "device": {"hand": "left", "motion_scale": 0.25, "force_scale": 1.0, "max_force_n": 15,
 ///              "damage_force_n": 4, "grip_open_rad": 1.0}                 all optional
@@ -28,7 +33,10 @@
 /// position; its shaft points along the track's direction. Grasper: jaws (two capsules) that
 /// hold the surface vertices between them while closed (jaw < 0.5). Energy hook: a capsule whose
 /// tip sphere is the heat source while act = 1. Clip applier: fires a clip onto `target` at the
-/// first key with act = 1; the clip then follows the vessel [A §5.4].
+/// first key with act = 1; the clip then follows the vessel [A §5.4]. Scissors: jaws that cut
+/// (a cold cut, sim::Dissection::shear) every tissue edge within `radius` of the blade (the jaw
+/// length back from the tip) each time they close (jaw falls below 0.5 from above it). Needle
+/// driver: short, strong jaws that hold what lies between them while closed, as a grasper's.
 /// Units SI; temperatures °C. Parsing is strict; errors name the origin, the field and the rule.
 #include "sim/scene/device_mapping.hpp"
 #include "sim/scene/instrument_track.hpp"
@@ -50,7 +58,11 @@ struct InstrumentDeviceDesc : DeviceMapping {
 };
 
 struct InstrumentDesc {
-    enum class Kind { Grasper, EnergyHook, ClipApplier };
+    enum class Kind { Grasper, EnergyHook, ClipApplier, Scissors, NeedleDriver };
+    /// Jaws that open and close (grasper, clip applier, scissors, needle driver; not the hook).
+    bool hasJaws() const { return kind != Kind::EnergyHook; }
+    /// Jaws that hold the tissue between them while closed (grasper, needle driver).
+    bool holds() const { return kind == Kind::Grasper || kind == Kind::NeedleDriver; }
     std::string name;
     Kind kind = Kind::Grasper;
     std::string trackPath;     ///< file inside the case

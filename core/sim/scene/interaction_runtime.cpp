@@ -64,6 +64,9 @@ struct InteractionRuntime::Instrument {
     std::vector<int32_t> held;   ///< collision-surface vertices
     std::vector<Vec3> heldLocal; ///< in the instrument frame at the grasp
     ToolShape::Pose pose = ToolShape::Pose::Identity();
+    // scissors
+    bool open = true;  ///< the jaws were open (armed for the next snip)
+    bool snip = false; ///< they closed this frame: the blade cuts
     // clip applier
     size_t target = 0;  ///< tet body it clips
     bool fired = false; ///< fired during this squeeze (act held)
@@ -85,6 +88,49 @@ struct InteractionRuntime::Clip {
 };
 
 InteractionRuntime::~InteractionRuntime() = default;
+
+void InteractionRuntime::makeDissection(const SceneDesc& scene, XpbdSystem& system,
+                                        const std::vector<const TetMesh*>& bodies,
+                                        const std::vector<const TriMesh*>& surfaces, const std::string& origin) {
+    const InteractionDesc& desc = *scene.interaction;
+    auto fail = [&](const std::string& field, const std::string& rule) {
+        throw InputError(origin + ": interaction." + field + ": " + rule);
+    };
+    DissectionDesc dd;
+    dd.system = &system;
+    for (const DissectionTissueDesc& t : desc.tissues) {
+        TissueDissectionParams p;
+        p.ignition = t.ignitionC;
+        p.conductivity = t.conductivity;
+        p.shrink = t.shrink;
+        bool found = false;
+        for (size_t s = 0; s < scene.surfaces.size() && !found; ++s)
+            if (scene.surfaces[s].name == t.layer) {
+                if (dd.fascia) fail("tissues", "only one surface layer can be dissected");
+                dd.fascia = surfaces[s];
+                dd.surface = s;
+                dd.fasciaTissue = p;
+                m_dissectSurface = s;
+                found = true;
+            }
+        for (size_t b = 0; b < scene.bodies.size() && !found; ++b)
+            if (scene.bodies[b].name == t.layer) {
+                if (dd.fat) fail("tissues", "only one tet body can be dissected");
+                dd.fat = bodies[b];
+                dd.tetBody = b;
+                dd.fatTissue = p;
+                m_dissectBody = b;
+                found = true;
+            }
+        if (!found) fail("tissues", "'" + t.layer + "' is not a body or surface of the scene");
+    }
+    try {
+        m_dissection = Dissection::create(dd);
+    } catch (const std::invalid_argument& e) {
+        fail("tissues", e.what());
+    }
+    if (dd.fascia) m_summary.fasciaVertices = m_summary.fasciaVerticesAtStart = dd.fascia->vertexCount();
+}
 
 std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& scene, XpbdSystem& system,
                                                                const std::vector<const TetMesh*>& bodies,
@@ -141,6 +187,8 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
         }
         switch (in->desc.kind) {
         case InstrumentDesc::Kind::Grasper:
+        case InstrumentDesc::Kind::Scissors:
+        case InstrumentDesc::Kind::NeedleDriver:
             in->shape =
                 std::make_unique<ToolShape>(ToolShape::jaws(in->desc.jawLength, in->desc.radius, kMaxJawOpening));
             break;
@@ -168,42 +216,8 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
         r->m_instruments.push_back(std::move(in));
     }
 
-    if (desc.has(InstrumentDesc::Kind::EnergyHook)) {
-        DissectionDesc dd;
-        dd.system = &system;
-        for (const DissectionTissueDesc& t : desc.tissues) {
-            TissueDissectionParams p;
-            p.ignition = t.ignitionC;
-            p.conductivity = t.conductivity;
-            p.shrink = t.shrink;
-            bool found = false;
-            for (size_t s = 0; s < scene.surfaces.size() && !found; ++s)
-                if (scene.surfaces[s].name == t.layer) {
-                    if (dd.fascia) fail("tissues", "only one surface layer can be dissected");
-                    dd.fascia = surfaces[s];
-                    dd.surface = s;
-                    dd.fasciaTissue = p;
-                    r->m_dissectSurface = s;
-                    found = true;
-                }
-            for (size_t b = 0; b < scene.bodies.size() && !found; ++b)
-                if (scene.bodies[b].name == t.layer) {
-                    if (dd.fat) fail("tissues", "only one tet body can be dissected");
-                    dd.fat = bodies[b];
-                    dd.tetBody = b;
-                    dd.fatTissue = p;
-                    r->m_dissectBody = b;
-                    found = true;
-                }
-            if (!found) fail("tissues", "'" + t.layer + "' is not a body or surface of the scene");
-        }
-        try {
-            r->m_dissection = Dissection::create(dd);
-        } catch (const std::invalid_argument& e) {
-            fail("tissues", e.what());
-        }
-        if (dd.fascia) r->m_summary.fasciaVertices = r->m_summary.fasciaVerticesAtStart = dd.fascia->vertexCount();
-    }
+    if (desc.has(InstrumentDesc::Kind::EnergyHook) || desc.has(InstrumentDesc::Kind::Scissors))
+        r->makeDissection(scene, system, bodies, surfaces, origin);
     InteractionRuntime* self = r.get();
     system.setIterationHook([self](XpbdParticles& p, const XpbdIterationInfo& info) { self->runHook(p, info); });
     // The hook touches the collision surface's particles only (contacts, grasped vertices), and
@@ -305,8 +319,7 @@ void InteractionRuntime::beforeStep(double t, double dt) {
         if (in.shape) {
             // Jaws and the hook's shaft end at the track's tip: the frame origin sits one jaw
             // length (grasper) or half the shaft piece (hook capsule centre) behind it.
-            const double back =
-                in.desc.kind == InstrumentDesc::Kind::Grasper ? in.desc.jawLength : 0.5 * in.desc.jawLength;
+            const double back = in.desc.hasJaws() ? in.desc.jawLength : 0.5 * in.desc.jawLength;
             in.pose = framePose(in.key.position - back * dir, dir, in.key.roll);
             in.shape->setPose(in.pose);
             in.shape->setOpening(kMaxJawOpening * in.key.jaw);
@@ -314,7 +327,13 @@ void InteractionRuntime::beforeStep(double t, double dt) {
             const bool near = (box[0].array() <= hi.array()).all() && (box[1].array() >= lo.array()).all();
             in.colliding = near && !(in.desc.kind == InstrumentDesc::Kind::EnergyHook && in.key.act);
         }
-        if (in.desc.kind == InstrumentDesc::Kind::Grasper) {
+        if (in.desc.kind == InstrumentDesc::Kind::Scissors) {
+            // a snip as the jaws close (from open to below the grasp threshold): cut once, re-armed
+            // when they open again
+            in.snip = in.open && in.key.jaw < kGraspClose;
+            in.open = in.key.jaw > kGraspClose;
+        }
+        if (in.desc.holds()) {
             if (!in.holding && in.key.jaw < kGraspClose) {
                 in.holding = true;
                 in.held.clear();
@@ -347,6 +366,14 @@ void InteractionRuntime::beforeStep(double t, double dt) {
     if (m_dissection) {
         t0 = std::chrono::steady_clock::now();
         for (auto& inp : m_instruments) {
+            if (inp->desc.kind == InstrumentDesc::Kind::Scissors && inp->snip) {
+                try { // the blade: the jaws from the clevis to the tip
+                    const Vec3 tip = inp->key.position;
+                    recordCut(
+                        m_dissection->shear(tip - inp->desc.jawLength * inp->key.direction, tip, inp->desc.radius));
+                } catch (const std::invalid_argument&) { // a non-finite pose: no cut this frame
+                }
+            }
             if (inp->desc.kind != InstrumentDesc::Kind::EnergyHook) continue;
             EnergyTool tool;
             tool.centre = inp->key.position;
@@ -354,19 +381,22 @@ void InteractionRuntime::beforeStep(double t, double dt) {
             tool.temperature = inp->desc.temperatureC;
             tool.energized = inp->key.act;
             try {
-                const DissectionFrameStats st = m_dissection->update(tool, dt);
-                m_summary.fasciaEdgesCut = static_cast<int>(st.fascia.totalEdgesCut);
-                m_summary.fasciaTrianglesCut = static_cast<int>(st.fascia.totalPrimitivesCut);
-                m_summary.fatEdgesCut = static_cast<int>(st.fat.totalEdgesCut);
-                m_summary.fatTetsCut = static_cast<int>(st.fat.totalPrimitivesCut);
-                if (m_dissection->hasFascia()) m_summary.fasciaVertices = st.fascia.vertexCount;
-                m_summary.maxEdgeHeat = std::max({m_summary.maxEdgeHeat, st.fascia.maxEdgeHeat, st.fat.maxEdgeHeat});
-                m_summary.gridMaxC = std::max(m_summary.gridMaxC, st.gridMax);
+                recordCut(m_dissection->update(tool, dt));
             } catch (const std::invalid_argument&) { // a non-finite tool pose: no heat this frame
             }
         }
         m_summary.dissectionMs += msSince(t0);
     }
+}
+
+void InteractionRuntime::recordCut(const DissectionFrameStats& st) {
+    m_summary.fasciaEdgesCut = static_cast<int>(st.fascia.totalEdgesCut);
+    m_summary.fasciaTrianglesCut = static_cast<int>(st.fascia.totalPrimitivesCut);
+    m_summary.fatEdgesCut = static_cast<int>(st.fat.totalEdgesCut);
+    m_summary.fatTetsCut = static_cast<int>(st.fat.totalPrimitivesCut);
+    if (m_dissection->hasFascia()) m_summary.fasciaVertices = st.fascia.vertexCount;
+    m_summary.maxEdgeHeat = std::max({m_summary.maxEdgeHeat, st.fascia.maxEdgeHeat, st.fat.maxEdgeHeat});
+    m_summary.gridMaxC = std::max(m_summary.gridMaxC, st.gridMax);
 }
 
 void InteractionRuntime::runHook(XpbdParticles& particles, const XpbdIterationInfo& info) {
@@ -408,7 +438,7 @@ void InteractionRuntime::afterStep() {
         s.tip = in.key.position;
         s.direction = in.key.direction;
         s.jaw = in.key.jaw;
-        s.act = in.key.act;
+        s.act = in.desc.kind == InstrumentDesc::Kind::Scissors ? in.snip : in.key.act; // scissors: cut this frame
         s.contacts = in.collision && in.colliding ? in.collision->stats().contacts : 0;
         s.grasped = static_cast<int>(in.held.size());
         s.force = in.force;

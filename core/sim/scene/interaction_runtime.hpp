@@ -131,6 +131,11 @@ private:
     struct Clip;
     InteractionRuntime() = default;
     void runHook(XpbdParticles& particles, const XpbdIterationInfo& info);
+    /// The dissection of the tissues the hook and the scissors cut (InputError naming the field).
+    void makeDissection(const SceneDesc& scene, XpbdSystem& system, const std::vector<const TetMesh*>& bodies,
+                        const std::vector<const TriMesh*>& surfaces, const std::string& origin);
+    /// A cut's totals (hook or scissors) into the summary.
+    void recordCut(const DissectionFrameStats& st);
     void fireClip(Instrument& in, double t);
 
     XpbdSystem* m_sys = nullptr;

@@ -53,7 +53,7 @@ std::optional<PortFrame> instrumentPortFrame(const InstrumentDesc& in) {
 std::vector<ReachTarget> targetsToReach(const InstrumentDesc& instrument, const AssessmentDesc& a) {
     const InstrumentDesc::Kind kind = instrument.kind;
     std::vector<ReachTarget> out;
-    if (kind == InstrumentDesc::Kind::EnergyHook)
+    if (kind == InstrumentDesc::Kind::EnergyHook || kind == InstrumentDesc::Kind::Scissors)
         for (size_t c = 0; c < a.cuts.size(); ++c)
             out.push_back({"assessment.targets.cut[" + std::to_string(c) + "]", linePoints(a.cuts[c].line)});
     if (kind == InstrumentDesc::Kind::ClipApplier)

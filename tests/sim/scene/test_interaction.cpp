@@ -53,7 +53,8 @@ TEST(Interaction, RejectsBadSectionsNamingTheField) {
     EXPECT_THAT(sectionError(R"({"instruments": []})"),
                 HasSubstr("interaction.instruments: must have 1 to 8 elements"));
     EXPECT_THAT(sectionError(R"({"instruments": [{"name": "g", "kind": "saw", "track": "t"}]})"),
-                HasSubstr("instruments[0].kind: 'saw' is not an instrument (grasper, energy_hook, clip_applier)"));
+                HasSubstr("instruments[0].kind: 'saw' is not an instrument (grasper, energy_hook, clip_applier, "
+                          "scissors, needle_driver)"));
     EXPECT_THAT(sectionError(R"({"instruments": [{"name": "g", "kind": "grasper", "track": "/etc/t"}]})"),
                 HasSubstr("instruments[0].track: '/etc/t': absolute entry path"));
     EXPECT_THAT(
@@ -154,4 +155,100 @@ TEST(Interaction, WorldGraspsCutsAndClipsAndIsRepeatable) {
     ASSERT_EQ(a.size(), b.size());
     for (size_t i = 0; i < a.size(); ++i)
         ASSERT_EQ(a[i], b[i]) << "repeat runs are bit-identical (vertex " << i << ")";
+}
+
+namespace {
+/// The rig with scissors (and a needle driver) instead of its hook and clip applier. The scissors
+/// come down open onto the fascia along y at x = 2 cm, close at 0.30 s (a snip), open at 0.45 s,
+/// move 1 cm along y and close again at 0.75 s. The needle driver closes on the fascia at x = 1 cm.
+Rig scissorsRig(bool close) {
+    Rig r = makeRig();
+    InteractionDesc& in = *r.scene.interaction;
+    InstrumentDesc sc;
+    sc.name = "scissors";
+    sc.kind = InstrumentDesc::Kind::Scissors;
+    sc.trackPath = "tools/scissors.track";
+    sc.radius = 0.0008;
+    sc.jawLength = 0.012;
+    const char* jaw = close ? "0" : "1";
+    sc.trackText = std::string(kHeader) + "0.00 0.020 0.016 0.020 0 1 0 1 0\n" + // open, shaft along +y
+                   "0.25 0.020 0.016 0.0102 0 1 0 1 0\n" + "0.30 0.020 0.016 0.0102 0 1 0 " + jaw + " 0\n" +
+                   "0.45 0.020 0.016 0.0102 0 1 0 1 0\n" + "0.60 0.020 0.026 0.0102 0 1 0 1 0\n" +
+                   "0.75 0.020 0.026 0.0102 0 1 0 " + jaw + " 0\n";
+    InstrumentDesc driver = in.instruments[0]; // the grasper's track, as a needle driver
+    driver.name = "driver";
+    driver.kind = InstrumentDesc::Kind::NeedleDriver;
+    driver.trackPath = "tools/driver.track";
+    driver.jawLength = 0.009;
+    driver.radius = 0.002;
+    in.instruments = {driver, sc};
+    return r;
+}
+} // namespace
+
+TEST(Interaction, ScissorsCutTheTissueAlongTheirBladeEachTimeTheyCloseAndNowhereElse) {
+    std::unique_ptr<World> w = assemble(scissorsRig(true));
+    EXPECT_EQ(requiredFeatures(scissorsRig(true).scene),
+              (std::vector<std::string>{"collision", "dissection", "embedding", "fascia", "gravity", "xpbd"}));
+    std::vector<int> cutAfter; // fascia edges cut after each frame
+    int snips = 0;
+    for (int f = 0; f < 54; ++f) { // 0.9 s
+        const FrameRecord rec = w->step();
+        ASSERT_TRUE(rec.finite) << "frame " << f;
+        const InteractionSummary& s = w->interaction()->summary();
+        cutAfter.push_back(s.fasciaEdgesCut);
+        snips += s.instruments.at(1).act ? 1 : 0;
+    }
+    EXPECT_EQ(snips, 2) << "act marks the two frames the jaws closed";
+    const InteractionSummary& s = w->interaction()->summary();
+    EXPECT_EQ(cutAfter.at(14), 0) << "nothing cut while the open jaws came down (0.25 s)";
+    const int first = cutAfter.at(20);
+    EXPECT_GT(first, 4) << "the first snip cut the fascia under the blade";
+    EXPECT_EQ(cutAfter.at(36), first)
+        << "opening and moving cut nothing more (0.62 s; the jaws close past half at 0.675 s)";
+    EXPECT_GT(s.fasciaEdgesCut, first) << "the second snip cut again";
+    EXPECT_GT(s.fasciaTrianglesCut, 0);
+    // every cut edge lies along the blades: x within radius + an edge of 2 cm, y from the first
+    // blade's clevis to the second's tip
+    std::vector<uint8_t> mask;
+    w->interaction()->surfaceFaceMaskInto(0, mask);
+    const TriMesh& sheet = w->surfaceMesh(0);
+    int off = 0;
+    for (size_t t = 0; t < mask.size(); ++t) {
+        if (mask[t]) continue;
+        Vec3 c = Vec3::Zero();
+        for (int k = 0; k < 3; ++k)
+            c += sheet.positions()[sheet.triangles()[t][k]] / 3.0;
+        if (std::abs(c.x() - 0.020) > 0.003 || c.y() < 0.016 - 0.012 - 0.003 || c.y() > 0.026 + 0.003) ++off;
+    }
+    EXPECT_EQ(off, 0) << "a cut triangle away from the blades";
+    EXPECT_GT(s.instruments.at(0).grasped, 0) << "the needle driver holds the fascia between its jaws";
+    EXPECT_EQ(s.grasps, 1);
+}
+
+TEST(Interaction, ScissorsThatNeverCloseCutNothing) {
+    std::unique_ptr<World> w = assemble(scissorsRig(false));
+    for (int f = 0; f < 54; ++f)
+        ASSERT_TRUE(w->step().finite);
+    EXPECT_EQ(w->interaction()->summary().fasciaEdgesCut, 0);
+}
+
+TEST(Interaction, ScissorsAreReadAndWrittenAndNeedATissue) {
+    const InteractionDesc d = *scissorsRig(true).scene.interaction;
+    const std::string text = formatInteractionSection(d);
+    EXPECT_NE(text.find("\"needle_driver\""), std::string::npos) << text;
+    EXPECT_NE(text.find("\"scissors\""), std::string::npos) << text;
+    const InteractionDesc back = parseInteractionSection(text, "scene.json");
+    EXPECT_EQ(back.instruments.at(1).kind, InstrumentDesc::Kind::Scissors);
+    EXPECT_EQ(back.instruments.at(0).kind, InstrumentDesc::Kind::NeedleDriver);
+    EXPECT_EQ(formatInteractionSection(back), text);
+    InteractionDesc noTissue = d;
+    noTissue.tissues.clear();
+    try {
+        parseInteractionSection(formatInteractionSection(noTissue), "scene.json");
+        ADD_FAILURE() << "scissors without a tissue were accepted";
+    } catch (const viscera::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("scissors need at least one tissue to cut"), std::string::npos)
+            << e.what();
+    }
 }

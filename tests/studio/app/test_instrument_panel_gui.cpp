@@ -17,6 +17,7 @@
 #include <QLineEdit>
 #include <QListWidget>
 #include <QPushButton>
+#include <QTreeWidgetItemIterator>
 #include <QUndoStack>
 
 #include <gtest/gtest.h>
@@ -245,6 +246,60 @@ TEST_F(InstrumentPanelFixture, AHookInAProjectWithoutInstrumentsBringsTheInterac
     undo->undo();
     ASSERT_EQ(instruments().size(), 1u);
     EXPECT_EQ(w->document()->project().scene.interaction->tissues.size(), 1u);
+}
+
+TEST_F(InstrumentPanelFixture, ScissorsAndANeedleDriverAreAddedEditedAndRemovedAsUndoSteps) {
+    open("tissue-slab");
+    QUndoStack* undo = w->document()->undoStack();
+    const int steps = undo->index();
+    addWithClicks(3); // scissors
+    EXPECT_EQ(error(), "");
+    ASSERT_EQ(instruments().size(), 1u);
+    const sim::InstrumentDesc& sc = instruments()[0];
+    EXPECT_EQ(sc.kind, Kind::Scissors);
+    EXPECT_EQ(sc.name, "scissors");
+    EXPECT_EQ(sc.device.hand, "right");
+    EXPECT_DOUBLE_EQ(sc.jawLength, 0.014) << "long slim blades";
+    ASSERT_EQ(w->document()->project().scene.interaction->tissues.size(), 1u)
+        << "the reader's rule: scissors cut a tissue";
+    EXPECT_EQ(undo->index(), steps + 1);
+    addWithClicks(4); // needle driver
+    ASSERT_EQ(instruments().size(), 2u);
+    EXPECT_EQ(instruments()[1].kind, Kind::NeedleDriver);
+    EXPECT_DOUBLE_EQ(instruments()[1].jawLength, 0.009) << "short strong jaws";
+    EXPECT_EQ(panel->list()->item(1)->text().contains("needle driver"), true)
+        << panel->list()->item(1)->text().toStdString();
+    EXPECT_EQ(undo->index(), steps + 2);
+    // the tree names the kinds
+    bool treeSaysScissors = false;
+    QStringList rows;
+    test::waitFor(
+        [&] { // the tree refreshes on its own time
+            rows.clear();
+            for (QTreeWidgetItemIterator it(w->tree()); *it; ++it) {
+                rows << (*it)->text(0) + " | " + (*it)->text(1);
+                treeSaysScissors =
+                    treeSaysScissors || ((*it)->text(0) == "scissors" && (*it)->text(1).startsWith("scissors, right"));
+            }
+            return treeSaysScissors;
+        },
+        3000);
+    EXPECT_TRUE(treeSaysScissors) << rows.join("\n").toStdString();
+    // a typed jaw length: one step; a refused one names the rule and changes nothing
+    panel->list()->setCurrentRow(0);
+    typeInto("jaw_length", "0.018");
+    EXPECT_EQ(error(), "");
+    EXPECT_DOUBLE_EQ(instruments()[0].jawLength, 0.018);
+    EXPECT_EQ(undo->index(), steps + 3);
+    typeInto("jaw_length", "0.5");
+    EXPECT_NE(error().find("jaw_length"), std::string::npos) << error();
+    EXPECT_DOUBLE_EQ(instruments()[0].jawLength, 0.018);
+    EXPECT_EQ(undo->index(), steps + 3);
+    EXPECT_EQ(studio::Document::check(w->document()->project()), "") << "the model passes the rules of load";
+    undo->undo();
+    undo->undo();
+    undo->undo();
+    EXPECT_FALSE(w->document()->project().scene.interaction) << "undo restores the project as it was";
 }
 
 } // namespace

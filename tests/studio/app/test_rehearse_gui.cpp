@@ -160,7 +160,12 @@ TEST_F(RehearseFixture, TheKeyboardInTheViewportDrivesTheLeftMasterAndStopEndsTh
     EXPECT_TRUE(o.judged);
     EXPECT_FALSE(o.passed) << "a few keys do not do the task";
     EXPECT_TRUE(panel->verdict()->text().startsWith("FAIL (")) << panel->verdict()->text().toStdString();
-    EXPECT_TRUE(panel->keepButton()->isEnabled());
+    // a failed session is no reference replay: Keep says why and writes nothing
+    panel->replayName()->setText("failing");
+    QTest::mouseClick(panel->keepButton(), Qt::LeftButton);
+    EXPECT_TRUE(panel->status()->text().contains("a reference replay must pass its case"))
+        << panel->status()->text().toStdString();
+    EXPECT_FALSE(fs::exists(dir / "replays" / "failing.csv"));
 }
 
 TEST_F(RehearseFixture, TheConsoleSimulatorDrivesTheSessionOverItsPairedLink) {
@@ -202,6 +207,21 @@ TEST_F(RehearseFixture, AMalformedDeviceIsRefusedNamingTheRuleAndNothingRuns) {
     EXPECT_TRUE(panel->status()->text().contains("unknown device backend")) << panel->status()->text().toStdString();
     EXPECT_TRUE(panel->startButton()->isEnabled());
     EXPECT_FALSE(panel->keepButton()->isEnabled()) << "nothing recorded";
+    panel->replayName()->setText("nothing");
+    EXPECT_FALSE(panel->keep()) << "nothing recorded: nothing kept";
+    EXPECT_FALSE(fs::exists(dir / "replays" / "nothing.csv"));
+    // Stop while the case exports: nothing runs, the window is as before
+    typeDevice("replay:" + QString::fromStdString((dir / "replays" / "dissection.csv").string()));
+    QSignalSpy stopped(panel->rehearsal(), &studio::Rehearsal::finished);
+    QTest::mouseClick(panel->startButton(), Qt::LeftButton);
+    ASSERT_EQ(panel->rehearsal()->state(), studio::Rehearsal::State::Exporting);
+    QTest::mouseClick(panel->stopButton(), Qt::LeftButton);
+    ASSERT_TRUE(test::waitFor([&] { return !stopped.isEmpty(); }, 10000));
+    EXPECT_EQ(panel->rehearsal()->state(), studio::Rehearsal::State::Idle);
+    EXPECT_TRUE(panel->status()->text().contains("stopped during the export")) << panel->status()->text().toStdString();
+    EXPECT_TRUE(panel->verdict()->text().startsWith("Not run"));
+    EXPECT_TRUE(panel->startButton()->isEnabled());
+    EXPECT_FALSE(w->preview()->paused()) << "the preview came back";
     typeDevice("replay:" + QString::fromStdString((dir / "replays" / "missing.csv").string()));
     ASSERT_TRUE(rehearse(60000));
     EXPECT_FALSE(panel->rehearsal()->outcome().ran);

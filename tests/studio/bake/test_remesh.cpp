@@ -250,3 +250,56 @@ TEST(bake_remesh, TheKidneySampleBecomesOneSoundBodyThatTetrahedralizes) {
     EXPECT_GT(t.mesh->tetCount(), 1000u);
     EXPECT_TRUE(t.report.quality.inverted.empty());
 }
+
+// The hepatocystic anatomy [issue 57 item 4] arrives as bought anatomy does: separate overlapping
+// parts, the liver and the ducts open, UVs on every part; the gallbladder with its ducts and
+// artery (what the case simulates) becomes one sound body that tetrahedralizes.
+TEST(bake_remesh, TheHepatocysticAnatomyIsBoughtLikeAndItsGallbladderPartsMakeOneSoundBody) {
+    const std::vector<bake::RemeshPart> parts = bake::hepatocysticAnatomy();
+    ASSERT_EQ(parts.size(), 5u);
+    const char* names[] = {"liver", "gallbladder", "cystic_duct", "common_bile_duct", "cystic_artery"};
+    for (size_t i = 0; i < parts.size(); ++i) {
+        EXPECT_EQ(parts[i].name, names[i]);
+        ASSERT_EQ(parts[i].uv.size(), parts[i].surface.triangleCount()) << names[i] << ": a UV triangle each";
+        for (const bake::CornerUv& c : parts[i].uv)
+            for (const auto& uv : c)
+                EXPECT_TRUE(uv.x() >= 0 && uv.x() <= 1 && uv.y() >= 0 && uv.y() <= 1) << names[i];
+    }
+    EXPECT_FALSE(parts[0].surface.isClosedOriented()) << "the liver's bare area is missing";
+    EXPECT_TRUE(parts[1].surface.isClosedOriented());
+    EXPECT_FALSE(parts[2].surface.isClosedOriented()) << "the cystic duct is an open tube";
+    EXPECT_FALSE(parts[3].surface.isClosedOriented());
+    EXPECT_TRUE(parts[4].surface.isClosedOriented());
+    // sizes: a liver lobe 18 cm across, a gallbladder 8.4 cm long, ducts of 2.5 and 4 mm radius
+    auto extent = [](const sim::TriMesh& m) {
+        sim::Vec3 lo = sim::Vec3::Constant(1e9), hi = -lo;
+        for (const sim::Vec3& x : m.positions()) {
+            lo = lo.cwiseMin(x);
+            hi = hi.cwiseMax(x);
+        }
+        return std::pair{lo, hi};
+    };
+    const auto [liverLo, liverHi] = extent(parts[0].surface);
+    const auto [gallLo, gallHi] = extent(parts[1].surface);
+    EXPECT_NEAR(liverHi.x() - liverLo.x(), 0.18, 0.002);
+    EXPECT_NEAR(gallHi.y() - gallLo.y(), 0.084, 0.002);
+    EXPECT_GT(gallHi.z(), liverLo.z() + 0.01) << "the gallbladder lies in its bed, overlapping the liver";
+    // the neck is narrower than the body: the pear's taper
+    double neckHalfWidth = 0, bodyHalfWidth = 0;
+    for (const sim::Vec3& x : parts[1].surface.positions()) {
+        if (std::abs(x.y() - (-0.04)) < 0.004) neckHalfWidth = std::max(neckHalfWidth, std::abs(x.x()));
+        if (std::abs(x.y() - (-0.005)) < 0.004) bodyHalfWidth = std::max(bodyHalfWidth, std::abs(x.x()));
+    }
+    EXPECT_LT(neckHalfWidth, 0.6 * bodyHalfWidth);
+    // the gallbladder, both ducts and the artery: one sound body
+    const std::vector<bake::RemeshPart> gall(parts.begin() + 1, parts.end());
+    const bake::RemeshResult r = bake::voxelRemesh(gall, params(96));
+    expectSound(r);
+    EXPECT_EQ(r.report.openParts, 2u) << "the two open ducts";
+    bake::MeshingParams m;
+    m.cellSize = 0.004;
+    m.facetSize = 0.003;
+    const bake::TetrahedralizeResult t = bake::tetrahedralize(r.mesh, m);
+    EXPECT_GT(t.mesh->tetCount(), 1000u);
+    EXPECT_TRUE(t.report.quality.inverted.empty());
+}

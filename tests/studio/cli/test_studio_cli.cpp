@@ -287,3 +287,33 @@ TEST(StudioCli, ImportMeshRemeshAndExportWriteTheirTypedResults) {
     EXPECT_EQ(remeshed.uv.size(), 3u);
     EXPECT_EQ(studio::readRemeshedSurface(scratch / "k.vremesh").surface.triangleCount(), size_t(remeshed.triangles));
 }
+
+// `sample hepatocystic` [issue 57 item 4]: the cholecystectomy's anatomy written as bought anatomy
+// arrives (five OBJ parts with UVs and their atlas, no project), read back by `import` as the
+// studio reads it: the liver and the ducts open, the gallbladder and the artery closed, all with UVs.
+TEST(StudioCli, TheHepatocysticSampleIsAnatomyToImport) {
+    test::Scratch scratch("viscera-studio-cli-hepatocystic");
+    const fs::path dir = scratch.dir / "anatomy";
+    auto r = runStudio({"sample", "hepatocystic", "-o", dir.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_THAT(r.out, HasSubstr("wrote 5 anatomy parts and the atlas hepatocystic.png"));
+    EXPECT_FALSE(fs::exists(dir / "project.json")) << "the case is built in the studio";
+    EXPECT_TRUE(fs::exists(dir / "hepatocystic.png"));
+    std::vector<std::string> args = {"import"};
+    for (const char* part : {"liver", "gallbladder", "cystic_duct", "common_bile_duct", "cystic_artery"})
+        args.push_back((dir / (std::string(part) + ".obj")).string());
+    args.push_back("--result");
+    args.push_back(std::string(scratch / "import.json"));
+    r = runStudio(args);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto imported = studio::readStepResult<studio::ImportStepResult>(scratch / "import.json");
+    ASSERT_EQ(imported.parts.size(), 5u);
+    const bool closed[] = {false, true, false, false, true};
+    for (size_t i = 0; i < 5; ++i) {
+        EXPECT_EQ(imported.parts[i].closed, closed[i]) << imported.parts[i].file;
+        EXPECT_TRUE(imported.parts[i].hasUv) << imported.parts[i].file;
+    }
+    r = runStudio({"sample", "spleen", "-o", dir.string()});
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_THAT(r.err, HasSubstr("'hepatocystic -o <folder>' (the built-in samples)"));
+}
