@@ -127,9 +127,9 @@ struct SurroundingsSlot {
                 names.insert(sp.scene.name);
             for (const sim::ToolDesc& t : p.scene.tools)
                 names.insert(t.name);
-            const nlohmann::json doc = sceneryJson(v.scenery);
+            const nlohmann::json doc = sceneryJson(v.scenery, p.dir);
             const std::string origin = "project.json"; // JsonField keeps a pointer to it
-            readSceneryProject(sim::JsonField(doc, "scenery", origin), names);
+            readSceneryProject(sim::JsonField(doc, "scenery", origin), names, p.dir);
         } catch (const std::exception& e) {
             return withoutOrigin(e);
         }

@@ -199,7 +199,10 @@ void ProjectTreePanel::rebuild() {
         QTreeWidgetItem* surroundings = group(tr("Surroundings"), kGroup); // render-only scenery
         for (const SceneryProject& sc : p.scenery)
             leaf(surroundings, QString::fromStdString(sc.name),
-                 sc.generator == SceneryProject::Generator::Disc ? tr("disc") : tr("wall"), kGroup, -1);
+                 sc.generator == SceneryProject::Generator::Disc   ? tr("disc")
+                 : sc.generator == SceneryProject::Generator::File ? tr("imported mesh")
+                                                                   : tr("wall"),
+                 kGroup, -1);
         QTreeWidgetItem* instruments = group(tr("Instruments"), kGroup);
         if (p.scene.interaction)
             for (size_t t = 0; t < p.scene.interaction->instruments.size(); ++t) {

@@ -1,8 +1,14 @@
 #include "app/surroundings_panel.hpp"
 
+#include "app/anatomy_steps.hpp"
 #include "app/document.hpp"
 #include "app/number_text.hpp"
+#include "bake/import.hpp"
 #include "project/anatomy_shapes.hpp"
+
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QSettings>
 
 #include <QComboBox>
 #include <QFormLayout>
@@ -66,10 +72,13 @@ SurroundingsPanel::SurroundingsPanel(Document* doc, QWidget* parent) : QWidget(p
     m_addFloor->setToolTip(tr("A disc (the floor below the organs, an end wall)"));
     m_remove = new QPushButton(tr("Remove"), this);
     m_remove->setObjectName("removeScenery");
+    m_import = new QPushButton(tr("Import mesh…"), this);
+    m_import->setObjectName("importScenery");
+    m_import->setToolTip(tr("Static anatomy from a surface file (OBJ, STL, PLY, glTF, FBX), drawn as it is"));
     m_maps = new QPushButton(tr("Material maps…"), this);
     m_maps->setObjectName("sceneryMaps");
     m_maps->setToolTip(tr("The selected surrounding's texture: spec, tiles per metre, normal strength"));
-    for (QPushButton* b : {m_addWall, m_addFloor, m_remove, m_maps})
+    for (QPushButton* b : {m_addWall, m_addFloor, m_import, m_remove, m_maps})
         buttons->addWidget(b);
     buttons->addStretch(1);
     layout->addLayout(buttons);
@@ -77,7 +86,7 @@ SurroundingsPanel::SurroundingsPanel(Document* doc, QWidget* parent) : QWidget(p
     const std::pair<const char*, QString> keys[] = {
         {"name", tr("Name")},         {"radius_mm", tr("Radius (mm)")}, {"start", tr("Axis start (m)")},
         {"end", tr("Axis end (m)")},  {"from_deg", tr("Arc from (°)")}, {"to_deg", tr("Arc to (°)")},
-        {"center", tr("Centre (m)")}, {"normal", tr("Normal")}};
+        {"center", tr("Centre (m)")}, {"normal", tr("Normal")},         {"scale", tr("Metres per file unit")}};
     for (const auto& [key, label] : keys) {
         auto* e = new QLineEdit(this);
         e->setObjectName(QString("scenery_") + key);
@@ -108,6 +117,7 @@ SurroundingsPanel::SurroundingsPanel(Document* doc, QWidget* parent) : QWidget(p
     });
     connect(m_addWall, &QPushButton::clicked, this, [this] { add(true); });
     connect(m_addFloor, &QPushButton::clicked, this, [this] { add(false); });
+    connect(m_import, &QPushButton::clicked, this, &SurroundingsPanel::askImport);
     connect(m_remove, &QPushButton::clicked, this, &SurroundingsPanel::remove);
     connect(m_doc, &Document::changed, this, [this](const Change&) { fill(); });
     fill();
@@ -125,26 +135,33 @@ void SurroundingsPanel::fill() {
     m_list->clear();
     for (const SceneryProject& s : scenery) {
         const bool wall = s.generator == SceneryProject::Generator::Cylinder;
+        const bool file = s.generator == SceneryProject::Generator::File;
         m_list->addItem(QString::fromStdString(s.name) + " — " +
-                        (wall ? (s.inward ? tr("wall, seen from inside") : tr("cylinder, outward")) : tr("disc")));
+                        (file   ? tr("imported %1").arg(QString::fromStdString(s.file.filename().string()))
+                         : wall ? (s.inward ? tr("wall, seen from inside") : tr("cylinder, outward"))
+                                : tr("disc")));
     }
     if (m_selected >= static_cast<int>(scenery.size())) m_selected = static_cast<int>(scenery.size()) - 1;
     m_list->setCurrentRow(m_selected);
     const SceneryProject* s = m_selected >= 0 ? &scenery[static_cast<size_t>(m_selected)] : nullptr;
     const bool wall = s && s->generator == SceneryProject::Generator::Cylinder;
+    const bool file = s && s->generator == SceneryProject::Generator::File;
     const std::map<QString, QString> text = {{"name", s ? QString::fromStdString(s->name) : QString()},
                                              {"radius_mm", s ? numberText(s->radius * 1e3) : QString()},
                                              {"start", wall ? vecText(s->start) : QString()},
                                              {"end", wall ? vecText(s->end) : QString()},
                                              {"from_deg", wall ? numberText(s->fromDeg) : QString()},
                                              {"to_deg", wall ? numberText(s->toDeg) : QString()},
-                                             {"center", s && !wall ? vecText(s->center) : QString()},
-                                             {"normal", s && !wall ? vecText(s->normal) : QString()}};
+                                             {"center", s && !wall && !file ? vecText(s->center) : QString()},
+                                             {"normal", s && !wall && !file ? vecText(s->normal) : QString()},
+                                             {"scale", file ? numberText(s->scale) : QString()}};
     for (const auto& [key, e] : m_fields) {
         e->setText(text.at(key));
         const bool wallOnly = key == "start" || key == "end" || key == "from_deg" || key == "to_deg";
         const bool discOnly = key == "center" || key == "normal";
-        e->setEnabled(s && (!wallOnly || wall) && (!discOnly || !wall));
+        const bool shape = key != "name" && key != "scale"; // a primitive's geometry
+        e->setEnabled(s && (!wallOnly || wall) && (!discOnly || !wall) && (key != "scale" || file) &&
+                      (!shape || !file));
     }
     m_facing->setCurrentIndex(s && !s->inward ? 1 : 0);
     m_facing->setEnabled(wall);
@@ -163,6 +180,10 @@ void SurroundingsPanel::typed(const QString& key) {
     QString why;
     if (key == "name") {
         s.name = t.trimmed().toStdString();
+    } else if (key == "scale") {
+        const auto v = parseNumberText(t, field, why);
+        if (!v) return show(why);
+        s.scale = *v;
     } else if (key == "radius_mm" || key == "from_deg" || key == "to_deg") {
         const auto v = parseNumberText(t, field, why);
         if (!v) return show(why);
@@ -174,7 +195,8 @@ void SurroundingsPanel::typed(const QString& key) {
         if (!v) return show(why);
         (key == "start" ? s.start : key == "end" ? s.end : key == "center" ? s.center : s.normal) = *v;
     }
-    if (sceneryJson(scenery) == sceneryJson(m_doc->project().scenery)) return; // nothing changed: no step
+    const std::filesystem::path& dir = m_doc->project().dir;
+    if (sceneryJson(scenery, dir) == sceneryJson(m_doc->project().scenery, dir)) return; // nothing changed: no step
     show(m_doc->editScenery(tr("Surroundings: %1 %2").arg(QString::fromStdString(s.name), key), scenery,
                             m_doc->project().sceneryTextures));
 }
@@ -202,6 +224,65 @@ void SurroundingsPanel::add(bool wall) {
     show(why);
     fill();
     if (why.isEmpty()) emit selectedChanged(m_selected);
+}
+
+void SurroundingsPanel::askImport() {
+    if (!m_doc->hasProject()) return;
+    // Opens where the last anatomy came from, as Import anatomy does (the project folder the first time).
+    const QString start = QSettings().value(QStringLiteral("studio/anatomyFolder"), m_doc->folder()).toString();
+    auto* dlg = new QFileDialog(this, tr("Import a mesh as surrounding anatomy"), start,
+                                tr("Surfaces (*.obj *.stl *.ply *.gltf *.glb *.fbx)"));
+    dlg->setObjectName("sceneryImportDialog");
+    dlg->setAttribute(Qt::WA_DeleteOnClose);
+    dlg->setFileMode(QFileDialog::ExistingFile);
+    dlg->setOption(QFileDialog::DontUseNativeDialog);
+    connect(dlg, &QFileDialog::fileSelected, this, [this](const QString& f) {
+        QSettings().setValue(QStringLiteral("studio/anatomyFolder"), QFileInfo(f).absolutePath());
+        importFile(f);
+    });
+    dlg->open();
+}
+
+QString SurroundingsPanel::importFile(const QString& path) {
+    if (!m_doc->hasProject()) return tr("no project is open");
+    QString why;
+    const QString copied = copyIntoProject(m_doc->folder(), path, &why);
+    if (copied.isEmpty()) {
+        show(why);
+        return why;
+    }
+    SceneryProject s;
+    s.generator = SceneryProject::Generator::File;
+    s.file = copied.toStdString();
+    try { // the unit from the size, as Import anatomy guesses it
+        const sim::TriMesh m = bake::importSurface(s.file);
+        sim::Vec3 lo = sim::Vec3::Constant(INFINITY), hi = -lo;
+        for (const sim::Vec3& x : m.positions()) {
+            lo = lo.cwiseMin(x);
+            hi = hi.cwiseMax(x);
+        }
+        const double extent = (hi - lo).maxCoeff();
+        const bake::LengthUnit unit = bake::guessLengthUnit(extent);
+        s.scale = bake::metresPerUnit(unit);
+        m_guess = tr("'%1': %2 units long: looks like %3 (%4 m per unit)")
+                      .arg(QFileInfo(path).fileName(), numberText(extent),
+                           QString::fromUtf8(bake::unitLongName(unit).data(), int(bake::unitLongName(unit).size())),
+                           numberText(s.scale));
+    } catch (const std::exception& e) {
+        show(QString::fromStdString(e.what()));
+        return m_error->text();
+    }
+    std::vector<SceneryProject> scenery = m_doc->project().scenery;
+    std::vector<std::optional<TextureProject>> textures = m_doc->project().sceneryTextures;
+    s.name = freeName(QFileInfo(path).completeBaseName().toStdString(), scenery);
+    scenery.push_back(s);
+    textures.resize(scenery.size());
+    why = m_doc->editScenery(tr("Import %1").arg(QString::fromStdString(s.name)), scenery, textures);
+    if (why.isEmpty()) m_selected = static_cast<int>(scenery.size()) - 1;
+    show(why);
+    fill();
+    if (why.isEmpty()) emit selectedChanged(m_selected);
+    return why;
 }
 
 void SurroundingsPanel::remove() {

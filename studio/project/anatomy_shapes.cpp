@@ -1,5 +1,8 @@
 #include "project/anatomy_shapes.hpp"
 
+#include "bake/import.hpp"
+#include "project/project.hpp"
+
 #include "sim/scene/scene_json.hpp"
 
 #include <Eigen/Geometry>
@@ -107,11 +110,21 @@ void bendPoints(const BendSpec& bend, std::vector<Vec3>& points) {
     }
 }
 
-std::vector<SceneryProject> readSceneryProject(const JsonField& scenery, std::set<std::string>& names) {
+std::vector<SceneryProject> readSceneryProject(const JsonField& scenery, std::set<std::string>& names,
+                                               const std::filesystem::path& dir) {
     std::vector<SceneryProject> out;
     for (const JsonField& j : scenery.items(1, 16)) {
         SceneryProject s;
-        const std::string gen = j["generator"].choice({"cylinder", "disc"}, "a scenery generator");
+        const std::string gen = j["generator"].choice({"cylinder", "disc", "file"}, "a scenery generator");
+        if (gen == "file") { // an imported surface, as it is
+            j.object({"name", "generator", "file", "scale", "texture"});
+            s.generator = SceneryProject::Generator::File;
+            s.name = sim::readName(j["name"], names);
+            s.file = projectFileOf(j["file"], dir);
+            s.scale = j.number("scale", s.scale, NumberRule::aboveUpTo(0, 1000.0));
+            out.push_back(std::move(s));
+            continue;
+        }
         s.generator = gen == "disc" ? SceneryProject::Generator::Disc : SceneryProject::Generator::Cylinder;
         if (s.generator == SceneryProject::Generator::Cylinder)
             j.object({"name", "generator", "start", "end", "radius", "from_deg", "to_deg", "facing", "slices", "rings",
@@ -141,9 +154,17 @@ std::vector<SceneryProject> readSceneryProject(const JsonField& scenery, std::se
     return out;
 }
 
-json sceneryJson(const std::vector<SceneryProject>& scenery) {
+json sceneryJson(const std::vector<SceneryProject>& scenery, const std::filesystem::path& dir) {
     json a = json::array();
-    for (const SceneryProject& s : scenery) {
+    for (size_t k = 0; k < scenery.size(); ++k) {
+        const SceneryProject& s = scenery[k];
+        if (s.generator == SceneryProject::Generator::File) {
+            a.push_back({{"name", s.name},
+                         {"generator", "file"},
+                         {"file", projectRelativePath(s.file, dir, "scenery[" + std::to_string(k) + "].file")},
+                         {"scale", s.scale}});
+            continue;
+        }
         json j = {{"name", s.name}, {"radius", s.radius}, {"slices", s.slices}, {"rings", s.rings}};
         if (s.generator == SceneryProject::Generator::Cylinder) {
             j["generator"] = "cylinder";
@@ -163,6 +184,11 @@ json sceneryJson(const std::vector<SceneryProject>& scenery) {
 }
 
 sim::TriMesh scenerySurface(const SceneryProject& s) {
+    if (s.generator == SceneryProject::Generator::File) {
+        bake::ImportOptions o;
+        o.scale = s.scale;
+        return bake::importSurface(s.file, o);
+    }
     return s.generator == SceneryProject::Generator::Disc ? disc(s) : cylinder(s);
 }
 

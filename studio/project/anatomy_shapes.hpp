@@ -32,6 +32,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <optional>
 #include <set>
 #include <string>
@@ -45,7 +46,7 @@ struct BendSpec {
 };
 
 struct SceneryProject {
-    enum class Generator { Cylinder, Disc };
+    enum class Generator { Cylinder, Disc, File };
     std::string name;
     Generator generator = Generator::Cylinder;
     sim::Vec3 start = sim::Vec3::Zero(), end = sim::Vec3::UnitX();     ///< cylinder axis, m
@@ -54,6 +55,10 @@ struct SceneryProject {
     double fromDeg = 0, toDeg = 360; ///< cylinder
     bool inward = true;              ///< cylinder: faces its axis (a wall seen from inside), else outward
     int slices = 48, rings = 8;
+    /// File: a surface of the project folder (OBJ, STL, PLY, glTF, FBX: bake::importSurface's
+    /// rules) and the metres per file unit; imported as it is, drawn two-sided.
+    std::filesystem::path file;
+    double scale = 1.0;
 };
 
 BendSpec readBend(const sim::JsonField& bend);
@@ -65,10 +70,14 @@ sim::Vec3 bendPoint(const BendSpec& bend, const sim::Vec3& p);
 void bendPoints(const BendSpec& bend, std::vector<sim::Vec3>& points);
 
 /// "scenery"; names must be new to `names` (bodies, surfaces, tools) and are added to it. A
-/// "texture" key is the caller's (Project::sceneryTextures).
-std::vector<SceneryProject> readSceneryProject(const sim::JsonField& scenery, std::set<std::string>& names);
-nlohmann::json sceneryJson(const std::vector<SceneryProject>& scenery);
-/// The surface of one scenery entry, in scene coordinates.
+/// "texture" key is the caller's (Project::sceneryTextures). An imported one:
+///   {"name": "liver", "generator": "file", "file": "anatomy/liver.obj", "scale": 0.01}
+/// its file inside the project folder `dir` (projectFileOf's rule), scale in (0, 1000].
+std::vector<SceneryProject> readSceneryProject(const sim::JsonField& scenery, std::set<std::string>& names,
+                                               const std::filesystem::path& dir);
+nlohmann::json sceneryJson(const std::vector<SceneryProject>& scenery, const std::filesystem::path& dir);
+/// The surface of one scenery entry, in scene coordinates (an imported one read from its file:
+/// InputError naming the file, the element and the rule when it is not a surface).
 sim::TriMesh scenerySurface(const SceneryProject& s);
 
 } // namespace viscera::studio

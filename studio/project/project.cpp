@@ -85,13 +85,7 @@ struct WriteContext {
 /// The project.json form of a file of the project (projectFile's inverse): `file` relative to
 /// the project folder. Lexical, so that dir / "a/b.obj" gives back "a/b.obj" exactly.
 std::string projectFileJson(const std::filesystem::path& file, const WriteContext& w, const std::string& field) {
-    namespace fs = std::filesystem;
-    const fs::path base = fs::absolute(w.dir.empty() ? fs::path(".") : w.dir).lexically_normal();
-    const std::string rel = fs::absolute(file).lexically_normal().lexically_relative(base).generic_string();
-    if (rel.empty() || sim::entryNameProblem(rel))
-        throw InputError(w.origin + ": " + field + ": '" + file.string() + "' is not inside the project folder '" +
-                         w.dir.string() + "'");
-    return rel;
+    return projectRelativePath(file, w.dir, w.origin + ": " + field);
 }
 
 bake::MeshingParams readMeshing(const JsonField& mesh) {
@@ -707,7 +701,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     if (auto a = root.find("assessment")) scene.assessment = sim::readAssessment(*a);
     if (auto b = root.find("bend")) p.bend = readBend(*b);
     if (auto sc = root.find("scenery")) {
-        p.scenery = readSceneryProject(*sc, names);
+        p.scenery = readSceneryProject(*sc, names, dir);
         const std::vector<JsonField> items = sc->items();
         p.sceneryTextures.resize(p.scenery.size());
         for (size_t k = 0; k < items.size() && k < p.scenery.size(); ++k)
@@ -756,7 +750,7 @@ std::string projectJsonText(const Project& p) {
     if (scene.assessment) sim::writeAssessment(*scene.assessment, doc);
     if (p.bend) doc["bend"] = bendJson(*p.bend);
     if (!p.scenery.empty()) {
-        doc["scenery"] = sceneryJson(p.scenery);
+        doc["scenery"] = sceneryJson(p.scenery, p.dir);
         for (size_t k = 0; k < p.scenery.size() && k < p.sceneryTextures.size(); ++k)
             if (p.sceneryTextures[k]) doc["scenery"][k]["texture"] = textureJson(*p.sceneryTextures[k]);
     }
@@ -1395,6 +1389,20 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
     result.bytes = std::filesystem::file_size(out);
     if (publish.key) result.keyId = vcase::keyId(publish.key->publicKey());
     return result;
+}
+
+std::filesystem::path projectFileOf(const JsonField& f, const std::filesystem::path& dir) {
+    return projectFile(f, dir);
+}
+
+std::string projectRelativePath(const std::filesystem::path& file, const std::filesystem::path& dir,
+                                const std::string& where) {
+    namespace fs = std::filesystem;
+    const fs::path base = fs::absolute(dir.empty() ? fs::path(".") : dir).lexically_normal();
+    const std::string rel = fs::absolute(file).lexically_normal().lexically_relative(base).generic_string();
+    if (rel.empty() || sim::entryNameProblem(rel))
+        throw InputError(where + ": '" + file.string() + "' is not inside the project folder '" + dir.string() + "'");
+    return rel;
 }
 
 } // namespace viscera::studio

@@ -433,4 +433,13 @@ std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::
                                             std::vector<render::CornerUvF>* boundaryUv = nullptr,
                                             const std::filesystem::path& projectDir = {});
 
+/// A file named by a project.json field: a relative path by the entry-name rule (no '..', not
+/// absolute) inside the project folder `dir` through links too; InputError naming the field and
+/// the rule otherwise. Nothing outside the folder the user gave is read.
+std::filesystem::path projectFileOf(const sim::JsonField& f, const std::filesystem::path& dir);
+/// The project.json form of such a file: relative to `dir` (lexical); InputError "<where>: ..."
+/// when it lies outside.
+std::string projectRelativePath(const std::filesystem::path& file, const std::filesystem::path& dir,
+                                const std::string& where);
+
 } // namespace viscera::studio

@@ -7,19 +7,28 @@
 #include "app/surroundings_panel.hpp"
 #include "app/texture_panel.hpp"
 #include "gui_test_support.hpp"
+#include "project/anatomy_shapes.hpp"
+#include "project/sample_hepatocystic.hpp"
 #include "window_fixture.hpp"
 
 #include <QComboBox>
+#include <QDialogButtonBox>
 #include <QDockWidget>
+#include <QFileDialog>
 #include <QLabel>
 #include <QLineEdit>
+#include <QListView>
 #include <QListWidget>
+#include <QPlainTextEdit>
 #include <QPushButton>
+#include <QSettings>
 #include <QTreeWidget>
 #include <QUndoStack>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include <fstream>
 
 namespace {
 
@@ -173,4 +182,77 @@ TEST_F(SurroundingsFixture, ASurroundingsMaterialMapsAreEditedInTheMaterialMapsD
     EXPECT_FALSE(w->document()->project().sceneryTextures[static_cast<size_t>(floor)]->generator.empty());
     EXPECT_EQ(undo()->index(), beforeNew + 1);
     test::saveShot("surroundings_material_maps");
+}
+
+TEST_F(SurroundingsFixture, AnImportedMeshIsStaticAnatomyAddedAsOneStepWithItsUnitGuessed) {
+    const std::filesystem::path source = scratch.dir / "bought";
+    studio::writeHepatocysticAnatomy(source);
+    const size_t before = scenery().size();
+    const int steps = undo()->index();
+    // Import mesh…: the dialog opens where the last anatomy came from; the liver's name typed, Open
+    QSettings().setValue("studio/anatomyFolder", QString::fromStdString(source.string()));
+    QTest::mouseClick(panel->importButton(), Qt::LeftButton);
+    QFileDialog* dlg = nullptr;
+    ASSERT_TRUE(
+        test::waitFor([&] { return (dlg = w->findChild<QFileDialog*>("sceneryImportDialog")) != nullptr; }, 5000));
+    ASSERT_TRUE(test::waitFor([&] { return dlg->isVisible(); }, 5000));
+    auto* name = dlg->findChild<QLineEdit*>("fileNameEdit");
+    ASSERT_NE(name, nullptr);
+    auto* list = dlg->findChild<QListView*>("listView");
+    ASSERT_NE(list, nullptr);
+    ASSERT_TRUE(test::waitFor([&] { return list->model()->rowCount(list->rootIndex()) == 5; }, 5000))
+        << "the five parts listed";
+    name->setFocus();
+    QTest::keyClicks(name, "liver.obj");
+    auto* box = dlg->findChild<QDialogButtonBox*>("buttonBox");
+    ASSERT_NE(box, nullptr);
+    QTest::mouseClick(box->button(QDialogButtonBox::Open), Qt::LeftButton);
+    ASSERT_TRUE(test::waitFor([&] { return scenery().size() == before + 1; }, 10000))
+        << panel->errorLabel()->text().toStdString();
+    const studio::SceneryProject& liver = scenery().back();
+    EXPECT_EQ(liver.name, "liver");
+    EXPECT_EQ(liver.generator, studio::SceneryProject::Generator::File);
+    EXPECT_EQ(liver.file.parent_path().filename(), "anatomy") << "copied into the project";
+    EXPECT_TRUE(std::filesystem::exists(liver.file));
+    EXPECT_DOUBLE_EQ(liver.scale, 1.0) << "a liver 0.18 units long: metres";
+    EXPECT_THAT(panel->unitGuess().toStdString(), HasSubstr("looks like metres"));
+    EXPECT_EQ(undo()->index(), steps + 1);
+    EXPECT_EQ(studio::Document::check(w->document()->project()), "") << "the model passes the rules of load";
+    EXPECT_GT(studio::scenerySurface(liver).triangleCount(), 1000u);
+    if (const char* shots = std::getenv("VISCERA_GUI_SHOTS"); shots && *shots) { // the liver in the viewport
+        const int meshes = w->viewport()->meshCount();
+        const bool shown = test::waitFor(
+            [&] {
+                for (const auto& m : w->viewport()->view().meshes())
+                    if (m.name == "liver") return true;
+                return false;
+            },
+            20000);
+        EXPECT_TRUE(shown) << "the preview draws the imported liver; log:\n"
+                           << w->log()->toPlainText().toStdString() << " meshes " << meshes;
+        w->viewport()->frameAll();
+        QTest::qWait(300);
+        w->viewport()->grabFramebuffer().save(QString(shots) + "/surroundings_imported_liver_viewport.png");
+    }
+    // only its name and scale are fields; the primitives' geometry is not
+    EXPECT_TRUE(panel->field("scale")->isEnabled());
+    EXPECT_FALSE(panel->field("radius_mm")->isEnabled());
+    EXPECT_FALSE(panel->field("start")->isEnabled());
+    type("scale", "0.5");
+    EXPECT_DOUBLE_EQ(scenery().back().scale, 0.5);
+    EXPECT_EQ(undo()->index(), steps + 2);
+    type("scale", "-1");
+    EXPECT_THAT(panel->errorLabel()->text().toStdString(), HasSubstr("scale"));
+    EXPECT_DOUBLE_EQ(scenery().back().scale, 0.5);
+    EXPECT_EQ(undo()->index(), steps + 2);
+    // the tree lists it; undo takes it out again
+    undo()->undo();
+    undo()->undo();
+    EXPECT_EQ(scenery().size(), before);
+    // a file that is no surface is refused naming the file, the model as it was
+    std::ofstream(scratch.dir / "broken.obj") << "v 0 0 0\nv 1 0 0\nf 1 2 7\n";
+    const QString why = panel->importFile(QString::fromStdString((scratch.dir / "broken.obj").string()));
+    EXPECT_THAT(why.toStdString(), HasSubstr("broken"));
+    EXPECT_EQ(scenery().size(), before);
+    test::saveShot("surroundings_imported_liver");
 }

@@ -13,6 +13,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -139,8 +140,28 @@ TEST(AnatomyShapes, BadSceneryAndBendNameTheFieldAndRule) {
         }
         return std::string("accepted");
     };
-    EXPECT_THAT(error("\"generator\": \"disc\"", "\"generator\": \"cone\""),
-                HasSubstr("project.json: scenery[2].generator: 'cone' is not a scenery generator (cylinder, disc)"));
+    EXPECT_THAT(
+        error("\"generator\": \"disc\"", "\"generator\": \"cone\""),
+        HasSubstr("project.json: scenery[2].generator: 'cone' is not a scenery generator (cylinder, disc, file)"));
+    // an imported surrounding: its file inside the project folder, a positive scale, no primitive keys
+    auto fileEntryError = [&](const nlohmann::json& entry) {
+        nlohmann::json doc = nlohmann::json::parse(text);
+        doc["scenery"][2] = entry;
+        try {
+            studio::loadProjectText(doc.dump(), src, "project.json");
+        } catch (const InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    EXPECT_THAT(fileEntryError({{"name", "peritoneum"}, {"generator", "file"}, {"file", "../outside.obj"}}),
+                HasSubstr("project.json: scenery[2].file:"));
+    EXPECT_THAT(
+        fileEntryError({{"name", "peritoneum"}, {"generator", "file"}, {"file", "anatomy/liver.obj"}, {"scale", 0}}),
+        HasSubstr("project.json: scenery[2].scale: must be in (0, 1000]"));
+    EXPECT_THAT(
+        fileEntryError({{"name", "peritoneum"}, {"generator", "file"}, {"file", "anatomy/liver.obj"}, {"radius", 1}}),
+        HasSubstr("project.json: scenery[2].radius: unknown field"));
     EXPECT_THAT(error("\"from_deg\": 55, \"to_deg\": 305", "\"from_deg\": 55, \"to_deg\": 500"),
                 HasSubstr("project.json: scenery[1].to_deg: must be in [-360, 360]"));
     EXPECT_THAT(error("\"from_deg\": 55, \"to_deg\": 305", "\"from_deg\": 55, \"to_deg\": 40"),
