@@ -10,7 +10,7 @@ KeyboardDevice::KeyboardDevice(double speed, double metresPerPixel) : m_speed(sp
     m_caps.arms = 1;
     m_caps.arm[0].hand = Hand::Either;
     m_caps.arm[0].dof = 3;
-    m_caps.arm[0].grip = false;
+    m_caps.arm[0].grip = true; // the grip key
     m_caps.arm[0].maxForce = 0.0;
     m_caps.pedals = 0;
     m_caps.realtime = true;
@@ -49,7 +49,10 @@ void KeyboardDevice::poll(int64_t now_ns, DeviceState& out) {
     out.timestamp_ns = now_ns;
     out.sequence = ++m_seq;
     out.connected = true;
-    out.pedals = ((k & KeyClutch) ? uint32_t(kPedalClutch) : 0u) | ((k & KeyCamera) ? uint32_t(kPedalCamera) : 0u);
+    out.pedals = ((k & KeyClutch) ? uint32_t(kPedalClutch) : 0u) | ((k & KeyCamera) ? uint32_t(kPedalCamera) : 0u) |
+                 ((k & KeyCut) ? uint32_t(kPedalEnergyCut) : 0u);
+    out.arms[0].jaw_measured_js = (k & KeyGrip) ? 0.0 : kOpenGrip;
+    out.arms[0].buttons = (k & KeyButton) ? 1u : 0u;
     out.arms[0].measured_cp.position = m_pos;
     out.arms[0].measured_cp.orientation = Quat::Identity();
     out.arms[0].measured_cv.linear = m_vel;

@@ -3,8 +3,10 @@
 /// motion through lock-free setters; poll() (servo thread) integrates them into arm 0's pose.
 /// Keys move the master at `speed` m/s: Left/Right = ∓x/±x, Up/Down = ±y, PageUp/PageDown = ±z;
 /// the clutch key holds the clutch pedal. Mouse drags move x/y by metresPerPixel per pixel and
-/// the wheel moves z. Positions stay inside the workspace. No force can be rendered: the device
-/// has no motors, so commands are only recorded.
+/// the wheel moves z. Positions stay inside the workspace. The grip key closes the jaws while held
+/// (grip 0 rad, else open at kOpenGrip), the cut key holds the energy (cut) pedal, the button key
+/// presses the arm's first button (which hands the arm to the next instrument of its hand). No
+/// force can be rendered: the device has no motors, so commands are only recorded.
 #include "haptics/device.hpp"
 
 #include <atomic>
@@ -21,8 +23,13 @@ public:
         KeyPageUp = 16,
         KeyPageDown = 32,
         KeyClutch = 64,
-        KeyCamera = 128 ///< the Cam pedal: the keys steer the laparoscope
+        KeyCamera = 128, ///< the Cam pedal: the keys steer the laparoscope
+        KeyGrip = 256,   ///< held: the jaws closed
+        KeyCut = 512,    ///< held: the energy (cut) pedal
+        KeyButton = 1024 ///< held: the arm's first button
     };
+    static constexpr uint32_t kAllKeys = 2047;
+    static constexpr double kOpenGrip = 1.0; ///< rad, the grip while the grip key is up
     explicit KeyboardDevice(double speed = 0.05, double metresPerPixel = 2e-4);
     const DeviceCapabilities& capabilities() const override { return m_caps; }
     void poll(int64_t now_ns, DeviceState& out) override;

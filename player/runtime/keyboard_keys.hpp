@@ -1,6 +1,7 @@
 #pragma once
 /// Which Qt key drives which key of the keyboard master (haptics::KeyboardDevice): arrows move
-/// x/y, Page Up/Down move z, Space holds the clutch, C the camera pedal. One table for the
+/// x/y, Page Up/Down move z, Space holds the clutch, C the camera pedal, G closes the grip, E holds
+/// the energy (cut) pedal, B presses the arm's button (the next instrument of the hand). One table for the
 /// trainee window and the studio's rehearsal. Header only, for the Qt front ends (the runtime
 /// itself does not link Qt).
 #include "haptics/keyboard_device.hpp"
@@ -30,6 +31,12 @@ inline std::optional<haptics::KeyboardDevice::Key> keyboardKey(int qtKey) {
         return K::KeyClutch;
     case Qt::Key_C: // held: the Cam pedal
         return K::KeyCamera;
+    case Qt::Key_G:
+        return K::KeyGrip;
+    case Qt::Key_E:
+        return K::KeyCut;
+    case Qt::Key_B:
+        return K::KeyButton;
     default:
         return std::nullopt;
     }

@@ -199,8 +199,10 @@ void Rehearsal::onStarted() {
     if (!m_scene) return;
     m_appliedFrames = -1;
     m_poll.start();
-    emit progress(m_run->keyboard ? tr("running: arrows, Page Up/Down and a drag move the tool; Space clutch")
-                                  : tr("running %1").arg(m_options.device));
+    emit progress(m_run->keyboard
+                      ? tr("running: arrows, Page Up/Down and a drag move the tool; G grip, E cut pedal, B next "
+                           "instrument, Space clutch")
+                      : tr("running %1").arg(m_options.device));
     emit started();
 }
 

@@ -255,7 +255,7 @@ bool RehearsePanel::keyboardEvent(QEvent* event) {
     case QEvent::WindowDeactivate:
     case QEvent::Hide: {
         // the releases would go elsewhere: nothing stays held, no drag carries on
-        for (uint32_t k = haptics::KeyboardDevice::KeyLeft; k <= haptics::KeyboardDevice::KeyCamera; k <<= 1)
+        for (uint32_t k = haptics::KeyboardDevice::KeyLeft; k & haptics::KeyboardDevice::kAllKeys; k <<= 1)
             kb->setKey(static_cast<haptics::KeyboardDevice::Key>(k), false);
         m_dragging = false;
         return false;

@@ -139,4 +139,21 @@ TEST(KeyboardDevice, KeysAndMouseMoveTheMasterInsideTheWorkspace) {
     dev.poll(300 * kMs, st);
     EXPECT_NEAR(st.arms[0].measured_cp.position.x(), dev.capabilities().arm[0].workspaceMax.x(), 1e-12);
     EXPECT_EQ(dev.capabilities().arm[0].maxForce, 0.0);
+    // the grip, cut and button keys: jaws closed, the energy pedal, the arm's button, while held
+    EXPECT_TRUE(dev.capabilities().arm[0].grip);
+    EXPECT_DOUBLE_EQ(st.arms[0].jaw_measured_js, KeyboardDevice::kOpenGrip);
+    dev.setKey(KeyboardDevice::KeyGrip, true);
+    dev.setKey(KeyboardDevice::KeyCut, true);
+    dev.setKey(KeyboardDevice::KeyButton, true);
+    dev.poll(400 * kMs, st);
+    EXPECT_DOUBLE_EQ(st.arms[0].jaw_measured_js, 0.0);
+    EXPECT_TRUE(st.pedals & kPedalEnergyCut);
+    EXPECT_EQ(st.arms[0].buttons, 1u);
+    dev.setKey(KeyboardDevice::KeyGrip, false);
+    dev.setKey(KeyboardDevice::KeyCut, false);
+    dev.setKey(KeyboardDevice::KeyButton, false);
+    dev.poll(500 * kMs, st);
+    EXPECT_DOUBLE_EQ(st.arms[0].jaw_measured_js, KeyboardDevice::kOpenGrip);
+    EXPECT_FALSE(st.pedals & kPedalEnergyCut);
+    EXPECT_EQ(st.arms[0].buttons, 0u);
 }

@@ -145,6 +145,11 @@ TEST_F(RehearseFixture, TheKeyboardInTheViewportDrivesTheLeftMasterAndStopEndsTh
     keyOnCanvas(true, Qt::Key_PageDown); // −z
     QTest::qWait(400);
     keyOnCanvas(false, Qt::Key_PageDown);
+    keyOnCanvas(true, Qt::Key_G); // the grip closed, the cut pedal held
+    keyOnCanvas(true, Qt::Key_E);
+    QTest::qWait(300);
+    keyOnCanvas(false, Qt::Key_G);
+    keyOnCanvas(false, Qt::Key_E);
     QTest::qWait(200);
     shoot("rehearse_keyboard");
     QTest::mouseClick(panel->stopButton(), Qt::LeftButton);
@@ -155,6 +160,14 @@ TEST_F(RehearseFixture, TheKeyboardInTheViewportDrivesTheLeftMasterAndStopEndsTh
     EXPECT_LT(end.y() - start.y(), -0.015) << "Down held 0.6 s at 5 cm/s";
     EXPECT_LT(end.z() - start.z(), -0.008) << "Page Down held 0.4 s";
     EXPECT_NEAR(end.x(), start.x(), 1e-6) << "nothing moved x";
+    bool closed = false, cutting = false;
+    for (const haptics::TrajectorySample& x : rec.samples(0)) {
+        closed = closed || x.grip == 0.0;
+        cutting = cutting || (x.pedals & haptics::kPedalEnergyCut);
+    }
+    EXPECT_TRUE(closed) << "G closed the grip";
+    EXPECT_TRUE(cutting) << "E held the cut pedal";
+    EXPECT_EQ(rec.samples(0).back().grip, haptics::KeyboardDevice::kOpenGrip) << "open again";
     const studio::Rehearsal::Outcome& o = panel->rehearsal()->outcome();
     ASSERT_TRUE(o.ran) << o.error.toStdString();
     EXPECT_TRUE(o.judged);
