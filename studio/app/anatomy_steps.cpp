@@ -225,22 +225,29 @@ void AnatomySteps::onFinished(bool ok, const QString& message) {
 
 // ---- import -----------------------------------------------------------------------------------
 
-void AnatomySteps::askImport() {
-    // Opens where the last anatomy came from (the project folder the first time).
-    const QString start = QSettings().value(QStringLiteral("studio/anatomyFolder"), m_doc->folder()).toString();
-    auto* dlg = new QFileDialog(m_window, tr("Import anatomy: parts and an optional PNG texture"), start,
-                                tr("Anatomy (*.obj *.stl *.ply *.gltf *.glb *.fbx *.png)"));
-    dlg->setObjectName("importAnatomyDialog");
+void openAnatomyDialog(QWidget* parent, const QString& projectFolder, const QString& title, const QString& filter,
+                       const QString& objectName, bool many, std::function<void(const QStringList&)> chosen) {
+    const QString start = QSettings().value(QStringLiteral("studio/anatomyFolder"), projectFolder).toString();
+    auto* dlg = new QFileDialog(parent, title, start, filter);
+    dlg->setObjectName(objectName);
     dlg->setOption(QFileDialog::DontUseNativeDialog);
-    dlg->setFileMode(QFileDialog::ExistingFiles);
+    dlg->setFileMode(many ? QFileDialog::ExistingFiles : QFileDialog::ExistingFile);
     dlg->setAttribute(Qt::WA_DeleteOnClose);
-    connect(dlg, &QFileDialog::filesSelected, this, [this](const QStringList& files) {
+    QObject::connect(dlg, &QFileDialog::filesSelected, dlg, [chosen = std::move(chosen)](const QStringList& files) {
         if (!files.isEmpty())
             QSettings().setValue(QStringLiteral("studio/anatomyFolder"), QFileInfo(files[0]).absolutePath());
-        QString why;
-        if (!importAnatomy(files, &why)) fail(why);
+        chosen(files);
     });
     dlg->open();
+}
+
+void AnatomySteps::askImport() {
+    openAnatomyDialog(m_window, m_doc->folder(), tr("Import anatomy: parts and an optional PNG texture"),
+                      tr("Anatomy (*.obj *.stl *.ply *.gltf *.glb *.fbx *.png)"), "importAnatomyDialog", true,
+                      [this](const QStringList& files) {
+                          QString why;
+                          if (!importAnatomy(files, &why)) fail(why);
+                      });
 }
 
 bool AnatomySteps::importAnatomy(const QStringList& files, QString* why) {

@@ -32,6 +32,8 @@
 #include <QString>
 #include <QStringList>
 
+#include <functional>
+
 class QAction;
 class QDialog;
 class QLabel;
@@ -46,6 +48,12 @@ class Selection;
 /// `file` copied into <projectFolder>/anatomy/ (a free name: "liver-2.obj" beside "liver.obj"),
 /// or `file` itself when it is one of the project's files already. Empty on failure, with why.
 QString copyIntoProject(const QString& projectFolder, const QString& file, QString* why);
+
+/// The studio's dialog for files made elsewhere (anatomy, tet meshes, surroundings): not native,
+/// deleted on close, opened where the last such file came from (`projectFolder` the first time),
+/// that folder remembered; the files chosen go to `chosen`. `many`: several files at once.
+void openAnatomyDialog(QWidget* parent, const QString& projectFolder, const QString& title, const QString& filter,
+                       const QString& objectName, bool many, std::function<void(const QStringList&)> chosen);
 
 class AnatomySteps : public QObject {
     Q_OBJECT

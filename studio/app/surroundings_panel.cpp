@@ -228,19 +228,11 @@ void SurroundingsPanel::add(bool wall) {
 
 void SurroundingsPanel::askImport() {
     if (!m_doc->hasProject()) return;
-    // Opens where the last anatomy came from, as Import anatomy does (the project folder the first time).
-    const QString start = QSettings().value(QStringLiteral("studio/anatomyFolder"), m_doc->folder()).toString();
-    auto* dlg = new QFileDialog(this, tr("Import a mesh as surrounding anatomy"), start,
-                                tr("Surfaces (*.obj *.stl *.ply *.gltf *.glb *.fbx)"));
-    dlg->setObjectName("sceneryImportDialog");
-    dlg->setAttribute(Qt::WA_DeleteOnClose);
-    dlg->setFileMode(QFileDialog::ExistingFile);
-    dlg->setOption(QFileDialog::DontUseNativeDialog);
-    connect(dlg, &QFileDialog::fileSelected, this, [this](const QString& f) {
-        QSettings().setValue(QStringLiteral("studio/anatomyFolder"), QFileInfo(f).absolutePath());
-        importFile(f);
-    });
-    dlg->open();
+    openAnatomyDialog(this, m_doc->folder(), tr("Import a mesh as surrounding anatomy"),
+                      tr("Surfaces (*.obj *.stl *.ply *.gltf *.glb *.fbx)"), "sceneryImportDialog", false,
+                      [this](const QStringList& files) {
+                          if (!files.isEmpty()) importFile(files.front());
+                      });
 }
 
 QString SurroundingsPanel::importFile(const QString& path) {

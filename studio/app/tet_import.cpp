@@ -74,17 +74,10 @@ void TetImport::ask() {
         emit failed(tr("Import tet mesh: save the project first (the mesh is copied into its folder)"));
         return;
     }
-    const QString start = QSettings().value(QStringLiteral("studio/anatomyFolder"), m_doc->folder()).toString();
-    auto* dlg = new QFileDialog(m_window, tr("Import tet mesh"), start, tr("Tet meshes (*.msh *.vtu *.vtet)"));
-    dlg->setObjectName("importTetMeshDialog");
-    dlg->setOption(QFileDialog::DontUseNativeDialog);
-    dlg->setFileMode(QFileDialog::ExistingFile);
-    dlg->setAttribute(Qt::WA_DeleteOnClose);
-    connect(dlg, &QFileDialog::fileSelected, this, [this](const QString& file) {
-        QSettings().setValue(QStringLiteral("studio/anatomyFolder"), QFileInfo(file).absolutePath());
-        askUnit(file);
-    });
-    dlg->open();
+    openAnatomyDialog(m_window, m_doc->folder(), tr("Import tet mesh"), tr("Tet meshes (*.msh *.vtu *.vtet)"),
+                      "importTetMeshDialog", false, [this](const QStringList& files) {
+                          if (!files.isEmpty()) askUnit(files.front());
+                      });
 }
 
 void TetImport::askUnit(const QString& file) {
