@@ -1,6 +1,7 @@
 #include "runtime/assessment.hpp"
 
 #include "runtime/session.hpp"
+#include "sim/collision/distance.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -118,6 +119,15 @@ std::optional<double> judgeCuts(const SessionTimeline& tl, const sim::Assessment
                 continue;
             }
             inside = true;
+            if (e.swept.size() == 3) { // scissors: the line opens where their blades swept
+                for (size_t k = 0; k < cov.bins[t].size(); ++k)
+                    if ((sim::closestPointOnTriangle(cov.bins[t][k], e.swept[0], e.swept[1], e.swept[2]).point -
+                         cov.bins[t][k])
+                            .norm() <= kCutHalfWidth)
+                        cov.hit[t][k] = 1;
+                last[t].reset();
+                continue;
+            }
             const Vec3 from = last[t] && (*last[t] - e.at).norm() <= kCutPassGap ? *last[t] : e.at;
             for (size_t k = 0; k < cov.bins[t].size(); ++k)
                 if (pointSegment(cov.bins[t][k], from, e.at) <= kCutHalfWidth) cov.hit[t][k] = 1;

@@ -268,13 +268,20 @@ static nlohmann::json timelineJson(const SessionTimeline& tl) {
             {{"name", tool.name}, {"kind", tool.kind}, {"hand", tool.hand}, {"tip_m", tip}, {"force_n", force}});
     }
     json events = json::array();
-    for (const SessionTimeline::Event& e : tl.events)
+    for (const SessionTimeline::Event& e : tl.events) {
         events.push_back({{"t_s", round(e.t_s, 1e-6)},
                           {"frame", e.frame},
                           {"kind", e.kind},
                           {"tool", e.tool},
                           {"count", e.count},
                           {"at_m", {round(e.at.x(), 1e-6), round(e.at.y(), 1e-6), round(e.at.z(), 1e-6)}}});
+        if (!e.swept.empty()) {
+            json swept = json::array();
+            for (const Eigen::Vector3d& p : e.swept)
+                swept.push_back({round(p.x(), 1e-6), round(p.y(), 1e-6), round(p.z(), 1e-6)});
+            events.back()["swept_m"] = swept;
+        }
+    }
     json doc = {{"stride_frames", tl.stride}, {"t_s", t}, {"tools", tools}, {"events", events}};
     if (!tl.cameraTip.empty()) {
         json tip = json::array(), steering = json::array();

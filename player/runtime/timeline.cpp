@@ -115,16 +115,20 @@ void TimelineRecorder::record(const sim::World& world) {
         }
         const int cut = s.fasciaEdgesCut + s.fatEdgesCut;
         if (cut > m_cut) {
-            std::string by; // the energized hook or the scissors that closed, else the first cutter
-            Eigen::Vector3d at =
-                Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()); // no cutter: nowhere
+            // The energized hook or the scissors that closed, else the first cutter; where the
+            // tissue was cut (the cut edges' mean) when the cutter says, else its tip.
+            std::string by;
+            Eigen::Vector3d at = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()); // no cutter
+            std::vector<Eigen::Vector3d> swept;
             for (const sim::InstrumentState& st : s.instruments)
                 if ((std::string_view(st.kind) == "energy_hook" || std::string_view(st.kind) == "scissors") &&
-                    (by.empty() || st.act)) {
+                    (by.empty() || st.act || st.cutAt)) {
                     by = st.name;
-                    at = st.tip;
+                    at = st.cutAt.value_or(st.tip);
+                    swept.clear();
+                    if (st.swept) swept.assign(st.swept->begin(), st.swept->end());
                 }
-            m_tl.events.push_back({t, frame, "cut", by, cut - m_cut, at});
+            m_tl.events.push_back({t, frame, "cut", by, cut - m_cut, at, std::move(swept)});
         }
         m_cut = cut;
         for (size_t c = static_cast<size_t>(m_clips); c < s.clips.size(); ++c)

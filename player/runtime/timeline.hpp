@@ -8,6 +8,7 @@
 /// samples per tool). Events are never dropped.
 #include <Eigen/Core>
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,9 @@ struct SessionTimeline {
         /// m, scene: where it happened (cut: the energized hook's tip; clip: the clip's centre when
         /// fired; puncture: the needle's tip; grasp, release: the grasper's tip).
         Eigen::Vector3d at = Eigen::Vector3d::Zero();
+        /// m, scene: a cut by scissors, the wedge their blades swept (clevis, tip, tip; `at` is
+        /// where the edges they cut lie); empty for a cut at a point (the hook).
+        std::vector<Eigen::Vector3d> swept;
     };
     std::vector<double> t_s; ///< s, the end of each sampled frame
     int stride = 1;          ///< frames per sample

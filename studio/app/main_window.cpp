@@ -5,6 +5,7 @@
 #include "app/error_banner.hpp"
 #include "app/export_runner.hpp"
 #include "app/fit_dialog.hpp"
+#include "app/hold_tool.hpp"
 #include "app/instrument_panel.hpp"
 #include "app/material_panel.hpp"
 #include "app/number_text.hpp"
@@ -165,6 +166,7 @@ void MainWindow::viewportToolOn(QObject* tool) {
         m_paint->setPaintTool(m_paint->samplesAction(), false);
     }
     if (tool != m_portTool) m_portTool->action()->setChecked(false);
+    if (tool != m_holdTool) m_holdTool->action()->setChecked(false);
     if (tool != m_targetTool && m_targetTool->pick() != TargetTool::Pick::None)
         m_targetTool->action(m_targetTool->pick())->setChecked(false);
     // a tool going off sets the paint mode off: the one that came on (the paint tools set it
@@ -186,6 +188,9 @@ void MainWindow::buildDocks() {
     m_material = new MaterialPanel(&m_doc, this);
     m_material->setObjectName("materialPanel");
     m_properties = new PropertiesPanel(&m_doc, &m_sel, m_material, this);
+    m_holdTool = new HoldTool(&m_doc, this); // [issue 57 item 4] a body's holds, drawn on it
+    m_properties->setHoldTool(m_holdTool);
+    connect(&m_sel, &Selection::changed, m_holdTool, [this] { m_holdTool->setShown(m_sel.body() >= 0); });
     dock("propertiesDock", tr("Properties"), m_properties, Qt::LeftDockWidgetArea);
     dock("materialDock", tr("Material curves"), m_material, Qt::BottomDockWidgetArea);
 
@@ -345,6 +350,8 @@ void MainWindow::buildViewMenu(QMenu* view, QToolBar* toolbar) {
     m_portTool = new PortTool(&m_doc, this);
     view->addAction(m_portTool->action());
     toolbar->addAction(m_portTool->action());
+    view->addAction(m_holdTool->action());
+    toolbar->addAction(m_holdTool->action());
     view->addSeparator();
     for (auto pick : {TargetTool::Pick::CutLine, TargetTool::Pick::ClipSite, TargetTool::Pick::SuturePlane,
                       TargetTool::Pick::Vessel})
@@ -352,6 +359,10 @@ void MainWindow::buildViewMenu(QMenu* view, QToolBar* toolbar) {
     connect(m_portTool, &PortTool::activeChanged, this, [this](bool on) {
         if (on) viewportToolOn(m_portTool);
     });
+    connect(m_holdTool, &HoldTool::activeChanged, this, [this](bool on) {
+        if (on) viewportToolOn(m_holdTool);
+    });
+    connect(m_holdTool, &HoldTool::refused, this, &MainWindow::showError);
     connect(m_targetTool, &TargetTool::activeChanged, this, [this](bool on) {
         if (on) viewportToolOn(m_targetTool);
     });
@@ -385,6 +396,7 @@ void MainWindow::setViewportHost(ViewportHost host) {
         m_viewport = nullptr;
         m_paint->connectViewport(nullptr);
         m_portTool->connectViewport(nullptr);
+        m_holdTool->connectViewport(nullptr);
         m_targetTool->connectViewport(nullptr);
         m_rehearse->connectViewport(nullptr);
         m_centre->removeWidget(old);
@@ -401,6 +413,7 @@ void MainWindow::setViewportHost(ViewportHost host) {
     connect(v, &Viewport::rendererFailed, this, &MainWindow::showError);
     m_paint->connectViewport(v);
     m_portTool->connectViewport(v);
+    m_holdTool->connectViewport(v);
     m_targetTool->connectViewport(v);
     m_rehearse->connectViewport(v);
     m_centre->addWidget(v);
@@ -416,7 +429,7 @@ void MainWindow::setViewportHost(ViewportHost host) {
     v->setSelectedName(selected);
     if (m_lookAction) v->setLook(m_lookAction->isChecked() ? Viewport::Look::Trainee : Viewport::Look::Authoring);
     v->setPaintMode(painting() || paintingSamples() || m_portTool->action()->isChecked() ||
-                    m_targetTool->pick() != TargetTool::Pick::None);
+                    m_holdTool->action()->isChecked() || m_targetTool->pick() != TargetTool::Pick::None);
     m_paint->showOverlay();
     QSettings().setValue("viewport/host", viewportHostText(host));
     if (m_widgetHostAction) m_widgetHostAction->setChecked(host == ViewportHost::Widget);

@@ -37,6 +37,7 @@ namespace viscera::studio {
 class AnatomySteps;
 class PortTool;
 class TargetTool;
+class HoldTool;
 class TetImport;
 class InstrumentPanel;
 class ErrorBanner;
@@ -106,6 +107,7 @@ public:
     /// Placing trocar ports in the viewport (port_tool.hpp).
     PortTool* portTool() { return m_portTool; }
     TargetTool* targetTool() { return m_targetTool; }
+    HoldTool* holdTool() { return m_holdTool; }
     RehearsePanel* rehearsePanel() { return m_rehearse; }
     TetImport* tetImport() { return m_tetImport; }
     AnatomySteps* anatomySteps() { return m_anatomy; }
@@ -181,6 +183,7 @@ private:
     PaintTools* m_paint = nullptr;
     PortTool* m_portTool = nullptr;
     TetImport* m_tetImport = nullptr;
+    HoldTool* m_holdTool = nullptr;      ///< [issue 57 item 4] where a body is held, drawn
     TargetTool* m_targetTool = nullptr;  ///< [issue 57 item 2] the assessment's targets, drawn
     RehearsePanel* m_rehearse = nullptr; ///< [issue 57 item 3] the case run in the viewport
     bool m_rehearsing = false, m_previewWasPaused = false;

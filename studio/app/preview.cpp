@@ -252,7 +252,7 @@ Project Preview::specimenProject(const Project& source, const sim::Material& mat
     b.mesh.box.origin = sim::Vec3(-0.01, -0.01, -0.06);
     b.mesh.box.size = sim::Vec3(0.02, 0.02, 0.06);
     b.mesh.box.cells = {4, 4, 12};
-    b.fixedBox = std::array<sim::Vec3, 2>{sim::Vec3(-1, -1, -0.0001), sim::Vec3(1, 1, 1)};
+    b.fixedBoxes = {std::array<sim::Vec3, 2>{sim::Vec3(-1, -1, -0.0001), sim::Vec3(1, 1, 1)}};
     p.bodies.push_back(std::move(b));
     return p;
 }

@@ -1,15 +1,19 @@
 #include "app/properties_panel.hpp"
 
+#include "app/hold_tool.hpp"
 #include "app/material_panel.hpp"
 #include "app/number_text.hpp"
 #include "sim/material/material.hpp"
 
 #include <QComboBox>
 #include <QFormLayout>
+#include <QHBoxLayout>
 #include <QLabel>
 #include <QLineEdit>
+#include <QPushButton>
 #include <QRegularExpression>
 #include <QTimer>
+#include <QToolButton>
 #include <QVBoxLayout>
 
 #include <algorithm>
@@ -21,6 +25,15 @@ namespace {
 const char* const kBodyFields[] = {"youngs_modulus", "poisson_ratio", "density"};
 const char* const kSolverFields[] = {"dt", "substeps", "iterations", "damping"};
 const char* const kPlacementFields[] = {"unit", "scale", "rotation_deg"};
+const char* const kHoldMargin = "hold_margin_mm";
+/// A meshed body's CGAL sizes, typed in millimetres (project.json meshing.facet_size, cell_size).
+const char* const kMeshingFields[] = {"facet_size_mm", "cell_size_mm"};
+
+/// A body whose tets CGAL makes from its remeshed anatomy: its sizes are typed.
+bool meshedFromSurface(const Project& p, int body) {
+    return body >= 0 && body < static_cast<int>(p.bodies.size()) &&
+           p.bodies[static_cast<size_t>(body)].mesh.kind == MeshSource::Kind::Remesh;
+}
 
 bool madeFromAnatomy(const Project& p, int body) {
     return body >= 0 && body < static_cast<int>(p.bodies.size()) &&
@@ -28,7 +41,13 @@ bool madeFromAnatomy(const Project& p, int body) {
 }
 
 /// The text field `name` shows for the project (empty: not a field of this selection).
-QString valueText(const Project& p, int body, const QString& name) {
+QString valueText(const Project& p, int body, const QString& name, const HoldTool* hold) {
+    if (name == kHoldMargin && hold) return numberText(hold->margin() * 1000);
+    if (meshedFromSurface(p, body)) {
+        const auto& m = p.bodies[static_cast<size_t>(body)].mesh.meshing;
+        if (name == "facet_size_mm") return numberText(m.facetSize * 1000);
+        if (name == "cell_size_mm") return numberText(m.cellSize * 1000);
+    }
     if (body >= 0 && body < static_cast<int>(p.bodies.size())) {
         const sim::Material& m = p.bodies[body].scene.material;
         if (name == "youngs_modulus") return numberText(m.youngsModulus);
@@ -110,6 +129,29 @@ void PropertiesPanel::addPlacementFields(const bake::ImportPlacement& placement)
     addField("rotation_deg", tr("Rotation x y z [°]"));
 }
 
+void PropertiesPanel::addHoldRows(int body) {
+    const size_t n = m_doc->project().bodies[static_cast<size_t>(body)].fixedBoxes.size();
+    auto* count = new QLabel(n == 0 ? tr("nowhere (it falls under gravity)") : tr("in %n place(s)", "", int(n)), this);
+    count->setObjectName("heldCount");
+    m_form->addRow(tr("Held"), count);
+    auto* tool = new QToolButton(this);
+    tool->setObjectName("holdTissueButton");
+    tool->setDefaultAction(m_hold->action());
+    auto* release = new QPushButton(tr("Release holds"), this);
+    release->setObjectName("releaseHoldsButton");
+    release->setEnabled(n > 0);
+    connect(release, &QPushButton::clicked, this, [this, body] {
+        const QString why = m_hold->release(body);
+        m_error->setText(why);
+        if (!why.isEmpty()) emit logMessage(why);
+    });
+    auto* row = new QHBoxLayout;
+    row->addWidget(tool);
+    row->addWidget(release);
+    m_form->addRow(QString(), row);
+    addField(kHoldMargin, tr("Hold margin [mm]"));
+}
+
 void PropertiesPanel::rebuild() {
     ++m_builds;
     while (m_form->rowCount() > 0)
@@ -133,6 +175,11 @@ void PropertiesPanel::rebuild() {
         addField("poisson_ratio", tr("Poisson ratio ν"));
         addField("density", tr("Density [kg/m³]"));
         if (madeFromAnatomy(p, body)) addPlacementFields(p.bodies[static_cast<size_t>(body)].mesh.remesh.placement);
+        if (meshedFromSurface(p, body)) {
+            addField("facet_size_mm", tr("Surface triangle size [mm]"));
+            addField("cell_size_mm", tr("Tet size [mm]"));
+        }
+        if (m_hold) addHoldRows(body);
     } else if (m_sel->kind() == Selection::Kind::Solver && p.scene.solverType == "xpbd") {
         addField("dt", tr("Frame step dt [s]"));
         addField("substeps", tr("Substeps per frame"));
@@ -156,7 +203,7 @@ void PropertiesPanel::fillValues(bool force) {
     if (!m_doc->hasProject()) return;
     const Project& p = m_doc->project();
     for (QLineEdit* e : findChildren<QLineEdit*>()) {
-        const QString v = valueText(p, m_sel->body(), e->objectName());
+        const QString v = valueText(p, m_sel->body(), e->objectName(), m_hold);
         if (v.isEmpty() || e->text() == v || (!force && e->isModified())) continue;
         e->setText(v);
         e->setModified(false);
@@ -179,7 +226,15 @@ QString PropertiesPanel::setProperty(const QString& field, const QString& text) 
     const bool solver = std::find(std::begin(kSolverFields), std::end(kSolverFields), field) != std::end(kSolverFields);
     const bool placement =
         std::find(std::begin(kPlacementFields), std::end(kPlacementFields), field) != std::end(kPlacementFields);
-    if (placement) {
+    const bool meshing =
+        std::find(std::begin(kMeshingFields), std::end(kMeshingFields), field) != std::end(kMeshingFields);
+    if (meshing) {
+        const std::optional<double> v = parseNumberText(text, field, why);
+        if (v) why = setMeshingValue(field, *v / 1000);
+    } else if (field == kHoldMargin && m_hold) {
+        const std::optional<double> v = parseNumberText(text, field, why);
+        if (v) why = m_hold->setMargin(*v / 1000);
+    } else if (placement) {
         why = setPlacementValue(field, text);
     } else if (material) {
         why = setMaterialValue(field, text);
@@ -250,6 +305,18 @@ QString PropertiesPanel::setPlacementValue(const QString& field, const QString& 
         }
     }
     return m_doc->editPlacement(tr("Set %1").arg(field), b, q);
+}
+
+QString PropertiesPanel::setMeshingValue(const QString& field, double metres) {
+    const int b = m_sel->body();
+    if (!m_doc->hasProject() || !meshedFromSurface(m_doc->project(), b)) return tr("no meshed body selected");
+    return m_doc->edit(
+        tr("Set %1").arg(field),
+        [&](Project& p) {
+            bake::MeshingParams& m = p.bodies[static_cast<size_t>(b)].mesh.meshing;
+            (field == "cell_size_mm" ? m.cellSize : m.facetSize) = metres;
+        },
+        0, Change{Change::Structure});
 }
 
 QString PropertiesPanel::setSolverValue(const QString& field, double v, const QString& text) {

@@ -1,6 +1,8 @@
 #pragma once
 /// The properties of the selection: a body's material model, E, ν and density (and, for a body
-/// made from anatomy, its parts' unit, scale and rotation); the solver's dt,
+/// made from anatomy, its parts' unit, scale and rotation; for a body meshed from a surface, its
+/// triangle and tet sizes in mm; where it is held: the Hold tissue tool,
+/// its margin and Release holds, hold_tool.hpp); the solver's dt,
 /// substeps, iterations and damping; the render settings and a surface's figures. A typed value
 /// is one undo step through the Document (a material value as a typed material edit, checked by
 /// the reader's material rules); a refused value shows the rule under the fields and the field
@@ -17,6 +19,7 @@ class QLabel;
 
 namespace viscera::studio {
 
+class HoldTool;
 class MaterialPanel;
 
 class PropertiesPanel : public QWidget {
@@ -28,6 +31,8 @@ public:
     /// "youngs_modulus", "substeps", "model"). Returns the error shown, empty when accepted.
     QString setProperty(const QString& field, const QString& text);
     QLabel* errorLabel() { return m_error; }
+    /// The tool a body's hold rows drive (none: no hold rows).
+    void setHoldTool(HoldTool* tool) { m_hold = tool; }
     /// How many times the fields were made (a test checks that a drag makes none).
     int builds() const { return m_builds; }
 
@@ -44,14 +49,19 @@ private:
     void fillValues(bool force);
     QString setMaterialValue(const QString& field, const QString& text);
     QString setSolverValue(const QString& field, double v, const QString& text);
+    /// A meshed body's facet or cell size (m), one undo step under the reader's rule.
+    QString setMeshingValue(const QString& field, double metres);
     /// A body made from anatomy: its parts' unit, scale or rotation (Document::editPlacement).
     QString setPlacementValue(const QString& field, const QString& text);
     void addPlacementFields(const bake::ImportPlacement& placement);
+    /// A body's hold rows: how many places hold it, the tool's button, its margin, Release holds.
+    void addHoldRows(int body);
     void addField(const QString& name, const QString& label);
 
     Document* m_doc;
     Selection* m_sel;
     MaterialPanel* m_material;
+    HoldTool* m_hold = nullptr;
     QFormLayout* m_form = nullptr;
     QLabel* m_error = nullptr;
     bool m_pending = false;

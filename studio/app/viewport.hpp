@@ -115,7 +115,7 @@ public:
     void setRestPose(int index, render::RenderMesh::Source source = render::RenderMesh::Source::Body);
     /// Who draws authoring meshes: each tool replaces its own layer, the layers drawn in this
     /// order (the paint tools' skeleton and brush, a port's workspace, the assessment's targets).
-    enum class Layer { Paint = 0, Port, Targets, Count };
+    enum class Layer { Paint = 0, Port, Targets, Holds, Count };
     /// Static meshes of `layer` drawn after the scene's; not hit.
     void setAuthoringLayer(Layer layer, std::vector<render::RenderMesh> meshes);
     /// The paint layer's meshes (the paint tool's skeleton and section).

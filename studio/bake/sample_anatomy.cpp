@@ -214,19 +214,20 @@ std::vector<RemeshPart> hepatocysticAnatomy(int slices) {
     }
     parts.push_back({"gallbladder", sim::TriMesh::fromArrays(std::move(gp), gallUndeformed.triangles(), "gallbladder"),
                      CsgOp::Union, std::move(gallUv)});
-    // Cystic duct: an open tube from the neck down to the common bile duct.
-    const sim::Vec3 da(0, -0.043, 0.009), db(0.007, -0.072, 0.001);
+    // Cystic duct: an open tube from the neck down to the common bile duct, 3.5 cm long, 2 cm of
+    // it free between them: room for two clips on each side of the cut.
+    const sim::Vec3 da(0, -0.043, 0.009), db(0.012, -0.075, 0.001);
     sim::TriMesh duct = uncapped(sim::makeTubeSurface(da, db, 0.0025, slices / 4, slices / 4), da, db, "cystic_duct");
     std::vector<CornerUv> ductUv = tubeUv(duct, da, db, 0.0025, {0.62, 0.27, 0.79, 0.48}, {}, {});
     parts.push_back({"cystic_duct", std::move(duct), CsgOp::Union, std::move(ductUv)});
     // Common bile duct: an open tube past the duct's end, overlapping it.
-    const sim::Vec3 ca(0.004, -0.055, 0.004), cb(0.013, -0.115, -0.008);
+    const sim::Vec3 ca(0.011, -0.068, 0.003), cb(0.02, -0.125, -0.008);
     sim::TriMesh cbd =
         uncapped(sim::makeTubeSurface(ca, cb, 0.004, slices / 4, slices / 4), ca, cb, "common_bile_duct");
     std::vector<CornerUv> cbdUv = tubeUv(cbd, ca, cb, 0.004, {0.62, 0.02, 0.79, 0.23}, {}, {});
     parts.push_back({"common_bile_duct", std::move(cbd), CsgOp::Union, std::move(cbdUv)});
     // Cystic artery: a closed, capped tube up to the gallbladder's neck, its end inside it.
-    const sim::Vec3 aa(0.016, -0.07, 0.006), ab(0.006, -0.036, 0.012);
+    const sim::Vec3 aa(0.024, -0.07, 0.008), ab(0.008, -0.036, 0.012);
     sim::TriMesh artery = sim::makeTubeSurface(aa, ab, 0.0015, slices / 6, slices / 6);
     std::vector<CornerUv> arteryUv =
         tubeUv(artery, aa, ab, 0.0015, {0.81, 0.14, 0.98, 0.48}, {0.81, 0.02, 0.885, 0.12}, {0.905, 0.02, 0.98, 0.12});

@@ -52,6 +52,15 @@ std::array<sim::Vec3, 2> readBox(const JsonField& f) {
     return {lo, hi};
 }
 
+/// "fixed": one box, or a list of 1 to kMaxHoldBoxes boxes.
+std::vector<std::array<sim::Vec3, 2>> readHoldBoxes(const JsonField& f) {
+    if (!f.value().is_array()) return {readBox(f)};
+    std::vector<std::array<sim::Vec3, 2>> boxes;
+    for (const JsonField& box : f.items(1, kMaxHoldBoxes))
+        boxes.push_back(readBox(box));
+    return boxes;
+}
+
 json boxJson(const std::array<sim::Vec3, 2>& box) {
     return {{"min", vec3Json(box[0])}, {"max", vec3Json(box[1])}};
 }
@@ -676,7 +685,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
         if (auto sp = b.find("stiffness_paint")) body.paint = readPaint(*sp, true);
         if (auto ls = b.find("light_samples")) body.lightSamples = readLightSamples(*ls);
         if (auto t = b.find("texture")) body.texture = readTexture(*t, dir);
-        if (auto fx = b.find("fixed")) body.fixedBox = readBox(*fx);
+        if (auto fx = b.find("fixed")) body.fixedBoxes = readHoldBoxes(*fx);
         p.bodies.push_back(std::move(body));
     }
     if (auto surfaces = root.find("surfaces"))
@@ -760,7 +769,12 @@ std::string projectJsonText(const Project& p) {
         const BodyProject& b = p.bodies[i];
         json j = {{"mesh", meshSourceJson(b.mesh, w, "bodies[" + std::to_string(i) + "].mesh")}};
         sim::writeBodyCommon(b.scene, j);
-        if (b.fixedBox) j["fixed"] = boxJson(*b.fixedBox);
+        if (b.fixedBoxes.size() == 1) j["fixed"] = boxJson(b.fixedBoxes.front());
+        if (b.fixedBoxes.size() > 1) {
+            j["fixed"] = json::array();
+            for (const auto& box : b.fixedBoxes)
+                j["fixed"].push_back(boxJson(box));
+        }
         if (!b.stiffnessRegions.empty()) {
             json regions = json::array();
             for (const StiffnessRegion& r : b.stiffnessRegions)
@@ -1280,11 +1294,19 @@ BodyExport checkBodyMesh(const BodyProject& b, const sim::TetMesh& mesh, sim::Bo
         throw InputError(origin + ": " + field + ".mesh: tet " + std::to_string(be.quality.degenerate.front()) +
                          " is degenerate (" + std::to_string(be.quality.degenerate.size()) + " in all)");
     const auto& pos = mesh.positions();
-    if (b.fixedBox) {
-        for (int32_t v = 0; v < static_cast<int32_t>(pos.size()); ++v)
-            if (inBox(pos[v], (*b.fixedBox)[0], (*b.fixedBox)[1])) desc.fixedNodes.push_back(v);
-        if (desc.fixedNodes.empty()) throw InputError(origin + ": " + field + ".fixed: the box contains no mesh node");
+    std::vector<bool> held(pos.size(), false);
+    for (size_t k = 0; k < b.fixedBoxes.size(); ++k) {
+        const auto& box = b.fixedBoxes[k];
+        bool any = false;
+        for (size_t v = 0; v < pos.size(); ++v)
+            if (inBox(pos[v], box[0], box[1])) held[v] = any = true;
+        if (!any)
+            throw InputError(origin + ": " + field + ".fixed" +
+                             (b.fixedBoxes.size() > 1 ? "[" + std::to_string(k) + "]" : std::string()) +
+                             ": the box contains no mesh node");
     }
+    for (int32_t v = 0; v < static_cast<int32_t>(pos.size()); ++v)
+        if (held[static_cast<size_t>(v)]) desc.fixedNodes.push_back(v);
     be.fixedNodes = desc.fixedNodes.size();
     return be;
 }

@@ -22,7 +22,8 @@
 ///          | {"file": "liver.msh", "scale": 0.01}   a tet mesh (.msh, .vtu, .vtet; sim::readTetFile) as it is
 ///          | {"remesh": {..see RemeshSource..}, "meshing": {..}},
 ///     "material": {see readMaterial in core/sim/scene/scene_json.hpp},
-///     "fixed": {"min": [..], "max": [..]},     nodes inside this box (metres) are fixed
+///     "fixed": {"min": [..], "max": [..]},     nodes inside this box (metres) are fixed; or a list of
+///              [{"min": .., "max": ..}, ..]     such boxes (at most kMaxHoldBoxes), nodes in any one fixed
 ///     "stiffness_regions": [{"min": [..], "max": [..], "weight": 4}],
 ///     "stiffness_paint": {"skeleton": {"min_edge_length_rel": 0.002, "medially_centered": true},
 ///                         "base_weight": 1, "min_weight": 0.001, "max_weight": 1e6,
@@ -198,11 +199,15 @@ TextureProject embedTextureSpec(const TextureProject& t, const std::filesystem::
 /// The range of a light-sample brush radius in project.json, m (the reader's rule and the studio's
 /// typed edits: NumberRule::closed of these).
 inline constexpr double kMinSampleBrushRadius = 1e-4, kMaxSampleBrushRadius = 10.0;
+/// The most boxes a body's "fixed" may list.
+inline constexpr size_t kMaxHoldBoxes = 64;
 
 struct BodyProject {
     sim::BodyDesc scene;
     MeshSource mesh;
-    std::optional<std::array<sim::Vec3, 2>> fixedBox; ///< {min, max}, metres
+    /// {min, max} boxes, metres: the nodes inside any one are held in place ("fixed"; each box must
+    /// hold a node of the mesh). Empty: nothing held.
+    std::vector<std::array<sim::Vec3, 2>> fixedBoxes;
     std::vector<StiffnessRegion> stiffnessRegions;
     std::optional<StiffnessPaintProject> paint; ///< exported as meshes/<body>.vweights
     /// Light-sample painting [A §6.3.2], by position; exported as maps/<body>.vsamples only when

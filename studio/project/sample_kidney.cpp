@@ -55,7 +55,7 @@ Project writeKidneySample(const std::filesystem::path& dir) {
     body.mesh.meshing.cellSize = 0.008;
     body.mesh.meshing.seed = 7;
     // Held at the hilum, where the artery and ureter leave it.
-    body.fixedBox = std::array<sim::Vec3, 2>{sim::Vec3(0.014, -0.012, -0.012), sim::Vec3(0.034, 0.014, 0.014)};
+    body.fixedBoxes = {std::array<sim::Vec3, 2>{sim::Vec3(0.014, -0.012, -0.012), sim::Vec3(0.034, 0.014, 0.014)}};
     p.scene.xpbd.substeps = 40;
     p.scene.xpbd.inertiaScaling = 10; // the few small tets the remeshed hilum leaves get extra inertia
     saveProject(p, dir);

@@ -112,8 +112,12 @@ std::unique_ptr<Dissection> Dissection::create(const DissectionDesc& d) {
         L.body = d.tetBody;
         L.tissue = d.fatTissue;
         L.edges = EdgeStructure::fromTets(d.fat->tets(), d.fat->vertexCount());
-        for (const Tet& t : d.fat->tets())
+        L.liveTets.assign(d.fat->vertexCount(), 0);
+        for (const Tet& t : d.fat->tets()) {
             L.prims.push_back({t[0], t[1], t[2], t[3]});
+            for (int32_t v : t)
+                ++L.liveTets[static_cast<size_t>(v)];
+        }
         out->m_fat = std::move(L);
         if (d.fat->level() >= 3) {
             out->m_hasFatBoundary = true;
@@ -184,14 +188,24 @@ void Dissection::cutEdges(Layer& L, const std::vector<int32_t>& edges, const Ene
     EdgeStructure& E = L.edges;
     const std::vector<Vec3>& x = L.tets ? m_sys->tetPositions(L.body) : m_sys->surfacePositions(L.body);
     m_newlyCut.clear();
+    Vec3 sum = Vec3::Zero();
     for (int32_t e : edges)
-        if (E.dissect(static_cast<size_t>(e), &m_newlyCut)) ++st.edgesCut;
+        if (E.dissect(static_cast<size_t>(e), &m_newlyCut)) {
+            ++st.edgesCut;
+            sum += 0.5 * (x[E.edge(static_cast<size_t>(e))[0]] + x[E.edge(static_cast<size_t>(e))[1]]);
+        }
+    if (st.edgesCut > 0) st.cutCentre = sum / static_cast<double>(st.edgesCut);
     st.primitivesCut = m_newlyCut.size();
     for (int32_t p : m_newlyCut) {
-        if (L.tets)
-            m_sys->setTetActive(L.body, p, false);
-        else
+        if (!L.tets) {
             m_sys->setTriangleActive(L.body, p, false);
+            continue;
+        }
+        m_sys->setTetActive(L.body, p, false);
+        // a node whose tets are all cut belongs to no tissue any more: it stays where it was cut
+        // (held), not falling out of the scene on its own
+        for (int32_t v : L.prims[static_cast<size_t>(p)])
+            if (--L.liveTets[static_cast<size_t>(v)] == 0) m_sys->holdTetNode(L.body, static_cast<size_t>(v));
     }
     if (shrinkBy && L.tissue.shrinkage && !(L.tissue.shrink.array() == 1.0).all())
         for (int32_t p : m_newlyCut)
@@ -216,32 +230,37 @@ void Dissection::cutEdges(Layer& L, const std::vector<int32_t>& edges, const Ene
         if (!E.isDissected(e)) st.maxEdgeHeat = std::max(st.maxEdgeHeat, L.heat[e]);
 }
 
-DissectionFrameStats Dissection::shear(const Vec3& a, const Vec3& b, double radius) {
+DissectionFrameStats Dissection::shear(const Vec3& clevis, const Vec3& tipA, const Vec3& tipB, double radius) {
     const std::string where = "sim::Dissection::shear(): ";
-    if (!a.allFinite() || !b.allFinite() || !std::isfinite(radius))
-        throw std::invalid_argument(where + "blade ends or radius not finite");
+    if (!clevis.allFinite() || !tipA.allFinite() || !tipB.allFinite() || !std::isfinite(radius))
+        throw std::invalid_argument(where + "blade points or radius not finite");
     if (!(radius > 0)) throw std::invalid_argument(where + "radius is " + formatNumber(radius) + " (must be > 0)");
     DissectionFrameStats st;
     st.gridMin = m_heat.minTemperature();
     st.gridMax = m_heat.maxTemperature();
+    const bool wedge = (tipA - tipB).norm() > 1e-9;
+    const Vec3 lo = clevis.cwiseMin(tipA).cwiseMin(tipB) - Vec3::Constant(radius);
+    const Vec3 hi = clevis.cwiseMax(tipA).cwiseMax(tipB) + Vec3::Constant(radius);
     for (std::optional<Layer>* Lp : {&m_fascia, &m_fat}) {
         if (!Lp->has_value()) continue;
         Layer& L = **Lp;
         DissectionLayerStats& ls = Lp == &m_fascia ? st.fascia : st.fat;
         const std::vector<Vec3>& x = L.tets ? m_sys->tetPositions(L.body) : m_sys->surfacePositions(L.body);
         ls.vertexCount = x.size();
-        const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(radius), hi = a.cwiseMax(b) + Vec3::Constant(radius);
         std::vector<int32_t> snipped;
         for (size_t e = 0; e < L.edges.edgeCount(); ++e) {
             if (L.edges.isDissected(e)) continue;
             const Vec3& p = x[L.edges.edge(e)[0]];
             const Vec3& q = x[L.edges.edge(e)[1]];
             if ((p.cwiseMax(q).array() < lo.array()).any() || (p.cwiseMin(q).array() > hi.array()).any()) continue;
-            if (!(overlapFraction(a, b, radius, p, q) > 0)) continue;
+            const bool near = wedge ? closestPointsSegmentTriangle(p, q, clevis, tipA, tipB).distance <= radius
+                                    : overlapFraction(clevis, tipA, radius, p, q) > 0;
+            if (!near) continue;
             ++ls.edgesTouched;
             snipped.push_back(static_cast<int32_t>(e));
         }
         cutEdges(L, snipped, nullptr, ls); // a cold cut: no heat, no shrinking
+        if (ls.edgesCut > 0) st.swept = std::array<Vec3, 3>{clevis, tipA, tipB};
     }
     return st;
 }

@@ -39,6 +39,7 @@
 #include "sim/dissection/heat_grid.hpp"
 #include "sim/xpbd/xpbd_system.hpp"
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -86,10 +87,11 @@ struct EnergyTool {
 };
 
 struct DissectionLayerStats {
-    size_t edgesTouched = 0;     ///< intact edges overlapping the tool this frame
-    size_t edgesCut = 0;         ///< dissected this frame
-    size_t primitivesCut = 0;    ///< became cut this frame
-    size_t primitivesShrunk = 0; ///< rest shape changed this frame
+    size_t edgesTouched = 0;       ///< intact edges overlapping the tool this frame
+    size_t edgesCut = 0;           ///< dissected this frame
+    Vec3 cutCentre = Vec3::Zero(); ///< m: the mean midpoint of the edges dissected this frame (0 without any)
+    size_t primitivesCut = 0;      ///< became cut this frame
+    size_t primitivesShrunk = 0;   ///< rest shape changed this frame
     size_t totalEdgesCut = 0;
     size_t totalPrimitivesCut = 0;
     size_t vertexCount = 0; ///< never changes
@@ -98,6 +100,8 @@ struct DissectionLayerStats {
 
 struct DissectionFrameStats {
     DissectionLayerStats fascia, fat;
+    /// shear(): the wedge the blades swept (clevis, one tip, the other) when it cut anything.
+    std::optional<std::array<Vec3, 3>> swept;
     int heatSubsteps = 0;
     double gridMin = 0, gridMax = 0; ///< °C
 };
@@ -116,9 +120,11 @@ public:
     /// nothing) on a non-finite or out-of-range tool or dt ≤ 0; valid input never throws.
     DissectionFrameStats update(const EnergyTool& tool, double dt);
     /// A cold cut (scissors closing): every edge of each layer that passes within `radius` of the
-    /// blade segment a–b (m, world frame) is cut at once, with no heat and no shrinking. Throws
-    /// std::invalid_argument (changing nothing) on a non-finite segment or radius ≤ 0.
-    DissectionFrameStats shear(const Vec3& a, const Vec3& b, double radius);
+    /// wedge the blades sweep as they shut, the triangle clevis–tipA–tipB (m, world frame; the two
+    /// tips where the open blades' tips were), is cut at once, with no heat and no shrinking.
+    /// tipA = tipB: one blade, the segment clevis–tip. Throws std::invalid_argument (changing
+    /// nothing) on a non-finite point or radius ≤ 0.
+    DissectionFrameStats shear(const Vec3& clevis, const Vec3& tipA, const Vec3& tipB, double radius);
 
     bool hasFascia() const { return m_fascia.has_value(); }
     bool hasFat() const { return m_fat.has_value(); }
@@ -152,6 +158,7 @@ private:
         std::vector<double> heat;    ///< τ_e
         std::vector<uint8_t> shrunk; ///< per primitive
         std::vector<std::array<int32_t, 4>> prims;
+        std::vector<int32_t> liveTets; ///< tets: per node, its tets not cut yet
     };
     explicit Dissection(const HeatGridSettings& grid) : m_heat(grid) {}
     void updateLayer(Layer& L, const EnergyTool& tool, const Vec3& from, double dt, DissectionLayerStats& st);

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <utility>
 
 namespace viscera::sim {
 namespace {
@@ -65,8 +66,11 @@ struct InteractionRuntime::Instrument {
     std::vector<Vec3> heldLocal; ///< in the instrument frame at the grasp
     ToolShape::Pose pose = ToolShape::Pose::Identity();
     // scissors
-    bool open = true;  ///< the jaws were open (armed for the next snip)
-    bool snip = false; ///< they closed this frame: the blade cuts
+    bool open = true;                         ///< the jaws were open (armed for the next snip)
+    bool snip = false;                        ///< they closed this frame: the blade cuts
+    std::optional<Vec3> cutAt;                ///< where it cut this frame (InstrumentState::cutAt)
+    std::optional<std::array<Vec3, 3>> swept; ///< InstrumentState::swept
+    double openJaw = 1;                       ///< scissors: the jaw the last frame they were open (the blades' sweep)
     // clip applier
     size_t target = 0;  ///< tet body it clips
     bool fired = false; ///< fired during this squeeze (act held)
@@ -325,13 +329,18 @@ void InteractionRuntime::beforeStep(double t, double dt) {
             in.shape->setOpening(kMaxJawOpening * in.key.jaw);
             const auto box = in.shape->bounds();
             const bool near = (box[0].array() <= hi.array()).all() && (box[1].array() >= lo.array()).all();
-            in.colliding = near && !(in.desc.kind == InstrumentDesc::Kind::EnergyHook && in.key.act);
+            // The energized hook passes through what it burns, the scissors' blades through what
+            // they close on and cut (their push is not modelled: closed on the cut tissue, a
+            // contact would throw it out of the blades in one substep).
+            in.colliding = near && !(in.desc.kind == InstrumentDesc::Kind::EnergyHook && in.key.act) &&
+                           in.desc.kind != InstrumentDesc::Kind::Scissors;
         }
         if (in.desc.kind == InstrumentDesc::Kind::Scissors) {
             // a snip as the jaws close (from open to below the grasp threshold): cut once, re-armed
             // when they open again
             in.snip = in.open && in.key.jaw < kGraspClose;
             in.open = in.key.jaw > kGraspClose;
+            if (in.open) in.openJaw = in.key.jaw;
         }
         if (in.desc.holds()) {
             if (!in.holding && in.key.jaw < kGraspClose) {
@@ -367,10 +376,14 @@ void InteractionRuntime::beforeStep(double t, double dt) {
         t0 = std::chrono::steady_clock::now();
         for (auto& inp : m_instruments) {
             if (inp->desc.kind == InstrumentDesc::Kind::Scissors && inp->snip) {
-                try { // the blade: the jaws from the clevis to the tip
-                    const Vec3 tip = inp->key.position;
-                    recordCut(
-                        m_dissection->shear(tip - inp->desc.jawLength * inp->key.direction, tip, inp->desc.radius));
+                try { // the wedge the blades sweep: from the clevis to where their tips were open
+                    const double half = 0.5 * kMaxJawOpening * inp->openJaw, len = inp->desc.jawLength;
+                    const ToolShape::Pose& pose = inp->pose; // frame origin at the clevis, x along the jaws
+                    const DissectionFrameStats st = m_dissection->shear(
+                        pose.translation(), pose * Vec3(len * std::cos(half), 0, -len * std::sin(half)),
+                        pose * Vec3(len * std::cos(half), 0, len * std::sin(half)), inp->desc.radius);
+                    inp->cutAt = recordCut(st);
+                    inp->swept = st.swept;
                 } catch (const std::invalid_argument&) { // a non-finite pose: no cut this frame
                 }
             }
@@ -381,15 +394,15 @@ void InteractionRuntime::beforeStep(double t, double dt) {
             tool.temperature = inp->desc.temperatureC;
             tool.energized = inp->key.act;
             try {
-                recordCut(m_dissection->update(tool, dt));
-            } catch (const std::invalid_argument&) { // a non-finite tool pose: no heat this frame
+                recordCut(m_dissection->update(tool, dt)); // the hook's cut: where its tip is
+            } catch (const std::invalid_argument&) {       // a non-finite tool pose: no heat this frame
             }
         }
         m_summary.dissectionMs += msSince(t0);
     }
 }
 
-void InteractionRuntime::recordCut(const DissectionFrameStats& st) {
+std::optional<Vec3> InteractionRuntime::recordCut(const DissectionFrameStats& st) {
     m_summary.fasciaEdgesCut = static_cast<int>(st.fascia.totalEdgesCut);
     m_summary.fasciaTrianglesCut = static_cast<int>(st.fascia.totalPrimitivesCut);
     m_summary.fatEdgesCut = static_cast<int>(st.fat.totalEdgesCut);
@@ -397,6 +410,11 @@ void InteractionRuntime::recordCut(const DissectionFrameStats& st) {
     if (m_dissection->hasFascia()) m_summary.fasciaVertices = st.fascia.vertexCount;
     m_summary.maxEdgeHeat = std::max({m_summary.maxEdgeHeat, st.fascia.maxEdgeHeat, st.fat.maxEdgeHeat});
     m_summary.gridMaxC = std::max(m_summary.gridMaxC, st.gridMax);
+    const size_t n = st.fascia.edgesCut + st.fat.edgesCut;
+    if (n == 0) return std::nullopt;
+    return Vec3((static_cast<double>(st.fascia.edgesCut) * st.fascia.cutCentre +
+                 static_cast<double>(st.fat.edgesCut) * st.fat.cutCentre) /
+                static_cast<double>(n));
 }
 
 void InteractionRuntime::runHook(XpbdParticles& particles, const XpbdIterationInfo& info) {
@@ -439,6 +457,8 @@ void InteractionRuntime::afterStep() {
         s.direction = in.key.direction;
         s.jaw = in.key.jaw;
         s.act = in.desc.kind == InstrumentDesc::Kind::Scissors ? in.snip : in.key.act; // scissors: cut this frame
+        s.cutAt = std::exchange(in.cutAt, std::nullopt);
+        s.swept = std::exchange(in.swept, std::nullopt);
         s.contacts = in.collision && in.colliding ? in.collision->stats().contacts : 0;
         s.grasped = static_cast<int>(in.held.size());
         s.force = in.force;

@@ -24,6 +24,7 @@
 #include "sim/xpbd/xpbd_system.hpp"
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,11 @@ struct InstrumentState {
     Vec3 direction = -Vec3::UnitZ();
     double jaw = 1;
     bool act = false;
+    /// m: where the scissors cut this frame, the mean midpoint of the edges they cut; none when
+    /// they cut nothing (and for the hook, whose cut is at its tip).
+    std::optional<Vec3> cutAt;
+    /// m: scissors, the wedge their blades swept as they cut this frame (DissectionFrameStats::swept).
+    std::optional<std::array<Vec3, 3>> swept;
     int contacts = 0;          ///< collision projections in the last sweep of the frame
     int grasped = 0;           ///< vertices held
     Vec3 force = Vec3::Zero(); ///< N, on the instrument from the tissue, mean over the frame's substeps
@@ -135,7 +141,9 @@ private:
     void makeDissection(const SceneDesc& scene, XpbdSystem& system, const std::vector<const TetMesh*>& bodies,
                         const std::vector<const TriMesh*>& surfaces, const std::string& origin);
     /// A cut's totals (hook or scissors) into the summary.
-    void recordCut(const DissectionFrameStats& st);
+    /// Takes the frame's cut figures; returns where it cut (the mean midpoint of the edges cut),
+    /// none when nothing was cut.
+    std::optional<Vec3> recordCut(const DissectionFrameStats& st);
     void fireClip(Instrument& in, double t);
 
     XpbdSystem* m_sys = nullptr;

@@ -55,6 +55,8 @@ std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::
     w->m_dt = scene.xpbd.dt;
     w->m_meshes = std::move(meshes);
     w->m_surfaces = std::move(surfaces);
+    // The instruments collide with the first body's boundary when there is no fascia over it.
+    if (scene.interaction && w->m_surfaces.empty() && !w->m_meshes.empty()) w->m_meshes.front()->requireLevel(3);
     w->m_solver = makeSceneSolver({w->m_scene, w->m_meshes, w->m_surfaces, origin});
     for (const BodyDesc& b : scene.bodies)
         w->m_names.push_back(b.name);

@@ -473,6 +473,15 @@ void XpbdSystem::setTetActive(size_t b, size_t t, bool active) {
     syncStrainUnit(r, t);
 }
 
+void XpbdSystem::holdTetNode(size_t b, size_t v) {
+    const Range& r = m_tet.at(b);
+    if (v >= r.x.size()) throw std::out_of_range("sim::XpbdSystem::holdTetNode(): node out of range");
+    detail::Engine& eng = *m_engine;
+    const size_t p = r.first + v;
+    eng.xw[4 * p + 3] = 0;
+    eng.v[p] = Vec3::Zero();
+}
+
 bool XpbdSystem::tetActive(size_t b, size_t t) const {
     return m_tet.at(b).active.at(t) != 0;
 }

@@ -136,6 +136,9 @@ public:
     /// node whose tets are all cut moves freely. Throws std::out_of_range on a bad b or t.
     void setTetActive(size_t b, size_t t, bool active);
     bool tetActive(size_t b, size_t t) const;
+    /// Holds node v of tet body b where it is from now on (inverse mass 0, velocity 0), as a fixed
+    /// node: dissection holds a node whose tets are all cut. Throws std::out_of_range on a bad b or v.
+    void holdTetNode(size_t b, size_t v);
     /// Shrinkage [A §5.3.3, eq. 5.12]: with F = Fe·Fs the elastic part is measured from the rest
     /// edge matrix Fs·Dm₀ (Dm₀: the rest shape at create(); not cumulative, Fs = I restores it).
     /// Fs is a 3 × 3 matrix in the world rest frame, finite with det Fs > 0. The energy stays

@@ -319,6 +319,51 @@ TEST(Dissection, ColdOrSwitchedOffToolCutsNothing) {
     EXPECT_EQ(s.dissection->fasciaEdges().dissectedEdgeCount(), 0u);
 }
 
+// Scissors [issue 57 item 4]: closing, the blades cut what lies in the wedge they sweep (the
+// triangle clevis-tip-tip), not only along one blade; a node whose tets are all cut stays where
+// it was (held), rather than falling out of the scene.
+TEST(Dissection, ScissorsCutTheWedgeTheirBladesSweepAndFreedNodesStayPut) {
+    FatScene s = makeFatScene();
+    // a wedge standing in the block's middle plane y = 0: clevis above, the tips 14 mm apart
+    const Vec3 clevis(0, 0, 0.004), tipA(-0.007, 0, -0.012), tipB(0.007, 0, -0.012);
+    const DissectionFrameStats st = s.dissection->shear(clevis, tipA, tipB, 5e-4);
+    ASSERT_GT(st.fat.edgesCut, 20u);
+    ASSERT_TRUE(st.swept.has_value());
+    EXPECT_EQ((*st.swept)[1], tipA);
+    const EdgeStructure& E = s.dissection->fatEdges();
+    const auto& X = s.mesh->positions();
+    bool farFromBlade = false; // an edge cut in the wedge's middle, 3 mm and more from either blade
+    for (size_t e = 0; e < E.edgeCount(); ++e) {
+        if (!E.isDissected(e)) continue;
+        const Vec3 &p = X[E.edge(e)[0]], &q = X[E.edge(e)[1]];
+        ASSERT_LE(closestPointsSegmentTriangle(p, q, clevis, tipA, tipB).distance, 5e-4 + 1e-12) << e;
+        const SegmentPair a = closestPointsSegments(clevis, tipA, p, q), b = closestPointsSegments(clevis, tipB, p, q);
+        const double toA = (a.onP - a.onQ).norm(), toB = (b.onP - b.onQ).norm();
+        farFromBlade = farFromBlade || std::min(toA, toB) > 0.003;
+    }
+    EXPECT_TRUE(farFromBlade) << "the wedge between the blades is cut, not only the blades' lines";
+    // a fine slab cut out whole: every node of the slab's tets inside it is held where it is
+    const DissectionFrameStats all =
+        s.dissection->shear(Vec3(-0.03, 0.0, 0.0), Vec3(0.03, 0.0, -0.03), Vec3(0.03, 0.0, 0.0), 0.006);
+    ASSERT_GT(all.fat.primitivesCut, 0u);
+    std::vector<size_t> freed;
+    for (size_t v = 0; v < X.size(); ++v) {
+        bool live = false;
+        for (size_t t = 0; t < s.mesh->tetCount() && !live; ++t)
+            for (int32_t k : s.mesh->tets()[t])
+                live = live || (k == int32_t(v) && s.system->tetActive(0, t));
+        if (!live) freed.push_back(v);
+    }
+    ASSERT_FALSE(freed.empty());
+    const std::vector<Vec3> before = s.system->tetPositions(0);
+    for (int f = 0; f < 30; ++f)
+        ASSERT_TRUE(s.system->step().finite);
+    for (size_t v : freed)
+        EXPECT_LT((s.system->tetPositions(0)[v] - before[v]).norm(), 1e-12) << "freed node " << v << " fell";
+    EXPECT_THROW(s.dissection->shear(clevis, Vec3(NAN, 0, 0), tipB, 1e-3), std::invalid_argument);
+    EXPECT_THROW(s.dissection->shear(clevis, tipA, tipB, 0), std::invalid_argument);
+}
+
 TEST(Dissection, BadInputNamesTheField) {
     FasciaScene s = makeFasciaScene();
     auto msg = [](auto fn) {

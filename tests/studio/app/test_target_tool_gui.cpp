@@ -59,15 +59,6 @@ struct TargetToolFixture : test::MainWindowFixture {
         ASSERT_EQ(tool->pick(), pick);
         ASSERT_TRUE(w->viewport()->paintMode());
     }
-    /// A widget position over a drawn surface whose mesh is named `name` (empty: any); (-1, -1): none.
-    QPoint over(const QString& name = {}) const {
-        const Viewport* v = w->viewport();
-        for (int y = v->height() / 10; y < v->height(); y += v->height() / 20)
-            for (int x = v->width() / 10; x < v->width(); x += v->width() / 20)
-                if (const auto hit = v->hitAt(QPoint(x, y)); hit && (name.isEmpty() || hit->name == name))
-                    return {x, y};
-        return {-1, -1};
-    }
     /// A horizontal run of `length` px whose every 10th pixel lies over a surface.
     std::pair<QPoint, QPoint> run(int length) const {
         const Viewport* v = w->viewport();
@@ -80,26 +71,8 @@ struct TargetToolFixture : test::MainWindowFixture {
             }
         return {{-1, -1}, {-1, -1}};
     }
-    void press(QPoint at) {
-        if (QWindow* win = w->viewport()->canvasWindow()) {
-            QTest::mousePress(win, Qt::LeftButton, {}, at);
-            QTest::mouseRelease(win, Qt::LeftButton, {}, at);
-        } else {
-            test::click(w->viewport()->canvasWidget(), at);
-        }
-        QCoreApplication::processEvents();
-    }
-    void dragAlong(QPoint from, QPoint to) {
-        if (QWindow* win = w->viewport()->canvasWindow()) {
-            QTest::mousePress(win, Qt::LeftButton, {}, from);
-            for (int i = 1; i <= 30; ++i)
-                QTest::mouseMove(win, from + (to - from) * i / 30);
-            QTest::mouseRelease(win, Qt::LeftButton, {}, to);
-        } else {
-            test::drag(w->viewport()->canvasWidget(), from, to, 30);
-        }
-        QCoreApplication::processEvents();
-    }
+    void press(QPoint at) { viewportClick(at); }
+    void dragAlong(QPoint from, QPoint to) { viewportDrag(from, to); }
     /// Types `text` into the value cell of `row` as a user does: F2, the text, Enter.
     void typeInto(int row, const QString& text) {
         QTableWidget* t = panel->table();

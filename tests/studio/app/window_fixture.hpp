@@ -4,6 +4,7 @@
 // one), 1500 × 950, shown and exposed), a scratch copy of a sample project opened
 // in it, and the live preview stopped at the end.
 #include "app/main_window.hpp"
+#include "app/viewport.hpp"
 #include "gui_test_support.hpp"
 
 #include <QSettings>
@@ -35,6 +36,38 @@ struct MainWindowFixture : ::testing::Test {
     void TearDown() override {
         w->preview()->stop();
         w.reset();
+    }
+    /// A left click on the viewport at `at` as a user does (its embedded window or its widget).
+    void viewportClick(QPoint at) {
+        if (QWindow* win = w->viewport()->canvasWindow()) {
+            QTest::mousePress(win, Qt::LeftButton, {}, at);
+            QTest::mouseRelease(win, Qt::LeftButton, {}, at);
+        } else {
+            click(w->viewport()->canvasWidget(), at);
+        }
+        QCoreApplication::processEvents();
+    }
+    /// A left drag on the viewport from `from` to `to` in 30 moves.
+    void viewportDrag(QPoint from, QPoint to) {
+        if (QWindow* win = w->viewport()->canvasWindow()) {
+            QTest::mousePress(win, Qt::LeftButton, {}, from);
+            for (int i = 1; i <= 30; ++i)
+                QTest::mouseMove(win, from + (to - from) * i / 30);
+            QTest::mouseRelease(win, Qt::LeftButton, {}, to);
+        } else {
+            drag(w->viewport()->canvasWidget(), from, to, 30);
+        }
+        QCoreApplication::processEvents();
+    }
+    /// A viewport position over a drawn surface whose mesh is named `name` (empty: any), on a
+    /// 20 × 20 grid; (-1, -1): none.
+    QPoint over(const QString& name = {}) const {
+        const studio::Viewport* v = w->viewport();
+        for (int y = v->height() / 10; y < v->height(); y += v->height() / 20)
+            for (int x = v->width() / 10; x < v->width(); x += v->width() / 20)
+                if (const auto hit = v->hitAt(QPoint(x, y)); hit && (name.isEmpty() || hit->name == name))
+                    return {x, y};
+        return {-1, -1};
     }
     /// Opens a scratch copy of projects/<sample>; returns its folder.
     std::filesystem::path open(const std::string& sample) {

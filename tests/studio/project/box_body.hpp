@@ -13,8 +13,8 @@ inline studio::BodyProject boxBody(const sim::Vec3& size, std::array<int, 3> cel
     b.mesh.box.origin = sim::Vec3::Zero();
     b.mesh.box.size = size;
     b.mesh.box.cells = cells;
-    b.fixedBox =
-        std::array<sim::Vec3, 2>{sim::Vec3::Constant(-0.001), sim::Vec3(0.0001, size.y() + 0.001, size.z() + 0.001)};
+    b.fixedBoxes = {
+        std::array<sim::Vec3, 2>{sim::Vec3::Constant(-0.001), sim::Vec3(0.0001, size.y() + 0.001, size.z() + 0.001)}};
     return b;
 }
 

@@ -162,6 +162,33 @@ TEST_F(ProjectTest, ExportRefusesEmptyFixedRegionAndKeepsTheOldCase) {
     EXPECT_EQ(std::filesystem::file_size(out), before) << "a failed export leaves the previous case intact";
 }
 
+// Several held regions [issue 57 item 4]: a body attached at more than one place (a duct to the
+// gallbladder and to the common bile duct) lists its boxes; a node in any one is fixed; each box
+// must hold a node; the list round-trips.
+TEST_F(ProjectTest, ABodyHeldInSeveralBoxesFixesTheNodesOfEach) {
+    const std::string one = "\"fixed\": {\"min\": [-1, -1, -1], \"max\": [0.0001, 1, 1]}";
+    const std::string two = "\"fixed\": [{\"min\": [-1, -1, -1], \"max\": [0.0001, 1, 1]}, "
+                            "{\"min\": [0.0399, -1, -1], \"max\": [1, 1, 1]}]";
+    write(replaced(kGood, one, two));
+    const studio::Project p = studio::loadProject(m_dir);
+    ASSERT_EQ(p.bodies[0].fixedBoxes.size(), 2u);
+    studio::ExportResult r = studio::exportCase(p, m_dir / "held.vcase");
+    EXPECT_EQ(r.bodies[0].fixedNodes, 8u) << "both end faces of the 4 x 1 x 1 box";
+    studio::saveProject(p, m_dir);
+    EXPECT_EQ(studio::loadProject(m_dir).bodies[0].fixedBoxes, p.bodies[0].fixedBoxes) << "the list round-trips";
+    write(replaced(kGood, one, "\"fixed\": []"));
+    EXPECT_THAT(loadError(), HasSubstr("bodies[0].fixed"));
+    write(replaced(kGood, one,
+                   "\"fixed\": [{\"min\": [-1, -1, -1], \"max\": [0.0001, 1, 1]}, "
+                   "{\"min\": [5, 5, 5], \"max\": [6, 6, 6]}]"));
+    try {
+        studio::exportCase(studio::loadProject(m_dir), m_dir / "held2.vcase");
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_THAT(e.what(), HasSubstr("bodies[0] ('slab').fixed[1]: the box contains no mesh node"));
+    }
+}
+
 TEST_F(ProjectTest, ImportedSurfaceIsTetrahedralized) {
     // A closed box surface written as OBJ, imported and meshed with CGAL through the project.
     writeFileAtomic(m_dir / "cube.obj",
