@@ -152,6 +152,13 @@ void MainWindow::followPortDocks() {
         m_scopeInView = on;
         if (on) m_portTool->setCurrent(PortTool::kScopePort);
     });
+    // a laparoscope added (or removed) while its dock is in view: its port is (no longer) current
+    connect(&m_doc, &Document::changed, this, [this](const Change& what) {
+        if (!m_scopeInView || !what.touches(Change::Scene) || !m_doc.hasProject()) return;
+        const bool scope = m_doc.project().scene.laparoscope.has_value();
+        if (scope != (m_portTool->current() == PortTool::kScopePort))
+            m_portTool->setCurrent(scope ? PortTool::kScopePort : PortTool::kNoPort);
+    });
     for (QDockWidget* d : {m_instrumentDock, m_scopeTaskDock})
         connect(d, &QDockWidget::visibilityChanged, this, [this](bool on) {
             if (!on && !m_instrumentInView && !m_scopeInView && !m_portTool->action()->isChecked())
