@@ -71,11 +71,6 @@ QString HoldTool::setMargin(double metres) {
     return {};
 }
 
-void HoldTool::setShown(bool on) {
-    m_shown = on;
-    redraw();
-}
-
 void HoldTool::setActive(bool on) {
     m_dragging = false;
     m_stroke.clear();
@@ -118,7 +113,7 @@ QString HoldTool::release(int body) {
 
 void HoldTool::redraw() {
     if (!m_viewport) return;
-    if (!(m_shown || m_action->isChecked()) || !m_doc->hasProject()) {
+    if (!m_action->isChecked() || !m_doc->hasProject()) {
         if (m_drawn) m_viewport->setAuthoringLayer(Viewport::Layer::Holds, {});
         m_drawn = false;
         return;

@@ -7,7 +7,7 @@
 /// Document::edit (the project reader's rules: each box must hold a node at export, at most
 /// kMaxHoldBoxes). A click on a layer (fascia) holds the body under it; on anything else (a
 /// surrounding) it is refused with the reason. "Release holds" removes a body's boxes as one undo step. While the tool
-/// is on or a body is selected, every body's boxes are drawn in the viewport (cyan wire boxes). Esc ends the tool.
+/// is on, every body's boxes are drawn in the viewport (cyan wire boxes). Esc ends the tool.
 #include "sim/mesh/tet_mesh.hpp"
 
 #include <QObject>
@@ -33,8 +33,6 @@ public:
     double margin() const { return m_margin; }
     /// Refuses (returns the rule) a margin outside (0, 0.1] m or not finite; empty when taken.
     QString setMargin(double metres);
-    /// Shows every body's held boxes (a body selected) or not (the tool on shows them anyway).
-    void setShown(bool on);
 
     // The edits, each one undo step; each returns the refusal (one line naming the field and the
     // rule), empty when taken.
@@ -56,7 +54,7 @@ private:
     Viewport* m_viewport = nullptr;
     QAction* m_action = nullptr;
     double m_margin = kDefaultMargin;
-    bool m_shown = false, m_drawn = false, m_dragging = false;
+    bool m_drawn = false, m_dragging = false;
     QString m_body;
     std::vector<sim::Vec3> m_stroke;
 };

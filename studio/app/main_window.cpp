@@ -197,7 +197,6 @@ void MainWindow::buildDocks() {
     m_properties = new PropertiesPanel(&m_doc, &m_sel, m_material, this);
     m_holdTool = new HoldTool(&m_doc, this); // [issue 57 item 4] a body's holds, drawn on it
     m_properties->setHoldTool(m_holdTool);
-    connect(&m_sel, &Selection::changed, m_holdTool, [this] { m_holdTool->setShown(m_sel.body() >= 0); });
     dock("propertiesDock", tr("Properties"), m_properties, Qt::LeftDockWidgetArea);
     dock("materialDock", tr("Material curves"), m_material, Qt::BottomDockWidgetArea);
 
