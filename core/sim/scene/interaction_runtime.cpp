@@ -1,5 +1,6 @@
 #include "sim/scene/interaction_runtime.hpp"
 
+#include "sim/scene/tool_probe.hpp"
 #include "sim/util/error.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -162,10 +163,12 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
             surfaceInverseMass(*surfaces[0], scene.surfaces[0].arealDensity, scene.surfaces[0].fixedNodes);
         r->m_surfaceVertices = surfaces[0]->vertexCount();
     } else {
+        // the nodes' lumped inverse masses (fixed: 0): the contact force on an instrument is
+        // the tissue's momentum it changes (with unit masses it came out 10^4 too large)
         const TetMesh& m = *bodies.at(0);
-        std::vector<double> w(m.vertexCount(), 1.0);
-        for (int32_t f : scene.bodies[0].fixedNodes)
-            w[f] = 0;
+        std::vector<double> w = lumpedMasses(m, scene.bodies[0].material.density, scene.bodies[0].fixedNodes);
+        for (double& x : w)
+            x = x > 0 ? 1.0 / x : 0.0;
         surface = CollisionSurfaceDesc::fromTetMesh(m, std::move(w));
         r->m_particleOffset = static_cast<size_t>(system.tetParticleOffset(0));
         r->m_surfaceVertices = m.vertexCount();

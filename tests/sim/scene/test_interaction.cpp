@@ -161,6 +161,33 @@ namespace {
 /// The rig with scissors (and a needle driver) instead of its hook and clip applier. The scissors
 /// come down open onto the fascia along y at x = 2 cm, close at 0.30 s (a snip), open at 0.45 s,
 /// move 1 cm along y and close again at 0.75 s. The needle driver closes on the fascia at x = 1 cm.
+// An instrument pressing a tet body that has no fascia over it [issue 57 item 4]: the contact
+// force it reports is the tissue's, from the nodes' masses (with unit masses it came out 10^4
+// times too large: 97 kN on a grasper touching a gallbladder), and the press is stable.
+TEST(Interaction, APressOnABareTetBodyReportsATissueSizedForce) {
+    Rig r = makeRig();
+    r.scene.bodies.resize(1); // the fat pad alone: no vessel, no fascia
+    r.meshes.resize(1);
+    r.scene.surfaces.clear();
+    r.surfaces.clear();
+    InstrumentDesc probe = r.scene.interaction->instruments.at(1); // the hook, never energized
+    probe.trackText = std::string(kHeader) + "0.00 0.020 0.015 0.030 0 0 -1 1 0\n"
+                                             "0.30 0.020 0.015 0.0085 0 0 -1 1 0\n"
+                                             "1.00 0.020 0.015 0.0085 0 0 -1 1 0\n";
+    r.scene.interaction->instruments = {probe};
+    r.scene.interaction->tissues = {{"fat", 190, 0.4, Vec3(0.1, 0.3, 1.0)}};
+    std::unique_ptr<World> w = assemble(std::move(r));
+    double force = 0;
+    for (int f = 0; f < 48; ++f) { // 0.8 s: pressed 2.7 mm deep and held
+        ASSERT_TRUE(w->step().finite) << "frame " << f;
+        force = w->interaction()->summary().instruments.at(0).force.norm();
+        ASSERT_LT(force, 20.0) << "frame " << f << ": a 3 kPa pad pressed a few mm pushes back with far less";
+    }
+    EXPECT_GT(force, 0.005) << "the pressed pad pushes back";
+    EXPECT_GT(w->interaction()->summary().instruments.at(0).force.z(), 0) << "upwards, against the press";
+    EXPECT_TRUE(w->invariants().allFinite);
+}
+
 Rig scissorsRig(bool close) {
     Rig r = makeRig();
     InteractionDesc& in = *r.scene.interaction;
