@@ -34,8 +34,9 @@
 /// hold the surface vertices between them while closed (jaw < 0.5). Energy hook: a capsule whose
 /// tip sphere is the heat source while act = 1. Clip applier: fires a clip onto `target` at the
 /// first key with act = 1; the clip then follows the vessel [A §5.4]. Scissors: jaws that cut
-/// (a cold cut, sim::Dissection::shear) every tissue edge within `radius` of the blade (the jaw
-/// length back from the tip) each time they close (jaw falls below 0.5 from above it). Needle
+/// (a cold cut, sim::Dissection::shear) every tissue edge within `radius` of the wedge their blades
+/// sweep (the clevis to both open tips) each time they close (jaw falls below 0.5 from above it);
+/// their blades pass through what they close on. Needle
 /// driver: short, strong jaws that hold what lies between them while closed, as a grasper's.
 /// Units SI; temperatures °C. Parsing is strict; errors name the origin, the field and the rule.
 #include "sim/scene/device_mapping.hpp"
