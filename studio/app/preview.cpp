@@ -27,6 +27,7 @@ std::string structureKey(const Project& p, Preview::Mode mode, int body) {
     q.scene.xpbd = sim::XpbdSettings{};
     for (BodyProject& b : q.bodies) {
         b.scene.material = sim::Material{};
+        b.fixedBoxes.clear(); // the holds go onto the meshes already built (applyMaterials)
         b.lightSamples.clear();
         if (b.paint) b.paint->strokes.clear();
     }
@@ -491,11 +492,14 @@ std::unique_ptr<sim::World> Preview::applyMaterials(Worker& w, const Project& pr
                                      .toStdString());
     std::vector<sim::Material> old;
     std::vector<std::vector<double>> oldWeights, oldSurfaceWeights;
+    std::vector<std::vector<int32_t>> oldFixed;
     auto restore = [&] {
         for (size_t i = 0; i < old.size(); ++i) {
             b.scene.bodies[i].material = old[i];
             b.scene.bodies[i].nodeWeights = oldWeights[i];
         }
+        for (size_t i = 0; i < oldFixed.size(); ++i)
+            b.scene.bodies[i].fixedNodes = oldFixed[i];
         for (size_t s = 0; s < oldSurfaceWeights.size(); ++s)
             b.scene.surfaces[s].nodeWeights = oldSurfaceWeights[s];
     };
@@ -515,7 +519,12 @@ std::unique_ptr<sim::World> Preview::applyMaterials(Worker& w, const Project& pr
         for (size_t i = 0; i < b.scene.bodies.size(); ++i) {
             old.push_back(b.scene.bodies[i].material);
             oldWeights.push_back(b.scene.bodies[i].nodeWeights);
+            oldFixed.push_back(b.scene.bodies[i].fixedNodes);
             b.scene.bodies[i].material = project.bodies[i].scene.material;
+            // where it is held (the Hold tissue tool), on the mesh as the export reads it
+            const sim::TetMesh& flat = i < b.flatMeshes.size() ? *b.flatMeshes[i] : *b.meshes[i];
+            b.scene.bodies[i].fixedNodes =
+                heldNodes(project.bodies[i], flat, origin, "bodies[" + std::to_string(i) + "]");
             // painted bodies: their strokes again, through the skeleton already made
             // (on the flat mesh where the project bends it: the strokes are placed there)
             if (project.bodies[i].paint && i < b.skeletons.size())

@@ -1293,6 +1293,14 @@ BodyExport checkBodyMesh(const BodyProject& b, const sim::TetMesh& mesh, sim::Bo
     if (!be.quality.degenerate.empty())
         throw InputError(origin + ": " + field + ".mesh: tet " + std::to_string(be.quality.degenerate.front()) +
                          " is degenerate (" + std::to_string(be.quality.degenerate.size()) + " in all)");
+    const std::vector<int32_t> held = heldNodes(b, mesh, origin, field);
+    desc.fixedNodes.insert(desc.fixedNodes.end(), held.begin(), held.end());
+    be.fixedNodes = desc.fixedNodes.size();
+    return be;
+}
+
+std::vector<int32_t> heldNodes(const BodyProject& b, const sim::TetMesh& mesh, const std::string& origin,
+                               const std::string& field) {
     const auto& pos = mesh.positions();
     std::vector<bool> held(pos.size(), false);
     for (size_t k = 0; k < b.fixedBoxes.size(); ++k) {
@@ -1305,10 +1313,10 @@ BodyExport checkBodyMesh(const BodyProject& b, const sim::TetMesh& mesh, sim::Bo
                              (b.fixedBoxes.size() > 1 ? "[" + std::to_string(k) + "]" : std::string()) +
                              ": the box contains no mesh node");
     }
+    std::vector<int32_t> nodes;
     for (int32_t v = 0; v < static_cast<int32_t>(pos.size()); ++v)
-        if (held[static_cast<size_t>(v)]) desc.fixedNodes.push_back(v);
-    be.fixedNodes = desc.fixedNodes.size();
-    return be;
+        if (held[static_cast<size_t>(v)]) nodes.push_back(v);
+    return nodes;
 }
 
 BuiltScene buildScene(const Project& project, const ExportProgress& progress) {

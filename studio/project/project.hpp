@@ -371,10 +371,15 @@ struct BuiltScene {
 
 /// The checks and figures export applies to a body's built mesh, `field` "bodies[i]": nodes, tets,
 /// quality (InputError "<origin>: <field>.mesh: tet 4 is inverted (2 inverted in all)", the same
-/// for a degenerate tet) and the nodes in its fixed box into desc.fixedNodes ("<field>.fixed: the
-/// box contains no mesh node" when there are none). Used by export and `viscera-studio mesh`.
+/// for a degenerate tet) and the nodes in its fixed boxes into desc.fixedNodes (heldNodes). Used by export and
+/// `viscera-studio mesh`.
 BodyExport checkBodyMesh(const BodyProject& b, const sim::TetMesh& mesh, sim::BodyDesc& desc, const std::string& origin,
                          const std::string& field);
+/// The nodes of `mesh` (the body's mesh before any bend) inside any of b.fixedBoxes, ascending;
+/// InputError "<origin>: <field>.fixed[k]: the box contains no mesh node" for a box without one.
+/// checkBodyMesh's rule; the preview applies it again when only the holds changed.
+std::vector<int32_t> heldNodes(const BodyProject& b, const sim::TetMesh& mesh, const std::string& origin,
+                               const std::string& field);
 /// The node weights of body `b` on `mesh`: its stiffness regions times its stiffness paint
 /// (empty: neither). The paint's skeleton is extracted into `skeleton` when it is empty, and
 /// reused when given (the same mesh, painted again). Throws viscera::InputError naming

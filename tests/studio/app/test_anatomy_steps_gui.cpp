@@ -30,7 +30,6 @@
 #include <QSettings>
 #include <QSpinBox>
 #include <QThread>
-#include <QTimer>
 #include <QUndoStack>
 
 #include <gtest/gtest.h>
@@ -188,19 +187,7 @@ TEST_F(AnatomyFixture, ImportMakeSimulationReadyTetrahedralizeAndExportByGuiActi
     // File → Export case…: the save dialog the action opens gets the path typed and Enter.
     auto* exportAction = w->findChild<QAction*>("actionExportCase");
     ASSERT_NE(exportAction, nullptr);
-    QTimer typer;
-    QObject::connect(&typer, &QTimer::timeout, [&] {
-        auto* dlg = qobject_cast<QFileDialog*>(QApplication::activeModalWidget());
-        if (!dlg || !dlg->isVisible()) return;
-        typer.stop();
-        auto* name = dlg->findChild<QLineEdit*>("fileNameEdit");
-        name->clear();
-        QTest::keyClicks(name, QString::fromStdString(out.string()));
-        QTest::keyClick(name, Qt::Key_Return);
-    });
-    typer.start(100);
-    exportAction->trigger(); // the dialog runs its own loop until the keys accept it
-    EXPECT_FALSE(typer.isActive()) << "no save dialog appeared";
+    typeIntoFileDialog(QString::fromStdString(out.string()), [exportAction] { exportAction->trigger(); });
     // no publisher key in the test's config folder: the studio says so and the case goes out
     // unsigned by choice
     ASSERT_TRUE(test::waitFor([&] { return w->unsignedExportBox() && w->unsignedExportBox()->isVisible(); }, 5000));

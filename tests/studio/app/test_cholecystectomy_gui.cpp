@@ -53,7 +53,6 @@
 #include <QSignalSpy>
 #include <QSpinBox>
 #include <QTableWidget>
-#include <QTimer>
 #include <QToolButton>
 #include <QUndoStack>
 #include <QWheelEvent>
@@ -95,22 +94,9 @@ struct CholeFixture : test::MainWindowFixture {
     studio::AnatomySteps* steps() { return w->anatomySteps(); }
     const studio::Project& model() { return w->document()->project(); }
 
-    /// The next modal file dialog gets `path` typed into its name field and Enter; `trigger`
-    /// opens it (and runs its loop until the keys accept it).
+    /// The fixture's file dialog typer, counted as two actions (the path, Enter).
     void typeIntoFileDialog(const QString& path, const std::function<void()>& trigger) {
-        QTimer typer;
-        QObject::connect(&typer, &QTimer::timeout, [&] {
-            auto* dlg = qobject_cast<QFileDialog*>(QApplication::activeModalWidget());
-            if (!dlg || !dlg->isVisible()) return;
-            typer.stop();
-            auto* name = dlg->findChild<QLineEdit*>("fileNameEdit");
-            name->clear();
-            QTest::keyClicks(name, path);
-            QTest::keyClick(name, Qt::Key_Return);
-        });
-        typer.start(100);
-        trigger();
-        EXPECT_FALSE(typer.isActive()) << "no file dialog appeared";
+        MainWindowFixture::typeIntoFileDialog(path, trigger);
         actions += 2;
     }
     /// Types `text` into the line edit and presses Enter, as a user does.
@@ -238,15 +224,7 @@ struct CholeFixture : test::MainWindowFixture {
     /// A right drag over the viewport by `by` pixels: the camera orbits.
     void orbit(QPoint by) {
         const QPoint c(w->viewport()->width() / 2, w->viewport()->height() / 2);
-        if (QWindow* win = w->viewport()->canvasWindow()) {
-            QTest::mousePress(win, Qt::RightButton, {}, c);
-            for (int i = 1; i <= 20; ++i)
-                QTest::mouseMove(win, c + by * i / 20);
-            QTest::mouseRelease(win, Qt::RightButton, {}, c + by);
-        } else {
-            test::drag(w->viewport()->canvasWidget(), c, c + by, 20, Qt::RightButton);
-        }
-        QCoreApplication::processEvents();
+        viewportDrag(c, c + by, Qt::RightButton);
         ++actions;
     }
     double since(QElapsedTimer& t) const { return double(t.elapsed()) / 1000.0; }
@@ -644,14 +622,7 @@ struct CholeSteps : CholeFixture {
         {
             const QPoint from = project(kCut), centre(w->viewport()->width() / 2, w->viewport()->height() / 2);
             ASSERT_GE(from.x(), 0);
-            if (QWindow* win = w->viewport()->canvasWindow()) {
-                QTest::mousePress(win, Qt::MiddleButton, {}, from);
-                for (int i = 1; i <= 20; ++i)
-                    QTest::mouseMove(win, from + (centre - from) * i / 20);
-                QTest::mouseRelease(win, Qt::MiddleButton, {}, centre);
-            } else {
-                test::drag(w->viewport()->canvasWidget(), from, centre, 20, Qt::MiddleButton);
-            }
+            viewportDrag(from, centre, Qt::MiddleButton); // a pan: the duct to the middle
             ++actions;
             for (int notch = 0; notch < 6; ++notch) {
                 QWheelEvent wheel(QPointF(centre), QPointF(w->viewport()->mapToGlobal(centre)), QPoint(),

@@ -17,7 +17,6 @@
 #include <QPlainTextEdit>
 #include <QPushButton>
 #include <QStatusBar>
-#include <QTimer>
 
 #include <gtest/gtest.h>
 
@@ -45,19 +44,7 @@ struct SigningFixture : test::MainWindowFixture {
     void exportByDialog(const fs::path& out) {
         auto* action = w->findChild<QAction*>("actionExportCase");
         ASSERT_NE(action, nullptr);
-        QTimer typer;
-        QObject::connect(&typer, &QTimer::timeout, [&] {
-            auto* dlg = qobject_cast<QFileDialog*>(QApplication::activeModalWidget());
-            if (!dlg || !dlg->isVisible()) return;
-            typer.stop();
-            auto* name = dlg->findChild<QLineEdit*>("fileNameEdit");
-            name->clear();
-            QTest::keyClicks(name, QString::fromStdString(out.string()));
-            QTest::keyClick(name, Qt::Key_Return);
-        });
-        typer.start(100);
-        action->trigger(); // the dialog runs its own loop until the keys accept it
-        EXPECT_FALSE(typer.isActive()) << "no save dialog appeared";
+        typeIntoFileDialog(QString::fromStdString(out.string()), [action] { action->trigger(); });
     }
 
     /// The package at `out` checked as a player checks it, `trusted` its only trust anchor.

@@ -6,6 +6,7 @@
 #include "app/document.hpp"
 #include "app/hold_tool.hpp"
 #include "app/main_window.hpp"
+#include "app/preview.hpp"
 #include "app/properties_panel.hpp"
 #include "app/viewport.hpp"
 #include "gui_test_support.hpp"
@@ -15,6 +16,7 @@
 #include <QDockWidget>
 #include <QLabel>
 #include <QLineEdit>
+#include <QPlainTextEdit>
 #include <QPushButton>
 #include <QToolButton>
 #include <QUndoStack>
@@ -61,8 +63,15 @@ TEST_F(HoldToolFixture, AClickOrADragOnABodyHoldsItThereAsOneUndoStep) {
     const auto before = holds(0);
     holdOn(onBody);
     const int steps = undo()->index();
+    auto caughtUp = [&] { return w->preview()->snapshot().serial >= w->lastPreviewSubmit().first; };
+    ASSERT_TRUE(test::waitFor(caughtUp, 60000));
+    const int meshed = w->log()->toPlainText().count("preview: building meshes");
     viewportClick(onBody);
     ASSERT_EQ(holds(0).size(), before.size() + 1);
+    ASSERT_TRUE(test::waitFor(caughtUp, 60000));
+    EXPECT_TRUE(w->preview()->snapshot().error.isEmpty()) << w->preview()->snapshot().error.toStdString();
+    EXPECT_EQ(w->log()->toPlainText().count("preview: building meshes"), meshed)
+        << "a hold goes onto the meshes the preview built: no meshing again";
     EXPECT_EQ(undo()->index(), steps + 1) << "one click, one undo step";
     const auto& box = holds(0).back();
     EXPECT_NEAR(box[1].x() - box[0].x(), 2 * HoldTool::kDefaultMargin, 1e-9) << "a click: the point ± the margin";

@@ -7,10 +7,15 @@
 #include "app/viewport.hpp"
 #include "gui_test_support.hpp"
 
+#include <QApplication>
+#include <QFileDialog>
+#include <QLineEdit>
 #include <QSettings>
+#include <QTimer>
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <memory>
 
 namespace viscera::test {
@@ -47,17 +52,35 @@ struct MainWindowFixture : ::testing::Test {
         }
         QCoreApplication::processEvents();
     }
-    /// A left drag on the viewport from `from` to `to` in 30 moves.
-    void viewportDrag(QPoint from, QPoint to) {
+    /// A drag on the viewport with `button` (left: paint or pick, right: orbit, middle: pan) from
+    /// `from` to `to` in 30 moves.
+    void viewportDrag(QPoint from, QPoint to, Qt::MouseButton button = Qt::LeftButton) {
         if (QWindow* win = w->viewport()->canvasWindow()) {
-            QTest::mousePress(win, Qt::LeftButton, {}, from);
+            QTest::mousePress(win, button, {}, from);
             for (int i = 1; i <= 30; ++i)
                 QTest::mouseMove(win, from + (to - from) * i / 30);
-            QTest::mouseRelease(win, Qt::LeftButton, {}, to);
+            QTest::mouseRelease(win, button, {}, to);
         } else {
-            drag(w->viewport()->canvasWidget(), from, to, 30);
+            drag(w->viewport()->canvasWidget(), from, to, 30, button);
         }
         QCoreApplication::processEvents();
+    }
+    /// The next modal file dialog gets `path` typed into its name field and Enter; `trigger` opens
+    /// it (and runs the dialog's loop until the keys accept it).
+    void typeIntoFileDialog(const QString& path, const std::function<void()>& trigger) {
+        QTimer typer;
+        QObject::connect(&typer, &QTimer::timeout, [&] {
+            auto* dlg = qobject_cast<QFileDialog*>(QApplication::activeModalWidget());
+            if (!dlg || !dlg->isVisible()) return;
+            typer.stop();
+            auto* name = dlg->findChild<QLineEdit*>("fileNameEdit");
+            name->clear();
+            QTest::keyClicks(name, path);
+            QTest::keyClick(name, Qt::Key_Return);
+        });
+        typer.start(100);
+        trigger();
+        EXPECT_FALSE(typer.isActive()) << "no file dialog appeared";
     }
     /// A viewport position over a drawn surface whose mesh is named `name` (empty: any), on a
     /// 20 × 20 grid; (-1, -1): none.
