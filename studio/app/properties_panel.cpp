@@ -195,6 +195,7 @@ void PropertiesPanel::rebuild() {
         m_form->addRow(tr("Surface"), new QLabel(QString::fromStdString(s.name), this));
         m_form->addRow(tr("Stretch stiffness"), new QLabel(numberText(s.stretchStiffness), this));
         m_form->addRow(tr("Areal density"), new QLabel(numberText(s.arealDensity), this));
+        m_form->addRow(tr("Subdivisions"), new QLabel(QString::number(p.surfaces[surface].subdivide), this));
     }
     fillValues(true);
 }

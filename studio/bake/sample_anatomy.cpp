@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <map>
 #include <numbers>
 
 namespace viscera::bake {
@@ -132,6 +134,93 @@ std::vector<CornerUv> tubeUv(const sim::TriMesh& tube, const sim::Vec3& a, const
     return uv;
 }
 
+/// A surface made of parameter grids, welded where grids share points (to 0.01 µm); triangles
+/// left with a repeated corner by the weld (a grid's pinched row: a pole) are dropped.
+class GridSurface {
+public:
+    using Map = std::function<sim::Vec3(double, double)>;
+    using UvMap = std::function<Eigen::Vector2d(double, double)>;
+
+    /// ns × nt quads over (s, t) in [0, 1]², two triangles each, wound so that ∂/∂s × ∂/∂t is the
+    /// front (the back when `flip`); corner UVs by `uv`.
+    void add(int ns, int nt, const Map& point, const UvMap& uv, bool flip) {
+        auto at = [&](int i, int j) { return std::pair{double(i) / ns, double(j) / nt}; };
+        for (int i = 0; i < ns; ++i)
+            for (int j = 0; j < nt; ++j) {
+                const std::array<std::pair<double, double>, 4> q{at(i, j), at(i + 1, j), at(i + 1, j + 1),
+                                                                 at(i, j + 1)};
+                const std::array<std::array<int, 3>, 2> halves{{{0, 1, 2}, {0, 2, 3}}};
+                for (const auto& h : halves) {
+                    std::array<int, 3> c = h;
+                    if (flip) std::swap(c[1], c[2]);
+                    sim::Tri tri;
+                    CornerUv cu;
+                    for (int k = 0; k < 3; ++k) {
+                        const auto [s, t] = q[size_t(c[k])];
+                        tri[k] = vertex(point(s, t));
+                        cu[k] = uv(s, t);
+                    }
+                    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) continue;
+                    m_tris.push_back(tri);
+                    m_uv.push_back(cu);
+                }
+            }
+    }
+
+    RemeshPart part(const std::string& name) {
+        return {name, sim::TriMesh::fromArrays(std::move(m_pos), std::move(m_tris), name), CsgOp::Union,
+                std::move(m_uv)};
+    }
+
+private:
+    int32_t vertex(const sim::Vec3& p) {
+        const std::array<long, 3> key{std::lround(p.x() * 1e8), std::lround(p.y() * 1e8), std::lround(p.z() * 1e8)};
+        auto [it, added] = m_index.try_emplace(key, int32_t(m_pos.size()));
+        if (added) m_pos.push_back(p);
+        return it->second;
+    }
+
+    std::map<std::array<long, 3>, int32_t> m_index;
+    std::vector<sim::Vec3> m_pos;
+    std::vector<sim::Tri> m_tris;
+    std::vector<CornerUv> m_uv;
+};
+
+/// The six faces of the unit cube of parameters (u, v, w), `n` cells along each, through `map`
+/// (orientation-preserving: the faces come out facing outwards). UVs: the face w = 1 by (u, v) in
+/// `outer`, w = 0 in `inner`, the four others each a quarter of `rims`.
+void addMappedCube(GridSurface& g, const std::array<int, 3>& n, const std::function<sim::Vec3(const sim::Vec3&)>& map,
+                   const Rect& outer, const Rect& inner, const Rect& rims) {
+    int rim = 0;
+    for (int a = 0; a < 3; ++a)
+        for (int side = 0; side < 2; ++side) {
+            const int b = (a + 1) % 3, c = (a + 2) % 3;
+            auto point = [&, a, b, c, side](double s, double t) {
+                sim::Vec3 q;
+                q[a] = side;
+                q[b] = s;
+                q[c] = t;
+                return map(q);
+            };
+            Rect r = rims;
+            if (a == 2)
+                r = side == 1 ? outer : inner;
+            else {
+                const double w = (rims.x1 - rims.x0) / 4;
+                r = {rims.x0 + rim * w, rims.y0, rims.x0 + (rim + 1) * w - 0.005, rims.y1};
+                ++rim;
+            }
+            // Face a = 2 is (u, v): keep u across the island for it; the others by (s, t).
+            auto uv = [r, a](double s, double t) { return a == 2 ? r.at(t, s) : r.at(s, t); };
+            g.add(n[size_t(b)], n[size_t(c)], point, uv, side == 0);
+        }
+}
+
+double smoothstep(double e0, double e1, double x) {
+    const double t = std::clamp((x - e0) / (e1 - e0), 0.0, 1.0);
+    return t * t * (3 - 2 * t);
+}
+
 } // namespace
 
 std::vector<RemeshPart> kidneyAnatomy(int slices) {
@@ -232,6 +321,72 @@ std::vector<RemeshPart> hepatocysticAnatomy(int slices) {
     std::vector<CornerUv> arteryUv =
         tubeUv(artery, aa, ab, 0.0015, {0.81, 0.14, 0.98, 0.48}, {0.81, 0.02, 0.885, 0.12}, {0.905, 0.02, 0.98, 0.12});
     parts.push_back({"cystic_artery", std::move(artery), CsgOp::Union, std::move(arteryUv)});
+    return parts;
+}
+
+namespace {
+
+/// The mesorectum of rectumAnatomy: the cube of (u along x, v around the rectum, w outwards).
+RemeshPart mesorectumPart(int slices) {
+    auto shell = [](const sim::Vec3& q) {
+        const double x = -0.062 + 0.124 * q.x(), theta = (-95.0 + 190.0 * q.y()) * kPi / 180.0;
+        const double deg = std::abs(theta) * 180.0 / kPi;
+        const double lobes = 0.0009 * smoothstep(20, 45, deg) * std::sin(2 * kPi * x / 0.028) * std::sin(6 * theta);
+        const double ri = 0.0225, ro = 0.032 + lobes;
+        const double ex = std::max(0.0, std::abs(x) - 0.048) / 0.014, et = std::max(0.0, deg - 70) / 25;
+        const double thin = std::sqrt(std::max(0.45, 1 - ex * ex)) * std::sqrt(std::max(0.45, 1 - et * et));
+        const double r = ri + q.z() * (ro - ri) * thin;
+        return sim::Vec3(x, 0.01 + r * std::sin(theta), -0.032 + r * std::cos(theta));
+    };
+    GridSurface g;
+    addMappedCube(g, {slices, slices / 2, 4}, shell, {0.02, 0.02, 0.58, 0.98}, {0.62, 0.52, 0.98, 0.98},
+                  {0.62, 0.27, 0.98, 0.48});
+    return g.part("mesorectum");
+}
+
+/// The pelvic side walls and sacral hollow of rectumAnatomy, facing the axis.
+RemeshPart pelvicWallPart(int slices) {
+    auto wall = [](double s, double t) {
+        const double x = -0.1 + 0.21 * s, phi = (55.0 + 250.0 * t) * kPi / 180.0;
+        const double sacrum = std::pow(std::max(0.0, -std::cos(phi)), 2) * (0.004 + 0.006 * s);
+        const double r = 0.075 + sacrum;
+        return sim::Vec3(x, 0.01 - r * std::sin(phi), -0.025 + r * std::cos(phi));
+    };
+    const Rect island{0.02, 0.02, 0.58, 0.98};
+    GridSurface g;
+    g.add(
+        slices / 2, slices, wall, [island](double s, double t) { return island.at(s, t); }, false);
+    return g.part("pelvic_wall");
+}
+
+/// The peritoneal reflection of rectumAnatomy: a shallow dome facing −x.
+RemeshPart peritoneumPart(int slices) {
+    constexpr double R = 0.075;
+    auto dome = [](double s, double t) {
+        const double a = 2 * kPi * t;
+        return sim::Vec3(0.11 + 0.01 * (1 - s * s), 0.01 + s * R * std::cos(a), -0.025 + s * R * std::sin(a));
+    };
+    const Rect island{0.62, 0.02, 0.98, 0.23};
+    auto uv = [island](double s, double t) {
+        const double a = 2 * kPi * t;
+        return island.at(0.5 + 0.5 * s * std::cos(a), 0.5 + 0.5 * s * std::sin(a));
+    };
+    GridSurface g;
+    g.add(slices / 8, slices, dome, uv, true);
+    return g.part("peritoneum");
+}
+
+} // namespace
+
+std::vector<RemeshPart> rectumAnatomy(int slices) {
+    std::vector<RemeshPart> parts;
+    parts.push_back(mesorectumPart(slices));
+    const sim::Vec3 ra(-0.1, 0.01, -0.032), rb(0.11, 0.01, -0.032);
+    sim::TriMesh rectum = uncapped(sim::makeTubeSurface(ra, rb, 0.0246, slices, slices / 2), ra, rb, "rectum");
+    std::vector<CornerUv> rectumUv = tubeUv(rectum, ra, rb, 0.0246, {0.62, 0.52, 0.98, 0.98}, {}, {});
+    parts.push_back({"rectum", std::move(rectum), CsgOp::Union, std::move(rectumUv)});
+    parts.push_back(pelvicWallPart(slices));
+    parts.push_back(peritoneumPart(slices));
     return parts;
 }
 

@@ -24,7 +24,7 @@ std::vector<RemeshPart> kidneyAnatomy(int slices = 96);
 
 /// The hepatocystic triangle's anatomy made by code [issue 57 item 4], as bought render anatomy
 /// arrives: separate overlapping parts, some open, each with UVs in one atlas (the layout of
-/// hepatocysticAtlas in project/sample_hepatocystic.hpp). Metres, z up (the patient's anterior).
+/// hepatocysticAtlas in project/sample_anatomy_files.hpp). Metres, z up (the patient's anterior).
 ///   "liver"             the right lobe's underside: a flattened ellipsoid 180 × 130 × 60 mm
 ///                       whose top (the bare area) is missing: open; one island
 ///   "gallbladder"       a pear 32 × 84 mm in its bed, its top 13 mm inside the liver, the fundus
@@ -35,5 +35,23 @@ std::vector<RemeshPart> kidneyAnatomy(int slices = 96);
 ///                       three islands (side and caps)
 /// `slices` sets the tessellation. Deterministic.
 std::vector<RemeshPart> hepatocysticAnatomy(int slices = 64);
+
+/// The mesorectum and its pelvis made by code [issue 57 item 5], as bought anatomy arrives: separate
+/// parts that overlap, some open, each with UVs in one atlas. Metres; x runs along the rectum
+/// (proximal −x to distal +x), z up (the patient's posterior, seen from the laparoscope above). The
+/// rectum's axis is the line along x through y 10 mm, z −32 mm.
+///   "mesorectum"   the fat around the rectum over its upper 190°: a closed shell from x −62 to
+///                  +62 mm whose inner face (radius 22.5 mm) lies 2 mm inside the rectal wall and
+///                  whose outer face (radius 32 mm, lobulated by up to ±0.9 mm away from its top
+///                  40°) is smooth where the surgeon opens it; it thins towards its ends and sides.
+///                  Three islands (outer face, inner face, rims)
+///   "rectum"       an open tube (no caps) of radius 24.6 mm from x −100 to +110 mm; one island
+///   "pelvic_wall"  the pelvic side walls and sacral hollow: an open part of a cylinder of radius
+///                  75 mm (about the line along x through y 10 mm, z −25 mm) from 55° to 305° of
+///                  +z, deepening towards the sacrum; its triangles face the axis; one island
+///   "peritoneum"   the peritoneal reflection closing the pelvis at x +110 mm: a shallow dome of
+///                  radius 75 mm facing −x; one island
+/// `slices` sets the tessellation. Deterministic.
+std::vector<RemeshPart> rectumAnatomy(int slices = 64);
 
 } // namespace viscera::bake

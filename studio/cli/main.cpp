@@ -11,6 +11,7 @@
 //   viscera-studio texture <spec.json> -o <dir>
 //   viscera-studio sample kidney -o <project-dir>
 //   viscera-studio sample hepatocystic -o <folder>
+//   viscera-studio sample rectum -o <folder>
 //
 // remesh runs the voxel remesh (bake/remesh.hpp) on the parts and prints its figures.
 //
@@ -46,7 +47,7 @@
 #include "project/project.hpp"
 #include "project/publishing.hpp"
 #include "project/remesh_cache.hpp"
-#include "project/sample_hepatocystic.hpp"
+#include "project/sample_anatomy_files.hpp"
 #include "project/sample_kidney.hpp"
 #include "project/step_result.hpp"
 #include "sim/mesh/tet_io.hpp"
@@ -87,6 +88,7 @@ void usage(std::FILE* out) {
                "       viscera-studio texture <spec.json> -o <dir>\n"
                "       viscera-studio sample kidney -o <project-dir>\n"
                "       viscera-studio sample hepatocystic -o <folder>\n"
+               "       viscera-studio sample rectum -o <folder>\n"
                "       viscera-studio replay <project-dir> -o <replay.csv> [--frames N]\n"
                "       viscera-studio --version\n",
                out);
@@ -158,6 +160,7 @@ constexpr const char* kRemeshHelp =
 constexpr const char* kSampleHelp =
     "usage: viscera-studio sample kidney -o <project-dir>\n"
     "       viscera-studio sample hepatocystic -o <folder>\n"
+    "       viscera-studio sample rectum -o <folder>\n"
     "\n"
     "Writes the kidney sample project, made by code: the kidney-like render anatomy (four\n"
     "overlapping parts with UV islands and seams) as anatomy/*.obj with UVs, its texture atlas\n"
@@ -168,7 +171,11 @@ constexpr const char* kSampleHelp =
     "hepatocystic writes the anatomy of a cholecystectomy step as bought anatomy arrives, to import\n"
     "in the studio (File > Import anatomy): liver, gallbladder, cystic_duct, common_bile_duct and\n"
     "cystic_artery .obj (overlapping parts, the liver and the ducts open, UVs in one atlas) and the\n"
-    "atlas hepatocystic.png. No project is written: the case is built in the studio.\n";
+    "atlas hepatocystic.png. No project is written: the case is built in the studio.\n"
+    "\n"
+    "rectum writes the mesorectum and its pelvis the same way: mesorectum (a closed fat shell over\n"
+    "the rectum, overlapping it), rectum (an open tube), pelvic_wall and peritoneum (open surfaces)\n"
+    ".obj with UVs, to import in the studio like the hepatocystic parts.\n";
 constexpr const char* kOpenHelp = "usage: viscera-studio open <project-dir>\n"
                                   "\n"
                                   "Opens the desktop studio on a project (without a folder: an empty studio).\n";
@@ -517,14 +524,16 @@ int parseCount(const std::string& flag, const std::string& v, int lo, int hi) {
 }
 
 int cmdSample(const std::vector<std::string>& args) {
-    if (args.size() != 3 || (args[0] != "kidney" && args[0] != "hepatocystic") || args[1] != "-o")
-        throw std::invalid_argument(
-            "sample needs 'kidney -o <project-dir>' or 'hepatocystic -o <folder>' (the built-in samples)");
+    if (args.size() != 3 || (args[0] != "kidney" && args[0] != "hepatocystic" && args[0] != "rectum") ||
+        args[1] != "-o")
+        throw std::invalid_argument("sample needs 'kidney -o <project-dir>', 'hepatocystic -o <folder>' or 'rectum -o "
+                                    "<folder>' (the built-in samples)");
     const std::filesystem::path dir = args[2];
-    if (args[0] == "hepatocystic") {
-        const studio::HepatocysticFiles f = studio::writeHepatocysticAnatomy(dir);
-        std::printf("wrote %zu anatomy parts and the atlas %s into %s\n", f.parts.size(), f.atlas.filename().c_str(),
-                    dir.c_str());
+    if (args[0] != "kidney") {
+        const studio::AnatomyFiles f =
+            args[0] == "rectum" ? studio::writeRectumAnatomy(dir) : studio::writeHepatocysticAnatomy(dir);
+        std::printf("wrote %zu anatomy parts%s%s into %s\n", f.parts.size(), f.atlas.empty() ? "" : " and the atlas ",
+                    f.atlas.filename().c_str(), dir.c_str());
         return 0;
     }
     std::error_code ec;

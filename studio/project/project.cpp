@@ -1,6 +1,7 @@
 #include "project/project.hpp"
 
 #include "project/remesh_cache.hpp"
+#include "project/surface_refine.hpp"
 
 #include "bake/texture.hpp"
 #include "render/case_references.hpp"
@@ -691,7 +692,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
     if (auto surfaces = root.find("surfaces"))
         for (const JsonField& sj : surfaces->items()) {
             sj.object({"name", "areal_density", "stretch_stiffness", "attach_distance", "attach_compliance",
-                       "from_boundary_of", "region", "stiffness_paint", "texture"});
+                       "from_boundary_of", "region", "stiffness_paint", "texture", "subdivide"});
             SurfaceProject sp;
             sim::readSurfaceCommon(sj, sp.scene, names);
             const JsonField from = sj["from_boundary_of"];
@@ -703,6 +704,7 @@ Project loadProjectText(const std::string& text, const std::filesystem::path& di
             if (auto r = sj.find("region")) sp.region = readBox(*r);
             if (auto pt = sj.find("stiffness_paint")) sp.paint = readPaint(*pt, false);
             if (auto t = sj.find("texture")) sp.texture = readTexture(*t, dir);
+            sp.subdivide = sj.integer("subdivide", 0, 0, 3);
             p.surfaces.push_back(std::move(sp));
         }
     if (auto t = root.find("tools")) scene.tools = sim::readTools(*t, names);
@@ -794,6 +796,7 @@ std::string projectJsonText(const Project& p) {
             if (s.region) j["region"] = boxJson(*s.region);
             if (s.paint) j["stiffness_paint"] = paintJson(*s.paint, false);
             if (s.texture) j["texture"] = textureJson(*s.texture);
+            if (s.subdivide != 0) j["subdivide"] = s.subdivide;
             doc["surfaces"].push_back(j);
         }
     }
@@ -1241,7 +1244,7 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
             ++body;
         sim::TriMesh tri;
         try {
-            tri = cutBoundary(*meshes[body], sp.region);
+            tri = midpointSubdivide(cutBoundary(*meshes[body], sp.region), sp.subdivide);
         } catch (const std::invalid_argument&) {
             throw InputError(origin + ": surfaces[" + std::to_string(s) +
                              "].region: contains no boundary triangle of '" + from + "'");

@@ -226,6 +226,10 @@ struct SurfaceProject {
     /// meshes/<surface>.vweights. By position, so it survives the body being meshed again.
     std::optional<StiffnessPaintProject> paint;
     std::optional<TextureProject> texture;
+    /// Rounds of midpoint subdivision of the cut layer ("subdivide", 0..3): a fascia finer than the
+    /// body's boundary (each round halves its edges), so the energy hook opens it along its path
+    /// however coarse the tets under it are.
+    int subdivide = 0;
 };
 
 /// Where the suture's needle trajectory comes from ("suture.trajectory" of project.json): the

@@ -6,12 +6,15 @@
 #include "app/error_banner.hpp"
 #include "app/main_window.hpp"
 #include "app/project_tree_panel.hpp"
+#include "app/properties_panel.hpp"
 #include "gui_test_support.hpp"
 #include "project/project.hpp"
 #include "window_fixture.hpp"
 
 #include <QAction>
+#include <QFormLayout>
 #include <QInputDialog>
+#include <QLabel>
 #include <QLineEdit>
 #include <QMenu>
 #include <QMessageBox>
@@ -231,6 +234,36 @@ TEST_F(BodyEditFixture, TheBodyItemsContextMenuRenamesAndDeletes) {
     EXPECT_NE(tree->lastRefusal().toStdString().find("bodies[1].name: 'organ' is used twice"), std::string::npos);
     EXPECT_EQ(w->errorBanner()->text(), tree->lastRefusal());
     EXPECT_EQ(project().bodies[1].scene.name, "vessel");
+}
+
+// A layer picked in the tree shows its subdivision rounds in Properties beside its stiffness and
+// density (the fascia's "subdivide" of project.json; 0 unless set).
+TEST_F(BodyEditFixture, APickedSurfaceShowsItsSubdivisionsInProperties) {
+    open("liver");
+    QTreeWidgetItem* surface = nullptr;
+    for (int g = 0; g < tree->topLevelItemCount() && !surface; ++g)
+        if (tree->topLevelItem(g)->text(0) == "Surfaces" && tree->topLevelItem(g)->childCount() > 0)
+            surface = tree->topLevelItem(g)->child(0);
+    ASSERT_NE(surface, nullptr);
+    tree->scrollToItem(surface);
+    test::click(tree->viewport(), tree->visualItemRect(surface).center());
+    ASSERT_EQ(tree->currentItem(), surface);
+    auto rowText = [&](const QString& label) {
+        auto* form = w->propertiesPanel()->findChild<QFormLayout*>();
+        for (int r = 0; form && r < form->rowCount(); ++r) {
+            auto* l = qobject_cast<QLabel*>(
+                form->itemAt(r, QFormLayout::LabelRole) ? form->itemAt(r, QFormLayout::LabelRole)->widget() : nullptr);
+            auto* f = form->itemAt(r, QFormLayout::FieldRole)
+                          ? qobject_cast<QLabel*>(form->itemAt(r, QFormLayout::FieldRole)->widget())
+                          : nullptr;
+            if (l && f && l->text() == label) return f->text();
+        }
+        return QString("(no row)");
+    };
+    ASSERT_TRUE(test::waitFor([&] { return rowText("Subdivisions") != "(no row)"; }, 2000));
+    EXPECT_EQ(rowText("Subdivisions"), QString::number(project().surfaces[0].subdivide));
+    EXPECT_EQ(rowText("Surface").toStdString(), project().surfaces[0].scene.name);
+    test::saveShot("surface_properties");
 }
 
 } // namespace

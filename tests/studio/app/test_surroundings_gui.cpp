@@ -8,7 +8,7 @@
 #include "app/texture_panel.hpp"
 #include "gui_test_support.hpp"
 #include "project/anatomy_shapes.hpp"
-#include "project/sample_hepatocystic.hpp"
+#include "project/sample_anatomy_files.hpp"
 #include "window_fixture.hpp"
 
 #include <QComboBox>

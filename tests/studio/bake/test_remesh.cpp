@@ -63,6 +63,30 @@ void expectSound(const bake::RemeshResult& r) {
     EXPECT_GT(r.mesh.signedVolume(), 0);
 }
 
+/// The remeshed surface tetrahedralizes at (cell, facet) into at least minTets tets, none inverted.
+bake::TetrahedralizeResult expectTetrahedralizes(const bake::RemeshResult& r, double cell, double facet,
+                                                 size_t minTets) {
+    bake::MeshingParams m;
+    m.cellSize = cell;
+    m.facetSize = facet;
+    bake::TetrahedralizeResult t = bake::tetrahedralize(r.mesh, m);
+    EXPECT_GT(t.mesh->tetCount(), minTets);
+    EXPECT_TRUE(t.report.quality.inverted.empty());
+    return t;
+}
+
+/// The parts carry these names in order and a UV triangle each, inside the unit square.
+void expectNamedPartsWithUvs(const std::vector<bake::RemeshPart>& parts, const std::vector<std::string>& names) {
+    ASSERT_EQ(parts.size(), names.size());
+    for (size_t i = 0; i < parts.size(); ++i) {
+        EXPECT_EQ(parts[i].name, names[i]);
+        ASSERT_EQ(parts[i].uv.size(), parts[i].surface.triangleCount()) << names[i] << ": a UV triangle each";
+        for (const bake::CornerUv& c : parts[i].uv)
+            for (const auto& uv : c)
+                EXPECT_TRUE(uv.x() >= 0 && uv.x() <= 1 && uv.y() >= 0 && uv.y() <= 1) << names[i];
+    }
+}
+
 } // namespace
 
 TEST(bake_remesh, UnionOfOverlappingCubesIsOneClosedSurfaceOfTheirVolume) {
@@ -103,12 +127,7 @@ TEST(bake_remesh, AnOpenPartIsThickenedIntoAClosedShell) {
 
 TEST(bake_remesh, TheResultTetrahedralizes) {
     const bake::RemeshResult r = bake::voxelRemesh(twoCubes(bake::CsgOp::Union), params(48));
-    bake::MeshingParams m;
-    m.cellSize = 0.003;
-    m.facetSize = 0.002;
-    const bake::TetrahedralizeResult t = bake::tetrahedralize(r.mesh, m);
-    EXPECT_GT(t.mesh->tetCount(), 100u);
-    EXPECT_TRUE(t.report.quality.inverted.empty());
+    const bake::TetrahedralizeResult t = expectTetrahedralizes(r, 0.003, 0.002, 100);
     EXPECT_NEAR(t.report.tetVolume, r.report.volume, 0.03 * r.report.volume);
 }
 
@@ -243,12 +262,7 @@ TEST(bake_remesh, TheKidneySampleBecomesOneSoundBodyThatTetrahedralizes) {
     EXPECT_EQ(r.report.closedHoles, 1u);
     EXPECT_EQ(r.report.openParts, 1u);
     EXPECT_LT(r.report.distanceMaxMm, 3.0 * r.report.voxelSize * 1e3);
-    bake::MeshingParams m;
-    m.cellSize = 0.004;
-    m.facetSize = 0.003;
-    const bake::TetrahedralizeResult t = bake::tetrahedralize(r.mesh, m);
-    EXPECT_GT(t.mesh->tetCount(), 1000u);
-    EXPECT_TRUE(t.report.quality.inverted.empty());
+    expectTetrahedralizes(r, 0.004, 0.003, 1000);
 }
 
 // The hepatocystic anatomy [issue 57 item 4] arrives as bought anatomy does: separate overlapping
@@ -256,15 +270,8 @@ TEST(bake_remesh, TheKidneySampleBecomesOneSoundBodyThatTetrahedralizes) {
 // artery (what the case simulates) becomes one sound body that tetrahedralizes.
 TEST(bake_remesh, TheHepatocysticAnatomyIsBoughtLikeAndItsGallbladderPartsMakeOneSoundBody) {
     const std::vector<bake::RemeshPart> parts = bake::hepatocysticAnatomy();
-    ASSERT_EQ(parts.size(), 5u);
-    const char* names[] = {"liver", "gallbladder", "cystic_duct", "common_bile_duct", "cystic_artery"};
-    for (size_t i = 0; i < parts.size(); ++i) {
-        EXPECT_EQ(parts[i].name, names[i]);
-        ASSERT_EQ(parts[i].uv.size(), parts[i].surface.triangleCount()) << names[i] << ": a UV triangle each";
-        for (const bake::CornerUv& c : parts[i].uv)
-            for (const auto& uv : c)
-                EXPECT_TRUE(uv.x() >= 0 && uv.x() <= 1 && uv.y() >= 0 && uv.y() <= 1) << names[i];
-    }
+    ASSERT_NO_FATAL_FAILURE(
+        expectNamedPartsWithUvs(parts, {"liver", "gallbladder", "cystic_duct", "common_bile_duct", "cystic_artery"}));
     EXPECT_FALSE(parts[0].surface.isClosedOriented()) << "the liver's bare area is missing";
     EXPECT_TRUE(parts[1].surface.isClosedOriented());
     EXPECT_FALSE(parts[2].surface.isClosedOriented()) << "the cystic duct is an open tube";
@@ -296,10 +303,36 @@ TEST(bake_remesh, TheHepatocysticAnatomyIsBoughtLikeAndItsGallbladderPartsMakeOn
     const bake::RemeshResult r = bake::voxelRemesh(gall, params(96));
     expectSound(r);
     EXPECT_EQ(r.report.openParts, 2u) << "the two open ducts";
-    bake::MeshingParams m;
-    m.cellSize = 0.004;
-    m.facetSize = 0.003;
-    const bake::TetrahedralizeResult t = bake::tetrahedralize(r.mesh, m);
-    EXPECT_GT(t.mesh->tetCount(), 1000u);
-    EXPECT_TRUE(t.report.quality.inverted.empty());
+    expectTetrahedralizes(r, 0.004, 0.003, 1000);
+}
+
+// The rectum's anatomy [issue 57 item 5] as bought anatomy: the mesorectum a closed shell that
+// overlaps the rectal wall, the rectum, pelvic wall and peritoneum open, UVs on every part; the
+// mesorectum alone makes one sound body that tetrahedralizes.
+TEST(bake_remesh, TheRectumAnatomyIsBoughtLikeAndItsMesorectumMakesOneSoundBody) {
+    const std::vector<bake::RemeshPart> parts = bake::rectumAnatomy();
+    ASSERT_NO_FATAL_FAILURE(expectNamedPartsWithUvs(parts, {"mesorectum", "rectum", "pelvic_wall", "peritoneum"}));
+    const bool closed[] = {true, false, false, false};
+    for (size_t i = 0; i < parts.size(); ++i)
+        EXPECT_EQ(parts[i].surface.isClosedOriented(), closed[i]) << parts[i].name;
+    // sizes: the fat 124 mm long, its top (the dissection plane) at z 0; the rectal wall's radius
+    // 24.6 mm reaches 2 mm into the fat's inner face (22.5 mm)
+    sim::Vec3 lo = sim::Vec3::Constant(1e9), hi = -lo;
+    double innerMin = 1e9;
+    for (const sim::Vec3& x : parts[0].surface.positions()) {
+        lo = lo.cwiseMin(x);
+        hi = hi.cwiseMax(x);
+        innerMin = std::min(innerMin, std::hypot(x.y() - 0.01, x.z() + 0.032));
+    }
+    EXPECT_NEAR(hi.x() - lo.x(), 0.124, 1e-6);
+    EXPECT_NEAR(hi.z(), 0.0, 2e-4);
+    EXPECT_NEAR(innerMin, 0.0225, 1e-4);
+    double rectumRadius = 0;
+    for (const sim::Vec3& x : parts[1].surface.positions())
+        rectumRadius = std::max(rectumRadius, std::hypot(x.y() - 0.01, x.z() + 0.032));
+    EXPECT_NEAR(rectumRadius, 0.0246, 1e-4);
+    const bake::RemeshResult r = bake::voxelRemesh({parts[0]}, params(96));
+    expectSound(r);
+    EXPECT_EQ(r.report.openParts, 0u);
+    expectTetrahedralizes(r, 0.005, 0.005, 1000);
 }

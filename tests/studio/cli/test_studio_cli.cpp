@@ -288,6 +288,24 @@ TEST(StudioCli, ImportMeshRemeshAndExportWriteTheirTypedResults) {
     EXPECT_EQ(studio::readRemeshedSurface(scratch / "k.vremesh").surface.triangleCount(), size_t(remeshed.triangles));
 }
 
+/// `import` of the parts <dir>/<name>.obj reads each back with UVs, closed or open as given.
+void expectImported(const test::Scratch& scratch, const fs::path& dir, const std::vector<std::string>& names,
+                    const std::vector<bool>& closed) {
+    std::vector<std::string> args = {"import"};
+    for (const std::string& part : names)
+        args.push_back((dir / (part + ".obj")).string());
+    args.push_back("--result");
+    args.push_back(std::string(scratch / "import.json"));
+    const auto r = runStudio(args);
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto imported = studio::readStepResult<studio::ImportStepResult>(scratch / "import.json");
+    ASSERT_EQ(imported.parts.size(), names.size());
+    for (size_t i = 0; i < names.size(); ++i) {
+        EXPECT_EQ(imported.parts[i].closed, closed[i]) << imported.parts[i].file;
+        EXPECT_TRUE(imported.parts[i].hasUv) << imported.parts[i].file;
+    }
+}
+
 // `sample hepatocystic` [issue 57 item 4]: the cholecystectomy's anatomy written as bought anatomy
 // arrives (five OBJ parts with UVs and their atlas, no project), read back by `import` as the
 // studio reads it: the liver and the ducts open, the gallbladder and the artery closed, all with UVs.
@@ -299,21 +317,23 @@ TEST(StudioCli, TheHepatocysticSampleIsAnatomyToImport) {
     EXPECT_THAT(r.out, HasSubstr("wrote 5 anatomy parts and the atlas hepatocystic.png"));
     EXPECT_FALSE(fs::exists(dir / "project.json")) << "the case is built in the studio";
     EXPECT_TRUE(fs::exists(dir / "hepatocystic.png"));
-    std::vector<std::string> args = {"import"};
-    for (const char* part : {"liver", "gallbladder", "cystic_duct", "common_bile_duct", "cystic_artery"})
-        args.push_back((dir / (std::string(part) + ".obj")).string());
-    args.push_back("--result");
-    args.push_back(std::string(scratch / "import.json"));
-    r = runStudio(args);
-    ASSERT_EQ(r.exitCode, 0) << r.err;
-    const auto imported = studio::readStepResult<studio::ImportStepResult>(scratch / "import.json");
-    ASSERT_EQ(imported.parts.size(), 5u);
-    const bool closed[] = {false, true, false, false, true};
-    for (size_t i = 0; i < 5; ++i) {
-        EXPECT_EQ(imported.parts[i].closed, closed[i]) << imported.parts[i].file;
-        EXPECT_TRUE(imported.parts[i].hasUv) << imported.parts[i].file;
-    }
+    ASSERT_NO_FATAL_FAILURE(expectImported(scratch, dir,
+                                           {"liver", "gallbladder", "cystic_duct", "common_bile_duct", "cystic_artery"},
+                                           {false, true, false, false, true}));
     r = runStudio({"sample", "spleen", "-o", dir.string()});
     EXPECT_NE(r.exitCode, 0);
-    EXPECT_THAT(r.err, HasSubstr("'hepatocystic -o <folder>' (the built-in samples)"));
+    EXPECT_THAT(r.err, HasSubstr("'rectum -o <folder>' (the built-in samples)"));
+}
+
+// `sample rectum` [issue 57 item 5]: the rectum's anatomy the same way (four OBJ parts with UVs, no
+// atlas, no project); `import` reads the mesorectum closed and the other three open, all with UVs.
+TEST(StudioCli, TheRectumSampleIsAnatomyToImport) {
+    test::Scratch scratch("viscera-studio-cli-rectum");
+    const fs::path dir = scratch.dir / "anatomy";
+    auto r = runStudio({"sample", "rectum", "-o", dir.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_THAT(r.out, HasSubstr("wrote 4 anatomy parts into"));
+    EXPECT_FALSE(fs::exists(dir / "project.json"));
+    ASSERT_NO_FATAL_FAILURE(expectImported(scratch, dir, {"mesorectum", "rectum", "pelvic_wall", "peritoneum"},
+                                           {true, false, false, false}));
 }

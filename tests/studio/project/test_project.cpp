@@ -2,6 +2,7 @@
 #include "project/project.hpp"
 #include "render/case_references.hpp"
 #include "render/sample_map.hpp"
+#include "sim/collision/distance.hpp"
 #include "sim/mesh/tet_io.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/scene_json.hpp"
@@ -313,6 +314,64 @@ TEST_F(ProjectTest, RemeshingKeepsAFasciasPaintedWeightMass) {
     } catch (const InputError& e) {
         EXPECT_THAT(e.what(), HasSubstr("p.json: surfaces[0].stiffness_paint"));
         EXPECT_THAT(e.what(), HasSubstr("skeleton"));
+    }
+}
+
+// "subdivide" on a layer [issue 57 item 5]: each round splits every triangle of the cut boundary in
+// four at its edge midpoints, so the fascia is finer than the tets under it while it still lies on
+// their boundary (the solver attaches every vertex); the field round-trips and 0..3 is the rule.
+TEST_F(ProjectTest, ASubdividedFasciaIsFinerAndStillLiesOnItsBody) {
+    studio::Project p = studio::loadProject(std::filesystem::path(VISCERA_SOURCE_DIR) / "projects/liver");
+    p.dir = m_dir;
+    ASSERT_FALSE(p.surfaces.empty());
+    EXPECT_EQ(p.surfaces[0].subdivide, 0);
+    studio::Project q = p;
+    q.surfaces[0].subdivide = 2;
+    const studio::BuiltScene A = studio::buildScene(p), B = studio::buildScene(q);
+    const sim::TriMesh &a = A.surfaces[0], &b = B.surfaces[0];
+    EXPECT_EQ(b.triangleCount(), 16 * a.triangleCount());
+    auto meanEdge = [](const sim::TriMesh& m) {
+        double sum = 0;
+        for (const sim::Tri& t : m.triangles())
+            for (int k = 0; k < 3; ++k)
+                sum += (m.positions()[t[k]] - m.positions()[t[(k + 1) % 3]]).norm();
+        return sum / (3.0 * double(m.triangleCount()));
+    };
+    EXPECT_NEAR(meanEdge(b) / meanEdge(a), 0.25, 1e-9);
+    double area[2] = {0, 0};
+    for (int k = 0; k < 2; ++k) {
+        const sim::TriMesh& m = k ? b : a;
+        for (const sim::Tri& t : m.triangles())
+            area[k] +=
+                0.5 *
+                (m.positions()[t[1]] - m.positions()[t[0]]).cross(m.positions()[t[2]] - m.positions()[t[0]]).norm();
+    }
+    EXPECT_NEAR(area[1], area[0], 1e-12) << "the same surface, only finer";
+    // every vertex of the finer layer lies on the body's boundary (on one of its flat triangles)
+    const sim::TriMesh& boundary = B.meshes[0]->boundary();
+    size_t off = 0;
+    for (const sim::Vec3& x : b.positions()) {
+        double best = 1e9;
+        for (const sim::Tri& t : boundary.triangles())
+            best = std::min(best, (sim::closestPointOnTriangle(x, boundary.positions()[t[0]],
+                                                               boundary.positions()[t[1]], boundary.positions()[t[2]])
+                                       .point -
+                                   x)
+                                      .norm());
+        off += best > 1e-9;
+    }
+    EXPECT_EQ(off, 0u);
+    const std::string text = studio::projectJsonText(q);
+    EXPECT_EQ(nlohmann::json::parse(text)["surfaces"][0]["subdivide"], 2);
+    EXPECT_EQ(studio::loadProjectText(text, m_dir, "again").surfaces[0].subdivide, 2);
+    EXPECT_EQ(nlohmann::json::parse(studio::projectJsonText(p))["surfaces"][0].count("subdivide"), 0u);
+    nlohmann::json bad = nlohmann::json::parse(text);
+    bad["surfaces"][0]["subdivide"] = 4;
+    try {
+        studio::loadProjectText(bad.dump(), m_dir, "bad");
+        ADD_FAILURE() << "subdivide 4 accepted";
+    } catch (const std::exception& e) {
+        EXPECT_THAT(e.what(), HasSubstr("surfaces[0].subdivide: must be an integer in [0, 3]"));
     }
 }
 

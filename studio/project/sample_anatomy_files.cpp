@@ -1,4 +1,4 @@
-#include "project/sample_hepatocystic.hpp"
+#include "project/sample_anatomy_files.hpp"
 
 #include "bake/sample_anatomy.hpp"
 #include "bake/uv_transfer.hpp"
@@ -10,16 +10,29 @@
 
 namespace viscera::studio {
 
-HepatocysticFiles writeHepatocysticAnatomy(const std::filesystem::path& dir) {
+namespace {
+
+AnatomyFiles writeParts(const std::filesystem::path& dir, const std::vector<bake::RemeshPart>& parts) {
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     if (ec) throw InputError(dir.string() + ": cannot make the folder: " + ec.message());
     requireWritableFolder(dir);
-    HepatocysticFiles out;
-    for (const bake::RemeshPart& part : bake::hepatocysticAnatomy()) {
+    AnatomyFiles out;
+    for (const bake::RemeshPart& part : parts) {
         out.parts.push_back(dir / (part.name + ".obj"));
         bake::writeObjWithUv(out.parts.back().string(), part.surface, part.uv);
     }
+    return out;
+}
+
+} // namespace
+
+AnatomyFiles writeRectumAnatomy(const std::filesystem::path& dir) {
+    return writeParts(dir, bake::rectumAnatomy());
+}
+
+AnatomyFiles writeHepatocysticAnatomy(const std::filesystem::path& dir) {
+    AnatomyFiles out = writeParts(dir, bake::hepatocysticAnatomy());
     // The islands of bake::hepatocysticAnatomy's UVs, in tissue colours.
     const AtlasRegion regions[] = {{0.02, 0.02, 0.58, 0.98, {112, 42, 34}},   // liver: red-brown
                                    {0.62, 0.52, 0.79, 0.98, {92, 118, 70}},   // gallbladder: green
