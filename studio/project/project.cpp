@@ -938,11 +938,9 @@ bool inBox(const sim::Vec3& p, const sim::Vec3& lo, const sim::Vec3& hi) {
     return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all();
 }
 
-/// The boundary triangles of `mesh` whose centroid lies in `region` (all when absent), as a
-/// surface with its own compacted vertices.
-sim::TriMesh cutBoundary(sim::TetMesh& mesh, const std::optional<std::array<sim::Vec3, 2>>& region) {
-    mesh.requireLevel(3);
-    const sim::TriMesh& b = mesh.boundary();
+/// The triangles of `b` whose centroid lies in `region` (all when absent), as a surface with its
+/// own compacted vertices.
+sim::TriMesh cutRegion(const sim::TriMesh& b, const std::optional<std::array<sim::Vec3, 2>>& region) {
     std::vector<int32_t> remap(b.vertexCount(), sim::kNone);
     std::vector<sim::Vec3> pos;
     std::vector<sim::Tri> tris;
@@ -960,6 +958,14 @@ sim::TriMesh cutBoundary(sim::TetMesh& mesh, const std::optional<std::array<sim:
         tris.push_back(out);
     }
     return sim::TriMesh::fromArrays(std::move(pos), std::move(tris), "fascia region");
+}
+
+/// A layer cut from the boundary of `mesh`: its triangles in `region`. Subdivided layers are cut
+/// after subdividing, so their border follows the region in steps of the finer triangles.
+sim::TriMesh cutBoundary(sim::TetMesh& mesh, const std::optional<std::array<sim::Vec3, 2>>& region, int subdivide) {
+    mesh.requireLevel(3);
+    if (subdivide == 0) return cutRegion(mesh.boundary(), region);
+    return cutRegion(midpointSubdivide(mesh.boundary(), subdivide), region);
 }
 
 } // namespace
@@ -1244,7 +1250,7 @@ BuiltScene buildSceneCounted(const Project& project, StageCounter& stage) {
             ++body;
         sim::TriMesh tri;
         try {
-            tri = midpointSubdivide(cutBoundary(*meshes[body], sp.region), sp.subdivide);
+            tri = cutBoundary(*meshes[body], sp.region, sp.subdivide);
         } catch (const std::invalid_argument&) {
             throw InputError(origin + ": surfaces[" + std::to_string(s) +
                              "].region: contains no boundary triangle of '" + from + "'");

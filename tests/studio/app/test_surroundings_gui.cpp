@@ -67,10 +67,14 @@ struct SurroundingsFixture : test::MainWindowFixture {
 
 TEST_F(SurroundingsFixture, TypedValuesAreUndoableEditsAndRefusalsNameTheRule) {
     ASSERT_EQ(panel->list()->count(), static_cast<int>(scenery().size()));
-    const int wall = row("pelvic_wall");
+    // the rectum's surroundings are imported anatomy: a wall added to edit
+    QTest::mouseClick(panel->addWallButton(), Qt::LeftButton);
+    const int wall = row("wall");
     ASSERT_GE(wall, 0);
     panel->list()->setCurrentRow(wall);
-    EXPECT_EQ(panel->field("radius_mm")->text(), "75");
+    const double radius0 = scenery()[size_t(wall)].radius;
+    const bool inward0 = scenery()[size_t(wall)].inward;
+    EXPECT_EQ(panel->field("radius_mm")->text(), QString::number(radius0 * 1e3));
     EXPECT_FALSE(panel->field("center")->isEnabled()) << "a wall has no centre";
     const int steps = undo()->count();
     type("radius_mm", "70");
@@ -83,20 +87,21 @@ TEST_F(SurroundingsFixture, TypedValuesAreUndoableEditsAndRefusalsNameTheRule) {
     EXPECT_EQ(panel->field("radius_mm")->text(), "70") << "the model's value again";
     type("end", "0.11, 0.01");
     EXPECT_THAT(panel->errorLabel()->text().toStdString(), HasSubstr("is not three numbers"));
-    type("end", "-0.1, 0.01, -0.025");
+    const sim::Vec3 start = scenery()[size_t(wall)].start;
+    type("end", QString("%1, %2, %3").arg(start.x(), 0, 'g', 17).arg(start.y(), 0, 'g', 17).arg(start.z(), 0, 'g', 17));
     EXPECT_THAT(panel->errorLabel()->text().toStdString(), HasSubstr("end: must differ from start"));
     type("name", "fat");
     EXPECT_THAT(panel->errorLabel()->text().toStdString(),
                 HasSubstr(QString("scenery[%1].name").arg(wall).toStdString()));
-    EXPECT_EQ(scenery()[size_t(wall)].name, "pelvic_wall");
-    panel->facing()->setCurrentIndex(1);
-    EXPECT_FALSE(scenery()[size_t(wall)].inward);
+    EXPECT_EQ(scenery()[size_t(wall)].name, "wall");
+    panel->facing()->setCurrentIndex(panel->facing()->currentIndex() == 0 ? 1 : 0);
+    EXPECT_NE(scenery()[size_t(wall)].inward, inward0);
     EXPECT_EQ(undo()->count(), steps + 2);
     test::saveShot("surroundings_dock");
     undo()->undo();
     undo()->undo();
-    EXPECT_TRUE(scenery()[size_t(wall)].inward);
-    EXPECT_DOUBLE_EQ(scenery()[size_t(wall)].radius, 0.075);
+    EXPECT_EQ(scenery()[size_t(wall)].inward, inward0);
+    EXPECT_DOUBLE_EQ(scenery()[size_t(wall)].radius, radius0);
 }
 
 TEST_F(SurroundingsFixture, AddAndRemoveAreOneStepEachAndTheTreeListsThem) {

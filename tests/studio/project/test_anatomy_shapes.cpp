@@ -1,7 +1,8 @@
 // Anatomy made by code (studio/project/anatomy_shapes.hpp): the bend keeps lengths along the
 // sheet's top and never inverts a tet, refuses a node below its axis naming the field; the
-// scenery generators give the surfaces asked for; bad scenery names the field and rule; the rectum
-// sample exports its bent mesorectum and its scenery, and the package holds them.
+// scenery generators give the surfaces asked for; bad scenery names the field and rule; a bent sheet
+// of fat (the rectum sample as it was before its anatomy was imported, tests/studio/project/data)
+// exports with its primitive scenery; the shipped rectum exports its imported anatomy.
 #include "case/case_package.hpp"
 #include "project/anatomy_shapes.hpp"
 #include "project/project.hpp"
@@ -22,6 +23,30 @@
 using namespace viscera;
 using sim::Vec3;
 using ::testing::HasSubstr;
+
+namespace {
+
+/// projects/rectum: the textures and tracks the bent sheet's text names.
+std::filesystem::path rectumDir() {
+    return std::filesystem::path(VISCERA_SOURCE_DIR) / "projects" / "rectum";
+}
+
+/// The rectum sample's project as it was with a bent box of fat and primitive scenery.
+std::string bentSheetText() {
+    std::string text;
+    const std::filesystem::path file =
+        std::filesystem::path(VISCERA_SOURCE_DIR) / "tests/studio/project/data/bent_sheet_project.json";
+    if (std::FILE* f = std::fopen(file.c_str(), "rb")) {
+        char buf[4096];
+        size_t n;
+        while ((n = std::fread(buf, 1, sizeof buf, f)) > 0)
+            text.append(buf, n);
+        std::fclose(f);
+    }
+    return text;
+}
+
+} // namespace
 
 TEST(AnatomyShapes, TheBendKeepsLengthsAlongTheTopAndInvertsNoTet) {
     const studio::BendSpec bend{0.032, 0.01};
@@ -116,17 +141,9 @@ TEST(AnatomyShapes, SceneryGeneratorsGiveTheSurfacesAskedFor) {
 }
 
 TEST(AnatomyShapes, BadSceneryAndBendNameTheFieldAndRule) {
-    const std::filesystem::path src = std::filesystem::path(VISCERA_SOURCE_DIR) / "projects" / "rectum";
-    std::string text;
-    {
-        std::FILE* f = std::fopen((src / "project.json").c_str(), "rb");
-        ASSERT_NE(f, nullptr);
-        char buf[4096];
-        size_t n;
-        while ((n = std::fread(buf, 1, sizeof buf, f)) > 0)
-            text.append(buf, n);
-        std::fclose(f);
-    }
+    const std::filesystem::path src = rectumDir();
+    const std::string text = bentSheetText();
+    ASSERT_FALSE(text.empty());
     auto error = [&](const std::string& from, const std::string& to) {
         std::string t = text;
         const size_t at = t.find(from);
@@ -195,10 +212,10 @@ TEST(AnatomyShapes, BadSceneryAndBendNameTheFieldAndRule) {
     EXPECT_FALSE(std::filesystem::exists(out)) << "nothing written";
 }
 
-TEST(AnatomyShapes, TheRectumSampleExportsItsBentMesorectumAndItsScenery) {
+TEST(AnatomyShapes, ABentSheetOfFatExportsAsAShellWithItsScenery) {
     const test::Scratch scratch("viscera-anatomy");
     const std::filesystem::path out = scratch.dir / "rectum.vcase";
-    const studio::Project p = studio::loadProject(std::filesystem::path(VISCERA_SOURCE_DIR) / "projects" / "rectum");
+    const studio::Project p = studio::loadProjectText(bentSheetText(), rectumDir(), "bent_sheet_project.json");
     ASSERT_TRUE(p.bend.has_value());
     ASSERT_EQ(p.scenery.size(), 3u);
     // Round trip through the project's text.
@@ -227,4 +244,55 @@ TEST(AnatomyShapes, TheRectumSampleExportsItsBentMesorectumAndItsScenery) {
     EXPECT_NEAR(maxR, 0.032, 1e-9);
     for (int32_t v : scene.bodies[0].fixedNodes)
         EXPECT_NEAR(std::hypot(fat->positions()[v].y() - 0.01, fat->positions()[v].z() + 0.032), 0.024, 1e-6);
+}
+
+// The shipped rectum [issue 57 item 5]: its fat is the mesorectum of `viscera-studio sample rectum`
+// through Make simulation-ready and Tetrahedralize, its rectum, pelvic wall and peritoneum are that
+// anatomy imported as surroundings, its fascia the fat's top subdivided twice; nothing is bent.
+TEST(AnatomyShapes, TheRectumSampleExportsItsImportedAnatomy) {
+    const test::Scratch scratch("viscera-anatomy-rectum");
+    const std::filesystem::path out = scratch.dir / "rectum.vcase";
+    const studio::Project p = studio::loadProject(rectumDir());
+    EXPECT_FALSE(p.bend.has_value());
+    ASSERT_EQ(p.bodies[0].scene.name, "fat");
+    ASSERT_EQ(p.bodies[0].mesh.kind, studio::MeshSource::Kind::Remesh);
+    ASSERT_EQ(p.bodies[0].mesh.remesh.parts.size(), 1u);
+    EXPECT_EQ(p.bodies[0].mesh.remesh.parts[0].file.filename(), "mesorectum.obj");
+    ASSERT_EQ(p.scenery.size(), 3u);
+    const char* scenery[] = {"rectum", "pelvic_wall", "peritoneum"};
+    for (size_t k = 0; k < 3; ++k) {
+        EXPECT_EQ(p.scenery[k].name, scenery[k]);
+        EXPECT_EQ(p.scenery[k].file.filename(), std::string(scenery[k]) + ".obj");
+    }
+    ASSERT_EQ(p.surfaces.size(), 1u);
+    EXPECT_EQ(p.surfaces[0].subdivide, 2);
+    studio::exportCase(p, out);
+    auto pkg = vcase::CasePackage::open(out);
+    const sim::SceneDesc scene = sim::parseScene(pkg->read("scene.json"), "scene.json");
+    ASSERT_EQ(scene.scenery.size(), 3u);
+    for (const sim::SceneryDesc& s : scene.scenery)
+        EXPECT_GT(sim::parseVtri(pkg->read(s.meshPath), s.meshPath).triangleCount(), 500u) << s.name;
+    // The fat is the shell of the anatomy: inner face 22.5 mm from the rectum's axis, outer 32 mm
+    // (lobules ±0.9 mm), to within the remesh's voxel.
+    const auto fat = sim::parseVtet(pkg->read(scene.bodies[0].meshPath), "fat");
+    auto radius = [](const Vec3& q) { return std::hypot(q.y() - 0.01, q.z() + 0.032); };
+    double minR = 1, maxR = 0;
+    for (const Vec3& q : fat->positions()) {
+        minR = std::min(minR, radius(q));
+        maxR = std::max(maxR, radius(q));
+    }
+    EXPECT_NEAR(minR, 0.0225, 0.001);
+    EXPECT_NEAR(maxR, 0.032, 0.0015);
+    ASSERT_GT(scene.bodies[0].fixedNodes.size(), 100u);
+    // the held boxes follow the inner face in 15° steps: a few nodes past the rectal wall (24.6 mm)
+    // at their corners, none in the outer half of the shell
+    size_t pastWall = 0;
+    for (int32_t v : scene.bodies[0].fixedNodes) {
+        EXPECT_LT(radius(fat->positions()[v]), 0.0275) << "node " << v;
+        pastWall += radius(fat->positions()[v]) > 0.0246;
+    }
+    EXPECT_LT(pastWall, scene.bodies[0].fixedNodes.size() / 20);
+    EXPECT_GT(fat->tetCount(), 3000u);
+    const sim::TriMesh fascia = sim::parseVtri(pkg->read(scene.surfaces[0].meshPath), "fascia");
+    EXPECT_GT(fascia.vertexCount(), 2000u) << "subdivided: finer than the fat's boundary";
 }

@@ -224,7 +224,7 @@ double paintedMass(const sim::TetMesh& mesh, const std::vector<double>& w, doubl
 
 TEST_F(ProjectTest, RemeshingABodyKeepsItsPaintedWeightMass) {
     // Strokes are stored by position (mesh frame): a body meshed again with other parameters is
-    // painted by the same strokes. The rectum's fat (box) and vessel (hollow tube), each meshed
+    // painted by the same strokes. The rectum's fat (remeshed anatomy) and vessel (hollow tube), each meshed
     // two ways: at least 99 % of the painted mass is kept (and it does not grow by more than the
     // discretization can explain, 5 %: the poly6 field is sampled at other nodes).
     studio::Project p = studio::loadProject(std::filesystem::path(VISCERA_SOURCE_DIR) / "projects/rectum");
@@ -233,7 +233,7 @@ TEST_F(ProjectTest, RemeshingABodyKeepsItsPaintedWeightMass) {
     studio::BodyProject& fat = p.bodies[0];
     studio::BodyProject& vessel = p.bodies[1];
     ASSERT_TRUE(fat.paint.has_value());
-    fat.paint->strokes.push_back({sim::Vec3(0.02, -0.01, -0.004), 0.025, 3.0});
+    fat.paint->strokes.push_back({sim::Vec3(0.02, 0.01, -0.005), 0.025, 3.0}); // in the fat's top
     sim::BrushStroke mix{sim::Vec3(-0.03, 0.02, -0.004), 0.02, 0.7};
     mix.mode = sim::BrushMode::Mix;
     mix.target = 0.3;
@@ -244,7 +244,8 @@ TEST_F(ProjectTest, RemeshingABodyKeepsItsPaintedWeightMass) {
     vessel.paint->strokes.push_back({0.8 * a + 0.2 * b, 0.01, -0.5});
 
     studio::Project q = p;
-    q.bodies[0].mesh.box.cells = {48, 40, 3};
+    q.bodies[0].mesh.meshing.cellSize = 0.004; // the imported mesorectum, tetrahedralized finer
+    q.bodies[0].mesh.meshing.facetSize = 0.004;
     q.bodies[1].mesh.hollow.rings = 31;
     q.bodies[1].mesh.hollow.slices = 16;
     q.bodies[1].mesh.hollow.layers = 2;
@@ -317,14 +318,32 @@ TEST_F(ProjectTest, RemeshingKeepsAFasciasPaintedWeightMass) {
     }
 }
 
-// "subdivide" on a layer [issue 57 item 5]: each round splits every triangle of the cut boundary in
-// four at its edge midpoints, so the fascia is finer than the tets under it while it still lies on
-// their boundary (the solver attaches every vertex); the field round-trips and 0..3 is the rule.
+// "subdivide" on a layer [issue 57 item 5]: each round splits every triangle of the body's boundary
+// in four at its edge midpoints, so the fascia is finer than the tets under it while it still lies
+// on their boundary (the solver attaches every vertex); the region is cut after subdividing, so its
+// border steps by the finer triangles; the field round-trips and 0..3 is the rule.
 TEST_F(ProjectTest, ASubdividedFasciaIsFinerAndStillLiesOnItsBody) {
     studio::Project p = studio::loadProject(std::filesystem::path(VISCERA_SOURCE_DIR) / "projects/liver");
     p.dir = m_dir;
     ASSERT_FALSE(p.surfaces.empty());
     EXPECT_EQ(p.surfaces[0].subdivide, 0);
+    ASSERT_TRUE(p.surfaces[0].region.has_value());
+    {
+        // with its region (z >= 0): every finer triangle's centroid in it, about the same area
+        studio::Project r = p;
+        r.surfaces[0].subdivide = 2;
+        const studio::BuiltScene C = studio::buildScene(p), D = studio::buildScene(r);
+        const sim::TriMesh &c = C.surfaces[0], &d = D.surfaces[0];
+        double area[2] = {0, 0};
+        for (int k = 0; k < 2; ++k)
+            for (const sim::Tri& t : (k ? d : c).triangles()) {
+                const std::vector<sim::Vec3>& x = (k ? d : c).positions();
+                area[k] += 0.5 * (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).norm();
+                if (k) EXPECT_GE((x[t[0]] + x[t[1]] + x[t[2]]).z() / 3, 0.0);
+            }
+        EXPECT_NEAR(area[1], area[0], 0.1 * area[0]);
+    }
+    p.surfaces[0].region.reset(); // the whole boundary: exactly four triangles for one, twice
     studio::Project q = p;
     q.surfaces[0].subdivide = 2;
     const studio::BuiltScene A = studio::buildScene(p), B = studio::buildScene(q);
