@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 PROJECT=${1:-tissue-slab}
 FRAMES=${2:-300}
 BUILD_DIR=${VISCERA_BUILD_DIR:-build}
-bash scripts/configure.sh viscera-studio viscera-player viscera_sample_key
+bash scripts/configure.sh viscera-studio viscera-player viscera_sample_key viscera_rectum_anatomy
 mkdir -p out
 # Signed with the build's sample publisher key (a test key); the player trusts its public half.
 key="$BUILD_DIR/keys/viscera-samples.pem"
