@@ -28,6 +28,8 @@ const char* const kPlacementFields[] = {"unit", "scale", "rotation_deg"};
 const char* const kHoldMargin = "hold_margin_mm";
 /// A meshed body's CGAL sizes, typed in millimetres (project.json meshing.facet_size, cell_size).
 const char* const kMeshingFields[] = {"facet_size_mm", "cell_size_mm"};
+/// A tissue layer's fields (project.json surfaces[i]).
+const char* const kSurfaceFields[] = {"stretch_stiffness", "areal_density", "subdivide"};
 
 /// A body whose tets CGAL makes from its remeshed anatomy: its sizes are typed.
 bool meshedFromSurface(const Project& p, int body) {
@@ -41,8 +43,15 @@ bool madeFromAnatomy(const Project& p, int body) {
 }
 
 /// The text field `name` shows for the project (empty: not a field of this selection).
-QString valueText(const Project& p, int body, const QString& name, const HoldTool* hold) {
+QString valueText(const Project& p, int body, int surface, const QString& name, const HoldTool* hold) {
     if (name == kHoldMargin && hold) return numberText(hold->margin() * 1000);
+    if (surface >= 0 && surface < static_cast<int>(p.surfaces.size())) {
+        const SurfaceProject& s = p.surfaces[static_cast<size_t>(surface)];
+        if (name == "stretch_stiffness") return numberText(s.scene.stretchStiffness);
+        if (name == "areal_density") return numberText(s.scene.arealDensity);
+        if (name == "subdivide") return QString::number(s.subdivide);
+        return {};
+    }
     if (meshedFromSurface(p, body)) {
         const auto& m = p.bodies[static_cast<size_t>(body)].mesh.meshing;
         if (name == "facet_size_mm") return numberText(m.facetSize * 1000);
@@ -193,9 +202,9 @@ void PropertiesPanel::rebuild() {
     } else if (surface >= 0 && surface < static_cast<int>(p.surfaces.size())) {
         const auto& s = p.surfaces[surface].scene;
         m_form->addRow(tr("Surface"), new QLabel(QString::fromStdString(s.name), this));
-        m_form->addRow(tr("Stretch stiffness"), new QLabel(numberText(s.stretchStiffness), this));
-        m_form->addRow(tr("Areal density"), new QLabel(numberText(s.arealDensity), this));
-        m_form->addRow(tr("Subdivisions"), new QLabel(QString::number(p.surfaces[surface].subdivide), this));
+        addField("stretch_stiffness", tr("Stretch stiffness"));
+        addField("areal_density", tr("Areal density [kg/m²]"));
+        addField("subdivide", tr("Subdivisions (each halves its edges)"));
     }
     fillValues(true);
 }
@@ -204,7 +213,7 @@ void PropertiesPanel::fillValues(bool force) {
     if (!m_doc->hasProject()) return;
     const Project& p = m_doc->project();
     for (QLineEdit* e : findChildren<QLineEdit*>()) {
-        const QString v = valueText(p, m_sel->body(), e->objectName(), m_hold);
+        const QString v = valueText(p, m_sel->body(), m_sel->surface(), e->objectName(), m_hold);
         if (v.isEmpty() || e->text() == v || (!force && e->isModified())) continue;
         e->setText(v);
         e->setModified(false);
@@ -229,7 +238,11 @@ QString PropertiesPanel::setProperty(const QString& field, const QString& text) 
         std::find(std::begin(kPlacementFields), std::end(kPlacementFields), field) != std::end(kPlacementFields);
     const bool meshing =
         std::find(std::begin(kMeshingFields), std::end(kMeshingFields), field) != std::end(kMeshingFields);
-    if (meshing) {
+    const bool surface =
+        std::find(std::begin(kSurfaceFields), std::end(kSurfaceFields), field) != std::end(kSurfaceFields);
+    if (surface) {
+        why = setSurfaceValue(field, text);
+    } else if (meshing) {
         const std::optional<double> v = parseNumberText(text, field, why);
         if (v) why = setMeshingValue(field, *v / 1000);
     } else if (field == kHoldMargin && m_hold) {
@@ -316,6 +329,26 @@ QString PropertiesPanel::setMeshingValue(const QString& field, double metres) {
         [&](Project& p) {
             bake::MeshingParams& m = p.bodies[static_cast<size_t>(b)].mesh.meshing;
             (field == "cell_size_mm" ? m.cellSize : m.facetSize) = metres;
+        },
+        0, Change{Change::Structure});
+}
+
+QString PropertiesPanel::setSurfaceValue(const QString& field, const QString& text) {
+    const int s = m_sel->surface();
+    if (!m_doc->hasProject() || s < 0 || s >= static_cast<int>(m_doc->project().surfaces.size()))
+        return tr("no tissue layer selected");
+    QString why;
+    const std::optional<double> v = parseNumberText(text, field, why);
+    if (!v) return why;
+    if (field == "subdivide" && *v != std::floor(*v)) // its range is the reader's rule, checked by edit()
+        return tr("surfaces[%1].subdivide: '%2' must be a whole number").arg(s).arg(text);
+    return m_doc->edit(
+        tr("Set %1").arg(field),
+        [&](Project& p) {
+            SurfaceProject& layer = p.surfaces[static_cast<size_t>(s)];
+            if (field == "stretch_stiffness") layer.scene.stretchStiffness = *v;
+            if (field == "areal_density") layer.scene.arealDensity = *v;
+            if (field == "subdivide") layer.subdivide = static_cast<int>(std::clamp(*v, -1e9, 1e9));
         },
         0, Change{Change::Structure});
 }

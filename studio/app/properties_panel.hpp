@@ -51,6 +51,9 @@ private:
     QString setSolverValue(const QString& field, double v, const QString& text);
     /// A meshed body's facet or cell size (m), one undo step under the reader's rule.
     QString setMeshingValue(const QString& field, double metres);
+    /// A tissue layer's stretch_stiffness, areal_density or subdivide, as one undo step checked by
+    /// the project reader's rule for surfaces[i].
+    QString setSurfaceValue(const QString& field, const QString& text);
     /// A body made from anatomy: its parts' unit, scale or rotation (Document::editPlacement).
     QString setPlacementValue(const QString& field, const QString& text);
     void addPlacementFields(const bake::ImportPlacement& placement);

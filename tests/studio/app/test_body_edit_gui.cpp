@@ -12,7 +12,6 @@
 #include "window_fixture.hpp"
 
 #include <QAction>
-#include <QFormLayout>
 #include <QInputDialog>
 #include <QLabel>
 #include <QLineEdit>
@@ -236,9 +235,10 @@ TEST_F(BodyEditFixture, TheBodyItemsContextMenuRenamesAndDeletes) {
     EXPECT_EQ(project().bodies[1].scene.name, "vessel");
 }
 
-// A layer picked in the tree shows its subdivision rounds in Properties beside its stiffness and
-// density (the fascia's "subdivide" of project.json; 0 unless set).
-TEST_F(BodyEditFixture, APickedSurfaceShowsItsSubdivisionsInProperties) {
+// A tissue layer picked in the tree: its stretch stiffness, areal density and subdivision rounds are
+// typed in Properties, each one undo step checked by the project reader's rule for surfaces[i]; a
+// refused value names the field and the rule and leaves the model unchanged; undo restores it.
+TEST_F(BodyEditFixture, ALayersFieldsAreTypedUndoableEditsOfTheModel) {
     open("liver");
     QTreeWidgetItem* surface = nullptr;
     for (int g = 0; g < tree->topLevelItemCount() && !surface; ++g)
@@ -248,22 +248,50 @@ TEST_F(BodyEditFixture, APickedSurfaceShowsItsSubdivisionsInProperties) {
     tree->scrollToItem(surface);
     test::click(tree->viewport(), tree->visualItemRect(surface).center());
     ASSERT_EQ(tree->currentItem(), surface);
-    auto rowText = [&](const QString& label) {
-        auto* form = w->propertiesPanel()->findChild<QFormLayout*>();
-        for (int r = 0; form && r < form->rowCount(); ++r) {
-            auto* l = qobject_cast<QLabel*>(
-                form->itemAt(r, QFormLayout::LabelRole) ? form->itemAt(r, QFormLayout::LabelRole)->widget() : nullptr);
-            auto* f = form->itemAt(r, QFormLayout::FieldRole)
-                          ? qobject_cast<QLabel*>(form->itemAt(r, QFormLayout::FieldRole)->widget())
-                          : nullptr;
-            if (l && f && l->text() == label) return f->text();
-        }
-        return QString("(no row)");
+    QLineEdit* field = nullptr;
+    ASSERT_TRUE(test::waitFor(
+        [&] { return (field = w->propertiesPanel()->findChild<QLineEdit*>("subdivide")) != nullptr; }, 2000));
+    EXPECT_EQ(field->text(), "0");
+    auto* error = w->propertiesPanel()->findChild<QLabel*>("propertyError");
+    ASSERT_NE(error, nullptr);
+    auto type = [&](const char* name, const QString& text) {
+        QLineEdit* e = w->propertiesPanel()->findChild<QLineEdit*>(name);
+        ASSERT_NE(e, nullptr) << name;
+        e->setFocus();
+        QTest::keyClick(e, Qt::Key_A, Qt::ControlModifier);
+        QTest::keyClicks(e, text);
+        QTest::keyClick(e, Qt::Key_Return);
+        QCoreApplication::processEvents();
     };
-    ASSERT_TRUE(test::waitFor([&] { return rowText("Subdivisions") != "(no row)"; }, 2000));
-    EXPECT_EQ(rowText("Subdivisions"), QString::number(project().surfaces[0].subdivide));
-    EXPECT_EQ(rowText("Surface").toStdString(), project().surfaces[0].scene.name);
-    test::saveShot("surface_properties");
+    const std::string before = text();
+    const int steps = undo()->count();
+    type("subdivide", "2");
+    EXPECT_EQ(project().surfaces[0].subdivide, 2);
+    EXPECT_EQ(undo()->count(), steps + 1);
+    type("subdivide", "4");
+    EXPECT_NE(error->text().toStdString().find("surfaces[0].subdivide: must be an integer in [0, 3]"),
+              std::string::npos)
+        << error->text().toStdString();
+    type("subdivide", "1.5");
+    EXPECT_NE(error->text().toStdString().find("must be a whole number"), std::string::npos);
+    EXPECT_EQ(project().surfaces[0].subdivide, 2) << "refused: unchanged";
+    type("stretch_stiffness", "-3");
+    EXPECT_NE(error->text().toStdString().find("surfaces[0].stretch_stiffness"), std::string::npos)
+        << error->text().toStdString();
+    type("stretch_stiffness", "80");
+    EXPECT_DOUBLE_EQ(project().surfaces[0].scene.stretchStiffness, 80);
+    EXPECT_EQ(undo()->count(), steps + 2);
+    test::saveShot("layer_properties");
+    undo()->undo();
+    undo()->undo();
+    EXPECT_EQ(text(), before) << "undo restores the model exactly";
+    EXPECT_TRUE(test::waitFor(
+        [&] {
+            auto* e = w->propertiesPanel()->findChild<QLineEdit*>("subdivide");
+            return e && e->text() == "0";
+        },
+        2000))
+        << "the field shows the model's value again";
 }
 
 } // namespace
