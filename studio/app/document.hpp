@@ -156,6 +156,14 @@ public:
     /// rules of load refuse the result; the model is then unchanged. Returns the empty string
     /// when done.
     QString removeBody(int body);
+    /// Adds a tissue layer (a fascia, project.json "surfaces") over the whole boundary of body
+    /// `body`, named "fascia" (else "fascia_2", ...) with the reader's default stiffness and
+    /// density, one undo step checked by the rules of load. Returns the empty string when done.
+    QString addLayer(int body);
+    /// Removes tissue layer `surface`, one undo step. Refused while the interaction's tissues
+    /// name it ("<folder>/project.json: surfaces[0].name: 'fascia' is named by
+    /// interaction.tissues[0].layer (change or delete that first)"); the model is then unchanged.
+    QString removeLayer(int surface);
     /// A fresh merge key for one drag or one continuous gesture.
     int newMergeKey() { return ++m_lastMergeKey; }
 

@@ -1,4 +1,5 @@
-// Renaming and deleting a body as edits of the one model [issue 57 item 7]: general edits (the
+// Renaming and deleting a body, adding and removing a tissue layer over one, as edits of the one
+// model [issue 57 items 4 and 7]: general edits (the
 // command holds both models, so undo restores the model exactly) checked by the project reader's
 // name rule (sim::readName) and then by the rules of load (check()).
 #include "app/document.hpp"
@@ -102,6 +103,40 @@ QString Document::removeBody(int body) {
     return edit(
         tr("Delete body %1").arg(QString::fromStdString(name)),
         [body](Project& q) { q.bodies.erase(q.bodies.begin() + body); }, 0, bodyChange());
+}
+
+QString Document::addLayer(int body) {
+    if (!m_project || body < 0 || body >= static_cast<int>(m_project->bodies.size())) return tr("no body selected");
+    const Project& p = *m_project;
+    const std::set<std::string> names = otherNames(p, -1);
+    std::string name = "fascia";
+    for (int k = 2; names.count(name); ++k)
+        name = "fascia_" + std::to_string(k);
+    SurfaceProject layer;
+    layer.scene.name = name;
+    layer.scene.attachTo = p.bodies[static_cast<size_t>(body)].scene.name;
+    return edit(
+        tr("Add tissue layer %1 over %2")
+            .arg(QString::fromStdString(name), QString::fromStdString(layer.scene.attachTo)),
+        [&](Project& q) { q.surfaces.push_back(layer); }, 0, bodyChange());
+}
+
+QString Document::removeLayer(int surface) {
+    if (!m_project || surface < 0 || surface >= static_cast<int>(m_project->surfaces.size()))
+        return tr("no tissue layer selected");
+    const Project& p = *m_project;
+    const std::string name = p.surfaces[static_cast<size_t>(surface)].scene.name;
+    std::string refs;
+    if (const auto& in = p.scene.interaction)
+        for (size_t t = 0; t < in->tissues.size(); ++t)
+            if (in->tissues[t].layer == name)
+                refs += (refs.empty() ? "" : ", ") + ("interaction.tissues[" + std::to_string(t) + "].layer");
+    if (!refs.empty())
+        return QString::fromStdString((p.dir / "project.json").string() + ": surfaces[" + std::to_string(surface) +
+                                      "].name: '" + name + "' is named by " + refs + " (change or delete that first)");
+    return edit(
+        tr("Delete tissue layer %1").arg(QString::fromStdString(name)),
+        [surface](Project& q) { q.surfaces.erase(q.surfaces.begin() + surface); }, 0, bodyChange());
 }
 
 } // namespace viscera::studio

@@ -57,15 +57,27 @@ ProjectTreePanel::ProjectTreePanel(Document* doc, Selection* selection, QWidget*
     }
     connect(m_rename, &QAction::triggered, this, &ProjectTreePanel::startRename);
     connect(m_delete, &QAction::triggered, this, &ProjectTreePanel::deleteCurrentBody);
+    m_addLayer = new QAction(tr("Add tissue layer"), this);
+    m_addLayer->setObjectName("addLayerAction");
+    m_deleteLayer = new QAction(tr("Delete tissue layer"), this);
+    m_deleteLayer->setObjectName("deleteLayerAction");
+    connect(m_addLayer, &QAction::triggered, this, &ProjectTreePanel::addLayerToCurrentBody);
+    connect(m_deleteLayer, &QAction::triggered, this, &ProjectTreePanel::deleteCurrentLayer);
     connect(this, &QTreeWidget::currentItemChanged, this, &ProjectTreePanel::updateActions);
     setContextMenuPolicy(Qt::CustomContextMenu);
     connect(this, &QWidget::customContextMenuRequested, this, [this](const QPoint& at) {
         QTreeWidgetItem* item = itemAt(at);
-        if (!item || item->data(0, kKindRole).toInt() != kindValue(Selection::Kind::Body)) return;
+        const int kind = item ? item->data(0, kKindRole).toInt() : -1;
+        if (kind != kindValue(Selection::Kind::Body) && kind != kindValue(Selection::Kind::Surface)) return;
         setCurrentItem(item);
         QMenu menu(this);
-        menu.addAction(m_rename);
-        menu.addAction(m_delete);
+        if (kind == kindValue(Selection::Kind::Body)) {
+            menu.addAction(m_rename);
+            menu.addAction(m_delete);
+            menu.addAction(m_addLayer);
+        } else {
+            menu.addAction(m_deleteLayer);
+        }
         menu.exec(viewport()->mapToGlobal(at));
     });
     updateActions();
@@ -77,10 +89,18 @@ int ProjectTreePanel::currentBody() const {
     return item->data(0, kIndexRole).toInt();
 }
 
+int ProjectTreePanel::currentLayer() const {
+    const QTreeWidgetItem* item = currentItem();
+    if (!item || item->data(0, kKindRole).toInt() != kindValue(Selection::Kind::Surface)) return -1;
+    return item->data(0, kIndexRole).toInt();
+}
+
 void ProjectTreePanel::updateActions() {
     const bool body = currentBody() >= 0;
     m_rename->setEnabled(body);
     m_delete->setEnabled(body);
+    m_addLayer->setEnabled(body);
+    m_deleteLayer->setEnabled(currentLayer() >= 0);
 }
 
 void ProjectTreePanel::keyPressEvent(QKeyEvent* event) {
@@ -91,6 +111,10 @@ void ProjectTreePanel::keyPressEvent(QKeyEvent* event) {
     }
     if (currentBody() >= 0 && event->key() == Qt::Key_Delete && event->modifiers() == Qt::NoModifier) {
         deleteCurrentBody();
+        return event->accept();
+    }
+    if (currentLayer() >= 0 && event->key() == Qt::Key_Delete && event->modifiers() == Qt::NoModifier) {
+        deleteCurrentLayer();
         return event->accept();
     }
     QTreeWidget::keyPressEvent(event);
@@ -123,6 +147,22 @@ void ProjectTreePanel::deleteCurrentBody() {
     if (body < 0) return;
     const QString why = m_doc->removeBody(body);
     if (why.isEmpty() && m_sel->body() >= body) m_sel->clear(); // it named the body gone or one that moved
+    report(why);
+}
+
+void ProjectTreePanel::addLayerToCurrentBody() {
+    const int body = currentBody();
+    if (body < 0 || !m_doc->hasProject()) return;
+    const QString why = m_doc->addLayer(body);
+    if (why.isEmpty()) m_sel->set(Selection::Kind::Surface, static_cast<int>(m_doc->project().surfaces.size()) - 1);
+    report(why);
+}
+
+void ProjectTreePanel::deleteCurrentLayer() {
+    const int layer = currentLayer();
+    if (layer < 0) return;
+    const QString why = m_doc->removeLayer(layer);
+    if (why.isEmpty() && m_sel->surface() >= layer) m_sel->clear();
     report(why);
 }
 

@@ -29,7 +29,27 @@ const char* const kHoldMargin = "hold_margin_mm";
 /// A meshed body's CGAL sizes, typed in millimetres (project.json meshing.facet_size, cell_size).
 const char* const kMeshingFields[] = {"facet_size_mm", "cell_size_mm"};
 /// A tissue layer's fields (project.json surfaces[i]).
-const char* const kSurfaceFields[] = {"stretch_stiffness", "areal_density", "subdivide"};
+const char* const kSurfaceFields[] = {"stretch_stiffness", "areal_density", "subdivide", "region_min", "region_max"};
+
+/// Three numbers "x y z" (spaces or commas) into `out`; else the reason in `why`, `count` when
+/// there are not three.
+bool parseThreeNumbers(const QString& text, const QString& field, const QString& count, sim::Vec3& out, QString& why) {
+    const QStringList parts = text.split(QRegularExpression("[\\s,]+"), Qt::SkipEmptyParts);
+    if (parts.size() != 3) {
+        why = count;
+        return false;
+    }
+    for (int k = 0; k < 3; ++k) {
+        const std::optional<double> v = parseNumberText(parts[k], field, why);
+        if (!v) return false;
+        out[k] = *v;
+    }
+    return true;
+}
+
+QString vec3Text(const sim::Vec3& v) {
+    return QStringLiteral("%1 %2 %3").arg(numberText(v.x()), numberText(v.y()), numberText(v.z()));
+}
 
 /// A body whose tets CGAL makes from its remeshed anatomy: its sizes are typed.
 bool meshedFromSurface(const Project& p, int body) {
@@ -50,6 +70,8 @@ QString valueText(const Project& p, int body, int surface, const QString& name, 
         if (name == "stretch_stiffness") return numberText(s.scene.stretchStiffness);
         if (name == "areal_density") return numberText(s.scene.arealDensity);
         if (name == "subdivide") return QString::number(s.subdivide);
+        if (name == "region_min" && s.region) return vec3Text((*s.region)[0]);
+        if (name == "region_max" && s.region) return vec3Text((*s.region)[1]);
         return {};
     }
     if (meshedFromSurface(p, body)) {
@@ -205,6 +227,8 @@ void PropertiesPanel::rebuild() {
         addField("stretch_stiffness", tr("Stretch stiffness"));
         addField("areal_density", tr("Areal density [kg/m²]"));
         addField("subdivide", tr("Subdivisions (each halves its edges)"));
+        addField("region_min", tr("Region min x y z [m] (empty: all)"));
+        addField("region_max", tr("Region max x y z [m] (empty: all)"));
     }
     fillValues(true);
 }
@@ -310,13 +334,11 @@ QString PropertiesPanel::setPlacementValue(const QString& field, const QString& 
         if (!v) return why;
         q.scale = *v;
     } else {
-        const QStringList parts = text.split(QRegularExpression("[\\s,]+"), Qt::SkipEmptyParts);
-        if (parts.size() != 3) return tr("rotation_deg: '%1' must be three angles (x y z, degrees)").arg(text);
-        for (int k = 0; k < 3; ++k) {
-            const std::optional<double> v = parseNumberText(parts[k], field, why);
-            if (!v) return why;
-            q.rotationDeg[k] = *v;
-        }
+        sim::Vec3 angles;
+        if (!parseThreeNumbers(text, field, tr("rotation_deg: '%1' must be three angles (x y z, degrees)").arg(text),
+                               angles, why))
+            return why;
+        q.rotationDeg = angles;
     }
     return m_doc->editPlacement(tr("Set %1").arg(field), b, q);
 }
@@ -338,6 +360,7 @@ QString PropertiesPanel::setSurfaceValue(const QString& field, const QString& te
     if (!m_doc->hasProject() || s < 0 || s >= static_cast<int>(m_doc->project().surfaces.size()))
         return tr("no tissue layer selected");
     QString why;
+    if (field == "region_min" || field == "region_max") return setLayerRegion(s, field, text);
     const std::optional<double> v = parseNumberText(text, field, why);
     if (!v) return why;
     if (field == "subdivide" && *v != std::floor(*v)) // its range is the reader's rule, checked by edit()
@@ -351,6 +374,25 @@ QString PropertiesPanel::setSurfaceValue(const QString& field, const QString& te
             if (field == "subdivide") layer.subdivide = static_cast<int>(std::clamp(*v, -1e9, 1e9));
         },
         0, Change{Change::Structure});
+}
+
+QString PropertiesPanel::setLayerRegion(int s, const QString& field, const QString& text) {
+    std::optional<std::array<sim::Vec3, 2>> region = m_doc->project().surfaces[static_cast<size_t>(s)].region;
+    if (!text.trimmed().isEmpty()) {
+        sim::Vec3 corner;
+        QString why;
+        if (!parseThreeNumbers(text, field,
+                               tr("surfaces[%1].region: '%2' must be three numbers (x y z, m)").arg(s).arg(text),
+                               corner, why))
+            return why;
+        if (!region) region = std::array<sim::Vec3, 2>{sim::Vec3::Constant(-1), sim::Vec3::Constant(1)};
+        (*region)[field == "region_min" ? 0 : 1] = corner;
+    } else {
+        region.reset(); // the whole boundary
+    }
+    return m_doc->edit(
+        tr("Set %1").arg(field), [&](Project& p) { p.surfaces[static_cast<size_t>(s)].region = region; }, 0,
+        Change{Change::Structure});
 }
 
 QString PropertiesPanel::setSolverValue(const QString& field, double v, const QString& text) {

@@ -54,6 +54,8 @@ private:
     /// A tissue layer's stretch_stiffness, areal_density or subdivide, as one undo step checked by
     /// the project reader's rule for surfaces[i].
     QString setSurfaceValue(const QString& field, const QString& text);
+    /// Layer `s`'s region corner typed as "x y z" (m); empty text: the whole boundary.
+    QString setLayerRegion(int s, const QString& field, const QString& text);
     /// A body made from anatomy: its parts' unit, scale or rotation (Document::editPlacement).
     QString setPlacementValue(const QString& field, const QString& text);
     void addPlacementFields(const bake::ImportPlacement& placement);
