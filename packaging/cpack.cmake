@@ -73,7 +73,8 @@ add_custom_target(viscera_samples DEPENDS ${VISCERA_SAMPLE_CASES})
 if(TARGET viscera_sample_key) # the test key (studio/cli); packaging/samples has a publisher key
   add_dependencies(viscera_samples viscera_sample_key)
 endif()
-add_dependencies(viscera_samples viscera_rectum_anatomy) # projects/rectum imports made anatomy
+include(${VISCERA_ROOT}/cmake/viscera_rectum_anatomy.cmake) # projects/rectum imports made anatomy
+add_dependencies(viscera_samples viscera_rectum_anatomy)
 install(FILES ${VISCERA_SAMPLE_CASES} DESTINATION share/viscera/samples COMPONENT samples OPTIONAL)
 # The samples' recorded console sessions (`--device replay:FILE`): every projects/<project>/replays/*.csv
 # in share/viscera/samples/replays/<project>/.
