@@ -61,6 +61,17 @@ std::set<std::string> otherNames(const Project& p, int self) {
     return names;
 }
 
+/// The refusal of deleting `field`'s `name` while the model names it: every naming field, or empty
+/// when none does. `self` as in forEachReference (-1: a layer, no body of its own).
+QString namedByRefusal(const Project& p, const std::string& field, const std::string& name, int self) {
+    std::string refs;
+    forEachReference(p, name, self,
+                     [&](const std::string& at, const std::string&) { refs += (refs.empty() ? "" : ", ") + at; });
+    if (refs.empty()) return {};
+    return QString::fromStdString((p.dir / "project.json").string() + ": " + field + ".name: '" + name +
+                                  "' is named by " + refs + " (change or delete that first)");
+}
+
 /// What renaming or deleting a body changes: its name in the tree and the meshes (Structure), and
 /// the references in the scene's interaction and the assessment.
 Change bodyChange() {
@@ -94,12 +105,7 @@ QString Document::removeBody(int body) {
     if (!m_project || body < 0 || body >= static_cast<int>(m_project->bodies.size())) return tr("no body selected");
     const Project& p = *m_project;
     const std::string name = p.bodies[static_cast<size_t>(body)].scene.name;
-    std::string refs;
-    forEachReference(p, name, body,
-                     [&](const std::string& field, const std::string&) { refs += (refs.empty() ? "" : ", ") + field; });
-    if (!refs.empty())
-        return QString::fromStdString((p.dir / "project.json").string() + ": " + bodyField(body) + ".name: '" + name +
-                                      "' is named by " + refs + " (change or delete that first)");
+    if (QString why = namedByRefusal(p, bodyField(body), name, body); !why.isEmpty()) return why;
     return edit(
         tr("Delete body %1").arg(QString::fromStdString(name)),
         [body](Project& q) { q.bodies.erase(q.bodies.begin() + body); }, 0, bodyChange());
@@ -126,14 +132,9 @@ QString Document::removeLayer(int surface) {
         return tr("no tissue layer selected");
     const Project& p = *m_project;
     const std::string name = p.surfaces[static_cast<size_t>(surface)].scene.name;
-    std::string refs;
-    if (const auto& in = p.scene.interaction)
-        for (size_t t = 0; t < in->tissues.size(); ++t)
-            if (in->tissues[t].layer == name)
-                refs += (refs.empty() ? "" : ", ") + ("interaction.tissues[" + std::to_string(t) + "].layer");
-    if (!refs.empty())
-        return QString::fromStdString((p.dir / "project.json").string() + ": surfaces[" + std::to_string(surface) +
-                                      "].name: '" + name + "' is named by " + refs + " (change or delete that first)");
+    // names are unique across bodies and layers: only the interaction's tissues can name a layer
+    if (QString why = namedByRefusal(p, "surfaces[" + std::to_string(surface) + "]", name, -1); !why.isEmpty())
+        return why;
     return edit(
         tr("Delete tissue layer %1").arg(QString::fromStdString(name)),
         [surface](Project& q) { q.surfaces.erase(q.surfaces.begin() + surface); }, 0, bodyChange());
