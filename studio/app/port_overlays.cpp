@@ -77,4 +77,20 @@ render::RenderMesh reachMarkersMesh(const std::vector<ReachMarker>& markers, dou
     return mesh;
 }
 
+std::vector<render::RenderMesh> portGizmoMeshes(const sim::Vec3& at, double length, uint32_t material) {
+    std::vector<render::RenderMesh> meshes;
+    if (!at.allFinite() || !(length > 0)) return meshes;
+    const Eigen::Vector4f colours[3] = {
+        {0.95f, 0.25f, 0.2f, 1.0f}, {0.3f, 0.85f, 0.3f, 1.0f}, {0.3f, 0.5f, 1.0f, 1.0f}};
+    const char* names[3] = {"port gizmo x", "port gizmo y", "port gizmo z"};
+    for (int k = 0; k < 3; ++k) {
+        // a rod with a cross-bar at its end (where the grip is easiest to see)
+        const sim::Vec3 e = sim::Vec3::Unit(k), side = sim::Vec3::Unit((k + 1) % 3) * (0.2 * length);
+        const sim::Vec3 end = at + length * e;
+        meshes.push_back(lineTubes({at, end, end - side, end + side}, {{0, 1}, {2, 3}}, 0.06 * length, names[k],
+                                   colours[k], material));
+    }
+    return meshes;
+}
+
 } // namespace viscera::studio

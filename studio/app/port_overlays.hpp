@@ -36,4 +36,9 @@ struct ReachMarker {
 /// "port targets". Non-finite points are skipped.
 render::RenderMesh reachMarkersMesh(const std::vector<ReachMarker>& markers, double size, uint32_t material);
 
+/// The port gizmo: a handle per world axis from `at`, `length` (m) long, x red, y green, z blue,
+/// each its own mesh named "port gizmo x", "… y", "… z" (in axis order). Empty for a non-finite
+/// point.
+std::vector<render::RenderMesh> portGizmoMeshes(const sim::Vec3& at, double length, uint32_t material);
+
 } // namespace viscera::studio

@@ -7,6 +7,9 @@
 
 #include <QAction>
 
+#include <algorithm>
+#include <cmath>
+
 namespace viscera::studio {
 
 PortTool::PortTool(Document* doc, QObject* parent) : QObject(parent), m_doc(doc) {
@@ -19,6 +22,10 @@ PortTool::PortTool(Document* doc, QObject* parent) : QObject(parent), m_doc(doc)
     connect(doc, &Document::changed, this, [this](const Change& what) {
         if (what.touches(Change::Scene | Change::Assessment | Change::Structure)) setCurrent(m_current);
     });
+}
+
+PortTool::~PortTool() {
+    if (m_viewport) m_viewport->setHandleGrabber(nullptr);
 }
 
 void PortTool::connectViewport(Viewport* v) {
@@ -43,7 +50,71 @@ void PortTool::connectViewport(Viewport* v) {
         m_action->setChecked(false);
     });
     connect(v, &Viewport::paintEscaped, this, [this] { m_action->setChecked(false); });
+    v->setHandleGrabber(this);
     redraw();
+}
+
+int PortTool::handleAt(QPoint pos) const {
+    const std::optional<sim::PortFrame> frame = currentFrame();
+    if (!m_viewport || !m_action->isChecked() || !frame) return -1;
+    const sim::Vec3& at = frame->desc.position;
+    int best = -1;
+    double nearest = kGrabPixels;
+    for (int k = 0; k < 3; ++k) {
+        const auto a = m_viewport->toScreen(at.cast<float>());
+        const auto b = m_viewport->toScreen((at + kGizmoLength * sim::Vec3::Unit(k)).cast<float>());
+        if (!a || !b) continue;
+        const QPointF ab = *b - *a, ap = QPointF(pos) - *a;
+        const double len2 = QPointF::dotProduct(ab, ab);
+        const double t = len2 > 0 ? std::clamp(QPointF::dotProduct(ap, ab) / len2, 0.0, 1.0) : 0.0;
+        const QPointF off = QPointF(pos) - (*a + t * ab);
+        const double d = std::hypot(off.x(), off.y());
+        if (d <= nearest) {
+            nearest = d;
+            best = k;
+        }
+    }
+    return best;
+}
+
+std::optional<double> PortTool::alongHandle(QPoint pos) const {
+    if (!m_viewport || m_axis < 0) return std::nullopt;
+    Eigen::Vector3f o, d;
+    m_viewport->ray(pos, o, d);
+    // the axis line p(s) = from + s e and the ray q(t) = o + t d: their closest points
+    const sim::Vec3 e = sim::Vec3::Unit(m_axis), dd = d.cast<double>(), w = m_grabFrom - o.cast<double>();
+    const double b = e.dot(dd), denom = 1 - b * b; // both unit
+    if (!(denom > 1e-6)) return std::nullopt;      // looking along the axis: no drag
+    const double s = (b * w.dot(dd) - w.dot(e)) / denom;
+    if (!std::isfinite(s)) return std::nullopt;
+    return s;
+}
+
+bool PortTool::grab(QPoint pos) {
+    m_axis = handleAt(pos);
+    if (m_axis < 0) return false;
+    m_grabFrom = currentFrame()->desc.position;
+    const std::optional<double> s = alongHandle(pos);
+    if (!s) {
+        m_axis = -1;
+        return false;
+    }
+    m_grabAt = *s;
+    m_dragKey = m_doc->newMergeKey();
+    return true;
+}
+
+void PortTool::drag(QPoint pos) {
+    const std::optional<double> s = alongHandle(pos);
+    if (!s || m_dragKey == 0) return;
+    // a refused position mid-drag leaves the port at the last one taken; say why
+    const QString why = placeAt(m_grabFrom + (*s - m_grabAt) * sim::Vec3::Unit(m_axis), m_dragKey);
+    if (!why.isEmpty()) emit refused(why);
+}
+
+void PortTool::release() {
+    m_axis = -1;
+    m_dragKey = 0;
 }
 
 void PortTool::setCurrent(int port) {
@@ -58,8 +129,10 @@ void PortTool::setCurrent(int port) {
 
 void PortTool::setActive(bool on) {
     m_dragKey = 0;
+    m_axis = -1;
     emit activeChanged(on); // the paint tools go off first: they would set the paint mode off
     if (m_viewport) m_viewport->setPaintMode(on);
+    redraw(); // the gizmo: drawn while the tool is on
 }
 
 QString PortTool::placeAt(const sim::Vec3& point, int mergeKey) {
@@ -113,6 +186,9 @@ void PortTool::redraw() {
         return;
     }
     std::vector<render::RenderMesh> meshes{portWorkspaceMesh(*frame, 0)};
+    if (m_action->isChecked())
+        for (render::RenderMesh& handle : portGizmoMeshes(frame->desc.position, kGizmoLength, 0))
+            meshes.push_back(std::move(handle));
     const Project& p = m_doc->project();
     if (m_current >= 0 && p.scene.assessment) {
         std::vector<ReachMarker> markers;

@@ -12,9 +12,13 @@
 /// merge key); a position the reader refuses (the rest tip then out of the insertion range) is
 /// not taken and the rule is reported (refused()); Esc ends the tool. The port's rest tip (the
 /// track's first key, the scope's tip) stays where it is: the port's axis turns towards it.
+/// While it is on, the gizmo's three axis handles are drawn at the port: a drag on a handle
+/// (taken before the surface under it) slides the port along that axis alone.
+#include "app/viewport.hpp"
 #include "sim/scene/port.hpp"
 
 #include <QObject>
+#include <QPointer>
 #include <QString>
 #include <optional>
 #include <utility>
@@ -24,14 +28,14 @@ class QAction;
 namespace viscera::studio {
 
 class Document;
-class Viewport;
 struct Change;
 
-class PortTool : public QObject {
+class PortTool : public QObject, public Viewport::HandleGrabber {
     Q_OBJECT
 public:
     static constexpr int kNoPort = -1, kScopePort = -2;
     PortTool(Document* doc, QObject* parent = nullptr);
+    ~PortTool() override;
 
     /// The checkable "Place port" action (disabled while no port is current).
     QAction* action() { return m_action; }
@@ -49,6 +53,17 @@ public:
     /// How many of the current instrument's task points its port reaches, and of how many.
     std::pair<int, int> reachCounts() const;
 
+    /// The gizmo (drawn while "Place port" is on): a handle per world axis from the port,
+    /// kGizmoLength long; a left drag on one slides the port along that axis only, one undo step
+    /// per drag, a position the reader refuses leaving the port at the last one taken.
+    static constexpr double kGizmoLength = 0.05; ///< m
+    static constexpr double kGrabPixels = 8;     ///< how near a handle's drawn rod a press takes it
+    /// The axis (0 x, 1 y, 2 z) whose handle is drawn within kGrabPixels of `pos`; -1: none.
+    int handleAt(QPoint pos) const;
+    bool grab(QPoint pos) override;
+    void drag(QPoint pos) override;
+    void release() override;
+
 signals:
     /// A placement the reader refused: the rule, one line.
     void refused(const QString& why);
@@ -61,10 +76,15 @@ private:
     void redraw();
 
     Document* m_doc;
-    Viewport* m_viewport = nullptr;
+    QPointer<Viewport> m_viewport; ///< null once the viewport is gone
     QAction* m_action = nullptr;
     int m_current = kNoPort;
     int m_dragKey = 0;
+    int m_axis = -1;                          ///< the handle being dragged
+    double m_grabAt = 0;                      ///< where along it the press took it, m
+    sim::Vec3 m_grabFrom = sim::Vec3::Zero(); ///< the port's position at the press
+    /// Where along the axis `m_axis` through m_grabFrom the eye ray through `pos` passes nearest.
+    std::optional<double> alongHandle(QPoint pos) const;
     bool m_drawn = false; ///< the authoring meshes are ours
 };
 

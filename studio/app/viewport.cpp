@@ -671,6 +671,20 @@ void Viewport::ray(QPoint pos, Eigen::Vector3f& origin, Eigen::Vector3f& dir) co
     dir = (b.head<3>() / b.w() - origin).normalized();
 }
 
+std::optional<QPointF> Viewport::toScreen(const Eigen::Vector3f& x) const {
+    const float aspect = static_cast<float>(std::max(1, width())) / static_cast<float>(std::max(1, height()));
+    const render::EyeView eye = render::monoEye(m_camera, aspect);
+    const Eigen::Vector4f c = eye.viewProjection * Eigen::Vector4f(x.x(), x.y(), x.z(), 1);
+    if (!(c.w() > 0)) return std::nullopt;
+    const float nx = c.x() / c.w(), ny = c.y() / c.w();
+    return QPointF(0.5 * (nx + 1) * std::max(1, width()) - 0.5, 0.5 * (1 - ny) * std::max(1, height()) - 0.5);
+}
+
+void Viewport::setHandleGrabber(HandleGrabber* grabber) {
+    m_grabber = grabber;
+    m_handleDrag = false;
+}
+
 std::optional<Viewport::SurfaceHit> Viewport::hitAt(QPoint pos) const {
     Eigen::Vector3f o, d;
     ray(pos, o, d);
@@ -821,7 +835,8 @@ void Viewport::trackMouse(bool on) {
 
 void Viewport::setPaintMode(bool on) {
     if (m_painting && !on) emit paintCancelled();
-    m_painting = false;
+    if (m_handleDrag && m_grabber) m_grabber->release();
+    m_painting = m_handleDrag = false;
     m_paintMode = on;
     trackMouse(on); // the brush outline follows the cursor without a button
     if (!on) emit brushLeft();
@@ -840,6 +855,10 @@ void Viewport::mousePressEvent(QMouseEvent* e) {
     m_button = e->button();
     m_dragged = false;
     if (m_paintMode && m_button == Qt::LeftButton && !(e->modifiers() & Qt::AltModifier)) {
+        if (m_grabber && m_grabber->grab(m_pressPos)) {
+            m_handleDrag = true;
+            return;
+        }
         if (auto hit = hitAt(m_pressPos)) {
             m_painting = true;
             hit->invert = (e->modifiers() & Qt::ControlModifier) != 0;
@@ -858,6 +877,10 @@ void Viewport::mouseMoveEvent(QMouseEvent* e) {
         return;
     }
     if ((p - m_pressPos).manhattanLength() > 3) m_dragged = true;
+    if (m_handleDrag) {
+        if (m_grabber) m_grabber->drag(p);
+        return;
+    }
     if (m_paintMode && (m_button == Qt::NoButton || m_painting)) { // the brush outline follows the cursor
         if (const auto hit = hitAt(p))
             emit brushHovered(*hit);
@@ -889,6 +912,12 @@ void Viewport::mouseMoveEvent(QMouseEvent* e) {
 }
 
 void Viewport::mouseReleaseEvent(QMouseEvent* e) {
+    if (m_handleDrag && e->button() == Qt::LeftButton) {
+        m_handleDrag = false;
+        m_button = Qt::NoButton;
+        if (m_grabber) m_grabber->release();
+        return;
+    }
     if (m_painting && e->button() == Qt::LeftButton) {
         m_painting = false;
         m_button = Qt::NoButton;

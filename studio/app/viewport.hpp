@@ -136,6 +136,23 @@ public:
     void setPaintMode(bool on);
     bool paintMode() const { return m_paintMode; }
 
+    /// A tool's handles drawn in the viewport (the port gizmo): in paint mode a left press the
+    /// grabber takes (grab() true) drags the handle (drag() per move, release() at the end)
+    /// instead of painting or orbiting.
+    class HandleGrabber {
+    public:
+        virtual ~HandleGrabber() = default;
+        virtual bool grab(QPoint pos) = 0;
+        virtual void drag(QPoint pos) = 0;
+        virtual void release() = 0;
+    };
+    /// The grabber asked first on a press (null: none; the viewport does not own it).
+    void setHandleGrabber(HandleGrabber* grabber);
+    /// The eye ray through widget position `pos` (world frame, unit direction).
+    void ray(QPoint pos, Eigen::Vector3f& origin, Eigen::Vector3f& dir) const;
+    /// Where world point `x` appears in the widget (px); none behind the eye.
+    std::optional<QPointF> toScreen(const Eigen::Vector3f& x) const;
+
     /// The mesh name under widget position `pos` (empty: none): what a click selects.
     QString pick(QPoint pos) const;
     /// One line: "llvmpipe (...)", or why the renderer could not be made (empty before the
@@ -187,7 +204,6 @@ private:
     void viewChanged();
     void updateCamera();
     /// The eye ray through widget position `pos`: origin and unit direction, world frame.
-    void ray(QPoint pos, Eigen::Vector3f& origin, Eigen::Vector3f& dir) const;
 
     ViewportHost m_host;
     ViewportCanvas* m_canvas = nullptr;                   ///< owned through the Qt object tree
@@ -203,6 +219,8 @@ private:
     float m_distance = 0.3f, m_yaw = -1.5708f, m_pitch = 0.5f;
     QPoint m_pressPos, m_lastPos;
     Qt::MouseButton m_button = Qt::NoButton;
+    HandleGrabber* m_grabber = nullptr;
+    bool m_handleDrag = false; ///< a left drag on a handle the grabber took
     bool m_dragged = false;
     bool m_framed = false;
     Look m_look = Look::Authoring;

@@ -16,6 +16,7 @@ namespace viscera::sim {
 namespace {
 
 constexpr double kGraspClose = 0.5;    ///< jaw below this holds, above releases
+constexpr double kGraspTouch = 0.0015; ///< m beyond a jaw's surface: tissue touching it is held
 constexpr double kMaxJawOpening = 0.6; ///< rad, grasper jaws fully open (jaw = 1)
 
 double msSince(std::chrono::steady_clock::time_point t0) {
@@ -71,7 +72,8 @@ struct InteractionRuntime::Instrument {
     bool snip = false;                        ///< they closed this frame: the blade cuts
     std::optional<Vec3> cutAt;                ///< where it cut this frame (InstrumentState::cutAt)
     std::optional<std::array<Vec3, 3>> swept; ///< InstrumentState::swept
-    double openJaw = 1;                       ///< scissors: the jaw the last frame they were open (the blades' sweep)
+    double openJaw =
+        1; ///< scissors: the jaw the last frame they were open (the blades' sweep); holders: last frame's jaw
     // clip applier
     size_t target = 0;  ///< tet body it clips
     bool fired = false; ///< fired during this squeeze (act held)
@@ -290,6 +292,40 @@ void InteractionRuntime::fireClip(Instrument& in, double t) {
     m_clips.push_back(std::move(c));
 }
 
+// Jaws that close take the surface vertices within a third of their length of the tip, and those
+// touching their distal half as the jaws stood the frame before (a fold pressed between or
+// against them: the capsule jaws, as thick as the shaft, leave too narrow a gap for the tissue to
+// enter between them, so touching is what holds).
+void InteractionRuntime::updateGrasp(Instrument& in, const std::vector<Vec3>& sx) {
+    const double jawBefore = std::exchange(in.openJaw, in.key.jaw);
+    if (in.holding && in.key.jaw > kGraspClose) {
+        in.holding = false;
+        in.held.clear();
+        in.heldLocal.clear();
+    }
+    if (in.holding || !(in.key.jaw < kGraspClose)) return;
+    in.holding = true;
+    in.held.clear();
+    in.heldLocal.clear();
+    const double reach = in.desc.jawLength / 3, L = in.desc.jawLength;
+    const double touch = in.desc.radius + kGraspTouch;
+    const double half = 0.5 * kMaxJawOpening * std::clamp(jawBefore, 0.0, 1.0);
+    const Vec3 tips[2] = {L * Vec3(std::cos(half), 0, -std::sin(half)), L * Vec3(std::cos(half), 0, std::sin(half))};
+    const ToolShape::Pose toJaws = in.pose.inverse();
+    for (size_t v = 0; v < sx.size(); ++v) {
+        const Vec3 p = toJaws * sx[v];
+        bool held = (sx[v] - in.key.position).norm() <= reach;
+        for (const Vec3& tip : tips) {
+            const double s = std::clamp(p.dot(tip) / tip.squaredNorm(), 0.5, 1.0); // the distal half
+            held = held || (p - s * tip).norm() <= touch;
+        }
+        if (!held) continue;
+        in.held.push_back(static_cast<int32_t>(v));
+        in.heldLocal.push_back(p);
+    }
+    if (!in.held.empty()) ++m_summary.grasps;
+}
+
 void InteractionRuntime::beforeStep(double t, double dt) {
     const std::vector<Vec3>& sx = m_surfaceIsLayer ? m_sys->surfacePositions(m_surfaceIndex) : m_sys->tetPositions(0);
     auto t0 = std::chrono::steady_clock::now();
@@ -345,24 +381,7 @@ void InteractionRuntime::beforeStep(double t, double dt) {
             in.open = in.key.jaw > kGraspClose;
             if (in.open) in.openJaw = in.key.jaw;
         }
-        if (in.desc.holds()) {
-            if (!in.holding && in.key.jaw < kGraspClose) {
-                in.holding = true;
-                in.held.clear();
-                in.heldLocal.clear();
-                const double reach = in.desc.jawLength / 3;
-                for (size_t v = 0; v < sx.size(); ++v)
-                    if ((sx[v] - in.key.position).norm() <= reach) {
-                        in.held.push_back(static_cast<int32_t>(v));
-                        in.heldLocal.push_back(in.pose.inverse() * sx[v]);
-                    }
-                if (!in.held.empty()) ++m_summary.grasps;
-            } else if (in.holding && in.key.jaw > kGraspClose) {
-                in.holding = false;
-                in.held.clear();
-                in.heldLocal.clear();
-            }
-        }
+        if (in.desc.holds()) updateGrasp(in, sx);
         if (in.desc.kind == InstrumentDesc::Kind::ClipApplier) { // one clip per squeeze; re-armed on release
             if (!in.fired && in.key.act) fireClip(in, t);
             if (!in.key.act) in.fired = false;

@@ -145,6 +145,8 @@ private:
     /// none when nothing was cut.
     std::optional<Vec3> recordCut(const DissectionFrameStats& st);
     void fireClip(Instrument& in, double t);
+    /// A holder's jaws: closing takes the surface vertices they hold, opening lets them go.
+    void updateGrasp(Instrument& in, const std::vector<Vec3>& sx);
 
     XpbdSystem* m_sys = nullptr;
     std::vector<const TetMesh*> m_bodies;

@@ -245,8 +245,8 @@ fs::path writeBoughtAnatomy(const fs::path& dir) {
 
 /// A two-handed console session over the built case, as a trainee's device records it (device
 /// frame: metres from each master's workspace centre; the case maps them with each instrument's
-/// motion scale from its rest tip, through its robotic port): the left grasper waits; the right
-/// arm's clip applier fires a clip at each clip site (unless
+/// motion scale from its rest tip, through its robotic port): the left grasper takes the fundus
+/// and lifts it; then the right arm's clip applier fires a clip at each clip site (unless
 /// `withClips` is false: it stays at rest), its button hands the arm to the scissors, which come
 /// down across the duct at the cut line, turned so that their blades shut across it, and close.
 /// Returns the CSV text (haptics::Trajectory's format) and, in `afterClips`, the time the clips are
@@ -269,11 +269,16 @@ std::string consoleSession(const studio::Project& p, bool withClips, double* aft
         return sim::Vec3((tip - restOf(i).position) / ins[i].device.motionScale);
     };
     auto shaft = [&](size_t i, const sim::Vec3& tip) { return sim::Vec3((tip - ins[i].port.position).normalized()); };
-    // left: the grasper waits at rest (its jaws closed on the soft gallbladder threw it about:
-    // see the closing note of issue 57)
-    double t = 0;
-    rows.push_back({t, 0, sim::Vec3::Zero(), none, 1.0, 0});
-    t = 0.5;
+    // left: the grasper comes down on the fundus along its shaft, closes on it and lifts it 13 mm
+    // (the retraction that opens Calot's triangle), holding it to the end
+    const sim::Vec3 hold = kFundus + sim::Vec3(0, 0, 0.003), along = shaft(0, hold);
+    const sim::Vec3 lifted = hold + sim::Vec3(0, 0, 0.013);
+    rows.push_back({0, 0, sim::Vec3::Zero(), none, 1.0, 0});
+    rows.push_back({0.8, 0, device(0, hold - 0.04 * along), none, 1.0, 0});
+    rows.push_back({2.0, 0, device(0, hold), none, 1.0, 0});
+    rows.push_back({2.3, 0, device(0, hold), none, 0.05, 0}); // the jaws shut: the grasp
+    rows.push_back({3.3, 0, device(0, lifted), none, 0.05, 0});
+    const double t = 3.5; // the right arm starts once the fundus is up
     // right: the clip applier at each site, the tip 2 mm into the duct
     double r = t;
     rows.push_back({0, 1, sim::Vec3::Zero(), none, 1.0, 0});
@@ -305,7 +310,7 @@ std::string consoleSession(const studio::Project& p, bool withClips, double* aft
     rows.push_back({r += 0.3, 1, device(2, tip), turn, 1.0, 0});
     rows.push_back({r += 0.3, 1, device(2, pre), turn, 1.0, 0});
     rows.push_back({r += 0.6, 1, sim::Vec3::Zero(), turn, 1.0, 0});
-    rows.push_back({r + 0.7, 0, sim::Vec3::Zero(), none, 1.0, 0});
+    rows.push_back({r + 0.7, 0, device(0, lifted), none, 0.05, 0});
     rows.push_back({r + 0.7, 1, sim::Vec3::Zero(), turn, 1.0, 0});
     *end = r + 0.7;
     std::string csv = "# viscera-trajectory 1\n# A cholecystectomy step on the console (made by the GUI test)\n"
@@ -759,6 +764,8 @@ struct CholeSteps : CholeFixture {
         timings.emplace_back("player run (reference)", since(clock));
         EXPECT_EQ(passCode, 0) << passed.toStdString();
         EXPECT_TRUE(passed.contains(QRegularExpression("verdict +PASS"))) << passed.toStdString();
+        EXPECT_TRUE(passed.contains(QRegularExpression("contacts, 1 grasps;")))
+            << "the fundus held: " << passed.toStdString();
         std::printf("%s\n", passed.section("step time", 1, 1)
                                 .section('\n', 0, 0)
                                 .prepend("reference: step time")

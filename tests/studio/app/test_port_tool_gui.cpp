@@ -186,4 +186,60 @@ TEST_F(PortToolFixture, TheLaparoscopesPortIsPlacedTheSameWay) {
     EXPECT_EQ(model().scene.laparoscope->port.position, before);
 }
 
+// The gizmo [issue 57 item 1]: with "Place port" on, an x, y and z handle are drawn at the port;
+// a left drag on the x handle (synthetic mouse events on the viewport) slides the port along x
+// alone, one undo step, and is not taken by the surface under the handle; a drag far along it
+// would take the hook's rest tip out of its insertion range: the reader refuses, the port stays
+// at the last position taken and the rule is said; undo restores the port.
+TEST_F(PortToolFixture, TheGizmoSlidesThePortAlongTheDraggedAxisAsOneUndoStep) {
+    const int hook = instrument("hook");
+    tool->setCurrent(hook);
+    tool->action()->setChecked(true);
+    QCoreApplication::processEvents();
+    std::vector<std::string> names;
+    for (const auto& m : w->viewport()->authoringMeshes())
+        names.push_back(m.name);
+    EXPECT_THAT(names, ::testing::IsSupersetOf({"port workspace", "port gizmo x", "port gizmo y", "port gizmo z"}));
+    Viewport* v = w->viewport();
+    const sim::Vec3 before = port(hook).position;
+    const int steps = w->document()->undoStack()->count();
+    const auto a = v->toScreen(before.cast<float>());
+    const auto b = v->toScreen((before + 0.7 * PortTool::kGizmoLength * sim::Vec3::UnitX()).cast<float>());
+    ASSERT_TRUE(a && b);
+    const QPointF along = (*b - *a) / std::hypot((*b - *a).x(), (*b - *a).y());
+    const QPoint grip = b->toPoint();
+    ASSERT_EQ(tool->handleAt(grip), 0) << "the x handle is under the cursor";
+    viewportDrag(grip, (*b + 30 * along).toPoint());
+    EXPECT_EQ(w->document()->undoStack()->count(), steps + 1) << "one drag, one step";
+    const sim::Vec3 moved = port(hook).position;
+    EXPECT_GT(moved.x(), before.x() + 0.002) << "slid along +x";
+    EXPECT_NEAR(moved.y(), before.y(), 1e-12);
+    EXPECT_NEAR(moved.z(), before.z(), 1e-12);
+    test::saveShot("port_gizmo_dragged");
+    if (const char* dir = std::getenv("VISCERA_GUI_SHOTS"); dir && *dir)
+        v->grabFramebuffer().save(QString(dir) + "/port_gizmo_dragged_viewport.png");
+    // far along x: refused past the insertion range, the port at the last position taken
+    QSignalSpy refusals(tool, &PortTool::refused);
+    const auto c = v->toScreen((moved + 0.7 * PortTool::kGizmoLength * sim::Vec3::UnitX()).cast<float>());
+    ASSERT_TRUE(c);
+    ASSERT_EQ(tool->handleAt(c->toPoint()), 0);
+    viewportDrag(c->toPoint(), (*c + 2000 * along).toPoint());
+    ASSERT_FALSE(refusals.isEmpty()) << "a 2000 px drag takes the port metres away";
+    EXPECT_THAT(refusals.last().at(0).toString().toStdString(), HasSubstr("insertion"));
+    const sim::Vec3 last = port(hook).position;
+    EXPECT_TRUE(last.allFinite());
+    EXPECT_NEAR(last.y(), before.y(), 1e-12);
+    EXPECT_EQ(sim::restTipError(
+                  port(hook), sim::instrumentPortFrame(model().scene.interaction->instruments[size_t(hook)])->restTip),
+              "")
+        << "the port taken last is one the reader accepts";
+    EXPECT_EQ(w->document()->undoStack()->count(), steps + 2);
+    w->document()->undoStack()->undo();
+    w->document()->undoStack()->undo();
+    EXPECT_EQ(port(hook).position, before);
+    tool->action()->setChecked(false);
+    for (const auto& m : w->viewport()->authoringMeshes())
+        EXPECT_EQ(m.name.rfind("port gizmo", 0), std::string::npos) << "the gizmo goes with the tool";
+}
+
 } // namespace
