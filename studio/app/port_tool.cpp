@@ -58,12 +58,13 @@ int PortTool::handleAt(QPoint pos) const {
     const std::optional<sim::PortFrame> frame = currentFrame();
     if (!m_viewport || !m_action->isChecked() || !frame) return -1;
     const sim::Vec3& at = frame->desc.position;
+    const auto a = m_viewport->toScreen(at.cast<float>());
+    if (!a) return -1;
     int best = -1;
     double nearest = kGrabPixels;
     for (int k = 0; k < 3; ++k) {
-        const auto a = m_viewport->toScreen(at.cast<float>());
         const auto b = m_viewport->toScreen((at + kGizmoLength * sim::Vec3::Unit(k)).cast<float>());
-        if (!a || !b) continue;
+        if (!b) continue;
         const QPointF ab = *b - *a, ap = QPointF(pos) - *a;
         const double len2 = QPointF::dotProduct(ab, ab);
         const double t = len2 > 0 ? std::clamp(QPointF::dotProduct(ap, ab) / len2, 0.0, 1.0) : 0.0;

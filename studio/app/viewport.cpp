@@ -660,9 +660,13 @@ void Viewport::updateCamera() {
     m_camera.farPlane = 20.0f * m_distance + 1.0f;
 }
 
-void Viewport::ray(QPoint pos, Eigen::Vector3f& origin, Eigen::Vector3f& dir) const {
+render::EyeView Viewport::eye() const {
     const float aspect = static_cast<float>(std::max(1, width())) / static_cast<float>(std::max(1, height()));
-    const render::EyeView eye = render::monoEye(m_camera, aspect);
+    return render::monoEye(m_camera, aspect);
+}
+
+void Viewport::ray(QPoint pos, Eigen::Vector3f& origin, Eigen::Vector3f& dir) const {
+    const render::EyeView eye = this->eye();
     const float nx = 2.0f * (pos.x() + 0.5f) / std::max(1, width()) - 1.0f;
     const float ny = 1.0f - 2.0f * (pos.y() + 0.5f) / std::max(1, height());
     Eigen::Vector4f a = eye.inverseViewProjection * Eigen::Vector4f(nx, ny, -1, 1);
@@ -672,9 +676,7 @@ void Viewport::ray(QPoint pos, Eigen::Vector3f& origin, Eigen::Vector3f& dir) co
 }
 
 std::optional<QPointF> Viewport::toScreen(const Eigen::Vector3f& x) const {
-    const float aspect = static_cast<float>(std::max(1, width())) / static_cast<float>(std::max(1, height()));
-    const render::EyeView eye = render::monoEye(m_camera, aspect);
-    const Eigen::Vector4f c = eye.viewProjection * Eigen::Vector4f(x.x(), x.y(), x.z(), 1);
+    const Eigen::Vector4f c = eye().viewProjection * Eigen::Vector4f(x.x(), x.y(), x.z(), 1);
     if (!(c.w() > 0)) return std::nullopt;
     const float nx = c.x() / c.w(), ny = c.y() / c.w();
     return QPointF(0.5 * (nx + 1) * std::max(1, width()) - 0.5, 0.5 * (1 - ny) * std::max(1, height()) - 0.5);

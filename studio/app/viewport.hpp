@@ -197,6 +197,8 @@ protected:
 
 private:
     friend class ViewportCanvas;
+    /// The camera's mono eye at the widget's aspect (what ray() and toScreen() map through).
+    render::EyeView eye() const;
     /// The snapshot of what to draw now (the scene is shared until it changes).
     ViewportFrame frame();
     void requestFrame();

@@ -72,8 +72,8 @@ struct InteractionRuntime::Instrument {
     bool snip = false;                        ///< they closed this frame: the blade cuts
     std::optional<Vec3> cutAt;                ///< where it cut this frame (InstrumentState::cutAt)
     std::optional<std::array<Vec3, 3>> swept; ///< InstrumentState::swept
-    double openJaw =
-        1; ///< scissors: the jaw the last frame they were open (the blades' sweep); holders: last frame's jaw
+    /// scissors: the jaw the last frame they were open (the blades' sweep); holders: last frame's jaw
+    double openJaw = 1;
     // clip applier
     size_t target = 0;  ///< tet body it clips
     bool fired = false; ///< fired during this squeeze (act held)
