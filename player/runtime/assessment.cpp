@@ -153,8 +153,9 @@ std::optional<double> judgeClips(const SessionTimeline& tl, const sim::Assessmen
         if (e.kind != "clip") continue;
         int best = -1;
         double bestD = std::numeric_limits<double>::infinity();
+        const Vec3 where = e.rest.value_or(e.at); // the targets were picked on the rest pose
         for (size_t t = 0; t < a.clips.size(); ++t)
-            if (const double d = (e.at - a.clips[t].position).norm(); d <= a.clips[t].tolerance && d < bestD)
+            if (const double d = (where - a.clips[t].position).norm(); d <= a.clips[t].tolerance && d < bestD)
                 best = int(t), bestD = d;
         if (best < 0) {
             ++out.clipsOff;

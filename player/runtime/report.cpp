@@ -281,6 +281,8 @@ static nlohmann::json timelineJson(const SessionTimeline& tl) {
                 swept.push_back({round(p.x(), 1e-6), round(p.y(), 1e-6), round(p.z(), 1e-6)});
             events.back()["swept_m"] = swept;
         }
+        if (e.rest)
+            events.back()["rest_m"] = {round(e.rest->x(), 1e-6), round(e.rest->y(), 1e-6), round(e.rest->z(), 1e-6)};
     }
     json doc = {{"stride_frames", tl.stride}, {"t_s", t}, {"tools", tools}, {"events", events}};
     if (!tl.cameraTip.empty()) {

@@ -132,7 +132,14 @@ void TimelineRecorder::record(const sim::World& world) {
         }
         m_cut = cut;
         for (size_t c = static_cast<size_t>(m_clips); c < s.clips.size(); ++c)
-            m_tl.events.push_back({s.clips[c].firedAt, frame, "clip", s.clips[c].instrument, 1, s.clips[c].centre});
+            m_tl.events.push_back({s.clips[c].firedAt,
+                                   frame,
+                                   "clip",
+                                   s.clips[c].instrument,
+                                   1,
+                                   s.clips[c].centre,
+                                   {},
+                                   s.clips[c].restCentre});
         m_clips = static_cast<int>(s.clips.size());
     }
     if (const sim::SutureReport* su = world.sutureReport(); su && !su->frames().empty()) {

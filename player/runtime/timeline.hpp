@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,9 @@ struct SessionTimeline {
         /// m, scene: a cut by scissors, the wedge their blades swept (clevis, tip, tip; `at` is
         /// where the edges they cut lie); empty for a cut at a point (the hook).
         std::vector<Eigen::Vector3d> swept;
+        /// m, the body's rest pose: a clip's place on the anatomy (ClipState::restCentre), what the
+        /// clip targets (picked on the rest pose) are judged against; unset for other events.
+        std::optional<Eigen::Vector3d> rest;
     };
     std::vector<double> t_s; ///< s, the end of each sampled frame
     int stride = 1;          ///< frames per sample

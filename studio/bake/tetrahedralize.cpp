@@ -29,6 +29,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <iterator>
 #include <stdexcept>
 #include <string>
@@ -232,6 +233,79 @@ void optimize(C3t3& c3t3, const Domain& domain, const MeshingParams& p, const Pr
     }
 }
 
+/// A grid of points hashed by cell (side `cell`): which stored point lies within `reach` of a query
+/// (reach <= cell).
+class PointGrid {
+public:
+    explicit PointGrid(double cell) : m_cell(cell) {}
+    void add(const sim::Vec3& p) { m_cells[key(cellOf(p))].push_back(p); }
+    bool near(const sim::Vec3& p, double reach) const {
+        const std::array<int64_t, 3> c = cellOf(p);
+        for (int64_t dz = -1; dz <= 1; ++dz)
+            for (int64_t dy = -1; dy <= 1; ++dy)
+                for (int64_t dx = -1; dx <= 1; ++dx) {
+                    const auto it = m_cells.find(key({c[0] + dx, c[1] + dy, c[2] + dz}));
+                    if (it == m_cells.end()) continue;
+                    for (const sim::Vec3& q : it->second)
+                        if ((q - p).squaredNorm() <= reach * reach) return true;
+                }
+        return false;
+    }
+
+private:
+    std::array<int64_t, 3> cellOf(const sim::Vec3& p) const {
+        return {static_cast<int64_t>(std::floor(p.x() / m_cell)), static_cast<int64_t>(std::floor(p.y() / m_cell)),
+                static_cast<int64_t>(std::floor(p.z() / m_cell))};
+    }
+    static uint64_t key(const std::array<int64_t, 3>& c) {
+        return (static_cast<uint64_t>(c[0] & 0x1FFFFF) << 42) | (static_cast<uint64_t>(c[1] & 0x1FFFFF) << 21) |
+               static_cast<uint64_t>(c[2] & 0x1FFFFF);
+    }
+    double m_cell;
+    std::unordered_map<uint64_t, std::vector<sim::Vec3>> m_cells;
+};
+
+/// Delaunay refinement starts from a few points shot at the surface and grows the mesh where its
+/// restricted facets are bad; a thin part the first points and their Voronoi edges never meet
+/// (a 3 mm artery beside a gallbladder, meshed at 3 mm) stays out of the mesh altogether. Seeds
+/// such parts: every input triangle whose centre lies farther than 1.5 facet sizes from each
+/// vertex of the complex's boundary gives a surface point (one per facet-size cell, with the
+/// domain's own patch index), inserted into the triangulation. Returns the number inserted; the
+/// caller refines again (refine_mesh_3 rescans a triangulation that gained vertices).
+size_t seedMissedSurface(C3t3& c3t3, const Domain& domain, const sim::TriMesh& surface, const MeshingParams& p) {
+    const double reach = 1.5 * p.facetSize;
+    Tr& tr = c3t3.triangulation();
+    const auto point = tr.geom_traits().construct_point_3_object();
+    PointGrid boundary(reach), seeded(p.facetSize);
+    for (auto f = c3t3.facets_in_complex_begin(); f != c3t3.facets_in_complex_end(); ++f)
+        for (int k = 1; k < 4; ++k) {
+            const K::Point_3 q = point(tr.point(f->first->vertex((f->second + k) % 4)));
+            boundary.add(sim::Vec3(q.x(), q.y(), q.z()));
+        }
+    const auto intersect = domain.construct_intersection_object();
+    const auto weighted = tr.geom_traits().construct_weighted_point_3_object();
+    size_t inserted = 0;
+    for (const sim::Tri& t : surface.triangles()) {
+        const sim::Vec3& a = surface.positions()[t[0]];
+        const sim::Vec3& b = surface.positions()[t[1]];
+        const sim::Vec3& c = surface.positions()[t[2]];
+        const sim::Vec3 centre = (a + b + c) / 3;
+        if (boundary.near(centre, reach) || seeded.near(centre, p.facetSize)) continue;
+        const sim::Vec3 n = (b - a).cross(c - a).normalized() * std::max(p.facetDistance, 1e-6);
+        const sim::Vec3 from = centre - n, to = centre + n;
+        const Domain::Intersection hit =
+            intersect(K::Segment_3(K::Point_3(from.x(), from.y(), from.z()), K::Point_3(to.x(), to.y(), to.z())));
+        if (std::get<2>(hit) != 2) continue; // no surface point with a patch index
+        const Tr::Vertex_handle v = tr.insert(weighted(std::get<0>(hit)));
+        if (v == Tr::Vertex_handle()) continue; // hidden by a protecting ball
+        c3t3.set_dimension(v, 2);
+        c3t3.set_index(v, std::get<1>(hit));
+        seeded.add(centre);
+        ++inserted;
+    }
+    return inserted;
+}
+
 /// The cells of a complex as arrays: compact vertices, positively oriented tets.
 struct TetArrays {
     std::vector<sim::Vec3> positions;
@@ -324,6 +398,9 @@ TetrahedralizeResult tetrahedralize(const sim::TriMesh& surface, const MeshingPa
         progress.begin(MeshingStage::Refine);
         C3t3 c3t3 =
             CGAL::make_mesh_3<C3t3>(domain, criteria, cp::no_perturb(), cp::no_exude(), cp::no_odt(), cp::no_lloyd());
+        if (p.seedMissedSurface) report.missedSurfaceSeeds = seedMissedSurface(c3t3, domain, surface, p);
+        if (report.missedSurfaceSeeds > 0)
+            CGAL::refine_mesh_3(c3t3, domain, criteria, cp::no_perturb(), cp::no_exude(), cp::no_odt(), cp::no_lloyd());
         const auto tOpt = std::chrono::steady_clock::now();
         report.refineSeconds = std::chrono::duration<double>(tOpt - t0).count();
         optimize(c3t3, domain, p, progress);

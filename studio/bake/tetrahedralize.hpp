@@ -42,6 +42,9 @@ struct MeshingParams {
     bool exude = true;
     /// Iteration cap for odt / lloyd; 0 = until they converge.
     int smoothingMaxIterations = 0;
+    /// After the first refinement, seed the input surface the mesh missed (no boundary vertex
+    /// within 1.5 facet sizes: a thin part the refinement never met) and refine again.
+    bool seedMissedSurface = true;
     /// Seed of the random generators used by the mesher and the optimizers.
     uint32_t seed = 0;
     /// Refuse parameters whose cell size would give more tets than this (estimated from the
@@ -66,6 +69,9 @@ struct MeshingReport {
     size_t tetCount = 0;
     size_t boundaryTriangleCount = 0; ///< boundary facets of the tet mesh
     size_t featureEdgeCount = 0;      ///< input edges protected as sharp features
+    /// Surface points seeded after the first refinement because no boundary vertex lay within 1.5
+    /// facet sizes of them (thin parts the first pass missed); 0: the first pass covered it all.
+    size_t missedSurfaceSeeds = 0;
     sim::QualityReport quality;
     double tetVolume = 0;       ///< sum of tet volumes, m^3
     double surfaceVolume = 0;   ///< volume enclosed by the input surface, m^3

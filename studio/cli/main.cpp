@@ -400,6 +400,9 @@ int cmdImport(const std::vector<std::string>& args) {
     });
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("tetrahedralized: %zu nodes, %zu tets in %.2f s\n", r.mesh->vertexCount(), r.mesh->tetCount(), secs);
+    if (r.report.missedSurfaceSeeds > 0)
+        std::printf("seeded %zu surface point(s) the first refinement missed (thin parts)\n",
+                    r.report.missedSurfaceSeeds);
     printQuality(r.mesh->quality());
     if (out) {
         sim::writeVtet(*out, *r.mesh);

@@ -186,6 +186,26 @@ TEST(Assessment, TargetsAreMetInTimeAndCutsAndClipsOutsideThemCount) {
     EXPECT_THAT(player::assessmentSummary(a), HasSubstr("verdict       FAIL (clips_off_target)"));
 }
 
+// Clip sites are picked on the rest pose: a clip counts for the site nearest where it holds the
+// anatomy at rest, not where the sagging vessel happened to hang when it fired.
+TEST(Assessment, ClipsAreJudgedWhereTheyHoldTheAnatomyAtRest) {
+    player::SessionResult r = timeline(60, {mover("clipper", "right", 60, 0, 0, 0)});
+    const Vec3 site(0.01, 0, 0.008);
+    // fired on the vessel hanging 6 mm below its rest place: at rest the held region is on the site
+    r.timeline.events.push_back({1.0, 20, "clip", "clipper", 1, site - Vec3(0, 0, 0.006), {}, site});
+    // fired where the site hangs now, on a stretch whose rest place is 6 mm away: off target
+    r.timeline.events.push_back({2.0, 40, "clip", "clipper", 1, site, {}, site + Vec3(0, 0.006, 0)});
+    // no rest place known (an older report): judged where it fired
+    r.timeline.events.push_back({3.0, 60, "clip", "clipper", 1, site + Vec3(0.001, 0, 0)});
+    sim::AssessmentDesc d;
+    d.clips.push_back({site, 0.004, 2});
+    const player::Assessment a = player::assessSession(r, d);
+    EXPECT_EQ(*a.find("clips_on_target")->value, 2.0);
+    EXPECT_EQ(*a.find("clips_off_target")->value, 1.0);
+    ASSERT_TRUE(a.completionS);
+    EXPECT_NEAR(*a.completionS, 3.0, 1e-12);
+}
+
 // Punctures on either side of the wound's plane z = 0: a bite is a pass through the wall on one
 // side (two punctures) followed by one on the other; a bite too shallow is missed.
 TEST(Assessment, BitesAcrossTheWoundAreCountedWithDepthAndSpacing) {

@@ -287,6 +287,7 @@ void InteractionRuntime::fireClip(Instrument& in, double t) {
     c->state.target = in.desc.target;
     c->state.firedAt = t;
     c->state.centre = c->attachment->centre();
+    c->state.restCentre = c->attachment->restCentre();
     c->state.regionVertices = static_cast<int>(c->attachment->regionVertices().size());
     c->state.auxiliaryNodes = static_cast<int>(c->attachment->auxiliaryNodes().size());
     m_clips.push_back(std::move(c));

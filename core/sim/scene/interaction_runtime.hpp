@@ -60,8 +60,11 @@ struct ClipState {
     std::string instrument, target;
     double firedAt = 0;         ///< s
     Vec3 centre = Vec3::Zero(); ///< m, current
-    double rotationDeg = 0;     ///< since application
-    double travel = 0;          ///< m, centre moved since application
+    /// m, the vessel's rest pose: where on the anatomy the clip holds (the centre of its region at
+    /// rest), whatever the tissue's sag or retraction when it fired.
+    Vec3 restCentre = Vec3::Zero();
+    double rotationDeg = 0; ///< since application
+    double travel = 0;      ///< m, centre moved since application
     /// m: largest distance between a contact point carried by the clip and the vessel vertex it
     /// was on at application (how well the clip follows the vessel material).
     double maxContactDrift = 0;

@@ -1,5 +1,7 @@
 // Tetrahedralization: valid meshes for an ellipsoid and a box, surface rules, parameter checks.
 // Sizes are coarse so that each meshing runs in about a second.
+#include "bake/remesh.hpp"
+#include "bake/sample_anatomy.hpp"
 #include "bake/tetrahedralize.hpp"
 
 #include "sim/mesh/generators.hpp"
@@ -8,7 +10,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <numbers>
+#include <string>
 #include <vector>
 
 using namespace viscera;
@@ -130,6 +136,49 @@ TEST(bake_tetrahedralize, AutomaticSizesAndOptimizers) {
     EXPECT_NEAR(r.report.resolved.facetSize, diagonal / 20, 1e-12);
     EXPECT_EQ(r.report.resolved.cellSize, r.report.resolved.facetSize);
     EXPECT_LT(std::abs(r.report.volumeRelError), 0.05);
+}
+
+// The hepatocystic sample's gallbladder, ducts and 3 mm cystic artery, remeshed into one surface
+// as the studio does (200 voxels) and meshed at 3 mm: Delaunay refinement grows from points shot at
+// the surface, and the artery's free stretch, which neither those points nor the Voronoi edges
+// around them met, came out with no tets (the clip applier and the scissors then found nothing to
+// act on). The missed surface is seeded and refined again: every point of the artery's axis has
+// a tet vertex within its radius plus a millimetre. With the seeding off the same input loses it.
+TEST(bake_tetrahedralize, AThinArteryBesideTheGallbladderIsMeshedAlongItsWholeLength) {
+    std::vector<bake::RemeshPart> parts = bake::hepatocysticAnatomy();
+    std::erase_if(parts, [](const bake::RemeshPart& part) { return part.name == "liver"; });
+    bake::RemeshParams remesh;
+    remesh.voxelCount = 200; // with the seam cut and its second remesh, as the studio's Make simulation-ready
+    const sim::TriMesh surface = bake::voxelRemesh(parts, remesh).mesh;
+    const sim::Vec3 a(0.024, -0.07, 0.008), b(0.008, -0.036, 0.012); // the artery's axis
+    const double radius = 0.0015;
+    auto axisMeshed = [&](const sim::TetMesh& m) {
+        std::string seen; // '#': a tet vertex near the axis point, '.': none
+        for (int i = 0; i <= 20; ++i) {
+            const sim::Vec3 x = a + (i / 20.0) * (b - a);
+            double nearest = 1;
+            for (const sim::Vec3& q : m.positions())
+                nearest = std::min(nearest, (q - x).norm());
+            seen += nearest < radius + 0.001 ? '#' : '.';
+        }
+        return seen;
+    };
+    bake::MeshingParams p = coarse(0.003);
+    p.facetDistance = 0.001;
+    p.featureAngleDeg = 0; // the studio's for a remeshed surface: no sharp edge left
+    const bake::TetrahedralizeResult seeded = bake::tetrahedralize(surface, p);
+    expectValidMesh(seeded);
+    p.seedMissedSurface = false;
+    const bake::TetrahedralizeResult plain = bake::tetrahedralize(surface, p);
+    const std::string with = axisMeshed(*seeded.mesh), without = axisMeshed(*plain.mesh);
+    std::printf("artery axis meshed, seeded (%zu seeds, %zu tets): %s; without seeding (%zu tets): %s\n",
+                seeded.report.missedSurfaceSeeds, seeded.report.tetCount, with.c_str(), plain.report.tetCount,
+                without.c_str());
+    EXPECT_EQ(with, std::string(21, '#'));
+    EXPECT_GT(seeded.report.missedSurfaceSeeds, 0u);
+    EXPECT_NE(without, std::string(21, '#')) << "the first refinement alone misses part of the artery";
+    EXPECT_EQ(plain.report.missedSurfaceSeeds, 0u);
+    EXPECT_LT(std::abs(seeded.report.volumeRelError), 0.1);
 }
 
 TEST(bake_tetrahedralize, OpenSurfaceIsRejectedNamingAnEdge) {
