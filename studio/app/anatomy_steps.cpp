@@ -13,6 +13,7 @@
 #include <QDialog>
 #include <QDialogButtonBox>
 #include <QDir>
+#include <QDoubleSpinBox>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QFormLayout>
@@ -99,10 +100,11 @@ private:
 
 /// The remesh block as Make simulation-ready's settings `chosen` make it (Run remeshes this block;
 /// Apply writes it into the body).
-void applyChoice(RemeshSource& r, int voxels, int smoothing, const QString& uvMethod) {
+void applyChoice(RemeshSource& r, int voxels, int smoothing, const QString& uvMethod, double fillOpenings) {
     r.params.voxelSize = 0;
     r.params.voxelCount = voxels;
     r.params.smoothingIterations = smoothing;
+    r.params.fillOpenings = fillOpenings;
     r.uvTransfer = uvMethod == "none"      ? std::nullopt
                    : uvMethod == "closest" ? std::optional(bake::UvTransferMethod::ClosestPoint)
                    : uvMethod == "island"  ? std::optional(bake::UvTransferMethod::IslandLabelled)
@@ -378,6 +380,14 @@ void AnatomySteps::askSimulationReady() {
     smoothing->setObjectName("smoothing");
     smoothing->setRange(0, 100);
     smoothing->setValue(r.params.smoothingIterations);
+    auto* fill = new QDoubleSpinBox(dlg);
+    fill->setObjectName("fillOpenings");
+    fill->setRange(0, 100);
+    fill->setDecimals(1);
+    fill->setSuffix(tr(" mm"));
+    fill->setValue(r.params.fillOpenings * 1e3);
+    fill->setToolTip(tr("Open parts whose openings are all at most this wide are capped and made solid (an open "
+                        "duct becomes a solid one, not a hollow shell); 0: none"));
     auto* uv = new QComboBox(dlg);
     uv->setObjectName("uvTransfer");
     uv->addItems({"seam-cut", "closest", "island", "none"});
@@ -397,14 +407,16 @@ void AnatomySteps::askSimulationReady() {
     form->addRow(tr("Voxels along the longest axis"), voxels);
     form->addRow(QString(), size);
     form->addRow(tr("Smoothing passes"), smoothing);
+    form->addRow(tr("Fill openings up to"), fill);
     form->addRow(tr("UV transfer"), uv);
     auto* buttons = new QDialogButtonBox(QDialogButtonBox::Close, dlg);
     QPushButton* runButton = buttons->addButton(tr("Run"), QDialogButtonBox::AcceptRole);
     runButton->setObjectName("runRemesh");
     connect(buttons, &QDialogButtonBox::rejected, dlg, &QDialog::close);
-    connect(runButton, &QPushButton::clicked, this, [this, voxels, smoothing, uv] {
+    connect(runButton, &QPushButton::clicked, this, [this, voxels, smoothing, uv, fill] {
         QString why;
-        if (!makeSimulationReady(voxels->value(), smoothing->value(), uv->currentText(), &why)) fail(why);
+        if (!makeSimulationReady(voxels->value(), smoothing->value(), uv->currentText(), fill->value() * 1e-3, &why))
+            fail(why);
     });
     auto* layout = new QHBoxLayout(dlg);
     layout->addWidget(grid, 1);
@@ -417,7 +429,8 @@ void AnatomySteps::askSimulationReady() {
     dlg->show();
 }
 
-bool AnatomySteps::makeSimulationReady(int voxels, int smoothing, const QString& uvMethod, QString* why) {
+bool AnatomySteps::makeSimulationReady(int voxels, int smoothing, const QString& uvMethod, double fillOpenings,
+                                       QString* why) {
     const int b = remeshBody();
     if (b < 0) {
         if (why) *why = tr("Make simulation-ready: select a body made from anatomy");
@@ -429,7 +442,7 @@ bool AnatomySteps::makeSimulationReady(int voxels, int smoothing, const QString&
     // placement): Apply keeps this very surface (remesh_cache.hpp).
     Project candidate = m_doc->project();
     BodyProject& body = candidate.bodies[size_t(b)];
-    applyChoice(body.mesh.remesh, voxels, smoothing, uvMethod);
+    applyChoice(body.mesh.remesh, voxels, smoothing, uvMethod, fillOpenings);
     const QString projectFile = QDir(work).filePath("project.json");
     if (!writeProjectFile(candidate, projectFile, why)) {
         m_task.discard();
@@ -448,7 +461,7 @@ bool AnatomySteps::makeSimulationReady(int voxels, int smoothing, const QString&
                      "--result",
                      m_task.resultFile()};
     if (uvMethod != "none") args << "--uv-preview" << QDir(work).filePath("preview.png");
-    m_pendingRemesh = {voxels, smoothing, uvMethod, name};
+    m_pendingRemesh = {voxels, smoothing, uvMethod, fillOpenings, name};
     return run(kReady, args, 8, why);
 }
 
@@ -523,7 +536,8 @@ void AnatomySteps::applyRemesh(const Pending& chosen, const std::string& key, co
     const QString problem = m_doc->edit(
         tr("Make simulation-ready"),
         [&](Project& p) {
-            applyChoice(p.bodies.at(size_t(b)).mesh.remesh, chosen.voxels, chosen.smoothing, chosen.uvMethod);
+            applyChoice(p.bodies.at(size_t(b)).mesh.remesh, chosen.voxels, chosen.smoothing, chosen.uvMethod,
+                        chosen.fillOpenings);
         },
         0, Change{Change::Structure});
     if (!problem.isEmpty()) {
@@ -596,6 +610,9 @@ void AnatomySteps::showMeshingResult(const MeshingStepResult& result) {
                 .arg(f.degenerate)
                 .arg(f.slivers)
                 .arg(f.volume, 0, 'g', 4);
+    if (result.seededPoints > 0)
+        text += tr("thin parts: %1 surface point(s) the first refinement missed were seeded and meshed\n")
+                    .arg(result.seededPoints);
     const bool unstable = result.requiredSubsteps > result.substeps;
     if (unstable) // the load-time stability rule: the export would refuse this
         text += tr("unstable: stiffness number %1 at %2 substeps per frame; use at least %3 substeps\n")

@@ -70,7 +70,7 @@ public:
     /// The steps with their inputs (the actions ask for them). Each returns false and sets `why`
     /// (one line) when it cannot start; the result arrives through the task.
     bool importAnatomy(const QStringList& files, QString* why);
-    bool makeSimulationReady(int voxels, int smoothing, const QString& uvMethod, QString* why);
+    bool makeSimulationReady(int voxels, int smoothing, const QString& uvMethod, double fillOpenings, QString* why);
     bool tetrahedralize(QString* why);
 
     StudioTask& task() { return m_task; }
@@ -113,7 +113,8 @@ private:
     struct Pending {
         int voxels = 0, smoothing = 0;
         QString uvMethod;
-        QString body; ///< the body the remesh ran on (by name: the selection may change meanwhile)
+        double fillOpenings = 0; ///< m
+        QString body;            ///< the body the remesh ran on (by name: the selection may change meanwhile)
     } m_pendingRemesh;
 };
 

@@ -16,9 +16,11 @@
 #include <CGAL/AABB_tree.h>
 #include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/border.h>
 #include <CGAL/Polygon_mesh_processing/detect_features.h>
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 #include <CGAL/Surface_mesh.h>
 
 #include <algorithm>
@@ -52,6 +54,8 @@ void validate(const RemeshParams& p) {
     require(std::isfinite(p.targetEdgeLength) && p.targetEdgeLength >= 0, "targetEdgeLength",
             "must be finite and >= 0");
     require(p.remeshIterations >= 0 && p.remeshIterations <= 20, "remeshIterations", "must be in [0, 20]");
+    require(std::isfinite(p.fillOpenings) && p.fillOpenings >= 0 && p.fillOpenings <= 1, "fillOpenings",
+            "must be in [0, 1] m");
     require(std::isfinite(p.featureAngleDeg) && p.featureAngleDeg > 0 && p.featureAngleDeg <= 180, "featureAngleDeg",
             "must be in (0, 180]");
     require(p.maxTriangles >= 4, "maxTriangles", "must be at least 4");
@@ -293,6 +297,28 @@ void reportStage(const RemeshProgress& progress, const std::atomic<bool>* cancel
                  double fraction) {
     checkCancel(cancel);
     if (progress && !progress(stage, fraction)) throw RemeshCancelled();
+}
+
+sim::TriMesh capOpenings(const sim::TriMesh& mesh, const std::string& name) {
+    SurfaceMesh sm;
+    std::vector<SurfaceMesh::Vertex_index> v;
+    v.reserve(mesh.vertexCount());
+    for (const sim::Vec3& p : mesh.positions())
+        v.push_back(sm.add_vertex(K::Point_3(p.x(), p.y(), p.z())));
+    for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+        const sim::Tri& tri = mesh.triangles()[t];
+        if (sm.add_face(v[tri[0]], v[tri[1]], v[tri[2]]) == SurfaceMesh::null_face())
+            throw InputError(name + ": cannot fill its openings: the surface is not manifold at triangle " +
+                             std::to_string(t));
+    }
+    std::vector<SurfaceMesh::Halfedge_index> cycles;
+    PMP::extract_boundary_cycles(sm, std::back_inserter(cycles));
+    for (SurfaceMesh::Halfedge_index h : cycles) {
+        std::vector<SurfaceMesh::Face_index> added;
+        PMP::triangulate_hole(sm, h, std::back_inserter(added));
+        if (added.empty()) throw InputError(name + ": an opening could not be filled (CGAL hole triangulation)");
+    }
+    return toTriMesh(sm);
 }
 
 void checkCancel(const std::atomic<bool>* cancel) {

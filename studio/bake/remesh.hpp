@@ -80,7 +80,11 @@ struct RemeshParams {
     int smoothingIterations = 0; ///< mean-curvature passes on the combined level set, in [0, 100]
     /// Target edge length of the result, m; 0: 1.5 voxels. Not below half a voxel.
     double targetEdgeLength = 0;
-    int remeshIterations = 3;        ///< CGAL isotropic remeshing iterations, in [0, 20] (0: the isosurface)
+    int remeshIterations = 3; ///< CGAL isotropic remeshing iterations, in [0, 20] (0: the isosurface)
+    /// Open parts whose openings are all at most this wide (m, a hole's bounding-box diagonal) are
+    /// capped (CGAL hole triangulation) and taken as closed, so that an open tube (a duct) becomes
+    /// a solid one instead of a hollow shell 1.5 voxels thick; 0: none, in [0, 1].
+    double fillOpenings = 0;
     double featureAngleDeg = 60;     ///< dihedral angle that makes an edge hard, degrees, in (0, 180]
     int maxVoxelsPerAxis = 2048;     ///< refuses finer grids
     size_t maxTriangles = 2'000'000; ///< refuses larger results (isosurface or remeshed)
@@ -98,6 +102,7 @@ struct RemeshReport {
     size_t openParts = 0;        ///< parts meshed through the unsigned-distance fallback
     size_t closedHoles = 0;      ///< parts with holes narrower than the band, closed over them
     size_t leakedParts = 0;      ///< parts with small holes whose inside leaked out, thickened instead
+    size_t filledParts = 0;      ///< open parts capped under RemeshParams::fillOpenings, taken as closed
     size_t isoTriangles = 0;     ///< triangles of the isosurface
     size_t featureEdges = 0;     ///< edges held as hard edges while remeshing
     size_t vertices = 0, triangles = 0;
@@ -164,6 +169,10 @@ double secondsSince(std::chrono::steady_clock::time_point t0);
 /// The largest extent (bounding-box diagonal, m) of a hole of `mesh`: a loop of edges that belong
 /// to one triangle only; 0 when there is none. O(triangles).
 double largestHoleDiameter(const sim::TriMesh& mesh);
+
+/// `mesh` with every hole capped by CGAL's hole triangulation (remesh.cpp); throws InputError
+/// naming `name` when a hole cannot be capped.
+sim::TriMesh capOpenings(const sim::TriMesh& mesh, const std::string& name);
 
 /// Throws RemeshCancelled when progress returns false or *cancel becomes true.
 sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const RemeshParams& params,

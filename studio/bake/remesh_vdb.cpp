@@ -166,6 +166,7 @@ struct LevelSetContext {
     const openvdb::math::Transform& xform;
     double voxelSize;
     float band;
+    double fillOpenings; ///< RemeshParams::fillOpenings, m
     CancelInterrupter& interrupter;
     const std::atomic<bool>* cancel;
     std::vector<openvdb::Vec3s> points;
@@ -213,11 +214,22 @@ openvdb::FloatGrid::Ptr shellLevelSet(const RemeshPart& part, LevelSetContext& c
                                                               shellQuads, ctx.band);
 }
 
-/// One part's level set: closed (holes included, if they close) or thickened.
+/// One part's level set: closed (holes included, if they close; openings up to fillOpenings capped
+/// first) or thickened.
 openvdb::FloatGrid::Ptr partLevelSet(const RemeshPart& part, LevelSetContext& ctx, RemeshReport& report) {
-    toVdb(part.surface, ctx.points, ctx.tris);
     openvdb::FloatGrid::Ptr grid;
     const double hole = part.surface.isClosedOriented() ? 0.0 : largestHoleDiameter(part.surface);
+    if (hole > 0 && hole <= ctx.fillOpenings) {
+        const RemeshPart filled{part.name, capOpenings(part.surface, part.name), part.op, {}};
+        toVdb(filled.surface, ctx.points, ctx.tris);
+        grid = closedLevelSet(filled, 0.0, ctx, report);
+        checkCancel(ctx.cancel);
+        if (grid) {
+            ++report.filledParts;
+            return grid;
+        }
+    }
+    toVdb(part.surface, ctx.points, ctx.tris);
     const bool thicken = hole >= kMaxClosedHoleVoxels * ctx.voxelSize;
     if (!thicken) grid = closedLevelSet(part, hole, ctx, report);
     if (!grid) grid = shellLevelSet(part, ctx, report);
@@ -276,7 +288,7 @@ sim::TriMesh combinedIsosurface(const std::vector<RemeshPart>& parts, const Reme
     const double vs = gridVoxelSize(parts, params, report);
     const auto xform = openvdb::math::Transform::createLinearTransform(vs);
     CancelInterrupter interrupter(cancel);
-    LevelSetContext ctx{*xform, vs, float(params.bandVoxels), interrupter, cancel, {}, {}};
+    LevelSetContext ctx{*xform, vs, float(params.bandVoxels), params.fillOpenings, interrupter, cancel, {}, {}};
 
     const auto t0 = Clock::now();
     openvdb::FloatGrid::Ptr combined;

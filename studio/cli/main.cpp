@@ -144,6 +144,8 @@ constexpr const char* kRemeshHelp =
     "  --smooth N          mean-curvature smoothing passes (default 0)\n"
     "  --edge-length M     target edge length, m (default 1.5 voxels)\n"
     "  --iterations N      remeshing iterations (default 3; 0 keeps the isosurface)\n"
+    "  --fill-openings M   cap the openings of open parts up to M wide, m (an open duct becomes\n"
+    "                      solid, not a hollow shell; default: none)\n"
     "  --feature-angle D   dihedral angle that makes an edge hard, degrees (default 60)\n"
     "When every part has UVs (the sample does), the result is cut along the parts' UV seams,\n"
     "remeshed with the seam edges hard and given UVs by seam cutting [A 3.3.4]; the closest-point\n"
@@ -613,7 +615,10 @@ RemeshArgs parseRemeshArgs(const std::vector<std::string>& args) {
             params.targetEdgeLength = parsePositive(a, value());
         else if (a == "--iterations")
             params.remeshIterations = parseCount(a, value(), 0, 20);
-        else if (a == "--feature-angle") {
+        else if (a == "--fill-openings") {
+            params.fillOpenings = parsePositive(a, value());
+            if (params.fillOpenings > 1) throw std::invalid_argument("--fill-openings must be in (0, 1] m");
+        } else if (a == "--feature-angle") {
             params.featureAngleDeg = parsePositive(a, value());
             if (params.featureAngleDeg > 180) throw std::invalid_argument("--feature-angle must be in (0, 180]");
         } else if (a == "-o" || a == "--output")
@@ -690,9 +695,9 @@ std::vector<bake::RemeshPart> loadRemeshParts(const RemeshArgs& a) {
 
 void printRemeshReport(const bake::RemeshReport& q, double secs) {
     std::printf("grid: voxel %.4g mm, %d x %d x %d voxels, %zu active; %zu open part(s) thickened (%zu of them "
-                "leaked), %zu closed over small holes\n",
+                "leaked), %zu closed over small holes, %zu filled\n",
                 q.voxelSize * 1e3, q.voxels[0], q.voxels[1], q.voxels[2], q.activeVoxels, q.openParts, q.leakedParts,
-                q.closedHoles);
+                q.closedHoles, q.filledParts);
     std::printf("isosurface: %zu triangles, volume %.6g m^3\n", q.isoTriangles, q.isoVolume);
     std::printf("result: %zu vertices, %zu triangles, target edge %.4g mm, %zu hard edges\n", q.vertices, q.triangles,
                 q.targetEdgeLength * 1e3, q.featureEdges);

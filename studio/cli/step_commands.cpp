@@ -104,8 +104,9 @@ int cmdMesh(const std::vector<std::string>& args) {
     const auto t0 = std::chrono::steady_clock::now();
     const uint64_t remeshes = studio::remeshRunCount();
     std::unique_ptr<sim::TetMesh> mesh;
+    size_t seeded = 0;
     try {
-        mesh = studio::buildBodyMesh(b, origin, nullptr, project.dir);
+        mesh = studio::buildBodyMesh(b, origin, nullptr, project.dir, &seeded);
     } catch (const std::invalid_argument& e) {
         throw InputError(origin + ": " + field + ".mesh: " + e.what());
     }
@@ -124,10 +125,13 @@ int cmdMesh(const std::vector<std::string>& args) {
         r.stiffnessNumber = f.maxStiffnessNumber;
     }
     r.remeshReused = b.mesh.kind == studio::MeshSource::Kind::Remesh && studio::remeshRunCount() == remeshes;
+    r.seededPoints = static_cast<int64_t>(seeded);
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("meshed body %s: %zu nodes, %zu tets, %zu fixed in %.2f s%s\n", be.name.c_str(), be.nodes, be.tets,
                 be.fixedNodes, r.seconds, r.remeshReused ? " (the kept remesh)" : "");
     printQuality(be.quality);
+    if (seeded > 0)
+        std::printf("  thin parts: %zu surface point(s) the first refinement missed, seeded and meshed\n", seeded);
     std::printf("  stability: stiffness number %.3g at %d substeps per frame; %d needed\n", r.stiffnessNumber,
                 r.substeps, r.requiredSubsteps);
     if (a.out) {

@@ -152,7 +152,7 @@ void writePlacement(const bake::ImportPlacement& p, json& j) {
 /// The "remesh" block (RemeshSource): the numbers by the rules of bake::RemeshParams.
 RemeshSource readRemesh(const JsonField& r, const std::filesystem::path& dir) {
     r.object({"parts", "unit", "scale", "rotation_deg", "voxel_size", "voxel_count", "smoothing", "edge_length",
-              "iterations", "uv_transfer", "texture"});
+              "iterations", "fill_openings", "uv_transfer", "texture"});
     RemeshSource out;
     const JsonField parts = r["parts"];
     if (!parts.value().is_array() || parts.value().empty() || parts.value().size() > 64)
@@ -176,6 +176,7 @@ RemeshSource readRemesh(const JsonField& r, const std::filesystem::path& dir) {
     q.smoothingIterations = r.integer("smoothing", q.smoothingIterations, 0, 100);
     q.targetEdgeLength = r.number("edge_length", 0.0, NumberRule::positive());
     q.remeshIterations = r.integer("iterations", q.remeshIterations, 0, 20);
+    q.fillOpenings = r.number("fill_openings", 0.0, NumberRule::aboveUpTo(0, 1));
     if (auto u = r.find("uv_transfer")) {
         const std::string m = u->choice({"seam-cut", "closest", "island", "none"}, "a UV transfer method");
         out.uvTransfer = m == "none"      ? std::nullopt
@@ -209,6 +210,7 @@ json remeshJson(const RemeshSource& r, const WriteContext& w, const std::string&
     else
         j["voxel_count"] = r.params.voxelCount;
     if (r.params.targetEdgeLength > 0) j["edge_length"] = r.params.targetEdgeLength;
+    if (r.params.fillOpenings > 0) j["fill_openings"] = r.params.fillOpenings;
     if (!r.texture.empty()) j["texture"] = projectFileJson(r.texture, w, field + ".texture");
     writePlacement(r.placement, j);
     return j;
@@ -883,11 +885,13 @@ namespace {
 /// boundary triangle).
 std::unique_ptr<sim::TetMesh> remeshBody(const RemeshSource& r, const bake::MeshingParams& meshing,
                                          std::vector<render::CornerUvF>* boundaryUv,
-                                         const std::filesystem::path& projectDir) {
+                                         const std::filesystem::path& projectDir, size_t& seededPoints) {
     RemeshedSurface s = keptOrFreshRemesh(r, projectDir);
     bake::MeshingParams smooth = meshing;
     smooth.featureAngleDeg = 0; // the voxel remesh rounded every edge: no feature to protect
-    std::unique_ptr<sim::TetMesh> mesh = bake::tetrahedralize(s.hull, smooth).mesh;
+    bake::TetrahedralizeResult meshed = bake::tetrahedralize(s.hull, smooth);
+    seededPoints = meshed.report.missedSurfaceSeeds;
+    std::unique_ptr<sim::TetMesh> mesh = std::move(meshed.mesh);
     if (!boundaryUv || s.uv.empty()) return mesh;
     const bake::UvSource remeshed({{"remeshed surface", std::move(s.surface), bake::CsgOp::Union, std::move(s.uv)}});
     auto probe = mesh->clone(); // the boundary in the render mesh's order
@@ -904,19 +908,26 @@ std::unique_ptr<sim::TetMesh> remeshBody(const RemeshSource& r, const bake::Mesh
 
 std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::string& origin,
                                             std::vector<render::CornerUvF>* boundaryUv,
-                                            const std::filesystem::path& projectDir) {
+                                            const std::filesystem::path& projectDir, size_t* seededPoints) {
     const MeshSource& s = body.mesh;
     bake::MeshingParams params = s.meshing;
     params.label = origin + ": body '" + body.scene.name + "'";
+    size_t seeded = 0;
+    if (seededPoints) *seededPoints = 0;
+    auto meshed = [&](const sim::TriMesh& surface) {
+        bake::TetrahedralizeResult r = bake::tetrahedralize(surface, params);
+        if (seededPoints) *seededPoints = r.report.missedSurfaceSeeds;
+        return std::move(r.mesh);
+    };
     switch (s.kind) {
     case MeshSource::Kind::Box:
         return sim::makeBoxTetMesh(s.box);
     case MeshSource::Kind::Ellipsoid:
-        return bake::tetrahedralize(sim::makeEllipsoidSurface(s.center, s.radii, s.slices, s.stacks), params).mesh;
+        return meshed(sim::makeEllipsoidSurface(s.center, s.radii, s.slices, s.stacks));
     case MeshSource::Kind::Liver:
-        return bake::tetrahedralize(sim::makeLiverSurface(s.center, s.radii, s.wedge, s.slices, s.stacks), params).mesh;
+        return meshed(sim::makeLiverSurface(s.center, s.radii, s.wedge, s.slices, s.stacks));
     case MeshSource::Kind::Tube:
-        return bake::tetrahedralize(sim::makeTubeSurface(s.center, s.end, s.radius, s.slices, s.stacks), params).mesh;
+        return meshed(sim::makeTubeSurface(s.center, s.end, s.radius, s.slices, s.stacks));
     case MeshSource::Kind::HollowTube:
         return sim::makeHollowTubeTetMesh(s.hollow);
     case MeshSource::Kind::File: {
@@ -924,10 +935,13 @@ std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::
         bake::ImportOptions opt;
         opt.scale = s.scale;
         params.label = s.file.filename().string();
-        return bake::tetrahedralize(bake::importSurface(s.file, opt), params).mesh;
+        return meshed(bake::importSurface(s.file, opt));
     }
-    case MeshSource::Kind::Remesh:
-        return remeshBody(s.remesh, params, boundaryUv, projectDir);
+    case MeshSource::Kind::Remesh: {
+        std::unique_ptr<sim::TetMesh> mesh = remeshBody(s.remesh, params, boundaryUv, projectDir, seeded);
+        if (seededPoints) *seededPoints = seeded;
+        return mesh;
+    }
     }
     throw InputError(origin + ": unknown mesh source");
 }

@@ -442,10 +442,12 @@ ExportResult exportCase(const Project& project, const std::filesystem::path& out
 /// Builds one body's tet mesh from its source (exposed for the import command and tests). A
 /// remesh body's surface is the one kept in <projectDir>/cache by Make simulation-ready's Apply
 /// when it is there for the block as it is (remesh_cache.hpp), else it is remeshed now; an empty
-/// projectDir always remeshes.
+/// projectDir always remeshes. `seededPoints`, when given, receives the meshing's
+/// bake::MeshingReport::missedSurfaceSeeds (0 for a mesh not made by tetrahedralize).
 std::unique_ptr<sim::TetMesh> buildBodyMesh(const BodyProject& body, const std::string& origin,
                                             std::vector<render::CornerUvF>* boundaryUv = nullptr,
-                                            const std::filesystem::path& projectDir = {});
+                                            const std::filesystem::path& projectDir = {},
+                                            size_t* seededPoints = nullptr);
 
 /// A file named by a project.json field: a relative path by the entry-name rule (no '..', not
 /// absolute) inside the project folder `dir` through links too; InputError naming the field and

@@ -124,6 +124,9 @@ std::string remeshKey(const RemeshSource& r) {
                   pl.rotationDeg.z(), q.voxelSize, q.voxelCount, q.bandVoxels, q.smoothingIterations,
                   q.targetEdgeLength, q.remeshIterations, q.featureAngleDeg, q.maxVoxelsPerAxis, q.maxTriangles,
                   r.uvTransfer ? int(*r.uvTransfer) : -1);
+    if (q.fillOpenings > 0) { // only then: the keys of blocks without it stay as they were
+        std::snprintf(buf + std::strlen(buf), sizeof buf - std::strlen(buf), "fill %.17g\n", q.fillOpenings);
+    }
     return vcase::sha256Hex(text + buf);
 }
 

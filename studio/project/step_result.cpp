@@ -154,11 +154,13 @@ json toJson(const MeshingStepResult& r) {
             {"required_substeps", r.requiredSubsteps},
             {"stiffness_number", r.stiffnessNumber},
             {"remesh_reused", r.remeshReused},
-            {"seconds", r.seconds}};
+            {"seconds", r.seconds},
+            {"seeded_surface_points", r.seededPoints}};
 }
 
 MeshingStepResult readMeshing(const JsonField& f) {
-    f.object({"kind", "body", "substeps", "required_substeps", "stiffness_number", "remesh_reused", "seconds"});
+    f.object({"kind", "body", "substeps", "required_substeps", "stiffness_number", "remesh_reused", "seconds",
+              "seeded_surface_points"});
     MeshingStepResult r;
     r.body = readBody(f["body"]);
     r.substeps = f["substeps"].integer(1, INT32_MAX);
@@ -166,6 +168,7 @@ MeshingStepResult readMeshing(const JsonField& f) {
     r.stiffnessNumber = f["stiffness_number"].number(NumberRule::nonNegative());
     r.remeshReused = f["remesh_reused"].boolean();
     r.seconds = f["seconds"].number(NumberRule::nonNegative());
+    r.seededPoints = count(f["seeded_surface_points"]);
     return r;
 }
 

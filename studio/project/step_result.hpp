@@ -78,6 +78,9 @@ struct MeshingStepResult {
     double stiffnessNumber = 0; ///< the largest over the tets (limit sim::kMaxStiffnessNumber)
     bool remeshReused = false;  ///< the body's kept remesh was read instead of remeshing
     double seconds = 0;
+    /// Surface points seeded after the first refinement on thin parts it missed
+    /// (bake::MeshingReport::missedSurfaceSeeds); 0: it covered the whole surface.
+    int64_t seededPoints = 0;
     bool operator==(const MeshingStepResult&) const = default;
 };
 struct ExportStepResult {

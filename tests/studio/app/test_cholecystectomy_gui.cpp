@@ -38,6 +38,7 @@
 #include <QDialog>
 #include <QDialogButtonBox>
 #include <QDockWidget>
+#include <QDoubleSpinBox>
 #include <QElapsedTimer>
 #include <QFileDialog>
 #include <QInputDialog>
@@ -388,7 +389,8 @@ struct CholeSteps : CholeFixture {
         ASSERT_EQ(model().bodies[0].mesh.remesh.parts.size(), 4u);
     }
     /// 3. Mesh → Make simulation-ready…: 200 voxels along the longest axis (the 1.5 mm artery
-    /// needs them), Run, Apply.
+    /// needs them), openings up to 12 mm filled (the open ducts become solid, not hollow shells),
+    /// Run, Apply.
     void makeSimulationReady() {
         clock.restart();
         steps()->simulationReadyAction()->trigger();
@@ -398,6 +400,12 @@ struct CholeSteps : CholeFixture {
         voxels->selectAll();
         QTest::keyClicks(voxels, "200");
         actions += 2;
+        auto* fill = steps()->settingsDialog()->findChild<QDoubleSpinBox*>("fillOpenings");
+        ASSERT_NE(fill, nullptr);
+        fill->setFocus();
+        fill->selectAll();
+        QTest::keyClicks(fill, "12");
+        actions += 2;
         clickButton(steps()->settingsDialog()->findChild<QPushButton*>("runRemesh"));
         ASSERT_TRUE(
             test::waitFor([&] { return steps()->resultDialog() && steps()->resultDialog()->isVisible(); }, 240000))
@@ -406,6 +414,7 @@ struct CholeSteps : CholeFixture {
                     HasSubstr("closed yes, manifold yes"));
         clickButton(steps()->resultDialog()->findChild<QPushButton*>("applyRemesh"));
         EXPECT_EQ(model().bodies[0].mesh.remesh.params.voxelCount, 200);
+        EXPECT_DOUBLE_EQ(model().bodies[0].mesh.remesh.params.fillOpenings, 0.012);
         timings.emplace_back("make simulation-ready", since(clock));
         if (QDialog* settings = steps()->settingsDialog(); settings && settings->isVisible())
             clickButton(settings->findChild<QDialogButtonBox*>()->button(QDialogButtonBox::Close));
@@ -429,6 +438,8 @@ struct CholeSteps : CholeFixture {
             meshed = steps()->resultDialog()->findChild<QLabel*>("meshingFigures")->text();
         }
         EXPECT_THAT(meshed.toStdString(), HasSubstr("0 inverted"));
+        EXPECT_THAT(meshed.toStdString(), HasSubstr("surface point(s) the first refinement missed were seeded"))
+            << "the thin artery, seeded";
         EXPECT_FALSE(meshed.contains("unstable")) << meshed.toStdString();
         timings.emplace_back("tetrahedralize", since(clock));
         std::printf("tetrahedralized: %s\n", meshed.section('\n', 0, 0).toStdString().c_str());
@@ -813,6 +824,11 @@ struct CholeSteps : CholeFixture {
             << failed.toStdString();
         EXPECT_TRUE(failed.contains(QRegularExpression("clips_on_target 0 count \\(limit ≥ 4\\) FAIL")))
             << failed.toStdString();
+        std::printf("%s\n", failed.section("step time", 1, 1)
+                                .section('\n', 0, 0)
+                                .prepend("unclipped: step time")
+                                .toStdString()
+                                .c_str());
         if (const char* dir = std::getenv("VISCERA_GUI_SHOTS"); dir && *dir)
             for (const auto& [name, seconds] : std::vector<std::pair<QString, double>>{
                      {"chole_scope_start", 0.5}, {"chole_scope_clipped", afterClips}, {"chole_scope_cut", end}})

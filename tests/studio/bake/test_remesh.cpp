@@ -125,6 +125,44 @@ TEST(bake_remesh, AnOpenPartIsThickenedIntoAClosedShell) {
     EXPECT_LT(r.report.distanceMaxMm, 2.0 * r.report.voxelSize * 1e3);
 }
 
+// An open tube (a duct as bought anatomy has it: no end caps) with its openings filled becomes a
+// solid cylinder of the tube's volume; openings wider than the limit leave it a hollow shell.
+TEST(bake_remesh, OpeningsUpToTheFillWidthAreCappedAndTheTubeIsSolid) {
+    const sim::Vec3 a(0, 0, 0), b(0.03, 0, 0);
+    const double radius = 0.004;
+    const sim::TriMesh closed = sim::makeTubeSurface(a, b, radius, 24, 12);
+    std::vector<sim::Tri> open; // the caps off: triangles with all corners on an end plane
+    for (const sim::Tri& t : closed.triangles()) {
+        bool cap = true;
+        for (const double end : {0.0, 0.03}) {
+            bool onEnd = true;
+            for (int32_t v : t)
+                onEnd = onEnd && std::abs(closed.positions()[v].x() - end) < 1e-9;
+            cap = cap && !onEnd;
+        }
+        if (cap) open.push_back(t);
+    }
+    std::vector<bake::RemeshPart> parts{
+        {"duct", sim::TriMesh::fromArrays(closed.positions(), open), bake::CsgOp::Union, {}}};
+    ASSERT_FALSE(parts[0].surface.isClosedOriented());
+    bake::RemeshParams p = params(96);
+    p.fillOpenings = 0.012; // the 8 mm openings' box diagonal is 11.3 mm
+    const bake::RemeshResult filled = bake::voxelRemesh(parts, p);
+    expectSound(filled);
+    EXPECT_EQ(filled.report.filledParts, 1u);
+    EXPECT_EQ(filled.report.openParts, 0u);
+    const double solid = M_PI * radius * radius * 0.03;
+    EXPECT_NEAR(filled.report.volume, solid, 0.08 * solid);
+    p.fillOpenings = 0.01; // narrower than the openings: a shell
+    const bake::RemeshResult shell = bake::voxelRemesh(parts, p);
+    expectSound(shell);
+    EXPECT_EQ(shell.report.filledParts, 0u);
+    EXPECT_EQ(shell.report.openParts, 1u);
+    EXPECT_LT(shell.report.volume, 0.7 * solid);
+    p.fillOpenings = -1;
+    EXPECT_THROW(bake::voxelRemesh(parts, p), std::invalid_argument);
+}
+
 TEST(bake_remesh, TheResultTetrahedralizes) {
     const bake::RemeshResult r = bake::voxelRemesh(twoCubes(bake::CsgOp::Union), params(48));
     const bake::TetrahedralizeResult t = expectTetrahedralizes(r, 0.003, 0.002, 100);

@@ -65,6 +65,7 @@ TEST_F(RemeshBlock, TheKidneySampleRoundTripsThroughTheOneReaderAndWriter) {
     r["voxel_size"] = 0.0015;
     r["edge_length"] = 0.002;
     r["smoothing"] = 2;
+    r["fill_openings"] = 0.006;
     r["uv_transfer"] = "island";
     r["parts"][1]["op"] = "difference";
     const studio::Project q = studio::loadProjectText(doc.dump(1), m_dir, (m_dir / "project.json").string());
@@ -72,6 +73,7 @@ TEST_F(RemeshBlock, TheKidneySampleRoundTripsThroughTheOneReaderAndWriter) {
     EXPECT_EQ(s.params.voxelSize, 0.0015);
     EXPECT_EQ(s.params.targetEdgeLength, 0.002);
     EXPECT_EQ(s.params.smoothingIterations, 2);
+    EXPECT_EQ(s.params.fillOpenings, 0.006);
     EXPECT_EQ(s.uvTransfer, bake::UvTransferMethod::IslandLabelled);
     EXPECT_EQ(s.parts[1].op, bake::CsgOp::Difference);
     const std::string again = studio::projectJsonText(q);
@@ -88,6 +90,8 @@ TEST_F(RemeshBlock, EveryFieldIsRefusedByNameAndRule) {
     EXPECT_THAT(loadError([](json& r) { r["voxel_count"] = 4; }), HasSubstr(at + "voxel_count"));
     EXPECT_THAT(loadError([](json& r) { r["smoothing"] = 101; }), HasSubstr(at + "smoothing"));
     EXPECT_THAT(loadError([](json& r) { r["iterations"] = -1; }), HasSubstr(at + "iterations"));
+    EXPECT_THAT(loadError([](json& r) { r["fill_openings"] = 0; }), HasSubstr(at + "fill_openings"));
+    EXPECT_THAT(loadError([](json& r) { r["fill_openings"] = 2; }), HasSubstr(at + "fill_openings"));
     EXPECT_THAT(loadError([](json& r) { r["scale"] = 0; }), HasSubstr(at + "scale"));
     EXPECT_THAT(loadError([](json& r) { r["uv_transfer"] = "nearest"; }), HasSubstr(at + "uv_transfer"));
     EXPECT_THAT(loadError([](json& r) { r["texture"] = "anatomy/kidney.jpg"; }),

@@ -39,7 +39,7 @@ std::vector<studio::StepResult> samples() {
     r.uv = {{"closest", 12, 1.5, 0.002}, {"island", 3, 0.75, 0.001}, {"seam-cut", 0, 0.25, 0.0}};
     r.preview = "/p/.viscera-task-1/preview.png";
     r.seconds = 2.5;
-    studio::MeshingStepResult m{body(), 10, 14, 1.9, true, 3.25};
+    studio::MeshingStepResult m{body(), 10, 14, 1.9, true, 3.25, 14};
     studio::ExportStepResult e;
     e.casePath = "/out/case.vcase";
     e.bytes = 123456;
