@@ -92,7 +92,8 @@ size_t remeshWithHardEdges(SurfaceMesh& sm, double edge, const RemeshParams& par
     return features;
 }
 
-SurfaceMesh toSurfaceMesh(const sim::TriMesh& m) {
+/// `what` names the surface in the refusal ("remesh: the isosurface is not manifold at triangle 7").
+SurfaceMesh toSurfaceMesh(const sim::TriMesh& m, const std::string& what = "remesh: the isosurface") {
     SurfaceMesh sm;
     std::vector<SurfaceMesh::Vertex_index> v;
     v.reserve(m.vertexCount());
@@ -101,7 +102,7 @@ SurfaceMesh toSurfaceMesh(const sim::TriMesh& m) {
     for (size_t t = 0; t < m.triangleCount(); ++t) {
         const sim::Tri& tri = m.triangles()[t];
         if (sm.add_face(v[tri[0]], v[tri[1]], v[tri[2]]) == SurfaceMesh::null_face())
-            throw InputError("remesh: the isosurface is not manifold at triangle " + std::to_string(t));
+            throw InputError(what + " is not manifold at triangle " + std::to_string(t));
     }
     return sm;
 }
@@ -300,17 +301,7 @@ void reportStage(const RemeshProgress& progress, const std::atomic<bool>* cancel
 }
 
 sim::TriMesh capOpenings(const sim::TriMesh& mesh, const std::string& name) {
-    SurfaceMesh sm;
-    std::vector<SurfaceMesh::Vertex_index> v;
-    v.reserve(mesh.vertexCount());
-    for (const sim::Vec3& p : mesh.positions())
-        v.push_back(sm.add_vertex(K::Point_3(p.x(), p.y(), p.z())));
-    for (size_t t = 0; t < mesh.triangleCount(); ++t) {
-        const sim::Tri& tri = mesh.triangles()[t];
-        if (sm.add_face(v[tri[0]], v[tri[1]], v[tri[2]]) == SurfaceMesh::null_face())
-            throw InputError(name + ": cannot fill its openings: the surface is not manifold at triangle " +
-                             std::to_string(t));
-    }
+    SurfaceMesh sm = toSurfaceMesh(mesh, name + ": cannot fill its openings: the surface");
     std::vector<SurfaceMesh::Halfedge_index> cycles;
     PMP::extract_boundary_cycles(sm, std::back_inserter(cycles));
     for (SurfaceMesh::Halfedge_index h : cycles) {
