@@ -406,6 +406,7 @@ struct CholeSteps : CholeFixture {
         fill->selectAll();
         QTest::keyClicks(fill, "12");
         actions += 2;
+        shot("chole_simulation_ready_settings");
         clickButton(steps()->settingsDialog()->findChild<QPushButton*>("runRemesh"));
         ASSERT_TRUE(
             test::waitFor([&] { return steps()->resultDialog() && steps()->resultDialog()->isVisible(); }, 240000))
@@ -443,6 +444,7 @@ struct CholeSteps : CholeFixture {
         EXPECT_FALSE(meshed.contains("unstable")) << meshed.toStdString();
         timings.emplace_back("tetrahedralize", since(clock));
         std::printf("tetrahedralized: %s\n", meshed.section('\n', 0, 0).toStdString().c_str());
+        shot("chole_tetrahedralize_result");
         steps()->resultDialog()->close();
         ASSERT_TRUE(test::waitFor([&] { return w->viewport()->meshCount() > 0; }, 120000))
             << "the preview draws the body";
