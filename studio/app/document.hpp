@@ -23,6 +23,16 @@
 
 namespace viscera::studio {
 
+/// What the studio gives a body a tissue layer covers when it enters the tissues the hook and the
+/// scissors cut beside the layer. The hook's burn is a dose (sim::Dissection: τ_e = Σ ξ ū_e δt /
+/// t_ref against the ignition): the layer (160 °C, ξ 0.4) opens after 160 / (0.4 · 170) = 2.4
+/// reference frames at the hook's 170 °C, the organ under it after 400 / (0.05 · 170) = 47
+/// (0.78 s), longer than a pass of the hook lasts over an edge; so the hook opens the layer and
+/// leaves the organ, and the scissors (a cold cut) divide both. Measured on the cholecystectomy:
+/// at the layer's own 160 °C / 0.4 the hook's pass burned 80 of the duct's edges and divided it.
+inline constexpr double kCoveredBodyIgnitionC = 400;
+inline constexpr double kCoveredBodyConductivity = 0.05;
+
 /// What an edit changed: the panels and the preview redo only what depends on it.
 struct Change {
     enum Part : unsigned {

@@ -78,6 +78,25 @@ Change bodyChange() {
     return {Change::Structure | Change::Scene | Change::Assessment, -1};
 }
 
+/// A first tissue layer added to a scene whose hook or scissors cut only bodies: the layer enters
+/// their tissues (the dissection takes one layer), and the body it covers, cut at the reader's
+/// defaults, takes kCoveredBodyIgnitionC and kCoveredBodyConductivity so that the hook opens the
+/// layer over it.
+void cutLayerToo(Project& q) {
+    if (!q.scene.interaction || q.scene.interaction->tissues.empty()) return;
+    std::vector<sim::DissectionTissueDesc>& tissues = q.scene.interaction->tissues;
+    const SurfaceProject& layer = q.surfaces.front();
+    for (sim::DissectionTissueDesc& t : tissues)
+        if (t.layer == layer.scene.attachTo && t.ignitionC == sim::DissectionTissueDesc{}.ignitionC &&
+            t.conductivity == sim::DissectionTissueDesc{}.conductivity) {
+            t.ignitionC = kCoveredBodyIgnitionC;
+            t.conductivity = kCoveredBodyConductivity;
+        }
+    sim::DissectionTissueDesc t;
+    t.layer = layer.scene.name;
+    tissues.insert(tissues.begin(), t);
+}
+
 } // namespace
 
 QString Document::renameBody(int body, const QString& name) {
@@ -124,7 +143,11 @@ QString Document::addLayer(int body) {
     return edit(
         tr("Add tissue layer %1 over %2")
             .arg(QString::fromStdString(name), QString::fromStdString(layer.scene.attachTo)),
-        [&](Project& q) { q.surfaces.push_back(layer); }, 0, bodyChange());
+        [&](Project& q) {
+            q.surfaces.push_back(layer);
+            if (q.surfaces.size() == 1) cutLayerToo(q);
+        },
+        0, bodyChange());
 }
 
 QString Document::removeLayer(int surface) {
@@ -133,11 +156,21 @@ QString Document::removeLayer(int surface) {
     const Project& p = *m_project;
     const std::string name = p.surfaces[static_cast<size_t>(surface)].scene.name;
     // names are unique across bodies and layers: only the interaction's tissues can name a layer
-    if (QString why = namedByRefusal(p, "surfaces[" + std::to_string(surface) + "]", name, -1); !why.isEmpty())
+    // the interaction's tissues may name it: the layer leaves them with it (when a tissue is left)
+    Project without = p;
+    if (auto& in = without.scene.interaction) {
+        std::erase_if(in->tissues, [&](const sim::DissectionTissueDesc& t) { return t.layer == name; });
+        if (in->tissues.empty()) without.scene.interaction = p.scene.interaction;
+    }
+    if (QString why = namedByRefusal(without, "surfaces[" + std::to_string(surface) + "]", name, -1); !why.isEmpty())
         return why;
     return edit(
         tr("Delete tissue layer %1").arg(QString::fromStdString(name)),
-        [surface](Project& q) { q.surfaces.erase(q.surfaces.begin() + surface); }, 0, bodyChange());
+        [&](Project& q) {
+            q.surfaces.erase(q.surfaces.begin() + surface);
+            q.scene.interaction = without.scene.interaction;
+        },
+        0, bodyChange());
 }
 
 } // namespace viscera::studio

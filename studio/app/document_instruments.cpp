@@ -224,12 +224,25 @@ std::string newInstrumentName(const Project& p, Kind kind, const std::string& tr
     throw InputError((p.dir / "tools").string() + ": no free track file name for a new " + base);
 }
 
-/// What an energy hook may cut when the scene names nothing: the first surface (a fascia), else
-/// the first body, with the reader's defaults.
-sim::DissectionTissueDesc defaultTissue(const Project& p) {
-    sim::DissectionTissueDesc t;
-    t.layer = p.surfaces.empty() ? p.bodies.front().scene.name : p.surfaces.front().scene.name;
-    return t;
+/// What an energy hook and the scissors cut when the scene names nothing: the first tissue layer
+/// and the body it covers (kCoveredBodyIgnitionC and kCoveredBodyConductivity: the hook opens the
+/// layer, the scissors divide both), else the first body, with the reader's defaults.
+std::vector<sim::DissectionTissueDesc> defaultTissues(const Project& p) {
+    std::vector<sim::DissectionTissueDesc> out(1);
+    if (p.surfaces.empty()) {
+        out[0].layer = p.bodies.front().scene.name;
+        return out;
+    }
+    out[0].layer = p.surfaces.front().scene.name;
+    for (const BodyProject& b : p.bodies)
+        if (b.scene.name == p.surfaces.front().scene.attachTo) {
+            sim::DissectionTissueDesc under;
+            under.layer = b.scene.name;
+            under.ignitionC = kCoveredBodyIgnitionC;
+            under.conductivity = kCoveredBodyConductivity;
+            out.push_back(under);
+        }
+    return out;
 }
 
 } // namespace
@@ -270,13 +283,16 @@ QString Document::addInstrument(const QString& text, Kind kind, const std::strin
                 // Tools on a body's own boundary: the polygon contact. On the soft bare body of the
                 // cholecystectomy the circumsphere's spheres, sized by the deforming triangles,
                 // threw nodes up to 60 mm a frame under a 34 mm/s press; the polygon contact moved
-                // none farther than the settling did (10.6 mm, frame 3). A fascia layer keeps
-                // the circumsphere (the rectum's, stable).
-                if (q.surfaces.empty()) q.scene.interaction->collisionMethod = "polygon";
+                // none farther than the settling did (10.6 mm, frame 3). The tools meet a body's
+                // own boundary wherever a tissue layer leaves it bare (bare_body), so every new
+                // interaction takes both (the rectum's hand-written circumsphere over its fascia
+                // stays, its tools meeting the fascia alone).
+                q.scene.interaction->collisionMethod = "polygon";
+                q.scene.interaction->bareBody = true;
             }
             sim::InteractionDesc& d = *q.scene.interaction;
             if ((kind == Kind::EnergyHook || kind == Kind::Scissors) && d.tissues.empty())
-                d.tissues.push_back(defaultTissue(q)); // what they cut
+                d.tissues = defaultTissues(q); // what they cut
             d.instruments.push_back(in);
             q.trackFiles.push_back(file);
         },

@@ -697,13 +697,17 @@ std::optional<Viewport::SurfaceHit> Viewport::hitAt(QPoint pos) const {
     auto corner = [](const std::vector<float>& xyz, uint32_t v) {
         return Eigen::Vector3f(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]);
     };
+    // A tissue layer lies on the body it was cut from (the same triangles): within kLayerTie of the
+    // body's hit the layer is what the ray meets first.
+    constexpr float kLayerTie = 1e-5f; // m
     for (size_t k = 0; k < meshes.size(); ++k) {
         const render::RenderMesh& m = meshes[k];
         if (!m.visible) continue;
+        const float tie = m.source == render::RenderMesh::Source::Surface ? kLayerTie : 0.0f;
         for (size_t f = 0; f + 2 < m.indices.size(); f += 3) {
             const float t = hitTriangle(o, d, corner(m.positions, m.indices[f]), corner(m.positions, m.indices[f + 1]),
                                         corner(m.positions, m.indices[f + 2]));
-            if (t < best) {
+            if (t < best + tie && std::isfinite(t)) {
                 best = t;
                 bestMesh = static_cast<int>(k);
                 bestFace = f;

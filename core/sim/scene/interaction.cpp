@@ -34,7 +34,7 @@ InteractionDesc readInteractionSection(const JsonField& doc) {
     doc.object({"collision", "instruments", "tissues"});
     InteractionDesc d;
     if (auto c = doc.find("collision")) {
-        c->object({"method", "delta"});
+        c->object({"method", "delta", "bare_body"});
         if (auto m = c->find("method")) {
             d.collisionMethod = m->nonEmptyString();
             CollisionMethod method;
@@ -42,6 +42,7 @@ InteractionDesc readInteractionSection(const JsonField& doc) {
                 m->fail("'" + d.collisionMethod + "' is not a method (" + kCollisionMethodNames + ")");
         }
         d.delta = c->number("delta", d.delta, NumberRule::closed(0.0, 10.0));
+        d.bareBody = c->boolean("bare_body", d.bareBody);
     }
     std::set<std::string> names;
     for (const JsonField& j : doc["instruments"].items(1, 8)) {
@@ -121,6 +122,7 @@ void checkInteractionNames(const InteractionDesc& d, const std::vector<std::stri
 json interactionJson(const InteractionDesc& d) {
     json doc;
     doc["collision"] = {{"method", d.collisionMethod}, {"delta", d.delta}};
+    if (d.bareBody) doc["collision"]["bare_body"] = true;
     doc["instruments"] = json::array();
     for (const InstrumentDesc& in : d.instruments) {
         json j = {{"name", in.name},

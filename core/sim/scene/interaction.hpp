@@ -3,7 +3,8 @@
 /// and what they do to the tissue [A ch. 5].
 ///
 /// "interaction": {
-///   "collision": {"method": "circumsphere", "delta": 0.7},          optional (defaults shown)
+///   "collision": {"method": "circumsphere", "delta": 0.7,           optional (defaults shown)
+///                 "bare_body": false},
 ///   "instruments": [
 ///     {"name": "grasper", "kind": "grasper", "track": "tools/grasper.track",
 ///      "radius": 0.0025, "jaw_length": 0.012},                       → features collision, grasp
@@ -88,6 +89,11 @@ struct DissectionTissueDesc {
 struct InteractionDesc {
     std::string collisionMethod = "circumsphere"; ///< circumsphere, bounding_sphere or polygon
     double delta = 0.7;                           ///< area-change update threshold δ [A §5.2.4]
+    /// "bare_body": with a tissue layer, the tools also meet the body it is attached to where the
+    /// layer leaves it bare (InteractionRuntime); off, they meet the layer alone (the cases packaged
+    /// before it keep their physics: the rectum's grasper would touch the bare fat at its fascia's
+    /// edge, 0.05 → 0.18 N). The studio turns it on for every interaction it makes.
+    bool bareBody = false;
     std::vector<InstrumentDesc> instruments;
     std::vector<DissectionTissueDesc> tissues;
 

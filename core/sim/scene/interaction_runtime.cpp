@@ -56,15 +56,15 @@ struct InteractionRuntime::Instrument {
     InstrumentDesc desc;
     InstrumentTrack track;
     InstrumentKey key;
-    std::optional<PortFrame> port;    ///< desc.port, declared
-    PortPose portPose;                ///< this frame, with a port
-    std::unique_ptr<ToolShape> shape; ///< null: no collision (clip applier)
-    std::unique_ptr<CollisionSolver> collision;
-    XpbdIterationHook hook;
+    std::optional<PortFrame> port;                           ///< desc.port, declared
+    PortPose portPose;                                       ///< this frame, with a port
+    std::unique_ptr<ToolShape> shape;                        ///< null: no collision (clip applier)
+    std::vector<std::unique_ptr<CollisionSolver>> collision; ///< one per contact surface
+    std::vector<XpbdIterationHook> hooks;
     bool colliding = false; ///< this frame
     // grasp
     bool holding = false;
-    std::vector<int32_t> held;   ///< collision-surface vertices
+    std::vector<size_t> held;    ///< particles of the contact surfaces
     std::vector<Vec3> heldLocal; ///< in the instrument frame at the grasp
     ToolShape::Pose pose = ToolShape::Pose::Identity();
     // scissors
@@ -95,6 +95,94 @@ struct InteractionRuntime::Clip {
 };
 
 InteractionRuntime::~InteractionRuntime() = default;
+
+const std::vector<Vec3>& InteractionRuntime::contactPositions(const ContactSurface& c) const {
+    return c.layer ? m_sys->surfacePositions(c.index) : m_sys->tetPositions(c.index);
+}
+
+namespace {
+
+/// Per triangle of `body`'s boundary (its collision numbering): a triangle of `layer` was cut
+/// from it (the layer is the body's boundary in a region, maybe midpoint-subdivided: a
+/// triangle's middle child keeps its centroid, up to a bend applied after the subdivision), at
+/// rest. A layer centroid within a sixth of the triangle's shortest edge of its centroid.
+std::vector<uint8_t> coveredTriangles(const CollisionSurfaceDesc& body, const TriMesh& layer) {
+    std::vector<Vec3> centres;
+    for (const Tri& t : layer.triangles())
+        centres.push_back((layer.positions()[t[0]] + layer.positions()[t[1]] + layer.positions()[t[2]]) / 3);
+    std::sort(centres.begin(), centres.end(), [](const Vec3& a, const Vec3& b) { return a.x() < b.x(); });
+    std::vector<uint8_t> covered(body.triangles.size(), 0);
+    for (size_t f = 0; f < body.triangles.size(); ++f) {
+        const Tri& t = body.triangles[f];
+        const Vec3 &a = body.restPositions[t[0]], &b = body.restPositions[t[1]], &d = body.restPositions[t[2]];
+        const Vec3 c = (a + b + d) / 3;
+        const double tolerance = std::min({(b - a).norm(), (d - b).norm(), (a - d).norm()}) / 6;
+        auto it = std::lower_bound(centres.begin(), centres.end(), c.x() - tolerance,
+                                   [](const Vec3& a, double x) { return a.x() < x; });
+        for (; it != centres.end() && it->x() <= c.x() + tolerance && !covered[f]; ++it)
+            covered[f] = (*it - c).norm() <= tolerance;
+    }
+    return covered;
+}
+
+} // namespace
+
+std::vector<InteractionRuntime::ContactSurface>
+InteractionRuntime::contactSurfaces(const SceneDesc& scene, XpbdSystem& system,
+                                    const std::vector<const TetMesh*>& bodies,
+                                    const std::vector<const TriMesh*>& surfaces) {
+    std::vector<ContactSurface> out;
+    // a body's boundary, the nodes' lumped inverse masses (fixed: 0): the contact force on an
+    // instrument is the tissue's momentum it changes (with unit masses it came out 10^4 too large)
+    auto bodySurface = [&](size_t b) {
+        ContactSurface c;
+        c.index = b;
+        c.particleOffset = static_cast<size_t>(system.tetParticleOffset(b));
+        const TetMesh& m = *bodies.at(b);
+        std::vector<double> w = lumpedMasses(m, scene.bodies[b].material.density, scene.bodies[b].fixedNodes);
+        for (double& x : w)
+            x = x > 0 ? 1.0 / x : 0.0;
+        c.desc = CollisionSurfaceDesc::fromTetMesh(m, std::move(w));
+        c.graspable.assign(m.vertexCount(), 1);
+        return c;
+    };
+    if (surfaces.empty()) {
+        out.push_back(bodySurface(0));
+        return out;
+    }
+    ContactSurface layer;
+    layer.layer = true;
+    layer.particleOffset = static_cast<size_t>(system.surfaceParticleOffset(0));
+    layer.desc.triangles = surfaces[0]->triangles();
+    layer.desc.restPositions = surfaces[0]->positions();
+    layer.desc.inverseMass =
+        surfaceInverseMass(*surfaces[0], scene.surfaces[0].arealDensity, scene.surfaces[0].fixedNodes);
+    layer.graspable.assign(surfaces[0]->vertexCount(), 1);
+    out.push_back(std::move(layer));
+    size_t under = 0;
+    while (under < scene.bodies.size() && scene.bodies[under].name != scene.surfaces[0].attachTo)
+        ++under;
+    if (!scene.interaction->bareBody || under == scene.bodies.size())
+        return out; // the tools meet the layer alone (or a free layer)
+    // the body where the layer leaves it bare: its boundary triangles the layer was not cut from
+    ContactSurface bare = bodySurface(under);
+    const std::vector<uint8_t> covered = coveredTriangles(bare.desc, *surfaces[0]);
+    std::vector<Tri> open;
+    std::vector<uint8_t> onOpen(bare.graspable.size(), 0);
+    for (size_t f = 0; f < covered.size(); ++f)
+        if (!covered[f]) {
+            open.push_back(bare.desc.triangles[f]);
+            for (int32_t v : bare.desc.triangles[f])
+                onOpen[static_cast<size_t>(v)] = 1;
+        }
+    if (open.empty()) return out;
+    // under the layer the grasper holds the layer (its attachments carry the body), elsewhere the
+    // body's bare surface: not the nodes inside it (under the layer they would be held through it)
+    bare.graspable = std::move(onOpen);
+    bare.desc.triangles = std::move(open);
+    out.push_back(std::move(bare));
+    return out;
+}
 
 void InteractionRuntime::makeDissection(const SceneDesc& scene, XpbdSystem& system,
                                         const std::vector<const TetMesh*>& bodies,
@@ -153,28 +241,7 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
     r->m_sys = &system;
     r->m_bodies = bodies;
 
-    // Collision surface: the first surface layer, else the boundary of the first tet body.
-    CollisionSurfaceDesc surface;
-    if (!surfaces.empty()) {
-        r->m_surfaceIsLayer = true;
-        r->m_surfaceIndex = 0;
-        r->m_particleOffset = static_cast<size_t>(system.surfaceParticleOffset(0));
-        surface.triangles = surfaces[0]->triangles();
-        surface.restPositions = surfaces[0]->positions();
-        surface.inverseMass =
-            surfaceInverseMass(*surfaces[0], scene.surfaces[0].arealDensity, scene.surfaces[0].fixedNodes);
-        r->m_surfaceVertices = surfaces[0]->vertexCount();
-    } else {
-        // the nodes' lumped inverse masses (fixed: 0): the contact force on an instrument is
-        // the tissue's momentum it changes (with unit masses it came out 10^4 too large)
-        const TetMesh& m = *bodies.at(0);
-        std::vector<double> w = lumpedMasses(m, scene.bodies[0].material.density, scene.bodies[0].fixedNodes);
-        for (double& x : w)
-            x = x > 0 ? 1.0 / x : 0.0;
-        surface = CollisionSurfaceDesc::fromTetMesh(m, std::move(w));
-        r->m_particleOffset = static_cast<size_t>(system.tetParticleOffset(0));
-        r->m_surfaceVertices = m.vertexCount();
-    }
+    r->m_contact = contactSurfaces(scene, system, bodies, surfaces);
     CollisionSettings cs;
     if (!parseCollisionMethod(desc.collisionMethod, cs.method))
         fail("collision", "unknown method '" + desc.collisionMethod + "'");
@@ -214,14 +281,15 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
             break;
         }
         }
-        if (in->shape) {
-            try {
-                in->collision = CollisionSolver::create(surface, cs);
-            } catch (const std::invalid_argument& e) {
-                fail("instruments[" + std::to_string(i) + "]", std::string("collision surface: ") + e.what());
+        if (in->shape)
+            for (const ContactSurface& c : r->m_contact) {
+                try {
+                    in->collision.push_back(CollisionSolver::create(c.desc, cs));
+                } catch (const std::invalid_argument& e) {
+                    fail("instruments[" + std::to_string(i) + "]", std::string("collision surface: ") + e.what());
+                }
+                in->hooks.push_back(makeCollisionHook(*in->collision.back(), *in->shape, c.particleOffset));
             }
-            in->hook = makeCollisionHook(*in->collision, *in->shape, r->m_particleOffset);
-        }
         r->m_instruments.push_back(std::move(in));
     }
 
@@ -229,11 +297,14 @@ std::unique_ptr<InteractionRuntime> InteractionRuntime::create(const SceneDesc& 
         r->makeDissection(scene, system, bodies, surfaces, origin);
     InteractionRuntime* self = r.get();
     system.setIterationHook([self](XpbdParticles& p, const XpbdIterationInfo& info) { self->runHook(p, info); });
-    // The hook touches the collision surface's particles only (contacts, grasped vertices), and
+    // The hook touches the contact surfaces' particles only (contacts, grasped vertices), and
     // cuts never add particles.
-    const size_t surfaceParticles =
-        r->m_surfaceIsLayer ? system.surfacePositions(r->m_surfaceIndex).size() : system.tetPositions(0).size();
-    system.setIterationHookParticles(r->m_particleOffset, surfaceParticles);
+    size_t first = SIZE_MAX, end = 0;
+    for (const ContactSurface& c : r->m_contact) {
+        first = std::min(first, c.particleOffset);
+        end = std::max(end, c.particleOffset + r->contactPositions(c).size());
+    }
+    system.setIterationHookParticles(first, end - first);
     return r;
 }
 
@@ -297,7 +368,7 @@ void InteractionRuntime::fireClip(Instrument& in, double t) {
 // touching their distal half as the jaws stood the frame before (a fold pressed between or
 // against them: the capsule jaws, as thick as the shaft, leave too narrow a gap for the tissue to
 // enter between them, so touching is what holds).
-void InteractionRuntime::updateGrasp(Instrument& in, const std::vector<Vec3>& sx) {
+void InteractionRuntime::updateGrasp(Instrument& in) {
     const double jawBefore = std::exchange(in.openJaw, in.key.jaw);
     if (in.holding && in.key.jaw > kGraspClose) {
         in.holding = false;
@@ -313,28 +384,32 @@ void InteractionRuntime::updateGrasp(Instrument& in, const std::vector<Vec3>& sx
     const double half = 0.5 * kMaxJawOpening * std::clamp(jawBefore, 0.0, 1.0);
     const Vec3 tips[2] = {L * Vec3(std::cos(half), 0, -std::sin(half)), L * Vec3(std::cos(half), 0, std::sin(half))};
     const ToolShape::Pose toJaws = in.pose.inverse();
-    for (size_t v = 0; v < sx.size(); ++v) {
-        const Vec3 p = toJaws * sx[v];
-        bool held = (sx[v] - in.key.position).norm() <= reach;
-        for (const Vec3& tip : tips) {
-            const double s = std::clamp(p.dot(tip) / tip.squaredNorm(), 0.5, 1.0); // the distal half
-            held = held || (p - s * tip).norm() <= touch;
+    for (const ContactSurface& c : m_contact) {
+        const std::vector<Vec3>& sx = contactPositions(c);
+        for (size_t v = 0; v < sx.size(); ++v) {
+            if (v < c.graspable.size() && !c.graspable[v]) continue;
+            const Vec3 p = toJaws * sx[v];
+            bool held = (sx[v] - in.key.position).norm() <= reach;
+            for (const Vec3& tip : tips) {
+                const double s = std::clamp(p.dot(tip) / tip.squaredNorm(), 0.5, 1.0); // the distal half
+                held = held || (p - s * tip).norm() <= touch;
+            }
+            if (!held) continue;
+            in.held.push_back(c.particleOffset + v);
+            in.heldLocal.push_back(p);
         }
-        if (!held) continue;
-        in.held.push_back(static_cast<int32_t>(v));
-        in.heldLocal.push_back(p);
     }
     if (!in.held.empty()) ++m_summary.grasps;
 }
 
 void InteractionRuntime::beforeStep(double t, double dt) {
-    const std::vector<Vec3>& sx = m_surfaceIsLayer ? m_sys->surfacePositions(m_surfaceIndex) : m_sys->tetPositions(0);
     auto t0 = std::chrono::steady_clock::now();
-    // The collision surface's box, grown by what it can move in a frame: a tool outside it runs no
+    // The contact surfaces' box, grown by what they can move in a frame: a tool outside it runs no
     // broad phase at all this frame (the hash rebuild per substep is the main collision cost).
     Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-    for (const Vec3& p : sx)
-        lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    for (const ContactSurface& c : m_contact)
+        for (const Vec3& p : contactPositions(c))
+            lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     const double grow = 0.005;
     lo.array() -= grow;
     hi.array() += grow;
@@ -382,7 +457,7 @@ void InteractionRuntime::beforeStep(double t, double dt) {
             in.open = in.key.jaw > kGraspClose;
             if (in.open) in.openJaw = in.key.jaw;
         }
-        if (in.desc.holds()) updateGrasp(in, sx);
+        if (in.desc.holds()) updateGrasp(in);
         if (in.desc.kind == InstrumentDesc::Kind::ClipApplier) { // one clip per squeeze; re-armed on release
             if (!in.fired && in.key.act) fireClip(in, t);
             if (!in.key.act) in.fired = false;
@@ -393,7 +468,7 @@ void InteractionRuntime::beforeStep(double t, double dt) {
     // schedule without hooks (the force on every tool is then zero, as the hook would sum).
     bool hooks = false;
     for (const auto& inp : m_instruments)
-        hooks = hooks || (inp->collision && inp->colliding) || (inp->holding && !inp->held.empty());
+        hooks = hooks || (!inp->collision.empty() && inp->colliding) || (inp->holding && !inp->held.empty());
     m_sys->setIterationHookActive(hooks);
     if (m_dissection) {
         t0 = std::chrono::steady_clock::now();
@@ -443,9 +518,14 @@ std::optional<Vec3> InteractionRuntime::recordCut(const DissectionFrameStats& st
 void InteractionRuntime::runHook(XpbdParticles& particles, const XpbdIterationInfo& info) {
     for (auto& inp : m_instruments) {
         Instrument& in = *inp;
-        if (in.collision && in.colliding) in.hook(particles, info);
+        if (in.colliding)
+            for (XpbdIterationHook& h : in.hooks)
+                h(particles, info);
         if (info.velocityPass) { // the substep's force on the tissue: contacts and grasp hold
-            Vec3 f = in.collision && in.colliding ? in.collision->contactForce() : Vec3::Zero();
+            Vec3 f = Vec3::Zero();
+            if (in.colliding)
+                for (const auto& c : in.collision)
+                    f += c->contactForce();
             if (info.h > 0) f += in.holdImpulse / (info.h * info.h);
             in.holdImpulse = Vec3::Zero();
             in.forceSum += f;
@@ -454,7 +534,7 @@ void InteractionRuntime::runHook(XpbdParticles& particles, const XpbdIterationIn
         }
         if (in.holding)
             for (size_t k = 0; k < in.held.size(); ++k) {
-                const size_t p = m_particleOffset + static_cast<size_t>(in.held[k]);
+                const size_t p = in.held[k];
                 if (p >= particles.size()) continue;
                 const double w = particles.inverseMass(p);
                 if (!(w > 0)) continue;
@@ -482,7 +562,10 @@ void InteractionRuntime::afterStep() {
         s.act = in.desc.kind == InstrumentDesc::Kind::Scissors ? in.snip : in.key.act; // scissors: cut this frame
         s.cutAt = std::exchange(in.cutAt, std::nullopt);
         s.swept = std::exchange(in.swept, std::nullopt);
-        s.contacts = in.collision && in.colliding ? in.collision->stats().contacts : 0;
+        s.contacts = 0;
+        if (in.colliding)
+            for (const auto& c : in.collision)
+                s.contacts += c->stats().contacts;
         s.grasped = static_cast<int>(in.held.size());
         s.force = in.force;
         s.driven = in.driven;

@@ -8,11 +8,14 @@
 /// contacts and the grasp holds inside its iterations; afterStep() moves the clips with their
 /// vessels and records the figures.
 ///   - Collision [A §5.2]: every grasper and every energy hook while its energy is off collides
-///     with the collision surface (the first surface layer, else the boundary of the first tet
-///     body), each through its own CollisionSolver; a live energy hook cuts instead of pushing.
-///   - Grasp: when a grasper's jaw closes below 0.5 the collision-surface vertices within
-///     jaw_length / 3 of its tip are held rigidly in the instrument's frame (set inside every
-///     XPBD iteration) until the jaw opens above 0.5.
+///     with the contact surfaces, each through its own CollisionSolver per surface; a live energy
+///     hook cuts instead of pushing. The contact surfaces: the first surface layer and, with
+///     collision.bare_body, the boundary of the body it is attached to where it does not cover
+///     it (a peritoneum over part of an organ: the tools meet the layer there and the bare organ
+///     elsewhere); without a layer the boundary of the first tet body.
+///   - Grasp: when a grasper's jaw closes below 0.5 the contact-surface vertices within
+///     jaw_length / 3 of its tip (and those touching its jaws) are held rigidly in the
+///     instrument's frame (set inside every XPBD iteration) until the jaw opens above 0.5.
 ///   - Dissection [A §5.3]: sim/dissection (feature "dissection").
 ///   - Clip [A §5.4]: sim/clip, fired at a clip applier's first key with act = 1 (feature "clip").
 /// Deterministic: repeat runs are bit-identical.
@@ -149,7 +152,7 @@ private:
     std::optional<Vec3> recordCut(const DissectionFrameStats& st);
     void fireClip(Instrument& in, double t);
     /// A holder's jaws: closing takes the surface vertices they hold, opening lets them go.
-    void updateGrasp(Instrument& in, const std::vector<Vec3>& sx);
+    void updateGrasp(Instrument& in);
 
     XpbdSystem* m_sys = nullptr;
     std::vector<const TetMesh*> m_bodies;
@@ -158,11 +161,21 @@ private:
     std::unique_ptr<Dissection> m_dissection;
     size_t m_dissectSurface = SIZE_MAX;
     size_t m_dissectBody = SIZE_MAX;
-    // collision surface
-    bool m_surfaceIsLayer = false;
-    size_t m_surfaceIndex = 0;
-    size_t m_particleOffset = 0;
-    size_t m_surfaceVertices = 0;
+    /// What the tools touch (see the file comment): a surface layer or a tet body's boundary.
+    struct ContactSurface {
+        bool layer = false;
+        size_t index = 0;               ///< scene.surfaces / scene.bodies index
+        size_t particleOffset = 0;      ///< its first particle in the XPBD system
+        CollisionSurfaceDesc desc;      ///< the triangles the tools meet
+        std::vector<uint8_t> graspable; ///< per vertex: a closing grasper may hold it
+    };
+    /// The contact surfaces of the scene (InputError naming `origin` when one cannot be built).
+    static std::vector<ContactSurface> contactSurfaces(const SceneDesc& scene, XpbdSystem& system,
+                                                       const std::vector<const TetMesh*>& bodies,
+                                                       const std::vector<const TriMesh*>& surfaces);
+    const std::vector<Vec3>& contactPositions(const ContactSurface& c) const;
+
+    std::vector<ContactSurface> m_contact;
     InteractionSummary m_summary;
 };
 

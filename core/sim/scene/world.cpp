@@ -55,8 +55,12 @@ std::unique_ptr<World> World::assemble(const SceneDesc& scene, std::vector<std::
     w->m_dt = scene.xpbd.dt;
     w->m_meshes = std::move(meshes);
     w->m_surfaces = std::move(surfaces);
-    // The instruments collide with the first body's boundary when there is no fascia over it.
+    // The instruments collide with the first body's boundary when there is no fascia over it, and
+    // with the boundary of the body the first fascia covers where it leaves it bare (bare_body).
     if (scene.interaction && w->m_surfaces.empty() && !w->m_meshes.empty()) w->m_meshes.front()->requireLevel(3);
+    if (scene.interaction && scene.interaction->bareBody && !scene.surfaces.empty())
+        for (size_t b = 0; b < scene.bodies.size() && b < w->m_meshes.size(); ++b)
+            if (scene.bodies[b].name == scene.surfaces.front().attachTo) w->m_meshes[b]->requireLevel(3);
     w->m_solver = makeSceneSolver({w->m_scene, w->m_meshes, w->m_surfaces, origin});
     for (const BodyDesc& b : scene.bodies)
         w->m_names.push_back(b.name);

@@ -333,3 +333,120 @@ TEST(Interaction, ScissorsAreReadAndWrittenAndNeedATissue) {
             << e.what();
     }
 }
+
+namespace {
+
+/// The fat pad alone with a tissue layer cut from its top where x < 2 cm (the studio's
+/// from_boundary_of with a region), and a 5 mm grasper with 6 mm jaws closing at (x, 1.5 cm) and
+/// lifting 8 mm; collision.bare_body as given.
+Rig halfCoveredPad(double x, bool bareBody) {
+    Rig r = makeRig();
+    r.scene.bodies.resize(1);
+    r.meshes.resize(1);
+    TetMesh& pad = *r.meshes[0];
+    pad.requireLevel(3);
+    const TriMesh& boundary = pad.boundary();
+    std::vector<int32_t> index(boundary.vertexCount(), -1);
+    std::vector<Vec3> p;
+    std::vector<Tri> t;
+    for (const Tri& f : boundary.triangles()) {
+        const Vec3 c = (boundary.positions()[f[0]] + boundary.positions()[f[1]] + boundary.positions()[f[2]]) / 3;
+        if (!(c.x() < 0.02 && c.z() > kTop - 1e-6)) continue;
+        Tri g;
+        for (int k = 0; k < 3; ++k) {
+            if (index[f[k]] < 0) {
+                index[f[k]] = static_cast<int32_t>(p.size());
+                p.push_back(boundary.positions()[f[k]]);
+            }
+            g[k] = index[f[k]];
+        }
+        t.push_back(g);
+    }
+    r.surfaces = {TriMesh::fromArrays(std::move(p), std::move(t))};
+    InstrumentDesc grasper = r.scene.interaction->instruments.at(0);
+    grasper.radius = 0.0025;
+    grasper.jawLength = 0.006;
+    char track[512];
+    std::snprintf(track, sizeof track,
+                  "%s0.00 %.3f 0.015 0.030 0 0 -1 1 0\n0.40 %.3f 0.015 0.0090 0 0 -1 1 0\n"
+                  "0.55 %.3f 0.015 0.0090 0 0 -1 1 0\n0.65 %.3f 0.015 0.0090 0 0 -1 0.05 0\n"
+                  "1.00 %.3f 0.015 0.0170 0 0 -1 0.05 0\n",
+                  kHeader, x, x, x, x, x);
+    grasper.trackText = track;
+    r.scene.interaction->instruments = {grasper};
+    r.scene.interaction->tissues = {{"fascia", 160, 0.4, Vec3(0.1, 0.3, 1.0)}};
+    r.scene.interaction->collisionMethod = "polygon";
+    r.scene.interaction->bareBody = bareBody;
+    return r;
+}
+
+struct Lifted {
+    int grasped = 0;
+    double padLift = 0, layerLift = 0, thrown = 0; ///< m
+    std::vector<Vec3> last;
+};
+
+Lifted liftOn(Rig r) {
+    std::unique_ptr<World> w = assemble(std::move(r));
+    Lifted out;
+    std::vector<Vec3> before = w->positions(0);
+    for (int f = 0; f < 66; ++f) { // 1.1 s
+        EXPECT_TRUE(w->step().finite) << "frame " << f;
+        const std::vector<Vec3>& x = w->positions(0);
+        for (size_t v = 0; v < x.size(); ++v) {
+            out.thrown = std::max(out.thrown, (x[v] - before[v]).norm());
+            out.padLift = std::max(out.padLift, x[v].z() - kTop);
+        }
+        for (const Vec3& q : w->surfacePositions(0))
+            out.layerLift = std::max(out.layerLift, q.z() - kTop);
+        before = x;
+    }
+    EXPECT_TRUE(w->invariants().allFinite);
+    out.grasped = w->interaction()->summary().instruments.at(0).grasped;
+    out.last = w->positions(0);
+    return out;
+}
+
+} // namespace
+
+// A tissue layer over part of an organ [issue 57 item 4: the peritoneum over Calot's triangle, the
+// gallbladder's fundus bare]: with collision.bare_body the tools meet the layer where it lies and
+// the organ's own surface where it leaves it bare, so a grasper lifts the bare part; without it
+// (the packaged cases before it) the tools meet the layer alone and the jaws close on nothing
+// there. On the covered part the grasper holds the layer (its attachments carry the organ), not
+// the organ's nodes under it. Finite, repeatable, nothing thrown.
+TEST(Interaction, WithBareBodyTheToolsMeetTheOrganWhereItsLayerLeavesItBare) {
+    const Lifted bare = liftOn(halfCoveredPad(0.03, true));
+    EXPECT_GE(bare.grasped, 3) << "the bare pad under the jaws is held";
+    EXPECT_GT(bare.padLift, 0.004) << "and lifted with the jaws (8 mm)";
+    EXPECT_LT(bare.thrown, 0.004) << "largest node move in one frame";
+    EXPECT_EQ(liftOn(halfCoveredPad(0.03, true)).last, bare.last) << "repeatable";
+
+    const Lifted layerAlone = liftOn(halfCoveredPad(0.03, false));
+    EXPECT_EQ(layerAlone.grasped, 0) << "without bare_body the jaws pass into the bare pad and hold nothing";
+    EXPECT_LT(layerAlone.padLift, 0.001);
+
+    const Lifted covered = liftOn(halfCoveredPad(0.01, true));
+    EXPECT_GE(covered.grasped, 3) << "the layer under the jaws is held";
+    EXPECT_GT(covered.layerLift, 0.004) << "the layer rose with the jaws";
+    EXPECT_LT(covered.thrown, 0.004);
+    const Lifted coveredLayerAlone = liftOn(halfCoveredPad(0.01, false));
+    std::printf("bare part: %d held, pad lift %.2f mm, largest move %.2f mm; layer alone there: %d held, lift %.2f mm; "
+                "covered part: %d held, layer lift %.2f mm (layer alone %d held)\n",
+                bare.grasped, bare.padLift * 1e3, bare.thrown * 1e3, layerAlone.grasped, layerAlone.padLift * 1e3,
+                covered.grasped, covered.layerLift * 1e3, coveredLayerAlone.grasped);
+    EXPECT_EQ(coveredLayerAlone.grasped, covered.grasped) << "on the layer the same vertices are held either way";
+}
+
+// collision.bare_body is read and written by the one reader; off by default.
+TEST(Interaction, BareBodyRoundTripsAndIsOffByDefault) {
+    InteractionDesc d = *makeRig().scene.interaction;
+    EXPECT_FALSE(d.bareBody);
+    EXPECT_EQ(formatInteractionSection(d).find("bare_body"), std::string::npos) << "absent when off";
+    d.bareBody = true;
+    const std::string text = formatInteractionSection(d);
+    EXPECT_TRUE(parseInteractionSection(text, "scene.json").bareBody) << text;
+    std::string bad = text;
+    bad.replace(bad.find("true"), 4, "1");
+    EXPECT_THAT(sectionError(bad), HasSubstr("bare_body"));
+}

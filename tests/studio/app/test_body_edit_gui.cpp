@@ -258,8 +258,7 @@ TEST_F(BodyEditFixture, TheBodyItemsContextMenuRenamesAndDeletes) {
 // A tissue layer added over a body from its context menu [issue 57 item 4: the peritoneum over
 // Calot's triangle is such a layer]: one undo step, listed under Surfaces and selected; its region
 // typed in Properties (a bad corner refused with the reader's rule, the model unchanged); Delete on
-// the layer's item removes it in one step, a layer the interaction names is refused naming the
-// reference; undo restores the model exactly.
+// the layer's item removes it in one step; undo restores the model exactly.
 TEST_F(BodyEditFixture, ATissueLayerIsAddedOverABodyRegionedAndDeletedAsUndoSteps) {
     open("organ-blob");
     const std::string before = text();
@@ -313,17 +312,47 @@ TEST_F(BodyEditFixture, ATissueLayerIsAddedOverABodyRegionedAndDeletedAsUndoStep
     EXPECT_EQ(text(), before) << "undo restores the model exactly";
 }
 
-// The rectum's fascia is a tissue layer of its interaction (the hook cuts it): not deleted, the
-// refusal names the reference.
-TEST_F(BodyEditFixture, ALayerTheInteractionNamesIsNotDeleted) {
+// The rectum's fascia is a tissue layer its hook cuts: deleting it takes it out of the
+// interaction's tissues in the same undo step (the fat stays cut); undo restores both.
+TEST_F(BodyEditFixture, DeletingALayerTheHookCutsTakesItOutOfTheTissues) {
     open("rectum");
     ASSERT_FALSE(project().surfaces.empty());
     const std::string before = text();
-    const QString why = w->document()->removeLayer(0);
-    EXPECT_NE(why.toStdString().find("surfaces[0].name: 'fascia' is named by interaction.tissues[0].layer"),
-              std::string::npos)
-        << why.toStdString();
-    EXPECT_EQ(text(), before);
+    const int steps = undo()->count();
+    EXPECT_EQ(w->document()->removeLayer(0).toStdString(), "");
+    EXPECT_TRUE(project().surfaces.empty());
+    ASSERT_EQ(project().scene.interaction->tissues.size(), 1u);
+    EXPECT_EQ(project().scene.interaction->tissues[0].layer, "fat");
+    EXPECT_EQ(undo()->count(), steps + 1) << "one undo step";
+    undo()->undo();
+    EXPECT_EQ(text(), before) << "undo restores the layer and its tissue";
+}
+
+// A layer added under a hook that cuts the body alone [issue 57 item 4: the peritoneum over the
+// cystic duct]: the layer enters the tissues the hook and the scissors cut, first, and the body
+// under it takes the covered body's ignition and conductivity (a burn dose the hook's pass does
+// not reach: it opens the layer, not the organ), in the same undo step; undo restores them.
+TEST_F(BodyEditFixture, ALayerAddedUnderAHookIsWhatTheHookOpens) {
+    open("organ-blob");
+    ASSERT_TRUE(w->document()->project().surfaces.empty());
+    const int body = 0;
+    ASSERT_EQ(w->document()->addInstrument("Add a hook", sim::InstrumentDesc::Kind::EnergyHook, "right").toStdString(),
+              "");
+    ASSERT_EQ(project().scene.interaction->tissues.size(), 1u);
+    EXPECT_TRUE(project().scene.interaction->bareBody) << "a studio interaction meets bare bodies too";
+    const std::string organ = project().scene.interaction->tissues[0].layer;
+    const std::string before = text();
+    const int steps = undo()->count();
+    ASSERT_EQ(w->document()->addLayer(body).toStdString(), "");
+    const auto& tissues = project().scene.interaction->tissues;
+    ASSERT_EQ(tissues.size(), 2u);
+    EXPECT_EQ(tissues[0].layer, project().surfaces[0].scene.name);
+    EXPECT_EQ(tissues[1].layer, organ);
+    EXPECT_DOUBLE_EQ(tissues[1].ignitionC, studio::kCoveredBodyIgnitionC);
+    EXPECT_DOUBLE_EQ(tissues[1].conductivity, studio::kCoveredBodyConductivity);
+    EXPECT_EQ(undo()->count(), steps + 1);
+    undo()->undo();
+    EXPECT_EQ(text(), before) << "undo restores the tissues";
 }
 
 // A tissue layer picked in the tree: its stretch stiffness, areal density and subdivision rounds are

@@ -1,15 +1,17 @@
 // A new procedure built in the studio by GUI actions only [issue 57 item 4]: a laparoscopic
-// cholecystectomy step (clip the cystic duct and artery twice each, cut each between its clips) from the hepatocystic
-// anatomy made by code as bought anatomy (`viscera-studio sample hepatocystic`): New project,
-// Import anatomy (the gallbladder, both ducts and the artery with their texture), Make
-// simulation-ready, Tetrahedralize, the tissue held where it is attached, the clip sites and the
-// cut lines picked on the duct and the artery, the liver imported as a surrounding, an abdominal wall, three
-// instruments on their masters with their ports clicked on the wall, the laparoscope from the
-// studio camera, the task and the limits typed, the case exported signed. No project JSON is
-// written by hand or by the test. The exported case verifies and runs in the player: a device
-// recording that clips twice and cuts between passes its assessment; the same recording without
-// the clips fails on clips_on_target. Screenshots through the laparoscope at the start, after
-// the clips and after the cut (VISCERA_GUI_SHOTS).
+// cholecystectomy step (lift the fundus, open the peritoneum over the cystic duct, clip the duct
+// and the artery twice each, cut each between its clips) from the hepatocystic anatomy made by
+// code as bought anatomy (`viscera-studio sample hepatocystic`): New project, Import anatomy (the
+// gallbladder, both ducts and the artery with their texture), Make simulation-ready,
+// Tetrahedralize, the tissue held where it is attached, the clip sites and the cut lines picked
+// on the duct and the artery, a peritoneum layer over Calot's triangle, the liver imported as a
+// surrounding, an abdominal wall, four instruments on their masters with their ports clicked on
+// the wall, the laparoscope from the studio camera, the task and the limits typed, the case
+// exported signed. No project JSON is written by hand or by the test. The exported case verifies
+// and runs in the player: a device recording that opens the peritoneum with the hook, clips
+// twice and cuts between passes its assessment; the same recording without the clips fails on
+// clips_on_target. Screenshots through the laparoscope at the start, after the peritoneum is
+// opened, after the clips and after the cut (VISCERA_GUI_SHOTS).
 #include "app/anatomy_steps.hpp"
 #include "app/assessment_panel.hpp"
 #include "app/document.hpp"
@@ -46,6 +48,7 @@
 #include <QLineEdit>
 #include <QListView>
 #include <QListWidget>
+#include <QMenu>
 #include <QPlainTextEdit>
 #include <QProcess>
 #include <QPushButton>
@@ -54,7 +57,9 @@
 #include <QSignalSpy>
 #include <QSpinBox>
 #include <QTableWidget>
+#include <QTimer>
 #include <QToolButton>
+#include <QTreeWidgetItemIterator>
 #include <QUndoStack>
 #include <QWheelEvent>
 
@@ -95,6 +100,13 @@ const sim::Vec3 kArteryClipNear = onArtery(0.28), kArteryClipFar = onArtery(0.52
 const sim::Vec3 kGallTop(0, -0.032, 0.024), kGallTopFundus(0, 0.02, 0.027);
 const sim::Vec3 kFundus(0, 0.035, 0.006);
 const sim::Vec3 kBileDuctNear(0.0121, -0.075, 0.0056), kBileDuctFar(0.0197, -0.122, -0.0036);
+// The peritoneum over Calot's triangle (the studio's tissue layer region, m): the cystic duct, the
+// artery's free stretch and the gallbladder's neck.
+const char* const kPeritoneumMin = "-0.01 -0.078 -0.008";
+const char* const kPeritoneumMax = "0.032 -0.038 0.02";
+// The console's pedals column (haptics::Pedal bits): the deadman held, and with it the energy's
+// cut pedal.
+constexpr int kPedalsIdle = 4, kPedalsCut = 4 | 8;
 
 struct CholeFixture : test::MainWindowFixture {
     CholeFixture() : MainWindowFixture("viscera-chole-gui") {}
@@ -262,8 +274,10 @@ fs::path writeBoughtAnatomy(const fs::path& dir) {
 /// then the same across the artery.
 /// Returns the CSV text (haptics::Trajectory's format) and, in `afterClips`, the time the clips are
 /// on and the scissors start.
-std::string consoleSession(const studio::Project& p, bool withClips, double* afterClips, double* end) {
-    const auto& ins = p.scene.interaction->instruments; // grasper, clip applier, scissors (the Add order)
+std::string consoleSession(const studio::Project& p, bool withClips, double* afterClips, double* end,
+                           double* afterHook = nullptr) {
+    const auto& ins = p.scene.interaction->instruments; // grasper, hook, clip applier, scissors (the Add order)
+    constexpr size_t kHook = 1, kClipper = 2, kScissors = 3;
     const sim::AssessmentDesc& a = *p.scene.assessment;
     auto restOf = [&](size_t i) { return sim::InstrumentTrack::parse(ins[i].trackText, "track").keys().front(); };
     struct Row {
@@ -273,6 +287,7 @@ std::string consoleSession(const studio::Project& p, bool withClips, double* aft
         Eigen::Quaterniond q;
         double grip;
         int buttons;
+        int pedals = kPedalsIdle;
     };
     std::vector<Row> rows;
     const Eigen::Quaterniond none = Eigen::Quaterniond::Identity();
@@ -290,17 +305,36 @@ std::string consoleSession(const studio::Project& p, bool withClips, double* aft
     rows.push_back({2.3, 0, device(0, hold), none, 0.05, 0}); // the jaws shut: the grasp
     rows.push_back({3.3, 0, device(0, lifted), none, 0.05, 0});
     const double t = 3.5; // the right arm starts once the fundus is up
-    // right: the clip applier at each site (the duct's two, the artery's two), the tip 2 mm in
     double r = t;
     rows.push_back({0, 1, sim::Vec3::Zero(), none, 1.0, 0});
+    // right: the hook along the peritoneum's line over the duct (the third cut line), its tip
+    // 1 mm in, the cut pedal held from its first point to its last at 8 mm/s
+    {
+        const std::vector<sim::Vec3>& line = a.cuts.at(2).line;
+        auto in = [&](const sim::Vec3& q) { return sim::Vec3(q + 0.001 * shaft(kHook, q)); };
+        const sim::Vec3 pre = line.front() - 0.012 * shaft(kHook, line.front());
+        rows.push_back({r += 0.8, 1, device(kHook, pre), none, 1.0, 0});
+        rows.push_back({r += 0.5, 1, device(kHook, in(line.front())), none, 1.0, 0});
+        rows.push_back({r += 0.05, 1, device(kHook, in(line.front())), none, 1.0, 0, kPedalsCut});
+        for (size_t k = 1; k < line.size(); ++k)
+            rows.push_back({r += std::max(0.05, (line[k] - line[k - 1]).norm() / 0.008), 1, device(kHook, in(line[k])),
+                            none, 1.0, 0, kPedalsCut});
+        rows.push_back({r += 0.05, 1, device(kHook, in(line.back())), none, 1.0, 0});
+        rows.push_back({r += 0.3, 1, device(kHook, line.back() - 0.012 * shaft(kHook, line.back())), none, 1.0, 0});
+        if (afterHook) *afterHook = r;
+        rows.push_back({r += 0.6, 1, sim::Vec3::Zero(), none, 1.0, 0});
+        rows.push_back({r += 0.1, 1, sim::Vec3::Zero(), none, 1.0, 1}); // the arm's button: the clip applier
+        rows.push_back({r += 0.1, 1, sim::Vec3::Zero(), none, 1.0, 0});
+    }
+    // the clip applier at each site (the duct's two, the artery's two), the tip 2 mm in
     if (withClips)
         for (const sim::ClipTarget& c : a.clips) {
-            const sim::Vec3 d = shaft(1, c.position), tip = c.position + 0.002 * d, pre = tip - 0.012 * d;
-            rows.push_back({r += 0.8, 1, device(1, pre), none, 1.0, 0});
-            rows.push_back({r += 0.5, 1, device(1, tip), none, 1.0, 0});
-            rows.push_back({r += 0.2, 1, device(1, tip), none, 0.05, 0}); // squeezed shut: the clip fires
-            rows.push_back({r += 0.3, 1, device(1, tip), none, 1.0, 0});
-            rows.push_back({r += 0.3, 1, device(1, pre), none, 1.0, 0});
+            const sim::Vec3 d = shaft(kClipper, c.position), tip = c.position + 0.002 * d, pre = tip - 0.012 * d;
+            rows.push_back({r += 0.8, 1, device(kClipper, pre), none, 1.0, 0});
+            rows.push_back({r += 0.5, 1, device(kClipper, tip), none, 1.0, 0});
+            rows.push_back({r += 0.2, 1, device(kClipper, tip), none, 0.05, 0}); // squeezed shut: the clip fires
+            rows.push_back({r += 0.3, 1, device(kClipper, tip), none, 1.0, 0});
+            rows.push_back({r += 0.3, 1, device(kClipper, pre), none, 1.0, 0});
         }
     rows.push_back({r += 0.6, 1, sim::Vec3::Zero(), none, 1.0, 0});
     rows.push_back({r += 0.1, 1, sim::Vec3::Zero(), none, 1.0, 1}); // the arm's button: the scissors
@@ -313,17 +347,17 @@ std::string consoleSession(const studio::Project& p, bool withClips, double* aft
     for (size_t c = 0; c < std::min<size_t>(a.cuts.size(), 2); ++c) {
         const std::vector<sim::Vec3>& line = a.cuts[c].line;
         const sim::Vec3 mid = 0.5 * (line.front() + line.back());
-        const sim::Vec3 d = shaft(2, mid), tip = mid + 0.006 * d, pre = mid - 0.012 * d;
+        const sim::Vec3 d = shaft(kScissors, mid), tip = mid + 0.006 * d, pre = mid - 0.012 * d;
         const sim::Vec3 y0 = Eigen::Quaterniond::FromTwoVectors(sim::Vec3::UnitX(), d) * sim::Vec3::UnitY();
         const sim::Vec3 across = (vesselAxes[c] - vesselAxes[c].dot(d) * d).normalized();
         const double roll = std::atan2(y0.cross(across).dot(d), y0.dot(across));
-        turn = Eigen::Quaterniond(Eigen::AngleAxisd(roll, restOf(2).direction.normalized()));
+        turn = Eigen::Quaterniond(Eigen::AngleAxisd(roll, restOf(kScissors).direction.normalized()));
         rows.push_back({r += 0.3, 1, sim::Vec3::Zero(), turn, 1.0, 0});
-        rows.push_back({r += 0.8, 1, device(2, pre), turn, 1.0, 0});
-        rows.push_back({r += 0.5, 1, device(2, tip), turn, 1.0, 0});
-        rows.push_back({r += 0.2, 1, device(2, tip), turn, 0.05, 0}); // the blades shut: the cut
-        rows.push_back({r += 0.3, 1, device(2, tip), turn, 1.0, 0});
-        rows.push_back({r += 0.3, 1, device(2, pre), turn, 1.0, 0});
+        rows.push_back({r += 0.8, 1, device(kScissors, pre), turn, 1.0, 0});
+        rows.push_back({r += 0.5, 1, device(kScissors, tip), turn, 1.0, 0});
+        rows.push_back({r += 0.2, 1, device(kScissors, tip), turn, 0.05, 0}); // the blades shut: the cut
+        rows.push_back({r += 0.3, 1, device(kScissors, tip), turn, 1.0, 0});
+        rows.push_back({r += 0.3, 1, device(kScissors, pre), turn, 1.0, 0});
         rows.push_back({r += 0.6, 1, sim::Vec3::Zero(), turn, 1.0, 0});
     }
     rows.push_back({r + 0.7, 0, device(0, lifted), none, 0.05, 0});
@@ -335,9 +369,9 @@ std::string consoleSession(const studio::Project& p, bool withClips, double* aft
     for (int arm = 0; arm < 2; ++arm)
         for (const Row& k : rows) {
             if (k.arm != arm) continue;
-            std::snprintf(line_, sizeof line_, "%.3f,%d,%.5f,%.5f,%.5f,%.6f,%.6f,%.6f,%.6f,%.3f,%d,4\n", k.t, k.arm,
+            std::snprintf(line_, sizeof line_, "%.3f,%d,%.5f,%.5f,%.5f,%.6f,%.6f,%.6f,%.6f,%.3f,%d,%d\n", k.t, k.arm,
                           k.device.x(), k.device.y(), k.device.z(), k.q.w(), k.q.x(), k.q.y(), k.q.z(), k.grip,
-                          k.buttons);
+                          k.buttons, k.pedals);
             csv += line_;
         }
     return csv;
@@ -348,7 +382,7 @@ struct CholeSteps : CholeFixture {
     // what the steps hand on
     fs::path bought, dir, reference, out, session;
     QString trust;
-    double afterClips = 0, end = 0;
+    double afterClips = 0, end = 0, afterHook = 0;
     QElapsedTimer clock;
     /// 1. File → New project…: the folder typed into the dialog.
     void newProject() {
@@ -538,7 +572,17 @@ struct CholeSteps : CholeFixture {
             ++actions;
         }
         ASSERT_EQ(model().scene.assessment->cuts.size(), 2u) << targets->errorLabel()->text().toStdString();
-        for (const char* cut : {"cut 1", "cut 2"})
+        // the peritoneum's line: a drag along the duct's top, where the hook opens the peritoneum
+        {
+            double ga = 0, gb = 0;
+            const QPoint a = nearest(onDuct(0.15), "calot", &ga), b = nearest(onDuct(0.7), "calot", &gb);
+            ASSERT_LT(ga, 0.004);
+            ASSERT_LT(gb, 0.004);
+            viewportDrag(a, b);
+            ++actions;
+        }
+        ASSERT_EQ(model().scene.assessment->cuts.size(), 3u) << targets->errorLabel()->text().toStdString();
+        for (const char* cut : {"cut 1", "cut 2", "cut 3"})
             typeCell(targets->table(), targets->row(cut, "radius (mm)"), studio::TargetPanel::Value, "4");
         const sim::AssessmentDesc& a = *model().scene.assessment;
         EXPECT_EQ(a.clips[0].count, 1);
@@ -548,11 +592,49 @@ struct CholeSteps : CholeFixture {
         EXPECT_LT((a.clips[3].position - kArteryClipFar).norm(), 0.003) << "on the artery";
         for (const sim::Vec3& p : a.cuts[1].line)
             EXPECT_LT((p - kArteryCut).norm(), 0.006) << "the second cut line lies across the artery";
+        EXPECT_GT((a.cuts[2].line.back() - a.cuts[2].line.front()).norm(), 0.012) << "the third along the duct";
         EXPECT_DOUBLE_EQ(a.cuts[0].radius, 0.004);
         shot("chole_targets");
         targetTool->action(targetTool->pick())->setChecked(false);
     }
-    /// 8. Surroundings: the liver imported (its unit guessed), an abdominal wall around it all.
+    /// 8. The peritoneum over Calot's triangle: Add tissue layer from the body's context menu in
+    /// the project tree, one subdivision and its region typed in Properties (the box around the
+    /// cystic duct, the artery and the gallbladder's neck). The hook will open it; the scissors
+    /// divide it with the vessels under it.
+    void peritoneum() {
+        auto* tree = w->projectTree();
+        QTreeWidgetItem* body = nullptr;
+        for (QTreeWidgetItemIterator it(tree); *it && !body; ++it)
+            if ((*it)->text(0) == "calot") body = *it;
+        ASSERT_NE(body, nullptr);
+        tree->scrollToItem(body);
+        QTimer::singleShot(0, tree, [&] { // the menu's entry
+            test::waitFor([] { return QApplication::activePopupWidget() != nullptr; }, 2000);
+            if (auto* menu = qobject_cast<QMenu*>(QApplication::activePopupWidget())) {
+                for (QAction* a : menu->actions())
+                    if (a->objectName() == "addLayerAction") a->trigger();
+                menu->close();
+            }
+        });
+        const QPoint at = tree->visualItemRect(body).center();
+        QContextMenuEvent menuEvent(QContextMenuEvent::Mouse, at, tree->viewport()->mapToGlobal(at));
+        QApplication::sendEvent(tree->viewport(), &menuEvent);
+        actions += 2;
+        ASSERT_EQ(model().surfaces.size(), 1u) << tree->lastRefusal().toStdString();
+        raise("propertiesDock");
+        typeField(find<QLineEdit>("subdivide"), "1"); // 1.5 mm edges: the hook opens it along its pass
+        typeField(find<QLineEdit>("region_min"), kPeritoneumMin);
+        typeField(find<QLineEdit>("region_max"), kPeritoneumMax);
+        ASSERT_TRUE(model().surfaces[0].region.has_value());
+        EXPECT_EQ(model().surfaces[0].scene.attachTo, "calot");
+        EXPECT_DOUBLE_EQ((*model().surfaces[0].region)[1].y(), -0.038);
+        EXPECT_EQ(model().surfaces[0].subdivide, 1);
+        ASSERT_TRUE(
+            test::waitFor([&] { return nearest(kCut, model().surfaces[0].scene.name.c_str()).x() >= 0; }, 120000))
+            << "the layer drawn over the duct; log: " << w->log()->toPlainText().right(3000).toStdString();
+        shot("chole_peritoneum");
+    }
+    /// 9. Surroundings: the liver imported (its unit guessed), an abdominal wall around it all.
     void surroundings() {
         raise("surroundingsDock");
         auto* surroundings = w->findChild<studio::SurroundingsPanel*>("surroundingsPanel");
@@ -581,14 +663,14 @@ struct CholeSteps : CholeFixture {
         EXPECT_DOUBLE_EQ(model().scenery[1].radius, 0.15);
         ASSERT_TRUE(test::waitFor([&] { return over("abdominal_wall").x() >= 0; }, 60000)) << "the wall drawn";
     }
-    /// 9. Instruments: a grasper on the left master, the clip applier and the scissors on the
-    /// right (its button hands the arm from one to the other), each port clicked on the wall
-    /// where it reaches the task's targets; the clip applier's jaws 6 mm (the duct's width).
+    /// 10. Instruments: a grasper on the left master, the energy hook, the clip applier and the
+    /// scissors on the right (its button hands the arm from one to the next), each port clicked on
+    /// the wall where it reaches the task's targets; the clip applier's jaws 6 mm (the duct's width).
     void instrumentsAndPorts() {
         raise("instrumentDock");
         auto* instruments = w->findChild<studio::InstrumentPanel*>("instrumentPanel");
-        for (auto kind : {sim::InstrumentDesc::Kind::Grasper, sim::InstrumentDesc::Kind::ClipApplier,
-                          sim::InstrumentDesc::Kind::Scissors}) {
+        for (auto kind : {sim::InstrumentDesc::Kind::Grasper, sim::InstrumentDesc::Kind::EnergyHook,
+                          sim::InstrumentDesc::Kind::ClipApplier, sim::InstrumentDesc::Kind::Scissors}) {
             QComboBox* box = instruments->addKindBox();
             box->setCurrentIndex(box->findData(static_cast<int>(kind)));
             ++actions;
@@ -596,21 +678,28 @@ struct CholeSteps : CholeFixture {
         }
         ASSERT_TRUE(model().scene.interaction.has_value());
         const auto& ins = model().scene.interaction->instruments;
-        ASSERT_EQ(ins.size(), 3u);
+        ASSERT_EQ(ins.size(), 4u);
         EXPECT_EQ(ins[0].device.hand, "left");
-        EXPECT_EQ(ins[1].device.hand, "right");
-        EXPECT_EQ(ins[2].device.hand, "right");
-        EXPECT_EQ(ins[1].target, "calot") << "the clip applier clips the one body";
-        instruments->list()->setCurrentRow(1);
+        for (size_t i = 1; i < 4; ++i)
+            EXPECT_EQ(ins[i].device.hand, "right");
+        EXPECT_EQ(ins[2].target, "calot") << "the clip applier clips the one body";
+        const auto& tissues = model().scene.interaction->tissues;
+        ASSERT_EQ(tissues.size(), 2u) << "the hook and the scissors cut the peritoneum and the body under it";
+        EXPECT_EQ(tissues[0].layer, model().surfaces[0].scene.name);
+        EXPECT_EQ(tissues[1].layer, "calot");
+        EXPECT_DOUBLE_EQ(tissues[1].ignitionC, studio::kCoveredBodyIgnitionC)
+            << "the hook opens the layer, not the duct";
+        instruments->list()->setCurrentRow(2);
         ++actions;
         typeField(instruments->field("jaw_length"), "0.006");
-        EXPECT_DOUBLE_EQ(ins[1].jawLength, 0.006);
+        EXPECT_DOUBLE_EQ(ins[2].jawLength, 0.006);
         // Place port (the toolbar's button) on, each instrument chosen in the dock, a click on the wall
         clickAction(w->portTool()->action());
         ASSERT_TRUE(w->portTool()->action()->isChecked());
-        const std::vector<sim::Vec3> rightTargets = {kClipNear,       kClipFar,       kCut,
-                                                     kArteryClipNear, kArteryClipFar, kArteryCut};
-        for (int i = 0; i < 3; ++i) {
+        std::vector<sim::Vec3> rightTargets = {kClipNear, kClipFar, kCut, kArteryClipNear, kArteryClipFar, kArteryCut};
+        for (const sim::Vec3& p : model().scene.assessment->cuts[2].line)
+            rightTargets.push_back(p);
+        for (int i = 0; i < 4; ++i) {
             instruments->list()->setCurrentRow(i);
             ++actions;
             ASSERT_EQ(w->portTool()->current(), i);
@@ -629,7 +718,7 @@ struct CholeSteps : CholeFixture {
         shot("chole_ports");
         w->portTool()->action()->setChecked(false);
         // the console's arms hold the instruments: robotic ports (a remote centre of motion)
-        for (int i = 0; i < 3; ++i) {
+        for (int i = 0; i < 4; ++i) {
             instruments->list()->setCurrentRow(i);
             QComboBox* mode = instruments->modeBox();
             mode->setCurrentIndex(mode->findData(static_cast<int>(sim::PortMode::Robotic)));
@@ -639,7 +728,7 @@ struct CholeSteps : CholeFixture {
                 << instruments->findChild<QLabel*>("instrumentError")->text().toStdString();
         }
     }
-    /// 10. The laparoscope: on, its port clicked on the wall in front of the task, the studio
+    /// 11. The laparoscope: on, its port clicked on the wall in front of the task, the studio
     /// camera flown to the duct (a middle drag pans it there, the wheel zooms in), "Set scope
     /// view from here", a forward-viewing (0°) optic.
     void laparoscope() {
@@ -690,13 +779,16 @@ struct CholeSteps : CholeFixture {
         EXPECT_DOUBLE_EQ(model().scene.laparoscope->opticDeg, 0);
         shot("chole_scope_set");
     }
-    /// 11. The task: title, instructions and three ordered steps.
+    /// 12. The task: title, instructions and four ordered steps.
     void task() {
         auto* scope = w->findChild<studio::ScopeTaskPanel*>("scopeTaskPanel");
         typeField(scope->titleField(), "Laparoscopic cholecystectomy: clip and divide the cystic duct and artery");
-        typeField(scope->instructionsField(), "Lift the fundus, clip the cystic duct and the cystic artery twice each "
-                                              "at the marked sites and cut each between its clips.");
+        typeField(scope->instructionsField(),
+                  "Lift the fundus, open the peritoneum over the cystic duct with the hook, "
+                  "clip the cystic duct and the cystic artery twice each at the marked "
+                  "sites and cut each between its clips.");
         for (const char* step : {"Grasp the fundus with the left grasper and lift it",
+                                 "Open the peritoneum along the cystic duct with the hook",
                                  "Clip the cystic duct and the cystic artery twice each",
                                  "Cut the duct, then the artery, between their clips with the scissors"}) {
             clickButton(scope->addStepButton());
@@ -711,10 +803,10 @@ struct CholeSteps : CholeFixture {
                 QCoreApplication::processEvents();
             QCoreApplication::sendPostedEvents(nullptr, QEvent::DeferredDelete);
         }
-        EXPECT_EQ(model().scene.steps.size(), 3u);
+        EXPECT_EQ(model().scene.steps.size(), 4u);
         EXPECT_EQ(model().title, "Laparoscopic cholecystectomy: clip and divide the cystic duct and artery");
     }
-    /// 12. The verdict's limits typed in the Assessment table.
+    /// 13. The verdict's limits typed in the Assessment table.
     void limits() {
         raise("assessmentDock");
         QTableWidget* metrics = w->assessmentPanel()->table();
@@ -727,11 +819,11 @@ struct CholeSteps : CholeFixture {
             << w->assessmentPanel()->errorLabel()->text().toStdString();
         EXPECT_EQ(model().scene.assessment->metrics.size(), 4u);
     }
-    /// 13. Rehearse in the studio with the console session (a replay of it), see PASS, keep it as
+    /// 14. Rehearse in the studio with the console session (a replay of it), see PASS, keep it as
     /// the case's reference replay.
     void rehearseAndKeep() {
         session = scratch.dir / "console-session.csv";
-        { std::ofstream(session) << consoleSession(model(), true, &afterClips, &end); }
+        { std::ofstream(session) << consoleSession(model(), true, &afterClips, &end, &afterHook); }
         raise("rehearseDock");
         auto* rehearse = w->rehearsePanel();
         QComboBox* deviceBox = rehearse->deviceBox();
@@ -765,7 +857,7 @@ struct CholeSteps : CholeFixture {
         EXPECT_TRUE(rehearse->verdict()->text().startsWith("The kept replay: PASS"))
             << rehearse->verdict()->text().toStdString();
     }
-    /// 14. Save (Ctrl+S) and File → Export case…, signed with a publisher key made on the way.
+    /// 15. Save (Ctrl+S) and File → Export case…, signed with a publisher key made on the way.
     void exportSigned() {
         clickAction(w->findChild<QAction*>("actionSave"));
         out = scratch.dir / "cholecystectomy.vcase";
@@ -785,7 +877,7 @@ struct CholeSteps : CholeFixture {
         timings.emplace_back("export", since(clock));
         trust = QString::fromStdString(studio::publicKeyPathFor(studio::defaultPublisherKeyPath()).string());
     }
-    /// 15. The player: the case verifies; the reference replay passes; without the clips the
+    /// 16. The player: the case verifies; the reference replay passes; without the clips the
     /// same session fails on clips_on_target. Frames through the laparoscope at the start, after
     /// the clips and after the cut.
     void playerVerdicts() {
@@ -809,6 +901,8 @@ struct CholeSteps : CholeFixture {
         EXPECT_TRUE(passed.contains(QRegularExpression("verdict +PASS"))) << passed.toStdString();
         EXPECT_TRUE(passed.contains(QRegularExpression("contacts, 1 grasps;")))
             << "the fundus held: " << passed.toStdString();
+        EXPECT_TRUE(passed.contains(QRegularExpression("cut [1-9][0-9]* fascia edges")))
+            << "the hook opened the peritoneum: " << passed.toStdString();
         std::printf("%s\n", passed.section("step time", 1, 1)
                                 .section('\n', 0, 0)
                                 .prepend("reference: step time")
@@ -832,8 +926,11 @@ struct CholeSteps : CholeFixture {
                                 .toStdString()
                                 .c_str());
         if (const char* dir = std::getenv("VISCERA_GUI_SHOTS"); dir && *dir)
-            for (const auto& [name, seconds] : std::vector<std::pair<QString, double>>{
-                     {"chole_scope_start", 0.5}, {"chole_scope_clipped", afterClips}, {"chole_scope_cut", end}})
+            for (const auto& [name, seconds] :
+                 std::vector<std::pair<QString, double>>{{"chole_scope_start", 0.5},
+                                                         {"chole_scope_opened", afterHook},
+                                                         {"chole_scope_clipped", afterClips},
+                                                         {"chole_scope_cut", end}})
                 player({"run", QString::fromStdString(out.string()), "--headless", "--device",
                         "replay:" + QString::fromStdString(reference.string()), "--frames",
                         QString::number(int(seconds * 60)), "--screenshot", QString(dir) + "/" + name + ".png"});
@@ -845,11 +942,12 @@ struct CholeSteps : CholeFixture {
 TEST_F(CholeSteps, ACholecystectomyStepIsBuiltByGuiActionsAndItsCaseIsJudgedFairly) {
     bought = writeBoughtAnatomy(scratch.dir / "bought");
     using Step = void (CholeSteps::*)();
-    for (Step step : {&CholeSteps::newProject, &CholeSteps::importAnatomy, &CholeSteps::makeSimulationReady,
-                      &CholeSteps::tetrahedralize, &CholeSteps::renameBody, &CholeSteps::holdWhereAttached,
-                      &CholeSteps::pickTargets, &CholeSteps::surroundings, &CholeSteps::instrumentsAndPorts,
-                      &CholeSteps::laparoscope, &CholeSteps::task, &CholeSteps::limits, &CholeSteps::rehearseAndKeep,
-                      &CholeSteps::exportSigned, &CholeSteps::playerVerdicts}) {
+    for (Step step :
+         {&CholeSteps::newProject, &CholeSteps::importAnatomy, &CholeSteps::makeSimulationReady,
+          &CholeSteps::tetrahedralize, &CholeSteps::renameBody, &CholeSteps::holdWhereAttached,
+          &CholeSteps::pickTargets, &CholeSteps::peritoneum, &CholeSteps::surroundings,
+          &CholeSteps::instrumentsAndPorts, &CholeSteps::laparoscope, &CholeSteps::task, &CholeSteps::limits,
+          &CholeSteps::rehearseAndKeep, &CholeSteps::exportSigned, &CholeSteps::playerVerdicts}) {
         (this->*step)();
         ASSERT_FALSE(HasFatalFailure());
     }
