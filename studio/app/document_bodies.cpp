@@ -155,8 +155,8 @@ QString Document::removeLayer(int surface) {
         return tr("no tissue layer selected");
     const Project& p = *m_project;
     const std::string name = p.surfaces[static_cast<size_t>(surface)].scene.name;
-    // names are unique across bodies and layers: only the interaction's tissues can name a layer
-    // the interaction's tissues may name it: the layer leaves them with it (when a tissue is left)
+    // names are unique across bodies and layers: only the interaction's tissues can name a layer,
+    // and the layer leaves them with it (refused when it is the only tissue they have)
     Project without = p;
     if (auto& in = without.scene.interaction) {
         std::erase_if(in->tissues, [&](const sim::DissectionTissueDesc& t) { return t.layer == name; });
