@@ -32,6 +32,11 @@ namespace viscera::studio {
 /// at the layer's own 160 °C / 0.4 the hook's pass burned 80 of the duct's edges and divided it.
 inline constexpr double kCoveredBodyIgnitionC = 400;
 inline constexpr double kCoveredBodyConductivity = 0.05;
+/// Tissue `t` as the organ under a layer (kCoveredBodyIgnitionC, kCoveredBodyConductivity).
+inline void coverByLayer(sim::DissectionTissueDesc& t) {
+    t.ignitionC = kCoveredBodyIgnitionC;
+    t.conductivity = kCoveredBodyConductivity;
+}
 
 /// What an edit changed: the panels and the preview redo only what depends on it.
 struct Change {

@@ -88,10 +88,8 @@ void cutLayerToo(Project& q) {
     const SurfaceProject& layer = q.surfaces.front();
     for (sim::DissectionTissueDesc& t : tissues)
         if (t.layer == layer.scene.attachTo && t.ignitionC == sim::DissectionTissueDesc{}.ignitionC &&
-            t.conductivity == sim::DissectionTissueDesc{}.conductivity) {
-            t.ignitionC = kCoveredBodyIgnitionC;
-            t.conductivity = kCoveredBodyConductivity;
-        }
+            t.conductivity == sim::DissectionTissueDesc{}.conductivity)
+            coverByLayer(t);
     sim::DissectionTissueDesc t;
     t.layer = layer.scene.name;
     tissues.insert(tissues.begin(), t);

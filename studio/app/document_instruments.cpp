@@ -238,8 +238,7 @@ std::vector<sim::DissectionTissueDesc> defaultTissues(const Project& p) {
         if (b.scene.name == p.surfaces.front().scene.attachTo) {
             sim::DissectionTissueDesc under;
             under.layer = b.scene.name;
-            under.ignitionC = kCoveredBodyIgnitionC;
-            under.conductivity = kCoveredBodyConductivity;
+            coverByLayer(under);
             out.push_back(under);
         }
     return out;

@@ -49,21 +49,7 @@ struct BodyEditFixture : test::MainWindowFixture {
     /// Opens `item`'s context menu with a synthetic right-click event; returns the texts of its
     /// actions and triggers the one named `trigger` (none when null) before the menu closes.
     QStringList contextMenu(QTreeWidgetItem* item, const char* trigger = nullptr) {
-        QStringList shown;
-        QTimer::singleShot(0, tree, [&] {
-            test::waitFor([] { return QApplication::activePopupWidget() != nullptr; }, 2000);
-            if (auto* menu = qobject_cast<QMenu*>(QApplication::activePopupWidget())) {
-                for (QAction* a : menu->actions())
-                    shown << a->text();
-                for (QAction* a : menu->actions())
-                    if (trigger && a->objectName() == trigger) a->trigger();
-                menu->close();
-            }
-        });
-        const QPoint at = tree->visualItemRect(item).center();
-        QContextMenuEvent menuEvent(QContextMenuEvent::Mouse, at, tree->viewport()->mapToGlobal(at));
-        QApplication::sendEvent(tree->viewport(), &menuEvent);
-        return shown;
+        return MainWindowFixture::contextMenu(tree, item, trigger);
     }
     /// Types `value` into the Properties field `name` as a user does: select all, type, Return.
     void typeProperty(const char* name, const QString& value) {

@@ -48,7 +48,6 @@
 #include <QLineEdit>
 #include <QListView>
 #include <QListWidget>
-#include <QMenu>
 #include <QPlainTextEdit>
 #include <QProcess>
 #include <QPushButton>
@@ -57,7 +56,6 @@
 #include <QSignalSpy>
 #include <QSpinBox>
 #include <QTableWidget>
-#include <QTimer>
 #include <QToolButton>
 #include <QTreeWidgetItemIterator>
 #include <QUndoStack>
@@ -608,17 +606,7 @@ struct CholeSteps : CholeFixture {
             if ((*it)->text(0) == "calot") body = *it;
         ASSERT_NE(body, nullptr);
         tree->scrollToItem(body);
-        QTimer::singleShot(0, tree, [&] { // the menu's entry
-            test::waitFor([] { return QApplication::activePopupWidget() != nullptr; }, 2000);
-            if (auto* menu = qobject_cast<QMenu*>(QApplication::activePopupWidget())) {
-                for (QAction* a : menu->actions())
-                    if (a->objectName() == "addLayerAction") a->trigger();
-                menu->close();
-            }
-        });
-        const QPoint at = tree->visualItemRect(body).center();
-        QContextMenuEvent menuEvent(QContextMenuEvent::Mouse, at, tree->viewport()->mapToGlobal(at));
-        QApplication::sendEvent(tree->viewport(), &menuEvent);
+        contextMenu(tree, body, "addLayerAction");
         actions += 2;
         ASSERT_EQ(model().surfaces.size(), 1u) << tree->lastRefusal().toStdString();
         raise("propertiesDock");

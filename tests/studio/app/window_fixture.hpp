@@ -8,10 +8,13 @@
 #include "gui_test_support.hpp"
 
 #include <QApplication>
+#include <QContextMenuEvent>
 #include <QFileDialog>
 #include <QLineEdit>
+#include <QMenu>
 #include <QSettings>
 #include <QTimer>
+#include <QTreeWidget>
 
 #include <gtest/gtest.h>
 
@@ -54,6 +57,25 @@ struct MainWindowFixture : ::testing::Test {
     }
     /// A drag on the viewport with `button` (left: paint or pick, right: orbit, middle: pan) from
     /// `from` to `to` in 30 moves.
+    /// Opens `item`'s context menu in `tree` as a right click does, triggers the entry whose
+    /// object name is `trigger` (none: only looks) and closes the menu; returns the entries' texts.
+    static QStringList contextMenu(QTreeWidget* tree, QTreeWidgetItem* item, const char* trigger = nullptr) {
+        QStringList shown;
+        QTimer::singleShot(0, tree, [&] {
+            test::waitFor([] { return QApplication::activePopupWidget() != nullptr; }, 2000);
+            if (auto* menu = qobject_cast<QMenu*>(QApplication::activePopupWidget())) {
+                for (QAction* a : menu->actions())
+                    shown << a->text();
+                for (QAction* a : menu->actions())
+                    if (trigger && a->objectName() == trigger) a->trigger();
+                menu->close();
+            }
+        });
+        const QPoint at = tree->visualItemRect(item).center();
+        QContextMenuEvent menuEvent(QContextMenuEvent::Mouse, at, tree->viewport()->mapToGlobal(at));
+        QApplication::sendEvent(tree->viewport(), &menuEvent);
+        return shown;
+    }
     void viewportDrag(QPoint from, QPoint to, Qt::MouseButton button = Qt::LeftButton) {
         if (QWindow* win = w->viewport()->canvasWindow()) {
             QTest::mousePress(win, button, {}, from);
